@@ -1,0 +1,50 @@
+"""``navlab bench NAME --json``: measured performance figures, printed as JSON.
+
+Each benchmark is a function ``run(args) -> dict`` registered in ``BENCHES`` by import path, so a
+concern's benchmark lives beside its code.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import json
+from typing import Any
+
+# name -> "module:function"; the function takes the parsed args and returns a JSON-able dict.
+BENCHES: dict[str, str] = {
+    "core": "navlab.core.bench:run",
+}
+
+
+def _run_one(name: str, args: argparse.Namespace) -> dict[str, Any]:
+    module, func = BENCHES[name].split(":")
+    return getattr(importlib.import_module(module), func)(args)
+
+
+def _cmd(args: argparse.Namespace) -> int:
+    names = list(BENCHES) if args.name == "all" else [args.name]
+    results = {name: _run_one(name, args) for name in names}
+    out = results[names[0]] if len(names) == 1 else results
+    if args.json:
+        print(json.dumps(out))
+    else:
+        for name, res in results.items():
+            print(name + ":")
+            for key, value in res.items():
+                print(f"  {key}: {value}")
+    return 0
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    """Add the ``bench`` verb."""
+    p = sub.add_parser(
+        "bench",
+        help="measure performance and print the figures (JSON with --json)",
+        description="Run a benchmark and print its figures. Targets are in DESIGN.md's performance "
+        "budget; run on an idle machine for stable numbers.",
+    )
+    p.add_argument("name", choices=[*BENCHES, "all"], help="which benchmark to run")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    p.set_defaults(func=_cmd)

@@ -1,0 +1,50 @@
+"""The ``navlab`` command: one verb per step of the paper's pipeline.
+
+Each concern registers its verbs from its own ``cli`` module (a ``register(subparsers)`` function),
+so this file only assembles them and turns ``NavlabError`` into a one-line message.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+
+from navlab.errors import NavlabError
+
+# Modules that define ``register(subparsers: argparse._SubParsersAction) -> None``.
+COMMAND_MODULES = (
+    "navlab.core.cli",
+    "navlab.bench",
+)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The full argument parser with every registered verb."""
+    parser = argparse.ArgumentParser(
+        prog="navlab",
+        description="The paper's ROS/Gazebo mobile-robot stack in plain Python: simulate, map, "
+        "localize, navigate, view and experiment.",
+    )
+    sub = parser.add_subparsers(dest="command", metavar="VERB", required=True)
+    for name in COMMAND_MODULES:
+        importlib.import_module(name).register(sub)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of the ``navlab`` console script; returns the exit code."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return int(args.func(args) or 0)
+    except NavlabError as exc:
+        print(f"navlab: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("navlab: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,167 @@
+"""The robot model that description loading produces and the simulator consumes.
+
+Plain dataclasses, in SI units and REP-103 frames. Poses are ``(xyz, rpy)`` of a child frame in
+its parent frame (URDF ``<origin>`` semantics). Loading (xacro/URDF/<gazebo>) fills these; the
+MuJoCo builder in ``navlab.sim`` reads them.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Literal
+
+Vec3 = tuple[float, float, float]
+
+GeometryKind = Literal["box", "cylinder", "sphere", "mesh"]
+
+
+@dataclass(frozen=True)
+class Origin:
+    """A pose of a child frame in its parent: translation (m) and roll-pitch-yaw (rad, fixed axes)."""
+
+    xyz: Vec3 = (0.0, 0.0, 0.0)
+    rpy: Vec3 = (0.0, 0.0, 0.0)
+
+
+@dataclass(frozen=True)
+class Geometry:
+    """A shape. ``size``: box full extents (x, y, z); cylinder (radius, length) along z; sphere (radius,).
+
+    Meshes: ``mesh_path`` is an absolute path to an STL/OBJ/DAE file, already resolved from
+    ``package://``/``file://``/``model://``; ``mesh_scale`` includes any COLLADA unit scale.
+    """
+
+    kind: GeometryKind
+    size: tuple[float, ...] = ()
+    mesh_path: Path | None = None
+    mesh_scale: Vec3 = (1.0, 1.0, 1.0)
+
+
+@dataclass(frozen=True)
+class Inertial:
+    """Mass (kg), centre of mass origin, and inertia tensor (kg m², about the COM in ``origin``'s frame)."""
+
+    mass: float
+    origin: Origin = Origin()
+    ixx: float = 0.0
+    ixy: float = 0.0
+    ixz: float = 0.0
+    iyy: float = 0.0
+    iyz: float = 0.0
+    izz: float = 0.0
+
+
+@dataclass(frozen=True)
+class Shape:
+    """A collision or visual element: geometry at an origin in the link frame."""
+
+    geometry: Geometry
+    origin: Origin = Origin()
+    rgba: tuple[float, float, float, float] | None = None
+    name: str = ""
+
+
+@dataclass
+class Link:
+    """A rigid body. ``mu1``/``mu2`` are Gazebo's friction coefficients (None: simulator default)."""
+
+    name: str
+    inertial: Inertial | None = None
+    collisions: list[Shape] = field(default_factory=list)
+    visuals: list[Shape] = field(default_factory=list)
+    mu1: float | None = None
+    mu2: float | None = None
+
+
+JointType = Literal["fixed", "continuous", "revolute", "prismatic", "floating", "planar"]
+
+
+@dataclass
+class Joint:
+    """A URDF joint: ``origin`` is the child frame in the parent link frame; ``axis`` in the child frame."""
+
+    name: str
+    type: JointType
+    parent: str
+    child: str
+    origin: Origin = Origin()
+    axis: Vec3 = (1.0, 0.0, 0.0)
+    lower: float | None = None
+    upper: float | None = None
+    effort: float | None = None
+    velocity: float | None = None
+    damping: float = 0.0
+    friction: float = 0.0
+
+
+@dataclass
+class DiffDriveConfig:
+    """Gazebo's differential-drive plugin (ROS 1 ``libgazebo_ros_diff_drive`` and ROS 2 spellings)."""
+
+    left_joint: str = "left_wheel_hinge"
+    right_joint: str = "right_wheel_hinge"
+    wheel_separation: float = 0.34
+    wheel_diameter: float = 0.15
+    max_torque: float = 5.0  # N m per wheel
+    max_accel: float = 0.0  # rad/s² of the wheels; 0 = unlimited (ROS 1 wheelAcceleration)
+    update_rate: float = 100.0  # Hz
+    command_topic: str = "cmd_vel"
+    odometry_topic: str = "odom"
+    odometry_frame: str = "odom"
+    robot_base_frame: str = "base_footprint"
+    odometry_source: Literal["encoder", "world"] = "world"
+    publish_tf: bool = True
+    publish_wheel_tf: bool = False
+    cmd_timeout: float = 0.5  # s without cmd_vel before the wheels are stopped
+    namespace: str = ""
+
+
+@dataclass
+class LidarConfig:
+    """A ray/gpu_ray sensor with a ROS laser plugin. ``origin`` is the sensor in ``link``'s frame."""
+
+    link: str
+    origin: Origin = Origin()
+    update_rate: float = 10.0  # Hz
+    samples: int = 360
+    min_angle: float = -3.141592653589793
+    max_angle: float = 3.141592653589793
+    range_min: float = 0.1
+    range_max: float = 10.0
+    range_resolution: float = 0.01
+    noise_mean: float = 0.0
+    noise_stddev: float = 0.0
+    topic: str = "scan"
+    frame_id: str = ""  # defaults to the link name
+    name: str = "laser"
+
+
+@dataclass
+class ImuConfig:
+    """An imu sensor with a ROS IMU plugin. Noise std devs: rad/s (gyro), m/s² (accel)."""
+
+    link: str
+    origin: Origin = Origin()
+    update_rate: float = 100.0
+    topic: str = "imu"
+    frame_id: str = ""
+    gyro_noise_stddev: float = 0.0
+    accel_noise_stddev: float = 0.0
+    name: str = "imu"
+
+
+@dataclass
+class RobotModel:
+    """A whole robot: links by name, joints in file order, the root link, and its plugins."""
+
+    name: str
+    links: dict[str, Link]
+    joints: list[Joint]
+    root_link: str
+    diff_drive: DiffDriveConfig | None = None
+    lidars: list[LidarConfig] = field(default_factory=list)
+    imus: list[ImuConfig] = field(default_factory=list)
+    warnings: list[str] = field(default_factory=list)
+    source: Path | None = None
+    urdf_xml: str = ""  # the expanded URDF (after xacro), for robot_description

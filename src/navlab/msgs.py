@@ -1,0 +1,155 @@
+"""ROS 2 message types (from rosbags' typestore) and small helpers.
+
+Messages are the typestore's dataclasses with the exact ROS field names; array fields are numpy
+arrays. Helpers convert between yaw and quaternions, nanoseconds and ``builtin_interfaces/Time``,
+and build the messages navlab publishes most often.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+from rosbags.typesys import Stores, get_typestore
+
+TYPESTORE = get_typestore(Stores.ROS2_HUMBLE)
+_T = TYPESTORE.types
+
+Time = _T["builtin_interfaces/msg/Time"]
+Duration = _T["builtin_interfaces/msg/Duration"]
+Header = _T["std_msgs/msg/Header"]
+String = _T["std_msgs/msg/String"]
+Empty = _T["std_msgs/msg/Empty"]
+Float64 = _T["std_msgs/msg/Float64"]
+Vector3 = _T["geometry_msgs/msg/Vector3"]
+Point = _T["geometry_msgs/msg/Point"]
+Quaternion = _T["geometry_msgs/msg/Quaternion"]
+Pose = _T["geometry_msgs/msg/Pose"]
+PoseStamped = _T["geometry_msgs/msg/PoseStamped"]
+PoseArray = _T["geometry_msgs/msg/PoseArray"]
+PoseWithCovariance = _T["geometry_msgs/msg/PoseWithCovariance"]
+PoseWithCovarianceStamped = _T["geometry_msgs/msg/PoseWithCovarianceStamped"]
+Twist = _T["geometry_msgs/msg/Twist"]
+TwistWithCovariance = _T["geometry_msgs/msg/TwistWithCovariance"]
+Transform = _T["geometry_msgs/msg/Transform"]
+TransformStamped = _T["geometry_msgs/msg/TransformStamped"]
+Odometry = _T["nav_msgs/msg/Odometry"]
+OccupancyGrid = _T["nav_msgs/msg/OccupancyGrid"]
+MapMetaData = _T["nav_msgs/msg/MapMetaData"]
+Path = _T["nav_msgs/msg/Path"]
+LaserScan = _T["sensor_msgs/msg/LaserScan"]
+Imu = _T["sensor_msgs/msg/Imu"]
+JointState = _T["sensor_msgs/msg/JointState"]
+TFMessage = _T["tf2_msgs/msg/TFMessage"]
+Marker = _T["visualization_msgs/msg/Marker"]
+MarkerArray = _T["visualization_msgs/msg/MarkerArray"]
+ColorRGBA = _T["std_msgs/msg/ColorRGBA"]
+
+
+class MessageTypeError(LookupError):
+    """An unknown ROS message type name was asked for."""
+
+
+def get_type(name: str) -> type:
+    """Return the message class for a ROS type name (``geometry_msgs/msg/Twist`` or ``geometry_msgs/Twist``)."""
+    key = name if "/msg/" in name else name.replace("/", "/msg/", 1)
+    try:
+        return _T[key]
+    except KeyError:
+        import difflib
+
+        close = difflib.get_close_matches(key, list(_T), n=3)
+        hint = f"; did you mean {', '.join(close)}?" if close else ""
+        raise MessageTypeError(f"unknown message type {name!r}{hint}") from None
+
+
+def type_name(msg_or_cls: Any) -> str:
+    """ROS type name of a message or message class, e.g. ``nav_msgs/msg/Odometry``."""
+    return str(msg_or_cls.__msgtype__)
+
+
+# --- time -----------------------------------------------------------------------------------------
+
+
+def time_from_ns(ns: int) -> Any:
+    """``builtin_interfaces/Time`` from integer nanoseconds."""
+    sec, nsec = divmod(int(ns), 1_000_000_000)
+    return Time(sec=sec, nanosec=nsec)
+
+
+def ns_from_time(t: Any) -> int:
+    """Integer nanoseconds from a ``builtin_interfaces/Time`` (or Duration)."""
+    return int(t.sec) * 1_000_000_000 + int(t.nanosec)
+
+
+def header(stamp_ns: int, frame_id: str) -> Any:
+    """``std_msgs/Header`` with a stamp in nanoseconds."""
+    return Header(stamp=time_from_ns(stamp_ns), frame_id=frame_id)
+
+
+# --- rotations ------------------------------------------------------------------------------------
+
+
+def quaternion_from_yaw(yaw: float) -> Any:
+    """``geometry_msgs/Quaternion`` for a rotation of ``yaw`` radians about z."""
+    return Quaternion(x=0.0, y=0.0, z=math.sin(yaw / 2.0), w=math.cos(yaw / 2.0))
+
+
+def yaw_from_quaternion(q: Any) -> float:
+    """Yaw (radians, about z) of a ``geometry_msgs/Quaternion``."""
+    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+
+
+def normalize_angle(a: float) -> float:
+    """Wrap an angle to [-pi, pi)."""
+    return (a + math.pi) % (2.0 * math.pi) - math.pi
+
+
+# --- poses ----------------------------------------------------------------------------------------
+
+
+def pose_from_2d(x: float, y: float, yaw: float) -> Any:
+    """``geometry_msgs/Pose`` in the plane."""
+    return Pose(position=Point(x=float(x), y=float(y), z=0.0), orientation=quaternion_from_yaw(yaw))
+
+
+def pose2d(pose: Any) -> tuple[float, float, float]:
+    """(x, y, yaw) of a ``geometry_msgs/Pose``."""
+    return float(pose.position.x), float(pose.position.y), yaw_from_quaternion(pose.orientation)
+
+
+def pose_stamped(stamp_ns: int, frame_id: str, x: float, y: float, yaw: float) -> Any:
+    """``geometry_msgs/PoseStamped`` in the plane."""
+    return PoseStamped(header=header(stamp_ns, frame_id), pose=pose_from_2d(x, y, yaw))
+
+
+def transform_stamped(
+    stamp_ns: int, parent: str, child: str, x: float, y: float, yaw: float, z: float = 0.0
+) -> Any:
+    """``geometry_msgs/TransformStamped`` ``parent_T_child`` in the plane (plus height ``z``)."""
+    return TransformStamped(
+        header=header(stamp_ns, parent),
+        child_frame_id=child,
+        transform=Transform(
+            translation=Vector3(x=float(x), y=float(y), z=float(z)), rotation=quaternion_from_yaw(yaw)
+        ),
+    )
+
+
+def twist(vx: float = 0.0, wz: float = 0.0, vy: float = 0.0) -> Any:
+    """``geometry_msgs/Twist`` for a planar robot (m/s, rad/s)."""
+    return Twist(linear=Vector3(x=float(vx), y=float(vy), z=0.0), angular=Vector3(x=0.0, y=0.0, z=float(wz)))
+
+
+def covariance(diag: tuple[float, ...] | None = None) -> np.ndarray:
+    """A 6×6 row-major covariance (36 float64) with the given diagonal (zeros if None)."""
+    cov = np.zeros(36, dtype=np.float64)
+    if diag is not None:
+        cov[[0, 7, 14, 21, 28, 35][: len(diag)]] = diag
+    return cov
+
+
+def stamp_ns(msg: Any) -> int:
+    """Header stamp of a message in nanoseconds."""
+    return ns_from_time(msg.header.stamp)
