@@ -1,0 +1,277 @@
+"""The deterministic simulated-time executor: clock, timer queue, topics, pacing, inbox.
+
+One process, one thread of execution. Time is an integer count of nanoseconds. Timers are ordered
+by (time, priority, sequence); published messages are queued and delivered in publish order before
+simulated time advances. Physics engines register as *steppers* and are advanced to each event's
+time before the event runs, so they integrate between events without Python in the loop.
+"""
+
+from __future__ import annotations
+
+import heapq
+import queue
+import time
+import zlib
+from collections import deque
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any, Protocol
+
+import numpy as np
+
+from navlab.core.errors import CoreError
+from navlab.core.tf import TfBuffer
+from navlab.msgs import TFMessage, type_name
+
+if TYPE_CHECKING:
+    from navlab.core.node import Node, Subscription, Timer
+
+NS_PER_S = 1_000_000_000
+
+
+class Stepper(Protocol):
+    """A physics engine or anything that must integrate up to an event's time before it runs."""
+
+    def advance_to(self, t_ns: int) -> None: ...
+
+
+@dataclass
+class Topic:
+    """A named topic: its type, who publishes and subscribes, and (if latched) its last message."""
+
+    name: str
+    msgtype: type
+    publishers: list[str] = field(default_factory=list)
+    subscriptions: list[Subscription] = field(default_factory=list)
+    latched: Any = None
+    count: int = 0
+
+
+def seconds_to_ns(seconds: float) -> int:
+    """Simulated seconds to integer nanoseconds (rounded)."""
+    return round(seconds * NS_PER_S)
+
+
+class Executor:
+    """Owns the simulated clock, the event queue, the topics, tf, services and the nodes.
+
+    ``seed`` seeds every node's random generator; ``rate`` is the pacing (0 = as fast as
+    possible, r > 0 keeps simulated time at r × wall-clock time).
+    """
+
+    def __init__(self, *, seed: int = 0, rate: float = 0.0, tf_cache_s: float = 10.0) -> None:
+        if rate < 0:
+            raise CoreError(f"rate must be >= 0 (0 = as fast as possible), got {rate}")
+        self.seed = int(seed)
+        self.rate = float(rate)
+        self.now_ns = 0
+        self.nodes: dict[str, Node] = {}
+        self.topics: dict[str, Topic] = {}
+        self.services: dict[str, Callable[[Any], Any]] = {}
+        self.tf = TfBuffer(cache_ns=seconds_to_ns(tf_cache_s))
+        self._heap: list[tuple[int, int, int, Timer]] = []
+        self._seq = 0
+        self._deliveries: deque[tuple[Subscription, Any]] = deque()
+        self._steppers: list[Stepper] = []
+        self._listeners: list[Callable[[str, Any, int], None]] = []
+        self._inbox: queue.SimpleQueue[Callable[[], None]] = queue.SimpleQueue()
+        self._construct: dict[str, Any] = {}
+        self._stop = False
+        self._running = False
+        self.events = 0  # timer callbacks + message deliveries handled so far
+
+    # --- nodes and construction context --------------------------------------------------------
+
+    def _register_node(self, node: Node) -> None:
+        if node.fully_qualified_name in self.nodes:
+            raise CoreError(f"a node named {node.fully_qualified_name!r} already exists")
+        self.nodes[node.fully_qualified_name] = node
+
+    @contextmanager
+    def node_context(self, *, remappings: dict[str, str] | None = None) -> Iterator[None]:
+        """Nodes constructed inside this block get these topic remappings (launch files use it)."""
+        old = self._construct
+        self._construct = {"remappings": dict(remappings or {})}
+        try:
+            yield
+        finally:
+            self._construct = old
+
+    def make_rng(self, name: str) -> np.random.Generator:
+        """A generator seeded from the run's seed and ``name`` (stable across runs and platforms)."""
+        return np.random.Generator(np.random.PCG64(np.random.SeedSequence([self.seed, zlib.crc32(name.encode())])))
+
+    # --- topics ----------------------------------------------------------------------------------
+
+    def topic(self, name: str, msgtype: type) -> Topic:
+        """The topic ``name``, created on first use; its type must agree with earlier users."""
+        t = self.topics.get(name)
+        if t is None:
+            t = self.topics[name] = Topic(name, msgtype)
+            if name in ("/tf", "/tf_static"):
+                self._attach_tf(t)
+        elif t.msgtype is not msgtype:
+            raise CoreError(
+                f"topic {name!r} has type {type_name(t.msgtype)}, but {type_name(msgtype)} was asked for"
+            )
+        return t
+
+    def _attach_tf(self, topic: Topic) -> None:
+        static = topic.name == "/tf_static"
+        buf = self.tf
+
+        def feed(msg: Any) -> None:
+            buf.add_message(msg, static=static)
+
+        from navlab.core.node import Subscription  # local: node imports executor
+
+        topic.subscriptions.append(Subscription(topic.name, TFMessage, feed, "/_tf_buffer"))
+
+    def publish(self, topic: Topic, msg: Any, *, latched: bool = False) -> None:
+        """Queue ``msg`` for every subscriber of ``topic`` (delivered before time advances)."""
+        topic.count += 1
+        if latched:
+            topic.latched = msg
+        for sub in topic.subscriptions:
+            self._deliveries.append((sub, msg))
+        for listener in self._listeners:
+            listener(topic.name, msg, self.now_ns)
+        if not self._running:  # published from user code between runs: deliver now
+            self._drain()
+
+    def add_listener(self, fn: Callable[[str, Any, int], None]) -> None:
+        """Call ``fn(topic, msg, t_ns)`` for every message published (recording, echo, hz)."""
+        self._listeners.append(fn)
+
+    def remove_listener(self, fn: Callable[[str, Any, int], None]) -> None:
+        """Stop calling a listener added with :meth:`add_listener`."""
+        self._listeners.remove(fn)
+
+    def subscribe(self, sub: Subscription, msgtype: type) -> None:
+        """Attach a subscription; a latched topic hands it its last message at once."""
+        topic = self.topic(sub.topic, msgtype)
+        topic.subscriptions.append(sub)
+        if topic.latched is not None:
+            self._deliveries.append((sub, topic.latched))
+
+    # --- timers, services, steppers, inbox -------------------------------------------------------
+
+    def schedule(self, timer: Timer, t_ns: int) -> None:
+        """Put ``timer`` in the queue to fire at ``t_ns``."""
+        self._seq += 1
+        heapq.heappush(self._heap, (t_ns, timer.priority, self._seq, timer))
+
+    def add_stepper(self, stepper: Stepper) -> None:
+        """Advance ``stepper`` to every event's time before the event runs."""
+        self._steppers.append(stepper)
+
+    def add_service(self, name: str, callback: Callable[[Any], Any]) -> None:
+        """Register a callable service (ROS services, synchronous in simulated time)."""
+        if name in self.services:
+            raise CoreError(f"service {name!r} is already offered")
+        self.services[name] = callback
+
+    def call_service(self, name: str, request: Any = None) -> Any:
+        """Call a service by its full name and return its response."""
+        try:
+            fn = self.services[name]
+        except KeyError:
+            known = ", ".join(sorted(self.services)) or "none"
+            raise CoreError(f"no service {name!r} (offered: {known})") from None
+        result = fn(request)
+        self._drain()
+        return result
+
+    def post(self, fn: Callable[[], None]) -> None:
+        """Thread-safe: run ``fn`` in the executor's thread before the next event."""
+        self._inbox.put(fn)
+
+    def stop(self) -> None:
+        """Make the current :meth:`run` return after the event being handled (thread-safe)."""
+        self._stop = True
+
+    # --- running ---------------------------------------------------------------------------------
+
+    def _drain_inbox(self) -> None:
+        while True:
+            try:
+                fn = self._inbox.get_nowait()
+            except queue.Empty:
+                return
+            fn()
+
+    def _drain(self) -> None:
+        deliveries = self._deliveries
+        while deliveries:
+            sub, msg = deliveries.popleft()
+            self.events += 1
+            sub.callback(msg)
+
+    def _advance(self, t_ns: int) -> None:
+        for stepper in self._steppers:
+            stepper.advance_to(t_ns)
+        self.now_ns = t_ns
+
+    def _pace(self, t_ns: int, sim0: int, wall0: float) -> None:
+        target = wall0 + (t_ns - sim0) / NS_PER_S / self.rate
+        while True:
+            self._drain_inbox()
+            delay = target - time.perf_counter()
+            if delay <= 0:
+                return
+            time.sleep(min(delay, 0.01))
+
+    def run(self, duration: float) -> None:
+        """Advance simulated time by ``duration`` seconds, handling every event on the way."""
+        self.run_until(None, timeout=duration)
+
+    def run_until(self, predicate: Callable[[], bool] | None, *, timeout: float) -> bool:
+        """Run until ``predicate()`` is true (checked after each event) or ``timeout`` simulated seconds pass.
+
+        Returns whether the predicate became true (False on timeout or :meth:`stop`).
+        """
+        for node in list(self.nodes.values()):
+            node.check_parameters()
+        self._running = True
+        try:
+            return self._run_until(predicate, seconds_to_ns(timeout))
+        finally:
+            self._running = False
+
+    def _run_until(self, predicate: Callable[[], bool] | None, timeout_ns: int) -> bool:
+        end = self.now_ns + timeout_ns
+        sim0, wall0 = self.now_ns, time.perf_counter()
+        self._stop = False
+        heap = self._heap
+        self._drain_inbox()
+        self._drain()
+        if predicate is not None and predicate():
+            return True
+        while heap and heap[0][0] <= end and not self._stop:
+            t_ns, _, _, timer = heapq.heappop(heap)
+            if timer.cancelled:
+                continue
+            if t_ns > self.now_ns:
+                if self.rate > 0:
+                    self._pace(t_ns, sim0, wall0)
+                else:
+                    self._drain_inbox()
+                self._advance(t_ns)
+            self.events += 1
+            timer.fire()
+            self._drain()
+            if predicate is not None and predicate():
+                return True
+        if not self._stop and end > self.now_ns:
+            if self.rate > 0:
+                self._pace(end, sim0, wall0)
+            self._advance(end)
+            self._drain_inbox()
+            self._drain()
+        return predicate is not None and predicate()
+
+    def spin(self) -> None:
+        """Run until :meth:`stop` is called (use with ``rate > 0`` and another thread posting inputs)."""
+        while not self._stop:
+            self.run_until(lambda: self._stop, timeout=3600.0)

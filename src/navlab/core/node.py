@@ -1,0 +1,308 @@
+"""rclpy-like nodes: publishers, subscriptions, timers, clock, logger, parameters, tf, services."""
+
+from __future__ import annotations
+
+import difflib
+import logging
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+from navlab.core.errors import CoreError, ParameterError
+from navlab.core.executor import Executor, Topic, seconds_to_ns
+from navlab.msgs import TFMessage, time_from_ns
+
+
+def resolve_name(name: str, namespace: str) -> str:
+    """ROS name resolution: absolute names stay; relative ones go under ``namespace``."""
+    if name.startswith("/"):
+        return name
+    ns = namespace.strip("/")
+    return f"/{ns}/{name}" if ns else f"/{name}"
+
+
+@dataclass
+class Subscription:
+    """A callback attached to a topic (``node`` is the subscribing node's full name)."""
+
+    topic: str
+    msgtype: type
+    callback: Callable[[Any], None]
+    node: str
+
+
+class Publisher:
+    """Publishes messages of one type on one topic."""
+
+    def __init__(self, executor: Executor, topic: Topic, *, latched: bool) -> None:
+        self._executor = executor
+        self.topic = topic
+        self.latched = latched
+
+    @property
+    def topic_name(self) -> str:
+        """The resolved topic name."""
+        return self.topic.name
+
+    def publish(self, msg: Any) -> None:
+        """Send ``msg`` to every subscriber."""
+        self._executor.publish(self.topic, msg, latched=self.latched)
+
+    def get_subscription_count(self) -> int:
+        """How many subscriptions the topic has."""
+        return len(self.topic.subscriptions)
+
+
+class Timer:
+    """Calls ``callback`` every ``period_ns`` of simulated time, at ``start + k·period``."""
+
+    def __init__(
+        self, executor: Executor, period_ns: int, callback: Callable[[], None], priority: int, start_ns: int
+    ) -> None:
+        if period_ns <= 0:
+            raise CoreError(f"timer period must be > 0 s, got {period_ns / 1e9}")
+        self._executor = executor
+        self.period_ns = period_ns
+        self.callback = callback
+        self.priority = priority
+        self.cancelled = False
+        self._start = start_ns
+        self._k = 1
+        executor.schedule(self, start_ns + period_ns)
+
+    def fire(self) -> None:
+        """Run the callback and schedule the next firing (called by the executor)."""
+        self._k += 1
+        self._executor.schedule(self, self._start + self._k * self.period_ns)
+        self.callback()
+
+    def cancel(self) -> None:
+        """Stop the timer."""
+        self.cancelled = True
+
+
+class Clock:
+    """Simulated-time clock of an executor."""
+
+    def __init__(self, executor: Executor) -> None:
+        self._executor = executor
+
+    def now_ns(self) -> int:
+        """Current simulated time in nanoseconds."""
+        return self._executor.now_ns
+
+    def now(self) -> Any:
+        """Current simulated time as ``builtin_interfaces/Time``."""
+        return time_from_ns(self._executor.now_ns)
+
+    def seconds(self) -> float:
+        """Current simulated time in seconds."""
+        return self._executor.now_ns / 1e9
+
+
+class _SimTimeAdapter(logging.LoggerAdapter):  # type: ignore[type-arg]
+    def process(self, msg: Any, kwargs: Any) -> tuple[Any, Any]:
+        ex: Executor = self.extra["executor"]  # type: ignore[index]
+        return f"[{ex.now_ns / 1e9:.3f}] [{self.extra['node']}] {msg}", kwargs  # type: ignore[index]
+
+    def warn(self, msg: Any, *args: Any, **kwargs: Any) -> None:
+        """rclpy spelling of :meth:`warning`."""
+        self.warning(msg, *args, **kwargs)
+
+
+def flatten_params(params: dict[str, Any], prefix: str = "") -> dict[str, Any]:
+    """Nested parameter dicts to dotted names (``global_costmap.update_frequency``)."""
+    out: dict[str, Any] = {}
+    for key, value in params.items():
+        name = f"{prefix}{key}"
+        if isinstance(value, dict):
+            out.update(flatten_params(value, name + "."))
+        else:
+            out[name] = value
+    return out
+
+
+def _coerce(name: str, value: Any, default: Any) -> Any:
+    """Check ``value`` against the type of ``default`` (ints are accepted for floats)."""
+    if default is None or value is None:
+        return value
+    kind = type(default)
+    if kind is float and isinstance(value, int) and not isinstance(value, bool):
+        return float(value)
+    if kind is bool and not isinstance(value, bool):
+        raise ParameterError(f"parameter {name!r}: expected true/false, got {value!r}")
+    if kind is int and isinstance(value, bool):
+        raise ParameterError(f"parameter {name!r}: expected an integer, got {value!r}")
+    if kind in (list, tuple) and isinstance(value, list | tuple):
+        return kind(value)
+    if not isinstance(value, kind):
+        raise ParameterError(f"parameter {name!r}: expected {kind.__name__}, got {value!r}")
+    return value
+
+
+class Node:
+    """Base class of every navlab node, shaped like ``rclpy.node.Node``."""
+
+    def __init__(
+        self,
+        name: str,
+        executor: Executor,
+        *,
+        parameters: dict[str, Any] | None = None,
+        namespace: str = "",
+    ) -> None:
+        self.name = name
+        self.namespace = "/" + namespace.strip("/") if namespace.strip("/") else ""
+        self.fully_qualified_name = f"{self.namespace}/{name}"
+        self.executor = executor
+        self.remappings: dict[str, str] = dict(executor._construct.get("remappings", {}))
+        self._overrides = flatten_params(parameters or {})
+        self._declared: dict[str, Any] = {}
+        self._params_checked = False
+        self.publishers: list[Publisher] = []
+        self.subscriptions: list[Subscription] = []
+        self.timers: list[Timer] = []
+        self.rng = executor.make_rng(self.fully_qualified_name)
+        self._clock = Clock(executor)
+        self._logger = _SimTimeAdapter(
+            logging.getLogger(f"navlab{self.fully_qualified_name.replace('/', '.')}"),
+            {"executor": executor, "node": self.fully_qualified_name},
+        )
+        executor._register_node(self)
+
+    # --- names -----------------------------------------------------------------------------------
+
+    def resolve_topic_name(self, topic: str) -> str:
+        """Apply this node's remappings, then resolve against its namespace."""
+        for key in (topic, resolve_name(topic, self.namespace)):
+            if key in self.remappings:
+                return resolve_name(self.remappings[key], self.namespace)
+        return resolve_name(topic, self.namespace)
+
+    # --- communication ---------------------------------------------------------------------------
+
+    def create_publisher(self, msgtype: type, topic: str, qos: int = 10, *, latched: bool = False) -> Publisher:
+        """Publisher of ``msgtype`` on ``topic`` (``latched``: ROS transient_local)."""
+        t = self.executor.topic(self.resolve_topic_name(topic), msgtype)
+        t.publishers.append(self.fully_qualified_name)
+        pub = Publisher(self.executor, t, latched=latched)
+        self.publishers.append(pub)
+        return pub
+
+    def create_subscription(
+        self, msgtype: type, topic: str, callback: Callable[[Any], None], qos: int = 10
+    ) -> Subscription:
+        """Call ``callback(msg)`` for each message on ``topic``."""
+        sub = Subscription(self.resolve_topic_name(topic), msgtype, callback, self.fully_qualified_name)
+        self.executor.subscribe(sub, msgtype)
+        self.subscriptions.append(sub)
+        return sub
+
+    def create_timer(self, period: float, callback: Callable[[], None], *, priority: int = 0) -> Timer:
+        """Call ``callback()`` every ``period`` simulated seconds (lower ``priority`` runs first on ties)."""
+        timer = Timer(self.executor, seconds_to_ns(period), callback, priority, self.executor.now_ns)
+        self.timers.append(timer)
+        return timer
+
+    def create_service(self, name: str, callback: Callable[[Any], Any]) -> str:
+        """Offer ``callback(request) -> response`` as a service; returns the resolved name."""
+        full = resolve_name(name, self.namespace)
+        self.executor.add_service(full, callback)
+        return full
+
+    def send_transform(self, transforms: Any | Sequence[Any]) -> None:
+        """Broadcast ``TransformStamped`` (one or a list) on ``/tf``."""
+        self._tf_publisher("/tf").publish(TFMessage(transforms=_as_list(transforms)))
+
+    def send_static_transform(self, transforms: Any | Sequence[Any]) -> None:
+        """Broadcast ``TransformStamped`` (one or a list) on ``/tf_static``."""
+        self._tf_publisher("/tf_static").publish(TFMessage(transforms=_as_list(transforms)))
+
+    def _tf_publisher(self, topic: str) -> Publisher:
+        for pub in self.publishers:
+            if pub.topic_name == topic:
+                return pub
+        return self.create_publisher(TFMessage, topic, latched=topic == "/tf_static")
+
+    # --- clock, logger ---------------------------------------------------------------------------
+
+    def get_clock(self) -> Clock:
+        """The simulated clock."""
+        return self._clock
+
+    def get_logger(self) -> _SimTimeAdapter:
+        """A logger whose lines carry simulated time and the node name."""
+        return self._logger
+
+    def get_name(self) -> str:
+        """The node's name (without namespace)."""
+        return self.name
+
+    # --- parameters ------------------------------------------------------------------------------
+
+    def declare_parameter(self, name: str, default: Any = None, *, aliases: Sequence[str] = ()) -> Any:
+        """Declare a parameter and return its value: the override given at construction, or ``default``.
+
+        ``aliases`` are other accepted spellings (e.g. Nav2's name for a ROS 1 parameter).
+        """
+        key = name.replace("/", ".")
+        value = default
+        for cand in (key, *(a.replace("/", ".") for a in aliases)):
+            if cand in self._overrides:
+                value = _coerce(cand, self._overrides[cand], default)
+                self._declared[cand] = value
+                break
+        self._declared[key] = value
+        return value
+
+    def get_parameter(self, name: str) -> Any:
+        """Value of a declared parameter."""
+        key = name.replace("/", ".")
+        try:
+            return self._declared[key]
+        except KeyError:
+            raise ParameterError(f"node {self.fully_qualified_name}: parameter {name!r} was not declared") from None
+
+    def set_parameter(self, name: str, value: Any) -> None:
+        """Change a declared parameter's value (the node reads it on its next use)."""
+        key = name.replace("/", ".")
+        self._declared[key] = _coerce(key, value, self.get_parameter(key))
+
+    def get_parameters_by_prefix(self, prefix: str) -> dict[str, Any]:
+        """Overrides under ``prefix.`` (undeclared ones too), with the prefix removed."""
+        p = prefix.replace("/", ".") + "."
+        return {k[len(p) :]: v for k, v in self._overrides.items() if k.startswith(p)}
+
+    def accept_parameters(self, prefix: str) -> None:
+        """Mark every override under ``prefix.`` as known (for sub-objects that read them themselves)."""
+        p = prefix.replace("/", ".") + "."
+        for k in self._overrides:
+            if k.startswith(p):
+                self._declared.setdefault(k, self._overrides[k])
+
+    def check_parameters(self) -> None:
+        """Refuse overrides that no declaration asked for, suggesting the closest names."""
+        if self._params_checked:
+            return
+        self._params_checked = True
+        unknown = [k for k in self._overrides if k not in self._declared]
+        if unknown:
+            lines = []
+            for key in unknown:
+                close = difflib.get_close_matches(key, list(self._declared), n=1)
+                lines.append(f"{key!r}" + (f" (did you mean {close[0]!r}?)" if close else ""))
+            raise ParameterError(f"node {self.fully_qualified_name}: unknown parameter " + ", ".join(lines))
+
+    def destroy_node(self) -> None:
+        """Cancel timers and detach subscriptions."""
+        for timer in self.timers:
+            timer.cancel()
+        for sub in self.subscriptions:
+            topic = self.executor.topics.get(sub.topic)
+            if topic is not None and sub in topic.subscriptions:
+                topic.subscriptions.remove(sub)
+        self.executor.nodes.pop(self.fully_qualified_name, None)
+
+
+def _as_list(x: Any | Sequence[Any]) -> list[Any]:
+    return list(x) if isinstance(x, list | tuple) else [x]

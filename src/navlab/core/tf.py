@@ -1,0 +1,258 @@
+"""A tf buffer: time-stamped transforms, static transforms, interpolation and chain lookups.
+
+Each child frame has one parent. A transform ``parent_T_child`` maps points from the child frame
+into the parent frame. ``lookup_transform(target, source, t)`` returns ``target_T_source``,
+interpolating each dynamic edge linearly in translation and by slerp in rotation.
+"""
+
+from __future__ import annotations
+
+import bisect
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+from navlab.core.errors import TfError
+from navlab.msgs import Quaternion, Transform, TransformStamped, Vector3, header, ns_from_time
+
+# A transform as (x, y, z, qx, qy, qz, qw).
+Tf = tuple[float, float, float, float, float, float, float]
+IDENTITY: Tf = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0)
+
+
+def qmul(a: tuple[float, float, float, float], b: tuple[float, float, float, float]) -> tuple[float, ...]:
+    """Hamilton product of quaternions (x, y, z, w)."""
+    ax, ay, az, aw = a
+    bx, by, bz, bw = b
+    return (
+        aw * bx + ax * bw + ay * bz - az * by,
+        aw * by - ax * bz + ay * bw + az * bx,
+        aw * bz + ax * by - ay * bx + az * bw,
+        aw * bw - ax * bx - ay * by - az * bz,
+    )
+
+
+def qrotate(q: tuple[float, ...], v: tuple[float, float, float]) -> tuple[float, float, float]:
+    """Rotate vector ``v`` by unit quaternion ``q`` (x, y, z, w)."""
+    qx, qy, qz, qw = q
+    vx, vy, vz = v
+    # t = 2 q_vec × v ; v' = v + w t + q_vec × t
+    tx = 2.0 * (qy * vz - qz * vy)
+    ty = 2.0 * (qz * vx - qx * vz)
+    tz = 2.0 * (qx * vy - qy * vx)
+    return (
+        vx + qw * tx + (qy * tz - qz * ty),
+        vy + qw * ty + (qz * tx - qx * tz),
+        vz + qw * tz + (qx * ty - qy * tx),
+    )
+
+
+def compose(a: Tf, b: Tf) -> Tf:
+    """``a ∘ b``: if a = A_T_B and b = B_T_C, the result is A_T_C."""
+    t = qrotate(a[3:], b[:3])
+    q = qmul(a[3:], b[3:])  # type: ignore[arg-type]
+    return (a[0] + t[0], a[1] + t[1], a[2] + t[2], *q)  # type: ignore[return-value]
+
+
+def inverse(a: Tf) -> Tf:
+    """Inverse transform: B_T_A from A_T_B."""
+    qi = (-a[3], -a[4], -a[5], a[6])
+    t = qrotate(qi, (-a[0], -a[1], -a[2]))
+    return (*t, *qi)  # type: ignore[return-value]
+
+
+def interpolate(a: Tf, b: Tf, s: float) -> Tf:
+    """Linear interpolation of translation and slerp of rotation, ``s`` in [0, 1]."""
+    qa, qb = a[3:], b[3:]
+    dot = sum(x * y for x, y in zip(qa, qb, strict=True))
+    if dot < 0.0:
+        qb, dot = tuple(-x for x in qb), -dot
+    if dot > 0.9995:
+        q = [x + s * (y - x) for x, y in zip(qa, qb, strict=True)]
+    else:
+        th = math.acos(min(1.0, dot))
+        sa, sb = math.sin((1 - s) * th) / math.sin(th), math.sin(s * th) / math.sin(th)
+        q = [sa * x + sb * y for x, y in zip(qa, qb, strict=True)]
+    n = math.sqrt(sum(x * x for x in q))
+    return (*(a[i] + s * (b[i] - a[i]) for i in range(3)), *(x / n for x in q))  # type: ignore[return-value]
+
+
+def tf_from_msg(tr: Any) -> Tf:
+    """Tuple form of a ``geometry_msgs/Transform``."""
+    t, r = tr.translation, tr.rotation
+    return (t.x, t.y, t.z, r.x, r.y, r.z, r.w)
+
+
+def yaw_of(tf: Tf) -> float:
+    """Yaw (rad) of a transform's rotation."""
+    qx, qy, qz, qw = tf[3:]
+    return math.atan2(2.0 * (qw * qz + qx * qy), 1.0 - 2.0 * (qy * qy + qz * qz))
+
+
+@dataclass
+class _Edge:
+    parent: str
+    static: bool
+    times: list[int] = field(default_factory=list)
+    values: list[Tf] = field(default_factory=list)
+
+
+class TfBuffer:
+    """Stores transforms between frames and answers lookups between any two connected frames.
+
+    ``cache_ns`` bounds the history kept per dynamic edge; ``tolerance_ns`` allows lookups that
+    slightly extrapolate past the newest (or before the oldest) transform of an edge.
+    """
+
+    def __init__(self, *, cache_ns: int = 10_000_000_000, tolerance_ns: int = 0) -> None:
+        self.cache_ns = cache_ns
+        self.tolerance_ns = tolerance_ns
+        self._edges: dict[str, _Edge] = {}
+
+    def frames(self) -> list[str]:
+        """Every frame seen, as parent or child."""
+        names = set(self._edges)
+        names.update(e.parent for e in self._edges.values())
+        return sorted(names)
+
+    def parent_of(self, frame: str) -> str | None:
+        """Parent frame of ``frame`` (None for a root or unknown frame)."""
+        e = self._edges.get(frame)
+        return e.parent if e else None
+
+    def set_transform(self, parent: str, child: str, t_ns: int, tf: Tf, *, static: bool = False) -> None:
+        """Add ``parent_T_child`` valid at ``t_ns`` (static transforms are valid at every time)."""
+        if not parent or not child:
+            raise TfError(f"transform needs both frame names, got parent={parent!r} child={child!r}")
+        e = self._edges.get(child)
+        if e is None or e.parent != parent or e.static != static:
+            e = self._edges[child] = _Edge(parent, static)
+        if static:
+            e.times, e.values = [t_ns], [tf]
+            return
+        if e.times and t_ns < e.times[-1]:
+            i = bisect.bisect_right(e.times, t_ns)
+            e.times.insert(i, t_ns)
+            e.values.insert(i, tf)
+        else:
+            e.times.append(t_ns)
+            e.values.append(tf)
+        if e.times[-1] - e.times[0] > self.cache_ns:
+            cut = bisect.bisect_left(e.times, e.times[-1] - self.cache_ns)
+            del e.times[:cut], e.values[:cut]
+
+    def add_message(self, msg: Any, *, static: bool = False) -> None:
+        """Add every transform of a ``tf2_msgs/TFMessage``."""
+        for ts in msg.transforms:
+            self.set_transform(
+                ts.header.frame_id.lstrip("/"),
+                ts.child_frame_id.lstrip("/"),
+                ns_from_time(ts.header.stamp),
+                tf_from_msg(ts.transform),
+                static=static,
+            )
+
+    def _edge_at(self, child: str, e: _Edge, t_ns: int | None) -> Tf:
+        if e.static:
+            return e.values[0]
+        times = e.times
+        if t_ns is None:
+            return e.values[-1]
+        if t_ns >= times[-1]:
+            if t_ns - times[-1] > self.tolerance_ns:
+                raise TfError(
+                    f"lookup of {e.parent}->{child} at t={t_ns / 1e9:.3f} s would extrapolate into the future "
+                    f"(newest transform at {times[-1] / 1e9:.3f} s)"
+                )
+            return e.values[-1]
+        if t_ns <= times[0]:
+            if times[0] - t_ns > self.tolerance_ns:
+                raise TfError(
+                    f"lookup of {e.parent}->{child} at t={t_ns / 1e9:.3f} s would extrapolate into the past "
+                    f"(oldest transform at {times[0] / 1e9:.3f} s)"
+                )
+            return e.values[0]
+        i = bisect.bisect_right(times, t_ns)
+        t0, t1 = times[i - 1], times[i]
+        return interpolate(e.values[i - 1], e.values[i], (t_ns - t0) / (t1 - t0))
+
+    def _to_root(self, frame: str, t_ns: int | None) -> list[tuple[str, Tf]]:
+        """[(frame, root_T_frame...)] walking up from ``frame``: each entry is parent_T_child."""
+        chain = []
+        seen = {frame}
+        while frame in self._edges:
+            e = self._edges[frame]
+            chain.append((frame, self._edge_at(frame, e, t_ns)))
+            frame = e.parent
+            if frame in seen:
+                raise TfError(f"tf tree has a loop through frame {frame!r}")
+            seen.add(frame)
+        chain.append((frame, IDENTITY))
+        return chain
+
+    def _latest_common(self, target: str, source: str) -> int | None:
+        newest = None
+        for f in (target, source):
+            while f in self._edges:
+                e = self._edges[f]
+                if not e.static:
+                    newest = e.times[-1] if newest is None else min(newest, e.times[-1])
+                f = e.parent
+        return newest
+
+    def lookup(self, target: str, source: str, t_ns: int | None = None) -> Tf:
+        """``target_T_source`` at ``t_ns`` (None: the latest time every edge on the path has)."""
+        target, source = target.lstrip("/"), source.lstrip("/")
+        known = self.frames()
+        for f in (target, source):
+            if f not in known:
+                raise TfError(f"frame {f!r} does not exist (known frames: {', '.join(known) or 'none'})")
+        if t_ns is None:
+            t_ns = self._latest_common(target, source)
+        up_s = self._to_root(source, t_ns)
+        up_t = self._to_root(target, t_ns)
+        if up_s[-1][0] != up_t[-1][0]:
+            raise TfError(
+                f"frames {target!r} and {source!r} are not connected "
+                f"(roots {up_t[-1][0]!r} and {up_s[-1][0]!r})"
+            )
+        names_t = [f for f, _ in up_t]
+        # Walk source up to the first frame that is also an ancestor of target.
+        root_T_src: Tf = IDENTITY
+        common = None
+        for f, tf in up_s:
+            if f in names_t:
+                common = f
+                break
+            root_T_src = compose(tf, root_T_src)
+        common_T_tgt: Tf = IDENTITY
+        for f, tf in up_t:
+            if f == common:
+                break
+            common_T_tgt = compose(tf, common_T_tgt)
+        return compose(inverse(common_T_tgt), root_T_src)
+
+    def can_transform(self, target: str, source: str, t_ns: int | None = None) -> bool:
+        """Whether :meth:`lookup` would succeed."""
+        try:
+            self.lookup(target, source, t_ns)
+        except TfError:
+            return False
+        return True
+
+    def lookup_transform(self, target: str, source: str, t_ns: int | None = None) -> Any:
+        """``target_T_source`` as a ``geometry_msgs/TransformStamped`` (frame_id=target, child=source)."""
+        tf = self.lookup(target, source, t_ns)
+        return TransformStamped(
+            header=header(t_ns or 0, target),
+            child_frame_id=source,
+            transform=Transform(
+                translation=Vector3(x=tf[0], y=tf[1], z=tf[2]),
+                rotation=Quaternion(x=tf[3], y=tf[4], z=tf[5], w=tf[6]),
+            ),
+        )
+
+    def lookup_pose2d(self, target: str, source: str, t_ns: int | None = None) -> tuple[float, float, float]:
+        """(x, y, yaw) of ``source``'s origin in ``target``."""
+        tf = self.lookup(target, source, t_ns)
+        return tf[0], tf[1], yaw_of(tf)
