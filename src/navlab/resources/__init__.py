@@ -1,0 +1,59 @@
+"""Files shipped with navlab: robots, worlds, parameters and launch files.
+
+``path("robots/mybot/mybot.xacro")`` returns the absolute path of a shipped file, and
+``package_paths()`` maps the ROS package names of shipped descriptions (``mybot_description``) to
+their directories, for ``$(find pkg)`` and ``package://pkg/...``.
+"""
+
+from __future__ import annotations
+
+from importlib import resources
+from pathlib import Path
+
+from navlab.errors import NavlabError
+
+# ROS package name -> directory (relative to this package) of the shipped robot descriptions.
+_SHIPPED_PACKAGES = (("mybot_description", "robots/mybot"),)
+
+
+class ResourceError(NavlabError):
+    """A shipped file that does not exist was asked for."""
+
+
+def root() -> Path:
+    """The directory that holds navlab's shipped files."""
+    return Path(str(resources.files(__name__)))
+
+
+def path(relative: str, *, must_exist: bool = True) -> Path:
+    """Absolute path of a shipped file, e.g. ``path("worlds/room.world")``.
+
+    Raises ``ResourceError`` naming the file (and what exists beside it) when it is missing.
+    """
+    full = root() / relative
+    if must_exist and not full.exists():
+        parent = full.parent
+        choices = sorted(p.name for p in parent.iterdir()) if parent.is_dir() else []
+        hint = f"; {parent} holds: {', '.join(choices)}" if choices else ""
+        raise ResourceError(f"no shipped file {relative!r} (looked for {full}){hint}")
+    return full
+
+
+def package_paths() -> dict[str, Path]:
+    """ROS package name -> directory for the robot descriptions shipped with navlab."""
+    return {name: root() / rel for name, rel in _SHIPPED_PACKAGES}
+
+
+def world(name: str) -> Path:
+    """A shipped world by name (``"room"`` or ``"room.world"``)."""
+    return path(f"worlds/{name if name.endswith('.world') else name + '.world'}")
+
+
+def robot(name: str) -> Path:
+    """A shipped robot's top xacro by name (``"mybot"``)."""
+    return path(f"robots/{name}/{name}.xacro")
+
+
+def model_path() -> Path:
+    """The directory of Gazebo models shipped with navlab (``ground_plane``, ``sun``)."""
+    return root() / "worlds" / "models"
