@@ -1,0 +1,222 @@
+"""ROS-style tools: ``navlab launch``, ``navlab topic list|echo|hz``, ``navlab node list``, ``navlab graph``.
+
+The introspection verbs look at a launch that they start themselves (``--launch FILE name:=value``,
+run for ``--duration`` simulated seconds) or at a recording (``--bag DIR``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from navlab.core.errors import CoreError
+from navlab.core.graph import Graph
+from navlab.core.launch import Session, start
+from navlab.core.runner import parse_launch_args, run_for
+from navlab.io.files import write_text_atomic
+
+
+def _add_source(p: argparse.ArgumentParser) -> None:
+    src = p.add_mutually_exclusive_group(required=True)
+    src.add_argument(
+        "--launch", nargs="+", metavar="FILE [name:=value]",
+        help="start this launch (file or shipped name, then its arguments) and watch it",
+    )
+    src.add_argument("--bag", metavar="DIR", help="read a rosbag2 recording instead")
+    p.add_argument("--duration", type=float, default=5.0, help="simulated seconds to run the launch (default 5)")
+    p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+
+
+def _start(args: argparse.Namespace) -> Session:
+    file, *items = args.launch
+    return start(file, seed=args.seed, launch_args=parse_launch_args(items))
+
+
+def _msg_to_dict(msg: Any) -> Any:
+    if hasattr(msg, "__dataclass_fields__"):
+        return {k: _msg_to_dict(getattr(msg, k)) for k in msg.__dataclass_fields__ if k != "__msgtype__"}
+    if isinstance(msg, np.ndarray):
+        return msg.tolist()
+    if isinstance(msg, list):
+        return [_msg_to_dict(m) for m in msg]
+    return msg
+
+
+def _format_msg(d: Any, indent: int = 0) -> str:
+    pad = "  " * indent
+    if isinstance(d, dict):
+        lines = []
+        for k, v in d.items():
+            if isinstance(v, dict):
+                lines.append(f"{pad}{k}:\n{_format_msg(v, indent + 1)}")
+            else:
+                lines.append(f"{pad}{k}: {_short(v)}")
+        return "\n".join(lines)
+    return pad + _short(d)
+
+
+def _short(v: Any) -> str:
+    if isinstance(v, list) and len(v) > 12:
+        return "[" + ", ".join(_short(x) for x in v[:10]) + f", ... ({len(v)} items)]"
+    if isinstance(v, float):
+        return f"{v:.6g}"
+    return json.dumps(v) if isinstance(v, list | str) else str(v)
+
+
+def _messages(args: argparse.Namespace, topic: str) -> list[tuple[int, Any]]:
+    """(t_ns, msg) on ``topic`` from the bag or from running the launch."""
+    if args.bag:
+        from navlab.io.rosbag import read_bag
+
+        return [(t, m) for _, t, m in read_bag(args.bag, topics=[topic])]
+    session = _start(args)
+    got: list[tuple[int, Any]] = []
+
+    def listen(name: str, msg: Any, t_ns: int) -> None:
+        if name == topic:
+            got.append((t_ns, msg))
+
+    session.executor.add_listener(listen)
+    run_for(session.executor, args.duration, quiet=True)
+    if topic not in session.executor.topics:
+        raise CoreError(f"no topic {topic!r} in this launch (topics: {', '.join(sorted(session.executor.topics))})")
+    return got
+
+
+def _cmd_launch(args: argparse.Namespace) -> int:
+    session = start(args.file, seed=args.seed, pace=args.rate, launch_args=parse_launch_args(args.args))
+    ex = session.executor
+    if args.duration is None:
+        ex.spin()
+    else:
+        run_for(ex, args.duration, record=args.record, quiet=args.quiet, desc=Path(args.file).stem)
+    summary = {
+        "sim_seconds": ex.now_ns / 1e9,
+        "nodes": sorted(ex.nodes),
+        "topics": {name: t.count for name, t in sorted(ex.topics.items())},
+    }
+    if args.record:
+        summary["record"] = str(args.record)
+    if args.json:
+        print(json.dumps(summary))
+    else:
+        print(f"ran {summary['sim_seconds']:.2f} simulated s; {len(ex.nodes)} nodes")
+        for name, count in summary["topics"].items():  # type: ignore[union-attr]
+            print(f"  {name}: {count} messages")
+    return 0
+
+
+def _cmd_topic(args: argparse.Namespace) -> int:
+    if args.action == "list":
+        if args.bag:
+            from navlab.io.rosbag import bag_topics
+
+            rows = {k: v for k, v in bag_topics(args.bag).items()}
+        else:
+            session = _start(args)
+            run_for(session.executor, args.duration, quiet=True)
+            rows = {k: (t.msgtype.__msgtype__, t.count) for k, t in session.executor.topics.items()}
+        for name in sorted(rows):
+            msgtype, count = rows[name]
+            print(f"{name} [{msgtype}]" + (f" {count} msgs" if args.verbose else ""))
+        return 0
+    if not args.topic:
+        raise CoreError(f"navlab topic {args.action} needs a TOPIC name")
+    msgs = _messages(args, args.topic)
+    if args.action == "echo":
+        for _t_ns, msg in msgs[: args.count] if args.count else msgs:
+            print(_format_msg(_msg_to_dict(msg)))
+            print("---")
+        return 0
+    # hz
+    times = np.array([t for t, _ in msgs], dtype=np.int64)
+    if len(times) < 2:
+        raise CoreError(f"topic {args.topic!r}: fewer than 2 messages, no rate to compute")
+    periods = np.diff(times) / 1e9
+    res = {
+        "topic": args.topic,
+        "messages": len(times),
+        "average_rate_hz": float(1.0 / periods.mean()),
+        "min_period_s": float(periods.min()),
+        "max_period_s": float(periods.max()),
+        "std_dev_s": float(periods.std()),
+    }
+    if args.json:
+        print(json.dumps(res))
+    else:
+        print(
+            f"average rate: {res['average_rate_hz']:.3f}\n\tmin: {res['min_period_s']:.3f}s "
+            f"max: {res['max_period_s']:.3f}s std dev: {res['std_dev_s']:.5f}s window: {res['messages']}"
+        )
+    return 0
+
+
+def _graph_of(args: argparse.Namespace) -> Graph:
+    if args.bag:
+        from navlab.io.rosbag import bag_graph, bag_topics
+
+        data = bag_graph(args.bag)
+        if data is not None:
+            return Graph.from_json(data)
+        return Graph(topics={t: ([], []) for t in bag_topics(args.bag)})
+    session = _start(args)
+    run_for(session.executor, args.duration, quiet=True)
+    return Graph.from_executor(session.executor)
+
+
+def _cmd_node(args: argparse.Namespace) -> int:
+    graph = _graph_of(args)
+    for n in graph.nodes:
+        print(n)
+    return 0
+
+
+def _cmd_graph(args: argparse.Namespace) -> int:
+    graph = _graph_of(args)
+    out = Path(args.out)
+    write_text_atomic(out.with_suffix(".dot"), graph.to_dot())
+    graph.write_svg(out.with_suffix(".svg"))
+    print(f"wrote {out.with_suffix('.dot')} and {out.with_suffix('.svg')}")
+    return 0
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    """Add ``launch``, ``topic``, ``node`` and ``graph``."""
+    p = sub.add_parser(
+        "launch",
+        help="run a YAML launch file (ROS 2 YAML launch shape)",
+        description="Run a launch file (a path or a shipped name) with name:=value arguments.",
+    )
+    p.add_argument("file", help="launch file or shipped launch name")
+    p.add_argument("args", nargs="*", metavar="name:=value", help="launch arguments")
+    p.add_argument("--duration", type=float, default=None, help="simulated seconds to run (default: until Ctrl-C)")
+    p.add_argument("--rate", type=float, default=0.0, help="pacing: 0 = as fast as possible, 1 = real time")
+    p.add_argument("--record", metavar="DIR", help="write every topic to a rosbag2 (MCAP) in DIR")
+    p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--json", action="store_true", help="print the summary as JSON")
+    p.set_defaults(func=_cmd_launch)
+
+    p = sub.add_parser("topic", help="list, echo or measure the rate of topics (rostopic)")
+    p.add_argument("action", choices=["list", "echo", "hz"], help="what to do")
+    p.add_argument("topic", nargs="?", help="topic name (echo, hz)")
+    _add_source(p)
+    p.add_argument("--count", type=int, default=0, help="echo: at most this many messages")
+    p.add_argument("-v", "--verbose", action="store_true", help="list: show message counts")
+    p.add_argument("--json", action="store_true", help="hz: print JSON")
+    p.set_defaults(func=_cmd_topic)
+
+    p = sub.add_parser("node", help="list the nodes of a launch or recording (rosnode list)")
+    p.add_argument("action", choices=["list"], help="what to do")
+    _add_source(p)
+    p.set_defaults(func=_cmd_node)
+
+    p = sub.add_parser("graph", help="write the node/topic graph as DOT and SVG (rqt_graph)")
+    _add_source(p)
+    p.add_argument("--out", default="graph", help="output path without suffix (writes .dot and .svg)")
+    p.set_defaults(func=_cmd_graph)
+

@@ -1,0 +1,228 @@
+"""YAML launch files in the shape of ROS 2's YAML launch format.
+
+```yaml
+launch:
+- arg: {name: world, default: room, description: "world file or shipped name"}
+- let: {name: scan, value: /mybot/laser/scan}
+- include: {file: "$(find-pkg-share navlab)/launch/sim.launch.yaml", arg: [{name: world, value: "$(var world)"}]}
+- node:
+    pkg: navlab
+    exec: amcl
+    name: amcl
+    namespace: ""
+    param: [{from: "$(find-pkg-share navlab)/params/amcl.yaml"}, {name: use_map_topic, value: true}]
+    remap: [{from: scan, to: "$(var scan)"}]
+```
+
+Substitutions: ``$(var NAME)``, ``$(env NAME [default])``, ``$(find-pkg-share PKG)`` (``navlab`` is
+the package's ``resources`` folder). ``exec`` names a node in ``navlab.nodes.NODES`` or, for user
+code, ``module:Class``.
+"""
+
+from __future__ import annotations
+
+import importlib
+import os
+import re
+from dataclasses import dataclass, field
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+from navlab.core.errors import LaunchError
+from navlab.core.executor import Executor
+from navlab.core.node import Node
+from navlab.core.params import load_params, merge_params, read_yaml
+
+_SUBST = re.compile(r"\$\((\S+)(?:\s+([^)]*))?\)")
+
+
+def resources_dir() -> Path:
+    """The package's shipped resources (robots/, worlds/, params/, launch/)."""
+    return Path(str(resources.files("navlab") / "resources"))
+
+
+def find_launch_file(name_or_path: str) -> Path:
+    """A launch file path, or a shipped launch by name (``mapping`` → resources/launch/mapping.launch.yaml)."""
+    p = Path(name_or_path)
+    if p.is_file():
+        return p
+    shipped = resources_dir() / "launch"
+    for cand in (shipped / name_or_path, shipped / f"{name_or_path}.launch.yaml"):
+        if cand.is_file():
+            return cand
+    names = sorted(f.name.removesuffix(".launch.yaml") for f in shipped.glob("*.launch.yaml"))
+    raise LaunchError(f"no launch file {name_or_path!r} (shipped launches: {', '.join(names) or 'none'})")
+
+
+def load_node_class(exec_name: str) -> type[Node]:
+    """The node class for a launch ``exec`` (registered name or ``module:Class``)."""
+    from navlab.nodes import NODES
+
+    target = NODES.get(exec_name, exec_name)
+    if ":" not in target:
+        raise LaunchError(f"unknown node executable {exec_name!r} (navlab provides: {', '.join(sorted(NODES))})")
+    module, cls = target.split(":", 1)
+    try:
+        return getattr(importlib.import_module(module), cls)  # type: ignore[no-any-return]
+    except (ImportError, AttributeError) as exc:
+        raise LaunchError(f"node executable {exec_name!r}: cannot load {target} ({exc})") from None
+
+
+@dataclass
+class Session:
+    """A started launch: its executor, its nodes by name, and the arguments it was given."""
+
+    executor: Executor
+    nodes: dict[str, Node] = field(default_factory=dict)
+    args: dict[str, str] = field(default_factory=dict)
+
+    def run(self, duration: float) -> None:
+        """Advance simulated time by ``duration`` seconds."""
+        self.executor.run(duration)
+
+    def node(self, name: str) -> Node:
+        """A node of this launch by name (with or without leading slash)."""
+        for key in (name, "/" + name.lstrip("/")):
+            if key in self.nodes:
+                return self.nodes[key]
+        raise LaunchError(f"no node {name!r} in this launch (nodes: {', '.join(self.nodes)})")
+
+
+class _Context:
+    def __init__(self, file: Path, args: dict[str, str]) -> None:
+        self.file = file
+        self.vars: dict[str, str] = dict(args)
+
+    def subst(self, value: Any, where: str) -> Any:
+        if isinstance(value, list):
+            return [self.subst(v, where) for v in value]
+        if isinstance(value, dict):
+            return {k: self.subst(v, where) for k, v in value.items()}
+        if not isinstance(value, str):
+            return value
+
+        def repl(m: re.Match[str]) -> str:
+            kind, arg = m.group(1), (m.group(2) or "").strip()
+            if kind == "var":
+                if arg not in self.vars:
+                    known = ", ".join(self.vars) or "none"
+                    raise LaunchError(f"{self.file}: {where}: $(var {arg}) is not defined (args: {known})")
+                return self.vars[arg]
+            if kind == "env":
+                name, _, default = arg.partition(" ")
+                return os.environ.get(name, default)
+            if kind == "find-pkg-share":
+                if arg == "navlab":
+                    return str(resources_dir())
+                raise LaunchError(f"{self.file}: {where}: unknown package {arg!r} in $(find-pkg-share)")
+            raise LaunchError(f"{self.file}: {where}: unknown substitution $({kind})")
+
+        out = _SUBST.sub(repl, value)
+        return _typed(out) if out != value else value
+
+
+def _typed(text: str) -> Any:
+    """Substituted text as YAML would read it (numbers, booleans) so parameters keep their type."""
+    import yaml
+
+    try:
+        return yaml.safe_load(text) if text.strip() else text
+    except yaml.YAMLError:
+        return text
+
+
+def _entries(file: Path) -> list[dict[str, Any]]:
+    data = read_yaml(file)
+    if not isinstance(data, dict) or not isinstance(data.get("launch"), list):
+        raise LaunchError(f"{file}: expected a top-level 'launch:' list of arg/let/include/node entries")
+    return data["launch"]
+
+
+def _node_params(ctx: _Context, spec: dict[str, Any], where: str) -> dict[str, Any]:
+    params: dict[str, Any] = {}
+    for item in spec.get("param", []) or []:
+        item = ctx.subst(item, where)
+        if "from" in item:
+            path = Path(str(item["from"]))
+            if not path.is_absolute():
+                path = ctx.file.parent / path
+            params = merge_params(params, load_params(path, node=spec.get("name") or None))
+        elif "name" in item:
+            params = merge_params(params, {str(item["name"]): item.get("value")})
+        else:
+            raise LaunchError(f"{ctx.file}: {where}: a param entry needs 'name'+'value' or 'from'")
+    return params
+
+
+def _run_entries(ctx: _Context, session: Session, depth: int) -> None:
+    if depth > 20:
+        raise LaunchError(f"{ctx.file}: includes nest deeper than 20 levels (an include loop?)")
+    for i, entry in enumerate(_entries(ctx.file)):
+        if not isinstance(entry, dict) or len(entry) != 1:
+            raise LaunchError(f"{ctx.file}: entry {i + 1}: expected one of arg/let/include/node")
+        kind, spec = next(iter(entry.items()))
+        where = f"entry {i + 1} ({kind})"
+        if kind == "arg":
+            name = spec.get("name")
+            if not name:
+                raise LaunchError(f"{ctx.file}: {where}: an arg needs a 'name'")
+            if name not in ctx.vars:
+                if "default" not in spec:
+                    raise LaunchError(f"{ctx.file}: argument {name!r} has no default; pass {name}:=VALUE")
+                ctx.vars[name] = str(ctx.subst(spec["default"], where))
+        elif kind == "let":
+            ctx.vars[spec["name"]] = str(ctx.subst(spec["value"], where))
+        elif kind == "include":
+            path = Path(str(ctx.subst(spec.get("file", ""), where)))
+            if not path.is_absolute():
+                path = ctx.file.parent / path
+            if not path.is_file():
+                raise LaunchError(f"{ctx.file}: {where}: included file {path} does not exist")
+            sub_args = {a["name"]: str(ctx.subst(a["value"], where)) for a in spec.get("arg", []) or []}
+            _run_entries(_Context(path, sub_args), session, depth + 1)
+        elif kind == "node":
+            exec_name = spec.get("exec")
+            if not exec_name:
+                raise LaunchError(f"{ctx.file}: {where}: a node needs 'exec'")
+            cls = load_node_class(str(exec_name))
+            remaps = {r["from"]: ctx.subst(r["to"], where) for r in spec.get("remap", []) or []}
+            kwargs: dict[str, Any] = {"parameters": _node_params(ctx, spec, where)}
+            if spec.get("name"):
+                kwargs["name"] = spec["name"]
+            if spec.get("namespace"):
+                kwargs["namespace"] = ctx.subst(spec["namespace"], where)
+            with session.executor.node_context(remappings=remaps):
+                node = cls(session.executor, **kwargs)
+            session.nodes[node.fully_qualified_name] = node
+        else:
+            raise LaunchError(f"{ctx.file}: {where}: unknown entry {kind!r} (expected arg, let, include or node)")
+
+
+def declared_args(name_or_path: str) -> list[dict[str, Any]]:
+    """The ``arg`` entries of a launch file (for ``--help``-like listings)."""
+    return [e["arg"] for e in _entries(find_launch_file(name_or_path)) if isinstance(e, dict) and "arg" in e]
+
+
+def start(
+    name_or_path: str,
+    *,
+    executor: Executor | None = None,
+    seed: int = 0,
+    pace: float = 0.0,
+    launch_args: dict[str, Any] | None = None,
+    **args: Any,
+) -> Session:
+    """Start a launch (shipped name or file) with arguments; returns the session.
+
+    Arguments come as keywords (``start("mapping", world="room")``) or, for names that clash with
+    this function's own (``seed``, ``pace``), in ``launch_args``. ``pace`` is the executor's rate
+    (0 = as fast as possible, 1 = real time).
+    """
+    file = find_launch_file(name_or_path)
+    all_args = {**(launch_args or {}), **args}
+    session = Session(executor or Executor(seed=seed, rate=pace), args={k: str(v) for k, v in all_args.items()})
+    ctx = _Context(file, session.args)
+    _run_entries(ctx, session, 0)
+    session.args = ctx.vars
+    return session

@@ -1,0 +1,9 @@
+"""Node executables that launch files can name (``exec: amcl``), as ``module:Class`` paths.
+
+Each class takes ``(executor, *, name=..., parameters=None, namespace="")``.
+"""
+
+NODES: dict[str, str] = {
+    "talker": "navlab.core.demo_nodes:Talker",
+    "listener": "navlab.core.demo_nodes:Listener",
+}
