@@ -1,0 +1,100 @@
+"""Launch files (args, includes, params, remaps), recording round trip, CLI tools."""
+
+import json
+
+import numpy as np
+import pytest
+
+from navlab import msgs
+from navlab.cli import main
+from navlab.core import Executor, LaunchError, Node
+from navlab.core.launch import start
+from navlab.io.rosbag import Recorder, bag_graph, read_bag
+
+
+def test_shipped_launch_with_args():
+    s = start("talker_listener", launch_args={"rate": "10"})
+    s.run(2.0)
+    assert s.node("listener").heard[-1] == "Hello World: 20"
+
+
+def test_include_param_file_and_remap(tmp_path):
+    (tmp_path / "p.yaml").write_text("rate: 4.0\n")
+    (tmp_path / "inner.launch.yaml").write_text(
+        "launch:\n- arg: {name: topic}\n"
+        "- node: {pkg: navlab, exec: listener, name: ears, remap: [{from: chatter, to: $(var topic)}]}\n"
+    )
+    (tmp_path / "outer.launch.yaml").write_text(
+        "launch:\n- arg: {name: t, default: /talk}\n"
+        "- node: {pkg: navlab, exec: talker, name: mouth, param: [{from: p.yaml}],"
+        " remap: [{from: chatter, to: /talk}]}\n"
+        "- include: {file: inner.launch.yaml, arg: [{name: topic, value: $(var t)}]}\n"
+    )
+    s = start(str(tmp_path / "outer.launch.yaml"))
+    s.run(1.0)
+    assert len(s.node("ears").heard) == 4
+    assert "/talk" in s.executor.topics and "/chatter" not in s.executor.topics
+
+
+def test_launch_errors(tmp_path):
+    with pytest.raises(LaunchError, match="shipped launches"):
+        start("no_such_launch")
+    f = tmp_path / "x.launch.yaml"
+    f.write_text("launch:\n- node: {pkg: navlab, exec: tlker}\n")
+    with pytest.raises(LaunchError, match="unknown node executable 'tlker'"):
+        start(str(f))
+    f.write_text("launch:\n- arg: {name: needed}\n")
+    with pytest.raises(LaunchError, match="needed:=VALUE"):
+        start(str(f))
+
+
+def test_recording_round_trip(tmp_path):
+    ex = Executor(seed=3)
+    node = Node("odom_pub", ex)
+    pub = node.create_publisher(msgs.Odometry, "odom")
+    scan_pub = node.create_publisher(msgs.LaserScan, "scan")
+    sent = []
+
+    def tick() -> None:
+        t = ex.now_ns
+        m = msgs.Odometry(
+            header=msgs.header(t, "odom"), child_frame_id="chassis",
+            pose=msgs.PoseWithCovariance(pose=msgs.pose_from_2d(t / 1e9, 0.5, 0.1), covariance=msgs.covariance((1, 2))),
+            twist=msgs.TwistWithCovariance(twist=msgs.twist(0.3, 0.1), covariance=msgs.covariance()),
+        )
+        pub.publish(m)
+        sent.append((t, m))
+        scan_pub.publish(msgs.LaserScan(
+            header=msgs.header(t, "laser"), angle_min=-1.0, angle_max=1.0, angle_increment=0.5, time_increment=0.0,
+            scan_time=0.1, range_min=0.2, range_max=25.0,
+            ranges=node.rng.random(5).astype("float32"), intensities=np.zeros(0, "float32"),
+        ))
+
+    node.create_timer(0.1, tick)
+    bag = tmp_path / "run"
+    rec = Recorder(ex, bag, topics=["/odom"])
+    ex.run(1.0)
+    rec.close()
+    got = list(read_bag(bag))
+    assert [t for _, t, _ in got] == [t for t, _ in sent]
+    for (_, _, a), (_, b) in zip(got, sent, strict=True):
+        assert a.pose.pose.position.x == b.pose.pose.position.x
+        assert a.twist.twist.linear.x == 0.3 and list(a.pose.covariance[:8]) == list(b.pose.covariance[:8])
+    assert {topic for topic, _, _ in got} == {"/odom"}
+    assert "/odom_pub" in bag_graph(bag)["nodes"]
+
+
+def test_cli_topic_hz_and_graph(tmp_path, capsys):
+    assert main(["topic", "hz", "/chatter", "--json", "--launch", "talker_listener", "rate:=20"]) == 0
+    hz = json.loads(capsys.readouterr().out)
+    assert hz["average_rate_hz"] == pytest.approx(20.0)
+    assert main(["graph", "--launch", "talker_listener", "--out", str(tmp_path / "g")]) == 0
+    dot = (tmp_path / "g.dot").read_text()
+    assert '"/talker" -> "/chatter"' in dot and '"/chatter" -> "/listener"' in dot
+    assert (tmp_path / "g.svg").read_text().lstrip().startswith("<?xml")
+
+
+def test_cli_error_is_one_line(capsys):
+    assert main(["launch", "missing_launch", "--duration", "1"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("navlab: error: no launch file") and "Traceback" not in err

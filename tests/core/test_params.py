@@ -1,0 +1,80 @@
+"""Parameter files (ROS 1 and Nav2 layouts), typed declarations, did-you-mean, malformed YAML."""
+
+import pytest
+
+from navlab.core import Executor, Node, ParameterError, load_params
+
+ROS1 = """\
+controller_frequency: 5.0
+TrajectoryPlannerROS:
+  max_vel_x: 0.45
+  min_vel_x: 0.1
+global_costmap:
+  update_frequency: 2
+  inflation_radius: 0.55
+"""
+
+NAV2 = """\
+amcl:
+  ros__parameters:
+    min_particles: 500
+    max_particles: 2000
+    laser_model_type: likelihood_field
+controller_server:
+  ros__parameters:
+    controller_frequency: 20.0
+"""
+
+
+class Planner(Node):
+    def __init__(self, ex: Executor, **kw):
+        super().__init__("move_base", ex, **kw)
+        self.freq = self.declare_parameter("controller_frequency", 20.0)
+        self.max_vel = self.declare_parameter("TrajectoryPlannerROS/max_vel_x", 0.5)
+        self.min_vel = self.declare_parameter("TrajectoryPlannerROS.min_vel_x", 0.1)
+        self.upd = self.declare_parameter("global_costmap/update_frequency", 5.0)
+        self.infl = self.declare_parameter("global_costmap/inflation_radius", 0.55)
+
+
+def test_ros1_layout(tmp_path):
+    f = tmp_path / "move_base.yaml"
+    f.write_text(ROS1)
+    node = Planner(Executor(), parameters=load_params(f))
+    assert (node.freq, node.max_vel, node.upd) == (5.0, 0.45, 2.0)
+    assert isinstance(node.upd, float)
+    node.check_parameters()
+
+
+def test_nav2_layout(tmp_path):
+    f = tmp_path / "nav2.yaml"
+    f.write_text(NAV2)
+    p = load_params(f, node="amcl")
+    assert p == {"min_particles": 500, "max_particles": 2000, "laser_model_type": "likelihood_field"}
+    assert set(load_params(f)) == {"amcl", "controller_server"}
+    with pytest.raises(ParameterError, match="no parameters for node 'bt_navigator'"):
+        load_params(f, node="bt_navigator")
+
+
+def test_unknown_key_did_you_mean():
+    node = Planner(Executor(), parameters={"controller_frequncy": 3.0})
+    with pytest.raises(ParameterError, match="did you mean 'controller_frequency'"):
+        node.check_parameters()
+
+
+def test_unknown_key_refused_when_run_starts():
+    ex = Executor()
+    Planner(ex, parameters={"TrajectoryPlannerROS": {"max_vel_xx": 1.0}})
+    with pytest.raises(ParameterError, match=r"TrajectoryPlannerROS\.max_vel_x"):
+        ex.run(0.1)
+
+
+def test_wrong_type_is_refused():
+    with pytest.raises(ParameterError, match="controller_frequency"):
+        Planner(Executor(), parameters={"controller_frequency": "fast"})
+
+
+def test_malformed_yaml_names_file_and_line(tmp_path):
+    f = tmp_path / "bad.yaml"
+    f.write_text("a: 1\nb: [1, 2\nc: 3\n")
+    with pytest.raises(ParameterError, match=r"bad\.yaml:\d+:\d+: malformed YAML"):
+        load_params(f)

@@ -1,0 +1,67 @@
+"""tf buffer: chains, static transforms, interpolation, errors — against hand-computed values."""
+
+import math
+
+import pytest
+
+from navlab import msgs
+from navlab.core import Executor, Node, TfBuffer, TfError
+
+
+def _buf() -> TfBuffer:
+    buf = TfBuffer()
+    buf.set_transform("chassis", "laser", 0, (0.1, 0.0, 0.06, 0.0, 0.0, 0.0, 1.0), static=True)
+    q = msgs.quaternion_from_yaw(math.pi / 2)
+    buf.set_transform("odom", "chassis", 0, (1.0, 2.0, 0.0, 0.0, 0.0, q.z, q.w))
+    q2 = msgs.quaternion_from_yaw(math.pi)
+    buf.set_transform("odom", "chassis", 1_000_000_000, (3.0, 2.0, 0.0, 0.0, 0.0, q2.z, q2.w))
+    buf.set_transform("map", "odom", 0, (0.5, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0), static=True)
+    return buf
+
+
+def test_chain_lookup_map_to_laser():
+    # At t=0 chassis is at (1, 2) facing +y; the laser 0.1 m ahead is at (1, 2.1) in odom, (1.5, 2.1) in map.
+    x, y, yaw = _buf().lookup_pose2d("map", "laser", 0)
+    assert (x, y, yaw) == pytest.approx((1.5, 2.1, math.pi / 2))
+
+
+def test_interpolation_halfway():
+    x, y, yaw = _buf().lookup_pose2d("odom", "chassis", 500_000_000)
+    assert (x, y, yaw) == pytest.approx((2.0, 2.0, 3 * math.pi / 4))
+
+
+def test_inverse_lookup():
+    x, y, yaw = _buf().lookup_pose2d("laser", "odom", 0)
+    # odom origin seen from the laser at (1, 2.1) facing +y: it lies 2.1 m behind-right.
+    assert (x, y, yaw) == pytest.approx((-2.1, 1.0, -math.pi / 2))
+
+
+def test_latest_common_time():
+    assert _buf().lookup_pose2d("map", "chassis")[:2] == pytest.approx((3.5, 2.0))
+
+
+def test_unknown_frame_and_extrapolation():
+    buf = _buf()
+    with pytest.raises(TfError, match="base_link"):
+        buf.lookup("map", "base_link", 0)
+    with pytest.raises(TfError, match="future"):
+        buf.lookup("odom", "chassis", 2_000_000_000)
+    buf.tolerance_ns = 1_500_000_000
+    assert buf.lookup_pose2d("odom", "chassis", 2_000_000_000)[0] == pytest.approx(3.0)
+
+
+def test_disconnected_frames():
+    buf = _buf()
+    buf.set_transform("world", "camera", 0, (0, 0, 0, 0, 0, 0, 1), static=True)
+    with pytest.raises(TfError, match="not connected"):
+        buf.lookup("map", "camera", 0)
+
+
+def test_executor_feeds_tf_from_topics():
+    ex = Executor()
+    node = Node("pub", ex)
+    node.send_static_transform(msgs.transform_stamped(0, "chassis", "laser", 0.0, 0.0, 0.0, 0.06))
+    node.create_timer(0.1, lambda: node.send_transform(msgs.transform_stamped(ex.now_ns, "odom", "chassis",
+                                                                                ex.now_ns / 1e9, 0.0, 0.0)))
+    ex.run(1.0)
+    assert ex.tf.lookup_pose2d("odom", "laser", 550_000_000)[0] == pytest.approx(0.55)
