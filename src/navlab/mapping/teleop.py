@@ -1,0 +1,170 @@
+"""Driving the robot by hand or by script: teleop_twist_keyboard's keys, a joystick, scripted routes.
+
+- ``TeleopKeyboard``: teleop_twist_keyboard's bindings and defaults (speed 0.5 m/s, turn 1.0 rad/s).
+  Keys come in through :meth:`TeleopKeyboard.press` (thread-safe), from a terminal or the viewer.
+- ``RouteFollower``: a repeatable route for mapping runs, from a YAML file of velocity segments
+  (``{linear, angular, duration}``) and/or waypoints (``[x, y]`` in the odom frame).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from navlab import msgs
+from navlab.core import Executor, Node, TfError
+from navlab.core.params import read_yaml
+from navlab.mapping.errors import MappingError
+from navlab.mapping.explore import follow_path
+
+# teleop_twist_keyboard: key -> (x, y, z, th) direction, and key -> (speed, turn) multipliers.
+MOVE_BINDINGS: dict[str, tuple[int, int, int, int]] = {
+    "i": (1, 0, 0, 0), "o": (1, 0, 0, -1), "j": (0, 0, 0, 1), "l": (0, 0, 0, -1),
+    "u": (1, 0, 0, 1), ",": (-1, 0, 0, 0), ".": (-1, 0, 0, 1), "m": (-1, 0, 0, -1),
+    "O": (1, -1, 0, 0), "I": (1, 0, 0, 0), "J": (0, 1, 0, 0), "L": (0, -1, 0, 0),
+    "U": (1, 1, 0, 0), "<": (-1, 0, 0, 0), ">": (-1, -1, 0, 0), "M": (-1, 1, 0, 0),
+    "t": (0, 0, 1, 0), "b": (0, 0, -1, 0),
+}  # fmt: skip
+SPEED_BINDINGS: dict[str, tuple[float, float]] = {
+    "q": (1.1, 1.1), "z": (0.9, 0.9), "w": (1.1, 1.0), "x": (0.9, 1.0), "e": (1.0, 1.1), "c": (1.0, 0.9),
+}  # fmt: skip
+
+HELP = """Moving around:   u i o / j k l / m , .
+q/z: all speeds +/-10%   w/x: linear only   e/c: angular only
+k or any other key: stop   CTRL-C: quit"""
+
+
+@dataclass
+class TeleopState:
+    """The keyboard teleop's state: direction and speeds (teleop_twist_keyboard semantics)."""
+
+    speed: float = 0.5
+    turn: float = 1.0
+    x: int = 0
+    y: int = 0
+    z: int = 0
+    th: int = 0
+
+    def key(self, k: str) -> None:
+        """Apply one key press."""
+        if k in MOVE_BINDINGS:
+            self.x, self.y, self.z, self.th = MOVE_BINDINGS[k]
+        elif k in SPEED_BINDINGS:
+            s, t = SPEED_BINDINGS[k]
+            self.speed *= s
+            self.turn *= t
+        else:
+            self.x = self.y = self.z = self.th = 0
+
+    def twist(self) -> Any:
+        """The ``geometry_msgs/Twist`` this state commands."""
+        t = msgs.twist(self.x * self.speed, self.th * self.turn, self.y * self.speed)
+        t.linear.z = float(self.z * self.speed)
+        return t
+
+
+class TeleopKeyboard(Node):
+    """Publishes ``cmd_vel`` from key presses, repeated at ``repeat_rate`` Hz while a key holds."""
+
+    def __init__(
+        self,
+        executor: Executor,
+        *,
+        name: str = "teleop_twist_keyboard",
+        parameters: dict[str, Any] | None = None,
+        namespace: str = "",
+    ) -> None:
+        super().__init__(name, executor, parameters=parameters, namespace=namespace)
+        self.state = TeleopState(self.declare_parameter("speed", 0.5), self.declare_parameter("turn", 1.0))
+        rate = self.declare_parameter("repeat_rate", 10.0)
+        self.pub = self.create_publisher(msgs.Twist, "cmd_vel", 1)
+        self.create_timer(1.0 / rate, lambda: self.pub.publish(self.state.twist()))
+
+    def press(self, key: str) -> None:
+        """Thread-safe: apply a key press before the next event."""
+        self.executor.post(lambda: self.state.key(key))
+
+
+def load_route(path: str | Path) -> tuple[list[tuple[float, float, float]], np.ndarray]:
+    """A route file: ``segments: [{linear, angular, duration}]`` and/or ``waypoints: [[x, y], ...]``."""
+    data = read_yaml(path)
+    if not isinstance(data, dict) or not ({"segments", "waypoints"} & set(data)):
+        raise MappingError(f"{path}: a route file needs 'segments' and/or 'waypoints'")
+    segments = []
+    for k, seg in enumerate(data.get("segments") or []):
+        try:
+            segments.append((float(seg.get("linear", 0.0)), float(seg.get("angular", 0.0)), float(seg["duration"])))
+        except (KeyError, TypeError, ValueError, AttributeError):
+            raise MappingError(f"{path}: segments[{k}]: expected {{linear, angular, duration}} numbers") from None
+    try:
+        waypoints = np.array(data.get("waypoints") or [], dtype=float).reshape(-1, 2)
+    except ValueError:
+        raise MappingError(f"{path}: waypoints: expected a list of [x, y] pairs") from None
+    return segments, waypoints
+
+
+class RouteFollower(Node):
+    """Drives a scripted route: velocity segments first, then waypoints (pure pursuit on odometry).
+
+    Parameters: ``segments`` (list of {linear, angular, duration}), ``waypoints`` (list of [x, y] in
+    ``odom_frame``), ``base_frame``, ``odom_frame``, ``max_vel_x``, ``rate``. ``done`` becomes True at the end.
+    """
+
+    def __init__(
+        self,
+        executor: Executor,
+        *,
+        name: str = "route_follower",
+        parameters: dict[str, Any] | None = None,
+        namespace: str = "",
+    ) -> None:
+        super().__init__(name, executor, parameters=parameters, namespace=namespace)
+        raw_segments = self.declare_parameter("segments", [])
+        self.waypoints = np.array(self.declare_parameter("waypoints", []), dtype=float).reshape(-1, 2)
+        self.base_frame = self.declare_parameter("base_frame", "chassis")
+        self.odom_frame = self.declare_parameter("odom_frame", "odom")
+        self.max_v = self.declare_parameter("max_vel_x", 0.3)
+        rate = self.declare_parameter("rate", 10.0)
+        self.segments = [(float(s.get("linear", 0)), float(s.get("angular", 0)), float(s["duration"]))
+                         for s in raw_segments]
+        self.done = False
+        self._seg_end: int | None = None
+        self._wp = 0
+        self.pub = self.create_publisher(msgs.Twist, "cmd_vel", 1)
+        self.create_timer(1.0 / rate, self._tick)
+
+    def _tick(self) -> None:
+        if self.done:
+            return
+        now = self.executor.now_ns
+        if self.segments:
+            if self._seg_end is None:
+                self._seg_end = now + round(self.segments[0][2] * 1e9)
+            if now < self._seg_end:
+                v, w, _ = self.segments[0]
+                self.pub.publish(msgs.twist(v, w))
+                return
+            self.segments.pop(0)
+            self._seg_end = None
+            self._tick()
+            return
+        if self._wp >= len(self.waypoints):
+            self.done = True
+            self.pub.publish(msgs.twist(0.0, 0.0))
+            return
+        try:
+            pose = self.executor.tf.lookup_pose2d(self.odom_frame, self.base_frame)
+        except TfError:
+            return
+        target = self.waypoints[self._wp]
+        if math.hypot(target[0] - pose[0], target[1] - pose[1]) < 0.1:
+            self._wp += 1
+            self._tick()
+            return
+        path = np.array([pose[:2], target])
+        v, w, _ = follow_path(pose, path, lookahead=0.05, max_v=self.max_v)
+        self.pub.publish(msgs.twist(v, w))
