@@ -28,14 +28,19 @@ class Origin:
 class Geometry:
     """A shape. ``size``: box full extents (x, y, z); cylinder (radius, length) along z; sphere (radius,).
 
-    Meshes: ``mesh_path`` is an absolute path to an STL/OBJ/DAE file, already resolved from
-    ``package://``/``file://``/``model://``; ``mesh_scale`` includes any COLLADA unit scale.
+    Meshes: ``mesh_path`` is an absolute path to an STL or OBJ file, already resolved from
+    ``package://``/``file://``/``model://`` (a COLLADA ``.dae`` is converted to a cached OBJ and named
+    in ``mesh_source``); ``mesh_scale`` includes any COLLADA unit scale. ``convex`` is filled by the
+    world loader for collision meshes (None: not checked).
     """
 
     kind: GeometryKind
     size: tuple[float, ...] = ()
     mesh_path: Path | None = None
     mesh_scale: Vec3 = (1.0, 1.0, 1.0)
+    # Added by the description/world loaders:
+    mesh_source: Path | None = None  # the file the description named (e.g. a .dae converted to mesh_path)
+    convex: bool | None = None  # meshes: True if the mesh is its own convex hull; False: needs decomposition
 
 
 @dataclass(frozen=True)
@@ -115,6 +120,7 @@ class DiffDriveConfig:
     publish_wheel_tf: bool = False
     cmd_timeout: float = 0.5  # s without cmd_vel before the wheels are stopped
     namespace: str = ""
+    legacy_mode: bool = False  # ROS 1 <legacyMode> true: left/right wheel speeds swapped when turning
 
 
 @dataclass

@@ -1,0 +1,88 @@
+"""``load_robot``: a xacro/URDF file with ``<gazebo>`` tags → :class:`RobotModel`."""
+
+from __future__ import annotations
+
+import os
+import xml.etree.ElementTree as ET
+from collections.abc import Iterable, Mapping
+from pathlib import Path
+
+from navlab.description.errors import DescriptionError
+from navlab.description.gazebo import check_plugin_joints, read_gazebo_tags
+from navlab.description.meshes import prepare_mesh
+from navlab.description.model import RobotModel
+from navlab.description.packages import PackageIndex
+from navlab.description.urdf import parse_urdf
+from navlab.description.xacro import expand
+
+
+def _moving_mass_check(model: RobotModel, source: str) -> None:
+    """Every moving body (root or child of a non-fixed joint) needs mass, counting fixed children.
+
+    MuJoCo (like Gazebo) cannot simulate a body with zero mass on a joint, so a moving link with no
+    ``<inertial>`` (and no massive link fixed to it) is an error naming that link.
+    """
+    fixed_children: dict[str, list[str]] = {}
+    moving = {model.root_link}
+    for j in model.joints:
+        if j.type == "fixed":
+            fixed_children.setdefault(j.parent, []).append(j.child)
+        else:
+            moving.add(j.child)
+
+    def mass(link: str) -> float:
+        inertial = model.links[link].inertial
+        own = inertial.mass if inertial is not None else 0.0
+        return own + sum(mass(c) for c in fixed_children.get(link, []))
+
+    for link in sorted(moving):
+        if mass(link) <= 0.0:
+            how = "the root link (it floats freely)" if link == model.root_link else "on a moving joint"
+            raise DescriptionError(
+                f'{source}: <link name="{link}"> is {how} but has no <inertial> with mass > 0 (nor a '
+                "massive link fixed to it); add <inertial><mass value=.../><inertia .../></inertial>"
+            )
+
+
+def load_robot(
+    path: str | os.PathLike[str],
+    *,
+    search_paths: Iterable[str | os.PathLike[str]] = (),
+    args: Mapping[str, str] | None = None,
+) -> RobotModel:
+    """Load a robot description (``.xacro`` or ``.urdf``) with its Gazebo plugin tags.
+
+    ``search_paths``: directories holding ROS packages (or package directories) for ``$(find pkg)``
+    and ``package://pkg/...``; ``ROS_PACKAGE_PATH``, the packages enclosing ``path`` and navlab's
+    shipped packages (``mybot_description``) are searched after them. ``args``: xacro arguments
+    (``name:=value``). Raises DescriptionError naming the file and element on bad input; unknown
+    plugins, sensors and tags become ``RobotModel.warnings``.
+    """
+    path = Path(path).expanduser().resolve()
+    index = PackageIndex(search_paths, near=path)
+    urdf_xml, warnings = expand(path, index, args)
+    source = str(path)
+    try:
+        root = ET.fromstring(urdf_xml)
+    except ET.ParseError as exc:  # pragma: no cover - xacro already parsed it
+        raise DescriptionError(f"{source}: expanded URDF is not XML ({exc})") from None
+
+    def resolve_mesh(filename: str, where: str) -> tuple[Path, float, Path]:
+        named = index.resolve_uri(filename, base_dir=path.parent)
+        sim_path, unit = prepare_mesh(named, where)
+        return sim_path, unit, named
+
+    name, links, joints, root_link = parse_urdf(root, source, resolve_mesh)
+    model = RobotModel(name=name, links=links, joints=joints, root_link=root_link, source=path,
+                       urdf_xml=urdf_xml, warnings=list(warnings))
+    _moving_mass_check(model, source)
+    tags = read_gazebo_tags(root, links, {j.name for j in joints}, source)
+    check_plugin_joints(tags, {j.name: j.type for j in joints}, links, source)
+    model.diff_drive = tags.diff_drive
+    model.lidars = tags.lidars
+    model.imus = tags.imus
+    model.warnings += tags.warnings
+    if model.diff_drive is None:
+        model.warnings.append(f"{source}: no libgazebo_ros_diff_drive.so plugin; cmd_vel will not move "
+                              "the robot")
+    return model

@@ -1,0 +1,307 @@
+"""Meshes: check and prepare STL/OBJ/DAE files for the simulator, read their triangles.
+
+MuJoCo reads STL and OBJ only, so a COLLADA ``.dae`` file is converted once to an OBJ in a cache
+directory (``$NAVLAB_CACHE`` or ``~/.cache/navlab``, under ``meshes/``). The COLLADA node transforms
+and ``<up_axis>`` are applied to the vertices; the ``<unit meter=...>`` scale is returned so callers
+fold it into the mesh scale (the model's ``mesh_scale`` then includes it).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import struct
+import tempfile
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import numpy as np
+from scipy.spatial import ConvexHull, QhullError
+
+from navlab.description.errors import DescriptionError
+
+MESH_SUFFIXES = (".stl", ".obj", ".dae")
+
+
+def cache_dir() -> Path:
+    """Directory for converted meshes (created on demand)."""
+    base = os.environ.get("NAVLAB_CACHE") or Path.home() / ".cache" / "navlab"
+    return Path(base) / "meshes"
+
+
+def _atomic_write_text(path: Path, text: str) -> None:
+    """Write ``text`` to a temporary file beside ``path`` and rename it into place."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=path.name, suffix=".tmp")
+    try:
+        with os.fdopen(fd, "w") as f:
+            f.write(text)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+# ---------------------------------------------------------------------------------------- reading
+def read_stl(path: Path) -> tuple[np.ndarray, np.ndarray]:
+    """Vertices (n, 3) and triangle indices (m, 3) of a binary or ASCII STL file."""
+    data = path.read_bytes()
+    if len(data) >= 84:
+        (count,) = struct.unpack_from("<I", data, 80)
+        if 84 + 50 * count == len(data):
+            rec = np.frombuffer(data, dtype=np.dtype([("n", "<f4", 3), ("v", "<f4", (3, 3)), ("a", "<u2")]),
+                                count=count, offset=84)
+            verts = rec["v"].reshape(-1, 3).astype(float)
+            return verts, np.arange(len(verts)).reshape(-1, 3)
+    text = data.decode("ascii", errors="replace")
+    if not text.lstrip().startswith("solid"):
+        raise DescriptionError(f"{path}: not a binary or ASCII STL file")
+    coords = [line.split()[1:4] for line in text.splitlines() if line.strip().startswith("vertex")]
+    try:
+        verts = np.array(coords, dtype=float).reshape(-1, 3)
+    except ValueError:
+        raise DescriptionError(f"{path}: malformed ASCII STL 'vertex' line") from None
+    if len(verts) % 3:
+        raise DescriptionError(f"{path}: ASCII STL has {len(verts)} vertices, not a multiple of 3")
+    return verts, np.arange(len(verts)).reshape(-1, 3)
+
+
+def read_obj(path: Path) -> tuple[np.ndarray, np.ndarray]:
+    """Vertices and triangles (polygons fan-triangulated) of a Wavefront OBJ file."""
+    verts: list[list[float]] = []
+    faces: list[list[int]] = []
+    for lineno, line in enumerate(path.read_text(errors="replace").splitlines(), 1):
+        parts = line.split()
+        if not parts:
+            continue
+        try:
+            if parts[0] == "v":
+                verts.append([float(x) for x in parts[1:4]])
+            elif parts[0] == "f":
+                idx = [int(p.split("/")[0]) for p in parts[1:]]
+                idx = [i - 1 if i > 0 else len(verts) + i for i in idx]
+                faces += [[idx[0], idx[k], idx[k + 1]] for k in range(1, len(idx) - 1)]
+        except ValueError:
+            raise DescriptionError(f"{path}:{lineno}: malformed OBJ line {line.strip()!r}") from None
+    return np.array(verts, dtype=float).reshape(-1, 3), np.array(faces, dtype=int).reshape(-1, 3)
+
+
+def read_mesh(path: Path) -> tuple[np.ndarray, np.ndarray]:
+    """Vertices and triangles of an STL, OBJ or DAE file (DAE: with node transforms, in its own units)."""
+    suffix = path.suffix.lower()
+    if suffix == ".stl":
+        return read_stl(path)
+    if suffix == ".obj":
+        return read_obj(path)
+    if suffix == ".dae":
+        verts, faces, _ = read_dae(path)
+        return verts, faces
+    raise DescriptionError(f"{path}: unsupported mesh type {suffix!r} (expected .stl, .obj or .dae)")
+
+
+# ---------------------------------------------------------------------------------------- COLLADA
+def _local(tag: str) -> str:
+    return tag.rsplit("}", 1)[-1]
+
+
+def _children(elem: ET.Element, name: str) -> list[ET.Element]:
+    return [c for c in elem if _local(c.tag) == name]
+
+
+def _child(elem: ET.Element, name: str) -> ET.Element | None:
+    found = _children(elem, name)
+    return found[0] if found else None
+
+
+def _floats(elem: ET.Element | None) -> np.ndarray:
+    return np.array((elem.text or "").split() if elem is not None else [], dtype=float)
+
+
+def _rotation(axis: np.ndarray, angle_deg: float) -> np.ndarray:
+    """4x4 homogeneous rotation about ``axis`` by ``angle_deg`` degrees (Rodrigues)."""
+    a = axis / (np.linalg.norm(axis) or 1.0)
+    t = np.radians(angle_deg)
+    k = np.array([[0, -a[2], a[1]], [a[2], 0, -a[0]], [-a[1], a[0], 0]])
+    m = np.eye(4)
+    m[:3, :3] = np.eye(3) + np.sin(t) * k + (1 - np.cos(t)) * (k @ k)
+    return m
+
+
+def _node_matrix(node: ET.Element) -> np.ndarray:
+    """The node's local transform: its <matrix>/<translate>/<rotate>/<scale> children in order."""
+    m = np.eye(4)
+    for c in node:
+        name = _local(c.tag)
+        v = _floats(c) if name in ("matrix", "translate", "rotate", "scale") else None
+        if name == "matrix" and v is not None and v.size == 16:
+            m = m @ v.reshape(4, 4)
+        elif name == "translate" and v is not None and v.size == 3:
+            t = np.eye(4)
+            t[:3, 3] = v
+            m = m @ t
+        elif name == "rotate" and v is not None and v.size == 4:
+            m = m @ _rotation(v[:3], v[3])
+        elif name == "scale" and v is not None and v.size == 3:
+            m = m @ np.diag([*v, 1.0])
+    return m
+
+
+def _geometry_triangles(geom: ET.Element, path: Path) -> tuple[np.ndarray, np.ndarray]:
+    """Positions and triangles of one <geometry><mesh> (triangles, polylist, polygons)."""
+    mesh = _child(geom, "mesh")
+    if mesh is None:
+        return np.zeros((0, 3)), np.zeros((0, 3), dtype=int)
+    sources = {s.get("id"): s for s in _children(mesh, "source")}
+    vertices = _child(mesh, "vertices")
+    pos_id = None
+    for inp in _children(vertices, "input") if vertices is not None else []:
+        if inp.get("semantic") == "POSITION":
+            pos_id = (inp.get("source") or "").lstrip("#")
+    if pos_id not in sources:
+        raise DescriptionError(f"{path}: <geometry id={geom.get('id')!r}> has no POSITION source")
+    src = sources[pos_id]
+    acc = next((e for e in src.iter() if _local(e.tag) == "accessor"), None)
+    stride = max(int(acc.get("stride", "3")), 3) if acc is not None else 3
+    positions = _floats(_child(src, "float_array"))
+    positions = positions[: positions.size // stride * stride].reshape(-1, stride)[:, :3]
+    faces: list[np.ndarray] = []
+    for prim in mesh:
+        kind = _local(prim.tag)
+        if kind not in ("triangles", "polylist", "polygons"):
+            continue
+        inputs = _children(prim, "input")
+        n_in = max(int(i.get("offset", "0")) for i in inputs) + 1 if inputs else 1
+        v_off = next((int(i.get("offset", "0")) for i in inputs if i.get("semantic") == "VERTEX"), 0)
+        polys: list[np.ndarray] = []
+        if kind == "polygons":
+            polys = [_floats(p).astype(int).reshape(-1, n_in)[:, v_off] for p in _children(prim, "p")]
+        else:
+            idx = np.concatenate([_floats(p).astype(int) for p in _children(prim, "p")] or [np.zeros(0, int)])
+            idx = idx[: idx.size // n_in * n_in].reshape(-1, n_in)[:, v_off]
+            if kind == "triangles":
+                faces.append(idx[: idx.size // 3 * 3].reshape(-1, 3))
+                continue
+            counts = _floats(_child(prim, "vcount")).astype(int)
+            starts = np.concatenate([[0], np.cumsum(counts)[:-1]])
+            polys = [idx[s : s + c] for s, c in zip(starts, counts, strict=True)]
+        for poly in polys:
+            if len(poly) >= 3:
+                faces.append(np.stack([np.full(len(poly) - 2, poly[0]), poly[1:-1], poly[2:]], axis=1))
+    tri = np.concatenate(faces) if faces else np.zeros((0, 3), dtype=int)
+    if tri.size and (tri.max() >= len(positions) or tri.min() < 0):
+        raise DescriptionError(f"{path}: <geometry id={geom.get('id')!r}> indexes a vertex out of range")
+    return positions, tri
+
+
+def read_dae(path: Path) -> tuple[np.ndarray, np.ndarray, float]:
+    """Vertices (node transforms and up axis applied, in the file's units), triangles, and unit meters."""
+    try:
+        root = ET.parse(path).getroot()
+    except ET.ParseError as exc:
+        raise DescriptionError(f"{path}: malformed COLLADA file ({exc})") from None
+    asset = _child(root, "asset")
+    unit, up = 1.0, "Y_UP"
+    if asset is not None:
+        u = _child(asset, "unit")
+        if u is not None and u.get("meter"):
+            unit = float(u.get("meter", "1"))
+        ua = _child(asset, "up_axis")
+        if ua is not None and ua.text:
+            up = ua.text.strip()
+    geoms = {g.get("id"): g for lib in _children(root, "library_geometries") for g in _children(lib, "geometry")}
+    lib_nodes = {n.get("id"): n for lib in _children(root, "library_nodes") for n in _children(lib, "node")}
+    scenes = {s.get("id"): s for lib in _children(root, "library_visual_scenes")
+              for s in _children(lib, "visual_scene")}
+    instances: list[tuple[str, np.ndarray]] = []
+
+    def visit(node: ET.Element, parent: np.ndarray, depth: int) -> None:
+        if depth > 64:
+            raise DescriptionError(f"{path}: COLLADA node hierarchy too deep (a cycle in <instance_node>?)")
+        m = parent @ _node_matrix(node)
+        for c in node:
+            name = _local(c.tag)
+            if name == "instance_geometry":
+                instances.append(((c.get("url") or "").lstrip("#"), m))
+            elif name == "instance_node" and (c.get("url") or "").lstrip("#") in lib_nodes:
+                visit(lib_nodes[(c.get("url") or "").lstrip("#")], m, depth + 1)
+            elif name == "node":
+                visit(c, m, depth + 1)
+
+    scene_el = _child(root, "scene")
+    inst = _child(scene_el, "instance_visual_scene") if scene_el is not None else None
+    scene = scenes.get((inst.get("url") or "").lstrip("#")) if inst is not None else None
+    if scene is None and scenes:
+        scene = next(iter(scenes.values()))
+    if scene is not None:
+        for node in _children(scene, "node"):
+            visit(node, np.eye(4), 0)
+    else:
+        instances = [(gid, np.eye(4)) for gid in geoms]
+    all_v, all_f, offset = [], [], 0
+    for gid, m in instances:
+        if gid not in geoms:
+            raise DescriptionError(f"{path}: <instance_geometry url='#{gid}'> names no <geometry>")
+        v, f = _geometry_triangles(geoms[gid], path)
+        v = v @ m[:3, :3].T + m[:3, 3]
+        all_v.append(v)
+        all_f.append(f + offset)
+        offset += len(v)
+    verts = np.concatenate(all_v) if all_v else np.zeros((0, 3))
+    faces = np.concatenate(all_f) if all_f else np.zeros((0, 3), dtype=int)
+    if up == "Y_UP":
+        verts = verts[:, [0, 2, 1]] * np.array([1.0, -1.0, 1.0])  # y up -> z up (+90° about x)
+    elif up == "X_UP":
+        verts = verts[:, [1, 0, 2]] * np.array([-1.0, 1.0, 1.0])
+        verts = verts[:, [0, 2, 1]] * np.array([1.0, -1.0, 1.0])
+    if len(faces) == 0:
+        raise DescriptionError(f"{path}: COLLADA file has no triangles")
+    return verts, faces, unit
+
+
+def dae_to_obj(path: Path) -> tuple[Path, float]:
+    """Convert a COLLADA file to a cached OBJ (converted once per file version); return it and unit meters."""
+    stat = path.stat()
+    key = hashlib.sha1(f"{path.resolve()}|{stat.st_mtime_ns}|{stat.st_size}".encode()).hexdigest()[:16]
+    verts, faces, unit = read_dae(path)
+    out = cache_dir() / f"{path.stem}-{key}.obj"
+    if not out.exists():
+        lines = [f"# converted by navlab from {path}"]
+        lines += [f"v {x:.9g} {y:.9g} {z:.9g}" for x, y, z in verts]
+        lines += [f"f {a + 1} {b + 1} {c + 1}" for a, b, c in faces]
+        _atomic_write_text(out, "\n".join(lines) + "\n")
+    return out, unit
+
+
+def prepare_mesh(path: Path, where: str) -> tuple[Path, float]:
+    """Check a mesh file and make it simulator-readable; return its path and a unit scale factor.
+
+    ``where`` names the file and element for errors. DAE files come back as a cached OBJ with the
+    COLLADA unit as the factor; STL/OBJ come back unchanged with factor 1.
+    """
+    if not path.is_file():
+        raise DescriptionError(f"{where}: mesh file {path} not found")
+    suffix = path.suffix.lower()
+    if suffix not in MESH_SUFFIXES:
+        raise DescriptionError(f"{where}: mesh {path} has unsupported type {suffix!r} (expected .stl/.obj/.dae)")
+    if suffix == ".dae":
+        try:
+            return dae_to_obj(path)
+        except DescriptionError as exc:
+            raise DescriptionError(f"{where}: {exc}") from None
+    return path, 1.0
+
+
+def is_convex(verts: np.ndarray, *, rel_tol: float = 1e-3) -> bool:
+    """True if every vertex lies on the convex hull's surface (so the hull is the shape).
+
+    Flat or degenerate vertex sets count as convex.
+    """
+    if len(verts) < 4:
+        return True
+    try:
+        hull = ConvexHull(verts)
+    except QhullError:
+        return True
+    tol = rel_tol * float(np.ptp(verts, axis=0).max() or 1.0)
+    depth = (verts @ hull.equations[:, :3].T + hull.equations[:, 3]).max(axis=1)  # <= 0 inside
+    return bool((depth >= -tol).all())
