@@ -1,0 +1,472 @@
+"""RobotModel + WorldModel → a MuJoCo model, built directly with ``mujoco.MjSpec``.
+
+Conventions of the built model (what the simulator and the lidar rely on):
+
+- The robot's links become bodies nested along the joint tree, named as in the URDF; fixed links stay
+  bodies (so the laser frame exists) and the root gets a free joint at the spawn pose.
+- World model links become bodies named ``model::link`` (Gazebo's scoped names); static models have
+  no joint, dynamic links each get a free joint.
+- Geom groups: 0 world collision (rays hit), 1 robot collision (rays ignore), 2 visuals (render only,
+  no contacts), 3 ray-only true surfaces of world meshes, 4 collision hulls of world meshes.
+- Contact bits: the world's static geoms only touch the robot and dynamic models; robot parts never
+  touch each other (Gazebo's ``self_collide`` off).
+- Friction follows Gazebo (combined by min, not MuJoCo's max): robot geoms get contact priority so
+  their own friction decides; passive casters (links rigidly fixed to the chassis without an explicit
+  ``mu1``, or with ``mu1 == 0``) are frictionless (``condim`` 1) so they do not drag.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import mujoco
+import numpy as np
+
+from navlab.description.model import Geometry, Link, Origin, RobotModel, Shape
+from navlab.sim.errors import SimError
+from navlab.world.model import ModelSpec, WorldModel
+
+GROUP_WORLD = 0
+GROUP_ROBOT = 1
+GROUP_VISUAL = 2
+GROUP_RAY_MESH = 3
+GROUP_WORLD_HULL = 4
+#: geom groups a lidar ray can hit (mj_multiRay's geomgroup filter)
+RAY_GEOMGROUP = np.array([1, 0, 0, 1, 0, 0], dtype=np.uint8)
+
+_BIT_STATIC, _BIT_ROBOT, _BIT_DYNAMIC = 1, 2, 4
+_CONTACT_BITS = {
+    "static": (_BIT_STATIC, _BIT_ROBOT | _BIT_DYNAMIC),
+    "robot": (_BIT_ROBOT, _BIT_STATIC | _BIT_DYNAMIC),
+    "dynamic": (_BIT_DYNAMIC, _BIT_STATIC | _BIT_ROBOT | _BIT_DYNAMIC),
+}
+#: velocity-actuator gain of the wheel motors (N m s/rad); ODE's joint motor is a hard velocity
+#: constraint capped by fmax, approximated here by a stiff implicit damper capped by forcerange.
+WHEEL_KV = 50.0
+#: WHEELS_AS_ELLIPSOIDS: a robot cylinder spinning about its own axis (a wheel) collides as the
+#: ellipsoid inscribed in it. MuJoCo's cylinder-plane contact puts points on both rim edges; the outer
+#: edge then sets the turning rate (7 % slow on mybot) and the flat rim bounces. The ellipsoid touches
+#: the floor in one point at mid-tread, like a wheel's contact patch.
+#: contact softness for the robot (time constant s, damping ratio): critically damped, no bounce
+ROBOT_SOLREF = (0.005, 1.0)
+ROBOT_SOLIMP = (0.95, 0.99, 0.001, 0.5, 2.0)
+DEFAULT_MU = 1.0  # Gazebo/ODE's friction when a link names none
+MIN_MASS = 1e-3  # kg given to a moving link that has no <inertial>
+MIN_STEP, MAX_STEP = 0.0005, 0.002  # s; 5 ms tips robots over
+
+
+@dataclass
+class BuildInfo:
+    """Names in the built model that the simulator needs, plus warnings raised while building."""
+
+    robot_name: str = ""
+    root_body: str = ""
+    link_bodies: dict[str, str] = field(default_factory=dict)  # URDF link -> MuJoCo body name
+    lidar_sites: list[str] = field(default_factory=list)  # one per RobotModel.lidars entry
+    imu_sites: list[str] = field(default_factory=list)  # one per RobotModel.imus entry
+    wheel_actuators: tuple[str, str] | None = None  # (left, right) velocity actuators
+    world_bodies: dict[str, list[str]] = field(default_factory=dict)  # model name -> body names
+    warnings: list[str] = field(default_factory=list)
+
+
+# --- rotations ------------------------------------------------------------------------------------
+
+
+def quat_from_rpy(rpy: tuple[float, float, float]) -> np.ndarray:
+    """MuJoCo quaternion (w, x, y, z) of URDF roll-pitch-yaw (fixed axes: R = Rz(y) Ry(p) Rx(r))."""
+    r, p, y = (0.5 * float(a) for a in rpy)
+    cr, sr, cp, sp, cy, sy = math.cos(r), math.sin(r), math.cos(p), math.sin(p), math.cos(y), math.sin(y)
+    return np.array(
+        [
+            cr * cp * cy + sr * sp * sy,
+            sr * cp * cy - cr * sp * sy,
+            cr * sp * cy + sr * cp * sy,
+            cr * cp * sy - sr * sp * cy,
+        ]
+    )
+
+
+def mat_from_rpy(rpy: tuple[float, float, float]) -> np.ndarray:
+    """3×3 rotation matrix of URDF roll-pitch-yaw."""
+    mat = np.zeros(9)
+    mujoco.mju_quat2Mat(mat, quat_from_rpy(rpy))
+    return mat.reshape(3, 3)
+
+
+def _set_pose(element: object, origin: Origin) -> None:
+    element.pos = np.asarray(origin.xyz, dtype=float)  # type: ignore[attr-defined]
+    element.quat = quat_from_rpy(origin.rpy)  # type: ignore[attr-defined]
+
+
+def _compose(a: Origin, b: Origin) -> Origin:
+    """Pose ``b`` (in frame ``a``) expressed in ``a``'s parent."""
+    ra = mat_from_rpy(a.rpy)
+    xyz = np.asarray(a.xyz) + ra @ np.asarray(b.xyz)
+    rot = ra @ mat_from_rpy(b.rpy)
+    yaw = math.atan2(rot[1, 0], rot[0, 0])
+    pitch = math.asin(max(-1.0, min(1.0, -rot[2, 0])))
+    roll = math.atan2(rot[2, 1], rot[2, 2])
+    return Origin(xyz=(float(xyz[0]), float(xyz[1]), float(xyz[2])), rpy=(roll, pitch, yaw))
+
+
+# --- geometry -------------------------------------------------------------------------------------
+
+
+class _Geoms:
+    """Adds shapes to bodies, registering mesh assets once per (file, scale)."""
+
+    def __init__(self, spec: mujoco.MjSpec, info: BuildInfo) -> None:
+        self.spec = spec
+        self.info = info
+        self.meshes: dict[tuple[str, tuple[float, ...]], str] = {}
+
+    def mesh_asset(self, geometry: Geometry, where: str) -> str:
+        path = geometry.mesh_path
+        if path is None or not path.is_file():
+            raise SimError(f"{where}: mesh file {path} not found (expected a resolved STL/OBJ path)")
+        if path.suffix.lower() not in (".stl", ".obj"):
+            raise SimError(
+                f"{where}: mesh {path} is {path.suffix or 'of unknown type'}; MuJoCo reads STL and OBJ "
+                "(convert COLLADA .dae meshes to .stl/.obj)"
+            )
+        key = (str(path), tuple(float(s) for s in geometry.mesh_scale))
+        if key not in self.meshes:
+            name = f"mesh{len(self.meshes)}_{path.stem}"
+            mesh = self.spec.add_mesh(name=name, file=str(path))
+            mesh.scale = np.asarray(geometry.mesh_scale, dtype=float)
+            self.meshes[key] = name
+        return self.meshes[key]
+
+    def add(self, body: mujoco.MjsBody, shape: Shape, where: str, **props: object) -> mujoco.MjsGeom:
+        g = shape.geometry
+        geom = body.add_geom()
+        size = tuple(float(s) for s in g.size)
+        try:
+            if g.kind == "box":
+                geom.type = mujoco.mjtGeom.mjGEOM_BOX
+                geom.size = np.array([size[0] / 2, size[1] / 2, size[2] / 2])
+            elif g.kind == "cylinder":
+                geom.type = mujoco.mjtGeom.mjGEOM_CYLINDER
+                geom.size = np.array([size[0], size[1] / 2, 0.0])
+            elif g.kind == "sphere":
+                geom.type = mujoco.mjtGeom.mjGEOM_SPHERE
+                geom.size = np.array([size[0], 0.0, 0.0])
+            elif g.kind == "mesh":
+                geom.type = mujoco.mjtGeom.mjGEOM_MESH
+                geom.meshname = self.mesh_asset(g, where)
+            else:
+                raise SimError(f"{where}: unknown geometry kind {g.kind!r} (expected box/cylinder/sphere/mesh)")
+        except IndexError:
+            raise SimError(f"{where}: {g.kind} geometry needs more size values than {size}") from None
+        if g.kind != "mesh" and min(s for s in size if s is not None) <= 0:
+            raise SimError(f"{where}: {g.kind} size {size} must be positive")
+        _set_pose(geom, shape.origin)
+        for key, value in props.items():
+            setattr(geom, key, value)
+        return geom
+
+
+def _contact_props(kind: str, group: int) -> dict[str, object]:
+    contype, conaffinity = _CONTACT_BITS[kind]
+    return {"contype": contype, "conaffinity": conaffinity, "group": group}
+
+
+_VISUAL_PROPS: dict[str, object] = {"contype": 0, "conaffinity": 0, "group": GROUP_VISUAL, "mass": 0.0}
+
+
+def _set_inertial(body: mujoco.MjsBody, link: Link, moving: bool, info: BuildInfo, where: str) -> None:
+    inertial = link.inertial
+    if inertial is None:
+        if moving:
+            info.warnings.append(f"{where}: moving link has no <inertial>; given {MIN_MASS} kg")
+        body.mass = MIN_MASS if moving else 0.0  # URDF: a link without <inertial> is massless
+        body.inertia = np.full(3, 1e-6 if moving else 0.0)
+        body.explicitinertial = True
+        return
+    if inertial.mass <= 0:
+        raise SimError(f"{where}: <inertial> mass must be positive, got {inertial.mass}")
+    tensor = np.array(
+        [
+            [inertial.ixx, inertial.ixy, inertial.ixz],
+            [inertial.ixy, inertial.iyy, inertial.iyz],
+            [inertial.ixz, inertial.iyz, inertial.izz],
+        ]
+    )
+    rot = mat_from_rpy(inertial.origin.rpy)
+    tensor = rot @ tensor @ rot.T
+    if np.all(np.abs(tensor) < 1e-12):
+        tensor = np.eye(3) * 1e-6
+    body.mass = float(inertial.mass)
+    body.ipos = np.asarray(inertial.origin.xyz, dtype=float)
+    body.iquat = np.array([1.0, 0.0, 0.0, 0.0])
+    body.fullinertia = np.array(
+        [tensor[0, 0], tensor[1, 1], tensor[2, 2], tensor[0, 1], tensor[0, 2], tensor[1, 2]]
+    )
+    body.explicitinertial = True
+
+
+# --- robot ----------------------------------------------------------------------------------------
+
+
+def _link_friction(link: Link, rigid_to_root: bool) -> tuple[float, int]:
+    """(mu, condim) of a robot link's contacts under Gazebo semantics (see module docstring)."""
+    if link.mu1 is None and link.mu2 is None:
+        return (0.0, 1) if rigid_to_root else (DEFAULT_MU, 3)
+    mus = [m for m in (link.mu1, link.mu2) if m is not None]
+    mu = float(min(mus))
+    if mu < 0:
+        raise SimError(f"link {link.name!r}: friction mu1/mu2 must be >= 0, got {mus}")
+    return (0.0, 1) if mu <= 1e-6 else (mu, 3)
+
+
+def _check_tree(robot: RobotModel) -> dict[str, list]:
+    """Validate links/joints form a tree under ``root_link``; return parent link -> child joints."""
+    where = f"robot {robot.name!r}" + (f" ({robot.source})" if robot.source else "")
+    if robot.root_link not in robot.links:
+        raise SimError(f"{where}: root link {robot.root_link!r} is not among its links")
+    children: dict[str, list] = {}
+    parents: dict[str, str] = {}
+    for joint in robot.joints:
+        for end in (joint.parent, joint.child):
+            if end not in robot.links:
+                raise SimError(f"{where}: joint {joint.name!r} names unknown link {end!r}")
+        if joint.child in parents:
+            raise SimError(f"{where}: link {joint.child!r} has two parent joints")
+        parents[joint.child] = joint.name
+        children.setdefault(joint.parent, []).append(joint)
+    if robot.root_link in parents:
+        raise SimError(f"{where}: root link {robot.root_link!r} has a parent joint {parents[robot.root_link]!r}")
+    return children
+
+
+def add_robot(
+    spec: mujoco.MjSpec,
+    robot: RobotModel,
+    info: BuildInfo,
+    pose: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0),
+) -> None:
+    """Add ``robot`` with its root at ``pose`` = (x, y, z, yaw) in the world frame (m, rad)."""
+    children = _check_tree(robot)
+    geoms = _Geoms(spec, info)
+    info.robot_name = robot.name
+    info.root_body = robot.root_link
+    contact = {**_contact_props("robot", GROUP_ROBOT), "priority": 1}
+    contact["solref"] = np.array(ROBOT_SOLREF)
+    contact["solimp"] = np.array(ROBOT_SOLIMP)
+
+    def fill(body: mujoco.MjsBody, link: Link, axis: np.ndarray | None, rigid_to_root: bool) -> None:
+        where = f"robot {robot.name!r} link {link.name!r}"
+        info.link_bodies[link.name] = body.name
+        _set_inertial(body, link, axis is not None, info, where)
+        mu, condim = _link_friction(link, rigid_to_root)
+        for i, shape in enumerate(link.collisions):
+            g = geoms.add(body, shape, f"{where} collision {i}", friction=np.array([mu, 0.005, 0.0001]),
+                          condim=condim, **contact)
+            if shape.geometry.kind == "cylinder" and axis is not None:
+                cyl_axis = mat_from_rpy(shape.origin.rpy)[:, 2]
+                if abs(float(cyl_axis @ axis)) > 0.99:  # a wheel: see WHEELS_AS_ELLIPSOIDS
+                    radius, length = (float(v) for v in shape.geometry.size[:2])
+                    g.type = mujoco.mjtGeom.mjGEOM_ELLIPSOID
+                    g.size = np.array([radius, radius, length / 2])
+        shown = link.visuals or link.collisions
+        for i, shape in enumerate(shown):
+            try:
+                g = geoms.add(body, shape, f"{where} visual {i}", **_VISUAL_PROPS)
+            except SimError as exc:
+                info.warnings.append(f"{exc}; visual skipped")
+                continue
+            g.rgba = np.array(shape.rgba if shape.rgba is not None else (0.6, 0.6, 0.65, 1.0))
+        for joint in children.get(link.name, []):
+            child = robot.links[joint.child]
+            cbody = body.add_body(name=child.name)
+            _set_pose(cbody, joint.origin)
+            _add_joint(cbody, joint, f"robot {robot.name!r} joint {joint.name!r}", info)
+            fixed = joint.type == "fixed"
+            jaxis = None if fixed else np.asarray(joint.axis, dtype=float) / np.linalg.norm(joint.axis)
+            fill(cbody, child, jaxis, rigid_to_root=rigid_to_root and fixed)
+
+    x, y, z, yaw = pose
+    root = spec.worldbody.add_body(name=robot.root_link)
+    _set_pose(root, Origin(xyz=(x, y, z), rpy=(0.0, 0.0, yaw)))
+    root.add_freejoint(name=f"{robot.name}::root")
+    fill(root, robot.links[robot.root_link], None, rigid_to_root=True)
+
+    for i, lidar in enumerate(robot.lidars):
+        info.lidar_sites.append(_add_site(spec, info, lidar.link, lidar.origin, f"{lidar.name}_{i}", robot))
+    for i, imu in enumerate(robot.imus):
+        site = _add_site(spec, info, imu.link, imu.origin, f"{imu.name}_{i}", robot)
+        info.imu_sites.append(site)
+        for kind, suffix in (
+            (mujoco.mjtSensor.mjSENS_GYRO, "gyro"),
+            (mujoco.mjtSensor.mjSENS_ACCELEROMETER, "accel"),
+            (mujoco.mjtSensor.mjSENS_FRAMEQUAT, "quat"),
+        ):
+            spec.add_sensor(name=f"{site}_{suffix}", type=kind, objtype=mujoco.mjtObj.mjOBJ_SITE, objname=site)
+    if robot.diff_drive is not None:
+        info.wheel_actuators = _add_wheel_motors(spec, robot)
+
+
+def _add_joint(body: mujoco.MjsBody, joint: object, where: str, info: BuildInfo) -> None:
+    kind = joint.type  # type: ignore[attr-defined]
+    if kind == "fixed":
+        return
+    axis = np.asarray(joint.axis, dtype=float)  # type: ignore[attr-defined]
+    norm = float(np.linalg.norm(axis))
+    if norm < 1e-9:
+        raise SimError(f"{where}: <axis> must be non-zero, got {tuple(axis)}")
+    axis /= norm
+    common = {"damping": float(joint.damping), "frictionloss": float(joint.friction)}  # type: ignore[attr-defined]
+    if kind in ("continuous", "revolute", "prismatic"):
+        jtype = mujoco.mjtJoint.mjJNT_SLIDE if kind == "prismatic" else mujoco.mjtJoint.mjJNT_HINGE
+        j = body.add_joint(name=joint.name, type=jtype, axis=axis, **common)  # type: ignore[attr-defined]
+        lower, upper = joint.lower, joint.upper  # type: ignore[attr-defined]
+        if kind != "continuous" and lower is not None and upper is not None and upper > lower:
+            j.limited = mujoco.mjtLimited.mjLIMITED_TRUE
+            j.range = np.array([lower, upper])
+        else:
+            j.limited = mujoco.mjtLimited.mjLIMITED_FALSE
+    elif kind == "planar":
+        a = np.array([1.0, 0.0, 0.0]) if abs(axis[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+        u = np.cross(axis, a)
+        u /= np.linalg.norm(u)
+        v = np.cross(axis, u)
+        for suffix, ax in (("x", u), ("y", v)):
+            body.add_joint(name=f"{joint.name}_{suffix}", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=ax, **common)  # type: ignore[attr-defined]
+        body.add_joint(name=f"{joint.name}_yaw", type=mujoco.mjtJoint.mjJNT_HINGE, axis=axis, **common)  # type: ignore[attr-defined]
+    elif kind == "floating":
+        info.warnings.append(f"{where}: floating joint below the root is simulated as fixed")
+    else:
+        raise SimError(f"{where}: unknown joint type {kind!r}")
+
+
+def _add_site(spec: mujoco.MjSpec, info: BuildInfo, link: str, origin: Origin, name: str, robot: RobotModel) -> str:
+    if link not in info.link_bodies:
+        raise SimError(f"robot {robot.name!r}: sensor {name!r} is attached to unknown link {link!r}")
+    body = spec.body(info.link_bodies[link])
+    site = body.add_site(name=name)
+    _set_pose(site, origin)
+    return name
+
+
+def _add_wheel_motors(spec: mujoco.MjSpec, robot: RobotModel) -> tuple[str, str]:
+    dd = robot.diff_drive
+    assert dd is not None
+    names = []
+    for jname in (dd.left_joint, dd.right_joint):
+        joint = next((j for j in robot.joints if j.name == jname), None)
+        if joint is None or joint.type not in ("continuous", "revolute"):
+            found = "missing" if joint is None else f"a {joint.type} joint"
+            raise SimError(
+                f"robot {robot.name!r}: diff_drive wheel joint {jname!r} is {found}; expected a continuous joint"
+            )
+        act = spec.add_actuator(name=f"{jname}::motor", target=jname, trntype=mujoco.mjtTrn.mjTRN_JOINT)
+        act.set_to_velocity(kv=WHEEL_KV)
+        act.forcelimited = mujoco.mjtLimited.mjLIMITED_TRUE
+        act.forcerange = np.array([-dd.max_torque, dd.max_torque])
+        names.append(act.name)
+    return names[0], names[1]
+
+
+# --- world ----------------------------------------------------------------------------------------
+
+
+def add_world_model(spec: mujoco.MjSpec, model: ModelSpec, info: BuildInfo) -> list[str]:
+    """Add one SDF model (static: welded to the world; dynamic: a free body per link); return body names."""
+    if model.name in info.world_bodies or model.name == info.robot_name:
+        raise SimError(f"a model named {model.name!r} already exists in the world")
+    geoms = _Geoms(spec, info)
+    x, y, z, roll, pitch, yaw = model.pose
+    model_pose = Origin(xyz=(x, y, z), rpy=(roll, pitch, yaw))
+    kind = "static" if model.static else "dynamic"
+    props = _contact_props(kind, GROUP_WORLD)
+    names = []
+    for link in model.links:
+        where = f"model {model.name!r} link {link.name!r}"
+        body = spec.worldbody.add_body(name=f"{model.name}::{link.name}")
+        _set_pose(body, _compose(model_pose, model.link_origins.get(link.name, Origin())))
+        if not model.static:
+            body.add_freejoint(name=f"{model.name}::{link.name}::free")
+            if link.inertial is not None:
+                _set_inertial(body, link, True, info, where)
+        mu = DEFAULT_MU if link.mu1 is None else float(link.mu1)
+        friction = np.array([mu, 0.005, 0.0001])
+        for i, shape in enumerate(link.collisions):
+            cwhere = f"{where} collision {i}"
+            extra: dict[str, object] = {"friction": friction}
+            if not model.static and link.inertial is None:
+                extra["mass"] = 1.0 / len(link.collisions)  # Gazebo's default link mass: 1 kg
+            if shape.geometry.kind == "mesh":
+                # the true triangles for rays; the hull (convex parts) for contacts
+                geoms.add(body, shape, cwhere, contype=0, conaffinity=0, group=GROUP_RAY_MESH, mass=0.0)
+                hull = {**props, "group": GROUP_WORLD_HULL}
+                geoms.add(body, shape, cwhere, **hull, **extra)
+                info.warnings.append(f"{cwhere}: mesh collides as its convex hull; rays hit its triangles")
+            else:
+                geoms.add(body, shape, cwhere, **props, **extra)
+        for i, shape in enumerate(link.visuals or link.collisions):
+            try:
+                g = geoms.add(body, shape, f"{where} visual {i}", **_VISUAL_PROPS)
+            except SimError as exc:
+                info.warnings.append(f"{exc}; visual skipped")
+                continue
+            g.rgba = np.array(shape.rgba if shape.rgba is not None else (0.75, 0.72, 0.68, 1.0))
+        names.append(body.name)
+    info.world_bodies[model.name] = names
+    return names
+
+
+def _add_scenery(spec: mujoco.MjSpec, world: WorldModel) -> None:
+    spec.option.gravity = np.asarray(world.gravity, dtype=float)
+    spec.visual.headlight.ambient = np.array([0.35, 0.35, 0.35])
+    spec.add_texture(
+        name="grid", type=mujoco.mjtTexture.mjTEXTURE_2D, builtin=mujoco.mjtBuiltin.mjBUILTIN_CHECKER,
+        rgb1=np.array([0.62, 0.62, 0.62]), rgb2=np.array([0.55, 0.55, 0.55]), width=256, height=256,
+    )
+    mat = spec.add_material(name="grid", texrepeat=np.array([1.0, 1.0]), texuniform=True)
+    mat.textures[mujoco.mjtTextureRole.mjTEXROLE_RGB] = "grid"
+    spec.worldbody.add_light(name="sun", type=mujoco.mjtLightType.mjLIGHT_DIRECTIONAL, pos=np.array([0.0, 0.0, 10.0]),
+                             dir=np.array([0.3, 0.2, -1.0]), diffuse=np.array([0.6, 0.6, 0.6]))
+    if world.ground_plane:
+        spec.worldbody.add_geom(name="ground_plane", type=mujoco.mjtGeom.mjGEOM_PLANE,
+                                size=np.array([0.0, 0.0, 1.0]), **_contact_props("static", GROUP_WORLD),
+                                rgba=np.array([0.0, 0.0, 0.0, 0.0]))
+        spec.worldbody.add_geom(name="ground_plane_visual", type=mujoco.mjtGeom.mjGEOM_PLANE,
+                                size=np.array([50.0, 50.0, 1.0]), material="grid", **_VISUAL_PROPS)
+
+
+def build_spec(
+    robot: RobotModel | None,
+    world: WorldModel,
+    *,
+    timestep: float | None = None,
+    robot_pose: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0),
+) -> tuple[mujoco.MjSpec, BuildInfo]:
+    """The MuJoCo spec of ``world`` with ``robot`` at ``robot_pose`` (x, y, z, yaw), and its names.
+
+    ``timestep`` (s) defaults to the world's ``max_step_size`` and must lie in [0.5 ms, 2 ms].
+    """
+    step = world.max_step_size if timestep is None else timestep
+    if not MIN_STEP <= step <= MAX_STEP:
+        raise SimError(f"physics timestep {step} s is outside [{MIN_STEP}, {MAX_STEP}] s (5 ms tips robots over)")
+    spec = mujoco.MjSpec()
+    spec.modelname = world.name or "world"
+    spec.option.timestep = float(step)
+    spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
+    spec.compiler.degree = False
+    spec.compiler.autolimits = True
+    info = BuildInfo()
+    _add_scenery(spec, world)
+    if robot is not None:
+        add_robot(spec, robot, info, robot_pose)
+    for model in world.models:
+        add_world_model(spec, model, info)
+    return spec, info
+
+
+def compile_spec(spec: mujoco.MjSpec, what: str = "model") -> mujoco.MjModel:
+    """Compile, turning MuJoCo's compiler errors into a ``SimError``."""
+    try:
+        return spec.compile()
+    except ValueError as exc:
+        raise SimError(f"MuJoCo could not compile the {what}: {exc}") from None

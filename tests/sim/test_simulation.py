@@ -1,0 +1,141 @@
+"""The pure simulator: driving, turning, torque limit, lidar semantics, spawning, determinism."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from conftest import box_model, make_mybot, make_room
+
+from navlab.sim import SimError, Simulation
+from navlab.sim.simulation import lidar_angles
+from navlab.world.model import WorldModel
+
+WHEEL_R = 0.08
+HALF_SEP = 0.2
+
+
+def _drive(sim: Simulation, v: float, w: float, seconds: float) -> None:
+    sim.set_wheel_velocity_targets((v - w * HALF_SEP) / WHEEL_R, (v + w * HALF_SEP) / WHEEL_R)
+    sim.advance_to(sim.time_ns + round(seconds * 1e9))
+
+
+def test_drives_two_metres_straight() -> None:
+    sim = Simulation(make_mybot(), make_room(), seed=0)
+    x0, y0, yaw0 = sim.base_pose2d()
+    _drive(sim, 0.5, 0.0, 4.0)
+    x, y, yaw = sim.base_pose2d()
+    assert x - x0 == pytest.approx(2.0, abs=0.1)
+    assert abs(y - y0) < 0.02
+    assert abs(yaw - yaw0) < 0.01
+    assert sim.link_pose().position[2] == pytest.approx(0.08, abs=0.005)  # stayed on its wheels
+
+
+def test_turns_three_radians_in_place() -> None:
+    sim = Simulation(make_mybot(), make_room(), seed=0)
+    _drive(sim, 0.0, 1.0, 3.0)
+    x, y, yaw = sim.base_pose2d()
+    assert yaw == pytest.approx(3.0, abs=0.15)
+    assert math.hypot(x, y) < 0.02
+
+
+def test_torque_limit_caps_acceleration() -> None:
+    weak = Simulation(make_mybot(torque=0.5), make_room(), seed=0)
+    strong = Simulation(make_mybot(torque=15.0), make_room(), seed=0)
+    for sim in (weak, strong):
+        _drive(sim, 0.5, 0.0, 0.3)
+    v_weak = weak.link_velocity()[0][0]
+    v_strong = strong.link_velocity()[0][0]
+    # 2 wheels x 0.5 N m / 0.08 m on 14 kg plus the wheels' rotational inertia (2 kg equivalent)
+    expected = 2 * 0.5 / WHEEL_R / 16.0 * 0.3
+    assert v_weak == pytest.approx(expected, rel=0.15)
+    assert v_strong == pytest.approx(0.5, abs=0.02)
+
+
+def test_lidar_sees_wall_at_known_distance_within_noise() -> None:
+    sim = Simulation(make_mybot(noise=0.01), make_room(), seed=3)
+    ranges = sim.scan()
+    angles = lidar_angles(make_mybot().lidars[0])
+    assert ranges.dtype == np.float32 and ranges.shape == (720,)
+    east = np.abs(angles) < math.atan2(3.9, 5.0)  # beams ending on the east wall's inner face, x = 5
+    expected = 5.0 / np.cos(angles[east])
+    err = ranges[east] - expected
+    assert np.mean(np.abs(err) < 3 * 0.01) > 0.99  # gaussian: 99.7 % of beams within 3 sigma
+    assert np.all(np.abs(err) < 5 * 0.01)
+    assert abs(np.mean(err)) < 3 * 0.01 / math.sqrt(len(err))  # no bias
+    assert np.std(err) == pytest.approx(0.01, rel=0.25)  # the noise is really there
+
+
+def test_lidar_inf_beyond_range_max_and_nothing_under_range_min() -> None:
+    far = WorldModel("far", models=[box_model("far_wall", 30.0, 0.0, (0.2, 60.0, 2.0))])
+    ranges = Simulation(make_mybot(), far, seed=0).scan()
+    assert np.all(np.isinf(ranges))  # only a wall 30 m away: beyond the 25 m range
+
+    # a small box at the laser's height 0.11 m in front of it, clear of the chassis: inside range_min,
+    # so (as in Gazebo, whose rays start at range_min) the beam sees the wall behind it
+    sim = Simulation(make_mybot(noise=0.0), make_room(), seed=0)
+    laser_z = sim.data.site_xpos[sim._lidar_site[0]][2]
+    tiny = box_model("tiny", 0.12, 0.0, (0.02, 0.02, 0.02))
+    tiny.pose = (0.12, 0.0, laser_z, 0.0, 0.0, 0.0)
+    sim.spawn(tiny)
+    ranges = sim.scan()
+    finite = ranges[np.isfinite(ranges)]
+    assert finite.min() >= 0.2
+    assert ranges[360] == pytest.approx(5.0, abs=1e-3)  # beam 360 of 720 points straight ahead
+
+
+def test_spawned_box_appears_in_next_scan_and_removal_clears_it() -> None:
+    sim = Simulation(make_mybot(noise=0.0), make_room(), seed=0)
+    sim.step(100)
+    assert sim.scan()[360] == pytest.approx(5.0, abs=1e-3)
+    sim.spawn(box_model("box1", 2.0, 0.0, (0.5, 0.5, 0.5), static=False))
+    assert sim.scan()[360] == pytest.approx(1.75, abs=1e-3)
+    sim.step(500)  # a dynamic box rests on the floor and the robot keeps its state
+    assert sim.model_pose("box1").position[2] == pytest.approx(0.25, abs=0.005)
+    assert sim.scan()[360] == pytest.approx(1.75, abs=5e-3)
+    assert sim.time_ns == 600 * sim.dt_ns
+    sim.remove("box1")
+    assert sim.scan()[360] == pytest.approx(5.0, abs=1e-3)
+    with pytest.raises(SimError, match="box1"):
+        sim.remove("box1")
+
+
+def test_spawn_keeps_robot_motion() -> None:
+    sim = Simulation(make_mybot(), make_room(), seed=0)
+    _drive(sim, 0.5, 0.0, 1.0)
+    before = sim.base_pose2d()
+    sim.spawn(box_model("box1", -3.0, 2.0, (0.3, 0.3, 0.3)))
+    assert sim.base_pose2d() == pytest.approx(before, abs=1e-9)
+    _drive(sim, 0.5, 0.0, 1.0)  # still commanded, still moving at 0.5 m/s
+    assert sim.base_pose2d()[0] - before[0] == pytest.approx(0.5, abs=0.02)
+
+
+def test_same_seed_same_scans() -> None:
+    def scans(seed: int) -> list[np.ndarray]:
+        sim = Simulation(make_mybot(), make_room(), seed=seed)
+        out = []
+        for _ in range(3):
+            _drive(sim, 0.3, 0.2, 0.2)
+            out.append(sim.scan())
+        return out
+
+    a, b, c = scans(5), scans(5), scans(6)
+    assert all(np.array_equal(x, y) for x, y in zip(a, b, strict=True))
+    assert not np.array_equal(a[0], c[0])
+
+
+def test_bad_input_is_a_clear_error() -> None:
+    robot = make_mybot()
+    robot.diff_drive.left_joint = "no_such_joint"  # type: ignore[union-attr]
+    with pytest.raises(SimError, match="no_such_joint"):
+        Simulation(robot, make_room())
+    robot = make_mybot()
+    robot.lidars[0].link = "nowhere"
+    with pytest.raises(SimError, match="nowhere"):
+        Simulation(robot, make_room())
+    with pytest.raises(SimError, match="timestep"):
+        Simulation(make_mybot(), make_room(), timestep=0.005)
+    sim = Simulation(make_mybot(), make_room())
+    with pytest.raises(SimError, match="wall_north"):
+        sim.spawn(box_model("wall_north", 1.0, 1.0, (0.1, 0.1, 0.1)))
