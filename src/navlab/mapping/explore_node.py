@@ -1,0 +1,123 @@
+"""The exploration node (explore_lite's role): drive to frontiers of ``/map`` until none is reachable."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from navlab import msgs
+from navlab.core import Executor, Node, TfError
+from navlab.mapping.explore import follow_path, plan_to_frontier
+from navlab.mapping.grid import GridMap
+
+
+class Explore(Node):
+    """Frontier exploration on the SLAM map, with a pure-pursuit follower that stops for obstacles.
+
+    Subscribes ``map`` and ``scan``; tf ``global_frame``→``robot_base_frame``. Publishes ``cmd_vel``
+    and the current plan on ``explore/plan``. ``done`` is True once no reachable frontier remains
+    (checked ``done_checks`` times in a row, so a map still being updated is not mistaken for done).
+    """
+
+    def __init__(
+        self,
+        executor: Executor,
+        *,
+        name: str = "explore",
+        parameters: dict[str, Any] | None = None,
+        namespace: str = "",
+    ) -> None:
+        super().__init__(name, executor, parameters=parameters, namespace=namespace)
+        self.global_frame = self.declare_parameter("global_frame", "map")
+        self.base_frame = self.declare_parameter("robot_base_frame", "chassis")
+        self.robot_radius = self.declare_parameter("robot_radius", 0.3)
+        self.min_frontier_cells = self.declare_parameter("min_frontier_size", 5)
+        self.planner_frequency = self.declare_parameter("planner_frequency", 0.5)
+        self.max_v = self.declare_parameter("max_vel_x", 0.35)
+        self.max_w = self.declare_parameter("max_vel_theta", 1.2)
+        self.progress_timeout = self.declare_parameter("progress_timeout", 20.0)
+        self.done_checks = self.declare_parameter("done_checks", 3)
+        self.done = False
+        self.grid: GridMap | None = None
+        self.path: np.ndarray | None = None
+        self.blacklist: list[np.ndarray] = []
+        self._front_range = math.inf
+        self._no_frontier = 0
+        self._last_progress = (0, math.inf)  # (time ns, distance to goal)
+        self.pub = self.create_publisher(msgs.Twist, "cmd_vel", 1)
+        self.plan_pub = self.create_publisher(msgs.Path, "explore/plan", 1)
+        self.create_subscription(msgs.OccupancyGrid, "map", self._on_map, 1)
+        self.create_subscription(msgs.LaserScan, "scan", self._on_scan, 1)
+        self.create_timer(1.0 / self.planner_frequency, self._replan)
+        self.create_timer(0.1, self._control)
+
+    def _on_map(self, msg: Any) -> None:
+        self.grid = GridMap.from_msg(msg)
+
+    def _on_scan(self, msg: Any) -> None:
+        r = np.asarray(msg.ranges, dtype=float)
+        a = msg.angle_min + msg.angle_increment * np.arange(len(r))
+        front = (np.abs(np.arctan2(np.sin(a), np.cos(a))) < 0.5) & np.isfinite(r) & (r >= msg.range_min)
+        self._front_range = float(r[front].min()) if front.any() else math.inf
+
+    def _pose(self) -> tuple[float, float, float] | None:
+        try:
+            return self.executor.tf.lookup_pose2d(self.global_frame, self.base_frame)
+        except TfError:
+            return None
+
+    def _replan(self) -> None:
+        pose = self._pose()
+        if self.grid is None or pose is None or self.done:
+            return
+        path = plan_to_frontier(
+            self.grid, pose[:2], robot_radius=self.robot_radius,
+            min_frontier_cells=self.min_frontier_cells, blacklist=self.blacklist,
+        )
+        if path is None:
+            self._no_frontier += 1
+            self.path = None
+            if self._no_frontier >= self.done_checks:
+                self.done = True
+                self.pub.publish(msgs.twist(0.0, 0.0))
+                self.get_logger().info("exploration finished: no reachable frontier left")
+            return
+        self._no_frontier = 0
+        goal_changed = self.path is None or np.hypot(*(self.path[-1] - path[-1])) > 0.3
+        self.path = path
+        if goal_changed:
+            self._last_progress = (self.executor.now_ns, math.inf)
+        now = self.executor.now_ns
+        self.plan_pub.publish(msgs.Path(
+            header=msgs.header(now, self.global_frame),
+            poses=[msgs.pose_stamped(now, self.global_frame, x, y, 0.0) for x, y in path[::4]],
+        ))
+
+    def _control(self) -> None:
+        if self.done or self.path is None:
+            if not self.done:
+                self.pub.publish(msgs.twist(0.0, 0.0))
+            return
+        pose = self._pose()
+        if pose is None:
+            return
+        remaining = float(np.hypot(*(self.path[-1] - pose[:2])))
+        now = self.executor.now_ns
+        t_best, d_best = self._last_progress
+        if remaining < d_best - 0.05:
+            self._last_progress = (now, remaining)
+        elif now - t_best > self.progress_timeout * 1e9:  # stuck: give up on this frontier
+            self.blacklist.append(self.path[-1].copy())
+            self.path = None
+            return
+        if remaining < 0.15:
+            self.path = None
+            self.pub.publish(msgs.twist(0.0, 0.0))
+            self._replan()
+            return
+        v, w, _ = follow_path(pose, self.path, max_v=self.max_v, max_w=self.max_w, min_front_range=self._front_range)
+        if v == 0.0 and self._front_range < 0.35 and abs(w) < 0.3:
+            w = self.max_w * 0.5  # blocked ahead: turn away rather than wait
+        self.pub.publish(msgs.twist(v, w))
