@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import logging
 import sys
 
 from navlab.errors import NavlabError
@@ -26,6 +27,7 @@ def build_parser() -> argparse.ArgumentParser:
         description="The paper's ROS/Gazebo mobile-robot stack in plain Python: simulate, map, "
         "localize, navigate, view and experiment.",
     )
+    parser.add_argument("-v", "--verbose", action="store_true", help="show the nodes' info-level log lines")
     sub = parser.add_subparsers(dest="command", metavar="VERB", required=True)
     for name in COMMAND_MODULES:
         importlib.import_module(name).register(sub)
@@ -36,6 +38,7 @@ def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``navlab`` console script; returns the exit code."""
     parser = build_parser()
     args = parser.parse_args(argv)
+    logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING, format="%(levelname)s %(message)s")
     try:
         return int(args.func(args) or 0)
     except NavlabError as exc:
