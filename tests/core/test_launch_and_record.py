@@ -36,6 +36,17 @@ def test_include_param_file_and_remap(tmp_path):
     assert "/talk" in s.executor.topics and "/chatter" not in s.executor.topics
 
 
+def test_if_and_unless(tmp_path):
+    f = tmp_path / "c.launch.yaml"
+    f.write_text(
+        "launch:\n- arg: {name: talk, default: 'false'}\n"
+        "- node: {if: $(var talk), pkg: navlab, exec: talker, name: t}\n"
+        "- node: {unless: $(var talk), pkg: navlab, exec: listener, name: l}\n"
+    )
+    assert list(start(str(f)).nodes) == ["/l"]
+    assert list(start(str(f), talk="true").nodes) == ["/t"]
+
+
 def test_launch_errors(tmp_path):
     with pytest.raises(LaunchError, match="shipped launches"):
         start("no_such_launch")

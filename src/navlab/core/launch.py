@@ -6,6 +6,7 @@ launch:
 - let: {name: scan, value: /mybot/laser/scan}
 - include: {file: "$(find-pkg-share navlab)/launch/sim.launch.yaml", arg: [{name: world, value: "$(var world)"}]}
 - node:
+    if: "$(var localize)"      # ROS 2 launch's if/unless attributes
     pkg: navlab
     exec: amcl
     name: amcl
@@ -155,6 +156,19 @@ def _node_params(ctx: _Context, spec: dict[str, Any], where: str) -> dict[str, A
     return params
 
 
+def _truthy(value: Any) -> bool:
+    return str(value).strip().lower() in ("true", "1", "yes", "on")
+
+
+def _condition(ctx: _Context, spec: Any, where: str) -> bool:
+    """ROS 2 launch's ``if:`` / ``unless:`` attributes."""
+    if not isinstance(spec, dict):
+        raise LaunchError(f"{ctx.file}: {where}: expected a mapping of attributes")
+    if "if" in spec and not _truthy(ctx.subst(spec["if"], where)):
+        return False
+    return not ("unless" in spec and _truthy(ctx.subst(spec["unless"], where)))
+
+
 def _run_entries(ctx: _Context, session: Session, depth: int) -> None:
     if depth > 20:
         raise LaunchError(f"{ctx.file}: includes nest deeper than 20 levels (an include loop?)")
@@ -163,6 +177,8 @@ def _run_entries(ctx: _Context, session: Session, depth: int) -> None:
             raise LaunchError(f"{ctx.file}: entry {i + 1}: expected one of arg/let/include/node")
         kind, spec = next(iter(entry.items()))
         where = f"entry {i + 1} ({kind})"
+        if not _condition(ctx, spec, where):
+            continue
         if kind == "arg":
             name = spec.get("name")
             if not name:
