@@ -1,0 +1,165 @@
+"""Resampling, KLD-sampling and particle clustering for AMCL.
+
+KLD-sampling (Fox 2003; ROS amcl ``pf_resample_limit``): particles are histogrammed into bins of
+0.5 m × 0.5 m × 10°; after drawing c samples that occupy k bins, drawing stops once
+``c > (k-1)/(2 kld_err) * (1 - 2/(9(k-1)) + sqrt(2/(9(k-1))) * kld_z)**3`` (clamped to
+[min_particles, max_particles]). As in ROS, ``kld_z`` is used directly as the normal quantile.
+
+Clustering (ROS ``pf_cluster_stats``): occupied bins that touch (26-neighbourhood, yaw wrapping
+around) form one cluster; each cluster gets its weight, mean and covariance, and the estimate is
+the heaviest cluster's mean.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
+
+BIN_XY = 0.5  # m
+BIN_YAW = math.radians(10.0)
+N_YAW_BINS = 36
+_OFF = 1 << 20
+_SPAN = 1 << 21
+
+
+def low_variance_indices(weights: np.ndarray, n: int, rng: np.random.Generator) -> np.ndarray:
+    """Indices of ``n`` draws by low-variance (systematic) resampling; ``weights`` need not sum to 1."""
+    cum = np.cumsum(weights)
+    total = cum[-1]
+    points = (rng.random() + np.arange(n)) * (total / n)
+    idx = np.searchsorted(cum, points, side="right")
+    return np.minimum(idx, weights.shape[0] - 1)
+
+
+def kld_limit(k: np.ndarray, kld_err: float, kld_z: float, min_n: int, max_n: int) -> np.ndarray:
+    """Sample count KLD-sampling asks for when the samples occupy ``k`` bins (ROS ``pf_resample_limit``)."""
+    k = np.asarray(k, dtype=np.float64)
+    km1 = np.maximum(k - 1.0, 1.0)
+    b = 2.0 / (9.0 * km1)
+    n = np.ceil(km1 / (2.0 * kld_err) * (1.0 - b + np.sqrt(b) * kld_z) ** 3)
+    n = np.where(k <= 1, max_n, n)
+    return np.clip(n, min_n, max_n).astype(np.int64)
+
+
+def bin_keys(poses: np.ndarray) -> np.ndarray:
+    """One int64 key per pose for its (x, y, yaw) histogram bin."""
+    ix = np.floor(poses[:, 0] / BIN_XY).astype(np.int64) + _OFF
+    iy = np.floor(poses[:, 1] / BIN_XY).astype(np.int64) + _OFF
+    it = np.floor(poses[:, 2] / BIN_YAW).astype(np.int64) % N_YAW_BINS
+    return (ix * _SPAN + iy) * N_YAW_BINS + it
+
+
+def kld_count(candidates: np.ndarray, kld_err: float, kld_z: float, min_n: int, max_n: int) -> int:
+    """How many of ``candidates`` (drawn in random order) KLD-sampling keeps."""
+    keys = bin_keys(candidates)
+    _, first = np.unique(keys, return_index=True)
+    is_new = np.zeros(keys.shape[0], dtype=np.int64)
+    is_new[first] = 1
+    k = np.cumsum(is_new)
+    counts = np.arange(1, keys.shape[0] + 1)
+    over = np.flatnonzero(counts > kld_limit(k, kld_err, kld_z, min_n, max_n))
+    n = int(counts[over[0]]) if over.size else keys.shape[0]
+    return max(min(n, max_n), min_n)
+
+
+@dataclass(frozen=True)
+class Clusters:
+    """Per-cluster weight (sum of normalised weights), mean (x, y, yaw) and 3×3 covariance."""
+
+    weight: np.ndarray  # (C,)
+    mean: np.ndarray  # (C, 3)
+    cov: np.ndarray  # (C, 3, 3)
+    labels: np.ndarray  # (N,) cluster of each particle
+
+    @property
+    def best(self) -> int:
+        """Index of the heaviest cluster."""
+        return int(np.argmax(self.weight))
+
+
+@njit(cache=True)
+def _find(parent: np.ndarray, a: int) -> int:
+    while parent[a] != a:
+        parent[a] = parent[parent[a]]
+        a = parent[a]
+    return a
+
+
+@njit(cache=True)
+def _label_bins(ukeys: np.ndarray) -> np.ndarray:
+    """Connected components of occupied bins (26-neighbourhood, yaw wraps); labels 0..C-1 per bin."""
+    u = ukeys.shape[0]
+    parent = np.arange(u)
+    for a in range(u):
+        key = ukeys[a]
+        it = key % N_YAW_BINS
+        ixy = key // N_YAW_BINS
+        ix = ixy // _SPAN
+        iy = ixy % _SPAN
+        # half of the 26 offsets suffice for an undirected union
+        for dx in range(0, 2):
+            for dy in range(-1, 2):
+                for dt in range(-1, 2):
+                    if dx == 0 and (dy < 0 or (dy == 0 and dt <= 0)):
+                        continue
+                    nk = ((ix + dx) * _SPAN + (iy + dy)) * N_YAW_BINS + (it + dt) % N_YAW_BINS
+                    b = np.searchsorted(ukeys, nk)
+                    if b < u and ukeys[b] == nk:
+                        ra = _find(parent, a)
+                        rb = _find(parent, b)
+                        if ra != rb:
+                            parent[max(ra, rb)] = min(ra, rb)
+    labels = np.empty(u, dtype=np.int64)
+    remap = np.full(u, -1, dtype=np.int64)
+    c = 0
+    for a in range(u):
+        r = _find(parent, a)
+        if remap[r] < 0:
+            remap[r] = c
+            c += 1
+        labels[a] = remap[r]
+    return labels
+
+
+@njit(cache=True)
+def _cluster_sums(labels: np.ndarray, n_comp: int, poses: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """Per cluster: [sum w, sum w x, sum w y, sum w cos, sum w sin, sum w xx, sum w yy, sum w xy]."""
+    acc = np.zeros((n_comp, 8))
+    for k in range(poses.shape[0]):
+        c = labels[k]
+        wk = w[k]
+        x = poses[k, 0]
+        y = poses[k, 1]
+        acc[c, 0] += wk
+        acc[c, 1] += wk * x
+        acc[c, 2] += wk * y
+        acc[c, 3] += wk * math.cos(poses[k, 2])
+        acc[c, 4] += wk * math.sin(poses[k, 2])
+        acc[c, 5] += wk * x * x
+        acc[c, 6] += wk * y * y
+        acc[c, 7] += wk * x * y
+    return acc
+
+
+def cluster(poses: np.ndarray, weights: np.ndarray) -> Clusters:
+    """Group particles into clusters of touching histogram bins and compute their statistics."""
+    ukeys, inv = np.unique(bin_keys(poses), return_inverse=True)
+    bin_label = _label_bins(ukeys)
+    n_comp = int(bin_label.max()) + 1
+    labels = bin_label[inv]
+    acc = _cluster_sums(labels, n_comp, np.ascontiguousarray(poses, dtype=np.float64),
+                        np.ascontiguousarray(weights, dtype=np.float64))
+    wsum = acc[:, 0]
+    safe = np.where(wsum > 0, wsum, 1.0)
+    mx, my, cth, sth = (acc[:, i] / safe for i in (1, 2, 3, 4))
+    r = np.clip(np.hypot(cth, sth), 1e-12, 1.0)
+    cov = np.zeros((n_comp, 3, 3))
+    cov[:, 0, 0] = np.maximum(acc[:, 5] / safe - mx**2, 0.0)
+    cov[:, 1, 1] = np.maximum(acc[:, 6] / safe - my**2, 0.0)
+    cov[:, 0, 1] = cov[:, 1, 0] = acc[:, 7] / safe - mx * my
+    cov[:, 2, 2] = -2.0 * np.log(r)
+    mean = np.stack([mx, my, np.arctan2(sth, cth)], axis=1)
+    return Clusters(weight=wsum, mean=mean, cov=cov, labels=labels)
