@@ -1,0 +1,357 @@
+"""``load_world``: a Gazebo-classic SDF ``.world`` (SDF 1.4–1.7) → :class:`WorldModel`.
+
+Reads the ground plane, gravity, ``<physics><max_step_size>``, ``<model>`` elements (static or
+dynamic, nested models flattened to ``parent::child`` link names) with box/cylinder/sphere/mesh
+collisions and visuals, ``<include><uri>model://name</uri>`` through a model path, and a saved
+``<state>``'s model poses. Lights, scenes, GUI settings are ignored; plugins, actors, joints and
+unsupported geometry are reported in ``WorldModel.warnings``.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import xml.etree.ElementTree as ET
+from collections.abc import Iterable
+from pathlib import Path
+
+from navlab import resources
+from navlab.description.errors import DescriptionError
+from navlab.description.meshes import is_convex, prepare_mesh, read_mesh
+from navlab.description.model import Geometry, Inertial, Link, Origin, Shape
+from navlab.description.packages import PackageIndex
+from navlab.world.errors import WorldError
+from navlab.world.model import ModelSpec, Pose6, WorldModel
+from navlab.world.transforms import compose, to_matrix, to_origin
+
+SUPPORTED_VERSIONS = ("1.4", "1.5", "1.6", "1.7")
+_COLORS = {  # Gazebo material script names -> rgba
+    "Gazebo/Grey": (0.7, 0.7, 0.7, 1.0), "Gazebo/DarkGrey": (0.35, 0.35, 0.35, 1.0),
+    "Gazebo/White": (1.0, 1.0, 1.0, 1.0), "Gazebo/Black": (0.05, 0.05, 0.05, 1.0),
+    "Gazebo/Red": (0.8, 0.1, 0.1, 1.0), "Gazebo/Green": (0.1, 0.7, 0.1, 1.0),
+    "Gazebo/Blue": (0.1, 0.1, 0.8, 1.0), "Gazebo/Yellow": (0.9, 0.9, 0.1, 1.0),
+    "Gazebo/Orange": (1.0, 0.5, 0.05, 1.0), "Gazebo/Wood": (0.55, 0.4, 0.25, 1.0),
+}
+_IGNORED_WORLD_TAGS = ("light", "scene", "gui", "audio", "wind", "atmosphere", "spherical_coordinates",
+                       "magnetic_field", "physics", "gravity", "state", "road", "frame")
+
+
+def _floats(text: str | None, n: int, where: str) -> tuple[float, ...]:
+    parts = (text or "").split()
+    try:
+        vals = tuple(float(p) for p in parts)
+    except ValueError:
+        raise WorldError(f"{where}: expected {n} numbers, got {text!r}") from None
+    if len(vals) != n or not all(math.isfinite(v) for v in vals):
+        raise WorldError(f"{where}: expected {n} finite numbers, got {text!r}")
+    return vals
+
+
+def _num(el: ET.Element | None, tag: str, where: str, default: float) -> float:
+    sub = el.find(tag) if el is not None else None
+    if sub is None or not (sub.text or "").strip():
+        return default
+    return _floats(sub.text, 1, f"{where}/<{tag}>")[0]
+
+
+def _pose(el: ET.Element, where: str) -> Pose6:
+    p = el.find("pose")
+    if p is None or not (p.text or "").strip():
+        return (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    v = _floats(p.text, 6, f"{where}/<pose>")
+    return (v[0], v[1], v[2], v[3], v[4], v[5])
+
+
+def _bool(el: ET.Element, tag: str, default: bool) -> bool:
+    text = (el.findtext(tag) or "").strip().lower()
+    return default if not text else text in ("1", "true")
+
+
+def _parse_xml(path: Path, what: str) -> ET.Element:
+    if not path.is_file():
+        raise WorldError(f"{path}: {what} not found")
+    try:
+        return ET.parse(path).getroot()
+    except ET.ParseError as exc:
+        raise WorldError(f"{path}: malformed XML ({exc})") from None
+
+
+class _Loader:
+    """One world load: model path, warnings, and whether a ground plane was seen."""
+
+    def __init__(self, model_paths: list[Path]) -> None:
+        self.model_paths = model_paths
+        self.index = PackageIndex(use_env=True)
+        self.warnings: list[str] = []
+        self.ground_plane = False
+
+    # ------------------------------------------------------------------------------- includes
+    def find_model_dir(self, uri: str, base_dir: Path, where: str) -> Path:
+        """The directory of an included model (``model://name``, ``file://dir`` or a path)."""
+        if uri.startswith("model://"):
+            name = uri[len("model://") :].strip("/")
+            for root in self.model_paths:
+                if (root / name).is_dir():
+                    return root / name
+            raise WorldError(f"{where}: model {uri!r} not found in the model path "
+                             f"({', '.join(str(p) for p in self.model_paths) or 'empty'}); add its parent "
+                             "directory to model_path / GAZEBO_MODEL_PATH")
+        path = Path(uri[len("file://") :] if uri.startswith("file://") else uri)
+        path = path if path.is_absolute() else base_dir / path
+        if not path.exists():
+            raise WorldError(f"{where}: included model {uri!r} not found (looked for {path})")
+        return path
+
+    def model_sdf_file(self, model_dir: Path, where: str) -> Path:
+        """The SDF file a model directory's ``model.config`` names (highest version ≤ 1.7 preferred)."""
+        if model_dir.is_file():
+            return model_dir
+        config = model_dir / "model.config"
+        if config.is_file():
+            root = _parse_xml(config, "model.config")
+            entries = [(e.get("version", "0"), (e.text or "").strip()) for e in root.findall("sdf")]
+            entries = [e for e in entries if e[1]]
+
+            def key(e: tuple[str, str]) -> tuple[bool, tuple[int, ...]]:
+                try:
+                    ver = tuple(int(x) for x in e[0].split("."))
+                except ValueError:
+                    ver = (0,)
+                return (ver <= (1, 7), ver)
+
+            if entries:
+                return model_dir / max(entries, key=key)[1]
+        for name in ("model.sdf", f"{model_dir.name}.sdf"):
+            if (model_dir / name).is_file():
+                return model_dir / name
+        raise WorldError(f"{where}: model directory {model_dir} has no model.config naming an SDF file "
+                         "(nor a model.sdf)")
+
+    def include(self, el: ET.Element, base_dir: Path, where: str) -> list[ModelSpec]:
+        """An ``<include>``: load the model file and apply the include's name, pose and static."""
+        uri = (el.findtext("uri") or "").strip()
+        if not uri:
+            raise WorldError(f"{where}: <include> without <uri>")
+        w = f"{where}/<include uri={uri!r}>"
+        sdf_file = self.model_sdf_file(self.find_model_dir(uri, base_dir, w), w)
+        root = _parse_xml(sdf_file, "model SDF")
+        model_el = root.find("model")
+        if model_el is None:
+            if root.find("light") is None and root.find("actor") is None:
+                self.warnings.append(f"{w}: {sdf_file} holds no <model>; ignored")
+            return []
+        name = (el.findtext("name") or "").strip() or model_el.get("name", "")
+        pose = _pose(el, w) if el.find("pose") is not None else None
+        static = _bool(el, "static", _bool(model_el, "static", False))
+        return self.model(model_el, sdf_file, name=name, pose=pose, static=static)
+
+    # ------------------------------------------------------------------------------- models
+    def model(self, el: ET.Element, file: Path, *, name: str | None = None, pose: Pose6 | None = None,
+              static: bool | None = None) -> list[ModelSpec]:
+        """A ``<model>`` (nested models and includes flattened into it). Returns [] if it had only planes."""
+        name = name or el.get("name") or ""
+        where = f'{file}: <model name="{name}">'
+        if not name:
+            raise WorldError(f"{file}: a <model> has no name attribute")
+        spec = ModelSpec(name=name, pose=pose if pose is not None else _pose(el, where),
+                         static=static if static is not None else _bool(el, "static", False))
+        self._fill(spec, el, file, where, prefix="", frame=(0.0, 0.0, 0.0, 0.0, 0.0, 0.0))
+        return [spec] if spec.links else []
+
+    def _fill(self, spec: ModelSpec, el: ET.Element, file: Path, where: str, prefix: str, frame: Pose6) -> None:
+        """Add ``el``'s links to ``spec`` with names ``prefix + link`` at ``frame`` ∘ link pose."""
+        for child in el:
+            tag = child.tag
+            if tag == "link":
+                link, origin = self.link(child, file, f'{where}/<link name="{child.get("name")}">', spec.static)
+                if link is None:
+                    continue
+                link.name = prefix + link.name
+                if link.name in spec.link_origins:
+                    raise WorldError(f'{where}: duplicate link name "{link.name}"')
+                spec.links.append(link)
+                spec.link_origins[link.name] = to_origin(to_matrix(frame) @ to_matrix(origin))
+            elif tag == "model":
+                sub = child.get("name", "")
+                w = f'{where}/<model name="{sub}">'
+                self._fill(spec, child, file, w, prefix + sub + "::", compose(frame, _pose(child, w)))
+            elif tag == "include":
+                for inc in self.include(child, file.parent, where):
+                    for link in inc.links:
+                        o = inc.link_origins[link.name]
+                        link.name = f"{prefix}{inc.name}::{link.name}"
+                        spec.links.append(link)
+                        spec.link_origins[link.name] = to_origin(to_matrix(compose(frame, inc.pose)) @ to_matrix(o))
+            elif tag == "joint" and not spec.static:
+                self.warnings.append(f'{where}/<joint name="{child.get("name")}">: joints of world models are not '
+                                     "simulated; the links move freely")
+            elif tag == "plugin":
+                self.warnings.append(f'{where}/<plugin filename="{child.get("filename")}">: model plugins are '
+                                     "not simulated; ignored")
+
+    def link(self, el: ET.Element, file: Path, where: str, static: bool) -> tuple[Link | None, Pose6]:
+        """A ``<link>``: collisions, visuals, inertial (SDF default 1 kg, unit inertia)."""
+        name = el.get("name") or ""
+        if not name:
+            raise WorldError(f"{where}: a <link> has no name attribute")
+        link = Link(name=name)
+        inertial = el.find("inertial")
+        if inertial is not None or not static:
+            iw = f"{where}/<inertial>"
+            inertia = inertial.find("inertia") if inertial is not None else None
+            mass = _num(inertial, "mass", iw, 1.0)
+            if mass <= 0:
+                raise WorldError(f"{iw}/<mass>: must be > 0 kg, got {mass}")
+            vals = {k: _num(inertia, k, iw + "/<inertia>", 1.0 if k in ("ixx", "iyy", "izz") else 0.0)
+                    for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")}
+            o = _pose(inertial, iw) if inertial is not None else (0.0,) * 6
+            link.inertial = Inertial(mass=mass, origin=Origin(xyz=o[:3], rpy=o[3:]), **vals)  # type: ignore[arg-type]
+        had_shapes = False
+        for tag in ("collision", "visual"):
+            for i, sel in enumerate(el.findall(tag)):
+                had_shapes = True
+                sw = f'{where}/<{tag} name="{sel.get("name", i)}">'
+                shape = self.shape(sel, file, sw, tag == "collision")
+                if shape is None:
+                    continue
+                (link.collisions if tag == "collision" else link.visuals).append(shape)
+                if tag == "collision" and link.mu1 is None:
+                    ode = sel.find("surface/friction/ode")
+                    if ode is not None and ode.find("mu") is not None:
+                        link.mu1 = _num(ode, "mu", sw, 1.0)
+                        link.mu2 = _num(ode, "mu2", sw, link.mu1)
+        if had_shapes and not link.collisions and not link.visuals:
+            return None, (0.0,) * 6  # only planes: the ground
+        return link, _pose(el, where)
+
+    def shape(self, el: ET.Element, file: Path, where: str, collision: bool) -> Shape | None:
+        """A collision or visual; None for a plane (recorded as the ground) or unsupported geometry."""
+        geo = el.find("geometry")
+        if geo is None:
+            raise WorldError(f"{where}: missing <geometry>")
+        kinds = [c for c in geo if isinstance(c.tag, str)]
+        if not kinds:
+            if collision:
+                self.warnings.append(f"{where}: empty <geometry>; ignored")
+            return None
+        g = kinds[0]
+        gw = f"{where}/<geometry>/<{g.tag}>"
+        if g.tag == "plane":
+            normal = _floats(g.findtext("normal") or "0 0 1", 3, gw + "/<normal>")
+            if normal[2] > 0.99 and collision:
+                self.ground_plane = True
+            elif collision:
+                self.warnings.append(f"{gw}: only a horizontal ground plane is supported; ignored")
+            return None
+        if g.tag == "box":
+            size = _floats(g.findtext("size"), 3, gw + "/<size>")
+            geometry = Geometry("box", size=size)
+        elif g.tag == "cylinder":
+            geometry = Geometry("cylinder", size=(_num(g, "radius", gw, 0.0), _num(g, "length", gw, 0.0)))
+        elif g.tag == "sphere":
+            geometry = Geometry("sphere", size=(_num(g, "radius", gw, 0.0),))
+        elif g.tag == "mesh":
+            geometry = self.mesh(g, file, gw, collision)
+        else:
+            self.warnings.append(f"{gw}: geometry <{g.tag}> is not supported (box, cylinder, sphere, mesh, "
+                                 "plane); ignored")
+            return None
+        if g.tag != "mesh" and any(v <= 0 for v in geometry.size):
+            raise WorldError(f"{gw}: sizes must be positive, got {geometry.size}")
+        p = _pose(el, where)
+        return Shape(geometry=geometry, origin=Origin(xyz=p[:3], rpy=p[3:]), name=el.get("name", ""),
+                     rgba=None if collision else self.rgba(el, where))
+
+    def mesh(self, g: ET.Element, file: Path, where: str, collision: bool) -> Geometry:
+        """A ``<mesh><uri>`` resolved through the model path; DAE converted; convexity checked."""
+        uri = (g.findtext("uri") or "").strip()
+        if not uri:
+            raise WorldError(f"{where}: missing <uri>")
+        if g.find("submesh") is not None:
+            self.warnings.append(f"{where}: <submesh> not supported; the whole mesh is used")
+        scale = _floats(g.findtext("scale") or "1 1 1", 3, where + "/<scale>")
+        try:
+            named = self.index.resolve_uri(uri, base_dir=file.parent, model_paths=self.model_paths)
+            sim_path, unit = prepare_mesh(named, where)
+            convex = is_convex(read_mesh(sim_path)[0]) if collision else None
+        except DescriptionError as exc:
+            raise WorldError(str(exc)) from None
+        return Geometry("mesh", mesh_path=sim_path, mesh_scale=(scale[0] * unit, scale[1] * unit, scale[2] * unit),
+                        mesh_source=named, convex=convex)
+
+    def rgba(self, el: ET.Element, where: str) -> tuple[float, float, float, float] | None:
+        mat = el.find("material")
+        if mat is None:
+            return None
+        for tag in ("diffuse", "ambient"):
+            text = mat.findtext(tag)
+            if text and len(text.split()) in (3, 4):
+                v = _floats(text, len(text.split()), f"{where}/<material>/<{tag}>")
+                return (v[0], v[1], v[2], v[3] if len(v) == 4 else 1.0)
+        return _COLORS.get((mat.findtext("script/name") or "").strip())
+
+
+def default_model_paths(model_path: Iterable[str | os.PathLike[str]], world_file: Path) -> list[Path]:
+    """Model search order: given paths, ``GAZEBO_MODEL_PATH``, ``models/`` beside the world, shipped models."""
+    paths = [Path(p).expanduser() for p in model_path]
+    paths += [Path(p) for p in os.environ.get("GAZEBO_MODEL_PATH", "").split(os.pathsep) if p]
+    paths += [world_file.parent / "models", world_file.parent, resources.model_path()]
+    return paths
+
+
+def load_world(path: str | os.PathLike[str], *, model_path: Iterable[str | os.PathLike[str]] = ()) -> WorldModel:
+    """Load a Gazebo-classic ``.world`` SDF file.
+
+    ``model_path``: directories holding Gazebo models for ``<include><uri>model://name``; searched
+    before ``GAZEBO_MODEL_PATH``, a ``models/`` directory beside the world and navlab's shipped models
+    (``ground_plane``, ``sun``). Raises WorldError naming the file and element on bad input.
+    """
+    file = Path(path).expanduser().resolve()
+    root = _parse_xml(file, "world file")
+    if root.tag != "sdf":
+        raise WorldError(f"{file}: top element is <{root.tag}>, expected <sdf>")
+    version = root.get("version", "")
+    world_el = root.find("world")
+    if world_el is None:
+        raise WorldError(f"{file}: <sdf> has no <world> (a model file? include it from a world)")
+    name = world_el.get("name") or file.stem
+    where = f'{file}: <world name="{name}">'
+    loader = _Loader(default_model_paths(model_path, file))
+    if version not in SUPPORTED_VERSIONS:
+        loader.warnings.append(f"{file}: SDF version {version!r} (navlab reads Gazebo classic 1.4-1.7)")
+    world = WorldModel(name=name, source=file)
+    for child in world_el:
+        if child.tag == "model":
+            world.models += loader.model(child, file)
+        elif child.tag == "include":
+            world.models += loader.include(child, file.parent, where)
+        elif child.tag in ("plugin", "actor", "population"):
+            loader.warnings.append(f'{where}/<{child.tag} name="{child.get("name", "")}">: not simulated; ignored')
+        elif isinstance(child.tag, str) and child.tag not in _IGNORED_WORLD_TAGS:
+            loader.warnings.append(f"{where}/<{child.tag}>: unknown element ignored")
+    physics = [p for p in world_el.findall("physics")]
+    if physics:
+        chosen = next((p for p in physics if p.get("default") in ("1", "true")), physics[0])
+        pw = f"{where}/<physics>"
+        world.max_step_size = _num(chosen, "max_step_size", pw, 0.001)
+        if world.max_step_size <= 0:
+            raise WorldError(f"{pw}/<max_step_size>: must be > 0 s, got {world.max_step_size}")
+        if chosen.find("gravity") is not None:  # SDF 1.4
+            world.gravity = _floats(chosen.findtext("gravity"), 3, pw + "/<gravity>")  # type: ignore[assignment]
+    if world_el.find("gravity") is not None:
+        world.gravity = _floats(world_el.findtext("gravity"), 3, f"{where}/<gravity>")  # type: ignore[assignment]
+    names = [m.name for m in world.models]
+    dup = {n for n in names if names.count(n) > 1}
+    if dup:
+        raise WorldError(f"{where}: duplicate model names {sorted(dup)}")
+    state = world_el.find("state")
+    if state is not None:  # a saved world: the state's model poses win
+        by_name = {m.name: m for m in world.models}
+        for m in state.findall("model"):
+            if m.get("name") in by_name and m.find("pose") is not None:
+                by_name[m.get("name", "")].pose = _pose(m, f'{where}/<state>/<model name="{m.get("name")}">')
+    world.ground_plane = loader.ground_plane
+    world.warnings = loader.warnings
+    if not world.ground_plane:
+        world.warnings.append(f"{file}: no ground plane (include model://ground_plane); things will fall")
+    return world
