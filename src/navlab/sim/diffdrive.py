@@ -1,0 +1,70 @@
+"""Differential-drive kinematics and wheel-encoder odometry (pure: numbers in, numbers out).
+
+Frames: the robot base frame has x forward, y left (REP-103); odometry is in the odometry frame,
+which starts at the base frame's pose when the odometry is (re)set.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+#: Gazebo ROS 1 diff_drive's fixed covariances (pose and twist diagonals: x y z roll pitch yaw)
+ODOM_COVARIANCE_DIAG = (1e-5, 1e-5, 1e12, 1e12, 1e12, 1e-3)
+
+
+def wheel_speeds(v: float, w: float, separation: float, diameter: float) -> tuple[float, float]:
+    """(left, right) wheel angular velocities (rad/s) for body speed ``v`` (m/s) and yaw rate ``w`` (rad/s)."""
+    if separation <= 0 or diameter <= 0:
+        raise ValueError(f"wheel separation {separation} and diameter {diameter} must be positive")
+    r = diameter / 2.0
+    return (v - w * separation / 2.0) / r, (v + w * separation / 2.0) / r
+
+
+def ramp(current: float, target: float, max_accel: float, dt: float) -> float:
+    """Move ``current`` toward ``target`` by at most ``max_accel * dt`` (``max_accel`` <= 0: jump)."""
+    if max_accel <= 0 or dt <= 0:
+        return target
+    step = max_accel * dt
+    return current + max(-step, min(step, target - current))
+
+
+@dataclass
+class EncoderOdometry:
+    """Integrates wheel angles into a planar pose (midpoint rule), like Gazebo's ``odometrySource encoder``.
+
+    ``update(left, right, dt)`` takes the wheel joint angles (rad, unwrapped) and the time since the
+    previous call (s), and returns ``(x, y, yaw, v, w)``: pose in the odometry frame (m, rad) and
+    body velocities (m/s, rad/s).
+    """
+
+    separation: float
+    diameter: float
+    x: float = 0.0
+    y: float = 0.0
+    yaw: float = 0.0
+    _left: float | None = None
+    _right: float | None = None
+
+    def reset(self, left: float, right: float, x: float = 0.0, y: float = 0.0, yaw: float = 0.0) -> None:
+        """Start integrating from pose (x, y, yaw) at these wheel angles."""
+        self._left, self._right = left, right
+        self.x, self.y, self.yaw = x, y, yaw
+
+    def update(self, left: float, right: float, dt: float) -> tuple[float, float, float, float, float]:
+        """Advance with new wheel angles; returns (x, y, yaw, v, w)."""
+        if self._left is None or self._right is None:
+            self.reset(left, right, self.x, self.y, self.yaw)
+        r = self.diameter / 2.0
+        sl = (left - self._left) * r  # type: ignore[operator]
+        sr = (right - self._right) * r  # type: ignore[operator]
+        self._left, self._right = left, right
+        ds = 0.5 * (sl + sr)
+        dyaw = (sr - sl) / self.separation
+        mid = self.yaw + 0.5 * dyaw
+        self.x += ds * math.cos(mid)
+        self.y += ds * math.sin(mid)
+        self.yaw = math.atan2(math.sin(self.yaw + dyaw), math.cos(self.yaw + dyaw))
+        if dt > 0:
+            return self.x, self.y, self.yaw, ds / dt, dyaw / dt
+        return self.x, self.y, self.yaw, 0.0, 0.0

@@ -1,0 +1,170 @@
+"""The ``gazebo`` node: owns the Simulation, steps it with the executor's clock, runs the robot's
+plugins and offers ``/spawn_entity`` and ``/delete_entity``; :func:`launch_sim` starts it."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+from navlab.core import Executor, Node
+from navlab.description.model import RobotModel
+from navlab.sim.errors import SimError
+from navlab.sim.plugins import DiffDrivePlugin, GroundTruthPlugin, ImuPlugin, JointStatePlugin, LidarPlugin
+from navlab.sim.simulation import Simulation
+from navlab.sim.spawn import load_sdf_model, parse_spawn_spec, primitive_model
+from navlab.world.model import ModelSpec, WorldModel
+
+
+def load_robot_named(name_or_path: str) -> RobotModel:
+    """A robot from a shipped name (``mybot``) or a .xacro/.urdf path."""
+    from navlab import resources
+    from navlab.description import load_robot
+
+    path = Path(name_or_path).expanduser()
+    if not path.suffix and not path.exists():
+        path = resources.robot(name_or_path)
+    return load_robot(path)
+
+
+def load_world_named(name_or_path: str) -> WorldModel:
+    """A world from a shipped name (``room``, ``room_obstacles``) or a .world/.sdf path."""
+    from navlab import resources
+
+    try:
+        from navlab.world import load_world  # type: ignore[attr-defined]
+    except ImportError:
+        raise SimError("loading .world files needs navlab.world.load_world, which is not available") from None
+    path = Path(name_or_path).expanduser()
+    if not path.suffix and not path.exists():
+        path = resources.world(name_or_path)
+    return load_world(path)
+
+
+class GazeboSim(Node):
+    """Gazebo in a node. Parameters: ``world`` (shipped name or file, default ``room``), ``robot``
+    (default ``mybot``), ``x``/``y``/``yaw`` (spawn pose, m/rad), ``timestep`` (s; 0 = the world's
+    ``max_step_size``), ``joint_state_rate`` and ``ground_truth_rate`` (Hz; 0 = off), ``seed``
+    (sensor noise seed; -1 = the executor's). ``robot_model``/``world_model`` replace the files."""
+
+    def __init__(self, executor: Executor, *, name: str = "gazebo", parameters: dict[str, Any] | None = None,
+                 namespace: str = "", robot_model: RobotModel | None = None,
+                 world_model: WorldModel | None = None) -> None:
+        super().__init__(name, executor, parameters=parameters, namespace=namespace)
+        world_name = self.declare_parameter("world", "room")
+        robot_name = self.declare_parameter("robot", "mybot")
+        pose = (self.declare_parameter("x", 0.0), self.declare_parameter("y", 0.0),
+                self.declare_parameter("yaw", 0.0))
+        timestep = self.declare_parameter("timestep", 0.0)
+        js_rate = self.declare_parameter("joint_state_rate", 30.0)
+        gt_rate = self.declare_parameter("ground_truth_rate", 50.0)
+        seed = self.declare_parameter("seed", -1)
+        robot = robot_model if robot_model is not None else load_robot_named(robot_name)
+        world = world_model if world_model is not None else load_world_named(world_name)
+        for warning in [*robot.warnings, *world.warnings]:
+            self.get_logger().warning(warning)
+        self.sim = Simulation(robot, world, seed=self.rng, timestep=timestep or None, robot_pose=pose)
+        self.sim.advance_to(executor.now_ns)
+        for warning in self.sim.info.warnings:
+            self.get_logger().warning(warning)
+        executor.add_stepper(self)
+        self.plugins: list[Node] = []
+        if robot.diff_drive is not None:
+            self.plugins.append(DiffDrivePlugin(executor, self.sim, robot.diff_drive, namespace=namespace))
+        self.plugins += [LidarPlugin(executor, self.sim, i, namespace=namespace) for i in range(len(robot.lidars))]
+        self.plugins += [ImuPlugin(executor, self.sim, i, namespace=namespace) for i in range(len(robot.imus))]
+        self.plugins.append(JointStatePlugin(executor, self.sim, rate=js_rate, namespace=namespace))
+        if gt_rate > 0:
+            base = robot.diff_drive.robot_base_frame if robot.diff_drive else robot.root_link
+            self.plugins.append(GroundTruthPlugin(executor, self.sim, base_frame=base, rate=gt_rate,
+                                                  namespace=namespace))
+        if seed >= 0:
+            import zlib
+
+            import numpy as np
+
+            for node in [self, *self.plugins]:
+                name_key = zlib.crc32(node.fully_qualified_name.encode())
+                node.rng = np.random.Generator(np.random.PCG64(np.random.SeedSequence([seed, name_key])))
+        self.create_service("/spawn_entity", self._spawn_service)
+        self.create_service("/delete_entity", self._delete_service)
+
+    def advance_to(self, t_ns: int) -> None:
+        """Stepper hook: integrate physics up to ``t_ns``."""
+        self.sim.advance_to(t_ns)
+
+    def spawn(self, model: ModelSpec) -> list[str]:
+        """Add a model to the running world; returns its MuJoCo body names."""
+        bodies = self.sim.spawn(model)
+        self.get_logger().info(f"spawned {model.name!r}")
+        return bodies
+
+    def spawn_primitive(self, kind: str, name: str, dims: tuple[float, ...], **place: Any) -> list[str]:
+        """Spawn a box (sx, sy, sz), cylinder (radius, length) or sphere (radius,); see ``primitive_model``."""
+        return self.spawn(primitive_model(kind, name, dims, **place))
+
+    def delete(self, name: str) -> None:
+        """Remove a model from the running world."""
+        self.sim.remove(name)
+        self.get_logger().info(f"deleted {name!r}")
+
+    def _spawn_service(self, request: Any) -> dict[str, Any]:
+        """``/spawn_entity``: request is a ModelSpec, a spec string (``box:x=1,...``) or a dict with
+        ``name`` and ``kind`` + ``dims`` (+ placement keys), or ``xml``/``file`` (an SDF model)."""
+        try:
+            if isinstance(request, ModelSpec):
+                model = request
+            elif isinstance(request, str):
+                model, _ = parse_spawn_spec(request)
+            elif isinstance(request, dict) and "file" in request:
+                place = {k: request[k] for k in ("x", "y", "z", "yaw") if k in request}
+                model = load_sdf_model(Path(request["file"]), name=request.get("name"), **place)
+            elif isinstance(request, dict) and "kind" in request:
+                extra = {k: v for k, v in request.items() if k not in ("kind", "name", "dims")}
+                model = primitive_model(request["kind"], request.get("name", request["kind"]),
+                                        tuple(request["dims"]), **extra)
+            else:
+                raise SimError(f"/spawn_entity: cannot spawn {request!r}; give a ModelSpec, a spec string "
+                               "or a dict with kind+dims or file")
+            self.spawn(model)
+        except SimError as exc:
+            return {"success": False, "status_message": str(exc)}
+        return {"success": True, "status_message": f"spawned {model.name}"}
+
+    def _delete_service(self, request: Any) -> dict[str, Any]:
+        """``/delete_entity``: request is the model name or ``{"name": ...}``."""
+        name = request.get("name") if isinstance(request, dict) else request
+        try:
+            self.delete(str(name))
+        except SimError as exc:
+            return {"success": False, "status_message": str(exc)}
+        return {"success": True, "status_message": f"deleted {name}"}
+
+
+def launch_sim(
+    executor: Executor,
+    *,
+    world: str | WorldModel = "room",
+    robot: str | RobotModel = "mybot",
+    pose: tuple[float, float, float] = (0.0, 0.0, 0.0),
+    seed: int | None = None,
+    **parameters: Any,
+) -> GazeboSim:
+    """Start the simulator with its plugins on ``executor``; returns the ``gazebo`` node.
+
+    ``world``/``robot``: shipped names, file paths or loaded models; ``pose`` = (x, y, yaw) of the
+    robot; ``seed``: sensor-noise seed (default: the executor's); other keywords are GazeboSim
+    parameters (``timestep``, ``joint_state_rate``, ``ground_truth_rate``).
+    """
+    params: dict[str, Any] = {"x": pose[0], "y": pose[1], "yaw": pose[2], **parameters}
+    if seed is not None:
+        params["seed"] = int(seed)
+    kwargs: dict[str, Any] = {}
+    if isinstance(world, WorldModel):
+        kwargs["world_model"] = world
+    else:
+        params["world"] = str(world)
+    if isinstance(robot, RobotModel):
+        kwargs["robot_model"] = robot
+    else:
+        params["robot"] = str(robot)
+    return GazeboSim(executor, parameters=params, **kwargs)

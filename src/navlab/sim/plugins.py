@@ -1,0 +1,285 @@
+"""Gazebo's ROS plugins as navlab nodes: diff_drive, laser, imu, joint states, ground truth, static tf.
+
+Each plugin is a thin node around a :class:`~navlab.sim.simulation.Simulation`: it reads the plugin's
+configuration from the robot description (``RobotModel``), runs on a timer in simulated time, and
+publishes the ROS messages a Gazebo user expects on the topics named in the description.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from navlab import msgs
+from navlab.core import Executor, Node
+from navlab.description.model import DiffDriveConfig, ImuConfig, LidarConfig, Origin
+from navlab.sim.builder import quat_from_rpy
+from navlab.sim.diffdrive import ODOM_COVARIANCE_DIAG, EncoderOdometry, ramp, wheel_speeds
+from navlab.sim.simulation import Simulation, lidar_angles
+
+_ODOM_COV = msgs.covariance(ODOM_COVARIANCE_DIAG)
+
+
+def _quat_msg(wxyz: np.ndarray) -> Any:
+    w, x, y, z = (float(v) for v in wxyz)
+    return msgs.Quaternion(x=x, y=y, z=z, w=w)
+
+
+def _transform(stamp_ns: int, parent: str, child: str, xyz: Any, wxyz: Any) -> Any:
+    return msgs.TransformStamped(
+        header=msgs.header(stamp_ns, parent),
+        child_frame_id=child,
+        transform=msgs.Transform(
+            translation=msgs.Vector3(x=float(xyz[0]), y=float(xyz[1]), z=float(xyz[2])),
+            rotation=_quat_msg(np.asarray(wxyz, dtype=float)),
+        ),
+    )
+
+
+def _origin_transform(stamp_ns: int, parent: str, child: str, origin: Origin) -> Any:
+    return _transform(stamp_ns, parent, child, origin.xyz, quat_from_rpy(origin.rpy))
+
+
+def base_frame_link(sim: Simulation, frame: str) -> str:
+    """The robot link that carries ``frame`` (the root link when no link has that name)."""
+    assert sim.robot is not None
+    return frame if frame in sim.robot.links else sim.robot.root_link
+
+
+class DiffDrivePlugin(Node):
+    """``libgazebo_ros_diff_drive``: ``cmd_vel`` → wheel velocity targets (torque-limited), odometry and tf.
+
+    Every ``1/update_rate`` s: stop the wheels if no command came within ``cmd_timeout`` s, set the
+    wheel targets (ramped by ``max_accel``), then publish ``nav_msgs/Odometry`` on ``odometry_topic`` in
+    ``odometry_frame`` — integrated from the wheel encoders, or with ``odometry_source: world`` the
+    true pose — and the tf ``odometry_frame → robot_base_frame``.
+    """
+
+    def __init__(self, executor: Executor, sim: Simulation, config: DiffDriveConfig, *,
+                 name: str = "diff_drive", namespace: str = "") -> None:
+        super().__init__(name, executor, namespace=namespace or config.namespace)
+        self.sim = sim
+        self.cfg = config
+        self.base_link = base_frame_link(sim, config.robot_base_frame)
+        if self.base_link != config.robot_base_frame:
+            self.get_logger().warning(
+                f"robotBaseFrame {config.robot_base_frame!r} is not a link; odometry follows "
+                f"the root link {self.base_link!r}"
+            )
+        self.cmd = (0.0, 0.0)
+        self.last_cmd_ns: int | None = None
+        self.wheel_targets = (0.0, 0.0)
+        self.odometry = EncoderOdometry(config.wheel_separation, config.wheel_diameter)
+        self.odometry.reset(*sim.wheel_angles())
+        self.last_ns = executor.now_ns
+        self.odom_pub = self.create_publisher(msgs.Odometry, config.odometry_topic, 10)
+        self.create_subscription(msgs.Twist, config.command_topic, self.on_cmd_vel, 10)
+        self.create_timer(1.0 / config.update_rate, self.update)
+
+    def on_cmd_vel(self, msg: Any) -> None:
+        """Store the commanded body velocity (m/s, rad/s); applied at the next update."""
+        self.cmd = (float(msg.linear.x), float(msg.angular.z))
+        self.last_cmd_ns = self.get_clock().now_ns()
+
+    def update(self) -> None:
+        """One plugin update: wheel targets, odometry, tf."""
+        now = self.get_clock().now_ns()
+        dt = (now - self.last_ns) / 1e9
+        self.last_ns = now
+        cfg = self.cfg
+        v, w = self.cmd
+        if cfg.cmd_timeout > 0 and (self.last_cmd_ns is None or now - self.last_cmd_ns > cfg.cmd_timeout * 1e9):
+            v, w = 0.0, 0.0
+        left, right = wheel_speeds(v, w, cfg.wheel_separation, cfg.wheel_diameter)
+        self.wheel_targets = (
+            ramp(self.wheel_targets[0], left, cfg.max_accel, dt),
+            ramp(self.wheel_targets[1], right, cfg.max_accel, dt),
+        )
+        self.sim.set_wheel_velocity_targets(*self.wheel_targets)
+        self.publish_odometry(now, dt)
+
+    def publish_odometry(self, now: int, dt: float) -> None:
+        """Odometry message and odom → base tf at time ``now``."""
+        cfg = self.cfg
+        if cfg.odometry_source == "world":
+            pose = self.sim.link_pose(self.base_link)
+            lin, ang = self.sim.link_velocity(self.base_link)
+            position, quat = pose.position, pose.quaternion
+        else:
+            x, y, yaw, v, w = self.odometry.update(*self.sim.wheel_angles(), dt)
+            position = np.array([x, y, 0.0])
+            quat = np.array([np.cos(yaw / 2), 0.0, 0.0, np.sin(yaw / 2)])
+            lin, ang = np.array([v, 0.0, 0.0]), np.array([0.0, 0.0, w])
+        odom = msgs.Odometry(
+            header=msgs.header(now, cfg.odometry_frame),
+            child_frame_id=cfg.robot_base_frame,
+            pose=msgs.PoseWithCovariance(
+                pose=msgs.Pose(position=msgs.Point(x=float(position[0]), y=float(position[1]),
+                                                   z=float(position[2])), orientation=_quat_msg(quat)),
+                covariance=_ODOM_COV.copy(),
+            ),
+            twist=msgs.TwistWithCovariance(
+                twist=msgs.Twist(linear=msgs.Vector3(x=float(lin[0]), y=float(lin[1]), z=float(lin[2])),
+                                 angular=msgs.Vector3(x=float(ang[0]), y=float(ang[1]), z=float(ang[2]))),
+                covariance=_ODOM_COV.copy(),
+            ),
+        )
+        self.odom_pub.publish(odom)
+        if cfg.publish_tf:
+            self.send_transform(_transform(now, cfg.odometry_frame, cfg.robot_base_frame, position, quat))
+
+
+class LidarPlugin(Node):
+    """``gazebo_ros_laser``: a ``sensor_msgs/LaserScan`` every ``1/update_rate`` s on the configured topic."""
+
+    def __init__(self, executor: Executor, sim: Simulation, index: int, *, name: str = "",
+                 namespace: str = "") -> None:
+        assert sim.robot is not None
+        cfg: LidarConfig = sim.robot.lidars[index]
+        super().__init__(name or f"{cfg.name}_plugin", executor, namespace=namespace)
+        self.sim, self.index, self.cfg = sim, index, cfg
+        self.frame_id = cfg.frame_id or cfg.link
+        n = cfg.samples
+        self.angle_increment = float(np.diff(lidar_angles(cfg))[0]) if n > 1 else 0.0
+        self.pub = self.create_publisher(msgs.LaserScan, cfg.topic, 10)
+        self.create_timer(1.0 / cfg.update_rate, self.update)
+        self._empty = np.zeros(0, dtype=np.float32)
+
+    def update(self) -> None:
+        """Cast the rays and publish the scan."""
+        cfg = self.cfg
+        ranges = self.sim.scan(self.index, rng=self.rng)
+        self.pub.publish(msgs.LaserScan(
+            header=msgs.header(self.get_clock().now_ns(), self.frame_id),
+            angle_min=float(cfg.min_angle), angle_max=float(cfg.max_angle), angle_increment=self.angle_increment,
+            time_increment=0.0, scan_time=1.0 / cfg.update_rate, range_min=float(cfg.range_min),
+            range_max=float(cfg.range_max), ranges=ranges, intensities=self._empty,
+        ))
+
+
+class ImuPlugin(Node):
+    """``gazebo_ros_imu_sensor``: ``sensor_msgs/Imu`` (orientation in world, rates and accelerations in
+    the IMU frame, with the configured noise)."""
+
+    def __init__(self, executor: Executor, sim: Simulation, index: int, *, name: str = "",
+                 namespace: str = "") -> None:
+        assert sim.robot is not None
+        cfg: ImuConfig = sim.robot.imus[index]
+        super().__init__(name or f"{cfg.name}_plugin", executor, namespace=namespace)
+        self.sim, self.index, self.cfg = sim, index, cfg
+        self.frame_id = cfg.frame_id or cfg.link
+        self.pub = self.create_publisher(msgs.Imu, cfg.topic, 10)
+        self.create_timer(1.0 / cfg.update_rate, self.update)
+        g2, a2 = cfg.gyro_noise_stddev**2, cfg.accel_noise_stddev**2
+        self.cov = (np.zeros(9), np.diag([g2, g2, g2]).ravel(), np.diag([a2, a2, a2]).ravel())
+
+    def update(self) -> None:
+        """Read the IMU and publish."""
+        quat, gyro, accel = self.sim.imu(self.index, rng=self.rng)
+        self.pub.publish(msgs.Imu(
+            header=msgs.header(self.get_clock().now_ns(), self.frame_id),
+            orientation=_quat_msg(quat), orientation_covariance=self.cov[0].copy(),
+            angular_velocity=msgs.Vector3(x=float(gyro[0]), y=float(gyro[1]), z=float(gyro[2])),
+            angular_velocity_covariance=self.cov[1].copy(),
+            linear_acceleration=msgs.Vector3(x=float(accel[0]), y=float(accel[1]), z=float(accel[2])),
+            linear_acceleration_covariance=self.cov[2].copy(),
+        ))
+
+
+class JointStatePlugin(Node):
+    """``gazebo_ros_joint_state_publisher`` + ``robot_state_publisher``: ``/joint_states`` of the moving
+    joints and their tf (parent link → child link) every ``1/rate`` s; fixed joints and sensor frames
+    once, as static tf."""
+
+    def __init__(self, executor: Executor, sim: Simulation, *, rate: float = 30.0, publish_tf: bool = True,
+                 name: str = "robot_state_publisher", namespace: str = "") -> None:
+        super().__init__(name, executor, namespace=namespace)
+        assert sim.robot is not None
+        self.sim = sim
+        self.publish_tf = publish_tf
+        robot = sim.robot
+        self.joints = [j for j in robot.joints if j.name in set(sim.joint_names())]
+        self.pub = self.create_publisher(msgs.JointState, "joint_states", 10)
+        self.send_static_transform(static_transforms(sim, executor.now_ns))
+        if rate > 0 and self.joints:
+            self.create_timer(1.0 / rate, self.update)
+
+    def update(self) -> None:
+        """Publish joint states (and the moving joints' tf)."""
+        now = self.get_clock().now_ns()
+        pos = np.array([self.sim.joint_position(j.name) for j in self.joints])
+        vel = np.array([self.sim.joint_velocity(j.name) for j in self.joints])
+        self.pub.publish(msgs.JointState(header=msgs.header(now, ""), name=[j.name for j in self.joints],
+                                         position=pos, velocity=vel, effort=np.zeros(len(pos))))
+        if self.publish_tf:
+            tfs = []
+            for joint, q in zip(self.joints, pos, strict=True):
+                xyz, quat = joint_motion(joint, float(q))
+                tfs.append(_transform(now, joint.parent, joint.child, xyz, quat))
+            self.send_transform(tfs)
+
+
+def joint_motion(joint: Any, q: float) -> tuple[np.ndarray, np.ndarray]:
+    """Pose (xyz, wxyz) of a joint's child frame in its parent link at joint position ``q``."""
+    import mujoco
+
+    base = quat_from_rpy(joint.origin.rpy)
+    xyz = np.asarray(joint.origin.xyz, dtype=float)
+    axis = np.asarray(joint.axis, dtype=float)
+    axis = axis / np.linalg.norm(axis)
+    if joint.type == "prismatic":
+        rot = np.zeros(9)
+        mujoco.mju_quat2Mat(rot, base)
+        return xyz + rot.reshape(3, 3) @ axis * q, base
+    turn = np.array([np.cos(q / 2), *(np.sin(q / 2) * axis)])
+    out = np.zeros(4)
+    mujoco.mju_mulQuat(out, base, turn)
+    return xyz, out
+
+
+def static_transforms(sim: Simulation, stamp_ns: int) -> list[Any]:
+    """Fixed joints (parent → child) and sensor frames that are not links (link → frame), as tf."""
+    assert sim.robot is not None
+    robot = sim.robot
+    out = [_origin_transform(stamp_ns, j.parent, j.child, j.origin) for j in robot.joints if j.type == "fixed"]
+    for cfg in [*robot.lidars, *robot.imus]:
+        frame = cfg.frame_id or cfg.link
+        if frame != cfg.link and frame not in robot.links:
+            out.append(_origin_transform(stamp_ns, cfg.link, frame, cfg.origin))
+    return out
+
+
+class GroundTruthPlugin(Node):
+    """``libgazebo_ros_p3d``: the true pose and twist of the base link, ``nav_msgs/Odometry`` in ``world``
+    on ``/ground_truth/odom`` (for evaluation only)."""
+
+    def __init__(self, executor: Executor, sim: Simulation, *, base_frame: str, rate: float = 50.0,
+                 topic: str = "/ground_truth/odom", frame: str = "world", name: str = "ground_truth",
+                 namespace: str = "") -> None:
+        super().__init__(name, executor, namespace=namespace)
+        self.sim = sim
+        self.frame, self.base_frame = frame, base_frame
+        self.link = base_frame_link(sim, base_frame)
+        self.pub = self.create_publisher(msgs.Odometry, topic, 10)
+        self.create_timer(1.0 / rate, self.update)
+
+    def update(self) -> None:
+        """Publish the true pose."""
+        pose = self.sim.link_pose(self.link)
+        lin, ang = self.sim.link_velocity(self.link)
+        p = pose.position
+        self.pub.publish(msgs.Odometry(
+            header=msgs.header(self.get_clock().now_ns(), self.frame),
+            child_frame_id=self.base_frame,
+            pose=msgs.PoseWithCovariance(
+                pose=msgs.Pose(position=msgs.Point(x=float(p[0]), y=float(p[1]), z=float(p[2])),
+                               orientation=_quat_msg(pose.quaternion)),
+                covariance=np.zeros(36),
+            ),
+            twist=msgs.TwistWithCovariance(
+                twist=msgs.Twist(linear=msgs.Vector3(x=float(lin[0]), y=float(lin[1]), z=float(lin[2])),
+                                 angular=msgs.Vector3(x=float(ang[0]), y=float(ang[1]), z=float(ang[2]))),
+                covariance=np.zeros(36),
+            ),
+        ))
