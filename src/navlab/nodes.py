@@ -6,4 +6,5 @@ Each class takes ``(executor, *, name=..., parameters=None, namespace="")``.
 NODES: dict[str, str] = {
     "talker": "navlab.core.demo_nodes:Talker",
     "listener": "navlab.core.demo_nodes:Listener",
+    "amcl": "navlab.localization.amcl_node:Amcl",
 }

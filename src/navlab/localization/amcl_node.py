@@ -1,0 +1,232 @@
+"""The ``amcl`` node: ROS 1 amcl's topics, frames, parameters and services around ``localization.amcl``.
+
+Subscribes ``scan`` (sensor_msgs/LaserScan), ``map`` (nav_msgs/OccupancyGrid, latched) and
+``initialpose`` (PoseWithCovarianceStamped); reads odometry from tf ``odom_frame_id → base_frame_id``
+at each scan's stamp. Publishes tf ``global_frame_id → odom_frame_id`` stamped scan time +
+``transform_tolerance``, ``amcl_pose`` (PoseWithCovarianceStamped) and ``particlecloud`` (PoseArray).
+Services: ``global_localization`` and ``request_nomotion_update`` (std_srvs/Empty: request ignored).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from navlab import msgs
+from navlab.core import Executor, Node, TfError
+from navlab.localization import amcl as pf
+from navlab.localization.errors import LocalizationError
+from navlab.localization.field import field_from_map
+from navlab.mapping.errors import MappingError
+from navlab.mapping.grid import GridMap
+
+# ROS 1 name -> (default, Nav2 spellings accepted too). Filter parameters map onto AmclParams.
+_FILTER_PARAMS: dict[str, tuple[Any, tuple[str, ...]]] = {
+    "min_particles": (100, ()),
+    "max_particles": (5000, ()),
+    "kld_err": (0.01, ("pf_err",)),
+    "kld_z": (0.99, ("pf_z",)),
+    "update_min_d": (0.2, ()),
+    "update_min_a": (math.pi / 6.0, ()),
+    "resample_interval": (2, ()),
+    "recovery_alpha_slow": (0.0, ()),
+    "recovery_alpha_fast": (0.0, ()),
+    "selective_resampling": (False, ()),
+    "laser_max_beams": (30, ("max_beams",)),
+    "laser_min_range": (-1.0, ()),
+    "laser_max_range": (-1.0, ()),
+    "laser_z_hit": (0.95, ("z_hit",)),
+    "laser_z_short": (0.1, ("z_short",)),
+    "laser_z_max": (0.05, ("z_max",)),
+    "laser_z_rand": (0.05, ("z_rand",)),
+    "laser_sigma_hit": (0.2, ("sigma_hit",)),
+    "laser_lambda_short": (0.1, ("lambda_short",)),
+    "laser_likelihood_max_dist": (2.0, ()),
+    "laser_model_type": ("likelihood_field", ()),
+    "odom_model_type": ("diff", ("robot_model_type",)),
+    "odom_alpha1": (0.2, ("alpha1",)),
+    "odom_alpha2": (0.2, ("alpha2",)),
+    "odom_alpha3": (0.2, ("alpha3",)),
+    "odom_alpha4": (0.2, ("alpha4",)),
+    "initial_cov_xx": (0.5 * 0.5, ()),
+    "initial_cov_yy": (0.5 * 0.5, ()),
+    "initial_cov_aa": ((math.pi / 12.0) ** 2, ()),
+}
+_NAV2_MODELS = {"nav2_amcl::DifferentialMotionModel": "diff-corrected", "differential": "diff-corrected"}
+
+
+class Amcl(Node):
+    """Adaptive Monte Carlo localization on the map from ``map``, with ROS 1 amcl's interface."""
+
+    def __init__(
+        self, executor: Executor, *, name: str = "amcl", parameters: dict[str, Any] | None = None, namespace: str = ""
+    ) -> None:
+        super().__init__(name, executor, parameters=parameters, namespace=namespace)
+        values = {k: self.declare_parameter(k, d, aliases=a) for k, (d, a) in _FILTER_PARAMS.items()}
+        values["odom_model_type"] = _NAV2_MODELS.get(values["odom_model_type"], values["odom_model_type"])
+        self.params = pf.AmclParams(**values)
+        self.params.validate()
+        self.odom_alpha5 = self.declare_parameter("odom_alpha5", 0.2, aliases=("alpha5",))  # omni model only
+        self.transform_tolerance = self.declare_parameter("transform_tolerance", 0.1)
+        self.initial_pose = (
+            self.declare_parameter("initial_pose_x", 0.0),
+            self.declare_parameter("initial_pose_y", 0.0),
+            self.declare_parameter("initial_pose_a", 0.0),
+        )
+        self.odom_frame = self.declare_parameter("odom_frame_id", "odom")
+        self.base_frame = self.declare_parameter("base_frame_id", "base_link")
+        self.global_frame = self.declare_parameter("global_frame_id", "map")
+        self.tf_broadcast = self.declare_parameter("tf_broadcast", True)
+        self.first_map_only = self.declare_parameter("first_map_only", False)
+        # navlab always reads the latched map topic (what map_server's static_map service would return).
+        self.declare_parameter("use_map_topic", False)
+        self.declare_parameter("gui_publish_rate", -1.0)
+        self.declare_parameter("save_pose_rate", 0.5)
+        self.check_parameters()
+
+        self.filter: pf.Amcl | None = None
+        self.last_error: str | None = None
+        self._laser_poses: dict[str, tuple[float, float, float]] = {}
+        self._map_to_odom: tuple[float, float, float] | None = None
+        self._pending_global = False
+        self.pose_pub = self.create_publisher(msgs.PoseWithCovarianceStamped, "amcl_pose", 2)
+        self.cloud_pub = self.create_publisher(msgs.PoseArray, "particlecloud", 2)
+        self.create_subscription(msgs.OccupancyGrid, "map", self._on_map, 1)
+        self.create_subscription(msgs.LaserScan, "scan", self._on_scan, 100)
+        self.create_subscription(msgs.PoseWithCovarianceStamped, "initialpose", self._on_initial_pose, 2)
+        self.create_service("global_localization", self._srv_global)
+        self.create_service("request_nomotion_update", self._srv_nomotion)
+
+    # --- inputs ---------------------------------------------------------------------------------
+
+    def _refuse(self, message: str) -> None:
+        self.last_error = message
+        self.get_logger().error(message)
+
+    def _on_map(self, msg: Any) -> None:
+        if self.filter is not None and self.first_map_only:
+            return
+        try:
+            field = field_from_map(GridMap.from_msg(msg), max_dist=self.params.laser_likelihood_max_dist,
+                                   name=f"map on {self.resolve_topic_name('map')}")
+        except (LocalizationError, MappingError) as exc:
+            self._refuse(f"ignoring map: {exc}")
+            return
+        previous = self.filter
+        self.filter = pf.Amcl(field, self.params, rng=self.rng)
+        self._map_to_odom = None
+        if self._pending_global:
+            self.filter.global_localization()
+            self._pending_global = False
+            return
+        # ROS amcl keeps its last estimate across maps; otherwise it starts from initial_pose_*.
+        x, y, a = previous.estimate if previous is not None and previous.n_particles else self.initial_pose
+        try:
+            self.filter.set_initial_pose(x, y, a)
+        except LocalizationError as exc:
+            self._refuse(f"initial pose refused: {exc}; waiting for initialpose or global_localization")
+
+    def _on_initial_pose(self, msg: Any) -> None:
+        frame = str(msg.header.frame_id).lstrip("/")
+        if frame and frame != self.global_frame:
+            self._refuse(f"ignoring initialpose in frame {frame!r}: expected {self.global_frame!r}")
+            return
+        if self.filter is None:
+            self._refuse("ignoring initialpose: no map received yet")
+            return
+        x, y, yaw = msgs.pose2d(msg.pose.pose)
+        c = np.asarray(msg.pose.covariance, dtype=np.float64).reshape(6, 6)
+        cov = np.array([[c[0, 0], c[0, 1], 0.0], [c[1, 0], c[1, 1], 0.0], [0.0, 0.0, c[5, 5]]])
+        try:
+            self.filter.set_initial_pose(x, y, yaw, cov)
+        except LocalizationError as exc:
+            self._refuse(f"ignoring initialpose: {exc}")
+            return
+        self._map_to_odom = None
+        self.get_logger().info(f"initial pose set to ({x:.3f}, {y:.3f}, {yaw:.3f})")
+
+    def _srv_global(self, request: Any = None) -> dict[str, Any]:
+        if self.filter is None:
+            self._pending_global = True
+        else:
+            self.filter.global_localization()
+            self._map_to_odom = None
+        return {}
+
+    def _srv_nomotion(self, request: Any = None) -> dict[str, Any]:
+        if self.filter is not None:
+            self.filter.request_nomotion_update()
+        return {}
+
+    def _laser_pose(self, frame: str) -> tuple[float, float, float] | None:
+        if frame not in self._laser_poses:
+            try:
+                self._laser_poses[frame] = self.executor.tf.lookup_pose2d(self.base_frame, frame)
+            except TfError as exc:
+                self.get_logger().warning(f"no transform {self.base_frame} → {frame} for the scan: {exc}")
+                return None
+        return self._laser_poses[frame]
+
+    def _odom_pose(self, t_ns: int) -> tuple[float, float, float] | None:
+        err: Exception | None = None
+        for t in (t_ns, None):
+            try:
+                return self.executor.tf.lookup_pose2d(self.odom_frame, self.base_frame, t)
+            except TfError as exc:
+                err = exc
+        self.get_logger().warning(f"no odometry {self.odom_frame} → {self.base_frame}: {err}")
+        return None
+
+    def _on_scan(self, msg: Any) -> None:
+        f = self.filter
+        if f is None or f.n_particles == 0:
+            return
+        t_ns = msgs.stamp_ns(msg)
+        laser = self._laser_pose(str(msg.header.frame_id).lstrip("/") or self.base_frame)
+        odom = self._odom_pose(t_ns)
+        if laser is None or odom is None:
+            return
+        scan = pf.Scan(
+            ranges=np.asarray(msg.ranges, dtype=np.float64),
+            angle_min=float(msg.angle_min),
+            angle_increment=float(msg.angle_increment),
+            range_min=float(msg.range_min),
+            range_max=float(msg.range_max),
+        )
+        if f.update(odom, scan, laser):
+            self._map_to_odom = f.map_to_odom()
+            self._publish_estimate(t_ns)
+        if self._map_to_odom is not None and self.tf_broadcast:
+            stamp = t_ns + round(self.transform_tolerance * 1e9)
+            self.send_transform(msgs.transform_stamped(stamp, self.global_frame, self.odom_frame, *self._map_to_odom))
+
+    # --- outputs --------------------------------------------------------------------------------
+
+    def _publish_estimate(self, t_ns: int) -> None:
+        f = self.filter
+        assert f is not None
+        cov = msgs.covariance()
+        cov[[0, 1, 6, 7]] = f.covariance[:2, :2].ravel()
+        cov[35] = f.covariance[2, 2]
+        self.pose_pub.publish(
+            msgs.PoseWithCovarianceStamped(
+                header=msgs.header(t_ns, self.global_frame),
+                pose=msgs.PoseWithCovariance(pose=msgs.pose_from_2d(*f.estimate), covariance=cov),
+            )
+        )
+        # Building thousands of Pose messages is costly: only when someone listens (a subscriber or a recorder).
+        if not (self.cloud_pub.get_subscription_count() or getattr(self.executor, "_listeners", None)):
+            return
+        self.cloud_pub.publish(
+            msgs.PoseArray(
+                header=msgs.header(t_ns, self.global_frame),
+                poses=[msgs.pose_from_2d(*p) for p in f.particles],
+            )
+        )
+
+    @property
+    def estimate(self) -> tuple[float, float, float] | None:
+        """The latest pose estimate (map frame) or None before the first update."""
+        return None if self.filter is None or self._map_to_odom is None else self.filter.estimate
