@@ -17,6 +17,8 @@ from navlab.errors import NavlabError
 COMMAND_MODULES = (
     "navlab.core.cli",
     "navlab.bench",
+    "navlab.mapping.cli",
+    "navlab.description.cli",
 )
 
 

@@ -255,6 +255,8 @@ def _imu_noise(sensor: ET.Element | None, where: str) -> tuple[float, float]:
 def parse_imu(plugin: ET.Element, link: str, where: str, sensor: ET.Element | None) -> ImuConfig:
     """An IMU from a sensor plugin (``gazebo_ros_imu_sensor``) or the ROS 1 model plugin ``gazebo_ros_imu``."""
     gyro, accel = _imu_noise(sensor, where)
+    if not (gyro or accel):  # the ROS 1 model plugin carries an SDF-1.4-style <imu><noise> block itself
+        gyro, accel = _imu_noise(plugin, where)
     gaussian = _num(plugin.find("gaussianNoise"), where, 0.0)
     ns, remaps = _remaps(plugin)
     if plugin.find("ros") is None:  # ROS 1: <topicName>, <frameName>/<bodyName>, <robotNamespace>

@@ -1,0 +1,144 @@
+"""Plain-data summaries of a robot or world, for ``navlab check`` (text or ``--json``)."""
+
+from __future__ import annotations
+
+from dataclasses import asdict
+from typing import Any
+
+import numpy as np
+
+from navlab.description.model import RobotModel, Shape
+
+
+def _shape(s: Shape) -> dict[str, Any]:
+    g = s.geometry
+    out: dict[str, Any] = {"kind": g.kind, "xyz": list(s.origin.xyz), "rpy": list(s.origin.rpy)}
+    if g.kind == "mesh":
+        out.update(mesh=str(g.mesh_path), scale=list(g.mesh_scale))
+        if g.mesh_source and g.mesh_source != g.mesh_path:
+            out["source"] = str(g.mesh_source)
+        if g.convex is not None:
+            out["convex"] = g.convex
+    else:
+        out["size"] = list(g.size)
+    return out
+
+
+def robot_summary(robot: RobotModel) -> dict[str, Any]:
+    """Links (mass, shapes), joints, plugins, sensors and warnings of a robot."""
+    links = {}
+    for name, link in robot.links.items():
+        links[name] = {
+            "mass": link.inertial.mass if link.inertial else None,
+            "collisions": [_shape(s) for s in link.collisions],
+            "visuals": len(link.visuals),
+            **({"mu1": link.mu1, "mu2": link.mu2} if link.mu1 is not None else {}),
+        }
+    return {
+        "kind": "robot",
+        "name": robot.name,
+        "source": str(robot.source) if robot.source else None,
+        "root_link": robot.root_link,
+        "total_mass": sum(link.inertial.mass for link in robot.links.values() if link.inertial),
+        "links": links,
+        "joints": [{"name": j.name, "type": j.type, "parent": j.parent, "child": j.child,
+                    "xyz": [round(v, 9) for v in j.origin.xyz], "rpy": [round(v, 9) for v in j.origin.rpy],
+                    "axis": [round(v, 9) for v in j.axis]}
+                   for j in robot.joints],
+        "diff_drive": asdict(robot.diff_drive) if robot.diff_drive else None,
+        "lidars": [{**asdict(lidar), "origin": asdict(lidar.origin)} for lidar in robot.lidars],
+        "imus": [{**asdict(imu), "origin": asdict(imu.origin)} for imu in robot.imus],
+        "warnings": list(robot.warnings),
+    }
+
+
+def world_summary(world: Any) -> dict[str, Any]:
+    """Models (static, links, shapes), extents in x/y, physics and warnings of a world."""
+    from navlab.world.occupancy import shape_footprints  # world depends on description, not back
+
+    models = []
+    for m in world.models:
+        shapes = [_shape(s) for link in m.links for s in link.collisions]
+        models.append({"name": m.name, "static": m.static, "pose": list(m.pose), "links": len(m.links),
+                       "collision_shapes": len(shapes),
+                       "kinds": sorted({s["kind"] for s in shapes}),
+                       "non_convex_meshes": [s["mesh"] for s in shapes if s.get("convex") is False]})
+    pts = []
+    for fp in shape_footprints(world, z_min=-1e9, z_max=1e9):
+        if fp.kind == "disc":
+            pts += [fp.points[0] - fp.radius, fp.points[0] + fp.radius]
+        elif fp.kind == "polygon":
+            pts += list(fp.points)
+        elif fp.triangles is not None:
+            pts += list(fp.triangles.reshape(-1, 3)[:, :2])
+    extents = None
+    if pts:
+        arr = np.array(pts)
+        lo, hi = arr.min(axis=0), arr.max(axis=0)
+        extents = {"x": [round(float(lo[0]), 4), round(float(hi[0]), 4)],
+                   "y": [round(float(lo[1]), 4), round(float(hi[1]), 4)]}
+    return {
+        "kind": "world",
+        "name": world.name,
+        "source": str(world.source) if world.source else None,
+        "ground_plane": world.ground_plane,
+        "gravity": list(world.gravity),
+        "max_step_size": world.max_step_size,
+        "models": models,
+        "extents": extents,
+        "warnings": list(world.warnings),
+    }
+
+
+def format_robot(s: dict[str, Any]) -> str:
+    """Human-readable text of :func:`robot_summary`."""
+    lines = [f"robot {s['name']}  ({s['source']})",
+             f"  root link {s['root_link']}, total mass {s['total_mass']:.3f} kg",
+             f"  links ({len(s['links'])}):"]
+    for name, link in s["links"].items():
+        mass = "no inertial" if link["mass"] is None else f"{link['mass']:g} kg"
+        shapes = ", ".join(f"{c['kind']} {c.get('size', c.get('scale'))}" for c in link["collisions"]) or "-"
+        fr = f", mu1 {link['mu1']:g}" if "mu1" in link else ""
+        lines.append(f"    {name:<22} {mass:<12} collision: {shapes}{fr}")
+    lines.append(f"  joints ({len(s['joints'])}):")
+    for j in s["joints"]:
+        lines.append(f"    {j['name']:<22} {j['type']:<10} {j['parent']} -> {j['child']}  xyz {j['xyz']} "
+                     f"axis {j['axis']}")
+    dd = s["diff_drive"]
+    if dd:
+        lines.append(f"  diff drive: joints {dd['left_joint']}/{dd['right_joint']}, separation "
+                     f"{dd['wheel_separation']} m, diameter {dd['wheel_diameter']} m, torque {dd['max_torque']} N m, "
+                     f"{dd['update_rate']} Hz, {dd['command_topic']} -> {dd['odometry_topic']} "
+                     f"({dd['odometry_frame']} -> {dd['robot_base_frame']}, source {dd['odometry_source']})")
+    else:
+        lines.append("  diff drive: none")
+    for lidar in s["lidars"]:
+        lines.append(f"  lidar {lidar['name']} on {lidar['link']}: {lidar['samples']} samples "
+                     f"{lidar['min_angle']:.4g}..{lidar['max_angle']:.4g} rad, {lidar['range_min']}-"
+                     f"{lidar['range_max']} m, noise {lidar['noise_stddev']} m, {lidar['update_rate']} Hz -> "
+                     f"{lidar['topic']} [{lidar['frame_id']}]")
+    for imu in s["imus"]:
+        lines.append(f"  imu {imu['name']} on {imu['link']}: {imu['update_rate']} Hz -> {imu['topic']} "
+                     f"[{imu['frame_id']}]")
+    lines += [f"  warning: {w}" for w in s["warnings"]]
+    lines.append("  OK" if not s["warnings"] else f"  OK with {len(s['warnings'])} warning(s)")
+    return "\n".join(lines)
+
+
+def format_world(s: dict[str, Any]) -> str:
+    """Human-readable text of :func:`world_summary`."""
+    lines = [f"world {s['name']}  ({s['source']})",
+             f"  ground plane {'yes' if s['ground_plane'] else 'NO'}, gravity {s['gravity']}, "
+             f"step {s['max_step_size']} s",
+             f"  models ({len(s['models'])}):"]
+    for m in s["models"]:
+        x, y, z = m["pose"][:3]
+        lines.append(f"    {m['name']:<22} {'static' if m['static'] else 'dynamic':<8} at ({x:g}, {y:g}, {z:g}), "
+                     f"{m['links']} link(s), {m['collision_shapes']} collision shape(s) {', '.join(m['kinds'])}")
+        for mesh in m["non_convex_meshes"]:
+            lines.append(f"      concave collision mesh (decomposed for physics): {mesh}")
+    if s["extents"]:
+        lines.append(f"  extents x {s['extents']['x']} m, y {s['extents']['y']} m")
+    lines += [f"  warning: {w}" for w in s["warnings"]]
+    lines.append("  OK" if not s["warnings"] else f"  OK with {len(s['warnings'])} warning(s)")
+    return "\n".join(lines)
