@@ -1,0 +1,158 @@
+"""CARMEN log reader (``FLASER``, ``ODOM``, ``ROBOTLASER1``), as used by the Kümmerle et al. SLAM benchmark.
+
+Poses are (x m, y m, theta rad) in the log's odometry frame; timestamps are the IPC timestamps (s),
+which are the ones relations files refer to. Comment lines (``#``) and message types the reader does
+not use are ignored; lines of a used type that are truncated or malformed are skipped and counted
+(``CarmenLog.skipped``) with a one-line reason each.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from navlab.mapping.errors import MappingError
+
+NO_RETURN = 81.9  # SICK "no return" in CARMEN logs (81.91 m); such ranges carry no hit
+
+
+@dataclass
+class LaserScan2D:
+    """One laser scan with the odometry of the robot and the laser when it was taken.
+
+    ``ranges`` (m, float32); beam k at ``angle_min + k * angle_increment`` (rad) in the laser frame.
+    ``laser_pose`` / ``odom_pose``: (x, y, theta) of the laser / robot in the odometry frame.
+    """
+
+    timestamp: float
+    ranges: np.ndarray
+    angle_min: float
+    angle_increment: float
+    max_range: float
+    laser_pose: tuple[float, float, float]
+    odom_pose: tuple[float, float, float]
+    kind: str = "FLASER"
+
+    @property
+    def laser_offset(self) -> tuple[float, float, float]:
+        """Pose of the laser in the robot frame (x, y, theta)."""
+        rx, ry, rt = self.odom_pose
+        lx, ly, lt = self.laser_pose
+        c, s = math.cos(rt), math.sin(rt)
+        dx, dy = lx - rx, ly - ry
+        dt = (lt - rt + math.pi) % (2 * math.pi) - math.pi
+        return c * dx + s * dy, -s * dx + c * dy, dt
+
+
+@dataclass
+class OdomRecord:
+    """An ``ODOM`` line: robot pose (x, y, theta) in the odometry frame, velocities (m/s, rad/s)."""
+
+    timestamp: float
+    pose: tuple[float, float, float]
+    tv: float
+    rv: float
+
+
+@dataclass
+class CarmenLog:
+    """The scans and odometry of a CARMEN log, in file order, and what was skipped."""
+
+    path: Path | None
+    scans: list[LaserScan2D] = field(default_factory=list)
+    odometry: list[OdomRecord] = field(default_factory=list)
+    skipped: list[str] = field(default_factory=list)
+    ignored_types: dict[str, int] = field(default_factory=dict)
+
+    @property
+    def duration(self) -> float:
+        """Seconds between the first and the last scan."""
+        return self.scans[-1].timestamp - self.scans[0].timestamp if len(self.scans) > 1 else 0.0
+
+
+class _Bad(Exception):
+    """A malformed line; the message says why."""
+
+
+def _floats(tokens: list[str], start: int, count: int, what: str) -> list[float]:
+    if len(tokens) < start + count:
+        raise _Bad(f"{what}: {len(tokens)} fields, expected at least {start + count}")
+    try:
+        vals = [float(t) for t in tokens[start : start + count]]
+    except ValueError as exc:
+        raise _Bad(f"{what}: {exc}") from None
+    if not all(math.isfinite(v) for v in vals):
+        raise _Bad(f"{what}: non-finite number")
+    return vals
+
+
+def _parse_flaser(tok: list[str]) -> LaserScan2D:
+    n = int(_floats(tok, 1, 1, "FLASER count")[0])
+    if n <= 1:
+        raise _Bad(f"FLASER with {n} readings")
+    ranges = _floats(tok, 2, n, f"FLASER with {n} readings")
+    x, y, t, ox, oy, ot, ts = _floats(tok, 2 + n, 7, f"FLASER with {n} readings")
+    inc = math.pi / (n - 1) if n % 2 == 1 else math.pi / n  # 361 -> 0.5°, 180 -> 1°
+    return LaserScan2D(ts, np.array(ranges, np.float32), -math.pi / 2, inc, NO_RETURN, (x, y, t), (ox, oy, ot))
+
+
+def _parse_robotlaser1(tok: list[str]) -> LaserScan2D:
+    head = _floats(tok, 1, 8, "ROBOTLASER1 header")
+    _ltype, start, _fov, res, max_range, _acc, _rmode, n_f = head
+    n = int(n_f)
+    ranges = _floats(tok, 9, n, f"ROBOTLASER1 with {n} readings")
+    n_rem = int(_floats(tok, 9 + n, 1, "ROBOTLASER1 remission count")[0])
+    base = 10 + n + n_rem
+    lx, ly, lt, rx, ry, rt = _floats(tok, base, 6, "ROBOTLASER1 poses")
+    ts = _floats(tok, base + 11, 1, "ROBOTLASER1 timestamp")[0]
+    return LaserScan2D(
+        ts, np.array(ranges, np.float32), start, res, max_range, (lx, ly, lt), (rx, ry, rt), kind="ROBOTLASER1"
+    )
+
+
+def _parse_odom(tok: list[str]) -> OdomRecord:
+    x, y, t, tv, rv, _acc, ts = _floats(tok, 1, 7, "ODOM")
+    return OdomRecord(ts, (x, y, t), tv, rv)
+
+
+def read_carmen(path: str | os.PathLike[str], *, max_skipped_report: int = 5) -> CarmenLog:
+    """Read a CARMEN log; raise ``MappingError`` if it cannot be read or holds no laser scan."""
+    p = Path(path)
+    try:
+        fh = p.open("r", errors="replace")
+    except OSError as exc:
+        raise MappingError(f"cannot read CARMEN log {p}: {exc.strerror or exc}") from None
+    log = CarmenLog(p)
+    with fh:
+        for lineno, line in enumerate(fh, 1):
+            tok = line.split()
+            if not tok or tok[0].startswith("#"):
+                continue
+            kind = tok[0]
+            try:
+                if kind == "FLASER":
+                    log.scans.append(_parse_flaser(tok))
+                elif kind == "ROBOTLASER1":
+                    log.scans.append(_parse_robotlaser1(tok))
+                elif kind == "ODOM":
+                    log.odometry.append(_parse_odom(tok))
+                else:
+                    log.ignored_types[kind] = log.ignored_types.get(kind, 0) + 1
+            except (_Bad, ValueError) as exc:
+                log.skipped.append(f"{p.name}:{lineno}: skipped {kind} line ({exc})")
+    if not log.scans:
+        extra = f"; {len(log.skipped)} malformed lines, first: {log.skipped[0]}" if log.skipped else ""
+        raise MappingError(f"{p}: no FLASER or ROBOTLASER1 scans found{extra}")
+    return log
+
+
+def skipped_summary(log: CarmenLog, limit: int = 3) -> str:
+    """A short human message about skipped lines ('' if none)."""
+    if not log.skipped:
+        return ""
+    more = f" (and {len(log.skipped) - limit} more)" if len(log.skipped) > limit else ""
+    return f"skipped {len(log.skipped)} malformed line(s): " + "; ".join(log.skipped[:limit]) + more

@@ -1,0 +1,28 @@
+"""``navlab bench slam``: graph SLAM over the MIT CSAIL log, real-time factor on this machine."""
+
+from __future__ import annotations
+
+import argparse
+import time
+from pathlib import Path
+from typing import Any
+
+from navlab.mapping.errors import MappingError
+
+CSAIL = Path("/work/shared/datasets/mit-csail/mit-csail.clf")
+
+
+def run(args: argparse.Namespace) -> dict[str, Any]:
+    """Time ``run_offline`` (graph mode, including the final map) on the CSAIL log."""
+    from navlab.io.carmen import read_carmen
+    from navlab.mapping.scanmatch import warmup
+    from navlab.mapping.slam import run_offline
+
+    if not CSAIL.exists():
+        raise MappingError(f"benchmark log {CSAIL} not found")
+    log = read_carmen(CSAIL)
+    warmup()  # numba compilation is not part of the figure (it is cached on disk after the first run)
+    t0 = time.perf_counter()
+    run_offline(log, mode="graph", seed=getattr(args, "seed", 0))
+    wall = time.perf_counter() - t0
+    return {"log_seconds": round(log.duration, 3), "wall_seconds": round(wall, 3), "rtf": round(log.duration / wall, 2)}

@@ -1,0 +1,230 @@
+"""Graph SLAM: scan-to-local-map matching, loop closure and sparse pose-graph optimisation.
+
+Every scan becomes a node. The front end predicts the scan's pose from odometry, finds it with a
+correlative search on a smoothed hit grid of the recent scans, and refines it by point-to-line ICP.
+Every ``loop_every`` nodes, the back end looks for old nodes (far along the path, near in space),
+matches the scan against their scans with a coarse-to-fine correlative search and ICP, and, if the
+match is good, adds a robust edge and re-optimises the whole graph; an edge the optimised graph
+still disagrees with is dropped. Pure: numpy arrays in, poses out; no topics, no clock.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, fields
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from navlab.mapping.errors import MappingError
+from navlab.mapping.posegraph import PoseGraph
+from navlab.mapping.scanmatch import (
+    LookupField,
+    between,
+    compose,
+    correlative_search,
+    icp_point_to_line,
+    rotate_vectors,
+    scan_points,
+    transform_points,
+)
+
+
+@dataclass
+class GraphSlamParams:
+    """Parameters of the graph mode (lengths m, angles rad)."""
+
+    maxUrange: float = 30.0
+    voxel: float = 0.05  # one point per voxel of this size (m)
+    local_window: int = 15  # recent nodes in the local map
+    search_lin: float = 0.3  # correlative search half-window around the odometry prediction (m)
+    search_ang: float = math.radians(15.0)
+    search_ang_step: float = math.radians(0.5)
+    field_resolution: float = 0.05
+    field_sigma: float = 0.05
+    icp_max_dist: float = 0.3
+    icp_min_dist: float = 0.08
+    icp_iterations: int = 12
+    odom_jump_lin: float = 0.1  # odometry step this far from the last estimated step -> try other priors
+    odom_jump_ang: float = math.radians(8.0)
+    min_inliers: float = 0.3  # below this the front end trusts odometry instead of the match
+    seq_sigma_xy: float = 0.02  # std. dev. of a sequential edge (m)
+    seq_sigma_theta: float = math.radians(0.5)
+    loop_every: int = 5  # attempt a loop closure every N nodes
+    loop_min_travel: float = 8.0  # candidates must be this far back along the path (m)
+    loop_radius: float = 5.0  # ... and this near in space (m)
+    loop_window: int = 10  # candidate's neighbours (± nodes) in the loop map
+    loop_search_lin: float = 2.0
+    loop_search_ang: float = math.radians(12.0)
+    loop_min_inliers: float = 0.65
+    loop_max_rms: float = 0.04
+    loop_sigma_xy: float = 0.05
+    loop_sigma_theta: float = math.radians(1.0)
+    loop_kernel: float = 3.0  # Cauchy kernel width (Mahalanobis)
+    loop_reject: float = 6.0  # drop a loop edge whose optimised Mahalanobis error exceeds this
+
+    @classmethod
+    def from_dict(cls, values: dict[str, float] | None) -> GraphSlamParams:
+        """Parameters from a dict of overrides; unknown names raise ``MappingError`` with suggestions."""
+        import difflib
+
+        names = [f.name for f in fields(cls)]
+        out = cls()
+        for key, val in (values or {}).items():
+            if key not in names:
+                close = difflib.get_close_matches(key, names, n=1)
+                hint = f"; did you mean '{close[0]}'?" if close else ""
+                raise MappingError(f"unknown graph SLAM parameter '{key}'{hint}")
+            setattr(out, key, type(getattr(out, key))(val))
+        return out
+
+
+class GraphSlam:
+    """Incremental graph SLAM over laser scans; ``poses`` are laser poses (x, y, theta) in the map frame."""
+
+    def __init__(self, params: GraphSlamParams | None = None) -> None:
+        self.p = params or GraphSlamParams()
+        self.graph = PoseGraph()
+        self.node_xy: list[np.ndarray] = []
+        self.node_normals: list[np.ndarray] = []
+        self.odom: list[np.ndarray] = []
+        self.path_length: list[float] = []
+        self.loop_edges = 0
+        self.loop_rejected = 0
+        self.frontend_failures = 0
+        self.odom_jumps = 0
+        self.loop_log: list[tuple[int, int, float, float, float, float]] = []
+        self._last_loop_node = -(10**9)
+
+    @property
+    def poses(self) -> np.ndarray:
+        """Current estimate of every node's laser pose (N, 3)."""
+        return self.graph.poses
+
+    def _cloud(self, idx: range | list[int]) -> tuple[np.ndarray, np.ndarray]:
+        xy, nrm = [], []
+        for k in idx:
+            pose = self.graph.poses[k]
+            xy.append(transform_points(pose, self.node_xy[k]))
+            nrm.append(rotate_vectors(pose[2], self.node_normals[k]))
+        return np.concatenate(xy), np.concatenate(nrm)
+
+    def _match(
+        self, cloud: tuple[np.ndarray, np.ndarray], pts: np.ndarray, prior: np.ndarray, lin: float, ang: float
+    ) -> tuple[np.ndarray, float, float, float]:
+        """Correlative search then ICP; returns (pose, correlative score, ICP inlier fraction, ICP rms)."""
+        map_xy, map_n = cloud
+        p = self.p
+        if lin > 0.2 or ang > math.radians(4.0):  # coarse-to-fine for wide windows
+            coarse = LookupField(map_xy, resolution=0.1, sigma=0.1)
+            sub = pts[:: max(1, len(pts) // 120)]
+            prior, _ = correlative_search(
+                coarse, sub, prior, lin_window=lin, ang_window=ang, ang_step=math.radians(1.0)
+            )
+            lin, ang = 0.15, math.radians(1.5)
+        fine = LookupField(map_xy, resolution=p.field_resolution, sigma=p.field_sigma)
+        pose, score = correlative_search(fine, pts, prior, lin_window=lin, ang_window=ang, ang_step=p.search_ang_step)
+        res = icp_point_to_line(
+            cKDTree(map_xy),
+            map_xy,
+            map_n,
+            pts,
+            pose,
+            max_dist=p.icp_max_dist,
+            min_dist=p.icp_min_dist,
+            iterations=p.icp_iterations,
+        )
+        return res.pose, score, res.inlier_fraction, res.rms
+
+    def add_scan(
+        self,
+        ranges: np.ndarray,
+        angle_min: float,
+        angle_increment: float,
+        odom_pose: np.ndarray | tuple[float, float, float],
+    ) -> np.ndarray:
+        """Add a scan taken with the laser at ``odom_pose`` (odometry frame); returns its map-frame pose."""
+        p = self.p
+        odom = np.asarray(odom_pose, dtype=np.float64)
+        sp = scan_points(ranges, angle_min, angle_increment, range_max=p.maxUrange, voxel=p.voxel)
+        n = len(self.odom)
+        if n == 0:
+            pose = odom.copy()
+            self.path_length.append(0.0)
+        else:
+            step = between(self.odom[-1], odom)
+            prior = compose(self.graph.poses[-1], step)
+            pose = prior
+            if len(sp.xy) >= 10:
+                lo = max(0, n - p.local_window)
+                cloud = self._cloud(range(lo, n))
+                if len(cloud[0]) >= 10:
+                    priors = [prior]
+                    if n >= 2:
+                        # odometry sometimes freezes and then jumps: when its step disagrees with the last
+                        # estimated step, also try constant velocity and standing still
+                        last = between(self.graph.poses[-2], self.graph.poses[-1])
+                        jump = step - last
+                        if math.hypot(jump[0], jump[1]) > p.odom_jump_lin or abs(jump[2]) > p.odom_jump_ang:
+                            priors += [compose(self.graph.poses[-1], last), self.graph.poses[-1].copy()]
+                            self.odom_jumps += 1
+                    best = None
+                    for pr in priors:
+                        cand, score, inl, _rms = self._match(cloud, sp.xy, pr, p.search_lin, p.search_ang)
+                        if best is None or (inl, score) > (best[2], best[1]):
+                            best = (cand, score, inl)
+                    assert best is not None
+                    if best[2] >= p.min_inliers:
+                        pose = best[0]
+                    else:
+                        self.frontend_failures += 1
+            self.path_length.append(self.path_length[-1] + float(np.hypot(*step[:2])))
+        self.node_xy.append(sp.xy)
+        self.node_normals.append(sp.normals)
+        self.odom.append(odom)
+        k = self.graph.add_node(pose)
+        if k > 0:
+            info = np.diag([p.seq_sigma_xy**-2, p.seq_sigma_xy**-2, p.seq_sigma_theta**-2])
+            self.graph.add_edge(k - 1, k, between(self.graph.poses[k - 1], pose), info)
+            if k - self._last_loop_node >= p.loop_every and len(sp.xy) >= 30:
+                self._try_loop(k, sp.xy)
+        return self.graph.poses[k].copy()
+
+    def _try_loop(self, k: int, pts: np.ndarray) -> bool:
+        p = self.p
+        poses = self.graph.poses
+        travel = np.asarray(self.path_length)
+        far = np.flatnonzero(travel[k] - travel[:k] > p.loop_min_travel)
+        if len(far) == 0:
+            return False
+        d = np.hypot(poses[far, 0] - poses[k, 0], poses[far, 1] - poses[k, 1])
+        near = d < p.loop_radius
+        if not near.any():
+            return False
+        self._last_loop_node = k
+        c = int(far[near][np.argmin(d[near])])
+        lo, hi = max(0, c - p.loop_window), min(k - 1, c + p.loop_window + 1)
+        # only nodes that are themselves far back along the path
+        idx = [m for m in range(lo, hi) if travel[k] - travel[m] > p.loop_min_travel]
+        cloud = self._cloud(idx)
+        pose, _score, inl, rms = self._match(cloud, pts, poses[k].copy(), p.loop_search_lin, p.loop_search_ang)
+        if inl < p.loop_min_inliers or rms > p.loop_max_rms:
+            return False
+        info = np.diag([p.loop_sigma_xy**-2, p.loop_sigma_xy**-2, p.loop_sigma_theta**-2])
+        backup = self.graph.poses.copy()
+        self.graph.add_edge(c, k, between(poses[c], pose), info, robust=True)
+        self.graph.optimize(iterations=15, kernel=p.loop_kernel)
+        dist = self.graph.edge_distances()[-1]
+        if dist > p.loop_reject:
+            self.graph.remove_edge(len(self.graph.edges_i) - 1)
+            self.graph.poses = backup
+            self.loop_rejected += 1
+            return False
+        self.loop_edges += 1
+        self.loop_log.append((c, k, float(np.hypot(*(pose - backup[k])[:2])), float(pose[2] - backup[k][2]), inl, rms))
+        return True
+
+    def finish(self, iterations: int = 20) -> np.ndarray:
+        """Final optimisation of the whole graph; returns the poses (N, 3)."""
+        self.graph.optimize(iterations=iterations, kernel=self.p.loop_kernel)
+        return self.graph.poses.copy()

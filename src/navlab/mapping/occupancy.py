@@ -1,0 +1,140 @@
+"""Log-odds occupancy from laser scans at known poses (numba ray casting), and conversion to ``GridMap``.
+
+Each beam marks the cells it crosses as free and, when it hit something within ``max_urange``, its end
+cell as occupied (GMapping's ``maxUrange`` / ``maxRange`` semantics: beams at or beyond ``max_range``
+are no-returns; returns beyond ``max_urange`` only clear space up to ``max_urange``).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+
+from navlab.mapping.grid import GridMap
+
+L_OCC = 0.85  # log-odds increment of a hit
+L_FREE = -0.4  # log-odds increment of a traversed cell
+L_CLAMP = 5.0
+
+
+@numba.njit(cache=True)
+def _raycast(
+    logodds: np.ndarray,
+    ox: float,
+    oy: float,
+    res: float,
+    px: float,
+    py: float,
+    pt: float,
+    ranges: np.ndarray,
+    angles: np.ndarray,
+    max_urange: float,
+    max_range: float,
+    l_occ: float,
+    l_free: float,
+    clamp: float,
+) -> None:
+    h, w = logodds.shape
+    i0 = math.floor((px - ox) / res)
+    j0 = math.floor((py - oy) / res)
+    for k in range(ranges.shape[0]):
+        r = ranges[k]
+        if not (r > 0.0) or r >= max_range:
+            continue
+        hit = r < max_urange
+        if not hit:
+            r = max_urange
+        a = pt + angles[k]
+        ex = px + r * math.cos(a)
+        ey = py + r * math.sin(a)
+        i1 = math.floor((ex - ox) / res)
+        j1 = math.floor((ey - oy) / res)
+        # Bresenham from (i0, j0) to (i1, j1), excluding the end cell
+        di = abs(i1 - i0)
+        dj = abs(j1 - j0)
+        si = 1 if i1 > i0 else -1
+        sj = 1 if j1 > j0 else -1
+        err = di - dj
+        i, j = i0, j0
+        while i != i1 or j != j1:
+            if 0 <= i < w and 0 <= j < h:
+                v = logodds[j, i] + l_free
+                logodds[j, i] = v if v > -clamp else -clamp
+            e2 = 2 * err
+            if e2 > -dj:
+                err -= dj
+                i += si
+            if e2 < di:
+                err += di
+                j += sj
+        if hit and 0 <= i1 < w and 0 <= j1 < h:
+            v = logodds[j1, i1] + l_occ
+            logodds[j1, i1] = v if v < clamp else clamp
+
+
+def integrate_scan(
+    logodds: np.ndarray,
+    origin: tuple[float, float],
+    resolution: float,
+    laser_pose: np.ndarray,
+    ranges: np.ndarray,
+    angles: np.ndarray,
+    *,
+    max_urange: float,
+    max_range: float,
+) -> None:
+    """Add one scan (laser at ``laser_pose`` in the map frame) to a log-odds grid in place."""
+    _raycast(
+        logodds,
+        float(origin[0]),
+        float(origin[1]),
+        float(resolution),
+        float(laser_pose[0]),
+        float(laser_pose[1]),
+        float(laser_pose[2]),
+        np.ascontiguousarray(ranges, dtype=np.float64),
+        np.ascontiguousarray(angles, dtype=np.float64),
+        float(max_urange),
+        float(max_range),
+        L_OCC,
+        L_FREE,
+        L_CLAMP,
+    )
+
+
+def logodds_to_grid(
+    logodds: np.ndarray, resolution: float, origin: tuple[float, float], *, frame_id: str = "map"
+) -> GridMap:
+    """``GridMap`` from log-odds: untouched cells (0) unknown, else occupancy percent rounded."""
+    p = 1.0 - 1.0 / (1.0 + np.exp(logodds))
+    data = np.where(logodds == 0.0, -1, np.rint(p * 100.0)).astype(np.int8)
+    return GridMap(data, resolution, (float(origin[0]), float(origin[1]), 0.0), frame_id)
+
+
+def build_map(
+    laser_poses: np.ndarray,
+    scans: list[tuple[np.ndarray, np.ndarray]],
+    *,
+    resolution: float = 0.05,
+    max_urange: float = 30.0,
+    max_range: float = 80.0,
+    margin: float = 1.0,
+    frame_id: str = "map",
+) -> GridMap:
+    """Occupancy grid of ``scans`` ((ranges, angles) in the laser frame) taken at ``laser_poses`` (N, 3)."""
+    pts = [laser_poses[:, :2]]
+    for pose, (r, a) in zip(laser_poses, scans, strict=True):
+        ok = (r > 0) & (r < max_range)
+        rr = np.minimum(r[ok], max_urange)
+        pts.append(np.stack([pose[0] + rr * np.cos(pose[2] + a[ok]), pose[1] + rr * np.sin(pose[2] + a[ok])], 1))
+    allp = np.concatenate(pts)
+    lo = allp.min(axis=0) - margin
+    hi = allp.max(axis=0) + margin
+    w = math.ceil((hi[0] - lo[0]) / resolution)
+    h = math.ceil((hi[1] - lo[1]) / resolution)
+    logodds = np.zeros((h, w), dtype=np.float64)
+    for pose, (r, a) in zip(laser_poses, scans, strict=True):
+        integrate_scan(logodds, (lo[0], lo[1]), resolution, pose, r, a, max_urange=max_urange, max_range=max_range)
+    return logodds_to_grid(logodds, resolution, (float(lo[0]), float(lo[1])), frame_id=frame_id)

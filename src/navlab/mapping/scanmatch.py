@@ -1,0 +1,318 @@
+"""Scan-matching primitives shared by the SLAM modes (pure numpy/numba; poses are (x, y, theta)).
+
+- ``scan_points``: ranges -> points in the laser frame (m), with per-point normals from beam neighbours.
+- ``LookupField``: a smoothed hit grid over a point set; ``correlative_search`` finds the pose on a
+  (x, y, theta) lattice maximising the summed field at the transformed scan points (Olson 2009).
+- ``icp_point_to_line``: fine refinement against a point set with normals (Gauss-Newton, Huber).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numba
+import numpy as np
+from scipy.spatial import cKDTree
+
+
+def compose(a: np.ndarray | tuple, b: np.ndarray | tuple) -> np.ndarray:
+    """a ∘ b for planar poses (x, y, theta)."""
+    c, s = math.cos(a[2]), math.sin(a[2])
+    return np.array([a[0] + c * b[0] - s * b[1], a[1] + s * b[0] + c * b[1], _wrap(a[2] + b[2])])
+
+
+def inverse(a: np.ndarray | tuple) -> np.ndarray:
+    """a^-1 for a planar pose."""
+    c, s = math.cos(a[2]), math.sin(a[2])
+    return np.array([-c * a[0] - s * a[1], s * a[0] - c * a[1], -a[2]])
+
+
+def between(a: np.ndarray | tuple, b: np.ndarray | tuple) -> np.ndarray:
+    """a^-1 ∘ b: the pose of b in the frame of a."""
+    return compose(inverse(a), b)
+
+
+def _wrap(t: float) -> float:
+    return (t + math.pi) % (2.0 * math.pi) - math.pi
+
+
+def transform_points(pose: np.ndarray | tuple, pts: np.ndarray) -> np.ndarray:
+    """Points (N, 2) in a frame at ``pose`` -> points in the parent frame."""
+    c, s = math.cos(pose[2]), math.sin(pose[2])
+    out = np.empty_like(pts)
+    out[:, 0] = pose[0] + c * pts[:, 0] - s * pts[:, 1]
+    out[:, 1] = pose[1] + s * pts[:, 0] + c * pts[:, 1]
+    return out
+
+
+def rotate_vectors(theta: float, v: np.ndarray) -> np.ndarray:
+    """Rotate vectors (N, 2) by ``theta`` rad."""
+    c, s = math.cos(theta), math.sin(theta)
+    return np.stack([c * v[:, 0] - s * v[:, 1], s * v[:, 0] + c * v[:, 1]], axis=1)
+
+
+@dataclass
+class ScanPoints:
+    """Hit points of one scan in the laser frame: ``xy`` (N, 2) m, ``normals`` (N, 2) unit (0 if unknown)."""
+
+    xy: np.ndarray
+    normals: np.ndarray
+
+
+def scan_points(
+    ranges: np.ndarray,
+    angle_min: float,
+    angle_increment: float,
+    *,
+    range_min: float = 0.05,
+    range_max: float = 30.0,
+    voxel: float = 0.0,
+    normal_gap: float = 0.25,
+) -> ScanPoints:
+    """Valid hits (range_min < r < range_max) of a scan as laser-frame points with normals.
+
+    A normal comes from the two neighbouring beams when both are hits within ``normal_gap`` m;
+    ``voxel`` > 0 keeps one point per voxel of that size (m).
+    """
+    r = np.asarray(ranges, dtype=np.float64)
+    ang = angle_min + angle_increment * np.arange(len(r))
+    ok = np.isfinite(r) & (r > range_min) & (r < range_max)
+    xy = np.stack([r * np.cos(ang), r * np.sin(ang)], axis=1)
+    normals = np.zeros_like(xy)
+    prev_ok = np.zeros_like(ok)
+    next_ok = np.zeros_like(ok)
+    prev_ok[1:] = ok[:-1]
+    next_ok[:-1] = ok[1:]
+    tang = np.zeros_like(xy)
+    tang[1:-1] = xy[2:] - xy[:-2]
+    gap = np.zeros(len(r))
+    gap[1:-1] = np.hypot(tang[1:-1, 0], tang[1:-1, 1])
+    good = ok & prev_ok & next_ok & (gap > 1e-6) & (gap < 2 * normal_gap)
+    normals[good, 0] = -tang[good, 1] / gap[good]
+    normals[good, 1] = tang[good, 0] / gap[good]
+    xy, normals = xy[ok], normals[ok]
+    if voxel > 0 and len(xy):
+        keys = np.floor(xy / voxel).astype(np.int64)
+        _, first = np.unique(keys[:, 0] * 1_000_003 + keys[:, 1], return_index=True)
+        first.sort()
+        xy, normals = xy[first], normals[first]
+    return ScanPoints(xy, normals)
+
+
+# --- correlative search ----------------------------------------------------------------------------
+
+
+@numba.njit(cache=True)
+def _splat(pts: np.ndarray, ox: float, oy: float, res: float, w: int, h: int, kernel: np.ndarray) -> np.ndarray:
+    grid = np.zeros((h, w), dtype=np.float32)
+    k = kernel.shape[0] // 2
+    for n in range(pts.shape[0]):
+        ci = math.floor((pts[n, 0] - ox) / res)
+        cj = math.floor((pts[n, 1] - oy) / res)
+        for dj in range(-k, k + 1):
+            j = cj + dj
+            if j < 0 or j >= h:
+                continue
+            for di in range(-k, k + 1):
+                i = ci + di
+                if i < 0 or i >= w:
+                    continue
+                v = kernel[dj + k, di + k]
+                if v > grid[j, i]:
+                    grid[j, i] = v
+    return grid
+
+
+class LookupField:
+    """Max-of-Gaussians hit likelihood on a grid covering ``points`` (world frame) plus a margin."""
+
+    def __init__(self, points: np.ndarray, *, resolution: float = 0.05, sigma: float = 0.05, margin: float = 1.0):
+        lo = points.min(axis=0) - margin
+        hi = points.max(axis=0) + margin
+        self.resolution = resolution
+        self.origin = (float(lo[0]), float(lo[1]))
+        self.width = math.ceil((hi[0] - lo[0]) / resolution) + 1
+        self.height = math.ceil((hi[1] - lo[1]) / resolution) + 1
+        k = max(1, math.ceil(2.5 * sigma / resolution))
+        d = np.arange(-k, k + 1) * resolution
+        kernel = np.exp(-(d[None, :] ** 2 + d[:, None] ** 2) / (2 * sigma**2))
+        self.grid = _splat(
+            np.ascontiguousarray(points, dtype=np.float64),
+            self.origin[0],
+            self.origin[1],
+            resolution,
+            self.width,
+            self.height,
+            kernel,
+        )
+
+
+@numba.njit(cache=True)
+def _correlative(
+    grid: np.ndarray,
+    ox: float,
+    oy: float,
+    res: float,
+    pts: np.ndarray,
+    x0: float,
+    y0: float,
+    t0: float,
+    nlin: int,
+    lin_step: float,
+    nang: int,
+    ang_step: float,
+) -> tuple[float, float, float, float]:
+    h, w = grid.shape
+    best = -1.0
+    bx, by, bt = x0, y0, t0
+    n = pts.shape[0]
+    ri = np.empty(n, dtype=np.int64)
+    rj = np.empty(n, dtype=np.int64)
+    for a in range(-nang, nang + 1):
+        th = t0 + a * ang_step
+        c, s = math.cos(th), math.sin(th)
+        for k in range(n):
+            ri[k] = math.floor((x0 + c * pts[k, 0] - s * pts[k, 1] - ox) / res)
+            rj[k] = math.floor((y0 + s * pts[k, 0] + c * pts[k, 1] - oy) / res)
+        # a linear penalty keeps ties near the prior
+        for dj in range(-nlin, nlin + 1):
+            for di in range(-nlin, nlin + 1):
+                tot = 0.0
+                for k in range(n):
+                    i = ri[k] + di
+                    j = rj[k] + dj
+                    if 0 <= i < w and 0 <= j < h:
+                        tot += grid[j, i]
+                if tot > best:
+                    best = tot
+                    bx = x0 + di * lin_step
+                    by = y0 + dj * lin_step
+                    bt = th
+    return bx, by, bt, best / max(n, 1)
+
+
+def correlative_search(
+    field: LookupField,
+    pts: np.ndarray,
+    prior: np.ndarray,
+    *,
+    lin_window: float,
+    ang_window: float,
+    ang_step: float,
+) -> tuple[np.ndarray, float]:
+    """Best pose (x, y, theta) within ±lin_window m / ±ang_window rad of ``prior`` and its mean field score.
+
+    Translations step one field cell; ``pts`` are scan points (N, 2) in the laser frame.
+    """
+    nlin = max(0, round(lin_window / field.resolution))
+    nang = max(0, round(ang_window / ang_step))
+    bx, by, bt, score = _correlative(
+        field.grid,
+        field.origin[0],
+        field.origin[1],
+        field.resolution,
+        np.ascontiguousarray(pts, dtype=np.float64),
+        float(prior[0]),
+        float(prior[1]),
+        float(prior[2]),
+        nlin,
+        field.resolution,
+        nang,
+        ang_step,
+    )
+    return np.array([bx, by, _wrap(bt)]), float(score)
+
+
+# --- ICP ----------------------------------------------------------------------------------------------
+
+
+@dataclass
+class IcpResult:
+    """Refined pose, the fraction of scan points with a correspondence, and the RMS point-to-line residual (m)."""
+
+    pose: np.ndarray
+    inlier_fraction: float
+    rms: float
+    hessian: np.ndarray
+
+
+def icp_point_to_line(
+    tree: cKDTree,
+    map_xy: np.ndarray,
+    map_normals: np.ndarray,
+    scan_xy: np.ndarray,
+    init: np.ndarray,
+    *,
+    max_dist: float = 0.3,
+    min_dist: float = 0.1,
+    iterations: int = 12,
+    huber: float = 0.03,
+) -> IcpResult:
+    """Refine the pose of a scan (points ``scan_xy`` in its own frame) against map points with normals.
+
+    Correspondences are nearest neighbours within a radius shrinking from ``max_dist`` to ``min_dist``;
+    map points without a normal pair point-to-point.
+    """
+    pose = np.array(init, dtype=np.float64)
+    dist_sched = np.geomspace(max_dist, min_dist, max(iterations // 2, 1))
+    h = np.zeros((3, 3))
+    frac, rms = 0.0, float("inf")
+    for it in range(iterations):
+        dmax = dist_sched[min(it, len(dist_sched) - 1)]
+        world = transform_points(pose, scan_xy)
+        d, idx = tree.query(world, distance_upper_bound=dmax)
+        ok = np.isfinite(d)
+        frac = float(ok.mean()) if len(ok) else 0.0
+        if ok.sum() < 6:
+            break
+        p = world[ok]
+        q = map_xy[idx[ok]]
+        nrm = map_normals[idx[ok]]
+        has_n = (nrm[:, 0] != 0) | (nrm[:, 1] != 0)
+        # residuals: point-to-line where a normal exists, else two point-to-point rows
+        rel = p - np.array([pose[0], pose[1]])  # d(p)/dtheta = perp(rel)
+        dth = np.stack([-rel[:, 1], rel[:, 0]], axis=1)
+        diff = p - q
+        rows_j, rows_r = [], []
+        nn = nrm[has_n]
+        rows_r.append(np.einsum("ij,ij->i", diff[has_n], nn))
+        rows_j.append(np.stack([nn[:, 0], nn[:, 1], np.einsum("ij,ij->i", dth[has_n], nn)], axis=1))
+        pp = ~has_n
+        if pp.any():
+            for ax in (0, 1):
+                jj = np.zeros((pp.sum(), 3))
+                jj[:, ax] = 1.0
+                jj[:, 2] = dth[pp, ax]
+                rows_j.append(jj)
+                rows_r.append(diff[pp, ax])
+        jac = np.concatenate(rows_j)
+        res = np.concatenate(rows_r)
+        a = np.abs(res)
+        wts = np.where(a <= huber, 1.0, huber / np.maximum(a, 1e-12))
+        h = jac.T @ (jac * wts[:, None])
+        g = jac.T @ (wts * res)
+        rms = float(np.sqrt(np.mean(res**2)))
+        try:
+            delta = -np.linalg.solve(h + 1e-9 * np.eye(3), g)
+        except np.linalg.LinAlgError:
+            break
+        pose[0] += delta[0]
+        pose[1] += delta[1]
+        pose[2] = _wrap(pose[2] + delta[2])
+        # rotating about the origin of the world moved the scan; rotation was linearised about the pose
+        if it >= len(dist_sched) and abs(delta[0]) + abs(delta[1]) < 1e-4 and abs(delta[2]) < 1e-4:
+            break
+    return IcpResult(pose, frac, rms, h)
+
+
+def warmup() -> None:
+    """Compile the numba kernels on a tiny input (they are cached on disk afterwards)."""
+    pts = np.array([[1.0, 0.0], [1.0, 0.5], [0.5, 1.0]])
+    f = LookupField(pts)
+    correlative_search(f, pts, np.zeros(3), lin_window=0.1, ang_window=0.01, ang_step=0.01)
+    from navlab.mapping.occupancy import integrate_scan
+
+    integrate_scan(
+        np.zeros((4, 4)), (-0.1, -0.1), 0.05, np.zeros(3), np.ones(2), np.zeros(2), max_urange=1, max_range=2
+    )

@@ -1,0 +1,123 @@
+"""Offline SLAM over a laser log: run a SLAM mode scan by scan, then build the map and write results.
+
+``run_offline`` feeds every scan of a ``CarmenLog`` to the chosen mode (``graph``: scan-to-map
+matching with loop closure and pose-graph optimisation; ``gmapping``: the paper's Rao-Blackwellized
+particle filter), and returns robot poses per scan plus the occupancy grid. ``write_outputs`` writes
+``map.yaml``/``map.pgm`` (map_saver format), ``poses.txt`` (``timestamp x y theta``) and ``map.png``.
+"""
+
+from __future__ import annotations
+
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from navlab.io.carmen import CarmenLog
+from navlab.mapping.errors import MappingError
+from navlab.mapping.grid import GridMap
+from navlab.mapping.mapfile import save_map
+from navlab.mapping.occupancy import build_map
+from navlab.mapping.scanmatch import compose, inverse
+
+MODES = ("graph", "gmapping")
+
+
+@dataclass
+class SlamResult:
+    """Per-scan timestamps (s) and robot poses (N, 3) in the map frame, the map, and run statistics."""
+
+    timestamps: np.ndarray
+    poses: np.ndarray
+    laser_poses: np.ndarray
+    grid: GridMap
+    stats: dict[str, Any] = field(default_factory=dict)
+
+
+def make_slam(mode: str, params: dict[str, Any] | None = None, *, seed: int = 0) -> Any:
+    """A SLAM object with ``add_scan(ranges, angle_min, angle_increment, odom_pose)`` and ``finish()``."""
+    if mode == "graph":
+        from navlab.mapping.graph_slam import GraphSlam, GraphSlamParams
+
+        return GraphSlam(GraphSlamParams.from_dict(params))
+    if mode == "gmapping":
+        from navlab.mapping.gmapping import GMapping, GMappingParams
+
+        return GMapping(GMappingParams.from_dict(params), rng=np.random.default_rng(seed))
+    raise MappingError(f"unknown SLAM mode '{mode}', expected one of {', '.join(MODES)}")
+
+
+def run_offline(
+    log: CarmenLog,
+    *,
+    mode: str = "graph",
+    params: dict[str, Any] | None = None,
+    seed: int = 0,
+    resolution: float = 0.05,
+    map_max_urange: float = 30.0,
+    max_scans: int | None = None,
+    progress: bool = False,
+) -> SlamResult:
+    """Run SLAM over the log's scans (all, or the first ``max_scans``) and build the final map."""
+    from tqdm import tqdm
+
+    scans = log.scans[:max_scans] if max_scans else log.scans
+    slam = make_slam(mode, params, seed=seed)
+    for s in tqdm(scans, desc=f"slam ({mode})", unit="scan", disable=not progress, file=sys.stderr):
+        slam.add_scan(s.ranges, s.angle_min, s.angle_increment, s.laser_pose)
+    laser = np.asarray(slam.finish(), dtype=np.float64)
+    robot = np.array([compose(lp, inverse(s.laser_offset)) for lp, s in zip(laser, scans, strict=True)])
+    grid = build_map(
+        laser,
+        [(s.ranges.astype(np.float64), s.angle_min + s.angle_increment * np.arange(len(s.ranges))) for s in scans],
+        resolution=resolution,
+        max_urange=map_max_urange,
+        max_range=min(s.max_range for s in scans),
+    )
+    stats = {
+        k: v for k, v in vars(slam).items() if isinstance(v, int) and not isinstance(v, bool) and not k.startswith("_")
+    }
+    return SlamResult(np.array([s.timestamp for s in scans]), robot, laser, grid, stats)
+
+
+def save_figure(grid: GridMap, poses: np.ndarray, path: str | Path, *, title: str = "") -> None:
+    """PNG of the map (grey: unknown) with the trajectory in red; written atomically."""
+    import io
+
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from navlab.mapping.mapfile import atomic_write_bytes
+
+    img = np.where(grid.data < 0, 0.8, 1.0 - grid.data / 100.0)
+    x0, y0, x1, y1 = grid.bounds()
+    fig, ax = plt.subplots(figsize=(8, 8 * grid.height / max(grid.width, 1) + 0.5))
+    ax.imshow(img, cmap="gray", vmin=0, vmax=1, origin="lower", extent=(x0, x1, y0, y1), interpolation="nearest")
+    ax.plot(poses[:, 0], poses[:, 1], "r-", lw=0.7)
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    if title:
+        ax.set_title(title)
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=120, bbox_inches="tight")
+    plt.close(fig)
+    atomic_write_bytes(path, buf.getvalue())
+
+
+def write_outputs(result: SlamResult, out_dir: str | Path, *, title: str = "") -> dict[str, Path]:
+    """Write map.yaml, map.pgm, poses.txt and map.png into ``out_dir`` (created if needed)."""
+    from navlab.experiments.metrics import write_poses
+
+    out = Path(out_dir)
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise MappingError(f"cannot create output directory {out}: {exc.strerror or exc}") from None
+    image = save_map(result.grid, out / "map.yaml")
+    write_poses(out / "poses.txt", result.timestamps, result.poses)
+    save_figure(result.grid, result.poses, out / "map.png", title=title)
+    return {"yaml": out / "map.yaml", "image": image, "poses": out / "poses.txt", "figure": out / "map.png"}
