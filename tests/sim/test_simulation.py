@@ -139,3 +139,27 @@ def test_bad_input_is_a_clear_error() -> None:
     sim = Simulation(make_mybot(), make_room())
     with pytest.raises(SimError, match="wall_north"):
         sim.spawn(box_model("wall_north", 1.0, 1.0, (0.1, 0.1, 0.1)))
+
+
+def test_numba_lidar_matches_mj_multiray() -> None:
+    from dataclasses import replace
+
+    from navlab.description.model import Origin
+    from navlab.sim.spawn import primitive_model
+
+    robot = make_mybot(noise=0.0)
+    tilted = replace(robot.lidars[0], origin=Origin((0.0, 0.0, 0.0), (0.25, 0.1, 0.0)), name="tilted")
+    robot.lidars.append(tilted)  # looks down at the floor on one side, up on the other
+    sim = Simulation(robot, make_room(), seed=0, robot_pose=(-1.0, 0.5, 0.7))
+    sim.spawn(primitive_model("box", "crate", (0.4, 0.7, 0.5), x=1.0, y=1.5, yaw=0.6))
+    sim.spawn(primitive_model("cylinder", "drum", (0.3, 0.8), x=-3.0, y=-1.0))
+    sim.spawn(primitive_model("sphere", "ball", (0.3,), x=-1.0, y=-2.0, static=False))
+    sim.step(50)
+    for index in (0, 1):
+        fast = sim.true_ranges(index, backend="numba")
+        ref = sim.true_ranges(index, backend="mujoco")
+        assert np.array_equal(np.isinf(fast), np.isinf(ref))
+        both = np.isfinite(ref)
+        assert both.sum() > 500
+        np.testing.assert_allclose(fast[both], ref[both], atol=1e-9)
+    assert np.nanmin(np.where(np.isfinite(ref), ref, np.nan)) < 1.0  # the tilted lidar sees the floor

@@ -18,7 +18,7 @@ Conventions of the built model (what the simulator and the lidar rely on):
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import mujoco
 import numpy as np
@@ -66,7 +66,10 @@ class BuildInfo:
     lidar_sites: list[str] = field(default_factory=list)  # one per RobotModel.lidars entry
     imu_sites: list[str] = field(default_factory=list)  # one per RobotModel.imus entry
     wheel_actuators: tuple[str, str] | None = None  # (left, right) velocity actuators
-    world_bodies: dict[str, list[str]] = field(default_factory=dict)  # model name -> body names
+    #: model name -> (free body names, geom names welded to the world)
+    world_parts: dict[str, tuple[list[str], list[str]]] = field(default_factory=dict)
+    model_poses: dict[str, tuple[float, ...]] = field(default_factory=dict)  # model name -> SDF pose
+    visuals: bool = True  # build visual geoms (rendering only)
     warnings: list[str] = field(default_factory=list)
 
 
@@ -269,7 +272,7 @@ def add_robot(
                     radius, length = (float(v) for v in shape.geometry.size[:2])
                     g.type = mujoco.mjtGeom.mjGEOM_ELLIPSOID
                     g.size = np.array([radius, radius, length / 2])
-        shown = link.visuals or link.collisions
+        shown = (link.visuals or link.collisions) if info.visuals else []
         for i, shape in enumerate(shown):
             try:
                 g = geoms.add(body, shape, f"{where} visual {i}", **_VISUAL_PROPS)
@@ -372,48 +375,81 @@ def _add_wheel_motors(spec: mujoco.MjSpec, robot: RobotModel) -> tuple[str, str]
 
 
 def add_world_model(spec: mujoco.MjSpec, model: ModelSpec, info: BuildInfo) -> list[str]:
-    """Add one SDF model (static: welded to the world; dynamic: a free body per link); return body names."""
-    if model.name in info.world_bodies or model.name == info.robot_name:
+    """Add one SDF model; returns the names of what was added (geoms for static models, bodies otherwise).
+
+    Static models' geoms are welded straight onto the world body (few bodies keep MuJoCo's broad
+    phase and kinematics cheap); each dynamic link becomes a free body.
+    """
+    if model.name in info.world_parts or model.name == info.robot_name:
         raise SimError(f"a model named {model.name!r} already exists in the world")
     geoms = _Geoms(spec, info)
     x, y, z, roll, pitch, yaw = model.pose
     model_pose = Origin(xyz=(x, y, z), rpy=(roll, pitch, yaw))
     kind = "static" if model.static else "dynamic"
     props = _contact_props(kind, GROUP_WORLD)
-    names = []
+    bodies: list[str] = []
+    geom_names: list[str] = []
     for link in model.links:
         where = f"model {model.name!r} link {link.name!r}"
-        body = spec.worldbody.add_body(name=f"{model.name}::{link.name}")
-        _set_pose(body, _compose(model_pose, model.link_origins.get(link.name, Origin())))
-        if not model.static:
-            body.add_freejoint(name=f"{model.name}::{link.name}::free")
+        scoped = f"{model.name}::{link.name}"
+        link_pose = _compose(model_pose, model.link_origins.get(link.name, Origin()))
+        if model.static:
+            body = spec.worldbody
+
+            def place(shape: Shape, _pose: Origin = link_pose) -> Shape:
+                return replace(shape, origin=_compose(_pose, shape.origin))
+        else:
+            body = spec.worldbody.add_body(name=scoped)
+            _set_pose(body, link_pose)
+            body.add_freejoint(name=f"{scoped}::free")
             if link.inertial is not None:
                 _set_inertial(body, link, True, info, where)
+            bodies.append(scoped)
+
+            def place(shape: Shape) -> Shape:
+                return shape
         mu = DEFAULT_MU if link.mu1 is None else float(link.mu1)
         friction = np.array([mu, 0.005, 0.0001])
         for i, shape in enumerate(link.collisions):
             cwhere = f"{where} collision {i}"
-            extra: dict[str, object] = {"friction": friction}
+            extra: dict[str, object] = {"friction": friction, "name": f"{scoped}::collision{i}"}
             if not model.static and link.inertial is None:
                 extra["mass"] = 1.0 / len(link.collisions)  # Gazebo's default link mass: 1 kg
             if shape.geometry.kind == "mesh":
-                # the true triangles for rays; the hull (convex parts) for contacts
-                geoms.add(body, shape, cwhere, contype=0, conaffinity=0, group=GROUP_RAY_MESH, mass=0.0)
-                hull = {**props, "group": GROUP_WORLD_HULL}
-                geoms.add(body, shape, cwhere, **hull, **extra)
+                # the true triangles for rays; the hull for contacts
+                geoms.add(body, place(shape), cwhere, contype=0, conaffinity=0, group=GROUP_RAY_MESH, mass=0.0,
+                          name=f"{scoped}::ray{i}")
+                geom_names.append(f"{scoped}::ray{i}")
+                geoms.add(body, place(shape), cwhere, **{**props, "group": GROUP_WORLD_HULL}, **extra)
                 info.warnings.append(f"{cwhere}: mesh collides as its convex hull; rays hit its triangles")
             else:
-                geoms.add(body, shape, cwhere, **props, **extra)
+                geoms.add(body, place(shape), cwhere, **props, **extra)
+            geom_names.append(f"{scoped}::collision{i}")
+        if not info.visuals:
+            continue
         for i, shape in enumerate(link.visuals or link.collisions):
             try:
-                g = geoms.add(body, shape, f"{where} visual {i}", **_VISUAL_PROPS)
+                g = geoms.add(body, place(shape), f"{where} visual {i}", **_VISUAL_PROPS, name=f"{scoped}::visual{i}")
             except SimError as exc:
                 info.warnings.append(f"{exc}; visual skipped")
                 continue
             g.rgba = np.array(shape.rgba if shape.rgba is not None else (0.75, 0.72, 0.68, 1.0))
-        names.append(body.name)
-    info.world_bodies[model.name] = names
-    return names
+            geom_names.append(f"{scoped}::visual{i}")
+    info.world_parts[model.name] = (bodies, [] if bodies else geom_names)
+    info.model_poses[model.name] = model.pose
+    return bodies or geom_names
+
+
+def remove_world_model(spec: mujoco.MjSpec, name: str, info: BuildInfo) -> None:
+    """Delete a model added by :func:`add_world_model` from the spec."""
+    if name not in info.world_parts:
+        raise SimError(f"no model named {name!r}; models: {sorted(info.world_parts)}")
+    bodies, geoms = info.world_parts.pop(name)
+    info.model_poses.pop(name, None)
+    for body in bodies:
+        spec.delete(spec.body(body))
+    for geom in geoms:
+        spec.delete(spec.geom(geom))
 
 
 def _add_scenery(spec: mujoco.MjSpec, world: WorldModel) -> None:
@@ -430,7 +466,7 @@ def _add_scenery(spec: mujoco.MjSpec, world: WorldModel) -> None:
     if world.ground_plane:
         spec.worldbody.add_geom(name="ground_plane", type=mujoco.mjtGeom.mjGEOM_PLANE,
                                 size=np.array([0.0, 0.0, 1.0]), **_contact_props("static", GROUP_WORLD),
-                                rgba=np.array([0.0, 0.0, 0.0, 0.0]))
+                                rgba=np.array([0.5, 0.5, 0.5, 1.0]))  # mj_ray skips transparent geoms
         spec.worldbody.add_geom(name="ground_plane_visual", type=mujoco.mjtGeom.mjGEOM_PLANE,
                                 size=np.array([50.0, 50.0, 1.0]), material="grid", **_VISUAL_PROPS)
 
@@ -441,10 +477,12 @@ def build_spec(
     *,
     timestep: float | None = None,
     robot_pose: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0),
+    visuals: bool = True,
 ) -> tuple[mujoco.MjSpec, BuildInfo]:
     """The MuJoCo spec of ``world`` with ``robot`` at ``robot_pose`` (x, y, z, yaw), and its names.
 
-    ``timestep`` (s) defaults to the world's ``max_step_size`` and must lie in [0.5 ms, 2 ms].
+    ``timestep`` (s) defaults to the world's ``max_step_size`` and must lie in [0.5 ms, 2 ms];
+    ``visuals=False`` leaves out the render-only geoms (faster stepping).
     """
     step = world.max_step_size if timestep is None else timestep
     if not MIN_STEP <= step <= MAX_STEP:
@@ -455,7 +493,7 @@ def build_spec(
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
     spec.compiler.degree = False
     spec.compiler.autolimits = True
-    info = BuildInfo()
+    info = BuildInfo(visuals=visuals)
     _add_scenery(spec, world)
     if robot is not None:
         add_robot(spec, robot, info, robot_pose)

@@ -13,8 +13,18 @@ import mujoco
 import numpy as np
 
 from navlab.description.model import DiffDriveConfig, LidarConfig, RobotModel
-from navlab.sim.builder import GROUP_ROBOT, RAY_GEOMGROUP, add_world_model, build_spec, compile_spec
+from navlab.sim.builder import (
+    GROUP_ROBOT,
+    GROUP_WORLD,
+    RAY_GEOMGROUP,
+    add_world_model,
+    build_spec,
+    compile_spec,
+    quat_from_rpy,
+    remove_world_model,
+)
 from navlab.sim.errors import SimError
+from navlab.sim.raycast import FAST_TYPES, cast_planar
 from navlab.world.model import ModelSpec, WorldModel
 
 SPAWN_GAP = 0.0005  # m between the robot's lowest point and the floor when it is placed
@@ -49,7 +59,8 @@ class Simulation:
     ``robot_pose`` = (x, y, yaw) of the robot's root link in the world (m, rad); the robot is placed
     with its lowest collision point on the floor. ``seed`` (int or ``numpy.random.Generator``) drives
     sensor noise when no generator is passed to a sensor call. ``timestep`` (s) defaults to the
-    world's ``max_step_size``.
+    world's ``max_step_size``. ``visuals=False`` builds no render-only geoms (faster).
+    ``lidar_backend``: "numba" (fast planar caster for primitives) or "mujoco" (``mj_multiRay``).
     """
 
     def __init__(
@@ -60,17 +71,24 @@ class Simulation:
         seed: int | np.random.Generator = 0,
         timestep: float | None = None,
         robot_pose: tuple[float, float, float] = (0.0, 0.0, 0.0),
+        visuals: bool = True,
+        lidar_backend: str = "numba",
     ) -> None:
+        if lidar_backend not in ("numba", "mujoco"):
+            raise SimError(f"lidar_backend must be 'numba' or 'mujoco', got {lidar_backend!r}")
         self.robot = robot
         self.world = world
+        self.lidar_backend = lidar_backend
         self.rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
         x, y, yaw = robot_pose
-        self.spec, self.info = build_spec(robot, world, timestep=timestep, robot_pose=(x, y, 0.0, yaw))
+        self.spec, self.info = build_spec(
+            robot, world, timestep=timestep, robot_pose=(x, y, 0.0, yaw), visuals=visuals
+        )
         self.model = compile_spec(self.spec, f"world {world.name!r}")
         self.data = mujoco.MjData(self.model)
         self.dt_ns = round(self.model.opt.timestep * 1e9)
         self.time_ns = 0
-        self._lidar_dirs: dict[int, np.ndarray] = {}
+        self._lidar_dirs: dict[int, np.ndarray] = {}  # lidar -> (2, n) cos, sin of its beams
         self._refresh_ids()
         if robot is not None:
             self._place_on_floor()
@@ -83,6 +101,14 @@ class Simulation:
         self._act = [name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, n) for n in (self.info.wheel_actuators or ())]
         self._lidar_site = [name2id(m, mujoco.mjtObj.mjOBJ_SITE, n) for n in self.info.lidar_sites]
         self._imu_site = [name2id(m, mujoco.mjtObj.mjOBJ_SITE, n) for n in self.info.imu_sites]
+        in_rays = RAY_GEOMGROUP[np.clip(m.geom_group, 0, 5)].astype(bool) & (m.geom_group < 6)
+        fast = in_rays & np.isin(m.geom_type, FAST_TYPES) & (m.geom_group == GROUP_WORLD)
+        self._ray_fast = np.flatnonzero(fast).astype(np.int32)
+        slow = np.unique(m.geom_group[in_rays & ~fast])
+        self._ray_slow_groups = None
+        if len(slow):
+            self._ray_slow_groups = np.zeros(6, dtype=np.uint8)
+            self._ray_slow_groups[slow] = 1
         self._body = {link: name2id(m, mujoco.mjtObj.mjOBJ_BODY, b) for link, b in self.info.link_bodies.items()}
         self._joints: dict[str, tuple[int, int]] = {}
         if self.robot is not None:
@@ -204,33 +230,56 @@ class Simulation:
         if self.robot is None or not 0 <= index < len(self.robot.lidars):
             raise SimError(f"no lidar number {index} on this robot")
         cfg = self.robot.lidars[index]
-        m, d = self.model, self.data
-        site = self._lidar_site[index]
-        local = self._lidar_dirs.get(index)
-        if local is None:
-            angles = lidar_angles(cfg)
-            local = np.stack([np.cos(angles), np.sin(angles), np.zeros_like(angles)], axis=1)
-            self._lidar_dirs[index] = local
-        n = len(local)
-        vec = local @ d.site_xmat[site].reshape(3, 3).T
-        pnt = d.site_xpos[site].copy()
-        dist = np.empty(n)
-        geomid = np.empty(n, dtype=np.int32)
-        mujoco.mj_multiRay(m, d, pnt, vec.ravel(), RAY_GEOMGROUP, 1, -1, geomid, dist, None, n, cfg.range_max)
-        dist[geomid < 0] = np.inf
-        close = np.flatnonzero(dist < cfg.range_min)
-        if len(close):
-            one = np.empty(1, dtype=np.int32)
-            for i in close:  # Gazebo's rays begin at range_min: look past what is closer
-                r = mujoco.mj_ray(m, d, pnt + cfg.range_min * vec[i], vec[i], RAY_GEOMGROUP, 1, -1, one)
-                dist[i] = cfg.range_min + r if r >= 0 else np.inf
-        dist[dist > cfg.range_max] = np.inf
+        dist = self.true_ranges(index)
+        n = len(dist)
         gen = self.rng if rng is None else rng
         if cfg.noise_stddev > 0 or cfg.noise_mean != 0:
             noise = gen.normal(cfg.noise_mean, cfg.noise_stddev, n) if cfg.noise_stddev > 0 else cfg.noise_mean
             hit = np.isfinite(dist)
             dist[hit] = np.clip(dist[hit] + np.broadcast_to(noise, (n,))[hit], cfg.range_min, cfg.range_max)
         return dist.astype(np.float32)
+
+    def true_ranges(self, index: int = 0, *, backend: str | None = None) -> np.ndarray:
+        """Noise-free ranges (m, float64) of lidar ``index``; ``backend`` "numba" (primitives by
+        :mod:`navlab.sim.raycast`, meshes by ``mj_multiRay``) or "mujoco" (all by ``mj_multiRay``)."""
+        assert self.robot is not None
+        cfg = self.robot.lidars[index]
+        m, d = self.model, self.data
+        site = self._lidar_site[index]
+        angles = self._lidar_dirs.get(index)
+        if angles is None:
+            a = lidar_angles(cfg)
+            angles = np.ascontiguousarray(np.stack([np.cos(a), np.sin(a)]))
+            self._lidar_dirs[index] = angles
+        n = angles.shape[1]
+        rot = d.site_xmat[site].reshape(3, 3)
+        pnt = d.site_xpos[site].copy()
+        if (backend or self.lidar_backend) == "mujoco":
+            return self._multiray(cfg, rot, pnt, angles, RAY_GEOMGROUP)
+        dist = np.empty(n)
+        inc = (cfg.max_angle - cfg.min_angle) / (n - 1) if n > 1 else 0.0
+        cast_planar(pnt, rot, angles[0], angles[1], cfg.min_angle, inc, self._ray_fast, m.geom_type,
+                    m.geom_size, d.geom_xpos, d.geom_xmat, cfg.range_min, cfg.range_max, dist)
+        if self._ray_slow_groups is not None:
+            np.minimum(dist, self._multiray(cfg, rot, pnt, angles, self._ray_slow_groups), out=dist)
+        return dist
+
+    def _multiray(
+        self, cfg: LidarConfig, rot: np.ndarray, pnt: np.ndarray, angles: np.ndarray, groups: np.ndarray
+    ) -> np.ndarray:
+        m, d = self.model, self.data
+        n = angles.shape[1]
+        vec = angles.T @ rot[:, :2].T
+        dist = np.empty(n)
+        geomid = np.empty(n, dtype=np.int32)
+        mujoco.mj_multiRay(m, d, pnt, vec.ravel(), groups, 1, -1, geomid, dist, None, n, cfg.range_max)
+        dist[geomid < 0] = np.inf
+        one = np.empty(1, dtype=np.int32)
+        for i in np.flatnonzero(dist < cfg.range_min):  # Gazebo's rays begin at range_min: look past
+            r = mujoco.mj_ray(m, d, pnt + cfg.range_min * vec[i], vec[i], groups, 1, -1, one)
+            dist[i] = cfg.range_min + r if r >= 0 else np.inf
+        dist[dist > cfg.range_max] = np.inf
+        return dist
 
     def imu(
         self, index: int = 0, rng: np.random.Generator | None = None
@@ -253,29 +302,30 @@ class Simulation:
     # --- spawning ---------------------------------------------------------------------------------
 
     def spawn(self, model: ModelSpec) -> list[str]:
-        """Add an SDF model to the running world (state of everything else kept); returns its body names."""
-        bodies = add_world_model(self.spec, model, self.info)
+        """Add an SDF model to the running world (state of everything else kept); returns its parts' names."""
+        parts = add_world_model(self.spec, model, self.info)
         self._recompile(f"model {model.name!r}")
-        return bodies
+        return parts
 
     def remove(self, name: str) -> None:
         """Delete a model (by its SDF name) from the running world."""
-        if name not in self.info.world_bodies:
-            raise SimError(f"no model named {name!r}; models: {sorted(self.info.world_bodies)}")
-        for body in self.info.world_bodies.pop(name):
-            self.spec.delete(self.spec.body(body))
+        remove_world_model(self.spec, name, self.info)
         self._recompile(f"world after removing {name!r}")
 
     def model_names(self) -> list[str]:
         """Names of the world's models (not the robot)."""
-        return list(self.info.world_bodies)
+        return list(self.info.world_parts)
 
     def model_pose(self, name: str) -> Pose3D:
-        """World pose of a model's first link."""
-        if name not in self.info.world_bodies:
-            raise SimError(f"no model named {name!r}")
-        b = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, self.info.world_bodies[name][0])
-        return Pose3D(self.data.xpos[b].copy(), self.data.xquat[b].copy())
+        """World pose of a model (its first link's body for dynamic models, its SDF pose if static)."""
+        if name not in self.info.world_parts:
+            raise SimError(f"no model named {name!r}; models: {sorted(self.info.world_parts)}")
+        bodies, _ = self.info.world_parts[name]
+        if bodies:
+            b = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, bodies[0])
+            return Pose3D(self.data.xpos[b].copy(), self.data.xquat[b].copy())
+        x, y, z, roll, pitch, yaw = self.info.model_poses[name]
+        return Pose3D(np.array([x, y, z]), quat_from_rpy((roll, pitch, yaw)))
 
     def _recompile(self, what: str) -> None:
         ctrl = {n: self.data.ctrl[i] for n, i in zip(self.info.wheel_actuators or (), self._act, strict=False)}
