@@ -291,17 +291,30 @@ def prepare_mesh(path: Path, where: str) -> tuple[Path, float]:
     return path, 1.0
 
 
-def is_convex(verts: np.ndarray, *, rel_tol: float = 1e-3) -> bool:
-    """True if every vertex lies on the convex hull's surface (so the hull is the shape).
+def is_convex(verts: np.ndarray, faces: np.ndarray | None = None, *, rel_tol: float = 1e-3) -> bool:
+    """True if the mesh is its own convex hull (so a convex collision shape is exact).
 
-    Flat or degenerate vertex sets count as convex.
+    With ``faces``: every vertex lies on one side of every face plane (a convex polyhedron). Without:
+    every vertex lies on the hull surface. Flat or degenerate meshes count as convex.
     """
     if len(verts) < 4:
+        return True
+    tol = rel_tol * float(np.ptp(verts, axis=0).max() or 1.0)
+    if faces is not None and len(faces):
+        tri = verts[faces[:: max(1, len(faces) // 20000)]]
+        normals = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+        norms = np.linalg.norm(normals, axis=1)
+        ok = norms > 1e-12
+        normals, origin = normals[ok] / norms[ok, None], tri[ok, 0]
+        for start in range(0, len(normals), 256):
+            n, o = normals[start : start + 256], origin[start : start + 256]
+            d = verts @ n.T - np.einsum("ij,ij->i", n, o)  # (V, chunk)
+            if ((d.max(axis=0) > tol) & (d.min(axis=0) < -tol)).any():
+                return False
         return True
     try:
         hull = ConvexHull(verts)
     except QhullError:
         return True
-    tol = rel_tol * float(np.ptp(verts, axis=0).max() or 1.0)
     depth = (verts @ hull.equations[:, :3].T + hull.equations[:, 3]).max(axis=1)  # <= 0 inside
     return bool((depth >= -tol).all())

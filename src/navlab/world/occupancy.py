@@ -21,7 +21,7 @@ from navlab.world.model import WorldModel
 from navlab.world.transforms import to_matrix
 
 _PRISM_SIDES = 32
-_EPS = 1e-9
+_EPS = 1e-6  # m: overlaps thinner than this (rounding at cell borders) do not count
 
 
 @dataclass(frozen=True)

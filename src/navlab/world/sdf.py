@@ -273,7 +273,7 @@ class _Loader:
         try:
             named = self.index.resolve_uri(uri, base_dir=file.parent, model_paths=self.model_paths)
             sim_path, unit = prepare_mesh(named, where)
-            convex = is_convex(read_mesh(sim_path)[0]) if collision else None
+            convex = is_convex(*read_mesh(sim_path)) if collision else None
         except DescriptionError as exc:
             raise WorldError(str(exc)) from None
         return Geometry("mesh", mesh_path=sim_path, mesh_scale=(scale[0] * unit, scale[1] * unit, scale[2] * unit),
