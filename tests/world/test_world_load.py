@@ -159,3 +159,20 @@ def test_shipped_world_walls_match_their_xml():
         x, y, z, _, _, yaw = (float(v) for v in link.findtext("pose").split())
         o = origins[link.get("name")]
         assert o.xyz == pytest.approx((x, y, z)) and math.isclose(o.rpy[2], yaw, abs_tol=1e-12)
+
+
+def test_load_model_for_spawning(tmp_path):
+    from navlab.world import load_model
+
+    models = FIX / "models"
+    by_dir = load_model(models / "l_wall")
+    by_file = load_model(models / "l_wall" / "model.sdf")
+    by_uri = load_model("model://inch_box", model_path=[models])
+    assert by_dir.name == by_file.name == "l_wall" and by_dir.static
+    assert by_dir.links[0].collisions[0].geometry.convex is False
+    assert by_uri.links[0].collisions[0].geometry.mesh_scale == pytest.approx((0.0254,) * 3)
+    with pytest.raises(WorldError, match="not found"):
+        load_model(tmp_path / "nothing")
+    (tmp_path / "light.sdf").write_text('<sdf version="1.6"><light name="l" type="point"/></sdf>')
+    with pytest.raises(WorldError, match=r"light\.sdf: no <model>"):
+        load_model(tmp_path / "light.sdf")

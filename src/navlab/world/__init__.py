@@ -8,6 +8,6 @@
 from navlab.world.errors import WorldError
 from navlab.world.model import ModelSpec, WorldModel
 from navlab.world.occupancy import occupancy, shape_footprints
-from navlab.world.sdf import load_world
+from navlab.world.sdf import load_model, load_world
 
-__all__ = ["ModelSpec", "WorldError", "WorldModel", "load_world", "occupancy", "shape_footprints"]
+__all__ = ["ModelSpec", "WorldError", "WorldModel", "load_model", "load_world", "occupancy", "shape_footprints"]

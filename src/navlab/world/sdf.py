@@ -355,3 +355,30 @@ def load_world(path: str | os.PathLike[str], *, model_path: Iterable[str | os.Pa
     if not world.ground_plane:
         world.warnings.append(f"{file}: no ground plane (include model://ground_plane); things will fall")
     return world
+
+
+def load_model(path: str | os.PathLike[str], *, model_path: Iterable[str | os.PathLike[str]] = ()) -> ModelSpec:
+    """Load one SDF model: a ``model.sdf`` file, a Gazebo model directory (with ``model.config``) or
+    a ``model://name`` URI found through the model path (for spawning at run time).
+
+    The model keeps the pose written in its file; callers place it. Raises WorldError naming the file.
+    """
+    text = str(path)
+    base = Path.cwd()
+    loader = _Loader(default_model_paths(model_path, base / "_"))
+    where = f"model {text!r}"
+    target = loader.find_model_dir(text, base, where) if text.startswith("model://") else Path(text).expanduser()
+    if not target.exists():
+        raise WorldError(f"{target}: SDF model file or directory not found")
+    sdf_file = loader.model_sdf_file(target.resolve(), where)
+    root = _parse_xml(sdf_file, "model SDF")
+    model_el = root.find("model") if root.tag == "sdf" else (root if root.tag == "model" else None)
+    if model_el is None:
+        world_el = root.find("world")
+        model_el = world_el.find("model") if world_el is not None else None
+    if model_el is None:
+        raise WorldError(f"{sdf_file}: no <model> element (expected <sdf><model name=...>)")
+    models = loader.model(model_el, sdf_file)
+    if not models:
+        raise WorldError(f"{sdf_file}: <model name=\"{model_el.get('name')}\"> has no links with shapes")
+    return models[0]
