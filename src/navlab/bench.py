@@ -16,6 +16,7 @@ BENCHES: dict[str, str] = {
     "slam": "navlab.mapping.bench:run",
     "core": "navlab.core.bench:run",
     "amcl": "navlab.localization.bench:run",
+    "description": "navlab.description.bench:run",
 }
 
 
