@@ -17,6 +17,7 @@ BENCHES: dict[str, str] = {
     "core": "navlab.core.bench:run",
     "amcl": "navlab.localization.bench:run",
     "description": "navlab.description.bench:run",
+    "sim": "navlab.sim.bench:run",
 }
 
 

@@ -35,19 +35,25 @@ GROUP_WORLD_HULL = 4
 #: geom groups a lidar ray can hit (mj_multiRay's geomgroup filter)
 RAY_GEOMGROUP = np.array([1, 0, 0, 1, 0, 0], dtype=np.uint8)
 
-_BIT_STATIC, _BIT_ROBOT, _BIT_DYNAMIC = 1, 2, 4
+# contact bits: a pair touches when (contype1 & conaffinity2) or (contype2 & conaffinity1)
+_STATIC, _ROBOT, _DYNAMIC, _GROUND, _WHEEL_FLOOR, _WHEEL = 1, 2, 4, 8, 16, 32
 _CONTACT_BITS = {
-    "static": (_BIT_STATIC, _BIT_ROBOT | _BIT_DYNAMIC),
-    "robot": (_BIT_ROBOT, _BIT_STATIC | _BIT_DYNAMIC),
-    "dynamic": (_BIT_DYNAMIC, _BIT_STATIC | _BIT_ROBOT | _BIT_DYNAMIC),
+    "static": (_STATIC, _ROBOT | _DYNAMIC | _WHEEL),
+    "ground": (_GROUND, _ROBOT | _DYNAMIC | _WHEEL_FLOOR),
+    "robot": (_ROBOT, _STATIC | _DYNAMIC | _GROUND),
+    "wheel": (_WHEEL, _STATIC | _DYNAMIC),  # a wheel's true cylinder: obstacles, not the floor
+    "wheel_floor": (_WHEEL_FLOOR, _GROUND),  # its floor contact (see WHEEL_FLOOR_SPHERES)
+    "dynamic": (_DYNAMIC, _STATIC | _ROBOT | _DYNAMIC | _GROUND | _WHEEL),
 }
 #: velocity-actuator gain of the wheel motors (N m s/rad); ODE's joint motor is a hard velocity
 #: constraint capped by fmax, approximated here by a stiff implicit damper capped by forcerange.
 WHEEL_KV = 50.0
-#: WHEELS_AS_ELLIPSOIDS: a robot cylinder spinning about its own axis (a wheel) collides as the
-#: ellipsoid inscribed in it. MuJoCo's cylinder-plane contact puts points on both rim edges; the outer
-#: edge then sets the turning rate (7 % slow on mybot) and the flat rim bounces. The ellipsoid touches
-#: the floor in one point at mid-tread, like a wheel's contact patch.
+#: WHEEL_FLOOR_SPHERES: a robot cylinder spinning about its own axis (a wheel) touches the floor through
+#: a sphere of its radius at its centre, and everything else through its true cylinder. MuJoCo's
+#: cylinder-plane contact puts points on both rim edges; the outer edge then sets the turning rate
+#: (7 % slow on mybot) and the flat rim bounces. The sphere touches the floor in one point at
+#: mid-tread, like a wheel's contact patch, and sphere-plane is MuJoCo's cheapest collision (an
+#: inscribed ellipsoid does the same through the general convex collider at ~4x the step cost).
 #: contact softness for the robot (time constant s, damping ratio): critically damped, no bounce
 ROBOT_SOLREF = (0.005, 1.0)
 ROBOT_SOLIMP = (0.95, 0.99, 0.001, 0.5, 2.0)
@@ -268,10 +274,12 @@ def add_robot(
                           condim=condim, **contact)
             if shape.geometry.kind == "cylinder" and axis is not None:
                 cyl_axis = mat_from_rpy(shape.origin.rpy)[:, 2]
-                if abs(float(cyl_axis @ axis)) > 0.99:  # a wheel: see WHEELS_AS_ELLIPSOIDS
-                    radius, length = (float(v) for v in shape.geometry.size[:2])
-                    g.type = mujoco.mjtGeom.mjGEOM_ELLIPSOID
-                    g.size = np.array([radius, radius, length / 2])
+                if abs(float(cyl_axis @ axis)) > 0.99:  # a wheel: see WHEEL_FLOOR_SPHERES
+                    g.contype, g.conaffinity = _CONTACT_BITS["wheel"]
+                    floor = Shape(Geometry("sphere", (float(shape.geometry.size[0]),)), origin=shape.origin)
+                    f = geoms.add(body, floor, f"{where} collision {i}", friction=np.array([mu, 0.005, 0.0001]),
+                                  condim=condim, **contact)
+                    f.contype, f.conaffinity = _CONTACT_BITS["wheel_floor"]
         shown = (link.visuals or link.collisions) if info.visuals else []
         for i, shape in enumerate(shown):
             try:
@@ -465,7 +473,7 @@ def _add_scenery(spec: mujoco.MjSpec, world: WorldModel) -> None:
                              dir=np.array([0.3, 0.2, -1.0]), diffuse=np.array([0.6, 0.6, 0.6]))
     if world.ground_plane:
         spec.worldbody.add_geom(name="ground_plane", type=mujoco.mjtGeom.mjGEOM_PLANE,
-                                size=np.array([0.0, 0.0, 1.0]), **_contact_props("static", GROUP_WORLD),
+                                size=np.array([0.0, 0.0, 1.0]), **_contact_props("ground", GROUP_WORLD),
                                 rgba=np.array([0.5, 0.5, 0.5, 1.0]))  # mj_ray skips transparent geoms
         spec.worldbody.add_geom(name="ground_plane_visual", type=mujoco.mjtGeom.mjGEOM_PLANE,
                                 size=np.array([50.0, 50.0, 1.0]), material="grid", **_VISUAL_PROPS)

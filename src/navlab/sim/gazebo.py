@@ -44,7 +44,8 @@ class GazeboSim(Node):
     """Gazebo in a node. Parameters: ``world`` (shipped name or file, default ``room``), ``robot``
     (default ``mybot``), ``x``/``y``/``yaw`` (spawn pose, m/rad), ``timestep`` (s; 0 = the world's
     ``max_step_size``), ``joint_state_rate`` and ``ground_truth_rate`` (Hz; 0 = off), ``seed``
-    (sensor noise seed; -1 = the executor's). ``robot_model``/``world_model`` replace the files."""
+    (sensor noise seed; -1 = the executor's), ``visuals`` (build render-only geoms; default off, faster).
+    ``robot_model``/``world_model`` replace the files."""
 
     def __init__(self, executor: Executor, *, name: str = "gazebo", parameters: dict[str, Any] | None = None,
                  namespace: str = "", robot_model: RobotModel | None = None,
@@ -58,11 +59,13 @@ class GazeboSim(Node):
         js_rate = self.declare_parameter("joint_state_rate", 30.0)
         gt_rate = self.declare_parameter("ground_truth_rate", 50.0)
         seed = self.declare_parameter("seed", -1)
+        visuals = self.declare_parameter("visuals", False)
         robot = robot_model if robot_model is not None else load_robot_named(robot_name)
         world = world_model if world_model is not None else load_world_named(world_name)
         for warning in [*robot.warnings, *world.warnings]:
             self.get_logger().warning(warning)
-        self.sim = Simulation(robot, world, seed=self.rng, timestep=timestep or None, robot_pose=pose)
+        self.sim = Simulation(robot, world, seed=self.rng, timestep=timestep or None, robot_pose=pose,
+                              visuals=visuals)
         self.sim.advance_to(executor.now_ns)
         for warning in self.sim.info.warnings:
             self.get_logger().warning(warning)

@@ -212,3 +212,19 @@ def cast_planar(
     for i in range(n):
         if out[i] > cutoff:
             out[i] = np.inf
+
+
+@njit(cache=True)
+def finish_ranges(
+    dist: np.ndarray, normals: np.ndarray, mean: float, stddev: float, range_min: float, range_max: float,
+    out: np.ndarray,
+) -> None:
+    """``out`` (float32) = hits + mean + stddev·normals clamped to [range_min, range_max]; misses stay inf."""
+    for i in range(dist.shape[0]):
+        r = dist[i]
+        if r <= range_max:
+            r += mean + (stddev * normals[i] if normals.shape[0] else 0.0)
+            r = min(max(r, range_min), range_max)
+        else:
+            r = np.inf
+        out[i] = r

@@ -24,7 +24,7 @@ from navlab.sim.builder import (
     remove_world_model,
 )
 from navlab.sim.errors import SimError
-from navlab.sim.raycast import FAST_TYPES, cast_planar
+from navlab.sim.raycast import FAST_TYPES, cast_planar, finish_ranges
 from navlab.world.model import ModelSpec, WorldModel
 
 SPAWN_GAP = 0.0005  # m between the robot's lowest point and the floor when it is placed
@@ -89,6 +89,7 @@ class Simulation:
         self.dt_ns = round(self.model.opt.timestep * 1e9)
         self.time_ns = 0
         self._lidar_dirs: dict[int, np.ndarray] = {}  # lidar -> (2, n) cos, sin of its beams
+        self._no_noise = np.zeros(0)
         self._refresh_ids()
         if robot is not None:
             self._place_on_floor()
@@ -231,13 +232,11 @@ class Simulation:
             raise SimError(f"no lidar number {index} on this robot")
         cfg = self.robot.lidars[index]
         dist = self.true_ranges(index)
-        n = len(dist)
         gen = self.rng if rng is None else rng
-        if cfg.noise_stddev > 0 or cfg.noise_mean != 0:
-            noise = gen.normal(cfg.noise_mean, cfg.noise_stddev, n) if cfg.noise_stddev > 0 else cfg.noise_mean
-            hit = np.isfinite(dist)
-            dist[hit] = np.clip(dist[hit] + np.broadcast_to(noise, (n,))[hit], cfg.range_min, cfg.range_max)
-        return dist.astype(np.float32)
+        normals = gen.standard_normal(len(dist)) if cfg.noise_stddev > 0 else self._no_noise
+        out = np.empty(len(dist), dtype=np.float32)
+        finish_ranges(dist, normals, cfg.noise_mean, cfg.noise_stddev, cfg.range_min, cfg.range_max, out)
+        return out
 
     def true_ranges(self, index: int = 0, *, backend: str | None = None) -> np.ndarray:
         """Noise-free ranges (m, float64) of lidar ``index``; ``backend`` "numba" (primitives by
