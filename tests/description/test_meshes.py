@@ -86,3 +86,28 @@ def test_convexity():
     assert is_convex(*tire)
     lwall = read_mesh(LWALL)
     assert not is_convex(*lwall)
+
+
+def test_dae_polylist_matrix_and_instance_node(tmp_path):
+    """A quad as <polylist>, placed by a <matrix> node that instantiates a library node, Z up."""
+    dae = tmp_path / "quad.dae"
+    dae.write_text("""<?xml version="1.0"?>
+<COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">
+  <asset><unit meter="0.001"/><up_axis>Z_UP</up_axis></asset>
+  <library_geometries><geometry id="q"><mesh>
+    <source id="p"><float_array id="pa" count="12">0 0 0 10 0 0 10 20 0 0 20 0</float_array>
+      <technique_common><accessor source="#pa" count="4" stride="3"/></technique_common></source>
+    <source id="n"><float_array id="na" count="3">0 0 1</float_array></source>
+    <vertices id="v"><input semantic="POSITION" source="#p"/></vertices>
+    <polylist count="1"><input semantic="VERTEX" source="#v" offset="0"/>
+      <input semantic="NORMAL" source="#n" offset="1"/><vcount>4</vcount><p>0 0 1 0 2 0 3 0</p></polylist>
+  </mesh></geometry></library_geometries>
+  <library_nodes><node id="part"><instance_geometry url="#q"/></node></library_nodes>
+  <library_visual_scenes><visual_scene id="s">
+    <node><matrix>1 0 0 100  0 1 0 0  0 0 1 5  0 0 0 1</matrix><instance_node url="#part"/></node>
+  </visual_scene></library_visual_scenes>
+  <scene><instance_visual_scene url="#s"/></scene>
+</COLLADA>""")
+    verts, faces, unit = read_dae(dae)
+    assert unit == 0.001 and faces.shape == (2, 3)
+    assert verts.min(axis=0) == pytest.approx([100, 0, 5]) and verts.max(axis=0) == pytest.approx([110, 20, 5])

@@ -143,3 +143,17 @@ def test_xacro_args(tmp_path):
         <inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link></robot>""")
     assert load_robot(f).links["base"].inertial.mass == 1.0
     assert load_robot(f, args={"mass": "2.5"}).links["base"].inertial.mass == 2.5
+
+
+def test_rplidar_visual_is_a_collada_mesh_in_millimetres(mybot):
+    """The paper inserts the RPLidar A2 as a .dae mesh; it is converted for MuJoCo with its units."""
+    (visual,) = mybot.links["laser"].visuals
+    geom = visual.geometry
+    assert geom.kind == "mesh" and geom.mesh_source.name == "rplidar_a2.dae"
+    assert geom.mesh_path.suffix == ".obj" and geom.mesh_path.exists()
+    assert geom.mesh_scale == pytest.approx((0.001, 0.001, 0.001))
+    from navlab.description.meshes import read_mesh
+
+    verts, _ = read_mesh(geom.mesh_path)
+    height = verts[:, 2].max() * geom.mesh_scale[2]
+    assert 0.04 < height <= mybot.lidars[0].origin.xyz[2]  # the scanner's top is just under the rays

@@ -24,9 +24,17 @@ MESH_SUFFIXES = (".stl", ".obj", ".dae")
 
 
 def cache_dir() -> Path:
-    """Directory for converted meshes (created on demand)."""
+    """Directory for converted meshes: ``$NAVLAB_CACHE/meshes`` or ``~/.cache/navlab/meshes``, falling
+    back to the system temporary directory when that is not writable."""
     base = os.environ.get("NAVLAB_CACHE") or Path.home() / ".cache" / "navlab"
-    return Path(base) / "meshes"
+    d = Path(base) / "meshes"
+    try:
+        d.mkdir(parents=True, exist_ok=True)
+        if os.access(d, os.W_OK):
+            return d
+    except OSError:
+        pass
+    return Path(tempfile.gettempdir()) / f"navlab-{os.getuid()}" / "meshes"
 
 
 def _atomic_write_text(path: Path, text: str) -> None:

@@ -75,6 +75,7 @@ def expand(path: Path, index: PackageIndex, args: Mapping[str, str] | None = Non
         ) from None
     finally:
         xacro.filestack = None
+        xacro.all_includes = []  # xacro's module-level include log would grow with every load
     warnings = [
         f"xacro: {line.strip()}"
         for line in stderr.getvalue().splitlines()
