@@ -73,8 +73,11 @@ class Explore(Node):
         if self.grid is None or pose is None or self.done:
             return
         path = plan_to_frontier(
-            self.grid, pose[:2], robot_radius=self.robot_radius,
-            min_frontier_cells=self.min_frontier_cells, blacklist=self.blacklist,
+            self.grid,
+            pose[:2],
+            robot_radius=self.robot_radius,
+            min_frontier_cells=self.min_frontier_cells,
+            blacklist=self.blacklist,
         )
         if path is None:
             self._no_frontier += 1
@@ -90,10 +93,12 @@ class Explore(Node):
         if goal_changed:
             self._last_progress = (self.executor.now_ns, math.inf)
         now = self.executor.now_ns
-        self.plan_pub.publish(msgs.Path(
-            header=msgs.header(now, self.global_frame),
-            poses=[msgs.pose_stamped(now, self.global_frame, x, y, 0.0) for x, y in path[::4]],
-        ))
+        self.plan_pub.publish(
+            msgs.Path(
+                header=msgs.header(now, self.global_frame),
+                poses=[msgs.pose_stamped(now, self.global_frame, x, y, 0.0) for x, y in path[::4]],
+            )
+        )
 
     def _control(self) -> None:
         if self.done or self.path is None:

@@ -129,8 +129,9 @@ class RouteFollower(Node):
         self.odom_frame = self.declare_parameter("odom_frame", "odom")
         self.max_v = self.declare_parameter("max_vel_x", 0.3)
         rate = self.declare_parameter("rate", 10.0)
-        self.segments = [(float(s.get("linear", 0)), float(s.get("angular", 0)), float(s["duration"]))
-                         for s in raw_segments]
+        self.segments = [
+            (float(s.get("linear", 0)), float(s.get("angular", 0)), float(s["duration"])) for s in raw_segments
+        ]
         self.done = False
         self._seg_end: int | None = None
         self._wp = 0
