@@ -302,27 +302,39 @@ def prepare_mesh(path: Path, where: str) -> tuple[Path, float]:
 def is_convex(verts: np.ndarray, faces: np.ndarray | None = None, *, rel_tol: float = 1e-3) -> bool:
     """True if the mesh is its own convex hull (so a convex collision shape is exact).
 
-    With ``faces``: every vertex lies on one side of every face plane (a convex polyhedron). Without:
-    every vertex lies on the hull surface. Flat or degenerate meshes count as convex.
+    Closed meshes (every edge shared by two triangles): the enclosed volume equals the hull's volume
+    within ``rel_tol``. Open meshes: every vertex lies on one side of every face plane. Without
+    ``faces``: every vertex lies on the hull surface. Flat or degenerate meshes count as convex.
     """
     if len(verts) < 4:
         return True
-    tol = rel_tol * float(np.ptp(verts, axis=0).max() or 1.0)
-    if faces is not None and len(faces):
-        tri = verts[faces[:: max(1, len(faces) // 20000)]]
-        normals = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
-        norms = np.linalg.norm(normals, axis=1)
-        ok = norms > 1e-12
-        normals, origin = normals[ok] / norms[ok, None], tri[ok, 0]
-        for start in range(0, len(normals), 256):
-            n, o = normals[start : start + 256], origin[start : start + 256]
-            d = verts @ n.T - np.einsum("ij,ij->i", n, o)  # (V, chunk)
-            if ((d.max(axis=0) > tol) & (d.min(axis=0) < -tol)).any():
-                return False
-        return True
+    scale = float(np.ptp(verts, axis=0).max() or 1.0)
+    tol = rel_tol * scale
+    uverts, inverse = np.unique(np.round(verts / scale, 9), axis=0, return_inverse=True)
+    uverts = uverts * scale
     try:
-        hull = ConvexHull(verts)
+        hull = ConvexHull(uverts)
     except QhullError:
         return True
-    depth = (verts @ hull.equations[:, :3].T + hull.equations[:, 3]).max(axis=1)  # <= 0 inside
-    return bool((depth >= -tol).all())
+    if faces is None or not len(faces):
+        depth = (uverts @ hull.equations[:, :3].T + hull.equations[:, 3]).max(axis=1)  # <= 0 inside
+        return bool((depth >= -tol).all())
+    f = inverse.reshape(-1)[faces]
+    f = f[(f[:, 0] != f[:, 1]) & (f[:, 1] != f[:, 2]) & (f[:, 0] != f[:, 2])]
+    edges = np.sort(np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]]), axis=1)
+    _, counts = np.unique(edges, axis=0, return_counts=True)
+    if len(counts) and (counts == 2).all():
+        tri = uverts[f]
+        volume = abs(float(np.einsum("ij,ij->i", tri[:, 0], np.cross(tri[:, 1], tri[:, 2])).sum()) / 6.0)
+        return volume >= hull.volume * (1.0 - rel_tol)
+    tri = uverts[f]
+    normals = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    norms = np.linalg.norm(normals, axis=1)
+    ok = norms > 1e-12 * scale * scale
+    normals, origin = normals[ok] / norms[ok, None], tri[ok, 0]
+    for start in range(0, len(normals), 256):
+        n, o = normals[start : start + 256], origin[start : start + 256]
+        d = uverts @ n.T - np.einsum("ij,ij->i", n, o)  # (V, chunk)
+        if ((d.max(axis=0) > tol) & (d.min(axis=0) < -tol)).any():
+            return False
+    return True

@@ -179,12 +179,69 @@ class _Grid:
         dy = np.maximum(np.abs(cy - centre[1]) - h, 0.0)
         self.cells[si, sj] |= dx * dx + dy * dy < radius * radius - _EPS
 
+    def surface(self, tris: np.ndarray, z0: float, z1: float, chunk: int = 200_000) -> None:
+        """Mark cells touched by any triangle's part inside the band (vectorised separating-axis test).
+
+        Each triangle ∩ slab is the hull of up to 9 candidate points (3 vertices, 6 edge/plane
+        crossings); its separating axes are among x, y and the normals of candidate-point pairs.
+        """
+        z = tris[:, :, 2]
+        cand = [tris[:, :, :2]]
+        valid = [(z >= z0) & (z <= z1)]
+        for a, b in ((0, 1), (1, 2), (2, 0)):
+            for plane in (z0, z1):
+                da, db = z[:, a] - plane, z[:, b] - plane
+                cross = da * db < 0
+                t = np.where(cross, da / np.where(cross, da - db, 1.0), 0.0)[:, None]
+                cand.append((tris[:, a, :2] + t * (tris[:, b, :2] - tris[:, a, :2]))[:, None, :])
+                valid.append(cross[:, None])
+        pts = np.concatenate(cand, axis=1)  # (T, 9, 2)
+        ok = np.concatenate(valid, axis=1)  # (T, 9)
+        keep = ok.any(axis=1)
+        pts, ok = pts[keep], ok[keep]
+        if not len(pts):
+            return
+        big = np.where(ok[..., None], pts, np.nan)
+        lo, hi = np.nanmin(big, axis=1), np.nanmax(big, axis=1)
+        j0 = np.clip(np.floor((lo[:, 0] - self.x0) / self.res).astype(int), 0, self.nx)
+        j1 = np.clip(np.floor((hi[:, 0] - self.x0) / self.res).astype(int) + 1, 0, self.nx)
+        i0 = np.clip(np.floor((lo[:, 1] - self.y0) / self.res).astype(int), 0, self.ny)
+        i1 = np.clip(np.floor((hi[:, 1] - self.y0) / self.res).astype(int) + 1, 0, self.ny)
+        width = np.maximum(j1 - j0, 0)
+        counts = width * np.maximum(i1 - i0, 0)
+        # axes: normals of every candidate-point pair of a triangle (invalid pairs get a zero axis)
+        ia, ib = np.triu_indices(9, 1)
+        d = pts[:, ib] - pts[:, ia]
+        axes = np.stack([-d[..., 1], d[..., 0]], axis=-1)
+        length = np.linalg.norm(axes, axis=-1)
+        good = ok[:, ia] & ok[:, ib] & (length > 1e-12)
+        axes = np.where(good[..., None], axes / np.where(length > 1e-12, length, 1.0)[..., None], 0.0)
+        proj = np.einsum("tak,tpk->tap", axes, pts)  # (T, A, 9)
+        pmin = np.where(ok[:, None, :], proj, np.inf).min(axis=2)
+        pmax = np.where(ok[:, None, :], proj, -np.inf).max(axis=2)
+        h, eps = self.res / 2, _EPS
+        starts = np.concatenate([[0], np.cumsum(counts)[:-1]])
+        total = int(counts.sum())
+        for s0 in range(0, total, chunk):
+            k = np.arange(s0, min(s0 + chunk, total))
+            t = np.searchsorted(starts, k, side="right") - 1
+            local = k - starts[t]
+            i = i0[t] + local // np.maximum(width[t], 1)
+            j = j0[t] + local % np.maximum(width[t], 1)
+            cx = self.x0 + (j + 0.5) * self.res
+            cy = self.y0 + (i + 0.5) * self.res
+            hit = ((cx + h >= lo[t, 0] - eps) & (cx - h <= hi[t, 0] + eps)
+                   & (cy + h >= lo[t, 1] - eps) & (cy - h <= hi[t, 1] + eps))
+            ax = axes[t]  # (P, A, 2)
+            c = ax[..., 0] * cx[:, None] + ax[..., 1] * cy[:, None]
+            r = h * (np.abs(ax[..., 0]) + np.abs(ax[..., 1]))
+            sep = (c + r < pmin[t] - eps) | (c - r > pmax[t] + eps)
+            hit &= ~(sep & good[t]).any(axis=1)
+            self.cells[i[hit], j[hit]] = True
+
     def mesh(self, tris: np.ndarray, z0: float, z1: float) -> None:
         """Mark cells touched by the mesh surface in the band, and cells inside its closed slices."""
-        for tri in tris:
-            pts = _hull2d(_slab_points(tri, z0, z1))
-            if len(pts):
-                self.polygon(pts if len(pts) > 1 else np.repeat(pts, 2, axis=0), strict=False)
+        self.surface(tris, z0, z1)
         lo, hi = tris.reshape(-1, 3).min(axis=0), tris.reshape(-1, 3).max(axis=0)
         win = self.window(lo[:2], hi[:2])
         if win is None:
