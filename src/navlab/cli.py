@@ -19,6 +19,7 @@ COMMAND_MODULES = (
     "navlab.bench",
     "navlab.mapping.cli",
     "navlab.description.cli",
+    "navlab.localization.cli",
     "navlab.sim.cli",
 )
 

@@ -136,10 +136,9 @@ class Amcl:
         p = self.params
         if not all(math.isfinite(float(v)) for v in (x, y, yaw)):
             raise LocalizationError(f"initial pose ({x}, {y}, {yaw}) is not finite; expected numbers (m, m, rad)")
-        g = self.field.to_grid(np.array([[x, y, yaw]], dtype=np.float64))[0]
         h, w = self.field.shape
         res = self.field.resolution
-        if not (0 <= g[0] < w * res and 0 <= g[1] < h * res):
+        if not self.field.contains(x, y):
             raise LocalizationError(f"initial pose ({x:.3f}, {y:.3f}) lies outside the map "
                                     f"({w}×{h} cells of {res} m from origin {self.field.origin[:2]})")
         if cov is None:

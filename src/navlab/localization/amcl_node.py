@@ -91,6 +91,7 @@ class Amcl(Node):
         self._laser_poses: dict[str, tuple[float, float, float]] = {}
         self._map_to_odom: tuple[float, float, float] | None = None
         self._pending_global = False
+        self._odom_failures = 0
         self.pose_pub = self.create_publisher(msgs.PoseWithCovarianceStamped, "amcl_pose", 2)
         self.cloud_pub = self.create_publisher(msgs.PoseArray, "particlecloud", 2)
         self.create_subscription(msgs.OccupancyGrid, "map", self._on_map, 1)
@@ -173,10 +174,15 @@ class Amcl(Node):
         err: Exception | None = None
         for t in (t_ns, None):
             try:
-                return self.executor.tf.lookup_pose2d(self.odom_frame, self.base_frame, t)
+                pose = self.executor.tf.lookup_pose2d(self.odom_frame, self.base_frame, t)
+                self._odom_failures = 0
+                return pose
             except TfError as exc:
                 err = exc
-        self.get_logger().warning(f"no odometry {self.odom_frame} → {self.base_frame}: {err}")
+        # Expected for the first scans before odometry arrives (debug); a warning when it persists.
+        self._odom_failures += 1
+        log = self.get_logger().warning if self._odom_failures % 200 == 20 else self.get_logger().debug
+        log(f"no odometry {self.odom_frame} → {self.base_frame} yet, skipping the scan: {err}")
         return None
 
     def _on_scan(self, msg: Any) -> None:

@@ -62,6 +62,12 @@ class MapField:
         out[:, 2] = wrap(poses[:, 2] + oyaw)
         return out
 
+    def contains(self, x: float, y: float) -> bool:
+        """Whether the map-frame point (m) lies within the grid's bounds."""
+        g = self.to_grid(np.array([[x, y, 0.0]]))[0]
+        h, w = self.shape
+        return bool(0 <= g[0] < w * self.resolution and 0 <= g[1] < h * self.resolution)
+
     def is_free(self, x: float, y: float) -> bool:
         """Whether the map-frame point (m) lies in a free cell of the map."""
         g = self.to_grid(np.array([[x, y, 0.0]]))[0]
