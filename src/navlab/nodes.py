@@ -7,4 +7,5 @@ NODES: dict[str, str] = {
     "talker": "navlab.core.demo_nodes:Talker",
     "listener": "navlab.core.demo_nodes:Listener",
     "amcl": "navlab.localization.amcl_node:Amcl",
+    "gazebo": "navlab.sim.gazebo:GazeboSim",
 }
