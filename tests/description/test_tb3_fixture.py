@@ -76,3 +76,9 @@ def test_copied_package_loads_through_search_path(tmp_path):
                    'filename="$(find turtlebot3_description)/urdf/turtlebot3_burger.urdf.xacro"/></robot>')
     robot = load_robot(top, search_paths=[ws])
     assert robot.links["base_link"].visuals[0].geometry.mesh_path.is_relative_to(ws)
+
+
+def test_load_by_package_uri():
+    robot = load_robot("package://turtlebot3_description/urdf/turtlebot3_burger.urdf.xacro",
+                       search_paths=[PKG.parent])
+    assert robot.name == "turtlebot3_burger" and robot.source == TOP

@@ -103,11 +103,14 @@ def test_nested_models_dynamic_defaults_and_state(tmp_path):
 
 def test_unsupported_things_warn(tmp_path):
     body = """<plugin name="ros_state" filename="libgazebo_ros_state.so"/>
+      <model name="k"><static>true</static><link name="l"><pose relative_to="other">1 0 0 0 0 0</pose>
+        <collision name="c"><geometry><box><size>1 1 1</size></box></geometry></collision></link></model>
       <model name="m"><static>true</static><link name="l"><collision name="c"><geometry><heightmap/>
       </geometry></collision></link><plugin name="p" filename="libfoo.so"/></model>"""
     world = load_world(_write(tmp_path, body, version="1.9"))
     text = "\n".join(world.warnings)
     assert "ros_state" in text and "heightmap" in text and "libfoo.so" in text and "1.9" in text
+    assert "frame 'other'" in text
 
 
 def test_no_ground_plane_warns(tmp_path):
@@ -171,6 +174,7 @@ def test_load_model_for_spawning(tmp_path):
     assert by_dir.name == by_file.name == "l_wall" and by_dir.static
     assert by_dir.links[0].collisions[0].geometry.convex is False
     assert by_uri.links[0].collisions[0].geometry.mesh_scale == pytest.approx((0.0254,) * 3)
+    assert by_uri.warnings == []
     with pytest.raises(WorldError, match="not found"):
         load_model(tmp_path / "nothing")
     (tmp_path / "light.sdf").write_text('<sdf version="1.6"><light name="l" type="point"/></sdf>')

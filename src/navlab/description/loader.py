@@ -50,7 +50,8 @@ def load_robot(
     search_paths: Iterable[str | os.PathLike[str]] = (),
     args: Mapping[str, str] | None = None,
 ) -> RobotModel:
-    """Load a robot description (``.xacro`` or ``.urdf``) with its Gazebo plugin tags.
+    """Load a robot description (``.xacro`` or ``.urdf``, a path or ``package://pkg/...``) with its
+    Gazebo plugin tags.
 
     ``search_paths``: directories holding ROS packages (or package directories) for ``$(find pkg)``
     and ``package://pkg/...``; ``ROS_PACKAGE_PATH``, the packages enclosing ``path`` and navlab's
@@ -58,6 +59,10 @@ def load_robot(
     (``name:=value``). Raises DescriptionError naming the file and element on bad input; unknown
     plugins, sensors and tags become ``RobotModel.warnings``.
     """
+    search_paths = list(search_paths)
+    text = str(path)
+    if text.startswith("package://"):  # a description named by its package, e.g. package://pkg/urdf/x.xacro
+        path = PackageIndex(search_paths).resolve_uri(text, base_dir=Path.cwd())
     path = Path(path).expanduser().resolve()
     index = PackageIndex(search_paths, near=path)
     urdf_xml, warnings = expand(path, index, args)

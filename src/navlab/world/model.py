@@ -22,6 +22,7 @@ class ModelSpec:
     static: bool = False
     links: list[Link] = field(default_factory=list)
     link_origins: dict[str, Origin] = field(default_factory=dict)
+    warnings: list[str] = field(default_factory=list)  # from load_model (world loads use WorldModel's)
 
 
 @dataclass

@@ -54,10 +54,14 @@ def _num(el: ET.Element | None, tag: str, where: str, default: float) -> float:
     return _floats(sub.text, 1, f"{where}/<{tag}>")[0]
 
 
-def _pose(el: ET.Element, where: str) -> Pose6:
+def _pose(el: ET.Element, where: str, warnings: list[str] | None = None) -> Pose6:
+    """The element's ``<pose>`` (x y z roll pitch yaw) relative to its parent frame."""
     p = el.find("pose")
     if p is None or not (p.text or "").strip():
         return (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    frame = p.get("relative_to") or p.get("frame") or ""
+    if frame and frame not in ("world", "__model__") and warnings is not None:
+        warnings.append(f"{where}/<pose>: frame {frame!r} is not supported; taken relative to the parent")
     v = _floats(p.text, 6, f"{where}/<pose>")
     return (v[0], v[1], v[2], v[3], v[4], v[5])
 
@@ -153,7 +157,7 @@ class _Loader:
         where = f'{file}: <model name="{name}">'
         if not name:
             raise WorldError(f"{file}: a <model> has no name attribute")
-        spec = ModelSpec(name=name, pose=pose if pose is not None else _pose(el, where),
+        spec = ModelSpec(name=name, pose=pose if pose is not None else _pose(el, where, self.warnings),
                          static=static if static is not None else _bool(el, "static", False))
         self._fill(spec, el, file, where, prefix="", frame=(0.0, 0.0, 0.0, 0.0, 0.0, 0.0))
         return [spec] if spec.links else []
@@ -222,7 +226,7 @@ class _Loader:
                         link.mu2 = _num(ode, "mu2", sw, link.mu1)
         if had_shapes and not link.collisions and not link.visuals:
             return None, (0.0,) * 6  # only planes: the ground
-        return link, _pose(el, where)
+        return link, _pose(el, where, self.warnings)
 
     def shape(self, el: ET.Element, file: Path, where: str, collision: bool) -> Shape | None:
         """A collision or visual; None for a plane (recorded as the ground) or unsupported geometry."""
@@ -258,7 +262,7 @@ class _Loader:
             return None
         if g.tag != "mesh" and any(v <= 0 for v in geometry.size):
             raise WorldError(f"{gw}: sizes must be positive, got {geometry.size}")
-        p = _pose(el, where)
+        p = _pose(el, where, self.warnings)
         return Shape(geometry=geometry, origin=Origin(xyz=p[:3], rpy=p[3:]), name=el.get("name", ""),
                      rgba=None if collision else self.rgba(el, where))
 
@@ -381,4 +385,5 @@ def load_model(path: str | os.PathLike[str], *, model_path: Iterable[str | os.Pa
     models = loader.model(model_el, sdf_file)
     if not models:
         raise WorldError(f"{sdf_file}: <model name=\"{model_el.get('name')}\"> has no links with shapes")
+    models[0].warnings = loader.warnings
     return models[0]
