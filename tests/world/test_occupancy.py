@@ -149,3 +149,14 @@ def test_bad_arguments():
         occupancy(world, 0.0, BOUNDS)
     with pytest.raises(WorldError, match="bounds"):
         occupancy(world, 0.05, (1, 1, 0, 2))
+
+
+def test_extents():
+    from navlab.world import extents
+
+    world = load_world(resources.world("room_obstacles"))
+    assert extents(world) == pytest.approx((-5.1, -4.1, 5.1, 4.1))
+    mesh_world = load_world(FIX / "mesh_world.world", model_path=[FIX / "models"])
+    x0, y0, x1, y1 = extents(mesh_world)
+    assert (x0, y0) == pytest.approx((-3.0, -2.0)) and (x1, y1) == pytest.approx((2.254, 1.127))
+    assert extents(world, z_min=2.0, z_max=3.0) is None  # nothing that tall

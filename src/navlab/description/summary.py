@@ -2,10 +2,9 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import asdict
 from typing import Any
-
-import numpy as np
 
 from navlab.description.model import RobotModel, Shape
 
@@ -54,7 +53,7 @@ def robot_summary(robot: RobotModel) -> dict[str, Any]:
 
 def world_summary(world: Any) -> dict[str, Any]:
     """Models (static, links, shapes), extents in x/y, physics and warnings of a world."""
-    from navlab.world.occupancy import shape_footprints  # world depends on description, not back
+    from navlab.world.occupancy import extents  # world depends on description, not back
 
     models = []
     for m in world.models:
@@ -63,20 +62,10 @@ def world_summary(world: Any) -> dict[str, Any]:
                        "collision_shapes": len(shapes),
                        "kinds": sorted({s["kind"] for s in shapes}),
                        "non_convex_meshes": [s["mesh"] for s in shapes if s.get("convex") is False]})
-    pts = []
-    for fp in shape_footprints(world, z_min=-1e9, z_max=1e9):
-        if fp.kind == "disc":
-            pts += [fp.points[0] - fp.radius, fp.points[0] + fp.radius]
-        elif fp.kind == "polygon":
-            pts += list(fp.points)
-        elif fp.triangles is not None:
-            pts += list(fp.triangles.reshape(-1, 3)[:, :2])
-    extents = None
-    if pts:
-        arr = np.array(pts)
-        lo, hi = arr.min(axis=0), arr.max(axis=0)
-        extents = {"x": [round(float(lo[0]), 4), round(float(hi[0]), 4)],
-                   "y": [round(float(lo[1]), 4), round(float(hi[1]), 4)]}
+    box = extents(world, z_min=-math.inf, z_max=math.inf)
+    ext = None
+    if box is not None:
+        ext = {"x": [round(box[0], 4), round(box[2], 4)], "y": [round(box[1], 4), round(box[3], 4)]}
     return {
         "kind": "world",
         "name": world.name,
@@ -85,7 +74,7 @@ def world_summary(world: Any) -> dict[str, Any]:
         "gravity": list(world.gravity),
         "max_step_size": world.max_step_size,
         "models": models,
-        "extents": extents,
+        "extents": ext,
         "warnings": list(world.warnings),
     }
 

@@ -7,7 +7,16 @@
 
 from navlab.world.errors import WorldError
 from navlab.world.model import ModelSpec, WorldModel
-from navlab.world.occupancy import occupancy, shape_footprints
+from navlab.world.occupancy import extents, occupancy, shape_footprints
 from navlab.world.sdf import load_model, load_world
 
-__all__ = ["ModelSpec", "WorldError", "WorldModel", "load_model", "load_world", "occupancy", "shape_footprints"]
+__all__ = [
+    "ModelSpec",
+    "WorldError",
+    "WorldModel",
+    "extents",
+    "load_model",
+    "load_world",
+    "occupancy",
+    "shape_footprints",
+]

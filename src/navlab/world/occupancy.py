@@ -38,6 +38,15 @@ class Footprint:
     radius: float = 0.0
     triangles: np.ndarray | None = None
 
+    def bounds(self) -> tuple[float, float, float, float]:
+        """(x_min, y_min, x_max, y_max) of the footprint (m, world frame)."""
+        if self.kind == "disc":
+            (cx, cy), r = self.points[0], self.radius
+            return (cx - r, cy - r, cx + r, cy + r)
+        pts = self.triangles.reshape(-1, 3)[:, :2] if self.triangles is not None else self.points
+        lo, hi = pts.min(axis=0), pts.max(axis=0)
+        return (float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1]))
+
 
 def _slab_points(verts: np.ndarray, z0: float, z1: float) -> np.ndarray:
     """xy of (convex hull of ``verts``) ∩ {z0 <= z <= z1}: vertices inside plus segment crossings."""
@@ -128,6 +137,19 @@ def shape_footprints(world: WorldModel, *, z_min: float = 0.05, z_max: float = 0
                 if fp is not None:
                     out.append(fp)
     return out
+
+
+def extents(world: WorldModel, *, z_min: float = 0.05, z_max: float = 0.5,
+            static_only: bool = False) -> tuple[float, float, float, float] | None:
+    """(x_min, y_min, x_max, y_max) of every collision shape in the height band; None if there is none.
+
+    Pass ``z_min=-math.inf, z_max=math.inf`` for the full extents regardless of height.
+    """
+    boxes = [fp.bounds() for fp in shape_footprints(world, z_min=z_min, z_max=z_max, static_only=static_only)]
+    if not boxes:
+        return None
+    arr = np.array(boxes)
+    return (float(arr[:, 0].min()), float(arr[:, 1].min()), float(arr[:, 2].max()), float(arr[:, 3].max()))
 
 
 class _Grid:
