@@ -54,12 +54,18 @@ def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "check",
         help="validate a robot description or a world file and print a summary",
-        description="Load a robot description (.xacro/.urdf with <gazebo> plugin tags) or a Gazebo "
-        "world (.world SDF) exactly as the simulator would, and print what it contains: links, joints, "
-        "masses, plugins, sensors (robot); models, shapes, extents (world); and every warning. Exit "
-        "status 2 with a one-line error naming the file and element if it is malformed.",
-        epilog="examples:  navlab check robot mybot   navlab check world room_obstacles --json   "
-        "navlab check robot turtlebot3_burger.urdf.xacro --package-path ~/catkin_ws/src",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+        description="Load a robot description (.xacro/.urdf with <gazebo> plugin tags) or a Gazebo\n"
+        "world (.world SDF) exactly as the simulator would, and print what it contains:\n"
+        "links, joints, masses, plugins, sensors (robot); models, shapes, extents (world);\n"
+        "and every warning. A malformed file exits with status 2 and a one-line error\n"
+        "naming the file and the element.",
+        epilog="examples:\n"
+        "  navlab check robot mybot\n"
+        "  navlab check world room_obstacles --json\n"
+        "  navlab check robot turtlebot3_burger.urdf.xacro --package-path ~/catkin_ws/src\n"
+        "  navlab check robot package://my_description/urdf/robot.xacro --arg use_lidar:=true\n"
+        "  navlab check world my.world --model-path ~/.gazebo/models",
     )
     p.add_argument("kind", choices=("robot", "world"), help="what FILE is")
     p.add_argument("file", help="path of the .xacro/.urdf or .world file, or a shipped name "
