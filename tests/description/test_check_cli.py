@@ -70,3 +70,9 @@ def test_check_world_error(tmp_path, capsys):
     assert main(["check", "world", str(f)]) == 2
     err = capsys.readouterr().err
     assert "w.world" in err and "model://nope" in err
+
+
+def test_check_robot_by_package_uri(capsys):
+    argv = ["check", "robot", "package://turtlebot3_description/urdf/turtlebot3_burger.urdf.xacro",
+            "--package-path", str(FIX), "--json"]
+    assert _json(capsys, argv)["name"] == "turtlebot3_burger"

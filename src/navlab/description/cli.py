@@ -20,10 +20,12 @@ def _xacro_args(pairs: list[str]) -> dict[str, str]:
     return out
 
 
-def _resolve(file: str, kind: str) -> Path:
-    """A path, or a shipped name (``mybot``, ``room``)."""
+def _resolve(file: str, kind: str) -> Path | str:
+    """A path, a ``package://`` URI (kept as text), or a shipped name (``mybot``, ``room``)."""
     from navlab import resources
 
+    if file.startswith("package://"):
+        return file
     p = Path(file).expanduser()
     if p.exists() or "/" in file:
         return p
