@@ -7,5 +7,7 @@ NODES: dict[str, str] = {
     "talker": "navlab.core.demo_nodes:Talker",
     "listener": "navlab.core.demo_nodes:Listener",
     "amcl": "navlab.localization.amcl_node:Amcl",
+    "map_server": "navlab.mapping.map_server:MapServer",
+    "slam_gmapping": "navlab.mapping.slam_node:SlamGMapping",
     "gazebo": "navlab.sim.gazebo:GazeboSim",
 }

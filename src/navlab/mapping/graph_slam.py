@@ -24,6 +24,7 @@ from navlab.mapping.scanmatch import (
     compose,
     correlative_search,
     icp_point_to_line,
+    inverse,
     rotate_vectors,
     scan_points,
     transform_points,
@@ -54,12 +55,19 @@ class GraphSlamParams:
     loop_min_travel: float = 8.0  # candidates must be this far back along the path (m)
     loop_radius: float = 5.0  # ... and this near in space (m)
     loop_window: int = 10  # candidate's neighbours (± nodes) in the loop map
-    loop_search_lin: float = 2.0
-    loop_search_ang: float = math.radians(12.0)
+    loop_search_lin: float = 3.5  # cap of the loop search half-window (m)
+    loop_search_ang: float = math.radians(15.0)
     loop_min_inliers: float = 0.65
     loop_max_rms: float = 0.04
     loop_sigma_xy: float = 0.05
     loop_sigma_theta: float = math.radians(1.0)
+    loop_drift_lin: float = 0.2  # a closure may correct at most lin + rate * path length (m)
+    loop_drift_rate: float = 0.03
+    loop_drift_ang: float = math.radians(3.0)  # ... and at most ang + ang_rate * path length (rad)
+    loop_drift_ang_rate: float = math.radians(0.1)
+    loop_confirm_above: float = 0.3  # corrections larger than this (m) need a confirming second match
+    loop_confirm_lin: float = 0.3  # ... agreeing within this (m)
+    loop_confirm_ang: float = math.radians(2.0)
     loop_kernel: float = 3.0  # Cauchy kernel width (Mahalanobis)
     loop_reject: float = 6.0  # drop a loop edge whose optimised Mahalanobis error exceeds this
 
@@ -92,9 +100,11 @@ class GraphSlam:
         self.loop_edges = 0
         self.loop_rejected = 0
         self.frontend_failures = 0
+        self.loop_implausible = 0
         self.odom_jumps = 0
         self.loop_log: list[tuple[int, int, float, float, float, float]] = []
         self._last_loop_node = -(10**9)
+        self._pending: tuple[int, int, np.ndarray, np.ndarray] | None = None
 
     @property
     def poses(self) -> np.ndarray:
@@ -207,20 +217,61 @@ class GraphSlam:
         # only nodes that are themselves far back along the path
         idx = [m for m in range(lo, hi) if travel[k] - travel[m] > p.loop_min_travel]
         cloud = self._cloud(idx)
-        pose, _score, inl, rms = self._match(cloud, pts, poses[k].copy(), p.loop_search_lin, p.loop_search_ang)
+        # search as far as the front end could have drifted along the path since c (capped)
+        path = travel[k] - travel[c]
+        lin = min(p.loop_search_lin, p.loop_drift_lin + p.loop_drift_rate * path)
+        ang = min(p.loop_search_ang, p.loop_drift_ang + p.loop_drift_ang_rate * path)
+        pose, _score, inl, rms = self._match(cloud, pts, poses[k].copy(), lin, ang)
         if inl < p.loop_min_inliers or rms > p.loop_max_rms:
             return False
+        # the correction must be a drift the front end could have accumulated along the path since c
+        corr = pose - poses[k]
+        if (
+            math.hypot(corr[0], corr[1]) > p.loop_drift_lin + p.loop_drift_rate * path
+            or abs(math.remainder(corr[2], 2 * math.pi)) > p.loop_drift_ang + p.loop_drift_ang_rate * path
+        ):
+            self.loop_implausible += 1
+            return False
+        # a large correction must be confirmed by a second, nearby match implying the same correction
+        # (corridors alias along their length); small corrections are accepted at once
+        edges = [(c, k, between(poses[c], pose))]
+        if math.hypot(corr[0], corr[1]) > p.loop_confirm_above:
+            pend = self._pending
+            correction = compose(pose, inverse(poses[k]))  # map-frame correction this match implies
+            self._pending = (c, k, between(poses[c], pose), correction)
+            if pend is None or k - pend[1] > 3 * p.loop_every:
+                return False
+            diff = between(pend[3], correction)
+            if math.hypot(diff[0], diff[1]) > p.loop_confirm_lin or abs(diff[2]) > p.loop_confirm_ang:
+                return False
+            edges.insert(0, pend[:3])
+            self._pending = None
+        return self._add_loop_edges(edges, k, pose, inl, rms)
+
+    def _add_loop_edges(self, edges: list, k: int, pose: np.ndarray, inl: float, rms: float) -> bool:
+        p = self.p
         info = np.diag([p.loop_sigma_xy**-2, p.loop_sigma_xy**-2, p.loop_sigma_theta**-2])
         backup = self.graph.poses.copy()
-        self.graph.add_edge(c, k, between(poses[c], pose), info, robust=True)
+        robust = np.asarray(self.graph.edges_robust, dtype=bool)
+        before = self.graph.edge_distances()[robust]
+        # a verified match may need a large correction: optimise with the new edge at full weight, then
+        # keep it only if it is satisfied and no earlier loop edge became unsatisfied because of it
+        n_old = len(self.graph.edges_i)
+        for a, b, z in edges:
+            self.graph.add_edge(a, b, z, info, robust=False)
         self.graph.optimize(iterations=15, kernel=p.loop_kernel)
-        dist = self.graph.edge_distances()[-1]
-        if dist > p.loop_reject:
-            self.graph.remove_edge(len(self.graph.edges_i) - 1)
+        after = self.graph.edge_distances()
+        broken = (after[:n_old][robust] > p.loop_reject) & (before <= p.loop_reject)
+        if after[n_old:].max() > p.loop_reject or broken.any():
+            for _ in edges:
+                self.graph.remove_edge(len(self.graph.edges_i) - 1)
             self.graph.poses = backup
             self.loop_rejected += 1
             return False
-        self.loop_edges += 1
+        for e in range(n_old, len(self.graph.edges_i)):
+            self.graph.edges_robust[e] = True
+        c = edges[-1][0]
+        self.loop_edges += len(edges)
         self.loop_log.append((c, k, float(np.hypot(*(pose - backup[k])[:2])), float(pose[2] - backup[k][2]), inl, rms))
         return True
 

@@ -1,0 +1,404 @@
+"""GMapping-style Rao-Blackwellized particle filter SLAM (Grisetti, Stachniss, Burgard 2007).
+
+Each particle carries a pose, a trajectory and its own occupancy map. For every scan the particles
+move by the odometry step with GMapping's motion noise (srr, srt, str, stt); once the robot has moved
+``linearUpdate`` m or turned ``angularUpdate`` rad (or ``temporalUpdate`` s passed), each particle's
+pose is improved by GMapping's hill-climbing scan matcher against its own map (the scan-matching
+proposal), its weight gains the scan's log-likelihood, particles are resampled when N_eff drops below
+``resampleThreshold`` * N, and each map integrates the scan. Parameter names and defaults are
+GMapping's. Pure: numpy in, poses and maps out; the random generator is passed in.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, fields
+
+import numba
+import numpy as np
+
+from navlab.mapping.errors import MappingError
+from navlab.mapping.grid import GridMap
+from navlab.mapping.occupancy import L_CLAMP, L_FREE, L_OCC, _raycast, logodds_to_grid
+from navlab.mapping.scanmatch import between, compose
+
+
+@dataclass
+class GMappingParams:
+    """slam_gmapping's parameters (ROS names and defaults; lengths m, angles rad, times s)."""
+
+    particles: int = 30
+    linearUpdate: float = 1.0
+    angularUpdate: float = 0.5
+    temporalUpdate: float = -1.0
+    delta: float = 0.05
+    maxUrange: float = 80.0
+    maxRange: float = 0.0
+    sigma: float = 0.05
+    kernelSize: int = 1
+    lstep: float = 0.05
+    astep: float = 0.05
+    iterations: int = 5
+    lsigma: float = 0.075
+    ogain: float = 3.0
+    lskip: int = 0
+    minimumScore: float = 0.0
+    srr: float = 0.1
+    srt: float = 0.2
+    str: float = 0.1
+    stt: float = 0.2
+    resampleThreshold: float = 0.5
+    xmin: float = -100.0
+    ymin: float = -100.0
+    xmax: float = 100.0
+    ymax: float = 100.0
+    llsamplerange: float = 0.01
+    llsamplestep: float = 0.01
+    lasamplerange: float = 0.005
+    lasamplestep: float = 0.005
+    occ_thresh: float = 0.25
+
+    @classmethod
+    def from_dict(cls, values: dict | None) -> GMappingParams:
+        """Parameters from overrides; unknown names raise ``MappingError`` with a suggestion."""
+        import difflib
+
+        names = [f.name for f in fields(cls)]
+        out = cls()
+        for key, val in (values or {}).items():
+            if key not in names:
+                close = difflib.get_close_matches(key, names, n=1)
+                hint = f"; did you mean '{close[0]}'?" if close else ""
+                raise MappingError(f"unknown gmapping parameter '{key}'{hint}")
+            setattr(out, key, type(getattr(out, key))(val))
+        if out.particles < 1:
+            raise MappingError(f"gmapping parameter 'particles' must be >= 1, got {out.particles}")
+        return out
+
+
+@numba.njit(cache=True)
+def _score(
+    grid: np.ndarray,
+    ox: float,
+    oy: float,
+    res: float,
+    px: float,
+    py: float,
+    pt: float,
+    ranges: np.ndarray,
+    angles: np.ndarray,
+    max_urange: float,
+    kernel: int,
+    sigma: float,
+    lsigma: float,
+    skip: int,
+) -> tuple[float, float, int]:
+    """GMapping's score and log-likelihood of a scan at a pose: for each beam endpoint, the nearest
+    occupied cell within ``kernel`` cells whose cell one step back along the beam is free."""
+    h, w = grid.shape
+    s = 0.0
+    lik = 0.0
+    n = 0
+    null_l = -0.5 / lsigma  # GMapping: nullLikelihood = -0.5
+    for k in range(0, ranges.shape[0], skip + 1):
+        r = ranges[k]
+        if not (r > 0.0) or r >= max_urange:
+            continue
+        a = pt + angles[k]
+        ca, sa = math.cos(a), math.sin(a)
+        ex, ey = px + r * ca, py + r * sa
+        fx, fy = ex - res * ca, ey - res * sa  # a point one cell back along the beam
+        ei = math.floor((ex - ox) / res)
+        ej = math.floor((ey - oy) / res)
+        fi = math.floor((fx - ox) / res)
+        fj = math.floor((fy - oy) / res)
+        best = 1e9
+        found = False
+        for dj in range(-kernel, kernel + 1):
+            for di in range(-kernel, kernel + 1):
+                i, j = ei + di, ej + dj
+                i2, j2 = fi + di, fj + dj
+                if i < 0 or j < 0 or i >= w or j >= h or i2 < 0 or j2 < 0 or i2 >= w or j2 >= h:
+                    continue
+                if grid[j, i] > 0.0 and grid[j2, i2] < 0.0:
+                    cx = ox + (i + 0.5) * res
+                    cy = oy + (j + 0.5) * res
+                    d2 = (cx - ex) ** 2 + (cy - ey) ** 2
+                    if d2 < best:
+                        best = d2
+                        found = True
+        if found:
+            s += math.exp(-best / sigma)
+            lik += -best / lsigma
+            n += 1
+        else:
+            lik += null_l
+    return s, lik, n
+
+
+@numba.njit(cache=True)
+def _optimize(
+    grid: np.ndarray,
+    ox: float,
+    oy: float,
+    res: float,
+    x0: float,
+    y0: float,
+    t0: float,
+    ranges: np.ndarray,
+    angles: np.ndarray,
+    max_urange: float,
+    kernel: int,
+    sigma: float,
+    lsigma: float,
+    skip: int,
+    lstep: float,
+    astep: float,
+    iterations: int,
+) -> tuple[float, float, float, float]:
+    """GMapping's hill climbing: try ±lstep in x, y and ±astep in theta; halve the steps when no move
+    improves the score, ``iterations`` times."""
+    cx, cy, ct = x0, y0, t0
+    cur = _score(grid, ox, oy, res, cx, cy, ct, ranges, angles, max_urange, kernel, sigma, lsigma, skip)[0]
+    ld, ad = lstep, astep
+    refinement = 0
+    best = -1.0
+    for _ in range(200):
+        if best >= cur:
+            refinement += 1
+            ld *= 0.5
+            ad *= 0.5
+        if not (cur > best or refinement < iterations):
+            break
+        best = cur
+        bx, by, bt = cx, cy, ct
+        for move in range(6):
+            nx, ny, nt = cx, cy, ct
+            if move == 0:
+                nx += ld
+            elif move == 1:
+                nx -= ld
+            elif move == 2:
+                ny += ld
+            elif move == 3:
+                ny -= ld
+            elif move == 4:
+                nt += ad
+            else:
+                nt -= ad
+            sc = _score(grid, ox, oy, res, nx, ny, nt, ranges, angles, max_urange, kernel, sigma, lsigma, skip)[0]
+            if sc > cur:
+                cur = sc
+                bx, by, bt = nx, ny, nt
+        cx, cy, ct = bx, by, bt
+    return cx, cy, ct, cur
+
+
+class _Particle:
+    __slots__ = ("grid", "node", "pose", "weight")
+
+    def __init__(self, pose: np.ndarray, grid: np.ndarray, node: tuple | None, weight: float = 0.0) -> None:
+        self.pose = pose
+        self.grid = grid
+        self.node = node  # trajectory: (scan index, pose, parent node)
+        self.weight = weight
+
+
+class GMapping:
+    """The RBPF. ``add_scan`` takes laser ranges and the laser's odometry pose; poses are laser poses."""
+
+    def __init__(self, params: GMappingParams | None = None, *, rng: np.random.Generator | None = None) -> None:
+        self.p = params or GMappingParams()
+        self.rng = rng if rng is not None else np.random.default_rng(0)
+        self.particles: list[_Particle] = []
+        self.origin = np.zeros(2)
+        self.resamples = 0
+        self.updates = 0
+        self._odom_last: np.ndarray | None = None
+        self._odom_at_update: np.ndarray | None = None
+        self._time = 0.0
+        self._time_at_update = -math.inf
+        self._scan_count = 0
+        self._scan_ref: list[tuple[int, np.ndarray]] = []  # per scan: (last updated scan, odom step since)
+        self._last_update_scan = -1
+        self._odom_by_scan: dict[int, np.ndarray] = {}
+
+    # --- map bookkeeping ----------------------------------------------------------------------------
+
+    def _ensure_extent(self, lo: np.ndarray, hi: np.ndarray) -> None:
+        """Grow every particle's grid (keeping cell alignment) so that [lo, hi] is inside."""
+        res = self.p.delta
+        if not self.particles:
+            return
+        h, w = self.particles[0].grid.shape
+        cur_lo = self.origin
+        cur_hi = self.origin + np.array([w, h]) * res
+        if np.all(lo >= cur_lo) and np.all(hi <= cur_hi):
+            return
+        grow_lo = np.ceil(np.maximum(cur_lo - lo, 0) / res + 20).astype(int) * (lo < cur_lo)
+        grow_hi = np.ceil(np.maximum(hi - cur_hi, 0) / res + 20).astype(int) * (hi > cur_hi)
+        for part in self.particles:
+            part.grid = np.pad(part.grid, ((grow_lo[1], grow_hi[1]), (grow_lo[0], grow_hi[0])))
+        self.origin = self.origin - grow_lo * res
+
+    # --- the filter ---------------------------------------------------------------------------------
+
+    def _sample_motion(self, pose: np.ndarray, step: np.ndarray) -> np.ndarray:
+        """GMapping's MotionModel::drawFromMotion: noise scaled by translation and rotation of the step."""
+        p = self.p
+        dist = math.hypot(step[0], step[1])
+        rot = abs(math.atan2(math.sin(step[2]), math.cos(step[2])))
+        sx = p.srr * abs(step[0]) + p.str * rot
+        sy = p.srr * abs(step[1]) + p.str * rot
+        st = p.stt * rot + p.srt * dist
+        noisy = step + self.rng.normal(0.0, 1.0, 3) * np.array([sx, sy, st])
+        return compose(pose, noisy)
+
+    def add_scan(
+        self,
+        ranges: np.ndarray,
+        angle_min: float,
+        angle_increment: float,
+        odom_pose: np.ndarray | tuple[float, float, float],
+        *,
+        stamp: float | None = None,
+    ) -> np.ndarray:
+        """Process one scan with the laser at ``odom_pose`` (odometry frame); returns the best particle's pose."""
+        p = self.p
+        odom = np.asarray(odom_pose, dtype=np.float64)
+        r = np.ascontiguousarray(ranges, dtype=np.float64)
+        ang = angle_min + angle_increment * np.arange(len(r))
+        max_range = p.maxRange if p.maxRange > 0 else float(np.nanmax(np.where(np.isfinite(r), r, 0))) + 1e-3
+        max_urange = min(p.maxUrange, max_range)
+        self._time = stamp if stamp is not None else self._time + 1.0
+        k = self._scan_count
+        self._scan_count += 1
+        self._odom_by_scan[k] = odom
+        if not self.particles:
+            self._init(odom, r, ang, max_urange, max_range)
+            self._odom_last = odom
+            self._odom_at_update = odom
+            self._time_at_update = self._time
+            self._mark_update(k)
+            return odom.copy()
+        step = between(self._odom_last, odom)
+        self._odom_last = odom
+        for part in self.particles:
+            part.pose = self._sample_motion(part.pose, step)
+        moved = between(self._odom_at_update, odom)
+        due = (
+            math.hypot(moved[0], moved[1]) >= p.linearUpdate
+            or abs(moved[2]) >= p.angularUpdate
+            or (p.temporalUpdate >= 0 and self._time - self._time_at_update > p.temporalUpdate)
+        )
+        if due:
+            self._update(k, r, ang, max_urange, max_range)
+            self._odom_at_update = odom
+            self._time_at_update = self._time
+        else:
+            self._scan_ref.append((self._last_update_scan, between(self._odom_by_scan[self._last_update_scan], odom)))
+        return self.best().pose.copy()
+
+    def _init(self, odom: np.ndarray, r: np.ndarray, ang: np.ndarray, max_urange: float, max_range: float) -> None:
+        p = self.p
+        reach = min(max_urange, 30.0) + 2.0
+        lo = np.maximum([p.xmin, p.ymin], odom[:2] - reach)
+        hi = np.minimum([p.xmax, p.ymax], odom[:2] + reach)
+        lo = np.minimum(lo, odom[:2] - 1.0)
+        hi = np.maximum(hi, odom[:2] + 1.0)
+        self.origin = np.floor(lo / p.delta) * p.delta
+        w = math.ceil((hi[0] - self.origin[0]) / p.delta)
+        h = math.ceil((hi[1] - self.origin[1]) / p.delta)
+        grid = np.zeros((h, w), dtype=np.float32)
+        self._integrate(grid, odom, r, ang, max_urange, max_range)
+        node = (0, odom.copy(), None)
+        self.particles = [_Particle(odom.copy(), grid.copy(), node) for _ in range(p.particles)]
+
+    def _integrate(
+        self, grid: np.ndarray, pose: np.ndarray, r: np.ndarray, ang: np.ndarray, max_urange: float, max_range: float
+    ) -> None:
+        _raycast(
+            grid, float(self.origin[0]), float(self.origin[1]), self.p.delta, float(pose[0]), float(pose[1]),
+            float(pose[2]), r, ang, max_urange, max_range, L_OCC, L_FREE, L_CLAMP,
+        )  # fmt: skip
+
+    def _mark_update(self, k: int) -> None:
+        self._scan_ref.append((k, np.zeros(3)))
+        self._last_update_scan = k
+
+    def _update(self, k: int, r: np.ndarray, ang: np.ndarray, max_urange: float, max_range: float) -> None:
+        p = self.p
+        self.updates += 1
+        # grow maps to hold this scan from any particle
+        poses = np.array([q.pose for q in self.particles])
+        reach = min(max_urange, 30.0) + 1.0
+        self._ensure_extent(poses[:, :2].min(axis=0) - reach, poses[:, :2].max(axis=0) + reach)
+        ox, oy, res = float(self.origin[0]), float(self.origin[1]), p.delta
+        for part in self.particles:
+            x, y, t, score = _optimize(
+                part.grid, ox, oy, res, part.pose[0], part.pose[1], part.pose[2], r, ang, max_urange,
+                p.kernelSize, p.sigma, p.lsigma, p.lskip, p.lstep, p.astep, p.iterations,
+            )  # fmt: skip
+            if score > p.minimumScore:
+                part.pose = np.array([x, y, (t + math.pi) % (2 * math.pi) - math.pi])
+            _s, lik, _n = _score(
+                part.grid, ox, oy, res, part.pose[0], part.pose[1], part.pose[2], r, ang, max_urange,
+                p.kernelSize, p.sigma, p.lsigma, p.lskip,
+            )  # fmt: skip
+            part.weight += lik
+        # normalise (GMapping: gain 1 / (ogain * N)) and resample on N_eff
+        lw = np.array([q.weight for q in self.particles])
+        w = np.exp((lw - lw.max()) / (p.ogain * len(lw)))
+        w /= w.sum()
+        neff = 1.0 / float(np.sum(w**2))
+        if neff < p.resampleThreshold * len(w):
+            self.resamples += 1
+            # systematic resampling
+            pos = (self.rng.random() + np.arange(len(w))) / len(w)
+            idx = np.minimum(np.searchsorted(np.cumsum(w), pos), len(w) - 1)
+            used: set[int] = set()
+            new = []
+            for i in idx:
+                src = self.particles[int(i)]
+                grid = src.grid if int(i) not in used else src.grid.copy()
+                used.add(int(i))
+                new.append(_Particle(src.pose.copy(), grid, src.node, 0.0))
+            self.particles = new
+        for part in self.particles:
+            part.node = (k, part.pose.copy(), part.node)
+            self._integrate(part.grid, part.pose, r, ang, max_urange, max_range)
+        self._mark_update(k)
+
+    # --- results ------------------------------------------------------------------------------------
+
+    def best(self) -> _Particle:
+        """The particle with the highest accumulated weight."""
+        return max(self.particles, key=lambda q: q.weight)
+
+    def trajectory(self) -> dict[int, np.ndarray]:
+        """Best particle's pose at every updated scan (scan index -> laser pose)."""
+        out: dict[int, np.ndarray] = {}
+        node = self.best().node
+        while node is not None:
+            out[node[0]] = node[1]
+            node = node[2]
+        return out
+
+    def finish(self) -> np.ndarray:
+        """Laser poses (N, 3) for every scan added: updated scans from the best trajectory, the others
+        from the preceding updated scan plus the odometry step since."""
+        traj = self.trajectory()
+        out = np.zeros((self._scan_count, 3))
+        for k, (ref, step) in enumerate(self._scan_ref):
+            base = traj.get(ref)
+            if base is None:  # before resampling histories joined; fall back on odometry
+                base = self._odom_by_scan[ref]
+            out[k] = compose(base, step)
+        return out
+
+    def map(self, *, frame_id: str = "map") -> GridMap:
+        """The best particle's occupancy grid."""
+        g = self.best().grid
+        return logodds_to_grid(
+            g.astype(np.float64), self.p.delta, (float(self.origin[0]), float(self.origin[1])), frame_id=frame_id
+        )
