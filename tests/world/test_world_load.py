@@ -180,3 +180,13 @@ def test_load_model_for_spawning(tmp_path):
     (tmp_path / "light.sdf").write_text('<sdf version="1.6"><light name="l" type="point"/></sdf>')
     with pytest.raises(WorldError, match=r"light\.sdf: no <model>"):
         load_model(tmp_path / "light.sdf")
+
+
+def test_world_saved_by_gazebo_gui():
+    """A world as Gazebo 9's "Save World" writes it: inline ground plane, <state> poses, GUI blocks."""
+    world = load_world(FIX / "gazebo_saved.world")
+    assert world.ground_plane and [m.name for m in world.models] == ["unit_box", "unit_cylinder"]
+    box = world.models[0]
+    assert not box.static and box.pose == pytest.approx((2, 1, 0.499995, 0, -1e-05, 0.3))  # from <state>
+    assert box.links[0].inertial.ixx == pytest.approx(0.166667) and box.links[0].mu1 is None
+    assert len(world.warnings) == 1 and "<scale>: 0.5 0.5 1 is not applied" in world.warnings[0]

@@ -352,10 +352,15 @@ def load_world(path: str | os.PathLike[str], *, model_path: Iterable[str | os.Pa
     if state is not None:  # a saved world: the state's model poses win
         by_name = {m.name: m for m in world.models}
         for m in state.findall("model"):
+            sw = f'{where}/<state>/<model name="{m.get("name")}">'
             if m.get("name") in by_name and m.find("pose") is not None:
-                by_name[m.get("name", "")].pose = _pose(m, f'{where}/<state>/<model name="{m.get("name")}">')
+                by_name[m.get("name", "")].pose = _pose(m, sw)
+            scale = m.findtext("scale")
+            if m.get("name") in by_name and scale and _floats(scale, 3, sw + "/<scale>") != (1.0, 1.0, 1.0):
+                world.warnings.append(f"{sw}/<scale>: {scale.strip()} is not applied; the model keeps the "
+                                      "sizes in its <geometry> (resize it there)")
     world.ground_plane = loader.ground_plane
-    world.warnings = loader.warnings
+    world.warnings = loader.warnings + world.warnings
     if not world.ground_plane:
         world.warnings.append(f"{file}: no ground plane (include model://ground_plane); things will fall")
     return world
