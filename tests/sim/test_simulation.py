@@ -163,3 +163,17 @@ def test_numba_lidar_matches_mj_multiray() -> None:
         assert both.sum() > 500
         np.testing.assert_allclose(fast[both], ref[both], atol=1e-9)
     assert np.nanmin(np.where(np.isfinite(ref), ref, np.nan)) < 1.0  # the tilted lidar sees the floor
+
+
+def test_fixed_links_keep_their_frames() -> None:
+    sim = Simulation(make_mybot(), make_room(), seed=0, robot_pose=(1.0, 2.0, 0.7))
+    _drive(sim, 0.0, 1.0, 0.5)  # turning in place
+    chassis = sim.link_pose("chassis")
+    laser = sim.link_pose("laser")  # fused into the chassis body, 6 cm above it
+    np.testing.assert_allclose(laser.position, chassis.position + np.array([0.0, 0.0, 0.06]), atol=1e-9)
+    assert laser.yaw == pytest.approx(chassis.yaw)
+    lin, ang = sim.link_velocity("laser")
+    assert ang[2] == pytest.approx(1.0, abs=0.05) and np.linalg.norm(lin) < 0.02
+    np.testing.assert_allclose(sim.data.site_xpos[sim._lidar_site[0]], laser.position, atol=1e-9)
+    with pytest.raises(SimError, match="no link 'nope'"):
+        sim.link_pose("nope")

