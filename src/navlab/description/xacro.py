@@ -50,6 +50,8 @@ def expand(path: Path, index: PackageIndex, args: Mapping[str, str] | None = Non
     DescriptionError naming the file being read and xacro's message.
     """
     path = Path(path)
+    if path.is_dir():
+        raise DescriptionError(f"{path}: is a directory; expected a .xacro or .urdf file")
     if not path.is_file():
         raise DescriptionError(f"{path}: robot description file not found")
     mappings = {str(k): str(v) for k, v in (args or {}).items()}

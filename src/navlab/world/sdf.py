@@ -72,6 +72,8 @@ def _bool(el: ET.Element, tag: str, default: bool) -> bool:
 
 
 def _parse_xml(path: Path, what: str) -> ET.Element:
+    if path.is_dir():
+        raise WorldError(f"{path}: is a directory; expected a {what}")
     if not path.is_file():
         raise WorldError(f"{path}: {what} not found")
     try:
