@@ -112,6 +112,17 @@ def test_updates_only_after_enough_motion_or_on_request() -> None:
     assert amcl.n_updates == 3
 
 
+def test_a_new_initial_pose_is_not_moved_by_motion_from_before_it() -> None:
+    field = room_field()
+    rng = np.random.default_rng(0)
+    amcl = Amcl(field, AmclParams(), rng=np.random.default_rng(0))
+    amcl.set_initial_pose(1.0, 1.0, 0.0)
+    assert amcl.update((0.0, 0.0, 0.0), scan_at(field, (1.0, 1.0, 0.0), rng))
+    amcl.set_initial_pose(3.0, 3.0, 0.0, np.diag([0.01, 0.01, 0.001]))  # robot drove 1 m meanwhile
+    assert amcl.update((1.0, 0.0, 0.0), scan_at(field, (3.0, 3.0, 0.0), rng))
+    assert math.dist(amcl.estimate[:2], (3.0, 3.0)) < 0.1
+
+
 def test_all_inf_scan_is_no_update() -> None:
     field = room_field()
     amcl = Amcl(field, AmclParams(), rng=np.random.default_rng(0))

@@ -163,6 +163,7 @@ class Amcl:
         self.weights = np.full(pts.shape[0], 1.0 / pts.shape[0])
         self.w_slow = self.w_fast = 0.0
         self.resample_count = 0
+        self.odom_ref = None  # the next scan sets the odometry reference (no motion from before the reset)
         self._force = True
         self._estimate()
 
