@@ -61,5 +61,9 @@ def test_localize_cli_prints_json_and_saves_a_picture(tmp_path: Path, capsys: py
     assert png.stat().st_size > 10_000
     assert main(["localize", "--initial", "50", "0", "0", "--duration", "1", "--png", ""]) == 2
     assert "outside the map" in capsys.readouterr().err
+    bad = tmp_path / "amcl.yaml"
+    bad.write_text("amcl:\n  ros__parameters:\n    min_particle: 200\n")
+    assert main(["localize", "--params", str(bad), "--duration", "1", "--png", ""]) == 2
+    assert "did you mean 'min_particles'" in capsys.readouterr().err
     with pytest.raises(LocalizationError, match="not finite"):
         run_localization(initial=(math.nan, 0.0, 0.0), duration=1.0)
