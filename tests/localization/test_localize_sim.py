@@ -67,3 +67,10 @@ def test_localize_cli_prints_json_and_saves_a_picture(tmp_path: Path, capsys: py
     assert "did you mean 'min_particles'" in capsys.readouterr().err
     with pytest.raises(LocalizationError, match="not finite"):
         run_localization(initial=(math.nan, 0.0, 0.0), duration=1.0)
+
+
+def test_same_seed_same_run() -> None:
+    a = run_localization("room_obstacles", global_localization=True, duration=4.0, seed=3)
+    b = run_localization("room_obstacles", global_localization=True, duration=4.0, seed=3)
+    assert np.array_equal(a.estimate, b.estimate, equal_nan=True)
+    assert np.array_equal(a.truth, b.truth)
