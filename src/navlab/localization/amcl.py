@@ -173,8 +173,9 @@ class Amcl:
 
     # --- update -----------------------------------------------------------------------------------
 
-    def _beams(self, scan: Scan, laser_pose: tuple[float, float, float]) -> tuple[np.ndarray, ...] | None:
-        """Chosen beams: (bearings, ranges, valid mask) or None when no beam has a usable return."""
+    def _beams(self, scan: Scan) -> tuple[np.ndarray, ...] | None:
+        """Chosen beams: (bearings, ranges, hit mask, [range_min, range_max]) or None when no beam has
+        a usable return."""
         p = self.params
         ranges = np.asarray(scan.ranges, dtype=np.float64)
         n = ranges.shape[0]
@@ -239,10 +240,10 @@ class Amcl:
             moved = abs(dx) > p.update_min_d or abs(dy) > p.update_min_d or abs(da) > p.update_min_a
         if not (moved or self._force or self.odom_ref is None):
             return False
-        beams = self._beams(scan, laser_pose)
+        beams = self._beams(scan)
         if beams is None:
             return False
-        if moved and self.odom_ref is not None:
+        if self.odom_ref is not None:  # moved, or a forced update: apply whatever motion there was
             models.sample_motion_diff(
                 self.particles, self.odom_ref, odom,
                 (p.odom_alpha1, p.odom_alpha2, p.odom_alpha3, p.odom_alpha4), self.rng,
