@@ -1,5 +1,7 @@
 """A localization run: simulator + map_server + amcl + a scripted route, scored against ground truth.
 
+Without a map file the world's true occupancy is saved to a temporary map_server map and served.
+
 ``run_localization`` is what ``navlab localize`` does; tests and the example call it directly. The
 map frame is taken to coincide with the world frame (true for the world's true map, and for a SLAM
 map made by a robot spawned at the world origin), so the estimate is compared with the true pose.
@@ -8,6 +10,7 @@ map made by a robot spawned at the world origin), so the estimate is compared wi
 from __future__ import annotations
 
 import math
+import tempfile
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -51,16 +54,6 @@ def true_map(world: Any, start_xy: tuple[float, float], resolution: float = 0.05
     else:
         data[~occ] = 0
     return GridMap(data, resolution, (float(lo[0]), float(lo[1]), 0.0))
-
-
-class MapServer(Node):
-    """map_server: publishes a ``GridMap`` once, latched, on ``map`` (and ``map_metadata``)."""
-
-    def __init__(self, executor: Executor, grid: GridMap, *, name: str = "map_server") -> None:
-        super().__init__(name, executor)
-        msg = grid.to_msg(executor.now_ns)
-        self.create_publisher(msgs.MapMetaData, "map_metadata", 1, latched=True).publish(msg.info)
-        self.create_publisher(msgs.OccupancyGrid, "map", 1, latched=True).publish(msg)
 
 
 class GroundTruthRoute(Node):
@@ -165,13 +158,17 @@ def run_localization(
         raise LocalizationError(f"duration must be > 0 s, got {duration}")
     if initial is not None and not all(math.isfinite(v) for v in initial):
         raise LocalizationError(f"initial pose {initial} is not finite")
-    world_model = load_world_named(world)
-    if map_yaml is not None:
-        from navlab.mapping.mapfile import load_map
+    from navlab.mapping.map_server import MapServer
+    from navlab.mapping.mapfile import load_map, save_map
 
+    world_model = load_world_named(world)
+    tmp = None
+    if map_yaml is not None:
         grid = load_map(map_yaml)
-    else:
+    else:  # serve the world's true map through a map file, as map_server would
+        tmp = tempfile.TemporaryDirectory(prefix="navlab-localize-")
         grid = true_map(world_model, (0.0, 0.0))
+        save_map(grid, Path(tmp.name) / "true_map.yaml")
     name = str(map_yaml or f"true map of {world}")
     fld = field_from_map(grid, name=name)  # refuse a bad map before running
     if initial is not None and not fld.contains(initial[0], initial[1]):
@@ -194,7 +191,7 @@ def run_localization(
         amcl = Amcl(ex, parameters=params)
     if global_localization:
         ex.call_service("/global_localization")
-    MapServer(ex, grid)
+    MapServer(ex, parameters={"yaml_filename": str(map_yaml or Path(tmp.name) / "true_map.yaml")})  # type: ignore[union-attr]
     driver = GroundTruthRoute(ex, route)
     rows: list[tuple[float, ...]] = []
     kidnap: dict[str, Any] = {}
@@ -230,6 +227,8 @@ def run_localization(
     if bar is not None:
         bar.close()
     wall = time.perf_counter() - wall0
+    if tmp is not None:
+        tmp.cleanup()
     a = np.array(rows, dtype=np.float64).reshape(-1, 7)
     res = LocalizeResult(t=a[:, 0], truth=a[:, 1:4], estimate=a[:, 4:7], grid=grid)
     res.summary = _summarize(res, amcl, kidnap, wall, duration, world, map_yaml, global_localization)
