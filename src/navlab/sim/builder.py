@@ -18,6 +18,7 @@ Conventions of the built model (what the simulator and the lidar rely on):
 
 from __future__ import annotations
 
+import hashlib
 import math
 from dataclasses import dataclass, field, replace
 
@@ -129,7 +130,6 @@ class _Geoms:
     def __init__(self, spec: mujoco.MjSpec, info: BuildInfo) -> None:
         self.spec = spec
         self.info = info
-        self.meshes: dict[tuple[str, tuple[float, ...]], str] = {}
 
     def mesh_asset(self, geometry: Geometry, where: str) -> str:
         path = geometry.mesh_path
@@ -140,13 +140,12 @@ class _Geoms:
                 f"{where}: mesh {path} is {path.suffix or 'of unknown type'}; MuJoCo reads STL and OBJ "
                 "(convert COLLADA .dae meshes to .stl/.obj)"
             )
-        key = (str(path), tuple(float(s) for s in geometry.mesh_scale))
-        if key not in self.meshes:
-            name = f"mesh{len(self.meshes)}_{path.stem}"
+        scale = tuple(float(s) for s in geometry.mesh_scale)
+        name = f"mesh_{hashlib.sha1(repr((str(path), scale)).encode()).hexdigest()[:12]}_{path.stem}"
+        if self.spec.mesh(name) is None:  # one asset per (file, scale), shared by every geom using it
             mesh = self.spec.add_mesh(name=name, file=str(path))
-            mesh.scale = np.asarray(geometry.mesh_scale, dtype=float)
-            self.meshes[key] = name
-        return self.meshes[key]
+            mesh.scale = np.asarray(scale)
+        return name
 
     def add(self, body: mujoco.MjsBody, shape: Shape, where: str, **props: object) -> mujoco.MjsGeom:
         g = shape.geometry
@@ -425,12 +424,16 @@ def add_world_model(spec: mujoco.MjSpec, model: ModelSpec, info: BuildInfo) -> l
             if not model.static and link.inertial is None:
                 extra["mass"] = 1.0 / len(link.collisions)  # Gazebo's default link mass: 1 kg
             if shape.geometry.kind == "mesh":
-                # the true triangles for rays; the hull for contacts
+                # the true triangles for rays; the hull (or, if concave, convex parts) for contacts
                 geoms.add(body, place(shape), cwhere, contype=0, conaffinity=0, group=GROUP_RAY_MESH, mass=0.0,
                           name=f"{scoped}::ray{i}")
                 geom_names.append(f"{scoped}::ray{i}")
-                geoms.add(body, place(shape), cwhere, **{**props, "group": GROUP_WORLD_HULL}, **extra)
-                info.warnings.append(f"{cwhere}: mesh collides as its convex hull; rays hit its triangles")
+                hull_props = {**props, "group": GROUP_WORLD_HULL}
+                if getattr(shape.geometry, "convex", None) is False:
+                    _add_convex_parts(spec, body, place(shape), cwhere, f"{scoped}::collision{i}", hull_props,
+                                      extra, geom_names)
+                    continue
+                geoms.add(body, place(shape), cwhere, **hull_props, **extra)
             else:
                 geoms.add(body, place(shape), cwhere, **props, **extra)
             geom_names.append(f"{scoped}::collision{i}")
@@ -449,6 +452,27 @@ def add_world_model(spec: mujoco.MjSpec, model: ModelSpec, info: BuildInfo) -> l
     return bodies or geom_names
 
 
+def _add_convex_parts(spec: mujoco.MjSpec, body: mujoco.MjsBody, shape: Shape, where: str, name: str,
+                      props: dict[str, object], extra: dict[str, object], names: list[str]) -> None:
+    """Collide a concave mesh as its convex parts (see navlab.sim.decompose)."""
+    from navlab.sim.decompose import convex_parts
+
+    g = shape.geometry
+    assert g.mesh_path is not None
+    parts = convex_parts(g.mesh_path, g.mesh_scale)
+    extra = dict(extra)
+    if "mass" in extra:
+        extra["mass"] = float(extra["mass"]) / len(parts)  # type: ignore[arg-type]
+    for k, (verts, faces) in enumerate(parts):
+        part = f"{name}::part{k}"
+        spec.add_mesh(name=part, uservert=verts.ravel().tolist(), userface=faces.ravel().tolist())
+        geom = body.add_geom(type=mujoco.mjtGeom.mjGEOM_MESH, meshname=part)
+        _set_pose(geom, shape.origin)
+        for key, value in {**props, **extra, "name": part}.items():
+            setattr(geom, key, value)
+        names.append(part)
+
+
 def remove_world_model(spec: mujoco.MjSpec, name: str, info: BuildInfo) -> None:
     """Delete a model added by :func:`add_world_model` from the spec."""
     if name not in info.world_parts:
@@ -459,6 +483,8 @@ def remove_world_model(spec: mujoco.MjSpec, name: str, info: BuildInfo) -> None:
         spec.delete(spec.body(body))
     for geom in geoms:
         spec.delete(spec.geom(geom))
+    for mesh in [m for m in spec.meshes if m.name.startswith(f"{name}::")]:  # its convex parts
+        spec.delete(mesh)
 
 
 def _add_scenery(spec: mujoco.MjSpec, world: WorldModel) -> None:
