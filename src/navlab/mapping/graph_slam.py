@@ -14,7 +14,6 @@ import math
 from dataclasses import dataclass, fields
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from navlab.mapping.errors import MappingError
 from navlab.mapping.posegraph import PoseGraph
@@ -104,6 +103,7 @@ class GraphSlam:
         self.odom_jumps = 0
         self.loop_log: list[tuple[int, int, float, float, float, float]] = []
         self._last_loop_node = -(10**9)
+        self._travel_at_loop = -math.inf
         self._pending: tuple[int, int, np.ndarray, np.ndarray] | None = None
 
     @property
@@ -125,9 +125,15 @@ class GraphSlam:
         """Correlative search then ICP; returns (pose, correlative score, ICP inlier fraction, ICP rms)."""
         map_xy, map_n = cloud
         p = self.p
+        sub = pts[:: max(1, len(pts) // 120)]
+        if lin > 1.0:  # very wide (loop closure) windows start on a 0.2 m grid
+            coarse = LookupField(map_xy, resolution=0.2, sigma=0.2)
+            prior, _ = correlative_search(
+                coarse, sub, prior, lin_window=lin, ang_window=ang, ang_step=math.radians(1.0)
+            )
+            lin, ang = 0.3, math.radians(2.0)
         if lin > 0.2 or ang > math.radians(4.0):  # coarse-to-fine for wide windows
             coarse = LookupField(map_xy, resolution=0.1, sigma=0.1)
-            sub = pts[:: max(1, len(pts) // 120)]
             prior, _ = correlative_search(
                 coarse, sub, prior, lin_window=lin, ang_window=ang, ang_step=math.radians(1.0)
             )
@@ -135,7 +141,6 @@ class GraphSlam:
         fine = LookupField(map_xy, resolution=p.field_resolution, sigma=p.field_sigma)
         pose, score = correlative_search(fine, pts, prior, lin_window=lin, ang_window=ang, ang_step=p.search_ang_step)
         res = icp_point_to_line(
-            cKDTree(map_xy),
             map_xy,
             map_n,
             pts,
@@ -272,6 +277,7 @@ class GraphSlam:
             self.graph.edges_robust[e] = True
         c = edges[-1][0]
         self.loop_edges += len(edges)
+        self._travel_at_loop = self.path_length[k]
         self.loop_log.append((c, k, float(np.hypot(*(pose - backup[k])[:2])), float(pose[2] - backup[k][2]), inl, rms))
         return True
 

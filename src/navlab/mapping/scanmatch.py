@@ -13,7 +13,6 @@ from dataclasses import dataclass
 
 import numba
 import numpy as np
-from scipy.spatial import cKDTree
 
 
 def compose(a: np.ndarray | tuple, b: np.ndarray | tuple) -> np.ndarray:
@@ -228,6 +227,137 @@ def correlative_search(
 # --- ICP ----------------------------------------------------------------------------------------------
 
 
+@numba.njit(cache=True)
+def _build_hash(pts: np.ndarray, cell: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, float, float, int, int]:
+    """Bucket points into a dense grid of ``cell``-sized bins: (order, start, count, ox, oy, w, h)."""
+    n = pts.shape[0]
+    ox = pts[:, 0].min() - cell
+    oy = pts[:, 1].min() - cell
+    w = int((pts[:, 0].max() - ox) / cell) + 2
+    h = int((pts[:, 1].max() - oy) / cell) + 2
+    keys = np.empty(n, dtype=np.int64)
+    for k in range(n):
+        keys[k] = int((pts[k, 1] - oy) / cell) * w + int((pts[k, 0] - ox) / cell)
+    order = np.argsort(keys)
+    start = np.zeros(w * h + 1, dtype=np.int64)
+    for k in range(n):
+        start[keys[k] + 1] += 1
+    count = start[1:].copy()
+    for c in range(w * h):
+        start[c + 1] += start[c]
+    return order, start, count, ox, oy, w, h
+
+
+@numba.njit(cache=True)
+def _icp(
+    map_xy: np.ndarray,
+    map_n: np.ndarray,
+    scan: np.ndarray,
+    x0: float,
+    y0: float,
+    t0: float,
+    max_dist: float,
+    min_dist: float,
+    iterations: int,
+    huber: float,
+) -> tuple[float, float, float, float, float, np.ndarray]:
+    order, start, count, ox, oy, w, h = _build_hash(map_xy, max_dist)
+    x, y, t = x0, y0, t0
+    n = scan.shape[0]
+    half = max(iterations // 2, 1)
+    ratio = (min_dist / max_dist) ** (1.0 / max(half - 1, 1))
+    frac, rms = 0.0, 1e9
+    hess = np.zeros((3, 3))
+    for it in range(iterations):
+        dmax = max_dist * ratio ** min(it, half - 1)
+        c, s = math.cos(t), math.sin(t)
+        hess = np.zeros((3, 3))
+        g = np.zeros(3)
+        matched = 0
+        sq = 0.0
+        rows = 0
+        for k in range(n):
+            px = x + c * scan[k, 0] - s * scan[k, 1]
+            py = y + s * scan[k, 0] + c * scan[k, 1]
+            ci = int((px - ox) / max_dist)
+            cj = int((py - oy) / max_dist)
+            best = dmax * dmax
+            bi = -1
+            for dj in range(-1, 2):
+                j = cj + dj
+                if j < 0 or j >= h:
+                    continue
+                for di in range(-1, 2):
+                    i = ci + di
+                    if i < 0 or i >= w:
+                        continue
+                    cell = j * w + i
+                    for q in range(start[cell], start[cell] + count[cell]):
+                        m = order[q]
+                        d2 = (map_xy[m, 0] - px) ** 2 + (map_xy[m, 1] - py) ** 2
+                        if d2 < best:
+                            best = d2
+                            bi = m
+            if bi < 0:
+                continue
+            matched += 1
+            rx, ry = px - x, py - y
+            dthx, dthy = -ry, rx  # d(p)/d(theta)
+            ex, ey = px - map_xy[bi, 0], py - map_xy[bi, 1]
+            nx, ny = map_n[bi, 0], map_n[bi, 1]
+            if nx != 0.0 or ny != 0.0:
+                r = ex * nx + ey * ny
+                jx, jy, jt = nx, ny, dthx * nx + dthy * ny
+                a = abs(r)
+                wt = 1.0 if a <= huber else huber / a
+                hess[0, 0] += wt * jx * jx
+                hess[0, 1] += wt * jx * jy
+                hess[0, 2] += wt * jx * jt
+                hess[1, 1] += wt * jy * jy
+                hess[1, 2] += wt * jy * jt
+                hess[2, 2] += wt * jt * jt
+                g[0] += wt * jx * r
+                g[1] += wt * jy * r
+                g[2] += wt * jt * r
+                sq += r * r
+                rows += 1
+            else:
+                for ax in range(2):
+                    r = ex if ax == 0 else ey
+                    jx = 1.0 if ax == 0 else 0.0
+                    jy = 1.0 - jx
+                    jt = dthx if ax == 0 else dthy
+                    a = abs(r)
+                    wt = 1.0 if a <= huber else huber / a
+                    hess[0, 0] += wt * jx * jx
+                    hess[0, 1] += wt * jx * jy
+                    hess[0, 2] += wt * jx * jt
+                    hess[1, 1] += wt * jy * jy
+                    hess[1, 2] += wt * jy * jt
+                    hess[2, 2] += wt * jt * jt
+                    g[0] += wt * jx * r
+                    g[1] += wt * jy * r
+                    g[2] += wt * jt * r
+                    sq += r * r
+                    rows += 1
+        frac = matched / max(n, 1)
+        if matched < 6:
+            break
+        hess[1, 0] = hess[0, 1]
+        hess[2, 0] = hess[0, 2]
+        hess[2, 1] = hess[1, 2]
+        rms = math.sqrt(sq / max(rows, 1))
+        for d in range(3):
+            hess[d, d] += 1e-9
+        delta = -np.linalg.solve(hess, g)
+        x += delta[0]
+        y += delta[1]
+        t += delta[2]
+        if it >= half and abs(delta[0]) + abs(delta[1]) < 1e-4 and abs(delta[2]) < 1e-4:
+            break
+    return x, y, t, frac, rms, hess
+
+
 @dataclass
 class IcpResult:
     """Refined pose, the fraction of scan points with a correspondence, and the RMS point-to-line residual (m)."""
@@ -239,7 +369,6 @@ class IcpResult:
 
 
 def icp_point_to_line(
-    tree: cKDTree,
     map_xy: np.ndarray,
     map_normals: np.ndarray,
     scan_xy: np.ndarray,
@@ -252,59 +381,22 @@ def icp_point_to_line(
 ) -> IcpResult:
     """Refine the pose of a scan (points ``scan_xy`` in its own frame) against map points with normals.
 
-    Correspondences are nearest neighbours within a radius shrinking from ``max_dist`` to ``min_dist``;
-    map points without a normal pair point-to-point.
+    Correspondences are nearest neighbours within a radius shrinking from ``max_dist`` to ``min_dist``
+    (m); map points without a normal pair point-to-point. Gauss-Newton with a Huber kernel (m).
     """
-    pose = np.array(init, dtype=np.float64)
-    dist_sched = np.geomspace(max_dist, min_dist, max(iterations // 2, 1))
-    h = np.zeros((3, 3))
-    frac, rms = 0.0, float("inf")
-    for it in range(iterations):
-        dmax = dist_sched[min(it, len(dist_sched) - 1)]
-        world = transform_points(pose, scan_xy)
-        d, idx = tree.query(world, distance_upper_bound=dmax)
-        ok = np.isfinite(d)
-        frac = float(ok.mean()) if len(ok) else 0.0
-        if ok.sum() < 6:
-            break
-        p = world[ok]
-        q = map_xy[idx[ok]]
-        nrm = map_normals[idx[ok]]
-        has_n = (nrm[:, 0] != 0) | (nrm[:, 1] != 0)
-        # residuals: point-to-line where a normal exists, else two point-to-point rows
-        rel = p - np.array([pose[0], pose[1]])  # d(p)/dtheta = perp(rel)
-        dth = np.stack([-rel[:, 1], rel[:, 0]], axis=1)
-        diff = p - q
-        rows_j, rows_r = [], []
-        nn = nrm[has_n]
-        rows_r.append(np.einsum("ij,ij->i", diff[has_n], nn))
-        rows_j.append(np.stack([nn[:, 0], nn[:, 1], np.einsum("ij,ij->i", dth[has_n], nn)], axis=1))
-        pp = ~has_n
-        if pp.any():
-            for ax in (0, 1):
-                jj = np.zeros((pp.sum(), 3))
-                jj[:, ax] = 1.0
-                jj[:, 2] = dth[pp, ax]
-                rows_j.append(jj)
-                rows_r.append(diff[pp, ax])
-        jac = np.concatenate(rows_j)
-        res = np.concatenate(rows_r)
-        a = np.abs(res)
-        wts = np.where(a <= huber, 1.0, huber / np.maximum(a, 1e-12))
-        h = jac.T @ (jac * wts[:, None])
-        g = jac.T @ (wts * res)
-        rms = float(np.sqrt(np.mean(res**2)))
-        try:
-            delta = -np.linalg.solve(h + 1e-9 * np.eye(3), g)
-        except np.linalg.LinAlgError:
-            break
-        pose[0] += delta[0]
-        pose[1] += delta[1]
-        pose[2] = _wrap(pose[2] + delta[2])
-        # rotating about the origin of the world moved the scan; rotation was linearised about the pose
-        if it >= len(dist_sched) and abs(delta[0]) + abs(delta[1]) < 1e-4 and abs(delta[2]) < 1e-4:
-            break
-    return IcpResult(pose, frac, rms, h)
+    x, y, t, frac, rms, hess = _icp(
+        np.ascontiguousarray(map_xy, dtype=np.float64),
+        np.ascontiguousarray(map_normals, dtype=np.float64),
+        np.ascontiguousarray(scan_xy, dtype=np.float64),
+        float(init[0]),
+        float(init[1]),
+        float(init[2]),
+        float(max_dist),
+        float(min_dist),
+        int(iterations),
+        float(huber),
+    )
+    return IcpResult(np.array([x, y, _wrap(t)]), float(frac), float(rms), hess)
 
 
 def warmup() -> None:
@@ -312,6 +404,7 @@ def warmup() -> None:
     pts = np.array([[1.0, 0.0], [1.0, 0.5], [0.5, 1.0]])
     f = LookupField(pts)
     correlative_search(f, pts, np.zeros(3), lin_window=0.1, ang_window=0.01, ang_step=0.01)
+    icp_point_to_line(pts, np.zeros_like(pts), pts, np.zeros(3))
     from navlab.mapping.occupancy import integrate_scan
 
     integrate_scan(
