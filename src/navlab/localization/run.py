@@ -164,11 +164,13 @@ def run_localization(
     world_model = load_world_named(world)
     tmp = None
     if map_yaml is not None:
-        grid = load_map(map_yaml)
+        served = Path(map_yaml)
+        grid = load_map(served)
     else:  # serve the world's true map through a map file, as map_server would
         tmp = tempfile.TemporaryDirectory(prefix="navlab-localize-")
+        served = Path(tmp.name) / "true_map.yaml"
         grid = true_map(world_model, (0.0, 0.0))
-        save_map(grid, Path(tmp.name) / "true_map.yaml")
+        save_map(grid, served)
     name = str(map_yaml or f"true map of {world}")
     fld = field_from_map(grid, name=name)  # refuse a bad map before running
     if initial is not None and not fld.contains(initial[0], initial[1]):
@@ -191,7 +193,7 @@ def run_localization(
         amcl = Amcl(ex, parameters=params)
     if global_localization:
         ex.call_service("/global_localization")
-    MapServer(ex, parameters={"yaml_filename": str(map_yaml or Path(tmp.name) / "true_map.yaml")})  # type: ignore[union-attr]
+    MapServer(ex, parameters={"yaml_filename": str(served)})
     driver = GroundTruthRoute(ex, route)
     rows: list[tuple[float, ...]] = []
     kidnap: dict[str, Any] = {}
