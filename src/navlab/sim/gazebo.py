@@ -42,7 +42,7 @@ def load_world_named(name_or_path: str) -> WorldModel:
 
 class GazeboSim(Node):
     """Gazebo in a node. Parameters: ``world`` (shipped name or file, default ``room``), ``robot``
-    (default ``mybot``), ``x``/``y``/``yaw`` (spawn pose, m/rad), ``timestep`` (s; 0 = the world's
+    (default ``mybot``), ``x``/``y``/``yaw`` (spawn pose, m/rad), ``timestep`` (s; 0 = 2 ms or the world's larger
     ``max_step_size``), ``joint_state_rate`` and ``ground_truth_rate`` (Hz; 0 = off), ``seed``
     (sensor noise seed; -1 = the executor's), ``visuals`` (build render-only geoms; default off, faster).
     ``robot_model``/``world_model`` replace the files."""

@@ -7,6 +7,8 @@ publishes the ROS messages a Gazebo user expects on the topics named in the desc
 
 from __future__ import annotations
 
+import functools
+import math
 from typing import Any
 
 import numpy as np
@@ -21,9 +23,8 @@ from navlab.sim.simulation import Simulation, lidar_angles
 _ODOM_COV = msgs.covariance(ODOM_COVARIANCE_DIAG)
 
 
-def _quat_msg(wxyz: np.ndarray) -> Any:
-    w, x, y, z = (float(v) for v in wxyz)
-    return msgs.Quaternion(x=x, y=y, z=z, w=w)
+def _quat_msg(wxyz: Any) -> Any:
+    return msgs.Quaternion(x=float(wxyz[1]), y=float(wxyz[2]), z=float(wxyz[3]), w=float(wxyz[0]))
 
 
 def _transform(stamp_ns: int, parent: str, child: str, xyz: Any, wxyz: Any) -> Any:
@@ -32,7 +33,7 @@ def _transform(stamp_ns: int, parent: str, child: str, xyz: Any, wxyz: Any) -> A
         child_frame_id=child,
         transform=msgs.Transform(
             translation=msgs.Vector3(x=float(xyz[0]), y=float(xyz[1]), z=float(xyz[2])),
-            rotation=_quat_msg(np.asarray(wxyz, dtype=float)),
+            rotation=_quat_msg(wxyz),
         ),
     )
 
@@ -213,29 +214,45 @@ class JointStatePlugin(Node):
         self.pub.publish(msgs.JointState(header=msgs.header(now, ""), name=[j.name for j in self.joints],
                                          position=pos, velocity=vel, effort=np.zeros(len(pos))))
         if self.publish_tf:
-            tfs = []
-            for joint, q in zip(self.joints, pos, strict=True):
-                xyz, quat = joint_motion(joint, float(q))
-                tfs.append(_transform(now, joint.parent, joint.child, xyz, quat))
-            self.send_transform(tfs)
+            self.send_transform([
+                _transform(now, joint.parent, joint.child, *joint_motion(joint, float(q)))
+                for joint, q in zip(self.joints, pos, strict=True)
+            ])
 
 
-def joint_motion(joint: Any, q: float) -> tuple[np.ndarray, np.ndarray]:
+def joint_motion(joint: Any, q: float) -> tuple[tuple[float, float, float], tuple[float, float, float, float]]:
     """Pose (xyz, wxyz) of a joint's child frame in its parent link at joint position ``q``."""
-    import mujoco
+    (w0, x0, y0, z0), (ox, oy, oz), (ax, ay, az) = _joint_constants(
+        tuple(joint.origin.rpy), tuple(joint.origin.xyz), tuple(joint.axis)
+    )
+    if joint.type == "prismatic":  # translate along the axis, expressed in the parent via the origin
+        tx, ty, tz = _rotate((w0, x0, y0, z0), (ax * q, ay * q, az * q))
+        return (ox + tx, oy + ty, oz + tz), (w0, x0, y0, z0)
+    c, s = math.cos(q / 2), math.sin(q / 2)
+    w1, x1, y1, z1 = c, s * ax, s * ay, s * az
+    return (ox, oy, oz), (
+        w0 * w1 - x0 * x1 - y0 * y1 - z0 * z1,
+        w0 * x1 + x0 * w1 + y0 * z1 - z0 * y1,
+        w0 * y1 - x0 * z1 + y0 * w1 + z0 * x1,
+        w0 * z1 + x0 * y1 - y0 * x1 + z0 * w1,
+    )
 
-    base = quat_from_rpy(joint.origin.rpy)
-    xyz = np.asarray(joint.origin.xyz, dtype=float)
-    axis = np.asarray(joint.axis, dtype=float)
-    axis = axis / np.linalg.norm(axis)
-    if joint.type == "prismatic":
-        rot = np.zeros(9)
-        mujoco.mju_quat2Mat(rot, base)
-        return xyz + rot.reshape(3, 3) @ axis * q, base
-    turn = np.array([np.cos(q / 2), *(np.sin(q / 2) * axis)])
-    out = np.zeros(4)
-    mujoco.mju_mulQuat(out, base, turn)
-    return xyz, out
+
+@functools.lru_cache(maxsize=256)
+def _joint_constants(rpy: tuple, xyz: tuple, axis: tuple) -> tuple[tuple, tuple, tuple]:
+    """(origin quaternion, origin translation, unit axis) of a joint, as float tuples."""
+    w0, x0, y0, z0 = (float(v) for v in quat_from_rpy(rpy))
+    ax, ay, az = (float(v) for v in axis)
+    norm = math.sqrt(ax * ax + ay * ay + az * az)
+    return (w0, x0, y0, z0), tuple(float(v) for v in xyz), (ax / norm, ay / norm, az / norm)
+
+
+def _rotate(q: tuple[float, float, float, float], v: tuple[float, float, float]) -> tuple[float, float, float]:
+    """Vector ``v`` rotated by unit quaternion ``q`` (w, x, y, z)."""
+    w, x, y, z = q
+    vx, vy, vz = v
+    tx, ty, tz = 2 * (y * vz - z * vy), 2 * (z * vx - x * vz), 2 * (x * vy - y * vx)
+    return (vx + w * tx + y * tz - z * ty, vy + w * ty + z * tx - x * tz, vz + w * tz + x * ty - y * tx)
 
 
 def static_transforms(sim: Simulation, stamp_ns: int) -> list[Any]:

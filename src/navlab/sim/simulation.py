@@ -58,8 +58,8 @@ class Simulation:
 
     ``robot_pose`` = (x, y, yaw) of the robot's root link in the world (m, rad); the robot is placed
     with its lowest collision point on the floor. ``seed`` (int or ``numpy.random.Generator``) drives
-    sensor noise when no generator is passed to a sensor call. ``timestep`` (s) defaults to the
-    world's ``max_step_size``. ``visuals=False`` builds no render-only geoms (faster).
+    sensor noise when no generator is passed to a sensor call. ``timestep`` (s) defaults to 2 ms (see
+    ``builder.DEFAULT_STEP``). ``visuals=False`` builds no render-only geoms (faster).
     ``lidar_backend``: "numba" (fast planar caster for primitives) or "mujoco" (``mj_multiRay``).
     """
 
@@ -206,6 +206,8 @@ class Simulation:
         """True world pose of a robot link's frame (default: the root link)."""
         b, xyz, quat = self._link_frame(link)
         self._sync()
+        if not xyz.any() and quat[0] == 1.0:  # the link is the body's own frame
+            return Pose3D(self.data.xpos[b].copy(), self.data.xquat[b].copy())
         rot = self.data.xmat[b].reshape(3, 3)
         q = np.zeros(4)
         mujoco.mju_mulQuat(q, self.data.xquat[b], quat)
@@ -222,11 +224,15 @@ class Simulation:
         self._sync()
         vel = np.zeros(6)
         mujoco.mj_objectVelocity(self.model, self.data, mujoco.mjtObj.mjOBJ_XBODY, b, vel, 1)
-        ang, lin = vel[:3], vel[3:] + np.cross(vel[:3], xyz)  # at the link origin, in the body frame
+        if not xyz.any() and quat[0] == 1.0:  # the link is the body's own frame
+            return vel[3:], vel[:3]
+        wx, wy, wz = vel[:3]
+        rx, ry, rz = xyz
+        lin = vel[3:] + np.array([wy * rz - wz * ry, wz * rx - wx * rz, wx * ry - wy * rx])  # v + w x r
         rot = np.zeros(9)
         mujoco.mju_quat2Mat(rot, quat)
         rot_t = rot.reshape(3, 3).T
-        return rot_t @ lin, rot_t @ ang
+        return rot_t @ lin, rot_t @ vel[:3]
 
     def _link_frame(self, link: str | None) -> tuple[int, np.ndarray, np.ndarray]:
         if self.robot is None:
