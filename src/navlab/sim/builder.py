@@ -1,16 +1,18 @@
-"""RobotModel + WorldModel → a MuJoCo model, built directly with ``mujoco.MjSpec``.
+"""RobotModel → MuJoCo bodies, built directly with ``mujoco.MjSpec``, and the conventions shared with
+:mod:`navlab.sim.scene` (which adds the world and builds the whole spec).
 
 Conventions of the built model (what the simulator and the lidar rely on):
 
 - The robot's links become bodies nested along the joint tree, named as in the URDF, and the root gets
   a free joint at the spawn pose. Fixed links are fused into their parent body when compiling
   (MuJoCo's ``fusestatic``); sensor frames survive as sites and link frames as fixed offsets.
-- World model links become bodies named ``model::link`` (Gazebo's scoped names); static models have
-  no joint, dynamic links each get a free joint.
+- World models keep Gazebo's scoped names (``model::link``): a static model's geoms are welded onto
+  the world body (``model::link::collisionN``), each dynamic link is a free body ``model::link``.
 - Geom groups: 0 world collision (rays hit), 1 robot collision (rays ignore), 2 visuals (render only,
   no contacts), 3 ray-only true surfaces of world meshes, 4 collision hulls of world meshes.
 - Contact bits: the world's static geoms only touch the robot and dynamic models; robot parts never
-  touch each other (Gazebo's ``self_collide`` off).
+  touch each other (Gazebo's ``self_collide`` off); wheels touch the floor through a sphere
+  (WHEEL_FLOOR_SPHERES below) and everything else through their cylinder.
 - Friction follows Gazebo (combined by min, not MuJoCo's max): robot geoms get contact priority so
   their own friction decides; passive casters (links rigidly fixed to the chassis without an explicit
   ``mu1``, or with ``mu1 == 0``) are frictionless (``condim`` 1) so they do not drag.
@@ -20,14 +22,13 @@ from __future__ import annotations
 
 import hashlib
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 import mujoco
 import numpy as np
 
 from navlab.description.model import Geometry, Link, Origin, RobotModel, Shape
 from navlab.sim.errors import SimError
-from navlab.world.model import ModelSpec, WorldModel
 
 GROUP_WORLD = 0
 GROUP_ROBOT = 1
@@ -381,173 +382,3 @@ def _add_wheel_motors(spec: mujoco.MjSpec, robot: RobotModel) -> tuple[str, str]
         act.forcerange = np.array([-dd.max_torque, dd.max_torque])
         names.append(act.name)
     return names[0], names[1]
-
-
-# --- world ----------------------------------------------------------------------------------------
-
-
-def add_world_model(spec: mujoco.MjSpec, model: ModelSpec, info: BuildInfo) -> list[str]:
-    """Add one SDF model; returns the names of what was added (geoms for static models, bodies otherwise).
-
-    Static models' geoms are welded straight onto the world body (few bodies keep MuJoCo's broad
-    phase and kinematics cheap); each dynamic link becomes a free body.
-    """
-    if model.name in info.world_parts or model.name == info.robot_name:
-        raise SimError(f"a model named {model.name!r} already exists in the world")
-    geoms = _Geoms(spec, info)
-    x, y, z, roll, pitch, yaw = model.pose
-    model_pose = Origin(xyz=(x, y, z), rpy=(roll, pitch, yaw))
-    kind = "static" if model.static else "dynamic"
-    props = _contact_props(kind, GROUP_WORLD)
-    bodies: list[str] = []
-    geom_names: list[str] = []
-    for link in model.links:
-        where = f"model {model.name!r} link {link.name!r}"
-        scoped = f"{model.name}::{link.name}"
-        link_pose = _compose(model_pose, model.link_origins.get(link.name, Origin()))
-        if model.static:
-            body = spec.worldbody
-
-            def place(shape: Shape, _pose: Origin = link_pose) -> Shape:
-                return replace(shape, origin=_compose(_pose, shape.origin))
-        else:
-            body = spec.worldbody.add_body(name=scoped)
-            _set_pose(body, link_pose)
-            body.add_freejoint(name=f"{scoped}::free")
-            if link.inertial is not None:
-                _set_inertial(body, link, True, info, where)
-            bodies.append(scoped)
-
-            def place(shape: Shape) -> Shape:
-                return shape
-        mu = DEFAULT_MU if link.mu1 is None else float(link.mu1)
-        friction = np.array([mu, 0.005, 0.0001])
-        for i, shape in enumerate(link.collisions):
-            cwhere = f"{where} collision {i}"
-            extra: dict[str, object] = {"friction": friction, "name": f"{scoped}::collision{i}"}
-            if not model.static and link.inertial is None:
-                extra["mass"] = 1.0 / len(link.collisions)  # Gazebo's default link mass: 1 kg
-            if shape.geometry.kind == "mesh":
-                # the true triangles for rays; the hull (or, if concave, convex parts) for contacts
-                geoms.add(body, place(shape), cwhere, contype=0, conaffinity=0, group=GROUP_RAY_MESH, mass=0.0,
-                          name=f"{scoped}::ray{i}")
-                geom_names.append(f"{scoped}::ray{i}")
-                hull_props = {**props, "group": GROUP_WORLD_HULL}
-                if getattr(shape.geometry, "convex", None) is False:
-                    _add_convex_parts(spec, body, place(shape), cwhere, f"{scoped}::collision{i}", hull_props,
-                                      extra, geom_names)
-                    continue
-                geoms.add(body, place(shape), cwhere, **hull_props, **extra)
-            else:
-                geoms.add(body, place(shape), cwhere, **props, **extra)
-            geom_names.append(f"{scoped}::collision{i}")
-        if not info.visuals:
-            continue
-        for i, shape in enumerate(link.visuals or link.collisions):
-            try:
-                g = geoms.add(body, place(shape), f"{where} visual {i}", **_VISUAL_PROPS, name=f"{scoped}::visual{i}")
-            except SimError as exc:
-                info.warnings.append(f"{exc}; visual skipped")
-                continue
-            g.rgba = np.array(shape.rgba if shape.rgba is not None else (0.75, 0.72, 0.68, 1.0))
-            geom_names.append(f"{scoped}::visual{i}")
-    info.world_parts[model.name] = (bodies, [] if bodies else geom_names)
-    info.model_poses[model.name] = model.pose
-    return bodies or geom_names
-
-
-def _add_convex_parts(spec: mujoco.MjSpec, body: mujoco.MjsBody, shape: Shape, where: str, name: str,
-                      props: dict[str, object], extra: dict[str, object], names: list[str]) -> None:
-    """Collide a concave mesh as its convex parts (see navlab.sim.decompose)."""
-    from navlab.sim.decompose import convex_parts
-
-    g = shape.geometry
-    assert g.mesh_path is not None
-    parts = convex_parts(g.mesh_path, g.mesh_scale)
-    extra = dict(extra)
-    if "mass" in extra:
-        extra["mass"] = float(extra["mass"]) / len(parts)  # type: ignore[arg-type]
-    for k, (verts, faces) in enumerate(parts):
-        part = f"{name}::part{k}"
-        spec.add_mesh(name=part, uservert=verts.ravel().tolist(), userface=faces.ravel().tolist())
-        geom = body.add_geom(type=mujoco.mjtGeom.mjGEOM_MESH, meshname=part)
-        _set_pose(geom, shape.origin)
-        for key, value in {**props, **extra, "name": part}.items():
-            setattr(geom, key, value)
-        names.append(part)
-
-
-def remove_world_model(spec: mujoco.MjSpec, name: str, info: BuildInfo) -> None:
-    """Delete a model added by :func:`add_world_model` from the spec."""
-    if name not in info.world_parts:
-        raise SimError(f"no model named {name!r}; models: {sorted(info.world_parts)}")
-    bodies, geoms = info.world_parts.pop(name)
-    info.model_poses.pop(name, None)
-    for body in bodies:
-        spec.delete(spec.body(body))
-    for geom in geoms:
-        spec.delete(spec.geom(geom))
-    for mesh in [m for m in spec.meshes if m.name.startswith(f"{name}::")]:  # its convex parts
-        spec.delete(mesh)
-
-
-def _add_scenery(spec: mujoco.MjSpec, world: WorldModel) -> None:
-    spec.option.gravity = np.asarray(world.gravity, dtype=float)
-    spec.visual.headlight.ambient = np.array([0.35, 0.35, 0.35])
-    spec.add_texture(
-        name="grid", type=mujoco.mjtTexture.mjTEXTURE_2D, builtin=mujoco.mjtBuiltin.mjBUILTIN_CHECKER,
-        rgb1=np.array([0.62, 0.62, 0.62]), rgb2=np.array([0.55, 0.55, 0.55]), width=256, height=256,
-    )
-    mat = spec.add_material(name="grid", texrepeat=np.array([1.0, 1.0]), texuniform=True)
-    mat.textures[mujoco.mjtTextureRole.mjTEXROLE_RGB] = "grid"
-    spec.worldbody.add_light(name="sun", type=mujoco.mjtLightType.mjLIGHT_DIRECTIONAL, pos=np.array([0.0, 0.0, 10.0]),
-                             dir=np.array([0.3, 0.2, -1.0]), diffuse=np.array([0.6, 0.6, 0.6]))
-    if world.ground_plane:
-        spec.worldbody.add_geom(name="ground_plane", type=mujoco.mjtGeom.mjGEOM_PLANE,
-                                size=np.array([0.0, 0.0, 1.0]), **_contact_props("ground", GROUP_WORLD),
-                                rgba=np.array([0.5, 0.5, 0.5, 1.0]))  # mj_ray skips transparent geoms
-        spec.worldbody.add_geom(name="ground_plane_visual", type=mujoco.mjtGeom.mjGEOM_PLANE,
-                                size=np.array([50.0, 50.0, 1.0]), material="grid", **_VISUAL_PROPS)
-
-
-def build_spec(
-    robot: RobotModel | None,
-    world: WorldModel,
-    *,
-    timestep: float | None = None,
-    robot_pose: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0),
-    visuals: bool = True,
-) -> tuple[mujoco.MjSpec, BuildInfo]:
-    """The MuJoCo spec of ``world`` with ``robot`` at ``robot_pose`` (x, y, z, yaw), and its names.
-
-    ``timestep`` (s) must lie in [0.5 ms, 2 ms]; by default the world's ``max_step_size`` raised to
-    ``DEFAULT_STEP`` (2 ms);
-    ``visuals=False`` leaves out the render-only geoms (faster stepping).
-    """
-    step = min(max(world.max_step_size, DEFAULT_STEP), MAX_STEP) if timestep is None else timestep
-    if not MIN_STEP <= step <= MAX_STEP:
-        raise SimError(f"physics timestep {step} s is outside [{MIN_STEP}, {MAX_STEP}] s (5 ms tips robots over)")
-    spec = mujoco.MjSpec()
-    spec.modelname = world.name or "world"
-    spec.option.timestep = float(step)
-    spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
-    spec.compiler.degree = False
-    spec.compiler.autolimits = True
-    # fixed links are merged into their moving parent at compile time (fewer bodies: ~12 % faster
-    # steps); their frames live on as sites and as offsets (Simulation.link_pose)
-    spec.compiler.fusestatic = True
-    info = BuildInfo(visuals=visuals)
-    _add_scenery(spec, world)
-    if robot is not None:
-        add_robot(spec, robot, info, robot_pose)
-    for model in world.models:
-        add_world_model(spec, model, info)
-    return spec, info
-
-
-def compile_spec(spec: mujoco.MjSpec, what: str = "model") -> mujoco.MjModel:
-    """Compile, turning MuJoCo's compiler errors into a ``SimError``."""
-    try:
-        return spec.compile()
-    except ValueError as exc:
-        raise SimError(f"MuJoCo could not compile the {what}: {exc}") from None

@@ -13,18 +13,10 @@ import mujoco
 import numpy as np
 
 from navlab.description.model import DiffDriveConfig, LidarConfig, RobotModel
-from navlab.sim.builder import (
-    GROUP_ROBOT,
-    GROUP_WORLD,
-    RAY_GEOMGROUP,
-    add_world_model,
-    build_spec,
-    compile_spec,
-    quat_from_rpy,
-    remove_world_model,
-)
+from navlab.sim.builder import GROUP_ROBOT, GROUP_WORLD, RAY_GEOMGROUP, quat_from_rpy
 from navlab.sim.errors import SimError
 from navlab.sim.raycast import FAST_TYPES, cast_planar, finish_ranges
+from navlab.sim.scene import add_world_model, build_spec, compile_spec, remove_world_model
 from navlab.world.model import ModelSpec, WorldModel
 
 SPAWN_GAP = 0.0005  # m between the robot's lowest point and the floor when it is placed
