@@ -65,3 +65,14 @@ def test_executor_feeds_tf_from_topics():
                                                                                 ex.now_ns / 1e9, 0.0, 0.0)))
     ex.run(1.0)
     assert ex.tf.lookup_pose2d("odom", "laser", 550_000_000)[0] == pytest.approx(0.55)
+
+
+def test_edges_above_the_common_ancestor_do_not_limit_lookups():
+    buf = TfBuffer()
+    buf.set_transform("map", "odom", 5_000_000_000, (0, 0, 0, 0, 0, 0, 1))  # localization started late
+    buf.set_transform("odom", "chassis", 0, (0.0, 0, 0, 0, 0, 0, 1))
+    buf.set_transform("odom", "chassis", 1_000_000_000, (1.0, 0, 0, 0, 0, 0, 1))
+    assert buf.lookup_pose2d("odom", "chassis", 500_000_000)[0] == pytest.approx(0.5)
+    assert buf.lookup_pose2d("odom", "chassis")[0] == pytest.approx(1.0)
+    with pytest.raises(TfError, match="past"):
+        buf.lookup("map", "chassis", 500_000_000)

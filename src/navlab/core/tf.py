@@ -176,28 +176,35 @@ class TfBuffer:
         t0, t1 = times[i - 1], times[i]
         return interpolate(e.values[i - 1], e.values[i], (t_ns - t0) / (t1 - t0))
 
-    def _to_root(self, frame: str, t_ns: int | None) -> list[tuple[str, Tf]]:
-        """[(frame, root_T_frame...)] walking up from ``frame``: each entry is parent_T_child."""
-        chain = []
-        seen = {frame}
+    def _ancestors(self, frame: str) -> list[str]:
+        """``frame`` and its parents up to the root, by name only (nothing is evaluated)."""
+        chain = [frame]
         while frame in self._edges:
-            e = self._edges[frame]
-            chain.append((frame, self._edge_at(frame, e, t_ns)))
-            frame = e.parent
-            if frame in seen:
+            frame = self._edges[frame].parent
+            if frame in chain:
                 raise TfError(f"tf tree has a loop through frame {frame!r}")
-            seen.add(frame)
-        chain.append((frame, IDENTITY))
+            chain.append(frame)
         return chain
 
+    def _up_to(self, frame: str, stop: str, t_ns: int | None) -> Tf:
+        """``stop_T_frame``: compose the edges from ``frame`` up to its ancestor ``stop``."""
+        out: Tf = IDENTITY
+        while frame != stop:
+            e = self._edges[frame]
+            out = compose(self._edge_at(frame, e, t_ns), out)
+            frame = e.parent
+        return out
+
     def _latest_common(self, target: str, source: str) -> int | None:
+        """The newest time every dynamic edge between the two frames has (None if all are static)."""
+        up_s, up_t = self._ancestors(source), self._ancestors(target)
+        common = set(up_s) & set(up_t)
         newest = None
-        for f in (target, source):
-            while f in self._edges:
-                e = self._edges[f]
-                if not e.static:
-                    newest = e.times[-1] if newest is None else min(newest, e.times[-1])
-                f = e.parent
+        for f in (*up_s, *up_t):
+            e = self._edges.get(f)
+            if e is None or f in common or e.static:
+                continue
+            newest = e.times[-1] if newest is None else min(newest, e.times[-1])
         return newest
 
     def lookup(self, target: str, source: str, t_ns: int | None = None) -> Tf:
@@ -209,28 +216,14 @@ class TfBuffer:
                 raise TfError(f"frame {f!r} does not exist (known frames: {', '.join(known) or 'none'})")
         if t_ns is None:
             t_ns = self._latest_common(target, source)
-        up_s = self._to_root(source, t_ns)
-        up_t = self._to_root(target, t_ns)
-        if up_s[-1][0] != up_t[-1][0]:
-            raise TfError(
-                f"frames {target!r} and {source!r} are not connected "
-                f"(roots {up_t[-1][0]!r} and {up_s[-1][0]!r})"
-            )
-        names_t = [f for f, _ in up_t]
-        # Walk source up to the first frame that is also an ancestor of target.
-        root_T_src: Tf = IDENTITY
-        common = None
-        for f, tf in up_s:
-            if f in names_t:
-                common = f
-                break
-            root_T_src = compose(tf, root_T_src)
-        common_T_tgt: Tf = IDENTITY
-        for f, tf in up_t:
-            if f == common:
-                break
-            common_T_tgt = compose(tf, common_T_tgt)
-        return compose(inverse(common_T_tgt), root_T_src)
+        up_s, up_t = self._ancestors(source), self._ancestors(target)
+        if up_s[-1] != up_t[-1]:
+            raise TfError(f"frames {target!r} and {source!r} are not connected (roots {up_t[-1]!r} and {up_s[-1]!r})")
+        in_target = set(up_t)
+        common = next(f for f in up_s if f in in_target)
+        # Only the edges below the common ancestor are evaluated, so an edge above it (map->odom while
+        # looking up odom->base) never limits the lookup time.
+        return compose(inverse(self._up_to(target, common, t_ns)), self._up_to(source, common, t_ns))
 
     def can_transform(self, target: str, source: str, t_ns: int | None = None) -> bool:
         """Whether :meth:`lookup` would succeed."""
