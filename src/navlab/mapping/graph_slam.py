@@ -35,7 +35,7 @@ class GraphSlamParams:
     """Parameters of the graph mode (lengths m, angles rad)."""
 
     maxUrange: float = 30.0
-    voxel: float = 0.05  # one point per voxel of this size (m)
+    voxel: float = 0.04  # one point per voxel of this size (m)
     local_window: int = 15  # recent nodes in the local map
     search_lin: float = 0.3  # correlative search half-window around the odometry prediction (m)
     search_ang: float = math.radians(15.0)
