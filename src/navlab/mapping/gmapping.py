@@ -243,16 +243,22 @@ class GMapping:
 
     # --- the filter ---------------------------------------------------------------------------------
 
-    def _sample_motion(self, pose: np.ndarray, step: np.ndarray) -> np.ndarray:
-        """GMapping's MotionModel::drawFromMotion: noise scaled by translation and rotation of the step."""
+    def _sample_motion_all(self, poses: np.ndarray, step: np.ndarray) -> np.ndarray:
+        """GMapping's MotionModel::drawFromMotion for all particles (N, 3): noise scaled by the step's
+        translation and rotation (srr, srt, str, stt)."""
         p = self.p
         dist = math.hypot(step[0], step[1])
         rot = abs(math.atan2(math.sin(step[2]), math.cos(step[2])))
-        sx = p.srr * abs(step[0]) + p.str * rot
-        sy = p.srr * abs(step[1]) + p.str * rot
-        st = p.stt * rot + p.srt * dist
-        noisy = step + self.rng.normal(0.0, 1.0, 3) * np.array([sx, sy, st])
-        return compose(pose, noisy)
+        sig = np.array(
+            [p.srr * abs(step[0]) + p.str * rot, p.srr * abs(step[1]) + p.str * rot, p.stt * rot + p.srt * dist]
+        )
+        noisy = step[None, :] + self.rng.normal(0.0, 1.0, poses.shape) * sig[None, :]
+        c, s_ = np.cos(poses[:, 2]), np.sin(poses[:, 2])
+        out = np.empty_like(poses)
+        out[:, 0] = poses[:, 0] + c * noisy[:, 0] - s_ * noisy[:, 1]
+        out[:, 1] = poses[:, 1] + s_ * noisy[:, 0] + c * noisy[:, 1]
+        out[:, 2] = (poses[:, 2] + noisy[:, 2] + math.pi) % (2 * math.pi) - math.pi
+        return out
 
     def add_scan(
         self,
@@ -283,8 +289,9 @@ class GMapping:
             return odom.copy()
         step = between(self._odom_last, odom)
         self._odom_last = odom
-        for part in self.particles:
-            part.pose = self._sample_motion(part.pose, step)
+        poses = self._sample_motion_all(np.array([q.pose for q in self.particles]), step)
+        for part, pose in zip(self.particles, poses, strict=True):
+            part.pose = pose
         moved = between(self._odom_at_update, odom)
         due = (
             math.hypot(moved[0], moved[1]) >= p.linearUpdate
