@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 import mujoco
 import numpy as np
 
-from navlab.description.model import Geometry, Link, Origin, RobotModel, Shape
+from navlab.description.model import Geometry, Joint, Link, Origin, RobotModel, Shape
 from navlab.sim.errors import SimError
 
 GROUP_WORLD = 0
@@ -48,9 +48,12 @@ _CONTACT_BITS = {
     "wheel_floor": (_WHEEL_FLOOR, _GROUND),  # its floor contact (see WHEEL_FLOOR_SPHERES)
     "dynamic": (_DYNAMIC, _STATIC | _ROBOT | _DYNAMIC | _GROUND | _WHEEL),
 }
-#: velocity-actuator gain of the wheel motors (N m s/rad); ODE's joint motor is a hard velocity
-#: constraint capped by fmax, approximated here by a stiff implicit damper capped by forcerange.
-WHEEL_KV = 50.0
+#: WHEEL_TAU: ODE's joint motor (Gazebo's diff drive) is a hard velocity constraint capped by the
+#: torque; here each wheel is a velocity actuator (an implicit damper capped by forcerange) whose gain
+#: kv = I_eff / WHEEL_TAU makes the wheel reach its target speed with this time constant (s), where
+#: I_eff is the wheel's own inertia about its axis plus its share of the robot's mass at the wheel
+#: radius. A fixed large gain is not stable: with TurtleBot3's 28 g wheels a kv of 50 diverges.
+WHEEL_TAU = 0.005
 #: WHEEL_FLOOR_SPHERES: a robot cylinder spinning about its own axis (a wheel) touches the floor through
 #: a sphere of its radius at its centre, and everything else through its true cylinder. MuJoCo's
 #: cylinder-plane contact puts points on both rim edges; the outer edge then sets the turning rate
@@ -365,6 +368,24 @@ def _add_site(spec: mujoco.MjSpec, info: BuildInfo, link: str, origin: Origin, n
     return name
 
 
+def _wheel_inertia(robot: RobotModel, joint: Joint) -> float:
+    """Effective inertia (kg m²) a wheel motor drives: the wheel about its axis plus half the robot's
+    mass at the wheel radius (what the wheel feels when it rolls without slipping)."""
+    dd = robot.diff_drive
+    assert dd is not None
+    total = sum(link.inertial.mass for link in robot.links.values() if link.inertial is not None)
+    own = 0.0
+    inertial = robot.links[joint.child].inertial
+    if inertial is not None:
+        tensor = np.array([[inertial.ixx, inertial.ixy, inertial.ixz], [inertial.ixy, inertial.iyy, inertial.iyz],
+                           [inertial.ixz, inertial.iyz, inertial.izz]])
+        rot = mat_from_rpy(inertial.origin.rpy)
+        axis = np.asarray(joint.axis, dtype=float) / np.linalg.norm(joint.axis)
+        com = np.asarray(inertial.origin.xyz, dtype=float)
+        own = float(axis @ rot @ tensor @ rot.T @ axis) + inertial.mass * float(com @ com - (com @ axis) ** 2)
+    return max(own + 0.5 * total * (dd.wheel_diameter / 2) ** 2, 1e-6)
+
+
 def _add_wheel_motors(spec: mujoco.MjSpec, robot: RobotModel) -> tuple[str, str]:
     dd = robot.diff_drive
     assert dd is not None
@@ -377,7 +398,7 @@ def _add_wheel_motors(spec: mujoco.MjSpec, robot: RobotModel) -> tuple[str, str]
                 f"robot {robot.name!r}: diff_drive wheel joint {jname!r} is {found}; expected a continuous joint"
             )
         act = spec.add_actuator(name=f"{jname}::motor", target=jname, trntype=mujoco.mjtTrn.mjTRN_JOINT)
-        act.set_to_velocity(kv=WHEEL_KV)
+        act.set_to_velocity(kv=_wheel_inertia(robot, joint) / WHEEL_TAU)
         act.forcelimited = mujoco.mjtLimited.mjLIMITED_TRUE
         act.forcerange = np.array([-dd.max_torque, dd.max_torque])
         names.append(act.name)

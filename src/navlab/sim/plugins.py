@@ -52,7 +52,8 @@ class DiffDrivePlugin(Node):
     """``libgazebo_ros_diff_drive``: ``cmd_vel`` → wheel velocity targets (torque-limited), odometry and tf.
 
     Every ``1/update_rate`` s: stop the wheels if no command came within ``cmd_timeout`` s, set the
-    wheel targets (ramped by ``max_accel``), then publish ``nav_msgs/Odometry`` on ``odometry_topic`` in
+    wheel targets (ramped by ``max_accel``, which Gazebo's plugin code applies to the wheel's rim
+    speed, so m/s², whatever its documentation says), then publish ``nav_msgs/Odometry`` on ``odometry_topic`` in
     ``odometry_frame`` — integrated from the wheel encoders, or with ``odometry_source: world`` the
     true pose — and the tf ``odometry_frame → robot_base_frame``.
     """
@@ -71,6 +72,7 @@ class DiffDrivePlugin(Node):
         self.cmd = (0.0, 0.0)
         self.last_cmd_ns: int | None = None
         self.wheel_targets = (0.0, 0.0)
+        self.max_wheel_accel = config.max_accel / (config.wheel_diameter / 2)  # rad/s² of the wheel joints
         self.odometry = EncoderOdometry(config.wheel_separation, config.wheel_diameter)
         self.odometry.reset(*sim.wheel_angles())
         self.last_ns = executor.now_ns
@@ -94,8 +96,8 @@ class DiffDrivePlugin(Node):
             v, w = 0.0, 0.0
         left, right = wheel_speeds(v, w, cfg.wheel_separation, cfg.wheel_diameter)
         self.wheel_targets = (
-            ramp(self.wheel_targets[0], left, cfg.max_accel, dt),
-            ramp(self.wheel_targets[1], right, cfg.max_accel, dt),
+            ramp(self.wheel_targets[0], left, self.max_wheel_accel, dt),
+            ramp(self.wheel_targets[1], right, self.max_wheel_accel, dt),
         )
         self.sim.set_wheel_velocity_targets(*self.wheel_targets)
         self.publish_odometry(now, dt)
