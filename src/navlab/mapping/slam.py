@@ -82,6 +82,19 @@ def run_offline(
     return SlamResult(np.array([s.timestamp for s in scans]), robot, laser, grid, stats)
 
 
+def _display_image(grid: GridMap, max_pixels: int = 1200) -> np.ndarray:
+    """Grey image of the grid (1 free, 0 occupied, 0.8 unknown), block-reduced so one-cell walls survive
+    when the grid is larger than ``max_pixels``: a block is occupied if any cell is, else free if any is."""
+    f = max(1, int(np.ceil(max(grid.width, grid.height) / max_pixels)))
+    occ = grid.occupied_mask()
+    free = grid.free_mask()
+    if f > 1:
+        h, w = (grid.height + f - 1) // f * f, (grid.width + f - 1) // f * f
+        occ = np.pad(occ, ((0, h - grid.height), (0, w - grid.width))).reshape(h // f, f, w // f, f).any(axis=(1, 3))
+        free = np.pad(free, ((0, h - grid.height), (0, w - grid.width))).reshape(h // f, f, w // f, f).any(axis=(1, 3))
+    return np.where(occ, 0.0, np.where(free, 1.0, 0.8))
+
+
 def save_figure(grid: GridMap, poses: np.ndarray, path: str | Path, *, title: str = "") -> None:
     """PNG of the map (grey: unknown) with the trajectory in red; written atomically."""
     import io
@@ -93,7 +106,7 @@ def save_figure(grid: GridMap, poses: np.ndarray, path: str | Path, *, title: st
 
     from navlab.mapping.mapfile import atomic_write_bytes
 
-    img = np.where(grid.data < 0, 0.8, 1.0 - grid.data / 100.0)
+    img = _display_image(grid)
     x0, y0, x1, y1 = grid.bounds()
     fig, ax = plt.subplots(figsize=(8, 8 * grid.height / max(grid.width, 1) + 0.5))
     ax.imshow(img, cmap="gray", vmin=0, vmax=1, origin="lower", extent=(x0, x1, y0, y1), interpolation="nearest")
