@@ -63,3 +63,14 @@ def test_render_writes_a_png(tmp_path: os.PathLike[str]) -> None:
     path = save_png(image, os.path.join(tmp_path, "room.png"))
     data = path.read_bytes()
     assert data[:8] == b"\x89PNG\r\n\x1a\n" and len(data) > 1000
+
+
+def test_spawn_sdf_model_spec() -> None:
+    from pathlib import Path
+
+    model_dir = Path(__file__).parents[1] / "fixtures" / "worlds" / "models" / "l_wall"
+    model, t = parse_spawn_spec(f"sdf:file={model_dir},name=wall2,x=1,y=2,yaw=0.5,t=3")
+    assert (model.name, model.pose, t) == ("wall2", (1.0, 2.0, 0.0, 0.0, 0.0, 0.5), 3.0)
+    assert model.static and model.links[0].collisions[0].geometry.kind == "mesh"
+    with pytest.raises(SimError, match="file=PATH"):
+        parse_spawn_spec("sdf:x=1")

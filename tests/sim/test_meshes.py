@@ -65,3 +65,22 @@ def test_convex_or_unknown_mesh_collides_as_its_hull(tmp_path: Path, monkeypatch
     sim.spawn(primitive_model("sphere", "ball", (0.15,), x=0.75, y=1.0, z=1.0, static=False))
     sim.step(1500)
     assert sim.model_pose("ball").position[2] == pytest.approx(0.5 + 0.15, abs=0.01)  # rests on the hull
+
+
+def test_sdf_world_with_stl_l_wall_and_dae_box(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The world loader's mesh fixture: a concave STL L-wall at (-3, -2) and a COLLADA box in inches."""
+    from navlab.world import load_world
+
+    monkeypatch.setenv("NAVLAB_CACHE", str(tmp_path / "cache"))
+    world = load_world(Path(__file__).parents[1] / "fixtures" / "worlds" / "mesh_world.world")
+    # inside the L (legs x -3..-1 at y -2..-1.8 and x -3..-2.8 at y -1.8..-0.3), facing its inner corner
+    sim = Simulation(make_mybot(noise=0.0), world, robot_pose=(-2.3, -1.3, -3 * math.pi / 4))
+    parts = [g for g in range(sim.model.ngeom) if sim.model.geom(g).name.startswith("l_wall::link::collision0::")]
+    assert len(parts) >= 2  # decomposed: the L is not its convex hull
+    ahead = sim.true_ranges()[360]  # towards the inner corner (-2.8, -1.8)
+    assert ahead == pytest.approx(math.hypot(0.5, 0.5), abs=0.02)
+    sim.spawn(primitive_model("sphere", "ball", (0.1,), x=-2.6, y=-1.6, z=1.3, static=False))
+    sim.step(1000)
+    assert sim.model_pose("ball").position[2] == pytest.approx(0.1, abs=0.01)  # fell into the notch
+    crate = sim.model_pose("crate").position
+    assert crate[:2] == pytest.approx((2.0, 1.0), abs=0.3)
