@@ -66,7 +66,7 @@ class GazeboSim(Node):
             self.get_logger().warning(warning)
         self.sim = Simulation(robot, world, seed=self.rng, timestep=timestep or None, robot_pose=pose,
                               visuals=visuals)
-        self.sim.advance_to(executor.now_ns)
+        self.sim.time_ns = executor.now_ns  # started late: physics time begins at the current time
         for warning in self.sim.info.warnings:
             self.get_logger().warning(warning)
         executor.add_stepper(self)
