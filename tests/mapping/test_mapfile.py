@@ -135,3 +135,9 @@ def test_malformed_pgm(tmp_path, payload, needle):
 def test_atomic_write_leaves_no_temp_files(tmp_path):
     save_map(GridMap(np.zeros((3, 3), np.int8), 0.1), tmp_path / "x.yaml")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["x.pgm", "x.yaml"]
+
+
+def test_save_creates_missing_directories(tmp_path):
+    grid = GridMap(np.zeros((2, 2), np.int8), 0.1)
+    save_map(grid, tmp_path / "a" / "b" / "m.yaml")
+    np.testing.assert_array_equal(load_map(tmp_path / "a" / "b" / "m.yaml").data, grid.data)

@@ -330,8 +330,10 @@ def save_map(
     if not 0.0 <= free_thresh < occupied_thresh <= 1.0:
         raise MappingError("save_map: thresholds must satisfy 0 <= free_thresh < occupied_thresh <= 1")
     ypath = Path(yaml_path)
-    if not ypath.parent.is_dir():
-        raise MappingError(f"save_map: directory {ypath.parent} does not exist")
+    try:
+        ypath.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise MappingError(f"save_map: cannot create directory {ypath.parent}: {exc.strerror or exc}") from None
     if image_name is None:
         image_name = ypath.stem + (".png" if mode == "scale" else ".pgm")
     ipath = Path(image_name) if Path(image_name).is_absolute() else ypath.parent / image_name
