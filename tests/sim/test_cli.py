@@ -74,3 +74,14 @@ def test_spawn_sdf_model_spec() -> None:
     assert model.static and model.links[0].collisions[0].geometry.kind == "mesh"
     with pytest.raises(SimError, match="file=PATH"):
         parse_spawn_spec("sdf:x=1")
+
+
+def test_sim_verb_records_a_rosbag(tmp_path: os.PathLike[str], capsys: pytest.CaptureFixture[str]) -> None:
+    from rosbags.rosbag2 import Reader
+
+    bag = os.path.join(tmp_path, "drive")
+    assert main(["sim", "--duration", "0.5", "--cmd-vel", "0.2,0", "--quiet", "--json", "--record", bag]) == 0
+    out = json.loads(capsys.readouterr().out)
+    with Reader(out["record"]) as reader:
+        counts = {c.topic: c.msgcount for c in reader.connections}
+    assert counts["/mybot/laser/scan"] == 20 and counts["/odom"] == 15 and counts["/cmd_vel"] >= 5
