@@ -1,6 +1,7 @@
 """MuJoCo simulation of a ROS robot in a Gazebo world, with Gazebo-like plugins.
 
-``Simulation`` is the pure stepping API (physics, wheel motors, lidar via ``mj_multiRay``, IMU,
+``Simulation`` is the pure stepping API (physics, wheel motors, lidar (a Numba planar caster that
+matches ``mj_multiRay``, which still casts against meshes), IMU,
 spawning); :mod:`navlab.sim.plugins` wraps it as nodes (diff_drive, lidar, imu, joint states,
 ground truth); :func:`launch_sim` starts the ``gazebo`` node with all of them on an executor.
 """
