@@ -77,7 +77,7 @@ def test_turns_in_place() -> None:
     probe = Probe(ex, 0.0, 1.0)
     ex.run(3.0)
     _, _, yaw = msgs.pose2d(probe.truth[-1].pose.pose)
-    assert yaw == pytest.approx(3.0 - 0.1, abs=0.15)  # first command arrives at t = 0 s, turning 3 s
+    assert yaw == pytest.approx(3.0 - 0.133, abs=0.15)  # first cmd_vel at 0.1 s, applied at the 0.133 s update
 
 
 def test_encoder_odometry_within_one_percent_over_ten_metres() -> None:
