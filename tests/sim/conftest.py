@@ -20,9 +20,12 @@ from navlab.description.model import (
 from navlab.world.model import ModelSpec, WorldModel
 
 
-def _cyl_inertial(mass: float, r: float, h: float) -> Inertial:
-    i_xy = mass * (3 * r * r + h * h) / 12.0
-    return Inertial(mass=mass, ixx=i_xy, iyy=i_xy, izz=mass * r * r / 2.0)
+def _cyl_inertial(mass: float, r: float, h: float, axis: str = "z") -> Inertial:
+    """Solid cylinder about its centre, its axis along ``axis`` (z: the chassis; y: a wheel on its axle)."""
+    side, along = mass * (3 * r * r + h * h) / 12.0, mass * r * r / 2.0
+    if axis == "y":
+        return Inertial(mass=mass, ixx=side, iyy=along, izz=side)
+    return Inertial(mass=mass, ixx=side, iyy=side, izz=along)
 
 
 def make_mybot(*, torque: float = 15.0, caster_mu: float | None = 0.0, odometry_source: str = "encoder",
@@ -43,12 +46,12 @@ def make_mybot(*, torque: float = 15.0, caster_mu: float | None = 0.0, odometry_
         ),
         "left_wheel": Link(
             "left_wheel",
-            inertial=_cyl_inertial(2.0, 0.08, 0.03),
+            inertial=_cyl_inertial(2.0, 0.08, 0.03, axis="y"),
             collisions=[Shape(Geometry("cylinder", (0.08, 0.03)), Origin(rpy=wheel_rpy))],
         ),
         "right_wheel": Link(
             "right_wheel",
-            inertial=_cyl_inertial(2.0, 0.08, 0.03),
+            inertial=_cyl_inertial(2.0, 0.08, 0.03, axis="y"),
             collisions=[Shape(Geometry("cylinder", (0.08, 0.03)), Origin(rpy=wheel_rpy))],
         ),
         "laser": Link("laser", collisions=[Shape(Geometry("box", (0.05, 0.05, 0.04)))]),

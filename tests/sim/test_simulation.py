@@ -49,7 +49,7 @@ def test_torque_limit_caps_acceleration() -> None:
     v_strong = strong.link_velocity()[0][0]
     # 2 wheels x 0.5 N m / 0.08 m on 14 kg plus the wheels' rotational inertia (2 kg equivalent)
     expected = 2 * 0.5 / WHEEL_R / 16.0 * 0.3
-    assert v_weak == pytest.approx(expected, rel=0.15)
+    assert v_weak == pytest.approx(expected, rel=0.05)
     assert v_strong == pytest.approx(0.5, abs=0.02)
 
 
