@@ -52,8 +52,8 @@ class DiffDrivePlugin(Node):
     """``libgazebo_ros_diff_drive``: ``cmd_vel`` → wheel velocity targets (torque-limited), odometry and tf.
 
     Every ``1/update_rate`` s: stop the wheels if no command came within ``cmd_timeout`` s, set the
-    wheel targets (ramped by ``max_accel``, which Gazebo's plugin code applies to the wheel's rim
-    speed, so m/s², whatever its documentation says), then publish ``nav_msgs/Odometry`` on ``odometry_topic`` in
+    wheel targets (ramped by ``max_accel`` in m/s² of the wheel rim, as Gazebo's plugin code applies
+    ``wheelAcceleration``), then publish ``nav_msgs/Odometry`` on ``odometry_topic`` in
     ``odometry_frame`` — integrated from the wheel encoders, or with ``odometry_source: world`` the
     true pose — and the tf ``odometry_frame → robot_base_frame``.
     """
