@@ -18,6 +18,7 @@ COMMAND_MODULES = (
     "navlab.core.cli",
     "navlab.bench",
     "navlab.mapping.cli",
+    "navlab.mapping.run_cli",
     "navlab.description.cli",
     "navlab.localization.cli",
     "navlab.sim.cli",

@@ -9,6 +9,8 @@ import time
 
 import yaml
 
+from navlab.mapping.run_cli import add_eval_map
+
 
 def _params_file(path: str | None) -> dict:
     if not path:
@@ -108,7 +110,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
     e = sub.add_parser(
         "eval",
-        help="score SLAM results (relations metric of Kümmerle et al. 2009)",
+        help="score SLAM results (relations metric of Kümmerle et al. 2009; maps against a simulated world)",
         description="Evaluate SLAM output against ground truth.",
     )
     esub = e.add_subparsers(dest="eval_kind", metavar="KIND", required=True)
@@ -124,3 +126,4 @@ def register(sub: argparse._SubParsersAction) -> None:
     r.add_argument("--tolerance", type=float, default=1e-3, help="timestamp match tolerance in s (default 0.001)")
     r.add_argument("--json", action="store_true", help="print one JSON object")
     r.set_defaults(func=_cmd_eval_relations)
+    add_eval_map(esub)

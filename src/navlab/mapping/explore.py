@@ -31,18 +31,29 @@ class Frontier:
         return len(self.cells)
 
 
-def find_frontiers(grid: GridMap, *, min_cells: int = 5, free_threshold: int = 25) -> list[Frontier]:
-    """Clusters (8-connected) of free cells with an unknown 4-neighbour, largest first."""
-    free = (grid.data >= 0) & (grid.data < free_threshold)
-    unknown = grid.data < 0
+def find_frontiers(
+    grid: GridMap, *, min_cells: int = 5, free_threshold: int = 25, occupied_threshold: int = 65
+) -> list[Frontier]:
+    """Clusters (8-connected) of free cells with an unknown 4-neighbour, largest first.
+
+    Cells between the free and occupied thresholds (seen too little to decide, as map_saver's trinary
+    mode would write them) count as unknown, so probabilistic maps explore like trinary ones.
+    """
+    d = grid.data
+    free = (d >= 0) & (d < free_threshold)
+    unknown = (d < 0) | ((d >= free_threshold) & (d < occupied_threshold))
     near_unknown = ndimage.binary_dilation(unknown, structure=ndimage.generate_binary_structure(2, 1))
     labels, n = ndimage.label(free & near_unknown, structure=np.ones((3, 3), bool))
+    jj, ii = np.nonzero(labels)
+    lab = labels[jj, ii]
+    order = np.argsort(lab, kind="stable")
+    bounds = np.searchsorted(lab[order], np.arange(1, n + 2))
     out = []
-    for k in range(1, n + 1):
-        jj, ii = np.nonzero(labels == k)
-        if len(ii) < min_cells:
+    for k in range(n):
+        idx = order[bounds[k] : bounds[k + 1]]
+        if len(idx) < min_cells:
             continue
-        cells = np.stack([ii, jj], axis=1)
+        cells = np.stack([ii[idx], jj[idx]], axis=1)
         out.append(Frontier(cells, grid.cell_to_world(cells).mean(axis=0)))
     return sorted(out, key=lambda f: -f.size)
 

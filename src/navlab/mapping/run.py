@@ -1,0 +1,215 @@
+"""The paper's mapping step in simulation: sim + slam_gmapping + (exploration | teleop | route) → saved map.
+
+``run_mapping`` is the Python API behind ``navlab map``; it returns the saved paths and, because a
+simulated world knows its truth, the map's score against the world and the trajectory's error.
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from navlab import msgs
+from navlab.core import Executor, Node, TfError
+from navlab.core.runner import run_for
+from navlab.mapping.errors import MappingError
+from navlab.mapping.evaluation import TruthGrid, free_coverage, score_map, trajectory_error
+from navlab.mapping.explore_node import Explore
+from navlab.mapping.grid import GridMap
+from navlab.mapping.mapfile import save_map
+from navlab.mapping.slam_node import SlamGMapping
+from navlab.mapping.teleop import HELP as TELEOP_HELP
+from navlab.mapping.teleop import RouteFollower, TeleopKeyboard, load_route
+
+
+class TrajectoryMonitor(Node):
+    """Samples the true pose (``/ground_truth/odom``) and the SLAM estimate (tf map→base) at ``rate`` Hz."""
+
+    def __init__(self, executor: Executor, *, base_frame: str, rate: float = 2.0) -> None:
+        super().__init__("trajectory_monitor", executor)
+        self.base_frame = base_frame
+        self.truth: list[tuple[float, float, float]] = []
+        self.estimate: list[tuple[float, float, float]] = []
+        self._latest_truth: tuple[float, float, float] | None = None
+        self.create_subscription(msgs.Odometry, "/ground_truth/odom", self._on_truth, 1)
+        self.create_timer(1.0 / rate, self._sample)
+
+    def _on_truth(self, msg: Any) -> None:
+        self._latest_truth = msgs.pose2d(msg.pose.pose)
+
+    def _sample(self) -> None:
+        if self._latest_truth is None:
+            return
+        try:
+            est = self.executor.tf.lookup_pose2d("map", self.base_frame)
+        except TfError:
+            return
+        self.truth.append(self._latest_truth)
+        self.estimate.append(est)
+
+
+@dataclass
+class MappingResult:
+    """What a mapping run produced: files, the final grid, and its scores against the world's truth."""
+
+    map_yaml: Path
+    grid: GridMap
+    sim_seconds: float
+    finished: bool
+    scores: dict[str, Any] = field(default_factory=dict)
+
+
+def true_occupancy(world: Any, grid: GridMap, margin: float = 1.0) -> TruthGrid:
+    """The world's occupancy at lidar height over the map's extent (plus ``margin`` m), in the world frame."""
+    from navlab.world.occupancy import occupancy
+
+    x0, y0, x1, y1 = grid.bounds()
+    bounds = (x0 - margin, y0 - margin, x1 + margin, y1 + margin)
+    occ = occupancy(world, grid.resolution, bounds, static_only=True)
+    return TruthGrid(occ, grid.resolution, (bounds[0], bounds[1]))
+
+
+def _terminal_keys(teleop: TeleopKeyboard, ex: Executor) -> threading.Thread:
+    """Read single key presses from the terminal (cbreak mode) and hand them to the teleop node."""
+    import sys
+    import termios
+    import tty
+
+    def loop() -> None:
+        fd = sys.stdin.fileno()
+        old = termios.tcgetattr(fd)
+        try:
+            tty.setcbreak(fd)
+            while True:
+                ch = sys.stdin.read(1)
+                if not ch or ch == "\x03":
+                    ex.post(ex.stop)
+                    return
+                teleop.press(ch)
+        finally:
+            termios.tcsetattr(fd, termios.TCSADRAIN, old)
+
+    t = threading.Thread(target=loop, daemon=True)
+    t.start()
+    return t
+
+
+def run_mapping(
+    *,
+    world: str = "room",
+    robot: str = "mybot",
+    out: str | Path = "map",
+    driver: str = "explore",
+    route: str | Path | None = None,
+    duration: float = 600.0,
+    mode: str = "gmapping",
+    seed: int = 0,
+    rate: float = 0.0,
+    record: str | Path | None = None,
+    quiet: bool = False,
+    slam_params: dict[str, Any] | None = None,
+) -> MappingResult:
+    """Map ``world`` with SLAM while ``driver`` (explore | teleop | route) drives; save ``out``/map.yaml.
+
+    Stops when exploration finds no reachable frontier, the route ends, or ``duration`` simulated
+    seconds pass (teleop: Ctrl-C or the duration).
+    """
+    from navlab.sim.gazebo import launch_sim
+
+    if driver not in ("explore", "teleop", "route"):
+        raise MappingError(f"driver must be explore, teleop or route, got {driver!r}")
+    ex = Executor(seed=seed, rate=1.0 if driver == "teleop" and rate == 0 else rate)
+    gazebo = launch_sim(ex, world=world, robot=robot)
+    model = gazebo.sim.robot
+    assert model is not None
+    base = model.diff_drive.robot_base_frame if model.diff_drive else model.root_link
+    scan_topic = model.lidars[0].topic if model.lidars else "scan"
+    slam = SlamGMapping(
+        ex, parameters={"base_frame": base, "scan_topic": scan_topic, "mode": mode, **(slam_params or {})}
+    )
+    monitor = TrajectoryMonitor(ex, base_frame=base)
+    is_done: Any
+    if driver == "explore":
+        with ex.node_context(remappings={"scan": scan_topic}):
+            explorer = Explore(ex, parameters={"robot_base_frame": base})
+        is_done = lambda: explorer.done  # noqa: E731
+    elif driver == "route":
+        if route is None:
+            raise MappingError("driver 'route' needs a route file (--route FILE)")
+        segments, waypoints = load_route(route)
+        follower = RouteFollower(ex, parameters={
+            "segments": [{"linear": v, "angular": w, "duration": d} for v, w, d in segments],
+            "waypoints": waypoints.tolist(), "base_frame": base,
+        })  # fmt: skip
+        is_done = lambda: follower.done  # noqa: E731
+    else:
+        teleop = TeleopKeyboard(ex)
+        print("teleop_twist_keyboard:\n" + TELEOP_HELP)
+        _terminal_keys(teleop, ex)
+        is_done = lambda: False  # noqa: E731
+
+    def stop_when_done(*_: Any) -> None:
+        if is_done():
+            ex.stop()
+
+    ex.add_listener(stop_when_done)
+    run_for(ex, duration, record=record, quiet=quiet, desc=f"mapping {world}")
+    if slam.grid is None:
+        raise MappingError("SLAM produced no map: did the robot receive scans? (check the robot's lidar)")
+    out_dir = Path(out)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    map_yaml = out_dir / "map.yaml"
+    save_map(slam.grid, map_yaml)
+    result = MappingResult(map_yaml, slam.grid, ex.now_ns / 1e9, bool(is_done()))
+    spawn = (float(gazebo.get_parameter("x")), float(gazebo.get_parameter("y")), float(gazebo.get_parameter("yaw")))
+    truth = true_occupancy(gazebo.sim.world, slam.grid)
+    result.scores = {
+        "sim_seconds": round(result.sim_seconds, 2),
+        "finished": result.finished,
+        "scans_processed": slam.scans_processed,
+        **score_map(slam.grid, truth, world_T_map=spawn),
+        "coverage": round(free_coverage(slam.grid, truth, world_T_map=spawn), 4),
+    }
+    if monitor.truth:
+        est = np.array(monitor.estimate)
+        tru = np.array(monitor.truth)
+        # the estimate is in the map frame = the spawn pose; bring the truth into it
+        c, s = math.cos(spawn[2]), math.sin(spawn[2])
+        dx, dy = tru[:, 0] - spawn[0], tru[:, 1] - spawn[1]
+        tru_map = np.stack([c * dx + s * dy, -s * dx + c * dy, tru[:, 2] - spawn[2]], axis=1)
+        result.scores.update(trajectory_error(est, tru_map))
+        _plot(slam.grid, est, tru_map, out_dir / "map.png")
+    return result
+
+
+def _plot(grid: GridMap, est: np.ndarray, truth: np.ndarray, path: Path) -> None:
+    """The map with the SLAM trajectory (blue) and the true one (green)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from navlab.io.files import save_figure_atomic
+
+    x0, y0, x1, y1 = grid.bounds()
+    img = np.where(grid.data < 0, 0.8, 1.0 - grid.data / 100.0)
+    fig, ax = plt.subplots(figsize=(8, 7))
+    ax.imshow(img, cmap="gray", origin="lower", extent=(x0, x1, y0, y1), vmin=0, vmax=1)
+    ax.plot(truth[:, 0], truth[:, 1], "g-", lw=1.5, label="ground truth")
+    ax.plot(est[:, 0], est[:, 1], "b--", lw=1.2, label="SLAM estimate")
+    jj, ii = np.nonzero(grid.data >= 0)  # crop to the known part of the map
+    if len(ii):
+        lo = grid.cell_to_world(np.array([[ii.min(), jj.min()]]))[0] - 0.5
+        hi = grid.cell_to_world(np.array([[ii.max(), jj.max()]]))[0] + 0.5
+        ax.set_xlim(lo[0], hi[0])
+        ax.set_ylim(lo[1], hi[1])
+    ax.set_xlabel("x [m] (map frame)")
+    ax.set_ylabel("y [m]")
+    ax.legend(loc="upper right")
+    save_figure_atomic(fig, path, dpi=120, bbox_inches="tight")
+    plt.close(fig)
