@@ -63,16 +63,31 @@ def traversable(grid: GridMap, robot_radius: float, *, occupied_threshold: int =
 
     Unknown cells count as not traversable, so plans stay in mapped free space.
     """
-    occ = grid.data >= occupied_threshold
-    if occ.any():
-        dist = ndimage.distance_transform_edt(~occ) * grid.resolution
-    else:
-        dist = np.full(grid.data.shape, np.inf)
+    dist = clearance(grid, occupied_threshold=occupied_threshold)
     return (dist > robot_radius) & (grid.data >= 0) & (grid.data < occupied_threshold)
 
 
-def grid_distances(mask: np.ndarray, start: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]:
+def clearance(grid: GridMap, *, occupied_threshold: int = 65) -> np.ndarray:
+    """Distance (m) from each cell centre to the nearest occupied cell (inf if there is none)."""
+    occ = grid.data >= occupied_threshold
+    if not occ.any():
+        return np.full(occ.shape, np.inf)
+    return ndimage.distance_transform_edt(~occ) * grid.resolution
+
+
+def clearance_cost(dist: np.ndarray, robot_radius: float, *, comfort: float = 0.4, weight: float = 4.0) -> np.ndarray:
+    """Per-cell cost factor ≥ 1 that grows as clearance falls from ``robot_radius + comfort`` to the radius,
+    so paths keep to the middle of free space (a costmap inflation layer's role)."""
+    excess = np.clip((robot_radius + comfort - dist) / comfort, 0.0, 1.0)
+    return 1.0 + weight * excess**2
+
+
+def grid_distances(
+    mask: np.ndarray, start: tuple[int, int], cell_cost: np.ndarray | None = None
+) -> tuple[np.ndarray, np.ndarray]:
     """Dijkstra over 8-connected cells of ``mask`` from ``start`` (col i, row j).
+
+    A step's cost is its length in cells times the mean of ``cell_cost`` (default 1) at both ends.
 
     Returns (distance in cells, shape of mask, inf where unreachable; predecessor flat index, -9999 if none).
     """
@@ -84,9 +99,10 @@ def grid_distances(mask: np.ndarray, start: tuple[int, int]) -> tuple[np.ndarray
         ok = (j2 >= 0) & (j2 < h) & (i2 >= 0) & (i2 < w)
         ok[ok] = mask[j2[ok], i2[ok]]
         a, b = jj[ok] * w + ii[ok], j2[ok] * w + i2[ok]
+        c = np.full(len(a), cost) if cell_cost is None else cost * 0.5 * (cell_cost.flat[a] + cell_cost.flat[b])
         rows += [a, b]
         cols += [b, a]
-        costs += [np.full(len(a), cost)] * 2
+        costs += [c, c]
     graph = sparse.csr_matrix(
         (np.concatenate(costs), (np.concatenate(rows), np.concatenate(cols))), shape=(h * w, h * w)
     )
@@ -121,6 +137,23 @@ def nearest_traversable(mask: np.ndarray, cell: tuple[int, int], max_cells: int 
     return int(ii[k] + i0), int(jj[k] + j0)
 
 
+def crop_to_known(grid: GridMap, margin_cells: int = 3) -> GridMap:
+    """The smallest sub-grid holding every known cell (plus a margin of unknown), same frame.
+
+    SLAM maps are allocated large (gmapping's xmin..xmax); planning on the known part is much cheaper.
+    """
+    jj, ii = np.nonzero(grid.data >= 0)
+    if len(ii) == 0:
+        return grid
+    j0, j1 = max(0, jj.min() - margin_cells), min(grid.height, jj.max() + margin_cells + 1)
+    i0, i1 = max(0, ii.min() - margin_cells), min(grid.width, ii.max() + margin_cells + 1)
+    ox, oy, yaw = grid.origin
+    c, s = math.cos(yaw), math.sin(yaw)
+    dx, dy = i0 * grid.resolution, j0 * grid.resolution
+    origin = (ox + c * dx - s * dy, oy + s * dx + c * dy, yaw)
+    return GridMap(grid.data[j0:j1, i0:i1].copy(), grid.resolution, origin, grid.frame_id)
+
+
 def plan_to_frontier(
     grid: GridMap,
     robot_xy: tuple[float, float],
@@ -134,23 +167,29 @@ def plan_to_frontier(
     The cost of a frontier is its path length minus a small bonus for its size (explore_lite's idea).
     Frontiers whose centroid lies within 0.5 m of a blacklisted point are skipped.
     """
-    mask = traversable(grid, robot_radius)
+    grid = crop_to_known(grid)
+    dist_m = clearance(grid)
+    mask = (dist_m > robot_radius) & (grid.data >= 0) & (grid.data < 65)
     start_cell = tuple(int(v) for v in grid.world_to_cell(np.array([robot_xy]))[0])
     start = nearest_traversable(mask, start_cell)  # type: ignore[arg-type]
     if start is None:
         return None
     mask[start[1], start[0]] = True
-    dist, pred = grid_distances(mask, start)
+    dist, pred = grid_distances(mask, start, clearance_cost(dist_m, robot_radius))
     best, best_cost = None, math.inf
+    banned = np.array(blacklist).reshape(-1, 2) if blacklist else np.zeros((0, 2))
     for f in find_frontiers(grid, min_cells=min_frontier_cells):
-        if blacklist and any(np.hypot(*(f.centroid - b)) < 0.5 for b in blacklist):
-            continue
-        # Go to the frontier cell that is cheapest to reach (cells inside the inflation are unreachable).
+        # Go to the frontier cell that is cheapest to reach (cells inside the inflation are unreachable),
+        # skipping cells near goals that were reached or given up on before.
         d = dist[f.cells[:, 1], f.cells[:, 0]]
+        if len(banned):
+            xy = grid.cell_to_world(f.cells)
+            near = np.hypot(xy[:, None, 0] - banned[None, :, 0], xy[:, None, 1] - banned[None, :, 1]).min(axis=1)
+            d = np.where(near < 0.5, np.inf, d)
         reach = np.isfinite(d)
         if not reach.any():
             continue
-        k = int(np.argmin(np.where(reach, d, np.inf)))
+        k = int(np.argmin(d))
         cost = d[k] * grid.resolution - 0.02 * f.size * grid.resolution
         if cost < best_cost:
             best, best_cost = (int(f.cells[k, 0]), int(f.cells[k, 1])), cost

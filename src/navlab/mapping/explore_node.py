@@ -33,7 +33,8 @@ class Explore(Node):
         self.global_frame = self.declare_parameter("global_frame", "map")
         self.base_frame = self.declare_parameter("robot_base_frame", "chassis")
         self.robot_radius = self.declare_parameter("robot_radius", 0.3)
-        self.min_frontier_cells = self.declare_parameter("min_frontier_size", 5)
+        # explore_lite's min_frontier_size is in metres (0.75); frontiers shorter than that are ignored
+        self.min_frontier_size = self.declare_parameter("min_frontier_size", 0.75)
         self.planner_frequency = self.declare_parameter("planner_frequency", 0.5)
         self.max_v = self.declare_parameter("max_vel_x", 0.35)
         self.max_w = self.declare_parameter("max_vel_theta", 1.2)
@@ -44,6 +45,7 @@ class Explore(Node):
         self.path: np.ndarray | None = None
         self.blacklist: list[np.ndarray] = []
         self._front_range = math.inf
+        self._rear_range = math.inf
         self._no_frontier = 0
         self._last_progress = (0, math.inf)  # (time ns, distance to goal)
         self.pub = self.create_publisher(msgs.Twist, "cmd_vel", 1)
@@ -59,8 +61,11 @@ class Explore(Node):
     def _on_scan(self, msg: Any) -> None:
         r = np.asarray(msg.ranges, dtype=float)
         a = msg.angle_min + msg.angle_increment * np.arange(len(r))
-        front = (np.abs(np.arctan2(np.sin(a), np.cos(a))) < 0.5) & np.isfinite(r) & (r >= msg.range_min)
+        rel = np.abs(np.arctan2(np.sin(a), np.cos(a)))
+        ok = np.isfinite(r) & (r >= msg.range_min)
+        front, rear = ok & (rel < 0.5), ok & (rel > math.pi - 0.6)
         self._front_range = float(r[front].min()) if front.any() else math.inf
+        self._rear_range = float(r[rear].min()) if rear.any() else math.inf
 
     def _pose(self) -> tuple[float, float, float] | None:
         try:
@@ -76,7 +81,7 @@ class Explore(Node):
             self.grid,
             pose[:2],
             robot_radius=self.robot_radius,
-            min_frontier_cells=self.min_frontier_cells,
+            min_frontier_cells=max(1, round(self.min_frontier_size / self.grid.resolution)),
             blacklist=self.blacklist,
         )
         if path is None:
@@ -118,11 +123,12 @@ class Explore(Node):
             self.path = None
             return
         if remaining < 0.15:
+            # Reached: what is left of this frontier could not be seen from here; look elsewhere next.
+            self.blacklist.append(self.path[-1].copy())
             self.path = None
             self.pub.publish(msgs.twist(0.0, 0.0))
-            self._replan()
             return
         v, w, _ = follow_path(pose, self.path, max_v=self.max_v, max_w=self.max_w, min_front_range=self._front_range)
-        if v == 0.0 and self._front_range < 0.35 and abs(w) < 0.3:
-            w = self.max_w * 0.5  # blocked ahead: turn away rather than wait
+        if v == 0.0 and self._front_range < 0.35 and self._rear_range > 0.4:
+            v = -0.1  # blocked ahead: back off while turning toward the path
         self.pub.publish(msgs.twist(v, w))

@@ -26,6 +26,15 @@ from navlab.mapping.slam_node import SlamGMapping
 from navlab.mapping.teleop import HELP as TELEOP_HELP
 from navlab.mapping.teleop import RouteFollower, TeleopKeyboard, load_route
 
+# slam_gmapping settings for a small room driven slowly (as TurtleBot3's gmapping.yaml tunes them):
+# update every 0.5 m / 0.25 rad or at least every 2 s, publish the map every 2 s.
+MAPPING_SLAM_PARAMS: dict[str, Any] = {
+    "linearUpdate": 0.5,
+    "angularUpdate": 0.25,
+    "temporalUpdate": 2.0,
+    "map_update_interval": 2.0,
+}
+
 
 class TrajectoryMonitor(Node):
     """Samples the true pose (``/ground_truth/odom``) and the SLAM estimate (tf map→base) at ``rate`` Hz."""
@@ -129,9 +138,8 @@ def run_mapping(
     assert model is not None
     base = model.diff_drive.robot_base_frame if model.diff_drive else model.root_link
     scan_topic = model.lidars[0].topic if model.lidars else "scan"
-    slam = SlamGMapping(
-        ex, parameters={"base_frame": base, "scan_topic": scan_topic, "mode": mode, **(slam_params or {})}
-    )
+    slam = SlamGMapping(ex, parameters={"base_frame": base, "scan_topic": scan_topic, "mode": mode,
+                                        **MAPPING_SLAM_PARAMS, **(slam_params or {})})  # fmt: skip
     monitor = TrajectoryMonitor(ex, base_frame=base)
     is_done: Any
     if driver == "explore":

@@ -128,7 +128,9 @@ class SlamGMapping(Node):
                 self.params.maxRange = rmax - 0.01
                 self.params.maxUrange = min(self.params.maxUrange, self.params.maxRange)
             before = self.slam.updates
-            pose = self.slam.add_scan(r, float(msg.angle_min), float(msg.angle_increment), odom_laser)
+            pose = self.slam.add_scan(
+                r, float(msg.angle_min), float(msg.angle_increment), odom_laser, stamp=t_ns * 1e-9
+            )
             if self.slam.updates == before and self.scans_processed > 0:
                 return
             self._stamps.append(t_ns)
