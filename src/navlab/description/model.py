@@ -121,6 +121,9 @@ class DiffDriveConfig:
     cmd_timeout: float = 0.5  # s without cmd_vel before the wheels are stopped
     namespace: str = ""
     legacy_mode: bool = False  # ROS 1 <legacyMode> true: left/right wheel speeds swapped when turning
+    # navlab extension (not a Gazebo tag): relative error of each wheel's encoder scale, drawn once per
+    # run from N(0, odometry_noise) with the run's seed; 0 = exact encoders. Makes odometry drift.
+    odometry_noise: float = 0.0
 
 
 @dataclass

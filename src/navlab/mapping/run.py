@@ -37,13 +37,15 @@ MAPPING_SLAM_PARAMS: dict[str, Any] = {
 
 
 class TrajectoryMonitor(Node):
-    """Samples the true pose (``/ground_truth/odom``) and the SLAM estimate (tf map→base) at ``rate`` Hz."""
+    """Samples the true pose (``/ground_truth/odom``), the SLAM estimate (tf map→base) and raw odometry
+    (tf odom→base) at ``rate`` Hz."""
 
     def __init__(self, executor: Executor, *, base_frame: str, rate: float = 2.0) -> None:
         super().__init__("trajectory_monitor", executor)
         self.base_frame = base_frame
         self.truth: list[tuple[float, float, float]] = []
         self.estimate: list[tuple[float, float, float]] = []
+        self.odometry: list[tuple[float, float, float]] = []
         self._latest_truth: tuple[float, float, float] | None = None
         self.create_subscription(msgs.Odometry, "/ground_truth/odom", self._on_truth, 1)
         self.create_timer(1.0 / rate, self._sample)
@@ -56,10 +58,12 @@ class TrajectoryMonitor(Node):
             return
         try:
             est = self.executor.tf.lookup_pose2d("map", self.base_frame)
+            odom = self.executor.tf.lookup_pose2d("odom", self.base_frame)
         except TfError:
             return
         self.truth.append(self._latest_truth)
         self.estimate.append(est)
+        self.odometry.append(odom)
 
 
 @dataclass
@@ -122,18 +126,20 @@ def run_mapping(
     record: str | Path | None = None,
     quiet: bool = False,
     slam_params: dict[str, Any] | None = None,
+    sim_params: dict[str, Any] | None = None,
 ) -> MappingResult:
     """Map ``world`` with SLAM while ``driver`` (explore | teleop | route) drives; save ``out``/map.yaml.
 
     Stops when exploration finds no reachable frontier, the route ends, or ``duration`` simulated
-    seconds pass (teleop: Ctrl-C or the duration).
+    seconds pass (teleop: Ctrl-C or the duration). ``sim_params`` go to the ``gazebo`` node (e.g.
+    ``odometry_noise``); ``slam_params`` to ``slam_gmapping``.
     """
     from navlab.sim.gazebo import launch_sim
 
     if driver not in ("explore", "teleop", "route"):
         raise MappingError(f"driver must be explore, teleop or route, got {driver!r}")
     ex = Executor(seed=seed, rate=1.0 if driver == "teleop" and rate == 0 else rate)
-    gazebo = launch_sim(ex, world=world, robot=robot)
+    gazebo = launch_sim(ex, world=world, robot=robot, **(sim_params or {}))
     model = gazebo.sim.robot
     assert model is not None
     base = model.diff_drive.robot_base_frame if model.diff_drive else model.root_link
@@ -191,6 +197,10 @@ def run_mapping(
         dx, dy = tru[:, 0] - spawn[0], tru[:, 1] - spawn[1]
         tru_map = np.stack([c * dx + s * dy, -s * dx + c * dy, tru[:, 2] - spawn[2]], axis=1)
         result.scores.update(trajectory_error(est, tru_map))
+        # raw odometry starts at the spawn pose too, so it is compared in the same frame
+        odom_err = trajectory_error(np.array(monitor.odometry), tru_map)
+        result.scores["odometry_position_error_mean_m"] = odom_err["position_error_mean_m"]
+        result.scores["odometry_yaw_error_mean_deg"] = odom_err["yaw_error_mean_deg"]
         _plot(slam.grid, est, tru_map, out_dir / "map.png")
     return result
 

@@ -45,6 +45,7 @@ class GazeboSim(Node):
     (default ``mybot``), ``x``/``y``/``yaw`` (spawn pose, m/rad), ``timestep`` (s; 0 = 2 ms or the world's larger
     ``max_step_size``), ``joint_state_rate`` and ``ground_truth_rate`` (Hz; 0 = off), ``seed``
     (sensor noise seed; -1 = the executor's), ``visuals`` (build render-only geoms; default off, faster).
+    ``odometry_noise`` (relative std dev of each wheel encoder's scale error; navlab extension, default 0).
     ``robot_model``/``world_model`` replace the files."""
 
     def __init__(self, executor: Executor, *, name: str = "gazebo", parameters: dict[str, Any] | None = None,
@@ -60,6 +61,7 @@ class GazeboSim(Node):
         gt_rate = self.declare_parameter("ground_truth_rate", 50.0)
         seed = self.declare_parameter("seed", -1)
         visuals = self.declare_parameter("visuals", False)
+        odometry_noise = self.declare_parameter("odometry_noise", 0.0)
         robot = robot_model if robot_model is not None else load_robot_named(robot_name)
         world = world_model if world_model is not None else load_world_named(world_name)
         for warning in [*robot.warnings, *world.warnings]:
@@ -72,6 +74,8 @@ class GazeboSim(Node):
         executor.add_stepper(self)
         self.plugins: list[Node] = []
         if robot.diff_drive is not None:
+            if odometry_noise > 0:
+                robot.diff_drive.odometry_noise = odometry_noise
             self.plugins.append(DiffDrivePlugin(executor, self.sim, robot.diff_drive, namespace=namespace))
         self.plugins += [LidarPlugin(executor, self.sim, i, namespace=namespace) for i in range(len(robot.lidars))]
         self.plugins += [ImuPlugin(executor, self.sim, i, namespace=namespace) for i in range(len(robot.imus))]

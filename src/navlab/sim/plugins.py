@@ -74,11 +74,22 @@ class DiffDrivePlugin(Node):
         self.wheel_targets = (0.0, 0.0)
         self.max_wheel_accel = config.max_accel / (config.wheel_diameter / 2)  # rad/s² of the wheel joints
         self.odometry = EncoderOdometry(config.wheel_separation, config.wheel_diameter)
-        self.odometry.reset(*sim.wheel_angles())
+        # Encoder scale errors (navlab's odometry_noise): wheel angles are read as if the wheels were
+        # slightly larger or smaller than described, so encoder odometry drifts as a real robot's does.
+        noise = config.odometry_noise
+        self.encoder_scale = 1.0 + self.rng.normal(0.0, noise, 2) if noise > 0 else None
+        self.odometry.reset(*self._encoders())
         self.last_ns = executor.now_ns
         self.odom_pub = self.create_publisher(msgs.Odometry, config.odometry_topic, 10)
         self.create_subscription(msgs.Twist, config.command_topic, self.on_cmd_vel, 10)
         self.create_timer(1.0 / config.update_rate, self.update)
+
+    def _encoders(self) -> tuple[float, float]:
+        """Wheel angles (rad) as the encoders report them."""
+        left, right = self.sim.wheel_angles()
+        if self.encoder_scale is None:
+            return left, right
+        return left * float(self.encoder_scale[0]), right * float(self.encoder_scale[1])
 
     def on_cmd_vel(self, msg: Any) -> None:
         """Store the commanded body velocity (m/s, rad/s); applied at the next update."""
@@ -110,7 +121,7 @@ class DiffDrivePlugin(Node):
             lin, ang = self.sim.link_velocity(self.base_link)
             position, quat = pose.position, pose.quaternion
         else:
-            x, y, yaw, v, w = self.odometry.update(*self.sim.wheel_angles(), dt)
+            x, y, yaw, v, w = self.odometry.update(*self._encoders(), dt)
             position = np.array([x, y, 0.0])
             quat = np.array([np.cos(yaw / 2), 0.0, 0.0, np.sin(yaw / 2)])
             lin, ang = np.array([v, 0.0, 0.0]), np.array([0.0, 0.0, w])
