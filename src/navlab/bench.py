@@ -13,6 +13,7 @@ from typing import Any
 
 # name -> "module:function"; the function takes the parsed args and returns a JSON-able dict.
 BENCHES: dict[str, str] = {
+    "mapping": "navlab.mapping.run:bench",
     "slam": "navlab.mapping.bench:run",
     "core": "navlab.core.bench:run",
     "amcl": "navlab.localization.bench:run",

@@ -108,6 +108,7 @@ class TfBuffer:
         self.cache_ns = cache_ns
         self.tolerance_ns = tolerance_ns
         self._edges: dict[str, _Edge] = {}
+        self._parents: set[str] = set()
 
     def frames(self) -> list[str]:
         """Every frame seen, as parent or child."""
@@ -127,6 +128,7 @@ class TfBuffer:
         e = self._edges.get(child)
         if e is None or e.parent != parent or e.static != static:
             e = self._edges[child] = _Edge(parent, static)
+            self._parents.add(parent)
         if static:
             e.times, e.values = [t_ns], [tf]
             return
@@ -210,10 +212,10 @@ class TfBuffer:
     def lookup(self, target: str, source: str, t_ns: int | None = None) -> Tf:
         """``target_T_source`` at ``t_ns`` (None: the latest time every edge on the path has)."""
         target, source = target.lstrip("/"), source.lstrip("/")
-        known = self.frames()
         for f in (target, source):
-            if f not in known:
-                raise TfError(f"frame {f!r} does not exist (known frames: {', '.join(known) or 'none'})")
+            if f not in self._edges and f not in self._parents:
+                known = ", ".join(self.frames()) or "none"
+                raise TfError(f"frame {f!r} does not exist (known frames: {known})")
         if t_ns is None:
             t_ns = self._latest_common(target, source)
         up_s, up_t = self._ancestors(source), self._ancestors(target)
