@@ -22,6 +22,7 @@ COMMAND_MODULES = (
     "navlab.description.cli",
     "navlab.localization.cli",
     "navlab.sim.cli",
+    "navlab.demo",
 )
 
 
