@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 from pathlib import Path
 from typing import Any
@@ -68,14 +69,24 @@ def _cmd_teleop(args: argparse.Namespace) -> int:
     from navlab.mapping.teleop import HELP, TeleopKeyboard
     from navlab.sim.gazebo import launch_sim
 
-    if not sys.stdin.isatty():
-        raise MappingError("navlab teleop reads keys from a terminal; run it in an interactive shell")
     ex = Executor(seed=args.seed, rate=args.rate)
     gazebo = launch_sim(ex, world=args.world, robot=args.robot)
-    teleop = TeleopKeyboard(ex, parameters={"speed": args.speed, "turn": args.turn})
-    print(HELP)
-    _terminal_keys(teleop, ex)
-    ex.spin()
+    if args.joy:
+        from navlab import msgs
+        from navlab.core import Node
+        from navlab.mapping.teleop import JoyMapping, joystick_thread
+
+        pub = Node("teleop_twist_joy", ex).create_publisher(msgs.Twist, "cmd_vel", 1)
+        joystick_thread(ex, pub, JoyMapping(scale_linear=args.speed, scale_angular=args.turn))
+        print("joystick: hold button 0 and move the left stick; Ctrl-C to quit")
+    else:
+        if not sys.stdin.isatty():
+            raise MappingError("navlab teleop reads keys from a terminal; run it in an interactive shell")
+        teleop = TeleopKeyboard(ex, parameters={"speed": args.speed, "turn": args.turn})
+        print(HELP)
+        _terminal_keys(teleop, ex)
+    with contextlib.suppress(KeyboardInterrupt):
+        ex.spin()
     x, y, yaw = gazebo.sim.base_pose2d()
     print(f"\nstopped at x={x:.2f} y={y:.2f} yaw={yaw:.2f} after {ex.now_ns / 1e9:.1f} simulated s")
     return 0
@@ -153,5 +164,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--speed", type=float, default=0.5, help="linear speed, m/s (default 0.5)")
     p.add_argument("--turn", type=float, default=1.0, help="angular speed, rad/s (default 1.0)")
     p.add_argument("--rate", type=float, default=1.0, help="pacing (default 1 = real time)")
+    p.add_argument("--joy", action="store_true",
+                   help="drive with the first joystick (pygame; teleop_twist_joy's axes and deadman button 0)")
     p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     p.set_defaults(func=_cmd_teleop)

@@ -169,3 +169,61 @@ class RouteFollower(Node):
         path = np.array([pose[:2], target])
         v, w, _ = follow_path(pose, path, lookahead=0.05, max_v=self.max_v)
         self.pub.publish(msgs.twist(v, w))
+
+
+@dataclass
+class JoyMapping:
+    """teleop_twist_joy's parameters and defaults: which axes drive, their scales, the deadman button."""
+
+    axis_linear: int = 1
+    axis_angular: int = 0
+    scale_linear: float = 0.5
+    scale_angular: float = 0.5
+    enable_button: int = 0
+    require_enable_button: bool = True
+
+    def twist(self, axes: list[float], buttons: list[int]) -> Any:
+        """``geometry_msgs/Twist`` for one joystick reading (zero unless the enable button is held)."""
+        enabled = not self.require_enable_button or (
+            0 <= self.enable_button < len(buttons) and bool(buttons[self.enable_button])
+        )
+        if not enabled:
+            return msgs.twist(0.0, 0.0)
+
+        def axis(k: int) -> float:
+            return float(axes[k]) if 0 <= k < len(axes) else 0.0
+
+        # pygame's stick y axis is +1 when pulled back; ROS joy reports forward as +1
+        return msgs.twist(-axis(self.axis_linear) * self.scale_linear, -axis(self.axis_angular) * self.scale_angular)
+
+
+def joystick_thread(ex: Executor, pub: Any, mapping: JoyMapping, rate: float = 20.0) -> Any:
+    """Read the first joystick with pygame and publish ``cmd_vel`` from it; a clear error without one."""
+    import os
+    import threading
+    import time
+
+    os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
+    try:
+        import pygame
+    except ImportError:
+        raise MappingError("joystick teleop needs pygame: pip install pygame") from None
+    pygame.init()
+    pygame.joystick.init()
+    if pygame.joystick.get_count() == 0:
+        raise MappingError("no joystick found (pygame sees none); use the keyboard: navlab teleop")
+    joy = pygame.joystick.Joystick(0)
+    joy.init()
+
+    def loop() -> None:
+        while True:
+            pygame.event.pump()
+            axes = [joy.get_axis(i) for i in range(joy.get_numaxes())]
+            buttons = [joy.get_button(i) for i in range(joy.get_numbuttons())]
+            msg = mapping.twist(axes, buttons)
+            ex.post(lambda m=msg: pub.publish(m))
+            time.sleep(1.0 / rate)
+
+    t = threading.Thread(target=loop, daemon=True)
+    t.start()
+    return t
