@@ -10,4 +10,7 @@ NODES: dict[str, str] = {
     "map_server": "navlab.mapping.map_server:MapServer",
     "slam_gmapping": "navlab.mapping.slam_node:SlamGMapping",
     "gazebo": "navlab.sim.gazebo:GazeboSim",
+    "explore": "navlab.mapping.explore_node:Explore",
+    "teleop_twist_keyboard": "navlab.mapping.teleop:TeleopKeyboard",
+    "route_follower": "navlab.mapping.teleop:RouteFollower",
 }
