@@ -96,14 +96,21 @@ def quaternion_from_yaw(yaw: float) -> Any:
     return Quaternion(x=0.0, y=0.0, z=math.sin(yaw / 2.0), w=math.cos(yaw / 2.0))
 
 
+def yaw_from_xyzw(x: float, y: float, z: float, w: float) -> float:
+    """Yaw (radians, about z) of a unit quaternion given by its components (ROS order x, y, z, w)."""
+    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+
+
 def yaw_from_quaternion(q: Any) -> float:
     """Yaw (radians, about z) of a ``geometry_msgs/Quaternion``."""
-    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+    return yaw_from_xyzw(q.x, q.y, q.z, q.w)
 
 
-def normalize_angle(a: float) -> float:
-    """Wrap an angle to [-pi, pi)."""
-    return (a + math.pi) % (2.0 * math.pi) - math.pi
+def normalize_angle(a: Any) -> Any:
+    """Wrap angles (rad) to [-pi, pi): a number gives a number, an array (or list) an array."""
+    if isinstance(a, float | int):
+        return (a + math.pi) % (2.0 * math.pi) - math.pi
+    return (np.asarray(a) + math.pi) % (2.0 * math.pi) - math.pi
 
 
 # --- poses ----------------------------------------------------------------------------------------

@@ -9,12 +9,16 @@ Two layouts are read:
 
 from __future__ import annotations
 
+import difflib
+from dataclasses import fields
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
 import yaml
 
 from navlab.core.errors import ParameterError
+
+T = TypeVar("T")
 
 
 def read_yaml(path: str | Path) -> Any:
@@ -75,6 +79,22 @@ def load_params(path: str | Path, *, node: str | None = None) -> dict[str, Any]:
         if key in nodes:
             return dict(nodes[key])
     raise ParameterError(f"{path}: no parameters for node {node!r} (nodes in file: {', '.join(nodes)})")
+
+
+def dataclass_from_dict(cls: type[T], values: dict[str, Any] | None, *, what: str, error: type[Exception]) -> T:
+    """An instance of dataclass ``cls`` with ``values`` overriding its defaults, each cast to its default's type.
+
+    An unknown name raises ``error``: "unknown WHAT parameter 'key'; did you mean 'closest'?".
+    """
+    names = [f.name for f in fields(cls)]  # type: ignore[arg-type]
+    out = cls()
+    for key, val in (values or {}).items():
+        if key not in names:
+            close = difflib.get_close_matches(key, names, n=1)
+            hint = f"; did you mean '{close[0]}'?" if close else ""
+            raise error(f"unknown {what} parameter '{key}'{hint}")
+        setattr(out, key, type(getattr(out, key))(val))
+    return out
 
 
 def merge_params(*layers: dict[str, Any]) -> dict[str, Any]:

@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from navlab.core.errors import TfError
-from navlab.msgs import Quaternion, Transform, TransformStamped, Vector3, header, ns_from_time
+from navlab.msgs import Quaternion, Transform, TransformStamped, Vector3, header, ns_from_time, yaw_from_xyzw
 
 # A transform as (x, y, z, qx, qy, qz, qw).
 Tf = tuple[float, float, float, float, float, float, float]
@@ -85,8 +85,7 @@ def tf_from_msg(tr: Any) -> Tf:
 
 def yaw_of(tf: Tf) -> float:
     """Yaw (rad) of a transform's rotation."""
-    qx, qy, qz, qw = tf[3:]
-    return math.atan2(2.0 * (qw * qz + qx * qy), 1.0 - 2.0 * (qy * qy + qz * qz))
+    return yaw_from_xyzw(*tf[3:])
 
 
 @dataclass

@@ -19,6 +19,7 @@ import numpy as np
 from scipy.spatial import ConvexHull, QhullError
 
 from navlab.description.errors import DescriptionError
+from navlab.io.files import write_text_atomic
 
 MESH_SUFFIXES = (".stl", ".obj", ".dae")
 
@@ -35,19 +36,6 @@ def cache_dir() -> Path:
     except OSError:
         pass
     return Path(tempfile.gettempdir()) / f"navlab-{os.getuid()}" / "meshes"
-
-
-def _atomic_write_text(path: Path, text: str) -> None:
-    """Write ``text`` to a temporary file beside ``path`` and rename it into place."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=path.name, suffix=".tmp")
-    try:
-        with os.fdopen(fd, "w") as f:
-            f.write(text)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
 
 
 # ---------------------------------------------------------------------------------------- reading
@@ -276,7 +264,7 @@ def dae_to_obj(path: Path) -> tuple[Path, float]:
         lines = [f"# converted by navlab from {path}"]
         lines += [f"v {x:.9g} {y:.9g} {z:.9g}" for x, y, z in verts]
         lines += [f"f {a + 1} {b + 1} {c + 1}" for a, b, c in faces]
-        _atomic_write_text(out, "\n".join(lines) + "\n")
+        write_text_atomic(out, "\n".join(lines) + "\n")
     return out, unit
 
 

@@ -8,13 +8,13 @@ their squares. Poses files hold ``timestamp x y theta`` per line (``#`` comments
 
 from __future__ import annotations
 
-import math
 import os
 from pathlib import Path
 
 import numpy as np
 
 from navlab.mapping.errors import MappingError
+from navlab.msgs import normalize_angle
 
 
 def _read_table(path: str | os.PathLike[str], min_cols: int, what: str) -> np.ndarray:
@@ -53,10 +53,10 @@ def read_relations(path: str | os.PathLike[str]) -> np.ndarray:
 
 def write_poses(path: str | os.PathLike[str], timestamps: np.ndarray, poses: np.ndarray) -> None:
     """Write ``timestamp x y theta`` lines atomically."""
-    from navlab.mapping.mapfile import atomic_write_bytes
+    from navlab.io.files import write_text_atomic
 
     lines = [f"{t:.6f} {p[0]:.6f} {p[1]:.6f} {p[2]:.6f}\n" for t, p in zip(timestamps, poses, strict=True)]
-    atomic_write_bytes(path, "".join(lines).encode())
+    write_text_atomic(path, "".join(lines))
 
 
 def _match(times: np.ndarray, query: np.ndarray, tol: float) -> np.ndarray:
@@ -98,7 +98,7 @@ def relations_error(
     et = b[:, 2] - a[:, 2]
     # error = relation ⊖ estimate = estimate^-1 ∘ relation; its translation norm is |t_rel - t_est|
     trans = np.hypot(r[:, 2] - ex, r[:, 3] - ey)
-    rot = np.degrees(np.abs((r[:, 4] - et + math.pi) % (2 * math.pi) - math.pi))
+    rot = np.degrees(np.abs(normalize_angle(r[:, 4] - et)))
     ddof = 1 if len(trans) > 1 else 0
     out.update(
         trans_abs_mean=float(trans.mean()),

@@ -17,6 +17,7 @@ import numpy as np
 from scipy.ndimage import distance_transform_edt
 
 from navlab.localization.errors import LocalizationError
+from navlab.msgs import normalize_angle
 
 OCCUPIED_MIN = 65  # ROS map_server occupied_thresh 0.65
 FREE_MAX = 19  # ROS map_server free_thresh 0.196
@@ -59,7 +60,7 @@ class MapField:
         out = np.empty_like(poses, dtype=np.float64)
         out[:, 0] = ox + c * poses[:, 0] - s * poses[:, 1]
         out[:, 1] = oy + s * poses[:, 0] + c * poses[:, 1]
-        out[:, 2] = wrap(poses[:, 2] + oyaw)
+        out[:, 2] = normalize_angle(poses[:, 2] + oyaw)
         return out
 
     def contains(self, x: float, y: float) -> bool:
@@ -85,11 +86,6 @@ class MapField:
         g[:, 1] = (idx // w + rng.random(n)) * self.resolution
         g[:, 2] = rng.uniform(-math.pi, math.pi, size=n)
         return self.from_grid(g)
-
-
-def wrap(a: np.ndarray | float) -> Any:
-    """Wrap angles (rad) to [-pi, pi)."""
-    return (np.asarray(a) + math.pi) % (2.0 * math.pi) - math.pi
 
 
 def build_field(

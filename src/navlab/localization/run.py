@@ -282,7 +282,7 @@ def plot_result(res: LocalizeResult, path: str | Path) -> Path:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from navlab.mapping.mapfile import atomic_write_bytes
+    from navlab.io.files import save_figure_atomic
 
     g = res.grid
     fig, (ax, ax2) = plt.subplots(1, 2, figsize=(12, 5), gridspec_kw={"width_ratios": [1.3, 1]})
@@ -312,12 +312,9 @@ def plot_result(res: LocalizeResult, path: str | Path) -> Path:
     ax2.set_ylabel("position error (cm)")
     ax2.set_title(f"mean {res.summary.get('mean_error_m')} m")
     fig.tight_layout()
-    from io import BytesIO
-
-    buf = BytesIO()
-    fig.savefig(buf, format="png", dpi=110)
-    plt.close(fig)
     out = Path(path)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    atomic_write_bytes(out, buf.getvalue())
+    try:
+        save_figure_atomic(fig, out, format="png", dpi=110)
+    finally:
+        plt.close(fig)
     return out

@@ -13,6 +13,7 @@ import numpy as np
 from scipy import ndimage
 
 from navlab.mapping.grid import GridMap
+from navlab.msgs import normalize_angle
 
 
 @dataclass(frozen=True)
@@ -138,7 +139,7 @@ def free_coverage(
 def trajectory_error(est: np.ndarray, truth: np.ndarray) -> dict[str, float]:
     """Absolute errors between matched poses (N, 3) (x, y, yaw): mean/max position (m) and mean yaw (deg)."""
     dpos = np.hypot(est[:, 0] - truth[:, 0], est[:, 1] - truth[:, 1])
-    dyaw = np.abs((est[:, 2] - truth[:, 2] + np.pi) % (2 * np.pi) - np.pi)
+    dyaw = np.abs(normalize_angle(est[:, 2] - truth[:, 2]))
     return {
         "poses": len(est),
         "position_error_mean_m": round(float(dpos.mean()), 4),

@@ -12,15 +12,17 @@ GMapping's. Pure: numpy in, poses and maps out; the random generator is passed i
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 
 import numba
 import numpy as np
 
+from navlab.core.params import dataclass_from_dict
 from navlab.mapping.errors import MappingError
 from navlab.mapping.grid import GridMap
 from navlab.mapping.occupancy import L_CLAMP, L_FREE, L_OCC, _raycast, logodds_to_grid
 from navlab.mapping.scanmatch import between, compose
+from navlab.msgs import normalize_angle
 
 
 @dataclass
@@ -61,16 +63,7 @@ class GMappingParams:
     @classmethod
     def from_dict(cls, values: dict | None) -> GMappingParams:
         """Parameters from overrides; unknown names raise ``MappingError`` with a suggestion."""
-        import difflib
-
-        names = [f.name for f in fields(cls)]
-        out = cls()
-        for key, val in (values or {}).items():
-            if key not in names:
-                close = difflib.get_close_matches(key, names, n=1)
-                hint = f"; did you mean '{close[0]}'?" if close else ""
-                raise MappingError(f"unknown gmapping parameter '{key}'{hint}")
-            setattr(out, key, type(getattr(out, key))(val))
+        out = dataclass_from_dict(cls, values, what="gmapping", error=MappingError)
         if out.particles < 1:
             raise MappingError(f"gmapping parameter 'particles' must be >= 1, got {out.particles}")
         return out
@@ -257,7 +250,7 @@ class GMapping:
         out = np.empty_like(poses)
         out[:, 0] = poses[:, 0] + c * noisy[:, 0] - s_ * noisy[:, 1]
         out[:, 1] = poses[:, 1] + s_ * noisy[:, 0] + c * noisy[:, 1]
-        out[:, 2] = (poses[:, 2] + noisy[:, 2] + math.pi) % (2 * math.pi) - math.pi
+        out[:, 2] = normalize_angle(poses[:, 2] + noisy[:, 2])
         return out
 
     def add_scan(
@@ -347,7 +340,7 @@ class GMapping:
                 p.kernelSize, p.sigma, p.lsigma, p.lskip, p.lstep, p.astep, p.iterations,
             )  # fmt: skip
             if score > p.minimumScore:
-                part.pose = np.array([x, y, (t + math.pi) % (2 * math.pi) - math.pi])
+                part.pose = np.array([x, y, normalize_angle(t)])
             _s, lik, _n = _score(
                 part.grid, ox, oy, res, part.pose[0], part.pose[1], part.pose[2], r, ang, max_urange,
                 p.kernelSize, p.sigma, p.lsigma, p.lskip,

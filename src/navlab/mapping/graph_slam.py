@@ -11,10 +11,11 @@ still disagrees with is dropped. Pure: numpy arrays in, poses out; no topics, no
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 
 import numpy as np
 
+from navlab.core.params import dataclass_from_dict
 from navlab.mapping.errors import MappingError
 from navlab.mapping.posegraph import PoseGraph
 from navlab.mapping.scanmatch import (
@@ -73,17 +74,7 @@ class GraphSlamParams:
     @classmethod
     def from_dict(cls, values: dict[str, float] | None) -> GraphSlamParams:
         """Parameters from a dict of overrides; unknown names raise ``MappingError`` with suggestions."""
-        import difflib
-
-        names = [f.name for f in fields(cls)]
-        out = cls()
-        for key, val in (values or {}).items():
-            if key not in names:
-                close = difflib.get_close_matches(key, names, n=1)
-                hint = f"; did you mean '{close[0]}'?" if close else ""
-                raise MappingError(f"unknown graph SLAM parameter '{key}'{hint}")
-            setattr(out, key, type(getattr(out, key))(val))
-        return out
+        return dataclass_from_dict(cls, values, what="graph SLAM", error=MappingError)
 
 
 class GraphSlam:

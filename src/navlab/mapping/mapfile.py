@@ -14,13 +14,13 @@ from __future__ import annotations
 import difflib
 import math
 import os
-import tempfile
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import yaml
 
+from navlab.io.files import write_bytes_atomic, write_text_atomic
 from navlab.mapping.errors import MappingError
 from navlab.mapping.grid import GridMap
 
@@ -283,22 +283,6 @@ def load_map(yaml_path: str | os.PathLike[str], *, frame_id: str = "map") -> Gri
 # --- writing --------------------------------------------------------------------------------------------
 
 
-def atomic_write_bytes(path: str | os.PathLike[str], data: bytes) -> None:
-    """Write ``data`` to a temporary file beside ``path`` and rename it into place."""
-    p = Path(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.", suffix=".tmp", dir=p.parent)
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)  # mkstemp creates 0600; give the file the usual permissions
-        os.replace(tmp, p)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-
-
 def _png_bytes(grey: np.ndarray, alpha: np.ndarray | None) -> bytes:
     import io
 
@@ -353,7 +337,7 @@ def save_map(
         payload = head.encode("ascii") + grey.tobytes()
     else:
         raise MappingError(f"save_map: image {ipath.name}: expected a .pgm or .png file name")
-    atomic_write_bytes(ipath, payload)
+    write_bytes_atomic(ipath, payload)
     ox, oy, oyaw = grid.origin
     image_field = image_name if not Path(image_name).is_absolute() else str(ipath)
     text = (
@@ -365,5 +349,5 @@ def save_map(
         f"free_thresh: {free_thresh:g}\n"
         f"mode: {mode}\n"
     )
-    atomic_write_bytes(ypath, text.encode())
+    write_text_atomic(ypath, text)
     return ipath

@@ -12,9 +12,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import spsolve
 
-
-def _wrap(a: np.ndarray) -> np.ndarray:
-    return (a + np.pi) % (2.0 * np.pi) - np.pi
+from navlab.msgs import normalize_angle
 
 
 @dataclass
@@ -51,10 +49,10 @@ class PoseGraph:
         dx, dy = xj[:, 0] - xi[:, 0], xj[:, 1] - xi[:, 1]
         # predicted relative pose in frame i, then error expressed in the frame of the measurement
         px, py = ci * dx + si * dy, -si * dx + ci * dy
-        pt = _wrap(xj[:, 2] - xi[:, 2])
+        pt = normalize_angle(xj[:, 2] - xi[:, 2])
         cz, sz = np.cos(z[:, 2]), np.sin(z[:, 2])
         ex0, ey0 = px - z[:, 0], py - z[:, 1]
-        e = np.stack([cz * ex0 + sz * ey0, -sz * ex0 + cz * ey0, _wrap(pt - z[:, 2])], axis=1)
+        e = np.stack([cz * ex0 + sz * ey0, -sz * ex0 + cz * ey0, normalize_angle(pt - z[:, 2])], axis=1)
         m = len(i)
         a = np.zeros((m, 3, 3))
         b = np.zeros((m, 3, 3))
@@ -129,7 +127,7 @@ class PoseGraph:
             dx = spsolve(hh.tocsc(), -g[3:])
             step = dx.reshape(-1, 3)
             self.poses[1:] += step
-            self.poses[:, 2] = _wrap(self.poses[:, 2])
+            self.poses[:, 2] = normalize_angle(self.poses[:, 2])
             if np.abs(step).max() < tol:
                 return it + 1
         return iterations

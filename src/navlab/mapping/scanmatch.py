@@ -14,11 +14,13 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
+from navlab.msgs import normalize_angle
+
 
 def compose(a: np.ndarray | tuple, b: np.ndarray | tuple) -> np.ndarray:
     """a ∘ b for planar poses (x, y, theta)."""
     c, s = math.cos(a[2]), math.sin(a[2])
-    return np.array([a[0] + c * b[0] - s * b[1], a[1] + s * b[0] + c * b[1], _wrap(a[2] + b[2])])
+    return np.array([a[0] + c * b[0] - s * b[1], a[1] + s * b[0] + c * b[1], normalize_angle(a[2] + b[2])])
 
 
 def inverse(a: np.ndarray | tuple) -> np.ndarray:
@@ -32,8 +34,6 @@ def between(a: np.ndarray | tuple, b: np.ndarray | tuple) -> np.ndarray:
     return compose(inverse(a), b)
 
 
-def _wrap(t: float) -> float:
-    return (t + math.pi) % (2.0 * math.pi) - math.pi
 
 
 def transform_points(pose: np.ndarray | tuple, pts: np.ndarray) -> np.ndarray:
@@ -221,7 +221,7 @@ def correlative_search(
         nang,
         ang_step,
     )
-    return np.array([bx, by, _wrap(bt)]), float(score)
+    return np.array([bx, by, normalize_angle(bt)]), float(score)
 
 
 # --- ICP ----------------------------------------------------------------------------------------------
@@ -305,9 +305,17 @@ def _icp(
             dthx, dthy = -ry, rx  # d(p)/d(theta)
             ex, ey = px - map_xy[bi, 0], py - map_xy[bi, 1]
             nx, ny = map_n[bi, 0], map_n[bi, 1]
-            if nx != 0.0 or ny != 0.0:
-                r = ex * nx + ey * ny
-                jx, jy, jt = nx, ny, dthx * nx + dthy * ny
+            point_to_line = nx != 0.0 or ny != 0.0
+            # one point-to-line residual along the normal, or two point-to-point residuals (x, y)
+            for ax in range(1 if point_to_line else 2):
+                if point_to_line:
+                    r = ex * nx + ey * ny
+                    jx, jy, jt = nx, ny, dthx * nx + dthy * ny
+                else:
+                    r = ex if ax == 0 else ey
+                    jx = 1.0 if ax == 0 else 0.0
+                    jy = 1.0 - jx
+                    jt = dthx if ax == 0 else dthy
                 a = abs(r)
                 wt = 1.0 if a <= huber else huber / a
                 hess[0, 0] += wt * jx * jx
@@ -321,25 +329,6 @@ def _icp(
                 g[2] += wt * jt * r
                 sq += r * r
                 rows += 1
-            else:
-                for ax in range(2):
-                    r = ex if ax == 0 else ey
-                    jx = 1.0 if ax == 0 else 0.0
-                    jy = 1.0 - jx
-                    jt = dthx if ax == 0 else dthy
-                    a = abs(r)
-                    wt = 1.0 if a <= huber else huber / a
-                    hess[0, 0] += wt * jx * jx
-                    hess[0, 1] += wt * jx * jy
-                    hess[0, 2] += wt * jx * jt
-                    hess[1, 1] += wt * jy * jy
-                    hess[1, 2] += wt * jy * jt
-                    hess[2, 2] += wt * jt * jt
-                    g[0] += wt * jx * r
-                    g[1] += wt * jy * r
-                    g[2] += wt * jt * r
-                    sq += r * r
-                    rows += 1
         frac = matched / max(n, 1)
         if matched < 6:
             break
@@ -396,7 +385,7 @@ def icp_point_to_line(
         int(iterations),
         float(huber),
     )
-    return IcpResult(np.array([x, y, _wrap(t)]), float(frac), float(rms), hess)
+    return IcpResult(np.array([x, y, normalize_angle(t)]), float(frac), float(rms), hess)
 
 
 def warmup() -> None:

@@ -97,14 +97,12 @@ def _display_image(grid: GridMap, max_pixels: int = 1200) -> np.ndarray:
 
 def save_figure(grid: GridMap, poses: np.ndarray, path: str | Path, *, title: str = "") -> None:
     """PNG of the map (grey: unknown) with the trajectory in red; written atomically."""
-    import io
-
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from navlab.mapping.mapfile import atomic_write_bytes
+    from navlab.io.files import save_figure_atomic
 
     img = _display_image(grid)
     x0, y0, x1, y1 = grid.bounds()
@@ -115,10 +113,10 @@ def save_figure(grid: GridMap, poses: np.ndarray, path: str | Path, *, title: st
     ax.set_ylabel("y [m]")
     if title:
         ax.set_title(title)
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=120, bbox_inches="tight")
-    plt.close(fig)
-    atomic_write_bytes(path, buf.getvalue())
+    try:
+        save_figure_atomic(fig, path, format="png", dpi=120, bbox_inches="tight")
+    finally:
+        plt.close(fig)
 
 
 def write_outputs(result: SlamResult, out_dir: str | Path, *, title: str = "") -> dict[str, Path]:

@@ -8,12 +8,11 @@ here, while lidar rays still hit the original triangles.
 from __future__ import annotations
 
 import hashlib
-import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
 
+from navlab.io.files import atomic_path
 from navlab.sim.errors import SimError
 
 #: CoACD's concavity threshold (smaller: more, tighter parts)
@@ -68,13 +67,6 @@ def convex_parts(
     arrays: dict[str, np.ndarray] = {"n": np.array(len(parts))}
     for i, (v, f) in enumerate(parts):
         arrays[f"v{i}"], arrays[f"f{i}"] = v, f
-    cached.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=cached.parent, suffix=".npz")
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            np.savez(fh, **arrays)  # type: ignore[arg-type]
-        os.replace(tmp, cached)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    with atomic_path(cached, suffix=".npz") as tmp, tmp.open("wb") as fh:
+        np.savez(fh, **arrays)  # type: ignore[arg-type]
     return parts

@@ -13,6 +13,7 @@ import mujoco
 import numpy as np
 
 from navlab.description.model import DiffDriveConfig, LidarConfig, RobotModel
+from navlab.msgs import yaw_from_xyzw
 from navlab.sim.builder import GROUP_ROBOT, GROUP_WORLD, RAY_GEOMGROUP, quat_from_rpy
 from navlab.sim.errors import SimError
 from navlab.sim.raycast import FAST_TYPES, cast_planar, finish_ranges
@@ -33,7 +34,7 @@ class Pose3D:
     def yaw(self) -> float:
         """Heading about world z (rad)."""
         w, x, y, z = self.quaternion
-        return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+        return yaw_from_xyzw(x, y, z, w)
 
 
 def lidar_angles(cfg: LidarConfig) -> np.ndarray:
