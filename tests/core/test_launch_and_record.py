@@ -4,6 +4,7 @@ import json
 
 import numpy as np
 import pytest
+import yaml
 
 from navlab import msgs
 from navlab.cli import main
@@ -86,6 +87,11 @@ def test_recording_round_trip(tmp_path):
     rec = Recorder(ex, bag, topics=["/odom"])
     ex.run(1.0)
     rec.close()
+    # the files inside carry the bag's final name, and no staging folder is left behind
+    assert sorted(f.name for f in bag.iterdir()) == ["metadata.yaml", "run.mcap"]
+    meta = yaml.safe_load((bag / "metadata.yaml").read_text())["rosbag2_bagfile_information"]
+    assert meta["relative_file_paths"] == ["run.mcap"]
+    assert [f.name for f in tmp_path.iterdir()] == ["run"]
     got = list(read_bag(bag))
     assert [t for _, t, _ in got] == [t for t, _ in sent]
     for (_, _, a), (_, b) in zip(got, sent, strict=True):

@@ -1,8 +1,10 @@
 """rosbag2 recording (MCAP storage) and reading, through rosbags.
 
 ``Recorder`` listens to every message an executor publishes and writes the chosen topics,
-stamped with simulated time. The bag is written under a temporary name and renamed when closed,
-so a crashed run never leaves a half-written bag behind under the asked name.
+stamped with simulated time. The bag is written inside a hidden staging folder beside it
+(``<parent>/.<name>.partial/<name>``) and moved into place when closed, so a crashed run never leaves
+a half-written bag under the asked name, and the finished bag's files and metadata carry its final
+name (``<name>/<name>.mcap``) as ``ros2 bag record`` would write them.
 """
 
 from __future__ import annotations
@@ -15,7 +17,7 @@ from pathlib import Path
 from typing import Any
 
 from rosbags.rosbag2 import Reader, StoragePlugin, Writer
-from rosbags.rosbag2.errors import ReaderError
+from rosbags.rosbag2.errors import ReaderError, WriterError
 
 from navlab.core.executor import Executor
 from navlab.errors import NavlabError
@@ -38,12 +40,17 @@ class Recorder:
         self.path = Path(path)
         if self.path.exists():
             raise BagError(f"{self.path}: already exists; choose a new directory for the recording")
-        self._tmp = self.path.with_name(self.path.name + ".partial")
-        if self._tmp.exists():
-            shutil.rmtree(self._tmp)
+        self._staging = self.path.parent / f".{self.path.name}.partial"
+        self._tmp = self._staging / self.path.name
+        try:
+            if self._staging.exists():  # left behind by a crashed run
+                shutil.rmtree(self._staging)
+            self._staging.mkdir(parents=True)
+            self._writer = Writer(self._tmp, version=8, storage_plugin=StoragePlugin.MCAP)
+            self._writer.open()
+        except (OSError, WriterError) as exc:
+            raise BagError(f"{self.path}: cannot start the recording ({exc})") from None
         self._patterns = [t if t.startswith("/") else "/" + t for t in topics]
-        self._writer = Writer(self._tmp, version=8, storage_plugin=StoragePlugin.MCAP)
-        self._writer.open()
         self._connections: dict[str, Any] = {}
         self._executor = executor
         self.count = 0
@@ -74,6 +81,7 @@ class Recorder:
         self._writer.set_custom_data(GRAPH_KEY, json.dumps(Graph.from_executor(self._executor).to_json()))
         self._writer.close()
         self._tmp.rename(self.path)
+        self._staging.rmdir()
         return self.path
 
     def __enter__(self) -> Recorder:
