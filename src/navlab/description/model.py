@@ -109,7 +109,7 @@ class DiffDriveConfig:
     wheel_separation: float = 0.34
     wheel_diameter: float = 0.15
     max_torque: float = 5.0  # N m per wheel
-    max_accel: float = 0.0  # rad/s² of the wheels; 0 = unlimited (ROS 1 wheelAcceleration)
+    max_accel: float = 0.0  # m/s² at the wheel rim (as Gazebo applies wheelAcceleration); 0 = unlimited
     update_rate: float = 100.0  # Hz
     command_topic: str = "cmd_vel"
     odometry_topic: str = "odom"
