@@ -10,6 +10,7 @@ import argparse
 import importlib
 import logging
 import sys
+from typing import NoReturn
 
 from navlab.errors import NavlabError
 
@@ -26,9 +27,17 @@ COMMAND_MODULES = (
 )
 
 
+class _Parser(argparse.ArgumentParser):
+    """Usage errors as one line, ``navlab: error: launch: argument --duration: ...``, like other errors."""
+
+    def error(self, message: str) -> NoReturn:
+        verb = self.prog.removeprefix("navlab").strip()
+        self.exit(2, f"navlab: error: {verb + ': ' if verb else ''}{message} (see `{self.prog} --help`)\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The full argument parser with every registered verb."""
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="navlab",
         description="The paper's ROS/Gazebo mobile-robot stack in plain Python: simulate, map, "
         "localize, navigate, view and experiment.",

@@ -115,3 +115,39 @@ def test_cli_error_is_one_line(capsys):
     assert main(["launch", "missing_launch", "--duration", "1"]) == 2
     err = capsys.readouterr().err
     assert err.startswith("navlab: error: no launch file") and "Traceback" not in err
+
+
+def test_cli_usage_errors_are_one_line(capsys):
+    bad = (["launch", "sim", "--duration", "x"], ["launch", "sim", "--duration", "-1"], ["sim", "--duration", "0"])
+    for argv in (*bad, ["no_such_verb"]):
+        with pytest.raises(SystemExit) as exc:
+            main(argv)
+        assert exc.value.code == 2
+        err = capsys.readouterr().err
+        assert err.startswith("navlab: error: ") and err.count("\n") == 1, err
+    assert main(["launch", "sim", "wrold:=room", "--duration", "1"]) == 2
+    assert "unknown launch argument 'wrold' (did you mean 'world'?" in capsys.readouterr().err
+
+
+def test_every_verb_documents_itself():
+    import argparse
+
+    from navlab.cli import build_parser
+
+    def walk(p: argparse.ArgumentParser) -> list[str]:
+        gaps = [] if (p.description or "").strip() else [f"{p.prog}: no description"]
+        for a in p._actions:
+            if isinstance(a, argparse._SubParsersAction):
+                for sp in a.choices.values():
+                    gaps += walk(sp)
+            elif not isinstance(a, argparse._HelpAction) and not (a.help or "").strip():
+                gaps.append(f"{p.prog}: {a.option_strings or a.dest} has no help")
+        return gaps
+
+    assert walk(build_parser()) == []
+
+
+def test_launch_show_args(capsys):
+    assert main(["launch", "localization", "--show-args"]) == 0
+    out = capsys.readouterr().out
+    assert "'map':" in out and "(required)" in out and "(default: 'room')" in out

@@ -16,7 +16,7 @@ import numpy as np
 from navlab.core.errors import CoreError
 from navlab.core.graph import Graph
 from navlab.core.launch import Session, start
-from navlab.core.runner import parse_launch_args, run_for
+from navlab.core.runner import parse_launch_args, positive_seconds, run_for
 from navlab.io.files import write_text_atomic
 
 
@@ -27,7 +27,8 @@ def _add_source(p: argparse.ArgumentParser) -> None:
         help="start this launch (file or shipped name, then its arguments) and watch it",
     )
     src.add_argument("--bag", metavar="DIR", help="read a rosbag2 recording instead")
-    p.add_argument("--duration", type=float, default=5.0, help="simulated seconds to run the launch (default 5)")
+    p.add_argument("--duration", type=positive_seconds, default=5.0,
+                   help="simulated seconds to run the launch (default 5)")
     p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
 
 
@@ -87,7 +88,21 @@ def _messages(args: argparse.Namespace, topic: str) -> list[tuple[int, Any]]:
     return got
 
 
+def _show_args(file: str) -> int:
+    from navlab.core.launch import declared_args
+
+    rows = declared_args(file)
+    if not rows:
+        print(f"{file}: no arguments")
+    for a in rows:
+        default = f" (default: {a['default']!r})" if "default" in a else " (required)"
+        print(f"  '{a.get('name')}':\n      {a.get('description', '')}{default}")
+    return 0
+
+
 def _cmd_launch(args: argparse.Namespace) -> int:
+    if args.show_args:
+        return _show_args(args.file)
     session = start(args.file, seed=args.seed, pace=args.rate, launch_args=parse_launch_args(args.args))
     ex = session.executor
     if args.duration is None:
@@ -184,24 +199,43 @@ def _cmd_graph(args: argparse.Namespace) -> int:
     return 0
 
 
+def _shipped_launches() -> list[str]:
+    from navlab.core.launch import resources_dir
+
+    return sorted(f.name.removesuffix(".launch.yaml") for f in (resources_dir() / "launch").glob("*.launch.yaml"))
+
+
 def register(sub: argparse._SubParsersAction) -> None:
     """Add ``launch``, ``topic``, ``node`` and ``graph``."""
     p = sub.add_parser(
         "launch",
         help="run a YAML launch file (ROS 2 YAML launch shape)",
-        description="Run a launch file (a path or a shipped name) with name:=value arguments.",
+        description="Run a launch file (a path or a shipped name) with name:=value arguments, in simulated "
+        "time, and print how many messages each topic carried. Shipped launches: "
+        f"{', '.join(_shipped_launches())} (e.g. `navlab launch mapping --duration 120`, "
+        "`navlab launch localization map:=map/map.yaml`); `navlab launch NAME --show-args` lists a launch's "
+        "arguments.",
     )
     p.add_argument("file", help="launch file or shipped launch name")
     p.add_argument("args", nargs="*", metavar="name:=value", help="launch arguments")
-    p.add_argument("--duration", type=float, default=None, help="simulated seconds to run (default: until Ctrl-C)")
+    p.add_argument("--duration", type=positive_seconds, default=None,
+                   help="simulated seconds to run (default: until Ctrl-C)")
     p.add_argument("--rate", type=float, default=0.0, help="pacing: 0 = as fast as possible, 1 = real time")
     p.add_argument("--record", metavar="DIR", help="write every topic to a rosbag2 (MCAP) in DIR")
     p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
+    p.add_argument("-s", "--show-args", action="store_true",
+                   help="list the launch's arguments (name, description, default) and exit")
     p.set_defaults(func=_cmd_launch)
 
-    p = sub.add_parser("topic", help="list, echo or measure the rate of topics (rostopic)")
+    p = sub.add_parser(
+        "topic",
+        help="list, echo or measure the rate of topics (rostopic)",
+        description="rostopic list|echo|hz on a launch that this command starts and runs for --duration "
+        "simulated seconds, or on a rosbag2 recording (--bag). e.g. `navlab topic hz /mybot/laser/scan "
+        "--launch sim`.",
+    )
     p.add_argument("action", choices=["list", "echo", "hz"], help="what to do")
     p.add_argument("topic", nargs="?", help="topic name (echo, hz)")
     _add_source(p)
@@ -210,12 +244,22 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--json", action="store_true", help="hz: print JSON")
     p.set_defaults(func=_cmd_topic)
 
-    p = sub.add_parser("node", help="list the nodes of a launch or recording (rosnode list)")
+    p = sub.add_parser(
+        "node",
+        help="list the nodes of a launch or recording (rosnode list)",
+        description="rosnode list on a launch that this command starts and runs for --duration simulated "
+        "seconds, or on a navlab rosbag2 recording (--bag; the graph is stored in its metadata).",
+    )
     p.add_argument("action", choices=["list"], help="what to do")
     _add_source(p)
     p.set_defaults(func=_cmd_node)
 
-    p = sub.add_parser("graph", help="write the node/topic graph as DOT and SVG (rqt_graph)")
+    p = sub.add_parser(
+        "graph",
+        help="write the node/topic graph as DOT and SVG (rqt_graph)",
+        description="rqt_graph as files: the nodes and topics of a launch (run for --duration simulated "
+        "seconds) or of a recording, written as OUT.dot and OUT.svg (node -> topic -> node).",
+    )
     _add_source(p)
     p.add_argument("--out", default="graph", help="output path without suffix (writes .dot and .svg)")
     p.set_defaults(func=_cmd_graph)

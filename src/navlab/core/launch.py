@@ -215,6 +215,20 @@ def _run_entries(ctx: _Context, session: Session, depth: int) -> None:
             raise LaunchError(f"{ctx.file}: {where}: unknown entry {kind!r} (expected arg, let, include or node)")
 
 
+def _check_args(file: Path, args: dict[str, Any]) -> None:
+    """Refuse arguments the file neither declares nor uses (a typo like ``wrold:=room`` would be ignored)."""
+    import difflib
+
+    entries = [e for e in _entries(file) if isinstance(e, dict) and isinstance(e.get("arg"), dict)]
+    known = {str(e["arg"].get("name")) for e in entries}
+    known |= {m.group(2).strip() for m in _SUBST.finditer(file.read_text()) if m.group(1) == "var" and m.group(2)}
+    for name in args:
+        if name not in known:
+            close = difflib.get_close_matches(name, sorted(known), n=1)
+            hint = f"did you mean {close[0]!r}? " if close else ""
+            raise LaunchError(f"{file}: unknown launch argument {name!r} ({hint}arguments: {', '.join(sorted(known))})")
+
+
 def declared_args(name_or_path: str) -> list[dict[str, Any]]:
     """The ``arg`` entries of a launch file (for ``--help``-like listings)."""
     return [e["arg"] for e in _entries(find_launch_file(name_or_path)) if isinstance(e, dict) and "arg" in e]
@@ -237,6 +251,7 @@ def start(
     """
     file = find_launch_file(name_or_path)
     all_args = {**(launch_args or {}), **args}
+    _check_args(file, all_args)
     session = Session(executor or Executor(seed=seed, rate=pace), args={k: str(v) for k, v in all_args.items()})
     ctx = _Context(file, session.args)
     _run_entries(ctx, session, 0)

@@ -49,6 +49,20 @@ def run_for(
     return path
 
 
+def positive_seconds(text: str) -> float:
+    """argparse ``type=`` for a duration in simulated seconds: a finite number > 0."""
+    import argparse
+    import math
+
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number of seconds, got {text!r}") from None
+    if not (math.isfinite(value) and value > 0):
+        raise argparse.ArgumentTypeError(f"expected a duration > 0 s, got {text}")
+    return value
+
+
 def parse_launch_args(items: Sequence[str]) -> dict[str, str]:
     """``name:=value`` command-line items to a dict (ROS's launch argument syntax)."""
     from navlab.core.errors import LaunchError

@@ -7,6 +7,8 @@ import json
 import sys
 from typing import Any
 
+from navlab.core.runner import positive_seconds
+
 
 def _amcl_params(path: str | None, sets: list[str]) -> dict[str, Any]:
     """AMCL parameters from a ROS 1 / Nav2 YAML file (``amcl`` node) plus ``--set name=value`` overrides."""
@@ -76,7 +78,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                        help="AMCL's initial pose in the map frame (m, m, rad); default 0 0 0 (the spawn pose)")
     start.add_argument("--global", dest="global_localization", action="store_true",
                        help="start from particles spread over the whole map (global_localization service)")
-    p.add_argument("--duration", type=float, default=60.0, help="simulated seconds to run (default 60)")
+    p.add_argument("--duration", type=positive_seconds, default=60.0, help="simulated seconds to run (default 60)")
     p.add_argument("--kidnap", type=float, metavar="T", default=None,
                    help="at T seconds teleport the robot to the route waypoint farthest from it")
     p.add_argument("--params", metavar="AMCL.yaml", default=None,

@@ -93,7 +93,10 @@ class SlamGMapping(Node):
                 return np.array(self.executor.tf.lookup_pose2d(self.odom_frame, self.base_frame, t))
             except TfError as exc:
                 err = exc
-        self.get_logger().warning(f"no odometry {self.odom_frame} → {self.base_frame}: {err}")
+        # Before the first processed scan this is the start-up order (a scan ahead of the first odometry),
+        # which slam_gmapping's tf message filter drops silently.
+        log = self.get_logger().warning if self.scans_processed else self.get_logger().debug
+        log(f"no odometry {self.odom_frame} → {self.base_frame}: {err}")
         return None
 
     def _due(self, odom_laser: np.ndarray, t_ns: int) -> bool:

@@ -9,6 +9,8 @@ import sys
 import time
 from typing import Any
 
+from navlab.core.runner import positive_seconds
+
 _SPAWN_HELP = (
     "spawn a model, KIND:key=value,... with KIND box|cylinder|sphere|sdf, e.g. 'box:name=crate,x=2,y=1,size=0.5', "
     "'cylinder:x=1,radius=0.2,length=1', 'sdf:file=model.sdf,x=1'; keys name x y z yaw static mass size "
@@ -36,7 +38,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         "simulated time. Prints a summary; --record leaves a rosbag2 (MCAP) of every topic.",
     )
     _add_common(p)
-    p.add_argument("--duration", type=float, default=10.0, help="simulated seconds to run (default 10)")
+    p.add_argument("--duration", type=positive_seconds, default=10.0, help="simulated seconds to run (default 10)")
     p.add_argument("--rate", type=float, default=0.0,
                    help="pacing: 0 = as fast as possible (default), 1 = real time, r = r x real time")
     p.add_argument("--seed", type=int, default=0, help="random seed of sensor noise (default 0)")
