@@ -27,16 +27,14 @@ from navlab.mapping.slam_node import SlamGMapping
 from navlab.mapping.teleop import HELP as TELEOP_HELP
 from navlab.mapping.teleop import RouteFollower, TeleopKeyboard, load_route
 
-# slam_gmapping settings for a small room driven slowly (as TurtleBot3's gmapping.yaml tunes them):
-# update every 0.5 m / 0.25 rad or at least every 2 s, publish the map every 2 s, and scan-match with
-# every 5th of the 720 beams (lskip 4; the map still integrates every beam).
-MAPPING_SLAM_PARAMS: dict[str, Any] = {
-    "lskip": 4,
-    "linearUpdate": 0.5,
-    "angularUpdate": 0.25,
-    "temporalUpdate": 2.0,
-    "map_update_interval": 2.0,
-}
+
+def mapping_slam_params() -> dict[str, Any]:
+    """slam_gmapping's parameters for the paper's room: the shipped ``params/gmapping.yaml`` (ROS
+    defaults, tuned for a small room driven slowly as TurtleBot3's gmapping params are)."""
+    from navlab.core.launch import resources_dir
+    from navlab.core.params import load_params
+
+    return load_params(resources_dir() / "params" / "gmapping.yaml")
 
 
 class TrajectoryMonitor(Node):
@@ -148,7 +146,7 @@ def run_mapping(
     base = model.diff_drive.robot_base_frame if model.diff_drive else model.root_link
     scan_topic = model.lidars[0].topic if model.lidars else "scan"
     slam = SlamGMapping(ex, parameters={"base_frame": base, "scan_topic": scan_topic, "mode": mode,
-                                        **MAPPING_SLAM_PARAMS, **(slam_params or {})})  # fmt: skip
+                                        **mapping_slam_params(), **(slam_params or {})})  # fmt: skip
     monitor = TrajectoryMonitor(ex, base_frame=base)
     is_done: Any
     if driver == "explore":
