@@ -145,7 +145,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--out", default="map", help="output folder (default ./map)")
     p.add_argument("--mode", choices=["gmapping", "graph"], default="gmapping",
                    help="SLAM algorithm: the paper's RBPF (default) or pose-graph")  # fmt: skip
-    p.add_argument("--duration", type=positive_seconds, default=600.0, help="at most this many simulated s (default 600)")
+    p.add_argument("--duration", type=positive_seconds, default=600.0, help="at most this many simulated s (600)")
     p.add_argument("--rate", type=float, default=0.0, help="pacing: 0 = as fast as possible, 1 = real time")
     p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     p.add_argument("--record", metavar="DIR", help="also write every topic to a rosbag2 (MCAP) in DIR")
