@@ -131,6 +131,18 @@ class GridMap:
         ox, oy, _ = self.origin
         return ox, oy, ox + self.width * self.resolution, oy + self.height * self.resolution
 
+    def known_bounds(self, margin: float = 0.5) -> tuple[float, float, float, float] | None:
+        """(xmin, ymin, xmax, ymax) in m around the known (not -1) cells plus ``margin``; None if none is known.
+
+        SLAM maps are allocated far larger than what they have seen; plots crop to this.
+        """
+        jj, ii = np.nonzero(self.data >= 0)
+        if len(ii) == 0:
+            return None
+        corners = self.cell_to_world(np.array([[ii.min(), jj.min()], [ii.max(), jj.max()]]))
+        lo, hi = corners.min(axis=0) - margin, corners.max(axis=0) + margin
+        return float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1])
+
     def copy(self) -> GridMap:
         """A deep copy."""
         return GridMap(self.data.copy(), self.resolution, self.origin, self.frame_id)

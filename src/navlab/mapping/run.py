@@ -225,12 +225,10 @@ def _plot(grid: GridMap, est: np.ndarray, truth: np.ndarray, path: Path) -> None
     ax.imshow(img, cmap="gray", origin="lower", extent=(x0, x1, y0, y1), vmin=0, vmax=1)
     ax.plot(truth[:, 0], truth[:, 1], "g-", lw=1.5, label="ground truth")
     ax.plot(est[:, 0], est[:, 1], "b--", lw=1.2, label="SLAM estimate")
-    jj, ii = np.nonzero(grid.data >= 0)  # crop to the known part of the map
-    if len(ii):
-        lo = grid.cell_to_world(np.array([[ii.min(), jj.min()]]))[0] - 0.5
-        hi = grid.cell_to_world(np.array([[ii.max(), jj.max()]]))[0] + 0.5
-        ax.set_xlim(lo[0], hi[0])
-        ax.set_ylim(lo[1], hi[1])
+    known = grid.known_bounds()
+    if known is not None:  # crop to the part of the map SLAM has seen
+        ax.set_xlim(known[0], known[2])
+        ax.set_ylim(known[1], known[3])
     ax.set_xlabel("x [m] (map frame)")
     ax.set_ylabel("y [m]")
     ax.legend(loc="upper right")
