@@ -15,15 +15,15 @@ from typing import NoReturn
 from navlab.errors import NavlabError
 
 # Modules that define ``register(subparsers: argparse._SubParsersAction) -> None``.
-COMMAND_MODULES = (
+COMMAND_MODULES = (  # in the order of the paper's pipeline, then the ROS-style tools
+    "navlab.demo",
+    "navlab.sim.cli",
+    "navlab.description.cli",
+    "navlab.mapping.run_cli",
+    "navlab.mapping.cli",
+    "navlab.localization.cli",
     "navlab.core.cli",
     "navlab.bench",
-    "navlab.mapping.cli",
-    "navlab.mapping.run_cli",
-    "navlab.description.cli",
-    "navlab.localization.cli",
-    "navlab.sim.cli",
-    "navlab.demo",
 )
 
 
@@ -39,8 +39,8 @@ def build_parser() -> argparse.ArgumentParser:
     """The full argument parser with every registered verb."""
     parser = _Parser(
         prog="navlab",
-        description="The paper's ROS/Gazebo mobile-robot stack in plain Python: simulate, map, "
-        "localize, navigate, view and experiment.",
+        description="The paper's ROS/Gazebo mobile-robot stack in plain Python: simulate the robot in "
+        "its world, map it with SLAM, localize with AMCL, and inspect runs with ROS-style tools.",
     )
     parser.add_argument("-v", "--verbose", action="store_true", help="show the nodes' info-level log lines")
     sub = parser.add_subparsers(dest="command", metavar="VERB", required=True)
