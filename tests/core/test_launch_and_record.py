@@ -101,6 +101,20 @@ def test_recording_round_trip(tmp_path):
     assert "/odom_pub" in bag_graph(bag)["nodes"]
 
 
+def test_recording_keeps_latched_messages_published_before_it_started(tmp_path):
+    ex = Executor()
+    node = Node("map_server", ex)
+    node.create_publisher(msgs.String, "map", latched=True).publish(msgs.String(data="the map"))
+    node.send_static_transform(msgs.transform_stamped(0, "chassis", "laser", 0.1, 0.0, 0.0))
+    Node("robot_state_publisher", ex).send_static_transform(msgs.transform_stamped(0, "chassis", "imu", 0, 0, 0))
+    with Recorder(ex, tmp_path / "bag"):
+        ex.run(0.5)
+    got = list(read_bag(tmp_path / "bag"))
+    assert [m.data for topic, _, m in got if topic == "/map"] == ["the map"]
+    statics = {m.transforms[0].child_frame_id for topic, _, m in got if topic == "/tf_static"}
+    assert statics == {"laser", "imu"}  # every latched publisher's message, not only the last one
+
+
 def test_cli_topic_hz_and_graph(tmp_path, capsys):
     assert main(["topic", "hz", "/chatter", "--json", "--launch", "talker_listener", "rate:=20"]) == 0
     hz = json.loads(capsys.readouterr().out)

@@ -38,13 +38,13 @@ class Stepper(Protocol):
 
 @dataclass
 class Topic:
-    """A named topic: its type, who publishes and subscribes, and (if latched) its last message."""
+    """A named topic: its type, who publishes and subscribes, and each latched publisher's last message."""
 
     name: str
     msgtype: type
     publishers: list[str] = field(default_factory=list)
     subscriptions: list[Subscription] = field(default_factory=list)
-    latched: Any = None
+    latched: dict[int, Any] = field(default_factory=dict)  # id(publisher) -> last message
     count: int = 0
 
 
@@ -128,11 +128,15 @@ class Executor:
 
         topic.subscriptions.append(Subscription(topic.name, TFMessage, feed, "/_tf_buffer"))
 
-    def publish(self, topic: Topic, msg: Any, *, latched: bool = False) -> None:
-        """Queue ``msg`` for every subscriber of ``topic`` (delivered before time advances)."""
+    def publish(self, topic: Topic, msg: Any, *, latch_key: int | None = None) -> None:
+        """Queue ``msg`` for every subscriber of ``topic`` (delivered before time advances).
+
+        ``latch_key`` (a latched publisher's id) keeps the message for late subscribers, one per
+        publisher, as ROS's transient_local durability does.
+        """
         topic.count += 1
-        if latched:
-            topic.latched = msg
+        if latch_key is not None:
+            topic.latched[latch_key] = msg
         for sub in topic.subscriptions:
             self._deliveries.append((sub, msg))
         for listener in self._listeners:
@@ -149,11 +153,11 @@ class Executor:
         self._listeners.remove(fn)
 
     def subscribe(self, sub: Subscription, msgtype: type) -> None:
-        """Attach a subscription; a latched topic hands it its last message at once."""
+        """Attach a subscription; each latched publisher of the topic hands it its last message at once."""
         topic = self.topic(sub.topic, msgtype)
         topic.subscriptions.append(sub)
-        if topic.latched is not None:
-            self._deliveries.append((sub, topic.latched))
+        for msg in topic.latched.values():
+            self._deliveries.append((sub, msg))
 
     # --- timers, services, steppers, inbox -------------------------------------------------------
 

@@ -46,7 +46,7 @@ class Publisher:
 
     def publish(self, msg: Any) -> None:
         """Send ``msg`` to every subscriber."""
-        self._executor.publish(self.topic, msg, latched=self.latched)
+        self._executor.publish(self.topic, msg, latch_key=id(self) if self.latched else None)
 
     def get_subscription_count(self) -> int:
         """How many subscriptions the topic has."""

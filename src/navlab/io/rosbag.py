@@ -54,6 +54,11 @@ class Recorder:
         self._connections: dict[str, Any] = {}
         self._executor = executor
         self.count = 0
+        # Latched topics (/map, /tf_static) were published before recording began: record their last
+        # message now, as `ros2 bag record` does for transient_local publishers.
+        for name, topic in sorted(executor.topics.items()):
+            for msg in topic.latched.values():
+                self._on_message(name, msg, executor.now_ns)
         executor.add_listener(self._on_message)
 
     def _wanted(self, topic: str) -> bool:

@@ -45,6 +45,7 @@ def _cmd_localize(args: argparse.Namespace) -> int:
         amcl_params=_amcl_params(args.params, args.set),
         robot=args.robot,
         progress=not args.quiet and sys.stderr.isatty(),
+        record=args.record,
     )
     summary = dict(result.summary)
     if args.png:
@@ -89,5 +90,6 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--png", default="localize.png", metavar="PATH",
                    help="where to save the truth-vs-estimate figure (default localize.png; '' for none)")
     p.add_argument("--json", action="store_true", help="print the figures as one JSON object")
+    p.add_argument("--record", metavar="DIR", help="also write every topic to a rosbag2 (MCAP) in DIR")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=_cmd_localize)

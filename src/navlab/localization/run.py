@@ -23,6 +23,7 @@ from scipy import ndimage
 
 from navlab import msgs
 from navlab.core import Executor, Node, TfError
+from navlab.core.runner import run_for
 from navlab.localization.amcl_node import Amcl
 from navlab.localization.errors import LocalizationError
 from navlab.localization.field import field_from_map
@@ -145,12 +146,14 @@ def run_localization(
     robot: str = "mybot",
     route: Sequence[tuple[float, float]] = DEFAULT_ROUTE,
     progress: bool = False,
+    record: str | Path | None = None,
 ) -> LocalizeResult:
     """Run the robot along ``route`` for ``duration`` simulated seconds with AMCL; see ``LocalizeResult``.
 
     ``initial``: AMCL's initial pose (default: the spawn pose (0, 0, 0)); ``global_localization``:
     start from particles spread over the whole map instead. ``kidnap_at``: at that time (s) the robot
     is teleported to the route waypoint farthest from it and continues the route from there.
+    ``record``: also write every topic to a rosbag2 (MCAP) in that folder.
     """
     from navlab.sim.gazebo import launch_sim, load_world_named
 
@@ -216,18 +219,7 @@ def run_localization(
     sampler = Node("localize_sampler", ex)
     sampler.create_timer(0.1, sample)
     wall0 = time.perf_counter()
-    steps = max(1, math.ceil(duration))
-    bar = None
-    if progress:
-        from tqdm import tqdm
-
-        bar = tqdm(total=steps, unit="sim s", desc="localize", leave=False)
-    for k in range(steps):
-        ex.run(min(1.0, duration - k))
-        if bar is not None:
-            bar.update(1)
-    if bar is not None:
-        bar.close()
+    run_for(ex, duration, record=record, quiet=not progress, chunk=1.0, desc="localize")
     wall = time.perf_counter() - wall0
     if tmp is not None:
         tmp.cleanup()
