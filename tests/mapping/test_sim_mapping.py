@@ -4,9 +4,12 @@ Each run maps the shipped room with the shipped robot (MuJoCo physics, 720-ray l
 slam_gmapping) and compares the saved map with the world's true occupancy.
 """
 
+import json
+
 import numpy as np
 import pytest
 
+from navlab.cli import main
 from navlab.mapping.mapfile import load_map
 from navlab.mapping.run import run_mapping
 
@@ -28,7 +31,7 @@ def route_file(tmp_path_factory):
     return f
 
 
-def test_route_mapping_puts_walls_where_the_world_has_them(route_file, tmp_path):
+def test_route_mapping_puts_walls_where_the_world_has_them(route_file, tmp_path, capsys):
     r = run_mapping(world="room", driver="route", route=route_file, out=tmp_path / "m", duration=150, quiet=True)
     s = r.scores
     assert r.finished, "the route did not finish within 150 s"
@@ -37,6 +40,11 @@ def test_route_mapping_puts_walls_where_the_world_has_them(route_file, tmp_path)
     saved = load_map(tmp_path / "m" / "map.yaml")
     assert saved.resolution == pytest.approx(0.05)
     assert (tmp_path / "m" / "map.png").stat().st_size > 10_000
+    # the saved (trinary) map scores the same way from the command line, trajectory included
+    assert main(["eval", "map", str(tmp_path / "m" / "map.yaml"), "--world", "room", "--json"]) == 0
+    e = json.loads(capsys.readouterr().out)
+    assert e["precision"] >= 0.9 and e["recall"] >= 0.8 and e["mean_wall_error_m"] <= 0.05, e
+    assert e["position_error_mean_m"] == s["position_error_mean_m"]
 
 
 def test_slam_beats_raw_odometry_when_encoders_are_off(route_file, tmp_path):

@@ -47,6 +47,7 @@ class TrajectoryMonitor(Node):
         self.truth: list[tuple[float, float, float]] = []
         self.estimate: list[tuple[float, float, float]] = []
         self.odometry: list[tuple[float, float, float]] = []
+        self.times: list[float] = []
         self._latest_truth: tuple[float, float, float] | None = None
         self.create_subscription(msgs.Odometry, "/ground_truth/odom", self._on_truth, 1)
         self.create_timer(1.0 / rate, self._sample)
@@ -62,6 +63,7 @@ class TrajectoryMonitor(Node):
             odom = self.executor.tf.lookup_pose2d("odom", self.base_frame)
         except TfError:
             return
+        self.times.append(self.executor.now_ns / 1e9)
         self.truth.append(self._latest_truth)
         self.estimate.append(est)
         self.odometry.append(odom)
@@ -202,12 +204,36 @@ def run_mapping(
         dx, dy = tru[:, 0] - spawn[0], tru[:, 1] - spawn[1]
         tru_map = np.stack([c * dx + s * dy, -s * dx + c * dy, tru[:, 2] - spawn[2]], axis=1)
         result.scores.update(trajectory_error(est, tru_map))
+        write_trajectory(out_dir / "trajectory.txt", np.array(monitor.times), est, tru_map)
         # raw odometry starts at the spawn pose too, so it is compared in the same frame
         odom_err = trajectory_error(np.array(monitor.odometry), tru_map)
         result.scores["odometry_position_error_mean_m"] = odom_err["position_error_mean_m"]
         result.scores["odometry_yaw_error_mean_deg"] = odom_err["yaw_error_mean_deg"]
         _plot(slam.grid, est, tru_map, out_dir / "map.png")
     return result
+
+
+TRAJECTORY_HEADER = "# t x y theta true_x true_y true_theta  (s, m, rad; map frame = the robot's start pose)"
+
+
+def write_trajectory(path: Path, t: np.ndarray, est: np.ndarray, truth: np.ndarray) -> None:
+    """The SLAM trajectory beside the true one, one line per sample (read by ``navlab eval map``)."""
+    from navlab.io.files import write_text_atomic
+
+    rows = np.column_stack([t, est, truth])
+    lines = [TRAJECTORY_HEADER, *(" ".join(f"{v:.6f}" for v in row) for row in rows)]
+    write_text_atomic(path, "\n".join(lines) + "\n")
+
+
+def read_trajectory(path: Path) -> tuple[np.ndarray, np.ndarray]:
+    """(estimate (N, 3), truth (N, 3)) from a file written by :func:`write_trajectory`."""
+    try:
+        rows = np.loadtxt(path, comments="#", ndmin=2)
+    except (OSError, ValueError) as exc:
+        raise MappingError(f"{path}: cannot read a trajectory ({exc}); expected lines of 7 numbers") from None
+    if rows.shape[1] != 7:
+        raise MappingError(f"{path}: expected 7 columns (t x y theta true_x true_y true_theta), got {rows.shape[1]}")
+    return rows[:, 1:4], rows[:, 4:7]
 
 
 def _plot(grid: GridMap, est: np.ndarray, truth: np.ndarray, path: Path) -> None:

@@ -95,16 +95,21 @@ def _cmd_teleop(args: argparse.Namespace) -> int:
 
 def cmd_eval_map(args: argparse.Namespace) -> int:
     """Score a saved map against a world's true occupancy (start pose known, no alignment)."""
-    from navlab.mapping.evaluation import free_coverage, score_map
+    from navlab.mapping.evaluation import free_coverage, score_map, trajectory_error
     from navlab.mapping.mapfile import load_map
-    from navlab.mapping.run import true_occupancy
+    from navlab.mapping.run import read_trajectory, true_occupancy
     from navlab.sim.gazebo import load_world_named
 
     grid = load_map(args.map)
     world = load_world_named(args.world)
     truth = true_occupancy(world, grid)
     start = tuple(args.start)
-    scores = {**score_map(grid, truth, world_T_map=start), "coverage": free_coverage(grid, truth, world_T_map=start)}
+    scores = score_map(grid, truth, world_T_map=start)
+    scores["coverage"] = round(free_coverage(grid, truth, world_T_map=start), 4)
+    traj = Path(args.trajectory) if args.trajectory else Path(args.map).with_name("trajectory.txt")
+    if args.trajectory or traj.is_file():
+        est, true = read_trajectory(traj)
+        scores.update(trajectory_error(est, true))
     _print_scores(scores, args.json)
     return 0
 
@@ -115,13 +120,17 @@ def add_eval_map(esub: argparse._SubParsersAction) -> None:
         "map",
         help="score a map against a simulated world's true occupancy",
         description="Occupied-cell precision and recall (a match within one cell), mean wall error and "
-        "free-space coverage of a map_server map against the world's true occupancy at lidar height. "
+        "free-space coverage of a map_server map against the world's true occupancy at lidar height, and the "
+        "SLAM trajectory's error against ground truth when a trajectory file is there. "
         "The map frame is the robot's start pose in the world (--start), so no alignment is searched.",
     )
     m.add_argument("map", help="map_server YAML file")
     m.add_argument("--world", required=True, help="world file or shipped name (room, room_obstacles)")
     m.add_argument("--start", nargs=3, type=float, default=(0.0, 0.0, 0.0), metavar=("X", "Y", "YAW"),
                    help="robot start pose in the world = the map frame (default 0 0 0)")  # fmt: skip
+    m.add_argument("--trajectory", metavar="FILE",
+                   help="SLAM vs true trajectory to score too (default: trajectory.txt beside the map, "
+                   "as navlab map writes it)")  # fmt: skip
     m.add_argument("--json", action="store_true", help="print JSON")
     m.set_defaults(func=cmd_eval_map)
 
