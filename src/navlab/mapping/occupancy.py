@@ -108,8 +108,9 @@ def logodds_to_grid(
     logodds: np.ndarray, resolution: float, origin: tuple[float, float], *, frame_id: str = "map"
 ) -> GridMap:
     """``GridMap`` from log-odds: untouched cells (0) unknown, else occupancy percent rounded."""
-    p = 1.0 - 1.0 / (1.0 + np.exp(logodds))
-    data = np.where(logodds == 0.0, -1, np.rint(p * 100.0)).astype(np.int8)
+    seen = np.flatnonzero(logodds)  # usually a small part of a SLAM map's allocation
+    data = np.full(logodds.shape, -1, dtype=np.int8)
+    data.flat[seen] = np.rint(100.0 - 100.0 / (1.0 + np.exp(logodds.flat[seen]))).astype(np.int8)
     return GridMap(data, resolution, (float(origin[0]), float(origin[1]), 0.0), frame_id)
 
 
