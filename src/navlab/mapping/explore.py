@@ -58,12 +58,15 @@ def find_frontiers(
     return sorted(out, key=lambda f: -f.size)
 
 
-def traversable(grid: GridMap, robot_radius: float, *, occupied_threshold: int = 65) -> np.ndarray:
+def traversable(
+    grid: GridMap, robot_radius: float, *, occupied_threshold: int = 65, clearance_m: np.ndarray | None = None
+) -> np.ndarray:
     """Cells whose centre is farther than ``robot_radius`` from every occupied cell and that are not unknown.
 
-    Unknown cells count as not traversable, so plans stay in mapped free space.
+    Unknown cells count as not traversable, so plans stay in mapped free space. ``clearance_m`` may
+    pass in :func:`clearance` when the caller has it already.
     """
-    dist = clearance(grid, occupied_threshold=occupied_threshold)
+    dist = clearance(grid, occupied_threshold=occupied_threshold) if clearance_m is None else clearance_m
     return (dist > robot_radius) & (grid.data >= 0) & (grid.data < occupied_threshold)
 
 
@@ -169,7 +172,7 @@ def plan_to_frontier(
     """
     grid = crop_to_known(grid)
     dist_m = clearance(grid)
-    mask = (dist_m > robot_radius) & (grid.data >= 0) & (grid.data < 65)
+    mask = traversable(grid, robot_radius, clearance_m=dist_m)
     start_cell = tuple(int(v) for v in grid.world_to_cell(np.array([robot_xy]))[0])
     start = nearest_traversable(mask, start_cell)  # type: ignore[arg-type]
     if start is None:
