@@ -7,7 +7,9 @@ run for ``--duration`` simulated seconds) or at a recording (``--bag DIR``).
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
+import math
 from pathlib import Path
 from typing import Any
 
@@ -103,12 +105,13 @@ def _show_args(file: str) -> int:
 def _cmd_launch(args: argparse.Namespace) -> int:
     if args.show_args:
         return _show_args(args.file)
-    session = start(args.file, seed=args.seed, pace=args.rate, launch_args=parse_launch_args(args.args))
+    # Like roslaunch, a launch without --duration runs in real time until Ctrl-C.
+    rate = args.rate if args.rate is not None else (1.0 if args.duration is None else 0.0)
+    session = start(args.file, seed=args.seed, pace=rate, launch_args=parse_launch_args(args.args))
     ex = session.executor
-    if args.duration is None:
-        ex.spin()
-    else:
-        run_for(ex, args.duration, record=args.record, quiet=args.quiet, desc=Path(args.file).stem)
+    duration = math.inf if args.duration is None else args.duration
+    with contextlib.suppress(KeyboardInterrupt):
+        run_for(ex, duration, record=args.record, quiet=args.quiet, desc=Path(args.file).stem)
     summary = {
         "sim_seconds": ex.now_ns / 1e9,
         "nodes": sorted(ex.nodes),
@@ -220,7 +223,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("args", nargs="*", metavar="name:=value", help="launch arguments")
     p.add_argument("--duration", type=positive_seconds, default=None,
                    help="simulated seconds to run (default: until Ctrl-C)")
-    p.add_argument("--rate", type=float, default=0.0, help="pacing: 0 = as fast as possible, 1 = real time")
+    p.add_argument("--rate", type=float, default=None,
+                   help="pacing: 0 = as fast as possible, 1 = real time (default: 0 with --duration, else 1)")
     p.add_argument("--record", metavar="DIR", help="write every topic to a rosbag2 (MCAP) in DIR")
     p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")

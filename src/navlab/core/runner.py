@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import sys
 from collections.abc import Sequence
 from pathlib import Path
@@ -30,8 +31,10 @@ def run_for(
 
     recorder = Recorder(ex, record, topics=record_topics) if record else None
     bar = tqdm(
-        total=round(duration, 3), unit="sim s", desc=desc, file=sys.stderr,
-        disable=quiet or not sys.stderr.isatty(), bar_format="{l_bar}{bar}| {n:.1f}/{total:.1f} sim s [{rate_fmt}]",
+        total=None if math.isinf(duration) else round(duration, 3), unit="sim s", desc=desc, file=sys.stderr,
+        disable=quiet or not sys.stderr.isatty(),
+        bar_format="{desc}: {n:.1f} sim s [{rate_fmt}]" if math.isinf(duration)
+        else "{l_bar}{bar}| {n:.1f}/{total:.1f} sim s [{rate_fmt}]",
     )
     try:
         done = 0.0
