@@ -88,15 +88,21 @@ class Graph:
         pos = {v: (c * 3.0, -r * 0.8) for c, vs in columns.items() for r, v in enumerate(vs)}
         height = max((len(v) for v in columns.values()), default=1)
         fig, ax = plt.subplots(figsize=(3 + 3 * len(columns), 1 + 0.6 * height))
-        for t, (pubs, subs) in self.topics.items():
-            for a, b in [*((p, t) for p in pubs), *((t, s) for s in subs)]:
-                ax.annotate("", xy=pos[b], xytext=pos[a], arrowprops={"arrowstyle": "->", "color": "0.4"})
+        boxes = {}
         for v, (x, y) in pos.items():
             is_topic = v in self.topics
-            ax.text(
-                x, y, v, ha="center", va="center", fontsize=8,
+            boxes[v] = ax.text(
+                x, y, v, ha="center", va="center", fontsize=8, zorder=2,
                 bbox={"boxstyle": "square" if is_topic else "round", "fc": "#e8f0ff" if is_topic else "#fff2cc"},
-            )
+            )  # fmt: skip
+        for t, (pubs, subs) in self.topics.items():
+            for a, b in [*((p, t) for p in pubs), *((t, s) for s in subs)]:
+                forward = pos[b][0] >= pos[a][0]  # arrows leave the right edge and enter the left edge
+                ax.annotate(
+                    "", xy=(0.0 if forward else 1.0, 0.5), xycoords=boxes[b],
+                    xytext=(1.0 if forward else 0.0, 0.5), textcoords=boxes[a],
+                    arrowprops={"arrowstyle": "-|>", "color": "0.35", "shrinkA": 3, "shrinkB": 3}, zorder=1,
+                )  # fmt: skip
         ax.set_axis_off()
         xs = [p[0] for p in pos.values()] or [0.0]
         ys = [p[1] for p in pos.values()] or [0.0]
