@@ -1,7 +1,8 @@
 """ROS-style tools: ``navlab launch``, ``navlab topic list|echo|hz``, ``navlab node list``, ``navlab graph``.
 
-The introspection verbs look at a launch that they start themselves (``--launch FILE name:=value``,
-run for ``--duration`` simulated seconds) or at a recording (``--bag DIR``).
+The introspection verbs look at a ``navlab launch`` running in another shell (the default; ``--pid``
+picks one of several), at a launch that they start themselves (``--launch FILE name:=value``, run
+for ``--duration`` simulated seconds), or at a recording (``--bag DIR``).
 """
 
 from __future__ import annotations
@@ -10,6 +11,8 @@ import argparse
 import contextlib
 import json
 import math
+import signal
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -23,14 +26,15 @@ from navlab.io.files import write_text_atomic
 
 
 def _add_source(p: argparse.ArgumentParser) -> None:
-    src = p.add_mutually_exclusive_group(required=True)
+    src = p.add_mutually_exclusive_group()
     src.add_argument(
         "--launch", nargs="+", metavar="FILE [name:=value]",
-        help="start this launch (file or shipped name, then its arguments) and watch it",
+        help="start this launch (file or shipped name, then its arguments) here and watch it",
     )
     src.add_argument("--bag", metavar="DIR", help="read a rosbag2 recording instead")
+    src.add_argument("--pid", type=int, help="which running `navlab launch` to watch when several run")
     p.add_argument("--duration", type=positive_seconds, default=5.0,
-                   help="simulated seconds to run the launch (default 5)")
+                   help="simulated seconds to watch (default 5)")
     p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
 
 
@@ -70,12 +74,34 @@ def _short(v: Any) -> str:
     return json.dumps(v) if isinstance(v, list | str) else str(v)
 
 
-def _messages(args: argparse.Namespace, topic: str) -> list[tuple[int, Any]]:
-    """(t_ns, msg) on ``topic`` from the bag or from running the launch."""
+def _running(args: argparse.Namespace) -> Path | None:
+    """The socket of a launch running in another process, when neither --launch nor --bag is given."""
+    from navlab.core.introspect import find_running
+
+    return None if args.launch or args.bag else find_running(args.pid)
+
+
+def _live_messages(path: Path, topic: str, duration: float, count: int) -> Iterator[tuple[int, Any]]:
+    """Messages of a running launch until ``count`` arrived or ``duration`` simulated seconds passed."""
+    from navlab.core.introspect import subscribe
+
+    t0 = None
+    for n, (t_ns, msg) in enumerate(subscribe(path, topic), 1):
+        t0 = t_ns if t0 is None else t0
+        yield t_ns, msg
+        if (count and n >= count) or (not count and t_ns - t0 >= duration * 1e9):
+            return
+
+
+def _messages(args: argparse.Namespace, topic: str) -> Iterator[tuple[int, Any]] | list[tuple[int, Any]]:
+    """(t_ns, msg) on ``topic`` from the bag, a running launch, or a launch started here."""
     if args.bag:
         from navlab.io.rosbag import read_bag
 
         return [(t, m) for _, t, m in read_bag(args.bag, topics=[topic])]
+    live = _running(args)
+    if live is not None:
+        return _live_messages(live, topic, args.duration, getattr(args, "count", 0) if args.action == "echo" else 0)
     session = _start(args)
     got: list[tuple[int, Any]] = []
 
@@ -110,7 +136,12 @@ def _cmd_launch(args: argparse.Namespace) -> int:
     session = start(args.file, seed=args.seed, pace=rate, launch_args=parse_launch_args(args.args))
     ex = session.executor
     duration = math.inf if args.duration is None else args.duration
-    with contextlib.suppress(KeyboardInterrupt):
+    from navlab.core.introspect import IntrospectionServer
+
+    # `navlab topic/node/graph` in another shell look into this launch while it runs; SIGTERM ends it
+    # cleanly like Ctrl-C (the recording is closed, the socket removed)
+    signal.signal(signal.SIGTERM, lambda *_: ex.post(ex.stop))
+    with IntrospectionServer(ex, name=args.file), contextlib.suppress(KeyboardInterrupt):
         run_for(ex, duration, record=args.record, quiet=args.quiet, desc=Path(args.file).stem)
     summary = {
         "sim_seconds": ex.now_ns / 1e9,
@@ -134,6 +165,10 @@ def _cmd_topic(args: argparse.Namespace) -> int:
             from navlab.io.rosbag import bag_topics
 
             rows = {k: v for k, v in bag_topics(args.bag).items()}
+        elif (live := _running(args)) is not None:
+            from navlab.core.introspect import request
+
+            rows = {k: tuple(v) for k, v in request(live, "graph")["types"].items()}
         else:
             session = _start(args)
             run_for(session.executor, args.duration, quiet=True)
@@ -146,12 +181,14 @@ def _cmd_topic(args: argparse.Namespace) -> int:
         raise CoreError(f"navlab topic {args.action} needs a TOPIC name")
     msgs = _messages(args, args.topic)
     if args.action == "echo":
-        for _t_ns, msg in msgs[: args.count] if args.count else msgs:
+        for k, (_t_ns, msg) in enumerate(msgs, 1):
             print(_format_msg(_msg_to_dict(msg)))
-            print("---")
+            print("---", flush=True)
+            if args.count and k >= args.count:
+                break
         return 0
     # hz
-    times = np.array([t for t, _ in msgs], dtype=np.int64)
+    times = np.array([t for t, _ in msgs], dtype=np.int64)  # simulated time stamps
     if len(times) < 2:
         raise CoreError(f"topic {args.topic!r}: fewer than 2 messages, no rate to compute")
     periods = np.diff(times) / 1e9
@@ -181,6 +218,11 @@ def _graph_of(args: argparse.Namespace) -> Graph:
         if data is not None:
             return Graph.from_json(data)
         return Graph(topics={t: ([], []) for t in bag_topics(args.bag)})
+    live = _running(args)
+    if live is not None:
+        from navlab.core.introspect import request
+
+        return Graph.from_json(request(live, "graph"))
     session = _start(args)
     run_for(session.executor, args.duration, quiet=True)
     return Graph.from_executor(session.executor)
@@ -236,9 +278,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "topic",
         help="list, echo or measure the rate of topics (rostopic)",
-        description="rostopic list|echo|hz on a launch that this command starts and runs for --duration "
-        "simulated seconds, or on a rosbag2 recording (--bag). e.g. `navlab topic hz /mybot/laser/scan "
-        "--launch sim`.",
+        description="rostopic list|echo|hz on a `navlab launch` running in another shell (the default), on a "
+        "launch that this command starts and runs for --duration simulated seconds (--launch), or on a "
+        "rosbag2 recording (--bag). e.g. `navlab topic hz /mybot/laser/scan` next to `navlab launch mapping`.",
     )
     p.add_argument("action", choices=["list", "echo", "hz"], help="what to do")
     p.add_argument("topic", nargs="?", help="topic name (echo, hz)")
@@ -251,8 +293,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "node",
         help="list the nodes of a launch or recording (rosnode list)",
-        description="rosnode list on a launch that this command starts and runs for --duration simulated "
-        "seconds, or on a navlab rosbag2 recording (--bag; the graph is stored in its metadata).",
+        description="rosnode list on a running `navlab launch` (the default), on a launch that this command "
+        "starts and runs for --duration simulated seconds (--launch), or on a navlab rosbag2 recording "
+        "(--bag; the graph is stored in its metadata).",
     )
     p.add_argument("action", choices=["list"], help="what to do")
     _add_source(p)
@@ -261,8 +304,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "graph",
         help="write the node/topic graph as DOT and SVG (rqt_graph)",
-        description="rqt_graph as files: the nodes and topics of a launch (run for --duration simulated "
-        "seconds) or of a recording, written as OUT.dot and OUT.svg (node -> topic -> node).",
+        description="rqt_graph as files: the nodes and topics of a running `navlab launch` (the default), of "
+        "a launch started here (--launch, run for --duration simulated seconds) or of a recording (--bag), "
+        "written as OUT.dot and OUT.svg (node -> topic -> node).",
     )
     _add_source(p)
     p.add_argument("--out", default="graph", help="output path without suffix (writes .dot and .svg)")

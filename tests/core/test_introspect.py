@@ -1,0 +1,59 @@
+"""Looking into a launch running in another process: topic list/echo/hz, node list, graph, clean stop."""
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import pytest
+
+from navlab.cli import main
+from navlab.core import CoreError
+from navlab.core.introspect import find_running, socket_dir
+
+
+@pytest.fixture
+def running_launch():
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "navlab.cli", "launch", "talker_listener", "rate:=20"],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+    )  # fmt: skip
+    sock = socket_dir() / f"{proc.pid}.sock"
+    deadline = time.monotonic() + 30
+    while not sock.exists() and time.monotonic() < deadline and proc.poll() is None:
+        time.sleep(0.1)
+    assert sock.exists(), proc.stderr.read() if proc.poll() is not None else "no socket after 30 s"
+    yield proc
+    if proc.poll() is None:
+        proc.kill()
+        proc.wait(10)
+
+
+def test_tools_see_a_launch_running_in_another_process(running_launch, capsys):
+    pid = str(running_launch.pid)
+    assert main(["topic", "list", "-v", "--pid", pid]) == 0
+    assert "/chatter [std_msgs/msg/String]" in capsys.readouterr().out
+    assert main(["topic", "echo", "/chatter", "--count", "2", "--pid", pid]) == 0
+    lines = [ln for ln in capsys.readouterr().out.splitlines() if ln.startswith("data:")]
+    assert len(lines) == 2 and lines[0].startswith('data: "Hello World: ')
+    assert main(["topic", "hz", "/chatter", "--duration", "1", "--json", "--pid", pid]) == 0
+    assert json.loads(capsys.readouterr().out)["average_rate_hz"] == pytest.approx(20.0)
+    assert main(["node", "list", "--pid", pid]) == 0
+    assert capsys.readouterr().out.split() == ["/listener", "/talker"]
+    assert main(["topic", "echo", "/nope", "--pid", pid]) == 2
+    assert "no topic '/nope'" in capsys.readouterr().err
+
+
+def test_sigterm_stops_the_launch_cleanly(running_launch):
+    sock = socket_dir() / f"{running_launch.pid}.sock"
+    running_launch.send_signal(signal.SIGTERM)
+    out, _ = running_launch.communicate(timeout=20)
+    assert running_launch.returncode == 0
+    assert "/chatter:" in out and not sock.exists()
+
+
+def test_no_running_launch_is_a_clear_error():
+    with pytest.raises(CoreError, match="no running navlab launch with pid"):
+        find_running(os.getpid())
