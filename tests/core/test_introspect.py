@@ -57,3 +57,21 @@ def test_sigterm_stops_the_launch_cleanly(running_launch):
 def test_no_running_launch_is_a_clear_error():
     with pytest.raises(CoreError, match="no running navlab launch with pid"):
         find_running(os.getpid())
+
+
+def test_map_save_takes_the_map_of_a_running_mapping_launch(tmp_path):
+    from navlab.mapping.mapfile import load_map
+
+    proc = subprocess.Popen([sys.executable, "-m", "navlab.cli", "launch", "mapping", "--rate", "4"],
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)  # fmt: skip
+    try:
+        sock = socket_dir() / f"{proc.pid}.sock"
+        deadline = time.monotonic() + 30
+        while not sock.exists() and time.monotonic() < deadline:
+            time.sleep(0.1)
+        assert main(["map", "save", "--out", str(tmp_path), "--pid", str(proc.pid)]) == 0
+    finally:
+        proc.terminate()
+        proc.wait(20)
+    grid = load_map(tmp_path / "map.yaml")
+    assert (grid.data == 100).sum() > 200  # walls seen by the lidar

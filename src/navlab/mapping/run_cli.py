@@ -38,15 +38,21 @@ def _cmd_map(args: argparse.Namespace) -> int:
 
 
 def _cmd_map_save(args: argparse.Namespace) -> int:
-    """Run a launch and save its latest ``/map`` (map_saver on a launch started here)."""
+    """map_saver: save the current ``/map`` of a running ``navlab launch``, or of one started here."""
     from navlab import msgs
     from navlab.core.launch import start
     from navlab.core.runner import parse_launch_args, run_for
     from navlab.mapping.grid import GridMap
     from navlab.mapping.mapfile import save_map
 
-    if not args.launch:
-        raise MappingError("navlab map save needs --launch FILE [name:=value ...] (the launch that makes /map)")
+    path = Path(args.out) / "map.yaml"
+    if not args.launch:  # the launch running in another shell: /map is latched, so its current map comes first
+        from navlab.core.introspect import find_running, subscribe
+
+        for _t, msg in subscribe(find_running(args.pid), "/map"):
+            save_map(GridMap.from_msg(msg), path)
+            print(f"saved {path}")
+            return 0
     file, *items = args.launch
     session = start(file, seed=args.seed, launch_args=parse_launch_args(items))
     latest: list[Any] = []
@@ -55,7 +61,6 @@ def _cmd_map_save(args: argparse.Namespace) -> int:
     maps = [m for m in latest if isinstance(m, msgs.OccupancyGrid)]
     if not maps:
         raise MappingError(f"the launch {file!r} published no /map in {args.duration} s (is a SLAM node running?)")
-    path = Path(args.out) / "map.yaml"
     save_map(GridMap.from_msg(maps[-1]), path)
     print(f"saved {path}")
     return 0
@@ -142,7 +147,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="build a map with SLAM in simulation (exploration, teleop or a route) and save it",
         description="The paper's mapping launch: simulator + slam_gmapping + a driver. Saves DIR/map.yaml, "
         "DIR/map.pgm and DIR/map.png (map with SLAM and true trajectories) and prints the map's score "
-        "against the world. `navlab map save --launch FILE ... --out DIR` saves the /map of a launch instead.",
+        "against the world. `navlab map save --out DIR` saves the current /map of a running `navlab launch` "
+        "(map_saver); with --launch FILE it starts the launch itself.",
     )
     p.add_argument("action", nargs="?", choices=["save"], help="save: run a launch and save its /map")
     p.add_argument("--world", default="room", help="world file or shipped name (default room)")
@@ -158,7 +164,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--rate", type=float, default=0.0, help="pacing: 0 = as fast as possible, 1 = real time")
     p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     p.add_argument("--record", metavar="DIR", help="also write every topic to a rosbag2 (MCAP) in DIR")
-    p.add_argument("--launch", nargs="+", metavar="FILE [name:=value]", help="save: the launch to run")
+    p.add_argument("--launch", nargs="+", metavar="FILE [name:=value]",
+                   help="save: start this launch here and save its /map after --duration (default: save the "
+                   "/map of the `navlab launch` running in another shell)")  # fmt: skip
+    p.add_argument("--pid", type=int, help="save: which running navlab launch, when several run")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.add_argument("--json", action="store_true", help="print the scores as JSON")
     p.set_defaults(func=_cmd_map)
