@@ -75,3 +75,27 @@ def test_map_save_takes_the_map_of_a_running_mapping_launch(tmp_path):
         proc.wait(20)
     grid = load_map(tmp_path / "map.yaml")
     assert (grid.data == 100).sum() > 200  # walls seen by the lidar
+
+
+def test_remote_cmd_vel_drives_the_robot_of_a_running_launch():
+    """What `navlab teleop` does next to a running launch: publish cmd_vel into it from here."""
+    from navlab import msgs
+    from navlab.core.introspect import RemotePublisher, subscribe
+
+    proc = subprocess.Popen([sys.executable, "-m", "navlab.cli", "launch", "sim", "--rate", "2"],
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)  # fmt: skip
+    try:
+        sock = socket_dir() / f"{proc.pid}.sock"
+        deadline = time.monotonic() + 30
+        while not sock.exists() and time.monotonic() < deadline:
+            time.sleep(0.1)
+        pub = RemotePublisher(sock)
+        for _ in range(30):  # 3 s of wall time at 10 Hz = 6 simulated s at rate 2
+            pub.publish("/cmd_vel", msgs.twist(0.5, 0.0))
+            time.sleep(0.1)
+        pub.close()
+        _, odom = next(iter(subscribe(sock, "/ground_truth/odom")))
+    finally:
+        proc.terminate()
+        proc.wait(20)
+    assert odom.pose.pose.position.x > 1.5  # drove forward about 3 m

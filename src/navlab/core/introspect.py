@@ -7,6 +7,8 @@ JSON request line and reads JSON lines back:
 - ``{"cmd": "graph"}`` → the node/topic graph with message types and counts
 - ``{"cmd": "subscribe", "topic": "/odom"}`` → one line per message: ``{"t": ns, "type": ..., "cdr": base64}``
   (messages are CDR-serialised as in a rosbag2, and deserialised by the client)
+- ``{"cmd": "publish"}`` then one line per message ``{"topic", "type", "cdr"}``: published in the launch
+  by a node named ``/navlab_remote`` (teleop from another shell)
 
 Everything that touches the executor runs in the executor's thread (through its inbox), so the
 server never races the simulation.
@@ -51,6 +53,7 @@ class IntrospectionServer:
         self._sock.bind(str(self.path))
         self._sock.listen(8)
         self._closed = threading.Event()
+        self._remote: Any = None
         threading.Thread(target=self._accept, name="navlab-introspection", daemon=True).start()
 
     def close(self) -> None:
@@ -97,6 +100,9 @@ class IntrospectionServer:
                 if cmd == "subscribe":
                     self._stream(f, str(req.get("topic", "")))
                     return
+                if cmd == "publish":
+                    self._receive(f)
+                    return
                 reply = self._in_executor(lambda: self._answer(cmd))
             except (CoreError, ValueError) as exc:
                 reply = {"error": str(exc)}
@@ -114,6 +120,24 @@ class IntrospectionServer:
             types = {n: [type_name(t.msgtype), t.count] for n, t in ex.topics.items()}
             return {**Graph.from_executor(ex).to_json(), "types": types}
         return {"error": f"unknown request {cmd!r} (info, graph, subscribe)"}
+
+    def _receive(self, f: Any) -> None:
+        """Publish every message line the client sends, until it disconnects."""
+        for raw in f:
+            line = json.loads(raw)
+            msg = TYPESTORE.deserialize_cdr(base64.b64decode(line["cdr"]), line["type"])
+            self.executor.post(lambda t=str(line["topic"]), m=msg: self._publisher(t, type(m)).publish(m))
+
+    def _publisher(self, topic: str, msgtype: type) -> Any:
+        """The remote node's publisher on ``topic`` (made on first use, in the executor's thread)."""
+        from navlab.core.node import Node
+
+        if self._remote is None:
+            self._remote = Node("navlab_remote", self.executor)
+        for pub in self._remote.publishers:
+            if pub.topic_name == topic:
+                return pub
+        return self._remote.create_publisher(msgtype, topic, 10)
 
     def _stream(self, f: Any, topic: str) -> None:
         q: queue.Queue[bytes] = queue.Queue(maxsize=1000)
@@ -203,6 +227,25 @@ def request(path: Path, cmd: str, timeout: float = 10.0) -> dict[str, Any]:
     if "error" in reply:
         raise CoreError(reply["error"])
     return reply
+
+
+class RemotePublisher:
+    """Publishes messages into a running launch (one connection, many messages)."""
+
+    def __init__(self, path: Path) -> None:
+        self._sock, self._f = _connect(path, {"cmd": "publish"})
+
+    def publish(self, topic: str, msg: Any) -> None:
+        """Send ``msg`` to be published on ``topic`` in the launch."""
+        cdr = base64.b64encode(bytes(TYPESTORE.serialize_cdr(msg, type_name(msg)))).decode()
+        self._f.write(json.dumps({"topic": topic, "type": type_name(msg), "cdr": cdr}).encode() + b"\n")
+        self._f.flush()
+
+    def close(self) -> None:
+        """Disconnect."""
+        with contextlib.suppress(OSError):
+            self._f.close()
+            self._sock.close()
 
 
 def subscribe(path: Path, topic: str) -> Iterator[tuple[int, Any]]:

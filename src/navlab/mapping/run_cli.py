@@ -67,16 +67,27 @@ def _cmd_map_save(args: argparse.Namespace) -> int:
 
 
 def _cmd_teleop(args: argparse.Namespace) -> int:
-    """Drive the robot in its world from the keyboard, in real time (teleop_twist_keyboard)."""
+    """Drive the robot from the keyboard (teleop_twist_keyboard) or a joystick, in real time: the robot
+    of a `navlab launch` running in another shell, or (with --world, or when none runs) a simulator
+    started here."""
     import sys
 
-    from navlab.core import Executor
+    from navlab.core import CoreError, Executor
+    from navlab.core.introspect import RemotePublisher, find_running
     from navlab.mapping.run import _terminal_keys
     from navlab.mapping.teleop import HELP, TeleopKeyboard
     from navlab.sim.gazebo import launch_sim
 
     ex = Executor(seed=args.seed, rate=args.rate)
-    gazebo = launch_sim(ex, world=args.world, robot=args.robot)
+    gazebo = remote = None
+    if args.world is None:
+        with contextlib.suppress(CoreError):
+            remote = RemotePublisher(find_running(args.pid))
+    if remote is not None:  # forward our cmd_vel into the running launch
+        ex.add_listener(lambda topic, msg, _t: remote.publish(topic, msg) if topic == "/cmd_vel" else None)
+        print("driving the robot of the running navlab launch")
+    else:
+        gazebo = launch_sim(ex, world=args.world or "room", robot=args.robot)
     if args.joy:
         from navlab import msgs
         from navlab.core import Node
@@ -93,8 +104,11 @@ def _cmd_teleop(args: argparse.Namespace) -> int:
         _terminal_keys(teleop, ex)
     with contextlib.suppress(KeyboardInterrupt):
         ex.spin()
-    x, y, yaw = gazebo.sim.base_pose2d()
-    print(f"\nstopped at x={x:.2f} y={y:.2f} yaw={yaw:.2f} after {ex.now_ns / 1e9:.1f} simulated s")
+    if remote is not None:
+        remote.close()
+    if gazebo is not None:
+        x, y, yaw = gazebo.sim.base_pose2d()
+        print(f"\nstopped at x={x:.2f} y={y:.2f} yaw={yaw:.2f} after {ex.now_ns / 1e9:.1f} simulated s")
     return 0
 
 
@@ -174,11 +188,15 @@ def register(sub: argparse._SubParsersAction) -> None:
 
     p = sub.add_parser(
         "teleop",
-        help="drive the robot from the keyboard (teleop_twist_keyboard) in its simulated world",
-        description="Starts the simulator in real time and publishes cmd_vel from keys: u i o / j k l / m , . "
-        "to move, q/z w/x e/c to change speeds, k to stop, Ctrl-C to quit.",
+        help="drive the robot from the keyboard (teleop_twist_keyboard) or a joystick",
+        description="Publishes cmd_vel from keys (u i o / j k l / m , . to move, q/z w/x e/c to change speeds, "
+        "k to stop, Ctrl-C to quit) into the `navlab launch` running in another shell, as "
+        "teleop_twist_keyboard does next to a ROS launch (e.g. `navlab launch mapping explore:=false`). "
+        "With --world, or when no launch runs, it starts the simulator here in real time.",
     )
-    p.add_argument("--world", default="room", help="world file or shipped name (default room)")
+    p.add_argument("--world", default=None,
+                   help="start this world here (file or shipped name) instead of driving a running launch")
+    p.add_argument("--pid", type=int, help="which running navlab launch to drive, when several run")
     p.add_argument("--robot", default="mybot", help="robot file or shipped name (default mybot)")
     p.add_argument("--speed", type=float, default=0.5, help="linear speed, m/s (default 0.5)")
     p.add_argument("--turn", type=float, default=1.0, help="angular speed, rad/s (default 1.0)")
