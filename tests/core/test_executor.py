@@ -142,3 +142,13 @@ def test_run_until_stops_when_condition_holds():
     assert ex.run_until(lambda: count[0] >= 5, timeout=10.0)
     assert ex.now_ns == 500_000_000
     assert not ex.run_until(lambda: count[0] >= 1000, timeout=1.0)
+
+
+def test_stop_from_another_thread_ends_chunked_runs():
+    from navlab.core.runner import run_for
+
+    ex = Executor(rate=10.0)
+    Node("n", ex).create_timer(0.05, lambda: None)
+    threading.Timer(0.05, lambda: ex.post(ex.stop)).start()
+    run_for(ex, 100.0, quiet=True, chunk=0.2)  # 10 s of wall time if the stop were lost
+    assert ex.stopped and ex.now_ns < 2_000_000_000

@@ -78,6 +78,7 @@ class Executor:
         self._inbox: queue.SimpleQueue[Callable[[], None]] = queue.SimpleQueue()
         self._construct: dict[str, Any] = {}
         self._stop = False
+        self.stopped = False  # whether the last run ended because stop() was called
         self._running = False
         self.events = 0  # timer callbacks + message deliveries handled so far
 
@@ -246,7 +247,7 @@ class Executor:
     def _run_until(self, predicate: Callable[[], bool] | None, timeout_ns: int) -> bool:
         end = self.now_ns + timeout_ns
         sim0, wall0 = self.now_ns, time.perf_counter()
-        self._stop = False
+        self._stop = self.stopped = False
         heap = self._heap
         self._drain_inbox()
         self._drain()
@@ -273,9 +274,12 @@ class Executor:
             self._advance(end)
             self._drain_inbox()
             self._drain()
+        self.stopped = self._stop
         return predicate is not None and predicate()
 
     def spin(self) -> None:
         """Run until :meth:`stop` is called (use with ``rate > 0`` and another thread posting inputs)."""
-        while not self._stop:
+        self.stopped = False
+        while not self.stopped:
             self.run_until(lambda: self._stop, timeout=3600.0)
+            self.stopped = self.stopped or self._stop

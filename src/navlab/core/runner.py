@@ -44,7 +44,7 @@ def run_for(
             ex.run(step)
             done += step
             bar.update((ex.now_ns - t0) / 1e9)
-            if ex.now_ns - t0 < round(step * 1e9):  # stopped
+            if ex.stopped:
                 break
     finally:
         bar.close()
