@@ -6,8 +6,6 @@ simulated world knows its truth, the map's score against the world and the traje
 
 from __future__ import annotations
 
-import math
-import threading
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -19,13 +17,13 @@ from navlab import msgs
 from navlab.core import Executor, Node, TfError
 from navlab.core.runner import run_for
 from navlab.mapping.errors import MappingError
-from navlab.mapping.evaluation import TruthGrid, free_coverage, score_map, trajectory_error
+from navlab.mapping.evaluation import TruthGrid, free_coverage, score_map, to_map, trajectory_error
 from navlab.mapping.explore_node import Explore
 from navlab.mapping.grid import GridMap
 from navlab.mapping.mapfile import save_map
 from navlab.mapping.slam_node import SlamGMapping
 from navlab.mapping.teleop import HELP as TELEOP_HELP
-from navlab.mapping.teleop import RouteFollower, TeleopKeyboard, load_route
+from navlab.mapping.teleop import RouteFollower, TeleopKeyboard, load_route, terminal_keys
 
 
 def mapping_slam_params() -> dict[str, Any]:
@@ -90,31 +88,6 @@ def true_occupancy(world: Any, grid: GridMap, margin: float = 1.0) -> TruthGrid:
     return TruthGrid(occ, grid.resolution, (bounds[0], bounds[1]))
 
 
-def _terminal_keys(teleop: TeleopKeyboard, ex: Executor) -> threading.Thread:
-    """Read single key presses from the terminal (cbreak mode) and hand them to the teleop node."""
-    import sys
-    import termios
-    import tty
-
-    def loop() -> None:
-        fd = sys.stdin.fileno()
-        old = termios.tcgetattr(fd)
-        try:
-            tty.setcbreak(fd)
-            while True:
-                ch = sys.stdin.read(1)
-                if not ch or ch == "\x03":
-                    ex.post(ex.stop)
-                    return
-                teleop.press(ch)
-        finally:
-            termios.tcsetattr(fd, termios.TCSADRAIN, old)
-
-    t = threading.Thread(target=loop, daemon=True)
-    t.start()
-    return t
-
-
 def run_mapping(
     *,
     world: str = "room",
@@ -167,7 +140,7 @@ def run_mapping(
     else:
         teleop = TeleopKeyboard(ex)
         print("teleop_twist_keyboard:\n" + TELEOP_HELP)
-        _terminal_keys(teleop, ex)
+        terminal_keys(teleop, ex)
         is_done = lambda: False  # noqa: E731
 
     def stop_when_done(*_: Any) -> None:
@@ -200,9 +173,7 @@ def run_mapping(
         est = np.array(monitor.estimate)
         tru = np.array(monitor.truth)
         # the estimate is in the map frame = the spawn pose; bring the truth into it
-        c, s = math.cos(spawn[2]), math.sin(spawn[2])
-        dx, dy = tru[:, 0] - spawn[0], tru[:, 1] - spawn[1]
-        tru_map = np.stack([c * dx + s * dy, -s * dx + c * dy, tru[:, 2] - spawn[2]], axis=1)
+        tru_map = np.column_stack([to_map(tru[:, :2], spawn), tru[:, 2] - spawn[2]])
         result.scores.update(trajectory_error(est, tru_map))
         write_trajectory(out_dir / "trajectory.txt", np.array(monitor.times), est, tru_map)
         # raw odometry starts at the spawn pose too, so it is compared in the same frame

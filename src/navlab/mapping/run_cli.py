@@ -74,8 +74,7 @@ def _cmd_teleop(args: argparse.Namespace) -> int:
 
     from navlab.core import CoreError, Executor
     from navlab.core.introspect import RemotePublisher, find_running
-    from navlab.mapping.run import _terminal_keys
-    from navlab.mapping.teleop import HELP, TeleopKeyboard
+    from navlab.mapping.teleop import HELP, TeleopKeyboard, terminal_keys
     from navlab.sim.gazebo import launch_sim
 
     ex = Executor(seed=args.seed, rate=args.rate)
@@ -101,7 +100,7 @@ def _cmd_teleop(args: argparse.Namespace) -> int:
             raise MappingError("navlab teleop reads keys from a terminal; run it in an interactive shell")
         teleop = TeleopKeyboard(ex, parameters={"speed": args.speed, "turn": args.turn})
         print(HELP)
-        _terminal_keys(teleop, ex)
+        terminal_keys(teleop, ex)
     with contextlib.suppress(KeyboardInterrupt):
         ex.spin()
     if remote is not None:

@@ -9,6 +9,7 @@
 from __future__ import annotations
 
 import math
+import threading
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -87,6 +88,31 @@ class TeleopKeyboard(Node):
     def press(self, key: str) -> None:
         """Thread-safe: apply a key press before the next event."""
         self.executor.post(lambda: self.state.key(key))
+
+
+def terminal_keys(teleop: TeleopKeyboard, ex: Executor) -> threading.Thread:
+    """Read single key presses from the terminal (cbreak mode) and hand them to the teleop node."""
+    import sys
+    import termios
+    import tty
+
+    def loop() -> None:
+        fd = sys.stdin.fileno()
+        old = termios.tcgetattr(fd)
+        try:
+            tty.setcbreak(fd)
+            while True:
+                ch = sys.stdin.read(1)
+                if not ch or ch == "\x03":
+                    ex.post(ex.stop)
+                    return
+                teleop.press(ch)
+        finally:
+            termios.tcsetattr(fd, termios.TCSADRAIN, old)
+
+    t = threading.Thread(target=loop, daemon=True)
+    t.start()
+    return t
 
 
 def load_route(path: str | Path) -> tuple[list[tuple[float, float, float]], np.ndarray]:
@@ -200,7 +226,6 @@ class JoyMapping:
 def joystick_thread(ex: Executor, pub: Any, mapping: JoyMapping, rate: float = 20.0) -> Any:
     """Read the first joystick with pygame and publish ``cmd_vel`` from it; a clear error without one."""
     import os
-    import threading
     import time
 
     os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
