@@ -7,11 +7,12 @@ and build the messages navlab publishes most often.
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 import numpy as np
 from rosbags.typesys import Stores, get_typestore
+
+from navlab.geometry import quat_from_yaw, yaw_from_quat
 
 TYPESTORE = get_typestore(Stores.ROS2_HUMBLE)
 _T = TYPESTORE.types
@@ -91,26 +92,24 @@ def header(stamp_ns: int, frame_id: str) -> Any:
 # --- rotations ------------------------------------------------------------------------------------
 
 
+def quaternion_msg(q: Any) -> Any:
+    """``geometry_msgs/Quaternion`` from (x, y, z, w) components."""
+    return Quaternion(x=float(q[0]), y=float(q[1]), z=float(q[2]), w=float(q[3]))
+
+
+def xyzw(q: Any) -> tuple[float, float, float, float]:
+    """(x, y, z, w) components of a ``geometry_msgs/Quaternion``."""
+    return float(q.x), float(q.y), float(q.z), float(q.w)
+
+
 def quaternion_from_yaw(yaw: float) -> Any:
     """``geometry_msgs/Quaternion`` for a rotation of ``yaw`` radians about z."""
-    return Quaternion(x=0.0, y=0.0, z=math.sin(yaw / 2.0), w=math.cos(yaw / 2.0))
-
-
-def yaw_from_xyzw(x: float, y: float, z: float, w: float) -> float:
-    """Yaw (radians, about z) of a unit quaternion given by its components (ROS order x, y, z, w)."""
-    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+    return quaternion_msg(quat_from_yaw(yaw))
 
 
 def yaw_from_quaternion(q: Any) -> float:
     """Yaw (radians, about z) of a ``geometry_msgs/Quaternion``."""
-    return yaw_from_xyzw(q.x, q.y, q.z, q.w)
-
-
-def normalize_angle(a: Any) -> Any:
-    """Wrap angles (rad) to [-pi, pi): a number gives a number, an array (or list) an array."""
-    if isinstance(a, float | int):
-        return (a + math.pi) % (2.0 * math.pi) - math.pi
-    return (np.asarray(a) + math.pi) % (2.0 * math.pi) - math.pi
+    return yaw_from_quat(xyzw(q))
 
 
 # --- poses ----------------------------------------------------------------------------------------

@@ -11,9 +11,9 @@ from amcl_synth import odometry, room_field, route, scan_at
 
 from navlab import msgs
 from navlab.core import Executor, Node, ParameterError
+from navlab.grid import GridMap
 from navlab.localization.amcl_node import Amcl
 from navlab.localization.synthetic import room_grid
-from navlab.mapping.grid import GridMap
 
 
 class FakeRobot(Node):

@@ -8,6 +8,8 @@ import math
 import numpy as np
 import pytest
 
+from navlab.geometry import between2, compose2
+
 
 class SynthWorld:
     """An 8 m x 6 m room with an inner wall and two boxes; ``scan(pose)`` ray-casts 361 beams over 180°."""
@@ -68,17 +70,16 @@ class SynthWorld:
 
 def noisy_odometry(gt: np.ndarray, rng: np.random.Generator, trans: float = 0.05, rot: float = 0.05) -> np.ndarray:
     """Odometry integrated from the true steps with proportional noise (fraction ``trans``/``rot``) + rot drift."""
-    from navlab.mapping.scanmatch import between, compose
 
     odo = [gt[0].copy()]
     for k in range(1, len(gt)):
-        z = between(gt[k - 1], gt[k])
+        z = between2(gt[k - 1], gt[k])
         dist = math.hypot(z[0], z[1])
         z = z + np.array(
             [rng.normal(0, trans * dist), rng.normal(0, trans * dist), rng.normal(0, rot * abs(z[2]) + 0.01 * dist)]
         )
         z[2] += 0.02 * dist  # systematic heading drift, rad/m
-        odo.append(compose(odo[-1], z))
+        odo.append(compose2(odo[-1], z))
     return np.array(odo)
 
 

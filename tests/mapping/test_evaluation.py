@@ -3,19 +3,19 @@
 import numpy as np
 import pytest
 
-from navlab.mapping.evaluation import TruthGrid, free_coverage, score_map, trajectory_error
-from navlab.mapping.grid import GridMap
+from navlab.grid import Grid, GridMap
+from navlab.mapping.evaluation import free_coverage, score_map, trajectory_error, truth_grid
 
 
-def _truth() -> TruthGrid:
+def _truth() -> Grid:
     occ = np.zeros((80, 100), bool)  # 5 × 4 m at 5 cm, origin (-2.5, -2)
     occ[:2, :] = occ[-2:, :] = True
     occ[:, :2] = occ[:, -2:] = True
-    return TruthGrid(occ, 0.05, (-2.5, -2.0))
+    return truth_grid(occ, 0.05, (-2.5, -2.0))
 
 
-def _map_from_truth(truth: TruthGrid, shift_cells: int = 0) -> GridMap:
-    data = np.where(truth.occupied, 100, 0).astype(np.int8)
+def _map_from_truth(truth: Grid, shift_cells: int = 0) -> GridMap:
+    data = np.where(truth.data, 100, 0).astype(np.int8)
     return GridMap(data, 0.05, (truth.origin[0] + shift_cells * 0.05, truth.origin[1], 0.0))
 
 

@@ -9,9 +9,9 @@ import pytest
 
 from navlab import msgs
 from navlab.core import Executor, Node
+from navlab.geometry import compose2, inverse2
 from navlab.mapping import GridMap, MappingError, save_map
 from navlab.mapping.map_server import MapServer
-from navlab.mapping.scanmatch import compose, inverse
 from navlab.mapping.slam_node import SlamGMapping
 
 
@@ -42,7 +42,7 @@ class _FakeRobot(Node):
             return
         t = self.get_clock().now_ns()
         # gt/odo are laser poses; base = laser ∘ LASER^-1
-        base_odo = compose(self.odo[self.k], inverse(self.LASER))
+        base_odo = compose2(self.odo[self.k], inverse2(self.LASER))
         self.send_transform(msgs.transform_stamped(t, "odom", "base_link", *base_odo))
         ranges = self.world.scan(self.gt[self.k], self.rng)
         ranges = np.where(ranges > 29.0, np.inf, ranges).astype(np.float32)
@@ -101,7 +101,7 @@ def test_slam_node_maps_the_room_and_corrects_odometry(synth_world, odometry_noi
     # tf map→odom corrects the odometry: map_T_laser close to the truth at the end
     t, odo_last = ex.now_ns, odo[-1]
     m_T_o = ex.tf.lookup_pose2d("map", "odom")
-    est = compose(m_T_o, odo_last)
+    est = compose2(m_T_o, odo_last)
     assert math.hypot(est[0] - gt[-1][0], est[1] - gt[-1][1]) < 0.1 < math.hypot(*(odo_last - gt[-1])[:2])
     assert t > 0
     # the map's occupied cells lie on the true walls (within two cells), in the map frame = start frame

@@ -10,6 +10,7 @@ from conftest import make_mybot, make_room
 
 from navlab import msgs
 from navlab.core import Executor, Node
+from navlab.geometry import wrap_angle
 from navlab.sim import launch_sim
 from navlab.world.model import WorldModel
 
@@ -68,7 +69,7 @@ def test_cmd_vel_drives_two_metres_and_topics_flow() -> None:
     q = wheel.transform.rotation
     assert wheel.transform.translation.y == pytest.approx(0.2)
     assert abs(q.x) < 1e-9 and abs(q.z) < 1e-9
-    assert msgs.normalize_angle(2 * math.atan2(q.y, q.w) - angle) == pytest.approx(0.0, abs=1e-6)
+    assert wrap_angle(2 * math.atan2(q.y, q.w) - angle) == pytest.approx(0.0, abs=1e-6)
     assert angle > 20  # 2 m of 0.08 m wheels: 25 rad
 
 

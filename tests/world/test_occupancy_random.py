@@ -7,9 +7,9 @@ import pytest
 from scipy.spatial import cKDTree
 
 from navlab.description.model import Geometry, Link, Origin, Shape
+from navlab.geometry import matrix_from_pose6
 from navlab.world import WorldModel, occupancy
 from navlab.world.model import ModelSpec
-from navlab.world.transforms import to_matrix
 
 RES, BOUNDS, Z0, Z1 = 0.05, (-2.0, -2.0, 2.0, 2.0), 0.05, 0.5
 
@@ -45,7 +45,7 @@ def test_occupancy_matches_point_sampling(seed):
     ys = np.arange(pose[1] - reach, pose[1] + reach, step)
     zs = np.linspace(Z0, Z1, 16)
     pts = np.stack(np.meshgrid(xs, ys, zs, indexing="ij"), axis=-1).reshape(-1, 3)
-    m = to_matrix(pose)
+    m = matrix_from_pose6(pose)
     local = (pts - m[:3, 3]) @ m[:3, :3]
     hits = pts[_inside(geom, local)]
     cols = ((hits[:, 0] - BOUNDS[0]) // RES).astype(int)

@@ -8,73 +8,12 @@ interpolating each dynamic edge linearly in translation and by slerp in rotation
 from __future__ import annotations
 
 import bisect
-import math
 from dataclasses import dataclass, field
 from typing import Any
 
 from navlab.core.errors import TfError
-from navlab.msgs import Quaternion, Transform, TransformStamped, Vector3, header, ns_from_time, yaw_from_xyzw
-
-# A transform as (x, y, z, qx, qy, qz, qw).
-Tf = tuple[float, float, float, float, float, float, float]
-IDENTITY: Tf = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0)
-
-
-def qmul(a: tuple[float, float, float, float], b: tuple[float, float, float, float]) -> tuple[float, ...]:
-    """Hamilton product of quaternions (x, y, z, w)."""
-    ax, ay, az, aw = a
-    bx, by, bz, bw = b
-    return (
-        aw * bx + ax * bw + ay * bz - az * by,
-        aw * by - ax * bz + ay * bw + az * bx,
-        aw * bz + ax * by - ay * bx + az * bw,
-        aw * bw - ax * bx - ay * by - az * bz,
-    )
-
-
-def qrotate(q: tuple[float, ...], v: tuple[float, float, float]) -> tuple[float, float, float]:
-    """Rotate vector ``v`` by unit quaternion ``q`` (x, y, z, w)."""
-    qx, qy, qz, qw = q
-    vx, vy, vz = v
-    # t = 2 q_vec × v ; v' = v + w t + q_vec × t
-    tx = 2.0 * (qy * vz - qz * vy)
-    ty = 2.0 * (qz * vx - qx * vz)
-    tz = 2.0 * (qx * vy - qy * vx)
-    return (
-        vx + qw * tx + (qy * tz - qz * ty),
-        vy + qw * ty + (qz * tx - qx * tz),
-        vz + qw * tz + (qx * ty - qy * tx),
-    )
-
-
-def compose(a: Tf, b: Tf) -> Tf:
-    """``a ∘ b``: if a = A_T_B and b = B_T_C, the result is A_T_C."""
-    t = qrotate(a[3:], b[:3])
-    q = qmul(a[3:], b[3:])  # type: ignore[arg-type]
-    return (a[0] + t[0], a[1] + t[1], a[2] + t[2], *q)  # type: ignore[return-value]
-
-
-def inverse(a: Tf) -> Tf:
-    """Inverse transform: B_T_A from A_T_B."""
-    qi = (-a[3], -a[4], -a[5], a[6])
-    t = qrotate(qi, (-a[0], -a[1], -a[2]))
-    return (*t, *qi)  # type: ignore[return-value]
-
-
-def interpolate(a: Tf, b: Tf, s: float) -> Tf:
-    """Linear interpolation of translation and slerp of rotation, ``s`` in [0, 1]."""
-    qa, qb = a[3:], b[3:]
-    dot = sum(x * y for x, y in zip(qa, qb, strict=True))
-    if dot < 0.0:
-        qb, dot = tuple(-x for x in qb), -dot
-    if dot > 0.9995:
-        q = [x + s * (y - x) for x, y in zip(qa, qb, strict=True)]
-    else:
-        th = math.acos(min(1.0, dot))
-        sa, sb = math.sin((1 - s) * th) / math.sin(th), math.sin(s * th) / math.sin(th)
-        q = [sa * x + sb * y for x, y in zip(qa, qb, strict=True)]
-    n = math.sqrt(sum(x * x for x in q))
-    return (*(a[i] + s * (b[i] - a[i]) for i in range(3)), *(x / n for x in q))  # type: ignore[return-value]
+from navlab.geometry import IDENTITY_TF, Tf, compose3, interpolate3, inverse3, yaw_from_quat
+from navlab.msgs import Quaternion, Transform, TransformStamped, Vector3, header, ns_from_time
 
 
 def tf_from_msg(tr: Any) -> Tf:
@@ -85,7 +24,7 @@ def tf_from_msg(tr: Any) -> Tf:
 
 def yaw_of(tf: Tf) -> float:
     """Yaw (rad) of a transform's rotation."""
-    return yaw_from_xyzw(*tf[3:])
+    return yaw_from_quat(tf[3:])
 
 
 @dataclass
@@ -175,7 +114,7 @@ class TfBuffer:
             return e.values[0]
         i = bisect.bisect_right(times, t_ns)
         t0, t1 = times[i - 1], times[i]
-        return interpolate(e.values[i - 1], e.values[i], (t_ns - t0) / (t1 - t0))
+        return interpolate3(e.values[i - 1], e.values[i], (t_ns - t0) / (t1 - t0))
 
     def _ancestors(self, frame: str) -> list[str]:
         """``frame`` and its parents up to the root, by name only (nothing is evaluated)."""
@@ -189,10 +128,10 @@ class TfBuffer:
 
     def _up_to(self, frame: str, stop: str, t_ns: int | None) -> Tf:
         """``stop_T_frame``: compose the edges from ``frame`` up to its ancestor ``stop``."""
-        out: Tf = IDENTITY
+        out: Tf = IDENTITY_TF
         while frame != stop:
             e = self._edges[frame]
-            out = compose(self._edge_at(frame, e, t_ns), out)
+            out = compose3(self._edge_at(frame, e, t_ns), out)
             frame = e.parent
         return out
 
@@ -224,7 +163,7 @@ class TfBuffer:
         common = next(f for f in up_s if f in in_target)
         # Only the edges below the common ancestor are evaluated, so an edge above it (map->odom while
         # looking up odom->base) never limits the lookup time.
-        return compose(inverse(self._up_to(target, common, t_ns)), self._up_to(source, common, t_ns))
+        return compose3(inverse3(self._up_to(target, common, t_ns)), self._up_to(source, common, t_ns))
 
     def can_transform(self, target: str, source: str, t_ns: int | None = None) -> bool:
         """Whether :meth:`lookup` would succeed."""

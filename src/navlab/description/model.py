@@ -11,6 +11,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Literal
 
+import numpy as np
+
+from navlab.geometry import Pose6, compose6, matrix_from_pose6, pose6_from_matrix
+
 Vec3 = tuple[float, float, float]
 
 GeometryKind = Literal["box", "cylinder", "sphere", "mesh"]
@@ -22,6 +26,29 @@ class Origin:
 
     xyz: Vec3 = (0.0, 0.0, 0.0)
     rpy: Vec3 = (0.0, 0.0, 0.0)
+
+    def as_pose6(self) -> Pose6:
+        """(x, y, z, roll, pitch, yaw)."""
+        return (*self.xyz, *self.rpy)
+
+    @classmethod
+    def from_pose6(cls, pose: Pose6 | tuple[float, ...]) -> Origin:
+        """An origin from (x, y, z, roll, pitch, yaw)."""
+        p = tuple(float(v) for v in pose)
+        return cls(xyz=(p[0], p[1], p[2]), rpy=(p[3], p[4], p[5]))
+
+    @classmethod
+    def from_matrix(cls, m: np.ndarray) -> Origin:
+        """An origin from a 4×4 homogeneous matrix."""
+        return cls.from_pose6(pose6_from_matrix(m))
+
+    def matrix(self) -> np.ndarray:
+        """4×4 homogeneous ``parent_T_child``."""
+        return matrix_from_pose6(self.as_pose6())
+
+    def then(self, child: Origin) -> Origin:
+        """``self ∘ child``: the pose of ``child`` (given in this frame) in this frame's parent."""
+        return Origin.from_pose6(compose6(self.as_pose6(), child.as_pose6()))
 
 
 @dataclass(frozen=True)

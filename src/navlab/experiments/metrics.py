@@ -13,8 +13,8 @@ from pathlib import Path
 
 import numpy as np
 
+from navlab.geometry import wrap_angle
 from navlab.mapping.errors import MappingError
-from navlab.msgs import normalize_angle
 
 
 def _read_table(path: str | os.PathLike[str], min_cols: int, what: str) -> np.ndarray:
@@ -98,7 +98,7 @@ def relations_error(
     et = b[:, 2] - a[:, 2]
     # error = relation ⊖ estimate = estimate^-1 ∘ relation; its translation norm is |t_rel - t_est|
     trans = np.hypot(r[:, 2] - ex, r[:, 3] - ey)
-    rot = np.degrees(np.abs(normalize_angle(r[:, 4] - et)))
+    rot = np.degrees(np.abs(wrap_angle(r[:, 4] - et)))
     ddof = 1 if len(trans) > 1 else 0
     out.update(
         trans_abs_mean=float(trans.mean()),

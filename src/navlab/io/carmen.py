@@ -15,8 +15,8 @@ from pathlib import Path
 
 import numpy as np
 
+from navlab.geometry import wrap_angle
 from navlab.mapping.errors import MappingError
-from navlab.msgs import normalize_angle
 
 NO_RETURN = 81.9  # SICK "no return" in CARMEN logs (81.91 m); such ranges carry no hit
 
@@ -45,7 +45,7 @@ class LaserScan2D:
         lx, ly, lt = self.laser_pose
         c, s = math.cos(rt), math.sin(rt)
         dx, dy = lx - rx, ly - ry
-        dt = normalize_angle(lt - rt)
+        dt = wrap_angle(lt - rt)
         return c * dx + s * dy, -s * dx + c * dy, dt
 
 

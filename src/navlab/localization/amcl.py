@@ -20,10 +20,10 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
+from navlab.geometry import wrap_angle
 from navlab.localization import models, sampling
 from navlab.localization.errors import LocalizationError
 from navlab.localization.field import MapField
-from navlab.msgs import normalize_angle
 
 
 @dataclass
@@ -152,7 +152,7 @@ class Amcl:
         std = vecs * np.sqrt(np.clip(vals, 0.0, None))
         n = p.max_particles
         pts = self.rng.standard_normal((n, 3)) @ std.T + np.array([x, y, yaw])
-        pts[:, 2] = normalize_angle(pts[:, 2])
+        pts[:, 2] = wrap_angle(pts[:, 2])
         self._reset(pts)
 
     def global_localization(self) -> None:
@@ -237,7 +237,7 @@ class Amcl:
         if self.odom_ref is not None:
             dx = odom[0] - self.odom_ref[0]
             dy = odom[1] - self.odom_ref[1]
-            da = float(normalize_angle(odom[2] - self.odom_ref[2]))
+            da = float(wrap_angle(odom[2] - self.odom_ref[2]))
             moved = abs(dx) > p.update_min_d or abs(dy) > p.update_min_d or abs(da) > p.update_min_a
         if not (moved or self._force or self.odom_ref is None):
             return False
@@ -313,14 +313,14 @@ class Amcl:
         ox, oy, oth = self.odom_ref
         yaw = eth - oth
         c, s = math.cos(yaw), math.sin(yaw)
-        return ex - (c * ox - s * oy), ey - (s * ox + c * oy), float(normalize_angle(yaw))
+        return ex - (c * ox - s * oy), ey - (s * ox + c * oy), float(wrap_angle(yaw))
 
     def pose_from_odom(self, odom_pose: tuple[float, float, float]) -> tuple[float, float, float]:
         """The robot's map-frame pose now, from its odometry pose now and the latest ``map_T_odom``."""
         mx, my, mth = self.map_to_odom()
         c, s = math.cos(mth), math.sin(mth)
         x, y, th = odom_pose
-        return mx + c * x - s * y, my + s * x + c * y, float(normalize_angle(mth + th))
+        return mx + c * x - s * y, my + s * x + c * y, float(wrap_angle(mth + th))
 
     @property
     def n_particles(self) -> int:

@@ -16,11 +16,11 @@ import numpy as np
 
 from navlab import msgs
 from navlab.core import Executor, Node, TfError
+from navlab.grid import GridMap
 from navlab.localization import amcl as pf
 from navlab.localization.errors import LocalizationError
 from navlab.localization.field import field_from_map
 from navlab.mapping.errors import MappingError
-from navlab.mapping.grid import GridMap
 
 # ROS 1 name -> (default, Nav2 spellings accepted too). Filter parameters map onto AmclParams.
 _FILTER_PARAMS: dict[str, tuple[Any, tuple[str, ...]]] = {

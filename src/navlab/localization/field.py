@@ -16,8 +16,8 @@ from typing import Any
 import numpy as np
 from scipy.ndimage import distance_transform_edt
 
+from navlab.geometry import wrap_angle
 from navlab.localization.errors import LocalizationError
-from navlab.msgs import normalize_angle
 
 OCCUPIED_MIN = 65  # ROS map_server occupied_thresh 0.65
 FREE_MAX = 19  # ROS map_server free_thresh 0.196
@@ -60,7 +60,7 @@ class MapField:
         out = np.empty_like(poses, dtype=np.float64)
         out[:, 0] = ox + c * poses[:, 0] - s * poses[:, 1]
         out[:, 1] = oy + s * poses[:, 0] + c * poses[:, 1]
-        out[:, 2] = normalize_angle(poses[:, 2] + oyaw)
+        out[:, 2] = wrap_angle(poses[:, 2] + oyaw)
         return out
 
     def contains(self, x: float, y: float) -> bool:

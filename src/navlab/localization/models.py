@@ -16,8 +16,8 @@ import math
 import numpy as np
 from numba import njit
 
+from navlab.geometry import wrap_angle
 from navlab.localization.raycast import _cast_one
-from navlab.msgs import normalize_angle
 
 ODOM_MODELS = ("diff", "diff-corrected")
 LASER_MODELS = ("likelihood_field", "beam")
@@ -25,7 +25,7 @@ LASER_MODELS = ("likelihood_field", "beam")
 
 def _angle_diff(a: np.ndarray | float, b: np.ndarray | float) -> np.ndarray:
     """Smallest signed difference a - b (rad)."""
-    return normalize_angle(np.asarray(a) - np.asarray(b))
+    return wrap_angle(np.asarray(a) - np.asarray(b))
 
 
 def sample_motion_diff(
@@ -68,7 +68,7 @@ def sample_motion_diff(
     heading = particles[:, 2] + rot1_hat
     particles[:, 0] += trans_hat * np.cos(heading)
     particles[:, 1] += trans_hat * np.sin(heading)
-    particles[:, 2] = normalize_angle(heading + rot2_hat)
+    particles[:, 2] = wrap_angle(heading + rot2_hat)
 
 
 LUT_SIZE = 4096

@@ -24,10 +24,10 @@ from scipy import ndimage
 from navlab import msgs
 from navlab.core import Executor, Node, TfError
 from navlab.core.runner import run_for
+from navlab.grid import GridMap
 from navlab.localization.amcl_node import Amcl
 from navlab.localization.errors import LocalizationError
 from navlab.localization.field import field_from_map
-from navlab.mapping.grid import GridMap
 
 # A 17.5 m loop through room.world / room_obstacles.world, at least 0.5 m from every obstacle.
 DEFAULT_ROUTE: tuple[tuple[float, float], ...] = (

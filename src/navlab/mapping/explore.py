@@ -13,7 +13,7 @@ import numpy as np
 from scipy import ndimage, sparse
 from scipy.sparse.csgraph import dijkstra
 
-from navlab.mapping.grid import GridMap
+from navlab.grid import GridMap
 
 _NEIGHBOURS = ((0, 1, 1.0), (1, 0, 1.0), (1, 1, math.sqrt(2.0)), (1, -1, math.sqrt(2.0)))
 
@@ -140,23 +140,6 @@ def nearest_traversable(mask: np.ndarray, cell: tuple[int, int], max_cells: int 
     return int(ii[k] + i0), int(jj[k] + j0)
 
 
-def crop_to_known(grid: GridMap, margin_cells: int = 3) -> GridMap:
-    """The smallest sub-grid holding every known cell (plus a margin of unknown), same frame.
-
-    SLAM maps are allocated large (gmapping's xmin..xmax); planning on the known part is much cheaper.
-    """
-    jj, ii = np.nonzero(grid.data >= 0)
-    if len(ii) == 0:
-        return grid
-    j0, j1 = max(0, jj.min() - margin_cells), min(grid.height, jj.max() + margin_cells + 1)
-    i0, i1 = max(0, ii.min() - margin_cells), min(grid.width, ii.max() + margin_cells + 1)
-    ox, oy, yaw = grid.origin
-    c, s = math.cos(yaw), math.sin(yaw)
-    dx, dy = i0 * grid.resolution, j0 * grid.resolution
-    origin = (ox + c * dx - s * dy, oy + s * dx + c * dy, yaw)
-    return GridMap(grid.data[j0:j1, i0:i1].copy(), grid.resolution, origin, grid.frame_id)
-
-
 def plan_to_frontier(
     grid: GridMap,
     robot_xy: tuple[float, float],
@@ -170,7 +153,7 @@ def plan_to_frontier(
     The cost of a frontier is its path length minus a small bonus for its size (explore_lite's idea).
     Frontiers whose centroid lies within 0.5 m of a blacklisted point are skipped.
     """
-    grid = crop_to_known(grid)
+    grid = grid.crop_to_known()
     dist_m = clearance(grid)
     mask = traversable(grid, robot_radius, clearance_m=dist_m)
     start_cell = tuple(int(v) for v in grid.world_to_cell(np.array([robot_xy]))[0])

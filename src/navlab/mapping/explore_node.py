@@ -9,8 +9,8 @@ import numpy as np
 
 from navlab import msgs
 from navlab.core import Executor, Node, TfError
+from navlab.grid import GridMap
 from navlab.mapping.explore import follow_path, plan_to_frontier
-from navlab.mapping.grid import GridMap
 
 
 class Explore(Node):

@@ -18,11 +18,10 @@ import numba
 import numpy as np
 
 from navlab.core.params import dataclass_from_dict
+from navlab.geometry import between2, compose2, wrap_angle
+from navlab.grid import GridMap
 from navlab.mapping.errors import MappingError
-from navlab.mapping.grid import GridMap
 from navlab.mapping.occupancy import L_CLAMP, L_FREE, L_OCC, _raycast, logodds_to_grid
-from navlab.mapping.scanmatch import between, compose
-from navlab.msgs import normalize_angle
 
 
 @dataclass
@@ -250,7 +249,7 @@ class GMapping:
         out = np.empty_like(poses)
         out[:, 0] = poses[:, 0] + c * noisy[:, 0] - s_ * noisy[:, 1]
         out[:, 1] = poses[:, 1] + s_ * noisy[:, 0] + c * noisy[:, 1]
-        out[:, 2] = normalize_angle(poses[:, 2] + noisy[:, 2])
+        out[:, 2] = wrap_angle(poses[:, 2] + noisy[:, 2])
         return out
 
     def add_scan(
@@ -280,12 +279,12 @@ class GMapping:
             self._time_at_update = self._time
             self._mark_update(k)
             return odom.copy()
-        step = between(self._odom_last, odom)
+        step = between2(self._odom_last, odom)
         self._odom_last = odom
         poses = self._sample_motion_all(np.array([q.pose for q in self.particles]), step)
         for part, pose in zip(self.particles, poses, strict=True):
             part.pose = pose
-        moved = between(self._odom_at_update, odom)
+        moved = between2(self._odom_at_update, odom)
         due = (
             math.hypot(moved[0], moved[1]) >= p.linearUpdate
             or abs(moved[2]) >= p.angularUpdate
@@ -296,7 +295,7 @@ class GMapping:
             self._odom_at_update = odom
             self._time_at_update = self._time
         else:
-            self._scan_ref.append((self._last_update_scan, between(self._odom_by_scan[self._last_update_scan], odom)))
+            self._scan_ref.append((self._last_update_scan, between2(self._odom_by_scan[self._last_update_scan], odom)))
         return self.best().pose.copy()
 
     def _init(self, odom: np.ndarray, r: np.ndarray, ang: np.ndarray, max_urange: float, max_range: float) -> None:
@@ -340,7 +339,7 @@ class GMapping:
                 p.kernelSize, p.sigma, p.lsigma, p.lskip, p.lstep, p.astep, p.iterations,
             )  # fmt: skip
             if score > p.minimumScore:
-                part.pose = np.array([x, y, normalize_angle(t)])
+                part.pose = np.array([x, y, wrap_angle(t)])
             _s, lik, _n = _score(
                 part.grid, ox, oy, res, part.pose[0], part.pose[1], part.pose[2], r, ang, max_urange,
                 p.kernelSize, p.sigma, p.lsigma, p.lskip,
@@ -393,7 +392,7 @@ class GMapping:
             base = traj.get(ref)
             if base is None:  # before resampling histories joined; fall back on odometry
                 base = self._odom_by_scan[ref]
-            out[k] = compose(base, step)
+            out[k] = compose2(base, step)
         return out
 
     def map(self, *, frame_id: str = "map") -> GridMap:

@@ -16,18 +16,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from navlab.core.params import dataclass_from_dict
+from navlab.geometry import between2, compose2, inverse2, rotate_vectors2, transform_points2
 from navlab.mapping.errors import MappingError
 from navlab.mapping.posegraph import PoseGraph
 from navlab.mapping.scanmatch import (
     LookupField,
-    between,
-    compose,
     correlative_search,
     icp_point_to_line,
-    inverse,
-    rotate_vectors,
     scan_points,
-    transform_points,
 )
 
 
@@ -106,8 +102,8 @@ class GraphSlam:
         xy, nrm = [], []
         for k in idx:
             pose = self.graph.poses[k]
-            xy.append(transform_points(pose, self.node_xy[k]))
-            nrm.append(rotate_vectors(pose[2], self.node_normals[k]))
+            xy.append(transform_points2(pose, self.node_xy[k]))
+            nrm.append(rotate_vectors2(pose[2], self.node_normals[k]))
         return np.concatenate(xy), np.concatenate(nrm)
 
     def _match(
@@ -158,8 +154,8 @@ class GraphSlam:
             pose = odom.copy()
             self.path_length.append(0.0)
         else:
-            step = between(self.odom[-1], odom)
-            prior = compose(self.graph.poses[-1], step)
+            step = between2(self.odom[-1], odom)
+            prior = compose2(self.graph.poses[-1], step)
             pose = prior
             if len(sp.xy) >= 10:
                 lo = max(0, n - p.local_window)
@@ -169,10 +165,10 @@ class GraphSlam:
                     if n >= 2:
                         # odometry sometimes freezes and then jumps: when its step disagrees with the last
                         # estimated step, also try constant velocity and standing still
-                        last = between(self.graph.poses[-2], self.graph.poses[-1])
+                        last = between2(self.graph.poses[-2], self.graph.poses[-1])
                         jump = step - last
                         if math.hypot(jump[0], jump[1]) > p.odom_jump_lin or abs(jump[2]) > p.odom_jump_ang:
-                            priors += [compose(self.graph.poses[-1], last), self.graph.poses[-1].copy()]
+                            priors += [compose2(self.graph.poses[-1], last), self.graph.poses[-1].copy()]
                             self.odom_jumps += 1
                     best = None
                     for pr in priors:
@@ -191,7 +187,7 @@ class GraphSlam:
         k = self.graph.add_node(pose)
         if k > 0:
             info = np.diag([p.seq_sigma_xy**-2, p.seq_sigma_xy**-2, p.seq_sigma_theta**-2])
-            self.graph.add_edge(k - 1, k, between(self.graph.poses[k - 1], pose), info)
+            self.graph.add_edge(k - 1, k, between2(self.graph.poses[k - 1], pose), info)
             if k - self._last_loop_node >= p.loop_every and len(sp.xy) >= 30:
                 self._try_loop(k, sp.xy)
         return self.graph.poses[k].copy()
@@ -230,14 +226,14 @@ class GraphSlam:
             return False
         # a large correction must be confirmed by a second, nearby match implying the same correction
         # (corridors alias along their length); small corrections are accepted at once
-        edges = [(c, k, between(poses[c], pose))]
+        edges = [(c, k, between2(poses[c], pose))]
         if math.hypot(corr[0], corr[1]) > p.loop_confirm_above:
             pend = self._pending
-            correction = compose(pose, inverse(poses[k]))  # map-frame correction this match implies
-            self._pending = (c, k, between(poses[c], pose), correction)
+            correction = compose2(pose, inverse2(poses[k]))  # map-frame correction this match implies
+            self._pending = (c, k, between2(poses[c], pose), correction)
             if pend is None or k - pend[1] > 3 * p.loop_every:
                 return False
-            diff = between(pend[3], correction)
+            diff = between2(pend[3], correction)
             if math.hypot(diff[0], diff[1]) > p.loop_confirm_lin or abs(diff[2]) > p.loop_confirm_ang:
                 return False
             edges.insert(0, pend[:3])

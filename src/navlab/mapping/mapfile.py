@@ -20,9 +20,9 @@ from typing import Any
 import numpy as np
 import yaml
 
+from navlab.grid import GridMap
 from navlab.io.files import write_bytes_atomic, write_text_atomic
 from navlab.mapping.errors import MappingError
-from navlab.mapping.grid import GridMap
 
 MODES = ("trinary", "scale", "raw")
 _KNOWN_KEYS = ("image", "resolution", "origin", "negate", "occupied_thresh", "free_thresh", "mode")

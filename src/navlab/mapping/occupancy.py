@@ -12,7 +12,7 @@ import math
 import numba
 import numpy as np
 
-from navlab.mapping.grid import GridMap
+from navlab.grid import GridMap
 
 L_OCC = 0.85  # log-odds increment of a hit
 L_FREE = -0.4  # log-odds increment of a traversed cell

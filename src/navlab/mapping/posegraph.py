@@ -12,7 +12,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import spsolve
 
-from navlab.msgs import normalize_angle
+from navlab.geometry import wrap_angle
 
 
 @dataclass
@@ -49,10 +49,10 @@ class PoseGraph:
         dx, dy = xj[:, 0] - xi[:, 0], xj[:, 1] - xi[:, 1]
         # predicted relative pose in frame i, then error expressed in the frame of the measurement
         px, py = ci * dx + si * dy, -si * dx + ci * dy
-        pt = normalize_angle(xj[:, 2] - xi[:, 2])
+        pt = wrap_angle(xj[:, 2] - xi[:, 2])
         cz, sz = np.cos(z[:, 2]), np.sin(z[:, 2])
         ex0, ey0 = px - z[:, 0], py - z[:, 1]
-        e = np.stack([cz * ex0 + sz * ey0, -sz * ex0 + cz * ey0, normalize_angle(pt - z[:, 2])], axis=1)
+        e = np.stack([cz * ex0 + sz * ey0, -sz * ex0 + cz * ey0, wrap_angle(pt - z[:, 2])], axis=1)
         m = len(i)
         a = np.zeros((m, 3, 3))
         b = np.zeros((m, 3, 3))
@@ -127,7 +127,7 @@ class PoseGraph:
             dx = spsolve(hh.tocsc(), -g[3:])
             step = dx.reshape(-1, 3)
             self.poses[1:] += step
-            self.poses[:, 2] = normalize_angle(self.poses[:, 2])
+            self.poses[:, 2] = wrap_angle(self.poses[:, 2])
             if np.abs(step).max() < tol:
                 return it + 1
         return iterations

@@ -16,10 +16,11 @@ import numpy as np
 from navlab import msgs
 from navlab.core import Executor, Node, TfError
 from navlab.core.runner import run_for
+from navlab.geometry import inverse_transform_points2
+from navlab.grid import Grid, GridMap
 from navlab.mapping.errors import MappingError
-from navlab.mapping.evaluation import TruthGrid, free_coverage, score_map, to_map, trajectory_error
+from navlab.mapping.evaluation import free_coverage, score_map, trajectory_error, truth_grid
 from navlab.mapping.explore_node import Explore
-from navlab.mapping.grid import GridMap
 from navlab.mapping.mapfile import save_map
 from navlab.mapping.slam_node import SlamGMapping
 from navlab.mapping.teleop import HELP as TELEOP_HELP
@@ -78,14 +79,14 @@ class MappingResult:
     scores: dict[str, Any] = field(default_factory=dict)
 
 
-def true_occupancy(world: Any, grid: GridMap, margin: float = 1.0) -> TruthGrid:
+def true_occupancy(world: Any, grid: GridMap, margin: float = 1.0) -> Grid:
     """The world's occupancy at lidar height over the map's extent (plus ``margin`` m), in the world frame."""
     from navlab.world.occupancy import occupancy
 
     x0, y0, x1, y1 = grid.bounds()
     bounds = (x0 - margin, y0 - margin, x1 + margin, y1 + margin)
     occ = occupancy(world, grid.resolution, bounds, static_only=True)
-    return TruthGrid(occ, grid.resolution, (bounds[0], bounds[1]))
+    return truth_grid(occ, grid.resolution, (bounds[0], bounds[1]))
 
 
 def run_mapping(
@@ -173,7 +174,7 @@ def run_mapping(
         est = np.array(monitor.estimate)
         tru = np.array(monitor.truth)
         # the estimate is in the map frame = the spawn pose; bring the truth into it
-        tru_map = np.column_stack([to_map(tru[:, :2], spawn), tru[:, 2] - spawn[2]])
+        tru_map = np.column_stack([inverse_transform_points2(spawn, tru[:, :2]), tru[:, 2] - spawn[2]])
         result.scores.update(trajectory_error(est, tru_map))
         write_trajectory(out_dir / "trajectory.txt", np.array(monitor.times), est, tru_map)
         # raw odometry starts at the spawn pose too, so it is compared in the same frame

@@ -42,7 +42,7 @@ def _cmd_map_save(args: argparse.Namespace) -> int:
     from navlab import msgs
     from navlab.core.launch import start
     from navlab.core.runner import parse_launch_args, run_for
-    from navlab.mapping.grid import GridMap
+    from navlab.grid import GridMap
     from navlab.mapping.mapfile import save_map
 
     path = Path(args.out) / "map.yaml"

@@ -14,41 +14,7 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
-from navlab.msgs import normalize_angle
-
-
-def compose(a: np.ndarray | tuple, b: np.ndarray | tuple) -> np.ndarray:
-    """a ∘ b for planar poses (x, y, theta)."""
-    c, s = math.cos(a[2]), math.sin(a[2])
-    return np.array([a[0] + c * b[0] - s * b[1], a[1] + s * b[0] + c * b[1], normalize_angle(a[2] + b[2])])
-
-
-def inverse(a: np.ndarray | tuple) -> np.ndarray:
-    """a^-1 for a planar pose."""
-    c, s = math.cos(a[2]), math.sin(a[2])
-    return np.array([-c * a[0] - s * a[1], s * a[0] - c * a[1], -a[2]])
-
-
-def between(a: np.ndarray | tuple, b: np.ndarray | tuple) -> np.ndarray:
-    """a^-1 ∘ b: the pose of b in the frame of a."""
-    return compose(inverse(a), b)
-
-
-
-
-def transform_points(pose: np.ndarray | tuple, pts: np.ndarray) -> np.ndarray:
-    """Points (N, 2) in a frame at ``pose`` -> points in the parent frame."""
-    c, s = math.cos(pose[2]), math.sin(pose[2])
-    out = np.empty_like(pts)
-    out[:, 0] = pose[0] + c * pts[:, 0] - s * pts[:, 1]
-    out[:, 1] = pose[1] + s * pts[:, 0] + c * pts[:, 1]
-    return out
-
-
-def rotate_vectors(theta: float, v: np.ndarray) -> np.ndarray:
-    """Rotate vectors (N, 2) by ``theta`` rad."""
-    c, s = math.cos(theta), math.sin(theta)
-    return np.stack([c * v[:, 0] - s * v[:, 1], s * v[:, 0] + c * v[:, 1]], axis=1)
+from navlab.geometry import wrap_angle
 
 
 @dataclass
@@ -221,7 +187,7 @@ def correlative_search(
         nang,
         ang_step,
     )
-    return np.array([bx, by, normalize_angle(bt)]), float(score)
+    return np.array([bx, by, wrap_angle(bt)]), float(score)
 
 
 # --- ICP ----------------------------------------------------------------------------------------------
@@ -385,7 +351,7 @@ def icp_point_to_line(
         int(iterations),
         float(huber),
     )
-    return IcpResult(np.array([x, y, normalize_angle(t)]), float(frac), float(rms), hess)
+    return IcpResult(np.array([x, y, wrap_angle(t)]), float(frac), float(rms), hess)
 
 
 def warmup() -> None:

@@ -15,12 +15,12 @@ from typing import Any
 
 import numpy as np
 
+from navlab.geometry import compose2, inverse2
+from navlab.grid import GridMap
 from navlab.io.carmen import CarmenLog
 from navlab.mapping.errors import MappingError
-from navlab.mapping.grid import GridMap
 from navlab.mapping.mapfile import save_map
 from navlab.mapping.occupancy import build_map
-from navlab.mapping.scanmatch import compose, inverse
 
 MODES = ("graph", "gmapping")
 
@@ -68,7 +68,7 @@ def run_offline(
     for s in tqdm(scans, desc=f"slam ({mode})", unit="scan", disable=not progress, file=sys.stderr):
         slam.add_scan(s.ranges, s.angle_min, s.angle_increment, s.laser_pose)
     laser = np.asarray(slam.finish(), dtype=np.float64)
-    robot = np.array([compose(lp, inverse(s.laser_offset)) for lp, s in zip(laser, scans, strict=True)])
+    robot = np.array([compose2(lp, inverse2(s.laser_offset)) for lp, s in zip(laser, scans, strict=True)])
     grid = build_map(
         laser,
         [(s.ranges.astype(np.float64), s.angle_min + s.angle_increment * np.arange(len(s.ranges))) for s in scans],

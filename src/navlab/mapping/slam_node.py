@@ -19,12 +19,12 @@ import numpy as np
 
 from navlab import msgs
 from navlab.core import Executor, Node, TfError
+from navlab.geometry import between2, compose2, inverse2
+from navlab.grid import GridMap
 from navlab.mapping.errors import MappingError
 from navlab.mapping.gmapping import GMapping, GMappingParams
 from navlab.mapping.graph_slam import GraphSlam, GraphSlamParams
-from navlab.mapping.grid import GridMap
 from navlab.mapping.occupancy import build_map
-from navlab.mapping.scanmatch import between, compose, inverse
 
 
 class SlamGMapping(Node):
@@ -104,7 +104,7 @@ class SlamGMapping(Node):
         if self._last_processed is None:
             return True
         gm = self.gm
-        moved = between(self._last_processed[0], odom_laser)
+        moved = between2(self._last_processed[0], odom_laser)
         dt = (t_ns - self._last_processed[1]) * 1e-9
         return (
             math.hypot(moved[0], moved[1]) >= gm.linearUpdate
@@ -121,7 +121,7 @@ class SlamGMapping(Node):
         odom = self._odom(t_ns)
         if laser is None or odom is None:
             return
-        odom_laser = compose(odom, laser)
+        odom_laser = compose2(odom, laser)
         r = np.asarray(msg.ranges, dtype=np.float64).copy()
         rmax = float(msg.range_max)
         # slam_gmapping: readings below range_min count as range_max; non-finite readings are no returns
@@ -148,7 +148,7 @@ class SlamGMapping(Node):
             self._max_range = rmax
         self.scans_processed += 1
         # map_T_odom = map_T_laser ∘ (odom_T_laser)^-1
-        self.map_to_odom = compose(pose, inverse(odom_laser))
+        self.map_to_odom = compose2(pose, inverse2(odom_laser))
         self._publish_tf()
         if self._last_map_ns is None or (t_ns - self._last_map_ns) * 1e-9 >= self.map_update_interval:
             self._last_map_ns = t_ns

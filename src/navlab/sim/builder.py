@@ -21,13 +21,13 @@ Conventions of the built model (what the simulator and the lidar rely on):
 from __future__ import annotations
 
 import hashlib
-import math
 from dataclasses import dataclass, field
 
 import mujoco
 import numpy as np
 
 from navlab.description.model import Geometry, Joint, Link, Origin, RobotModel, Shape
+from navlab.geometry import matrix_from_rpy, quat_from_rpy, wxyz_from_xyzw
 from navlab.sim.errors import SimError
 
 GROUP_WORLD = 0
@@ -92,41 +92,18 @@ class BuildInfo:
 # --- rotations ------------------------------------------------------------------------------------
 
 
-def quat_from_rpy(rpy: tuple[float, float, float]) -> np.ndarray:
-    """MuJoCo quaternion (w, x, y, z) of URDF roll-pitch-yaw (fixed axes: R = Rz(y) Ry(p) Rx(r))."""
-    r, p, y = (0.5 * float(a) for a in rpy)
-    cr, sr, cp, sp, cy, sy = math.cos(r), math.sin(r), math.cos(p), math.sin(p), math.cos(y), math.sin(y)
-    return np.array(
-        [
-            cr * cp * cy + sr * sp * sy,
-            sr * cp * cy - cr * sp * sy,
-            cr * sp * cy + sr * cp * sy,
-            cr * cp * sy - sr * sp * cy,
-        ]
-    )
+def mj_quat_from_rpy(rpy: tuple[float, float, float]) -> np.ndarray:
+    """MuJoCo's quaternion (w, x, y, z) of URDF roll-pitch-yaw: the MuJoCo boundary of ``geometry``."""
+    return wxyz_from_xyzw(quat_from_rpy(*(float(a) for a in rpy)))
 
 
-def mat_from_rpy(rpy: tuple[float, float, float]) -> np.ndarray:
-    """3×3 rotation matrix of URDF roll-pitch-yaw."""
-    mat = np.zeros(9)
-    mujoco.mju_quat2Mat(mat, quat_from_rpy(rpy))
-    return mat.reshape(3, 3)
 
 
 def _set_pose(element: object, origin: Origin) -> None:
     element.pos = np.asarray(origin.xyz, dtype=float)  # type: ignore[attr-defined]
-    element.quat = quat_from_rpy(origin.rpy)  # type: ignore[attr-defined]
+    element.quat = mj_quat_from_rpy(origin.rpy)  # type: ignore[attr-defined]
 
 
-def _compose(a: Origin, b: Origin) -> Origin:
-    """Pose ``b`` (in frame ``a``) expressed in ``a``'s parent."""
-    ra = mat_from_rpy(a.rpy)
-    xyz = np.asarray(a.xyz) + ra @ np.asarray(b.xyz)
-    rot = ra @ mat_from_rpy(b.rpy)
-    yaw = math.atan2(rot[1, 0], rot[0, 0])
-    pitch = math.asin(max(-1.0, min(1.0, -rot[2, 0])))
-    roll = math.atan2(rot[2, 1], rot[2, 2])
-    return Origin(xyz=(float(xyz[0]), float(xyz[1]), float(xyz[2])), rpy=(roll, pitch, yaw))
 
 
 # --- geometry -------------------------------------------------------------------------------------
@@ -210,7 +187,7 @@ def _set_inertial(body: mujoco.MjsBody, link: Link, moving: bool, info: BuildInf
             [inertial.ixz, inertial.iyz, inertial.izz],
         ]
     )
-    rot = mat_from_rpy(inertial.origin.rpy)
+    rot = matrix_from_rpy(*inertial.origin.rpy)
     tensor = rot @ tensor @ rot.T
     if np.all(np.abs(tensor) < 1e-12):
         tensor = np.eye(3) * 1e-6
@@ -281,7 +258,7 @@ def add_robot(
             g = geoms.add(body, shape, f"{where} collision {i}", friction=np.array([mu, 0.005, 0.0001]),
                           condim=condim, **contact)
             if shape.geometry.kind == "cylinder" and axis is not None:
-                cyl_axis = mat_from_rpy(shape.origin.rpy)[:, 2]
+                cyl_axis = matrix_from_rpy(*shape.origin.rpy)[:, 2]
                 if abs(float(cyl_axis @ axis)) > 0.99:  # a wheel: see WHEEL_FLOOR_SPHERES
                     g.contype, g.conaffinity = _CONTACT_BITS["wheel"]
                     floor = Shape(Geometry("sphere", (float(shape.geometry.size[0]),)), origin=shape.origin)
@@ -379,7 +356,7 @@ def _wheel_inertia(robot: RobotModel, joint: Joint) -> float:
     if inertial is not None:
         tensor = np.array([[inertial.ixx, inertial.ixy, inertial.ixz], [inertial.ixy, inertial.iyy, inertial.iyz],
                            [inertial.ixz, inertial.iyz, inertial.izz]])
-        rot = mat_from_rpy(inertial.origin.rpy)
+        rot = matrix_from_rpy(*inertial.origin.rpy)
         axis = np.asarray(joint.axis, dtype=float) / np.linalg.norm(joint.axis)
         com = np.asarray(inertial.origin.xyz, dtype=float)
         own = float(axis @ rot @ tensor @ rot.T @ axis) + inertial.mass * float(com @ com - (com @ axis) ** 2)

@@ -16,30 +16,27 @@ import numpy as np
 from navlab import msgs
 from navlab.core import Executor, Node
 from navlab.description.model import DiffDriveConfig, ImuConfig, LidarConfig, Origin
-from navlab.sim.builder import quat_from_rpy
+from navlab.geometry import qmul, qrotate, quat_from_rpy, quat_from_yaw
 from navlab.sim.diffdrive import ODOM_COVARIANCE_DIAG, EncoderOdometry, ramp, wheel_speeds
 from navlab.sim.simulation import Simulation, lidar_angles
 
 _ODOM_COV = msgs.covariance(ODOM_COVARIANCE_DIAG)
 
 
-def _quat_msg(wxyz: Any) -> Any:
-    return msgs.Quaternion(x=float(wxyz[1]), y=float(wxyz[2]), z=float(wxyz[3]), w=float(wxyz[0]))
-
-
-def _transform(stamp_ns: int, parent: str, child: str, xyz: Any, wxyz: Any) -> Any:
+def _transform(stamp_ns: int, parent: str, child: str, xyz: Any, q: Any) -> Any:
+    """``TransformStamped`` from a translation and a quaternion (x, y, z, w)."""
     return msgs.TransformStamped(
         header=msgs.header(stamp_ns, parent),
         child_frame_id=child,
         transform=msgs.Transform(
             translation=msgs.Vector3(x=float(xyz[0]), y=float(xyz[1]), z=float(xyz[2])),
-            rotation=_quat_msg(wxyz),
+            rotation=msgs.quaternion_msg(q),
         ),
     )
 
 
 def _origin_transform(stamp_ns: int, parent: str, child: str, origin: Origin) -> Any:
-    return _transform(stamp_ns, parent, child, origin.xyz, quat_from_rpy(origin.rpy))
+    return _transform(stamp_ns, parent, child, origin.xyz, quat_from_rpy(*origin.rpy))
 
 
 def base_frame_link(sim: Simulation, frame: str) -> str:
@@ -123,14 +120,14 @@ class DiffDrivePlugin(Node):
         else:
             x, y, yaw, v, w = self.odometry.update(*self._encoders(), dt)
             position = np.array([x, y, 0.0])
-            quat = np.array([np.cos(yaw / 2), 0.0, 0.0, np.sin(yaw / 2)])
+            quat = quat_from_yaw(yaw)
             lin, ang = np.array([v, 0.0, 0.0]), np.array([0.0, 0.0, w])
         odom = msgs.Odometry(
             header=msgs.header(now, cfg.odometry_frame),
             child_frame_id=cfg.robot_base_frame,
             pose=msgs.PoseWithCovariance(
                 pose=msgs.Pose(position=msgs.Point(x=float(position[0]), y=float(position[1]),
-                                                   z=float(position[2])), orientation=_quat_msg(quat)),
+                                                   z=float(position[2])), orientation=msgs.quaternion_msg(quat)),
                 covariance=_ODOM_COV.copy(),
             ),
             twist=msgs.TwistWithCovariance(
@@ -193,7 +190,7 @@ class ImuPlugin(Node):
         quat, gyro, accel = self.sim.imu(self.index, rng=self.rng)
         self.pub.publish(msgs.Imu(
             header=msgs.header(self.get_clock().now_ns(), self.frame_id),
-            orientation=_quat_msg(quat), orientation_covariance=self.cov[0].copy(),
+            orientation=msgs.quaternion_msg(quat), orientation_covariance=self.cov[0].copy(),
             angular_velocity=msgs.Vector3(x=float(gyro[0]), y=float(gyro[1]), z=float(gyro[2])),
             angular_velocity_covariance=self.cov[1].copy(),
             linear_acceleration=msgs.Vector3(x=float(accel[0]), y=float(accel[1]), z=float(accel[2])),
@@ -234,38 +231,23 @@ class JointStatePlugin(Node):
 
 
 def joint_motion(joint: Any, q: float) -> tuple[tuple[float, float, float], tuple[float, float, float, float]]:
-    """Pose (xyz, wxyz) of a joint's child frame in its parent link at joint position ``q``."""
-    (w0, x0, y0, z0), (ox, oy, oz), (ax, ay, az) = _joint_constants(
+    """Pose (xyz, quaternion x y z w) of a joint's child frame in its parent link at joint position ``q``."""
+    q0, (ox, oy, oz), (ax, ay, az) = _joint_constants(
         tuple(joint.origin.rpy), tuple(joint.origin.xyz), tuple(joint.axis)
     )
     if joint.type == "prismatic":  # translate along the axis, expressed in the parent via the origin
-        tx, ty, tz = _rotate((w0, x0, y0, z0), (ax * q, ay * q, az * q))
-        return (ox + tx, oy + ty, oz + tz), (w0, x0, y0, z0)
+        tx, ty, tz = qrotate(q0, (ax * q, ay * q, az * q))
+        return (ox + tx, oy + ty, oz + tz), q0
     c, s = math.cos(q / 2), math.sin(q / 2)
-    w1, x1, y1, z1 = c, s * ax, s * ay, s * az
-    return (ox, oy, oz), (
-        w0 * w1 - x0 * x1 - y0 * y1 - z0 * z1,
-        w0 * x1 + x0 * w1 + y0 * z1 - z0 * y1,
-        w0 * y1 - x0 * z1 + y0 * w1 + z0 * x1,
-        w0 * z1 + x0 * y1 - y0 * x1 + z0 * w1,
-    )
+    return (ox, oy, oz), qmul(q0, (s * ax, s * ay, s * az, c))
 
 
 @functools.lru_cache(maxsize=256)
 def _joint_constants(rpy: tuple, xyz: tuple, axis: tuple) -> tuple[tuple, tuple, tuple]:
-    """(origin quaternion, origin translation, unit axis) of a joint, as float tuples."""
-    w0, x0, y0, z0 = (float(v) for v in quat_from_rpy(rpy))
+    """(origin quaternion x y z w, origin translation, unit axis) of a joint, as float tuples."""
     ax, ay, az = (float(v) for v in axis)
     norm = math.sqrt(ax * ax + ay * ay + az * az)
-    return (w0, x0, y0, z0), tuple(float(v) for v in xyz), (ax / norm, ay / norm, az / norm)
-
-
-def _rotate(q: tuple[float, float, float, float], v: tuple[float, float, float]) -> tuple[float, float, float]:
-    """Vector ``v`` rotated by unit quaternion ``q`` (w, x, y, z)."""
-    w, x, y, z = q
-    vx, vy, vz = v
-    tx, ty, tz = 2 * (y * vz - z * vy), 2 * (z * vx - x * vz), 2 * (x * vy - y * vx)
-    return (vx + w * tx + y * tz - z * ty, vy + w * ty + z * tx - x * tz, vz + w * tz + x * ty - y * tx)
+    return quat_from_rpy(*rpy), tuple(float(v) for v in xyz), (ax / norm, ay / norm, az / norm)
 
 
 def static_transforms(sim: Simulation, stamp_ns: int) -> list[Any]:
@@ -304,7 +286,7 @@ class GroundTruthPlugin(Node):
             child_frame_id=self.base_frame,
             pose=msgs.PoseWithCovariance(
                 pose=msgs.Pose(position=msgs.Point(x=float(p[0]), y=float(p[1]), z=float(p[2])),
-                               orientation=_quat_msg(pose.quaternion)),
+                               orientation=msgs.quaternion_msg(pose.quaternion)),
                 covariance=np.zeros(36),
             ),
             twist=msgs.TwistWithCovariance(

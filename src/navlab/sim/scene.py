@@ -22,7 +22,6 @@ from navlab.sim.builder import (
     MAX_STEP,
     MIN_STEP,
     BuildInfo,
-    _compose,
     _contact_props,
     _Geoms,
     _set_inertial,
@@ -51,12 +50,12 @@ def add_world_model(spec: mujoco.MjSpec, model: ModelSpec, info: BuildInfo) -> l
     for link in model.links:
         where = f"model {model.name!r} link {link.name!r}"
         scoped = f"{model.name}::{link.name}"
-        link_pose = _compose(model_pose, model.link_origins.get(link.name, Origin()))
+        link_pose = model_pose.then(model.link_origins.get(link.name, Origin()))
         if model.static:
             body = spec.worldbody
 
             def place(shape: Shape, _pose: Origin = link_pose) -> Shape:
-                return replace(shape, origin=_compose(_pose, shape.origin))
+                return replace(shape, origin=_pose.then(shape.origin))
         else:
             body = spec.worldbody.add_body(name=scoped)
             _set_pose(body, link_pose)

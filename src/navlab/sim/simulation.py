@@ -13,8 +13,8 @@ import mujoco
 import numpy as np
 
 from navlab.description.model import DiffDriveConfig, LidarConfig, RobotModel
-from navlab.msgs import yaw_from_xyzw
-from navlab.sim.builder import GROUP_ROBOT, GROUP_WORLD, RAY_GEOMGROUP, quat_from_rpy
+from navlab.geometry import quat_from_rpy, xyzw_from_wxyz, yaw_from_quat
+from navlab.sim.builder import GROUP_ROBOT, GROUP_WORLD, RAY_GEOMGROUP, mj_quat_from_rpy
 from navlab.sim.errors import SimError
 from navlab.sim.raycast import FAST_TYPES, cast_planar, finish_ranges
 from navlab.sim.scene import add_world_model, build_spec, compile_spec, remove_world_model
@@ -25,7 +25,7 @@ SPAWN_GAP = 0.0005  # m between the robot's lowest point and the floor when it i
 
 @dataclass(frozen=True)
 class Pose3D:
-    """A pose in the world frame: position (m) and quaternion (w, x, y, z)."""
+    """A pose in the world frame: position (m) and quaternion (x, y, z, w), ROS's order."""
 
     position: np.ndarray
     quaternion: np.ndarray
@@ -33,8 +33,7 @@ class Pose3D:
     @property
     def yaw(self) -> float:
         """Heading about world z (rad)."""
-        w, x, y, z = self.quaternion
-        return yaw_from_xyzw(x, y, z, w)
+        return yaw_from_quat(self.quaternion)
 
 
 def lidar_angles(cfg: LidarConfig) -> np.ndarray:
@@ -187,7 +186,7 @@ class Simulation:
                     rot = np.zeros(9)
                     mujoco.mju_quat2Mat(rot, pquat)
                     quat = np.zeros(4)
-                    mujoco.mju_mulQuat(quat, pquat, quat_from_rpy(joint.origin.rpy))
+                    mujoco.mju_mulQuat(quat, pquat, mj_quat_from_rpy(joint.origin.rpy))
                     out[link] = (pb, pxyz + rot.reshape(3, 3) @ np.asarray(joint.origin.xyz), quat)
             return out[link]
 
@@ -200,11 +199,11 @@ class Simulation:
         b, xyz, quat = self._link_frame(link)
         self._sync()
         if not xyz.any() and quat[0] == 1.0:  # the link is the body's own frame
-            return Pose3D(self.data.xpos[b].copy(), self.data.xquat[b].copy())
+            return Pose3D(self.data.xpos[b].copy(), np.array(xyzw_from_wxyz(self.data.xquat[b])))
         rot = self.data.xmat[b].reshape(3, 3)
         q = np.zeros(4)
         mujoco.mju_mulQuat(q, self.data.xquat[b], quat)
-        return Pose3D(self.data.xpos[b] + rot @ xyz, q)
+        return Pose3D(self.data.xpos[b] + rot @ xyz, np.array(xyzw_from_wxyz(q)))
 
     def base_pose2d(self, link: str | None = None) -> tuple[float, float, float]:
         """True (x, y, yaw) of a robot link in the world (m, rad)."""
@@ -327,7 +326,7 @@ class Simulation:
     def imu(
         self, index: int = 0, rng: np.random.Generator | None = None
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(orientation quaternion w,x,y,z in world, angular velocity rad/s, linear acceleration m/s²) of IMU
+        """(orientation quaternion x,y,z,w in world, angular velocity rad/s, linear acceleration m/s²) of IMU
         ``index``; rates and accelerations in the IMU frame, with the configured gaussian noise."""
         if self.robot is None or not 0 <= index < len(self.robot.imus):
             raise SimError(f"no imu number {index} on this robot")
@@ -340,7 +339,7 @@ class Simulation:
             gyro = gyro + gen.normal(0.0, cfg.gyro_noise_stddev, 3)
         if cfg.accel_noise_stddev > 0:
             accel = accel + gen.normal(0.0, cfg.accel_noise_stddev, 3)
-        return quat, gyro, accel
+        return np.array(xyzw_from_wxyz(quat)), gyro, accel
 
     # --- spawning ---------------------------------------------------------------------------------
 
@@ -367,9 +366,9 @@ class Simulation:
         self._sync()
         if bodies:
             b = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, bodies[0])
-            return Pose3D(self.data.xpos[b].copy(), self.data.xquat[b].copy())
+            return Pose3D(self.data.xpos[b].copy(), np.array(xyzw_from_wxyz(self.data.xquat[b])))
         x, y, z, roll, pitch, yaw = self.info.model_poses[name]
-        return Pose3D(np.array([x, y, z]), quat_from_rpy((roll, pitch, yaw)))
+        return Pose3D(np.array([x, y, z]), np.array(quat_from_rpy(roll, pitch, yaw)))
 
     def _recompile(self, what: str) -> None:
         ctrl = {n: self.data.ctrl[i] for n, i in zip(self.info.wheel_actuators or (), self._act, strict=False)}

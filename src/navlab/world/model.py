@@ -6,8 +6,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from navlab.description.model import Link, Origin
-
-Pose6 = tuple[float, float, float, float, float, float]  # x y z roll pitch yaw, as in SDF <pose>
+from navlab.geometry import Pose6  # x y z roll pitch yaw, as in SDF <pose>
 
 
 @dataclass

@@ -16,9 +16,9 @@ from scipy.spatial import ConvexHull, QhullError
 
 from navlab.description.meshes import read_mesh
 from navlab.description.model import Shape
+from navlab.geometry import matrix_from_pose6
 from navlab.world.errors import WorldError
 from navlab.world.model import WorldModel
-from navlab.world.transforms import to_matrix
 
 _PRISM_SIDES = 32
 _EPS = 1e-6  # m: overlaps thinner than this (rounding at cell borders) do not count
@@ -128,11 +128,11 @@ def shape_footprints(world: WorldModel, *, z_min: float = 0.05, z_max: float = 0
     for model in world.models:
         if static_only and not model.static:
             continue
-        world_T_model = to_matrix(model.pose)
+        world_T_model = matrix_from_pose6(model.pose)
         for link in model.links:
-            model_T_link = to_matrix(model.link_origins.get(link.name, (0.0,) * 6))  # type: ignore[arg-type]
+            model_T_link = model.link_origins[link.name].matrix() if link.name in model.link_origins else np.eye(4)
             for k, shape in enumerate(link.collisions):
-                m = world_T_model @ model_T_link @ to_matrix(shape.origin)
+                m = world_T_model @ model_T_link @ shape.origin.matrix()
                 fp = _footprint(shape, m, f"{model.name}::{link.name}::{shape.name or k}", z_min, z_max)
                 if fp is not None:
                     out.append(fp)

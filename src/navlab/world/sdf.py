@@ -20,9 +20,9 @@ from navlab.description.errors import DescriptionError
 from navlab.description.meshes import is_convex, prepare_mesh, read_mesh
 from navlab.description.model import Geometry, Inertial, Link, Origin, Shape
 from navlab.description.packages import PackageIndex
+from navlab.geometry import compose6
 from navlab.world.errors import WorldError
 from navlab.world.model import ModelSpec, Pose6, WorldModel
-from navlab.world.transforms import compose, to_matrix, to_origin
 
 SUPPORTED_VERSIONS = ("1.4", "1.5", "1.6", "1.7")
 _COLORS = {  # Gazebo material script names -> rgba
@@ -176,18 +176,19 @@ class _Loader:
                 if link.name in spec.link_origins:
                     raise WorldError(f'{where}: duplicate link name "{link.name}"')
                 spec.links.append(link)
-                spec.link_origins[link.name] = to_origin(to_matrix(frame) @ to_matrix(origin))
+                spec.link_origins[link.name] = Origin.from_pose6(compose6(frame, origin))
             elif tag == "model":
                 sub = child.get("name", "")
                 w = f'{where}/<model name="{sub}">'
-                self._fill(spec, child, file, w, prefix + sub + "::", compose(frame, _pose(child, w)))
+                self._fill(spec, child, file, w, prefix + sub + "::", compose6(frame, _pose(child, w)))
             elif tag == "include":
                 for inc in self.include(child, file.parent, where):
                     for link in inc.links:
                         o = inc.link_origins[link.name]
                         link.name = f"{prefix}{inc.name}::{link.name}"
                         spec.links.append(link)
-                        spec.link_origins[link.name] = to_origin(to_matrix(compose(frame, inc.pose)) @ to_matrix(o))
+                        model_T_inc = compose6(frame, inc.pose)
+                        spec.link_origins[link.name] = Origin.from_pose6(compose6(model_T_inc, o.as_pose6()))
             elif tag == "joint" and not spec.static:
                 self.warnings.append(f'{where}/<joint name="{child.get("name")}">: joints of world models are not '
                                      "simulated; the links move freely")
