@@ -141,3 +141,92 @@ def test_save_creates_missing_directories(tmp_path):
     grid = GridMap(np.zeros((2, 2), np.int8), 0.1)
     save_map(grid, tmp_path / "a" / "b" / "m.yaml")
     np.testing.assert_array_equal(load_map(tmp_path / "a" / "b" / "m.yaml").data, grid.data)
+
+
+def _pgm_pixels(path) -> np.ndarray:
+    """Pixels of a P5 file written by save_map (header: magic, comment, size, maxval)."""
+    raw = path.read_bytes()
+    lines = raw.split(b"\n", 4)
+    w, h = map(int, lines[2].split())
+    return np.frombuffer(lines[4], dtype=np.uint8).reshape(h, w)
+
+
+def test_trinary_writes_only_map_saver_levels_for_any_occupancy(tmp_path):
+    # a SLAM map holds every percentage; map_saver writes 254 (<= 25 %), 0 (>= 65 %), 205 (the rest)
+    values = np.arange(-1, 101, dtype=np.int8)
+    save_map(GridMap(values.reshape(1, -1), 0.05), tmp_path / "m.yaml")
+    pixels = _pgm_pixels(tmp_path / "m.pgm")[0]
+    assert set(np.unique(pixels).tolist()) == {0, 205, 254}
+    np.testing.assert_array_equal(pixels[values == -1], 205)
+    np.testing.assert_array_equal(pixels[(values >= 0) & (values <= 25)], 254)
+    np.testing.assert_array_equal(pixels[(values > 25) & (values < 65)], 205)
+    np.testing.assert_array_equal(pixels[values >= 65], 0)
+    back = load_map(tmp_path / "m.yaml").data[0]
+    expected = np.where(values < 0, -1, np.where(values <= 25, 0, np.where(values >= 65, 100, -1)))
+    np.testing.assert_array_equal(back, expected)
+
+
+def test_trinary_thresholds_are_map_saver_occ_and_free(tmp_path):
+    values = np.array([[10, 30, 50, 70]], dtype=np.int8)
+    save_map(GridMap(values, 0.05), tmp_path / "m.yaml", threshold_free=30, threshold_occupied=50)
+    np.testing.assert_array_equal(_pgm_pixels(tmp_path / "m.pgm")[0], [254, 254, 0, 0])
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "needle"),
+    [
+        ({"threshold_free": 70, "threshold_occupied": 65}, "threshold_free 70"),
+        ({"free_thresh": 0.25}, "free_thresh 0.25"),
+        ({"occupied_thresh": 1.0}, "occupied_thresh 1.0"),
+        ({"crop_margin_cells": -1}, "crop_margin_cells -1"),
+    ],
+)
+def test_save_refuses_thresholds_that_break_the_round_trip(tmp_path, kwargs, needle):
+    with pytest.raises(MappingError, match=needle):
+        save_map(GridMap(np.zeros((2, 2), np.int8), 0.05), tmp_path / "m.yaml", **kwargs)
+
+
+def test_saved_map_is_cropped_to_known_cells_plus_margin(tmp_path):
+    # a SLAM-sized allocation (400 x 300 cells) of which a 40 x 20 block is known
+    data = np.full((300, 400), -1, np.int8)
+    data[100:120, 200:240] = 0
+    data[100, 200:240] = 100
+    grid = GridMap(data, 0.05, (-10.0, -7.5, 0.0))
+    save_map(grid, tmp_path / "m.yaml")
+    back = load_map(tmp_path / "m.yaml")
+    assert (back.width, back.height) == (40 + 20, 20 + 20)
+    assert back.origin == pytest.approx((-10.0 + 190 * 0.05, -7.5 + 90 * 0.05, 0.0))
+    # every cell keeps its place in the map frame
+    centres = grid.centers(np.ones_like(data, bool))
+    np.testing.assert_array_equal(back.value_at(centres), grid.value_at(centres))
+    save_map(grid, tmp_path / "full.yaml", crop_margin_cells=None)
+    assert load_map(tmp_path / "full.yaml").data.shape == (300, 400)
+
+
+def test_crop_stops_at_the_grid_edge_and_keeps_a_rotated_origin(tmp_path):
+    data = np.full((30, 50), -1, np.int8)
+    data[0:5, 45:50] = 0  # known cells in a corner: the margin is clipped there
+    grid = GridMap(data, 0.1, (1.0, 2.0, 0.5))
+    save_map(grid, tmp_path / "m.yaml", crop_margin_cells=3)
+    back = load_map(tmp_path / "m.yaml")
+    assert (back.width, back.height) == (5 + 3, 5 + 3)
+    centres = grid.centers(np.ones_like(data, bool))
+    np.testing.assert_array_equal(back.value_at(centres), grid.value_at(centres))
+
+
+def test_scale_loader_is_map_server_formula(tmp_path):
+    # p = (255 - grey) / 255; in between: 1 + 98 * (p - free) / (occ - free), truncated
+    greys = np.array([255, 254, 200, 150, 100, 89, 0], np.uint8)
+    (tmp_path / "s.pgm").write_bytes(b"P5\n7 1\n255\n" + greys.tobytes())
+    (tmp_path / "s.yaml").write_text("image: s.pgm\nresolution: 0.1\norigin: [0, 0, 0]\nmode: scale\n")
+    p = (255.0 - greys) / 255.0
+    mid = np.floor(1 + 98 * (p - 0.196) / (0.65 - 0.196)).astype(int)
+    expected = np.where(p > 0.65, 100, np.where(p < 0.196, 0, mid))
+    np.testing.assert_array_equal(load_map(tmp_path / "s.yaml").data[0], expected)
+    assert expected.tolist()[2:5] == [5, 47, 89]  # by hand: p = .216, .412, .608
+
+
+def test_raw_loader_is_the_pixel_value(tmp_path):
+    (tmp_path / "r.pgm").write_bytes(b"P5\n4 1\n255\n" + bytes([0, 37, 100, 255]))
+    (tmp_path / "r.yaml").write_text("image: r.pgm\nresolution: 0.1\norigin: [0, 0, 0]\nmode: raw\n")
+    np.testing.assert_array_equal(load_map(tmp_path / "r.yaml").data[0], [0, 37, 100, -1])

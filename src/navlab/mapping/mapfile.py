@@ -1,12 +1,18 @@
 """map_server's map files: a YAML description plus an image (PGM written; PGM/PPM/PNG read).
 
-Loading follows ROS 1 ``map_server`` (image_loader) exactly: the image path is relative to the YAML,
-the image's first row is the map's top row (rows flipped vs. grid rows), ``negate`` inverts grey
-levels, ``occ = (255 - grey) / 255``; trinary: occ > occupied_thresh -> 100, occ < free_thresh -> 0,
-else -1; scale: in-between values map to ``1 + 98 * ratio`` (unknown where alpha is 0); raw: the
-grey level is the cell value. Saving writes what ``map_saver`` writes: 254 free, 0 occupied,
-205 unknown (trinary), and the inverse of the loader for scale/raw, so a save/load round trip is
-exact wherever the image format can represent the value. Files are written atomically.
+Loading follows ROS 1 ``map_server`` (noetic image_loader) exactly: the image path is relative to the
+YAML, the image's first row is the map's top row (rows flipped vs. grid rows), ``negate`` inverts grey
+levels, ``p = (255 - grey) / 255``; trinary: p > occupied_thresh -> 100, p < free_thresh -> 0, else -1;
+scale: the same, except that in-between values become ``1 + 98 * ratio`` (truncated; unknown where
+alpha is 0), ratio = (p - free_thresh) / (occupied_thresh - free_thresh); raw: the grey level is the
+cell value.
+
+Saving writes what ``map_saver`` writes. Trinary: occupancy <= ``threshold_free`` % (default 25) ->
+254, >= ``threshold_occupied`` % (default 65) -> 0, everything else (unknown, in-between) -> 205, with
+``occupied_thresh: 0.65`` and ``free_thresh: 0.196`` in the YAML, so -1/0/100 reload exactly. Scale and
+raw: the inverse of the loader, exact wherever the image format can hold the value. The map is cropped to
+its known cells plus a margin by default (SLAM grids are larger than what they saw). Files are written
+atomically.
 """
 
 from __future__ import annotations
@@ -150,11 +156,12 @@ def _pixels_to_values(
 
 
 def _value_to_grey_lut(*, mode: str, occupied_thresh: float, free_thresh: float) -> np.ndarray:
-    """For cell values -1..100 (index value+1), the grey level the loader turns back into that value.
-
-    Where no grey level maps back exactly, the nearest one is used. map_saver's levels are kept:
-    254 free, 0 occupied, 205 unknown.
-    """
+    """Scale/raw modes: for cell values -1..100 (index value+1), the grey level the loader turns back into
+    that value (the nearest one where none does exactly); 254 free, 0 occupied, 205 unknown as map_saver."""
+    lut = np.zeros(102, dtype=np.uint8)
+    if mode == "raw":
+        lut[:] = np.arange(-1, 101) & 0xFF
+        return lut
     greys = np.arange(256, dtype=np.uint8).reshape(1, 256, 1)
     back = (
         _pixels_to_values(
@@ -163,24 +170,28 @@ def _value_to_grey_lut(*, mode: str, occupied_thresh: float, free_thresh: float)
         .reshape(256)
         .astype(np.int64)
     )
-    lut = np.zeros(102, dtype=np.uint8)
-    for v in range(-1, 101):
-        if mode == "raw":
-            lut[v + 1] = v & 0xFF
-            continue
+    known = np.flatnonzero(back >= 0)
+    lut[0] = 205
+    for v in range(101):
         exact = np.flatnonzero(back == v)
-        if v == 0 and 254 in exact:
-            lut[v + 1] = 254
-        elif v == 100 and 0 in exact:
-            lut[v + 1] = 0
-        elif v == -1:
-            lut[v + 1] = 205
+        preferred = {0: 254, 100: 0}.get(v)
+        if preferred is not None and preferred in exact:
+            lut[v + 1] = preferred
         elif exact.size:
             lut[v + 1] = exact[len(exact) // 2]
         else:
-            known = back >= 0
-            lut[v + 1] = np.flatnonzero(known)[np.argmin(np.abs(back[known] - v))]
+            lut[v + 1] = known[np.argmin(np.abs(back[known] - v))]
     return lut
+
+
+def trinary_grey(data: np.ndarray, *, threshold_occupied: int = 65, threshold_free: int = 25) -> np.ndarray:
+    """map_saver's trinary grey levels (uint8, same shape) of occupancy values ``data`` (-1 or 0..100 %):
+    0 <= v <= ``threshold_free`` -> 254 (free), v >= ``threshold_occupied`` -> 0 (occupied), else 205."""
+    v = np.asarray(data).astype(np.int16)
+    grey = np.full(v.shape, 205, dtype=np.uint8)
+    grey[(v >= 0) & (v <= threshold_free)] = 254
+    grey[v >= threshold_occupied] = 0
+    return grey
 
 
 # --- YAML ---------------------------------------------------------------------------------------------
@@ -303,16 +314,44 @@ def save_map(
     free_thresh: float = 0.196,
     mode: str = "trinary",
     negate: bool = False,
+    threshold_occupied: int = 65,
+    threshold_free: int = 25,
+    crop_margin_cells: int | None = 10,
 ) -> Path:
     """Write ``grid`` as map_saver does: ``yaml_path`` plus an image beside it; returns the image path.
 
-    ``image_name`` defaults to the YAML's stem + ``.pgm`` (``.png`` in scale mode, whose alpha channel
-    keeps unknown cells unknown; a PGM in scale mode stores unknown as grey 205).
+    Trinary (default): cells <= ``threshold_free`` % are written free (254), >= ``threshold_occupied`` %
+    occupied (0), the rest unknown (205): map_saver's ``--free``/``--occ``. ``occupied_thresh`` and
+    ``free_thresh`` are the loader's thresholds written into the YAML (and, in scale mode, used to pick grey
+    levels). ``image_name`` defaults to the YAML's stem + ``.pgm`` (``.png`` in scale mode, whose alpha
+    channel keeps unknown cells unknown; a PGM in scale mode stores unknown as grey 205).
+    ``crop_margin_cells``: save only the known cells plus this many cells around them (the origin moves
+    with the crop, cells keep their position in the map frame); ``None`` saves the whole grid.
     """
     if mode not in MODES:
         raise MappingError(f"save_map: mode {mode!r}, expected one of {', '.join(MODES)}")
     if not 0.0 <= free_thresh < occupied_thresh <= 1.0:
-        raise MappingError("save_map: thresholds must satisfy 0 <= free_thresh < occupied_thresh <= 1")
+        raise MappingError(
+            f"save_map: thresholds must satisfy 0 <= free_thresh < occupied_thresh <= 1, got "
+            f"free_thresh {free_thresh}, occupied_thresh {occupied_thresh}"
+        )
+    if mode == "trinary":
+        if not 0 <= threshold_free < threshold_occupied <= 100:
+            raise MappingError(
+                f"save_map: threshold_free {threshold_free} and threshold_occupied {threshold_occupied}: "
+                "expected percentages with 0 <= threshold_free < threshold_occupied <= 100"
+            )
+        # the loader must read 254 as free, 205 as unknown and 0 as occupied
+        if not (1 / 255 < free_thresh <= 50 / 255 <= occupied_thresh < 1.0):
+            raise MappingError(
+                f"save_map: free_thresh {free_thresh}, occupied_thresh {occupied_thresh} would not reload the "
+                "trinary grey levels 254/205/0 as free/unknown/occupied; expected "
+                "0.004 < free_thresh <= 0.196 <= occupied_thresh < 1"
+            )
+    if crop_margin_cells is not None:
+        if crop_margin_cells < 0:
+            raise MappingError(f"save_map: crop_margin_cells {crop_margin_cells}, expected >= 0 (or None)")
+        grid = grid.crop_to_known(int(crop_margin_cells))
     ypath = Path(yaml_path)
     try:
         ypath.parent.mkdir(parents=True, exist_ok=True)
@@ -322,8 +361,11 @@ def save_map(
         image_name = ypath.stem + (".png" if mode == "scale" else ".pgm")
     ipath = Path(image_name) if Path(image_name).is_absolute() else ypath.parent / image_name
     data = grid.data.astype(np.int64)
-    lut = _value_to_grey_lut(mode=mode, occupied_thresh=occupied_thresh, free_thresh=free_thresh)
-    grey = lut[np.clip(data, -1, 100) + 1]
+    if mode == "trinary":
+        grey = trinary_grey(data, threshold_occupied=threshold_occupied, threshold_free=threshold_free)
+    else:
+        lut = _value_to_grey_lut(mode=mode, occupied_thresh=occupied_thresh, free_thresh=free_thresh)
+        grey = lut[np.clip(data, -1, 100) + 1]
     grey = np.ascontiguousarray(grey[::-1])  # image row 0 is the top of the map
     if negate:
         grey = (255 - grey).astype(np.uint8)
