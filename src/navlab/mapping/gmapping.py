@@ -7,6 +7,10 @@ pose is improved by GMapping's hill-climbing scan matcher against its own map (t
 proposal), its weight gains the scan's log-likelihood, particles are resampled when N_eff drops below
 ``resampleThreshold`` * N, and each map integrates the scan. Parameter names and defaults are
 GMapping's. Pure: numpy in, poses and maps out; the random generator is passed in.
+
+The particles' maps grow as GMapping's ``ScanMatcherMap`` does: they start around the first scan and
+grow (by at least half their size, keeping every cell where it is) when a scan to integrate reaches
+past them; cells outside a map read as unknown, which is what an unseen cell inside it holds.
 """
 
 from __future__ import annotations
@@ -21,7 +25,9 @@ from navlab.core.params import dataclass_from_dict
 from navlab.geometry import between2, compose2, wrap_angle
 from navlab.grid import GridMap
 from navlab.mapping.errors import MappingError
-from navlab.mapping.occupancy import L_CLAMP, L_FREE, L_OCC, _raycast, logodds_to_grid
+from navlab.mapping.occupancy import L_CLAMP, L_FREE, L_OCC, _raycast, grow_window, logodds_to_grid, scan_cells
+
+MAP_MARGIN_CELLS = 20  # unknown cells kept around what a scan reaches when a map is allocated or grown
 
 
 @dataclass
@@ -49,6 +55,8 @@ class GMappingParams:
     str: float = 0.1
     stt: float = 0.2
     resampleThreshold: float = 0.5
+    # slam_gmapping's initial map extent; here maps start at the first scan and grow, and these only
+    # place the cell lattice (its corner: the start pose minus the laser's reach, clipped to xmin, ymin)
     xmin: float = -100.0
     ymin: float = -100.0
     xmax: float = 100.0
@@ -73,6 +81,8 @@ def _score(
     grid: np.ndarray,
     ox: float,
     oy: float,
+    oi: int,
+    oj: int,
     res: float,
     px: float,
     py: float,
@@ -86,7 +96,9 @@ def _score(
     skip: int,
 ) -> tuple[float, float, int]:
     """GMapping's score and log-likelihood of a scan at a pose: for each beam endpoint, the nearest
-    occupied cell within ``kernel`` cells whose cell one step back along the beam is free."""
+    occupied cell within ``kernel`` cells whose cell one step back along the beam is free. ``grid`` holds
+    the lattice cells from (``oi``, ``oj``) on (lattice anchored at ``ox``, ``oy``); cells outside it are
+    unknown."""
     h, w = grid.shape
     s = 0.0
     lik = 0.0
@@ -100,10 +112,10 @@ def _score(
         ca, sa = math.cos(a), math.sin(a)
         ex, ey = px + r * ca, py + r * sa
         fx, fy = ex - res * ca, ey - res * sa  # a point one cell back along the beam
-        ei = math.floor((ex - ox) / res)
-        ej = math.floor((ey - oy) / res)
-        fi = math.floor((fx - ox) / res)
-        fj = math.floor((fy - oy) / res)
+        ei = math.floor((ex - ox) / res) - oi
+        ej = math.floor((ey - oy) / res) - oj
+        fi = math.floor((fx - ox) / res) - oi
+        fj = math.floor((fy - oy) / res) - oj
         best = 1e9
         found = False
         for dj in range(-kernel, kernel + 1):
@@ -113,8 +125,8 @@ def _score(
                 if i < 0 or j < 0 or i >= w or j >= h or i2 < 0 or j2 < 0 or i2 >= w or j2 >= h:
                     continue
                 if grid[j, i] > 0.0 and grid[j2, i2] < 0.0:
-                    cx = ox + (i + 0.5) * res
-                    cy = oy + (j + 0.5) * res
+                    cx = ox + (i + oi + 0.5) * res
+                    cy = oy + (j + oj + 0.5) * res
                     d2 = (cx - ex) ** 2 + (cy - ey) ** 2
                     if d2 < best:
                         best = d2
@@ -133,6 +145,8 @@ def _optimize(
     grid: np.ndarray,
     ox: float,
     oy: float,
+    oi: int,
+    oj: int,
     res: float,
     x0: float,
     y0: float,
@@ -151,7 +165,7 @@ def _optimize(
     """GMapping's hill climbing: try ±lstep in x, y and ±astep in theta; halve the steps when no move
     improves the score, ``iterations`` times."""
     cx, cy, ct = x0, y0, t0
-    cur = _score(grid, ox, oy, res, cx, cy, ct, ranges, angles, max_urange, kernel, sigma, lsigma, skip)[0]
+    cur = _score(grid, ox, oy, oi, oj, res, cx, cy, ct, ranges, angles, max_urange, kernel, sigma, lsigma, skip)[0]
     ld, ad = lstep, astep
     refinement = 0
     best = -1.0
@@ -178,7 +192,9 @@ def _optimize(
                 nt += ad
             else:
                 nt -= ad
-            sc = _score(grid, ox, oy, res, nx, ny, nt, ranges, angles, max_urange, kernel, sigma, lsigma, skip)[0]
+            sc, _lik, _n = _score(
+                grid, ox, oy, oi, oj, res, nx, ny, nt, ranges, angles, max_urange, kernel, sigma, lsigma, skip
+            )
             if sc > cur:
                 cur = sc
                 bx, by, bt = nx, ny, nt
@@ -203,9 +219,11 @@ class GMapping:
         self.p = params or GMappingParams()
         self.rng = rng if rng is not None else np.random.default_rng(0)
         self.particles: list[_Particle] = []
-        self.origin = np.zeros(2)
+        self._anchor = np.zeros(2)  # map-frame corner (m) of lattice cell (0, 0)
+        self._offset = np.zeros(2, dtype=np.int64)  # lattice (column, row) of every map array's cell (0, 0)
         self.resamples = 0
         self.updates = 0
+        self.map_resizes = 0
         self._odom_last: np.ndarray | None = None
         self._odom_at_update: np.ndarray | None = None
         self._time = 0.0
@@ -217,21 +235,25 @@ class GMapping:
 
     # --- map bookkeeping ----------------------------------------------------------------------------
 
-    def _ensure_extent(self, lo: np.ndarray, hi: np.ndarray) -> None:
-        """Grow every particle's grid (keeping cell alignment) so that [lo, hi] is inside."""
-        res = self.p.delta
-        if not self.particles:
+    @property
+    def origin(self) -> np.ndarray:
+        """Map-frame (x, y) (m) of the lower-left corner of the particles' maps (they share one window)."""
+        return self._anchor + self._offset * self.p.delta
+
+    def _cover(self, poses: np.ndarray, r: np.ndarray, ang: np.ndarray, max_urange: float, max_range: float) -> None:
+        """Grow every particle's map (padding, cells stay put) to hold the scan integrated from ``poses``."""
+        lo, hi = scan_cells(
+            poses, r, ang, (float(self._anchor[0]), float(self._anchor[1])), self.p.delta,
+            max_urange=max_urange, max_range=max_range,
+        )  # fmt: skip
+        add = grow_window(self._offset, self.particles[0].grid.shape, lo, hi, margin=MAP_MARGIN_CELLS)
+        if add is None:
             return
-        h, w = self.particles[0].grid.shape
-        cur_lo = self.origin
-        cur_hi = self.origin + np.array([w, h]) * res
-        if np.all(lo >= cur_lo) and np.all(hi <= cur_hi):
-            return
-        grow_lo = np.ceil(np.maximum(cur_lo - lo, 0) / res + 20).astype(int) * (lo < cur_lo)
-        grow_hi = np.ceil(np.maximum(hi - cur_hi, 0) / res + 20).astype(int) * (hi > cur_hi)
+        left, right, bottom, top = add
         for part in self.particles:
-            part.grid = np.pad(part.grid, ((grow_lo[1], grow_hi[1]), (grow_lo[0], grow_hi[0])))
-        self.origin = self.origin - grow_lo * res
+            part.grid = np.pad(part.grid, ((bottom, top), (left, right)))
+        self._offset = self._offset - np.array([left, bottom])
+        self.map_resizes += 1
 
     # --- the filter ---------------------------------------------------------------------------------
 
@@ -301,13 +323,14 @@ class GMapping:
     def _init(self, odom: np.ndarray, r: np.ndarray, ang: np.ndarray, max_urange: float, max_range: float) -> None:
         p = self.p
         reach = min(max_urange, 30.0) + 2.0
-        lo = np.maximum([p.xmin, p.ymin], odom[:2] - reach)
-        hi = np.minimum([p.xmax, p.ymax], odom[:2] + reach)
-        lo = np.minimum(lo, odom[:2] - 1.0)
-        hi = np.maximum(hi, odom[:2] + 1.0)
-        self.origin = np.floor(lo / p.delta) * p.delta
-        w = math.ceil((hi[0] - self.origin[0]) / p.delta)
-        h = math.ceil((hi[1] - self.origin[1]) / p.delta)
+        lo = np.minimum(np.maximum([p.xmin, p.ymin], odom[:2] - reach), odom[:2] - 1.0)
+        self._anchor = np.floor(lo / p.delta) * p.delta
+        cells_lo, cells_hi = scan_cells(
+            odom, r, ang, (float(self._anchor[0]), float(self._anchor[1])), p.delta,
+            max_urange=max_urange, max_range=max_range,
+        )  # fmt: skip
+        self._offset = cells_lo - MAP_MARGIN_CELLS
+        w, h = (cells_hi - cells_lo + 1 + 2 * MAP_MARGIN_CELLS).tolist()
         grid = np.zeros((h, w), dtype=np.float32)
         self._integrate(grid, odom, r, ang, max_urange, max_range)
         node = (0, odom.copy(), None)
@@ -316,10 +339,15 @@ class GMapping:
     def _integrate(
         self, grid: np.ndarray, pose: np.ndarray, r: np.ndarray, ang: np.ndarray, max_urange: float, max_range: float
     ) -> None:
+        ox, oy, oi, oj = self._lattice()
         _raycast(
-            grid, float(self.origin[0]), float(self.origin[1]), self.p.delta, float(pose[0]), float(pose[1]),
-            float(pose[2]), r, ang, max_urange, max_range, L_OCC, L_FREE, L_CLAMP,
+            grid, ox, oy, oi, oj, self.p.delta, float(pose[0]), float(pose[1]), float(pose[2]), r, ang,
+            max_urange, max_range, L_OCC, L_FREE, L_CLAMP,
         )  # fmt: skip
+
+    def _lattice(self) -> tuple[float, float, int, int]:
+        """(anchor x, anchor y, offset column, offset row) as the numba kernels take them."""
+        return float(self._anchor[0]), float(self._anchor[1]), int(self._offset[0]), int(self._offset[1])
 
     def _mark_update(self, k: int) -> None:
         self._scan_ref.append((k, np.zeros(3)))
@@ -328,20 +356,17 @@ class GMapping:
     def _update(self, k: int, r: np.ndarray, ang: np.ndarray, max_urange: float, max_range: float) -> None:
         p = self.p
         self.updates += 1
-        # grow maps to hold this scan from any particle
-        poses = np.array([q.pose for q in self.particles])
-        reach = min(max_urange, 30.0) + 1.0
-        self._ensure_extent(poses[:, :2].min(axis=0) - reach, poses[:, :2].max(axis=0) + reach)
-        ox, oy, res = float(self.origin[0]), float(self.origin[1]), p.delta
+        ox, oy, oi, oj = self._lattice()
+        res = p.delta
         for part in self.particles:
             x, y, t, score = _optimize(
-                part.grid, ox, oy, res, part.pose[0], part.pose[1], part.pose[2], r, ang, max_urange,
+                part.grid, ox, oy, oi, oj, res, part.pose[0], part.pose[1], part.pose[2], r, ang, max_urange,
                 p.kernelSize, p.sigma, p.lsigma, p.lskip, p.lstep, p.astep, p.iterations,
             )  # fmt: skip
             if score > p.minimumScore:
                 part.pose = np.array([x, y, wrap_angle(t)])
             _s, lik, _n = _score(
-                part.grid, ox, oy, res, part.pose[0], part.pose[1], part.pose[2], r, ang, max_urange,
+                part.grid, ox, oy, oi, oj, res, part.pose[0], part.pose[1], part.pose[2], r, ang, max_urange,
                 p.kernelSize, p.sigma, p.lsigma, p.lskip,
             )  # fmt: skip
             part.weight += lik
@@ -363,6 +388,8 @@ class GMapping:
                 used.add(int(i))
                 new.append(_Particle(src.pose.copy(), grid, src.node, 0.0))
             self.particles = new
+        # grow the maps (rarely: by at least half their size) to hold this scan from every particle
+        self._cover(np.array([q.pose for q in self.particles]), r, ang, max_urange, max_range)
         for part in self.particles:
             part.node = (k, part.pose.copy(), part.node)
             self._integrate(part.grid, part.pose, r, ang, max_urange, max_range)

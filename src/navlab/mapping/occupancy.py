@@ -3,6 +3,11 @@
 Each beam marks the cells it crosses as free and, when it hit something within ``max_urange``, its end
 cell as occupied (GMapping's ``maxUrange`` / ``maxRange`` semantics: beams at or beyond ``max_range``
 are no-returns; returns beyond ``max_urange`` only clear space up to ``max_urange``).
+
+Growing maps (as GMapping's ``ScanMatcherMap``): cells sit on a fixed lattice, cell ``(I, J)`` covering
+``[ox + I*res, ox + (I+1)*res) x [oy + J*res, ...)`` for a fixed anchor ``(ox, oy)``; an array holds the
+window of lattice cells starting at ``(oi, oj)``. Growing the window (:func:`grow_window`) pads the array
+and never moves a cell, so cell indices are computed from the same anchor before and after.
 """
 
 from __future__ import annotations
@@ -24,6 +29,8 @@ def _raycast(
     logodds: np.ndarray,
     ox: float,
     oy: float,
+    oi: int,
+    oj: int,
     res: float,
     px: float,
     py: float,
@@ -37,8 +44,8 @@ def _raycast(
     clamp: float,
 ) -> None:
     h, w = logodds.shape
-    i0 = math.floor((px - ox) / res)
-    j0 = math.floor((py - oy) / res)
+    i0 = math.floor((px - ox) / res) - oi
+    j0 = math.floor((py - oy) / res) - oj
     for k in range(ranges.shape[0]):
         r = ranges[k]
         if not (r > 0.0) or r >= max_range:
@@ -49,8 +56,8 @@ def _raycast(
         a = pt + angles[k]
         ex = px + r * math.cos(a)
         ey = py + r * math.sin(a)
-        i1 = math.floor((ex - ox) / res)
-        j1 = math.floor((ey - oy) / res)
+        i1 = math.floor((ex - ox) / res) - oi
+        j1 = math.floor((ey - oy) / res) - oj
         # Bresenham from (i0, j0) to (i1, j1), excluding the end cell
         di = abs(i1 - i0)
         dj = abs(j1 - j0)
@@ -90,6 +97,8 @@ def integrate_scan(
         logodds,
         float(origin[0]),
         float(origin[1]),
+        0,
+        0,
         float(resolution),
         float(laser_pose[0]),
         float(laser_pose[1]),
@@ -102,6 +111,47 @@ def integrate_scan(
         L_FREE,
         L_CLAMP,
     )
+
+
+def scan_cells(
+    poses: np.ndarray,
+    ranges: np.ndarray,
+    angles: np.ndarray,
+    anchor: tuple[float, float],
+    resolution: float,
+    *,
+    max_urange: float,
+    max_range: float,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Lattice cell range ``(lo, hi)`` (int (2,) each, ``hi`` inclusive, (column, row)) that integrating the scan
+    from each laser pose in ``poses`` (N, 3) can touch: the poses and the beams' end points (no-returns
+    excluded, long returns cut at ``max_urange``), exactly as the ray caster treats them."""
+    poses = np.asarray(poses, dtype=np.float64).reshape(-1, 3)
+    r = np.asarray(ranges, dtype=np.float64)
+    ok = (r > 0.0) & (r < max_range)
+    rr = np.minimum(r[ok], max_urange)
+    a = poses[:, 2:3] + np.asarray(angles, dtype=np.float64)[ok][None, :]
+    xs = np.concatenate([poses[:, 0], (poses[:, 0:1] + rr * np.cos(a)).ravel()])
+    ys = np.concatenate([poses[:, 1], (poses[:, 1:2] + rr * np.sin(a)).ravel()])
+    lo = np.array([math.floor((xs.min() - anchor[0]) / resolution), math.floor((ys.min() - anchor[1]) / resolution)])
+    hi = np.array([math.floor((xs.max() - anchor[0]) / resolution), math.floor((ys.max() - anchor[1]) / resolution)])
+    return lo.astype(np.int64), hi.astype(np.int64)
+
+
+def grow_window(
+    offset: np.ndarray, shape: tuple[int, int], lo: np.ndarray, hi: np.ndarray, *, margin: int
+) -> tuple[int, int, int, int] | None:
+    """Cells to add (left, right, bottom, top) so that a window of lattice cells starting at ``offset``
+    ((column, row) of array cell (0, 0)) of ``shape`` (rows, columns) holds cells ``lo``..``hi``
+    (inclusive); ``None`` when it already does. A side that grows gains the shortfall plus ``margin``
+    cells, and at least half the window's size, so a map ``N`` cells wide is copied O(log N) times."""
+    size = np.array([shape[1], shape[0]])
+    end = offset + size  # exclusive
+    if np.all(lo >= offset) and np.all(hi < end):
+        return None
+    add_lo = np.where(lo < offset, np.maximum(offset - lo + margin, size // 2), 0)
+    add_hi = np.where(hi >= end, np.maximum(hi + 1 - end + margin, size // 2), 0)
+    return int(add_lo[0]), int(add_hi[0]), int(add_lo[1]), int(add_hi[1])
 
 
 def logodds_to_grid(
