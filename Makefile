@@ -22,6 +22,7 @@ demo: $(STAMP)
 
 test: $(STAMP)
 	$(BIN)/ruff check src tests
+	$(BIN)/python tools/check_layers.py
 	$(BIN)/python -m pytest
 
 lint: $(STAMP)

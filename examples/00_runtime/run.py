@@ -8,7 +8,8 @@ from tempfile import mkdtemp
 
 from navlab import msgs
 from navlab.core import Executor, Node
-from navlab.io.rosbag import Recorder, read_bag
+from navlab.core.record import Recorder
+from navlab.io.rosbag import read_bag
 
 
 class Counter(Node):

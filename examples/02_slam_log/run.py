@@ -4,6 +4,8 @@ Reads the MIT CSAIL CARMEN log, runs graph SLAM (scan matching + loop closure + 
 optimisation) on its first scans, saves the map as map_server files, draws it, and scores the
 trajectory and the raw odometry with the relations metric of Kümmerle et al. 2009.
 
+The log is found through NAVLAB_DATA (default: ../shared/datasets relative to the repository root).
+
 Run:  python examples/02_slam_log/run.py            (first 600 scans, a few seconds)
       python examples/02_slam_log/run.py --full     (the whole 424 s log)
       python examples/02_slam_log/run.py --mode gmapping   (the paper's particle filter)
@@ -17,11 +19,16 @@ from pathlib import Path
 
 import numpy as np
 
+from navlab.errors import NavlabError
 from navlab.experiments.metrics import read_relations, relations_error
 from navlab.io.carmen import read_carmen
+from navlab.io.datasets import dataset
 from navlab.mapping.slam import run_offline, write_outputs
 
-DATA = Path("/work/shared/datasets/mit-csail")
+try:
+    DATA = dataset("mit-csail")  # under NAVLAB_DATA (default: ../shared/datasets beside the repository)
+except NavlabError as exc:
+    sys.exit(f"02_slam_log: {exc}")
 OUT = Path("out/examples/02_slam_log")
 
 parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -32,7 +39,7 @@ args = parser.parse_args()
 log = read_carmen(DATA / "mit-csail.clf")
 n = None if args.full else 600
 result = run_offline(log, mode=args.mode, max_scans=n, progress=sys.stderr.isatty())
-files = write_outputs(result, OUT, title=f"MIT CSAIL, {len(result.timestamps)} scans ({args.mode})")
+files = write_outputs(result, OUT)
 print("wrote", ", ".join(str(p) for p in files.values()))
 
 # score only the relations between scans we processed

@@ -12,6 +12,7 @@ from typing import Any
 import numpy as np
 from rosbags.typesys import Stores, get_typestore
 
+from navlab.errors import NavlabError
 from navlab.geometry import quat_from_yaw, yaw_from_quat
 
 TYPESTORE = get_typestore(Stores.ROS2_HUMBLE)
@@ -48,8 +49,8 @@ MarkerArray = _T["visualization_msgs/msg/MarkerArray"]
 ColorRGBA = _T["std_msgs/msg/ColorRGBA"]
 
 
-class MessageTypeError(LookupError):
-    """An unknown ROS message type name was asked for."""
+class MessageTypeError(NavlabError, LookupError):
+    """An unknown ROS message type name was asked for (also a ``LookupError``, as before)."""
 
 
 def get_type(name: str) -> type:

@@ -10,7 +10,8 @@ from navlab import msgs
 from navlab.cli import main
 from navlab.core import Executor, LaunchError, Node
 from navlab.core.launch import start
-from navlab.io.rosbag import Recorder, bag_graph, read_bag
+from navlab.core.record import Recorder
+from navlab.io.rosbag import bag_graph, read_bag
 
 
 def test_shipped_launch_with_args():

@@ -7,8 +7,9 @@ import math
 import numpy as np
 import pytest
 
+from navlab.errors import NavlabError
 from navlab.io.carmen import read_carmen, skipped_summary
-from navlab.mapping import MappingError
+from navlab.io.errors import IoError
 
 
 def _flaser(n: int, r: float, pose: tuple[float, float, float], ts: float) -> str:
@@ -57,19 +58,14 @@ def test_truncated_line_is_skipped_and_counted(tmp_path):
 def test_log_without_scans_is_an_error(tmp_path):
     path = tmp_path / "empty.clf"
     path.write_text("# nothing\nODOM 0 0 0 0 0 0 1.0 host 1.0\n")
-    with pytest.raises(MappingError, match="no FLASER or ROBOTLASER1"):
+    with pytest.raises(IoError, match="no FLASER or ROBOTLASER1"):
         read_carmen(path)
-    with pytest.raises(MappingError, match="cannot read"):
+    with pytest.raises(NavlabError, match=r"cannot read CARMEN log .*missing\.clf"):  # IoError is a NavlabError
         read_carmen(tmp_path / "missing.clf")
 
 
-def test_reads_real_log_header():
-    from pathlib import Path
-
-    p = Path("/work/shared/datasets/mit-csail/mit-csail.clf")
-    if not p.exists():
-        pytest.skip("dataset not present")
-    log = read_carmen(p)
+def test_reads_real_log_header(dataset):
+    log = read_carmen(dataset("mit-csail/mit-csail.clf"))
     assert len(log.scans) == 1988 and not log.skipped
     assert log.duration == pytest.approx(424.0, abs=0.5)
     assert np.all(np.diff([s.timestamp for s in log.scans]) > 0)

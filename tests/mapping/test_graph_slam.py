@@ -3,30 +3,26 @@
 from __future__ import annotations
 
 import json
-from pathlib import Path
 
 import numpy as np
-import pytest
 
 from navlab.cli import main
 from navlab.experiments.metrics import read_relations, relations_error
 from navlab.mapping import load_map
 from navlab.mapping.graph_slam import GraphSlam, GraphSlamParams
 
-DATA = Path("/work/shared/datasets/mit-csail")
 
-
-@pytest.mark.skipif(not DATA.exists(), reason="dataset not present")
-def test_first_150_csail_scans_beat_raw_odometry():
+def test_first_150_csail_scans_beat_raw_odometry(dataset):
     from navlab.io.carmen import read_carmen
 
-    scans = read_carmen(DATA / "mit-csail.clf").scans[:150]
+    data = dataset("mit-csail")
+    scans = read_carmen(data / "mit-csail.clf").scans[:150]
     slam = GraphSlam()
     for s in scans:
         slam.add_scan(s.ranges, s.angle_min, s.angle_increment, s.laser_pose)
     est = slam.finish()
     ts = np.array([s.timestamp for s in scans])
-    rel = read_relations(DATA / "mit-csail.relations")
+    rel = read_relations(data / "mit-csail.relations")
     rel = rel[(rel[:, 0] <= ts[-1]) & (rel[:, 1] <= ts[-1])]
     assert len(rel) >= 40
     ours = relations_error(ts, est, rel)
@@ -56,10 +52,10 @@ def test_synthetic_loop_with_drifting_odometry(synth_world, odometry_noise):
     assert slam.loop_edges >= 1
 
 
-@pytest.mark.skipif(not DATA.exists(), reason="dataset not present")
-def test_cli_slam_writes_map_poses_and_figure(tmp_path, capsys):
+def test_cli_slam_writes_map_poses_and_figure(tmp_path, capsys, dataset):
+    data = dataset("mit-csail")
     out = tmp_path / "run"
-    rc = main(["slam", "--log", str(DATA / "mit-csail.clf"), "--out", str(out), "--max-scans", "60", "--json"])
+    rc = main(["slam", "--log", str(data / "mit-csail.clf"), "--out", str(out), "--max-scans", "60", "--json"])
     assert rc == 0
     summary = json.loads(capsys.readouterr().out)
     assert summary["scans"] == 60

@@ -27,7 +27,7 @@ def run_for(
     With ``record``, every (or each chosen) topic is written to a rosbag2 (MCAP) there; its path is
     returned. Stops early if the executor is stopped.
     """
-    from navlab.io.rosbag import Recorder
+    from navlab.core.record import Recorder
 
     recorder = Recorder(ex, record, topics=record_topics) if record else None
     bar = tqdm(

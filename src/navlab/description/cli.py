@@ -6,7 +6,7 @@ import argparse
 import json
 from pathlib import Path
 
-from navlab.description.summary import format_robot, format_world, robot_summary, world_summary
+from navlab.description.summary import format_robot, robot_summary
 from navlab.errors import NavlabError
 
 
@@ -44,6 +44,7 @@ def _cmd(args: argparse.Namespace) -> int:
         text = format_robot(summary)
     else:
         from navlab.world.sdf import load_world
+        from navlab.world.summary import format_world, world_summary
 
         summary = world_summary(load_world(path, model_path=args.model_path))
         text = format_world(summary)

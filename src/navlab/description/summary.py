@@ -1,15 +1,16 @@
-"""Plain-data summaries of a robot or world, for ``navlab check`` (text or ``--json``)."""
+"""Plain-data summary of a robot, for ``navlab check robot`` (text or ``--json``); a world's is
+``navlab.world.summary``."""
 
 from __future__ import annotations
 
-import math
 from dataclasses import asdict
 from typing import Any
 
 from navlab.description.model import RobotModel, Shape
 
 
-def _shape(s: Shape) -> dict[str, Any]:
+def shape_summary(s: Shape) -> dict[str, Any]:
+    """Kind, pose (xyz m, rpy rad) and size or mesh file of a collision shape."""
     g = s.geometry
     out: dict[str, Any] = {"kind": g.kind, "xyz": list(s.origin.xyz), "rpy": list(s.origin.rpy)}
     if g.kind == "mesh":
@@ -29,7 +30,7 @@ def robot_summary(robot: RobotModel) -> dict[str, Any]:
     for name, link in robot.links.items():
         links[name] = {
             "mass": link.inertial.mass if link.inertial else None,
-            "collisions": [_shape(s) for s in link.collisions],
+            "collisions": [shape_summary(s) for s in link.collisions],
             "visuals": len(link.visuals),
             **({"mu1": link.mu1, "mu2": link.mu2} if link.mu1 is not None else {}),
         }
@@ -48,34 +49,6 @@ def robot_summary(robot: RobotModel) -> dict[str, Any]:
         "lidars": [{**asdict(lidar), "origin": asdict(lidar.origin)} for lidar in robot.lidars],
         "imus": [{**asdict(imu), "origin": asdict(imu.origin)} for imu in robot.imus],
         "warnings": list(robot.warnings),
-    }
-
-
-def world_summary(world: Any) -> dict[str, Any]:
-    """Models (static, links, shapes), extents in x/y, physics and warnings of a world."""
-    from navlab.world.occupancy import extents  # world depends on description, not back
-
-    models = []
-    for m in world.models:
-        shapes = [_shape(s) for link in m.links for s in link.collisions]
-        models.append({"name": m.name, "static": m.static, "pose": list(m.pose), "links": len(m.links),
-                       "collision_shapes": len(shapes),
-                       "kinds": sorted({s["kind"] for s in shapes}),
-                       "non_convex_meshes": [s["mesh"] for s in shapes if s.get("convex") is False]})
-    box = extents(world, z_min=-math.inf, z_max=math.inf)
-    ext = None
-    if box is not None:
-        ext = {"x": [round(box[0], 4), round(box[2], 4)], "y": [round(box[1], 4), round(box[3], 4)]}
-    return {
-        "kind": "world",
-        "name": world.name,
-        "source": str(world.source) if world.source else None,
-        "ground_plane": world.ground_plane,
-        "gravity": list(world.gravity),
-        "max_step_size": world.max_step_size,
-        "models": models,
-        "extents": ext,
-        "warnings": list(world.warnings),
     }
 
 
@@ -109,25 +82,6 @@ def format_robot(s: dict[str, Any]) -> str:
     for imu in s["imus"]:
         lines.append(f"  imu {imu['name']} on {imu['link']}: {imu['update_rate']} Hz -> {imu['topic']} "
                      f"[{imu['frame_id']}]")
-    lines += [f"  warning: {w}" for w in s["warnings"]]
-    lines.append("  OK" if not s["warnings"] else f"  OK with {len(s['warnings'])} warning(s)")
-    return "\n".join(lines)
-
-
-def format_world(s: dict[str, Any]) -> str:
-    """Human-readable text of :func:`world_summary`."""
-    lines = [f"world {s['name']}  ({s['source']})",
-             f"  ground plane {'yes' if s['ground_plane'] else 'NO'}, gravity {s['gravity']}, "
-             f"step {s['max_step_size']} s",
-             f"  models ({len(s['models'])}):"]
-    for m in s["models"]:
-        x, y, z = m["pose"][:3]
-        lines.append(f"    {m['name']:<22} {'static' if m['static'] else 'dynamic':<8} at ({x:g}, {y:g}, {z:g}), "
-                     f"{m['links']} link(s), {m['collision_shapes']} collision shape(s) {', '.join(m['kinds'])}")
-        for mesh in m["non_convex_meshes"]:
-            lines.append(f"      concave collision mesh (decomposed for physics): {mesh}")
-    if s["extents"]:
-        lines.append(f"  extents x {s['extents']['x']} m, y {s['extents']['y']} m")
     lines += [f"  warning: {w}" for w in s["warnings"]]
     lines.append("  OK" if not s["warnings"] else f"  OK with {len(s['warnings'])} warning(s)")
     return "\n".join(lines)

@@ -3,60 +3,30 @@
 For each ground-truth relation (t1, t2, relative pose of the scan at t2 in the frame of the scan at
 t1), the error is ``relation ⊖ (pose(t1)^-1 ∘ pose(t2))``; the report gives mean ± sample standard
 deviation of the absolute translational error (m) and rotational error (deg), and the means of
-their squares. Poses files hold ``timestamp x y theta`` per line (``#`` comments allowed).
+their squares. Pose files (``timestamp x y theta`` per line) are read and written by
+``navlab.io.poses``; ``read_poses``/``write_poses`` are re-exported here.
 """
 
 from __future__ import annotations
 
 import os
-from pathlib import Path
 
 import numpy as np
 
 from navlab.geometry import wrap_angle
+from navlab.io.poses import read_poses, read_table, write_poses
 from navlab.mapping.errors import MappingError
 
-
-def _read_table(path: str | os.PathLike[str], min_cols: int, what: str) -> np.ndarray:
-    p = Path(path)
-    try:
-        lines = p.read_text().splitlines()
-    except OSError as exc:
-        raise MappingError(f"cannot read {what} file {p}: {exc.strerror or exc}") from None
-    rows = []
-    for lineno, line in enumerate(lines, 1):
-        s = line.split("#", 1)[0].split()
-        if not s:
-            continue
-        if len(s) < min_cols:
-            raise MappingError(f"{p}:{lineno}: {len(s)} columns, expected {min_cols} for a {what} line")
-        try:
-            rows.append([float(v) for v in s[:min_cols]])
-        except ValueError:
-            raise MappingError(f"{p}:{lineno}: non-numeric value in a {what} line") from None
-    if not rows:
-        raise MappingError(f"{p}: no {what} lines found")
-    return np.array(rows, dtype=np.float64)
-
-
-def read_poses(path: str | os.PathLike[str]) -> tuple[np.ndarray, np.ndarray]:
-    """(timestamps (N,), poses (N, 3) x y theta) from a ``timestamp x y theta`` file."""
-    t = _read_table(path, 4, "pose")
-    return t[:, 0], t[:, 1:4]
+__all__ = ["read_poses", "read_relations", "relations_error", "write_poses"]  # pose files live in navlab.io.poses
 
 
 def read_relations(path: str | os.PathLike[str]) -> np.ndarray:
-    """Relations (M, 5): t1, t2, x, y, yaw from ``t1 t2 x y z roll pitch yaw`` lines."""
-    t = _read_table(path, 8, "relation")
+    """Relations (M, 5): t1, t2, x, y, yaw from ``t1 t2 x y z roll pitch yaw`` lines (s, m, rad).
+
+    A malformed file raises ``navlab.io.IoError`` naming the file and line.
+    """
+    t = read_table(path, 8, "relation")
     return t[:, [0, 1, 2, 3, 7]]
-
-
-def write_poses(path: str | os.PathLike[str], timestamps: np.ndarray, poses: np.ndarray) -> None:
-    """Write ``timestamp x y theta`` lines atomically."""
-    from navlab.io.files import write_text_atomic
-
-    lines = [f"{t:.6f} {p[0]:.6f} {p[1]:.6f} {p[2]:.6f}\n" for t, p in zip(timestamps, poses, strict=True)]
-    write_text_atomic(path, "".join(lines))
 
 
 def _match(times: np.ndarray, query: np.ndarray, tol: float) -> np.ndarray:

@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from navlab.geometry import wrap_angle
-from navlab.mapping.errors import MappingError
+from navlab.io.errors import IoError
 
 NO_RETURN = 81.9  # SICK "no return" in CARMEN logs (81.91 m); such ranges carry no hit
 
@@ -121,12 +121,12 @@ def _parse_odom(tok: list[str]) -> OdomRecord:
 
 
 def read_carmen(path: str | os.PathLike[str], *, max_skipped_report: int = 5) -> CarmenLog:
-    """Read a CARMEN log; raise ``MappingError`` if it cannot be read or holds no laser scan."""
+    """Read a CARMEN log; raise ``IoError`` if it cannot be read or holds no laser scan."""
     p = Path(path)
     try:
         fh = p.open("r", errors="replace")
     except OSError as exc:
-        raise MappingError(f"cannot read CARMEN log {p}: {exc.strerror or exc}") from None
+        raise IoError(f"cannot read CARMEN log {p}: {exc.strerror or exc}") from None
     log = CarmenLog(p)
     with fh:
         for lineno, line in enumerate(fh, 1):
@@ -147,7 +147,7 @@ def read_carmen(path: str | os.PathLike[str], *, max_skipped_report: int = 5) ->
                 log.skipped.append(f"{p.name}:{lineno}: skipped {kind} line ({exc})")
     if not log.scans:
         extra = f"; {len(log.skipped)} malformed lines, first: {log.skipped[0]}" if log.skipped else ""
-        raise MappingError(f"{p}: no FLASER or ROBOTLASER1 scans found{extra}")
+        raise IoError(f"{p}: no FLASER or ROBOTLASER1 scans found{extra}")
     return log
 
 

@@ -1,15 +1,14 @@
-"""rosbag2 recording (MCAP storage) and reading, through rosbags.
+"""rosbag2 (MCAP storage) writing and reading, through rosbags; plain file I/O, no executor.
 
-``Recorder`` listens to every message an executor publishes and writes the chosen topics,
-stamped with simulated time. The bag is written inside a hidden staging folder beside it
-(``<parent>/.<name>.partial/<name>``) and moved into place when closed, so a crashed run never leaves
-a half-written bag under the asked name, and the finished bag's files and metadata carry its final
-name (``<name>/<name>.mcap``) as ``ros2 bag record`` would write them.
+``BagWriter`` writes messages into a bag inside a hidden staging folder beside it
+(``<parent>/.<name>.partial/<name>``) and moves it into place when closed, so a crashed run never
+leaves a half-written bag under the asked name, and the finished bag's files and metadata carry its
+final name (``<name>/<name>.mcap``) as ``ros2 bag record`` would write them. Recording a running
+executor is ``navlab.core.record.Recorder``, built on it.
 """
 
 from __future__ import annotations
 
-import fnmatch
 import json
 import shutil
 from collections.abc import Iterator, Sequence
@@ -19,24 +18,22 @@ from typing import Any
 from rosbags.rosbag2 import Reader, StoragePlugin, Writer
 from rosbags.rosbag2.errors import ReaderError, WriterError
 
-from navlab.core.executor import Executor
-from navlab.errors import NavlabError
+from navlab.io.errors import BagError
 from navlab.msgs import TYPESTORE, type_name
 
-GRAPH_KEY = "navlab.graph"
+__all__ = ["GRAPH_KEY", "BagError", "BagWriter", "bag_graph", "bag_topics", "read_bag"]
+
+GRAPH_KEY = "navlab.graph"  # custom-data key of the node/topic graph a navlab recording stores
 
 
-class BagError(NavlabError):
-    """A bag cannot be written or read."""
+class BagWriter:
+    """Write navlab (rosbags typestore) messages into a new rosbag2 directory with MCAP storage.
 
-
-class Recorder:
-    """Record topics of a running executor into a rosbag2 directory (MCAP storage).
-
-    ``topics``: names or glob patterns (``/tf*``); empty means every topic.
+    ``write(topic, msg, t_ns)`` adds a connection on a topic's first message; ``t_ns`` is the receive
+    time in integer nanoseconds. ``close()`` finishes the bag and renames it to ``path``.
     """
 
-    def __init__(self, executor: Executor, path: str | Path, *, topics: Sequence[str] = ()) -> None:
+    def __init__(self, path: str | Path) -> None:
         self.path = Path(path)
         if self.path.exists():
             raise BagError(f"{self.path}: already exists; choose a new directory for the recording")
@@ -50,46 +47,32 @@ class Recorder:
             self._writer.open()
         except (OSError, WriterError) as exc:
             raise BagError(f"{self.path}: cannot start the recording ({exc})") from None
-        self._patterns = [t if t.startswith("/") else "/" + t for t in topics]
         self._connections: dict[str, Any] = {}
-        self._executor = executor
         self.count = 0
-        # Latched topics (/map, /tf_static) were published before recording began: record their last
-        # message now, as `ros2 bag record` does for transient_local publishers.
-        for name, topic in sorted(executor.topics.items()):
-            for msg in topic.latched.values():
-                self._on_message(name, msg, executor.now_ns)
-        executor.add_listener(self._on_message)
+        self.closed = False
 
-    def _wanted(self, topic: str) -> bool:
-        return not self._patterns or any(fnmatch.fnmatchcase(topic, p) for p in self._patterns)
-
-    def _on_message(self, topic: str, msg: Any, t_ns: int) -> None:
+    def write(self, topic: str, msg: Any, t_ns: int) -> None:
+        """Append ``msg`` on ``topic`` at ``t_ns`` (ns); the topic's type is taken from its first message."""
         conn = self._connections.get(topic)
         if conn is None:
-            if not self._wanted(topic):
-                self._connections[topic] = False
-                return
-            conn = self._connections[topic] = self._writer.add_connection(
-                topic, type_name(msg), typestore=TYPESTORE
-            )
-        if conn is False:
-            return
+            conn = self._connections[topic] = self._writer.add_connection(topic, type_name(msg), typestore=TYPESTORE)
         self._writer.write(conn, t_ns, TYPESTORE.serialize_cdr(msg, type_name(msg)))
         self.count += 1
 
-    def close(self) -> Path:
-        """Finish the bag (with the node/topic graph as custom data) and move it to its final name."""
-        from navlab.core.graph import Graph
+    def set_custom_data(self, key: str, value: str) -> None:
+        """Store ``key: value`` in the bag's metadata (``custom_data``)."""
+        self._writer.set_custom_data(key, value)
 
-        self._executor.remove_listener(self._on_message)
-        self._writer.set_custom_data(GRAPH_KEY, json.dumps(Graph.from_executor(self._executor).to_json()))
-        self._writer.close()
-        self._tmp.rename(self.path)
-        self._staging.rmdir()
+    def close(self) -> Path:
+        """Finish the bag and move it to its final name; returns that path."""
+        if not self.closed:
+            self.closed = True
+            self._writer.close()
+            self._tmp.rename(self.path)
+            self._staging.rmdir()
         return self.path
 
-    def __enter__(self) -> Recorder:
+    def __enter__(self) -> BagWriter:
         return self
 
     def __exit__(self, *exc: object) -> None:

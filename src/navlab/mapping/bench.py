@@ -4,23 +4,22 @@ from __future__ import annotations
 
 import argparse
 import time
-from pathlib import Path
 from typing import Any
 
-from navlab.mapping.errors import MappingError
-
-CSAIL = Path("/work/shared/datasets/mit-csail/mit-csail.clf")
+CSAIL = "mit-csail/mit-csail.clf"  # under NAVLAB_DATA (default ../shared/datasets beside the repository)
 
 
 def run(args: argparse.Namespace) -> dict[str, Any]:
-    """Time ``run_offline`` (graph mode, including the final map) on the CSAIL log."""
+    """Time ``run_offline`` (graph mode, including the final map) on the CSAIL log.
+
+    A missing log raises ``DatasetNotFoundError`` saying where it was looked for and how to provide it.
+    """
     from navlab.io.carmen import read_carmen
+    from navlab.io.datasets import dataset
     from navlab.mapping.scanmatch import warmup
     from navlab.mapping.slam import run_offline
 
-    if not CSAIL.exists():
-        raise MappingError(f"benchmark log {CSAIL} not found")
-    log = read_carmen(CSAIL)
+    log = read_carmen(dataset(CSAIL))
     warmup()  # numba compilation is not part of the figure (it is cached on disk after the first run)
     t0, c0 = time.perf_counter(), time.process_time()
     run_offline(log, mode="graph", seed=getattr(args, "seed", 0))

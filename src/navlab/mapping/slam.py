@@ -121,7 +121,7 @@ def save_figure(grid: GridMap, poses: np.ndarray, path: str | Path, *, title: st
 
 def write_outputs(result: SlamResult, out_dir: str | Path, *, title: str = "") -> dict[str, Path]:
     """Write map.yaml, map.pgm, poses.txt and map.png into ``out_dir`` (created if needed)."""
-    from navlab.experiments.metrics import write_poses
+    from navlab.io.poses import write_poses
 
     out = Path(out_dir)
     try:

@@ -9,14 +9,21 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from navlab.sim.errors import SimError
+
 #: Gazebo ROS 1 diff_drive's fixed covariances (pose and twist diagonals: x y z roll pitch yaw)
 ODOM_COVARIANCE_DIAG = (1e-5, 1e-5, 1e12, 1e12, 1e12, 1e-3)
 
 
+def _check_geometry(separation: float, diameter: float) -> None:
+    if not (math.isfinite(separation) and separation > 0 and math.isfinite(diameter) and diameter > 0):
+        raise SimError(f"diff drive: wheel separation {separation} m and wheel diameter {diameter} m: "
+                       "expected finite numbers > 0")
+
+
 def wheel_speeds(v: float, w: float, separation: float, diameter: float) -> tuple[float, float]:
     """(left, right) wheel angular velocities (rad/s) for body speed ``v`` (m/s) and yaw rate ``w`` (rad/s)."""
-    if separation <= 0 or diameter <= 0:
-        raise ValueError(f"wheel separation {separation} and diameter {diameter} must be positive")
+    _check_geometry(separation, diameter)
     r = diameter / 2.0
     return (v - w * separation / 2.0) / r, (v + w * separation / 2.0) / r
 
@@ -45,6 +52,9 @@ class EncoderOdometry:
     yaw: float = 0.0
     _left: float | None = None
     _right: float | None = None
+
+    def __post_init__(self) -> None:
+        _check_geometry(self.separation, self.diameter)
 
     def reset(self, left: float, right: float, x: float = 0.0, y: float = 0.0, yaw: float = 0.0) -> None:
         """Start integrating from pose (x, y, yaw) at these wheel angles."""
