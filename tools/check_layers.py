@@ -10,7 +10,7 @@ Layers, bottom to top::
     3 sim mapping localization
     4 navigation
     5 experiments viz
-    6 top          cli demo bench, every package's cli.py and bench.py, navlab/__init__.py
+    6 top          cli cli_common demo bench, every package's cli.py and bench.py, navlab/__init__.py
 
 Every import statement counts: module level, inside functions, under ``if TYPE_CHECKING``. Strings
 (the lazy names of ``navlab/__init__.py``, the ``module:Class`` strings of the registries) are not
@@ -36,7 +36,7 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("sim/mapping/localization", ("sim", "mapping", "localization")),
     ("navigation", ("navigation",)),
     ("experiments/viz", ("experiments", "viz")),
-    ("top", ("cli", "demo", "bench", "__main__")),
+    ("top", ("cli", "cli_common", "demo", "bench", "__main__")),
 )
 LAYER_OF: dict[str, int] = {pkg: i for i, (_, pkgs) in enumerate(LAYERS) for pkg in pkgs}
 TOP = len(LAYERS) - 1
