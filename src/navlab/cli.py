@@ -19,6 +19,7 @@ COMMAND_MODULES = (  # in the order of the paper's pipeline, then the ROS-style 
     "navlab.demo",
     "navlab.sim.cli",
     "navlab.description.cli",
+    "navlab.world.cli",
     "navlab.mapping.run_cli",
     "navlab.mapping.cli",
     "navlab.localization.cli",

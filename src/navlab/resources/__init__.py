@@ -13,7 +13,11 @@ from pathlib import Path
 from navlab.errors import NavlabError
 
 # ROS package name -> directory (relative to this package) of the shipped robot descriptions.
-_SHIPPED_PACKAGES = (("mybot_description", "robots/mybot"),)
+_SHIPPED_PACKAGES = (
+    ("mybot_description", "robots/mybot"),
+    ("navlab_tb3_burger_description", "robots/tb3_burger"),
+    ("navlab_jackal_description", "robots/jackal"),
+)
 
 
 class ResourceError(NavlabError):

@@ -1,0 +1,122 @@
+"""``navlab world clutter``: generate a BARN-style cluttered world (.world SDF, optional PNG and JSON)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+from navlab.world.clutter import CYLINDER_RADIUS, FIELD, ClutterWorld, generate_clutter
+
+
+def save_png(world: ClutterWorld, path: str | Path) -> None:
+    """Top view (world frame, m): walls, cylinders, start, goal and the reference path."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.collections import PatchCollection
+    from matplotlib.patches import Circle, Rectangle
+
+    from navlab.io.files import save_figure_atomic
+
+    fig, ax = plt.subplots(figsize=(10, 5.2))
+    try:
+        ax.add_collection(PatchCollection([Rectangle((w.x - w.sx / 2, w.y - w.sy / 2), w.sx, w.sy)
+                                           for w in world.walls], facecolor="0.55", edgecolor="none"))
+        ax.add_collection(PatchCollection([Circle((x, y), CYLINDER_RADIUS) for x, y in world.cylinders],
+                                          facecolor="0.2", edgecolor="none"))
+        ax.add_patch(Rectangle((0.0, -FIELD / 2), FIELD, FIELD, fill=False, linestyle=":", edgecolor="0.6"))
+        ref = world.reference_path
+        ax.plot(ref[:, 0], ref[:, 1], "-", color="tab:blue", lw=1.5,
+                label=f"reference path {world.reference_path_m:.2f} m")
+        (sx, sy, _), (gx, gy, _) = world.start, world.goal
+        ax.add_patch(Circle((sx, sy), world.robot_radius, facecolor="none", edgecolor="tab:green", lw=1.5))
+        ax.plot([sx], [sy], "o", color="tab:green", label="start")
+        ax.plot([gx], [gy], "*", color="tab:red", ms=14, label="goal")
+        ax.set_aspect("equal")
+        ax.set_xlim(min(w.x - w.sx / 2 for w in world.walls) - 0.3, gx + 0.7)
+        ax.set_ylim(-FIELD / 2 - 0.6, FIELD / 2 + 0.6)
+        ax.set_xlabel("x (m)")
+        ax.set_ylabel("y (m)")
+        ax.set_title(f"{world.name}: {len(world.cylinders)} cylinders ({world.carved} carved), "
+                     f"difficulty {world.difficulty:.3f}")
+        ax.legend(loc="upper right", fontsize=8)
+        fig.tight_layout()
+        save_figure_atomic(fig, path, dpi=120)
+    finally:
+        plt.close(fig)
+
+
+def _cmd_clutter(args: argparse.Namespace) -> int:
+    world = generate_clutter(args.seed, fill=args.fill, smooth=args.smooth, robot_radius=args.robot_radius,
+                             margin=args.margin)
+    out = world.write_world(args.out)
+    if args.png:
+        save_png(world, args.png)
+    summary = {**world.summary(), "world_file": str(out), "png": str(args.png) if args.png else None}
+    if args.json:
+        print(json.dumps(summary))
+        return 0
+    (sx, sy, syaw), (gx, gy, gyaw) = world.start, world.goal
+    print(f"{world.name}: {len(world.cylinders)} cylinders ({world.carved} carved for the corridor), "
+          f"difficulty {world.difficulty:.3f}")
+    print(f"start  x {sx:.3f} y {sy:.3f} yaw {syaw:.3f}")
+    print(f"goal   x {gx:.3f} y {gy:.3f} yaw {gyaw:.3f}")
+    print(f"reference path {world.reference_path_m:.3f} m for robot radius {world.robot_radius} m "
+          f"(T_opt {world.t_opt():.2f} s at 2 m/s; narrowest passage half-width "
+          f"{world.metrics['bottleneck_m']:.3f} m)")
+    print(f"wrote {out}" + (f" and {args.png}" if args.png else ""))
+    return 0
+
+
+def _fraction(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number in [0, 1], got {text!r}") from None
+    if not 0.0 <= value <= 1.0:
+        raise argparse.ArgumentTypeError(f"expected a number in [0, 1], got {text!r}")
+    return value
+
+
+def _count(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected an integer >= 0, got {text!r}") from None
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"expected an integer >= 0, got {text!r}")
+    return value
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    """Add the ``world`` verb (``navlab world clutter``)."""
+    p = sub.add_parser("world", help="generate worlds (BARN-style clutter)",
+                       description="Generate Gazebo .world files navlab and Gazebo classic both load.")
+    verbs = p.add_subparsers(dest="world_command", metavar="WHAT", required=True)
+    c = verbs.add_parser(
+        "clutter",
+        help="a BARN-style field of cylinders between walls, with start, goal and reference path",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+        description="A 4.5 x 4.5 m field of 0.075 m-radius cylinders on a 0.15 m grid, grown by a cellular\n"
+        "automaton (random --fill, then --smooth rounds), between two walls, as in the BARN benchmark\n"
+        "(Perille et al. 2020). The robot starts at (-2, 0) facing +x, 2 m before the field; the goal\n"
+        "is (8, 0), 10 m away. A corridor wide enough for --robot-radius + --margin is always carved.\n"
+        "Prints start, goal and the reference (shortest collision-free) path length.",
+        epilog="examples:\n"
+        "  navlab world clutter --seed 3 --fill 0.3 --smooth 2 --out clutter.world --png clutter.png\n"
+        "  navlab sim --world clutter.world --x -2 --y 0 --duration 5",
+    )
+    c.add_argument("--seed", type=int, default=0, help="random seed (default 0); same seed, same world")
+    c.add_argument("--fill", type=_fraction, default=0.25, help="initial fill probability per cell (default 0.25)")
+    c.add_argument("--smooth", type=_count, default=2, help="cellular-automaton rounds (default 2)")
+    c.add_argument("--robot-radius", type=float, default=0.2,
+                   help="radius of the robot disc the reference path is planned for (m, default 0.2: mybot)")
+    c.add_argument("--margin", type=float, default=0.05,
+                   help="extra clearance of the carved corridor beyond the robot radius (m, default 0.05)")
+    c.add_argument("--out", required=True, metavar="FILE.world", help="the .world file to write")
+    c.add_argument("--png", default=None, metavar="FILE.png", help="also draw the world and the reference path")
+    c.add_argument("--json", action="store_true", help="print the summary as one JSON object")
+    c.set_defaults(func=_cmd_clutter)
+
