@@ -114,9 +114,19 @@ REGISTRY: dict[str, dict[str, str]] = {
     },
     "costmap_layer": {
         "navlab::ClearanceLayer": "navlab.mapping.explore:ClearanceLayer",
+        "costmap_2d::StaticLayer": "navlab.navigation.costmap.layers:StaticLayer",
+        "costmap_2d::ObstacleLayer": "navlab.navigation.costmap.layers:ObstacleLayer",
+        "costmap_2d::InflationLayer": "navlab.navigation.costmap.layers:InflationLayer",
+        "nav2_costmap_2d::StaticLayer": "navlab.navigation.costmap.layers:StaticLayer",
+        "nav2_costmap_2d::ObstacleLayer": "navlab.navigation.costmap.layers:ObstacleLayer",
+        "nav2_costmap_2d::InflationLayer": "navlab.navigation.costmap.layers:InflationLayer",
     },
     "global_planner": {
         "navlab/GridDijkstra": "navlab.mapping.explore:GridDijkstraPlanner",
+        "navfn/NavfnROS": "navlab.navigation.planners.navfn:NavfnPlanner",
+        "nav2_navfn_planner/NavfnPlanner": "navlab.navigation.planners.navfn:NavfnPlanner",
+        "global_planner/GlobalPlanner": "navlab.navigation.planners.navfn:GlobalPlanner",
+        "nav2_theta_star_planner/ThetaStarPlanner": "navlab.navigation.planners.theta_star:ThetaStarPlanner",
     },
     "controller": {
         "navlab/PurePursuit": "navlab.mapping.follow:PurePursuit",

@@ -1,0 +1,353 @@
+"""costmap_2d's parameters: ROS 1 names and defaults, Nav2 spellings accepted where they map.
+
+One costmap's dict is what a ROS 1 user writes under ``global_costmap:`` or ``local_costmap:`` (the
+common file merged in): flat costmap parameters, either a ``plugins:`` list of ``{name, type}`` (or
+Nav2's list of names with a ``plugin:`` key in each namespace) or none (ROS 1's pre-hydro layout:
+``static_map: true`` gives static + obstacle + inflation), a namespace dict per layer
+(``inflation_layer: {inflation_radius: 0.3}``, or the dotted ``inflation_layer.inflation_radius``), and
+one dict per name in ``observation_sources``. A layer reads the costmap-level value of each of its
+parameters unless its namespace sets it. Distances in metres, frequencies in Hz.
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+from dataclasses import dataclass, field, fields
+from typing import Any, TypeVar
+
+from navlab.core.params import dataclass_from_dict
+from navlab.navigation.errors import NavigationError
+
+T = TypeVar("T")
+
+STATIC = "costmap_2d::StaticLayer"
+OBSTACLE = "costmap_2d::ObstacleLayer"
+INFLATION = "costmap_2d::InflationLayer"
+
+# Nav2 spelling -> ROS 1 name, for layer and observation-source parameters
+ALIASES: dict[str, str] = {
+    "obstacle_max_range": "obstacle_range",
+    "raytrace_max_range": "raytrace_range",
+    "inflate_around_unknown": "inflate_unknown",
+}
+# accepted and ignored (runtime or Nav2-only settings with no effect on the pure layers)
+IGNORED: frozenset[str] = frozenset({"use_sim_time", "filters", "plugin", "map_subscribe_transient_local",
+                                     "initial_transform_timeout", "clearable_layers", "footprint_topic"})
+
+
+@dataclass
+class PluginSpec:
+    """One entry of ``plugins:``: the layer's ``name`` (its namespace) and its ROS ``type``."""
+
+    name: str
+    type: str
+
+
+@dataclass
+class ObservationSource:
+    """One sensor of ``observation_sources`` (ROS 1 obstacle layer names and defaults; ranges in m)."""
+
+    sensor_frame: str = ""
+    data_type: str = "LaserScan"
+    topic: str = ""
+    marking: bool = True
+    clearing: bool = False
+    obstacle_range: float = 2.5
+    raytrace_range: float = 3.0
+    obstacle_min_range: float = 0.0
+    raytrace_min_range: float = 0.0
+    min_obstacle_height: float = 0.0
+    max_obstacle_height: float = 2.0
+    inf_is_valid: bool = False
+    expected_update_rate: float = 0.0
+    observation_persistence: float = 0.0
+
+
+@dataclass
+class StaticLayerParams:
+    """``costmap_2d::StaticLayer``: how ``/map`` occupancy (-1, 0..100) becomes costs."""
+
+    enabled: bool = True
+    map_topic: str = "map"
+    first_map_only: bool = False
+    subscribe_to_updates: bool = False
+    track_unknown_space: bool = False
+    use_maximum: bool = False
+    lethal_cost_threshold: int = 100
+    unknown_cost_value: int = -1
+    trinary_costmap: bool = True
+
+
+@dataclass
+class ObstacleLayerParams:
+    """``costmap_2d::ObstacleLayer``: marking and clearing from sensor data (ranges in m)."""
+
+    enabled: bool = True
+    obstacle_range: float = 2.5
+    raytrace_range: float = 3.0
+    obstacle_min_range: float = 0.0
+    raytrace_min_range: float = 0.0
+    max_obstacle_height: float = 2.0
+    track_unknown_space: bool = False
+    footprint_clearing_enabled: bool = True
+    combination_method: int = 1
+    observation_sources: str = ""
+
+
+@dataclass
+class InflationLayerParams:
+    """``costmap_2d::InflationLayer``: ``inflation_radius`` (m) and the decay ``cost_scaling_factor`` (1/m)."""
+
+    enabled: bool = True
+    inflation_radius: float = 0.55
+    cost_scaling_factor: float = 10.0
+    inflate_unknown: bool = False
+
+
+@dataclass
+class CostmapParams:
+    """costmap_2d's costmap-level parameters (ROS 1 names and defaults) plus the parsed structure.
+
+    ``footprint`` is ROS's string form ("[[x, y], ...]", "[]" = use ``robot_radius``); a YAML list is accepted.
+    ``plugins``, ``sources`` and ``namespaces`` are filled by :func:`costmap_params`.
+    """
+
+    global_frame: str = "map"
+    robot_base_frame: str = "base_link"
+    update_frequency: float = 5.0
+    publish_frequency: float = 0.0
+    transform_tolerance: float = 0.2
+    static_map: bool = True
+    rolling_window: bool = False
+    always_send_full_costmap: bool = False
+    map_type: str = "costmap"
+    width: float = 10.0
+    height: float = 10.0
+    resolution: float = 0.05
+    origin_x: float = 0.0
+    origin_y: float = 0.0
+    # defaults the layers inherit
+    map_topic: str = "map"
+    track_unknown_space: bool = False
+    lethal_cost_threshold: int = 100
+    unknown_cost_value: int = -1
+    trinary_costmap: bool = True
+    use_maximum: bool = False
+    obstacle_range: float = 2.5
+    raytrace_range: float = 3.0
+    max_obstacle_height: float = 2.0
+    observation_sources: str = ""
+    inflation_radius: float = 0.55
+    cost_scaling_factor: float = 10.0
+    # the robot
+    footprint: str = "[]"
+    robot_radius: float = 0.46
+    footprint_padding: float = 0.01
+    # structure (not flat parameters)
+    plugins: list[PluginSpec] = field(default_factory=list)
+    sources: dict[str, ObservationSource] = field(default_factory=dict)
+    namespaces: dict[str, dict[str, Any]] = field(default_factory=dict)
+
+    def validate(self) -> None:
+        """Raise ``NavigationError`` naming the first bad parameter, its value and what was expected."""
+        for name in ("update_frequency", "publish_frequency", "transform_tolerance", "width", "height",
+                     "obstacle_range", "raytrace_range", "inflation_radius", "cost_scaling_factor"):
+            _non_negative("costmap", name, getattr(self, name))
+        for name in ("width", "height", "resolution"):
+            if getattr(self, name) <= 0:
+                raise NavigationError(f"costmap parameter {name}: expected > 0, got {getattr(self, name)}")
+        for name in ("origin_x", "origin_y", "robot_radius", "footprint_padding"):
+            _finite("costmap", name, getattr(self, name))
+        if self.map_type not in ("costmap", "voxel"):
+            raise NavigationError(f"costmap parameter map_type: expected 'costmap' or 'voxel', got {self.map_type!r}")
+
+
+def _finite(what: str, name: str, value: float) -> None:
+    if not math.isfinite(value):
+        raise NavigationError(f"{what} parameter {name}: expected a finite number, got {value!r}")
+
+
+def _non_negative(what: str, name: str, value: float) -> None:
+    _finite(what, name, value)
+    if value < 0:
+        raise NavigationError(f"{what} parameter {name}: expected >= 0, got {value}")
+
+
+def build(cls: type[T], values: dict[str, Any] | None, *, what: str) -> T:
+    """An instance of dataclass ``cls`` from ``values``: unknown keys say "did you mean"; a value of the wrong
+    type (a string for a number, 2.5 for an integer, "yes" for a boolean) names its key and what was expected."""
+    names = {f.name: f for f in fields(cls)}  # type: ignore[arg-type]
+    defaults = cls()
+    for key, val in (values or {}).items():
+        if key not in names:
+            continue  # dataclass_from_dict reports it with "did you mean"
+        kind = type(getattr(defaults, key))
+        ok = (
+            (kind is bool and (isinstance(val, bool) or val in (0, 1)))
+            or (kind is int and not isinstance(val, bool) and isinstance(val, int | float) and float(val).is_integer())
+            or (kind is float and not isinstance(val, bool) and isinstance(val, int | float))
+            or (kind is str and isinstance(val, str))
+            or kind not in (bool, int, float, str)
+        )
+        if not ok:
+            expected = {bool: "true or false", int: "an integer", float: "a number", str: "a string"}[kind]
+            raise NavigationError(f"{what} parameter {key}: expected {expected}, got {val!r}")
+    return dataclass_from_dict(cls, values, what=what, error=NavigationError)
+
+
+def _split_dotted(values: dict[str, Any]) -> dict[str, Any]:
+    """``{"inflation_layer.inflation_radius": 0.3}`` -> ``{"inflation_layer": {"inflation_radius": 0.3}}``."""
+    out: dict[str, Any] = {}
+    for key, val in values.items():
+        if isinstance(key, str) and "." in key:
+            head, _, tail = key.partition(".")
+            sub = out.setdefault(head, {})
+            if not isinstance(sub, dict):
+                raise NavigationError(f"costmap parameter {head}: both a value and a namespace ({key})")
+            sub.update(_split_dotted({tail: val}))
+        elif isinstance(val, dict) and isinstance(out.get(key), dict):
+            out[key].update(val)
+        else:
+            out[key] = val
+    return out
+
+
+def _parse_plugins(raw: Any, namespaces: dict[str, Any]) -> list[PluginSpec]:
+    """ROS 1's ``[{name, type}, ...]`` or Nav2's ``[name, ...]`` with ``name: {plugin: type}``."""
+    if not isinstance(raw, list):
+        raise NavigationError(f"costmap parameter plugins: expected a list of {{name, type}}, got {raw!r}")
+    out = []
+    for k, item in enumerate(raw):
+        if isinstance(item, dict):
+            unknown = set(item) - {"name", "type"}
+            if unknown or "name" not in item or "type" not in item:
+                raise NavigationError(f"costmap parameter plugins[{k}]: expected {{name: .., type: ..}}, got {item!r}")
+            out.append(PluginSpec(str(item["name"]), str(item["type"])))
+        elif isinstance(item, str):
+            ns = namespaces.get(item)
+            if not isinstance(ns, dict) or "plugin" not in ns:
+                raise NavigationError(f"costmap parameter plugins[{k}] {item!r}: Nav2 style needs "
+                                      f"'{item}: {{plugin: <type>}}' (or write {{name: {item}, type: <type>}})")
+            out.append(PluginSpec(item, str(ns["plugin"])))
+        else:
+            raise NavigationError(f"costmap parameter plugins[{k}]: expected {{name, type}} or a name, got {item!r}")
+    names = [p.name for p in out]
+    dup = {n for n in names if names.count(n) > 1}
+    if dup:
+        raise NavigationError(f"costmap parameter plugins: layer names must be unique, {sorted(dup)} repeated")
+    return out
+
+
+def default_plugins(static_map: bool) -> list[PluginSpec]:
+    """ROS 1's layers when there is no ``plugins:`` key: [static] + obstacle + inflation."""
+    out = [PluginSpec("static_layer", STATIC)] if static_map else []
+    return [*out, PluginSpec("obstacle_layer", OBSTACLE), PluginSpec("inflation_layer", INFLATION)]
+
+
+def costmap_params(values: dict[str, Any] | None = None) -> CostmapParams:
+    """Parse one costmap's parameter dict (see the module docstring) into validated ``CostmapParams``."""
+    values = _split_dotted(dict(values or {}))
+    flat: dict[str, Any] = {}
+    namespaces: dict[str, dict[str, Any]] = {}
+    for key, val in values.items():
+        if key in IGNORED:
+            continue
+        if isinstance(val, dict):
+            namespaces[str(key)] = dict(val)
+        elif key in ("sources", "namespaces"):
+            raise NavigationError(f"unknown costmap parameter '{key}'")
+        elif key != "plugins":
+            flat[key] = val
+    if isinstance(flat.get("footprint"), list | tuple):
+        flat["footprint"] = str([list(map(float, p)) for p in flat["footprint"]])
+    if isinstance(flat.get("observation_sources"), list | tuple):
+        flat["observation_sources"] = " ".join(map(str, flat["observation_sources"]))
+    params = build(CostmapParams, flat, what="costmap")
+    params.validate()
+    if "plugins" in values:
+        params.plugins = _parse_plugins(values["plugins"], namespaces)
+    else:
+        params.plugins = default_plugins(params.static_map)
+    # observation sources are named in the obstacle layers' (or the costmap's) observation_sources
+    owner: dict[str, dict[str, Any]] = {src: {} for src in params.observation_sources.split()}
+    for plugin in params.plugins:
+        ns = namespaces.get(plugin.name, {})
+        listed = ns.get("observation_sources", "")
+        for src in (listed.split() if isinstance(listed, str) else list(map(str, listed))):
+            owner[src] = ns
+    for src, ns in owner.items():
+        raw = namespaces.get(src, ns.get(src))  # ROS 1: costmap level; Nav2: inside the layer's namespace
+        if not isinstance(raw, dict):
+            raise NavigationError(f"costmap parameter observation_sources names {src!r} but there is no "
+                                  f"'{src}: {{topic: ..., data_type: LaserScan, ...}}'")
+        params.sources[src] = observation_source(raw, params, name=src, layer=_with_aliases(ns, src))
+    known = {p.name for p in params.plugins} | set(params.sources)
+    for key, ns in namespaces.items():
+        if key not in known:
+            close = difflib.get_close_matches(key, sorted(known) + [f.name for f in fields(CostmapParams)], n=1)
+            hint = f"; did you mean '{close[0]}'?" if close else ""
+            raise NavigationError(f"unknown costmap parameter '{key}' (a namespace that is neither a layer in "
+                                  f"plugins nor an observation source){hint}")
+        params.namespaces[key] = ns
+    return params
+
+
+def _with_aliases(values: dict[str, Any], what: str) -> dict[str, Any]:
+    out: dict[str, Any] = {}
+    for key, val in values.items():
+        if key in IGNORED or isinstance(val, dict):
+            continue
+        name = ALIASES.get(key, key)
+        if name == "observation_sources" and isinstance(val, list | tuple):
+            val = " ".join(map(str, val))
+        if name in out:
+            other = next(k for k in values if ALIASES.get(k, k) == name and k != key)
+            raise NavigationError(f"{what} parameters {other} and {key} both set (the same parameter); keep one")
+        out[name] = val
+    return out
+
+
+def observation_source(values: dict[str, Any], costmap: CostmapParams, *, name: str,
+                       layer: dict[str, Any] | None = None) -> ObservationSource:
+    """One observation source; its ranges default to its layer's (else the costmap's) ``obstacle_range``,
+    ``raytrace_range`` and ``max_obstacle_height``."""
+    inherited = {key: (layer or {}).get(key, getattr(costmap, key))
+                 for key in ("obstacle_range", "raytrace_range", "max_obstacle_height")}
+    src = build(ObservationSource, {**inherited, **_with_aliases(values, f"observation source {name}")},
+                what=f"observation source {name}")
+    for key in ("obstacle_range", "raytrace_range", "obstacle_min_range", "raytrace_min_range"):
+        _non_negative(f"observation source {name}", key, getattr(src, key))
+    if src.min_obstacle_height > src.max_obstacle_height:
+        raise NavigationError(f"observation source {name} parameters min_obstacle_height {src.min_obstacle_height} > "
+                              f"max_obstacle_height {src.max_obstacle_height}: expected min <= max")
+    if src.data_type not in ("LaserScan", "PointCloud", "PointCloud2"):
+        raise NavigationError(f"observation source {name} parameter data_type: expected LaserScan, PointCloud or "
+                              f"PointCloud2, got {src.data_type!r}")
+    return src
+
+
+def layer_params(cls: type[T], costmap: CostmapParams, name: str) -> T:
+    """A layer's parameters: the costmap-level value of each of its fields, overridden by its namespace ``name``."""
+    own = {f.name for f in fields(cls)}  # type: ignore[arg-type]
+    inherited = {f.name: getattr(costmap, f.name) for f in fields(CostmapParams) if f.name in own}
+    ns = _with_aliases(costmap.namespaces.get(name, {}), name)
+    params = build(cls, {**inherited, **ns}, what=name)
+    _validate_layer(params, name)
+    return params
+
+
+def _validate_layer(params: Any, name: str) -> None:
+    """Range checks shared by the layer parameter classes."""
+    if isinstance(params, InflationLayerParams):
+        _non_negative(name, "inflation_radius", params.inflation_radius)
+        _non_negative(name, "cost_scaling_factor", params.cost_scaling_factor)
+    elif isinstance(params, ObstacleLayerParams):
+        for key in ("obstacle_range", "raytrace_range", "obstacle_min_range", "raytrace_min_range"):
+            _non_negative(name, key, getattr(params, key))
+        if params.combination_method not in (0, 1):
+            raise NavigationError(f"{name} parameter combination_method: expected 0 (overwrite) or 1 (maximum), "
+                                  f"got {params.combination_method}")
+    elif isinstance(params, StaticLayerParams) and not 0 < params.lethal_cost_threshold <= 100:
+        raise NavigationError(f"{name} parameter lethal_cost_threshold: expected 1..100, "
+                              f"got {params.lethal_cost_threshold}")

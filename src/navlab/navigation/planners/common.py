@@ -1,0 +1,135 @@
+"""What the global planners share: costmap and pose checks, a binary heap for Numba, path helpers.
+
+Cell coordinates: cell ``(i, j)`` is ``data[j, i]``; "centre coordinates" ``u = (x - origin_x) / res - 0.5``
+put cell centres on integers. Paths are float (N, 2) arrays in metres in the costmap's frame.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numba
+import numpy as np
+
+from navlab.grid import COST_LETHAL, Grid
+from navlab.navigation.costmap.params import build
+from navlab.navigation.errors import NavigationError
+
+
+def check_costmap(costmap: Grid, who: str) -> np.ndarray:
+    """The costmap's uint8 cost array; refuses other dtypes, empty grids and a rotated origin."""
+    data = np.asarray(costmap.data)
+    if data.dtype != np.uint8 or data.ndim != 2 or data.size == 0:
+        raise NavigationError(f"{who}: costmap must be a 2-D uint8 grid of costmap_2d costs, got {data.dtype} "
+                              f"{data.shape}")
+    if costmap.origin[2] != 0.0:
+        raise NavigationError(f"{who}: costmap origin yaw must be 0, got {costmap.origin[2]}")
+    return data
+
+
+def pose_cell(costmap: Grid, pose: Any, what: str, who: str) -> tuple[int, int, float, float]:
+    """(i, j, u, v) of ``pose`` (x, y[, yaw]): its cell and centre coordinates; outside the map is an error."""
+    try:
+        x, y = float(pose[0]), float(pose[1])
+    except (TypeError, ValueError, IndexError):
+        raise NavigationError(f"{who}: {what} must be (x, y, yaw) in metres, got {pose!r}") from None
+    if not (math.isfinite(x) and math.isfinite(y)):
+        raise NavigationError(f"{who}: {what} must be finite, got ({x}, {y})")
+    ij = costmap.world_to_cell(np.array([[x, y]]))
+    if not costmap.in_bounds(ij)[0]:
+        xmin, ymin, xmax, ymax = costmap.bounds()
+        raise NavigationError(f"{who}: {what} ({x:.3f}, {y:.3f}) is outside the costmap "
+                              f"[{xmin:.2f}, {xmax:.2f}] x [{ymin:.2f}, {ymax:.2f}] m ({costmap.frame_id} frame)")
+    res = costmap.resolution
+    u = (x - costmap.origin[0]) / res - 0.5
+    v = (y - costmap.origin[1]) / res - 0.5
+    return int(ij[0, 0]), int(ij[0, 1]), u, v
+
+
+def check_start(data: np.ndarray, i: int, j: int, start: Any, who: str) -> None:
+    """A start on a lethal cell is an error (the robot's centre cannot be in an obstacle); an inscribed start
+    is fine (the planner clears the robot's cell, as navfn's ``clearRobotCell`` does)."""
+    if data[j, i] == COST_LETHAL:
+        raise NavigationError(f"{who}: start ({float(start[0]):.3f}, {float(start[1]):.3f}) is in an obstacle "
+                              f"(cost {COST_LETHAL} at cell ({i}, {j})); is the robot localized?")
+
+
+def params_from(cls: type, values: Any, *, what: str, aliases: dict[str, str] | None = None) -> Any:
+    """A planner's parameter dataclass from a dict (ROS names, "did you mean" on unknown keys) or as given."""
+    if values is None:
+        return cls()
+    if isinstance(values, cls):
+        return values
+    if not isinstance(values, dict):
+        raise NavigationError(f"{what}: parameters must be a dict or {cls.__name__}, got {type(values).__name__}")
+    renamed: dict[str, Any] = {}
+    for key, val in values.items():
+        name = (aliases or {}).get(key, key)
+        if name in renamed:
+            raise NavigationError(f"{what} parameters {key} and {name} both set; keep one")
+        renamed[name] = val
+    return build(cls, renamed, what=what)
+
+
+def path_length(path: np.ndarray | None) -> float:
+    """Length (m) of a polyline (N, 2); 0 for None or a single point."""
+    if path is None or len(path) < 2:
+        return 0.0
+    return float(np.hypot(*np.diff(np.asarray(path)[:, :2], axis=0).T).sum())
+
+
+def to_world(costmap: Grid, uv: np.ndarray) -> np.ndarray:
+    """Metres (N, 2) of centre coordinates ``uv`` (N, 2)."""
+    res = costmap.resolution
+    return np.stack([costmap.origin[0] + (uv[:, 0] + 0.5) * res, costmap.origin[1] + (uv[:, 1] + 0.5) * res], axis=1)
+
+
+def dedupe(path: np.ndarray, eps: float = 1e-9) -> np.ndarray:
+    """``path`` without consecutive repeated points."""
+    if len(path) < 2:
+        return path
+    keep = np.ones(len(path), bool)
+    keep[1:] = np.hypot(*np.diff(path, axis=0).T) > eps
+    return path[keep]
+
+
+# --- a binary min-heap on parallel arrays (Numba) ------------------------------------------------
+
+
+@numba.njit(cache=True, inline="always")
+def heap_push(keys: np.ndarray, vals: np.ndarray, size: int, key: float, val: int) -> int:
+    """Push (key, val); returns the new size. The caller sizes the arrays."""
+    k = size
+    keys[k] = key
+    vals[k] = val
+    while k > 0:
+        parent = (k - 1) >> 1
+        if keys[parent] <= keys[k]:
+            break
+        keys[parent], keys[k] = keys[k], keys[parent]
+        vals[parent], vals[k] = vals[k], vals[parent]
+        k = parent
+    return size + 1
+
+
+@numba.njit(cache=True, inline="always")
+def heap_pop(keys: np.ndarray, vals: np.ndarray, size: int) -> int:
+    """Remove the root (read ``keys[0]``, ``vals[0]`` first); returns the new size."""
+    size -= 1
+    keys[0] = keys[size]
+    vals[0] = vals[size]
+    k = 0
+    while True:
+        left = 2 * k + 1
+        if left >= size:
+            break
+        child = left
+        if left + 1 < size and keys[left + 1] < keys[left]:
+            child = left + 1
+        if keys[k] <= keys[child]:
+            break
+        keys[child], keys[k] = keys[k], keys[child]
+        vals[child], vals[k] = vals[k], vals[child]
+        k = child
+    return size

@@ -1,0 +1,379 @@
+"""navfn (ROS 1 ``navfn/NavfnROS``): a potential field over the costmap, then gradient descent on it.
+
+Costs map as navfn's ``setCostmap``: a cell of cost ``c`` < 253 costs ``COST_NEUTRAL + COST_FACTOR * c``
+(50 + 0.8 c) per cell crossed; inscribed (253) and lethal (254) cells are obstacles; unknown (255) cells
+cost 253 with ``allow_unknown`` (navfn's default) and are obstacles without it. The potential is the
+solution of the Eikonal equation ``|grad P| = cost`` grown from the start (fast marching with the exact
+two-neighbour quadratic update, Dijkstra order, or A* order with ``use_dijkstra: false``), so it
+measures Euclidean path length weighted by cost, not 8-connected steps. The path descends the
+interpolated gradient from the goal in half-cell steps (a grid step to the lowest neighbour next to
+obstacles or where the gradient fails) and is returned start to goal, in metres, in the costmap frame.
+``default_tolerance`` (m): a goal in an obstacle or cut off is replaced by the nearest reachable cell
+within that distance. ``planner_window_x/y``, ``visualize_potential`` and the like are accepted and
+ignored (the last potential stays available as ``planner.potential``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numba
+import numpy as np
+
+from navlab.grid import COST_INSCRIBED, COST_UNKNOWN, Grid
+from navlab.navigation.errors import NavigationError
+from navlab.navigation.planners.common import (
+    check_costmap,
+    check_start,
+    dedupe,
+    heap_pop,
+    heap_push,
+    params_from,
+    pose_cell,
+    to_world,
+)
+
+COST_NEUTRAL = 50.0
+COST_FACTOR = 0.8
+
+
+@dataclass
+class NavfnParams:
+    """``navfn/NavfnROS`` parameters (ROS 1 names and defaults; Nav2's ``use_astar``, ``tolerance`` accepted)."""
+
+    allow_unknown: bool = True
+    default_tolerance: float = 0.0  # m
+    use_dijkstra: bool = True  # false: A* order (navfn's compile-time option, global_planner's parameter)
+    visualize_potential: bool = False
+    planner_window_x: float = 0.0
+    planner_window_y: float = 0.0
+    planner_costmap_publish_frequency: float = 0.0
+    cost_factor: float = COST_FACTOR
+    neutral_cost: float = COST_NEUTRAL
+    lethal_cost: int = COST_INSCRIBED  # costs >= this are obstacles (navfn: COST_OBS_ROS = 253)
+
+    def validate(self, what: str = "navfn") -> None:
+        """Refuse a bad value naming the key."""
+        if not (math.isfinite(self.default_tolerance) and self.default_tolerance >= 0):
+            raise NavigationError(f"{what} parameter default_tolerance: expected >= 0 m, got {self.default_tolerance}")
+        if not (math.isfinite(self.neutral_cost) and self.neutral_cost > 0):
+            raise NavigationError(f"{what} parameter neutral_cost: expected > 0, got {self.neutral_cost}")
+        if not (math.isfinite(self.cost_factor) and self.cost_factor >= 0):
+            raise NavigationError(f"{what} parameter cost_factor: expected >= 0, got {self.cost_factor}")
+        if not 1 <= self.lethal_cost <= COST_UNKNOWN:
+            raise NavigationError(f"{what} parameter lethal_cost: expected 1..255, got {self.lethal_cost}")
+
+
+@dataclass
+class GlobalPlannerParams(NavfnParams):
+    """``global_planner/GlobalPlanner`` parameters (ROS 1 names and defaults); same engine as navfn.
+
+    ``use_quadratic`` (the exact quadratic update is always used), ``use_grid_path`` (must stay false),
+    ``old_navfn_behavior``, ``orientation_mode``, ``outline_map`` and ``publish_potential`` are accepted.
+    """
+
+    cost_factor: float = 3.0
+    use_quadratic: bool = True
+    use_grid_path: bool = False
+    old_navfn_behavior: bool = False
+    orientation_mode: int = 0
+    orientation_window_size: int = 1
+    outline_map: bool = True
+    publish_potential: bool = True
+
+    def validate(self, what: str = "global_planner") -> None:
+        super().validate(what)
+        if self.use_grid_path:
+            raise NavigationError(f"{what} parameter use_grid_path: only false (gradient-descent paths) is "
+                                  "supported, got true")
+
+
+# --- kernels (Numba) -----------------------------------------------------------------------------
+
+
+@numba.njit(cache=True)
+def _propagate(cost: np.ndarray, start: int, goal: int, astar: bool, h_scale: float, stop_at_goal: bool
+               ) -> tuple[np.ndarray, int]:  # fmt: skip
+    """Fast marching from ``start`` over ``cost`` (H, W) per cell (inf = obstacle). Returns the potential
+    (inf where not settled) and the number of settled cells. Stops when ``goal`` settles if ``stop_at_goal``."""
+    h, w = cost.shape
+    n = h * w
+    c = cost.ravel()
+    pot = np.full(n, np.inf)
+    done = np.zeros(n, np.bool_)
+    cap = 4 * n + 8
+    keys = np.empty(cap)
+    vals = np.empty(cap, np.int64)
+    gi, gj = goal % w, goal // w
+    pot[start] = 0.0
+    size = heap_push(keys, vals, 0, 0.0, start)
+    settled = 0
+    while size > 0:
+        k = vals[0]
+        size = heap_pop(keys, vals, size)
+        if done[k]:
+            continue
+        done[k] = True
+        settled += 1
+        if stop_at_goal and k == goal:
+            break
+        ki = k % w
+        kj = k // w
+        for d in range(4):
+            mi = ki
+            mj = kj
+            if d == 0:
+                mi -= 1
+            elif d == 1:
+                mi += 1
+            elif d == 2:
+                mj -= 1
+            else:
+                mj += 1
+            if mi < 0 or mj < 0 or mi >= w or mj >= h:
+                continue
+            m = mj * w + mi
+            if done[m]:
+                continue
+            hc = c[m]
+            if not math.isfinite(hc):
+                continue
+            ta = np.inf
+            if mi > 0 and done[m - 1]:
+                ta = pot[m - 1]
+            if mi < w - 1 and done[m + 1] and pot[m + 1] < ta:
+                ta = pot[m + 1]
+            tb = np.inf
+            if mj > 0 and done[m - w]:
+                tb = pot[m - w]
+            if mj < h - 1 and done[m + w] and pot[m + w] < tb:
+                tb = pot[m + w]
+            if tb < ta:
+                ta, tb = tb, ta
+            diff = tb - ta
+            if diff >= hc:
+                new = ta + hc
+            else:
+                new = 0.5 * (ta + tb + math.sqrt(2.0 * hc * hc - diff * diff))
+            if new < pot[m]:
+                pot[m] = new
+                key = new
+                if astar:
+                    di = mi - gi
+                    dj = mj - gj
+                    key += h_scale * math.sqrt(di * di + dj * dj)
+                if size < cap:
+                    size = heap_push(keys, vals, size, key, m)
+    for k in range(n):
+        if not done[k]:
+            pot[k] = np.inf
+    return pot.reshape(h, w), settled
+
+
+@numba.njit(cache=True)
+def _interp(pot: np.ndarray, u: float, v: float) -> float:
+    """Bilinear potential at centre coordinates (u, v); inf if a corner is unsettled or off the grid."""
+    h, w = pot.shape
+    i0 = math.floor(u)
+    j0 = math.floor(v)
+    if i0 < 0 or j0 < 0 or i0 + 1 >= w or j0 + 1 >= h:
+        return np.inf
+    fu = u - i0
+    fv = v - j0
+    a = pot[j0, i0]
+    b = pot[j0, i0 + 1]
+    c = pot[j0 + 1, i0]
+    d = pot[j0 + 1, i0 + 1]
+    return (a * (1 - fu) + b * fu) * (1 - fv) + (c * (1 - fu) + d * fu) * fv
+
+
+@numba.njit(cache=True)
+def _gradient(pot: np.ndarray, u: float, v: float) -> tuple[float, float, bool]:
+    """Bilinear interpolation of central-difference gradients at (u, v); ok False near unsettled cells."""
+    h, w = pot.shape
+    i0 = math.floor(u)
+    j0 = math.floor(v)
+    if i0 < 1 or j0 < 1 or i0 + 2 >= w or j0 + 2 >= h:
+        return 0.0, 0.0, False
+    for jj in range(j0 - 1, j0 + 3):
+        for ii in range(i0 - 1, i0 + 3):
+            if not math.isfinite(pot[jj, ii]):
+                return 0.0, 0.0, False
+    fu = u - i0
+    fv = v - j0
+    gx = 0.0
+    gy = 0.0
+    for dj in range(2):
+        for di in range(2):
+            wgt = (fu if di else 1 - fu) * (fv if dj else 1 - fv)
+            i = i0 + di
+            j = j0 + dj
+            gx += wgt * 0.5 * (pot[j, i + 1] - pot[j, i - 1])
+            gy += wgt * 0.5 * (pot[j + 1, i] - pot[j - 1, i])
+    return gx, gy, True
+
+
+@numba.njit(cache=True)
+def _descend(pot: np.ndarray, u: float, v: float, tu: float, tv: float, step: float) -> tuple[np.ndarray, bool]:
+    """Gradient descent on ``pot`` from (u, v) to the target (tu, tv) (centre coordinates) in ``step``-cell
+    steps; a grid step to the lowest 8-neighbour where the gradient is unusable. The potential strictly
+    decreases along the way, so the walk ends. Returns the points visited (M, 2) and whether it arrived."""
+    h, w = pot.shape
+    cap = 4 * (h * w) + 16
+    out = np.empty((cap, 2))
+    out[0, 0] = u
+    out[0, 1] = v
+    m = 1
+    ci = math.floor(u + 0.5)
+    cj = math.floor(v + 0.5)
+    cur = _interp(pot, u, v)
+    if not math.isfinite(cur):
+        cur = pot[cj, ci]
+    while m < cap - 1:
+        if (u - tu) ** 2 + (v - tv) ** 2 <= 1.0:
+            return out[:m], True
+        gx, gy, ok = _gradient(pot, u, v)
+        norm = math.sqrt(gx * gx + gy * gy)
+        moved = False
+        if ok and norm > 0.0:
+            nu = u - step * gx / norm
+            nv = v - step * gy / norm
+            val = _interp(pot, nu, nv)
+            if val < cur:
+                u, v, cur = nu, nv, val
+                moved = True
+        if not moved:
+            ci = math.floor(u + 0.5)
+            cj = math.floor(v + 0.5)
+            best = pot[cj, ci] if pot[cj, ci] < cur else cur
+            bi, bj = -1, -1
+            for dj in range(-1, 2):
+                for di in range(-1, 2):
+                    i = ci + di
+                    j = cj + dj
+                    if (di == 0 and dj == 0) or i < 0 or j < 0 or i >= w or j >= h:
+                        continue
+                    if pot[j, i] < best:
+                        best = pot[j, i]
+                        bi, bj = i, j
+            if bi < 0:
+                if pot[cj, ci] < cur:  # snap to the current cell's centre first
+                    bi, bj, best = ci, cj, pot[cj, ci]
+                else:
+                    return out[:m], False
+            u, v, cur = float(bi), float(bj), best
+        out[m, 0] = u
+        out[m, 1] = v
+        m += 1
+    return out[:m], False
+
+
+# --- the planner ---------------------------------------------------------------------------------
+
+
+class NavfnPlanner:
+    """``navfn/NavfnROS`` as a pure planner: :meth:`make_plan` over a costmap ``Grid`` (uint8 costs).
+
+    After a call, ``last_failure`` says why there was no path ("" on success), ``stats`` holds the
+    settled-cell count, and ``potential`` the potential field (H, W; inf where not reached).
+    """
+
+    params_class: type[NavfnParams] = NavfnParams
+    name = "navfn"
+
+    def __init__(self, params: NavfnParams | dict[str, Any] | None = None) -> None:
+        values = dict(params) if isinstance(params, dict) else params
+        if isinstance(values, dict) and "use_astar" in values:  # Nav2 navfn's spelling of the A* option
+            if "use_dijkstra" in values:
+                raise NavigationError(f"{self.name} parameters use_astar and use_dijkstra both set; keep one")
+            values["use_dijkstra"] = not bool(values.pop("use_astar"))
+        self.params = params_from(self.params_class, values, what=self.name,
+                                  aliases={"tolerance": "default_tolerance"})
+        self.params.validate()
+        self.last_failure = ""
+        self.stats: dict[str, int] = {}
+        self.potential: np.ndarray | None = None
+
+    def cell_costs(self, data: np.ndarray) -> np.ndarray:
+        """Per-cell traversal cost (float64; inf = obstacle) from costmap_2d costs, as navfn's ``setCostmap``."""
+        p = self.params
+        ceiling = max(float(p.lethal_cost), p.neutral_cost)  # navfn: COST_OBS - 1 = 253
+        cost = np.minimum(p.neutral_cost + p.cost_factor * data.astype(np.float64), ceiling)
+        obstacle = data >= p.lethal_cost
+        unknown = data == COST_UNKNOWN
+        cost[obstacle] = np.inf
+        if p.allow_unknown:
+            cost[unknown] = ceiling
+        return cost
+
+    def make_plan(self, costmap: Grid, start: tuple[float, float, float], goal: tuple[float, float, float]
+                  ) -> np.ndarray | None:  # fmt: skip
+        """A path (N, 2) in metres from ``start`` to ``goal`` (both included) in the costmap's frame, or None
+        when the goal cannot be reached (``last_failure`` says why). A start outside the map or in a lethal
+        cell, and a goal outside the map, raise ``NavigationError``."""
+        who = self.name
+        data = check_costmap(costmap, who)
+        si, sj, su, sv = pose_cell(costmap, start, "start", who)
+        gi, gj, gu, gv = pose_cell(costmap, goal, "goal", who)
+        check_start(data, si, sj, start, who)
+        self.last_failure = ""
+        cost = self.cell_costs(data)
+        cost[sj, si] = self.params.neutral_cost  # navfn clears the robot's cell
+        _h, w = cost.shape
+        goal_ok = math.isfinite(cost[gj, gi])
+        tol = self.params.default_tolerance
+        pot, settled = _propagate(cost, sj * w + si, gj * w + gi, not self.params.use_dijkstra,
+                                  float(self.params.neutral_cost), goal_ok)
+        self.potential = pot
+        self.stats = {"cells": int(settled)}
+        end_xy = (float(goal[0]), float(goal[1]))
+        eu, ev = gu, gv
+        if not math.isfinite(pot[gj, gi]):
+            best = _nearest_reached(pot, costmap, end_xy, tol)
+            if best is None:
+                why = f"in an obstacle (cost {int(data[gj, gi])})" if not goal_ok else "cut off from the start"
+                extra = f" and no reachable cell within default_tolerance {tol} m" if tol > 0 else ""
+                self.last_failure = f"goal ({end_xy[0]:.3f}, {end_xy[1]:.3f}) is {why}{extra}"
+                return None
+            bi, bj = best
+            eu, ev = float(bi), float(bj)
+            end_xy = tuple(to_world(costmap, np.array([[eu, ev]]))[0])  # type: ignore[assignment]
+        if (si, sj) == (round(eu), round(ev)) and math.hypot(eu - su, ev - sv) <= 1.0:
+            return np.array([[float(start[0]), float(start[1])], list(end_xy)])
+        pts, arrived = _descend(pot, eu, ev, su, sv, 0.5)
+        if not arrived:
+            self.last_failure = f"gradient descent from the goal did not reach the start after {len(pts)} steps"
+            return None
+        path = to_world(costmap, pts[::-1])
+        path = np.vstack([[float(start[0]), float(start[1])], path[:-1], [end_xy]])
+        return dedupe(path)
+
+
+def _nearest_reached(pot: np.ndarray, costmap: Grid, goal_xy: tuple[float, float], tol: float
+                     ) -> tuple[int, int] | None:  # fmt: skip
+    """The reached cell (i, j) nearest to ``goal_xy`` within ``tol`` m (centre distance), or None."""
+    if tol <= 0:
+        return None
+    res = costmap.resolution
+    r = math.ceil(tol / res) + 1
+    c = costmap.world_to_cell(np.array(goal_xy))[0]
+    i0, i1 = max(0, c[0] - r), min(costmap.width, c[0] + r + 1)
+    j0, j1 = max(0, c[1] - r), min(costmap.height, c[1] + r + 1)
+    jj, ii = np.mgrid[j0:j1, i0:i1]
+    centres = to_world(costmap, np.stack([ii.ravel(), jj.ravel()], axis=1).astype(np.float64))
+    d = np.hypot(centres[:, 0] - goal_xy[0], centres[:, 1] - goal_xy[1])
+    ok = (d <= tol + 1e-9) & np.isfinite(pot[jj.ravel(), ii.ravel()])
+    if not ok.any():
+        return None
+    k = int(np.argmin(np.where(ok, d, np.inf)))
+    return int(ii.ravel()[k]), int(jj.ravel()[k])
+
+
+class GlobalPlanner(NavfnPlanner):
+    """``global_planner/GlobalPlanner``: navfn's engine with global_planner's parameters (cost_factor 3.0,
+    ``use_dijkstra: false`` for A*)."""
+
+    params_class = GlobalPlannerParams
+    name = "global_planner"
