@@ -19,6 +19,7 @@ BENCHES: dict[str, str] = {
     "amcl": "navlab.localization.bench:run",
     "description": "navlab.description.bench:run",
     "sim": "navlab.sim.bench:run",
+    "planner": "navlab.navigation.bench:run_planner",
 }
 
 

@@ -94,31 +94,51 @@ def dedupe(path: np.ndarray, eps: float = 1e-9) -> np.ndarray:
     return path[keep]
 
 
-# --- a binary min-heap on parallel arrays (Numba) ------------------------------------------------
+# --- an indexed binary min-heap (one entry per cell, decrease-key) ---------------------------------
 
 
 @numba.njit(cache=True, inline="always")
-def heap_push(keys: np.ndarray, vals: np.ndarray, size: int, key: float, val: int) -> int:
-    """Push (key, val); returns the new size. The caller sizes the arrays."""
-    k = size
-    keys[k] = key
-    vals[k] = val
+def _sift_up(keys: np.ndarray, vals: np.ndarray, pos: np.ndarray, k: int) -> None:
+    key = keys[k]
+    val = vals[k]
     while k > 0:
         parent = (k - 1) >> 1
-        if keys[parent] <= keys[k]:
+        if keys[parent] <= key:
             break
-        keys[parent], keys[k] = keys[k], keys[parent]
-        vals[parent], vals[k] = vals[k], vals[parent]
+        keys[k] = keys[parent]
+        vals[k] = vals[parent]
+        pos[vals[k]] = k
         k = parent
-    return size + 1
+    keys[k] = key
+    vals[k] = val
+    pos[val] = k
 
 
 @numba.njit(cache=True, inline="always")
-def heap_pop(keys: np.ndarray, vals: np.ndarray, size: int) -> int:
-    """Remove the root (read ``keys[0]``, ``vals[0]`` first); returns the new size."""
+def iheap_update(keys: np.ndarray, vals: np.ndarray, pos: np.ndarray, size: int, key: float, val: int) -> int:
+    """Insert ``val`` with ``key``, or lower its key if it is queued (``pos[val]`` >= 0); returns the new size.
+    ``pos`` (one int per cell) starts at -1; ``keys``/``vals`` hold at most one entry per cell."""
+    k = pos[val]
+    if k < 0:
+        k = size
+        size += 1
+    elif keys[k] <= key:
+        return size
+    keys[k] = key
+    vals[k] = val
+    _sift_up(keys, vals, pos, k)
+    return size
+
+
+@numba.njit(cache=True, inline="always")
+def iheap_pop(keys: np.ndarray, vals: np.ndarray, pos: np.ndarray, size: int) -> int:
+    """Remove the root (read ``keys[0]``, ``vals[0]`` first; its ``pos`` becomes -2); returns the new size."""
+    pos[vals[0]] = -2
     size -= 1
-    keys[0] = keys[size]
-    vals[0] = vals[size]
+    if size == 0:
+        return 0
+    key = keys[size]
+    val = vals[size]
     k = 0
     while True:
         left = 2 * k + 1
@@ -127,9 +147,13 @@ def heap_pop(keys: np.ndarray, vals: np.ndarray, size: int) -> int:
         child = left
         if left + 1 < size and keys[left + 1] < keys[left]:
             child = left + 1
-        if keys[k] <= keys[child]:
+        if key <= keys[child]:
             break
-        keys[child], keys[k] = keys[k], keys[child]
-        vals[child], vals[k] = vals[k], vals[child]
+        keys[k] = keys[child]
+        vals[k] = vals[child]
+        pos[vals[k]] = k
         k = child
+    keys[k] = key
+    vals[k] = val
+    pos[val] = k
     return size

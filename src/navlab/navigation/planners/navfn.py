@@ -28,8 +28,8 @@ from navlab.navigation.planners.common import (
     check_costmap,
     check_start,
     dedupe,
-    heap_pop,
-    heap_push,
+    iheap_pop,
+    iheap_update,
     params_from,
     pose_cell,
     to_world,
@@ -94,31 +94,33 @@ class GlobalPlannerParams(NavfnParams):
 
 
 @numba.njit(cache=True)
-def _propagate(cost: np.ndarray, start: int, goal: int, astar: bool, h_scale: float, stop_at_goal: bool
-               ) -> tuple[np.ndarray, int]:  # fmt: skip
+def _propagate(cost: np.ndarray, start: int, goal: int, astar: bool, h_scale: float, stop_at_goal: bool,
+               margin: float) -> tuple[np.ndarray, int]:  # fmt: skip
     """Fast marching from ``start`` over ``cost`` (H, W) per cell (inf = obstacle). Returns the potential
-    (inf where not settled) and the number of settled cells. Stops when ``goal`` settles if ``stop_at_goal``."""
+    (exact where settled, an upper bound on the front, inf beyond) and the number of settled cells. With
+    ``stop_at_goal`` it stops once the queue's keys pass the goal's by ``margin``, so the goal sits inside
+    settled cells and the gradient around it is defined."""
     h, w = cost.shape
     n = h * w
     c = cost.ravel()
     pot = np.full(n, np.inf)
-    done = np.zeros(n, np.bool_)
-    cap = 4 * n + 8
-    keys = np.empty(cap)
-    vals = np.empty(cap, np.int64)
+    pos = np.full(n, -1, np.int64)  # heap slot, -1 never queued, -2 settled
+    keys = np.empty(n)
+    vals = np.empty(n, np.int64)
     gi, gj = goal % w, goal // w
     pot[start] = 0.0
-    size = heap_push(keys, vals, 0, 0.0, start)
+    size = iheap_update(keys, vals, pos, 0, 0.0, start)
     settled = 0
+    stop_key = np.inf
     while size > 0:
+        if keys[0] > stop_key:
+            break
         k = vals[0]
-        size = heap_pop(keys, vals, size)
-        if done[k]:
-            continue
-        done[k] = True
+        key_k = keys[0]
+        size = iheap_pop(keys, vals, pos, size)
         settled += 1
         if stop_at_goal and k == goal:
-            break
+            stop_key = key_k + margin
         ki = k % w
         kj = k // w
         for d in range(4):
@@ -135,20 +137,20 @@ def _propagate(cost: np.ndarray, start: int, goal: int, astar: bool, h_scale: fl
             if mi < 0 or mj < 0 or mi >= w or mj >= h:
                 continue
             m = mj * w + mi
-            if done[m]:
+            if pos[m] == -2:
                 continue
             hc = c[m]
             if not math.isfinite(hc):
                 continue
             ta = np.inf
-            if mi > 0 and done[m - 1]:
+            if mi > 0 and pos[m - 1] == -2:
                 ta = pot[m - 1]
-            if mi < w - 1 and done[m + 1] and pot[m + 1] < ta:
+            if mi < w - 1 and pos[m + 1] == -2 and pot[m + 1] < ta:
                 ta = pot[m + 1]
             tb = np.inf
-            if mj > 0 and done[m - w]:
+            if mj > 0 and pos[m - w] == -2:
                 tb = pot[m - w]
-            if mj < h - 1 and done[m + w] and pot[m + w] < tb:
+            if mj < h - 1 and pos[m + w] == -2 and pot[m + w] < tb:
                 tb = pot[m + w]
             if tb < ta:
                 ta, tb = tb, ta
@@ -164,11 +166,7 @@ def _propagate(cost: np.ndarray, start: int, goal: int, astar: bool, h_scale: fl
                     di = mi - gi
                     dj = mj - gj
                     key += h_scale * math.sqrt(di * di + dj * dj)
-                if size < cap:
-                    size = heap_push(keys, vals, size, key, m)
-    for k in range(n):
-        if not done[k]:
-            pot[k] = np.inf
+                size = iheap_update(keys, vals, pos, size, key, m)
     return pot.reshape(h, w), settled
 
 
@@ -190,28 +188,51 @@ def _interp(pot: np.ndarray, u: float, v: float) -> float:
 
 
 @numba.njit(cache=True)
+def _cell_gradient(pot: np.ndarray, i: int, j: int) -> tuple[float, float]:
+    """(dP/di, dP/dj) at a settled cell: central differences, one-sided next to obstacles or unreached cells."""
+    h, w = pot.shape
+    c = pot[j, i]
+    left = pot[j, i - 1] if i > 0 else np.inf
+    right = pot[j, i + 1] if i < w - 1 else np.inf
+    down = pot[j - 1, i] if j > 0 else np.inf
+    up = pot[j + 1, i] if j < h - 1 else np.inf
+    gx = 0.0
+    if math.isfinite(left) and math.isfinite(right):
+        gx = 0.5 * (right - left)
+    elif math.isfinite(right):
+        gx = right - c
+    elif math.isfinite(left):
+        gx = c - left
+    gy = 0.0
+    if math.isfinite(down) and math.isfinite(up):
+        gy = 0.5 * (up - down)
+    elif math.isfinite(up):
+        gy = up - c
+    elif math.isfinite(down):
+        gy = c - down
+    return gx, gy
+
+
+@numba.njit(cache=True)
 def _gradient(pot: np.ndarray, u: float, v: float) -> tuple[float, float, bool]:
-    """Bilinear interpolation of central-difference gradients at (u, v); ok False near unsettled cells."""
+    """Bilinear interpolation of the cell gradients at (u, v); ok False unless all four cells are reached."""
     h, w = pot.shape
     i0 = math.floor(u)
     j0 = math.floor(v)
-    if i0 < 1 or j0 < 1 or i0 + 2 >= w or j0 + 2 >= h:
+    if i0 < 0 or j0 < 0 or i0 + 1 >= w or j0 + 1 >= h:
         return 0.0, 0.0, False
-    for jj in range(j0 - 1, j0 + 3):
-        for ii in range(i0 - 1, i0 + 3):
-            if not math.isfinite(pot[jj, ii]):
-                return 0.0, 0.0, False
     fu = u - i0
     fv = v - j0
     gx = 0.0
     gy = 0.0
     for dj in range(2):
         for di in range(2):
+            if not math.isfinite(pot[j0 + dj, i0 + di]):
+                return 0.0, 0.0, False
+            cx, cy = _cell_gradient(pot, i0 + di, j0 + dj)
             wgt = (fu if di else 1 - fu) * (fv if dj else 1 - fv)
-            i = i0 + di
-            j = j0 + dj
-            gx += wgt * 0.5 * (pot[j, i + 1] - pot[j, i - 1])
-            gy += wgt * 0.5 * (pot[j + 1, i] - pot[j - 1, i])
+            gx += wgt * cx
+            gy += wgt * cy
     return gx, gy, True
 
 
@@ -324,8 +345,11 @@ class NavfnPlanner:
         _h, w = cost.shape
         goal_ok = math.isfinite(cost[gj, gi])
         tol = self.params.default_tolerance
+        # A*'s heuristic: the cheapest cell cost per cell of distance, over sqrt(2) because one quadratic update
+        # can raise the potential by as little as cost / sqrt(2) per step (keeps the heuristic consistent)
+        h_scale = float(self.params.neutral_cost) / math.sqrt(2.0)
         pot, settled = _propagate(cost, sj * w + si, gj * w + gi, not self.params.use_dijkstra,
-                                  float(self.params.neutral_cost), goal_ok)
+                                  h_scale, goal_ok, 4.0 * self.params.neutral_cost)
         self.potential = pot
         self.stats = {"cells": int(settled)}
         end_xy = (float(goal[0]), float(goal[1]))

@@ -1,14 +1,14 @@
 """Theta* (Nav2's ``nav2_theta_star_planner/ThetaStarPlanner``): any-angle A* over the costmap.
 
-A* on the 4- or 8-connected grid (``how_many_corners``) whose expansions try to connect each new cell
-straight to its parent's parent when the segment between their centres has line of sight: every cell
-it touches (an exact traversal, both cells at a corner crossing) is traversable, i.e. costs below 253
-(inscribed) and, unless ``allow_unknown``, not unknown. A segment of length ``L`` (cells) costs
-``L * (w_euc_cost + w_traversal_cost * mean((c / 252)^2))`` over the cells it touches, so paths bend
-toward low cost (unknown cells count as 252); the heuristic is ``w_heuristic_cost * w_euc_cost`` times
-the straight distance. Diagonal steps do not cut obstacle corners. The corner path is resampled at the
-costmap resolution and returned start to goal, in metres, in the costmap frame. Paths are shorter and
-straighter than navfn's through open space.
+A* on the 4- or 8-connected grid (``how_many_corners``); each expansion also tries to join the new cell
+straight to its parent's parent, and keeps that when it is cheaper and the segment between the cell
+centres has line of sight: every cell it touches (an exact traversal, both cells at a corner crossing)
+costs below 253 (inscribed) and, unless ``allow_unknown``, is not unknown. A segment of length ``L``
+(cells) costs ``L * (w_euc_cost + w_traversal_cost * mean((c / 252)^2))`` over the cells it touches, so
+paths bend around costly cells (unknown cells count as 252); the heuristic is ``w_heuristic_cost *
+w_euc_cost`` times the straight distance. Diagonal steps do not cut obstacle corners. The corner path is
+resampled at the costmap resolution and returned start to goal, in metres, in the costmap frame. Paths
+are shorter and straighter than navfn's through open space.
 """
 
 from __future__ import annotations
@@ -27,8 +27,8 @@ from navlab.navigation.planners.common import (
     check_costmap,
     check_start,
     dedupe,
-    heap_pop,
-    heap_push,
+    iheap_pop,
+    iheap_update,
     params_from,
     pose_cell,
     to_world,
@@ -110,23 +110,19 @@ def _theta_star(blocked: np.ndarray, trav: np.ndarray, start: int, goal: int, co
     n = h * w
     g = np.full(n, np.inf)
     parent = np.full(n, -1, np.int64)
-    closed = np.zeros(n, np.bool_)
-    cap = 8 * n + 8
-    keys = np.empty(cap)
-    vals = np.empty(cap, np.int64)
+    pos = np.full(n, -1, np.int64)  # heap slot, -1 never queued, -2 closed
+    keys = np.empty(n)
+    vals = np.empty(n, np.int64)
     gi, gj = goal % w, goal // w
     g[start] = 0.0
     parent[start] = start
-    size = heap_push(keys, vals, 0, 0.0, start)
+    size = iheap_update(keys, vals, pos, 0, 0.0, start)
     expanded = 0
     di8 = (1, -1, 0, 0, 1, 1, -1, -1)
     dj8 = (0, 0, 1, -1, 1, -1, 1, -1)
     while size > 0:
         s = vals[0]
-        size = heap_pop(keys, vals, size)
-        if closed[s]:
-            continue
-        closed[s] = True
+        size = iheap_pop(keys, vals, pos, size)
         expanded += 1
         if s == goal:
             break
@@ -140,28 +136,27 @@ def _theta_star(blocked: np.ndarray, trav: np.ndarray, start: int, goal: int, co
             if d >= 4 and (blocked[sj, ni] or blocked[nj, si]):
                 continue  # no corner cutting
             m = nj * w + ni
-            if closed[m]:
+            if pos[m] == -2:
                 continue
-            best_par = -1
-            best = np.inf
+            # path 1: from s; path 2: straight from s's parent when it has line of sight (the cheaper wins,
+            # since a straight line through costly cells can cost more than the bend around them)
+            length = math.sqrt(di8[d] ** 2 + dj8[d] ** 2)
+            best = g[s] + length * (w_euc + w_trav * 0.5 * (trav[sj, si] + trav[nj, ni]))
+            best_par = s
             if p != s:
                 mean = _line(blocked, trav, p, m, w)
                 if mean >= 0.0:
                     pi, pj = p % w, p // w
-                    length = math.sqrt((ni - pi) ** 2 + (nj - pj) ** 2)
-                    best = g[p] + length * (w_euc + w_trav * mean)
-                    best_par = p
-            if best_par < 0:
-                length = math.sqrt(di8[d] ** 2 + dj8[d] ** 2)
-                best = g[s] + length * (w_euc + w_trav * 0.5 * (trav[sj, si] + trav[nj, ni]))
-                best_par = s
+                    via = g[p] + math.sqrt((ni - pi) ** 2 + (nj - pj) ** 2) * (w_euc + w_trav * mean)
+                    if via <= best * (1.0 + 1e-9):  # ties (collinear cells) go to the older parent
+                        best = via
+                        best_par = p
             if best < g[m]:
                 g[m] = best
                 parent[m] = best_par
                 hx = ni - gi
                 hy = nj - gj
-                if size < cap:
-                    size = heap_push(keys, vals, size, best + w_heur * w_euc * math.sqrt(hx * hx + hy * hy), m)
+                size = iheap_update(keys, vals, pos, size, best + w_heur * w_euc * math.sqrt(hx * hx + hy * hy), m)
     return parent, expanded
 
 
