@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 
@@ -112,6 +114,22 @@ def test_plugins_list_ros1_and_nav2_styles() -> None:
     assert nav2.params.sources["scan"].obstacle_range == 2.0
     infl = nav2.layer("inflation_layer")
     assert isinstance(infl, InflationLayer) and infl.params.inflation_radius == 0.4 and infl.params.inflate_unknown
+
+
+def test_the_ros_wiki_tutorial_files_load() -> None:
+    common = {"obstacle_range": 2.5, "raytrace_range": 3.0, "footprint": "[[0.2, 0.15], [0.2, -0.15], [-0.2, -0.15], "
+              "[-0.2, 0.15]]", "inflation_radius": 0.55, "map_type": "voxel", "z_voxels": 2, "origin_z": 0.0,
+              "observation_sources": "laser_scan_sensor",
+              "laser_scan_sensor": {"sensor_frame": "laser", "data_type": "LaserScan", "topic": "scan",
+                                    "marking": True, "clearing": True}}
+    local = LayeredCostmap({**common, "global_frame": "odom", "robot_base_frame": "base_link", "update_frequency": 5.0,
+                            "publish_frequency": 2.0, "static_map": False, "rolling_window": True, "width": 6.0,
+                            "height": 6.0, "resolution": 0.05})
+    assert local.costmap.data.shape == (120, 120)
+    assert local.inscribed_radius == pytest.approx(0.16)  # padded by footprint_padding 0.01
+    assert local.circumscribed_radius == pytest.approx(math.hypot(0.21, 0.16))
+    glob = LayeredCostmap({**common, "global_frame": "/map", "robot_base_frame": "base_link", "static_map": True})
+    assert glob.costmap.frame_id == "map" and isinstance(glob.layers[0], StaticLayer)
 
 
 def test_track_unknown_space_fills_unknown() -> None:

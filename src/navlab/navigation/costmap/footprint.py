@@ -56,12 +56,12 @@ class Footprint:
 
         The cell holding the pose is always included (a footprint smaller than a cell still covers one).
         """
+        if grid.origin[2] != 0.0:
+            raise NavigationError(f"footprint cells need a costmap with origin yaw 0, got {grid.origin[2]}")
         x, y, _ = pose
         reach = self.circumscribed_radius
         lo = grid.world_to_cell(np.array([[x - reach, y - reach]]))[0]
         hi = grid.world_to_cell(np.array([[x + reach, y + reach]]))[0]
-        if grid.origin[2] != 0.0:
-            raise NavigationError(f"footprint cells need a costmap with origin yaw 0, got {grid.origin[2]}")
         ii, jj = np.meshgrid(np.arange(lo[0], hi[0] + 1), np.arange(lo[1], hi[1] + 1))
         ij = np.stack([ii.ravel(), jj.ravel()], axis=1)
         centres = grid.cell_to_world(ij)

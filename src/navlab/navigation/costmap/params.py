@@ -33,7 +33,10 @@ ALIASES: dict[str, str] = {
 }
 # accepted and ignored (runtime or Nav2-only settings with no effect on the pure layers)
 IGNORED: frozenset[str] = frozenset({"use_sim_time", "filters", "plugin", "map_subscribe_transient_local",
-                                     "initial_transform_timeout", "clearable_layers", "footprint_topic"})
+                                     "initial_transform_timeout", "clearable_layers", "footprint_topic",
+                                     # map_type: voxel's 3-D settings (a planar lidar fills one layer)
+                                     "origin_z", "z_resolution", "z_voxels", "unknown_threshold",
+                                     "mark_threshold", "publish_voxel_map"})
 
 
 @dataclass

@@ -229,4 +229,6 @@ def densify(path: np.ndarray, spacing: float) -> np.ndarray:
         k = max(1, math.ceil(float(np.hypot(*(b - a))) / spacing))
         t = np.arange(1, k + 1)[:, None] / k
         out.append(a + t * (b - a))
-    return np.vstack(out)
+    dense = np.vstack(out)
+    dense[-1] = path[-1]  # exactly the goal, not a rounded interpolation
+    return dense
