@@ -1,9 +1,12 @@
 """Navigation as ROS 1 move_base has it: costmap_2d layers, global planners (navfn, Theta*), controllers.
 
 Subpackages: ``costmap`` (layers and the layered master grid), ``planners`` (global planners),
-``controllers`` (local planners). Everything here is pure (numpy in, numpy out); nodes come later.
+``controllers`` (local planners). The algorithms are pure (numpy in, numpy out); nodes wire them to topics.
 """
 
+from navlab.navigation.costmap import LayeredCostmap, costmap_params
 from navlab.navigation.errors import NavigationError
+from navlab.navigation.planners import NavfnPlanner, ThetaStarPlanner, make_planner, path_length
 
-__all__ = ["NavigationError"]
+__all__ = ["LayeredCostmap", "NavfnPlanner", "NavigationError", "ThetaStarPlanner", "costmap_params",
+           "make_planner", "path_length"]
