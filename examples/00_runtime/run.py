@@ -16,7 +16,7 @@ class Counter(Node):
     """Publishes a growing number on /count at 5 Hz of simulated time."""
 
     def __init__(self, executor: Executor) -> None:
-        super().__init__("counter", executor)
+        super().__init__(executor, name="counter")
         self.n = 0
         self.pub = self.create_publisher(msgs.Float64, "count")
         self.create_timer(0.2, self.tick)
@@ -28,7 +28,7 @@ class Counter(Node):
 
 ex = Executor(seed=0, rate=0.0)  # rate=0: as fast as the CPU allows; rate=1.0 would be real time
 Counter(ex)
-printer = Node("printer", ex)
+printer = Node(ex, name="printer")
 printer.create_subscription(
     msgs.Float64, "count", lambda m: printer.get_logger().warning("heard %s", m.data)
 )

@@ -35,7 +35,7 @@ class SquareDriver(Node):
     """Open-loop teleop: forward SIDE metres, turn 90 degrees left, four times (10 Hz cmd_vel)."""
 
     def __init__(self, executor: Executor) -> None:
-        super().__init__("square_driver", executor)
+        super().__init__(executor, name="square_driver")
         self.cmd = self.create_publisher(msgs.Twist, "cmd_vel", 10)
         leg, turn = SIDE / SPEED, (math.pi / 2) / TURN_RATE
         self.plan = [(leg, SPEED, 0.0), (turn, 0.0, TURN_RATE)] * 4  # (seconds, v, w)
@@ -53,7 +53,7 @@ class Recorder(Node):
     """Keeps the ground-truth and odometry paths and the last scan."""
 
     def __init__(self, executor: Executor) -> None:
-        super().__init__("recorder", executor)
+        super().__init__(executor, name="recorder")
         self.truth, self.odom, self.scan = [], [], None
         self.create_subscription(msgs.Odometry, "/ground_truth/odom", self.on_truth)
         self.create_subscription(msgs.Odometry, "odom", self.on_odom)

@@ -2,9 +2,10 @@
 
 A parameter file picks an algorithm by its ROS plugin name (``base_global_planner: navfn/NavfnROS``,
 ``base_local_planner: dwa_local_planner/DWAPlannerROS``, a costmap ``plugins:`` entry's ``type:
-costmap_2d::InflationLayer``, slam_gmapping's ``mode``, amcl's ``laser_model_type``). The registry maps
-that name to ``"module:Class"``; :func:`load_plugin` imports it on first use. Adding an algorithm is one
-new file and one line here. This module is a leaf: it imports nothing of navlab but errors and types.
+costmap_2d::InflationLayer``, slam_gmapping's ``mode``, amcl's ``odom_model_type`` and
+``laser_model_type``). The registry maps that name to ``"module:Class"``; :func:`load_plugin` imports
+it on first use. Adding an algorithm is one new file and one line here. This module is a leaf: it
+imports nothing of navlab but errors and types.
 
 Every implementation is pure (numpy in, numpy out; no topics, no clock); its node holds parameters.
 Units: metres, radians, seconds; poses ``(x, y, yaw)``; paths ``(N, 2)`` or ``(N, 3)`` arrays in the
@@ -34,22 +35,62 @@ class PluginError(NavlabError):
 
 @runtime_checkable
 class SlamBackend(Protocol):
-    """Online SLAM over laser scans: slam_gmapping's ``mode`` (``gmapping``, ``graph``)."""
+    """Online SLAM over laser scans: slam_gmapping's ``mode`` (``gmapping``, ``graph``).
+
+    Built as ``cls(params, *, rng)``: ``params`` maps slam_gmapping parameter names to values (a mode's
+    own parameters under its name, ``graph.voxel``); names left out take their defaults, which
+    :meth:`parameters` lists for the node to declare. ``rng`` drives every random draw.
+    """
+
+    params: Any  # the mode's parameter object (e.g. ``GMappingParams``)
+
+    @classmethod
+    def parameters(cls) -> dict[str, Any]:
+        """Every parameter name the mode reads, with its ROS default."""
+        ...
 
     def add_scan(
-        self, ranges: np.ndarray, angle_min: float, angle_increment: float, odom_laser: np.ndarray
-    ) -> np.ndarray:
-        """Process one scan (ranges m; inf = no return) taken with the laser at ``odom_laser`` (x, y, yaw in
-        the odom frame); returns the laser's pose in the map frame."""
+        self,
+        ranges: np.ndarray,
+        angle_min: float,
+        angle_increment: float,
+        odom_laser: np.ndarray,
+        *,
+        range_max: float | None = None,
+        stamp_ns: int | None = None,
+    ) -> np.ndarray | None:
+        """Process one scan (ranges m; inf/NaN = no return) taken with the laser at ``odom_laser`` (x, y, yaw
+        in the odom frame) at ``stamp_ns`` (ns; None for a log's scans); returns the laser's pose in the map
+        frame, or None when the scan only moved the estimate and did not update the map. ``range_max``:
+        the sensor's (m), or None to take the ranges as they are."""
+        ...
+
+    def due(self, odom_laser: np.ndarray, stamp_ns: int) -> bool:
+        """Whether a node should hand this scan to :meth:`add_scan` (slam_gmapping's linearUpdate,
+        angularUpdate, temporalUpdate gating for modes that do not gate in ``add_scan`` themselves)."""
+        ...
+
+    def trajectory(self) -> np.ndarray:
+        """Laser poses (M, 3) in the map frame now, one per scan for which ``add_scan`` returned a pose."""
+        ...
+
+    def current_map(self, *, frame_id: str = "map") -> Grid | None:
+        """The occupancy grid now (``GridMap``), or None before the first scan."""
         ...
 
     def finish(self) -> np.ndarray:
-        """Final laser poses (N, 3) in the map frame, one per processed scan."""
+        """Final laser poses (N, 3) in the map frame, one per ``add_scan`` call."""
+        ...
+
+    def stats(self) -> dict[str, int]:
+        """Counters for a run's summary (updates, resamples, loop closures, ...)."""
         ...
 
 
 class MotionModel(Protocol):
-    """AMCL's ``odom_model_type``: move particles (N, 3) in place by an odometry step."""
+    """AMCL's ``odom_model_type``: move particles (N, 3; x, y m, yaw rad; map frame) in place by the
+    odometry step from ``odom_old`` to ``odom_new`` (robot poses in the odom frame), with noise
+    ``alphas`` = odom_alpha1..4 drawn from ``rng``."""
 
     def __call__(
         self,
@@ -59,6 +100,18 @@ class MotionModel(Protocol):
         alphas: tuple[float, float, float, float],
         rng: np.random.Generator,
     ) -> None: ...
+
+
+class LaserModel(Protocol):
+    """AMCL's ``laser_model_type``: a score per particle for one scan (ROS amcl's ``1 + sum(pz**3)``).
+
+    Built as ``cls(field, params)`` from the map's ``MapField`` and ``AmclParams``.
+    """
+
+    def weights(self, particles: np.ndarray, beams: Any, laser_pose: tuple[float, float, float]) -> np.ndarray:
+        """Scores (N,) of particles (N, 3; map frame) for the chosen ``beams`` (``models.Beams``) of a laser
+        at ``laser_pose`` (x, y, yaw in the robot base frame)."""
+        ...
 
 
 class CostmapLayer(Protocol):
@@ -99,15 +152,15 @@ class Controller(Protocol):
 # kind -> {ROS plugin name: "module:attribute"}
 REGISTRY: dict[str, dict[str, str]] = {
     "slam_backend": {
-        "gmapping": "navlab.mapping.gmapping:GMapping",
-        "graph": "navlab.mapping.graph_slam:GraphSlam",
+        "gmapping": "navlab.mapping.backends:GMappingBackend",
+        "graph": "navlab.mapping.backends:GraphBackend",
     },
     "motion_model": {
         "diff": "navlab.localization.models:sample_motion_diff",
         "diff-corrected": "navlab.localization.models:sample_motion_diff_corrected",
         "nav2_amcl::DifferentialMotionModel": "navlab.localization.models:sample_motion_diff_corrected",
         "differential": "navlab.localization.models:sample_motion_diff_corrected",
-    },
+    },  # ROS 1 amcl's omni models (omni, omni-corrected; Nav2 OmniMotionModel) are not provided
     "laser_model": {
         "likelihood_field": "navlab.localization.models:LikelihoodFieldModel",
         "beam": "navlab.localization.models:BeamModel",

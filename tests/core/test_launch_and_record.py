@@ -63,7 +63,7 @@ def test_launch_errors(tmp_path):
 
 def test_recording_round_trip(tmp_path):
     ex = Executor(seed=3)
-    node = Node("odom_pub", ex)
+    node = Node(ex, name="odom_pub")
     pub = node.create_publisher(msgs.Odometry, "odom")
     scan_pub = node.create_publisher(msgs.LaserScan, "scan")
     sent = []
@@ -104,10 +104,10 @@ def test_recording_round_trip(tmp_path):
 
 def test_recording_keeps_latched_messages_published_before_it_started(tmp_path):
     ex = Executor()
-    node = Node("map_server", ex)
+    node = Node(ex, name="map_server")
     node.create_publisher(msgs.String, "map", latched=True).publish(msgs.String(data="the map"))
     node.send_static_transform(msgs.transform_stamped(0, "chassis", "laser", 0.1, 0.0, 0.0))
-    Node("robot_state_publisher", ex).send_static_transform(msgs.transform_stamped(0, "chassis", "imu", 0, 0, 0))
+    Node(ex, name="robot_state_publisher").send_static_transform(msgs.transform_stamped(0, "chassis", "imu", 0, 0, 0))
     with Recorder(ex, tmp_path / "bag"):
         ex.run(0.5)
     got = list(read_bag(tmp_path / "bag"))

@@ -28,7 +28,7 @@ controller_server:
 
 class Planner(Node):
     def __init__(self, ex: Executor, **kw):
-        super().__init__("move_base", ex, **kw)
+        super().__init__(ex, name="move_base", **kw)
         self.freq = self.declare_parameter("controller_frequency", 20.0)
         self.max_vel = self.declare_parameter("TrajectoryPlannerROS/max_vel_x", 0.5)
         self.min_vel = self.declare_parameter("TrajectoryPlannerROS.min_vel_x", 0.1)

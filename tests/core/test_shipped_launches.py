@@ -7,6 +7,7 @@ from dataclasses import fields
 
 import numpy as np
 import pytest
+from navlab.localization.run import true_map
 from scipy import ndimage
 
 from navlab import msgs
@@ -14,7 +15,6 @@ from navlab.cli import main
 from navlab.core import LaunchError, Node
 from navlab.core.launch import resources_dir, start
 from navlab.core.params import load_params
-from navlab.localization.run import true_map
 from navlab.mapping import GridMap, save_map
 from navlab.mapping.gmapping import GMappingParams
 from navlab.mapping.teleop import RouteFollower
@@ -25,7 +25,7 @@ class _Recorder(Node):
     """Keeps the latest map, every amcl_pose and the latest true pose."""
 
     def __init__(self, executor) -> None:
-        super().__init__("test_recorder", executor)
+        super().__init__(executor, name="test_recorder")
         self.maps: list = []
         self.amcl: list = []
         self.truth: tuple[float, float, float] | None = None

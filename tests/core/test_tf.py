@@ -59,7 +59,7 @@ def test_disconnected_frames():
 
 def test_executor_feeds_tf_from_topics():
     ex = Executor()
-    node = Node("pub", ex)
+    node = Node(ex, name="pub")
     node.send_static_transform(msgs.transform_stamped(0, "chassis", "laser", 0.0, 0.0, 0.0, 0.06))
     node.create_timer(0.1, lambda: node.send_transform(msgs.transform_stamped(ex.now_ns, "odom", "chassis",
                                                                                 ex.now_ns / 1e9, 0.0, 0.0)))

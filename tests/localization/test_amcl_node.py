@@ -13,14 +13,16 @@ from navlab import msgs
 from navlab.core import Executor, Node, ParameterError
 from navlab.grid import GridMap
 from navlab.localization.amcl_node import Amcl
+from navlab.localization.errors import LocalizationError
+from navlab.localization.models import sample_motion_diff_corrected
 from navlab.localization.synthetic import room_grid
 
 
 class FakeRobot(Node):
     """Drives the synthetic route at 10 Hz: publishes tf odom→base_link, base_link→laser and scans."""
 
-    def __init__(self, executor: Executor, truth: list, odo: list) -> None:
-        super().__init__("fake_robot", executor)
+    def __init__(self, executor: Executor, *, name: str = "fake_robot", truth: list, odo: list) -> None:
+        super().__init__(executor, name=name)
         self.truth, self.odo, self.k = truth, odo, 0
         self.field = room_field()
         self.scan_rng = np.random.default_rng(0)
@@ -54,8 +56,8 @@ def _setup(params: dict[str, Any], n: int = 300, seed: int = 0) -> tuple[Executo
     odo = odometry(truth, np.random.default_rng(1), start=(0.5, -0.3, 0.2))
     got: dict[str, list] = {"pose": [], "tf": []}
     amcl = Amcl(ex, parameters=params)
-    robot = FakeRobot(ex, truth, odo)
-    probe = Node("probe", ex)
+    robot = FakeRobot(ex, truth=truth, odo=odo)
+    probe = Node(ex, name="probe")
     probe.create_subscription(msgs.PoseWithCovarianceStamped, "amcl_pose", got["pose"].append)
     probe.create_subscription(msgs.TFMessage, "/tf", lambda m: got["tf"].extend(
         t for t in m.transforms if t.child_frame_id == "odom"))
@@ -132,7 +134,7 @@ def test_bad_initial_pose_is_refused_and_all_inf_scans_do_not_update() -> None:
 def test_map_without_free_cells_is_refused_and_unknown_parameters_are_named() -> None:
     ex = Executor(seed=0)
     amcl = Amcl(ex)
-    probe = Node("probe", ex)
+    probe = Node(ex, name="probe")
     probe.create_publisher(msgs.OccupancyGrid, "map", latched=True).publish(
         _map_msg(np.full((50, 50), 100, dtype=np.int8)))
     ex.run(0.1)
@@ -142,4 +144,8 @@ def test_map_without_free_cells_is_refused_and_unknown_parameters_are_named() ->
         Amcl(Executor(), parameters={"laser_z_hitt": 0.5})
     nav2 = Amcl(Executor(), parameters={"z_hit": 0.5, "max_beams": 60, "robot_model_type": "differential"})
     assert nav2.params.laser_z_hit == 0.5 and nav2.params.laser_max_beams == 60
-    assert nav2.params.odom_model_type == "diff-corrected"
+    assert nav2.params.motion_model() is sample_motion_diff_corrected  # Nav2's name for ROS's diff-corrected
+    with pytest.raises(LocalizationError, match=r"odom_model_type 'dif' \(did you mean 'diff'\?"):
+        Amcl(Executor(), parameters={"odom_model_type": "dif"})
+    with pytest.raises(LocalizationError, match=r"laser_model_type 'beams' \(did you mean 'beam'\?"):
+        Amcl(Executor(), parameters={"laser_model_type": "beams"})

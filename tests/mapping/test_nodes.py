@@ -17,7 +17,7 @@ from navlab.mapping.slam_node import SlamGMapping
 
 class _Listener(Node):
     def __init__(self, executor: Executor) -> None:
-        super().__init__("listener", executor)
+        super().__init__(executor, name="listener")
         self.maps: list = []
         self.paths: list = []
         self.create_subscription(msgs.OccupancyGrid, "/map", self.maps.append, 1)
@@ -30,7 +30,7 @@ class _FakeRobot(Node):
     LASER = (0.1, 0.0, 0.0)  # laser 10 cm ahead of base_link
 
     def __init__(self, executor: Executor, world, gt: np.ndarray, odo: np.ndarray, rng) -> None:
-        super().__init__("fake_robot", executor)
+        super().__init__(executor, name="fake_robot")
         self.world, self.gt, self.odo, self.rng = world, gt, odo, rng
         self.k = 0
         self.scan_pub = self.create_publisher(msgs.LaserScan, "/mybot/laser/scan", 10)

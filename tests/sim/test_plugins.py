@@ -19,7 +19,7 @@ class Probe(Node):
     """Publishes a constant cmd_vel at 10 Hz (until ``stop_at`` s) and keeps what the plugins publish."""
 
     def __init__(self, ex: Executor, v: float, w: float, stop_at: float = math.inf) -> None:
-        super().__init__("probe", ex)
+        super().__init__(ex, name="probe")
         self.v, self.w, self.stop_at = v, w, stop_at
         self.cmd = self.create_publisher(msgs.Twist, "cmd_vel", 10)
         self.scans: list = []

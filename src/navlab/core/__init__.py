@@ -1,10 +1,11 @@
 """The simulated-time runtime: executor, nodes, topics, tf, parameters (see docs/core-api.md)."""
 
 from navlab.core.errors import CoreError, LaunchError, ParameterError, TfError
-from navlab.core.executor import NS_PER_S, Executor, Topic, seconds_to_ns
-from navlab.core.node import Clock, Node, Publisher, Subscription, Timer, resolve_name
+from navlab.core.executor import Executor
+from navlab.core.node import Clock, Node, dataclass_parameters, resolve_name
 from navlab.core.params import load_params, merge_params
-from navlab.core.tf import TfBuffer
+from navlab.core.tf import Pose2, TfBuffer
+from navlab.core.topics import NS_PER_S, Publisher, Subscription, Timer, Topic, seconds_to_ns
 
 __all__ = [
     "NS_PER_S",
@@ -14,12 +15,14 @@ __all__ = [
     "LaunchError",
     "Node",
     "ParameterError",
+    "Pose2",
     "Publisher",
     "Subscription",
     "TfBuffer",
     "TfError",
     "Timer",
     "Topic",
+    "dataclass_parameters",
     "load_params",
     "merge_params",
     "resolve_name",

@@ -15,7 +15,7 @@ class _Relay(Node):
     """Publishes on its own topic at 1 kHz and listens to the next node's topic."""
 
     def __init__(self, executor: Executor, index: int, n: int) -> None:
-        super().__init__(f"relay_{index}", executor)
+        super().__init__(executor, name=f"relay_{index}")
         self.received = 0
         self.pub = self.create_publisher(Float64, f"chain_{index}", 10)
         self.create_subscription(Float64, f"chain_{(index + 1) % n}", self._on_msg, 10)

@@ -15,7 +15,7 @@ class Talker(Node):
     def __init__(
         self, executor: Executor, *, name: str = "talker", parameters: dict[str, Any] | None = None, namespace: str = ""
     ) -> None:
-        super().__init__(name, executor, parameters=parameters, namespace=namespace)
+        super().__init__(executor, name=name, parameters=parameters, namespace=namespace)
         rate = self.declare_parameter("rate", 1.0)
         self.count = 0
         self.pub = self.create_publisher(String, "chatter", 10)
@@ -37,6 +37,6 @@ class Listener(Node):
         parameters: dict[str, Any] | None = None,
         namespace: str = "",
     ) -> None:
-        super().__init__(name, executor, parameters=parameters, namespace=namespace)
+        super().__init__(executor, name=name, parameters=parameters, namespace=namespace)
         self.heard: list[str] = []
         self.create_subscription(String, "chatter", lambda m: self.heard.append(m.data), 10)

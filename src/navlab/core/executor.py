@@ -15,19 +15,16 @@ import zlib
 from collections import deque
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, Protocol
+from typing import Any, Protocol
 
 import numpy as np
 
 from navlab.core.errors import CoreError
 from navlab.core.tf import TfBuffer
+from navlab.core.topics import NS_PER_S, Subscription, Timer, Topic, seconds_to_ns
 from navlab.msgs import TFMessage, type_name
 
-if TYPE_CHECKING:
-    from navlab.core.node import Node, Subscription, Timer
-
-NS_PER_S = 1_000_000_000
+__all__ = ["NS_PER_S", "Executor", "ExecutorNode", "Stepper", "Topic", "seconds_to_ns"]
 
 
 class Stepper(Protocol):
@@ -36,21 +33,12 @@ class Stepper(Protocol):
     def advance_to(self, t_ns: int) -> None: ...
 
 
-@dataclass
-class Topic:
-    """A named topic: its type, who publishes and subscribes, and each latched publisher's last message."""
+class ExecutorNode(Protocol):
+    """What the executor needs of a node (``navlab.core.node.Node`` is one)."""
 
-    name: str
-    msgtype: type
-    publishers: list[str] = field(default_factory=list)
-    subscriptions: list[Subscription] = field(default_factory=list)
-    latched: dict[int, Any] = field(default_factory=dict)  # id(publisher) -> last message
-    count: int = 0
+    fully_qualified_name: str
 
-
-def seconds_to_ns(seconds: float) -> int:
-    """Simulated seconds to integer nanoseconds (rounded)."""
-    return round(seconds * NS_PER_S)
+    def check_parameters(self) -> None: ...
 
 
 class Executor:
@@ -66,7 +54,7 @@ class Executor:
         self.seed = int(seed)
         self.rate = float(rate)
         self.now_ns = 0
-        self.nodes: dict[str, Node] = {}
+        self.nodes: dict[str, Any] = {}  # full name -> Node
         self.topics: dict[str, Topic] = {}
         self.services: dict[str, Callable[[Any], Any]] = {}
         self.tf = TfBuffer(cache_ns=seconds_to_ns(tf_cache_s))
@@ -76,7 +64,7 @@ class Executor:
         self._steppers: list[Stepper] = []
         self._listeners: list[Callable[[str, Any, int], None]] = []
         self._inbox: queue.SimpleQueue[Callable[[], None]] = queue.SimpleQueue()
-        self._construct: dict[str, Any] = {}
+        self._remappings: dict[str, str] = {}  # for nodes constructed inside node_context
         self._stop = False
         self.stopped = False  # whether the last run ended because stop() was called
         self._running = False
@@ -84,7 +72,8 @@ class Executor:
 
     # --- nodes and construction context --------------------------------------------------------
 
-    def _register_node(self, node: Node) -> None:
+    def register_node(self, node: ExecutorNode) -> None:
+        """Add a node under its full name (``Node.__init__`` calls this); a name may be used once."""
         if node.fully_qualified_name in self.nodes:
             raise CoreError(f"a node named {node.fully_qualified_name!r} already exists")
         self.nodes[node.fully_qualified_name] = node
@@ -92,12 +81,16 @@ class Executor:
     @contextmanager
     def node_context(self, *, remappings: dict[str, str] | None = None) -> Iterator[None]:
         """Nodes constructed inside this block get these topic remappings (launch files use it)."""
-        old = self._construct
-        self._construct = {"remappings": dict(remappings or {})}
+        old = self._remappings
+        self._remappings = dict(remappings or {})
         try:
             yield
         finally:
-            self._construct = old
+            self._remappings = old
+
+    def construction_remappings(self) -> dict[str, str]:
+        """The topic remappings (from -> to) for a node constructed now (see :meth:`node_context`)."""
+        return dict(self._remappings)
 
     def make_rng(self, name: str) -> np.random.Generator:
         """A generator seeded from the run's seed and ``name`` (stable across runs and platforms)."""
@@ -125,8 +118,6 @@ class Executor:
         def feed(msg: Any) -> None:
             buf.add_message(msg, static=static)
 
-        from navlab.core.node import Subscription  # local: node imports executor
-
         topic.subscriptions.append(Subscription(topic.name, TFMessage, feed, "/_tf_buffer"))
 
     def publish(self, topic: Topic, msg: Any, *, latch_key: int | None = None) -> None:
@@ -152,6 +143,11 @@ class Executor:
     def remove_listener(self, fn: Callable[[str, Any, int], None]) -> None:
         """Stop calling a listener added with :meth:`add_listener`."""
         self._listeners.remove(fn)
+
+    @property
+    def has_listeners(self) -> bool:
+        """Whether any listener (a recorder, ``topic echo``) sees every message, subscribed or not."""
+        return bool(self._listeners)
 
     def subscribe(self, sub: Subscription, msgtype: type) -> None:
         """Attach a subscription; each latched publisher of the topic hands it its last message at once."""

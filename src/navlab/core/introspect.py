@@ -133,7 +133,7 @@ class IntrospectionServer:
         from navlab.core.node import Node
 
         if self._remote is None:
-            self._remote = Node("navlab_remote", self.executor)
+            self._remote = Node(self.executor, name="navlab_remote")
         for pub in self._remote.publishers:
             if pub.topic_name == topic:
                 return pub

@@ -1,16 +1,33 @@
-"""rclpy-like nodes: publishers, subscriptions, timers, clock, logger, parameters, tf, services."""
+"""rclpy-like nodes: publishers, subscriptions, timers, clock, logger, parameters, tf, services.
+
+Every node class takes ``(executor, *, name=..., parameters=None, namespace="")``; objects a node
+needs besides its parameters (the simulation, for a Gazebo plugin) follow as keyword-only arguments.
+"""
 
 from __future__ import annotations
 
+import dataclasses
 import difflib
 import logging
-from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
-from navlab.core.errors import CoreError, ParameterError
-from navlab.core.executor import Executor, Topic, seconds_to_ns
+from navlab.core.errors import ParameterError
+from navlab.core.executor import Executor
+from navlab.core.tf import Pose2
+from navlab.core.topics import Publisher, Subscription, Timer, seconds_to_ns
 from navlab.msgs import TFMessage, time_from_ns
+
+__all__ = [
+    "Clock",
+    "Node",
+    "Publisher",
+    "Subscription",
+    "Timer",
+    "dataclass_parameters",
+    "flatten_params",
+    "resolve_name",
+]
 
 
 def resolve_name(name: str, namespace: str) -> str:
@@ -19,66 +36,6 @@ def resolve_name(name: str, namespace: str) -> str:
         return name
     ns = namespace.strip("/")
     return f"/{ns}/{name}" if ns else f"/{name}"
-
-
-@dataclass
-class Subscription:
-    """A callback attached to a topic (``node`` is the subscribing node's full name)."""
-
-    topic: str
-    msgtype: type
-    callback: Callable[[Any], None]
-    node: str
-
-
-class Publisher:
-    """Publishes messages of one type on one topic."""
-
-    def __init__(self, executor: Executor, topic: Topic, *, latched: bool) -> None:
-        self._executor = executor
-        self.topic = topic
-        self.latched = latched
-
-    @property
-    def topic_name(self) -> str:
-        """The resolved topic name."""
-        return self.topic.name
-
-    def publish(self, msg: Any) -> None:
-        """Send ``msg`` to every subscriber."""
-        self._executor.publish(self.topic, msg, latch_key=id(self) if self.latched else None)
-
-    def get_subscription_count(self) -> int:
-        """How many subscriptions the topic has."""
-        return len(self.topic.subscriptions)
-
-
-class Timer:
-    """Calls ``callback`` every ``period_ns`` of simulated time, at ``start + k·period``."""
-
-    def __init__(
-        self, executor: Executor, period_ns: int, callback: Callable[[], None], priority: int, start_ns: int
-    ) -> None:
-        if period_ns <= 0:
-            raise CoreError(f"timer period must be > 0 s, got {period_ns / 1e9}")
-        self._executor = executor
-        self.period_ns = period_ns
-        self.callback = callback
-        self.priority = priority
-        self.cancelled = False
-        self._start = start_ns
-        self._k = 1
-        executor.schedule(self, start_ns + period_ns)
-
-    def fire(self) -> None:
-        """Run the callback and schedule the next firing (called by the executor)."""
-        self._k += 1
-        self._executor.schedule(self, self._start + self._k * self.period_ns)
-        self.callback()
-
-    def cancel(self) -> None:
-        """Stop the timer."""
-        self.cancelled = True
 
 
 class Clock:
@@ -122,6 +79,25 @@ def flatten_params(params: dict[str, Any], prefix: str = "") -> dict[str, Any]:
     return out
 
 
+def dataclass_parameters(cls: type, *, prefix: str = "") -> dict[str, Any]:
+    """Parameter names and defaults from a parameters dataclass's fields (``prefix.name`` if a prefix is given).
+
+    The dataclass is where a component writes its ROS names and defaults once; nodes declare from it.
+    """
+    if not dataclasses.is_dataclass(cls):
+        raise ParameterError(f"{cls!r} is not a dataclass of parameters")
+    out: dict[str, Any] = {}
+    for f in dataclasses.fields(cls):
+        if f.default is not dataclasses.MISSING:
+            default = f.default
+        elif f.default_factory is not dataclasses.MISSING:
+            default = f.default_factory()
+        else:
+            raise ParameterError(f"{cls.__name__}.{f.name}: a parameter needs a default")
+        out[f"{prefix}.{f.name}" if prefix else f.name] = default
+    return out
+
+
 def _coerce(name: str, value: Any, default: Any) -> Any:
     """Check ``value`` against the type of ``default`` (ints are accepted for floats)."""
     if default is None or value is None:
@@ -145,9 +121,9 @@ class Node:
 
     def __init__(
         self,
-        name: str,
         executor: Executor,
         *,
+        name: str,
         parameters: dict[str, Any] | None = None,
         namespace: str = "",
     ) -> None:
@@ -155,7 +131,7 @@ class Node:
         self.namespace = "/" + namespace.strip("/") if namespace.strip("/") else ""
         self.fully_qualified_name = f"{self.namespace}/{name}"
         self.executor = executor
-        self.remappings: dict[str, str] = dict(executor._construct.get("remappings", {}))
+        self.remappings: dict[str, str] = executor.construction_remappings()
         self._overrides = flatten_params(parameters or {})
         self._declared: dict[str, Any] = {}
         self._params_checked = False
@@ -168,7 +144,8 @@ class Node:
             logging.getLogger(f"navlab{self.fully_qualified_name.replace('/', '.')}"),
             {"executor": executor, "node": self.fully_qualified_name},
         )
-        executor._register_node(self)
+        self._sensor_poses: dict[tuple[str, str], Pose2] = {}
+        executor.register_node(self)
 
     # --- names -----------------------------------------------------------------------------------
 
@@ -224,6 +201,27 @@ class Node:
                 return pub
         return self.create_publisher(TFMessage, topic, latched=topic == "/tf_static")
 
+    # --- tf ---------------------------------------------------------------------------------------
+
+    def pose_at(self, target: str, source: str, t_ns: int | None) -> Pose2:
+        """(x, y, yaw) of ``source`` in ``target`` at ``t_ns`` (a message's stamp), else the latest.
+
+        Falls back on the latest transform when tf has none at ``t_ns`` yet (a scan stamped just after
+        the last odometry). Raises ``TfError`` when the frames are not connected at all.
+        """
+        return self.executor.tf.lookup_pose2d_or_latest(target, source, t_ns)
+
+    def sensor_pose(self, base_frame: str, sensor_frame: str) -> Pose2:
+        """(x, y, yaw) of a sensor frame mounted on the robot, in ``base_frame``: looked up once, then cached.
+
+        Raises ``TfError`` until the transform is known (robot_state_publisher's static tf).
+        """
+        key = (base_frame, sensor_frame)
+        pose = self._sensor_poses.get(key)
+        if pose is None:
+            pose = self._sensor_poses[key] = self.executor.tf.lookup_pose2d(base_frame, sensor_frame)
+        return pose
+
     # --- clock, logger ---------------------------------------------------------------------------
 
     def get_clock(self) -> Clock:
@@ -254,6 +252,16 @@ class Node:
                 break
         self._declared[key] = value
         return value
+
+    def declare_parameters(
+        self, defaults: Mapping[str, Any], *, aliases: Mapping[str, Sequence[str]] | None = None
+    ) -> dict[str, Any]:
+        """Declare every ``name: default`` (e.g. from :func:`dataclass_parameters`); returns name -> value.
+
+        ``aliases`` maps a name to its other accepted spellings (Nav2's, for a ROS 1 name).
+        """
+        aka = aliases or {}
+        return {k: self.declare_parameter(k, d, aliases=aka.get(k, ())) for k, d in defaults.items()}
 
     def get_parameter(self, name: str) -> Any:
         """Value of a declared parameter."""

@@ -15,6 +15,8 @@ from navlab.core.errors import TfError
 from navlab.geometry import IDENTITY_TF, Tf, compose3, interpolate3, inverse3, yaw_from_quat
 from navlab.msgs import Quaternion, Transform, TransformStamped, Vector3, header, ns_from_time
 
+Pose2 = tuple[float, float, float]  # (x m, y m, yaw rad) of a frame's origin in another frame
+
 
 def tf_from_msg(tr: Any) -> Tf:
     """Tuple form of a ``geometry_msgs/Transform``."""
@@ -185,7 +187,20 @@ class TfBuffer:
             ),
         )
 
-    def lookup_pose2d(self, target: str, source: str, t_ns: int | None = None) -> tuple[float, float, float]:
+    def lookup_pose2d(self, target: str, source: str, t_ns: int | None = None) -> Pose2:
         """(x, y, yaw) of ``source``'s origin in ``target``."""
         tf = self.lookup(target, source, t_ns)
         return tf[0], tf[1], yaw_of(tf)
+
+    def lookup_pose2d_or_latest(self, target: str, source: str, t_ns: int | None) -> Pose2:
+        """(x, y, yaw) of ``source`` in ``target`` at ``t_ns``, else at the latest time tf has.
+
+        The pose "at the scan's stamp" of SLAM, AMCL and the costmaps: a message stamped a little ahead
+        of the newest odometry still gets a pose. Raises the latest lookup's ``TfError`` if both fail.
+        """
+        if t_ns is not None:
+            try:
+                return self.lookup_pose2d(target, source, t_ns)
+            except TfError:
+                pass
+        return self.lookup_pose2d(target, source, None)

@@ -92,7 +92,7 @@ def _cmd_teleop(args: argparse.Namespace) -> int:
         from navlab.core import Node
         from navlab.mapping.teleop import JoyMapping, joystick_thread
 
-        pub = Node("teleop_twist_joy", ex).create_publisher(msgs.Twist, "cmd_vel", 1)
+        pub = Node(ex, name="teleop_twist_joy").create_publisher(msgs.Twist, "cmd_vel", 1)
         joystick_thread(ex, pub, JoyMapping(scale_linear=args.speed, scale_angular=args.turn))
         print("joystick: hold button 0 and move the left stick; Ctrl-C to quit")
     else:

@@ -17,18 +17,26 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, fields
+from typing import Any
 
 import numpy as np
 
 from navlab.geometry import wrap_angle
-from navlab.localization import models, sampling
+from navlab.localization import sampling
 from navlab.localization.errors import LocalizationError
 from navlab.localization.field import MapField
+from navlab.localization.models import Beams
+from navlab.plugins import PluginError, load_plugin
 
 
 @dataclass
 class AmclParams:
-    """ROS 1 amcl's filter, laser and odometry parameters (same names, same defaults)."""
+    """ROS 1 amcl's filter, laser and odometry parameters (same names, same defaults).
+
+    ``odom_model_type`` and ``laser_model_type`` are plugin names (``navlab.plugins`` kinds
+    ``motion_model`` and ``laser_model``; Nav2's spellings such as ``nav2_amcl::DifferentialMotionModel``
+    are registered too).
+    """
 
     min_particles: int = 100
     max_particles: int = 5000
@@ -79,18 +87,29 @@ class AmclParams:
             raise LocalizationError(f"amcl parameter laser_max_beams: expected >= 1, got {self.laser_max_beams}")
         if self.laser_sigma_hit <= 0:
             raise LocalizationError(f"amcl parameter laser_sigma_hit: expected > 0, got {self.laser_sigma_hit}")
-        if self.laser_model_type not in models.LASER_MODELS:
-            raise LocalizationError(f"amcl parameter laser_model_type: expected one of {models.LASER_MODELS}, "
-                                    f"got {self.laser_model_type!r}")
-        if self.odom_model_type not in models.ODOM_MODELS:
-            raise LocalizationError(f"amcl parameter odom_model_type: expected one of {models.ODOM_MODELS}, "
-                                    f"got {self.odom_model_type!r}")
+        self.motion_model()
+        self.laser_model()
         for name in ("recovery_alpha_slow", "recovery_alpha_fast"):
             if not 0.0 <= getattr(self, name) <= 1.0:
                 raise LocalizationError(f"amcl parameter {name}: expected 0..1, got {getattr(self, name)}")
         if self.recovery_alpha_slow > 0 and self.recovery_alpha_fast <= self.recovery_alpha_slow:
             raise LocalizationError("amcl parameters recovery_alpha_fast must exceed recovery_alpha_slow "
                                     f"(got fast={self.recovery_alpha_fast}, slow={self.recovery_alpha_slow})")
+
+    def motion_model(self) -> Any:
+        """The ``odom_model_type`` plugin (a ``MotionModel`` function); an unknown name says "did you mean"."""
+        return _plugin("motion_model", "odom_model_type", self.odom_model_type)
+
+    def laser_model(self) -> Any:
+        """The ``laser_model_type`` plugin class (a ``LaserModel``, built from the map field and these params)."""
+        return _plugin("laser_model", "laser_model_type", self.laser_model_type)
+
+
+def _plugin(kind: str, param: str, name: str) -> Any:
+    try:
+        return load_plugin(kind, name, param=f"amcl parameter {param}")
+    except PluginError as exc:
+        raise LocalizationError(str(exc)) from None
 
 
 @dataclass(frozen=True)
@@ -112,8 +131,8 @@ class Amcl:
         self.params.validate()
         self.field = field
         self.rng = rng
-        self._lut = models.gaussian_lut(self.params.laser_sigma_hit, field.max_dist)
-        self._signed = np.ascontiguousarray(field.signed)
+        self.motion_model = self.params.motion_model()
+        self.laser_model = self.params.laser_model()(field, self.params)
         self.particles = np.zeros((0, 3))
         self.weights = np.zeros(0)
         self.w_slow = 0.0
@@ -174,9 +193,8 @@ class Amcl:
 
     # --- update -----------------------------------------------------------------------------------
 
-    def _beams(self, scan: Scan) -> tuple[np.ndarray, ...] | None:
-        """Chosen beams: (bearings, ranges, hit mask, [range_min, range_max]) or None when no beam has
-        a usable return."""
+    def _beams(self, scan: Scan) -> Beams | None:
+        """The ``laser_max_beams`` beams spread evenly over the scan, or None when none has a usable return."""
         p = self.params
         ranges = np.asarray(scan.ranges, dtype=np.float64)
         n = ranges.shape[0]
@@ -190,29 +208,7 @@ class Amcl:
         hit = np.isfinite(r) & (r >= rmin) & (r < rmax)
         if not hit.any():
             return None
-        return bearings, r, hit, np.array([rmin, rmax])
-
-    def _weigh(self, beams: tuple[np.ndarray, ...], laser_pose: tuple[float, float, float]) -> np.ndarray:
-        p = self.params
-        bearings, r, hit, (_, rmax) = beams
-        grid = self.field.to_grid(self.particles)
-        lx, ly, lyaw = laser_pose
-        if p.laser_model_type == "likelihood_field":
-            a = lyaw + bearings[hit]
-            rr = r[hit]
-            ex = np.ascontiguousarray(lx + rr * np.cos(a))
-            ey = np.ascontiguousarray(ly + rr * np.sin(a))
-            return models.likelihood_field_weights(
-                grid, ex, ey, self._signed, self.field.resolution, self.field.max_dist, self._lut,
-                p.laser_z_hit, p.laser_z_rand, rmax,
-            )
-        keep = ~np.isnan(r)
-        obs = np.where(np.isfinite(r[keep]), np.minimum(r[keep], rmax), rmax)
-        return models.beam_weights(
-            grid, laser_pose, bearings[keep], obs, self.field.occupied, self.field.resolution, rmax,
-            (p.laser_z_hit, p.laser_z_short, p.laser_z_max, p.laser_z_rand),
-            p.laser_sigma_hit, p.laser_lambda_short,
-        )
+        return Beams(bearings, r, hit, float(rmin), float(rmax))
 
     def update(
         self,
@@ -245,14 +241,11 @@ class Amcl:
         if beams is None:
             return False
         if self.odom_ref is not None:  # moved, or a forced update: apply whatever motion there was
-            models.sample_motion_diff(
-                self.particles, self.odom_ref, odom,
-                (p.odom_alpha1, p.odom_alpha2, p.odom_alpha3, p.odom_alpha4), self.rng,
-                corrected=p.odom_model_type == "diff-corrected",
-            )
+            alphas = (p.odom_alpha1, p.odom_alpha2, p.odom_alpha3, p.odom_alpha4)
+            self.motion_model(self.particles, self.odom_ref, odom, alphas, self.rng)
         self.odom_ref = odom
         self._force = False
-        score = self._weigh(beams, laser_pose)
+        score = self.laser_model.weights(self.particles, beams, laser_pose)
         w = self.weights * score
         total = float(w.sum())
         if total > 0 and math.isfinite(total):

@@ -9,52 +9,35 @@ Services: ``global_localization`` and ``request_nomotion_update`` (std_srvs/Empt
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 import numpy as np
 
 from navlab import msgs
-from navlab.core import Executor, Node, TfError
+from navlab.core import Executor, Node, TfError, dataclass_parameters
 from navlab.grid import GridMap
 from navlab.localization import amcl as pf
 from navlab.localization.errors import LocalizationError
 from navlab.localization.field import field_from_map
 from navlab.mapping.errors import MappingError
 
-# ROS 1 name -> (default, Nav2 spellings accepted too). Filter parameters map onto AmclParams.
-_FILTER_PARAMS: dict[str, tuple[Any, tuple[str, ...]]] = {
-    "min_particles": (100, ()),
-    "max_particles": (5000, ()),
-    "kld_err": (0.01, ("pf_err",)),
-    "kld_z": (0.99, ("pf_z",)),
-    "update_min_d": (0.2, ()),
-    "update_min_a": (math.pi / 6.0, ()),
-    "resample_interval": (2, ()),
-    "recovery_alpha_slow": (0.0, ()),
-    "recovery_alpha_fast": (0.0, ()),
-    "selective_resampling": (False, ()),
-    "laser_max_beams": (30, ("max_beams",)),
-    "laser_min_range": (-1.0, ()),
-    "laser_max_range": (-1.0, ()),
-    "laser_z_hit": (0.95, ("z_hit",)),
-    "laser_z_short": (0.1, ("z_short",)),
-    "laser_z_max": (0.05, ("z_max",)),
-    "laser_z_rand": (0.05, ("z_rand",)),
-    "laser_sigma_hit": (0.2, ("sigma_hit",)),
-    "laser_lambda_short": (0.1, ("lambda_short",)),
-    "laser_likelihood_max_dist": (2.0, ()),
-    "laser_model_type": ("likelihood_field", ()),
-    "odom_model_type": ("diff", ("robot_model_type",)),
-    "odom_alpha1": (0.2, ("alpha1",)),
-    "odom_alpha2": (0.2, ("alpha2",)),
-    "odom_alpha3": (0.2, ("alpha3",)),
-    "odom_alpha4": (0.2, ("alpha4",)),
-    "initial_cov_xx": (0.5 * 0.5, ()),
-    "initial_cov_yy": (0.5 * 0.5, ()),
-    "initial_cov_aa": ((math.pi / 12.0) ** 2, ()),
+# Nav2's spellings of ROS 1 amcl's parameters (the names and defaults themselves are AmclParams' fields).
+NAV2_ALIASES: dict[str, tuple[str, ...]] = {
+    "kld_err": ("pf_err",),
+    "kld_z": ("pf_z",),
+    "laser_max_beams": ("max_beams",),
+    "laser_z_hit": ("z_hit",),
+    "laser_z_short": ("z_short",),
+    "laser_z_max": ("z_max",),
+    "laser_z_rand": ("z_rand",),
+    "laser_sigma_hit": ("sigma_hit",),
+    "laser_lambda_short": ("lambda_short",),
+    "odom_model_type": ("robot_model_type",),
+    "odom_alpha1": ("alpha1",),
+    "odom_alpha2": ("alpha2",),
+    "odom_alpha3": ("alpha3",),
+    "odom_alpha4": ("alpha4",),
 }
-_NAV2_MODELS = {"nav2_amcl::DifferentialMotionModel": "diff-corrected", "differential": "diff-corrected"}
 
 
 class Amcl(Node):
@@ -63,9 +46,8 @@ class Amcl(Node):
     def __init__(
         self, executor: Executor, *, name: str = "amcl", parameters: dict[str, Any] | None = None, namespace: str = ""
     ) -> None:
-        super().__init__(name, executor, parameters=parameters, namespace=namespace)
-        values = {k: self.declare_parameter(k, d, aliases=a) for k, (d, a) in _FILTER_PARAMS.items()}
-        values["odom_model_type"] = _NAV2_MODELS.get(values["odom_model_type"], values["odom_model_type"])
+        super().__init__(executor, name=name, parameters=parameters, namespace=namespace)
+        values = self.declare_parameters(dataclass_parameters(pf.AmclParams), aliases=NAV2_ALIASES)
         self.params = pf.AmclParams(**values)
         self.params.validate()
         self.odom_alpha5 = self.declare_parameter("odom_alpha5", 0.2, aliases=("alpha5",))  # omni model only
@@ -88,7 +70,6 @@ class Amcl(Node):
 
         self.filter: pf.Amcl | None = None
         self.last_error: str | None = None
-        self._laser_poses: dict[str, tuple[float, float, float]] = {}
         self._map_to_odom: tuple[float, float, float] | None = None
         self._pending_global = False
         self._odom_failures = 0
@@ -161,39 +142,34 @@ class Amcl(Node):
             self.filter.request_nomotion_update()
         return {}
 
-    def _laser_pose(self, frame: str) -> tuple[float, float, float] | None:
-        if frame not in self._laser_poses:
-            try:
-                self._laser_poses[frame] = self.executor.tf.lookup_pose2d(self.base_frame, frame)
-            except TfError as exc:
-                self.get_logger().warning(f"no transform {self.base_frame} → {frame} for the scan: {exc}")
-                return None
-        return self._laser_poses[frame]
-
-    def _odom_pose(self, t_ns: int) -> tuple[float, float, float] | None:
-        err: Exception | None = None
-        for t in (t_ns, None):
-            try:
-                pose = self.executor.tf.lookup_pose2d(self.odom_frame, self.base_frame, t)
-                self._odom_failures = 0
-                return pose
-            except TfError as exc:
-                err = exc
-        # Expected for the first scans before odometry arrives (debug); a warning when it persists.
-        self._odom_failures += 1
-        log = self.get_logger().warning if self._odom_failures % 200 == 20 else self.get_logger().debug
-        log(f"no odometry {self.odom_frame} → {self.base_frame} yet, skipping the scan: {err}")
-        return None
+    def _poses(self, msg: Any) -> tuple[tuple[float, float, float], tuple[float, float, float]] | None:
+        """(odometry pose at the scan's stamp, laser pose in the base frame), or None (logged) if tf lacks one."""
+        frame = str(msg.header.frame_id).lstrip("/") or self.base_frame
+        try:
+            laser = self.sensor_pose(self.base_frame, frame)
+        except TfError as exc:
+            self.get_logger().warning(f"no transform {self.base_frame} → {frame} for the scan: {exc}")
+            return None
+        try:
+            odom = self.pose_at(self.odom_frame, self.base_frame, msgs.stamp_ns(msg))
+        except TfError as exc:
+            # Expected for the first scans before odometry arrives (debug); a warning when it persists.
+            self._odom_failures += 1
+            log = self.get_logger().warning if self._odom_failures % 200 == 20 else self.get_logger().debug
+            log(f"no odometry {self.odom_frame} → {self.base_frame} yet, skipping the scan: {exc}")
+            return None
+        self._odom_failures = 0
+        return odom, laser
 
     def _on_scan(self, msg: Any) -> None:
         f = self.filter
         if f is None or f.n_particles == 0:
             return
         t_ns = msgs.stamp_ns(msg)
-        laser = self._laser_pose(str(msg.header.frame_id).lstrip("/") or self.base_frame)
-        odom = self._odom_pose(t_ns)
-        if laser is None or odom is None:
+        poses = self._poses(msg)
+        if poses is None:
             return
+        odom, laser = poses
         scan = pf.Scan(
             ranges=np.asarray(msg.ranges, dtype=np.float64),
             angle_min=float(msg.angle_min),
@@ -223,7 +199,7 @@ class Amcl(Node):
             )
         )
         # Building thousands of Pose messages is costly: only when someone listens (a subscriber or a recorder).
-        if not (self.cloud_pub.get_subscription_count() or getattr(self.executor, "_listeners", None)):
+        if not (self.cloud_pub.get_subscription_count() or self.executor.has_listeners):
             return
         self.cloud_pub.publish(
             msgs.PoseArray(

@@ -1,17 +1,20 @@
 """AMCL's motion and sensor models (Probabilistic Robotics ch. 5–6, as in ROS 1 amcl).
 
-Motion: the odometry model in ROS amcl's two differential-drive variants, ``diff`` (ROS's original,
-which passes the variance expression as the standard deviation) and ``diff-corrected`` (square
-root taken, as the book writes it). Sensors: the likelihood-field model and the beam model, each
-returning ROS amcl's per-particle score ``1 + sum(pz**3)`` over the used beams.
+Motion (``odom_model_type``): the odometry model in ROS amcl's two differential-drive variants,
+``diff`` (:func:`sample_motion_diff`, ROS's original, which passes the variance expression as the
+standard deviation) and ``diff-corrected`` (:func:`sample_motion_diff_corrected`, square root taken,
+as the book writes it). Sensors (``laser_model_type``): :class:`LikelihoodFieldModel` and
+:class:`BeamModel`, each returning ROS amcl's per-particle score ``1 + sum(pz**3)`` over the used beams.
+The registry in ``navlab.plugins`` maps the ROS (and Nav2) names to these.
 
-Sensor functions take particle poses in the grid frame (``MapField.to_grid``) and beam endpoints in
-the robot base frame; they are compiled with Numba (one loop over particles × beams).
+The Numba kernels take particle poses in the grid frame (``MapField.to_grid``) and beam endpoints in
+the robot base frame (one loop over particles × beams).
 """
 
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 from numba import njit
@@ -19,8 +22,20 @@ from numba import njit
 from navlab.geometry import wrap_angle
 from navlab.localization.raycast import _cast_one
 
-ODOM_MODELS = ("diff", "diff-corrected")
-LASER_MODELS = ("likelihood_field", "beam")
+if TYPE_CHECKING:
+    from navlab.localization.amcl import AmclParams
+    from navlab.localization.field import MapField
+
+
+class Beams(NamedTuple):
+    """The beams of one scan a laser model scores: bearings (rad, laser frame), ranges (m), which of them
+    returned a usable hit, and the range limits (m) applied."""
+
+    bearings: np.ndarray
+    ranges: np.ndarray
+    hit: np.ndarray
+    range_min: float
+    range_max: float
 
 
 def _angle_diff(a: np.ndarray | float, b: np.ndarray | float) -> np.ndarray:
@@ -69,6 +84,18 @@ def sample_motion_diff(
     particles[:, 0] += trans_hat * np.cos(heading)
     particles[:, 1] += trans_hat * np.sin(heading)
     particles[:, 2] = wrap_angle(heading + rot2_hat)
+
+
+def sample_motion_diff_corrected(
+    particles: np.ndarray,
+    odom_old: tuple[float, float, float],
+    odom_new: tuple[float, float, float],
+    alphas: tuple[float, float, float, float],
+    rng: np.random.Generator,
+) -> None:
+    """ROS amcl's ``diff-corrected`` (Nav2's DifferentialMotionModel): :func:`sample_motion_diff` with the
+    noise standard deviations as Probabilistic Robotics writes them."""
+    sample_motion_diff(particles, odom_old, odom_new, alphas, rng, corrected=True)
 
 
 LUT_SIZE = 4096
@@ -212,3 +239,51 @@ def beam_weights(
         out,
     )
     return out
+
+
+class LikelihoodFieldModel:
+    """``laser_model_type: likelihood_field``: each beam endpoint scored by its distance to the nearest
+    obstacle (Gaussian of ``laser_sigma_hit``, mixed with ``laser_z_rand``); beams without a hit are skipped."""
+
+    def __init__(self, field: MapField, params: AmclParams) -> None:
+        self.field = field
+        self.z_hit = params.laser_z_hit
+        self.z_rand = params.laser_z_rand
+        self._lut = gaussian_lut(params.laser_sigma_hit, field.max_dist)
+        self._signed = np.ascontiguousarray(field.signed)
+
+    def weights(self, particles: np.ndarray, beams: Beams, laser_pose: tuple[float, float, float]) -> np.ndarray:
+        """Scores (N,) of ``particles`` (N, 3; map frame) for ``beams`` of a laser at ``laser_pose`` (base frame)."""
+        lx, ly, lyaw = laser_pose
+        hit = beams.hit
+        a = lyaw + beams.bearings[hit]
+        rr = beams.ranges[hit]
+        ex = np.ascontiguousarray(lx + rr * np.cos(a))
+        ey = np.ascontiguousarray(ly + rr * np.sin(a))
+        f = self.field
+        return likelihood_field_weights(
+            f.to_grid(particles), ex, ey, self._signed, f.resolution, f.max_dist, self._lut,
+            self.z_hit, self.z_rand, beams.range_max,
+        )  # fmt: skip
+
+
+class BeamModel:
+    """``laser_model_type: beam``: each beam's range compared with the range ray-cast in the map (hit, short,
+    max and random components); max-range readings count as readings of ``range_max``."""
+
+    def __init__(self, field: MapField, params: AmclParams) -> None:
+        self.field = field
+        self.z = (params.laser_z_hit, params.laser_z_short, params.laser_z_max, params.laser_z_rand)
+        self.sigma_hit = params.laser_sigma_hit
+        self.lambda_short = params.laser_lambda_short
+
+    def weights(self, particles: np.ndarray, beams: Beams, laser_pose: tuple[float, float, float]) -> np.ndarray:
+        """Scores (N,) of ``particles`` (N, 3; map frame) for ``beams`` of a laser at ``laser_pose`` (base frame)."""
+        r, rmax = beams.ranges, beams.range_max
+        keep = ~np.isnan(r)
+        obs = np.where(np.isfinite(r[keep]), np.minimum(r[keep], rmax), rmax)
+        f = self.field
+        return beam_weights(
+            f.to_grid(particles), laser_pose, beams.bearings[keep], obs, f.occupied, f.resolution, rmax,
+            self.z, self.sigma_hit, self.lambda_short,
+        )  # fmt: skip

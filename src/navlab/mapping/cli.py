@@ -95,12 +95,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--out", required=True, metavar="DIR", help="output directory (created if missing)")
     p.add_argument(
         "--mode",
-        choices=("graph", "gmapping"),
         default="graph",
         help="graph: scan-to-map matching + loop closure + pose-graph optimisation (default); "
         "gmapping: the paper's Rao-Blackwellized particle filter",
     )
-    p.add_argument("--params", metavar="YAML", help="SLAM parameters (GMapping names for gmapping mode)")
+    p.add_argument("--params", metavar="YAML", help="SLAM parameters: slam_gmapping's names (graph mode's own "
+                   "under 'graph:')")
     p.add_argument("--resolution", type=float, default=0.05, help="map resolution in m/cell (default 0.05)")
     p.add_argument("--max-scans", type=int, default=None, help="only the first N scans")
     p.add_argument("--seed", type=int, default=0, help="random seed (gmapping mode; default 0)")

@@ -29,7 +29,7 @@ class Explore(Node):
         parameters: dict[str, Any] | None = None,
         namespace: str = "",
     ) -> None:
-        super().__init__(name, executor, parameters=parameters, namespace=namespace)
+        super().__init__(executor, name=name, parameters=parameters, namespace=namespace)
         self.global_frame = self.declare_parameter("global_frame", "map")
         self.base_frame = self.declare_parameter("robot_base_frame", "chassis")
         self.robot_radius = self.declare_parameter("robot_radius", 0.3)

@@ -22,7 +22,7 @@ class MapServer(Node):
         self, executor: Executor, *, name: str = "map_server", parameters: dict[str, Any] | None = None,
         namespace: str = "",
     ) -> None:  # fmt: skip
-        super().__init__(name, executor, parameters=parameters, namespace=namespace)
+        super().__init__(executor, name=name, parameters=parameters, namespace=namespace)
         self.yaml_filename = self.declare_parameter("yaml_filename", "", aliases=("map", "map_file"))
         self.frame_id = self.declare_parameter("frame_id", "map")
         self.check_parameters()

@@ -15,14 +15,14 @@ from typing import Any
 
 import numpy as np
 
+from navlab.core.node import flatten_params
 from navlab.geometry import compose2, inverse2
 from navlab.grid import GridMap
 from navlab.io.carmen import CarmenLog
 from navlab.mapping.errors import MappingError
 from navlab.mapping.mapfile import save_map
 from navlab.mapping.occupancy import build_map
-
-MODES = ("graph", "gmapping")
+from navlab.plugins import PluginError, SlamBackend, load_plugin
 
 
 @dataclass
@@ -36,17 +36,18 @@ class SlamResult:
     stats: dict[str, Any] = field(default_factory=dict)
 
 
-def make_slam(mode: str, params: dict[str, Any] | None = None, *, seed: int = 0) -> Any:
-    """A SLAM object with ``add_scan(ranges, angle_min, angle_increment, odom_pose)`` and ``finish()``."""
-    if mode == "graph":
-        from navlab.mapping.graph_slam import GraphSlam, GraphSlamParams
+def make_slam(mode: str, params: dict[str, Any] | None = None, *, seed: int = 0) -> SlamBackend:
+    """The ``SlamBackend`` plugin registered as ``mode`` (slam_gmapping's ``mode``: ``gmapping``, ``graph``).
 
-        return GraphSlam(GraphSlamParams.from_dict(params))
-    if mode == "gmapping":
-        from navlab.mapping.gmapping import GMapping, GMappingParams
-
-        return GMapping(GMappingParams.from_dict(params), rng=np.random.default_rng(seed))
-    raise MappingError(f"unknown SLAM mode '{mode}', expected one of {', '.join(MODES)}")
+    ``params``: slam_gmapping's parameter names, as in its YAML file (a mode's own under its name:
+    ``{"graph": {"loop_every": 1}}`` or ``{"graph.loop_every": 1}``). An unknown mode says "did you mean".
+    """
+    try:
+        cls = load_plugin("slam_backend", mode, param="SLAM mode")
+    except PluginError as exc:
+        raise MappingError(str(exc)) from None
+    backend: SlamBackend = cls(flatten_params(params or {}), rng=np.random.default_rng(seed))
+    return backend
 
 
 def run_offline(
@@ -60,7 +61,9 @@ def run_offline(
     max_scans: int | None = None,
     progress: bool = False,
 ) -> SlamResult:
-    """Run SLAM over the log's scans (all, or the first ``max_scans``) and build the final map."""
+    """Run SLAM over the log's scans (all, or the first ``max_scans``) and build the final map.
+
+    Every scan goes to the mode's ``add_scan`` (a node's ``due`` gating is not applied to a log)."""
     from tqdm import tqdm
 
     scans = log.scans[:max_scans] if max_scans else log.scans
@@ -76,10 +79,7 @@ def run_offline(
         max_urange=map_max_urange,
         max_range=min(s.max_range for s in scans),
     )
-    stats = {
-        k: v for k, v in vars(slam).items() if isinstance(v, int) and not isinstance(v, bool) and not k.startswith("_")
-    }
-    return SlamResult(np.array([s.timestamp for s in scans]), robot, laser, grid, stats)
+    return SlamResult(np.array([s.timestamp for s in scans]), robot, laser, grid, slam.stats())
 
 
 def _display_image(grid: GridMap, max_pixels: int = 1200) -> np.ndarray:

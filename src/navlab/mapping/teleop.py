@@ -79,7 +79,7 @@ class TeleopKeyboard(Node):
         parameters: dict[str, Any] | None = None,
         namespace: str = "",
     ) -> None:
-        super().__init__(name, executor, parameters=parameters, namespace=namespace)
+        super().__init__(executor, name=name, parameters=parameters, namespace=namespace)
         self.state = TeleopState(self.declare_parameter("speed", 0.5), self.declare_parameter("turn", 1.0))
         rate = self.declare_parameter("repeat_rate", 10.0)
         self.pub = self.create_publisher(msgs.Twist, "cmd_vel", 1)
@@ -148,7 +148,7 @@ class RouteFollower(Node):
         parameters: dict[str, Any] | None = None,
         namespace: str = "",
     ) -> None:
-        super().__init__(name, executor, parameters=parameters, namespace=namespace)
+        super().__init__(executor, name=name, parameters=parameters, namespace=namespace)
         raw_segments = self.declare_parameter("segments", [])
         self.waypoints = np.array(self.declare_parameter("waypoints", []), dtype=float).reshape(-1, 2)
         self.base_frame = self.declare_parameter("base_frame", "chassis")

@@ -28,7 +28,7 @@ def _rtf(seed: int, seconds: float, **params: Any) -> tuple[float, float, Gazebo
     """(rtf by CPU time, rtf by wall time, the gazebo node) of one run."""
     ex = Executor(seed=seed)
     gazebo = launch_sim(ex, world=WORLD, robot=ROBOT, **params)
-    driver = Node("bench_driver", ex)
+    driver = Node(ex, name="bench_driver")
     cmd = driver.create_publisher(msgs.Twist, "cmd_vel", 10)
     driver.create_timer(0.1, lambda: cmd.publish(msgs.twist(0.3, 0.6)))
     ex.run(1.0)  # warm up (Numba loads its cache, first contacts)

@@ -92,7 +92,7 @@ def _cmd_sim(args: argparse.Namespace) -> int:
     ex = Executor(seed=args.seed, rate=args.rate)
     gazebo = launch_sim(ex, world=args.world, robot=args.robot, pose=(args.x, args.y, args.yaw),
                         timestep=args.timestep)
-    helper = Node("sim_cli", ex)
+    helper = Node(ex, name="sim_cli")
     for model, t in spawns:
         if t <= 0:
             gazebo.spawn(model)

@@ -51,7 +51,7 @@ class GazeboSim(Node):
     def __init__(self, executor: Executor, *, name: str = "gazebo", parameters: dict[str, Any] | None = None,
                  namespace: str = "", robot_model: RobotModel | None = None,
                  world_model: WorldModel | None = None) -> None:
-        super().__init__(name, executor, parameters=parameters, namespace=namespace)
+        super().__init__(executor, name=name, parameters=parameters, namespace=namespace)
         world_name = self.declare_parameter("world", "room")
         robot_name = self.declare_parameter("robot", "mybot")
         pose = (self.declare_parameter("x", 0.0), self.declare_parameter("y", 0.0),
@@ -76,14 +76,17 @@ class GazeboSim(Node):
         if robot.diff_drive is not None:
             if odometry_noise > 0:
                 robot.diff_drive.odometry_noise = odometry_noise
-            self.plugins.append(DiffDrivePlugin(executor, self.sim, robot.diff_drive, namespace=namespace))
-        self.plugins += [LidarPlugin(executor, self.sim, i, namespace=namespace) for i in range(len(robot.lidars))]
-        self.plugins += [ImuPlugin(executor, self.sim, i, namespace=namespace) for i in range(len(robot.imus))]
-        self.plugins.append(JointStatePlugin(executor, self.sim, rate=js_rate, namespace=namespace))
+            self.plugins.append(DiffDrivePlugin(executor, namespace=namespace, sim=self.sim, config=robot.diff_drive))
+        self.plugins += [LidarPlugin(executor, namespace=namespace, sim=self.sim, index=i)
+                         for i in range(len(robot.lidars))]
+        self.plugins += [ImuPlugin(executor, namespace=namespace, sim=self.sim, index=i)
+                         for i in range(len(robot.imus))]
+        self.plugins.append(JointStatePlugin(executor, parameters={"publish_frequency": js_rate}, namespace=namespace,
+                                             sim=self.sim))
         if gt_rate > 0:
             base = robot.diff_drive.robot_base_frame if robot.diff_drive else robot.root_link
-            self.plugins.append(GroundTruthPlugin(executor, self.sim, base_frame=base, rate=gt_rate,
-                                                  namespace=namespace))
+            self.plugins.append(GroundTruthPlugin(executor, parameters={"bodyName": base, "updateRate": gt_rate},
+                                                 namespace=namespace, sim=self.sim))
         if seed >= 0:
             import zlib
 

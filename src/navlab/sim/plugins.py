@@ -2,7 +2,9 @@
 
 Each plugin is a thin node around a :class:`~navlab.sim.simulation.Simulation`: it reads the plugin's
 configuration from the robot description (``RobotModel``), runs on a timer in simulated time, and
-publishes the ROS messages a Gazebo user expects on the topics named in the description.
+publishes the ROS messages a Gazebo user expects on the topics named in the description. Constructors
+follow every node's ``(executor, *, name=..., parameters=None, namespace="")``, then ``sim=`` and what
+picks the plugin's configuration (``config=``, ``index=``).
 """
 
 from __future__ import annotations
@@ -55,9 +57,9 @@ class DiffDrivePlugin(Node):
     true pose — and the tf ``odometry_frame → robot_base_frame``.
     """
 
-    def __init__(self, executor: Executor, sim: Simulation, config: DiffDriveConfig, *,
-                 name: str = "diff_drive", namespace: str = "") -> None:
-        super().__init__(name, executor, namespace=namespace or config.namespace)
+    def __init__(self, executor: Executor, *, name: str = "diff_drive", parameters: dict[str, Any] | None = None,
+                 namespace: str = "", sim: Simulation, config: DiffDriveConfig) -> None:
+        super().__init__(executor, name=name, parameters=parameters, namespace=namespace or config.namespace)
         self.sim = sim
         self.cfg = config
         self.base_link = base_frame_link(sim, config.robot_base_frame)
@@ -142,13 +144,14 @@ class DiffDrivePlugin(Node):
 
 
 class LidarPlugin(Node):
-    """``gazebo_ros_laser``: a ``sensor_msgs/LaserScan`` every ``1/update_rate`` s on the configured topic."""
+    """``gazebo_ros_laser``: a ``sensor_msgs/LaserScan`` every ``1/update_rate`` s on the configured topic,
+    for the robot's lidar number ``index`` (default name: the sensor's name + ``_plugin``)."""
 
-    def __init__(self, executor: Executor, sim: Simulation, index: int, *, name: str = "",
-                 namespace: str = "") -> None:
+    def __init__(self, executor: Executor, *, name: str = "", parameters: dict[str, Any] | None = None,
+                 namespace: str = "", sim: Simulation, index: int) -> None:
         assert sim.robot is not None
         cfg: LidarConfig = sim.robot.lidars[index]
-        super().__init__(name or f"{cfg.name}_plugin", executor, namespace=namespace)
+        super().__init__(executor, name=name or f"{cfg.name}_plugin", parameters=parameters, namespace=namespace)
         self.sim, self.index, self.cfg = sim, index, cfg
         self.frame_id = cfg.frame_id or cfg.link
         n = cfg.samples
@@ -171,13 +174,13 @@ class LidarPlugin(Node):
 
 class ImuPlugin(Node):
     """``gazebo_ros_imu_sensor``: ``sensor_msgs/Imu`` (orientation in world, rates and accelerations in
-    the IMU frame, with the configured noise)."""
+    the IMU frame, with the configured noise) for the robot's IMU number ``index``."""
 
-    def __init__(self, executor: Executor, sim: Simulation, index: int, *, name: str = "",
-                 namespace: str = "") -> None:
+    def __init__(self, executor: Executor, *, name: str = "", parameters: dict[str, Any] | None = None,
+                 namespace: str = "", sim: Simulation, index: int) -> None:
         assert sim.robot is not None
         cfg: ImuConfig = sim.robot.imus[index]
-        super().__init__(name or f"{cfg.name}_plugin", executor, namespace=namespace)
+        super().__init__(executor, name=name or f"{cfg.name}_plugin", parameters=parameters, namespace=namespace)
         self.sim, self.index, self.cfg = sim, index, cfg
         self.frame_id = cfg.frame_id or cfg.link
         self.pub = self.create_publisher(msgs.Imu, cfg.topic, 10)
@@ -200,15 +203,16 @@ class ImuPlugin(Node):
 
 class JointStatePlugin(Node):
     """``gazebo_ros_joint_state_publisher`` + ``robot_state_publisher``: ``/joint_states`` of the moving
-    joints and their tf (parent link → child link) every ``1/rate`` s; fixed joints and sensor frames
-    once, as static tf."""
+    joints and their tf (parent link → child link) every ``1/publish_frequency`` s (Hz, default 30; 0 = none);
+    fixed joints and sensor frames once, as static tf. ``publish_tf`` (default true): the moving joints' tf."""
 
-    def __init__(self, executor: Executor, sim: Simulation, *, rate: float = 30.0, publish_tf: bool = True,
-                 name: str = "robot_state_publisher", namespace: str = "") -> None:
-        super().__init__(name, executor, namespace=namespace)
+    def __init__(self, executor: Executor, *, name: str = "robot_state_publisher",
+                 parameters: dict[str, Any] | None = None, namespace: str = "", sim: Simulation) -> None:
+        super().__init__(executor, name=name, parameters=parameters, namespace=namespace)
         assert sim.robot is not None
         self.sim = sim
-        self.publish_tf = publish_tf
+        rate = float(self.declare_parameter("publish_frequency", 30.0))
+        self.publish_tf = self.declare_parameter("publish_tf", True)
         robot = sim.robot
         self.joints = [j for j in robot.joints if j.name in set(sim.joint_names())]
         self.pub = self.create_publisher(msgs.JointState, "joint_states", 10)
@@ -263,16 +267,22 @@ def static_transforms(sim: Simulation, stamp_ns: int) -> list[Any]:
 
 
 class GroundTruthPlugin(Node):
-    """``libgazebo_ros_p3d``: the true pose and twist of the base link, ``nav_msgs/Odometry`` in ``world``
-    on ``/ground_truth/odom`` (for evaluation only)."""
+    """``libgazebo_ros_p3d``: the true pose and twist of a link, ``nav_msgs/Odometry`` (for evaluation only).
 
-    def __init__(self, executor: Executor, sim: Simulation, *, base_frame: str, rate: float = 50.0,
-                 topic: str = "/ground_truth/odom", frame: str = "world", name: str = "ground_truth",
-                 namespace: str = "") -> None:
-        super().__init__(name, executor, namespace=namespace)
+    Parameters (p3d's): ``bodyName`` (the link; default the robot's root link), ``topicName``
+    (``/ground_truth/odom``), ``frameName`` (``world``), ``updateRate`` (Hz, 50).
+    """
+
+    def __init__(self, executor: Executor, *, name: str = "ground_truth", parameters: dict[str, Any] | None = None,
+                 namespace: str = "", sim: Simulation) -> None:
+        super().__init__(executor, name=name, parameters=parameters, namespace=namespace)
+        assert sim.robot is not None
         self.sim = sim
-        self.frame, self.base_frame = frame, base_frame
-        self.link = base_frame_link(sim, base_frame)
+        self.base_frame = self.declare_parameter("bodyName", sim.robot.root_link)
+        topic = self.declare_parameter("topicName", "/ground_truth/odom")
+        self.frame = self.declare_parameter("frameName", "world")
+        rate = float(self.declare_parameter("updateRate", 50.0))
+        self.link = base_frame_link(sim, self.base_frame)
         self.pub = self.create_publisher(msgs.Odometry, topic, 10)
         self.create_timer(1.0 / rate, self.update)
 
