@@ -17,9 +17,10 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
+import navlab
 from navlab import msgs
 from navlab.core import Executor, Node
-from navlab.sim import launch_sim, primitive_model
+from navlab.sim import primitive_model
 
 parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
 parser.add_argument("--out", default="drive.png", help="figure of the paths and the last scan")
@@ -69,9 +70,11 @@ class Recorder(Node):
         self.scan = msg
 
 
-ex = Executor(seed=args.seed)
 start = (-0.4, -0.4, 0.0)
-gazebo = launch_sim(ex, world="room_obstacles", robot="mybot", pose=start)
+# the shipped sim launch (like `ros2 launch ... sim.launch.yaml world:=room_obstacles x:=-0.4 y:=-0.4`)
+session = navlab.launch("sim", world="room_obstacles", robot="mybot", x=start[0], y=start[1], seed=args.seed)
+ex = session.executor
+gazebo = session.node("gazebo")
 SquareDriver(ex)
 rec = Recorder(ex)
 

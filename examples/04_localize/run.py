@@ -16,8 +16,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
+from navlab.experiments.localize_run import plot_result, run_localization
 from navlab.localization import Amcl, AmclParams
-from navlab.localization.run import plot_result, run_localization
 from navlab.localization.synthetic import room_field, simulated_scan
 
 OUT = Path("out/examples/04_localize")
@@ -54,6 +54,6 @@ fig.savefig(OUT / "particles.png", dpi=90)
 # --- part 2: the whole stack in the simulator ----------------------------------------------------
 result = run_localization("room_obstacles", global_localization=True, duration=30.0, seed=0,
                           amcl_params={"odom_model_type": "diff-corrected"})
-for key in ("converged_s", "mean_error_m", "mean_yaw_error_deg", "realtime_factor"):
+for key in ("converged_s", "position_error_mean_m", "yaw_error_mean_deg", "rtf"):
     print(f"{key}: {result.summary[key]}")
 print("figure:", plot_result(result, OUT / "localize.png"))

@@ -1,28 +1,25 @@
 """05 — the paper's mapping step: SLAM while the robot explores the room by itself, then save the map.
 
-Run:  python examples/05_map_room/run.py            (writes ./room_map/map.yaml, map.pgm, map.png)
+Run:  python examples/05_map_room/run.py            (writes ./room_map/map.yaml, map.pgm)
 
-The same from the shell: navlab map --world room --explore --out room_map
+It starts the shipped mapping launch (simulator + slam_gmapping with params/gmapping.yaml + frontier
+exploration), as `navlab launch mapping` does. The same from the shell, with scores and a picture:
+navlab map --world room --explore --out room_map
 """
 
-from navlab.core import Executor
-from navlab.mapping import GridMap, save_map
-from navlab.mapping.explore_node import Explore
-from navlab.mapping.slam_node import SlamGMapping
-from navlab.sim.gazebo import launch_sim
+import navlab
+from navlab.grid import GridMap
+from navlab.mapping import save_map
 
-ex = Executor(seed=0)  # simulated time, as fast as the CPU allows
-gazebo = launch_sim(ex, world="room", robot="mybot")  # MuJoCo + diff_drive + lidar plugins
-slam = SlamGMapping(ex, parameters={"base_frame": "chassis", "scan_topic": "/mybot/laser/scan",
-                                    "linearUpdate": 0.5, "temporalUpdate": 2.0, "lskip": 4})
-with ex.node_context(remappings={"scan": "/mybot/laser/scan"}):  # like <remap> in a launch file
-    explorer = Explore(ex, parameters={"robot_base_frame": "chassis"})
+session = navlab.launch("mapping", world="room", robot="mybot", seed=0)  # as fast as the CPU allows
+explorer = session.node("explore")
+slam = session.node("slam_gmapping")
 
-finished = ex.run_until(lambda: explorer.done, timeout=300.0)
-print(f"exploration {'finished' if finished else 'timed out'} after {ex.now_ns / 1e9:.0f} simulated s")
-assert slam.grid is not None
-save_map(slam.grid, "room_map/map.yaml")  # map_saver's format: 254 free, 0 occupied, 205 unknown
-grid: GridMap = slam.grid
+finished = session.executor.run_until(lambda: explorer.done, timeout=300.0)
+print(f"exploration {'finished' if finished else 'timed out'} after {session.executor.now_ns / 1e9:.0f} simulated s")
+grid: GridMap | None = slam.current_map()
+assert grid is not None, "SLAM produced no map"
+save_map(grid, "room_map/map.yaml")  # map_saver's format: 254 free, 0 occupied, 205 unknown
 print(f"saved room_map/map.yaml: {grid.width} x {grid.height} cells at {grid.resolution} m")
-x, y, yaw = gazebo.sim.base_pose2d()
+x, y, yaw = session.node("gazebo").sim.base_pose2d()
 print(f"robot ended at x={x:.2f} y={y:.2f} yaw={yaw:.2f} (world frame)")

@@ -13,12 +13,13 @@ from typing import Any
 
 # name -> "module:function"; the function takes the parsed args and returns a JSON-able dict.
 BENCHES: dict[str, str] = {
-    "mapping": "navlab.mapping.run:bench",
+    "mapping": "navlab.experiments.mapping_run:bench",
     "slam": "navlab.mapping.bench:run",
     "core": "navlab.core.bench:run",
     "amcl": "navlab.localization.bench:run",
     "description": "navlab.description.bench:run",
     "sim": "navlab.sim.bench:run",
+    "controller": "navlab.navigation.bench:run_controller",
     "planner": "navlab.navigation.bench:run_planner",
 }
 

@@ -20,9 +20,8 @@ COMMAND_MODULES = (  # in the order of the paper's pipeline, then the ROS-style 
     "navlab.sim.cli",
     "navlab.description.cli",
     "navlab.world.cli",
-    "navlab.mapping.run_cli",
     "navlab.mapping.cli",
-    "navlab.localization.cli",
+    "navlab.experiments.cli",
     "navlab.core.cli",
     "navlab.bench",
 )

@@ -24,8 +24,8 @@ def _say(text: str, quiet: bool) -> None:
 
 def run_demo(out: str | Path = "demo", *, seed: int = 0, quiet: bool = False, render: bool = True) -> dict[str, Any]:
     """Run the three steps, writing everything under ``out``; returns the figures."""
-    from navlab.localization.run import plot_result, run_localization
-    from navlab.mapping.run import run_mapping
+    from navlab.experiments.localize_run import plot_result, run_localization
+    from navlab.experiments.mapping_run import run_mapping
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
@@ -40,7 +40,7 @@ def run_demo(out: str | Path = "demo", *, seed: int = 0, quiet: bool = False, re
     _say("[3/3] AMCL on the saved map, in the room with new obstacles (room_obstacles.world) ...", quiet)
     loc = run_localization("room_obstacles", mapping.map_yaml, duration=60.0, seed=seed, progress=not quiet)
     summary["localization"] = {**loc.summary, "picture": str(plot_result(loc, out / "localize.png"))}
-    summary["wall_seconds"] = round(time.perf_counter() - t0, 1)
+    summary["wall_s"] = round(time.perf_counter() - t0, 1)
     return summary
 
 
@@ -68,14 +68,14 @@ def _cmd(args: argparse.Namespace) -> int:
     if "render" in summary:
         print(f"  robot in its world:  {summary['render']}")
     print(f"  map:                 {m['map']} (+ map.pgm), picture {m['picture']}")
-    print(f"    {m['sim_seconds']:.0f} simulated s mapped in {m['wall_seconds']:.1f} s wall ({m['rtf']}x real time)")
+    print(f"    {m['sim_s']:.0f} simulated s mapped in {m['wall_s']:.1f} s wall ({m['rtf']}x real time)")
     print(f"    walls: precision {m['precision']:.3f}, recall {m['recall']:.3f}, mean error {m['mean_wall_error_m']} m;"
           f" free space covered {m['coverage']:.1%}")  # fmt: skip
     print(f"    SLAM trajectory error {m['position_error_mean_m']} m mean (raw odometry "
           f"{m['odometry_position_error_mean_m']} m)")
-    print(f"  AMCL on that map with new obstacles: mean error {loc['mean_error_m']} m, "
-          f"{loc['mean_yaw_error_deg']}° over {loc['duration_s']:.0f} s; picture {loc['picture']}")
-    print(f"  total {summary['wall_seconds']} s wall")
+    print(f"  AMCL on that map with new obstacles: mean error {loc['position_error_mean_m']} m, "
+          f"{loc['yaw_error_mean_deg']}° over {loc['sim_s']:.0f} s; picture {loc['picture']}")
+    print(f"  total {summary['wall_s']} s wall")
     return 0
 
 

@@ -47,6 +47,14 @@ TFMessage = _T["tf2_msgs/msg/TFMessage"]
 Marker = _T["visualization_msgs/msg/Marker"]
 MarkerArray = _T["visualization_msgs/msg/MarkerArray"]
 ColorRGBA = _T["std_msgs/msg/ColorRGBA"]
+Point32 = _T["geometry_msgs/msg/Point32"]
+Polygon = _T["geometry_msgs/msg/Polygon"]
+PolygonStamped = _T["geometry_msgs/msg/PolygonStamped"]
+GoalStatus = _T["action_msgs/msg/GoalStatus"]
+GoalStatusArray = _T["action_msgs/msg/GoalStatusArray"]
+GoalInfo = _T["action_msgs/msg/GoalInfo"]
+UUID = _T["unique_identifier_msgs/msg/UUID"]
+Bool = _T["std_msgs/msg/Bool"]
 
 
 class MessageTypeError(NavlabError, LookupError):

@@ -13,4 +13,5 @@ NODES: dict[str, str] = {
     "explore": "navlab.mapping.explore_node:Explore",
     "teleop_twist_keyboard": "navlab.mapping.teleop:TeleopKeyboard",
     "route_follower": "navlab.mapping.teleop:RouteFollower",
+    "move_base": "navlab.navigation.move_base:MoveBase",
 }

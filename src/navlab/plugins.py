@@ -181,8 +181,17 @@ REGISTRY: dict[str, dict[str, str]] = {
         "global_planner/GlobalPlanner": "navlab.navigation.planners.navfn:GlobalPlanner",
         "nav2_theta_star_planner/ThetaStarPlanner": "navlab.navigation.planners.theta_star:ThetaStarPlanner",
     },
+    "recovery": {
+        "clear_costmap_recovery/ClearCostmapRecovery": "navlab.navigation.recovery:ClearCostmapRecovery",
+        "rotate_recovery/RotateRecovery": "navlab.navigation.recovery:RotateRecovery",
+        "nav2_behaviors/BackUp": "navlab.navigation.recovery:BackUpRecovery",
+    },
     "controller": {
         "navlab/PurePursuit": "navlab.mapping.follow:PurePursuit",
+        "base_local_planner/TrajectoryPlannerROS": "navlab.navigation.controllers.trajectory:TrajectoryPlannerROS",
+        "dwa_local_planner/DWAPlannerROS": "navlab.navigation.controllers.dwa:DWAPlannerROS",
+        "nav2_mppi_controller::MPPIController": "navlab.navigation.controllers.mppi:MPPIController",
+        "nav2_dwb_controller/DWBLocalPlanner": "navlab.navigation.controllers.dwa:DWBLocalPlanner",
     },
 }
 

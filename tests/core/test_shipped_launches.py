@@ -7,7 +7,6 @@ from dataclasses import fields
 
 import numpy as np
 import pytest
-from navlab.localization.run import true_map
 from scipy import ndimage
 
 from navlab import msgs
@@ -15,6 +14,7 @@ from navlab.cli import main
 from navlab.core import LaunchError, Node
 from navlab.core.launch import resources_dir, start
 from navlab.core.params import load_params
+from navlab.experiments.truth import true_map
 from navlab.mapping import GridMap, save_map
 from navlab.mapping.gmapping import GMappingParams
 from navlab.mapping.teleop import RouteFollower

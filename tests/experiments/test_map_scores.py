@@ -3,8 +3,9 @@
 import numpy as np
 import pytest
 
+from navlab.experiments.metrics import free_coverage, score_map, trajectory_error
+from navlab.experiments.truth import truth_grid
 from navlab.grid import Grid, GridMap
-from navlab.mapping.evaluation import free_coverage, score_map, trajectory_error, truth_grid
 
 
 def _truth() -> Grid:

@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from navlab.cli import main
+from navlab.experiments.mapping_run import run_mapping
 from navlab.mapping.mapfile import load_map
-from navlab.mapping.run import run_mapping
 
 # A loop through the room's open middle, clear of the partitions and the pillar (world frame = odom).
 ROUTE = """\

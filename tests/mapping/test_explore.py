@@ -5,7 +5,8 @@ import math
 import numpy as np
 
 from navlab.grid import GridMap
-from navlab.mapping.explore import find_frontiers, follow_path, plan_to_frontier, traversable
+from navlab.mapping.explore import find_frontiers, plan_to_frontier, traversable
+from navlab.mapping.follow import follow_path
 
 
 def _half_known_room() -> GridMap:

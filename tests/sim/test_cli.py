@@ -17,7 +17,7 @@ def test_sim_verb_drives_and_summarises(capsys: pytest.CaptureFixture[str]) -> N
                  "--spawn", "box:name=crate,x=3,y=2,size=0.4", "--spawn", "cylinder:name=drum,x=-3,t=1"])
     assert code == 0
     out = json.loads(capsys.readouterr().out)
-    assert out["sim_seconds"] == pytest.approx(2.0)
+    assert out["sim_s"] == pytest.approx(2.0)
     assert out["distance_m"] == pytest.approx(1.0, abs=0.1)  # 0.5 m/s for 2 s
     assert out["odom_pose"][0] == pytest.approx(out["true_pose"][0], abs=0.05)  # wheels slip at start
     assert {"crate", "drum"} <= set(out["models"])

@@ -49,7 +49,7 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
         "publish_us": round(publish_us, 3),
         "nodes": 10,
         "rate_hz": 1000,
-        "sim_seconds": 10.0,
+        "sim_s": 10.0,
         "events": events,
-        "wall_seconds": round(wall, 3),
+        "wall_s": round(wall, 3),
     }

@@ -77,6 +77,7 @@ class Session:
     executor: Executor
     nodes: dict[str, Node] = field(default_factory=dict)
     args: dict[str, str] = field(default_factory=dict)
+    overrides: dict[str, dict[str, Any]] = field(default_factory=dict)
 
     def run(self, duration: float) -> None:
         """Advance simulated time by ``duration`` seconds."""
@@ -148,7 +149,11 @@ def _node_params(ctx: _Context, spec: dict[str, Any], where: str) -> dict[str, A
             path = Path(str(item["from"]))
             if not path.is_absolute():
                 path = ctx.file.parent / path
-            params = merge_params(params, load_params(path, node=spec.get("name") or None))
+            loaded = load_params(path, node=spec.get("name") or None)
+            ns = str(item.get("ns") or "").strip("/")
+            for part in reversed(ns.split("/") if ns else []):  # rosparam load's ns=: nest under it
+                loaded = {part: loaded}
+            params = merge_params(params, loaded)
         elif "name" in item:
             params = merge_params(params, {str(item["name"]): item.get("value")})
         else:
@@ -203,7 +208,11 @@ def _run_entries(ctx: _Context, session: Session, depth: int) -> None:
                 raise LaunchError(f"{ctx.file}: {where}: a node needs 'exec'")
             cls = load_node_class(str(exec_name))
             remaps = {r["from"]: ctx.subst(r["to"], where) for r in spec.get("remap", []) or []}
-            kwargs: dict[str, Any] = {"parameters": _node_params(ctx, spec, where)}
+            params = _node_params(ctx, spec, where)
+            node_name = str(spec.get("name") or exec_name)
+            if node_name in session.overrides:  # like `ros2 launch ... --ros-args -p`: applied last
+                params = merge_params(params, session.overrides[node_name])
+            kwargs: dict[str, Any] = {"parameters": params}
             if spec.get("name"):
                 kwargs["name"] = spec["name"]
             if spec.get("namespace"):
@@ -241,19 +250,27 @@ def start(
     seed: int = 0,
     pace: float = 0.0,
     launch_args: dict[str, Any] | None = None,
+    overrides: dict[str, dict[str, Any]] | None = None,
     **args: Any,
 ) -> Session:
     """Start a launch (shipped name or file) with arguments; returns the session.
 
     Arguments come as keywords (``start("mapping", world="room")``) or, for names that clash with
     this function's own (``seed``, ``pace``), in ``launch_args``. ``pace`` is the executor's rate
-    (0 = as fast as possible, 1 = real time).
+    (0 = as fast as possible, 1 = real time). ``overrides`` maps a node name to parameters applied
+    after the launch file's own (``{"amcl": {"laser_max_beams": 60}}``); a name no node has is refused.
     """
     file = find_launch_file(name_or_path)
     all_args = {**(launch_args or {}), **args}
     _check_args(file, all_args)
-    session = Session(executor or Executor(seed=seed, rate=pace), args={k: str(v) for k, v in all_args.items()})
+    session = Session(executor or Executor(seed=seed, rate=pace), args={k: str(v) for k, v in all_args.items()},
+                      overrides={k.lstrip("/"): dict(v) for k, v in (overrides or {}).items()})
     ctx = _Context(file, session.args)
     _run_entries(ctx, session, 0)
     session.args = ctx.vars
+    started = {name.rsplit("/", 1)[-1] for name in session.nodes}
+    unknown = sorted(set(session.overrides) - started)
+    if unknown:
+        raise LaunchError(f"{file}: parameters given for {', '.join(map(repr, unknown))}, but the launch starts no "
+                          f"such node (nodes: {', '.join(sorted(started))})")
     return session

@@ -6,22 +6,42 @@
 0.4
 """
 
-from navlab.description.errors import DescriptionError
-from navlab.description.loader import load_robot
-from navlab.description.model import (
-    DiffDriveConfig,
-    Geometry,
-    ImuConfig,
-    Inertial,
-    Joint,
-    LidarConfig,
-    Link,
-    Origin,
-    RobotModel,
-    Shape,
-)
-from navlab.description.packages import PackageIndex
+from typing import TYPE_CHECKING
 
+from navlab.lazy import lazy_exports
+
+if TYPE_CHECKING:
+    from navlab.description.errors import DescriptionError
+    from navlab.description.loader import load_robot
+    from navlab.description.model import (
+        DiffDriveConfig,
+        Geometry,
+        ImuConfig,
+        Inertial,
+        Joint,
+        LidarConfig,
+        Link,
+        Origin,
+        RobotModel,
+        Shape,
+    )
+    from navlab.description.packages import PackageIndex
+
+_EXPORTS = {
+    "DescriptionError": "navlab.description.errors",
+    "DiffDriveConfig": "navlab.description.model",
+    "Geometry": "navlab.description.model",
+    "ImuConfig": "navlab.description.model",
+    "Inertial": "navlab.description.model",
+    "Joint": "navlab.description.model",
+    "LidarConfig": "navlab.description.model",
+    "Link": "navlab.description.model",
+    "Origin": "navlab.description.model",
+    "PackageIndex": "navlab.description.packages",
+    "RobotModel": "navlab.description.model",
+    "Shape": "navlab.description.model",
+    "load_robot": "navlab.description.loader",
+}
 __all__ = [
     "DescriptionError",
     "DiffDriveConfig",
@@ -37,3 +57,4 @@ __all__ = [
     "Shape",
     "load_robot",
 ]
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

@@ -1,39 +1,37 @@
-"""``navlab map``, ``navlab teleop`` and ``navlab eval map``: the paper's mapping step in simulation."""
+"""``navlab map``, ``navlab localize`` and ``navlab eval map``: the paper's mapping and localization steps
+in simulation, each a launch with a driver and monitors, scored against the world's truth."""
 
 from __future__ import annotations
 
 import argparse
-import contextlib
-import json
+import sys
 from pathlib import Path
 from typing import Any
 
-from navlab.core.runner import positive_seconds
-from navlab.mapping.errors import MappingError
-
-
-def _print_scores(scores: dict[str, Any], as_json: bool) -> None:
-    if as_json:
-        print(json.dumps(scores))
-    else:
-        for key, value in scores.items():
-            print(f"  {key}: {value}")
+from navlab.cli_common import (
+    add_pose_arguments,
+    add_set_argument,
+    parse_sets,
+    positive_seconds,
+    print_figures,
+    start_pose,
+)
 
 
 def _cmd_map(args: argparse.Namespace) -> int:
     if args.action == "save":
         return _cmd_map_save(args)
-    from navlab.mapping.run import run_mapping
+    from navlab.experiments.mapping_run import run_mapping
 
     driver = "teleop" if args.teleop else "route" if args.route else "explore"
     result = run_mapping(
-        world=args.world, robot=args.robot, out=args.out, driver=driver, route=args.route,
+        world=args.world, robot=args.robot, pose=start_pose(args), out=args.out, driver=driver, route=args.route,
         duration=args.duration, mode=args.mode, seed=args.seed, rate=args.rate, record=args.record,
-        quiet=args.quiet,
+        quiet=args.quiet, slam_params=parse_sets(args.set),
     )  # fmt: skip
     if not args.json:
-        print(f"saved {result.map_yaml} (+ map.pgm, map.png) after {result.sim_seconds:.1f} simulated s")
-    _print_scores(result.scores, args.json)
+        print(f"saved {result.map_yaml} (+ map.pgm, map.png) after {result.sim_s:.1f} simulated s")
+    print_figures(result.scores, args.json)
     return 0
 
 
@@ -43,6 +41,7 @@ def _cmd_map_save(args: argparse.Namespace) -> int:
     from navlab.core.launch import start
     from navlab.core.runner import parse_launch_args, run_for
     from navlab.grid import GridMap
+    from navlab.mapping.errors import MappingError
     from navlab.mapping.mapfile import save_map
 
     path = Path(args.out) / "map.yaml"
@@ -66,69 +65,81 @@ def _cmd_map_save(args: argparse.Namespace) -> int:
     return 0
 
 
-def _cmd_teleop(args: argparse.Namespace) -> int:
-    """Drive the robot from the keyboard (teleop_twist_keyboard) or a joystick, in real time: the robot
-    of a `navlab launch` running in another shell, or (with --world, or when none runs) a simulator
-    started here."""
-    import sys
+def _amcl_params(path: str | None, sets: list[str]) -> dict[str, Any]:
+    """AMCL parameters from a ROS 1 / Nav2 YAML file (``amcl`` node) plus ``--set name=value`` overrides."""
+    params: dict[str, Any] = {}
+    if path:
+        from navlab.core import load_params
 
-    from navlab.core import CoreError, Executor
-    from navlab.core.introspect import RemotePublisher, find_running
-    from navlab.mapping.teleop import HELP, TeleopKeyboard, terminal_keys
-    from navlab.sim.gazebo import launch_sim
+        params = dict(load_params(path, node="amcl"))
+        if set(params) == {"amcl"} and isinstance(params["amcl"], dict):
+            params = dict(params["amcl"])
+    return {**params, **parse_sets(sets)}
 
-    ex = Executor(seed=args.seed, rate=args.rate)
-    gazebo = remote = None
-    if args.world is None:
-        with contextlib.suppress(CoreError):
-            remote = RemotePublisher(find_running(args.pid))
-    if remote is not None:  # forward our cmd_vel into the running launch
-        ex.add_listener(lambda topic, msg, _t: remote.publish(topic, msg) if topic == "/cmd_vel" else None)
-        print("driving the robot of the running navlab launch")
-    else:
-        gazebo = launch_sim(ex, world=args.world or "room", robot=args.robot)
-    if args.joy:
-        from navlab import msgs
-        from navlab.core import Node
-        from navlab.mapping.teleop import JoyMapping, joystick_thread
 
-        pub = Node(ex, name="teleop_twist_joy").create_publisher(msgs.Twist, "cmd_vel", 1)
-        joystick_thread(ex, pub, JoyMapping(scale_linear=args.speed, scale_angular=args.turn))
-        print("joystick: hold button 0 and move the left stick; Ctrl-C to quit")
-    else:
-        if not sys.stdin.isatty():
-            raise MappingError("navlab teleop reads keys from a terminal; run it in an interactive shell")
-        teleop = TeleopKeyboard(ex, parameters={"speed": args.speed, "turn": args.turn})
-        print(HELP)
-        terminal_keys(teleop, ex)
-    with contextlib.suppress(KeyboardInterrupt):
-        ex.spin()
-    if remote is not None:
-        remote.close()
-    if gazebo is not None:
-        x, y, yaw = gazebo.sim.base_pose2d()
-        print(f"\nstopped at x={x:.2f} y={y:.2f} yaw={yaw:.2f} after {ex.now_ns / 1e9:.1f} simulated s")
+def _cmd_localize(args: argparse.Namespace) -> int:
+    from navlab.experiments.localize_run import plot_result, run_localization
+
+    result = run_localization(
+        args.world, args.map, initial=tuple(args.initial) if args.initial else None,
+        global_localization=args.global_localization, duration=args.duration, seed=args.seed,
+        kidnap_at=args.kidnap, amcl_params=_amcl_params(args.params, args.set), robot=args.robot,
+        pose=start_pose(args), progress=not args.quiet and sys.stderr.isatty(), record=args.record,
+    )  # fmt: skip
+    summary = dict(result.summary)
+    if args.out:
+        summary["png"] = str(plot_result(result, args.out))
+    print_figures(summary, args.json)
+    return 0
+
+
+def _cmd_navigate(args: argparse.Namespace) -> int:
+    from navlab.experiments.navigate_run import run_navigation
+    from navlab.experiments.plots import plot_navigation
+    from navlab.sim.spawn import parse_spawn_spec
+
+    spawns = []
+    for i, spec in enumerate(args.spawn):
+        model, t = parse_spawn_spec(spec, default_name=f"spawned_{i}")
+        spawns.append((t, model))
+    result = run_navigation(
+        [tuple(g) for g in args.goal], world=args.world, map_yaml=args.map, robot=args.robot, pose=start_pose(args),
+        controller=args.controller, params_dir=args.params, move_base_params=parse_sets(args.set), spawn=spawns,
+        goal_timeout=args.timeout, seed=args.seed, record=args.record, snapshots=bool(args.out),
+    )  # fmt: skip
+    figures: dict[str, Any] = {"goals": result.goals, **result.summary}
+    if args.out:
+        out = Path(args.out)
+        out.mkdir(parents=True, exist_ok=True)
+        pictures = []
+        for k, (goal, shot) in enumerate(zip(result.goals, result.snapshots, strict=True), 1):
+            title = f"goal {k} {tuple(goal['goal'])}: {goal['outcome']} in {goal['time_s']} s"
+            pictures.append(str(plot_navigation(result.grid, shot, out / f"goal_{k}.png", title=title,
+                                                goal=goal["goal"])))  # fmt: skip
+        figures["pictures"] = pictures
+    print_figures(figures, args.json)
     return 0
 
 
 def cmd_eval_map(args: argparse.Namespace) -> int:
     """Score a saved map against a world's true occupancy (start pose known, no alignment)."""
-    from navlab.mapping.evaluation import free_coverage, score_map, trajectory_error
+    from navlab.experiments.mapping_run import read_trajectory
+    from navlab.experiments.metrics import free_coverage, score_map, trajectory_error
+    from navlab.experiments.session import rounded
+    from navlab.experiments.truth import true_occupancy
     from navlab.mapping.mapfile import load_map
-    from navlab.mapping.run import read_trajectory, true_occupancy
     from navlab.sim.gazebo import load_world_named
 
     grid = load_map(args.map)
-    world = load_world_named(args.world)
-    truth = true_occupancy(world, grid)
-    start = tuple(args.start)
-    scores = score_map(grid, truth, world_T_map=start)
-    scores["coverage"] = round(free_coverage(grid, truth, world_T_map=start), 4)
+    truth = true_occupancy(load_world_named(args.world), grid)
+    start = start_pose(args)
+    scores: dict[str, Any] = dict(score_map(grid, truth, world_T_map=start))
+    scores["coverage"] = free_coverage(grid, truth, world_T_map=start)
     traj = Path(args.trajectory) if args.trajectory else Path(args.map).with_name("trajectory.txt")
     if args.trajectory or traj.is_file():
         est, true = read_trajectory(traj)
         scores.update(trajectory_error(est, true))
-    _print_scores(scores, args.json)
+    print_figures(rounded(scores), args.json)
     return 0
 
 
@@ -140,12 +151,11 @@ def add_eval_map(esub: argparse._SubParsersAction) -> None:
         description="Occupied-cell precision and recall (a match within one cell), mean wall error and "
         "free-space coverage of a map_server map against the world's true occupancy at lidar height, and the "
         "SLAM trajectory's error against ground truth when a trajectory file is there. "
-        "The map frame is the robot's start pose in the world (--start), so no alignment is searched.",
+        "The map frame is the robot's start pose in the world (--x --y --yaw), so no alignment is searched.",
     )
     m.add_argument("map", help="map_server YAML file")
     m.add_argument("--world", required=True, help="world file or shipped name (room, room_obstacles)")
-    m.add_argument("--start", nargs=3, type=float, default=(0.0, 0.0, 0.0), metavar=("X", "Y", "YAW"),
-                   help="robot start pose in the world = the map frame (default 0 0 0)")  # fmt: skip
+    add_pose_arguments(m, "robot start (= the map frame)")
     m.add_argument("--trajectory", metavar="FILE",
                    help="SLAM vs true trajectory to score too (default: trajectory.txt beside the map, "
                    "as navlab map writes it)")  # fmt: skip
@@ -153,26 +163,32 @@ def add_eval_map(esub: argparse._SubParsersAction) -> None:
     m.set_defaults(func=cmd_eval_map)
 
 
+def _add_world_robot(p: argparse.ArgumentParser, world: str) -> None:
+    p.add_argument("--world", default=world, help=f"world file or shipped name (default {world})")
+    p.add_argument("--robot", default="mybot", help="robot .xacro/.urdf or shipped name (default mybot)")
+    add_pose_arguments(p)
+
+
 def register(sub: argparse._SubParsersAction) -> None:
-    """Add ``map`` and ``teleop``."""
+    """Add ``map``, ``localize`` and ``navigate``."""
     p = sub.add_parser(
         "map",
         help="build a map with SLAM in simulation (exploration, teleop or a route) and save it",
         description="The paper's mapping launch: simulator + slam_gmapping + a driver. Saves DIR/map.yaml, "
-        "DIR/map.pgm and DIR/map.png (map with SLAM and true trajectories) and prints the map's score "
-        "against the world. `navlab map save --out DIR` saves the current /map of a running `navlab launch` "
-        "(map_saver); with --launch FILE it starts the launch itself.",
+        "DIR/map.pgm, DIR/map.png (map with SLAM and true trajectories) and DIR/trajectory.txt, and prints the "
+        "map's score against the world. `navlab map save --out DIR` saves the current /map of a running "
+        "`navlab launch` (map_saver); with --launch FILE it starts the launch itself.",
     )
     p.add_argument("action", nargs="?", choices=["save"], help="save: run a launch and save its /map")
-    p.add_argument("--world", default="room", help="world file or shipped name (default room)")
-    p.add_argument("--robot", default="mybot", help="robot .xacro/.urdf or shipped name (default mybot)")
+    _add_world_robot(p, "room")
     drive = p.add_mutually_exclusive_group()
     drive.add_argument("--explore", action="store_true", help="frontier exploration (the default)")
     drive.add_argument("--teleop", action="store_true", help="drive with the keyboard, in real time")
     drive.add_argument("--route", metavar="FILE", help="a route YAML: segments and/or waypoints")
-    p.add_argument("--out", default="map", help="output folder (default ./map)")
-    p.add_argument("--mode", choices=["gmapping", "graph"], default="gmapping",
-                   help="SLAM algorithm: the paper's RBPF (default) or pose-graph")  # fmt: skip
+    p.add_argument("--out", default="map", metavar="DIR", help="output folder (default ./map)")
+    p.add_argument("--mode", default="gmapping",
+                   help="SLAM mode: gmapping, the paper's RBPF (default), or graph (pose graph)")  # fmt: skip
+    add_set_argument(p, "slam_gmapping", "particles=50")
     p.add_argument("--duration", type=positive_seconds, default=600.0, help="at most this many simulated s (600)")
     p.add_argument("--rate", type=float, default=0.0, help="pacing: 0 = as fast as possible, 1 = real time")
     p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
@@ -186,21 +202,62 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=_cmd_map)
 
     p = sub.add_parser(
-        "teleop",
-        help="drive the robot from the keyboard (teleop_twist_keyboard) or a joystick",
-        description="Publishes cmd_vel from keys (u i o / j k l / m , . to move, q/z w/x e/c to change speeds, "
-        "k to stop, Ctrl-C to quit) into the `navlab launch` running in another shell, as "
-        "teleop_twist_keyboard does next to a ROS launch (e.g. `navlab launch mapping explore:=false`). "
-        "With --world, or when no launch runs, it starts the simulator here in real time.",
+        "localize",
+        help="localize the simulated robot with AMCL on a saved map and score it against ground truth",
+        description="The paper's localization launch (simulator, map_server and amcl with ROS 1 parameters) "
+        "while the robot drives a scripted loop steered on ground truth; prints the localization error against "
+        "ground truth (mean/max position and yaw error, convergence time with --global, recovery time with "
+        "--kidnap) and saves a PNG of the true and estimated paths. The map frame is taken to be the world "
+        "frame (true for the world's true map and for SLAM maps started at the world origin).",
     )
-    p.add_argument("--world", default=None,
-                   help="start this world here (file or shipped name) instead of driving a running launch")
-    p.add_argument("--pid", type=int, help="which running navlab launch to drive, when several run")
-    p.add_argument("--robot", default="mybot", help="robot file or shipped name (default mybot)")
-    p.add_argument("--speed", type=float, default=0.5, help="linear speed, m/s (default 0.5)")
-    p.add_argument("--turn", type=float, default=1.0, help="angular speed, rad/s (default 1.0)")
-    p.add_argument("--rate", type=float, default=1.0, help="pacing (default 1 = real time)")
-    p.add_argument("--joy", action="store_true",
-                   help="drive with the first joystick (pygame; teleop_twist_joy's axes and deadman button 0)")
+    _add_world_robot(p, "room_obstacles")
+    p.add_argument("--map", metavar="MAP.yaml", default=None,
+                   help="map_server map (YAML + image); default: the world's true occupancy at 5 cm")
+    start = p.add_mutually_exclusive_group()
+    start.add_argument("--initial", nargs=3, type=float, metavar=("X", "Y", "YAW"),
+                       help="AMCL's initial pose in the map frame (m, m, rad); default: the start pose")
+    start.add_argument("--global", dest="global_localization", action="store_true",
+                       help="start from particles spread over the whole map (global_localization service)")
+    p.add_argument("--duration", type=positive_seconds, default=60.0, help="simulated seconds to run (default 60)")
+    p.add_argument("--kidnap", type=float, metavar="T", default=None,
+                   help="at T seconds teleport the robot to the route waypoint farthest from it")
+    p.add_argument("--params", metavar="AMCL.yaml", default=None,
+                   help="amcl parameter file (ROS 1 layout, or Nav2 layout with an 'amcl' node)")
+    add_set_argument(p, "amcl", "recovery_alpha_fast=0.1")
+    p.add_argument("--seed", type=int, default=0, help="random seed of the run (default 0)")
+    p.add_argument("--out", default="localize.png", metavar="FILE.png",
+                   help="where to save the truth-vs-estimate figure (default localize.png; '' for none)")
+    p.add_argument("--json", action="store_true", help="print the figures as one JSON object")
+    p.add_argument("--record", metavar="DIR", help="also write every topic to a rosbag2 (MCAP) in DIR")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(func=_cmd_localize)
+
+    p = sub.add_parser(
+        "navigate",
+        help="navigate to goals with move_base on a map, as in the paper's experiments (Figs. 9-12)",
+        description="The paper's navigation launch (simulator, map_server, amcl and move_base with the ROS 1 "
+        "parameter files of --params) drives the robot to each --goal in turn. Prints each goal's outcome "
+        "(succeeded, aborted with move_base's reason, or timeout), time, path length, minimum clearance and "
+        "collisions (from the simulator's contacts), and with --out DIR saves one picture per goal: map, "
+        "inflation shadow, global plan (blue), local plan (green), robot (orange), laser (red).",
+    )
+    _add_world_robot(p, "room_obstacles")
+    p.add_argument("--map", metavar="MAP.yaml", default=None,
+                   help="map_server map to navigate on; default: the world's true occupancy at 5 cm")
+    p.add_argument("--goal", nargs=3, type=float, action="append", required=True, metavar=("X", "Y", "YAW"),
+                   help="a goal in the map frame (m, m, rad); repeat for a sequence")  # fmt: skip
+    p.add_argument("--controller", default=None,
+                   help="local planner: trajectory (TrajectoryPlannerROS), dwa (DWAPlannerROS), mppi, or a ROS "
+                   "plugin name (default: move_base_params.yaml's base_local_planner)")  # fmt: skip
+    p.add_argument("--params", metavar="DIR", default=None,
+                   help="folder of move_base's ROS 1 parameter files (default: the shipped params/mybot)")
+    add_set_argument(p, "move_base", "local_costmap.update_frequency=1.0")
+    p.add_argument("--spawn", action="append", default=[], metavar="SPEC",
+                   help="add an obstacle while running, e.g. 'cylinder:x=1,y=0.5,radius=0.15,length=0.5,t=5' "
+                   "(see navlab sim --help; repeatable)")  # fmt: skip
+    p.add_argument("--timeout", type=positive_seconds, default=90.0, help="simulated s allowed per goal (90)")
     p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
-    p.set_defaults(func=_cmd_teleop)
+    p.add_argument("--out", metavar="DIR", default=None, help="save one PNG per goal into DIR")
+    p.add_argument("--record", metavar="DIR", help="also write every topic to a rosbag2 (MCAP) in DIR")
+    p.add_argument("--json", action="store_true", help="print the figures as one JSON object")
+    p.set_defaults(func=_cmd_navigate)

@@ -1,4 +1,6 @@
-"""Accuracy metrics: the relations metric of Kümmerle et al. 2009 ("On measuring the accuracy of SLAM").
+"""Accuracy metrics, in one place: SLAM relations, maps and trajectories against the truth, settling times.
+
+The relations metric is that of Kümmerle et al. 2009 ("On measuring the accuracy of SLAM").
 
 For each ground-truth relation (t1, t2, relative pose of the scan at t2 in the frame of the scan at
 t1), the error is ``relation ⊖ (pose(t1)^-1 ∘ pose(t2))``; the report gives mean ± sample standard
@@ -9,15 +11,22 @@ their squares. Pose files (``timestamp x y theta`` per line) are read and writte
 
 from __future__ import annotations
 
+import math
 import os
 
 import numpy as np
+from scipy import ndimage
 
-from navlab.geometry import wrap_angle
+from navlab.experiments.truth import visible_surface
+from navlab.geometry import inverse_transform_points2, transform_points2, wrap_angle
+from navlab.grid import Grid, GridMap
 from navlab.io.poses import read_poses, read_table, write_poses
 from navlab.mapping.errors import MappingError
 
-__all__ = ["read_poses", "read_relations", "relations_error", "write_poses"]  # pose files live in navlab.io.poses
+__all__ = [
+    "free_coverage", "read_poses", "read_relations", "relations_error", "score_map", "settled_after",
+    "trajectory_error", "write_poses",
+]  # pose files live in navlab.io.poses
 
 
 def read_relations(path: str | os.PathLike[str]) -> np.ndarray:
@@ -79,3 +88,104 @@ def relations_error(
         rot_sq_mean_deg2=float((rot**2).mean()),
     )
     return out
+
+
+# --- maps and trajectories against a simulated world's truth ------------------------------------
+
+
+def score_map(
+    grid: GridMap,
+    truth: Grid,
+    *,
+    world_T_map: tuple[float, float, float] = (0.0, 0.0, 0.0),
+    tolerance_cells: int = 1,
+    occupied_threshold: int = 65,
+) -> dict[str, float | int]:
+    """Occupied-cell precision and recall of ``grid`` against ``truth`` (a boolean ``Grid``, world frame).
+
+    Precision: map-occupied cells with a true occupied cell within the tolerance. Recall: true visible
+    wall cells (see ``truth.visible_surface``) with a map-occupied cell within the tolerance. Also the
+    mean distance (m) from each map-occupied cell to the nearest true occupied cell.
+    """
+    jj, ii = np.nonzero(grid.data >= occupied_threshold)
+    if len(ii) == 0:
+        return {"occupied_cells": 0, "precision": 0.0, "recall": 0.0, "mean_wall_error_m": math.inf}
+    pts = transform_points2(world_T_map, grid.cell_to_world(np.stack([ii, jj], axis=1)))
+    tol_m = tolerance_cells * max(grid.resolution, truth.resolution)
+    dist_to_truth = ndimage.distance_transform_edt(~truth.data) * truth.resolution
+    cells = truth.world_to_cell(pts)
+    inside = truth.in_bounds(cells)
+    d = np.full(len(pts), np.inf)
+    d[inside] = dist_to_truth[cells[inside, 1], cells[inside, 0]]
+    # distance from a map cell centre to the nearest true cell *edge* is at most half a truth cell less.
+    precision = float(np.mean(d <= tol_m + 0.5 * truth.resolution))
+
+    spts = truth.centers(visible_surface(truth, (world_T_map[0], world_T_map[1])))
+    in_map = grid.world_to_cell(inverse_transform_points2(world_T_map, spts))
+    map_occ = grid.data >= occupied_threshold
+    dist_to_map = ndimage.distance_transform_edt(~map_occ) * grid.resolution
+    ok = grid.in_bounds(in_map)
+    ds = np.full(len(spts), np.inf)
+    ds[ok] = dist_to_map[in_map[ok, 1], in_map[ok, 0]]
+    recall = float(np.mean(ds <= tol_m + 0.5 * grid.resolution)) if len(ds) else 0.0
+    finite = d[np.isfinite(d)]
+    return {
+        "occupied_cells": len(pts),
+        "precision": round(precision, 4),
+        "recall": round(recall, 4),
+        "mean_wall_error_m": round(float(finite.mean()), 4) if len(finite) else math.inf,
+    }
+
+
+def free_coverage(
+    grid: GridMap,
+    truth: Grid,
+    *,
+    world_T_map: tuple[float, float, float] = (0.0, 0.0, 0.0),
+    robot_radius: float = 0.2,
+) -> float:
+    """Fraction of the true free space reachable by a robot of ``robot_radius`` from the start
+    (``world_T_map``'s position) that the map marks known (free or occupied)."""
+    start_xy = (world_T_map[0], world_T_map[1])
+    free = ~truth.data
+    clearance = ndimage.distance_transform_edt(free) * truth.resolution
+    labels, _ = ndimage.label(clearance > robot_radius)
+    i, j = truth.world_to_cell(np.array([start_xy]))[0]
+    reach = labels == labels[j, i]
+    # The reachable region grown by the robot radius is the space the robot's sensor footprint can reach.
+    reach = reach | (ndimage.binary_dilation(reach, iterations=max(1, round(robot_radius / truth.resolution))) & free)
+    pts = truth.centers(reach)
+    cells = grid.world_to_cell(inverse_transform_points2(world_T_map, pts))
+    ok = grid.in_bounds(cells)
+    known = np.zeros(len(pts), bool)
+    known[ok] = grid.data[cells[ok, 1], cells[ok, 0]] >= 0
+    return float(known.mean()) if len(known) else 0.0
+
+
+def trajectory_error(est: np.ndarray, truth: np.ndarray) -> dict[str, float]:
+    """Absolute errors between matched poses (N, 3) (x, y, yaw), rows with a NaN skipped: mean/max position
+    (m) and mean yaw (deg)."""
+    ok = np.isfinite(est).all(axis=1) & np.isfinite(truth).all(axis=1)
+    est, truth = est[ok], truth[ok]
+    if len(est) == 0:
+        return {"poses": 0, "position_error_mean_m": math.nan, "position_error_max_m": math.nan,
+                "yaw_error_mean_deg": math.nan}  # fmt: skip
+    dpos = np.hypot(est[:, 0] - truth[:, 0], est[:, 1] - truth[:, 1])
+    dyaw = np.abs(wrap_angle(est[:, 2] - truth[:, 2]))
+    return {
+        "poses": len(est),
+        "position_error_mean_m": round(float(dpos.mean()), 4),
+        "position_error_max_m": round(float(dpos.max()), 4),
+        "yaw_error_mean_deg": round(float(np.degrees(dyaw).mean()), 3),
+    }
+
+
+def settled_after(t: np.ndarray, err: np.ndarray, t0: float, threshold: float) -> float | None:
+    """First time >= ``t0`` from which ``err`` stays <= ``threshold`` to the end (None if never)."""
+    sel = t >= t0
+    tt, ee = t[sel], err[sel]
+    bad = np.flatnonzero(~(ee <= threshold))
+    if bad.size == 0:
+        return float(tt[0]) if tt.size else None
+    k = bad[-1] + 1
+    return float(tt[k]) if k < tt.size else None

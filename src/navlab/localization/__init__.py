@@ -1,9 +1,33 @@
 """Localization on a known map: AMCL (adaptive Monte Carlo localization, as in ROS 1 amcl)."""
 
-from navlab.localization.amcl import Amcl, AmclParams, Scan
-from navlab.localization.errors import LocalizationError
-from navlab.localization.field import MapField, build_field, field_from_map
-from navlab.localization.raycast import cast_rays
+from typing import TYPE_CHECKING
 
-__all__ = ["Amcl", "AmclParams", "LocalizationError", "MapField", "Scan", "build_field", "cast_rays",
-           "field_from_map"]
+from navlab.lazy import lazy_exports
+
+if TYPE_CHECKING:
+    from navlab.localization.amcl import Amcl, AmclParams, Scan
+    from navlab.localization.errors import LocalizationError
+    from navlab.localization.field import MapField, build_field, field_from_map
+    from navlab.localization.raycast import cast_rays
+
+_EXPORTS = {
+    "Amcl": "navlab.localization.amcl",
+    "AmclParams": "navlab.localization.amcl",
+    "LocalizationError": "navlab.localization.errors",
+    "MapField": "navlab.localization.field",
+    "Scan": "navlab.localization.amcl",
+    "build_field": "navlab.localization.field",
+    "cast_rays": "navlab.localization.raycast",
+    "field_from_map": "navlab.localization.field",
+}
+__all__ = [
+    "Amcl",
+    "AmclParams",
+    "LocalizationError",
+    "MapField",
+    "Scan",
+    "build_field",
+    "cast_rays",
+    "field_from_map",
+]
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

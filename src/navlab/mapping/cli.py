@@ -1,15 +1,17 @@
-"""CLI verbs of the mapping package: ``navlab slam`` (offline SLAM on a log) and ``navlab eval``."""
+"""CLI verbs of the mapping package: ``navlab teleop``, ``navlab slam`` (offline SLAM on a log) and ``navlab eval``."""
 
 from __future__ import annotations
 
 import argparse
-import json
+import contextlib
 import sys
 import time
+from pathlib import Path
 
 import yaml
 
-from navlab.mapping.run_cli import add_eval_map
+from navlab.cli_common import add_pose_arguments, print_figures, start_pose
+from navlab.experiments.cli import add_eval_map
 
 
 def _params_file(path: str | None) -> dict:
@@ -32,6 +34,8 @@ def _params_file(path: str | None) -> dict:
 
 
 def _cmd_slam(args: argparse.Namespace) -> int:
+    from navlab.experiments.plots import Track, plot_run
+    from navlab.experiments.session import rounded
     from navlab.io.carmen import read_carmen, skipped_summary
     from navlab.mapping.slam import run_offline, write_outputs
 
@@ -50,20 +54,69 @@ def _cmd_slam(args: argparse.Namespace) -> int:
         progress=not args.quiet and sys.stderr.isatty(),
     )
     wall = time.perf_counter() - t0
-    paths = write_outputs(result, args.out, title=f"{log.path.name if log.path else ''} ({args.mode})")
-    summary = {
+    paths = write_outputs(result, args.out)
+    paths["figure"] = Path(args.out) / "map.png"
+    plot_run(result.grid, [Track(result.poses, "SLAM trajectory", "r-", width=0.7)], paths["figure"],
+             title=f"{log.path.name if log.path else ''} ({args.mode})", crop=False)  # fmt: skip
+    log_s = float(result.timestamps[-1] - result.timestamps[0])
+    summary = rounded({
         "scans": len(result.timestamps),
         "skipped_lines": len(log.skipped),
-        "log_seconds": float(result.timestamps[-1] - result.timestamps[0]),
-        "wall_seconds": wall,
+        "log_s": log_s,
+        "wall_s": wall,
+        "rtf": log_s / wall if wall > 0 else None,
         **result.stats,
         **{k: str(v) for k, v in paths.items()},
-    }
-    if args.json:
-        print(json.dumps(summary))
-    elif not args.quiet:
-        for k, v in summary.items():
-            print(f"{k}: {v}")
+    })  # fmt: skip
+    if args.json or not args.quiet:
+        print_figures(summary, args.json)
+    return 0
+
+
+def _cmd_teleop(args: argparse.Namespace) -> int:
+    """Drive the robot from the keyboard (teleop_twist_keyboard) or a joystick, in real time: the robot
+    of a `navlab launch` running in another shell, or (with --world, or when none runs) a simulator
+    started here."""
+    from navlab.core import CoreError, Executor
+    from navlab.core.introspect import RemotePublisher, find_running
+    from navlab.experiments.session import start_run
+    from navlab.mapping.teleop import HELP, TeleopKeyboard, terminal_keys
+
+    gazebo = remote = None
+    if args.world is None:
+        with contextlib.suppress(CoreError):
+            remote = RemotePublisher(find_running(args.pid))
+    if remote is not None:  # forward our cmd_vel into the running launch
+        ex = Executor(seed=args.seed, rate=args.rate)
+        ex.add_listener(lambda topic, msg, _t: remote.publish(topic, msg) if topic == "/cmd_vel" else None)
+        print("driving the robot of the running navlab launch")
+    else:  # the sim launch, here, in real time
+        run = start_run("sim", world=args.world or "room", robot=args.robot, pose=start_pose(args), seed=args.seed,
+                        pace=args.rate)  # fmt: skip
+        ex, gazebo = run.executor, run.gazebo
+    if args.joy:
+        from navlab import msgs
+        from navlab.core import Node
+        from navlab.mapping.teleop import JoyMapping, joystick_thread
+
+        pub = Node(ex, name="teleop_twist_joy").create_publisher(msgs.Twist, "cmd_vel", 1)
+        joystick_thread(ex, pub, JoyMapping(scale_linear=args.speed, scale_angular=args.turn))
+        print("joystick: hold button 0 and move the left stick; Ctrl-C to quit")
+    else:
+        if not sys.stdin.isatty():
+            from navlab.mapping.errors import MappingError
+
+            raise MappingError("navlab teleop reads keys from a terminal; run it in an interactive shell")
+        teleop = TeleopKeyboard(ex, parameters={"speed": args.speed, "turn": args.turn})
+        print(HELP)
+        terminal_keys(teleop, ex)
+    with contextlib.suppress(KeyboardInterrupt):
+        ex.spin()
+    if remote is not None:
+        remote.close()
+    if gazebo is not None:
+        x, y, yaw = gazebo.sim.base_pose2d()
+        print(f"\nstopped at x={x:.2f} y={y:.2f} yaw={yaw:.2f} after {ex.now_ns / 1e9:.1f} simulated s")
     return 0
 
 
@@ -74,7 +127,7 @@ def _cmd_eval_relations(args: argparse.Namespace) -> int:
     rel = read_relations(args.relations)
     out = relations_error(ts, poses, rel, time_tolerance=args.tolerance)
     if args.json:
-        print(json.dumps(out))
+        print_figures(out, True)
     else:
         print(f"relations scored: {out['n_scored']} of {out['n_relations']}")
         print(f"translation: {out['trans_abs_mean']:.4f} ± {out['trans_abs_std']:.4f} m")
@@ -83,7 +136,28 @@ def _cmd_eval_relations(args: argparse.Namespace) -> int:
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    """Add the ``slam`` and ``eval`` verbs."""
+    """Add the ``teleop``, ``slam`` and ``eval`` verbs."""
+    p = sub.add_parser(
+        "teleop",
+        help="drive the robot from the keyboard (teleop_twist_keyboard) or a joystick",
+        description="Publishes cmd_vel from keys (u i o / j k l / m , . to move, q/z w/x e/c to change speeds, "
+        "k to stop, Ctrl-C to quit) into the `navlab launch` running in another shell, as "
+        "teleop_twist_keyboard does next to a ROS launch (e.g. `navlab launch mapping explore:=false`). "
+        "With --world, or when no launch runs, it starts the simulator here in real time.",
+    )
+    p.add_argument("--world", default=None,
+                   help="start this world here (file or shipped name) instead of driving a running launch")
+    p.add_argument("--pid", type=int, help="which running navlab launch to drive, when several run")
+    p.add_argument("--robot", default="mybot", help="robot file or shipped name (default mybot)")
+    add_pose_arguments(p)
+    p.add_argument("--speed", type=float, default=0.5, help="linear speed, m/s (default 0.5)")
+    p.add_argument("--turn", type=float, default=1.0, help="angular speed, rad/s (default 1.0)")
+    p.add_argument("--rate", type=float, default=1.0, help="pacing (default 1 = real time)")
+    p.add_argument("--joy", action="store_true",
+                   help="drive with the first joystick (pygame; teleop_twist_joy's axes and deadman button 0)")
+    p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    p.set_defaults(func=_cmd_teleop)
+
     p = sub.add_parser(
         "slam",
         help="run SLAM offline on a laser log and save the map and trajectory",
@@ -95,9 +169,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--out", required=True, metavar="DIR", help="output directory (created if missing)")
     p.add_argument(
         "--mode",
-        default="graph",
-        help="graph: scan-to-map matching + loop closure + pose-graph optimisation (default); "
-        "gmapping: the paper's Rao-Blackwellized particle filter",
+        default="gmapping",
+        help="slam_gmapping's mode, a SLAM plugin: gmapping: the paper's Rao-Blackwellized particle filter "
+        "(default, as in navlab map); graph: scan-to-map matching + loop closure + pose-graph optimisation",
     )
     p.add_argument("--params", metavar="YAML", help="SLAM parameters: slam_gmapping's names (graph mode's own "
                    "under 'graph:')")

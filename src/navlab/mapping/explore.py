@@ -1,7 +1,9 @@
-"""Frontier-based exploration (Yamauchi 1997), pure: frontiers, a grid planner, a safe path follower.
+"""Frontier-based exploration (Yamauchi 1997), pure: frontiers, a clearance costmap layer and a grid planner.
 
 Everything here works on a ``GridMap`` and numpy arrays in the map frame (metres, radians); the
-node in ``explore_node.py`` feeds it ``/map``, tf and the scan and publishes ``cmd_vel``.
+node in ``explore_node.py`` feeds it ``/map``, tf and the scan, follows the plan with
+``mapping.follow.PurePursuit`` and publishes ``cmd_vel``. ``ClearanceLayer`` and ``GridDijkstraPlanner``
+sit behind the ``plugins.CostmapLayer`` / ``plugins.GlobalPlanner`` seams.
 """
 
 from __future__ import annotations
@@ -13,7 +15,8 @@ import numpy as np
 from scipy import ndimage, sparse
 from scipy.sparse.csgraph import dijkstra
 
-from navlab.grid import GridMap
+from navlab.grid import COST_INSCRIBED, COST_LETHAL, COST_UNKNOWN, Grid, GridMap
+from navlab.mapping.errors import MappingError
 
 _NEIGHBOURS = ((0, 1, 1.0), (1, 0, 1.0), (1, 1, math.sqrt(2.0)), (1, -1, math.sqrt(2.0)))
 
@@ -78,11 +81,82 @@ def clearance(grid: GridMap, *, occupied_threshold: int = 65) -> np.ndarray:
     return ndimage.distance_transform_edt(~occ) * grid.resolution
 
 
-def clearance_cost(dist: np.ndarray, robot_radius: float, *, comfort: float = 0.4, weight: float = 4.0) -> np.ndarray:
-    """Per-cell cost factor ≥ 1 that grows as clearance falls from ``robot_radius + comfort`` to the radius,
-    so paths keep to the middle of free space (a costmap inflation layer's role)."""
+def clearance_costmap(
+    grid: GridMap, robot_radius: float, *, comfort: float = 0.4, occupied_threshold: int = 65
+) -> Grid:
+    """costmap_2d-style costs (uint8) from an occupancy map: 254 on occupied cells, 253 within
+    ``robot_radius`` of one, 255 on unknown cells, and 0..252 growing as clearance falls from
+    ``robot_radius + comfort`` to the radius (quadratically), so plans keep to the middle of free space."""
+    dist = clearance(grid, occupied_threshold=occupied_threshold)
     excess = np.clip((robot_radius + comfort - dist) / comfort, 0.0, 1.0)
-    return 1.0 + weight * excess**2
+    cost = np.rint(252.0 * excess**2).astype(np.uint8)
+    cost[dist <= robot_radius] = COST_INSCRIBED
+    cost[grid.data < 0] = COST_UNKNOWN
+    cost[grid.data >= occupied_threshold] = COST_LETHAL
+    return Grid(cost, grid.resolution, grid.origin, grid.frame_id)
+
+
+class ClearanceLayer:
+    """``navlab::ClearanceLayer`` (a ``plugins.CostmapLayer``): the exploration planner's costs from an
+    occupancy map of the same geometry as the master grid (see :func:`clearance_costmap`)."""
+
+    def __init__(self, robot_radius: float = 0.3, comfort: float = 0.4, occupied_threshold: int = 65) -> None:
+        self.robot_radius, self.comfort, self.occupied_threshold = robot_radius, comfort, occupied_threshold
+        self.map: GridMap | None = None
+
+    def set_map(self, grid: GridMap) -> None:
+        """The occupancy map the costs come from."""
+        self.map = grid
+
+    def update_costs(self, master: Grid) -> None:
+        """Write this layer's costs into ``master`` (the max of both, as costmap_2d combines layers)."""
+        if self.map is None:
+            return
+        if master.data.shape != self.map.data.shape:
+            raise MappingError(f"ClearanceLayer: master grid {master.data.shape} and map {self.map.data.shape} differ")
+        cost = clearance_costmap(self.map, self.robot_radius, comfort=self.comfort,
+                                 occupied_threshold=self.occupied_threshold).data  # fmt: skip
+        np.maximum(master.data, cost, out=master.data)
+
+
+class GridDijkstraPlanner:
+    """``navlab/GridDijkstra`` (a ``plugins.GlobalPlanner``): 8-connected Dijkstra over costmap cells below
+    ``COST_INSCRIBED`` (unknown cells only with ``allow_unknown``); a step costs its length times
+    ``1 + weight * cost / 252`` averaged over its two cells. The robot may start inside the inflation:
+    the nearest traversable cell within ``start_search_cells`` is used."""
+
+    def __init__(self, *, weight: float = 4.0, allow_unknown: bool = False, start_search_cells: int = 10) -> None:
+        self.weight, self.allow_unknown, self.start_search_cells = weight, allow_unknown, start_search_cells
+
+    def traversable(self, costmap: Grid) -> np.ndarray:
+        """Cells a plan may cross."""
+        c = costmap.data
+        return (c < COST_INSCRIBED) | ((c == COST_UNKNOWN) & self.allow_unknown)
+
+    def distances(self, costmap: Grid, start_xy: tuple[float, float]) -> tuple[np.ndarray, np.ndarray] | None:
+        """(distance in cells (H, W), predecessors) of a Dijkstra from the robot, or None if it has no
+        traversable cell nearby."""
+        mask = self.traversable(costmap)
+        cell = tuple(int(v) for v in costmap.world_to_cell(np.array([start_xy]))[0])
+        start = nearest_traversable(mask, cell, self.start_search_cells)  # type: ignore[arg-type]
+        if start is None:
+            return None
+        mask[start[1], start[0]] = True
+        cost = np.where(costmap.data < COST_INSCRIBED, costmap.data, 0).astype(np.float64)
+        return grid_distances(mask, start, 1.0 + self.weight * cost / 252.0)
+
+    def make_plan(
+        self, costmap: Grid, start: tuple[float, float, float], goal: tuple[float, float, float]
+    ) -> np.ndarray | None:
+        """A path (N, 2) in the costmap's frame from ``start`` to ``goal``, or None when none exists."""
+        found = self.distances(costmap, (start[0], start[1]))
+        if found is None:
+            return None
+        dist, pred = found
+        gi, gj = (int(v) for v in costmap.world_to_cell(np.array([goal[:2]]))[0])
+        if not (0 <= gi < costmap.width and 0 <= gj < costmap.height) or not np.isfinite(dist[gj, gi]):
+            return None
+        return costmap.cell_to_world(extract_path(pred, costmap.width, (gi, gj)))
 
 
 def grid_distances(
@@ -154,14 +228,11 @@ def plan_to_frontier(
     Frontiers whose centroid lies within 0.5 m of a blacklisted point are skipped.
     """
     grid = grid.crop_to_known()
-    dist_m = clearance(grid)
-    mask = traversable(grid, robot_radius, clearance_m=dist_m)
-    start_cell = tuple(int(v) for v in grid.world_to_cell(np.array([robot_xy]))[0])
-    start = nearest_traversable(mask, start_cell)  # type: ignore[arg-type]
-    if start is None:
+    planner = GridDijkstraPlanner()
+    found = planner.distances(clearance_costmap(grid, robot_radius), robot_xy)
+    if found is None:
         return None
-    mask[start[1], start[0]] = True
-    dist, pred = grid_distances(mask, start, clearance_cost(dist_m, robot_radius))
+    dist, pred = found
     best, best_cost = None, math.inf
     banned = np.array(blacklist).reshape(-1, 2) if blacklist else np.zeros((0, 2))
     for f in find_frontiers(grid, min_cells=min_frontier_cells):
@@ -183,38 +254,3 @@ def plan_to_frontier(
         return None
     cells = extract_path(pred, grid.width, best)
     return grid.cell_to_world(cells)
-
-
-def follow_path(
-    pose: tuple[float, float, float],
-    path: np.ndarray,
-    *,
-    lookahead: float = 0.4,
-    max_v: float = 0.35,
-    max_w: float = 1.2,
-    min_front_range: float = float("inf"),
-    stop_distance: float = 0.35,
-) -> tuple[float, float, int]:
-    """Pure pursuit toward the point ``lookahead`` ahead on ``path``; returns (v m/s, w rad/s, index reached).
-
-    Turns in place when the target is more than ~60° off the heading; stops forward motion when the
-    closest scan return ahead (``min_front_range``) is under ``stop_distance``.
-    """
-    x, y, yaw = pose
-    d = np.hypot(path[:, 0] - x, path[:, 1] - y)
-    nearest = int(np.argmin(d))
-    ahead = np.nonzero(d[nearest:] >= lookahead)[0]
-    k = nearest + int(ahead[0]) if len(ahead) else len(path) - 1
-    tx, ty = path[k]
-    dx, dy = tx - x, ty - y
-    c, s = math.cos(yaw), math.sin(yaw)
-    lx, ly = c * dx + s * dy, -s * dx + c * dy
-    heading_err = math.atan2(ly, lx)
-    w = float(np.clip(2.0 * heading_err, -max_w, max_w))
-    if abs(heading_err) > 1.0:
-        return 0.0, w, nearest
-    v = max_v * max(0.0, math.cos(heading_err))
-    v = min(v, 0.8 * math.hypot(dx, dy) + 0.05)
-    if min_front_range < stop_distance:
-        v = 0.0
-    return float(v), w, nearest

@@ -10,7 +10,8 @@ import numpy as np
 from navlab import msgs
 from navlab.core import Executor, Node, TfError
 from navlab.grid import GridMap
-from navlab.mapping.explore import follow_path, plan_to_frontier
+from navlab.mapping.explore import plan_to_frontier
+from navlab.mapping.follow import PurePursuit
 
 
 class Explore(Node):
@@ -40,6 +41,7 @@ class Explore(Node):
         self.max_w = self.declare_parameter("max_vel_theta", 1.2)
         self.progress_timeout = self.declare_parameter("progress_timeout", 20.0)
         self.done_checks = self.declare_parameter("done_checks", 3)
+        self.follower = PurePursuit(max_vel_x=self.max_v, max_vel_theta=self.max_w, xy_goal_tolerance=0.0)
         self.done = False
         self.grid: GridMap | None = None
         self.path: np.ndarray | None = None
@@ -95,6 +97,7 @@ class Explore(Node):
         self._no_frontier = 0
         goal_changed = self.path is None or np.hypot(*(self.path[-1] - path[-1])) > 0.3
         self.path = path
+        self.follower.set_plan(path)
         if goal_changed:
             self._last_progress = (self.executor.now_ns, math.inf)
         now = self.executor.now_ns
@@ -128,7 +131,8 @@ class Explore(Node):
             self.path = None
             self.pub.publish(msgs.twist(0.0, 0.0))
             return
-        v, w, _ = follow_path(pose, self.path, max_v=self.max_v, max_w=self.max_w, min_front_range=self._front_range)
+        self.follower.min_front_range = self._front_range
+        v, w = self.follower.compute_velocity(pose)
         if v == 0.0 and self._front_range < 0.35 and self._rear_range > 0.4:
             v = -0.1  # blocked ahead: back off while turning toward the path
         self.pub.publish(msgs.twist(v, w))

@@ -3,7 +3,7 @@
 ``run_offline`` feeds every scan of a ``CarmenLog`` to the chosen mode (``graph``: scan-to-map
 matching with loop closure and pose-graph optimisation; ``gmapping``: the paper's Rao-Blackwellized
 particle filter), and returns robot poses per scan plus the occupancy grid. ``write_outputs`` writes
-``map.yaml``/``map.pgm`` (map_saver format), ``poses.txt`` (``timestamp x y theta``) and ``map.png``.
+``map.yaml``/``map.pgm`` (map_saver format) and ``poses.txt`` (``timestamp x y theta``).
 """
 
 from __future__ import annotations
@@ -82,45 +82,9 @@ def run_offline(
     return SlamResult(np.array([s.timestamp for s in scans]), robot, laser, grid, slam.stats())
 
 
-def _display_image(grid: GridMap, max_pixels: int = 1200) -> np.ndarray:
-    """Grey image of the grid (1 free, 0 occupied, 0.8 unknown), block-reduced so one-cell walls survive
-    when the grid is larger than ``max_pixels``: a block is occupied if any cell is, else free if any is."""
-    f = max(1, int(np.ceil(max(grid.width, grid.height) / max_pixels)))
-    occ = grid.occupied_mask()
-    free = grid.free_mask()
-    if f > 1:
-        h, w = (grid.height + f - 1) // f * f, (grid.width + f - 1) // f * f
-        occ = np.pad(occ, ((0, h - grid.height), (0, w - grid.width))).reshape(h // f, f, w // f, f).any(axis=(1, 3))
-        free = np.pad(free, ((0, h - grid.height), (0, w - grid.width))).reshape(h // f, f, w // f, f).any(axis=(1, 3))
-    return np.where(occ, 0.0, np.where(free, 1.0, 0.8))
-
-
-def save_figure(grid: GridMap, poses: np.ndarray, path: str | Path, *, title: str = "") -> None:
-    """PNG of the map (grey: unknown) with the trajectory in red; written atomically."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    from navlab.io.files import save_figure_atomic
-
-    img = _display_image(grid)
-    x0, y0, x1, y1 = grid.bounds()
-    fig, ax = plt.subplots(figsize=(8, 8 * grid.height / max(grid.width, 1) + 0.5))
-    ax.imshow(img, cmap="gray", vmin=0, vmax=1, origin="lower", extent=(x0, x1, y0, y1), interpolation="nearest")
-    ax.plot(poses[:, 0], poses[:, 1], "r-", lw=0.7)
-    ax.set_xlabel("x [m]")
-    ax.set_ylabel("y [m]")
-    if title:
-        ax.set_title(title)
-    try:
-        save_figure_atomic(fig, path, format="png", dpi=120, bbox_inches="tight")
-    finally:
-        plt.close(fig)
-
-
-def write_outputs(result: SlamResult, out_dir: str | Path, *, title: str = "") -> dict[str, Path]:
-    """Write map.yaml, map.pgm, poses.txt and map.png into ``out_dir`` (created if needed)."""
+def write_outputs(result: SlamResult, out_dir: str | Path) -> dict[str, Path]:
+    """Write map.yaml, map.pgm and poses.txt into ``out_dir`` (created if needed); a picture of them is
+    ``experiments.plots.plot_run``'s job."""
     from navlab.io.poses import write_poses
 
     out = Path(out_dir)
@@ -130,5 +94,4 @@ def write_outputs(result: SlamResult, out_dir: str | Path, *, title: str = "") -
         raise MappingError(f"cannot create output directory {out}: {exc.strerror or exc}") from None
     image = save_map(result.grid, out / "map.yaml")
     write_poses(out / "poses.txt", result.timestamps, result.poses)
-    save_figure(result.grid, result.poses, out / "map.png", title=title)
-    return {"yaml": out / "map.yaml", "image": image, "poses": out / "poses.txt", "figure": out / "map.png"}
+    return {"yaml": out / "map.yaml", "image": image, "poses": out / "poses.txt"}

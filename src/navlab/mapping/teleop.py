@@ -20,7 +20,7 @@ from navlab import msgs
 from navlab.core import Executor, Node, TfError
 from navlab.core.params import read_yaml
 from navlab.mapping.errors import MappingError
-from navlab.mapping.explore import follow_path
+from navlab.mapping.follow import PurePursuit
 
 # teleop_twist_keyboard: key -> (x, y, z, th) direction, and key -> (speed, turn) multipliers.
 MOVE_BINDINGS: dict[str, tuple[int, int, int, int]] = {
@@ -134,10 +134,13 @@ def load_route(path: str | Path) -> tuple[list[tuple[float, float, float]], np.n
 
 
 class RouteFollower(Node):
-    """Drives a scripted route: velocity segments first, then waypoints (pure pursuit on odometry).
+    """Drives a scripted route: velocity segments first, then waypoints (pure pursuit, ``PurePursuit``).
 
     Parameters: ``segments`` (list of {linear, angular, duration}), ``waypoints`` (list of [x, y] in
-    ``odom_frame``), ``base_frame``, ``odom_frame``, ``max_vel_x``, ``rate``. ``done`` becomes True at the end.
+    ``odom_frame``), ``base_frame``, ``odom_frame``, ``max_vel_x``, ``rate``, ``loop`` (drive the waypoints
+    round and round), ``pose_topic`` (steer on a ``nav_msgs/Odometry`` topic such as
+    ``/ground_truth/odom`` instead of tf; its frame is then the waypoints' frame), ``waypoint_tolerance``
+    (m). ``done`` becomes True at the end of a route that does not loop.
     """
 
     def __init__(
@@ -154,15 +157,34 @@ class RouteFollower(Node):
         self.base_frame = self.declare_parameter("base_frame", "chassis")
         self.odom_frame = self.declare_parameter("odom_frame", "odom")
         self.max_v = self.declare_parameter("max_vel_x", 0.3)
+        self.loop = self.declare_parameter("loop", False)
+        self.tolerance = self.declare_parameter("waypoint_tolerance", 0.1)
+        pose_topic = self.declare_parameter("pose_topic", "")
         rate = self.declare_parameter("rate", 10.0)
         self.segments = [
             (float(s.get("linear", 0)), float(s.get("angular", 0)), float(s["duration"])) for s in raw_segments
         ]
+        self.follower = PurePursuit(lookahead=0.05, max_vel_x=self.max_v, xy_goal_tolerance=0.0)
         self.done = False
+        self.index = 0  # the waypoint driven to
         self._seg_end: int | None = None
-        self._wp = 0
+        self._topic_pose: tuple[float, float, float] | None = None
         self.pub = self.create_publisher(msgs.Twist, "cmd_vel", 1)
+        if pose_topic:
+            self.create_subscription(msgs.Odometry, pose_topic, self._on_pose, 10)
+        self._use_topic = bool(pose_topic)
         self.create_timer(1.0 / rate, self._tick)
+
+    def _on_pose(self, msg: Any) -> None:
+        self._topic_pose = msgs.pose2d(msg.pose.pose)
+
+    def _pose(self) -> tuple[float, float, float] | None:
+        if self._use_topic:
+            return self._topic_pose
+        try:
+            return self.executor.tf.lookup_pose2d(self.odom_frame, self.base_frame)
+        except TfError:
+            return None
 
     def _tick(self) -> None:
         if self.done:
@@ -179,22 +201,23 @@ class RouteFollower(Node):
             self._seg_end = None
             self._tick()
             return
-        if self._wp >= len(self.waypoints):
-            self.done = True
-            self.pub.publish(msgs.twist(0.0, 0.0))
+        if self.index >= len(self.waypoints):
+            if self.loop and len(self.waypoints):
+                self.index = 0
+            else:
+                self.done = True
+                self.pub.publish(msgs.twist(0.0, 0.0))
+                return
+        pose = self._pose()
+        if pose is None:
             return
-        try:
-            pose = self.executor.tf.lookup_pose2d(self.odom_frame, self.base_frame)
-        except TfError:
-            return
-        target = self.waypoints[self._wp]
-        if math.hypot(target[0] - pose[0], target[1] - pose[1]) < 0.1:
-            self._wp += 1
+        target = self.waypoints[self.index]
+        if math.hypot(target[0] - pose[0], target[1] - pose[1]) < self.tolerance:
+            self.index += 1
             self._tick()
             return
-        path = np.array([pose[:2], target])
-        v, w, _ = follow_path(pose, path, lookahead=0.05, max_v=self.max_v)
-        self.pub.publish(msgs.twist(v, w))
+        self.follower.set_plan(np.array([pose[:2], target]))
+        self.pub.publish(msgs.twist(*self.follower.compute_velocity(pose)))
 
 
 @dataclass

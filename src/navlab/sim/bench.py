@@ -70,7 +70,7 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
         "timestep_s": sim.timestep,
         "rtf_all_plugins": round(rtf_all, 1),
         "rtf_timestep_1ms": round(rtf_1ms, 1),
-        "sim_seconds_per_run": SIM_SECONDS,
+        "sim_s_per_run": SIM_SECONDS,
         "world": WORLD,
         "robot": ROBOT,
         "lidar_rays": sim.robot.lidars[0].samples if sim.robot else 0,

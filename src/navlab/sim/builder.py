@@ -40,6 +40,7 @@ RAY_GEOMGROUP = np.array([1, 0, 0, 1, 0, 0], dtype=np.uint8)
 
 # contact bits: a pair touches when (contype1 & conaffinity2) or (contype2 & conaffinity1)
 _STATIC, _ROBOT, _DYNAMIC, _GROUND, _WHEEL_FLOOR, _WHEEL = 1, 2, 4, 8, 16, 32
+GROUND_CONTACT_BIT = _GROUND  # the floor's contype (contacts with it are not collisions)
 _CONTACT_BITS = {
     "static": (_STATIC, _ROBOT | _DYNAMIC | _WHEEL),
     "ground": (_GROUND, _ROBOT | _DYNAMIC | _WHEEL_FLOOR),

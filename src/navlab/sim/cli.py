@@ -6,10 +6,9 @@ import argparse
 import json
 import math
 import sys
-import time
 from typing import Any
 
-from navlab.core.runner import positive_seconds
+from navlab.cli_common import add_pose_arguments, add_set_argument, parse_sets, positive_seconds, start_pose
 
 _SPAWN_HELP = (
     "spawn a model, KIND:key=value,... with KIND box|cylinder|sphere|sdf, e.g. 'box:name=crate,x=2,y=1,size=0.5', "
@@ -22,9 +21,7 @@ def _add_common(p: argparse.ArgumentParser) -> None:
     p.add_argument("--world", default="room", help="shipped world (room, room_obstacles) or a .world file "
                    "(default: room)")
     p.add_argument("--robot", default="mybot", help="shipped robot (mybot) or a .xacro/.urdf file (default: mybot)")
-    p.add_argument("--x", type=float, default=0.0, help="robot start x in the world (m, default 0)")
-    p.add_argument("--y", type=float, default=0.0, help="robot start y in the world (m, default 0)")
-    p.add_argument("--yaw", type=float, default=0.0, help="robot start heading (rad, default 0)")
+    add_pose_arguments(p)
     p.add_argument("--spawn", action="append", default=[], metavar="SPEC", help=_SPAWN_HELP)
 
 
@@ -46,6 +43,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="physics step in s, 0.0005-0.002 (default 0.002, or the world's max_step_size if larger)")
     p.add_argument("--cmd-vel", default=None, metavar="V,W",
                    help="publish this constant cmd_vel (m/s, rad/s) at 10 Hz, e.g. 0.3,0.2")
+    add_set_argument(p, "gazebo", "ground_truth_rate=100")
     p.add_argument("--record", default=None, metavar="DIR", help="record all topics to a rosbag2 in DIR")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.add_argument("--json", action="store_true", help="print the summary as one JSON object")
@@ -82,16 +80,15 @@ def _parse_cmd_vel(text: str | None) -> tuple[float, float] | None:
 
 def _cmd_sim(args: argparse.Namespace) -> int:
     from navlab import msgs
-    from navlab.core import Executor, Node
-    from navlab.core.runner import run_for
-    from navlab.sim.gazebo import launch_sim
+    from navlab.core import Node
+    from navlab.experiments.session import start_run
     from navlab.sim.spawn import parse_spawn_spec
 
     cmd_vel = _parse_cmd_vel(args.cmd_vel)
     spawns = [parse_spawn_spec(s, default_name=f"spawned_{i}") for i, s in enumerate(args.spawn)]
-    ex = Executor(seed=args.seed, rate=args.rate)
-    gazebo = launch_sim(ex, world=args.world, robot=args.robot, pose=(args.x, args.y, args.yaw),
-                        timestep=args.timestep)
+    run = start_run("sim", world=args.world, robot=args.robot, pose=start_pose(args), seed=args.seed,
+                    pace=args.rate, timestep=args.timestep, overrides={"gazebo": parse_sets(args.set)})
+    ex, gazebo = run.executor, run.gazebo
     helper = Node(ex, name="sim_cli")
     for model, t in spawns:
         if t <= 0:
@@ -111,16 +108,13 @@ def _cmd_sim(args: argparse.Namespace) -> int:
         helper.create_timer(0.1, lambda: pub.publish(msgs.twist(*cmd_vel)))
         pub.publish(msgs.twist(*cmd_vel))
     start = gazebo.sim.base_pose2d()
-    wall0 = time.perf_counter()
-    bag = run_for(ex, args.duration, record=args.record, quiet=args.quiet, desc="sim")
-    wall = time.perf_counter() - wall0
+    run.run(args.duration, record=args.record, quiet=args.quiet, desc="sim")
+    bag = run.bag
     end = gazebo.sim.base_pose2d()
     summary: dict[str, Any] = {
         "world": gazebo.sim.world.name,
         "robot": gazebo.sim.robot.name if gazebo.sim.robot else None,
-        "sim_seconds": ex.now_ns / 1e9,
-        "wall_seconds": round(wall, 3),
-        "rtf": round(ex.now_ns / 1e9 / wall, 1) if wall > 0 else None,
+        **run.figures(),
         "timestep_s": gazebo.sim.timestep,
         "start_pose": [round(v, 4) for v in start],
         "true_pose": [round(v, 4) for v in end],

@@ -8,6 +8,7 @@ from typing import Any
 
 from navlab.core import Executor, Node
 from navlab.description.model import RobotModel
+from navlab.sim.contacts import CollisionPlugin
 from navlab.sim.errors import SimError
 from navlab.sim.plugins import DiffDrivePlugin, GroundTruthPlugin, ImuPlugin, JointStatePlugin, LidarPlugin
 from navlab.sim.simulation import Simulation
@@ -87,6 +88,8 @@ class GazeboSim(Node):
             base = robot.diff_drive.robot_base_frame if robot.diff_drive else robot.root_link
             self.plugins.append(GroundTruthPlugin(executor, parameters={"bodyName": base, "updateRate": gt_rate},
                                                  namespace=namespace, sim=self.sim))
+        if robot is not None:  # Gazebo's bumper: what the robot touches, on /collisions
+            self.plugins.append(CollisionPlugin(executor, namespace=namespace, sim=self.sim))
         if seed >= 0:
             import zlib
 

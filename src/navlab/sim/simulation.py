@@ -13,8 +13,8 @@ import mujoco
 import numpy as np
 
 from navlab.description.model import DiffDriveConfig, LidarConfig, RobotModel
-from navlab.geometry import quat_from_rpy, xyzw_from_wxyz, yaw_from_quat
-from navlab.sim.builder import GROUP_ROBOT, GROUP_WORLD, RAY_GEOMGROUP, mj_quat_from_rpy
+from navlab.geometry import quat_from_rpy, quat_from_yaw, wxyz_from_xyzw, xyzw_from_wxyz, yaw_from_quat
+from navlab.sim.builder import GROUND_CONTACT_BIT, GROUP_ROBOT, GROUP_WORLD, RAY_GEOMGROUP, mj_quat_from_rpy
 from navlab.sim.errors import SimError
 from navlab.sim.raycast import FAST_TYPES, cast_planar, finish_ranges
 from navlab.sim.scene import add_world_model, build_spec, compile_spec, remove_world_model
@@ -204,6 +204,35 @@ class Simulation:
         q = np.zeros(4)
         mujoco.mju_mulQuat(q, self.data.xquat[b], quat)
         return Pose3D(self.data.xpos[b] + rot @ xyz, np.array(xyzw_from_wxyz(q)))
+
+    def robot_collisions(self) -> list[str]:
+        """Names of the world models the robot touches now (contacts of the last physics step; the floor
+        does not count): what Gazebo's bumper plugin would report."""
+        m, d = self.model, self.data
+        out: set[str] = set()
+        for k in range(int(d.ncon)):
+            g1, g2 = int(d.contact[k].geom[0]), int(d.contact[k].geom[1])
+            for mine, other in ((g1, g2), (g2, g1)):
+                if m.geom_group[mine] == GROUP_ROBOT and m.geom_group[other] != GROUP_ROBOT:
+                    if int(m.geom_contype[other]) & GROUND_CONTACT_BIT:
+                        continue
+                    name = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_GEOM, other) or ""
+                    out.add(name.split("::")[0] or "world")
+        return sorted(out)
+
+    def teleport(self, x: float, y: float, yaw: float) -> None:
+        """Move the robot's root to (x, y, yaw) in the world (m, rad), at rest: Gazebo's set_model_state
+        (the 'kidnapped robot')."""
+        if self.robot is None:
+            raise SimError("there is no robot in this simulation to teleport")
+        if not all(math.isfinite(v) for v in (x, y, yaw)):
+            raise SimError(f"teleport pose ({x}, {y}, {yaw}) is not finite")
+        q, v = self._root_qpos, self._root_dof
+        self.data.qpos[q:q + 2] = (x, y)
+        self.data.qpos[q + 3:q + 7] = wxyz_from_xyzw(quat_from_yaw(yaw))
+        self.data.qvel[v:v + 6] = 0.0
+        mujoco.mj_forward(self.model, self.data)
+        self._synced = True
 
     def base_pose2d(self, link: str | None = None) -> tuple[float, float, float]:
         """True (x, y, yaw) of a robot link in the world (m, rad)."""

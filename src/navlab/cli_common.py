@@ -1,0 +1,77 @@
+"""What every ``navlab`` verb shares, kept light so ``--help`` starts fast: start-pose options, ``--set``,
+durations and printing figures. Imports nothing heavy at module level."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+from collections.abc import Sequence
+from typing import Any
+
+
+def positive_seconds(text: str) -> float:
+    """argparse ``type=`` for a duration in simulated seconds: a finite number > 0."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number of seconds, got {text!r}") from None
+    if not (math.isfinite(value) and value > 0):
+        raise argparse.ArgumentTypeError(f"expected a duration > 0 s, got {text}")
+    return value
+
+
+def finite_float(text: str) -> float:
+    """argparse ``type=`` for a finite number."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"expected a finite number, got {text}")
+    return value
+
+
+def add_pose_arguments(p: argparse.ArgumentParser, what: str = "robot start") -> None:
+    """``--x --y --yaw``: the robot's start pose in the world (m, m, rad), the same on every verb."""
+    p.add_argument("--x", type=finite_float, default=0.0, help=f"{what} x in the world (m, default 0)")
+    p.add_argument("--y", type=finite_float, default=0.0, help=f"{what} y in the world (m, default 0)")
+    p.add_argument("--yaw", type=finite_float, default=0.0, help=f"{what} heading (rad, default 0)")
+
+
+def start_pose(args: argparse.Namespace) -> tuple[float, float, float]:
+    """(x, y, yaw) from :func:`add_pose_arguments`' options."""
+    return float(args.x), float(args.y), float(args.yaw)
+
+
+def add_set_argument(p: argparse.ArgumentParser, node: str, example: str) -> None:
+    """``--set NAME=VALUE`` (repeatable): one parameter of ``node``, parsed as YAML."""
+    p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
+                   help=f"override one {node} parameter, e.g. --set {example} (repeatable)")  # fmt: skip
+
+
+def parse_sets(items: Sequence[str]) -> dict[str, Any]:
+    """``--set name=value`` items to a dict; values are read as YAML (numbers, booleans, lists)."""
+    import yaml
+
+    from navlab.errors import NavlabError
+
+    out: dict[str, Any] = {}
+    for item in items:
+        name, sep, value = item.partition("=")
+        if not sep or not name.strip():
+            raise NavlabError(f"--set {item!r}: expected name=value (e.g. laser_max_beams=60)")
+        try:
+            out[name.strip()] = yaml.safe_load(value)
+        except yaml.YAMLError:
+            raise NavlabError(f"--set {item!r}: the value is not valid YAML") from None
+    return out
+
+
+def print_figures(figures: dict[str, Any], as_json: bool) -> None:
+    """Print a run's figures: one JSON object, or ``key: value`` lines."""
+    if as_json:
+        print(json.dumps(figures))
+    else:
+        for key, value in figures.items():
+            print(f"  {key}: {value}")

@@ -1,0 +1,160 @@
+"""The paper's mapping step in simulation: the ``mapping`` launch (sim + slam_gmapping [+ explore]) with a
+driver (exploration, teleop or a route), then the saved map scored against the world's truth.
+
+``run_mapping`` is the Python API behind ``navlab map``; the map frame is the robot's start pose.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from navlab.experiments.metrics import free_coverage, score_map, trajectory_error
+from navlab.experiments.monitors import PoseMonitor
+from navlab.experiments.plots import Track, plot_run
+from navlab.experiments.session import Run, rounded, start_run
+from navlab.experiments.truth import true_occupancy
+from navlab.geometry import inverse_transform_points2, wrap_angle
+from navlab.grid import GridMap
+from navlab.mapping.errors import MappingError
+from navlab.mapping.mapfile import save_map
+
+DRIVERS = ("explore", "teleop", "route")
+TRAJECTORY_HEADER = "# t x y theta true_x true_y true_theta  (s, m, rad; map frame = the robot's start pose)"
+
+
+@dataclass
+class MappingResult:
+    """What a mapping run produced: files, the final grid, and its scores against the world's truth."""
+
+    map_yaml: Path
+    grid: GridMap
+    sim_s: float
+    finished: bool
+    scores: dict[str, Any] = field(default_factory=dict)
+
+
+def _add_driver(run: Run, driver: str, route: str | Path | None) -> Any:
+    """Start the driver node; returns a callable telling whether it is done."""
+    from navlab.mapping.teleop import HELP, RouteFollower, TeleopKeyboard, load_route, terminal_keys
+
+    if driver == "explore":
+        explorer = run.node("explore")
+        return lambda: explorer.done  # type: ignore[attr-defined]
+    if driver == "route":
+        if route is None:
+            raise MappingError("driver 'route' needs a route file (--route FILE)")
+        segments, waypoints = load_route(route)
+        follower = run.add(RouteFollower, parameters={
+            "segments": [{"linear": v, "angular": w, "duration": d} for v, w, d in segments],
+            "waypoints": waypoints.tolist(), "base_frame": run.base_frame, "odom_frame": run.odom_frame,
+        })  # fmt: skip
+        return lambda: follower.done
+    teleop = run.add(TeleopKeyboard)
+    print("teleop_twist_keyboard:\n" + HELP)
+    terminal_keys(teleop, run.executor)
+    return lambda: False
+
+
+def run_mapping(
+    *,
+    world: str = "room",
+    robot: str = "mybot",
+    pose: tuple[float, float, float] = (0.0, 0.0, 0.0),
+    out: str | Path = "map",
+    driver: str = "explore",
+    route: str | Path | None = None,
+    duration: float = 600.0,
+    mode: str = "gmapping",
+    seed: int = 0,
+    rate: float = 0.0,
+    record: str | Path | None = None,
+    quiet: bool = False,
+    slam_params: dict[str, Any] | None = None,
+    sim_params: dict[str, Any] | None = None,
+) -> MappingResult:
+    """Map ``world`` with SLAM while ``driver`` (explore | teleop | route) drives; save ``out``/map.yaml.
+
+    Stops when exploration finds no reachable frontier, the route ends, or ``duration`` simulated
+    seconds pass (teleop: Ctrl-C or the duration). ``sim_params`` go to the ``gazebo`` node (e.g.
+    ``odometry_noise``); ``slam_params`` to ``slam_gmapping``.
+    """
+    if driver not in DRIVERS:
+        raise MappingError(f"driver must be one of {', '.join(DRIVERS)}, got {driver!r}")
+    overrides = {"slam_gmapping": {"mode": mode, **(slam_params or {})}}
+    if sim_params:
+        overrides["gazebo"] = dict(sim_params)
+    run = start_run("mapping", world=world, robot=robot, pose=pose, seed=seed,
+                    pace=1.0 if driver == "teleop" and rate == 0 else rate, overrides=overrides,
+                    explore=str(driver == "explore").lower())  # fmt: skip
+    is_done = _add_driver(run, driver, route)
+    monitor = run.add(PoseMonitor, parameters={"base_frame": run.base_frame, "odom_frame": run.odom_frame})
+    run.run(duration, until=is_done, record=record, quiet=quiet, desc=f"mapping {world}")
+    slam = run.node("slam_gmapping")
+    grid = slam.current_map()  # type: ignore[attr-defined]
+    if grid is None:
+        raise MappingError("SLAM produced no map: did the robot receive scans? (check the robot's lidar)")
+    out_dir = Path(out)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    map_yaml = out_dir / "map.yaml"
+    save_map(grid, map_yaml)
+    result = MappingResult(map_yaml, grid, run.timing["sim_s"], bool(is_done()))
+    truth = true_occupancy(run.sim.world, grid)
+    scores: dict[str, Any] = {
+        **run.figures(),
+        "finished": result.finished,
+        "scans_processed": slam.scans_processed,  # type: ignore[attr-defined]
+        **score_map(grid, truth, world_T_map=pose),
+        "coverage": free_coverage(grid, truth, world_T_map=pose),
+    }
+    s = monitor.samples()
+    if len(s["t"]):
+        # the estimate is in the map frame = the spawn pose; bring the truth into it
+        tru = s["truth"]
+        tru_map = np.column_stack([inverse_transform_points2(pose, tru[:, :2]), wrap_angle(tru[:, 2] - pose[2])])
+        est = s["estimate"]
+        scores.update(trajectory_error(est, tru_map))
+        odom_err = trajectory_error(s["odometry"], tru_map)  # raw odometry starts at the spawn pose too
+        scores["odometry_position_error_mean_m"] = odom_err["position_error_mean_m"]
+        scores["odometry_yaw_error_mean_deg"] = odom_err["yaw_error_mean_deg"]
+        write_trajectory(out_dir / "trajectory.txt", s["t"], est, tru_map)
+        plot_run(grid, [Track(tru_map, "ground truth", "g-", width=1.5), Track(est, "SLAM estimate", "b--")],
+                 out_dir / "map.png")  # fmt: skip
+    result.scores = rounded(scores)
+    return result
+
+
+def write_trajectory(path: Path, t: np.ndarray, est: np.ndarray, truth: np.ndarray) -> None:
+    """The SLAM trajectory beside the true one, one line per sample (read by ``navlab eval map``)."""
+    from navlab.io.files import write_text_atomic
+
+    ok = np.isfinite(est).all(axis=1)
+    rows = np.column_stack([t, est, truth])[ok]
+    lines = [TRAJECTORY_HEADER, *(" ".join(f"{v:.6f}" for v in row) for row in rows)]
+    write_text_atomic(path, "\n".join(lines) + "\n")
+
+
+def read_trajectory(path: Path) -> tuple[np.ndarray, np.ndarray]:
+    """(estimate (N, 3), truth (N, 3)) from a file written by :func:`write_trajectory`."""
+    try:
+        rows = np.loadtxt(path, comments="#", ndmin=2)
+    except (OSError, ValueError) as exc:
+        raise MappingError(f"{path}: cannot read a trajectory ({exc}); expected lines of 7 numbers") from None
+    if rows.shape[1] != 7:
+        raise MappingError(f"{path}: expected 7 columns (t x y theta true_x true_y true_theta), got {rows.shape[1]}")
+    return rows[:, 1:4], rows[:, 4:7]
+
+
+def bench(args: Any) -> dict[str, Any]:
+    """``navlab bench mapping``: the whole mapping stack (sim + lidar + slam_gmapping + exploration)
+    exploring room.world until done; real-time factor of the run loop (sim s / wall s)."""
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as tmp:
+        r = run_mapping(world="room", out=tmp, driver="explore", duration=300, seed=getattr(args, "seed", 0),
+                        quiet=True)  # fmt: skip
+    keys = ("sim_s", "wall_s", "rtf", "finished", "scans_processed", "coverage", "precision", "recall")
+    return {k: r.scores[k] for k in keys}

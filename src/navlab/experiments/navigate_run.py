@@ -1,0 +1,196 @@
+"""The paper's navigation step: the ``navigation`` launch (sim + map_server + amcl + move_base), goals sent
+one after another, each scored from ground truth and the simulator's contacts.
+
+``run_navigation`` is the Python API behind ``navlab navigate``; each goal's figures are its outcome
+(``succeeded`` | ``aborted`` | ``timeout``), move_base's reason, time, path length, minimum clearance
+(m between the robot's footprint and anything the lidar's true rays hit) and collisions (contact episodes).
+"""
+
+from __future__ import annotations
+
+import math
+import tempfile
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from navlab import msgs
+from navlab.core import Executor, Node, TfError
+from navlab.experiments.session import Run, rounded, start_run
+from navlab.experiments.truth import true_map
+from navlab.grid import GridMap
+from navlab.navigation.errors import NavigationError
+
+Pose = tuple[float, float, float]
+CONTROLLERS = {
+    "trajectory": "base_local_planner/TrajectoryPlannerROS",
+    "dwa": "dwa_local_planner/DWAPlannerROS",
+    "mppi": "nav2_mppi_controller::MPPIController",
+}
+
+
+class NavMonitor(Node):
+    """Ground truth for the goals: the true path, the closest approach to obstacles (true lidar ranges minus
+    the robot's radius) and contact episodes on ``/collisions``; also the last plan, local plan and scan."""
+
+    def __init__(self, executor: Executor, *, name: str = "nav_monitor", parameters: dict[str, Any] | None = None,
+                 namespace: str = "", sim: Any = None, move_base: Any = None) -> None:  # fmt: skip
+        super().__init__(executor, name=name, parameters=parameters, namespace=namespace)
+        self.radius = float(self.declare_parameter("robot_radius", 0.2))
+        self.sim, self.move_base = sim, move_base
+        self.path: list[tuple[float, float, float]] = []
+        self.clearance: list[float] = []
+        self.contacts: list[float] = []  # times (s) of /collisions messages
+        self.scan: Any = None
+        self.create_subscription(msgs.String, "/collisions", lambda _m: self.contacts.append(self.now_s()), 10)
+        self.create_timer(0.1, self._sample)
+
+    def now_s(self) -> float:
+        """Simulated time (s)."""
+        return self.executor.now_ns / 1e9
+
+    def _sample(self) -> None:
+        x, y, yaw = self.sim.base_pose2d()
+        self.path.append((self.now_s(), x, y))
+        ranges = self.sim.true_ranges(0)
+        finite = ranges[np.isfinite(ranges)]
+        self.clearance.append(float(finite.min()) - self.radius if finite.size else math.inf)
+        self.scan = (x, y, yaw, ranges)
+
+
+@dataclass
+class NavigateResult:
+    """Per-goal figures, the whole run's timing, and what the pictures need."""
+
+    goals: list[dict[str, Any]]
+    summary: dict[str, Any]
+    grid: GridMap
+    snapshots: list[dict[str, Any]] = field(default_factory=list)
+
+
+def _episodes(times: Sequence[float], t0: float, t1: float, gap: float = 0.25) -> int:
+    """Contact episodes in [t0, t1]: runs of /collisions messages no more than ``gap`` s apart."""
+    ts = [t for t in times if t0 <= t <= t1]
+    return sum(1 for k, t in enumerate(ts) if k == 0 or t - ts[k - 1] > gap)
+
+
+def _drive_goal(run: Run, mon: NavMonitor, goal: Pose, frame: str, timeout: float) -> dict[str, Any]:
+    mb = run.node("move_base")
+    t0 = mon.now_s()
+    k0 = len(mon.path)
+    handle = mb.send_goal(*goal, frame_id=frame)  # type: ignore[attr-defined]
+    run.run(timeout, until=handle.done, quiet=True, chunk=1.0)
+    if not handle.done():
+        mb.cancel_goal()  # type: ignore[attr-defined]
+    t1 = mon.now_s()
+    pts = np.array([p[1:] for p in mon.path[k0:]]).reshape(-1, 2)
+    final = run.sim.base_pose2d()
+    outcome = {"SUCCEEDED": "succeeded", "ABORTED": "aborted"}.get(handle.state, "timeout")
+    reasons = {"succeeded": "", "aborted": handle.reason, "timeout": f"not reached in {timeout:g} s"}
+    return {
+        "goal": list(goal),
+        "outcome": outcome,
+        "reason": reasons[outcome],
+        "time_s": t1 - t0,
+        "path_m": float(np.linalg.norm(np.diff(pts, axis=0), axis=1).sum()) if len(pts) > 1 else 0.0,
+        "min_clearance_m": min(mon.clearance[k0:], default=math.inf),
+        "collisions": _episodes(mon.contacts, t0, t1),
+        "final_error_m": math.dist(final[:2], goal[:2]),
+    }
+
+
+def run_navigation(
+    goals: Sequence[Pose],
+    *,
+    world: str = "room_obstacles",
+    map_yaml: str | Path | None = None,
+    robot: str = "mybot",
+    pose: Pose = (0.0, 0.0, 0.0),
+    controller: str | None = None,
+    params_dir: str | Path | None = None,
+    move_base_params: dict[str, Any] | None = None,
+    spawn: Sequence[tuple[float, Any]] = (),
+    goal_timeout: float = 90.0,
+    seed: int = 0,
+    record: str | Path | None = None,
+    snapshots: bool = False,
+) -> NavigateResult:
+    """Navigate to ``goals`` (x, y, yaw in the map frame) in turn; see ``NavigateResult``.
+
+    ``map_yaml``: the map to navigate on (default: the world's true map). ``controller``: ``trajectory``,
+    ``dwa``, ``mppi`` or a ROS plugin name (default: the parameter files'). ``move_base_params``: overrides
+    (``{"local_costmap.update_frequency": 0.5}``). ``spawn``: (time s, ModelSpec) obstacles added while
+    running. ``snapshots``: keep what the per-goal pictures need.
+    """
+    from navlab.mapping.mapfile import load_map, save_map
+    from navlab.sim.gazebo import load_world_named
+
+    if not goals:
+        raise NavigationError("no goals given (e.g. --goal 2.0 1.0 0.0)")
+    for g in goals:
+        if len(g) != 3 or not all(math.isfinite(float(v)) for v in g):
+            raise NavigationError(f"goal {g!r}: expected three finite numbers x y yaw")
+    overrides: dict[str, Any] = dict(move_base_params or {})
+    if controller:
+        overrides["base_local_planner"] = CONTROLLERS.get(controller, controller)
+    launch_args: dict[str, Any] = {}
+    if params_dir is not None:
+        launch_args["params"] = str(params_dir)
+    with tempfile.TemporaryDirectory(prefix="navlab-navigate-") as tmp:
+        if map_yaml is None:
+            served = Path(tmp) / "true_map.yaml"
+            save_map(true_map(load_world_named(world), pose[:2]), served)
+        else:
+            served = Path(map_yaml)
+        grid = load_map(served)
+        run = start_run("navigation", world=world, robot=robot, pose=pose, seed=seed, map=str(served),
+                        overrides={"move_base": overrides}, **launch_args)  # fmt: skip
+    mb = run.node("move_base")
+    radius = mb.local_costmap.layered.circumscribed_radius  # type: ignore[attr-defined]
+    mon = run.add(NavMonitor, parameters={"robot_radius": radius}, sim=run.sim, move_base=mb)
+    for t, model in spawn:
+        _at(run, float(t), lambda m=model: run.gazebo.spawn(m))
+    results, shots = [], []
+    run.run(1.0, record=record, quiet=True)  # amcl's first update, the costmaps' first maps
+    for goal in goals:
+        results.append(rounded(_drive_goal(run, mon, tuple(map(float, goal)), "map", goal_timeout)))  # type: ignore[arg-type]
+        if snapshots:
+            shots.append(_snapshot(run, mon))
+    summary = rounded({
+        "goals_succeeded": sum(r["outcome"] == "succeeded" for r in results),
+        "goals": len(results),
+        "collisions": sum(r["collisions"] for r in results),
+        **run.figures(),
+    })  # fmt: skip
+    return NavigateResult(results, summary, grid, shots)
+
+
+def _at(run: Run, t: float, fn: Any) -> None:
+    """Call ``fn`` once at simulated time ``t`` (s) of the run."""
+    node = run.add(Node, name=f"at_{t:g}_{len(run.session.nodes)}")
+    holder: dict[str, Any] = {}
+
+    def fire() -> None:
+        holder["timer"].cancel()
+        fn()
+
+    holder["timer"] = node.create_timer(max(t - run.executor.now_ns / 1e9, 1e-3), fire)
+
+
+def _snapshot(run: Run, mon: NavMonitor) -> dict[str, Any]:
+    mb = run.node("move_base")
+    gc = mb.global_costmap.costmap  # type: ignore[attr-defined]
+    plan = mb.global_plan  # type: ignore[attr-defined]
+    local = getattr(mb.controller, "local_plan", None)  # type: ignore[attr-defined]
+    odom_to_map = None
+    try:
+        odom_to_map = run.executor.tf.lookup_pose2d("map", mb.local_costmap.global_frame)  # type: ignore[attr-defined]
+    except TfError:  # no tf: no local plan drawn
+        local = None
+    return {"costmap": gc, "plan": None if plan is None else plan.copy(),
+            "local_plan": None if local is None else np.asarray(local).copy(), "odom_to_map": odom_to_map,
+            "path": np.array([p[1:] for p in mon.path]), "scan": mon.scan,
+            "footprint": mb.local_costmap.layered.footprint}  # type: ignore[attr-defined]  # fmt: skip

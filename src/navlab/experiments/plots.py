@@ -1,0 +1,187 @@
+"""The one map-and-trajectory plotter: a map (grey unknown, black walls) with paths drawn over it,
+optionally beside an error-over-time panel. Written atomically as PNG."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from navlab.grid import GridMap
+
+
+@dataclass
+class Track:
+    """A path to draw: (N, 2+) points in the map's frame, a legend label and a matplotlib style."""
+
+    xy: np.ndarray
+    label: str
+    style: str = "-"
+    color: str | None = None
+    width: float = 1.2
+
+
+@dataclass
+class ErrorPanel:
+    """An error-over-time panel: ``t`` (s), ``values`` (m), drawn in cm on a log scale."""
+
+    t: np.ndarray
+    values: np.ndarray
+    ylabel: str = "position error (cm)"
+    title: str = ""
+    threshold: float | None = None
+    events: dict[str, float] = field(default_factory=dict)  # label -> time (s), drawn as dashed lines
+
+
+def map_image(grid: GridMap, max_pixels: int = 1200) -> np.ndarray:
+    """Grey image of the grid (1 free, 0 occupied, 0.8 unknown), block-reduced so one-cell walls survive
+    when the grid is larger than ``max_pixels``: a block is occupied if any cell is, else free if any is."""
+    f = max(1, int(np.ceil(max(grid.width, grid.height) / max_pixels)))
+    occ = grid.occupied_mask()
+    free = grid.free_mask()
+    if f > 1:
+        h, w = (grid.height + f - 1) // f * f, (grid.width + f - 1) // f * f
+        occ = np.pad(occ, ((0, h - grid.height), (0, w - grid.width))).reshape(h // f, f, w // f, f).any(axis=(1, 3))
+        free = np.pad(free, ((0, h - grid.height), (0, w - grid.width))).reshape(h // f, f, w // f, f).any(axis=(1, 3))
+    return np.where(occ, 0.0, np.where(free, 1.0, 0.8))
+
+
+def plot_run(
+    grid: GridMap,
+    tracks: Sequence[Track],
+    path: str | Path,
+    *,
+    title: str = "",
+    error: ErrorPanel | None = None,
+    crop: bool = True,
+    dpi: int = 120,
+) -> Path:
+    """Save the map with ``tracks`` (and ``error`` beside it) as a PNG at ``path``; returns the path.
+
+    ``crop`` limits the view to the part of the map that is known (plus 0.5 m)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from navlab.io.files import save_figure_atomic
+
+    if error is None:
+        fig, ax = plt.subplots(figsize=(8, 7))
+        ax2 = None
+    else:
+        fig, (ax, ax2) = plt.subplots(1, 2, figsize=(12, 5), gridspec_kw={"width_ratios": [1.3, 1]})
+    x0, y0, x1, y1 = grid.bounds()
+    ax.imshow(map_image(grid), cmap="gray", vmin=0, vmax=1, origin="lower", extent=(x0, x1, y0, y1),
+              interpolation="nearest")  # fmt: skip
+    for tr in tracks:
+        xy = np.asarray(tr.xy, dtype=np.float64)
+        if len(xy):
+            style = {"color": tr.color} if tr.color else {}
+            ax.plot(xy[:, 0], xy[:, 1], tr.style, lw=tr.width, label=tr.label, **style)
+    known = grid.known_bounds() if crop else None
+    if known is not None:
+        ax.set_xlim(known[0], known[2])
+        ax.set_ylim(known[1], known[3])
+    ax.set_aspect("equal")
+    ax.set_xlabel(f"x [m] ({grid.frame_id} frame)")
+    ax.set_ylabel("y [m]")
+    if tracks:
+        ax.legend(loc="upper right", fontsize=8)
+    if title:
+        ax.set_title(title)
+    if ax2 is not None and error is not None:
+        ax2.plot(error.t, np.asarray(error.values) * 100, color="tab:red")
+        if error.threshold is not None:
+            ax2.axhline(error.threshold * 100, color="gray", ls=":", lw=1)
+        for label, t in error.events.items():
+            ax2.axvline(t, color="black", ls="--", lw=1, label=label)
+        if error.events:
+            ax2.legend(fontsize=8)
+        ax2.set_yscale("log")
+        ax2.set_xlabel("time (s)")
+        ax2.set_ylabel(error.ylabel)
+        ax2.set_title(error.title)
+    fig.tight_layout()
+    out = Path(path)
+    try:
+        save_figure_atomic(fig, out, format="png", dpi=dpi)
+    finally:
+        plt.close(fig)
+    return out
+
+
+def plot_navigation(grid: GridMap, shot: dict[str, np.ndarray | object], path: str | Path, *, title: str = "",
+                    goal: Sequence[float] | None = None) -> Path:  # fmt: skip
+    """A picture in the style of the paper's Figs. 9–12: the map, the global costmap's inflation as a dark
+    shadow and its obstacles, the driven path, the global plan (blue), the local plan (green), the robot's
+    footprint (orange) and the last laser scan (red points). ``shot`` is from ``navigate_run``."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from navlab.geometry import compose2, transform_points2
+    from navlab.io.files import save_figure_atomic
+
+    fig, ax = plt.subplots(figsize=(8, 7))
+    x0, y0, x1, y1 = grid.bounds()
+    ax.imshow(map_image(grid), cmap="gray", vmin=0, vmax=1, origin="lower", extent=(x0, x1, y0, y1),
+              interpolation="nearest")  # fmt: skip
+    cm = shot.get("costmap")
+    if cm is not None:
+        c = cm.data.astype(float)  # type: ignore[attr-defined]
+        shade = np.where((c > 0) & (c < 253), 0.15 + 0.45 * c / 252.0, 0.0)
+        shade = np.where((c == 253) | (c == 254), 0.75, shade)
+        rgba = np.zeros((*c.shape, 4))
+        rgba[..., 2] = 0.35
+        rgba[..., 3] = shade
+        cx0, cy0, cx1, cy1 = cm.bounds()  # type: ignore[attr-defined]
+        ax.imshow(rgba, origin="lower", extent=(cx0, cx1, cy0, cy1), interpolation="nearest")
+    trail = np.asarray(shot.get("path"))
+    if trail.ndim == 2 and len(trail):
+        ax.plot(trail[:, 0], trail[:, 1], "-", color="0.35", lw=1.0, label="driven path")
+    plan = shot.get("plan")
+    if plan is not None:
+        plan = np.asarray(plan)
+        ax.plot(plan[:, 0], plan[:, 1], "-", color="tab:blue", lw=2.0, label="global plan")
+    local, odom_to_map = shot.get("local_plan"), shot.get("odom_to_map")
+    if local is not None and odom_to_map is not None and len(local):  # type: ignore[arg-type]
+        lp = transform_points2(odom_to_map, np.asarray(local)[:, :2])  # type: ignore[arg-type]
+        ax.plot(lp[:, 0], lp[:, 1], "-", color="tab:green", lw=2.5, label="local plan")
+    scan = shot.get("scan")
+    if scan is not None:
+        sx, sy, syaw, ranges = scan  # type: ignore[misc]
+        a = syaw + np.linspace(-np.pi, np.pi, len(ranges), endpoint=False)
+        ok = np.isfinite(ranges)
+        ax.scatter(sx + ranges[ok] * np.cos(a[ok]), sy + ranges[ok] * np.sin(a[ok]), s=1.5, c="tab:red",
+                   label="laser")  # fmt: skip
+        footprint = shot.get("footprint")
+        poly = footprint.oriented((sx, sy, syaw)) if footprint is not None else None  # type: ignore[attr-defined]
+        if poly is None:
+            r = footprint.circumscribed_radius if footprint is not None else 0.2  # type: ignore[attr-defined]
+            ang = np.linspace(0, 2 * np.pi, 33)
+            poly = np.stack([sx + r * np.cos(ang), sy + r * np.sin(ang)], axis=1)
+        ax.fill(poly[:, 0], poly[:, 1], color="tab:orange", alpha=0.9, label="robot")
+        tip = compose2((sx, sy, syaw), (0.3, 0.0, 0.0))
+        ax.plot([sx, tip[0]], [sy, tip[1]], "-", color="black", lw=1.5)
+    if goal is not None:
+        ax.plot(goal[0], goal[1], "*", color="tab:purple", ms=14, label="goal")
+    known = grid.known_bounds()
+    if known is not None:
+        ax.set_xlim(known[0], known[2])
+        ax.set_ylim(known[1], known[3])
+    ax.set_aspect("equal")
+    ax.set_xlabel("x [m] (map frame)")
+    ax.set_ylabel("y [m]")
+    ax.legend(loc="upper right", fontsize=7)
+    if title:
+        ax.set_title(title)
+    out = Path(path)
+    try:
+        save_figure_atomic(fig, out, format="png", dpi=110, bbox_inches="tight")
+    finally:
+        plt.close(fig)
+    return out

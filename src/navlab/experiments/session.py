@@ -1,0 +1,147 @@
+"""One wiring path: every run starts a launch file and adds its drivers and monitors as nodes.
+
+``start_run("mapping", world=..., robot=..., pose=...)`` starts the shipped (or a user's) launch with the
+robot's own base frame and scan topic, and returns a ``Run``: the launch session, the simulator node,
+the robot's frames, and ``run()``, which advances simulated time with a progress bar (and optional
+rosbag2 recording) and reports ``sim_s``, ``wall_s`` and ``rtf`` — the keys every run prints.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from navlab.core import Executor, Node
+from navlab.core.launch import Session, start
+from navlab.core.runner import run_for
+
+
+@dataclass
+class Run:
+    """A started launch with its simulator: frames of the robot, and a clock-keeping ``run``."""
+
+    session: Session
+    gazebo: Any  # navlab.sim.gazebo.GazeboSim
+    base_frame: str
+    odom_frame: str
+    scan_topic: str
+    timing: dict[str, float] = field(default_factory=lambda: {"sim_s": 0.0, "wall_s": 0.0})
+    bag: Path | None = None  # the last recording made by ``run(record=...)``
+
+    @property
+    def executor(self) -> Executor:
+        """The run's executor."""
+        return self.session.executor
+
+    @property
+    def sim(self) -> Any:
+        """The MuJoCo simulation (``navlab.sim.Simulation``)."""
+        return self.gazebo.sim
+
+    def node(self, name: str) -> Node:
+        """A node of the launch by name."""
+        return self.session.node(name)
+
+    def add(self, node_class: type[Node], *, remappings: dict[str, str] | None = None, **kwargs: Any) -> Any:
+        """Start one more node (a driver or a monitor) on this run's executor, as a launch would."""
+        with self.executor.node_context(remappings=remappings):
+            node = node_class(self.executor, **kwargs)
+        self.session.nodes[node.fully_qualified_name] = node
+        return node
+
+    def run(
+        self,
+        duration: float,
+        *,
+        until: Callable[[], bool] | None = None,
+        record: str | Path | None = None,
+        quiet: bool = True,
+        desc: str = "sim",
+        chunk: float = 0.5,
+    ) -> bool:
+        """Run ``duration`` simulated s, or until ``until()`` is true (checked at each message); returns
+        whether ``until`` ended it. Adds the time to ``timing``."""
+        ex = self.executor
+        done = [False]
+
+        def check(*_: Any) -> None:
+            if until is not None and not done[0] and until():
+                done[0] = True
+                ex.stop()
+
+        if until is not None:
+            ex.add_listener(check)
+        t0, wall0 = ex.now_ns, time.perf_counter()
+        try:
+            bag = run_for(ex, duration, record=record, quiet=quiet, desc=desc, chunk=chunk)
+            self.bag = bag if bag is not None else self.bag
+        finally:
+            if until is not None:
+                ex.remove_listener(check)
+        self.timing["sim_s"] += (ex.now_ns - t0) / 1e9
+        self.timing["wall_s"] += time.perf_counter() - wall0
+        return done[0]
+
+    def figures(self) -> dict[str, float]:
+        """``{"sim_s", "wall_s", "rtf"}`` of everything run so far."""
+        sim_s, wall_s = self.timing["sim_s"], self.timing["wall_s"]
+        return {"sim_s": round(sim_s, 2), "wall_s": round(wall_s, 2),
+                "rtf": round(sim_s / wall_s, 1) if wall_s > 0 else math.inf}  # fmt: skip
+
+
+def robot_frames(robot: str) -> tuple[str, str, str]:
+    """(base frame, odom frame, scan topic) from a robot's plugin tags (shipped name or file)."""
+    from navlab.sim.gazebo import load_robot_named
+
+    model = load_robot_named(robot)
+    dd = model.diff_drive
+    base = dd.robot_base_frame if dd else model.root_link
+    odom = dd.odometry_frame if dd else "odom"
+    scan = model.lidars[0].topic if model.lidars else "scan"
+    return base, odom, scan
+
+
+def start_run(
+    launch: str,
+    *,
+    world: str = "room",
+    robot: str = "mybot",
+    pose: tuple[float, float, float] = (0.0, 0.0, 0.0),
+    seed: int = 0,
+    pace: float = 0.0,
+    overrides: dict[str, dict[str, Any]] | None = None,
+    **launch_args: Any,
+) -> Run:
+    """Start ``launch`` (a shipped name or a file with the sim's ``world``/``robot``/``x``/``y``/``yaw``
+    arguments, plus ``base_frame``/``scan_topic`` when it declares them) and return the ``Run``.
+
+    ``overrides`` maps node names to parameters applied after the launch file's (``--set``).
+    """
+    from navlab.core.launch import declared_args
+
+    base, odom, scan = robot_frames(robot)
+    args: dict[str, Any] = {"world": world, "robot": robot, "x": pose[0], "y": pose[1], "yaw": pose[2]}
+    declared = {str(a.get("name")) for a in declared_args(launch)}
+    for key, value in (("base_frame", base), ("scan_topic", scan)):
+        if key in declared:
+            args[key] = value
+    args.update(launch_args)
+    session = start(launch, seed=seed, pace=pace, launch_args=args, overrides=overrides)
+    return Run(session, session.node("gazebo"), base, odom, scan)
+
+
+def rounded(figures: dict[str, Any], digits: int = 4) -> dict[str, Any]:
+    """Floats rounded for printing (nested dicts too); non-finite floats become None (valid JSON)."""
+    out: dict[str, Any] = {}
+    for key, value in figures.items():
+        if isinstance(value, dict):
+            out[key] = rounded(value, digits)
+        elif isinstance(value, float):
+            out[key] = round(value, digits) if math.isfinite(value) else None
+        else:
+            out[key] = value
+    return out

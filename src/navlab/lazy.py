@@ -1,0 +1,31 @@
+"""Lazy package exports (PEP 562), so ``navlab --help`` and ``import navlab.x`` load no physics or Numba.
+
+A package ``__init__`` lists its public names and the module each comes from; the module is imported
+the first time the name is used::
+
+    __getattr__, __dir__ = lazy_exports(__name__, {"Simulation": "navlab.sim.simulation"})
+"""
+
+from __future__ import annotations
+
+import importlib
+import sys
+from collections.abc import Callable
+from typing import Any
+
+
+def lazy_exports(package: str, exports: dict[str, str]) -> tuple[Callable[[str], Any], Callable[[], list[str]]]:
+    """``(__getattr__, __dir__)`` for ``package`` exporting ``name -> module`` lazily."""
+
+    def __getattr__(name: str) -> Any:
+        module = exports.get(name)
+        if module is None:
+            raise AttributeError(f"module {package!r} has no attribute {name!r}")
+        value = getattr(importlib.import_module(module), name)
+        setattr(sys.modules[package], name, value)  # later lookups skip this function
+        return value
+
+    def __dir__() -> list[str]:
+        return sorted({*vars(sys.modules[package]), *exports})
+
+    return __getattr__, __dir__

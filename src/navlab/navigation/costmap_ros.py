@@ -1,0 +1,186 @@
+"""costmap_2d's ``Costmap2DROS``: a ``LayeredCostmap`` fed from topics and tf inside a node (move_base).
+
+It subscribes the static layer's ``map`` topic and each observation source's ``LaserScan`` topic, keeps
+the newest scan of each source (``observation_persistence`` 0, as ROS's default), and at
+``update_frequency`` (simulated time) applies them, re-centres a rolling window and lets the layers write
+the master grid. At ``publish_frequency`` it publishes ``<name>/costmap`` (``nav_msgs/OccupancyGrid`` with
+costmap_2d's cost translation) and ``<name>/footprint`` (``geometry_msgs/PolygonStamped``).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from navlab import msgs
+from navlab.core import Node, TfError
+from navlab.geometry import compose2, transform_points2
+from navlab.grid import COST_INSCRIBED, COST_LETHAL, COST_UNKNOWN, Grid, GridMap
+from navlab.navigation.costmap.layered import LayeredCostmap
+from navlab.navigation.costmap.layers import ObstacleLayer, StaticLayer
+
+
+def cost_translation() -> np.ndarray:
+    """costmap_2d_publisher's table: cost (0..255) -> OccupancyGrid value (0..100, -1)."""
+    table = np.zeros(256, dtype=np.int8)
+    table[1:253] = 1 + (97 * (np.arange(1, 253) - 1)) // 251
+    table[COST_INSCRIBED], table[COST_LETHAL], table[COST_UNKNOWN] = 99, 100, -1
+    return table
+
+
+class Costmap2DROS:
+    """A costmap named ``name`` (``global_costmap``, ``local_costmap``) living in ``node``.
+
+    ``params``: the costmap's ROS parameters (``costmap_common_params.yaml`` merged with its own file);
+    ``topic_prefix``: where ``costmap`` and ``footprint`` are published (default ``name``; move_base uses
+    ``/move_base/global_costmap``).
+    """
+
+    def __init__(self, node: Node, name: str, params: dict[str, Any], *, topic_prefix: str | None = None) -> None:
+        self.node, self.name = node, name
+        prefix = topic_prefix if topic_prefix is not None else name
+        self.layered = LayeredCostmap(params)
+        p = self.layered.params
+        self.global_frame = p.global_frame.lstrip("/")
+        self.base_frame = p.robot_base_frame.lstrip("/")
+        self.updated_ns: int | None = None
+        self.updates = 0
+        self._table = cost_translation()
+        self._pending: dict[str, Any] = {}
+        self._sensor_in_base: dict[str, tuple[float, float, float]] = {}
+        statics = [x for x in self.layered.layers if isinstance(x, StaticLayer)]
+        if statics:
+            node.create_subscription(msgs.OccupancyGrid, statics[0].params.map_topic, self._on_map, 1)
+        for src_name, src in p.sources.items():
+            if src.data_type != "LaserScan":
+                node.get_logger().warning(f"{name}: observation source {src_name} has data_type {src.data_type}; "
+                                          "navlab's sensors are LaserScan only, it is ignored")
+                continue
+            topic = src.topic or src_name
+            node.create_subscription(msgs.LaserScan, topic, lambda m, s=src_name: self._pending.__setitem__(s, m), 5)
+        self.costmap_pub = node.create_publisher(msgs.OccupancyGrid, f"{prefix}/costmap", 1, latched=True)
+        self.footprint_pub = node.create_publisher(msgs.PolygonStamped, f"{prefix}/footprint", 1)
+        if p.update_frequency > 0:
+            node.create_timer(1.0 / p.update_frequency, self.update)
+        if p.publish_frequency > 0:
+            node.create_timer(1.0 / p.publish_frequency, self.publish)
+
+    @property
+    def costmap(self) -> Grid:
+        """The master grid (uint8 costs) in ``global_frame``."""
+        return self.layered.costmap
+
+    # --- inputs -----------------------------------------------------------------------------------
+
+    def _on_map(self, msg: Any) -> None:
+        grid = GridMap.from_msg(msg)
+        map_frame = grid.frame_id.lstrip("/") or "map"
+        if map_frame == self.global_frame:
+            in_costmap = (0.0, 0.0, 0.0)
+        else:
+            try:
+                in_costmap = self.node.executor.tf.lookup_pose2d(self.global_frame, map_frame)
+            except TfError as exc:
+                self.node.get_logger().warning(f"{self.name}: cannot place map frame {map_frame}: {exc}")
+                return
+        self.layered.set_map(grid, map_in_costmap=in_costmap)
+
+    def robot_pose(self, t_ns: int | None = None) -> tuple[float, float, float] | None:
+        """The robot in ``global_frame`` (x, y, yaw), or None without tf."""
+        try:
+            return self.node.executor.tf.lookup_pose2d(self.global_frame, self.base_frame, t_ns)
+        except TfError:
+            return None
+
+    def _apply_scan(self, source: str, msg: Any) -> None:
+        frame = str(msg.header.frame_id).lstrip("/")
+        tf = self.node.executor.tf
+        if frame not in self._sensor_in_base:
+            try:
+                self._sensor_in_base[frame] = tf.lookup_pose2d(self.base_frame, frame)
+            except TfError as exc:
+                self.node.get_logger().warning(f"{self.name}: no transform {self.base_frame} -> {frame}: {exc}")
+                return
+        stamp = msgs.stamp_ns(msg)
+        base = self.robot_pose(stamp) or self.robot_pose()
+        if base is None:
+            return
+        sensor = compose2(base, self._sensor_in_base[frame])
+        src = self.layered.params.sources[source]
+        r = np.asarray(msg.ranges, dtype=np.float64)
+        a = float(msg.angle_min) + float(msg.angle_increment) * np.arange(len(r))
+        valid = np.isfinite(r) & (r >= float(msg.range_min)) & (r < float(msg.range_max))
+        # rays without a return clear out to raytrace_range (inf_is_valid), others end at their return
+        clear_to = src.raytrace_range if src.inf_is_valid else float(msg.range_max)
+        dist = np.where(valid, r, np.where(np.isnan(r), np.nan, clear_to))
+        keep = np.isfinite(dist)
+        pts = np.stack([dist[keep] * np.cos(a[keep]), dist[keep] * np.sin(a[keep])], axis=1)
+        self.layered.add_scan(sensor[:2], transform_points2(sensor, pts), valid[keep], source=source)
+
+    # --- update, publish, clear --------------------------------------------------------------------
+
+    def update(self) -> Grid | None:
+        """One costmap update now (the timer's job); returns the master grid, or None without a robot pose."""
+        pose = self.robot_pose()
+        if pose is None:
+            return None
+        for source, msg in list(self._pending.items()):
+            self._apply_scan(source, msg)
+        self._pending.clear()
+        grid = self.layered.update_map(pose)
+        self.updated_ns = self.node.executor.now_ns
+        self.updates += 1
+        return grid
+
+    def publish(self) -> None:
+        """Publish the costmap (OccupancyGrid) and the footprint polygon now."""
+        now = self.node.executor.now_ns
+        g = self.costmap
+        occ = GridMap(self._table[g.data], g.resolution, g.origin, self.global_frame)
+        self.costmap_pub.publish(occ.to_msg(now))
+        pose = self.layered.robot_pose or self.robot_pose()
+        if pose is not None:
+            poly = self.layered.footprint_at(pose)
+            self.footprint_pub.publish(msgs.PolygonStamped(
+                header=msgs.header(now, self.global_frame),
+                polygon=msgs.Polygon(points=[msgs.Point32(x=float(x), y=float(y), z=0.0) for x, y in poly]),
+            ))  # fmt: skip
+
+    def clear(self) -> None:
+        """Forget every observation (the ``clear_costmaps`` service)."""
+        self.layered.reset()
+        if self.layered.robot_pose is not None:
+            self.layered.update_map(self.layered.robot_pose)
+
+    def clear_outside(self, size: float) -> None:
+        """ClearCostmapRecovery: obstacle layers forget what lies outside a ``size`` x ``size`` m square
+        around the robot (ROS's conservative and aggressive resets)."""
+        pose = self.layered.robot_pose or self.robot_pose()
+        if pose is None:
+            return
+        for layer in self.layered.layers:
+            if isinstance(layer, ObstacleLayer) and layer.grid is not None:
+                g = layer.grid
+                xy = g.centers(np.ones(g.data.shape, bool)).reshape(g.height, g.width, 2)
+                outside = (np.abs(xy[..., 0] - pose[0]) > size / 2) | (np.abs(xy[..., 1] - pose[1]) > size / 2)
+                g.data[outside] = layer.default_value
+        self.layered.update_map(pose)
+
+    def cost_at(self, xy: tuple[float, float]) -> int:
+        """The cost of the cell under ``xy`` (``global_frame``); unknown outside the grid."""
+        return int(self.costmap.value_at(np.array([xy]), outside=COST_UNKNOWN)[0])
+
+    def footprint_cost(self, pose: tuple[float, float, float]) -> int:
+        """The highest cost under the robot's footprint at ``pose``."""
+        g = self.costmap
+        ij = self.layered.footprint.cells(g, pose)
+        if len(ij) == 0:
+            return COST_UNKNOWN
+        return int(g.data[ij[:, 1], ij[:, 0]].max())
+
+    def is_stale(self, max_age_s: float) -> bool:
+        """Whether the last update is older than ``max_age_s`` simulated s (or never happened)."""
+        if self.updated_ns is None:
+            return True
+        return (self.node.executor.now_ns - self.updated_ns) / 1e9 > max_age_s

@@ -1,0 +1,468 @@
+"""The ``move_base`` node: a goal in, a global plan and velocity commands out, recoveries when stuck.
+
+As ROS 1's move_base: two ``Costmap2DROS`` (``global_costmap`` in ``map``, ``local_costmap`` rolling in
+``odom``), a global planner (``base_global_planner``) and a local controller (``base_local_planner``)
+picked by their ROS plugin names, the PLANNING / CONTROLLING / CLEARING states with
+``planner_frequency``, ``planner_patience``, ``controller_frequency``, ``controller_patience``,
+``oscillation_timeout``/``oscillation_distance`` and ``recovery_behaviors`` in ROS order. Goals come on
+``move_base_simple/goal`` or through :meth:`MoveBase.send_goal` (actionlib's SimpleActionClient in
+spirit: feedback, cancel, result succeeded / aborted with a reason / preempted); state on
+``/move_base/status``. Services ``/move_base/clear_costmaps`` and ``/move_base/make_plan``.
+"""
+
+from __future__ import annotations
+
+import inspect
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from navlab import msgs
+from navlab.core import Executor, Node, TfError
+from navlab.geometry import transform_points2, wrap_angle
+from navlab.grid import COST_INSCRIBED, COST_UNKNOWN
+from navlab.navigation.costmap_ros import Costmap2DROS
+from navlab.navigation.errors import NavigationError
+from navlab.navigation.recovery import DEFAULT_RECOVERIES, ClearCostmapRecovery
+from navlab.plugins import load_plugin, plugin_names
+
+Pose = tuple[float, float, float]
+STATUS = {"PENDING": 1, "ACTIVE": 2, "PREEMPTED": 5, "SUCCEEDED": 4, "ABORTED": 6}
+_MB_DEFAULTS: dict[str, Any] = {
+    "base_global_planner": "navfn/NavfnROS",
+    "base_local_planner": "base_local_planner/TrajectoryPlannerROS",
+    "controller_frequency": 20.0,
+    "planner_frequency": 0.0,
+    "planner_patience": 5.0,
+    "controller_patience": 15.0,
+    "max_planning_retries": -1,
+    "conservative_reset_dist": 3.0,
+    "recovery_behavior_enabled": True,
+    "clearing_rotation_allowed": True,
+    "shutdown_costmaps": False,
+    "oscillation_timeout": 0.0,
+    "oscillation_distance": 0.5,
+    "make_plan_clear_costmap": True,
+    "make_plan_add_unreachable_goal": True,
+}
+
+
+@dataclass
+class GoalHandle:
+    """One goal's life: ``state`` PENDING -> ACTIVE -> SUCCEEDED | ABORTED | PREEMPTED, with ``reason``."""
+
+    goal: Pose
+    frame_id: str
+    id: int
+    state: str = "PENDING"
+    reason: str = ""
+    start_s: float = 0.0
+    end_s: float | None = None
+    feedback: Callable[[Pose], None] | None = None
+    on_done: Callable[[GoalHandle], None] | None = field(default=None, repr=False)
+
+    def done(self) -> bool:
+        """Whether the goal reached a terminal state."""
+        return self.state in ("SUCCEEDED", "ABORTED", "PREEMPTED")
+
+
+def short_name(plugin: str) -> str:
+    """The parameter namespace of a plugin: ``navfn/NavfnROS`` -> ``NavfnROS``."""
+    return plugin.replace("::", "/").rsplit("/", 1)[-1]
+
+
+def _construct(cls: Any, params: dict[str, Any], rng: np.random.Generator) -> Any:
+    """A plugin instance from its ROS parameter dict (and the node's generator when it takes one)."""
+    kwargs = {"rng": rng} if "rng" in inspect.signature(cls).parameters else {}
+    return cls(params, **kwargs)
+
+
+class MoveBase(Node):
+    """ROS 1 move_base over navlab's costmaps, planners and controllers (see the module docstring)."""
+
+    def __init__(self, executor: Executor, *, name: str = "move_base", parameters: dict[str, Any] | None = None,
+                 namespace: str = "") -> None:  # fmt: skip
+        super().__init__(executor, name=name, parameters=parameters, namespace=namespace)
+        p = {k: self.declare_parameter(k, v) for k, v in _MB_DEFAULTS.items()}
+        self.p = p
+        for key in ("controller_frequency", "planner_patience", "controller_patience", "oscillation_distance"):
+            if not (math.isfinite(p[key]) and p[key] > 0):
+                raise NavigationError(f"move_base parameter {key}: expected > 0, got {p[key]}")
+        for key in ("planner_frequency", "oscillation_timeout", "conservative_reset_dist"):
+            if not (math.isfinite(p[key]) and p[key] >= 0):
+                raise NavigationError(f"move_base parameter {key}: expected >= 0, got {p[key]}")
+        raw_recoveries = self.declare_parameter("recovery_behaviors", [dict(r) for r in DEFAULT_RECOVERIES])
+        private = self.fully_qualified_name
+        self.global_costmap = self._costmap("global_costmap", private)
+        self.local_costmap = self._costmap("local_costmap", private)
+        self.costmaps = {"global": self.global_costmap, "local": self.local_costmap}
+        gp, lp = str(p["base_global_planner"]), str(p["base_local_planner"])
+        self.planner_name, self.controller_name = short_name(gp), short_name(lp)
+        self.planner = _construct(load_plugin("global_planner", gp, param="base_global_planner"),
+                                  self._namespace(self.planner_name), self.rng)  # fmt: skip
+        self.controller = _construct(load_plugin("controller", lp, param="base_local_planner"),
+                                     self._namespace(self.controller_name), self.rng)  # fmt: skip
+        self.recoveries = self._recoveries(raw_recoveries)
+        # a parameter file may configure several planners (TrajectoryPlannerROS: and DWAPlannerROS:); ROS ignores
+        # the sections of the ones not in use, and so does navlab
+        for kind in ("global_planner", "controller"):
+            for plugin in plugin_names(kind):
+                self.accept_parameters(short_name(plugin))
+        self.check_parameters()
+
+        self.cmd_pub = self.create_publisher(msgs.Twist, "cmd_vel", 1)
+        self.plan_pub = self.create_publisher(msgs.Path, f"{private}/{self.planner_name}/plan", 1, latched=True)
+        self.local_plan_pub = self.create_publisher(msgs.Path, f"{private}/{self.controller_name}/local_plan", 1)
+        self.goal_pub = self.create_publisher(msgs.PoseStamped, f"{private}/current_goal", 1, latched=True)
+        self.status_pub = self.create_publisher(msgs.GoalStatusArray, f"{private}/status", 1)
+        self.create_subscription(msgs.PoseStamped, "move_base_simple/goal", self._on_goal_msg, 1)
+        self.create_subscription(msgs.Odometry, "odom", self._on_odom, 1)
+        self.create_service(f"{private}/clear_costmaps", self._srv_clear)
+        self.create_service(f"{private}/make_plan", self._srv_make_plan)
+        self.create_timer(1.0 / p["controller_frequency"], self._cycle)
+        self.create_timer(0.2, self._publish_status)
+        self.velocity = (0.0, 0.0)
+        self.handle: GoalHandle | None = None
+        self.state = "IDLE"  # IDLE, PLANNING, CONTROLLING, CLEARING
+        self.global_plan: np.ndarray | None = None
+        self._ids = 0
+        self._reset_goal_state()
+
+    # --- construction -------------------------------------------------------------------------------
+
+    def _namespace(self, prefix: str) -> dict[str, Any]:
+        self.accept_parameters(prefix)
+        return self.get_parameters_by_prefix(prefix)
+
+    def _costmap(self, name: str, private: str) -> Costmap2DROS:
+        return Costmap2DROS(self, name, self._namespace(name), topic_prefix=f"{private}/{name}")
+
+    def _recoveries(self, raw: Any) -> list[tuple[str, Any]]:
+        if not isinstance(raw, list) or not all(isinstance(r, dict) and {"name", "type"} <= set(r) for r in raw):
+            raise NavigationError("move_base parameter recovery_behaviors: expected a list of {name, type}, "
+                                  f"got {raw!r}")
+        out = []
+        for k, spec in enumerate(raw):
+            name, kind = str(spec["name"]), str(spec["type"])
+            cls = load_plugin("recovery", kind, param=f"recovery_behaviors[{k}] type")
+            params = self._namespace(name)
+            if cls is ClearCostmapRecovery:
+                default = self.p["conservative_reset_dist"] if name == "conservative_reset" else (
+                    4.0 * self.local_costmap.layered.circumscribed_radius)
+                out.append((name, cls(params, default_reset=default)))
+            else:
+                out.append((name, cls(params)))
+        return out
+
+    # --- goals ---------------------------------------------------------------------------------------
+
+    def _reset_goal_state(self) -> None:
+        now = self.executor.now_ns
+        self.recovery_index = 0
+        self.recovery_trigger = ""
+        self.active_recovery: Any = None
+        self.last_valid_plan_ns = now
+        self.last_valid_control_ns = now
+        self.last_plan_ns: int | None = None
+        self.planning_retries = 0
+        self.oscillation_pose: Pose | None = None
+        self.last_oscillation_reset_ns = now
+
+    def send_goal(self, x: float, y: float, yaw: float, *, frame_id: str = "map",
+                  feedback: Callable[[Pose], None] | None = None,
+                  on_done: Callable[[GoalHandle], None] | None = None) -> GoalHandle:  # fmt: skip
+        """Start driving to (x, y, yaw) in ``frame_id``; a goal still running is PREEMPTED. Returns its handle."""
+        if self.handle is not None and not self.handle.done():
+            self._finish("PREEMPTED", "preempted by a new goal")
+        self._ids += 1
+        handle = GoalHandle((float(x), float(y), float(yaw)), frame_id.lstrip("/") or "map", self._ids,
+                            start_s=self.executor.now_ns / 1e9, feedback=feedback, on_done=on_done)  # fmt: skip
+        self.handle = handle
+        if not all(math.isfinite(v) for v in handle.goal):
+            self._finish("ABORTED", f"goal {handle.goal} is not finite")
+            return handle
+        handle.state = "ACTIVE"
+        self._reset_goal_state()
+        self.global_plan = None
+        self.state = "PLANNING"
+        self.goal_pub.publish(msgs.pose_stamped(self.executor.now_ns, handle.frame_id, *handle.goal))
+        return handle
+
+    def cancel_goal(self) -> None:
+        """Stop the current goal (PREEMPTED) and the robot."""
+        if self.handle is not None and not self.handle.done():
+            self._finish("PREEMPTED", "cancelled")
+
+    def _on_goal_msg(self, msg: Any) -> None:
+        self.send_goal(*msgs.pose2d(msg.pose), frame_id=str(msg.header.frame_id) or "map")
+
+    def _on_odom(self, msg: Any) -> None:
+        t = msg.twist.twist
+        self.velocity = (float(t.linear.x), float(t.angular.z))
+
+    def _finish(self, state: str, reason: str = "") -> None:
+        h = self.handle
+        self.cmd_pub.publish(msgs.twist(0.0, 0.0))
+        self.state = "IDLE"
+        self.active_recovery = None
+        if h is None or h.done():
+            return
+        h.state, h.reason, h.end_s = state, reason, self.executor.now_ns / 1e9
+        log = self.get_logger().info if state == "SUCCEEDED" else self.get_logger().warning
+        log(f"goal {h.id} {state.lower()}" + (f": {reason}" if reason else ""))
+        self._publish_status()
+        if h.on_done is not None:
+            h.on_done(h)
+
+    # --- frames ----------------------------------------------------------------------------------------
+
+    def _goal_in(self, frame: str) -> Pose | None:
+        h = self.handle
+        assert h is not None
+        if h.frame_id == frame:
+            return h.goal
+        try:
+            t = self.executor.tf.lookup_pose2d(frame, h.frame_id)
+        except TfError:
+            return None
+        x, y = transform_points2(t, np.array([h.goal[:2]]))[0]
+        return float(x), float(y), float(wrap_angle(h.goal[2] + t[2]))
+
+    def _plan_in_local(self) -> np.ndarray | None:
+        plan = self.global_plan
+        gf, lf = self.global_costmap.global_frame, self.local_costmap.global_frame
+        if plan is None or gf == lf:
+            return plan
+        try:
+            t = self.executor.tf.lookup_pose2d(lf, gf)
+        except TfError:
+            return None
+        out = transform_points2(t, plan[:, :2])
+        if plan.shape[1] > 2:
+            out = np.column_stack([out, wrap_angle(plan[:, 2] + t[2])])
+        return out
+
+    # --- planning --------------------------------------------------------------------------------------
+
+    def _check_goal(self, goal: Pose) -> str | None:
+        """Why ``goal`` cannot be planned to on the global costmap (None if it may be)."""
+        g = self.global_costmap.costmap
+        ij = g.world_to_cell(np.array([goal[:2]]))
+        if not g.in_bounds(ij)[0]:
+            x0, y0, x1, y1 = g.bounds()
+            return (f"goal ({goal[0]:.2f}, {goal[1]:.2f}) is outside the map "
+                    f"(x {x0:.2f}..{x1:.2f}, y {y0:.2f}..{y1:.2f})")  # fmt: skip
+        return None
+
+    def make_plan(self, start: Pose, goal: Pose) -> np.ndarray | None:
+        """A global plan (N, 2+) in the global costmap's frame, or None."""
+        try:
+            plan = self.planner.make_plan(self.global_costmap.costmap, start, goal)
+        except NavigationError as exc:
+            self.get_logger().debug(f"planner: {exc}")
+            return None
+        return None if plan is None or len(plan) == 0 else np.asarray(plan, dtype=np.float64)
+
+    def _plan(self) -> bool:
+        gf = self.global_costmap.global_frame
+        start = self.global_costmap.robot_pose()
+        goal = self._goal_in(gf)
+        if start is None or goal is None:
+            return False
+        if self.global_costmap.updated_ns is None:
+            self.global_costmap.update()
+        why = self._check_goal(goal)
+        if why is not None:
+            self._finish("ABORTED", why)
+            return False
+        plan = self.make_plan(start, goal)
+        self.last_plan_ns = self.executor.now_ns
+        if plan is None:
+            self.planning_retries += 1
+            g = self.global_costmap
+            cost = g.cost_at(goal[:2])
+            if cost >= COST_INSCRIBED and cost != COST_UNKNOWN and self.recovery_index >= len(self.recoveries):
+                self._finish("ABORTED", f"goal ({goal[0]:.2f}, {goal[1]:.2f}) is in an obstacle "
+                                        f"(global costmap cost {cost})")  # fmt: skip
+            return False
+        self.global_plan = plan
+        self.last_valid_plan_ns = self.executor.now_ns
+        self.planning_retries = 0
+        if self.recovery_trigger == "PLANNING":
+            self.recovery_index = 0
+        now = self.executor.now_ns
+        self.plan_pub.publish(msgs.Path(header=msgs.header(now, gf), poses=[
+            msgs.pose_stamped(now, gf, float(q[0]), float(q[1]), float(q[2]) if len(q) > 2 else 0.0) for q in plan
+        ]))  # fmt: skip
+        local = self._plan_in_local()
+        if local is not None:
+            self.controller.set_plan(local)
+        return True
+
+    # --- the cycle -------------------------------------------------------------------------------------
+
+    def _cycle(self) -> None:
+        if self.handle is None or self.handle.done() or self.state == "IDLE":
+            return
+        now = self.executor.now_ns
+        pose = self.local_costmap.robot_pose()
+        if pose is None:
+            return
+        if self.handle.feedback is not None:
+            self.handle.feedback(pose)
+        self._check_oscillation(pose, now)
+        if self.state == "PLANNING":
+            if self._plan():
+                self.state = "CONTROLLING"
+            elif self.handle.done():
+                return
+            elif self._timed_out(self.last_valid_plan_ns, self.p["planner_patience"]) or (
+                    0 <= self.p["max_planning_retries"] < self.planning_retries):  # fmt: skip
+                self._enter_clearing("PLANNING")
+            self.cmd_pub.publish(msgs.twist(0.0, 0.0))
+            return
+        if self.state == "CLEARING":
+            self._clearing(pose)
+            return
+        self._controlling(pose, now)
+
+    def _timed_out(self, since_ns: int, patience_s: float) -> bool:
+        return (self.executor.now_ns - since_ns) / 1e9 > patience_s
+
+    def _check_oscillation(self, pose: Pose, now: int) -> None:
+        if self.oscillation_pose is None or math.dist(pose[:2], self.oscillation_pose[:2]) >= self.p[
+                "oscillation_distance"]:  # fmt: skip
+            self.oscillation_pose = pose
+            self.last_oscillation_reset_ns = now
+            if self.recovery_trigger == "OSCILLATION":
+                self.recovery_index = 0
+
+    def _controlling(self, pose: Pose, now: int) -> None:
+        p = self.p
+        if p["planner_frequency"] > 0 and self.last_plan_ns is not None and (
+                now - self.last_plan_ns) / 1e9 >= 1.0 / p["planner_frequency"]:  # fmt: skip
+            if not self._plan() and self._timed_out(self.last_valid_plan_ns, p["planner_patience"]):
+                self._enter_clearing("PLANNING")
+                return
+            if self.handle is None or self.handle.done():
+                return
+        local = self._plan_in_local()
+        if local is not None:
+            self.controller.set_plan(local)
+        if self.controller.is_goal_reached(pose, self.velocity):
+            self._finish("SUCCEEDED")
+            return
+        if p["oscillation_timeout"] > 0 and self._timed_out(self.last_oscillation_reset_ns, p["oscillation_timeout"]):
+            self._enter_clearing("OSCILLATION")
+            return
+        try:
+            cmd = self.controller.compute_velocity(pose, self.velocity, self.local_costmap.costmap)
+        except NavigationError as exc:
+            self.get_logger().debug(f"controller: {exc}")
+            cmd = None
+        valid = cmd is not None and all(math.isfinite(c) for c in cmd) and getattr(self.controller, "valid", True)
+        if valid:
+            assert cmd is not None
+            self.last_valid_control_ns = now
+            if self.recovery_trigger == "CONTROLLING":
+                self.recovery_index = 0
+            self.cmd_pub.publish(msgs.twist(*cmd))
+        else:
+            self.cmd_pub.publish(msgs.twist(0.0, 0.0))
+            if self._timed_out(self.last_valid_control_ns, p["controller_patience"]):
+                self._enter_clearing("CONTROLLING")
+            elif p["planner_frequency"] <= 0:
+                self.state = "PLANNING"  # ROS replans when the controller fails
+        self._publish_local_plan(now)
+
+    def _publish_local_plan(self, now: int) -> None:
+        traj = getattr(self.controller, "local_plan", None)
+        if traj is None or len(traj) == 0:
+            return
+        lf = self.local_costmap.global_frame
+        self.local_plan_pub.publish(msgs.Path(header=msgs.header(now, lf), poses=[
+            msgs.pose_stamped(now, lf, float(q[0]), float(q[1]), float(q[2]) if len(q) > 2 else 0.0) for q in traj
+        ]))  # fmt: skip
+
+    # --- recoveries ------------------------------------------------------------------------------------
+
+    def _enter_clearing(self, trigger: str) -> None:
+        self.recovery_trigger = trigger
+        self.cmd_pub.publish(msgs.twist(0.0, 0.0))
+        usable = [(n, r) for n, r in self.recoveries
+                  if self.p["clearing_rotation_allowed"] or "rotate" not in type(r).__name__.lower()]  # fmt: skip
+        if not self.p["recovery_behavior_enabled"] or self.recovery_index >= len(usable):
+            reason = {
+                "PLANNING": "Failed to find a valid plan. Even after executing recovery behaviors.",
+                "CONTROLLING": "Failed to find a valid control. Even after executing recovery behaviors.",
+                "OSCILLATION": "Robot is oscillating. Even after executing recovery behaviors.",
+            }[trigger]
+            self._finish("ABORTED", reason)
+            return
+        name, behavior = usable[self.recovery_index]
+        self.recovery_index += 1
+        pose = self.local_costmap.robot_pose()
+        if pose is None:
+            return
+        self.get_logger().info(f"recovery {self.recovery_index}/{len(usable)}: {name} ({trigger.lower()} failed)")
+        behavior.start(pose)
+        self.active_recovery = behavior
+        self.state = "CLEARING"
+
+    def _clearing(self, pose: Pose) -> None:
+        cmd = self.active_recovery.step(pose, self.costmaps) if self.active_recovery is not None else None
+        if cmd is not None:
+            self.cmd_pub.publish(msgs.twist(*cmd))
+            return
+        self.cmd_pub.publish(msgs.twist(0.0, 0.0))
+        self.active_recovery = None
+        now = self.executor.now_ns
+        self.last_valid_plan_ns = self.last_valid_control_ns = self.last_oscillation_reset_ns = now
+        self.oscillation_pose = pose
+        self.state = "PLANNING"
+
+    # --- services and status ---------------------------------------------------------------------------
+
+    def _srv_clear(self, request: Any = None) -> dict[str, Any]:
+        for cm in self.costmaps.values():
+            cm.clear()
+        return {}
+
+    def _srv_make_plan(self, request: Any) -> dict[str, Any]:
+        """``make_plan``: request ``{"start": (x, y, yaw) | None, "goal": (x, y, yaw)}`` in the global frame
+        (or PoseStamped messages); response ``{"plan": (N, 2+) array | None}``."""
+        def pose(v: Any) -> Pose | None:
+            if v is None:
+                return None
+            return msgs.pose2d(v.pose) if hasattr(v, "pose") else (float(v[0]), float(v[1]), float(v[2]))
+
+        start = pose(request.get("start")) or self.global_costmap.robot_pose()
+        goal = pose(request.get("goal"))
+        if start is None or goal is None:
+            return {"plan": None}
+        self.global_costmap.update()
+        return {"plan": self.make_plan(start, goal)}
+
+    def _publish_status(self) -> None:
+        h = self.handle
+        statuses = []
+        if h is not None:
+            uuid = np.zeros(16, dtype=np.uint8)
+            uuid[:8] = np.frombuffer(int(h.id).to_bytes(8, "little"), dtype=np.uint8)
+            statuses.append(msgs.GoalStatus(
+                goal_info=msgs.GoalInfo(goal_id=msgs.UUID(uuid=uuid), stamp=msgs.time_from_ns(round(h.start_s * 1e9))),
+                status=STATUS[h.state],
+            ))  # fmt: skip
+        self.status_pub.publish(msgs.GoalStatusArray(status_list=statuses))
+
+    def robot_pose_in(self, frame: str) -> Pose | None:
+        """The robot's pose in ``frame`` (tf), or None."""
+        base = self.local_costmap.base_frame
+        try:
+            return self.executor.tf.lookup_pose2d(frame, base)
+        except TfError:
+            return None
+
