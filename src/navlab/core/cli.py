@@ -144,7 +144,7 @@ def _cmd_launch(args: argparse.Namespace) -> int:
     with IntrospectionServer(ex, name=args.file), contextlib.suppress(KeyboardInterrupt):
         run_for(ex, duration, record=args.record, quiet=args.quiet, desc=Path(args.file).stem)
     summary = {
-        "sim_seconds": ex.now_ns / 1e9,
+        "sim_s": round(ex.now_ns / 1e9, 3),
         "nodes": sorted(ex.nodes),
         "topics": {name: t.count for name, t in sorted(ex.topics.items())},
     }
@@ -153,7 +153,7 @@ def _cmd_launch(args: argparse.Namespace) -> int:
     if args.json:
         print(json.dumps(summary))
     else:
-        print(f"ran {summary['sim_seconds']:.2f} simulated s; {len(ex.nodes)} nodes")
+        print(f"ran {summary['sim_s']:.2f} simulated s; {len(ex.nodes)} nodes")
         for name, count in summary["topics"].items():  # type: ignore[union-attr]
             print(f"  {name}: {count} messages")
     return 0

@@ -6,7 +6,6 @@ import argparse
 import json
 from pathlib import Path
 
-from navlab.description.summary import format_robot, robot_summary
 from navlab.errors import NavlabError
 
 
@@ -39,6 +38,7 @@ def _cmd(args: argparse.Namespace) -> int:
     path = _resolve(args.file, args.kind)
     if args.kind == "robot":
         from navlab.description.loader import load_robot
+        from navlab.description.summary import format_robot, robot_summary
 
         summary = robot_summary(load_robot(path, search_paths=args.package_path, args=_xacro_args(args.arg)))
         text = format_robot(summary)

@@ -21,7 +21,7 @@ from navlab import msgs
 from navlab.core import Executor, Node, TfError
 from navlab.experiments.session import Run, rounded, start_run
 from navlab.experiments.truth import true_map
-from navlab.grid import GridMap
+from navlab.grid import Grid, GridMap
 from navlab.navigation.errors import NavigationError
 
 Pose = tuple[float, float, float]
@@ -77,12 +77,17 @@ def _episodes(times: Sequence[float], t0: float, t1: float, gap: float = 0.25) -
     return sum(1 for k, t in enumerate(ts) if k == 0 or t - ts[k - 1] > gap)
 
 
-def _drive_goal(run: Run, mon: NavMonitor, goal: Pose, frame: str, timeout: float) -> dict[str, Any]:
+def _drive_goal(run: Run, mon: NavMonitor, goal: Pose, frame: str, timeout: float,
+                shots: list[dict[str, Any]] | None = None) -> dict[str, Any]:
+    """Send one goal and run until it ends or ``timeout`` s pass; ``shots`` collects a snapshot a second."""
     mb = run.node("move_base")
     t0 = mon.now_s()
     k0 = len(mon.path)
     handle = mb.send_goal(*goal, frame_id=frame)  # type: ignore[attr-defined]
-    run.run(timeout, until=handle.done, quiet=True, chunk=1.0)
+    while not handle.done() and mon.now_s() - t0 < timeout - 1e-9:
+        run.run(min(1.0, timeout - (mon.now_s() - t0)), until=handle.done, quiet=True, chunk=1.0)
+        if shots is not None:
+            shots.append(_snapshot(run, mon))
     if not handle.done():
         mb.cancel_goal()  # type: ignore[attr-defined]
     t1 = mon.now_s()
@@ -156,9 +161,10 @@ def run_navigation(
     results, shots = [], []
     run.run(1.0, record=record, quiet=True)  # amcl's first update, the costmaps' first maps
     for goal in goals:
-        results.append(rounded(_drive_goal(run, mon, tuple(map(float, goal)), "map", goal_timeout)))  # type: ignore[arg-type]
-        if snapshots:
-            shots.append(_snapshot(run, mon))
+        during: list[dict[str, Any]] | None = [] if snapshots else None
+        results.append(rounded(_drive_goal(run, mon, tuple(map(float, goal)), "map", goal_timeout, during)))  # type: ignore[arg-type]
+        if during:  # the paper's pictures show the robot on its way: the middle of the drive
+            shots.append(during[len(during) // 2])
     summary = rounded({
         "goals_succeeded": sum(r["outcome"] == "succeeded" for r in results),
         "goals": len(results),
@@ -183,6 +189,7 @@ def _at(run: Run, t: float, fn: Any) -> None:
 def _snapshot(run: Run, mon: NavMonitor) -> dict[str, Any]:
     mb = run.node("move_base")
     gc = mb.global_costmap.costmap  # type: ignore[attr-defined]
+    gc = Grid(gc.data.copy(), gc.resolution, gc.origin, gc.frame_id)  # the master changes in place
     plan = mb.global_plan  # type: ignore[attr-defined]
     local = getattr(mb.controller, "local_plan", None)  # type: ignore[attr-defined]
     odom_to_map = None

@@ -24,11 +24,11 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
     t0, c0 = time.perf_counter(), time.process_time()
     run_offline(log, mode="graph", seed=getattr(args, "seed", 0))
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
-    # cpu_seconds is this process's CPU time: on a busy machine it shows what one free core would take
+    # cpu_s is this process's CPU time: on a busy machine it shows what one free core would take
     return {
-        "log_seconds": round(log.duration, 3),
-        "wall_seconds": round(wall, 3),
+        "log_s": round(log.duration, 3),
+        "wall_s": round(wall, 3),
         "rtf": round(log.duration / wall, 2),
-        "cpu_seconds": round(cpu, 3),
+        "cpu_s": round(cpu, 3),
         "rtf_cpu": round(log.duration / cpu, 2),
     }

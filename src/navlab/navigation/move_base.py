@@ -74,10 +74,11 @@ def short_name(plugin: str) -> str:
     return plugin.replace("::", "/").rsplit("/", 1)[-1]
 
 
-def _construct(cls: Any, params: dict[str, Any], rng: np.random.Generator) -> Any:
-    """A plugin instance from its ROS parameter dict (and the node's generator when it takes one)."""
-    kwargs = {"rng": rng} if "rng" in inspect.signature(cls).parameters else {}
-    return cls(params, **kwargs)
+def _construct(cls: Any, params: dict[str, Any], **extra: Any) -> Any:
+    """A plugin instance from its ROS parameter dict, plus the ``extra`` keywords its constructor takes
+    (the node's random generator, the robot's footprint polygon)."""
+    accepted = inspect.signature(cls).parameters
+    return cls(params, **{k: v for k, v in extra.items() if k in accepted})
 
 
 class MoveBase(Node):
@@ -102,9 +103,11 @@ class MoveBase(Node):
         gp, lp = str(p["base_global_planner"]), str(p["base_local_planner"])
         self.planner_name, self.controller_name = short_name(gp), short_name(lp)
         self.planner = _construct(load_plugin("global_planner", gp, param="base_global_planner"),
-                                  self._namespace(self.planner_name), self.rng)  # fmt: skip
+                                  self._namespace(self.planner_name))  # fmt: skip
+        polygon = self.local_costmap.layered.footprint.polygon
         self.controller = _construct(load_plugin("controller", lp, param="base_local_planner"),
-                                     self._namespace(self.controller_name), self.rng)  # fmt: skip
+                                     self._namespace(self.controller_name), rng=self.rng,
+                                     footprint=polygon)  # fmt: skip
         self.recoveries = self._recoveries(raw_recoveries)
         # a parameter file may configure several planners (TrajectoryPlannerROS: and DWAPlannerROS:); ROS ignores
         # the sections of the ones not in use, and so does navlab
@@ -264,7 +267,9 @@ class MoveBase(Node):
         except NavigationError as exc:
             self.get_logger().debug(f"planner: {exc}")
             return None
-        return None if plan is None or len(plan) == 0 else np.asarray(plan, dtype=np.float64)
+        if plan is None or len(plan) == 0:
+            return None
+        return with_headings(np.asarray(plan, dtype=np.float64)[:, :2], goal[2])
 
     def _plan(self) -> bool:
         gf = self.global_costmap.global_frame
@@ -466,3 +471,13 @@ class MoveBase(Node):
         except TfError:
             return None
 
+
+
+def with_headings(xy: np.ndarray, goal_yaw: float) -> np.ndarray:
+    """A plan (N, 3): each pose heads to the next one, the last takes the goal's yaw (as navfn's plan does)."""
+    yaw = np.empty(len(xy))
+    if len(xy) > 1:
+        d = np.diff(xy, axis=0)
+        yaw[:-1] = np.arctan2(d[:, 1], d[:, 0])
+    yaw[-1] = goal_yaw
+    return np.column_stack([xy, yaw])

@@ -5,13 +5,17 @@ from __future__ import annotations
 import argparse
 import json
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from navlab.world.clutter import CYLINDER_RADIUS, FIELD, ClutterWorld, generate_clutter
+if TYPE_CHECKING:
+    from navlab.world.clutter import ClutterWorld
 
 
 def save_png(world: ClutterWorld, path: str | Path) -> None:
     """Top view (world frame, m): walls, cylinders, start, goal and the reference path."""
     import matplotlib
+
+    from navlab.world.clutter import CYLINDER_RADIUS, FIELD
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -49,6 +53,8 @@ def save_png(world: ClutterWorld, path: str | Path) -> None:
 
 
 def _cmd_clutter(args: argparse.Namespace) -> int:
+    from navlab.world.clutter import generate_clutter
+
     world = generate_clutter(args.seed, fill=args.fill, smooth=args.smooth, robot_radius=args.robot_radius,
                              margin=args.margin)
     out = world.write_world(args.out)
