@@ -18,10 +18,11 @@ from typing import Any
 
 import numpy as np
 
+from navlab.cli_common import positive_seconds
 from navlab.core.errors import CoreError
 from navlab.core.graph import Graph
 from navlab.core.launch import Session, start
-from navlab.core.runner import parse_launch_args, positive_seconds, run_for
+from navlab.core.runner import parse_launch_args, run_for
 from navlab.io.files import write_text_atomic
 
 

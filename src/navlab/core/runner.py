@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 import sys
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from tqdm import tqdm
@@ -21,11 +21,12 @@ def run_for(
     quiet: bool = False,
     chunk: float = 0.5,
     desc: str = "sim",
+    until: Callable[[], bool] | None = None,
 ) -> Path | None:
     """Run ``ex`` for ``duration`` simulated seconds, showing progress in simulated time.
 
     With ``record``, every (or each chosen) topic is written to a rosbag2 (MCAP) there; its path is
-    returned. Stops early if the executor is stopped.
+    returned. Stops early if the executor is stopped or ``until()`` becomes true (checked after each event).
     """
     from navlab.core.record import Recorder
 
@@ -41,29 +42,15 @@ def run_for(
         while done < duration - 1e-9:
             step = min(chunk, duration - done)
             t0 = ex.now_ns
-            ex.run(step)
-            done += step
+            reached = ex.run_until(until, timeout=step) if until is not None else (ex.run(step) or False)
+            done += (ex.now_ns - t0) / 1e9 if reached else step
             bar.update((ex.now_ns - t0) / 1e9)
-            if ex.stopped:
+            if reached or ex.stopped:
                 break
     finally:
         bar.close()
         path = recorder.close() if recorder else None
     return path
-
-
-def positive_seconds(text: str) -> float:
-    """argparse ``type=`` for a duration in simulated seconds: a finite number > 0."""
-    import argparse
-    import math
-
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a number of seconds, got {text!r}") from None
-    if not (math.isfinite(value) and value > 0):
-        raise argparse.ArgumentTypeError(f"expected a duration > 0 s, got {text}")
-    return value
 
 
 def parse_launch_args(items: Sequence[str]) -> dict[str, str]:

@@ -19,6 +19,7 @@ import numpy as np
 
 from navlab import msgs
 from navlab.core import Executor, Node, TfError
+from navlab.experiments.plots import NavSnapshot
 from navlab.experiments.session import Run, rounded, start_run
 from navlab.experiments.truth import true_map
 from navlab.grid import Grid, GridMap
@@ -68,7 +69,7 @@ class NavigateResult:
     goals: list[dict[str, Any]]
     summary: dict[str, Any]
     grid: GridMap
-    snapshots: list[dict[str, Any]] = field(default_factory=list)
+    snapshots: list[NavSnapshot] = field(default_factory=list)
 
 
 def _episodes(times: Sequence[float], t0: float, t1: float, gap: float = 0.25) -> int:
@@ -78,7 +79,7 @@ def _episodes(times: Sequence[float], t0: float, t1: float, gap: float = 0.25) -
 
 
 def _drive_goal(run: Run, mon: NavMonitor, goal: Pose, frame: str, timeout: float,
-                shots: list[dict[str, Any]] | None = None) -> dict[str, Any]:
+                shots: list[NavSnapshot] | None = None) -> dict[str, Any]:
     """Send one goal and run until it ends or ``timeout`` s pass; ``shots`` collects a snapshot a second."""
     mb = run.node("move_base")
     t0 = mon.now_s()
@@ -128,7 +129,8 @@ def run_navigation(
     ``map_yaml``: the map to navigate on (default: the world's true map). ``controller``: ``trajectory``,
     ``dwa``, ``mppi`` or a ROS plugin name (default: the parameter files'). ``move_base_params``: overrides
     (``{"local_costmap.update_frequency": 0.5}``). ``spawn``: (time s, ModelSpec) obstacles added while
-    running. ``snapshots``: keep what the per-goal pictures need.
+    running (or a function of the simulation that returns one, to place it relative to the robot then).
+    ``snapshots``: keep what the per-goal pictures need.
     """
     from navlab.mapping.mapfile import load_map, save_map
     from navlab.sim.gazebo import load_world_named
@@ -157,17 +159,16 @@ def run_navigation(
     radius = mb.local_costmap.layered.circumscribed_radius  # type: ignore[attr-defined]
     mon = run.add(NavMonitor, parameters={"robot_radius": radius}, sim=run.sim, move_base=mb)
     for t, model in spawn:
-        _at(run, float(t), lambda m=model: run.gazebo.spawn(m))
+        _at(run, float(t), lambda m=model: run.gazebo.spawn(m(run.sim) if callable(m) else m))
     results, shots = [], []
     run.run(1.0, record=record, quiet=True)  # amcl's first update, the costmaps' first maps
     for goal in goals:
-        during: list[dict[str, Any]] | None = [] if snapshots else None
+        during: list[NavSnapshot] | None = [] if snapshots else None
         results.append(rounded(_drive_goal(run, mon, tuple(map(float, goal)), "map", goal_timeout, during)))  # type: ignore[arg-type]
         if during:  # the paper's pictures show the robot on its way: the middle of the drive
             shots.append(during[len(during) // 2])
     summary = rounded({
         "goals_succeeded": sum(r["outcome"] == "succeeded" for r in results),
-        "goals": len(results),
         "collisions": sum(r["collisions"] for r in results),
         **run.figures(),
     })  # fmt: skip
@@ -186,7 +187,7 @@ def _at(run: Run, t: float, fn: Any) -> None:
     holder["timer"] = node.create_timer(max(t - run.executor.now_ns / 1e9, 1e-3), fire)
 
 
-def _snapshot(run: Run, mon: NavMonitor) -> dict[str, Any]:
+def _snapshot(run: Run, mon: NavMonitor) -> NavSnapshot:
     mb = run.node("move_base")
     gc = mb.global_costmap.costmap  # type: ignore[attr-defined]
     gc = Grid(gc.data.copy(), gc.resolution, gc.origin, gc.frame_id)  # the master changes in place

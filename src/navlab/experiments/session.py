@@ -66,25 +66,12 @@ class Run:
         """Run ``duration`` simulated s, or until ``until()`` is true (checked at each message); returns
         whether ``until`` ended it. Adds the time to ``timing``."""
         ex = self.executor
-        done = [False]
-
-        def check(*_: Any) -> None:
-            if until is not None and not done[0] and until():
-                done[0] = True
-                ex.stop()
-
-        if until is not None:
-            ex.add_listener(check)
         t0, wall0 = ex.now_ns, time.perf_counter()
-        try:
-            bag = run_for(ex, duration, record=record, quiet=quiet, desc=desc, chunk=chunk)
-            self.bag = bag if bag is not None else self.bag
-        finally:
-            if until is not None:
-                ex.remove_listener(check)
+        bag = run_for(ex, duration, record=record, quiet=quiet, desc=desc, chunk=chunk, until=until)
+        self.bag = bag if bag is not None else self.bag
         self.timing["sim_s"] += (ex.now_ns - t0) / 1e9
         self.timing["wall_s"] += time.perf_counter() - wall0
-        return done[0]
+        return until is not None and until()
 
     def figures(self) -> dict[str, float]:
         """``{"sim_s", "wall_s", "rtf"}`` of everything run so far."""

@@ -22,8 +22,8 @@ import numpy as np
 
 from navlab import msgs
 from navlab.core import Executor, Node, TfError
-from navlab.geometry import transform_points2, wrap_angle
-from navlab.grid import COST_INSCRIBED, COST_UNKNOWN
+from navlab.geometry import inverse_transform_points2, transform_points2, wrap_angle
+from navlab.navigation.costmap.layers import StaticLayer
 from navlab.navigation.costmap_ros import Costmap2DROS
 from navlab.navigation.errors import NavigationError
 from navlab.navigation.recovery import DEFAULT_RECOVERIES, ClearCostmapRecovery
@@ -171,6 +171,8 @@ class MoveBase(Node):
         self.last_valid_control_ns = now
         self.last_plan_ns: int | None = None
         self.planning_retries = 0
+        self.plan_failure = ""
+        self.recovery_log: list[str] = []  # the recovery behaviors run for this goal, in order
         self.oscillation_pose: Pose | None = None
         self.last_oscillation_reset_ns = now
 
@@ -260,6 +262,17 @@ class MoveBase(Node):
                     f"(x {x0:.2f}..{x1:.2f}, y {y0:.2f}..{y1:.2f})")  # fmt: skip
         return None
 
+    def _on_map_obstacle(self, goal: Pose) -> bool:
+        """Whether ``goal`` (global frame) lies on an occupied cell of a static layer's map."""
+        for layer in self.global_costmap.layered.layers:
+            grid = getattr(layer, "map", None)
+            if isinstance(layer, StaticLayer) and grid is not None:
+                mx, my, myaw = layer.map_in_costmap
+                xy = inverse_transform_points2((mx, my, myaw), np.array([goal[:2]]))
+                if int(grid.value_at(xy)[0]) >= layer.params.lethal_cost_threshold:
+                    return True
+        return False
+
     def make_plan(self, start: Pose, goal: Pose) -> np.ndarray | None:
         """A global plan (N, 2+) in the global costmap's frame, or None."""
         try:
@@ -287,21 +300,17 @@ class MoveBase(Node):
         self.last_plan_ns = self.executor.now_ns
         if plan is None:
             self.planning_retries += 1
-            g = self.global_costmap
-            cost = g.cost_at(goal[:2])
-            if cost >= COST_INSCRIBED and cost != COST_UNKNOWN and self.recovery_index >= len(self.recoveries):
-                self._finish("ABORTED", f"goal ({goal[0]:.2f}, {goal[1]:.2f}) is in an obstacle "
-                                        f"(global costmap cost {cost})")  # fmt: skip
+            self.plan_failure = str(getattr(self.planner, "last_failure", "") or "")
+            if self._on_map_obstacle(goal):  # no recovery clears the map itself: say so now
+                self._finish("ABORTED", f"goal ({goal[0]:.2f}, {goal[1]:.2f}) is in an obstacle on the map"
+                                        + (f" ({self.plan_failure})" if self.plan_failure else ""))  # fmt: skip
             return False
         self.global_plan = plan
         self.last_valid_plan_ns = self.executor.now_ns
         self.planning_retries = 0
         if self.recovery_trigger == "PLANNING":
             self.recovery_index = 0
-        now = self.executor.now_ns
-        self.plan_pub.publish(msgs.Path(header=msgs.header(now, gf), poses=[
-            msgs.pose_stamped(now, gf, float(q[0]), float(q[1]), float(q[2]) if len(q) > 2 else 0.0) for q in plan
-        ]))  # fmt: skip
+        self._publish_path(self.plan_pub, plan, gf)
         local = self._plan_in_local()
         if local is not None:
             self.controller.set_plan(local)
@@ -385,11 +394,16 @@ class MoveBase(Node):
 
     def _publish_local_plan(self, now: int) -> None:
         traj = getattr(self.controller, "local_plan", None)
-        if traj is None or len(traj) == 0:
+        if traj is not None and len(traj):
+            self._publish_path(self.local_plan_pub, traj, self.local_costmap.global_frame)
+
+    def _publish_path(self, pub: Any, poses: np.ndarray, frame: str) -> None:
+        """``nav_msgs/Path`` of (N, 2+) poses, built only when someone listens (hundreds of messages each)."""
+        if not (pub.get_subscription_count() or self.executor.has_listeners):
             return
-        lf = self.local_costmap.global_frame
-        self.local_plan_pub.publish(msgs.Path(header=msgs.header(now, lf), poses=[
-            msgs.pose_stamped(now, lf, float(q[0]), float(q[1]), float(q[2]) if len(q) > 2 else 0.0) for q in traj
+        now = self.executor.now_ns
+        pub.publish(msgs.Path(header=msgs.header(now, frame), poses=[
+            msgs.pose_stamped(now, frame, float(q[0]), float(q[1]), float(q[2]) if len(q) > 2 else 0.0) for q in poses
         ]))  # fmt: skip
 
     # --- recoveries ------------------------------------------------------------------------------------
@@ -405,10 +419,13 @@ class MoveBase(Node):
                 "CONTROLLING": "Failed to find a valid control. Even after executing recovery behaviors.",
                 "OSCILLATION": "Robot is oscillating. Even after executing recovery behaviors.",
             }[trigger]
+            if trigger == "PLANNING" and self.plan_failure:
+                reason += f" ({self.plan_failure})"
             self._finish("ABORTED", reason)
             return
         name, behavior = usable[self.recovery_index]
         self.recovery_index += 1
+        self.recovery_log.append(name)
         pose = self.local_costmap.robot_pose()
         if pose is None:
             return
