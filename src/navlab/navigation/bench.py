@@ -1,4 +1,10 @@
-"""``navlab bench planner``: navigation benchmarks (one section per part).
+"""``navlab bench controller`` and ``navlab bench planner``: navigation benchmarks (one section per part).
+
+Controllers: one control cycle of DWAPlannerROS with 20 x 40 velocity samples (vx_samples,
+vth_samples; sim_time 1.7 s at 2.5 cm) and of the MPPI controller with 1000 samples x 56 steps, on a
+4 m x 4 m rolling local costmap at 5 cm cut from a cluttered 8 m room (30 round obstacles, inflated
+as costmap_2d does: inscribed radius 0.2 m, inflation radius 0.55 m), the robot placed along a
+planned path moving at 0.4 m/s. Windows are cut outside the timed region; Numba compiles first.
 
 Planner: a 400 x 400-cell (20 m x 20 m, 5 cm) serpentine maze whose walls the global costmap inflates
 (static + inflation layers, the paper's robot_radius 0.2 m, inflation_radius 0.55 m); navfn plans from
@@ -14,9 +20,62 @@ from typing import Any
 
 import numpy as np
 
-from navlab.grid import GridMap
+from navlab.grid import Grid, GridMap
+from navlab.navigation.controllers import DWAPlannerROS, TrajectoryPlannerROS
+from navlab.navigation.controllers import synthetic as syn
+from navlab.navigation.controllers.mppi import MPPIController
 from navlab.navigation.costmap import LayeredCostmap
 from navlab.navigation.planners import NavfnPlanner, ThetaStarPlanner, path_length
+
+# --- controllers ------------------------------------------------------------------------------------
+
+
+def _time_cycles(ctrl: Any, plan: np.ndarray, scenes: list[tuple[tuple[float, float, float], Grid]],
+                 repeat: int) -> np.ndarray:
+    """Milliseconds of each ``compute_velocity`` over ``scenes`` (pose, local costmap), after a warm-up."""
+    ctrl.set_plan(plan)
+    for pose, local in scenes[:3]:
+        ctrl.compute_velocity(pose, (0.4, 0.0), local)
+    out = []
+    for _ in range(repeat):
+        for pose, local in scenes:
+            t0 = time.perf_counter()
+            ctrl.compute_velocity(pose, (0.4, 0.0), local)
+            out.append((time.perf_counter() - t0) * 1e3)
+    return np.array(out)
+
+
+def run_controller(args: argparse.Namespace) -> dict[str, Any]:
+    """Median and 95th-percentile cycle times (ms) of DWA (20 x 40), TrajectoryPlanner and MPPI (1000 x 56)."""
+    seed = int(getattr(args, "seed", 0))
+    rng = np.random.default_rng(seed)
+    start, goal = (0.8, 0.8), (7.2, 7.2)
+    mask = syn.clutter(rng, count=30, keep_clear=(start, goal))
+    world = Grid(syn.inflated(mask, 0.05), 0.05, (0.0, 0.0, 0.0), "odom")
+    plan = syn.grid_plan(world, start, goal)
+    scenes = []
+    for k in range(10, len(plan) - 40, 12):
+        x, y, yaw = plan[k]
+        scenes.append(((float(x), float(y), float(yaw)), syn.window(world, x, y)))
+    dwa = DWAPlannerROS({"vx_samples": 20, "vth_samples": 40})
+    tp = TrajectoryPlannerROS({"vx_samples": 20, "vtheta_samples": 40})
+    mppi = MPPIController({}, rng=np.random.default_rng(seed))
+    t_dwa = _time_cycles(dwa, plan, scenes, 5)
+    t_tp = _time_cycles(tp, plan, scenes, 5)
+    t_mppi = _time_cycles(mppi, plan, scenes, 3)
+    return {
+        "dwa_cycle_ms": round(float(np.median(t_dwa)), 3),
+        "dwa_cycle_ms_p95": round(float(np.percentile(t_dwa, 95)), 3),
+        "dwa_samples": len(dwa.samples),
+        "trajectory_planner_cycle_ms": round(float(np.median(t_tp)), 3),
+        "mppi_cycle_ms": round(float(np.median(t_mppi)), 3),
+        "mppi_cycle_ms_p95": round(float(np.percentile(t_mppi, 95)), 3),
+        "mppi_samples": mppi.params.batch_size,
+        "mppi_steps": mppi.params.time_steps,
+        "local_costmap_cells": list(scenes[0][1].data.shape),
+        "cycles": len(scenes),
+    }
+
 
 # --- planner ----------------------------------------------------------------------------------------
 

@@ -1,0 +1,290 @@
+"""Pieces the local controllers share: parameter spellings, plan checks, grid-local frames, goal and
+oscillation logic of base_local_planner (``LatchedStopRotateController``, ``OscillationCostFunction``).
+
+Frames: poses ``(x, y, yaw)`` and plans are in the costmap's frame (``odom`` for a rolling local
+costmap). Internally the controllers work in *grid-local* coordinates: the costmap frame moved to the
+grid's origin and turned by its yaw, so cell ``(i, j)`` holds ``floor(p / resolution)``. Units: m, rad,
+m/s, rad/s.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any, TypeVar
+
+import numpy as np
+
+from navlab.core.params import dataclass_from_dict
+from navlab.geometry import wrap_angle
+from navlab.grid import Grid
+from navlab.navigation.errors import NavigationError
+
+T = TypeVar("T")
+
+
+def params_from(cls: type[T], values: Mapping[str, Any] | T | None, *, what: str,
+                aliases: Mapping[str, str] | None = None, ignored: frozenset[str] = frozenset()) -> T:
+    """An instance of the parameter dataclass ``cls`` from a ROS parameter dict (or ``cls`` as is).
+
+    ``aliases`` maps another accepted spelling (an older ROS name) to the field name; giving both
+    spellings with different values is an error. Keys in ``ignored`` are accepted and dropped.
+    Unknown keys raise ``NavigationError`` with "did you mean".
+    """
+    if isinstance(values, cls):
+        return values
+    if values is not None and not isinstance(values, Mapping):
+        raise NavigationError(f"{what} parameters: expected a dict of ROS parameters, got {type(values).__name__}")
+    canon: dict[str, Any] = {}
+    spelled: dict[str, str] = {}
+    for key, val in (values or {}).items():
+        if key in ignored:
+            continue
+        name = (aliases or {}).get(key, key)
+        if name in canon and canon[name] != val:
+            raise NavigationError(f"{what} parameters {spelled[name]!r} and {key!r} are two spellings of one "
+                                  f"parameter with different values ({canon[name]!r} vs {val!r}): give one")
+        canon[name], spelled[name] = val, key
+    try:
+        return dataclass_from_dict(cls, canon, what=what, error=NavigationError)
+    except (TypeError, ValueError) as exc:
+        raise NavigationError(f"{what} parameters: a value has the wrong type ({exc})") from None
+
+
+def bad(what: str, key: str, value: Any, expected: str) -> NavigationError:
+    """The one-line error for a parameter ``key`` = ``value`` that is not ``expected``."""
+    return NavigationError(f"{what} parameter {key}={value!r}: expected {expected}")
+
+
+def check_finite(what: str, obj: Any) -> None:
+    """Refuse a NaN or infinite float field of the dataclass ``obj``."""
+    for key, val in vars(obj).items():
+        if isinstance(val, float) and not math.isfinite(val):
+            raise bad(what, key, val, "a finite number")
+
+
+def as_plan(path: Any) -> np.ndarray:
+    """A global plan as float array (N, 2) or (N, 3), checked (N >= 1, finite values)."""
+    arr = np.asarray(path, dtype=np.float64)
+    if arr.ndim != 2 or arr.shape[1] not in (2, 3) or len(arr) == 0:
+        raise NavigationError(f"plan: expected an array (N, 2) or (N, 3) with N >= 1, got shape {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        raise NavigationError("plan: expected finite coordinates, got NaN or inf")
+    return arr.copy()
+
+
+def densify(xy: np.ndarray, step: float) -> np.ndarray:
+    """Points (M, 2) along the polyline ``xy`` (N, 2) no more than ``step`` m apart (ends kept).
+
+    base_local_planner's ``adjustPlanResolution``: a plan whose poses skip cells still marks every cell.
+    """
+    if len(xy) < 2:
+        return xy.copy()
+    seg = np.diff(xy, axis=0)
+    n = np.maximum(1, np.ceil(np.hypot(seg[:, 0], seg[:, 1]) / step).astype(np.int64))
+    idx = np.repeat(np.arange(len(seg)), n)
+    frac = (np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n)) / np.repeat(n, n)
+    return np.vstack([xy[idx] + seg[idx] * frac[:, None], xy[-1:]])
+
+
+@dataclass(frozen=True)
+class LocalFrame:
+    """Grid-local coordinates of a costmap: origin at the grid's corner, axes along its rows/columns."""
+
+    ox: float
+    oy: float
+    oyaw: float
+
+    @classmethod
+    def of(cls, grid: Grid) -> LocalFrame:
+        """The grid-local frame of ``grid``."""
+        return cls(*grid.origin)
+
+    def points_in(self, xy: np.ndarray) -> np.ndarray:
+        """Costmap-frame points (N, 2) -> grid-local (N, 2)."""
+        d = np.asarray(xy, dtype=np.float64)[:, :2] - (self.ox, self.oy)
+        if self.oyaw == 0.0:
+            return d
+        c, s = math.cos(self.oyaw), math.sin(self.oyaw)
+        return np.stack([c * d[:, 0] + s * d[:, 1], -s * d[:, 0] + c * d[:, 1]], axis=1)
+
+    def pose_in(self, pose: tuple[float, float, float]) -> tuple[float, float, float]:
+        """A costmap-frame pose -> grid-local."""
+        p = self.points_in(np.array([[pose[0], pose[1]]]))[0]
+        return float(p[0]), float(p[1]), float(pose[2]) - self.oyaw
+
+    def poses_out(self, poses: np.ndarray) -> np.ndarray:
+        """Grid-local poses (N, 3) -> costmap frame (N, 3), yaw wrapped to [-pi, pi)."""
+        out = np.array(poses, dtype=np.float64, copy=True).reshape(-1, 3)
+        c, s = math.cos(self.oyaw), math.sin(self.oyaw)
+        x, y = out[:, 0].copy(), out[:, 1].copy()
+        out[:, 0] = self.ox + c * x - s * y
+        out[:, 1] = self.oy + s * x + c * y
+        out[:, 2] = wrap_angle(out[:, 2] + self.oyaw)
+        return out
+
+
+def footprint_outline(footprint: Any, resolution: float) -> np.ndarray | None:
+    """Points (M, 2) along the edges of a polygon footprint (base frame, m), at most resolution/2 apart;
+    None for a circular robot (no polygon, or fewer than 3 vertices: costmap_2d's rule)."""
+    if footprint is None:
+        return None
+    poly = np.asarray(footprint, dtype=np.float64)
+    if poly.ndim != 2 or poly.shape[1] != 2 or not np.all(np.isfinite(poly)):
+        raise NavigationError(f"footprint: expected a polygon [[x, y], ...] in metres, got {footprint!r}")
+    if len(poly) < 3:
+        return None
+    closed = np.vstack([poly, poly[:1]])
+    return densify(closed, 0.5 * resolution)[:-1]
+
+
+def goal_of(plan: np.ndarray) -> tuple[float, float, float | None]:
+    """The goal (x, y, yaw or None) of a plan: its last pose; an (N, 2) plan has no goal yaw."""
+    last = plan[-1]
+    return float(last[0]), float(last[1]), (float(last[2]) if plan.shape[1] == 3 else None)
+
+
+def same_goal(old: tuple[float, float, float | None] | None, new: tuple[float, float, float | None],
+              xy_tolerance: float, yaw_tolerance: float) -> bool:
+    """Whether a new plan leads to the same goal as before (within the goal tolerances): a plan re-sent
+    every cycle, or replanned to the same goal, keeps the goal latch and the oscillation flags."""
+    if old is None or math.hypot(new[0] - old[0], new[1] - old[1]) > xy_tolerance:
+        return False
+    if (old[2] is None) != (new[2] is None):
+        return False
+    return old[2] is None or new[2] is None or abs(float(wrap_angle(new[2] - old[2]))) <= yaw_tolerance
+
+
+def prune_plan(plan: np.ndarray, x: float, y: float) -> np.ndarray:
+    """Drop the poses before the first one within 1 m of (x, y) (base_local_planner's ``prunePlan``).
+
+    A plan with no pose within 1 m is kept whole (ROS would empty it)."""
+    near = np.nonzero(np.hypot(plan[:, 0] - x, plan[:, 1] - y) < 1.0)[0]
+    return plan[near[0]:] if len(near) else plan
+
+
+def stopped(velocity: tuple[float, float], trans_stopped_vel: float, theta_stopped_vel: float) -> bool:
+    """base_local_planner's ``stopped``: |v| and |w| under the thresholds (m/s, rad/s)."""
+    return abs(velocity[0]) <= trans_stopped_vel and abs(velocity[1]) <= theta_stopped_vel
+
+
+def stop_with_acc_limits(velocity: tuple[float, float], acc_x: float, acc_theta: float,
+                         sim_period: float) -> tuple[float, float]:
+    """The command that slows (v, w) towards zero as fast as the acceleration limits allow in one period."""
+    v, w = velocity
+    v_new = math.copysign(max(0.0, abs(v) - acc_x * sim_period), v)
+    w_new = math.copysign(max(0.0, abs(w) - acc_theta * sim_period), w)
+    return v_new, w_new
+
+
+def rotate_to_goal(yaw_error: float, w_now: float, *, max_w: float, min_in_place_w: float, acc_theta: float,
+                   sim_period: float) -> float:
+    """The in-place turn rate (rad/s) towards a goal ``yaw_error`` (rad, goal - robot, wrapped) away.
+
+    As base_local_planner's ``rotateToGoal``: at least ``min_in_place_w``, at most ``max_w``, within reach
+    of ``w_now`` in one ``sim_period``, slow enough to stop at the goal (sqrt(2 a |err|)); the minimum
+    wins over the acceleration limits.
+    """
+    w = min(max_w, max(min_in_place_w, abs(yaw_error)))
+    w = min(max(w, abs(w_now) - acc_theta * sim_period), abs(w_now) + acc_theta * sim_period)
+    w = min(w, math.sqrt(2.0 * acc_theta * abs(yaw_error)))
+    w = min(max_w, max(min_in_place_w, w))
+    return w if yaw_error >= 0.0 else -w
+
+
+class GoalLatch:
+    """xy/yaw goal tolerances with ``latch_xy_goal_tolerance``: once within xy tolerance, stay "arrived"
+    (only rotate) until a new plan, if latching is on."""
+
+    def __init__(self, xy_tolerance: float, yaw_tolerance: float, latch: bool) -> None:
+        self.xy_tolerance = xy_tolerance
+        self.yaw_tolerance = yaw_tolerance
+        self.latch = latch
+        self.latched = False
+
+    def reset(self) -> None:
+        """Forget the latch (a new plan)."""
+        self.latched = False
+
+    def xy_reached(self, pose: tuple[float, float, float], goal: tuple[float, float, float | None]) -> bool:
+        """Within ``xy_goal_tolerance`` of the goal now, or latched; sets the latch if latching is on."""
+        if self.latched:
+            return True
+        inside = math.hypot(pose[0] - goal[0], pose[1] - goal[1]) <= self.xy_tolerance
+        if inside and self.latch:
+            self.latched = True
+        return inside
+
+    def yaw_error(self, pose: tuple[float, float, float], goal: tuple[float, float, float | None]) -> float:
+        """Goal yaw minus robot yaw (rad, wrapped); 0 when the plan has no goal yaw."""
+        return 0.0 if goal[2] is None else float(wrap_angle(goal[2] - pose[2]))
+
+    def reached(self, pose: tuple[float, float, float], goal: tuple[float, float, float | None]) -> bool:
+        """Both tolerances met (the xy one possibly latched)."""
+        return self.xy_reached(pose, goal) and abs(self.yaw_error(pose, goal)) <= self.yaw_tolerance
+
+
+class OscillationFlags:
+    """base_local_planner's oscillation suppression (``OscillationCostFunction``).
+
+    After the chosen command turns one way and then the other while not translating (|v| <=
+    ``min_vel_trans``), or drives forward after backward (or back after forward), commands in the old
+    direction are forbidden until the robot moved ``reset_dist`` m (or turned ``reset_angle`` rad, if
+    that is >= 0) from where the flag was set.
+    """
+
+    def __init__(self, reset_dist: float, reset_angle: float = -1.0) -> None:
+        self.reset_dist = reset_dist
+        self.reset_angle = reset_angle
+        self.reset()
+        self._where = (0.0, 0.0, 0.0)
+
+    def reset(self) -> None:
+        """Clear every flag."""
+        self.forward_pos = self.forward_neg = self.rot_pos = self.rot_neg = False
+        self.forward_pos_only = self.forward_neg_only = self.rot_pos_only = self.rot_neg_only = False
+
+    def allowed(self, v: np.ndarray, w: np.ndarray) -> np.ndarray:
+        """Mask of the (v, w) samples the flags allow."""
+        ok = np.ones(np.shape(v), dtype=bool)
+        if self.forward_pos_only:
+            ok &= v >= 0.0
+        if self.forward_neg_only:
+            ok &= v <= 0.0
+        if self.rot_pos_only:
+            ok &= w >= 0.0
+        if self.rot_neg_only:
+            ok &= w <= 0.0
+        return ok
+
+    def _set(self, v: float, w: float, min_vel_trans: float) -> bool:
+        flag_set = False
+        if v < 0.0:
+            flag_set |= self.forward_pos
+            self.forward_neg_only |= self.forward_pos
+            self.forward_pos, self.forward_neg = False, True
+        if v > 0.0:
+            flag_set |= self.forward_neg
+            self.forward_pos_only |= self.forward_neg
+            self.forward_neg, self.forward_pos = False, True
+        if abs(v) <= min_vel_trans:
+            if w < 0.0:
+                flag_set |= self.rot_pos
+                self.rot_neg_only |= self.rot_pos
+                self.rot_pos, self.rot_neg = False, True
+            if w > 0.0:
+                flag_set |= self.rot_neg
+                self.rot_pos_only |= self.rot_neg
+                self.rot_neg, self.rot_pos = False, True
+        return flag_set
+
+    def update(self, pose: tuple[float, float, float], v: float, w: float, min_vel_trans: float) -> None:
+        """Record the command (v, w) chosen at ``pose``; clear the flags once moved far enough."""
+        if self._set(v, w, min_vel_trans):
+            self._where = pose
+        if self.forward_pos_only or self.forward_neg_only or self.rot_pos_only or self.rot_neg_only:
+            moved = math.hypot(pose[0] - self._where[0], pose[1] - self._where[1])
+            turned = abs(float(wrap_angle(pose[2] - self._where[2])))
+            if moved > self.reset_dist or (self.reset_angle >= 0.0 and turned > self.reset_angle):
+                self.reset()

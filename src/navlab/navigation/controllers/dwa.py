@@ -1,0 +1,147 @@
+"""dwa_local_planner/DWAPlannerROS: the dynamic window approach of ROS 1 (see ``trajectory`` for the
+shared rollout, distance maps and goal handling, and the cost it minimises)."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+
+from navlab.navigation.controllers import mapgrid
+from navlab.navigation.controllers.params import DWAPlannerParams
+from navlab.navigation.controllers.trajectory import (
+    LocalScene,
+    RolloutController,
+    footprint_costs,
+    lookup,
+    rollout,
+    velocity_samples,
+)
+
+_EPS = 1e-4
+
+
+class DWAPlannerROS(RolloutController):
+    """dwa_local_planner's DWAPlanner behind the Controller protocol.
+
+    ``params``: a DWAPlannerROS parameter dict (ROS 1 names, old and new spellings) or
+    ``DWAPlannerParams``; ``footprint``: polygon [[x, y], ...] (m, base frame) or None for a circular
+    robot (centre cell). ``rng`` is accepted for a uniform constructor and not used.
+    """
+
+    what = "DWAPlannerROS"
+    params: DWAPlannerParams
+
+    def __init__(self, params: Mapping[str, Any] | DWAPlannerParams | None = None, *, footprint: Any = None,
+                 rng: np.random.Generator | None = None) -> None:
+        super().__init__(params, footprint=footprint, rng=rng)
+        self._stopped_vel = (self.params.trans_stopped_vel, self.params.theta_stopped_vel)
+        self._accelerate = not self.params.use_dwa
+
+    @staticmethod
+    def _parse(params: Any) -> DWAPlannerParams:
+        return DWAPlannerParams.from_dict(params)
+
+    def _in_place_limits(self, err: float) -> tuple[float, float]:
+        return self.params.max_vel_theta, self.params.min_vel_theta
+
+    def is_goal_reached(self, pose: tuple[float, float, float], velocity: tuple[float, float]) -> bool:
+        """Within the xy (possibly latched) and yaw tolerances and stopped (trans/theta_stopped_vel)."""
+        v = (float(velocity[0]), float(velocity[1]))
+        return super().is_goal_reached(pose, velocity) and abs(v[0]) <= self.params.trans_stopped_vel \
+            and abs(v[1]) <= self.params.theta_stopped_vel
+
+    def window(self, velocity: tuple[float, float], dist_to_goal: float) -> np.ndarray:
+        """The (v, w) samples (S, 2) of one cycle: the dynamic window around ``velocity``, sampled as
+        ROS's VelocityIterator does, minus the pairs too slow to move (min_vel_trans and min_vel_theta)
+        or too fast (max_vel_trans)."""
+        p = self.params
+        v0, w0 = velocity
+        if p.use_dwa:
+            horizon, vmax_x = p.sim_period, p.max_vel_x
+        else:  # never plan to overshoot the goal within sim_time
+            horizon, vmax_x = p.sim_time, max(min(p.max_vel_x, dist_to_goal / p.sim_time), p.min_vel_x)
+        vhi = min(vmax_x, v0 + p.acc_lim_x * horizon)
+        vlo = min(max(p.min_vel_x, v0 - p.acc_lim_x * horizon), vhi)
+        whi = min(p.max_vel_theta, w0 + p.acc_lim_theta * horizon)
+        wlo = min(max(-p.max_vel_theta, w0 - p.acc_lim_theta * horizon), whi)
+        vs, ws = velocity_samples(vlo, vhi, p.vx_samples), velocity_samples(wlo, whi, p.vth_samples)
+        pairs = np.stack([np.repeat(vs, len(ws)), np.tile(ws, len(vs))], axis=1)
+        speed, turn = np.abs(pairs[:, 0]), np.abs(pairs[:, 1])
+        keep = ~(((speed + _EPS < p.min_vel_trans) & (turn + _EPS < p.min_vel_theta))
+                 | (speed - _EPS > p.max_vel_trans) | ((speed < _EPS) & (turn < _EPS)))
+        return pairs[keep]
+
+    def _front_goal_dist(self, scene: LocalScene) -> np.ndarray:
+        """Distances to the local goal pushed ``forward_point_distance`` beyond itself, away from the robot
+        (dwa_local_planner's ``goal_front_costs``); the local goal itself if that point is off the map."""
+        x, y, _ = scene.pose
+        g = scene.local_goal()
+        a = math.atan2(g[1] - y, g[0] - x)
+        front = g + self.params.forward_point_distance * np.array([math.cos(a), math.sin(a)])
+        seed = np.floor(front / scene.resolution).astype(np.int64)
+        h, w = scene.cost.shape
+        if not (0 <= seed[0] < w and 0 <= seed[1] < h) or scene.cost[seed[1], seed[0]] == 255:
+            seed = scene.path_cells[-1]
+        return mapgrid.distance_map(scene.cost, seed[None, :])
+
+    def score(self, scene: LocalScene, targets: np.ndarray, traj: np.ndarray) -> np.ndarray:
+        """Costs (S,) of the rollouts; -1 for a rejected one (blocked, off the map, no path, oscillating)."""
+        p = self.params
+        res = scene.resolution
+        pdist, gdist = res * p.path_distance_bias, res * p.goal_distance_bias
+        g = scene.local_goal()
+        sq_dist = (scene.pose[0] - g[0]) ** 2 + (scene.pose[1] - g[1]) ** 2
+        near = sq_dist <= p.forward_point_distance ** 2 * p.cheat_factor
+        align = 0.0 if near else pdist
+        total = np.zeros(len(targets))
+        rejected = ~self._osc.allowed(targets[:, 0], targets[:, 1])
+        if p.occdist_scale > 0:
+            fp = footprint_costs(scene.cost, res, traj, self._outline(res))
+            rejected |= (fp < 0).any(axis=1)
+            total += p.occdist_scale * fp.max(axis=1)
+        end = traj[:, -1]
+        nx = end[:, 0] + p.forward_point_distance * np.cos(end[:, 2])
+        ny = end[:, 1] + p.forward_point_distance * np.sin(end[:, 2])
+        if gdist > 0:
+            d, inside = lookup(self._front_goal_dist(scene), res, nx, ny)
+            rejected |= ~inside
+            total += gdist * d
+        if align > 0:
+            d, inside = lookup(scene.path_dist, res, nx, ny)
+            rejected |= ~inside
+            total += align * d
+        for scale, grid in ((pdist, scene.path_dist), (gdist, scene.goal_dist)):
+            if scale > 0:
+                d, inside = lookup(grid, res, end[:, 0], end[:, 1])
+                rejected |= ~inside | (d >= scene.impossible)
+                total += scale * d
+        if p.twirling_scale > 0:
+            total += p.twirling_scale * np.abs(targets[:, 1])
+        total[rejected] = -1.0
+        return total
+
+    def _drive(self, scene: LocalScene, pose: tuple[float, float, float], velocity: tuple[float, float],
+               goal: tuple[float, float, float | None]) -> tuple[float, float]:
+        p = self.params
+        g = scene.local_goal()
+        targets = self.window(velocity, math.hypot(g[0] - scene.pose[0], g[1] - scene.pose[1]))
+        if len(targets) == 0:
+            return self._finish(scene, targets, np.zeros((0, 0, 3)), np.zeros(0), -1, pose)
+        n = self._steps(targets)
+        traj = rollout(scene.pose, velocity, targets, n, p.sim_time / n, (p.acc_lim_x, p.acc_lim_theta),
+                       accelerate=self._accelerate)
+        costs = self.score(scene, targets, traj)
+        ok = costs >= 0
+        best = int(np.argmin(np.where(ok, costs, np.inf))) if ok.any() else -1
+        if best >= 0:
+            self._osc.update(pose, float(targets[best, 0]), float(targets[best, 1]), p.min_vel_trans)
+        return self._finish(scene, targets, traj, costs, best, pose)
+
+
+class DWBLocalPlanner(DWAPlannerROS):
+    """Nav2's DWB name for the same planner; it reads DWAPlannerROS's (ROS 1) parameter names."""
+
+    what = "DWBLocalPlanner"

@@ -1,0 +1,87 @@
+"""base_local_planner's MapGrid: cell distances (4-connected steps) to the plan or to the local goal.
+
+A breadth-first wave grows from seed cells over the local costmap; cells with cost LETHAL, INSCRIBED or
+NO_INFORMATION stop it and read ``obstacle_value`` (= cells in the grid), cells it never reaches read
+``unreachable_value`` (= cells + 1). Both mark a trajectory end as hopeless. Distances are in cells.
+"""
+
+from __future__ import annotations
+
+import numba
+import numpy as np
+
+from navlab.grid import COST_INSCRIBED
+from navlab.navigation.controllers.common import densify
+
+
+@numba.njit(cache=True)
+def _wave(cost: np.ndarray, seeds_i: np.ndarray, seeds_j: np.ndarray, free_i: np.ndarray,
+          free_j: np.ndarray, out: np.ndarray) -> None:  # pragma: no cover - compiled
+    h, w = cost.shape
+    obstacle = float(h * w)
+    out[:, :] = obstacle + 1.0
+    mark = np.zeros((h, w), dtype=np.bool_)
+    free = np.zeros((h, w), dtype=np.bool_)
+    for k in range(free_i.size):
+        free[free_j[k], free_i[k]] = True
+    qi = np.empty(h * w, dtype=np.int64)
+    qj = np.empty(h * w, dtype=np.int64)
+    head = 0
+    tail = 0
+    for k in range(seeds_i.size):
+        i, j = seeds_i[k], seeds_j[k]
+        if not mark[j, i]:
+            mark[j, i] = True
+            out[j, i] = 0.0
+            qi[tail], qj[tail] = i, j
+            tail += 1
+    di = (-1, 1, 0, 0)
+    dj = (0, 0, -1, 1)
+    while head < tail:
+        ci, cj = qi[head], qj[head]
+        head += 1
+        for n in range(4):
+            ni, nj = ci + di[n], cj + dj[n]
+            if ni < 0 or nj < 0 or ni >= w or nj >= h or mark[nj, ni]:
+                continue
+            mark[nj, ni] = True
+            if cost[nj, ni] >= COST_INSCRIBED and not free[nj, ni]:
+                out[nj, ni] = obstacle
+                continue
+            out[nj, ni] = out[cj, ci] + 1.0
+            qi[tail], qj[tail] = ni, nj
+            tail += 1
+
+
+def plan_cells(cost: np.ndarray, plan_xy: np.ndarray, resolution: float) -> np.ndarray:
+    """Cells (K, 2) as (i, j) of the plan's first stretch inside the grid (grid-local plan points, m).
+
+    The plan is densified to the resolution; cells of unknown cost break it (ROS's ``setTargetCells``).
+    """
+    pts = densify(plan_xy, resolution)
+    ij = np.floor(pts / resolution).astype(np.int64)
+    h, w = cost.shape
+    inside = (ij[:, 0] >= 0) & (ij[:, 0] < w) & (ij[:, 1] >= 0) & (ij[:, 1] < h)
+    inside[inside] = cost[ij[inside, 1], ij[inside, 0]] != 255
+    if not inside.any():
+        return np.zeros((0, 2), dtype=np.int64)
+    first = int(np.argmax(inside))
+    out_after = np.nonzero(~inside[first:])[0]
+    last = first + (int(out_after[0]) if len(out_after) else len(inside) - first)
+    cells = ij[first:last]
+    keep = np.ones(len(cells), dtype=bool)
+    keep[1:] = np.any(cells[1:] != cells[:-1], axis=1)
+    return cells[keep]
+
+
+def distance_map(cost: np.ndarray, seeds: np.ndarray, free: np.ndarray | None = None) -> np.ndarray:
+    """Cell distances (float, same shape as ``cost``) from the ``seeds`` cells (K, 2) as (i, j).
+
+    ``free`` cells (K', 2) are never obstacles (base_local_planner's cells "within the robot").
+    """
+    out = np.empty(cost.shape, dtype=np.float64)
+    seeds = np.asarray(seeds, dtype=np.int64).reshape(-1, 2)
+    free = np.zeros((0, 2), dtype=np.int64) if free is None else np.asarray(free, dtype=np.int64).reshape(-1, 2)
+    _wave(np.ascontiguousarray(cost), seeds[:, 0].copy(), seeds[:, 1].copy(), free[:, 0].copy(),
+          free[:, 1].copy(), out)
+    return out

@@ -1,0 +1,376 @@
+"""A Nav2-style MPPI controller (``nav2_mppi_controller::MPPIController``) for a differential base.
+
+Model Predictive Path Integral control: each cycle shifts the previous optimal control sequence one
+step (warm start), samples ``batch_size`` sequences around it (Gaussian noise ``vx_std``, ``wz_std``),
+limits them to what ``ax_max``/``ax_min``/``az_max`` allow from the current velocity, rolls every
+sequence out as a unicycle over ``time_steps`` x ``model_dt`` (one compiled loop, reading the costmap
+under each point), scores them with the critics (``mppi_critics``; ConstraintCritic charges samples
+beyond ``vx_min``/``vx_max``) plus the control cost ``gamma / std² · Σ u·ε``, and averages them with
+softmax weights ``exp(-(cost - min) / temperature)``; the average is clipped to the velocity and
+acceleration limits. After ``iteration_count`` rounds the sequence is smoothed (Savitzky-Golay, with
+the commands already sent) and its first control is the command.
+
+One navlab addition: ``noise_correlation`` makes each sample's noise an AR(1) process over time
+(same per-step spread, coherent swerves instead of jitter), which finds the way round obstacles the
+path runs into (default 0.9; 0 is Nav2's white noise, which stalls in front of an obstacle on the path).
+
+As in Nav2 the rollout's first step moves at the measured velocity (the command acts one
+``model_dt`` later). Trajectories through LETHAL/INSCRIBED/unknown cells take ``collision_cost``; if
+every sample collides the sequence is reset and the round retried (``retry_attempt_limit``), then
+the controller stops and sets ``valid`` False. Parameters: Nav2 names and defaults; a critic's own are
+in a dict under its name (``CostCritic: {cost_weight: 3.81}``) or dotted (``CostCritic.cost_weight``).
+The goal checker's ``xy_goal_tolerance``/``yaw_goal_tolerance`` (Nav2 SimpleGoalChecker, stateful)
+are read here too. Units: m, rad, s.
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field, fields
+from typing import Any
+
+import numba
+import numpy as np
+from scipy.signal import savgol_coeffs
+
+from navlab.grid import COST_INSCRIBED, Grid
+from navlab.navigation.controllers import mppi_critics as critics
+from navlab.navigation.controllers.common import (
+    GoalLatch,
+    LocalFrame,
+    as_plan,
+    bad,
+    check_finite,
+    densify,
+    footprint_outline,
+    goal_of,
+    params_from,
+    same_goal,
+)
+from navlab.navigation.errors import NavigationError
+
+WHAT = "MPPIController"
+PATH_SPACING = 0.05  # m: plans are resampled to this (Nav2's path-index offsets assume costmap cells)
+_IGNORED = frozenset({"plugin", "visualize", "publish_optimal_trajectory", "regenerate_noises", "reset_period",
+                      "transform_tolerance", "enforce_path_inversion", "use_sim_time", "TrajectoryVisualizer",
+                      "open_loop", "shift_control_sequence"})
+
+
+@dataclass
+class MppiParams:
+    """nav2_mppi_controller's parameters (Nav2 names and defaults; critic sections in ``critic_params``)."""
+
+    batch_size: int = 1000
+    time_steps: int = 56
+    model_dt: float = 0.05
+    iteration_count: int = 1
+    temperature: float = 0.3
+    gamma: float = 0.015
+    vx_std: float = 0.2
+    vy_std: float = 0.2
+    wz_std: float = 0.4
+    vx_max: float = 0.5
+    vx_min: float = -0.35
+    vy_max: float = 0.5
+    wz_max: float = 1.9
+    ax_max: float = 3.0
+    ax_min: float = -3.0
+    ay_max: float = 3.0
+    az_max: float = 3.5
+    motion_model: str = "DiffDrive"
+    prune_distance: float = 1.7
+    retry_attempt_limit: int = 1
+    noise_correlation: float = 0.9  # navlab: AR(1) coefficient of the noise over time (0: Nav2's white noise)
+    controller_frequency: float = 20.0
+    xy_goal_tolerance: float = 0.25
+    yaw_goal_tolerance: float = 0.25
+    stateful: bool = True
+    critics: list[str] = field(default_factory=lambda: [
+        "ConstraintCritic", "CostCritic", "GoalCritic", "GoalAngleCritic", "PathAlignCritic", "PathFollowCritic",
+        "PathAngleCritic", "PreferForwardCritic"])
+    critic_params: dict[str, Any] = field(default_factory=dict)
+
+    @classmethod
+    def from_dict(cls, values: Mapping[str, Any] | MppiParams | None) -> MppiParams:
+        """From a Nav2 controller namespace dict (critic sections nested or dotted), validated."""
+        if isinstance(values, MppiParams):
+            values.validate()
+            return values
+        flat: dict[str, Any] = {}
+        sections: dict[str, dict[str, Any]] = {}
+        names = [f.name for f in fields(cls) if f.name != "critic_params"]
+        for key, val in (values or {}).items():
+            head, dot, tail = str(key).partition(".")
+            if head in critics.CRITICS:
+                sections.setdefault(head, {}).update({tail: val} if dot else dict(val or {}))
+            elif dot or (isinstance(val, Mapping) and head not in _IGNORED):
+                close = difflib.get_close_matches(head, [*names, *critics.CRITICS], n=1)
+                hint = f"; did you mean '{close[0]}'?" if close else ""
+                raise NavigationError(f"unknown {WHAT} parameter '{key}'{hint}")
+            else:
+                flat[key] = val
+        out = params_from(cls, flat, what=WHAT, ignored=_IGNORED)
+        out.critics = [str(c).rsplit("::", 1)[-1] for c in out.critics]
+        out.critic_params = {name: params_from(critics.CRITICS[name], sec, what=f"{WHAT} {name}")
+                             for name, sec in sections.items()}
+        out.validate()
+        return out
+
+    def critic(self, name: str) -> Any:
+        """The parameters of critic ``name`` (its defaults if the file set none)."""
+        return self.critic_params.get(name) or critics.CRITICS[name]()
+
+    def validate(self) -> None:
+        """Raise ``NavigationError`` naming the first bad parameter."""
+        check_finite(WHAT, self)
+        for key in ("batch_size", "iteration_count", "retry_attempt_limit"):
+            if getattr(self, key) < 1:
+                raise bad(WHAT, key, getattr(self, key), ">= 1")
+        if self.time_steps < 2:
+            raise bad(WHAT, "time_steps", self.time_steps, ">= 2")
+        for key in ("model_dt", "temperature", "vx_std", "wz_std", "wz_max", "ax_max", "az_max", "prune_distance",
+                    "controller_frequency"):
+            if not getattr(self, key) > 0:
+                raise bad(WHAT, key, getattr(self, key), "> 0")
+        for key in ("gamma", "xy_goal_tolerance", "yaw_goal_tolerance"):
+            if not getattr(self, key) >= 0:
+                raise bad(WHAT, key, getattr(self, key), ">= 0")
+        if not 0.0 <= self.noise_correlation < 1.0:
+            raise bad(WHAT, "noise_correlation", self.noise_correlation, "0 <= value < 1")
+        if self.ax_min > 0:
+            raise bad(WHAT, "ax_min", self.ax_min, "<= 0 (a deceleration)")
+        if self.vx_min > self.vx_max:
+            raise bad(WHAT, "vx_min", self.vx_min, f"<= vx_max ({self.vx_max})")
+        if self.motion_model != "DiffDrive":
+            raise bad(WHAT, "motion_model", self.motion_model, "'DiffDrive' (navlab's controllers drive (v, w))")
+        for name in self.critics:
+            if name not in critics.CRITICS:
+                close = difflib.get_close_matches(name, list(critics.CRITICS), n=1)
+                hint = f"did you mean '{close[0]}'? " if close else ""
+                raise bad(WHAT, "critics", name, f"a known critic ({hint}known: {', '.join(critics.CRITICS)})")
+
+
+@numba.njit(cache=True)
+def _sample_rollout(rng: np.random.Generator, seq: np.ndarray, std: np.ndarray, corr: float, v0: float, w0: float,
+                    x0: float, y0: float, th0: float, dt: float, limits: np.ndarray, cost: np.ndarray, res: float,
+                    u: np.ndarray, xs: np.ndarray, ys: np.ndarray, ths: np.ndarray, cs: np.ndarray,
+                    arc: np.ndarray, dots: np.ndarray) -> None:  # pragma: no cover - compiled
+    """Sample controls ``seq`` (T, 2) + noise from ``rng`` (N(0, std) at every step, AR(1)-correlated over time
+    with coefficient ``corr``), constrain them into ``u`` (S, T, 2), roll every sample out (poses, cost under
+    each point, distance travelled) and sum ``seq · (u - seq) / std²`` into ``dots`` (S,) for the control cost."""
+    acc, dec, aw = limits[3], limits[4], limits[5]
+    n_s, n_t = u.shape[0], u.shape[1]
+    h, w = cost.shape
+    inv = 1.0 / res
+    iv, iw = 1.0 / (std[0] * std[0]), 1.0 / (std[1] * std[1])
+    fresh = math.sqrt(1.0 - corr * corr)
+    for s in range(n_s):
+        v, om, x, y, th, d, dot = v0, w0, x0, y0, th0, 0.0, 0.0
+        ev, ew = rng.standard_normal(), rng.standard_normal()
+        for t in range(n_t):
+            if t > 0:
+                ev = corr * ev + fresh * rng.standard_normal()
+                ew = corr * ew + fresh * rng.standard_normal()
+            step = v * dt
+            x += step * math.cos(th)
+            y += step * math.sin(th)
+            th += om * dt
+            d += abs(step)
+            xs[s, t], ys[s, t], ths[s, t], arc[s, t] = x, y, th, d
+            i, j = math.floor(x * inv), math.floor(y * inv)
+            cs[s, t] = cost[j, i] if 0 <= i < w and 0 <= j < h else 255
+            cv = seq[t, 0] + std[0] * ev
+            if v >= 0.0:
+                cv = min(max(cv, v + dec * dt), v + acc * dt)
+            else:
+                cv = min(max(cv, v - acc * dt), v - dec * dt)
+            cw = seq[t, 1] + std[1] * ew
+            cw = min(max(cw, om - aw * dt), om + aw * dt)
+            u[s, t, 0], u[s, t, 1] = cv, cw
+            dot += seq[t, 0] * (cv - seq[t, 0]) * iv + seq[t, 1] * (cw - seq[t, 1]) * iw
+            v, om = cv, cw
+        dots[s] = dot
+
+
+@numba.njit(cache=True)
+def _accel_limit(seq: np.ndarray, v0: float, w0: float, dt: float, limits: np.ndarray) -> None:  # pragma: no cover
+    """Limit each control of ``seq`` (T, 2) in place to what the acceleration limits allow from the one before."""
+    acc, dec, aw = limits[3], limits[4], limits[5]
+    v, om = v0, w0
+    for t in range(seq.shape[0]):
+        if v >= 0.0:
+            seq[t, 0] = min(max(seq[t, 0], v + dec * dt), v + acc * dt)
+        else:
+            seq[t, 0] = min(max(seq[t, 0], v - acc * dt), v - dec * dt)
+        seq[t, 1] = min(max(seq[t, 1], om - aw * dt), om + aw * dt)
+        v, om = seq[t, 0], seq[t, 1]
+
+
+class MPPIController:
+    """The MPPI controller behind the Controller protocol.
+
+    ``params``: a Nav2 MPPI parameter dict or ``MppiParams``; ``rng``: the seeded generator every noise
+    sample comes from (required: same seed, same commands); ``footprint``: polygon [[x, y], ...] (m, base
+    frame) for CostCritic's ``consider_footprint``, or None for a circular robot.
+
+    After each cycle: ``local_plan`` (T + 1, 3) the optimal trajectory (costmap frame), ``sequence``
+    (T, 2) the optimal controls, ``costs`` (S,) the samples' costs, ``valid`` False if every sample collided.
+    """
+
+    what = WHAT
+
+    def __init__(self, params: Mapping[str, Any] | MppiParams | None = None, *, rng: np.random.Generator | None = None,
+                 footprint: Any = None) -> None:
+        if not isinstance(rng, np.random.Generator):
+            raise NavigationError(f"{WHAT} needs rng=numpy.random.Generator (seeded), got {type(rng).__name__}")
+        self.params = MppiParams.from_dict(params)
+        self.rng = rng
+        self.footprint = None if footprint is None else np.asarray(footprint, dtype=np.float64)
+        footprint_outline(self.footprint, PATH_SPACING)  # validate now
+        p = self.params
+        self._limits = np.array([p.vx_min, p.vx_max, p.wz_max, p.ax_max, p.ax_min, p.az_max])
+        self._std = np.array([p.vx_std, p.wz_std])
+        self._sg = savgol_coeffs(9, 2)  # Nav2 smooths with a 9-point quadratic Savitzky-Golay filter
+        self._latch = GoalLatch(p.xy_goal_tolerance, p.yaw_goal_tolerance, p.stateful)
+        self._plan: np.ndarray | None = None
+        self._goal: tuple[float, float, float | None] = (0.0, 0.0, None)
+        self._progress = 0
+        self.reset()
+
+    def reset(self) -> None:
+        """Forget the optimal sequence and the command history (a new goal)."""
+        self.sequence = np.zeros((self.params.time_steps, 2))
+        self._history = np.zeros((4, 2))
+        self.local_plan = np.zeros((0, 3))
+        self.costs = np.zeros(0)
+        self.valid = True
+
+    def set_plan(self, path: np.ndarray) -> None:
+        """The global plan (N, 2) or (N, 3) in the costmap's frame (resampled at 5 cm); an (N, 3) plan's last
+        yaw is the goal yaw. A plan to a new goal (beyond the goal tolerances) resets the goal latch; one to
+        the same goal keeps the progress made along the old one."""
+        plan = as_plan(path)
+        goal = goal_of(plan)
+        dense = densify(plan[:, :2], PATH_SPACING)
+        p = self.params
+        if self._plan is not None and same_goal(self._goal, goal, p.xy_goal_tolerance, p.yaw_goal_tolerance):
+            anchor = self._plan[self._progress]  # keep the progress along a plan re-sent to the same goal
+            self._progress = int(np.argmin(np.hypot(dense[:, 0] - anchor[0], dense[:, 1] - anchor[1])))
+        else:
+            self._latch.reset()
+            self._progress = 0
+        self._goal = goal
+        self._plan = dense
+
+    def is_goal_reached(self, pose: tuple[float, float, float], velocity: tuple[float, float]) -> bool:
+        """Nav2's SimpleGoalChecker: within xy tolerance (latched if ``stateful``) and yaw tolerance."""
+        if self._plan is None:
+            return False
+        return self._latch.reached((float(pose[0]), float(pose[1]), float(pose[2])), self._goal)
+
+    def _local_path(self, pose: tuple[float, float, float]) -> np.ndarray:
+        """The plan from the point nearest the robot (searched ahead of the last one) to ``prune_distance``
+        along it (Nav2's path handler), in the costmap frame."""
+        assert self._plan is not None
+        plan = self._plan
+        ahead = plan[self._progress: self._progress + int(4.0 / PATH_SPACING)]
+        d = np.hypot(ahead[:, 0] - pose[0], ahead[:, 1] - pose[1])
+        self._progress += int(np.argmin(d))
+        rest = plan[self._progress:]
+        seg = np.hypot(*np.diff(rest, axis=0).T)
+        n = int(np.searchsorted(np.cumsum(seg), self.params.prune_distance)) + 2
+        return rest[:n]
+
+    def compute_velocity(self, pose: tuple[float, float, float], velocity: tuple[float, float],
+                         costmap: Grid | None) -> tuple[float, float]:
+        """(v m/s, w rad/s) for the robot at ``pose`` (costmap frame) moving at ``velocity`` (v, w)."""
+        if self._plan is None:
+            raise NavigationError(f"{WHAT}: compute_velocity called before set_plan")
+        if costmap is None:
+            raise NavigationError(f"{WHAT}: needs a local costmap (got None)")
+        p = self.params
+        pose = (float(pose[0]), float(pose[1]), float(pose[2]))
+        v0, w0 = float(velocity[0]), float(velocity[1])
+        frame = LocalFrame.of(costmap)
+        grid = np.ascontiguousarray(costmap.data, dtype=np.uint8)
+        res = costmap.resolution
+        px, py, pth = frame.pose_in(pose)
+        path = frame.points_in(self._local_path(pose))
+        g = frame.points_in(np.array([self._goal[:2]]))[0]
+        goal = (float(g[0]), float(g[1]), None if self._goal[2] is None else self._goal[2] - frame.oyaw)
+        dist_to_goal = math.hypot(pose[0] - self._goal[0], pose[1] - self._goal[1])
+        outline = footprint_outline(self.footprint, res)
+        s_n, t_n = p.batch_size, p.time_steps
+        u = np.empty((s_n, t_n, 2))
+        xs, ys, ths, arc = (np.empty((s_n, t_n)) for _ in range(4))
+        cs = np.empty((s_n, t_n), dtype=np.uint8)
+        dots = np.empty(s_n)
+        self.sequence = np.vstack([self.sequence[1:], self.sequence[-1:]])  # warm start
+        self.valid = True
+        attempts = 0
+        iteration = 0
+        while iteration < p.iteration_count:
+            _sample_rollout(self.rng, self.sequence, self._std, p.noise_correlation, v0, w0, px, py, pth, p.model_dt,
+                            self._limits, grid, res, u, xs, ys, ths, cs, arc, dots)
+            batch = critics.Batch(xs, ys, ths, u[..., 0], u[..., 1], cs, arc, (px, py, pth), path, goal,
+                                  dist_to_goal, p.model_dt, (p.vx_min, p.vx_max), grid, res, outline)
+            costs = self._score(batch)
+            if bool((cs >= COST_INSCRIBED).any(axis=1).all()):  # every sample collides
+                attempts += 1
+                self.sequence[:] = 0.0
+                if attempts > p.retry_attempt_limit:
+                    self.valid = False
+                    self.costs, self.local_plan = costs, np.zeros((0, 3))
+                    return 0.0, 0.0
+                continue
+            costs += p.gamma * dots
+            weights = np.exp(-(costs - costs.min()) / p.temperature)
+            weights /= weights.sum()
+            self.sequence = np.einsum("s,stc->tc", weights, u)
+            self._constrain_sequence(v0, w0)
+            self.costs = costs
+            iteration += 1
+        self._smooth()
+        v = float(min(max(self.sequence[0, 0], p.vx_min), p.vx_max))
+        w = float(min(max(self.sequence[0, 1], -p.wz_max), p.wz_max))
+        self._history = np.vstack([self._history[1:], [[v, w]]])
+        self.local_plan = frame.poses_out(self._optimal_trajectory(px, py, pth, v0, w0))
+        return v, w
+
+    def _score(self, batch: critics.Batch) -> np.ndarray:
+        total = np.zeros(len(batch.x))
+        for name in self.params.critics:
+            c = self.params.critic(name)
+            if c.enabled:
+                out = critics.SCORERS[name](c, batch)
+                if out is not None:
+                    total += out
+        return total
+
+    def _constrain_sequence(self, v0: float, w0: float) -> None:
+        """Clip the optimal sequence to the velocity limits and, step by step from the measured velocity, to
+        the acceleration limits (Nav2's ``applyControlSequenceConstraints``)."""
+        p = self.params
+        seq = self.sequence
+        np.clip(seq[:, 0], p.vx_min, p.vx_max, out=seq[:, 0])
+        np.clip(seq[:, 1], -p.wz_max, p.wz_max, out=seq[:, 1])
+        _accel_limit(seq, v0, w0, p.model_dt, self._limits)
+
+    def _smooth(self) -> None:
+        """Savitzky-Golay smoothing of the sequence, with the last 4 commands sent before it."""
+        seq = self.sequence
+        ext = np.vstack([self._history, seq, np.repeat(seq[-1:], 4, axis=0)])
+        for c in range(2):
+            seq[:, c] = np.convolve(ext[:, c], self._sg, mode="valid")
+
+    def _optimal_trajectory(self, x: float, y: float, th: float, v0: float, w0: float) -> np.ndarray:
+        """Poses (T + 1, 3) from the robot along the optimal sequence (first step at the measured velocity)."""
+        dt = self.params.model_dt
+        v = np.concatenate([[v0], self.sequence[:-1, 0]])
+        w = np.concatenate([[w0], self.sequence[:-1, 1]])
+        yaw = th + np.concatenate([[0.0], np.cumsum(w * dt)])
+        px = x + np.concatenate([[0.0], np.cumsum(v * np.cos(yaw[:-1]) * dt)])
+        py = y + np.concatenate([[0.0], np.cumsum(v * np.sin(yaw[:-1]) * dt)])
+        return np.column_stack([px, py, yaw])

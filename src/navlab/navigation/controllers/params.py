@@ -1,0 +1,194 @@
+"""Parameters of base_local_planner's TrajectoryPlannerROS and dwa_local_planner's DWAPlannerROS.
+
+ROS 1 names and defaults (the ROS wiki's tables). Older and newer ROS 1 spellings are both read:
+``backup_vel`` / ``escape_vel``, ``max_trans_vel`` / ``max_vel_trans``, ``max_rot_vel`` /
+``max_vel_theta``, ``min_rot_vel`` / ``min_vel_theta`` (DWA: the least |w|), ``acc_lim_th`` /
+``acc_lim_theta``, ``rot_stopped_vel`` / ``theta_stopped_vel``, and the scoring weights
+``pdist_scale`` / ``path_distance_bias``, ``gdist_scale`` / ``goal_distance_bias`` in both namespaces.
+``controller_frequency`` is move_base's (the planners search it upward); it sets ``sim_period``.
+Units: m, rad, s, m/s, rad/s, m/s², rad/s².
+
+Read but without effect, because navlab's controllers command a differential base (v, w):
+``holonomic_robot``, ``y_vels``, ``acc_lim_y``, ``max_vel_y``, ``min_vel_y``, ``vy_samples``; and, as in
+ROS noetic's dwa_local_planner, ``stop_time_buffer``, ``scaling_speed``, ``max_scaling_factor`` (the
+footprint is not scaled with speed).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+from navlab.navigation.controllers.common import bad, check_finite, params_from
+
+TP = "TrajectoryPlannerROS"
+DWA = "DWAPlannerROS"
+_VIEW_ONLY = frozenset({"publish_cost_grid_pc", "publish_traj_pc", "publish_cost_grid", "global_frame_id",
+                        "restore_defaults", "plugin", "use_sim_time"})
+
+
+@dataclass
+class TrajectoryPlannerParams:
+    """base_local_planner/TrajectoryPlannerROS (ROS 1 names and defaults)."""
+
+    acc_lim_x: float = 2.5
+    acc_lim_y: float = 2.5
+    acc_lim_theta: float = 3.2
+    max_vel_x: float = 0.5
+    min_vel_x: float = 0.1
+    max_vel_theta: float = 1.0
+    min_vel_theta: float = -1.0
+    min_in_place_vel_theta: float = 0.4
+    escape_vel: float = -0.1
+    holonomic_robot: bool = True
+    y_vels: list[float] = field(default_factory=lambda: [-0.3, -0.1, 0.1, 0.3])
+    sim_time: float = 1.0
+    sim_granularity: float = 0.025
+    angular_sim_granularity: float = -1.0  # <= 0: sim_granularity (ROS's default)
+    vx_samples: int = 3
+    vtheta_samples: int = 20
+    controller_frequency: float = 20.0
+    pdist_scale: float = 0.6
+    gdist_scale: float = 0.8
+    occdist_scale: float = 0.01
+    heading_lookahead: float = 0.325
+    heading_scoring: bool = False
+    heading_scoring_timestep: float = 0.8
+    simple_attractor: bool = False
+    dwa: bool = True
+    meter_scoring: bool = False
+    oscillation_reset_dist: float = 0.05
+    escape_reset_dist: float = 0.10
+    escape_reset_theta: float = math.pi / 4.0
+    xy_goal_tolerance: float = 0.1
+    yaw_goal_tolerance: float = 0.05
+    latch_xy_goal_tolerance: bool = False
+    prune_plan: bool = True
+
+    @classmethod
+    def from_dict(cls, values: Mapping[str, Any] | TrajectoryPlannerParams | None) -> TrajectoryPlannerParams:
+        """From a TrajectoryPlannerROS parameter dict (unknown keys: "did you mean"), validated."""
+        if isinstance(values, Mapping) and "max_rotational_vel" in values:  # the oldest spelling
+            values = dict(values)
+            vmax = values.pop("max_rotational_vel")
+            values.setdefault("max_vel_theta", vmax)
+            values.setdefault("min_vel_theta", -float(vmax))
+        out = params_from(cls, values, what=TP, ignored=_VIEW_ONLY, aliases={
+            "backup_vel": "escape_vel", "acc_lim_th": "acc_lim_theta", "path_distance_bias": "pdist_scale",
+            "goal_distance_bias": "gdist_scale", "vth_samples": "vtheta_samples"})
+        out.validate()
+        return out
+
+    @property
+    def sim_period(self) -> float:
+        """1 / controller_frequency (s)."""
+        return 1.0 / self.controller_frequency
+
+    def validate(self) -> None:
+        """Raise ``NavigationError`` naming the first bad parameter."""
+        check_finite(TP, self)
+        _positive(TP, self, "acc_lim_x", "acc_lim_theta", "sim_time", "sim_granularity", "controller_frequency",
+                  "max_vel_x")
+        _at_least(TP, self, 0.0, "min_in_place_vel_theta", "pdist_scale", "gdist_scale", "occdist_scale",
+                  "heading_lookahead", "oscillation_reset_dist", "xy_goal_tolerance", "yaw_goal_tolerance",
+                  "escape_reset_dist", "escape_reset_theta", "min_vel_x")
+        _at_least(TP, self, 1, "vx_samples", "vtheta_samples")
+        _ordered(TP, self, "min_vel_x", "max_vel_x")
+        _ordered(TP, self, "min_vel_theta", "max_vel_theta")
+        if self.escape_vel > 0.0:
+            raise bad(TP, "escape_vel", self.escape_vel, "<= 0 (a backward speed)")
+        for key in ("heading_scoring", "simple_attractor"):
+            if getattr(self, key):
+                raise bad(TP, key, True, "false (navlab scores trajectories by path and goal distance only)")
+
+
+@dataclass
+class DWAPlannerParams:
+    """dwa_local_planner/DWAPlannerROS (ROS 1 names and defaults; ``min_vel_theta`` is the least |w|)."""
+
+    acc_lim_x: float = 2.5
+    acc_lim_y: float = 2.5
+    acc_lim_theta: float = 3.2
+    acc_lim_trans: float = 0.1
+    max_vel_trans: float = 0.55
+    min_vel_trans: float = 0.1
+    max_vel_x: float = 0.55
+    min_vel_x: float = 0.0
+    max_vel_y: float = 0.1
+    min_vel_y: float = -0.1
+    max_vel_theta: float = 1.0
+    min_vel_theta: float = 0.4
+    trans_stopped_vel: float = 0.1
+    theta_stopped_vel: float = 0.1
+    sim_time: float = 1.7
+    sim_granularity: float = 0.025
+    angular_sim_granularity: float = 0.1
+    vx_samples: int = 3
+    vy_samples: int = 10
+    vth_samples: int = 20
+    controller_frequency: float = 20.0
+    path_distance_bias: float = 32.0
+    goal_distance_bias: float = 24.0
+    occdist_scale: float = 0.01
+    twirling_scale: float = 0.0
+    forward_point_distance: float = 0.325
+    stop_time_buffer: float = 0.2
+    scaling_speed: float = 0.25
+    max_scaling_factor: float = 0.2
+    oscillation_reset_dist: float = 0.05
+    oscillation_reset_angle: float = 0.2
+    xy_goal_tolerance: float = 0.1
+    yaw_goal_tolerance: float = 0.05
+    latch_xy_goal_tolerance: bool = False
+    prune_plan: bool = True
+    use_dwa: bool = True
+    cheat_factor: float = 1.0
+
+    @classmethod
+    def from_dict(cls, values: Mapping[str, Any] | DWAPlannerParams | None) -> DWAPlannerParams:
+        """From a DWAPlannerROS parameter dict (unknown keys: "did you mean"), validated."""
+        out = params_from(cls, values, what=DWA, ignored=_VIEW_ONLY, aliases={
+            "max_trans_vel": "max_vel_trans", "min_trans_vel": "min_vel_trans", "max_rot_vel": "max_vel_theta",
+            "min_rot_vel": "min_vel_theta", "acc_lim_th": "acc_lim_theta", "rot_stopped_vel": "theta_stopped_vel",
+            "pdist_scale": "path_distance_bias", "gdist_scale": "goal_distance_bias",
+            "vtheta_samples": "vth_samples", "dwa": "use_dwa"})
+        out.validate()
+        return out
+
+    @property
+    def sim_period(self) -> float:
+        """1 / controller_frequency (s)."""
+        return 1.0 / self.controller_frequency
+
+    def validate(self) -> None:
+        """Raise ``NavigationError`` naming the first bad parameter."""
+        check_finite(DWA, self)
+        _positive(DWA, self, "acc_lim_x", "acc_lim_theta", "sim_time", "sim_granularity", "angular_sim_granularity",
+                  "controller_frequency", "max_vel_trans")
+        _at_least(DWA, self, 0.0, "min_vel_trans", "min_vel_theta", "max_vel_theta", "path_distance_bias",
+                  "goal_distance_bias", "occdist_scale", "twirling_scale", "forward_point_distance",
+                  "oscillation_reset_dist", "xy_goal_tolerance", "yaw_goal_tolerance", "trans_stopped_vel",
+                  "theta_stopped_vel", "stop_time_buffer")
+        _at_least(DWA, self, 1, "vx_samples", "vy_samples", "vth_samples")
+        _ordered(DWA, self, "min_vel_x", "max_vel_x")
+        _ordered(DWA, self, "min_vel_trans", "max_vel_trans")
+        _ordered(DWA, self, "min_vel_theta", "max_vel_theta")
+
+
+def _positive(what: str, obj: Any, *keys: str) -> None:
+    for key in keys:
+        if not getattr(obj, key) > 0:
+            raise bad(what, key, getattr(obj, key), "> 0")
+
+
+def _at_least(what: str, obj: Any, low: float, *keys: str) -> None:
+    for key in keys:
+        if not getattr(obj, key) >= low:
+            raise bad(what, key, getattr(obj, key), f">= {low}")
+
+
+def _ordered(what: str, obj: Any, low: str, high: str) -> None:
+    if getattr(obj, low) > getattr(obj, high):
+        raise bad(what, low, getattr(obj, low), f"<= {high} ({getattr(obj, high)})")

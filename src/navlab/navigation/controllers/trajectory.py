@@ -1,0 +1,451 @@
+"""base_local_planner's TrajectoryPlanner (with its ``dwa`` flag) and dwa_local_planner's DWAPlanner.
+
+Both sample velocity pairs (v, w) in a dynamic window around the current velocity, roll every sample
+out over ``sim_time`` (all at once, numpy), score the rollouts on the local costmap and command the
+best one's velocity:
+
+- *window*: ``v ± acc_lim_x * T``, ``w ± acc_lim_theta * T`` clipped to the velocity limits, with
+  ``T = sim_period`` (1 / controller_frequency) for DWA and ``T = sim_time`` for plain trajectory rollout;
+- *distances*: base_local_planner's MapGrid, 4-connected cell steps from the plan's cells and from the
+  local goal (the plan's last cell in the local costmap), blocked by LETHAL/INSCRIBED/unknown cells;
+- *TrajectoryPlanner cost* = pdist_scale * path_dist + gdist_scale * goal_dist + occdist_scale *
+  max_cost, distances at the rollout's end (in cells, or metres with ``meter_scoring``), max_cost the
+  highest footprint cost along it; a rollout that leaves the map, touches a LETHAL/INSCRIBED/unknown
+  cell (circular robot: its centre cell; polygon: the cells under its edges, LETHAL/unknown), or
+  passes a cell with no path to the plan or goal is rejected. When no forward rollout is better it
+  turns in place towards the side whose look-ahead point (``heading_lookahead``) is closest to the
+  goal; with nothing valid it backs off at ``escape_vel``;
+- *DWA cost* = path_distance_bias * path_dist + goal_distance_bias * goal_dist + occdist_scale *
+  max_cost + the same biases at a point ``forward_point_distance`` ahead of the end pose (to the plan,
+  and to the goal pushed that far beyond itself) + ``twirling_scale`` * |w|; biases scaled by the
+  resolution (ROS does). As in ROS, a critic whose scale is 0 is skipped, rejections included.
+
+Near the goal both stop within the acceleration limits, then turn in place to the goal yaw
+(``xy_goal_tolerance``, ``yaw_goal_tolerance``, ``latch_xy_goal_tolerance``). Oscillation flags
+forbid turning back the other way (or reversing) until the robot moved ``oscillation_reset_dist``.
+
+Deliberate differences from ROS: every sample of one cycle is rolled out with the same number of
+steps (the largest any needs), so slow samples are checked more finely; TrajectoryPlanner samples
+its full turn-rate window and uses DWA's oscillation flags (on its in-place turns); holonomic
+(y-velocity) samples are not generated, since the controllers command a differential base.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numba
+import numpy as np
+
+from navlab.grid import COST_INSCRIBED, COST_LETHAL, COST_UNKNOWN, Grid
+from navlab.navigation.controllers import mapgrid
+from navlab.navigation.controllers.common import (
+    GoalLatch,
+    LocalFrame,
+    OscillationFlags,
+    as_plan,
+    footprint_outline,
+    goal_of,
+    prune_plan,
+    rotate_to_goal,
+    same_goal,
+    stop_with_acc_limits,
+    stopped,
+)
+from navlab.navigation.controllers.params import TrajectoryPlannerParams
+from navlab.navigation.errors import NavigationError
+
+# --- rollout and footprint cost (pure, vectorised over samples) --------------------------------------
+
+
+def rollout(pose: tuple[float, float, float], velocity: tuple[float, float], targets: np.ndarray, n: int,
+            dt: float, acc: tuple[float, float], *, accelerate: bool) -> np.ndarray:
+    """Poses (S, n, 3) at t = 0, dt, ..., (n-1) dt of a unicycle starting at ``pose`` with ``velocity``.
+
+    ``targets`` (S, 2): commanded (v m/s, w rad/s). With ``accelerate`` the velocity moves towards the
+    target by at most ``acc`` (m/s², rad/s²) * dt per step; otherwise it jumps to it (DWA).
+    Each step moves along the heading held before the step (base_local_planner's integration).
+    """
+    out = np.empty((len(targets), n, 3))
+    _rollout(float(pose[0]), float(pose[1]), float(pose[2]), float(velocity[0]), float(velocity[1]),
+             np.ascontiguousarray(targets, dtype=np.float64), dt, float(acc[0]), float(acc[1]), accelerate, out)
+    return out
+
+
+@numba.njit(cache=True)
+def _rollout(x0: float, y0: float, th0: float, v0: float, w0: float, targets: np.ndarray, dt: float, ax: float,
+             ath: float, accelerate: bool, out: np.ndarray) -> None:  # pragma: no cover - compiled
+    for s in range(out.shape[0]):
+        x, y, th, v, w = x0, y0, th0, v0, w0
+        tv, tw = targets[s, 0], targets[s, 1]
+        for k in range(out.shape[1]):
+            out[s, k, 0], out[s, k, 1], out[s, k, 2] = x, y, th
+            if accelerate:
+                v = min(max(tv, v - ax * dt), v + ax * dt)
+                w = min(max(tw, w - ath * dt), w + ath * dt)
+            else:
+                v, w = tv, tw
+            x += v * math.cos(th) * dt
+            y += v * math.sin(th) * dt
+            th += w * dt
+
+
+def lookup(grid: np.ndarray, resolution: float, x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Values of ``grid`` at grid-local points (any shape, same for x and y) and the mask of points inside it
+    (outside points read the grid's cell (0, 0))."""
+    shape = np.shape(x)
+    vals = np.empty(shape, dtype=grid.dtype)
+    inside = np.empty(shape, dtype=np.bool_)
+    _lookup(grid, 1.0 / resolution, np.ascontiguousarray(x, dtype=np.float64).reshape(-1),
+            np.ascontiguousarray(y, dtype=np.float64).reshape(-1), vals.reshape(-1), inside.reshape(-1))
+    return vals, inside
+
+
+@numba.njit(cache=True)
+def _lookup(grid: np.ndarray, inv: float, x: np.ndarray, y: np.ndarray, vals: np.ndarray,
+            inside: np.ndarray) -> None:  # pragma: no cover - compiled
+    h, w = grid.shape
+    for k in range(x.size):
+        i, j = math.floor(x[k] * inv), math.floor(y[k] * inv)
+        ok = 0 <= i < w and 0 <= j < h
+        inside[k] = ok
+        vals[k] = grid[j, i] if ok else grid[0, 0]
+
+
+def footprint_costs(cost: np.ndarray, resolution: float, poses: np.ndarray, outline: np.ndarray | None
+                    ) -> np.ndarray:
+    """costmap_2d's footprint cost at each grid-local pose (..., 3): -1 where the robot may not be.
+
+    Circular robot (``outline`` None): the centre cell's cost, -1 if LETHAL, INSCRIBED, unknown or off the
+    map. Polygon: the highest cost under its edges (``outline`` (M, 2) base-frame points), -1 if any is
+    LETHAL or unknown or the robot is off the map.
+    """
+    x, y = poses[..., 0], poses[..., 1]
+    centre, inside = lookup(cost, resolution, x, y)
+    if outline is None:
+        out = centre.astype(np.float64)
+        out[(centre >= COST_INSCRIBED) | ~inside] = -1.0
+        return out
+    c, s = np.cos(poses[..., 2])[..., None], np.sin(poses[..., 2])[..., None]
+    px = x[..., None] + c * outline[:, 0] - s * outline[:, 1]
+    py = y[..., None] + s * outline[:, 0] + c * outline[:, 1]
+    edge, edge_in = lookup(cost, resolution, px, py)
+    edge = np.where(edge_in, edge, COST_UNKNOWN)
+    out = edge.max(axis=-1).astype(np.float64)
+    out[(edge >= COST_LETHAL).any(axis=-1) | ~inside] = -1.0
+    return out
+
+
+def velocity_samples(low: float, high: float, n: int) -> np.ndarray:
+    """base_local_planner's VelocityIterator: ``n`` even steps from low to high, plus 0 if crossed."""
+    if low >= high:
+        return np.array([high])
+    n = max(2, n)
+    out = list(np.linspace(low, high, n))
+    for k in range(n - 1):
+        if out[k] < 0.0 < out[k + 1]:
+            return np.array([*out[: k + 1], 0.0, *out[k + 1:]])
+    return np.array(out)
+
+
+# --- the shared cycle ------------------------------------------------------------------------------
+
+
+@dataclass
+class LocalScene:
+    """One cycle's inputs in grid-local coordinates: pose, cost array, plan cells and distance maps."""
+
+    frame: LocalFrame
+    pose: tuple[float, float, float]
+    cost: np.ndarray
+    resolution: float
+    path_cells: np.ndarray
+    path_dist: np.ndarray
+    goal_dist: np.ndarray
+
+    @property
+    def impossible(self) -> float:
+        """MapGrid's obstacle value (cells in the grid): distances at or above it are hopeless."""
+        return float(self.cost.size)
+
+    def local_goal(self) -> np.ndarray:
+        """Grid-local centre (2,) of the plan's last cell inside the local costmap."""
+        return (self.path_cells[-1] + 0.5) * self.resolution
+
+
+class RolloutController:
+    """What TrajectoryPlannerROS and DWAPlannerROS share: plan, goal handling, outputs.
+
+    After each :meth:`compute_velocity`: ``local_plan`` (N, 3) chosen rollout (costmap frame; empty when
+    stopping, turning at the goal or failing), ``samples`` (S, 2) the (v, w) tried, ``costs`` (S,) their
+    costs (< 0: rejected), ``valid`` False when no valid command was found (ROS's ``computeVelocityCommands``
+    returning false: move_base's cue for recovery).
+    """
+
+    what = ""
+    params: Any
+    _stopped_vel = (0.01, 0.01)
+    _accelerate = True
+
+    def __init__(self, params: Mapping[str, Any] | Any | None = None, *, footprint: Any = None,
+                 rng: np.random.Generator | None = None) -> None:
+        self.params = self._parse(params)
+        self.footprint = None if footprint is None else np.asarray(footprint, dtype=np.float64)
+        footprint_outline(self.footprint, 0.05)  # validate now
+        p = self.params
+        self._latch = GoalLatch(p.xy_goal_tolerance, p.yaw_goal_tolerance, p.latch_xy_goal_tolerance)
+        self._osc = OscillationFlags(p.oscillation_reset_dist, getattr(p, "oscillation_reset_angle", -1.0))
+        self._plan: np.ndarray | None = None
+        self._rotating_to_goal = False
+        self._clear_outputs()
+
+    @staticmethod
+    def _parse(params: Any) -> Any:
+        raise NotImplementedError
+
+    def _clear_outputs(self) -> None:
+        self.local_plan = np.zeros((0, 3))
+        self.samples = np.zeros((0, 2))
+        self.costs = np.zeros(0)
+        self._traj = np.zeros((0, 0, 3))
+        self._frame = LocalFrame(0.0, 0.0, 0.0)
+        self.valid = True
+
+    @property
+    def trajectories(self) -> np.ndarray:
+        """Every rollout (S, n, 3) of the last cycle, in the costmap frame."""
+        if self._traj.size == 0:
+            return self._traj.copy()
+        return self._frame.poses_out(self._traj.reshape(-1, 3)).reshape(self._traj.shape)
+
+    def set_plan(self, path: np.ndarray) -> None:
+        """The global plan (N, 2) or (N, 3) in the costmap's frame; an (N, 3) plan's last yaw is the goal yaw.
+
+        A plan to a new goal (beyond the goal tolerances from the last one) clears the goal latch and the
+        oscillation flags; the same plan sent again every cycle keeps them."""
+        plan = as_plan(path)
+        p = self.params
+        if self._plan is None or not same_goal(goal_of(self._plan), goal_of(plan), p.xy_goal_tolerance,
+                                               p.yaw_goal_tolerance):
+            self._latch.reset()
+            self._osc.reset()
+            self._rotating_to_goal = False
+            self._new_goal()
+        self._plan = plan
+
+    def _new_goal(self) -> None:
+        """Forget per-goal state (subclasses add theirs)."""
+
+    def is_goal_reached(self, pose: tuple[float, float, float], velocity: tuple[float, float]) -> bool:
+        """Within xy (possibly latched) and yaw tolerance of the plan's last pose."""
+        if self._plan is None:
+            return False
+        return self._latch.reached(tuple(map(float, pose)), goal_of(self._plan))  # type: ignore[arg-type]
+
+    def compute_velocity(self, pose: tuple[float, float, float], velocity: tuple[float, float],
+                         costmap: Grid | None) -> tuple[float, float]:
+        """(v m/s, w rad/s) for the robot at ``pose`` (costmap frame) moving at ``velocity`` (v, w)."""
+        if self._plan is None:
+            raise NavigationError(f"{self.what}: compute_velocity called before set_plan")
+        if costmap is None:
+            raise NavigationError(f"{self.what}: needs a local costmap (got None)")
+        pose = (float(pose[0]), float(pose[1]), float(pose[2]))
+        velocity = (float(velocity[0]), float(velocity[1]))
+        self._clear_outputs()
+        if self.params.prune_plan:
+            self._plan = prune_plan(self._plan, pose[0], pose[1])
+        goal = goal_of(self._plan)
+        scene = self._scene(pose, costmap)
+        if self._latch.xy_reached(pose, goal):
+            return self._stop_rotate(pose, velocity, goal, scene)
+        if scene is None:
+            self.valid = False
+            return 0.0, 0.0
+        return self._drive(scene, pose, velocity, goal)
+
+    # --- pieces -----------------------------------------------------------------------------------
+
+    def _scene(self, pose: tuple[float, float, float], costmap: Grid) -> LocalScene | None:
+        assert self._plan is not None
+        frame = LocalFrame.of(costmap)
+        self._frame = frame
+        cost = np.ascontiguousarray(costmap.data, dtype=np.uint8)
+        res = costmap.resolution
+        pose_l = frame.pose_in(pose)
+        cells = mapgrid.plan_cells(cost, frame.points_in(self._plan[:, :2]), res)
+        if len(cells) == 0:
+            return None  # ROS: "None of the points of the global plan were in the local costmap"
+        free = self._free_cells(cost, pose_l, res)
+        return LocalScene(frame, pose_l, cost, res, cells, mapgrid.distance_map(cost, cells, free),
+                          mapgrid.distance_map(cost, cells[-1:], free))
+
+    def _free_cells(self, cost: np.ndarray, pose_l: tuple[float, float, float], res: float) -> np.ndarray | None:
+        return None
+
+    def _outline(self, res: float) -> np.ndarray | None:
+        return footprint_outline(self.footprint, res)
+
+    def _stop_rotate(self, pose: tuple[float, float, float], velocity: tuple[float, float],
+                     goal: tuple[float, float, float | None], scene: LocalScene | None) -> tuple[float, float]:
+        """At the goal position: stop within the acceleration limits, then turn in place to the goal yaw."""
+        p = self.params
+        err = self._latch.yaw_error(pose, goal)
+        if abs(err) <= p.yaw_goal_tolerance:
+            self._rotating_to_goal = False
+            return 0.0, 0.0
+        if not self._rotating_to_goal and not stopped(velocity, *self._stopped_vel):
+            cmd = stop_with_acc_limits(velocity, p.acc_lim_x, p.acc_lim_theta, p.sim_period)
+        else:
+            self._rotating_to_goal = True
+            max_w, min_w = self._in_place_limits(err)
+            cmd = (0.0, rotate_to_goal(err, velocity[1], max_w=max_w, min_in_place_w=min_w,
+                                       acc_theta=p.acc_lim_theta, sim_period=p.sim_period))
+        if scene is not None and not self._command_valid(scene, velocity, cmd):
+            self.valid = False
+            return 0.0, 0.0
+        return cmd
+
+    def _in_place_limits(self, err: float) -> tuple[float, float]:
+        raise NotImplementedError
+
+    def _command_valid(self, scene: LocalScene, velocity: tuple[float, float], cmd: tuple[float, float]) -> bool:
+        """Whether rolling ``cmd`` out for sim_time keeps the footprint clear (ROS's ``checkTrajectory``)."""
+        p = self.params
+        n = self._steps(np.array([cmd]))
+        traj = rollout(scene.pose, velocity, np.array([cmd]), n, p.sim_time / n, (p.acc_lim_x, p.acc_lim_theta),
+                       accelerate=self._accelerate)
+        return bool((footprint_costs(scene.cost, scene.resolution, traj, self._outline(scene.resolution)) >= 0).all())
+
+    def _steps(self, targets: np.ndarray) -> int:
+        p = self.params
+        ang = p.angular_sim_granularity if p.angular_sim_granularity > 0 else p.sim_granularity
+        need = p.sim_time * max(float(np.abs(targets[:, 0]).max()) / p.sim_granularity,
+                                float(np.abs(targets[:, 1]).max()) / ang)
+        return max(1, math.ceil(need - 1e-9))
+
+    def _finish(self, scene: LocalScene, targets: np.ndarray, traj: np.ndarray, costs: np.ndarray, best: int,
+                pose: tuple[float, float, float]) -> tuple[float, float]:
+        """Store the cycle's outputs; command sample ``best`` (or stop and flag failure if it is -1)."""
+        self.samples, self.costs, self._traj = targets, costs, traj
+        if best < 0:
+            self.valid = False
+            return 0.0, 0.0
+        self.local_plan = scene.frame.poses_out(traj[best])
+        return float(targets[best, 0]), float(targets[best, 1])
+
+    def _drive(self, scene: LocalScene, pose: tuple[float, float, float], velocity: tuple[float, float],
+               goal: tuple[float, float, float | None]) -> tuple[float, float]:
+        raise NotImplementedError
+
+
+# --- base_local_planner/TrajectoryPlannerROS ----------------------------------------------------------
+
+
+class TrajectoryPlannerROS(RolloutController):
+    """base_local_planner's trajectory rollout / DWA planner (``dwa`` flag) behind the Controller protocol.
+
+    ``params``: a TrajectoryPlannerROS parameter dict (ROS 1 names) or ``TrajectoryPlannerParams``;
+    ``footprint``: polygon [[x, y], ...] (m, base frame) or None for a circular robot (centre cell).
+    ``rng`` is accepted for a uniform constructor and not used (the planner is deterministic).
+    """
+
+    what = "TrajectoryPlannerROS"
+    params: TrajectoryPlannerParams
+
+    def __init__(self, params: Mapping[str, Any] | TrajectoryPlannerParams | None = None, *, footprint: Any = None,
+                 rng: np.random.Generator | None = None) -> None:
+        super().__init__(params, footprint=footprint, rng=rng)
+        self._escaping = False
+        self._escape_pose = (0.0, 0.0, 0.0)
+
+    @staticmethod
+    def _parse(params: Any) -> TrajectoryPlannerParams:
+        return TrajectoryPlannerParams.from_dict(params)
+
+    def _new_goal(self) -> None:
+        self._escaping = False
+
+    def _in_place_limits(self, err: float) -> tuple[float, float]:
+        p = self.params
+        return (p.max_vel_theta if err > 0 else -p.min_vel_theta), p.min_in_place_vel_theta
+
+    def _free_cells(self, cost: np.ndarray, pose_l: tuple[float, float, float], res: float) -> np.ndarray | None:
+        """Cells under the robot now, never obstacles for the distance wave (ROS's ``within_robot``)."""
+        i, j = math.floor(pose_l[0] / res), math.floor(pose_l[1] / res)
+        if 0 <= i < cost.shape[1] and 0 <= j < cost.shape[0]:
+            return np.array([[i, j]])
+        return None
+
+    def _score(self, scene: LocalScene, traj: np.ndarray) -> np.ndarray:
+        """Costs (S,): pdist * path_dist + gdist * goal_dist + occdist * max_cost; -1 blocked, -2 no path."""
+        p = self.params
+        res = scene.resolution
+        fp = footprint_costs(scene.cost, res, traj, self._outline(res))
+        pd, _ = lookup(scene.path_dist, res, traj[..., 0], traj[..., 1])
+        gd, _ = lookup(scene.goal_dist, res, traj[..., 0], traj[..., 1])
+        scale = res if p.meter_scoring else 1.0
+        cost = scale * (p.pdist_scale * pd[:, -1] + p.gdist_scale * gd[:, -1] + p.occdist_scale * fp.max(axis=1))
+        cost[((pd >= scene.impossible) | (gd >= scene.impossible)).any(axis=1)] = -2.0
+        cost[(fp < 0).any(axis=1)] = -1.0
+        return cost
+
+    def _drive(self, scene: LocalScene, pose: tuple[float, float, float], velocity: tuple[float, float],
+               goal: tuple[float, float, float | None]) -> tuple[float, float]:
+        p = self.params
+        v0, w0 = velocity
+        x, y, _ = scene.pose
+        lg = scene.local_goal()
+        horizon = p.sim_period if p.dwa else p.sim_time
+        vmax = min(p.max_vel_x, math.hypot(lg[0] - x, lg[1] - y) / p.sim_time)
+        vmax = max(min(vmax, v0 + p.acc_lim_x * horizon), p.min_vel_x)
+        vmin = min(max(p.min_vel_x, v0 - p.acc_lim_x * horizon), vmax)
+        wmax = min(p.max_vel_theta, w0 + p.acc_lim_theta * horizon)
+        wmin = min(max(p.min_vel_theta, w0 - p.acc_lim_theta * horizon), wmax)
+        vxs = np.linspace(vmin, vmax, p.vx_samples) if p.vx_samples > 1 else np.array([vmin])
+        ws = np.linspace(wmin, wmax, p.vtheta_samples) if p.vtheta_samples > 1 else np.array([wmin])
+        dw = (wmax - wmin) / (p.vtheta_samples - 1) if p.vtheta_samples > 1 else 0.0
+        fwd_w = np.concatenate([[0.0], ws])
+        forward = np.stack([np.repeat(vxs, len(fwd_w)), np.tile(fwd_w, len(vxs))], axis=1)
+        spin = np.where(ws > 0, np.maximum(ws, p.min_in_place_vel_theta), np.minimum(ws, -p.min_in_place_vel_theta))
+        in_place = np.stack([np.zeros_like(spin), spin], axis=1)
+        targets = np.vstack([forward, in_place, [[p.escape_vel, 0.0]]])
+        n = self._steps(targets)
+        traj = rollout(scene.pose, velocity, targets, n, p.sim_time / n, (p.acc_lim_x, p.acc_lim_theta),
+                       accelerate=True)
+        costs = self._score(scene, traj)
+        nf, ni = len(forward), len(in_place)
+        best = -1
+        if not self._escaping:
+            ok = costs[:nf] >= 0
+            if ok.any():
+                best = int(np.argmin(np.where(ok, costs[:nf], np.inf)))
+        # turn in place towards where the look-ahead point is nearest the goal
+        ahead = traj[nf:nf + ni, -1]
+        hx = ahead[:, 0] + p.heading_lookahead * np.cos(ahead[:, 2])
+        hy = ahead[:, 1] + p.heading_lookahead * np.sin(ahead[:, 2])
+        head_dist, head_in = lookup(scene.goal_dist, scene.resolution, hx, hy)
+        allowed = self._osc.allowed(in_place[:, 0], in_place[:, 1])
+        best_heading = math.inf
+        for k in range(ni):
+            c = costs[nf + k]
+            if c < 0 or not (best < 0 or c <= costs[best]) or abs(ws[k]) <= dw or not head_in[k] or not allowed[k]:
+                continue
+            if head_dist[k] < best_heading:
+                best, best_heading = nf + k, float(head_dist[k])
+        if best >= 0:
+            self._osc.update(pose, float(targets[best, 0]), float(targets[best, 1]), 0.0)
+            moved = math.hypot(pose[0] - self._escape_pose[0], pose[1] - self._escape_pose[1])
+            turned = abs(math.remainder(pose[2] - self._escape_pose[2], 2 * math.pi))
+            if moved > p.escape_reset_dist or turned > p.escape_reset_theta:
+                self._escaping = False
+            return self._finish(scene, targets, traj, costs, best, pose)
+        # nothing valid: back off slowly, even into cost (ROS does), unless there is no path at all
+        esc = len(targets) - 1
+        if costs[esc] == -2.0:
+            return self._finish(scene, targets, traj, costs, -1, pose)
+        if not self._escaping:
+            self._escaping, self._escape_pose = True, pose
+        return self._finish(scene, targets, traj, costs, esc, pose)
