@@ -23,6 +23,8 @@ Quat = tuple[float, float, float, float]  # (x, y, z, w)
 Tf = tuple[float, float, float, float, float, float, float]  # (x, y, z, qx, qy, qz, qw)
 Pose2 = tuple[float, float, float]  # (x, y, yaw)
 Pose6 = tuple[float, float, float, float, float, float]  # (x, y, z, roll, pitch, yaw)
+# A vector argument: a tuple/list of floats or a 1-D numpy array (an ndarray is not a typing ``Sequence``).
+Vec = Sequence[float] | np.ndarray
 IDENTITY_TF: Tf = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0)
 
 # --- angles -----------------------------------------------------------------------------------
@@ -48,7 +50,7 @@ def quat_from_yaw(yaw: float) -> Quat:
     return (0.0, 0.0, math.sin(yaw / 2.0), math.cos(yaw / 2.0))
 
 
-def yaw_from_quat(q: Sequence[float]) -> float:
+def yaw_from_quat(q: Vec) -> float:
     """Yaw (rad, about z) of a unit quaternion (x, y, z, w)."""
     x, y, z, w = (float(v) for v in q)
     return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
@@ -67,12 +69,12 @@ def quat_from_rpy(roll: float, pitch: float, yaw: float) -> Quat:
     )
 
 
-def rpy_from_quat(q: Sequence[float]) -> tuple[float, float, float]:
+def rpy_from_quat(q: Vec) -> tuple[float, float, float]:
     """Fixed-axis (roll, pitch, yaw) of a unit quaternion (x, y, z, w); pitch in [-pi/2, pi/2]."""
     return rpy_from_matrix(matrix_from_quat(q))
 
 
-def qmul(a: Sequence[float], b: Sequence[float]) -> Quat:
+def qmul(a: Vec, b: Vec) -> Quat:
     """Hamilton product ``a ⊗ b`` of quaternions (x, y, z, w)."""
     ax, ay, az, aw = a
     bx, by, bz, bw = b
@@ -84,7 +86,7 @@ def qmul(a: Sequence[float], b: Sequence[float]) -> Quat:
     )
 
 
-def qrotate(q: Sequence[float], v: Sequence[float]) -> tuple[float, float, float]:
+def qrotate(q: Vec, v: Vec) -> tuple[float, float, float]:
     """Vector ``v`` (3) rotated by unit quaternion ``q`` (x, y, z, w)."""
     qx, qy, qz, qw = q
     vx, vy, vz = v
@@ -99,7 +101,7 @@ def qrotate(q: Sequence[float], v: Sequence[float]) -> tuple[float, float, float
     )
 
 
-def matrix_from_quat(q: Sequence[float]) -> np.ndarray:
+def matrix_from_quat(q: Vec) -> np.ndarray:
     """3×3 rotation matrix of a unit quaternion (x, y, z, w)."""
     x, y, z, w = (float(v) for v in q)
     return np.array([
@@ -109,12 +111,12 @@ def matrix_from_quat(q: Sequence[float]) -> np.ndarray:
     ])  # fmt: skip
 
 
-def wxyz_from_xyzw(q: Sequence[float]) -> np.ndarray:
+def wxyz_from_xyzw(q: Vec) -> np.ndarray:
     """MuJoCo's (w, x, y, z) order from ROS's (x, y, z, w): use only at the MuJoCo boundary."""
     return np.array([q[3], q[0], q[1], q[2]], dtype=np.float64)
 
 
-def xyzw_from_wxyz(q: Sequence[float]) -> Quat:
+def xyzw_from_wxyz(q: Vec) -> Quat:
     """ROS's (x, y, z, w) order from MuJoCo's (w, x, y, z)."""
     return (float(q[1]), float(q[2]), float(q[3]), float(q[0]))
 
@@ -145,7 +147,7 @@ def rpy_from_matrix(r: np.ndarray) -> tuple[float, float, float]:
     return roll, pitch, yaw
 
 
-def matrix_from_pose6(pose: Sequence[float]) -> np.ndarray:
+def matrix_from_pose6(pose: Vec) -> np.ndarray:
     """4×4 homogeneous ``parent_T_child`` of (x, y, z, roll, pitch, yaw)."""
     m = np.eye(4)
     m[:3, :3] = matrix_from_rpy(pose[3], pose[4], pose[5])
@@ -159,7 +161,7 @@ def pose6_from_matrix(m: np.ndarray) -> Pose6:
     return (float(m[0, 3]), float(m[1, 3]), float(m[2, 3]), r, p, y)
 
 
-def compose6(a: Sequence[float], b: Sequence[float]) -> Pose6:
+def compose6(a: Vec, b: Vec) -> Pose6:
     """``a ∘ b`` for (x, y, z, roll, pitch, yaw) poses: ``parent_T_c`` from ``parent_T_b`` and ``b_T_c``."""
     return pose6_from_matrix(matrix_from_pose6(a) @ matrix_from_pose6(b))
 
@@ -167,7 +169,7 @@ def compose6(a: Sequence[float], b: Sequence[float]) -> Pose6:
 # --- SE(3) transforms as (x, y, z, qx, qy, qz, qw) ---------------------------------------------
 
 
-def tf_from_xyz_quat(xyz: Sequence[float], q: Sequence[float]) -> Tf:
+def tf_from_xyz_quat(xyz: Vec, q: Vec) -> Tf:
     """A ``Tf`` from a translation and a quaternion (x, y, z, w)."""
     return (float(xyz[0]), float(xyz[1]), float(xyz[2]), float(q[0]), float(q[1]), float(q[2]), float(q[3]))
 
@@ -177,7 +179,7 @@ def tf_from_pose2(x: float, y: float, yaw: float, z: float = 0.0) -> Tf:
     return (float(x), float(y), float(z), *quat_from_yaw(yaw))
 
 
-def pose2_from_tf(tf: Sequence[float]) -> Pose2:
+def pose2_from_tf(tf: Vec) -> Pose2:
     """(x, y, yaw) of a ``Tf``."""
     return float(tf[0]), float(tf[1]), yaw_from_quat(tf[3:7])
 
@@ -198,7 +200,8 @@ def inverse3(a: Tf) -> Tf:
 
 def interpolate3(a: Tf, b: Tf, s: float) -> Tf:
     """Linear interpolation of translation and slerp of rotation, ``s`` in [0, 1]."""
-    qa, qb = a[3:], b[3:]
+    qa: tuple[float, ...] = a[3:]
+    qb: tuple[float, ...] = b[3:]
     dot = sum(x * y for x, y in zip(qa, qb, strict=True))
     if dot < 0.0:
         qb, dot = tuple(-x for x in qb), -dot
@@ -216,31 +219,31 @@ def interpolate3(a: Tf, b: Tf, s: float) -> Tf:
 # --- SE(2) poses (x, y, yaw) --------------------------------------------------------------------
 
 
-def compose2(a: Sequence[float], b: Sequence[float]) -> np.ndarray:
+def compose2(a: Vec, b: Vec) -> np.ndarray:
     """``a ∘ b`` for planar poses (yaw wrapped to [-pi, pi)): ``map_T_base = compose2(map_T_odom, odom_T_base)``."""
     c, s = math.cos(a[2]), math.sin(a[2])
     return np.array([a[0] + c * b[0] - s * b[1], a[1] + s * b[0] + c * b[1], wrap_angle(float(a[2] + b[2]))])
 
 
-def inverse2(a: Sequence[float]) -> np.ndarray:
+def inverse2(a: Vec) -> np.ndarray:
     """``a^-1`` for a planar pose: ``odom_T_map`` from ``map_T_odom``."""
     c, s = math.cos(a[2]), math.sin(a[2])
     return np.array([-c * a[0] - s * a[1], s * a[0] - c * a[1], -a[2]])
 
 
-def between2(a: Sequence[float], b: Sequence[float]) -> np.ndarray:
+def between2(a: Vec, b: Vec) -> np.ndarray:
     """``a^-1 ∘ b``: the pose ``b`` seen from the frame of ``a`` (both in one parent frame)."""
     return compose2(inverse2(a), b)
 
 
-def compose2_many(a: Sequence[float], b: np.ndarray) -> np.ndarray:
+def compose2_many(a: Vec, b: np.ndarray) -> np.ndarray:
     """``a ∘ b[k]`` for every pose of ``b`` (N, 3) (yaw not wrapped)."""
     bb = np.asarray(b, dtype=np.float64).reshape(-1, 3)
     c, s = math.cos(a[2]), math.sin(a[2])
     return np.column_stack([a[0] + c * bb[:, 0] - s * bb[:, 1], a[1] + s * bb[:, 0] + c * bb[:, 1], a[2] + bb[:, 2]])
 
 
-def transform_points2(pose: Sequence[float], pts: np.ndarray) -> np.ndarray:
+def transform_points2(pose: Vec, pts: np.ndarray) -> np.ndarray:
     """Points (N, 2) given in the frame at ``pose`` -> the same points in the parent frame."""
     p = np.asarray(pts, dtype=np.float64).reshape(-1, 2)
     c, s = math.cos(pose[2]), math.sin(pose[2])
@@ -250,7 +253,7 @@ def transform_points2(pose: Sequence[float], pts: np.ndarray) -> np.ndarray:
     return out
 
 
-def inverse_transform_points2(pose: Sequence[float], pts: np.ndarray) -> np.ndarray:
+def inverse_transform_points2(pose: Vec, pts: np.ndarray) -> np.ndarray:
     """Points (N, 2) in the parent frame -> the same points in the frame at ``pose``."""
     p = np.asarray(pts, dtype=np.float64).reshape(-1, 2)
     c, s = math.cos(pose[2]), math.sin(pose[2])

@@ -23,7 +23,7 @@ import numpy as np
 from navlab.errors import NavlabError
 
 if TYPE_CHECKING:
-    from navlab.grid import Grid
+    from navlab.grid import Grid, GridMap
 
 
 class PluginError(NavlabError):
@@ -74,8 +74,8 @@ class SlamBackend(Protocol):
         """Laser poses (M, 3) in the map frame now, one per scan for which ``add_scan`` returned a pose."""
         ...
 
-    def current_map(self, *, frame_id: str = "map") -> Grid | None:
-        """The occupancy grid now (``GridMap``), or None before the first scan."""
+    def current_map(self, *, frame_id: str = "map") -> GridMap | None:
+        """The occupancy grid now, or None before the first scan."""
         ...
 
     def finish(self) -> np.ndarray:

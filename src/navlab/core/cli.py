@@ -144,18 +144,15 @@ def _cmd_launch(args: argparse.Namespace) -> int:
     signal.signal(signal.SIGTERM, lambda *_: ex.post(ex.stop))
     with IntrospectionServer(ex, name=args.file), contextlib.suppress(KeyboardInterrupt):
         run_for(ex, duration, record=args.record, quiet=args.quiet, desc=Path(args.file).stem)
-    summary = {
-        "sim_s": round(ex.now_ns / 1e9, 3),
-        "nodes": sorted(ex.nodes),
-        "topics": {name: t.count for name, t in sorted(ex.topics.items())},
-    }
+    topics = {name: t.count for name, t in sorted(ex.topics.items())}
+    summary: dict[str, Any] = {"sim_s": round(ex.now_ns / 1e9, 3), "nodes": sorted(ex.nodes), "topics": topics}
     if args.record:
         summary["record"] = str(args.record)
     if args.json:
         print(json.dumps(summary))
     else:
         print(f"ran {summary['sim_s']:.2f} simulated s; {len(ex.nodes)} nodes")
-        for name, count in summary["topics"].items():  # type: ignore[union-attr]
+        for name, count in topics.items():
             print(f"  {name}: {count} messages")
     return 0
 
@@ -171,9 +168,11 @@ def _cmd_topic(args: argparse.Namespace) -> int:
 
             rows = {k: tuple(v) for k, v in request(live, "graph")["types"].items()}
         else:
+            from navlab.msgs import type_name
+
             session = _start(args)
             run_for(session.executor, args.duration, quiet=True)
-            rows = {k: (t.msgtype.__msgtype__, t.count) for k, t in session.executor.topics.items()}
+            rows = {k: (type_name(t.msgtype), t.count) for k, t in session.executor.topics.items()}
         for name in sorted(rows):
             msgtype, count = rows[name]
             print(f"{name} [{msgtype}]" + (f" {count} msgs" if args.verbose else ""))

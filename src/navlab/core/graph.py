@@ -34,10 +34,10 @@ class Graph:
     @classmethod
     def from_json(cls, data: dict[str, object]) -> Graph:
         """Inverse of :meth:`to_json`."""
-        topics = data.get("topics", {})
-        assert isinstance(topics, dict)
+        nodes, topics = data.get("nodes", []), data.get("topics", {})
+        assert isinstance(nodes, list) and isinstance(topics, dict)
         return cls(
-            nodes=list(data.get("nodes", [])),  # type: ignore[call-overload]
+            nodes=list(nodes),
             topics={k: (list(v["pub"]), list(v["sub"])) for k, v in topics.items()},
         )
 

@@ -18,13 +18,14 @@ from __future__ import annotations
 
 import base64
 import contextlib
+import functools
 import json
 import os
 import queue
 import socket
 import tempfile
 import threading
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
@@ -79,11 +80,16 @@ class IntrospectionServer:
                 return
             threading.Thread(target=self._serve, args=(conn,), daemon=True).start()
 
-    def _in_executor(self, fn: Any, timeout: float = 5.0) -> Any:
+    def _in_executor(self, fn: Callable[[], Any], timeout: float = 5.0) -> Any:
         """Run ``fn()`` in the executor's thread and return its result."""
         done = threading.Event()
         box: list[Any] = []
-        self.executor.post(lambda: (box.append(fn()), done.set()))
+
+        def run() -> None:
+            box.append(fn())
+            done.set()
+
+        self.executor.post(run)
         if not done.wait(timeout):
             raise CoreError("the launch did not answer (is it paused or finished?)")
         return box[0]
@@ -126,7 +132,10 @@ class IntrospectionServer:
         for raw in f:
             line = json.loads(raw)
             msg = TYPESTORE.deserialize_cdr(base64.b64decode(line["cdr"]), line["type"])
-            self.executor.post(lambda t=str(line["topic"]), m=msg: self._publisher(t, type(m)).publish(m))
+            self.executor.post(functools.partial(self._publish, str(line["topic"]), msg))
+
+    def _publish(self, topic: str, msg: Any) -> None:
+        self._publisher(topic, type(msg)).publish(msg)
 
     def _publisher(self, topic: str, msgtype: type) -> Any:
         """The remote node's publisher on ``topic`` (made on first use, in the executor's thread)."""

@@ -65,7 +65,7 @@ def load_node_class(exec_name: str) -> type[Node]:
         raise LaunchError(f"unknown node executable {exec_name!r} (navlab provides: {', '.join(sorted(NODES))})")
     module, cls = target.split(":", 1)
     try:
-        return getattr(importlib.import_module(module), cls)  # type: ignore[no-any-return]
+        return getattr(importlib.import_module(module), cls)
     except (ImportError, AttributeError) as exc:
         raise LaunchError(f"node executable {exec_name!r}: cannot load {target} ({exc})") from None
 

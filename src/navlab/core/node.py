@@ -57,10 +57,16 @@ class Clock:
         return self._executor.now_ns / 1e9
 
 
-class _SimTimeAdapter(logging.LoggerAdapter):  # type: ignore[type-arg]
+class _SimTimeAdapter(logging.LoggerAdapter[logging.Logger]):
+    """Prefixes each message with the simulated time (s) and the node's name."""
+
+    def __init__(self, logger: logging.Logger, executor: Executor, node: str) -> None:
+        super().__init__(logger, {"executor": executor, "node": node})
+        self._executor = executor
+        self._node = node
+
     def process(self, msg: Any, kwargs: Any) -> tuple[Any, Any]:
-        ex: Executor = self.extra["executor"]  # type: ignore[index]
-        return f"[{ex.now_ns / 1e9:.3f}] [{self.extra['node']}] {msg}", kwargs  # type: ignore[index]
+        return f"[{self._executor.now_ns / 1e9:.3f}] [{self._node}] {msg}", kwargs
 
     def warn(self, msg: Any, *args: Any, **kwargs: Any) -> None:
         """rclpy spelling of :meth:`warning`."""
@@ -142,7 +148,8 @@ class Node:
         self._clock = Clock(executor)
         self._logger = _SimTimeAdapter(
             logging.getLogger(f"navlab{self.fully_qualified_name.replace('/', '.')}"),
-            {"executor": executor, "node": self.fully_qualified_name},
+            executor,
+            self.fully_qualified_name,
         )
         self._sensor_poses: dict[tuple[str, str], Pose2] = {}
         executor.register_node(self)

@@ -10,7 +10,7 @@ Two layouts are read:
 from __future__ import annotations
 
 import difflib
-from dataclasses import fields
+from dataclasses import fields, is_dataclass
 from pathlib import Path
 from typing import Any, TypeVar
 
@@ -86,7 +86,9 @@ def dataclass_from_dict(cls: type[T], values: dict[str, Any] | None, *, what: st
 
     An unknown name raises ``error``: "unknown WHAT parameter 'key'; did you mean 'closest'?".
     """
-    names = [f.name for f in fields(cls)]  # type: ignore[arg-type]
+    if not is_dataclass(cls):
+        raise TypeError(f"dataclass_from_dict needs a dataclass, got {cls!r}")
+    names = [f.name for f in fields(cls)]
     out = cls()
     for key, val in (values or {}).items():
         if key not in names:

@@ -42,7 +42,11 @@ def run_for(
         while done < duration - 1e-9:
             step = min(chunk, duration - done)
             t0 = ex.now_ns
-            reached = ex.run_until(until, timeout=step) if until is not None else (ex.run(step) or False)
+            reached = False
+            if until is not None:
+                reached = ex.run_until(until, timeout=step)
+            else:
+                ex.run(step)
             done += (ex.now_ns - t0) / 1e9 if reached else step
             bar.update((ex.now_ns - t0) / 1e9)
             if reached or ex.stopped:

@@ -12,6 +12,7 @@ import difflib
 import math
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
+from typing import Literal
 
 from navlab.description.errors import DescriptionError
 from navlab.description.model import DiffDriveConfig, ImuConfig, LidarConfig, Link, Origin
@@ -144,10 +145,12 @@ def parse_diff_drive(plugin: ET.Element, where: str, warnings: list[str]) -> Dif
         elif key in BOOL_FIELDS:
             setattr(cfg, key, _bool(raw, where + f" ({key})"))
         elif key == "odometry_source":
-            src = {"0": "encoder", "1": "world", "encoder": "encoder", "world": "world"}.get(raw.lower())
+            sources: dict[str, Literal["encoder", "world"]] = {
+                "0": "encoder", "1": "world", "encoder": "encoder", "world": "world"}  # fmt: skip
+            src = sources.get(raw.lower())
             if src is None:
                 raise DescriptionError(f"{where}: odometry source {raw!r}: expected encoder/world (0/1)")
-            cfg.odometry_source = src  # type: ignore[assignment]
+            cfg.odometry_source = src
         else:
             setattr(cfg, key, raw)
     if ns:
@@ -215,7 +218,7 @@ def parse_lidar(sensor: ET.Element, link: str, where: str, plugin: ET.Element,
             warnings.append(f"{where}: output_type {out_type} not supported; publishing sensor_msgs/LaserScan")
     return LidarConfig(
         link=link,
-        origin=Origin(xyz=pose[:3], rpy=pose[3:]),  # type: ignore[arg-type]
+        origin=Origin.from_pose6(pose),
         update_rate=_rate(_num(sensor.find("update_rate"), where, 0.0)),
         samples=samples,
         min_angle=_num(hor.find("min_angle"), where, 0.0),
@@ -271,7 +274,7 @@ def parse_imu(plugin: ET.Element, link: str, where: str, sensor: ET.Element | No
         rate = _num(sensor.find("update_rate"), where, 0.0)
     pose = floats((sensor.findtext("pose") if sensor is not None else None) or "0 0 0 0 0 0", 6, where, "<pose>")
     return ImuConfig(
-        link=link, origin=Origin(xyz=pose[:3], rpy=pose[3:]),  # type: ignore[arg-type]
+        link=link, origin=Origin.from_pose6(pose),
         update_rate=_rate(rate), topic=_scoped(ns, topic), frame_id=frame.lstrip("/"),
         gyro_noise_stddev=gyro or gaussian, accel_noise_stddev=accel or gaussian,
         name=(sensor.get("name", "imu") if sensor is not None else plugin.get("name", "imu")),

@@ -208,7 +208,7 @@ def read_dae(path: Path) -> tuple[np.ndarray, np.ndarray, float]:
     lib_nodes = {n.get("id"): n for lib in _children(root, "library_nodes") for n in _children(lib, "node")}
     scenes = {s.get("id"): s for lib in _children(root, "library_visual_scenes")
               for s in _children(lib, "visual_scene")}
-    instances: list[tuple[str, np.ndarray]] = []
+    instances: list[tuple[str | None, np.ndarray]] = []  # (geometry id, node_T_geometry)
 
     def visit(node: ET.Element, parent: np.ndarray, depth: int) -> None:
         if depth > 64:

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Literal
+from typing import Literal, TypeGuard, get_args
 
 import numpy as np
 
@@ -18,6 +18,11 @@ from navlab.geometry import Pose6, compose6, matrix_from_pose6, pose6_from_matri
 Vec3 = tuple[float, float, float]
 
 GeometryKind = Literal["box", "cylinder", "sphere", "mesh"]
+
+
+def is_geometry_kind(kind: str) -> TypeGuard[GeometryKind]:
+    """Whether ``kind`` names a geometry (box, cylinder, sphere, mesh)."""
+    return kind in get_args(GeometryKind)
 
 
 @dataclass(frozen=True)
@@ -107,6 +112,11 @@ class Link:
 
 
 JointType = Literal["fixed", "continuous", "revolute", "prismatic", "floating", "planar"]
+
+
+def is_joint_type(kind: str) -> TypeGuard[JointType]:
+    """Whether ``kind`` is a URDF joint type."""
+    return kind in get_args(JointType)
 
 
 @dataclass

@@ -12,7 +12,17 @@ from collections.abc import Callable
 from pathlib import Path
 
 from navlab.description.errors import DescriptionError
-from navlab.description.model import Geometry, Inertial, Joint, Link, Origin, Shape, Vec3
+from navlab.description.model import (
+    Geometry,
+    Inertial,
+    Joint,
+    Link,
+    Origin,
+    Shape,
+    Vec3,
+    is_geometry_kind,
+    is_joint_type,
+)
 
 JOINT_TYPES = ("fixed", "continuous", "revolute", "prismatic", "floating", "planar")
 
@@ -82,7 +92,9 @@ def parse_geometry(el: ET.Element | None, where: str, resolve_mesh: MeshResolver
         raise DescriptionError(f"{w}: unknown geometry (expected box, cylinder, sphere or mesh)")
     if any(v <= 0 for v in size):
         raise DescriptionError(f"{w}: sizes must be positive, got {size}")
-    return Geometry(s.tag, size=size)  # type: ignore[arg-type]
+    kind = s.tag
+    assert is_geometry_kind(kind)  # box, cylinder or sphere: anything else returned or raised above
+    return Geometry(kind, size=size)
 
 
 def _rgba(visual: ET.Element, materials: dict[str, tuple[float, float, float, float]],
@@ -143,7 +155,7 @@ def parse_link(el: ET.Element, where: str, resolve_mesh: MeshResolver,
 def parse_joint(el: ET.Element, where: str) -> Joint:
     """One ``<joint>``; revolute and prismatic joints need a ``<limit>``, as in urdfdom."""
     jtype = el.get("type", "")
-    if jtype not in JOINT_TYPES:
+    if not is_joint_type(jtype):
         raise DescriptionError(f"{where}: type {jtype!r} is not a URDF joint type (expected one of "
                                f"{', '.join(JOINT_TYPES)})")
     links = {}
@@ -178,7 +190,7 @@ def parse_joint(el: ET.Element, where: str) -> Joint:
         damping = _attr_float(dyn, "damping", where + "/<dynamics>", 0.0)
         friction = _attr_float(dyn, "friction", where + "/<dynamics>", 0.0)
     return Joint(
-        name=el.get("name", ""), type=jtype, parent=links["parent"], child=links["child"],  # type: ignore[arg-type]
+        name=el.get("name", ""), type=jtype, parent=links["parent"], child=links["child"],
         origin=parse_origin(el.find("origin"), where), axis=axis, lower=lower, upper=upper,
         effort=effort, velocity=velocity, damping=damping, friction=friction,
     )

@@ -145,13 +145,16 @@ def run_localization(
         run.run(duration, record=record, quiet=not progress, chunk=1.0, desc="localize")
     s = monitor.samples()
     res = LocalizeResult(t=s["t"], truth=s["truth"], estimate=s["estimate"], grid=grid)
+    from navlab.localization.amcl_node import Amcl
+
     node = run.node("amcl")
+    assert isinstance(node, Amcl)  # the shipped launch's amcl
     res.summary = rounded({
         "world": world, "map": str(map_yaml) if map_yaml else "true",
         "mode": "global" if global_localization else "tracking",
         **_errors(res, kidnapper.event if kidnapper else {}, global_localization),
-        "updates": node.filter.n_updates if node.filter else 0,  # type: ignore[attr-defined]
-        "particles_final": node.filter.n_particles if node.filter else 0,  # type: ignore[attr-defined]
+        "updates": node.filter.n_updates if node.filter else 0,
+        "particles_final": node.filter.n_particles if node.filter else 0,
         **run.figures(),
     })  # fmt: skip
     return res

@@ -42,8 +42,11 @@ def _add_driver(run: Run, driver: str, route: str | Path | None) -> Any:
     from navlab.mapping.teleop import HELP, RouteFollower, TeleopKeyboard, load_route, terminal_keys
 
     if driver == "explore":
+        from navlab.mapping.explore_node import Explore
+
         explorer = run.node("explore")
-        return lambda: explorer.done  # type: ignore[attr-defined]
+        assert isinstance(explorer, Explore)  # the shipped launch's explore
+        return lambda: explorer.done
     if driver == "route":
         if route is None:
             raise MappingError("driver 'route' needs a route file (--route FILE)")
@@ -93,8 +96,11 @@ def run_mapping(
     is_done = _add_driver(run, driver, route)
     monitor = run.add(PoseMonitor, parameters={"base_frame": run.base_frame, "odom_frame": run.odom_frame})
     run.run(duration, until=is_done, record=record, quiet=quiet, desc=f"mapping {world}")
+    from navlab.mapping.slam_node import SlamGMapping
+
     slam = run.node("slam_gmapping")
-    grid = slam.current_map()  # type: ignore[attr-defined]
+    assert isinstance(slam, SlamGMapping)  # the shipped launch's slam_gmapping
+    grid = slam.current_map()
     if grid is None:
         raise MappingError("SLAM produced no map: did the robot receive scans? (check the robot's lidar)")
     out_dir = Path(out)
@@ -106,7 +112,7 @@ def run_mapping(
     scores: dict[str, Any] = {
         **run.figures(),
         "finished": result.finished,
-        "scans_processed": slam.scans_processed,  # type: ignore[attr-defined]
+        "scans_processed": slam.scans_processed,
         **score_map(grid, truth, world_T_map=pose),
         "coverage": free_coverage(grid, truth, world_T_map=pose),
     }

@@ -13,7 +13,7 @@ import tempfile
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -24,6 +24,9 @@ from navlab.experiments.session import Run, rounded, start_run
 from navlab.experiments.truth import true_map
 from navlab.grid import Grid, GridMap
 from navlab.navigation.errors import NavigationError
+
+if TYPE_CHECKING:
+    from navlab.navigation.move_base import MoveBase
 
 Pose = tuple[float, float, float]
 CONTROLLERS = {
@@ -72,6 +75,15 @@ class NavigateResult:
     snapshots: list[NavSnapshot] = field(default_factory=list)
 
 
+def _move_base(run: Run) -> MoveBase:
+    """The run's move_base node (navlab's, as the shipped launch starts it)."""
+    from navlab.navigation.move_base import MoveBase
+
+    mb = run.node("move_base")
+    assert isinstance(mb, MoveBase)
+    return mb
+
+
 def _episodes(times: Sequence[float], t0: float, t1: float, gap: float = 0.25) -> int:
     """Contact episodes in [t0, t1]: runs of /collisions messages no more than ``gap`` s apart."""
     ts = [t for t in times if t0 <= t <= t1]
@@ -81,16 +93,16 @@ def _episodes(times: Sequence[float], t0: float, t1: float, gap: float = 0.25) -
 def _drive_goal(run: Run, mon: NavMonitor, goal: Pose, frame: str, timeout: float,
                 shots: list[NavSnapshot] | None = None) -> dict[str, Any]:
     """Send one goal and run until it ends or ``timeout`` s pass; ``shots`` collects a snapshot a second."""
-    mb = run.node("move_base")
+    mb = _move_base(run)
     t0 = mon.now_s()
     k0 = len(mon.path)
-    handle = mb.send_goal(*goal, frame_id=frame)  # type: ignore[attr-defined]
+    handle = mb.send_goal(*goal, frame_id=frame)
     while not handle.done() and mon.now_s() - t0 < timeout - 1e-9:
         run.run(min(1.0, timeout - (mon.now_s() - t0)), until=handle.done, quiet=True, chunk=1.0)
         if shots is not None:
             shots.append(_snapshot(run, mon))
     if not handle.done():
-        mb.cancel_goal()  # type: ignore[attr-defined]
+        mb.cancel_goal()
     t1 = mon.now_s()
     pts = np.array([p[1:] for p in mon.path[k0:]]).reshape(-1, 2)
     final = run.sim.base_pose2d()
@@ -155,8 +167,8 @@ def run_navigation(
         grid = load_map(served)
         run = start_run("navigation", world=world, robot=robot, pose=pose, seed=seed, map=str(served),
                         overrides={"move_base": overrides}, **launch_args)  # fmt: skip
-    mb = run.node("move_base")
-    radius = mb.local_costmap.layered.circumscribed_radius  # type: ignore[attr-defined]
+    mb = _move_base(run)
+    radius = mb.local_costmap.layered.circumscribed_radius
     mon = run.add(NavMonitor, parameters={"robot_radius": radius}, sim=run.sim, move_base=mb)
     for t, model in spawn:
         _at(run, float(t), lambda m=model: run.gazebo.spawn(m(run.sim) if callable(m) else m))
@@ -164,7 +176,8 @@ def run_navigation(
     run.run(1.0, record=record, quiet=True)  # amcl's first update, the costmaps' first maps
     for goal in goals:
         during: list[NavSnapshot] | None = [] if snapshots else None
-        results.append(rounded(_drive_goal(run, mon, tuple(map(float, goal)), "map", goal_timeout, during)))  # type: ignore[arg-type]
+        gx, gy, gyaw = (float(v) for v in goal)
+        results.append(rounded(_drive_goal(run, mon, (gx, gy, gyaw), "map", goal_timeout, during)))
         if during:  # the paper's pictures show the robot on its way: the middle of the drive
             shots.append(during[len(during) // 2])
     summary = rounded({
@@ -188,17 +201,17 @@ def _at(run: Run, t: float, fn: Any) -> None:
 
 
 def _snapshot(run: Run, mon: NavMonitor) -> NavSnapshot:
-    mb = run.node("move_base")
-    gc = mb.global_costmap.costmap  # type: ignore[attr-defined]
+    mb = _move_base(run)
+    gc = mb.global_costmap.costmap
     gc = Grid(gc.data.copy(), gc.resolution, gc.origin, gc.frame_id)  # the master changes in place
-    plan = mb.global_plan  # type: ignore[attr-defined]
-    local = getattr(mb.controller, "local_plan", None)  # type: ignore[attr-defined]
+    plan = mb.global_plan
+    local = getattr(mb.controller, "local_plan", None)
     odom_to_map = None
     try:
-        odom_to_map = run.executor.tf.lookup_pose2d("map", mb.local_costmap.global_frame)  # type: ignore[attr-defined]
+        odom_to_map = run.executor.tf.lookup_pose2d("map", mb.local_costmap.global_frame)
     except TfError:  # no tf: no local plan drawn
         local = None
     return {"costmap": gc, "plan": None if plan is None else plan.copy(),
             "local_plan": None if local is None else np.asarray(local).copy(), "odom_to_map": odom_to_map,
             "path": np.array([p[1:] for p in mon.path]), "scan": mon.scan,
-            "footprint": mb.local_costmap.layered.footprint}  # type: ignore[attr-defined]  # fmt: skip
+            "footprint": mb.local_costmap.layered.footprint}  # fmt: skip

@@ -6,10 +6,15 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING, Any, TypedDict
 
 import numpy as np
 
-from navlab.grid import GridMap
+from navlab.geometry import Pose2
+from navlab.grid import Grid, GridMap
+
+if TYPE_CHECKING:
+    from navlab.navigation.costmap.footprint import Footprint
 
 
 @dataclass
@@ -35,6 +40,19 @@ class ErrorPanel:
     events: dict[str, float] = field(default_factory=dict)  # label -> time (s), drawn as dashed lines
 
 
+class NavSnapshot(TypedDict, total=False):
+    """One moment of a navigation run as :func:`plot_navigation` draws it (map frame unless said; a
+    missing or None entry is not drawn)."""
+
+    costmap: Grid  # the global costmap (a copy)
+    plan: np.ndarray | None  # the global plan (N, 2+)
+    local_plan: np.ndarray | None  # the controller's local plan (N, 2+), odom frame
+    odom_to_map: Pose2 | None  # map_T_odom (x m, y m, yaw rad), to draw the local plan
+    path: np.ndarray  # the driven path (N, 2)
+    scan: tuple[float, float, float, np.ndarray] | None  # laser x (m), y (m), yaw (rad) and ranges (m)
+    footprint: Footprint | None  # the robot's padded footprint (None: a 0.2 m circle)
+
+
 def map_image(grid: GridMap, max_pixels: int = 1200) -> np.ndarray:
     """Grey image of the grid (1 free, 0 occupied, 0.8 unknown), block-reduced so one-cell walls survive
     when the grid is larger than ``max_pixels``: a block is occupied if any cell is, else free if any is."""
@@ -42,10 +60,16 @@ def map_image(grid: GridMap, max_pixels: int = 1200) -> np.ndarray:
     occ = grid.occupied_mask()
     free = grid.free_mask()
     if f > 1:
-        h, w = (grid.height + f - 1) // f * f, (grid.width + f - 1) // f * f
-        occ = np.pad(occ, ((0, h - grid.height), (0, w - grid.width))).reshape(h // f, f, w // f, f).any(axis=(1, 3))
-        free = np.pad(free, ((0, h - grid.height), (0, w - grid.width))).reshape(h // f, f, w // f, f).any(axis=(1, 3))
+        occ, free = _block_any(occ, f), _block_any(free, f)
     return np.where(occ, 0.0, np.where(free, 1.0, 0.8))
+
+
+def _block_any(mask: np.ndarray, f: int) -> np.ndarray:
+    """A bool (H, W) mask reduced over f×f blocks (zero-padded at the far edges): True where any cell is."""
+    h, w = mask.shape
+    hp, wp = (h + f - 1) // f * f, (w + f - 1) // f * f
+    blocks = np.pad(mask, ((0, hp - h), (0, wp - w))).reshape(hp // f, f, wp // f, f)
+    return np.asarray(blocks.any(axis=(1, 3)))
 
 
 def plot_run(
@@ -79,7 +103,7 @@ def plot_run(
     for tr in tracks:
         xy = np.asarray(tr.xy, dtype=np.float64)
         if len(xy):
-            style = {"color": tr.color} if tr.color else {}
+            style: dict[str, Any] = {"color": tr.color} if tr.color else {}  # None would override tr.style's colour
             ax.plot(xy[:, 0], xy[:, 1], tr.style, lw=tr.width, label=tr.label, **style)
     known = grid.known_bounds() if crop else None
     if known is not None:
@@ -113,7 +137,7 @@ def plot_run(
     return out
 
 
-def plot_navigation(grid: GridMap, shot: dict[str, np.ndarray | object], path: str | Path, *, title: str = "",
+def plot_navigation(grid: GridMap, shot: NavSnapshot, path: str | Path, *, title: str = "",
                     goal: Sequence[float] | None = None) -> Path:  # fmt: skip
     """A picture in the style of the paper's Figs. 9–12: the map, the global costmap's inflation as a dark
     shadow and its obstacles, the driven path, the global plan (blue), the local plan (green), the robot's
@@ -132,13 +156,13 @@ def plot_navigation(grid: GridMap, shot: dict[str, np.ndarray | object], path: s
               interpolation="nearest")  # fmt: skip
     cm = shot.get("costmap")
     if cm is not None:
-        c = cm.data.astype(float)  # type: ignore[attr-defined]
+        c = cm.data.astype(float)
         shade = np.where((c > 0) & (c < 253), 0.15 + 0.45 * c / 252.0, 0.0)
         shade = np.where((c == 253) | (c == 254), 0.75, shade)
         rgba = np.zeros((*c.shape, 4))
         rgba[..., 2] = 0.35
         rgba[..., 3] = shade
-        cx0, cy0, cx1, cy1 = cm.bounds()  # type: ignore[attr-defined]
+        cx0, cy0, cx1, cy1 = cm.bounds()
         ax.imshow(rgba, origin="lower", extent=(cx0, cx1, cy0, cy1), interpolation="nearest")
     trail = np.asarray(shot.get("path"))
     if trail.ndim == 2 and len(trail):
@@ -148,20 +172,20 @@ def plot_navigation(grid: GridMap, shot: dict[str, np.ndarray | object], path: s
         plan = np.asarray(plan)
         ax.plot(plan[:, 0], plan[:, 1], "-", color="tab:blue", lw=2.0, label="global plan")
     local, odom_to_map = shot.get("local_plan"), shot.get("odom_to_map")
-    if local is not None and odom_to_map is not None and len(local):  # type: ignore[arg-type]
-        lp = transform_points2(odom_to_map, np.asarray(local)[:, :2])  # type: ignore[arg-type]
+    if local is not None and odom_to_map is not None and len(local):
+        lp = transform_points2(odom_to_map, np.asarray(local)[:, :2])
         ax.plot(lp[:, 0], lp[:, 1], "-", color="tab:green", lw=2.5, label="local plan")
     scan = shot.get("scan")
     if scan is not None:
-        sx, sy, syaw, ranges = scan  # type: ignore[misc]
+        sx, sy, syaw, ranges = scan
         a = syaw + np.linspace(-np.pi, np.pi, len(ranges), endpoint=False)
         ok = np.isfinite(ranges)
         ax.scatter(sx + ranges[ok] * np.cos(a[ok]), sy + ranges[ok] * np.sin(a[ok]), s=1.5, c="tab:red",
                    label="laser")  # fmt: skip
         footprint = shot.get("footprint")
-        poly = footprint.oriented((sx, sy, syaw)) if footprint is not None else None  # type: ignore[attr-defined]
+        poly = footprint.oriented((sx, sy, syaw)) if footprint is not None else None
         if poly is None:
-            r = footprint.circumscribed_radius if footprint is not None else 0.2  # type: ignore[attr-defined]
+            r = footprint.circumscribed_radius if footprint is not None else 0.2
             ang = np.linspace(0, 2 * np.pi, 33)
             poly = np.stack([sx + r * np.cos(ang), sy + r * np.sin(ang)], axis=1)
         ax.fill(poly[:, 0], poly[:, 1], color="tab:orange", alpha=0.9, label="robot")

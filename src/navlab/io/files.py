@@ -21,7 +21,7 @@ def _umask() -> int:
 
 
 @contextmanager
-def atomic_path(path: str | Path, *, suffix: str = ".tmp") -> Iterator[Path]:
+def atomic_path(path: str | os.PathLike[str], *, suffix: str = ".tmp") -> Iterator[Path]:
     """A temporary path beside ``path`` to write to; renamed onto ``path`` when the block succeeds.
 
     On an exception the temporary file is removed and ``path`` is left as it was. ``suffix`` matters
@@ -40,18 +40,18 @@ def atomic_path(path: str | Path, *, suffix: str = ".tmp") -> Iterator[Path]:
             os.unlink(tmp)
 
 
-def write_bytes_atomic(path: str | Path, data: bytes) -> None:
+def write_bytes_atomic(path: str | os.PathLike[str], data: bytes) -> None:
     """Write ``data`` to ``path`` through a temporary file in the same folder and a rename."""
     with atomic_path(path) as tmp:
         tmp.write_bytes(data)
 
 
-def write_text_atomic(path: str | Path, text: str) -> None:
+def write_text_atomic(path: str | os.PathLike[str], text: str) -> None:
     """Write ``text`` (UTF-8) to ``path`` atomically."""
     write_bytes_atomic(path, text.encode())
 
 
-def save_figure_atomic(fig: Any, path: str | Path, **savefig_kwargs: Any) -> None:
+def save_figure_atomic(fig: Any, path: str | os.PathLike[str], **savefig_kwargs: Any) -> None:
     """Save a matplotlib figure to ``path`` atomically (format from the suffix)."""
     with atomic_path(path, suffix=Path(path).suffix) as tmp:
         fig.savefig(tmp, **savefig_kwargs)

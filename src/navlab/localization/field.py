@@ -39,7 +39,8 @@ class MapField:
     @property
     def shape(self) -> tuple[int, int]:
         """(height, width) in cells."""
-        return self.occupied.shape  # type: ignore[return-value]
+        h, w = self.occupied.shape
+        return h, w
 
     def to_grid(self, poses: np.ndarray) -> np.ndarray:
         """Poses ``(N, 3)`` in the map frame → poses in the grid frame (origin at cell (0,0)'s corner)."""
@@ -145,7 +146,7 @@ def field_from_map(grid: Any, *, max_dist: float = 2.0, name: str = "map") -> Ma
         if not hasattr(grid, attr):
             raise LocalizationError(f"{name}: expected a grid map with .data, .resolution and .origin; "
                                     f"missing .{attr}")
-    origin = tuple(float(v) for v in grid.origin)
-    if len(origin) == 2:
-        origin = (*origin, 0.0)
-    return build_field(grid.data, float(grid.resolution), origin[:3], max_dist=max_dist, name=name)
+    o = [float(v) for v in grid.origin]
+    if len(o) == 2:
+        o.append(0.0)
+    return build_field(grid.data, float(grid.resolution), (o[0], o[1], o[2]), max_dist=max_dist, name=name)

@@ -221,6 +221,7 @@ def beam_weights(
     ``z``: (z_hit, z_short, z_max, z_rand); ``laser_pose``: the laser in the base frame.
     """
     out = np.empty(poses_grid.shape[0])
+    z_hit, z_short, z_max, z_rand = (float(v) for v in z)
     _beam(
         np.ascontiguousarray(poses_grid[:, 0]),
         np.ascontiguousarray(poses_grid[:, 1]),
@@ -233,7 +234,10 @@ def beam_weights(
         occupied,
         float(resolution),
         float(range_max),
-        *map(float, z),
+        z_hit,
+        z_short,
+        z_max,
+        z_rand,
         float(sigma_hit),
         float(lambda_short),
         out,

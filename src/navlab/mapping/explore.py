@@ -137,8 +137,8 @@ class GridDijkstraPlanner:
         """(distance in cells (H, W), predecessors) of a Dijkstra from the robot, or None if it has no
         traversable cell nearby."""
         mask = self.traversable(costmap)
-        cell = tuple(int(v) for v in costmap.world_to_cell(np.array([start_xy]))[0])
-        start = nearest_traversable(mask, cell, self.start_search_cells)  # type: ignore[arg-type]
+        ci, cj = costmap.world_to_cell(np.array([start_xy]))[0]
+        start = nearest_traversable(mask, (int(ci), int(cj)), self.start_search_cells)
         if start is None:
             return None
         mask[start[1], start[0]] = True

@@ -301,6 +301,7 @@ class GMapping:
             self._time_at_update = self._time
             self._mark_update(k)
             return odom.copy()
+        assert self._odom_last is not None and self._odom_at_update is not None  # set with the first particles
         step = between2(self._odom_last, odom)
         self._odom_last = odom
         poses = self._sample_motion_all(np.array([q.pose for q in self.particles]), step)

@@ -116,8 +116,7 @@ def read_image(path: str | os.PathLike[str]) -> tuple[np.ndarray, bool]:
                 target = "LA" if img.mode in ("L", "LA") else "RGBA"
             else:
                 target = "L" if img.mode in grey_modes else "RGB"
-            img = img.convert(target)
-            arr = np.asarray(img, dtype=np.uint8)
+            arr = np.asarray(img.convert(target), dtype=np.uint8)
     except (UnidentifiedImageError, OSError) as exc:
         raise MappingError(f"{p}: not a readable image (PGM, PPM or PNG expected): {exc}") from None
     if arr.ndim == 2:

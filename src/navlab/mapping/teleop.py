@@ -8,6 +8,7 @@
 
 from __future__ import annotations
 
+import functools
 import math
 import threading
 from dataclasses import dataclass
@@ -17,7 +18,7 @@ from typing import Any
 import numpy as np
 
 from navlab import msgs
-from navlab.core import Executor, Node, TfError
+from navlab.core import Executor, Node, Publisher, TfError
 from navlab.core.params import read_yaml
 from navlab.mapping.errors import MappingError
 from navlab.mapping.follow import PurePursuit
@@ -246,7 +247,7 @@ class JoyMapping:
         return msgs.twist(-axis(self.axis_linear) * self.scale_linear, -axis(self.axis_angular) * self.scale_angular)
 
 
-def joystick_thread(ex: Executor, pub: Any, mapping: JoyMapping, rate: float = 20.0) -> Any:
+def joystick_thread(ex: Executor, pub: Publisher, mapping: JoyMapping, rate: float = 20.0) -> threading.Thread:
     """Read the first joystick with pygame and publish ``cmd_vel`` from it; a clear error without one."""
     import os
     import time
@@ -269,7 +270,7 @@ def joystick_thread(ex: Executor, pub: Any, mapping: JoyMapping, rate: float = 2
             axes = [joy.get_axis(i) for i in range(joy.get_numaxes())]
             buttons = [joy.get_button(i) for i in range(joy.get_numbuttons())]
             msg = mapping.twist(axes, buttons)
-            ex.post(lambda m=msg: pub.publish(m))
+            ex.post(functools.partial(pub.publish, msg))
             time.sleep(1.0 / rate)
 
     t = threading.Thread(target=loop, daemon=True)

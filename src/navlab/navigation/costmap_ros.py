@@ -9,6 +9,7 @@ costmap_2d's cost translation) and ``<name>/footprint`` (``geometry_msgs/Polygon
 
 from __future__ import annotations
 
+import functools
 from typing import Any
 
 import numpy as np
@@ -58,11 +59,11 @@ class Costmap2DROS:
                                           "navlab's sensors are LaserScan only, it is ignored")
                 continue
             topic = src.topic or src_name
-            node.create_subscription(msgs.LaserScan, topic, lambda m, s=src_name: self._pending.__setitem__(s, m), 5)
+            node.create_subscription(msgs.LaserScan, topic, functools.partial(self._on_scan, src_name), 5)
         self.costmap_pub = node.create_publisher(msgs.OccupancyGrid, f"{prefix}/costmap", 1, latched=True)
         self.footprint_pub = node.create_publisher(msgs.PolygonStamped, f"{prefix}/footprint", 1)
         if p.update_frequency > 0:
-            node.create_timer(1.0 / p.update_frequency, self.update)
+            node.create_timer(1.0 / p.update_frequency, self._on_update_timer)
         if p.publish_frequency > 0:
             node.create_timer(1.0 / p.publish_frequency, self.publish)
 
@@ -118,7 +119,14 @@ class Costmap2DROS:
         pts = np.stack([dist[keep] * np.cos(a[keep]), dist[keep] * np.sin(a[keep])], axis=1)
         self.layered.add_scan(sensor[:2], transform_points2(sensor, pts), valid[keep], source=source)
 
+    def _on_scan(self, source: str, msg: Any) -> None:
+        """Keep the newest scan of each observation source for the next update."""
+        self._pending[source] = msg
+
     # --- update, publish, clear --------------------------------------------------------------------
+
+    def _on_update_timer(self) -> None:
+        self.update()
 
     def update(self) -> Grid | None:
         """One costmap update now (the timer's job); returns the master grid, or None without a robot pose."""

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import hashlib
 from dataclasses import dataclass, field
+from typing import Any
 
 import mujoco
 import numpy as np
@@ -100,9 +101,10 @@ def mj_quat_from_rpy(rpy: tuple[float, float, float]) -> np.ndarray:
 
 
 
-def _set_pose(element: object, origin: Origin) -> None:
-    element.pos = np.asarray(origin.xyz, dtype=float)  # type: ignore[attr-defined]
-    element.quat = mj_quat_from_rpy(origin.rpy)  # type: ignore[attr-defined]
+def _set_pose(element: Any, origin: Origin) -> None:
+    """Set ``pos``/``quat`` of a MuJoCo spec element (``MjsBody``, ``MjsGeom``, ``MjsSite``...; untyped)."""
+    element.pos = np.asarray(origin.xyz, dtype=float)
+    element.quat = mj_quat_from_rpy(origin.rpy)
 
 
 
@@ -304,20 +306,20 @@ def add_robot(
         info.wheel_actuators = _add_wheel_motors(spec, robot)
 
 
-def _add_joint(body: mujoco.MjsBody, joint: object, where: str, info: BuildInfo) -> None:
-    kind = joint.type  # type: ignore[attr-defined]
+def _add_joint(body: mujoco.MjsBody, joint: Joint, where: str, info: BuildInfo) -> None:
+    kind = joint.type
     if kind == "fixed":
         return
-    axis = np.asarray(joint.axis, dtype=float)  # type: ignore[attr-defined]
+    axis = np.asarray(joint.axis, dtype=float)
     norm = float(np.linalg.norm(axis))
     if norm < 1e-9:
         raise SimError(f"{where}: <axis> must be non-zero, got {tuple(axis)}")
     axis /= norm
-    common = {"damping": float(joint.damping), "frictionloss": float(joint.friction)}  # type: ignore[attr-defined]
+    common = {"damping": float(joint.damping), "frictionloss": float(joint.friction)}
     if kind in ("continuous", "revolute", "prismatic"):
         jtype = mujoco.mjtJoint.mjJNT_SLIDE if kind == "prismatic" else mujoco.mjtJoint.mjJNT_HINGE
-        j = body.add_joint(name=joint.name, type=jtype, axis=axis, **common)  # type: ignore[attr-defined]
-        lower, upper = joint.lower, joint.upper  # type: ignore[attr-defined]
+        j = body.add_joint(name=joint.name, type=jtype, axis=axis, **common)
+        lower, upper = joint.lower, joint.upper
         if kind != "continuous" and lower is not None and upper is not None and upper > lower:
             j.limited = mujoco.mjtLimited.mjLIMITED_TRUE
             j.range = np.array([lower, upper])
@@ -329,8 +331,8 @@ def _add_joint(body: mujoco.MjsBody, joint: object, where: str, info: BuildInfo)
         u /= np.linalg.norm(u)
         v = np.cross(axis, u)
         for suffix, ax in (("x", u), ("y", v)):
-            body.add_joint(name=f"{joint.name}_{suffix}", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=ax, **common)  # type: ignore[attr-defined]
-        body.add_joint(name=f"{joint.name}_yaw", type=mujoco.mjtJoint.mjJNT_HINGE, axis=axis, **common)  # type: ignore[attr-defined]
+            body.add_joint(name=f"{joint.name}_{suffix}", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=ax, **common)
+        body.add_joint(name=f"{joint.name}_yaw", type=mujoco.mjtJoint.mjJNT_HINGE, axis=axis, **common)
     elif kind == "floating":
         info.warnings.append(f"{where}: floating joint below the root is simulated as fixed")
     else:

@@ -68,5 +68,5 @@ def convex_parts(
     for i, (v, f) in enumerate(parts):
         arrays[f"v{i}"], arrays[f"f{i}"] = v, f
     with atomic_path(cached, suffix=".npz") as tmp, tmp.open("wb") as fh:
-        np.savez(fh, **arrays)  # type: ignore[arg-type]
+        np.savez(fh, allow_pickle=False, **arrays)  # numeric arrays only
     return parts

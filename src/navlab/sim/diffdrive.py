@@ -65,9 +65,10 @@ class EncoderOdometry:
         """Advance with new wheel angles; returns (x, y, yaw, v, w)."""
         if self._left is None or self._right is None:
             self.reset(left, right, self.x, self.y, self.yaw)
+        assert self._left is not None and self._right is not None  # set by reset
         r = self.diameter / 2.0
-        sl = (left - self._left) * r  # type: ignore[operator]
-        sr = (right - self._right) * r  # type: ignore[operator]
+        sl = (left - self._left) * r
+        sr = (right - self._right) * r
         self._left, self._right = left, right
         ds = 0.5 * (sl + sr)
         dyaw = (sr - sl) / self.separation

@@ -32,7 +32,7 @@ def load_world_named(name_or_path: str) -> WorldModel:
     from navlab import resources
 
     try:
-        from navlab.world import load_world  # type: ignore[attr-defined]
+        from navlab.world import load_world
     except ImportError:
         raise SimError("loading .world files needs navlab.world.load_world, which is not available") from None
     path = Path(name_or_path).expanduser()
@@ -133,8 +133,8 @@ class GazeboSim(Node):
                 model = load_sdf_model(Path(request["file"]), name=request.get("name"), **place)
             elif isinstance(request, dict) and "kind" in request:
                 extra = {k: v for k, v in request.items() if k not in ("kind", "name", "dims")}
-                model = primitive_model(request["kind"], request.get("name", request["kind"]),
-                                        tuple(request["dims"]), **extra)
+                name = request["name"] if "name" in request else request["kind"]
+                model = primitive_model(request["kind"], name, tuple(request["dims"]), **extra)
             else:
                 raise SimError(f"/spawn_entity: cannot spawn {request!r}; give a ModelSpec, a spec string "
                                "or a dict with kind+dims or file")

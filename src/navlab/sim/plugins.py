@@ -18,7 +18,7 @@ import numpy as np
 from navlab import msgs
 from navlab.core import Executor, Node
 from navlab.description.model import DiffDriveConfig, ImuConfig, LidarConfig, Origin
-from navlab.geometry import qmul, qrotate, quat_from_rpy, quat_from_yaw
+from navlab.geometry import Vec, qmul, qrotate, quat_from_rpy, quat_from_yaw
 from navlab.sim.diffdrive import ODOM_COVARIANCE_DIAG, EncoderOdometry, ramp, wheel_speeds
 from navlab.sim.simulation import Simulation, lidar_angles
 
@@ -115,6 +115,7 @@ class DiffDrivePlugin(Node):
     def publish_odometry(self, now: int, dt: float) -> None:
         """Odometry message and odom → base tf at time ``now``."""
         cfg = self.cfg
+        quat: Vec  # (x, y, z, w)
         if cfg.odometry_source == "world":
             pose = self.sim.link_pose(self.base_link)
             lin, ang = self.sim.link_velocity(self.base_link)
@@ -259,7 +260,8 @@ def static_transforms(sim: Simulation, stamp_ns: int) -> list[Any]:
     assert sim.robot is not None
     robot = sim.robot
     out = [_origin_transform(stamp_ns, j.parent, j.child, j.origin) for j in robot.joints if j.type == "fixed"]
-    for cfg in [*robot.lidars, *robot.imus]:
+    sensors: list[LidarConfig | ImuConfig] = [*robot.lidars, *robot.imus]
+    for cfg in sensors:
         frame = cfg.frame_id or cfg.link
         if frame != cfg.link and frame not in robot.links:
             out.append(_origin_transform(stamp_ns, cfg.link, frame, cfg.origin))

@@ -9,12 +9,21 @@ from __future__ import annotations
 import io
 import os
 from pathlib import Path
+from typing import Protocol
 
 import numpy as np
 
 from navlab.sim.builder import GROUP_VISUAL
 from navlab.sim.errors import SimError
 from navlab.sim.simulation import Simulation
+
+
+class _GLContext(Protocol):
+    """What navlab uses of ``mujoco.egl.GLContext`` / ``mujoco.osmesa.GLContext``."""
+
+    def make_current(self) -> None: ...
+
+    def free(self) -> None: ...
 
 
 def _world_extent(sim: Simulation) -> tuple[np.ndarray, float]:
@@ -85,7 +94,7 @@ def render_image(
     return np.flipud(rgb).copy()
 
 
-def _gl_context(width: int, height: int) -> object:
+def _gl_context(width: int, height: int) -> _GLContext:
     """An offscreen OpenGL context: MUJOCO_GL's choice if it is egl/osmesa, else EGL, then OSMesa."""
     wanted = os.environ.get("MUJOCO_GL", "").lower()
     order = [wanted] if wanted in ("egl", "osmesa") else ["egl", "osmesa"]

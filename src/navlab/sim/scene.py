@@ -51,11 +51,10 @@ def add_world_model(spec: mujoco.MjSpec, model: ModelSpec, info: BuildInfo) -> l
         where = f"model {model.name!r} link {link.name!r}"
         scoped = f"{model.name}::{link.name}"
         link_pose = model_pose.then(model.link_origins.get(link.name, Origin()))
+        # static: geoms sit on the world body, so shapes move by the link pose; dynamic: the body carries it
+        offset = link_pose if model.static else None
         if model.static:
             body = spec.worldbody
-
-            def place(shape: Shape, _pose: Origin = link_pose) -> Shape:
-                return replace(shape, origin=_pose.then(shape.origin))
         else:
             body = spec.worldbody.add_body(name=scoped)
             _set_pose(body, link_pose)
@@ -64,8 +63,8 @@ def add_world_model(spec: mujoco.MjSpec, model: ModelSpec, info: BuildInfo) -> l
                 _set_inertial(body, link, True, info, where)
             bodies.append(scoped)
 
-            def place(shape: Shape) -> Shape:
-                return shape
+        def place(shape: Shape, _offset: Origin | None = offset) -> Shape:
+            return shape if _offset is None else replace(shape, origin=_offset.then(shape.origin))
         mu = DEFAULT_MU if link.mu1 is None else float(link.mu1)
         friction = np.array([mu, 0.005, 0.0001])
         for i, shape in enumerate(link.collisions):
@@ -111,8 +110,9 @@ def _add_convex_parts(spec: mujoco.MjSpec, body: mujoco.MjsBody, shape: Shape, w
     assert g.mesh_path is not None
     parts = convex_parts(g.mesh_path, g.mesh_scale)
     extra = dict(extra)
-    if "mass" in extra:
-        extra["mass"] = float(extra["mass"]) / len(parts)  # type: ignore[arg-type]
+    mass = extra.get("mass")
+    if isinstance(mass, float):
+        extra["mass"] = mass / len(parts)
     for k, (verts, faces) in enumerate(parts):
         part = f"{name}::part{k}"
         spec.add_mesh(name=part, uservert=verts.ravel().tolist(), userface=faces.ravel().tolist())

@@ -12,7 +12,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from navlab.description.model import Geometry, Inertial, Link, Shape
+from navlab.description.model import Geometry, Inertial, Link, Shape, is_geometry_kind
 from navlab.sim.errors import SimError
 from navlab.world.model import ModelSpec
 
@@ -52,14 +52,14 @@ def primitive_model(
     ``z`` defaults to resting on the floor (half the height).
     """
     expected = {"box": 3, "cylinder": 2, "sphere": 1}
-    if kind not in expected:
+    if not is_geometry_kind(kind) or kind not in expected:
         raise SimError(f"cannot spawn a {kind!r}; expected one of {', '.join(expected)} (or an SDF model)")
     if len(dims) != expected[kind] or min(dims) <= 0:
         raise SimError(f"spawn {kind} {name!r}: needs {expected[kind]} positive size values, got {dims}")
     if not static and mass <= 0:
         raise SimError(f"spawn {kind} {name!r}: mass must be positive, got {mass}")
     height = {"box": lambda: dims[2], "cylinder": lambda: dims[1], "sphere": lambda: 2 * dims[0]}[kind]()
-    shape = Shape(Geometry(kind, tuple(float(d) for d in dims)), rgba=rgba)  # type: ignore[arg-type]
+    shape = Shape(Geometry(kind, tuple(float(d) for d in dims)), rgba=rgba)
     link = Link("link", inertial=None if static else _inertial(kind, dims, mass), collisions=[shape],
                 visuals=[shape])
     pose = (float(x), float(y), height / 2 if z is None else float(z), 0.0, 0.0, float(yaw))
@@ -127,7 +127,7 @@ def load_sdf_model(
 ) -> ModelSpec:
     """An SDF model file (``model.sdf`` or a model directory) placed at (x, y, z, yaw) in the world."""
     try:
-        from navlab.world import load_model  # type: ignore[attr-defined]
+        from navlab.world import load_model
     except ImportError:
         raise SimError("loading SDF models needs navlab.world.load_model, which is not available") from None
     model: ModelSpec = load_model(path)

@@ -47,6 +47,11 @@ def _floats(text: str | None, n: int, where: str) -> tuple[float, ...]:
     return vals
 
 
+def _vec3(text: str | None, where: str) -> tuple[float, float, float]:
+    x, y, z = _floats(text, 3, where)
+    return x, y, z
+
+
 def _num(el: ET.Element | None, tag: str, where: str, default: float) -> float:
     sub = el.find(tag) if el is not None else None
     if sub is None or not (sub.text or "").strip():
@@ -212,7 +217,7 @@ class _Loader:
             vals = {k: _num(inertia, k, iw + "/<inertia>", 1.0 if k in ("ixx", "iyy", "izz") else 0.0)
                     for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")}
             o = _pose(inertial, iw) if inertial is not None else (0.0,) * 6
-            link.inertial = Inertial(mass=mass, origin=Origin(xyz=o[:3], rpy=o[3:]), **vals)  # type: ignore[arg-type]
+            link.inertial = Inertial(mass=mass, origin=Origin(xyz=o[:3], rpy=o[3:]), **vals)
         had_shapes = False
         for tag in ("collision", "visual"):
             for i, sel in enumerate(el.findall(tag)):
@@ -344,9 +349,9 @@ def load_world(path: str | os.PathLike[str], *, model_path: Iterable[str | os.Pa
         if world.max_step_size <= 0:
             raise WorldError(f"{pw}/<max_step_size>: must be > 0 s, got {world.max_step_size}")
         if chosen.find("gravity") is not None:  # SDF 1.4
-            world.gravity = _floats(chosen.findtext("gravity"), 3, pw + "/<gravity>")  # type: ignore[assignment]
+            world.gravity = _vec3(chosen.findtext("gravity"), pw + "/<gravity>")
     if world_el.find("gravity") is not None:
-        world.gravity = _floats(world_el.findtext("gravity"), 3, f"{where}/<gravity>")  # type: ignore[assignment]
+        world.gravity = _vec3(world_el.findtext("gravity"), f"{where}/<gravity>")
     names = [m.name for m in world.models]
     dup = {n for n in names if names.count(n) > 1}
     if dup:

@@ -24,6 +24,7 @@ The batch is in grid-local coordinates (see ``common``): positions m, yaw rad, c
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -267,6 +268,8 @@ def twirling(c: TwirlingCritic, b: Batch) -> np.ndarray | None:
     return _out(c, np.abs(b.wz).mean(axis=1))
 
 
-SCORERS = {"ConstraintCritic": constraint, "CostCritic": cost, "GoalCritic": goal, "GoalAngleCritic": goal_angle,
-           "PathAlignCritic": path_align, "PathFollowCritic": path_follow, "PathAngleCritic": path_angle,
-           "PreferForwardCritic": prefer_forward, "TwirlingCritic": twirling}
+Scorer = Callable[[Any, Batch], np.ndarray | None]  # (a critic's parameters, batch) -> costs (S,) or None
+SCORERS: dict[str, Scorer] = {
+    "ConstraintCritic": constraint, "CostCritic": cost, "GoalCritic": goal, "GoalAngleCritic": goal_angle,
+    "PathAlignCritic": path_align, "PathFollowCritic": path_follow, "PathAngleCritic": path_angle,
+    "PreferForwardCritic": prefer_forward, "TwirlingCritic": twirling}

@@ -48,7 +48,8 @@ def clutter(rng: np.random.Generator, *, size: float = 8.0, resolution: float = 
     """An obstacle mask (n, n) of a ``size`` m square room with ``count`` round obstacles (radii in
     ``radius``) placed from ``rng``, none within ``clear_radius`` of the ``keep_clear`` points."""
     n = round(size / resolution)
-    centres, radii = [], []
+    centres: list[np.ndarray] = []
+    radii: list[float] = []
     while len(centres) < count:
         c = rng.uniform(0.3, size - 0.3, 2)
         r = rng.uniform(*radius)

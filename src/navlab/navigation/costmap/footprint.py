@@ -65,10 +65,11 @@ class Footprint:
         ii, jj = np.meshgrid(np.arange(lo[0], hi[0] + 1), np.arange(lo[1], hi[1] + 1))
         ij = np.stack([ii.ravel(), jj.ravel()], axis=1)
         centres = grid.cell_to_world(ij)
-        if self.polygon is None:
+        poly = self.oriented(pose)
+        if poly is None:
             inside = np.hypot(centres[:, 0] - x, centres[:, 1] - y) <= reach
         else:
-            inside = points_in_polygon(centres, self.oriented(pose))  # type: ignore[arg-type]
+            inside = points_in_polygon(centres, poly)
         centre_cell = grid.world_to_cell(np.array([[x, y]]))
         out = np.concatenate([ij[inside], centre_cell])
         out = np.unique(out, axis=0)

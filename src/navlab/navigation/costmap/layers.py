@@ -116,7 +116,8 @@ class StaticLayer(Layer):
         (identity for a global costmap in ``map``; map->odom's inverse for a rolling one in ``odom``)."""
         self.map = grid
         self.costs = self.interpret(grid.data)
-        self.map_in_costmap = tuple(float(v) for v in map_in_costmap)  # type: ignore[assignment]
+        mx, my, myaw = map_in_costmap
+        self.map_in_costmap = (float(mx), float(my), float(myaw))
         self._lookup = None
 
     def _cells(self, master: Grid) -> tuple[np.ndarray, np.ndarray]:

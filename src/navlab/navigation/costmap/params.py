@@ -14,12 +14,15 @@ from __future__ import annotations
 import difflib
 import math
 from dataclasses import dataclass, field, fields
-from typing import Any, TypeVar
+from typing import TYPE_CHECKING, Any, TypeVar
 
 from navlab.core.params import dataclass_from_dict
 from navlab.navigation.errors import NavigationError
 
-T = TypeVar("T")
+if TYPE_CHECKING:
+    from _typeshed import DataclassInstance
+
+T = TypeVar("T", bound="DataclassInstance")
 
 STATIC = "costmap_2d::StaticLayer"
 OBSTACLE = "costmap_2d::ObstacleLayer"
@@ -180,7 +183,7 @@ def _non_negative(what: str, name: str, value: float) -> None:
 def build(cls: type[T], values: dict[str, Any] | None, *, what: str) -> T:
     """An instance of dataclass ``cls`` from ``values``: unknown keys say "did you mean"; a value of the wrong
     type (a string for a number, 2.5 for an integer, "yes" for a boolean) names its key and what was expected."""
-    names = {f.name: f for f in fields(cls)}  # type: ignore[arg-type]
+    names = {f.name: f for f in fields(cls)}
     defaults = cls()
     for key, val in (values or {}).items():
         if key not in names:
@@ -332,7 +335,7 @@ def observation_source(values: dict[str, Any], costmap: CostmapParams, *, name: 
 
 def layer_params(cls: type[T], costmap: CostmapParams, name: str) -> T:
     """A layer's parameters: the costmap-level value of each of its fields, overridden by its namespace ``name``."""
-    own = {f.name for f in fields(cls)}  # type: ignore[arg-type]
+    own = {f.name for f in fields(cls)}
     inherited = {f.name: getattr(costmap, f.name) for f in fields(CostmapParams) if f.name in own}
     ns = _with_aliases(costmap.namespaces.get(name, {}), name)
     params = build(cls, {**inherited, **ns}, what=name)

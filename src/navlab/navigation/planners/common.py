@@ -64,8 +64,10 @@ def params_from(cls: type, values: Any, *, what: str, aliases: dict[str, str] | 
     if not isinstance(values, dict):
         raise NavigationError(f"{what}: parameters must be a dict or {cls.__name__}, got {type(values).__name__}")
     renamed: dict[str, Any] = {}
+    names: dict[str, str] = aliases or {}
+    key: str  # parameter names (``build`` reports an unknown or non-string key)
     for key, val in values.items():
-        name = (aliases or {}).get(key, key)
+        name = names.get(key, key)
         if name in renamed:
             raise NavigationError(f"{what} parameters {key} and {name} both set; keep one")
         renamed[name] = val

@@ -363,7 +363,7 @@ class NavfnPlanner:
                 return None
             bi, bj = best
             eu, ev = float(bi), float(bj)
-            end_xy = tuple(to_world(costmap, np.array([[eu, ev]]))[0])  # type: ignore[assignment]
+            end_xy = tuple(to_world(costmap, np.array([[eu, ev]]))[0])
         if (si, sj) == (round(eu), round(ev)) and math.hypot(eu - su, ev - sv) <= 1.0:
             return np.array([[float(start[0]), float(start[1])], list(end_xy)])
         pts, arrived = _descend(pot, eu, ev, su, sv, 0.5)
