@@ -21,6 +21,8 @@ BENCHES: dict[str, str] = {
     "sim": "navlab.sim.bench:run",
     "controller": "navlab.navigation.bench:run_controller",
     "planner": "navlab.navigation.bench:run_planner",
+    "nav": "navlab.experiments.navigate_run:bench",
+    "clutter": "navlab.experiments.clutter_run:bench",
 }
 
 
@@ -54,4 +56,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("name", choices=[*BENCHES, "all"], help="which benchmark to run")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    p.add_argument("--controller", default=None,
+                   help="clutter: local planner to drive with (trajectory, dwa, mppi; default mppi)")
+    p.add_argument("--worlds", type=int, default=50, help="clutter: how many generated worlds (default 50)")
     p.set_defaults(func=_cmd)

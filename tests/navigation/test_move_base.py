@@ -142,3 +142,23 @@ def test_bad_parameters_get_one_line_errors(capsys: pytest.CaptureFixture[str]) 
                  "--set", "local_costmap.inflation_radius=-0.5"]) == 2
     err = capsys.readouterr().err.strip()
     assert "inflation_radius" in err and len(err.splitlines()) == 1
+
+
+def test_mapless_navigation_through_a_generated_clutter_world() -> None:
+    """No map, no amcl: move_base's global costmap rolls in odom; MPPI drives a BARN-style field."""
+    from navlab.experiments.clutter_run import run_clutter_world
+    from navlab.world.clutter import generate_clutter
+
+    world = generate_clutter(7, fill=0.3, smooth=2)
+    r = run_clutter_world(world, controller="mppi")
+    assert r["success"] and r["collisions"] == 0, r
+    assert r["time_s"] < 8 * world.t_opt() and r["score"] > 0.0
+
+
+def test_a_robot_with_a_polygon_footprint_navigates_with_its_own_parameter_files() -> None:
+    """The Jackal-sized robot: box footprint, another base frame (base_link) and scan topic (front/scan)."""
+    from navlab import resources
+
+    r = run_navigation([(3.0, 0.5, 0.0), (-3.0, -0.5, 3.14)], world="room", robot="jackal",
+                       params_dir=resources.root() / "params" / "jackal", controller="mppi", goal_timeout=60)
+    assert all(_ok(g) for g in r.goals), r.goals

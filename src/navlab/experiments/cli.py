@@ -105,7 +105,7 @@ def _cmd_navigate(args: argparse.Namespace) -> int:
     result = run_navigation(
         [tuple(g) for g in args.goal], world=args.world, map_yaml=args.map, robot=args.robot, pose=start_pose(args),
         controller=args.controller, params_dir=args.params, move_base_params=parse_sets(args.set), spawn=spawns,
-        goal_timeout=args.timeout, seed=args.seed, record=args.record, snapshots=bool(args.out),
+        goal_timeout=args.timeout, seed=args.seed, record=args.record, snapshots=bool(args.out), mapless=args.mapless,
     )  # fmt: skip
     figures: dict[str, Any] = {"goals": result.goals, **result.summary}
     if args.out:
@@ -244,8 +244,11 @@ def register(sub: argparse._SubParsersAction) -> None:
     _add_world_robot(p, "room_obstacles")
     p.add_argument("--map", metavar="MAP.yaml", default=None,
                    help="map_server map to navigate on; default: the world's true occupancy at 5 cm")
+    p.add_argument("--mapless", action="store_true",
+                   help="no map and no amcl: move_base's global costmap rolls in odom, built from the laser; "
+                   "goals are then in odom (the start pose)")  # fmt: skip
     p.add_argument("--goal", nargs=3, type=float, action="append", required=True, metavar=("X", "Y", "YAW"),
-                   help="a goal in the map frame (m, m, rad); repeat for a sequence")  # fmt: skip
+                   help="a goal in the map frame (odom with --mapless) (m, m, rad); repeat for a sequence")  # fmt: skip
     p.add_argument("--controller", default=None,
                    help="local planner: trajectory (TrajectoryPlannerROS), dwa (DWAPlannerROS), mppi, or a ROS "
                    "plugin name (default: move_base_params.yaml's base_local_planner)")  # fmt: skip

@@ -22,6 +22,7 @@ from navlab.core import Executor, Node, TfError
 from navlab.experiments.plots import NavSnapshot
 from navlab.experiments.session import Run, rounded, start_run
 from navlab.experiments.truth import true_map
+from navlab.geometry import compose2
 from navlab.grid import Grid, GridMap
 from navlab.navigation.errors import NavigationError
 
@@ -91,8 +92,9 @@ def _episodes(times: Sequence[float], t0: float, t1: float, gap: float = 0.25) -
 
 
 def _drive_goal(run: Run, mon: NavMonitor, goal: Pose, frame: str, timeout: float,
-                shots: list[NavSnapshot] | None = None) -> dict[str, Any]:
-    """Send one goal and run until it ends or ``timeout`` s pass; ``shots`` collects a snapshot a second."""
+                shots: list[NavSnapshot] | None = None, world_T_frame: Pose = (0.0, 0.0, 0.0)) -> dict[str, Any]:
+    """Send one goal (in ``frame``, which sits at ``world_T_frame``) and run until it ends or ``timeout`` s
+    pass; ``shots`` collects a snapshot a second."""
     mb = _move_base(run)
     t0 = mon.now_s()
     k0 = len(mon.path)
@@ -116,7 +118,7 @@ def _drive_goal(run: Run, mon: NavMonitor, goal: Pose, frame: str, timeout: floa
         "path_m": float(np.linalg.norm(np.diff(pts, axis=0), axis=1).sum()) if len(pts) > 1 else 0.0,
         "min_clearance_m": min(mon.clearance[k0:], default=math.inf),
         "collisions": _episodes(mon.contacts, t0, t1),
-        "final_error_m": math.dist(final[:2], goal[:2]),
+        "final_error_m": math.dist(final[:2], compose2(world_T_frame, goal)[:2]),
     }
 
 
@@ -135,6 +137,7 @@ def run_navigation(
     seed: int = 0,
     record: str | Path | None = None,
     snapshots: bool = False,
+    mapless: bool = False,
 ) -> NavigateResult:
     """Navigate to ``goals`` (x, y, yaw in the map frame) in turn; see ``NavigateResult``.
 
@@ -142,7 +145,8 @@ def run_navigation(
     ``dwa``, ``mppi`` or a ROS plugin name (default: the parameter files'). ``move_base_params``: overrides
     (``{"local_costmap.update_frequency": 0.5}``). ``spawn``: (time s, ModelSpec) obstacles added while
     running (or a function of the simulation that returns one, to place it relative to the robot then).
-    ``snapshots``: keep what the per-goal pictures need.
+    ``snapshots``: keep what the per-goal pictures need. ``mapless``: no map, no amcl — the global costmap
+    is a rolling window in ``odom`` built from scans, and ``goals`` are in ``odom`` (the start pose).
     """
     from navlab.mapping.mapfile import load_map, save_map
     from navlab.sim.gazebo import load_world_named
@@ -165,8 +169,12 @@ def run_navigation(
         else:
             served = Path(map_yaml)
         grid = load_map(served)
-        run = start_run("navigation", world=world, robot=robot, pose=pose, seed=seed, map=str(served),
-                        overrides={"move_base": overrides}, **launch_args)  # fmt: skip
+        if mapless:
+            run = start_run("navigation_mapless", world=world, robot=robot, pose=pose, seed=seed,
+                            overrides={"move_base": overrides}, **launch_args)  # fmt: skip
+        else:
+            run = start_run("navigation", world=world, robot=robot, pose=pose, seed=seed, map=str(served),
+                            overrides={"move_base": overrides}, **launch_args)  # fmt: skip
     mb = _move_base(run)
     radius = mb.local_costmap.layered.circumscribed_radius
     mon = run.add(NavMonitor, parameters={"robot_radius": radius}, sim=run.sim, move_base=mb)
@@ -174,10 +182,15 @@ def run_navigation(
         _at(run, float(t), lambda m=model: run.gazebo.spawn(m(run.sim) if callable(m) else m))
     results, shots = [], []
     run.run(1.0, record=record, quiet=True)  # amcl's first update, the costmaps' first maps
+    frame = run.odom_frame if mapless else "map"
+    # where the goals' frame sits in the world: the map is the world's; odom starts at the spawn pose
+    dd = run.sim.robot.diff_drive if run.sim.robot is not None else None
+    odom_is_world = dd is not None and dd.odometry_source == "world"
+    world_T_frame = pose if mapless and not odom_is_world else (0.0, 0.0, 0.0)
     for goal in goals:
-        during: list[NavSnapshot] | None = [] if snapshots else None
+        during: list[NavSnapshot] | None = [] if snapshots and not mapless else None
         gx, gy, gyaw = (float(v) for v in goal)
-        results.append(rounded(_drive_goal(run, mon, (gx, gy, gyaw), "map", goal_timeout, during)))
+        results.append(rounded(_drive_goal(run, mon, (gx, gy, gyaw), frame, goal_timeout, during, world_T_frame)))
         if during:  # the paper's pictures show the robot on its way: the middle of the drive
             shots.append(during[len(during) // 2])
     summary = rounded({
@@ -215,3 +228,13 @@ def _snapshot(run: Run, mon: NavMonitor) -> NavSnapshot:
             "local_plan": None if local is None else np.asarray(local).copy(), "odom_to_map": odom_to_map,
             "path": np.array([p[1:] for p in mon.path]), "scan": mon.scan,
             "footprint": mb.local_costmap.layered.footprint}  # fmt: skip
+
+
+def bench(args: Any) -> dict[str, Any]:
+    """``navlab bench nav``: the whole navigation stack (sim + lidar + amcl + costmaps + planner + controller)
+    driving across room_obstacles.world to four goals; real-time factor of the run loop."""
+    goals = [(4.3, 1.0, 0.0), (-3.5, -0.5, 3.14), (1.5, -2.5, 0.0), (0.0, 0.0, 0.0)]
+    run_navigation(goals[:1], world="room_obstacles", goal_timeout=5, seed=getattr(args, "seed", 0))  # warm-up: Numba
+    r = run_navigation(goals, world="room_obstacles", goal_timeout=90, seed=getattr(args, "seed", 0))
+    return {**{k: r.summary[k] for k in ("sim_s", "wall_s", "rtf")}, "goals_succeeded": r.summary["goals_succeeded"],
+            "goals": len(goals), "collisions": r.summary["collisions"]}  # fmt: skip
