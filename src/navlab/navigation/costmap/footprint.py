@@ -70,9 +70,9 @@ class Footprint:
             inside = np.hypot(centres[:, 0] - x, centres[:, 1] - y) <= reach
         else:
             inside = points_in_polygon(centres, poly)
-        centre_cell = grid.world_to_cell(np.array([[x, y]]))
-        out = np.concatenate([ij[inside], centre_cell])
-        out = np.unique(out, axis=0)
+        ci, cj = grid.world_to_cell(np.array([[x, y]]))[0]  # the cell under the pose: inside the box, always kept
+        inside[(cj - lo[1]) * (hi[0] - lo[0] + 1) + (ci - lo[0])] = True
+        out = ij[inside]
         return out[grid.in_bounds(out)]
 
 

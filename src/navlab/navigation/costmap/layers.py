@@ -321,6 +321,8 @@ class InflationLayer(Layer):
         self.name = name
         self.enabled = self.params.enabled
         self.footprint = footprint or make_footprint()
+        # the last inflation: ((origin, resolution, window), lethal seeds, costs), reused while nothing changed
+        self._inflated: tuple[Any, np.ndarray, np.ndarray] | None = None
 
     @classmethod
     def from_costmap_params(cls, name: str, costmap: CostmapParams, footprint: Footprint) -> Self:
@@ -333,6 +335,7 @@ class InflationLayer(Layer):
 
     def on_footprint_changed(self, footprint: Footprint) -> None:
         self.footprint = footprint
+        self._inflated = None
 
     def cost_at(self, distance_m: np.ndarray | float) -> np.ndarray:
         """Inflation cost (uint8) at ``distance_m`` (m) from the nearest obstacle cell's centre (0 = on it)."""
@@ -354,8 +357,14 @@ class InflationLayer(Layer):
         j0, j1 = max(0, jj.min() - reach), min(data.shape[0], jj.max() + reach + 1)
         i0, i1 = max(0, ii.min() - reach), min(data.shape[1], ii.max() + reach + 1)
         window = data[j0:j1, i0:i1]
-        dist = ndimage.distance_transform_edt(~seeds[j0:j1, i0:i1]) * master.resolution
-        cost = self.cost_at(dist)
+        key = (master.origin, master.resolution, (j0, j1, i0, i1))
+        cached = self._inflated
+        if cached is not None and cached[0] == key and np.array_equal(cached[1], seeds):
+            cost = cached[2]  # the same obstacles as last update: the same inflation (skips the transform)
+        else:
+            dist = ndimage.distance_transform_edt(~seeds[j0:j1, i0:i1]) * master.resolution
+            cost = self.cost_at(dist)
+            self._inflated = (key, seeds.copy(), cost)
         unknown = window == COST_UNKNOWN
         overwrite_unknown = unknown & ((cost > COST_FREE) if self.params.inflate_unknown else (cost >= COST_INSCRIBED))
         merged = np.where(unknown, np.where(overwrite_unknown, cost, window), np.maximum(window, cost))
