@@ -5,6 +5,9 @@
    as map.yaml + map.pgm and scored against the world.
 3. Localization: cubes and cylinders are added that the map does not have (room_obstacles), and AMCL
    tracks the robot on the saved map along a route; its error against ground truth is printed.
+4. Navigation (Figs. 9-12): move_base on the saved map drives to a sequence of goals in that room, plus one
+   more cylinder dropped in while it drives; each goal's outcome, time and collisions are printed and
+   drawn (navigate/goal_N.png).
 """
 
 from __future__ import annotations
@@ -23,25 +26,42 @@ def _say(text: str, quiet: bool) -> None:
 
 
 def run_demo(out: str | Path = "demo", *, seed: int = 0, quiet: bool = False, render: bool = True) -> dict[str, Any]:
-    """Run the three steps, writing everything under ``out``; returns the figures."""
+    """Run the four steps, writing everything under ``out``; returns the figures."""
     from navlab.experiments.localize_run import plot_result, run_localization
     from navlab.experiments.mapping_run import run_mapping
+    from navlab.experiments.navigate_run import run_navigation
+    from navlab.experiments.plots import plot_navigation
+    from navlab.sim.spawn import primitive_model
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     summary: dict[str, Any] = {"out": str(out)}
     t0 = time.perf_counter()
     if render:
-        _say("[1/3] rendering the robot in room_obstacles.world ...", quiet)
+        _say("[1/4] rendering the robot in room_obstacles.world ...", quiet)
         summary["render"] = _render(out / "world.png")
-    _say("[2/3] mapping room.world with slam_gmapping while the robot explores ...", quiet)
+    _say("[2/4] mapping room.world with slam_gmapping while the robot explores ...", quiet)
     mapping = run_mapping(world="room", out=out / "map", driver="explore", duration=300, seed=seed, quiet=quiet)
     summary["mapping"] = {"map": str(mapping.map_yaml), "picture": str(out / "map" / "map.png"), **mapping.scores}
-    _say("[3/3] AMCL on the saved map, in the room with new obstacles (room_obstacles.world) ...", quiet)
+    _say("[3/4] AMCL on the saved map, in the room with new obstacles (room_obstacles.world) ...", quiet)
     loc = run_localization("room_obstacles", mapping.map_yaml, duration=60.0, seed=seed, progress=not quiet)
     summary["localization"] = {**loc.summary, "picture": str(plot_result(loc, out / "localize.png"))}
+    _say("[4/4] move_base on the saved map, to goals among the new obstacles and one more cylinder ...", quiet)
+    late = primitive_model("cylinder", "late_cylinder", (0.15, 0.6), x=-1.0, y=-0.45)
+    nav = run_navigation(DEMO_GOALS, world="room_obstacles", map_yaml=mapping.map_yaml, spawn=[(20.0, late)],
+                         seed=seed, goal_timeout=90, snapshots=True)  # fmt: skip
+    (out / "navigate").mkdir(exist_ok=True)
+    for k, (goal, shot) in enumerate(zip(nav.goals, nav.snapshots, strict=True), 1):
+        title = f"goal {k} {tuple(goal['goal'])}: {goal['outcome']} in {goal['time_s']} s"
+        goal["picture"] = str(plot_navigation(nav.grid, shot, out / "navigate" / f"goal_{k}.png", title=title,
+                                              goal=goal["goal"]))  # fmt: skip
+    summary["navigation"] = {"goals": nav.goals, **nav.summary}
     summary["wall_s"] = round(time.perf_counter() - t0, 1)
     return summary
+
+
+# Goals across room_obstacles (map frame = the world frame: the robot mapped from the origin).
+DEMO_GOALS = [(4.3, 1.0, 0.0), (-3.5, -0.5, 3.14), (1.5, -2.5, 0.0)]
 
 
 def _render(path: Path) -> str:
@@ -75,6 +95,12 @@ def _cmd(args: argparse.Namespace) -> int:
           f"{m['odometry_position_error_mean_m']} m)")
     print(f"  AMCL on that map with new obstacles: mean error {loc['position_error_mean_m']} m, "
           f"{loc['yaw_error_mean_deg']}° over {loc['sim_s']:.0f} s; picture {loc['picture']}")
+    n = summary["navigation"]
+    print(f"  move_base on that map: {n['goals_succeeded']} of {len(n['goals'])} goals reached, "
+          f"{n['collisions']} collisions; pictures in {summary['out']}/navigate/")
+    for k, g in enumerate(n["goals"], 1):
+        print(f"    goal {k} {tuple(g['goal'])}: {g['outcome']} in {g['time_s']} s, path {g['path_m']} m, "
+              f"closest {g['min_clearance_m']} m" + (f" ({g['reason']})" if g["reason"] else ""))
     print(f"  total {summary['wall_s']} s wall")
     return 0
 
@@ -83,7 +109,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     """Add ``demo``."""
     p = sub.add_parser(
         "demo",
-        help="run the paper's pipeline: render, SLAM mapping by exploration, AMCL on the saved map",
+        help="run the paper's pipeline: render, SLAM mapping by exploration, AMCL and move_base on the saved map",
         description=__doc__,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
