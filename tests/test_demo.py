@@ -1,0 +1,21 @@
+"""``navlab demo``, the README's first command: the paper's pipeline end to end, headless."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from navlab.cli import main
+
+
+def test_demo_maps_localizes_and_navigates(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["demo", "--out", str(tmp_path / "demo"), "--no-render", "--quiet", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    m, loc, nav = out["mapping"], out["localization"], out["navigation"]
+    assert m["precision"] >= 0.9 and m["recall"] >= 0.9 and m["finished"], m
+    assert loc["position_error_mean_m"] <= 0.1, loc
+    assert [g["outcome"] for g in nav["goals"]] == ["succeeded"] * 3 and nav["collisions"] == 0, nav
+    for path in [m["map"], m["picture"], loc["picture"], *(g["picture"] for g in nav["goals"])]:
+        assert Path(path).stat().st_size > 0, path
