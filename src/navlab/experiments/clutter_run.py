@@ -36,10 +36,11 @@ def run_clutter_world(
 
     with tempfile.TemporaryDirectory(prefix="navlab-clutter-", dir=workdir) as tmp:
         path = world.write_world(Path(tmp) / f"{world.name}.world")
-        goal_in_odom = tuple(float(v) for v in between2(world.start, world.goal))
+        gx, gy, gyaw = (float(v) for v in between2(world.start, world.goal))  # the goal in odom (= the start)
+        sx, sy, syaw = (float(v) for v in world.start)
         params = {**CLUTTER_PARAMS, **(move_base_params or {})}
-        r = run_navigation([goal_in_odom], world=str(path), pose=tuple(world.start), mapless=True,  # type: ignore[arg-type]
-                           controller=controller, move_base_params=params, seed=seed, goal_timeout=timeout)  # fmt: skip
+        r = run_navigation([(gx, gy, gyaw)], world=str(path), pose=(sx, sy, syaw), mapless=True, controller=controller,
+                           move_base_params=params, seed=seed, goal_timeout=timeout)  # fmt: skip
     g = r.goals[0]
     success = g["collisions"] == 0 and g["final_error_m"] is not None and g["final_error_m"] <= SUCCESS_M
     missed = "missed" if g["outcome"] == "succeeded" else g["outcome"]  # move_base's tolerance is not BARN's
