@@ -162,3 +162,33 @@ def test_a_robot_with_a_polygon_footprint_navigates_with_its_own_parameter_files
     r = run_navigation([(3.0, 0.5, 0.0), (-3.0, -0.5, 3.14)], world="room", robot="jackal",
                        params_dir=resources.root() / "params" / "jackal", controller="mppi", goal_timeout=60)
     assert all(_ok(g) for g in r.goals), r.goals
+
+
+def test_move_base_publishes_costmaps_plans_and_status_as_ros_does() -> None:
+    from navlab import msgs
+    from navlab.core import Node
+    from navlab.experiments.session import start_run
+
+    run = start_run("navigation", world="room_obstacles", map=str(_room_true_map()))
+    got: dict[str, list] = {}
+    listener = run.add(Node, name="listener")
+    for topic, kind in [("/move_base/global_costmap/costmap", msgs.OccupancyGrid),
+                        ("/move_base/local_costmap/costmap", msgs.OccupancyGrid),
+                        ("/move_base/local_costmap/footprint", msgs.PolygonStamped),
+                        ("/move_base/NavfnROS/plan", msgs.Path),
+                        ("/move_base/TrajectoryPlannerROS/local_plan", msgs.Path),
+                        ("/move_base/status", msgs.GoalStatusArray), ("/cmd_vel", msgs.Twist)]:  # fmt: skip
+        listener.create_subscription(kind, topic, lambda m, t=topic: got.setdefault(t, []).append(m))
+    run.run(1.0)
+    goal = msgs.pose_stamped(run.executor.now_ns, "map", 4.3, 1.0, 0.0)
+    listener.create_publisher(msgs.PoseStamped, "/move_base_simple/goal").publish(goal)  # rviz's 2D Nav Goal
+    run.run(4.0)
+    assert all(got.get(t) for t in ["/move_base/global_costmap/costmap", "/move_base/local_costmap/costmap",
+                                    "/move_base/local_costmap/footprint", "/move_base/NavfnROS/plan",
+                                    "/move_base/TrajectoryPlannerROS/local_plan", "/cmd_vel"]), sorted(got)
+    local = got["/move_base/local_costmap/costmap"][-1]
+    assert local.header.frame_id == "odom" and local.info.width == 80  # a 4 m rolling window at 5 cm
+    assert set(np.unique(local.data)) <= set(range(-1, 101))  # costmap_2d's translation to 0..100, -1
+    plan = got["/move_base/NavfnROS/plan"][-1]
+    assert plan.header.frame_id == "map" and len(plan.poses) > 10
+    assert got["/move_base/status"][-1].status_list[-1].status == msgs.GoalStatus.STATUS_EXECUTING
