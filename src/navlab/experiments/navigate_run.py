@@ -22,7 +22,7 @@ from navlab.core import Executor, Node, TfError
 from navlab.experiments.plots import NavSnapshot
 from navlab.experiments.session import Run, rounded, start_run
 from navlab.experiments.truth import true_map
-from navlab.geometry import compose2
+from navlab.geometry import compose2, transform_points2
 from navlab.grid import Grid, GridMap
 from navlab.navigation.errors import NavigationError
 
@@ -38,32 +38,56 @@ CONTROLLERS = {
 
 
 class NavMonitor(Node):
-    """Ground truth for the goals: the true path, the closest approach to obstacles (true lidar ranges minus
-    the robot's radius) and contact episodes on ``/collisions``; also the last plan, local plan and scan."""
+    """Ground truth for the goals: the true path (10 Hz), the closest approach to obstacles (the nearest laser
+    return minus the robot's radius, over every scan) and contact episodes on ``/collisions``; and the last
+    scan's points in the world for the pictures."""
 
     def __init__(self, executor: Executor, *, name: str = "nav_monitor", parameters: dict[str, Any] | None = None,
                  namespace: str = "", sim: Any = None, move_base: Any = None) -> None:  # fmt: skip
         super().__init__(executor, name=name, parameters=parameters, namespace=namespace)
         self.radius = float(self.declare_parameter("robot_radius", 0.2))
+        self.base_frame = str(self.declare_parameter("base_frame", "base_link"))
         self.sim, self.move_base = sim, move_base
         self.path: list[tuple[float, float, float]] = []
         self.clearance: list[float] = []
         self.contacts: list[float] = []  # times (s) of /collisions messages
-        self.scan: Any = None
+        self._nearest = math.inf  # the nearest return since the last sample (m)
+        self._scan: Any = None
         self.create_subscription(msgs.String, "/collisions", lambda _m: self.contacts.append(self.now_s()), 10)
+        self.create_subscription(msgs.LaserScan, "scan", self._on_scan, 5)
         self.create_timer(0.1, self._sample)
+
+    def _on_scan(self, msg: Any) -> None:
+        r = np.asarray(msg.ranges, dtype=np.float64)
+        ok = np.isfinite(r) & (r >= float(msg.range_min)) & (r < float(msg.range_max))
+        if ok.any():
+            self._nearest = min(self._nearest, float(r[ok].min()))
+        self._scan = msg
 
     def now_s(self) -> float:
         """Simulated time (s)."""
         return self.executor.now_ns / 1e9
 
     def _sample(self) -> None:
-        x, y, yaw = self.sim.base_pose2d()
+        x, y, _ = self.sim.base_pose2d()
         self.path.append((self.now_s(), x, y))
-        ranges = self.sim.true_ranges(0)
-        finite = ranges[np.isfinite(ranges)]
-        self.clearance.append(float(finite.min()) - self.radius if finite.size else math.inf)
-        self.scan = (x, y, yaw, ranges)
+        self.clearance.append(self._nearest - self.radius)
+        self._nearest = math.inf
+
+    def scan_points(self) -> np.ndarray | None:
+        """The last scan's returns (N, 2) in the world frame (from the true pose), or None."""
+        msg = self._scan
+        if msg is None:
+            return None
+        try:
+            laser = self.sensor_pose(self.base_frame, str(msg.header.frame_id).lstrip("/"))
+        except TfError:
+            return None
+        r = np.asarray(msg.ranges, dtype=np.float64)
+        a = float(msg.angle_min) + float(msg.angle_increment) * np.arange(len(r))
+        ok = np.isfinite(r) & (r < float(msg.range_max))
+        pose = compose2(self.sim.base_pose2d(), laser)
+        return transform_points2(pose, np.stack([r[ok] * np.cos(a[ok]), r[ok] * np.sin(a[ok])], axis=1))
 
 
 @dataclass
@@ -177,7 +201,8 @@ def run_navigation(
                             overrides={"move_base": overrides}, **launch_args)  # fmt: skip
     mb = _move_base(run)
     radius = mb.local_costmap.layered.circumscribed_radius
-    mon = run.add(NavMonitor, parameters={"robot_radius": radius}, sim=run.sim, move_base=mb)
+    mon = run.add(NavMonitor, parameters={"robot_radius": radius, "base_frame": run.base_frame},
+                  remappings={"scan": run.scan_topic}, sim=run.sim, move_base=mb)
     for t, model in spawn:
         _at(run, float(t), lambda m=model: run.gazebo.spawn(m(run.sim) if callable(m) else m))
     results, shots = [], []
@@ -226,7 +251,7 @@ def _snapshot(run: Run, mon: NavMonitor) -> NavSnapshot:
         local = None
     return {"costmap": gc, "plan": None if plan is None else plan.copy(),
             "local_plan": None if local is None else np.asarray(local).copy(), "odom_to_map": odom_to_map,
-            "path": np.array([p[1:] for p in mon.path]), "scan": mon.scan,
+            "path": np.array([p[1:] for p in mon.path]), "scan_xy": mon.scan_points(), "robot": run.sim.base_pose2d(),
             "footprint": mb.local_costmap.layered.footprint}  # fmt: skip
 
 

@@ -49,7 +49,8 @@ class NavSnapshot(TypedDict, total=False):
     local_plan: np.ndarray | None  # the controller's local plan (N, 2+), odom frame
     odom_to_map: Pose2 | None  # map_T_odom (x m, y m, yaw rad), to draw the local plan
     path: np.ndarray  # the driven path (N, 2)
-    scan: tuple[float, float, float, np.ndarray] | None  # laser x (m), y (m), yaw (rad) and ranges (m)
+    scan_xy: np.ndarray | None  # the last scan's returns (N, 2)
+    robot: Pose2 | None  # the robot's pose (x m, y m, yaw rad)
     footprint: Footprint | None  # the robot's padded footprint (None: a 0.2 m circle)
 
 
@@ -175,13 +176,12 @@ def plot_navigation(grid: GridMap, shot: NavSnapshot, path: str | Path, *, title
     if local is not None and odom_to_map is not None and len(local):
         lp = transform_points2(odom_to_map, np.asarray(local)[:, :2])
         ax.plot(lp[:, 0], lp[:, 1], "-", color="tab:green", lw=2.5, label="local plan")
-    scan = shot.get("scan")
-    if scan is not None:
-        sx, sy, syaw, ranges = scan
-        a = syaw + np.linspace(-np.pi, np.pi, len(ranges), endpoint=False)
-        ok = np.isfinite(ranges)
-        ax.scatter(sx + ranges[ok] * np.cos(a[ok]), sy + ranges[ok] * np.sin(a[ok]), s=1.5, c="tab:red",
-                   label="laser")  # fmt: skip
+    scan_xy = shot.get("scan_xy")
+    if scan_xy is not None and len(scan_xy):
+        ax.scatter(scan_xy[:, 0], scan_xy[:, 1], s=1.5, c="tab:red", label="laser")
+    robot = shot.get("robot")
+    if robot is not None:
+        sx, sy, syaw = robot
         footprint = shot.get("footprint")
         poly = footprint.oriented((sx, sy, syaw)) if footprint is not None else None
         if poly is None:
