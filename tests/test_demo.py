@@ -19,3 +19,7 @@ def test_demo_maps_localizes_and_navigates(tmp_path: Path, capsys: pytest.Captur
     assert [g["outcome"] for g in nav["goals"]] == ["succeeded"] * 3 and nav["collisions"] == 0, nav
     for path in [m["map"], m["picture"], loc["picture"], *(g["picture"] for g in nav["goals"])]:
         assert Path(path).stat().st_size > 0, path
+    report = tmp_path / "demo"
+    assert json.loads((report / "report.json").read_text())["navigation"]["goals"] == nav["goals"]
+    assert "| (4.3, 1.0, 0.0) | succeeded |" in (report / "report.md").read_text()
+    assert (report / "map.png").is_file() and (report / "recording" / "metadata.yaml").is_file()

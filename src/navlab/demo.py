@@ -25,8 +25,9 @@ def _say(text: str, quiet: bool) -> None:
         print(text, file=sys.stderr, flush=True)
 
 
-def run_demo(out: str | Path = "demo", *, seed: int = 0, quiet: bool = False, render: bool = True) -> dict[str, Any]:
-    """Run the four steps, writing everything under ``out``; returns the figures."""
+def run_demo(out: str | Path = "navlab-demo", *, seed: int = 0, quiet: bool = False, render: bool = True,
+             record: bool = True) -> dict[str, Any]:  # fmt: skip
+    """Run the four steps, writing the report folder ``out``; returns the figures (also in report.json)."""
     from navlab.experiments.localize_run import plot_result, run_localization
     from navlab.experiments.mapping_run import run_mapping
     from navlab.experiments.navigate_run import run_navigation
@@ -49,7 +50,8 @@ def run_demo(out: str | Path = "demo", *, seed: int = 0, quiet: bool = False, re
     _say("[4/4] move_base on the saved map, to goals among the new obstacles and one more cylinder ...", quiet)
     late = primitive_model("cylinder", "late_cylinder", (0.15, 0.6), x=-1.0, y=-0.45)
     nav = run_navigation(DEMO_GOALS, world="room_obstacles", map_yaml=mapping.map_yaml, spawn=[(20.0, late)],
-                         seed=seed, goal_timeout=90, snapshots=True)  # fmt: skip
+                         seed=seed, goal_timeout=90, snapshots=True,
+                         record=out / "recording" if record else None)  # fmt: skip
     (out / "navigate").mkdir(exist_ok=True)
     for k, (goal, shot) in enumerate(zip(nav.goals, nav.snapshots, strict=True), 1):
         title = f"goal {k} {tuple(goal['goal'])}: {goal['outcome']} in {goal['time_s']} s"
@@ -57,7 +59,40 @@ def run_demo(out: str | Path = "demo", *, seed: int = 0, quiet: bool = False, re
                                               goal=goal["goal"]))  # fmt: skip
     summary["navigation"] = {"goals": nav.goals, **nav.summary}
     summary["wall_s"] = round(time.perf_counter() - t0, 1)
+    write_report(summary, out)
     return summary
+
+
+def write_report(summary: dict[str, Any], out: Path) -> None:
+    """``report.json`` (every figure) and ``report.md`` (the same, to read), and ``map.png`` (Fig. 7) on top."""
+    import shutil
+
+    from navlab.io.files import write_text_atomic
+
+    m, loc, nav = summary["mapping"], summary["localization"], summary["navigation"]
+    if Path(m["picture"]).is_file():
+        shutil.copyfile(m["picture"], out / "map.png")
+    write_text_atomic(out / "report.json", json.dumps(summary, indent=1) + "\n")
+    bag = f"; recording `{nav['record']}`" if nav.get("record") else ""
+    lines = [
+        "# navlab demo: the paper's pipeline in simulation", "",
+        f"Total {summary['wall_s']} s wall. Pictures: `map.png` (Fig. 7), `localize.png`, `navigate/goal_N.png` "
+        "(Figs. 9–12)" + (f", `{Path(summary['render']).name}` (Figs. 4–5)" if "render" in summary else "") + ".", "",
+        "## 1. Mapping: slam_gmapping while the robot explores room.world", "",
+        "| figure | value |", "| --- | --- |",
+        *(f"| {k} | {v} |" for k, v in m.items() if k not in ("map", "picture")), "",
+        "## 2. Localization: AMCL on the saved map, in room_obstacles.world", "",
+        "| figure | value |", "| --- | --- |",
+        *(f"| {k} | {v} |" for k, v in loc.items() if k != "picture"), "",
+        "## 3. Navigation: move_base on the saved map, obstacles added after mapping", "",
+        "| goal | outcome | time (s) | path (m) | closest (m) | collisions | reason |",
+        "| --- | --- | --- | --- | --- | --- | --- |",
+        *(f"| {tuple(g['goal'])} | {g['outcome']} | {g['time_s']} | {g['path_m']} | {g['min_clearance_m']} | "
+          f"{g['collisions']} | {g['reason']} |" for g in nav["goals"]),
+        "", f"{nav['goals_succeeded']} of {len(nav['goals'])} goals reached, {nav['collisions']} collisions; "
+        f"{nav['sim_s']} simulated s at {nav['rtf']}x real time{bag}.", "",
+    ]  # fmt: skip
+    write_text_atomic(out / "report.md", "\n".join(lines))
 
 
 # Goals across room_obstacles (map frame = the world frame: the robot mapped from the origin).
@@ -79,12 +114,13 @@ def _render(path: Path) -> str:
 
 
 def _cmd(args: argparse.Namespace) -> int:
-    summary = run_demo(args.out, seed=args.seed, quiet=args.quiet, render=not args.no_render)
+    summary = run_demo(args.out, seed=args.seed, quiet=args.quiet, render=not args.no_render,
+                       record=not args.no_record)
     if args.json:
         print(json.dumps(summary))
         return 0
     m, loc = summary["mapping"], summary["localization"]
-    print(f"\nnavlab demo — files in {summary['out']}/")
+    print(f"\nnavlab demo — report in {summary['out']}/report.md (+ report.json, pictures, recording)")
     if "render" in summary:
         print(f"  robot in its world:  {summary['render']}")
     print(f"  map:                 {m['map']} (+ map.pgm), picture {m['picture']}")
@@ -113,7 +149,10 @@ def register(sub: argparse._SubParsersAction) -> None:
         description=__doc__,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    p.add_argument("--out", default="demo", help="output folder (default ./demo)")
+    p.add_argument("--out", default="navlab-demo", metavar="DIR",
+                   help="the report folder: report.md, report.json, map.png, pictures and the recording "
+                   "(default ./navlab-demo)")
+    p.add_argument("--no-record", action="store_true", help="no rosbag2 recording of the navigation step")
     p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     p.add_argument("--no-render", action="store_true", help="skip the rendered picture (no OpenGL needed)")
     p.add_argument("--quiet", action="store_true", help="no progress output")

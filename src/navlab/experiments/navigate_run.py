@@ -19,6 +19,7 @@ import numpy as np
 
 from navlab import msgs
 from navlab.core import Executor, Node, TfError
+from navlab.core.record import Recorder
 from navlab.experiments.plots import NavSnapshot
 from navlab.experiments.session import Run, rounded, start_run
 from navlab.experiments.truth import true_map
@@ -206,7 +207,8 @@ def run_navigation(
     for t, model in spawn:
         _at(run, float(t), lambda m=model: run.gazebo.spawn(m(run.sim) if callable(m) else m))
     results, shots = [], []
-    run.run(1.0, record=record, quiet=True)  # amcl's first update, the costmaps' first maps
+    recorder = Recorder(run.executor, record) if record else None  # the whole run, every goal, in one bag
+    run.run(1.0, quiet=True)  # amcl's first update, the costmaps' first maps
     frame = run.odom_frame if mapless else "map"
     # where the goals' frame sits in the world: the map is the world's; odom starts at the spawn pose
     dd = run.sim.robot.diff_drive if run.sim.robot is not None else None
@@ -218,10 +220,12 @@ def run_navigation(
         results.append(rounded(_drive_goal(run, mon, (gx, gy, gyaw), frame, goal_timeout, during, world_T_frame)))
         if during:  # the paper's pictures show the robot on its way: the middle of the drive
             shots.append(during[len(during) // 2])
+    bag = recorder.close() if recorder else None
     summary = rounded({
         "goals_succeeded": sum(r["outcome"] == "succeeded" for r in results),
         "collisions": sum(r["collisions"] for r in results),
         **run.figures(),
+        **({"record": str(bag)} if bag else {}),
     })  # fmt: skip
     return NavigateResult(results, summary, grid, shots)
 
