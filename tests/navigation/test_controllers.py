@@ -16,9 +16,10 @@ from navlab.grid import COST_INSCRIBED, COST_LETHAL, Grid
 from navlab.navigation.controllers import DWAPlannerROS, TrajectoryPlannerROS
 from navlab.navigation.controllers import mppi_critics as critics
 from navlab.navigation.controllers import synthetic as syn
-from navlab.navigation.controllers.common import OscillationFlags
+from navlab.navigation.controllers.common import OscillationFlags, crop_plan
 from navlab.navigation.controllers.mapgrid import distance_map
 from navlab.navigation.controllers.mppi import MPPIController
+from navlab.navigation.controllers.trajectory import InPlaceFlags
 from navlab.navigation.errors import NavigationError
 from navlab.plugins import load_plugin
 
@@ -220,6 +221,48 @@ def test_polygon_footprint_edges_are_checked():
     circle.set_plan(np.column_stack([np.linspace(0, 2, 41), np.full(41, -0.25), np.zeros(41)]))
     circle.compute_velocity((0.0, -0.25, 0.0), (0.2, 0.0), grid)
     assert circle.valid  # the centre cell is free
+
+
+@pytest.mark.parametrize("cls", [DWAPlannerROS, TrajectoryPlannerROS])
+def test_robot_radius_is_checked_as_costmap_2d_16_gon(cls):
+    grid = free_map()
+    grid.data[39:41, 36:44] = COST_LETHAL  # a thin wall whose near face is 0.2 m to the robot's left
+    plan = np.column_stack([np.linspace(0, 2, 41), np.full(41, -0.25), np.zeros(41)])
+    forward = {}
+    for radius in (None, 0.15, 0.21):
+        ctrl = cls(robot_radius=radius)
+        ctrl.set_plan(plan)
+        forward[radius] = ctrl.compute_velocity((0.0, -0.25, 0.0), (0.2, 0.0), grid)[0] > 0
+    assert cls(robot_radius=0.21).footprint.shape == (16, 2)
+    # a point robot, and a 0.15 m one, drive on; a 0.21 m one overlaps the wall: DWA stops, TrajectoryPlanner
+    # backs off (its escape)
+    assert forward == {None: True, 0.15: True, 0.21: False}
+
+
+def test_move_base_controller_frequency_sets_sim_period_unless_the_planner_section_does():
+    ctrl = TrajectoryPlannerROS({"acc_lim_x": 0.2, "min_vel_x": 0.0}, controller_frequency=10.0)
+    ctrl.set_plan(straight_plan())
+    ctrl.compute_velocity((0.0, 0.0, 0.0), (0.3, 0.0), free_map())
+    assert ctrl.samples[ctrl.samples[:, 0] > 0, 0].max() == pytest.approx(0.3 + 0.2 / 10.0)
+    assert DWAPlannerROS({"controller_frequency": 5.0}, controller_frequency=10.0).params.sim_period == 0.2
+
+
+def test_plan_is_cropped_where_it_leaves_half_the_local_window():
+    out_and_back = np.vstack([straight_plan(-3.0, 3.0), straight_plan(-3.0, 3.0, y=0.5)[::-1]])
+    crop = crop_plan(out_and_back, 0.0, 0.0, 2.0)
+    assert crop[0, 0] == pytest.approx(-2.0) and crop[-1, 0] == pytest.approx(2.05)  # ROS keeps the first beyond
+    assert (crop[:, 1] == 0.0).all()  # not the way back, although it passes the window again
+    assert len(crop_plan(out_and_back, 0.0, 5.0, 2.0)) == 0
+
+
+def test_trajectory_planner_keeps_turning_in_place_the_same_way():
+    flags = InPlaceFlags(0.05)
+    flags.update((0.0, 0.0, 0.0), 0.0, -0.5)
+    assert list(flags.allowed(np.array([0.5, -0.5]))) == [True, True]
+    flags.update((0.0, 0.0, -0.1), 0.0, -0.5)  # right twice: left turns are no longer tried
+    assert list(flags.allowed(np.array([0.5, -0.5]))) == [False, True]
+    flags.update((0.06, 0.0, -0.1), 0.2, 0.0)  # driven away from where it turned
+    assert list(flags.allowed(np.array([0.5, -0.5]))) == [True, True]
 
 
 def test_closed_loop_dwa_reaches_goal_in_clutter(clutter_world):

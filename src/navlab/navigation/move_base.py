@@ -104,10 +104,13 @@ class MoveBase(Node):
         self.planner_name, self.controller_name = short_name(gp), short_name(lp)
         self.planner = _construct(load_plugin("global_planner", gp, param="base_global_planner"),
                                   self._namespace(self.planner_name))  # fmt: skip
-        polygon = self.local_costmap.layered.footprint.polygon
+        footprint = self.local_costmap.layered.footprint
+        # as ROS's planners see them: the costmap's footprint (a round robot's radius, for costmap_2d's 16-gon)
+        # and move_base's controller_frequency (they search the parameter upward)
         self.controller = _construct(load_plugin("controller", lp, param="base_local_planner"),
                                      self._namespace(self.controller_name), rng=self.rng,
-                                     footprint=polygon)  # fmt: skip
+                                     footprint=footprint.polygon, robot_radius=footprint.radius,
+                                     controller_frequency=p["controller_frequency"])  # fmt: skip
         self.recoveries = self._recoveries(raw_recoveries)
         # a parameter file may configure several planners (TrajectoryPlannerROS: and DWAPlannerROS:); ROS ignores
         # the sections of the ones not in use, and so does navlab

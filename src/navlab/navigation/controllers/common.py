@@ -164,6 +164,28 @@ def prune_plan(plan: np.ndarray, x: float, y: float) -> np.ndarray:
     return plan[near[0]:] if len(near) else plan
 
 
+def crop_plan(plan: np.ndarray, x: float, y: float, radius: float) -> np.ndarray:
+    """The stretch of ``plan`` around (x, y) that base_local_planner's ``transformGlobalPlan`` hands on: from
+    the first pose within ``radius`` m (half the local costmap's larger side) up to the first pose beyond it
+    again, that one included (ROS's loop keeps it). Empty when no pose is that close (ROS: an empty
+    transformed plan, no command)."""
+    inside = (plan[:, 0] - x) ** 2 + (plan[:, 1] - y) ** 2 <= radius * radius
+    if not inside.any():
+        return plan[:0]
+    first = int(np.argmax(inside))
+    beyond = np.nonzero(~inside[first:])[0]
+    return plan[first:first + (int(beyond[0]) + 1 if len(beyond) else len(plan) - first)]
+
+
+def circle_footprint(radius: float) -> np.ndarray:
+    """The polygon (16, 2) costmap_2d makes from ``robot_radius`` (``makeFootprintFromRadius``: 16 vertices on
+    the circle, base frame, m): what base_local_planner and dwa_local_planner check a round robot with."""
+    if not (math.isfinite(radius) and radius > 0):
+        raise NavigationError(f"robot_radius: expected a positive number (m), got {radius!r}")
+    a = np.arange(16) * (2.0 * math.pi / 16)
+    return np.column_stack([radius * np.cos(a), radius * np.sin(a)])
+
+
 def stopped(velocity: tuple[float, float], trans_stopped_vel: float, theta_stopped_vel: float) -> bool:
     """base_local_planner's ``stopped``: |v| and |w| under the thresholds (m/s, rad/s)."""
     return abs(velocity[0]) <= trans_stopped_vel and abs(velocity[1]) <= theta_stopped_vel

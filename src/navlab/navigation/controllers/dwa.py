@@ -14,8 +14,8 @@ from navlab.navigation.controllers.params import DWAPlannerParams
 from navlab.navigation.controllers.trajectory import (
     LocalScene,
     RolloutController,
-    footprint_costs,
     lookup,
+    occupancy_costs,
     rollout,
     velocity_samples,
 )
@@ -27,16 +27,19 @@ class DWAPlannerROS(RolloutController):
     """dwa_local_planner's DWAPlanner behind the Controller protocol.
 
     ``params``: a DWAPlannerROS parameter dict (ROS 1 names, old and new spellings) or
-    ``DWAPlannerParams``; ``footprint``: polygon [[x, y], ...] (m, base frame) or None for a circular
-    robot (centre cell). ``rng`` is accepted for a uniform constructor and not used.
+    ``DWAPlannerParams``; ``footprint``: polygon [[x, y], ...] (m, base frame), else ``robot_radius`` (m:
+    costmap_2d's 16-gon), else a point robot (centre cell); ``controller_frequency``: move_base's (Hz), used
+    unless ``params`` sets it. ``rng`` is accepted for a uniform constructor and not used.
     """
 
     what = "DWAPlannerROS"
     params: DWAPlannerParams
 
     def __init__(self, params: Mapping[str, Any] | DWAPlannerParams | None = None, *, footprint: Any = None,
+                 robot_radius: float | None = None, controller_frequency: float | None = None,
                  rng: np.random.Generator | None = None) -> None:
-        super().__init__(params, footprint=footprint, rng=rng)
+        super().__init__(params, footprint=footprint, robot_radius=robot_radius,
+                         controller_frequency=controller_frequency, rng=rng)
         self._stopped_vel = (self.params.trans_stopped_vel, self.params.theta_stopped_vel)
         self._accelerate = not self.params.use_dwa
 
@@ -76,16 +79,28 @@ class DWAPlannerROS(RolloutController):
 
     def _front_goal_dist(self, scene: LocalScene) -> np.ndarray:
         """Distances to the local goal pushed ``forward_point_distance`` beyond itself, away from the robot
-        (dwa_local_planner's ``goal_front_costs``); the local goal itself if that point is off the map."""
+        (dwa_local_planner's ``goal_front_costs``: the plan with its last pose moved, whose last cell in the
+        costmap seeds the wave); the local goal's cell if that plan leaves no cell."""
         x, y, _ = scene.pose
         g = scene.local_goal()
         a = math.atan2(g[1] - y, g[0] - x)
-        front = g + self.params.forward_point_distance * np.array([math.cos(a), math.sin(a)])
-        seed = np.floor(front / scene.resolution).astype(np.int64)
-        h, w = scene.cost.shape
-        if not (0 <= seed[0] < w and 0 <= seed[1] < h) or scene.cost[seed[1], seed[0]] == 255:
-            seed = scene.path_cells[-1]
+        front = scene.plan.copy()
+        front[-1] = g + self.params.forward_point_distance * np.array([math.cos(a), math.sin(a)])
+        cells = mapgrid.plan_cells(scene.cost, front, scene.resolution)
+        seed = cells[-1] if len(cells) else scene.path_cells[-1]
         return mapgrid.distance_map(scene.cost, seed[None, :])
+
+    def _steps(self, targets: np.ndarray) -> np.ndarray:
+        """``SimpleTrajectoryGenerator``: ceil(max(|v| sim_time / sim_granularity, |w| sim_time /
+        angular_sim_granularity)), at least 1."""
+        p = self.params
+        need = p.sim_time * np.maximum(np.abs(targets[:, 0]) / p.sim_granularity,
+                                       np.abs(targets[:, 1]) / p.angular_sim_granularity)
+        return np.maximum(1, np.ceil(need - 1e-9)).astype(np.int64)
+
+    def _check(self, scene: LocalScene, targets: np.ndarray, traj: np.ndarray) -> np.ndarray:
+        self._osc.reset()  # ROS's DWAPlanner::checkTrajectory resets the oscillation flags first
+        return self.score(scene, targets, traj)
 
     def score(self, scene: LocalScene, targets: np.ndarray, traj: np.ndarray) -> np.ndarray:
         """Costs (S,) of the rollouts; -1 for a rejected one (blocked, off the map, no path, oscillating)."""
@@ -99,25 +114,26 @@ class DWAPlannerROS(RolloutController):
         total = np.zeros(len(targets))
         rejected = ~self._osc.allowed(targets[:, 0], targets[:, 1])
         if p.occdist_scale > 0:
-            fp = footprint_costs(scene.cost, res, traj, self._outline(res))
+            fp = occupancy_costs(scene.cost, res, traj, self._outline(res))
             rejected |= (fp < 0).any(axis=1)
             total += p.occdist_scale * fp.max(axis=1)
-        end = traj[:, -1]
-        nx = end[:, 0] + p.forward_point_distance * np.cos(end[:, 2])
-        ny = end[:, 1] + p.forward_point_distance * np.sin(end[:, 2])
+        # the nose: every pose moved forward_point_distance ahead (MapGrid critics with an x shift read the
+        # last one, and reject a rollout any of whose shifted poses is off the map)
+        nx = traj[..., 0] + p.forward_point_distance * np.cos(traj[..., 2])
+        ny = traj[..., 1] + p.forward_point_distance * np.sin(traj[..., 2])
         if gdist > 0:
             d, inside = lookup(self._front_goal_dist(scene), res, nx, ny)
-            rejected |= ~inside
-            total += gdist * d
+            rejected |= ~inside.all(axis=1)
+            total += gdist * d[:, -1]
         if align > 0:
             d, inside = lookup(scene.path_dist, res, nx, ny)
-            rejected |= ~inside
-            total += align * d
+            rejected |= ~inside.all(axis=1)
+            total += align * d[:, -1]
         for scale, grid in ((pdist, scene.path_dist), (gdist, scene.goal_dist)):
-            if scale > 0:
-                d, inside = lookup(grid, res, end[:, 0], end[:, 1])
-                rejected |= ~inside | (d >= scene.impossible)
-                total += scale * d
+            if scale > 0:  # stop on failure: any pose with no path to the plan or goal rejects the rollout
+                d, inside = lookup(grid, res, traj[..., 0], traj[..., 1])
+                rejected |= (~inside | (d >= scene.impossible)).any(axis=1)
+                total += scale * d[:, -1]
         if p.twirling_scale > 0:
             total += p.twirling_scale * np.abs(targets[:, 1])
         total[rejected] = -1.0
@@ -130,9 +146,14 @@ class DWAPlannerROS(RolloutController):
         targets = self.window(velocity, math.hypot(g[0] - scene.pose[0], g[1] - scene.pose[1]))
         if len(targets) == 0:
             return self._finish(scene, targets, np.zeros((0, 0, 3)), np.zeros(0), -1, pose)
-        n = self._steps(targets)
-        traj = rollout(scene.pose, velocity, targets, n, p.sim_time / n, (p.acc_lim_x, p.acc_lim_theta),
+        steps = self._steps(targets)
+        traj = rollout(scene.pose, velocity, targets, steps, p.sim_time, (p.acc_lim_x, p.acc_lim_theta),
                        accelerate=self._accelerate)
+        if not p.use_dwa:  # continued acceleration: ROS commands the velocity reached after the first step
+            dt = (p.sim_time / steps)[:, None]
+            now = np.array(velocity)
+            acc = np.array([p.acc_lim_x, p.acc_lim_theta])
+            targets = np.clip(targets, now - acc * dt, now + acc * dt)
         costs = self.score(scene, targets, traj)
         ok = costs >= 0
         best = int(np.argmin(np.where(ok, costs, np.inf))) if ok.any() else -1

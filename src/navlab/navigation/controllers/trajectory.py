@@ -6,28 +6,47 @@ best one's velocity:
 
 - *window*: ``v ± acc_lim_x * T``, ``w ± acc_lim_theta * T`` clipped to the velocity limits, with
   ``T = sim_period`` (1 / controller_frequency) for DWA and ``T = sim_time`` for plain trajectory rollout;
+- *plan*: as ``transformGlobalPlan`` hands it on, the (pruned) plan from its first pose within half the
+  local costmap's larger side of the robot up to the first pose beyond that again; the *local goal* is
+  its last pose (it caps TrajectoryPlanner's speed at ``distance / sim_time``, DWA pushes it
+  ``forward_point_distance`` away from the robot for its front goal);
 - *distances*: base_local_planner's MapGrid, 4-connected cell steps from the plan's cells and from the
-  local goal (the plan's last cell in the local costmap), blocked by LETHAL/INSCRIBED/unknown cells;
+  local goal's cell (the plan's last cell in the local costmap), blocked by LETHAL/INSCRIBED/unknown
+  cells (TrajectoryPlanner: except, on the path map, the cells under the robot now);
+- *footprint*: costmap_2d's robot footprint, a polygon (``robot_radius`` alone: ``makeFootprintFromRadius``'s
+  16-gon). A pose is blocked when the polygon's edges cross a LETHAL or unknown cell, its cost is the
+  highest cost under the edges or at the centre cell (``occdist`` takes the highest along the rollout).
+  Without a polygon or radius the robot is a point: its centre cell, blocked from INSCRIBED up;
 - *TrajectoryPlanner cost* = pdist_scale * path_dist + gdist_scale * goal_dist + occdist_scale *
-  max_cost, distances at the rollout's end (in cells, or metres with ``meter_scoring``), max_cost the
-  highest footprint cost along it; a rollout that leaves the map, touches a LETHAL/INSCRIBED/unknown
-  cell (circular robot: its centre cell; polygon: the cells under its edges, LETHAL/unknown), or
-  passes a cell with no path to the plan or goal is rejected. When no forward rollout is better it
-  turns in place towards the side whose look-ahead point (``heading_lookahead``) is closest to the
-  goal; with nothing valid it backs off at ``escape_vel``;
+  max_cost, distances at the rollout's end (in cells, or metres with ``meter_scoring``); a rollout that
+  leaves the map, is blocked, or passes a cell with no path to the plan or goal is rejected. In-place
+  turns (at least ``min_in_place_vel_theta``) win when their cost is no higher than the best forward
+  rollout's (an in-place turn ends where the robot is: it wins when no forward rollout gets closer),
+  the one whose look-ahead point (``heading_lookahead``) is closest to the goal; with nothing valid it
+  backs off at ``escape_vel``;
 - *DWA cost* = path_distance_bias * path_dist + goal_distance_bias * goal_dist + occdist_scale *
   max_cost + the same biases at a point ``forward_point_distance`` ahead of the end pose (to the plan,
-  and to the goal pushed that far beyond itself) + ``twirling_scale`` * |w|; biases scaled by the
-  resolution (ROS does). As in ROS, a critic whose scale is 0 is skipped, rejections included.
+  and to the local goal pushed that far beyond itself) + ``twirling_scale`` * |w|; biases scaled by the
+  resolution (ROS does); a rollout any of whose poses sits on a cell with no path to the plan or goal is
+  rejected. As in ROS, a critic whose scale is 0 is skipped, rejections included.
+
+Each sample is rolled out in ROS's number of steps (from its speed and turn rate over
+``sim_granularity`` / ``angular_sim_granularity``) and scored at its last step, one step short of
+``sim_time``.
 
 Near the goal both stop within the acceleration limits, then turn in place to the goal yaw
 (``xy_goal_tolerance``, ``yaw_goal_tolerance``, ``latch_xy_goal_tolerance``). Oscillation flags
-forbid turning back the other way (or reversing) until the robot moved ``oscillation_reset_dist``.
+forbid turning back the other way (DWA: or reversing) until the robot moved ``oscillation_reset_dist``
+(TrajectoryPlanner's ``stuck_left``/``stuck_right`` on its in-place turns, DWA's
+``OscillationCostFunction``).
 
-Deliberate differences from ROS: every sample of one cycle is rolled out with the same number of
-steps (the largest any needs), so slow samples are checked more finely; TrajectoryPlanner samples
-its full turn-rate window and uses DWA's oscillation flags (on its in-place turns); holonomic
-(y-velocity) samples are not generated, since the controllers command a differential base.
+The planners read move_base's ``controller_frequency`` (ROS searches the parameter upward) unless their
+own section sets it: ``sim_period`` is one controller cycle.
+
+Deliberate differences from ROS: holonomic (y-velocity) samples are not generated, since the
+controllers command a differential base; the 16-gon of a round robot is not padded vertex by vertex
+(``robot_radius`` is taken as given, padding included); footprint edges are sampled every half cell
+rather than Bresenham-rasterised.
 """
 
 from __future__ import annotations
@@ -47,6 +66,8 @@ from navlab.navigation.controllers.common import (
     LocalFrame,
     OscillationFlags,
     as_plan,
+    circle_footprint,
+    crop_plan,
     footprint_outline,
     goal_of,
     prune_plan,
@@ -56,32 +77,42 @@ from navlab.navigation.controllers.common import (
     stopped,
 )
 from navlab.navigation.controllers.params import TrajectoryPlannerParams
+from navlab.navigation.costmap.footprint import points_in_polygon
 from navlab.navigation.errors import NavigationError
 
 # --- rollout and footprint cost (pure, vectorised over samples) --------------------------------------
 
 
-def rollout(pose: tuple[float, float, float], velocity: tuple[float, float], targets: np.ndarray, n: int,
-            dt: float, acc: tuple[float, float], *, accelerate: bool) -> np.ndarray:
-    """Poses (S, n, 3) at t = 0, dt, ..., (n-1) dt of a unicycle starting at ``pose`` with ``velocity``.
+def rollout(pose: tuple[float, float, float], velocity: tuple[float, float], targets: np.ndarray,
+            steps: int | np.ndarray, sim_time: float, acc: tuple[float, float], *, accelerate: bool) -> np.ndarray:
+    """Poses (S, max(steps), 3) of a unicycle starting at ``pose`` with ``velocity``: sample ``s`` at
+    t = 0, dt, ..., (n - 1) dt with n = ``steps[s]`` and dt = ``sim_time`` / n (ROS's rollouts end one step
+    short of sim_time), then its last pose repeated up to the longest sample's length.
 
     ``targets`` (S, 2): commanded (v m/s, w rad/s). With ``accelerate`` the velocity moves towards the
     target by at most ``acc`` (m/s², rad/s²) * dt per step; otherwise it jumps to it (DWA).
     Each step moves along the heading held before the step (base_local_planner's integration).
     """
-    out = np.empty((len(targets), n, 3))
+    n = np.broadcast_to(np.maximum(np.asarray(steps, dtype=np.int64), 1), (len(targets),)).copy()
+    out = np.empty((len(targets), int(n.max()) if len(n) else 1, 3))
     _rollout(float(pose[0]), float(pose[1]), float(pose[2]), float(velocity[0]), float(velocity[1]),
-             np.ascontiguousarray(targets, dtype=np.float64), dt, float(acc[0]), float(acc[1]), accelerate, out)
+             np.ascontiguousarray(targets, dtype=np.float64), n, float(sim_time), float(acc[0]), float(acc[1]),
+             accelerate, out)
     return out
 
 
 @numba.njit(cache=True)
-def _rollout(x0: float, y0: float, th0: float, v0: float, w0: float, targets: np.ndarray, dt: float, ax: float,
-             ath: float, accelerate: bool, out: np.ndarray) -> None:  # pragma: no cover - compiled
+def _rollout(x0: float, y0: float, th0: float, v0: float, w0: float, targets: np.ndarray, steps: np.ndarray,
+             sim_time: float, ax: float, ath: float, accelerate: bool,
+             out: np.ndarray) -> None:  # pragma: no cover - compiled
     for s in range(out.shape[0]):
         x, y, th, v, w = x0, y0, th0, v0, w0
         tv, tw = targets[s, 0], targets[s, 1]
+        dt = sim_time / steps[s]
         for k in range(out.shape[1]):
+            if k >= steps[s]:
+                out[s, k, 0], out[s, k, 1], out[s, k, 2] = out[s, k - 1, 0], out[s, k - 1, 1], out[s, k - 1, 2]
+                continue
             out[s, k, 0], out[s, k, 1], out[s, k, 2] = x, y, th
             if accelerate:
                 v = min(max(tv, v - ax * dt), v + ax * dt)
@@ -139,6 +170,46 @@ def footprint_costs(cost: np.ndarray, resolution: float, poses: np.ndarray, outl
     return out
 
 
+def occupancy_costs(cost: np.ndarray, resolution: float, poses: np.ndarray, outline: np.ndarray | None
+                    ) -> np.ndarray:
+    """base_local_planner's obstacle cost of each grid-local pose (..., 3): -1 where the robot may not be.
+
+    Polygon: ``max(footprint cost, centre cell cost)`` (``TrajectoryPlanner::generateTrajectory``,
+    ``ObstacleCostFunction::footprintCost``), the footprint cost being costmap_2d's ``footprintCost``
+    (the highest cost under the edges, -1 when one is LETHAL or unknown). Point robot: :func:`footprint_costs`.
+    """
+    fp = footprint_costs(cost, resolution, poses, outline)
+    if outline is None:
+        return fp
+    centre, _ = lookup(cost, resolution, poses[..., 0], poses[..., 1])
+    return np.where(fp < 0, -1.0, np.maximum(fp, centre))
+
+
+def footprint_cells(shape: tuple[int, int], resolution: float, pose: tuple[float, float, float],
+                    polygon: np.ndarray | None) -> np.ndarray:
+    """Cells (K, 2) as (i, j) under the robot at grid-local ``pose``: the centre cell, and with a polygon
+    (base frame, m) every cell whose centre lies inside it or that its edges cross (ROS's filled
+    ``getFootprintCells``)."""
+    x, y, th = pose
+    h, w = shape
+    cells = [np.array([[math.floor(x / resolution), math.floor(y / resolution)]])]
+    if polygon is not None:
+        c, s = math.cos(th), math.sin(th)
+        poly = np.column_stack([x + c * polygon[:, 0] - s * polygon[:, 1], y + s * polygon[:, 0] + c * polygon[:, 1]])
+        lo = np.floor(poly.min(axis=0) / resolution).astype(np.int64)
+        hi = np.floor(poly.max(axis=0) / resolution).astype(np.int64)
+        ii, jj = np.meshgrid(np.arange(lo[0], hi[0] + 1), np.arange(lo[1], hi[1] + 1))
+        box = np.column_stack([ii.ravel(), jj.ravel()])
+        cells.append(box[points_in_polygon((box + 0.5) * resolution, poly)])
+        edges = footprint_outline(polygon, resolution)
+        assert edges is not None
+        ex = x + c * edges[:, 0] - s * edges[:, 1]
+        ey = y + s * edges[:, 0] + c * edges[:, 1]
+        cells.append(np.floor(np.column_stack([ex, ey]) / resolution).astype(np.int64))
+    out = np.unique(np.vstack(cells), axis=0)
+    return out[(out[:, 0] >= 0) & (out[:, 0] < w) & (out[:, 1] >= 0) & (out[:, 1] < h)]
+
+
 def velocity_samples(low: float, high: float, n: int) -> np.ndarray:
     """base_local_planner's VelocityIterator: ``n`` even steps from low to high, plus 0 if crossed."""
     if low >= high:
@@ -156,12 +227,14 @@ def velocity_samples(low: float, high: float, n: int) -> np.ndarray:
 
 @dataclass
 class LocalScene:
-    """One cycle's inputs in grid-local coordinates: pose, cost array, plan cells and distance maps."""
+    """One cycle's inputs in grid-local coordinates: pose, cost array, the plan as ROS's planners get it
+    (``plan`` (N, 2), cropped around the robot), its cells and the distance maps."""
 
     frame: LocalFrame
     pose: tuple[float, float, float]
     cost: np.ndarray
     resolution: float
+    plan: np.ndarray
     path_cells: np.ndarray
     path_dist: np.ndarray
     goal_dist: np.ndarray
@@ -172,8 +245,8 @@ class LocalScene:
         return float(self.cost.size)
 
     def local_goal(self) -> np.ndarray:
-        """Grid-local centre (2,) of the plan's last cell inside the local costmap."""
-        return (self.path_cells[-1] + 0.5) * self.resolution
+        """Grid-local point (2,): the cropped plan's last pose (``transformed_plan.back()``)."""
+        return self.plan[-1].copy()
 
 
 class RolloutController:
@@ -191,10 +264,14 @@ class RolloutController:
     _accelerate = True
 
     def __init__(self, params: Mapping[str, Any] | Any | None = None, *, footprint: Any = None,
+                 robot_radius: float | None = None, controller_frequency: float | None = None,
                  rng: np.random.Generator | None = None) -> None:
+        if controller_frequency is not None and (params is None or isinstance(params, Mapping)):
+            params = {"controller_frequency": controller_frequency, **(params or {})}  # its own value wins
         self.params = self._parse(params)
         self.footprint = None if footprint is None else np.asarray(footprint, dtype=np.float64)
-        footprint_outline(self.footprint, 0.05)  # validate now
+        if footprint_outline(self.footprint, 0.05) is None:  # validate now; no polygon: the round robot's 16-gon
+            self.footprint = None if robot_radius is None else circle_footprint(float(robot_radius))
         p = self.params
         self._latch = GoalLatch(p.xy_goal_tolerance, p.yaw_goal_tolerance, p.latch_xy_goal_tolerance)
         self._osc = OscillationFlags(p.oscillation_reset_dist, getattr(p, "oscillation_reset_angle", -1.0))
@@ -275,14 +352,19 @@ class RolloutController:
         cost = np.ascontiguousarray(costmap.data, dtype=np.uint8)
         res = costmap.resolution
         pose_l = frame.pose_in(pose)
-        cells = mapgrid.plan_cells(cost, frame.points_in(self._plan[:, :2]), res)
+        reach = 0.5 * res * max(cost.shape)
+        plan = crop_plan(frame.points_in(self._plan[:, :2]), pose_l[0], pose_l[1], reach)
+        if len(plan) == 0:
+            return None  # ROS: an empty transformed plan (no pose of the plan near the robot)
+        cells = mapgrid.plan_cells(cost, plan, res)
         if len(cells) == 0:
             return None  # ROS: "None of the points of the global plan were in the local costmap"
         free = self._free_cells(cost, pose_l, res)
-        return LocalScene(frame, pose_l, cost, res, cells, mapgrid.distance_map(cost, cells, free),
-                          mapgrid.distance_map(cost, cells[-1:], free))
+        return LocalScene(frame, pose_l, cost, res, plan, cells, mapgrid.distance_map(cost, cells, free),
+                          mapgrid.distance_map(cost, cells[-1:]))
 
     def _free_cells(self, cost: np.ndarray, pose_l: tuple[float, float, float], res: float) -> np.ndarray | None:
+        """Cells never obstacles for the path map's wave (None: none)."""
         return None
 
     def _outline(self, res: float) -> np.ndarray | None:
@@ -312,19 +394,20 @@ class RolloutController:
         raise NotImplementedError
 
     def _command_valid(self, scene: LocalScene, velocity: tuple[float, float], cmd: tuple[float, float]) -> bool:
-        """Whether rolling ``cmd`` out for sim_time keeps the footprint clear (ROS's ``checkTrajectory``)."""
+        """Whether rolling ``cmd`` out for sim_time scores as a legal trajectory (ROS's ``checkTrajectory``)."""
         p = self.params
-        n = self._steps(np.array([cmd]))
-        traj = rollout(scene.pose, velocity, np.array([cmd]), n, p.sim_time / n, (p.acc_lim_x, p.acc_lim_theta),
-                       accelerate=self._accelerate)
-        return bool((footprint_costs(scene.cost, scene.resolution, traj, self._outline(scene.resolution)) >= 0).all())
+        targets = np.array([cmd])
+        traj = rollout(scene.pose, velocity, targets, self._steps(targets), p.sim_time,
+                       (p.acc_lim_x, p.acc_lim_theta), accelerate=self._accelerate)
+        return bool(self._check(scene, targets, traj)[0] >= 0)
 
-    def _steps(self, targets: np.ndarray) -> int:
-        p = self.params
-        ang = p.angular_sim_granularity if p.angular_sim_granularity > 0 else p.sim_granularity
-        need = p.sim_time * max(float(np.abs(targets[:, 0]).max()) / p.sim_granularity,
-                                float(np.abs(targets[:, 1]).max()) / ang)
-        return max(1, math.ceil(need - 1e-9))
+    def _check(self, scene: LocalScene, targets: np.ndarray, traj: np.ndarray) -> np.ndarray:
+        """Costs (S,) of rollouts checked outside the sampling loop (< 0: illegal)."""
+        raise NotImplementedError
+
+    def _steps(self, targets: np.ndarray) -> np.ndarray:
+        """Rollout steps (S,) of each sample, as the ROS planner counts them."""
+        raise NotImplementedError
 
     def _finish(self, scene: LocalScene, targets: np.ndarray, traj: np.ndarray, costs: np.ndarray, best: int,
                 pose: tuple[float, float, float]) -> tuple[float, float]:
@@ -333,7 +416,9 @@ class RolloutController:
         if best < 0:
             self.valid = False
             return 0.0, 0.0
-        self.local_plan = scene.frame.poses_out(traj[best])
+        path = traj[best]
+        moved = np.nonzero(np.any(path[1:] != path[:-1], axis=1))[0]
+        self.local_plan = scene.frame.poses_out(path[: (int(moved[-1]) + 2) if len(moved) else 1])
         return float(targets[best, 0]), float(targets[best, 1])
 
     def _drive(self, scene: LocalScene, pose: tuple[float, float, float], velocity: tuple[float, float],
@@ -344,11 +429,52 @@ class RolloutController:
 # --- base_local_planner/TrajectoryPlannerROS ----------------------------------------------------------
 
 
+class InPlaceFlags:
+    """TrajectoryPlanner's guard against turning on the spot back and forth (``stuck_left``/``stuck_right``).
+
+    Each in-place turn (v <= 0) is recorded with the pose it was chosen at; once the robot turned in place the
+    same way twice, in-place turns the other way are no longer tried. Everything is forgotten when the robot is
+    more than ``reset_dist`` m from the last in-place turn's pose.
+    """
+
+    def __init__(self, reset_dist: float) -> None:
+        self.reset_dist = reset_dist
+        self.prev = (0.0, 0.0)
+        self.reset()
+
+    def reset(self) -> None:
+        """Clear every flag."""
+        self.rotating_left = self.rotating_right = self.stuck_left = self.stuck_right = False
+
+    def allowed(self, w: np.ndarray) -> np.ndarray:
+        """Mask of the in-place turn rates (rad/s) that may be tried (ROS: w < 0 unless ``stuck_left``, w > 0
+        unless ``stuck_right``)."""
+        return ((w < 0) & (not self.stuck_left)) | ((w > 0) & (not self.stuck_right))
+
+    def moved(self, pose: tuple[float, float, float]) -> None:
+        """Forget the flags once the robot is far enough from the last in-place turn."""
+        if math.hypot(pose[0] - self.prev[0], pose[1] - self.prev[1]) > self.reset_dist:
+            self.reset()
+
+    def update(self, pose: tuple[float, float, float], v: float, w: float) -> None:
+        """Record the chosen command (v m/s, w rad/s) at ``pose``."""
+        if not v > 0:
+            if w < 0:
+                self.stuck_right |= self.rotating_right
+                self.rotating_right = True
+            elif w > 0:
+                self.stuck_left |= self.rotating_left
+                self.rotating_left = True
+            self.prev = (pose[0], pose[1])
+        self.moved(pose)
+
+
 class TrajectoryPlannerROS(RolloutController):
     """base_local_planner's trajectory rollout / DWA planner (``dwa`` flag) behind the Controller protocol.
 
     ``params``: a TrajectoryPlannerROS parameter dict (ROS 1 names) or ``TrajectoryPlannerParams``;
-    ``footprint``: polygon [[x, y], ...] (m, base frame) or None for a circular robot (centre cell).
+    ``footprint``: polygon [[x, y], ...] (m, base frame), else ``robot_radius`` (m: costmap_2d's 16-gon), else
+    a point robot (centre cell); ``controller_frequency``: move_base's (Hz), used unless ``params`` sets it.
     ``rng`` is accepted for a uniform constructor and not used (the planner is deterministic).
     """
 
@@ -356,10 +482,13 @@ class TrajectoryPlannerROS(RolloutController):
     params: TrajectoryPlannerParams
 
     def __init__(self, params: Mapping[str, Any] | TrajectoryPlannerParams | None = None, *, footprint: Any = None,
+                 robot_radius: float | None = None, controller_frequency: float | None = None,
                  rng: np.random.Generator | None = None) -> None:
-        super().__init__(params, footprint=footprint, rng=rng)
+        super().__init__(params, footprint=footprint, robot_radius=robot_radius,
+                         controller_frequency=controller_frequency, rng=rng)
         self._escaping = False
         self._escape_pose = (0.0, 0.0, 0.0)
+        self._spin = InPlaceFlags(self.params.oscillation_reset_dist)
 
     @staticmethod
     def _parse(params: Any) -> TrajectoryPlannerParams:
@@ -367,23 +496,32 @@ class TrajectoryPlannerROS(RolloutController):
 
     def _new_goal(self) -> None:
         self._escaping = False
+        self._spin.reset()
 
     def _in_place_limits(self, err: float) -> tuple[float, float]:
         p = self.params
         return (p.max_vel_theta if err > 0 else -p.min_vel_theta), p.min_in_place_vel_theta
 
     def _free_cells(self, cost: np.ndarray, pose_l: tuple[float, float, float], res: float) -> np.ndarray | None:
-        """Cells under the robot now, never obstacles for the distance wave (ROS's ``within_robot``)."""
-        i, j = math.floor(pose_l[0] / res), math.floor(pose_l[1] / res)
-        if 0 <= i < cost.shape[1] and 0 <= j < cost.shape[0]:
-            return np.array([[i, j]])
-        return None
+        """Cells under the robot now, never obstacles for the path map's wave (ROS's ``within_robot``)."""
+        return footprint_cells(cost.shape, res, pose_l, self.footprint if self._outline(res) is not None else None)
+
+    def _check(self, scene: LocalScene, targets: np.ndarray, traj: np.ndarray) -> np.ndarray:
+        return self._score(scene, traj)
+
+    def _steps(self, targets: np.ndarray) -> np.ndarray:
+        """``TrajectoryPlanner::generateTrajectory``: round(max(|v| sim_time / sim_granularity, |w| /
+        angular_sim_granularity)), at least 1 (ROS leaves sim_time out of the angular term)."""
+        p = self.params
+        ang = p.angular_sim_granularity if p.angular_sim_granularity > 0 else p.sim_granularity
+        need = np.maximum(np.abs(targets[:, 0]) * p.sim_time / p.sim_granularity, np.abs(targets[:, 1]) / ang)
+        return np.maximum(1, np.floor(need + 0.5)).astype(np.int64)
 
     def _score(self, scene: LocalScene, traj: np.ndarray) -> np.ndarray:
         """Costs (S,): pdist * path_dist + gdist * goal_dist + occdist * max_cost; -1 blocked, -2 no path."""
         p = self.params
         res = scene.resolution
-        fp = footprint_costs(scene.cost, res, traj, self._outline(res))
+        fp = occupancy_costs(scene.cost, res, traj, self._outline(res))
         pd, _ = lookup(scene.path_dist, res, traj[..., 0], traj[..., 1])
         gd, _ = lookup(scene.goal_dist, res, traj[..., 0], traj[..., 1])
         scale = res if p.meter_scoring else 1.0
@@ -404,16 +542,16 @@ class TrajectoryPlannerROS(RolloutController):
         vmin = min(max(p.min_vel_x, v0 - p.acc_lim_x * horizon), vmax)
         wmax = min(p.max_vel_theta, w0 + p.acc_lim_theta * horizon)
         wmin = min(max(p.min_vel_theta, w0 - p.acc_lim_theta * horizon), wmax)
+        # ROS's order: per speed the straight rollout, then vtheta_samples - 1 turn rates from the lowest up
         vxs = np.linspace(vmin, vmax, p.vx_samples) if p.vx_samples > 1 else np.array([vmin])
         ws = np.linspace(wmin, wmax, p.vtheta_samples) if p.vtheta_samples > 1 else np.array([wmin])
         dw = (wmax - wmin) / (p.vtheta_samples - 1) if p.vtheta_samples > 1 else 0.0
-        fwd_w = np.concatenate([[0.0], ws])
+        fwd_w = np.concatenate([[0.0], ws[:-1]]) if len(ws) > 1 else np.array([0.0])
         forward = np.stack([np.repeat(vxs, len(fwd_w)), np.tile(fwd_w, len(vxs))], axis=1)
         spin = np.where(ws > 0, np.maximum(ws, p.min_in_place_vel_theta), np.minimum(ws, -p.min_in_place_vel_theta))
         in_place = np.stack([np.zeros_like(spin), spin], axis=1)
         targets = np.vstack([forward, in_place, [[p.escape_vel, 0.0]]])
-        n = self._steps(targets)
-        traj = rollout(scene.pose, velocity, targets, n, p.sim_time / n, (p.acc_lim_x, p.acc_lim_theta),
+        traj = rollout(scene.pose, velocity, targets, self._steps(targets), p.sim_time, (p.acc_lim_x, p.acc_lim_theta),
                        accelerate=True)
         costs = self._score(scene, traj)
         nf, ni = len(forward), len(in_place)
@@ -427,7 +565,7 @@ class TrajectoryPlannerROS(RolloutController):
         hx = ahead[:, 0] + p.heading_lookahead * np.cos(ahead[:, 2])
         hy = ahead[:, 1] + p.heading_lookahead * np.sin(ahead[:, 2])
         head_dist, head_in = lookup(scene.goal_dist, scene.resolution, hx, hy)
-        allowed = self._osc.allowed(in_place[:, 0], in_place[:, 1])
+        allowed = self._spin.allowed(ws)
         best_heading = math.inf
         for k in range(ni):
             c = costs[nf + k]
@@ -436,16 +574,21 @@ class TrajectoryPlannerROS(RolloutController):
             if head_dist[k] < best_heading:
                 best, best_heading = nf + k, float(head_dist[k])
         if best >= 0:
-            self._osc.update(pose, float(targets[best, 0]), float(targets[best, 1]), 0.0)
-            moved = math.hypot(pose[0] - self._escape_pose[0], pose[1] - self._escape_pose[1])
-            turned = abs(math.remainder(pose[2] - self._escape_pose[2], 2 * math.pi))
-            if moved > p.escape_reset_dist or turned > p.escape_reset_theta:
-                self._escaping = False
+            self._spin.update(pose, float(targets[best, 0]), float(targets[best, 1]))
+            self._end_escape(pose)
             return self._finish(scene, targets, traj, costs, best, pose)
         # nothing valid: back off slowly, even into cost (ROS does), unless there is no path at all
+        self._spin.moved(pose)
         esc = len(targets) - 1
-        if costs[esc] == -2.0:
-            return self._finish(scene, targets, traj, costs, -1, pose)
-        if not self._escaping:
+        if costs[esc] > -2.0 and not self._escaping:
             self._escaping, self._escape_pose = True, pose
-        return self._finish(scene, targets, traj, costs, esc, pose)
+        self._end_escape(pose)
+        return self._finish(scene, targets, traj, costs, esc if costs[esc] > -2.0 else -1, pose)
+
+    def _end_escape(self, pose: tuple[float, float, float]) -> None:
+        """Leave escape mode once ``escape_reset_dist`` m or ``escape_reset_theta`` rad from where it began."""
+        p = self.params
+        moved = math.hypot(pose[0] - self._escape_pose[0], pose[1] - self._escape_pose[1])
+        turned = abs(math.remainder(pose[2] - self._escape_pose[2], 2 * math.pi))
+        if moved > p.escape_reset_dist or turned > p.escape_reset_theta:
+            self._escaping = False
