@@ -11,7 +11,7 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = ["00_runtime/run.py", "01_robot_description/run.py", "03_drive/run.py", "04_localize/run.py",
-            "05_map_room/run.py"]
+            "05_map_room/run.py", "06_navigate/run.py"]
 
 
 @pytest.mark.parametrize("script", EXAMPLES)
