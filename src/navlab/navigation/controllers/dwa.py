@@ -114,7 +114,7 @@ class DWAPlannerROS(RolloutController):
         total = np.zeros(len(targets))
         rejected = ~self._osc.allowed(targets[:, 0], targets[:, 1])
         if p.occdist_scale > 0:
-            fp = occupancy_costs(scene.cost, res, traj, self._outline(res))
+            fp = occupancy_costs(scene.cost, res, traj, self._outline(res), near_max=self._near_max(scene))
             rejected |= (fp < 0).any(axis=1)
             total += p.occdist_scale * fp.max(axis=1)
         # the nose: every pose moved forward_point_distance ahead (MapGrid critics with an x shift read the

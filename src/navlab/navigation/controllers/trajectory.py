@@ -146,50 +146,137 @@ def _lookup(grid: np.ndarray, inv: float, x: np.ndarray, y: np.ndarray, vals: np
         vals[k] = grid[j, i] if ok else grid[0, 0]
 
 
-def footprint_costs(cost: np.ndarray, resolution: float, poses: np.ndarray, outline: np.ndarray | None
-                    ) -> np.ndarray:
+def footprint_costs(cost: np.ndarray, resolution: float, poses: np.ndarray, outline: np.ndarray | None, *,
+                    near_max: np.ndarray | None = None) -> np.ndarray:
     """costmap_2d's footprint cost at each grid-local pose (..., 3): -1 where the robot may not be.
 
     Circular robot (``outline`` None): the centre cell's cost, -1 if LETHAL, INSCRIBED, unknown or off the
     map. Polygon: the highest cost under its edges (``outline`` (M, 2) base-frame points), -1 if any is
-    LETHAL or unknown or the robot is off the map.
+    LETHAL or unknown or the robot is off the map. ``near_max``: :func:`outline_reach_max` of ``cost`` and
+    ``outline``, if the caller has it (poses with nothing but free cells around skip their edges).
     """
-    x, y = poses[..., 0], poses[..., 1]
-    centre, inside = lookup(cost, resolution, x, y)
-    if outline is None:
-        out = centre.astype(np.float64)
-        out[(centre >= COST_INSCRIBED) | ~inside] = -1.0
-        return out
-    c, s = np.cos(poses[..., 2])[..., None], np.sin(poses[..., 2])[..., None]
-    px = x[..., None] + c * outline[:, 0] - s * outline[:, 1]
-    py = y[..., None] + s * outline[:, 0] + c * outline[:, 1]
-    edge, edge_in = lookup(cost, resolution, px, py)
-    edge = np.where(edge_in, edge, COST_UNKNOWN)
-    out = edge.max(axis=-1).astype(np.float64)
-    out[(edge >= COST_LETHAL).any(axis=-1) | ~inside] = -1.0
-    return out
+    return _pose_costs(cost, resolution, poses, outline, near_max, with_centre=False)
 
 
-def occupancy_costs(cost: np.ndarray, resolution: float, poses: np.ndarray, outline: np.ndarray | None
-                    ) -> np.ndarray:
+def occupancy_costs(cost: np.ndarray, resolution: float, poses: np.ndarray, outline: np.ndarray | None, *,
+                    near_max: np.ndarray | None = None) -> np.ndarray:
     """base_local_planner's obstacle cost of each grid-local pose (..., 3): -1 where the robot may not be.
 
     Polygon: ``max(footprint cost, centre cell cost)`` (``TrajectoryPlanner::generateTrajectory``,
     ``ObstacleCostFunction::footprintCost``), the footprint cost being costmap_2d's ``footprintCost``
     (the highest cost under the edges, -1 when one is LETHAL or unknown). Point robot: :func:`footprint_costs`.
+    ``near_max``: :func:`outline_reach_max` of ``cost`` and ``outline``, if the caller has it (poses whose
+    centre cell holds the highest cost around skip their edges).
     """
-    fp = footprint_costs(cost, resolution, poses, outline)
+    return _pose_costs(cost, resolution, poses, outline, near_max, with_centre=True)
+
+
+def outline_reach_max(cost: np.ndarray, resolution: float, outline: np.ndarray) -> np.ndarray:
+    """The highest cost (uint8, ``cost``'s shape; unknown for cells off the grid) in the square of cells that
+    the ``outline``'s points can fall in while the robot's centre is in each cell: where it equals the centre
+    cell's cost, no edge can cost more (the footprint cost needs no edge lookups)."""
+    reach = math.ceil(float(np.hypot(outline[:, 0], outline[:, 1]).max()) / resolution) + 1
+    out = np.empty(cost.shape, dtype=np.uint8)
+    _box_max(np.ascontiguousarray(cost, dtype=np.uint8), reach, out)
+    return out
+
+
+@numba.njit(cache=True)
+def _box_max(grid: np.ndarray, reach: int, out: np.ndarray) -> None:  # pragma: no cover - compiled
+    h, w = grid.shape
+    rows = np.empty((h, w), dtype=np.uint8)
+    for j in range(h):
+        for i in range(w):
+            m = grid[j, i]
+            if i - reach < 0 or i + reach >= w:
+                m = COST_UNKNOWN
+            else:
+                for k in range(i - reach, i + reach + 1):
+                    m = max(m, grid[j, k])
+            rows[j, i] = m
+    for j in range(h):
+        for i in range(w):
+            m = rows[j, i]
+            if j - reach < 0 or j + reach >= h:
+                m = COST_UNKNOWN
+            else:
+                for k in range(j - reach, j + reach + 1):
+                    m = max(m, rows[k, i])
+            out[j, i] = m
+
+
+def _pose_costs(cost: np.ndarray, resolution: float, poses: np.ndarray, outline: np.ndarray | None,
+                near_max: np.ndarray | None, *, with_centre: bool) -> np.ndarray:
+    """:func:`footprint_costs` (``with_centre`` False) or :func:`occupancy_costs` (True), one compiled pass."""
+    poses = np.asarray(poses, dtype=np.float64)
+    shape = poses.shape[:-1]
+    flat = poses.reshape(-1, 3)
+    out = np.empty(flat.shape[0], dtype=np.float64)
+    grid = np.ascontiguousarray(cost)
+    x, y = np.ascontiguousarray(flat[:, 0]), np.ascontiguousarray(flat[:, 1])
     if outline is None:
-        return fp
-    centre, _ = lookup(cost, resolution, poses[..., 0], poses[..., 1])
-    return np.where(fp < 0, -1.0, np.maximum(fp, centre))
+        empty = np.zeros(0)
+        _footprint_pass(grid, grid, 1.0 / resolution, x, y, empty, empty, empty, empty, False, False, with_centre,
+                        out)
+    else:
+        ol = np.asarray(outline, dtype=np.float64)
+        near = grid if near_max is None else np.ascontiguousarray(near_max, dtype=grid.dtype)
+        # numpy's cos/sin (as before); the edge points are formed in the kernel in the same operation order
+        _footprint_pass(grid, near, 1.0 / resolution, x, y, np.cos(flat[:, 2]), np.sin(flat[:, 2]),
+                        np.ascontiguousarray(ol[:, 0]), np.ascontiguousarray(ol[:, 1]), True, near_max is not None,
+                        with_centre, out)
+    return out.reshape(shape)
+
+
+@numba.njit(cache=True)
+def _footprint_pass(grid: np.ndarray, near: np.ndarray, inv: float, x: np.ndarray, y: np.ndarray, c: np.ndarray,
+                    s: np.ndarray, ox: np.ndarray, oy: np.ndarray, polygon: bool, use_near: bool, with_centre: bool,
+                    out: np.ndarray) -> None:  # pragma: no cover - compiled
+    h, w = grid.shape
+    for k in range(x.size):
+        if k > 0 and x[k] == x[k - 1] and y[k] == y[k - 1] and (not polygon or (c[k] == c[k - 1] and s[k] == s[k - 1])):
+            out[k] = out[k - 1]  # a rollout's last pose repeated: the same cost
+            continue
+        i, j = math.floor(x[k] * inv), math.floor(y[k] * inv)
+        inside = 0 <= i < w and 0 <= j < h
+        centre = grid[j, i] if inside else grid[0, 0]
+        if not polygon:
+            out[k] = -1.0 if (centre >= COST_INSCRIBED or not inside) else float(centre)
+            continue
+        if not inside:
+            out[k] = -1.0
+            continue
+        if use_near:  # every edge point lies in the square ``near`` holds the highest cost of
+            top = near[j, i]
+            if top < COST_LETHAL and (top == 0 or (with_centre and top == centre)):
+                out[k] = float(top)
+                continue
+        best = -1
+        blocked = False
+        for m in range(ox.size):
+            px = x[k] + c[k] * ox[m] - s[k] * oy[m]
+            py = y[k] + s[k] * ox[m] + c[k] * oy[m]
+            pi, pj = math.floor(px * inv), math.floor(py * inv)
+            v = int(grid[pj, pi]) if (0 <= pi < w and 0 <= pj < h) else COST_UNKNOWN
+            if v >= COST_LETHAL:
+                blocked = True
+                break
+            if v > best:
+                best = v
+        if blocked:
+            out[k] = -1.0
+        elif with_centre:
+            out[k] = float(max(best, int(centre)))
+        else:
+            out[k] = float(best)
 
 
 def footprint_cells(shape: tuple[int, int], resolution: float, pose: tuple[float, float, float],
-                    polygon: np.ndarray | None) -> np.ndarray:
+                    polygon: np.ndarray | None, *, edges: np.ndarray | None = None) -> np.ndarray:
     """Cells (K, 2) as (i, j) under the robot at grid-local ``pose``: the centre cell, and with a polygon
     (base frame, m) every cell whose centre lies inside it or that its edges cross (ROS's filled
-    ``getFootprintCells``)."""
+    ``getFootprintCells``), sorted by i then j. ``edges``: the polygon's ``footprint_outline`` at
+    ``resolution`` if the caller has it already."""
     x, y, th = pose
     h, w = shape
     cells = [np.array([[math.floor(x / resolution), math.floor(y / resolution)]])]
@@ -201,12 +288,18 @@ def footprint_cells(shape: tuple[int, int], resolution: float, pose: tuple[float
         ii, jj = np.meshgrid(np.arange(lo[0], hi[0] + 1), np.arange(lo[1], hi[1] + 1))
         box = np.column_stack([ii.ravel(), jj.ravel()])
         cells.append(box[points_in_polygon((box + 0.5) * resolution, poly)])
-        edges = footprint_outline(polygon, resolution)
+        if edges is None:
+            edges = footprint_outline(polygon, resolution)
         assert edges is not None
         ex = x + c * edges[:, 0] - s * edges[:, 1]
         ey = y + s * edges[:, 0] + c * edges[:, 1]
         cells.append(np.floor(np.column_stack([ex, ey]) / resolution).astype(np.int64))
-    out = np.unique(np.vstack(cells), axis=0)
+    both = np.vstack(cells)
+    # unique rows, in np.unique(axis=0)'s order, through one integer key per cell (faster on small arrays)
+    lo_ij = both.min(axis=0)
+    span = int(both[:, 1].max() - lo_ij[1]) + 1
+    keys = np.unique((both[:, 0] - lo_ij[0]) * span + (both[:, 1] - lo_ij[1]))
+    out = np.column_stack([keys // span + lo_ij[0], keys % span + lo_ij[1]])
     return out[(out[:, 0] >= 0) & (out[:, 0] < w) & (out[:, 1] >= 0) & (out[:, 1] < h)]
 
 
@@ -277,6 +370,8 @@ class RolloutController:
         self._osc = OscillationFlags(p.oscillation_reset_dist, getattr(p, "oscillation_reset_angle", -1.0))
         self._plan: np.ndarray | None = None
         self._rotating_to_goal = False
+        self._outlines: dict[tuple[float, bytes | None], np.ndarray | None] = {}
+        self._near: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
         self._clear_outputs()
 
     @staticmethod
@@ -368,7 +463,25 @@ class RolloutController:
         return None
 
     def _outline(self, res: float) -> np.ndarray | None:
-        return footprint_outline(self.footprint, res)
+        """The footprint's edge points at ``res`` (cached: the same footprint and resolution every cycle)."""
+        key = (res, None if self.footprint is None else self.footprint.tobytes())
+        if key not in self._outlines:
+            self._outlines[key] = footprint_outline(self.footprint, res)
+        return self._outlines[key]
+
+    def _near_max(self, scene: LocalScene) -> np.ndarray | None:
+        """``outline_reach_max`` of the scene's costs (None for a point robot), kept while the costs stay the
+        same (the local costmap updates less often than the controller runs)."""
+        outline = self._outline(scene.resolution)
+        if outline is None:
+            return None
+        cached = self._near
+        if (cached is not None and cached[0] is outline and cached[1].shape == scene.cost.shape
+                and np.array_equal(cached[1], scene.cost)):
+            return cached[2]
+        near = outline_reach_max(scene.cost, scene.resolution, outline)
+        self._near = (outline, scene.cost.copy(), near)
+        return near
 
     def _stop_rotate(self, pose: tuple[float, float, float], velocity: tuple[float, float],
                      goal: tuple[float, float, float | None], scene: LocalScene | None) -> tuple[float, float]:
@@ -504,7 +617,8 @@ class TrajectoryPlannerROS(RolloutController):
 
     def _free_cells(self, cost: np.ndarray, pose_l: tuple[float, float, float], res: float) -> np.ndarray | None:
         """Cells under the robot now, never obstacles for the path map's wave (ROS's ``within_robot``)."""
-        return footprint_cells(cost.shape, res, pose_l, self.footprint if self._outline(res) is not None else None)
+        edges = self._outline(res)
+        return footprint_cells(cost.shape, res, pose_l, self.footprint if edges is not None else None, edges=edges)
 
     def _check(self, scene: LocalScene, targets: np.ndarray, traj: np.ndarray) -> np.ndarray:
         return self._score(scene, traj)
@@ -521,7 +635,7 @@ class TrajectoryPlannerROS(RolloutController):
         """Costs (S,): pdist * path_dist + gdist * goal_dist + occdist * max_cost; -1 blocked, -2 no path."""
         p = self.params
         res = scene.resolution
-        fp = occupancy_costs(scene.cost, res, traj, self._outline(res))
+        fp = occupancy_costs(scene.cost, res, traj, self._outline(res), near_max=self._near_max(scene))
         pd, _ = lookup(scene.path_dist, res, traj[..., 0], traj[..., 1])
         gd, _ = lookup(scene.goal_dist, res, traj[..., 0], traj[..., 1])
         scale = res if p.meter_scoring else 1.0

@@ -321,7 +321,7 @@ class InflationLayer(Layer):
         self.name = name
         self.enabled = self.params.enabled
         self.footprint = footprint or make_footprint()
-        # the last inflation: ((origin, resolution, window), lethal seeds, costs), reused while nothing changed
+        # the last inflation: ((origin, resolution, shape), lethal seeds, costs over the whole grid)
         self._inflated: tuple[Any, np.ndarray, np.ndarray] | None = None
 
     @classmethod
@@ -352,20 +352,45 @@ class InflationLayer(Layer):
         seeds = data == COST_LETHAL
         if not seeds.any():
             return
-        reach = math.ceil(self.params.inflation_radius / master.resolution) + 1
-        jj, ii = np.nonzero(seeds)
-        j0, j1 = max(0, jj.min() - reach), min(data.shape[0], jj.max() + reach + 1)
-        i0, i1 = max(0, ii.min() - reach), min(data.shape[1], ii.max() + reach + 1)
-        window = data[j0:j1, i0:i1]
-        key = (master.origin, master.resolution, (j0, j1, i0, i1))
-        cached = self._inflated
-        if cached is not None and cached[0] == key and np.array_equal(cached[1], seeds):
-            cost = cached[2]  # the same obstacles as last update: the same inflation (skips the transform)
-        else:
-            dist = ndimage.distance_transform_edt(~seeds[j0:j1, i0:i1]) * master.resolution
-            cost = self.cost_at(dist)
-            self._inflated = (key, seeds.copy(), cost)
-        unknown = window == COST_UNKNOWN
+        cost = self._inflation(master, seeds)
+        unknown = data == COST_UNKNOWN
         overwrite_unknown = unknown & ((cost > COST_FREE) if self.params.inflate_unknown else (cost >= COST_INSCRIBED))
-        merged = np.where(unknown, np.where(overwrite_unknown, cost, window), np.maximum(window, cost))
-        data[j0:j1, i0:i1] = merged
+        data[:] = np.where(unknown, np.where(overwrite_unknown, cost, data), np.maximum(data, cost))
+
+    def _inflation(self, master: Grid, seeds: np.ndarray) -> np.ndarray:
+        """Inflation costs (uint8, the master's shape; 0 beyond ``inflation_radius``) of the lethal ``seeds``.
+
+        A cell's cost depends only on the seeds within ``reach`` cells of it, so after the first update only
+        the cells within ``reach`` of a seed that appeared or vanished are recomputed, from the seeds within
+        ``reach`` of those (exactly what a transform of the whole grid gives them)."""
+        reach = math.ceil(self.params.inflation_radius / master.resolution) + 1
+        key = (master.origin, master.resolution, seeds.shape)
+        cached = self._inflated
+        if cached is None or cached[0] != key:
+            cost = np.zeros(seeds.shape, dtype=np.uint8)
+            box = _box(seeds, reach, seeds.shape)
+        else:
+            cost = cached[2]
+            changed = seeds != cached[1]
+            if not changed.any():
+                return cost  # the same obstacles as last update: the same inflation (skips the transform)
+            box = _box(changed, reach, seeds.shape)
+        j0, j1, i0, i1 = box
+        o0, o1 = max(0, j0 - reach), min(seeds.shape[0], j1 + reach)
+        p0, p1 = max(0, i0 - reach), min(seeds.shape[1], i1 + reach)
+        near = seeds[o0:o1, p0:p1]
+        if near.any():
+            dist = ndimage.distance_transform_edt(~near) * master.resolution
+            cost[j0:j1, i0:i1] = self.cost_at(dist[j0 - o0:j1 - o0, i0 - p0:i1 - p0])
+        else:  # no obstacle within reach of the box: nothing to inflate there
+            cost[j0:j1, i0:i1] = 0
+        self._inflated = (key, seeds, cost)
+        return cost
+
+
+def _box(mask: np.ndarray, reach: int, shape: tuple[int, ...]) -> tuple[int, int, int, int]:
+    """Row and column bounds (j0, j1, i0, i1) of the cells within ``reach`` of a true cell of ``mask``."""
+    rows = np.flatnonzero(mask.any(axis=1))
+    cols = np.flatnonzero(mask.any(axis=0))
+    return (max(0, int(rows[0]) - reach), min(shape[0], int(rows[-1]) + reach + 1),
+            max(0, int(cols[0]) - reach), min(shape[1], int(cols[-1]) + reach + 1))
