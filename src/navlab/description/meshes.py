@@ -16,7 +16,6 @@ import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import numpy as np
-from scipy.spatial import ConvexHull, QhullError
 
 from navlab.description.errors import DescriptionError
 from navlab.io.files import write_text_atomic
@@ -300,6 +299,8 @@ def is_convex(verts: np.ndarray, faces: np.ndarray | None = None, *, rel_tol: fl
     tol = rel_tol * scale
     uverts, inverse = np.unique(np.round(verts / scale, 9), axis=0, return_inverse=True)
     uverts = uverts * scale
+    from scipy.spatial import ConvexHull, QhullError  # scipy.spatial costs 0.25 s to import: only here
+
     try:
         hull = ConvexHull(uverts)
     except QhullError:

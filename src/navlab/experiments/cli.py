@@ -121,6 +121,20 @@ def _cmd_navigate(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_experiment(args: argparse.Namespace) -> int:
+    from navlab.experiments.scenario import load_scenario
+    from navlab.experiments.trials import run_experiment
+
+    sc = load_scenario(args.file)
+    out = args.out or f"runs/{sc.name}"
+    summary = run_experiment(sc, out, trials=args.trials, seed=args.seed, workers=args.workers,
+                             progress=not args.quiet and sys.stderr.isatty())  # fmt: skip
+    if not args.json:
+        print(f"{summary['trials']} trials of {sc.name}: results in {out}/results.jsonl, summary in {out}/summary.json")
+    print_figures(summary, args.json)
+    return 0
+
+
 def cmd_eval_map(args: argparse.Namespace) -> int:
     """Score a saved map against a world's true occupancy (start pose known, no alignment)."""
     from navlab.experiments.mapping_run import read_trajectory
@@ -170,7 +184,7 @@ def _add_world_robot(p: argparse.ArgumentParser, world: str) -> None:
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    """Add ``map``, ``localize`` and ``navigate``."""
+    """Add ``map``, ``localize``, ``navigate`` and ``experiment``."""
     p = sub.add_parser(
         "map",
         help="build a map with SLAM in simulation (exploration, teleop or a route) and save it",
@@ -264,3 +278,23 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--record", metavar="DIR", help="also write every topic to a rosbag2 (MCAP) in DIR")
     p.add_argument("--json", action="store_true", help="print the figures as one JSON object")
     p.set_defaults(func=_cmd_navigate)
+
+    p = sub.add_parser(
+        "experiment",
+        help="run a scenario's trials headless and summarize them (the paper's Section V)",
+        description="navlab experiment run FILE: run the trials of a scenario YAML (or a shipped one: empty_room, "
+        "obstacles_after_mapping) headless, each with its own seed, in parallel processes with --workers. Each "
+        "finished trial is appended whole to DIR/results.jsonl; running again resumes and skips finished trials. "
+        "Prints (and writes DIR/summary.json) the success rate with a 95 % Wilson interval, collisions, failures "
+        "by kind, time quartiles, SPL, clearance, localization error and command jerk.",
+    )
+    p.add_argument("action", choices=["run"], help="run: run the scenario's trials")
+    p.add_argument("file", help="scenario YAML, or a shipped scenario's name")
+    p.add_argument("--trials", type=int, default=None, help="how many trials (default: the scenario's)")
+    p.add_argument("--seed", type=int, default=None,
+                   help="seed of trial 0; trial k uses seed + k (default: the scenario's)")
+    p.add_argument("--workers", type=int, default=1, help="parallel processes (default 1)")
+    p.add_argument("--out", metavar="DIR", default=None, help="results folder (default runs/<scenario name>)")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--json", action="store_true", help="print the summary as one JSON object")
+    p.set_defaults(func=_cmd_experiment)

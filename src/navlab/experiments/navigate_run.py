@@ -54,9 +54,16 @@ class NavMonitor(Node):
         self.contacts: list[float] = []  # times (s) of /collisions messages
         self._nearest = math.inf  # the nearest return since the last sample (m)
         self._scan: Any = None
+        self.estimate_frame = str(self.declare_parameter("estimate_frame", "map"))
+        self.localization_error: list[float] = []  # |estimate - truth| (m) at each sample, where there is one
+        self.cmd: list[tuple[float, float]] = []  # (t s, linear x m/s) of every cmd_vel
+        self.create_subscription(msgs.Twist, "cmd_vel", self._on_cmd, 10)
         self.create_subscription(msgs.String, "/collisions", lambda _m: self.contacts.append(self.now_s()), 10)
         self.create_subscription(msgs.LaserScan, "scan", self._on_scan, 5)
         self.create_timer(0.1, self._sample)
+
+    def _on_cmd(self, msg: Any) -> None:
+        self.cmd.append((self.now_s(), float(msg.linear.x)))
 
     def _on_scan(self, msg: Any) -> None:
         r = np.asarray(msg.ranges, dtype=np.float64)
@@ -72,6 +79,12 @@ class NavMonitor(Node):
     def _sample(self) -> None:
         x, y, _ = self.sim.base_pose2d()
         self.path.append((self.now_s(), x, y))
+        if self.estimate_frame:
+            try:
+                ex, ey, _ = self.executor.tf.lookup_pose2d(self.estimate_frame, self.base_frame)
+                self.localization_error.append(math.hypot(ex - x, ey - y))
+            except TfError:
+                pass
         self.clearance.append(self._nearest - self.radius)
         self._nearest = math.inf
 
@@ -202,7 +215,8 @@ def run_navigation(
                             overrides={"move_base": overrides}, **launch_args)  # fmt: skip
     mb = _move_base(run)
     radius = mb.local_costmap.layered.circumscribed_radius
-    mon = run.add(NavMonitor, parameters={"robot_radius": radius, "base_frame": run.base_frame},
+    mon = run.add(NavMonitor, parameters={"robot_radius": radius, "base_frame": run.base_frame,
+                                          "estimate_frame": "" if mapless else "map"},
                   remappings={"scan": run.scan_topic}, sim=run.sim, move_base=mb)
     for t, model in spawn:
         _at(run, float(t), lambda m=model: run.gazebo.spawn(m(run.sim) if callable(m) else m))
@@ -221,9 +235,13 @@ def run_navigation(
         if during:  # the paper's pictures show the robot on its way: the middle of the drive
             shots.append(during[len(during) // 2])
     bag = recorder.close() if recorder else None
+    loc = np.array(mon.localization_error)
     summary = rounded({
         "goals_succeeded": sum(r["outcome"] == "succeeded" for r in results),
         "collisions": sum(r["collisions"] for r in results),
+        "localization_error_mean_m": float(loc.mean()) if loc.size else None,
+        "localization_error_max_m": float(loc.max()) if loc.size else None,
+        "cmd_jerk_mean": mean_abs_jerk(mon.cmd),
         **run.figures(),
         **({"record": str(bag)} if bag else {}),
     })  # fmt: skip
@@ -267,3 +285,19 @@ def bench(args: Any) -> dict[str, Any]:
     r = run_navigation(goals, world="room_obstacles", goal_timeout=90, seed=getattr(args, "seed", 0))
     return {**{k: r.summary[k] for k in ("sim_s", "wall_s", "rtf")}, "goals_succeeded": r.summary["goals_succeeded"],
             "goals": len(goals), "collisions": r.summary["collisions"]}  # fmt: skip
+
+
+def mean_abs_jerk(cmd: Sequence[tuple[float, float]]) -> float | None:
+    """Mean |d²v/dt²| (m/s³) of the commanded linear speed, from (t s, v m/s) samples; None if too few."""
+    if len(cmd) < 3:
+        return None
+    a = np.array(cmd, dtype=np.float64)
+    t, v = a[:, 0], a[:, 1]
+    dt = np.diff(t)
+    keep = np.concatenate([[True], dt > 1e-9])  # one command per instant
+    t, v = t[keep], v[keep]
+    if len(t) < 3:
+        return None
+    acc = np.diff(v) / np.diff(t)
+    jerk = np.diff(acc) / np.diff(t)[1:]
+    return float(np.abs(jerk).mean())

@@ -122,13 +122,15 @@ def start_run(
 
 
 def rounded(figures: dict[str, Any], digits: int = 4) -> dict[str, Any]:
-    """Floats rounded for printing (nested dicts too); non-finite floats become None (valid JSON)."""
-    out: dict[str, Any] = {}
-    for key, value in figures.items():
-        if isinstance(value, dict):
-            out[key] = rounded(value, digits)
-        elif isinstance(value, float):
-            out[key] = round(value, digits) if math.isfinite(value) else None
-        else:
-            out[key] = value
-    return out
+    """Floats rounded for printing (in nested dicts and lists too); non-finite floats become None (valid JSON)."""
+    return {key: _round(value, digits) for key, value in figures.items()}
+
+
+def _round(value: Any, digits: int) -> Any:
+    if isinstance(value, dict):
+        return rounded(value, digits)
+    if isinstance(value, list | tuple):
+        return [_round(v, digits) for v in value]
+    if isinstance(value, float):
+        return round(value, digits) if math.isfinite(value) else None
+    return value

@@ -3,28 +3,15 @@
 >>> from navlab.world import load_world, occupancy
 >>> world = load_world(navlab.resources.world("room"))
 >>> grid = occupancy(world, 0.05, (-5.5, -4.5, 5.5, 4.5))
+
+(Imported eagerly: ``occupancy`` is both a submodule and a function, which a lazy export would let the
+submodule shadow.)
 """
 
-from typing import TYPE_CHECKING
-
-from navlab.lazy import lazy_exports
-
-if TYPE_CHECKING:
-    from navlab.world.errors import WorldError
-    from navlab.world.model import ModelSpec, WorldModel
-    from navlab.world.occupancy import extents, occupancy, shape_footprints
-    from navlab.world.sdf import load_model, load_world
-
-_EXPORTS = {
-    "ModelSpec": "navlab.world.model",
-    "WorldError": "navlab.world.errors",
-    "WorldModel": "navlab.world.model",
-    "extents": "navlab.world.occupancy",
-    "load_model": "navlab.world.sdf",
-    "load_world": "navlab.world.sdf",
-    "occupancy": "navlab.world.occupancy",
-    "shape_footprints": "navlab.world.occupancy",
-}
+from navlab.world.errors import WorldError
+from navlab.world.model import ModelSpec, WorldModel
+from navlab.world.occupancy import extents, occupancy, shape_footprints
+from navlab.world.sdf import load_model, load_world
 
 __all__ = [
     "ModelSpec",
@@ -36,4 +23,3 @@ __all__ = [
     "occupancy",
     "shape_footprints",
 ]
-__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

@@ -12,7 +12,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial import ConvexHull, QhullError
 
 from navlab.description.meshes import read_mesh
 from navlab.description.model import Shape
@@ -69,6 +68,8 @@ def _hull2d(pts: np.ndarray) -> np.ndarray:
         return pts
     pts = np.unique(np.round(pts, 12), axis=0)
     if len(pts) >= 3:
+        from scipy.spatial import ConvexHull, QhullError  # scipy.spatial costs 0.25 s to import: only here
+
         try:
             return pts[ConvexHull(pts).vertices]
         except QhullError:

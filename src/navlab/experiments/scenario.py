@@ -1,0 +1,139 @@
+"""Scenarios as YAML: what one experiment runs, trial after trial (the paper's Section V in a file).
+
+```yaml
+name: obstacles_after_mapping
+world: room_obstacles        # shipped name or .world file (relative paths: beside this file)
+map: map_first               # true (the world's true map) | map_first (SLAM in map_world first) | none | FILE
+map_world: room              # the world mapped first: the obstacles come after mapping
+robot: mybot
+start: [0.0, 0.0, 0.0]       # x y yaw in the world (m, rad)
+controller: trajectory       # trajectory | dwa | mppi | a ROS plugin name (default: the parameter files')
+params: null                 # folder of move_base's ROS 1 parameter files (default: the shipped robot's)
+overrides: {local_costmap.update_frequency: 5.0}   # move_base parameters
+obstacles: [{t: 20.0, spec: "cylinder:x=-1.0,y=-0.45,radius=0.15,length=0.6"}]   # added while running
+goals: [[4.3, 1.0, 0.0], [-3.5, -0.5, 3.14]]      # map frame (odom with map: none)
+trials: 20                   # trial k runs with seed + k
+seed: 0
+time_limit: 90.0             # s per goal
+```
+Unknown keys get "did you mean"; bad values one line naming the key.
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+from dataclasses import dataclass, field, fields
+from pathlib import Path
+from typing import Any
+
+from navlab.experiments.errors import ExperimentError
+
+MAP_MODES = ("true", "map_first", "none")
+
+
+@dataclass
+class Scenario:
+    """One experiment's settings (see the module docstring); ``path`` is the file it came from."""
+
+    name: str = "scenario"
+    world: str = "room_obstacles"
+    map: str = "true"
+    map_world: str | None = None
+    robot: str = "mybot"
+    start: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    controller: str | None = None
+    params: str | None = None
+    overrides: dict[str, Any] = field(default_factory=dict)
+    obstacles: list[dict[str, Any]] = field(default_factory=list)
+    goals: list[tuple[float, float, float]] = field(default_factory=list)
+    trials: int = 1
+    seed: int = 0
+    time_limit: float = 90.0
+    path: Path | None = None
+
+    def resolve(self, value: str | None) -> str | None:
+        """A file named in the scenario, relative to the scenario file; shipped names stay as they are."""
+        if value is None or self.path is None:
+            return value
+        candidate = self.path.parent / value
+        return str(candidate) if candidate.exists() else value
+
+
+def _pose(value: Any, where: str) -> tuple[float, float, float]:
+    try:
+        x, y, yaw = (float(v) for v in value)
+    except (TypeError, ValueError):
+        raise ExperimentError(f"{where}: expected [x, y, yaw] numbers, got {value!r}") from None
+    if not all(math.isfinite(v) for v in (x, y, yaw)):
+        raise ExperimentError(f"{where}: expected finite numbers, got {value!r}")
+    return x, y, yaw
+
+
+def scenario_from_dict(data: Any, *, where: str = "scenario", path: Path | None = None) -> Scenario:
+    """A validated ``Scenario`` from parsed YAML."""
+    if not isinstance(data, dict):
+        raise ExperimentError(f"{where}: expected a mapping of scenario keys, got {type(data).__name__}")
+    names = [f.name for f in fields(Scenario) if f.name != "path"]
+    for key in data:
+        if key not in names:
+            close = difflib.get_close_matches(str(key), names, n=1)
+            hint = f"; did you mean '{close[0]}'?" if close else ""
+            raise ExperimentError(f"{where}: unknown key '{key}'{hint} (keys: {', '.join(names)})")
+    sc = Scenario(path=path)
+    if isinstance(data.get("map"), bool):  # YAML reads `map: true` as a boolean
+        data = {**data, "map": "true" if data["map"] else "none"}
+    for key in ("name", "world", "map", "robot"):
+        if key in data:
+            if not isinstance(data[key], str) or not data[key]:
+                raise ExperimentError(f"{where}: {key}: expected a non-empty string, got {data[key]!r}")
+            setattr(sc, key, data[key])
+    for key in ("map_world", "controller", "params"):
+        if data.get(key) is not None:
+            setattr(sc, key, str(data[key]))
+    if sc.map not in MAP_MODES and not sc.map.endswith(".yaml"):
+        raise ExperimentError(f"{where}: map: expected {', '.join(MAP_MODES)} or a map .yaml file, got {sc.map!r}")
+    if "start" in data:
+        sc.start = _pose(data["start"], f"{where}: start")
+    goals = data.get("goals")
+    if not isinstance(goals, list) or not goals:
+        raise ExperimentError(f"{where}: goals: expected a list of [x, y, yaw], got {goals!r}")
+    sc.goals = [_pose(g, f"{where}: goals[{k}]") for k, g in enumerate(goals)]
+    overrides = data.get("overrides") or {}
+    if not isinstance(overrides, dict):
+        raise ExperimentError(f"{where}: overrides: expected a mapping of move_base parameters, got {overrides!r}")
+    sc.overrides = dict(overrides)
+    for k, ob in enumerate(data.get("obstacles") or []):
+        if not isinstance(ob, dict) or set(ob) != {"t", "spec"} or not isinstance(ob["spec"], str):
+            raise ExperimentError(f"{where}: obstacles[{k}]: expected {{t: seconds, spec: 'cylinder:x=..,y=..'}}, "
+                                  f"got {ob!r}")  # fmt: skip
+        if not (isinstance(ob["t"], int | float) and math.isfinite(ob["t"]) and ob["t"] >= 0):
+            raise ExperimentError(f"{where}: obstacles[{k}].t: expected a time >= 0 s, got {ob['t']!r}")
+        sc.obstacles.append(dict(ob))
+    for key, low in (("trials", 1), ("seed", 0)):
+        if key in data:
+            v = data[key]
+            if isinstance(v, bool) or not isinstance(v, int) or v < low:
+                raise ExperimentError(f"{where}: {key}: expected an integer >= {low}, got {v!r}")
+            setattr(sc, key, v)
+    if "time_limit" in data:
+        v = data["time_limit"]
+        if isinstance(v, bool) or not isinstance(v, int | float) or not (math.isfinite(v) and v > 0):
+            raise ExperimentError(f"{where}: time_limit: expected seconds > 0, got {v!r}")
+        sc.time_limit = float(v)
+    return sc
+
+
+def load_scenario(name_or_path: str | Path) -> Scenario:
+    """A scenario file, or a shipped one by name (``empty_room``, ``obstacles_after_mapping``)."""
+    from navlab import resources
+    from navlab.core.params import read_yaml
+
+    p = Path(name_or_path)
+    if not p.is_file():
+        shipped = resources.root() / "scenarios" / f"{p.name.removesuffix('.yaml')}.yaml"
+        if not shipped.is_file():
+            names = sorted(f.stem for f in (resources.root() / "scenarios").glob("*.yaml"))
+            raise ExperimentError(f"no scenario file {str(name_or_path)!r} (shipped: {', '.join(names)})")
+        p = shipped
+    return scenario_from_dict(read_yaml(p), where=str(p), path=p.resolve())

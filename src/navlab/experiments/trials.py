@@ -1,0 +1,206 @@
+"""Trials of a scenario: each one a headless run with its own seed, its figures one JSON line in
+``results.jsonl`` (written whole or not at all), so a run that is killed resumes where it stopped.
+
+Per trial: ``success`` (every goal reached with no collision), ``failure`` (collision, timeout, aborted —
+with move_base's reason), ``time_s``, ``path_m``, ``spl`` (success × shortest / max(path, shortest),
+shortest from the true map), ``min_clearance_m``, ``collisions``, localization error (mean, max) and the
+mean |jerk| of cmd_vel. The summary has the success rate with a 95 % Wilson interval, medians and quartiles.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import sys
+import tempfile
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from navlab.experiments.errors import ExperimentError
+from navlab.experiments.scenario import Scenario
+from navlab.experiments.session import rounded
+
+
+def wilson_interval(successes: int, n: int, z: float = 1.96) -> tuple[float, float]:
+    """95 % Wilson score interval of a success rate (0, 1 for no trials)."""
+    if n == 0:
+        return 0.0, 1.0
+    p = successes / n
+    centre = (p + z * z / (2 * n)) / (1 + z * z / n)
+    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
+    return max(0.0, centre - half), min(1.0, centre + half)
+
+
+def shortest_length(world: str, start: tuple[float, float, float], goals: list[tuple[float, float, float]],
+                    robot_radius: float = 0.2) -> float | None:  # fmt: skip
+    """Length (m) of the shortest collision-free route start -> goals on the world's true map (None if any
+    leg has none): SPL's reference."""
+    from navlab.experiments.truth import true_map
+    from navlab.mapping.explore import clearance_costmap
+    from navlab.navigation.planners.theta_star import ThetaStarPlanner
+    from navlab.sim.gazebo import load_world_named
+
+    costmap = clearance_costmap(true_map(load_world_named(world), start[:2]), robot_radius, comfort=0.01)
+    planner = ThetaStarPlanner({"w_traversal_cost": 0.0})  # any-angle: the geometric shortest route
+    total, here = 0.0, start
+    for goal in goals:
+        path = planner.make_plan(costmap, here, goal)
+        if path is None:
+            return None
+        total += float(np.linalg.norm(np.diff(path, axis=0), axis=1).sum())
+        here = goal
+    return total
+
+
+def run_trial(sc: Scenario, index: int) -> dict[str, Any]:
+    """Trial ``index`` of ``sc`` (seed = sc.seed + index); its figures."""
+    from navlab.experiments.mapping_run import run_mapping
+    from navlab.experiments.navigate_run import run_navigation
+    from navlab.sim.spawn import parse_spawn_spec
+
+    seed = sc.seed + index
+    world = sc.resolve(sc.world) or sc.world
+    spawns = [(float(ob["t"]), parse_spawn_spec(ob["spec"], default_name=f"obstacle_{k}")[0])
+              for k, ob in enumerate(sc.obstacles)]  # fmt: skip
+    with tempfile.TemporaryDirectory(prefix="navlab-trial-") as tmp:
+        map_yaml: str | Path | None = None
+        if sc.map == "map_first":
+            mapped = run_mapping(world=sc.resolve(sc.map_world) or sc.map_world or world, robot=sc.robot,
+                                 pose=sc.start, out=Path(tmp) / "map", seed=seed, quiet=True)  # fmt: skip
+            map_yaml = mapped.map_yaml
+        elif sc.map not in ("true", "none"):
+            map_yaml = sc.resolve(sc.map)
+        r = run_navigation(sc.goals, world=world, map_yaml=map_yaml, robot=sc.robot, pose=sc.start,
+                           controller=sc.controller, params_dir=sc.resolve(sc.params), move_base_params=sc.overrides,
+                           spawn=spawns, goal_timeout=sc.time_limit, seed=seed, mapless=sc.map == "none")  # fmt: skip
+    goals = r.goals
+    failed = next((g for g in goals if g["outcome"] != "succeeded" or g["collisions"]), None)
+    success = failed is None
+    failure = "" if failed is None else ("collision" if failed["collisions"] else failed["outcome"])
+    path_m = sum(g["path_m"] for g in goals)
+    shortest = shortest_length(world, sc.start, sc.goals) if sc.map != "none" else None
+    spl = (float(success) * shortest / max(path_m, shortest)) if shortest else None
+    return rounded({
+        "trial": index, "seed": seed, "success": success, "failure": failure,
+        "reason": "" if failed is None else failed["reason"],
+        "goals_succeeded": sum(g["outcome"] == "succeeded" for g in goals), "goals": len(goals),
+        "time_s": sum(g["time_s"] for g in goals), "path_m": path_m, "shortest_m": shortest, "spl": spl,
+        "min_clearance_m": min(g["min_clearance_m"] for g in goals), "collisions": sum(g["collisions"] for g in goals),
+        "localization_error_mean_m": r.summary.get("localization_error_mean_m"),
+        "localization_error_max_m": r.summary.get("localization_error_max_m"),
+        "cmd_jerk_mean": r.summary.get("cmd_jerk_mean"), "sim_s": r.summary["sim_s"], "wall_s": r.summary["wall_s"],
+        "per_goal": goals,
+    })  # fmt: skip
+
+
+def _append_line(path: Path, record: dict[str, Any]) -> None:
+    """One JSON line, written with a single ``write`` on an O_APPEND file and synced: whole or not at all."""
+    data = (json.dumps(record) + "\n").encode()
+    fd = os.open(path, os.O_RDWR | os.O_APPEND | os.O_CREAT, 0o644)
+    try:
+        size = os.fstat(fd).st_size
+        if size and os.pread(fd, 1, size - 1) != b"\n":  # a line torn by a crash: end it, keep it unparseable
+            data = b"\n" + data
+        os.write(fd, data)
+        os.fsync(fd)
+    finally:
+        os.close(fd)
+
+
+def read_results(path: Path) -> list[dict[str, Any]]:
+    """The finished trials in ``results.jsonl`` (a torn last line from a crash is ignored)."""
+    if not path.is_file():
+        return []
+    out = []
+    for line in path.read_text().splitlines():
+        try:
+            out.append(json.loads(line))
+        except json.JSONDecodeError:
+            continue
+    return out
+
+
+def summarize_trials(results: list[dict[str, Any]]) -> dict[str, Any]:
+    """Success rate with a 95 % Wilson interval, collisions, failures by kind, medians and quartiles."""
+    n = len(results)
+    ok = sum(bool(r["success"]) for r in results)
+    lo, hi = wilson_interval(ok, n)
+
+    def quartiles(key: str) -> list[float] | None:
+        vals = [r[key] for r in results if r.get(key) is not None]
+        return [float(v) for v in np.percentile(vals, [25, 50, 75])] if vals else None
+
+    times = quartiles("time_s")
+    failures: dict[str, int] = {}
+    for r in results:
+        if not r["success"]:
+            failures[r["failure"]] = failures.get(r["failure"], 0) + 1
+    return rounded({
+        "trials": n, "success_rate": ok / n if n else None, "success_ci95": [lo, hi],
+        "collisions": sum(r["collisions"] for r in results), "failures": failures,
+        "median_time_s": times[1] if times else None, "time_s_quartiles": times,
+        "median_path_m": _median(results, "path_m"), "spl_mean": _mean(results, "spl"),
+        "min_clearance_m": min((r["min_clearance_m"] for r in results), default=None),
+        "localization_error_mean_m": _mean(results, "localization_error_mean_m"),
+        "cmd_jerk_mean": _mean(results, "cmd_jerk_mean"),
+    })  # fmt: skip
+
+
+def _median(results: list[dict[str, Any]], key: str) -> float | None:
+    vals = [r[key] for r in results if r.get(key) is not None]
+    return float(np.median(vals)) if vals else None
+
+
+def _mean(results: list[dict[str, Any]], key: str) -> float | None:
+    vals = [r[key] for r in results if r.get(key) is not None]
+    return float(np.mean(vals)) if vals else None
+
+
+def _trial_in_worker(args: tuple[Scenario, int]) -> dict[str, Any]:
+    return run_trial(*args)
+
+
+def run_experiment(sc: Scenario, out: str | Path, *, trials: int | None = None, seed: int | None = None,
+                   workers: int = 1, progress: bool = False) -> dict[str, Any]:  # fmt: skip
+    """Run the scenario's trials not yet in ``out``/results.jsonl (in ``workers`` processes), append each as it
+    finishes, and return (and write ``summary.json``) the summary over all of them."""
+    from tqdm import tqdm
+
+    from navlab.io.files import write_text_atomic
+
+    if trials is not None:
+        sc.trials = trials
+    if seed is not None:
+        sc.seed = seed
+    if sc.trials < 1 or workers < 1:
+        raise ExperimentError(f"trials and workers must be >= 1, got {sc.trials} and {workers}")
+    folder = Path(out)
+    folder.mkdir(parents=True, exist_ok=True)
+    results_path = folder / "results.jsonl"
+    done = {int(r["trial"]): r for r in read_results(results_path) if r.get("seed") == sc.seed + int(r["trial"])}
+    todo = [k for k in range(sc.trials) if k not in done]
+    bar = tqdm(total=sc.trials, initial=sc.trials - len(todo), desc=sc.name, unit="trial", file=sys.stderr,
+               disable=not progress)  # fmt: skip
+    try:
+        if workers == 1 or len(todo) <= 1:
+            for k in todo:
+                done[k] = run_trial(sc, k)
+                _append_line(results_path, done[k])
+                bar.update(1)
+        else:
+            import multiprocessing
+
+            with multiprocessing.get_context("spawn").Pool(min(workers, len(todo))) as pool:
+                for rec in pool.imap_unordered(_trial_in_worker, [(sc, k) for k in todo]):
+                    done[int(rec["trial"])] = rec
+                    _append_line(results_path, rec)
+                    bar.update(1)
+    finally:
+        bar.close()
+    results = [done[k] for k in sorted(done) if k < sc.trials]
+    summary = {"scenario": sc.name, **summarize_trials(results)}
+    write_text_atomic(folder / "summary.json", json.dumps(summary, indent=1) + "\n")
+    return summary
