@@ -77,7 +77,6 @@ from navlab.navigation.controllers.common import (
     stopped,
 )
 from navlab.navigation.controllers.params import TrajectoryPlannerParams
-from navlab.navigation.costmap.footprint import points_in_polygon
 from navlab.navigation.errors import NavigationError
 
 # --- rollout and footprint cost (pure, vectorised over samples) --------------------------------------
@@ -228,79 +227,158 @@ def _pose_costs(cost: np.ndarray, resolution: float, poses: np.ndarray, outline:
     return out.reshape(shape)
 
 
+@numba.njit(cache=True, inline="always")
+def _pose_cost(grid: np.ndarray, near: np.ndarray, inv: float, x: float, y: float, c: float, s: float, ox: np.ndarray,
+               oy: np.ndarray, polygon: bool, use_near: bool, with_centre: bool) -> float:  # pragma: no cover
+    """One pose's footprint (``with_centre`` False) or occupancy (True) cost, -1 where the robot may not be."""
+    h, w = grid.shape
+    i, j = math.floor(x * inv), math.floor(y * inv)
+    inside = 0 <= i < w and 0 <= j < h
+    centre = grid[j, i] if inside else grid[0, 0]
+    if not polygon:
+        return -1.0 if (centre >= COST_INSCRIBED or not inside) else float(centre)
+    if not inside:
+        return -1.0
+    if use_near:  # every edge point lies in the square ``near`` holds the highest cost of
+        top = near[j, i]
+        if top < COST_LETHAL and (top == 0 or (with_centre and top == centre)):
+            return float(top)
+    # every edge point, without early exit (the loop compiles to branch-free code): off the grid or on a
+    # LETHAL/unknown cell is illegal, else the highest cost
+    best = np.uint8(0)
+    off = False
+    for m in range(ox.size):
+        px = x + c * ox[m] - s * oy[m]
+        py = y + s * ox[m] + c * oy[m]
+        pi, pj = np.int64(math.floor(px * inv)), np.int64(math.floor(py * inv))
+        ok = (pi >= 0) & (pi < w) & (pj >= 0) & (pj < h)
+        off |= not ok
+        best = max(best, grid[pj if ok else 0, pi if ok else 0])
+    if off or best >= COST_LETHAL:
+        return -1.0
+    return float(max(best, centre)) if with_centre else float(best)
+
+
 @numba.njit(cache=True)
 def _footprint_pass(grid: np.ndarray, near: np.ndarray, inv: float, x: np.ndarray, y: np.ndarray, c: np.ndarray,
                     s: np.ndarray, ox: np.ndarray, oy: np.ndarray, polygon: bool, use_near: bool, with_centre: bool,
                     out: np.ndarray) -> None:  # pragma: no cover - compiled
-    h, w = grid.shape
     for k in range(x.size):
         if k > 0 and x[k] == x[k - 1] and y[k] == y[k - 1] and (not polygon or (c[k] == c[k - 1] and s[k] == s[k - 1])):
             out[k] = out[k - 1]  # a rollout's last pose repeated: the same cost
             continue
-        i, j = math.floor(x[k] * inv), math.floor(y[k] * inv)
-        inside = 0 <= i < w and 0 <= j < h
-        centre = grid[j, i] if inside else grid[0, 0]
-        if not polygon:
-            out[k] = -1.0 if (centre >= COST_INSCRIBED or not inside) else float(centre)
-            continue
-        if not inside:
-            out[k] = -1.0
-            continue
-        if use_near:  # every edge point lies in the square ``near`` holds the highest cost of
-            top = near[j, i]
-            if top < COST_LETHAL and (top == 0 or (with_centre and top == centre)):
-                out[k] = float(top)
-                continue
-        best = -1
+        ck, sk = (c[k], s[k]) if polygon else (1.0, 0.0)
+        out[k] = _pose_cost(grid, near, inv, x[k], y[k], ck, sk, ox, oy, polygon, use_near, with_centre)
+
+
+@numba.njit(cache=True)
+def _rollout_scores(grid: np.ndarray, near: np.ndarray, path_dist: np.ndarray, goal_dist: np.ndarray, inv: float,
+                    traj: np.ndarray, c: np.ndarray, s: np.ndarray, ox: np.ndarray, oy: np.ndarray, polygon: bool,
+                    use_near: bool, weights: np.ndarray, impossible: float,
+                    out: np.ndarray) -> None:  # pragma: no cover - compiled
+    """TrajectoryPlanner's cost of each rollout (S, n, 3): ``weights`` = (scale, pdist, gdist, occdist);
+    -1 when a pose is blocked, else -2 when a pose has no path to the plan or goal."""
+    h, w = path_dist.shape
+    for r in range(traj.shape[0]):
+        top = -math.inf
         blocked = False
-        for m in range(ox.size):
-            px = x[k] + c[k] * ox[m] - s[k] * oy[m]
-            py = y[k] + s[k] * ox[m] + c[k] * oy[m]
-            pi, pj = math.floor(px * inv), math.floor(py * inv)
-            v = int(grid[pj, pi]) if (0 <= pi < w and 0 <= pj < h) else COST_UNKNOWN
-            if v >= COST_LETHAL:
+        no_path = False
+        fp = 0.0
+        pd = gd = 0.0
+        for k in range(traj.shape[1]):
+            x, y = traj[r, k, 0], traj[r, k, 1]
+            i, j = math.floor(x * inv), math.floor(y * inv)
+            inside = 0 <= i < w and 0 <= j < h
+            pd, gd = (path_dist[j, i], goal_dist[j, i]) if inside else (path_dist[0, 0], goal_dist[0, 0])
+            if pd >= impossible or gd >= impossible:
+                no_path = True
+            if blocked:
+                continue
+            if use_near and polygon and inside:
+                bound = near[j, i]  # no edge of this pose costs more: it cannot raise the rollout's cost
+                if bound < COST_LETHAL and bound <= top:
+                    continue
+            same = k > 0 and x == traj[r, k - 1, 0] and y == traj[r, k - 1, 1] and (
+                not polygon or (c[r, k] == c[r, k - 1] and s[r, k] == s[r, k - 1]))
+            if not same:  # a rollout's last pose repeated has the same cost
+                fp = _pose_cost(grid, near, inv, x, y, c[r, k], s[r, k], ox, oy, polygon, use_near, True)
+            if fp < 0:
                 blocked = True
-                break
-            if v > best:
-                best = v
+            elif fp > top:
+                top = fp
         if blocked:
-            out[k] = -1.0
-        elif with_centre:
-            out[k] = float(max(best, int(centre)))
+            out[r] = -1.0
+        elif no_path:
+            out[r] = -2.0
         else:
-            out[k] = float(best)
+            out[r] = weights[0] * (weights[1] * pd + weights[2] * gd + weights[3] * top)
 
 
 def footprint_cells(shape: tuple[int, int], resolution: float, pose: tuple[float, float, float],
                     polygon: np.ndarray | None, *, edges: np.ndarray | None = None) -> np.ndarray:
     """Cells (K, 2) as (i, j) under the robot at grid-local ``pose``: the centre cell, and with a polygon
-    (base frame, m) every cell whose centre lies inside it or that its edges cross (ROS's filled
-    ``getFootprintCells``), sorted by i then j. ``edges``: the polygon's ``footprint_outline`` at
+    (base frame, m) every cell whose centre lies inside it (even-odd rule) or that its edges cross (ROS's
+    filled ``getFootprintCells``), sorted by i then j. ``edges``: the polygon's ``footprint_outline`` at
     ``resolution`` if the caller has it already."""
     x, y, th = pose
     h, w = shape
-    cells = [np.array([[math.floor(x / resolution), math.floor(y / resolution)]])]
-    if polygon is not None:
-        c, s = math.cos(th), math.sin(th)
-        poly = np.column_stack([x + c * polygon[:, 0] - s * polygon[:, 1], y + s * polygon[:, 0] + c * polygon[:, 1]])
-        lo = np.floor(poly.min(axis=0) / resolution).astype(np.int64)
-        hi = np.floor(poly.max(axis=0) / resolution).astype(np.int64)
-        ii, jj = np.meshgrid(np.arange(lo[0], hi[0] + 1), np.arange(lo[1], hi[1] + 1))
-        box = np.column_stack([ii.ravel(), jj.ravel()])
-        cells.append(box[points_in_polygon((box + 0.5) * resolution, poly)])
-        if edges is None:
-            edges = footprint_outline(polygon, resolution)
-        assert edges is not None
-        ex = x + c * edges[:, 0] - s * edges[:, 1]
-        ey = y + s * edges[:, 0] + c * edges[:, 1]
-        cells.append(np.floor(np.column_stack([ex, ey]) / resolution).astype(np.int64))
-    both = np.vstack(cells)
-    # unique rows, in np.unique(axis=0)'s order, through one integer key per cell (faster on small arrays)
-    lo_ij = both.min(axis=0)
-    span = int(both[:, 1].max() - lo_ij[1]) + 1
-    keys = np.unique((both[:, 0] - lo_ij[0]) * span + (both[:, 1] - lo_ij[1]))
-    out = np.column_stack([keys // span + lo_ij[0], keys % span + lo_ij[1]])
-    return out[(out[:, 0] >= 0) & (out[:, 0] < w) & (out[:, 1] >= 0) & (out[:, 1] < h)]
+    if polygon is None:
+        i, j = math.floor(x / resolution), math.floor(y / resolution)
+        ok = 0 <= i < w and 0 <= j < h
+        return np.array([[i, j]] if ok else np.zeros((0, 2)), dtype=np.int64).reshape(-1, 2)
+    if edges is None:
+        edges = footprint_outline(polygon, resolution)
+    assert edges is not None
+    c, s = math.cos(th), math.sin(th)
+    poly = np.column_stack([x + c * polygon[:, 0] - s * polygon[:, 1], y + s * polygon[:, 0] + c * polygon[:, 1]])
+    ex = x + c * edges[:, 0] - s * edges[:, 1]
+    ey = y + s * edges[:, 0] + c * edges[:, 1]
+    return _footprint_cells(int(h), int(w), float(resolution), float(x), float(y), poly, np.ascontiguousarray(ex),
+                            np.ascontiguousarray(ey))
+
+
+@numba.njit(cache=True)
+def _footprint_cells(h: int, w: int, res: float, x: float, y: float, poly: np.ndarray, ex: np.ndarray,
+                     ey: np.ndarray) -> np.ndarray:  # pragma: no cover - compiled
+    ci, cj = math.floor(x / res), math.floor(y / res)
+    lo_i, lo_j = math.floor(poly[:, 0].min() / res), math.floor(poly[:, 1].min() / res)
+    hi_i, hi_j = math.floor(poly[:, 0].max() / res), math.floor(poly[:, 1].max() / res)
+    ei = np.empty(ex.size, dtype=np.int64)
+    ej = np.empty(ex.size, dtype=np.int64)
+    for k in range(ex.size):
+        ei[k], ej[k] = math.floor(ex[k] / res), math.floor(ey[k] / res)
+    # a box over every candidate cell: the centre, the polygon's bounding cells and the edge cells
+    bi0, bj0 = min(ci, lo_i, ei.min()), min(cj, lo_j, ej.min())
+    bi1, bj1 = max(ci, hi_i, ei.max()), max(cj, hi_j, ej.max())
+    mark = np.zeros((bi1 - bi0 + 1, bj1 - bj0 + 1), dtype=np.bool_)
+    mark[ci - bi0, cj - bj0] = True
+    for k in range(ex.size):
+        mark[ei[k] - bi0, ej[k] - bj0] = True
+    n = poly.shape[0]
+    for i in range(lo_i, hi_i + 1):
+        for j in range(lo_j, hi_j + 1):
+            px, py = (i + 0.5) * res, (j + 0.5) * res  # points_in_polygon's test of the cell centre
+            inside = False
+            for m in range(n):
+                ax, ay = poly[m, 0], poly[m, 1]
+                bx, by = poly[(m + 1) % n, 0], poly[(m + 1) % n, 1]
+                if (ay > py) != (by > py) and px < ax + (py - ay) * (bx - ax) / (by - ay):
+                    inside = not inside
+            if inside:
+                mark[i - bi0, j - bj0] = True
+    count = 0
+    for a in range(mark.shape[0]):
+        for b in range(mark.shape[1]):
+            if mark[a, b] and 0 <= a + bi0 < w and 0 <= b + bj0 < h:
+                count += 1
+    out = np.empty((count, 2), dtype=np.int64)
+    count = 0
+    for a in range(mark.shape[0]):
+        for b in range(mark.shape[1]):
+            if mark[a, b] and 0 <= a + bi0 < w and 0 <= b + bj0 < h:
+                out[count, 0], out[count, 1] = a + bi0, b + bj0
+                count += 1
+    return out
 
 
 def velocity_samples(low: float, high: float, n: int) -> np.ndarray:
@@ -635,13 +713,21 @@ class TrajectoryPlannerROS(RolloutController):
         """Costs (S,): pdist * path_dist + gdist * goal_dist + occdist * max_cost; -1 blocked, -2 no path."""
         p = self.params
         res = scene.resolution
-        fp = occupancy_costs(scene.cost, res, traj, self._outline(res), near_max=self._near_max(scene))
-        pd, _ = lookup(scene.path_dist, res, traj[..., 0], traj[..., 1])
-        gd, _ = lookup(scene.goal_dist, res, traj[..., 0], traj[..., 1])
-        scale = res if p.meter_scoring else 1.0
-        cost = scale * (p.pdist_scale * pd[:, -1] + p.gdist_scale * gd[:, -1] + p.occdist_scale * fp.max(axis=1))
-        cost[((pd >= scene.impossible) | (gd >= scene.impossible)).any(axis=1)] = -2.0
-        cost[(fp < 0).any(axis=1)] = -1.0
+        traj = np.ascontiguousarray(traj, dtype=np.float64)
+        outline = self._outline(res)
+        near = self._near_max(scene)
+        grid = scene.cost
+        if outline is None:
+            c = s = np.zeros(traj.shape[:2])
+            ox = oy = np.zeros(0)
+        else:  # numpy's cos/sin, as occupancy_costs
+            c, s = np.cos(traj[..., 2]), np.sin(traj[..., 2])
+            ox, oy = np.ascontiguousarray(outline[:, 0]), np.ascontiguousarray(outline[:, 1])
+        weights = np.array([res if p.meter_scoring else 1.0, p.pdist_scale, p.gdist_scale, p.occdist_scale])
+        cost = np.empty(traj.shape[0])
+        _rollout_scores(grid, grid if near is None else near, np.ascontiguousarray(scene.path_dist),
+                        np.ascontiguousarray(scene.goal_dist), 1.0 / res, traj, c, s, ox, oy, outline is not None,
+                        near is not None, weights, scene.impossible, cost)
         return cost
 
     def _drive(self, scene: LocalScene, pose: tuple[float, float, float], velocity: tuple[float, float],

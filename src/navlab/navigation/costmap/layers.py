@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 from typing import Any, Self
 
+import numba
 import numpy as np
 from scipy import ndimage
 
@@ -323,6 +324,7 @@ class InflationLayer(Layer):
         self.footprint = footprint or make_footprint()
         # the last inflation: ((origin, resolution, shape), lethal seeds, costs over the whole grid)
         self._inflated: tuple[Any, np.ndarray, np.ndarray] | None = None
+        self._costs: tuple[Any, np.ndarray] | None = None  # cost by squared cell distance (see _table)
 
     @classmethod
     def from_costmap_params(cls, name: str, costmap: CostmapParams, footprint: Footprint) -> Self:
@@ -347,15 +349,23 @@ class InflationLayer(Layer):
         cost = np.where(d > self.params.inflation_radius + 1e-9, 0, cost)
         return np.where(d <= 0.0, COST_LETHAL, cost).astype(np.uint8)
 
+    def _table(self, resolution: float, reach: int) -> np.ndarray:
+        """Costs (uint8) by squared distance in cells, 0 .. reach² (0 from there on): ``cost_at`` of the distance
+        a distance transform gives (sqrt of the squared cell distance, times the resolution)."""
+        key = (resolution, reach, self.params.inflation_radius, self.params.cost_scaling_factor,
+               self.inscribed_radius)
+        if self._costs is None or self._costs[0] != key:
+            d2 = np.arange(reach * reach + 1, dtype=np.float64)
+            self._costs = (key, self.cost_at(np.sqrt(d2) * resolution))
+        return self._costs[1]
+
     def update_costs(self, master: Grid) -> None:
         data = master.data
         seeds = data == COST_LETHAL
         if not seeds.any():
             return
         cost = self._inflation(master, seeds)
-        unknown = data == COST_UNKNOWN
-        overwrite_unknown = unknown & ((cost > COST_FREE) if self.params.inflate_unknown else (cost >= COST_INSCRIBED))
-        data[:] = np.where(unknown, np.where(overwrite_unknown, cost, data), np.maximum(data, cost))
+        _merge(data, cost, bool(self.params.inflate_unknown))
 
     def _inflation(self, master: Grid, seeds: np.ndarray) -> np.ndarray:
         """Inflation costs (uint8, the master's shape; 0 beyond ``inflation_radius``) of the lethal ``seeds``.
@@ -379,13 +389,41 @@ class InflationLayer(Layer):
         o0, o1 = max(0, j0 - reach), min(seeds.shape[0], j1 + reach)
         p0, p1 = max(0, i0 - reach), min(seeds.shape[1], i1 + reach)
         near = seeds[o0:o1, p0:p1]
-        if near.any():
-            dist = ndimage.distance_transform_edt(~near) * master.resolution
-            cost[j0:j1, i0:i1] = self.cost_at(dist[j0 - o0:j1 - o0, i0 - p0:i1 - p0])
+        if near.any():  # the nearest seed of each cell, its squared distance in cells, the cost of that
+            ft = ndimage.distance_transform_edt(~near, return_distances=False, return_indices=True)
+            _costs_from_features(ft, j0 - o0, i0 - p0, self._table(master.resolution, reach), cost[j0:j1, i0:i1])
         else:  # no obstacle within reach of the box: nothing to inflate there
             cost[j0:j1, i0:i1] = 0
         self._inflated = (key, seeds, cost)
         return cost
+
+
+@numba.njit(cache=True)
+def _costs_from_features(ft: np.ndarray, r0: int, c0: int, table: np.ndarray,
+                         out: np.ndarray) -> None:  # pragma: no cover - compiled
+    """``out[j, i]`` = ``table`` at the squared distance (cells) from cell (r0 + j, c0 + i) to its nearest seed
+    (``ft``: scipy's feature transform), the table's last entry beyond its end."""
+    last = table.size - 1
+    for j in range(out.shape[0]):
+        for i in range(out.shape[1]):
+            dj = np.int64(ft[0, r0 + j, c0 + i]) - (r0 + j)
+            di = np.int64(ft[1, r0 + j, c0 + i]) - (c0 + i)
+            d2 = dj * dj + di * di
+            out[j, i] = table[d2 if d2 < last else last]
+
+
+@numba.njit(cache=True)
+def _merge(data: np.ndarray, cost: np.ndarray, inflate_unknown: bool) -> None:  # pragma: no cover - compiled
+    """Inflation into the master: the larger cost; an unknown cell only takes inscribed or lethal costs (any
+    positive cost with ``inflate_unknown``)."""
+    for j in range(data.shape[0]):
+        for i in range(data.shape[1]):
+            d, c = data[j, i], cost[j, i]
+            if d == COST_UNKNOWN:
+                if c >= COST_INSCRIBED or (inflate_unknown and c > COST_FREE):
+                    data[j, i] = c
+            elif c > d:
+                data[j, i] = c
 
 
 def _box(mask: np.ndarray, reach: int, shape: tuple[int, ...]) -> tuple[int, int, int, int]:
