@@ -7,11 +7,12 @@ NO_INFORMATION stop it and read ``obstacle_value`` (= cells in the grid), cells 
 
 from __future__ import annotations
 
+import math
+
 import numba
 import numpy as np
 
-from navlab.grid import COST_INSCRIBED
-from navlab.navigation.controllers.common import densify
+from navlab.grid import COST_INSCRIBED, COST_UNKNOWN
 
 
 @numba.njit(cache=True)
@@ -56,22 +57,45 @@ def _wave(cost: np.ndarray, seeds_i: np.ndarray, seeds_j: np.ndarray, free_i: np
 def plan_cells(cost: np.ndarray, plan_xy: np.ndarray, resolution: float) -> np.ndarray:
     """Cells (K, 2) as (i, j) of the plan's first stretch inside the grid (grid-local plan points, m).
 
-    The plan is densified to the resolution; cells of unknown cost break it (ROS's ``setTargetCells``).
+    The plan is densified to the resolution (``common.densify``'s points); cells of unknown cost break it
+    (ROS's ``setTargetCells``).
     """
-    pts = densify(plan_xy, resolution)
-    ij = np.floor(pts / resolution).astype(np.int64)
+    xy = np.ascontiguousarray(np.asarray(plan_xy, dtype=np.float64)[:, :2])
+    if len(xy) >= 2:
+        seg = np.diff(xy, axis=0)
+        n = np.maximum(1, np.ceil(np.hypot(seg[:, 0], seg[:, 1]) / resolution).astype(np.int64))
+    else:
+        n = np.zeros(0, dtype=np.int64)
+    return _plan_cells(np.ascontiguousarray(cost), xy, n, float(resolution))
+
+
+@numba.njit(cache=True)
+def _plan_cells(cost: np.ndarray, xy: np.ndarray, n: np.ndarray, res: float) -> np.ndarray:  # pragma: no cover
     h, w = cost.shape
-    inside = (ij[:, 0] >= 0) & (ij[:, 0] < w) & (ij[:, 1] >= 0) & (ij[:, 1] < h)
-    inside[inside] = cost[ij[inside, 1], ij[inside, 0]] != 255
-    if not inside.any():
-        return np.zeros((0, 2), dtype=np.int64)
-    first = int(np.argmax(inside))
-    out_after = np.nonzero(~inside[first:])[0]
-    last = first + (int(out_after[0]) if len(out_after) else len(inside) - first)
-    cells = ij[first:last]
-    keep = np.ones(len(cells), dtype=bool)
-    keep[1:] = np.any(cells[1:] != cells[:-1], axis=1)
-    return cells[keep]
+    total = n.sum() + 1 if xy.shape[0] >= 2 else xy.shape[0]
+    out = np.empty((total, 2), dtype=np.int64)
+    count = 0
+    s, q = 0, 0  # the point: segment s, step q of n[s] (densify's order), then the plan's last point
+    for _ in range(total):
+        if s < n.size:
+            frac = q / n[s]
+            px = xy[s, 0] + (xy[s + 1, 0] - xy[s, 0]) * frac
+            py = xy[s, 1] + (xy[s + 1, 1] - xy[s, 1]) * frac
+            q += 1
+            if q == n[s]:
+                s, q = s + 1, 0
+        else:
+            px, py = xy[xy.shape[0] - 1, 0], xy[xy.shape[0] - 1, 1]
+        i, j = math.floor(px / res), math.floor(py / res)
+        inside = 0 <= i < w and 0 <= j < h and cost[j, i] != COST_UNKNOWN
+        if not inside:
+            if count > 0:
+                break
+            continue
+        if count == 0 or out[count - 1, 0] != i or out[count - 1, 1] != j:
+            out[count, 0], out[count, 1] = i, j
+            count += 1
+    return out[:count].copy()
 
 
 def distance_map(cost: np.ndarray, seeds: np.ndarray, free: np.ndarray | None = None) -> np.ndarray:
