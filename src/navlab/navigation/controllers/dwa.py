@@ -11,14 +11,8 @@ import numpy as np
 
 from navlab.navigation.controllers import mapgrid
 from navlab.navigation.controllers.params import DWAPlannerParams
-from navlab.navigation.controllers.trajectory import (
-    LocalScene,
-    RolloutController,
-    lookup,
-    occupancy_costs,
-    rollout,
-    velocity_samples,
-)
+from navlab.navigation.controllers.rollout import lookup, occupancy_costs, rollout, velocity_samples
+from navlab.navigation.controllers.trajectory import LocalScene, RolloutController
 
 _EPS = 1e-4
 

@@ -31,7 +31,7 @@ from typing import Any
 import numpy as np
 
 from navlab.grid import COST_INSCRIBED, COST_LETHAL
-from navlab.navigation.controllers.trajectory import footprint_costs
+from navlab.navigation.controllers.rollout import footprint_costs
 
 
 @dataclass
