@@ -74,3 +74,20 @@ def test_shipped_scenarios_load_and_wilson_interval() -> None:
     assert sc.map == "map_first" and sc.map_world == "room" and len(sc.obstacles) == 1
     lo, hi = wilson_interval(19, 20)
     assert lo == pytest.approx(0.7639, abs=1e-3) and hi == pytest.approx(0.9911, abs=1e-3)
+
+
+def test_a_two_by_two_sweep_writes_its_table_and_plots(tmp_path: Path) -> None:
+    from navlab.experiments.sweep import parse_params, run_sweep
+
+    params = parse_params(["local_costmap.update_frequency=1,5", "controller=trajectory,mppi"])
+    rows = run_sweep(scenario_from_dict({**SMALL, "trials": 1}), params, tmp_path)
+    assert [(r["local_costmap.update_frequency"], r["controller"]) for r in rows] == [
+        (1, "trajectory"), (1, "mppi"), (5, "trajectory"), (5, "mppi")]
+    assert all(r["success_rate"] == 1.0 and r["collisions"] == 0 for r in rows), rows
+    table = (tmp_path / "sweep.md").read_text().splitlines()
+    assert len(table) == 2 + 4 and "local_costmap.update_frequency" in table[0]
+    assert len((tmp_path / "sweep.csv").read_text().splitlines()) == 5
+    for name in ("local_costmap.update_frequency", "controller"):
+        assert (tmp_path / f"{name}.png").stat().st_size > 10_000
+    with pytest.raises(ExperimentError, match="expected name=value1,value2"):
+        parse_params(["max_vel_x"])

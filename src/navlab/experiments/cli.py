@@ -122,11 +122,25 @@ def _cmd_navigate(args: argparse.Namespace) -> int:
 
 
 def _cmd_experiment(args: argparse.Namespace) -> int:
+    from navlab.experiments.errors import ExperimentError
     from navlab.experiments.scenario import load_scenario
     from navlab.experiments.trials import run_experiment
 
     sc = load_scenario(args.file)
     out = args.out or f"runs/{sc.name}"
+    if args.action == "sweep":
+        from navlab.experiments.sweep import parse_params, run_sweep
+
+        rows = run_sweep(sc, parse_params(args.param), out, trials=args.trials, workers=args.workers,
+                         progress=not args.quiet and sys.stderr.isatty())  # fmt: skip
+        if not args.json:
+            print(f"{len(rows)} combinations of {sc.name}: {out}/sweep.md (+ sweep.csv, a PNG per parameter)")
+            print((Path(out) / "sweep.md").read_text())
+        else:
+            print_figures({"scenario": sc.name, "rows": rows}, True)
+        return 0
+    if args.param:
+        raise ExperimentError("--param is for `navlab experiment sweep`")
     summary = run_experiment(sc, out, trials=args.trials, seed=args.seed, workers=args.workers,
                              progress=not args.quiet and sys.stderr.isatty())  # fmt: skip
     if not args.json:
@@ -281,19 +295,25 @@ def register(sub: argparse._SubParsersAction) -> None:
 
     p = sub.add_parser(
         "experiment",
-        help="run a scenario's trials headless and summarize them (the paper's Section V)",
+        help="run a scenario's trials headless and summarize them, or sweep parameters (the paper's Section V)",
         description="navlab experiment run FILE: run the trials of a scenario YAML (or a shipped one: empty_room, "
         "obstacles_after_mapping) headless, each with its own seed, in parallel processes with --workers. Each "
         "finished trial is appended whole to DIR/results.jsonl; running again resumes and skips finished trials. "
         "Prints (and writes DIR/summary.json) the success rate with a 95 % Wilson interval, collisions, failures "
-        "by kind, time quartiles, SPL, clearance, localization error and command jerk.",
+        "by kind, time quartiles, SPL, clearance, localization error and command jerk. navlab experiment sweep FILE "
+        "--param name=v1,v2 [--param ...]: the same for every combination, with DIR/sweep.md, sweep.csv and a plot "
+        "per parameter.",
     )
-    p.add_argument("action", choices=["run"], help="run: run the scenario's trials")
+    p.add_argument("action", choices=["run", "sweep"],
+                   help="run: the scenario's trials; sweep: the trials for every combination of --param values")
     p.add_argument("file", help="scenario YAML, or a shipped scenario's name")
     p.add_argument("--trials", type=int, default=None, help="how many trials (default: the scenario's)")
     p.add_argument("--seed", type=int, default=None,
                    help="seed of trial 0; trial k uses seed + k (default: the scenario's)")
     p.add_argument("--workers", type=int, default=1, help="parallel processes (default 1)")
+    p.add_argument("--param", action="append", default=[], metavar="NAME=V1,V2,...",
+                   help="sweep: a move_base parameter (or controller) and its values, e.g. "
+                   "local_costmap.update_frequency=0.5,1,2,5 (repeatable: the grid of all combinations)")
     p.add_argument("--out", metavar="DIR", default=None, help="results folder (default runs/<scenario name>)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.add_argument("--json", action="store_true", help="print the summary as one JSON object")

@@ -1,0 +1,118 @@
+"""Parameter sweeps: a scenario's trials over the grid of ``--param name=v1,v2,...`` values.
+
+Each combination runs as its own experiment in ``DIR/<name>=<value>,...`` (resumable like any experiment).
+``DIR/sweep.csv`` and ``DIR/sweep.md`` hold one row per combination (success with its Wilson interval,
+collisions, median time), and ``DIR/<param>.png`` plots success, collisions and time against each parameter.
+Parameter names are move_base parameters (``local_costmap.update_frequency``, ``max_vel_x`` for the local
+planner's section is written ``TrajectoryPlannerROS.max_vel_x``) or the scenario's ``controller``.
+"""
+
+from __future__ import annotations
+
+import copy
+import itertools
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from navlab.experiments.errors import ExperimentError
+from navlab.experiments.scenario import Scenario
+from navlab.experiments.trials import run_experiment
+
+COLUMNS = ("success_rate", "success_ci95", "collisions", "median_time_s", "spl_mean", "min_clearance_m")
+
+
+def parse_params(items: list[str]) -> dict[str, list[Any]]:
+    """``name=v1,v2,...`` items to {name: [values]} (values read as YAML: numbers, booleans, strings)."""
+    out: dict[str, list[Any]] = {}
+    for item in items:
+        name, sep, values = item.partition("=")
+        if not sep or not name.strip() or not values.strip():
+            raise ExperimentError(f"--param {item!r}: expected name=value1,value2,... "
+                                  "(e.g. local_costmap.update_frequency=0.5,1,2,5)")  # fmt: skip
+        out[name.strip()] = [yaml.safe_load(v) for v in values.split(",")]
+    if not out:
+        raise ExperimentError("a sweep needs at least one --param name=value1,value2,...")
+    return out
+
+
+def combinations(params: dict[str, list[Any]]) -> list[dict[str, Any]]:
+    """Every combination of the parameter values, in the order given."""
+    return [dict(zip(params, values, strict=True)) for values in itertools.product(*params.values())]
+
+
+def run_sweep(sc: Scenario, params: dict[str, list[Any]], out: str | Path, *, trials: int | None = None,
+              workers: int = 1, progress: bool = False) -> list[dict[str, Any]]:  # fmt: skip
+    """Run the scenario for every combination; write the table and the plots; return the rows."""
+    folder = Path(out)
+    rows = []
+    for combo in combinations(params):
+        variant = copy.deepcopy(sc)
+        for name, value in combo.items():
+            if name == "controller":
+                variant.controller = str(value)
+            else:
+                variant.overrides[name] = value
+        tag = ",".join(f"{k}={v}" for k, v in combo.items())
+        summary = run_experiment(variant, folder / tag, trials=trials, workers=workers, progress=progress)
+        rows.append({**combo, **{c: summary.get(c) for c in COLUMNS}})
+    write_table(rows, list(params), folder)
+    plot_sweep(rows, list(params), folder)
+    return rows
+
+
+def write_table(rows: list[dict[str, Any]], names: list[str], folder: Path) -> None:
+    """``sweep.csv`` and ``sweep.md``: one row per combination."""
+    from navlab.io.files import write_text_atomic
+
+    header = [*names, *COLUMNS]
+
+    def cell(v: Any) -> str:
+        return "/".join(str(x) for x in v) if isinstance(v, list) else str(v)
+
+    csv = [",".join(header), *(",".join(cell(r[h]) for h in header) for r in rows)]
+    md = ["| " + " | ".join(header) + " |", "|" + " --- |" * len(header),
+          *("| " + " | ".join(cell(r[h]) for h in header) + " |" for r in rows)]  # fmt: skip
+    write_text_atomic(folder / "sweep.csv", "\n".join(csv) + "\n")
+    write_text_atomic(folder / "sweep.md", "\n".join(md) + "\n")
+
+
+def plot_sweep(rows: list[dict[str, Any]], names: list[str], folder: Path) -> list[Path]:
+    """One PNG per parameter: success rate (with its interval), collisions and median time against it."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from navlab.io.files import save_figure_atomic
+
+    out = []
+    for name in names:
+        values = sorted({r[name] for r in rows}, key=str)
+        fig, axes = plt.subplots(1, 3, figsize=(13, 3.6))
+        for others, group in itertools.groupby(sorted(rows, key=lambda r: str([r[n] for n in names if n != name])),
+                                               key=lambda r: [r[n] for n in names if n != name]):  # fmt: skip
+            g = sorted(group, key=lambda r: values.index(r[name]))
+            xs = [values.index(r[name]) for r in g]
+            label = ", ".join(f"{n}={v}" for n, v in zip([n for n in names if n != name], others, strict=True)) or None
+            ci = [r["success_ci95"] or [0, 1] for r in g]
+            axes[0].errorbar(xs, [r["success_rate"] for r in g], yerr=[[r["success_rate"] - c[0] for r, c in zip(g, ci,
+                             strict=True)], [c[1] - r["success_rate"] for r, c in zip(g, ci, strict=True)]],
+                             marker="o", capsize=3, label=label)  # fmt: skip
+            axes[1].plot(xs, [r["collisions"] for r in g], marker="o", label=label)
+            axes[2].plot(xs, [r["median_time_s"] for r in g], marker="o", label=label)
+        for ax, title in zip(axes, ("success rate (95 % CI)", "collisions", "median time (s)"), strict=True):
+            ax.set_xticks(range(len(values)), [str(v) for v in values])
+            ax.set_xlabel(name)
+            ax.set_title(title)
+        if len(names) > 1:
+            axes[0].legend(fontsize=7)
+        fig.tight_layout()
+        path = folder / f"{name}.png"
+        try:
+            save_figure_atomic(fig, path, dpi=100)
+        finally:
+            plt.close(fig)
+        out.append(path)
+    return out
