@@ -15,7 +15,6 @@ from __future__ import annotations
 import inspect
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -26,11 +25,11 @@ from navlab.geometry import inverse_transform_points2, transform_points2, wrap_a
 from navlab.navigation.costmap.layers import StaticLayer
 from navlab.navigation.costmap_ros import Costmap2DROS
 from navlab.navigation.errors import NavigationError
+from navlab.navigation.goal import STATUS, GoalHandle, with_headings
 from navlab.navigation.recovery import DEFAULT_RECOVERIES, ClearCostmapRecovery
 from navlab.plugins import load_plugin, plugin_names
 
 Pose = tuple[float, float, float]
-STATUS = {"PENDING": 1, "ACTIVE": 2, "PREEMPTED": 5, "SUCCEEDED": 4, "ABORTED": 6}
 _MB_DEFAULTS: dict[str, Any] = {
     "base_global_planner": "navfn/NavfnROS",
     "base_local_planner": "base_local_planner/TrajectoryPlannerROS",
@@ -48,25 +47,6 @@ _MB_DEFAULTS: dict[str, Any] = {
     "make_plan_clear_costmap": True,
     "make_plan_add_unreachable_goal": True,
 }
-
-
-@dataclass
-class GoalHandle:
-    """One goal's life: ``state`` PENDING -> ACTIVE -> SUCCEEDED | ABORTED | PREEMPTED, with ``reason``."""
-
-    goal: Pose
-    frame_id: str
-    id: int
-    state: str = "PENDING"
-    reason: str = ""
-    start_s: float = 0.0
-    end_s: float | None = None
-    feedback: Callable[[Pose], None] | None = None
-    on_done: Callable[[GoalHandle], None] | None = field(default=None, repr=False)
-
-    def done(self) -> bool:
-        """Whether the goal reached a terminal state."""
-        return self.state in ("SUCCEEDED", "ABORTED", "PREEMPTED")
 
 
 def short_name(plugin: str) -> str:
@@ -482,22 +462,3 @@ class MoveBase(Node):
                 status=STATUS[h.state],
             ))  # fmt: skip
         self.status_pub.publish(msgs.GoalStatusArray(status_list=statuses))
-
-    def robot_pose_in(self, frame: str) -> Pose | None:
-        """The robot's pose in ``frame`` (tf), or None."""
-        base = self.local_costmap.base_frame
-        try:
-            return self.executor.tf.lookup_pose2d(frame, base)
-        except TfError:
-            return None
-
-
-
-def with_headings(xy: np.ndarray, goal_yaw: float) -> np.ndarray:
-    """A plan (N, 3): each pose heads to the next one, the last takes the goal's yaw (as navfn's plan does)."""
-    yaw = np.empty(len(xy))
-    if len(xy) > 1:
-        d = np.diff(xy, axis=0)
-        yaw[:-1] = np.arctan2(d[:, 1], d[:, 0])
-    yaw[-1] = goal_yaw
-    return np.column_stack([xy, yaw])

@@ -31,6 +31,7 @@ from scipy.spatial import cKDTree
 
 from navlab.io.files import write_text_atomic
 from navlab.world.errors import WorldError
+from navlab.world.sdf_writer import box_geometry, cylinder_geometry, link, static_model, world_sdf
 
 CELL = 0.15  # m: BARN's grid cell
 CELLS = 30  # cells per side of the field (4.5 m)
@@ -461,51 +462,23 @@ def clutter_suite(n: int = 50, seed: int = 0, *, robot_radius: float = 0.2, marg
 
 
 # ------------------------------------------------------------------------------------------- SDF
-def _box_link(w: Box) -> str:
-    size = f"{w.sx:.4f} {w.sy:.4f} {w.height:.4f}"
-    geom = f"<geometry><box><size>{size}</size></box></geometry>"
-    return (f'      <link name="{w.name}">\n        <pose>{w.x:.4f} {w.y:.4f} {w.height / 2:.4f} 0 0 0</pose>\n'
-            f'        <collision name="{w.name}_collision">{geom}</collision>\n'
-            f'        <visual name="{w.name}_visual">{geom}\n'
-            "          <material><ambient>0.9 0.9 0.85 1</ambient><diffuse>0.9 0.9 0.85 1</diffuse></material>\n"
-            "        </visual>\n      </link>\n")
-
-
-def _cylinder_link(k: int, x: float, y: float) -> str:
-    geom = (f"<geometry><cylinder><radius>{CYLINDER_RADIUS}</radius><length>{CYLINDER_HEIGHT}</length>"
-            "</cylinder></geometry>")
-    return (f'      <link name="cylinder_{k:03d}">\n'
-            f"        <pose>{x:.4f} {y:.4f} {CYLINDER_HEIGHT / 2:.4f} 0 0 0</pose>\n"
-            f'        <collision name="collision">{geom}</collision>\n'
-            f'        <visual name="visual">{geom}\n'
-            "          <material><ambient>0.3 0.3 0.35 1</ambient><diffuse>0.3 0.3 0.35 1</diffuse></material>\n"
-            "        </visual>\n      </link>\n")
-
-
 def _sdf(w: ClutterWorld) -> str:
     sx, sy, _ = w.start
     gx, gy, _ = w.goal
-    head = (
-        '<?xml version="1.0" ?>\n'
-        f"<!-- navlab BARN-style clutter world: seed {w.seed}, fill {w.fill}, smooth {w.smooth}; "
+    comment = (
+        f"navlab BARN-style clutter world: seed {w.seed}, fill {w.fill}, smooth {w.smooth}; "
         f"{len(w.cylinders)} cylinders r {CYLINDER_RADIUS} m on a {CELL} m grid over x 0..{FIELD}, "
         f"y {-FIELD / 2}..{FIELD / 2};\n"
         f"     start ({sx:g}, {sy:g}, yaw 0), goal ({gx:g}, {gy:g}); reference path {w.reference_path_m:.3f} m "
-        f"for robot radius {w.robot_radius} m; difficulty (fill after smoothing) {w.difficulty:.4f} -->\n"
-        '<sdf version="1.6">\n'
-        f'  <world name="{w.name}">\n'
-        "    <include>\n      <uri>model://ground_plane</uri>\n    </include>\n"
-        "    <include>\n      <uri>model://sun</uri>\n    </include>\n"
-        "    <gravity>0 0 -9.8</gravity>\n"
-        '    <physics name="default_physics" default="0" type="ode">\n'
-        "      <max_step_size>0.001</max_step_size>\n      <real_time_factor>1</real_time_factor>\n"
-        "      <real_time_update_rate>1000</real_time_update_rate>\n    </physics>\n"
+        f"for robot radius {w.robot_radius} m; difficulty (fill after smoothing) {w.difficulty:.4f}"
     )
-    walls = ('    <model name="clutter_walls">\n      <static>true</static>\n      <pose>0 0 0 0 0 0</pose>\n'
-             + "".join(_box_link(b) for b in w.walls) + "    </model>\n")
-    cyl = ""
+    walls = [link(b.name, b.x, b.y, b.height / 2, box_geometry(b.sx, b.sy, b.height), "0.9 0.9 0.85",
+                  parts=f"{b.name}_") for b in w.walls]  # fmt: skip
+    models = [static_model("clutter_walls", walls)]
     if len(w.cylinders):
-        cyl = ('    <model name="clutter_cylinders">\n      <static>true</static>\n      <pose>0 0 0 0 0 0</pose>\n'
-               + "".join(_cylinder_link(k, float(x), float(y)) for k, (x, y) in enumerate(w.cylinders))
-               + "    </model>\n")
-    return head + walls + cyl + "  </world>\n</sdf>\n"
+        geometry = cylinder_geometry(CYLINDER_RADIUS, CYLINDER_HEIGHT)
+        models.append(static_model("clutter_cylinders", [
+            link(f"cylinder_{k:03d}", float(x), float(y), CYLINDER_HEIGHT / 2, geometry, "0.3 0.3 0.35")
+            for k, (x, y) in enumerate(w.cylinders)
+        ]))  # fmt: skip
+    return world_sdf(w.name, models, comment)

@@ -29,8 +29,19 @@ _VIEW_ONLY = frozenset({"publish_cost_grid_pc", "publish_traj_pc", "publish_cost
                         "restore_defaults", "plugin", "use_sim_time"})
 
 
+class _Periodic:
+    """What both planners' parameters derive from ``controller_frequency``."""
+
+    controller_frequency: float
+
+    @property
+    def sim_period(self) -> float:
+        """1 / controller_frequency (s)."""
+        return 1.0 / self.controller_frequency
+
+
 @dataclass
-class TrajectoryPlannerParams:
+class TrajectoryPlannerParams(_Periodic):
     """base_local_planner/TrajectoryPlannerROS (ROS 1 names and defaults)."""
 
     acc_lim_x: float = 2.5
@@ -81,11 +92,6 @@ class TrajectoryPlannerParams:
         out.validate()
         return out
 
-    @property
-    def sim_period(self) -> float:
-        """1 / controller_frequency (s)."""
-        return 1.0 / self.controller_frequency
-
     def validate(self) -> None:
         """Raise ``NavigationError`` naming the first bad parameter."""
         check_finite(TP, self)
@@ -105,7 +111,7 @@ class TrajectoryPlannerParams:
 
 
 @dataclass
-class DWAPlannerParams:
+class DWAPlannerParams(_Periodic):
     """dwa_local_planner/DWAPlannerROS (ROS 1 names and defaults; ``min_vel_theta`` is the least |w|)."""
 
     acc_lim_x: float = 2.5
@@ -156,11 +162,6 @@ class DWAPlannerParams:
             "vtheta_samples": "vth_samples", "dwa": "use_dwa"})
         out.validate()
         return out
-
-    @property
-    def sim_period(self) -> float:
-        """1 / controller_frequency (s)."""
-        return 1.0 / self.controller_frequency
 
     def validate(self) -> None:
         """Raise ``NavigationError`` naming the first bad parameter."""
