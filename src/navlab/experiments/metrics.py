@@ -17,6 +17,7 @@ import os
 import numpy as np
 from scipy import ndimage
 
+from navlab.experiments.trajectory import ate
 from navlab.experiments.truth import visible_surface
 from navlab.geometry import inverse_transform_points2, transform_points2, wrap_angle
 from navlab.grid import Grid, GridMap
@@ -24,7 +25,7 @@ from navlab.io.poses import read_poses, read_table, write_poses
 from navlab.mapping.errors import MappingError
 
 __all__ = [
-    "free_coverage", "read_poses", "read_relations", "relations_error", "score_map", "settled_after",
+    "ate", "free_coverage", "read_poses", "read_relations", "relations_error", "score_map", "settled_after",
     "trajectory_error", "write_poses",
 ]  # pose files live in navlab.io.poses
 

@@ -1,4 +1,5 @@
-"""CARMEN log reader (``FLASER``, ``ODOM``, ``ROBOTLASER1``), as used by the Kümmerle et al. SLAM benchmark.
+"""CARMEN log reader (``FLASER``, ``ODOM``, ``ROBOTLASER1``), as used by the Kümmerle et al. SLAM benchmark,
+and a writer (``write_carmen``: ``ROBOTLASER1`` and ``ODOM`` lines).
 
 Poses are (x m, y m, theta rad) in the log's odometry frame; timestamps are the IPC timestamps (s),
 which are the ones relations files refer to. Comment lines (``#``) and message types the reader does
@@ -157,3 +158,36 @@ def skipped_summary(log: CarmenLog, limit: int = 3) -> str:
         return ""
     more = f" (and {len(log.skipped) - limit} more)" if len(log.skipped) > limit else ""
     return f"skipped {len(log.skipped)} malformed line(s): " + "; ".join(log.skipped[:limit]) + more
+
+
+def write_carmen(path: str | os.PathLike[str], log: CarmenLog, *, comment: str = "") -> Path:
+    """Write ``log``'s scans as ``ROBOTLASER1`` lines (exact start angle and beam spacing, laser and robot
+    poses) and its odometry as ``ODOM`` lines, in timestamp order, atomically; ``read_carmen`` reads them
+    back. Non-finite ranges (no return) are written as ``NO_RETURN``. Returns the path."""
+    from navlab.io.files import write_text_atomic
+
+    rows: list[tuple[float, str]] = []
+    for s in log.scans:
+        n = len(s.ranges)
+        r = np.where(np.isfinite(s.ranges), s.ranges, NO_RETURN)
+        fov = s.angle_increment * (n - 1)
+        lx, ly, lt = s.laser_pose
+        rx, ry, rt = s.odom_pose
+        rows.append((s.timestamp, (
+            f"ROBOTLASER1 0 {s.angle_min:.9f} {fov:.9f} {s.angle_increment:.9f} {s.max_range:g} 0.01 0 {n} "
+            + " ".join(f"{v:.3f}" for v in r)
+            + f" 0 {lx:.6f} {ly:.6f} {lt:.6f} {rx:.6f} {ry:.6f} {rt:.6f} 0 0 0 0 0 "
+            f"{s.timestamp:.6f} navlab {s.timestamp:.6f}"
+        )))  # fmt: skip
+    for o in log.odometry:
+        x, y, t = o.pose
+        rows.append((o.timestamp, f"ODOM {x:.6f} {y:.6f} {t:.6f} {o.tv:.6f} {o.rv:.6f} 0 {o.timestamp:.6f} navlab "
+                                  f"{o.timestamp:.6f}"))  # fmt: skip
+    rows.sort(key=lambda row: row[0])
+    head = "".join(f"# {line}\n" for line in comment.splitlines())
+    out = Path(path)
+    try:
+        write_text_atomic(out, head + "".join(line + "\n" for _, line in rows))
+    except OSError as exc:
+        raise IoError(f"cannot write CARMEN log {out}: {exc.strerror or exc}") from None
+    return out

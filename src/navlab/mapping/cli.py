@@ -121,9 +121,10 @@ def _cmd_teleop(args: argparse.Namespace) -> int:
 
 
 def _cmd_eval_relations(args: argparse.Namespace) -> int:
-    from navlab.experiments.metrics import read_poses, read_relations, relations_error
+    from navlab.experiments.metrics import read_relations, relations_error
+    from navlab.experiments.trajectory import read_trajectory
 
-    ts, poses = read_poses(args.poses)
+    ts, poses = read_trajectory(args.poses, carmen=args.carmen)
     rel = read_relations(args.relations)
     out = relations_error(ts, poses, rel, time_tolerance=args.tolerance)
     if args.json:
@@ -132,6 +133,23 @@ def _cmd_eval_relations(args: argparse.Namespace) -> int:
         print(f"relations scored: {out['n_scored']} of {out['n_relations']}")
         print(f"translation: {out['trans_abs_mean']:.4f} ± {out['trans_abs_std']:.4f} m")
         print(f"rotation:    {out['rot_abs_mean_deg']:.3f} ± {out['rot_abs_std_deg']:.3f} deg")
+    return 0
+
+
+def _cmd_eval_trajectory(args: argparse.Namespace) -> int:
+    from navlab.experiments.trajectory import read_trajectory, trajectory_ate
+
+    est = read_trajectory(args.estimate, carmen=args.carmen)
+    truth = read_trajectory(args.truth or args.estimate, carmen=args.carmen_truth,
+                            columns="estimate" if args.truth else "truth")  # fmt: skip
+    out = trajectory_ate(est, truth, tolerance=args.tolerance, align=not args.no_align, far=args.far)
+    if args.json:
+        print_figures(out, True)
+    else:
+        print(f"poses compared: {out['poses']} ({out['n_estimated']} estimated, {out['n_truth']} true)")
+        print(f"ATE RMSE {out['rmse_m']:.4f} m, mean {out['mean_m']:.4f} m, max {out['max_m']:.4f} m")
+        print(f"poses off by > {args.far} m: {100 * out['share_over_far']:.1f} %; mean yaw error "
+              f"{out['yaw_mean_deg']:.3f} deg")  # fmt: skip
     return 0
 
 
@@ -195,9 +213,35 @@ def register(sub: argparse._SubParsersAction) -> None:
         "absolute translational (m) and rotational (deg) errors and the means of their squares. Relations "
         "whose timestamps match no pose are counted as not scored.",
     )
-    r.add_argument("poses", help="poses file: 'timestamp x y theta' per line")
+    r.add_argument("poses", help="poses file: 'timestamp x y theta' per line, a TUM file, or a CARMEN log "
+                   "(its own odometry: see --carmen)")
+    r.add_argument("--carmen", choices=("flaser", "odom", "laser"), default="flaser",
+                   help="poses of a CARMEN log: flaser = the robot's odometry pose of each scan (default), "
+                   "odom = ODOM lines, laser = the laser's pose of each scan")
     r.add_argument("relations", help="relations file: 't1 t2 x y z roll pitch yaw' per line")
     r.add_argument("--tolerance", type=float, default=1e-3, help="timestamp match tolerance in s (default 0.001)")
     r.add_argument("--json", action="store_true", help="print one JSON object")
     r.set_defaults(func=_cmd_eval_relations)
+    t = esub.add_parser(
+        "trajectory",
+        help="absolute trajectory error: EST vs TRUTH after rigid SE(2) alignment (RMSE, max, share > 0.5 m)",
+        description="Pairs EST's poses with TRUTH's by nearest timestamp (within --tolerance), aligns EST to "
+        "TRUTH by the rigid 2-D transform minimising the squared position error (Umeyama/Horn, no scale) "
+        "and prints the position error's RMSE, mean, median and max (m), the share of poses off by more "
+        "than --far m, and the mean yaw error (deg). Files: 't x y theta' (navlab slam's poses.txt, TUM "
+        "2-D), 't x y z qx qy qz qw' (TUM), CARMEN logs (see --carmen), and navlab map's trajectory.txt "
+        "('t x y theta true_x true_y true_theta': without TRUTH its true columns are the truth).",
+    )
+    t.add_argument("estimate", metavar="EST", help="estimated trajectory file")
+    t.add_argument("truth", metavar="TRUTH", nargs="?", help="reference trajectory file (default: EST's true "
+                   "columns, for navlab map's trajectory.txt)")
+    t.add_argument("--carmen", choices=("flaser", "odom", "laser"), default="flaser",
+                   help="poses of EST when it is a CARMEN log (default flaser: the robot pose of each scan)")
+    t.add_argument("--carmen-truth", choices=("flaser", "odom", "laser"), default="flaser",
+                   help="poses of TRUTH when it is a CARMEN log (default flaser)")
+    t.add_argument("--tolerance", type=float, default=0.02, help="timestamp match tolerance in s (default 0.02)")
+    t.add_argument("--far", type=float, default=0.5, help="error (m) counted as far off (default 0.5)")
+    t.add_argument("--no-align", action="store_true", help="compare the poses as given (no rigid alignment)")
+    t.add_argument("--json", action="store_true", help="print one JSON object")
+    t.set_defaults(func=_cmd_eval_trajectory)
     add_eval_map(esub)
