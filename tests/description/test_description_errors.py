@@ -59,9 +59,9 @@ def _robot(body: str) -> str:
     (f'<link name="a">{INERTIA}</link><link name="b">{INERTIA}</link>', r"one root; roots found: \['a', 'b'\]"),
     # negative mass
     ('<link name="a"><inertial><mass value="-2"/></inertial></link>', r"<inertial>/<mass>: mass must be >= 0"),
-    # a missing mesh
-    (f'<link name="a">{INERTIA}<visual><geometry><mesh filename="meshes/gone.stl"/></geometry></visual></link>',
-     r'<link name="a">/<visual>\[0\]/<geometry>/<mesh>: mesh file .*gone\.stl not found'),
+    # a missing collision mesh (a missing visual mesh only warns, as in Gazebo: tests/description/test_ros_robots.py)
+    (f'<link name="a">{INERTIA}<collision><geometry><mesh filename="meshes/gone.stl"/></geometry></collision>'
+     '</link>', r'<link name="a">/<collision>\[0\]/<geometry>/<mesh>: mesh file .*gone\.stl not found'),
 ])
 def test_bad_input_names_file_and_element(tmp_path, body, pattern):
     with pytest.raises(DescriptionError, match=pattern):
@@ -69,7 +69,8 @@ def test_bad_input_names_file_and_element(tmp_path, body, pattern):
 
 
 def test_missing_package_mesh_names_package(tmp_path):
-    body = f'<link name="a">{INERTIA}<visual><geometry><mesh filename="package://ghost_pkg/m.stl"/></geometry></visual></link>'
+    body = (f'<link name="a">{INERTIA}<collision><geometry><mesh filename="package://ghost_pkg/m.stl"/></geometry>'
+            '</collision></link>')
     with pytest.raises(DescriptionError, match="ghost_pkg"):
         load_robot(_write(tmp_path, _robot(body)))
 

@@ -43,7 +43,8 @@ def test_dae_units_up_axis_and_node_transform():
     assert unit == pytest.approx(0.0254)
     assert len(faces) == 12
     lo, hi = verts.min(axis=0), verts.max(axis=0)
-    # 20 x 10 x 30 inches, Y-up file turned Z-up, lifted by its node <translate> to stand on z = 0
+    # 20 x 10 x 30 inches; the file declares Y_UP but, as in Gazebo classic, it is not turned: the
+    # box stands 30 in tall, lifted by its node <translate> to stand on z = 0
     assert hi - lo == pytest.approx([20, 10, 30])
     assert lo[2] == pytest.approx(0) and (lo[:2] + hi[:2]) == pytest.approx([0, 0])
 

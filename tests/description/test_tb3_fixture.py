@@ -44,7 +44,8 @@ def test_meshes_resolved_from_package_uris(burger):
     assert geom.mesh_path == PKG / "meshes" / "bases" / "burger_base.stl"
     assert geom.mesh_path.is_absolute() and geom.mesh_path.exists()
     assert geom.mesh_scale == pytest.approx((0.001, 0.001, 0.001))
-    assert burger.links["base_link"].visuals[0].rgba == pytest.approx((0.4, 0.4, 0.4, 1.0))
+    # <gazebo reference="base_link"><material>Gazebo/DarkGrey: Gazebo draws it so, over the URDF colour
+    assert burger.links["base_link"].visuals[0].rgba == pytest.approx((0.175, 0.175, 0.175, 1.0))
     assert "package://" not in str(burger.links["base_scan"].visuals[0].geometry.mesh_path)
 
 

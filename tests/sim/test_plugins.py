@@ -96,7 +96,7 @@ def test_encoder_odometry_within_one_percent_over_ten_metres() -> None:
 
 
 def test_cmd_timeout_stops_the_robot() -> None:
-    ex, gazebo = _start()
+    ex, gazebo = _start(cmd_timeout=0.5)  # navlab's watchdog, off unless set
     Probe(ex, 0.5, 0.0, stop_at=1.0)
     ex.run(3.0)
     x_then = gazebo.sim.base_pose2d()[0]  # type: ignore[attr-defined]

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import argparse
 import json
-from pathlib import Path
 
 from navlab.errors import NavlabError
 
@@ -19,23 +18,8 @@ def _xacro_args(pairs: list[str]) -> dict[str, str]:
     return out
 
 
-def _resolve(file: str, kind: str) -> Path | str:
-    """A path, a ``package://`` URI (kept as text), or a shipped name (``mybot``, ``room``)."""
-    from navlab import resources
-
-    if file.startswith("package://"):
-        return file
-    p = Path(file).expanduser()
-    if p.exists() or "/" in file:
-        return p
-    try:
-        return resources.robot(file) if kind == "robot" else resources.world(file)
-    except NavlabError:
-        return p
-
-
 def _cmd(args: argparse.Namespace) -> int:
-    path = _resolve(args.file, args.kind)
+    path = args.file  # a path, package:// URI or shipped name: the loaders resolve it (one resolver)
     if args.kind == "robot":
         from navlab.description.loader import load_robot
         from navlab.description.summary import format_robot, robot_summary

@@ -9,3 +9,9 @@ class DescriptionError(NavlabError):
     The message names the file and the element (``<link name="...">/<inertial>``) and says what was
     expected.
     """
+
+
+class NotFoundError(DescriptionError):
+    """A file, ROS package or Gazebo model that a description names cannot be found. The message
+    names what was looked for and every folder searched. A visual whose mesh is not found is skipped
+    with a warning, as Gazebo does; a collision's stays an error."""

@@ -11,10 +11,11 @@ from __future__ import annotations
 import difflib
 import math
 import xml.etree.ElementTree as ET
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Literal
 
 from navlab.description.errors import DescriptionError
+from navlab.description.materials import gazebo_material
 from navlab.description.model import DiffDriveConfig, ImuConfig, LidarConfig, Link, Origin
 from navlab.description.urdf import floats
 
@@ -66,6 +67,7 @@ class GazeboTags:
     lidars: list[LidarConfig] = field(default_factory=list)
     imus: list[ImuConfig] = field(default_factory=list)
     warnings: list[str] = field(default_factory=list)
+    legacy_mode_given: bool = True  # the diff-drive plugin wrote <legacyMode> (else ROS 1's default applied)
 
 
 def _bool(text: str, where: str) -> bool:
@@ -130,9 +132,7 @@ def parse_diff_drive(plugin: ET.Element, where: str, warnings: list[str]) -> Dif
                             f"{_did_you_mean(child.tag, known)}")
     ros2 = any(c.tag in DD_KEYS_ROS2 for c in plugin) or plugin.find("ros") is not None
     if "legacy_mode" not in values and not ros2:
-        warnings.append(f"{where}: <legacyMode> not given; ROS 1's default (true) swaps the wheels' "
-                        "roles when turning; set <legacyMode>false</legacyMode>")
-        cfg.legacy_mode = True
+        cfg.legacy_mode = True  # ROS 1's default; what it does to this robot is reported by check_plugin_joints
     if "odometry_source" not in values:
         cfg.odometry_source = "world"  # both plugins default to the true pose
     for key, raw in values.items():
@@ -305,6 +305,8 @@ def read_gazebo_tags(root: ET.Element, links: dict[str, Link], joint_names: set[
                 continue
             if ref is not None and child.tag in ("mu1", "mu2"):
                 setattr(links[ref], child.tag, _num(child, f"{where}/<{child.tag}>", 0.0))
+            elif ref is not None and child.tag == "material":
+                _apply_material(links[ref], child, f"{where}/<material>", out.warnings)
             elif ref is not None and child.tag == "sensor":
                 _read_sensor(child, ref, where, out, imu_sensors)
             elif child.tag == "plugin":
@@ -318,6 +320,19 @@ def read_gazebo_tags(root: ET.Element, links: dict[str, Link], joint_names: set[
             out.warnings.append(f'{source}: <gazebo reference="{link}">: imu sensor '
                                 f"{sensor.get('name')!r} has no ROS plugin; nothing is published")
     return out
+
+
+def _apply_material(link: Link, el: ET.Element, where: str, warnings: list[str]) -> None:
+    """``<gazebo reference="link"><material>Gazebo/Orange</material>``: Gazebo draws every visual of the
+    link in that named material (over the URDF's ``<material>`` colour)."""
+    name = (el.text or "").strip() or (el.findtext("script/name") or "").strip()
+    rgba = gazebo_material(name)
+    if rgba is None:
+        if name:
+            warnings.append(f"{where}: material {name!r} is not one of Gazebo's named materials navlab knows "
+                            "(Gazebo/Orange, Gazebo/Grey, ...); the URDF colour is kept")
+        return
+    link.visuals = [replace(v, rgba=rgba) for v in link.visuals]
 
 
 def _read_sensor(sensor: ET.Element, link: str, where: str, out: GazeboTags,
@@ -353,6 +368,7 @@ def _read_model_plugin(plugin: ET.Element, where: str, out: GazeboTags) -> None:
             out.warnings.append(f"{w}: a second diff-drive plugin; the first one is used")
         else:
             out.diff_drive = parse_diff_drive(plugin, w, out.warnings)
+            out.legacy_mode_given = plugin.find("legacyMode") is not None
     elif fname in IMU_MODEL_PLUGINS:
         body = (plugin.findtext("bodyName") or "").strip()
         if not body:
@@ -363,8 +379,48 @@ def _read_model_plugin(plugin: ET.Element, where: str, out: GazeboTags) -> None:
                             "laser/ray-sensor and imu plugins)")
 
 
-def check_plugin_joints(tags: GazeboTags, joints: dict[str, str], links: dict[str, Link], source: str) -> None:
-    """The diff-drive joints must be continuous/revolute joints; sensors must sit on existing links."""
+def _side(joint: str, chain: dict[str, tuple[str, Origin]]) -> float:
+    """y (m) of a joint's frame in the root link's frame, following parent joints up the tree."""
+    pose = Origin()
+    name: str | None = joint
+    seen: set[str] = set()
+    while name is not None and name in chain and name not in seen:
+        seen.add(name)
+        parent_joint, origin = chain[name]
+        pose = origin.then(pose)
+        name = parent_joint or None
+    return pose.xyz[1]
+
+
+def legacy_mode_note(dd: DiffDriveConfig, chain: dict[str, tuple[str, Origin]], given: bool) -> str | None:
+    """What ROS 1's ``<legacyMode>`` does to this robot, or None when it changes nothing worth saying.
+
+    ``chain``: joint name -> (its parent link's parent joint name or "", its origin), to find on which
+    side (+y: left) each wheel sits. With legacy mode the joint named in ``<leftJoint>`` is driven
+    as the right wheel, so only a robot whose ``<leftJoint>`` is physically on the right turns
+    the way cmd_vel asks."""
+    left_y, right_y = _side(dd.left_joint, chain), _side(dd.right_joint, chain)
+    swapped = left_y < right_y  # <leftJoint> names the wheel on the right
+    how = "<legacyMode> not given: ROS 1's default true applies" if not given else "<legacyMode> true"
+    if dd.legacy_mode and not swapped:
+        return (f"{how}; <leftJoint> {dd.left_joint!r} (on the left) is driven as the right wheel, so the "
+                "robot turns the opposite way to cmd_vel's angular.z, as it does in Gazebo; odometry "
+                "follows the wheels (legacyMode false gives REP-103 turning)")
+    if dd.legacy_mode and swapped:
+        return (f"{how}; <leftJoint> {dd.left_joint!r} is the wheel on the right, and legacy mode drives "
+                "it as the right wheel: the robot turns as cmd_vel asks, as it does in Gazebo")
+    if swapped:
+        return (f"<legacyMode> false but <leftJoint> {dd.left_joint!r} is the wheel on the right: the robot "
+                "turns the opposite way to cmd_vel's angular.z, as it does in Gazebo")
+    return None
+
+
+def check_plugin_joints(tags: GazeboTags, joints: dict[str, str], links: dict[str, Link], source: str,
+                        chain: dict[str, tuple[str, Origin]] | None = None, *, legacy_given: bool = True) -> None:
+    """The diff-drive joints must be continuous/revolute joints; sensors must sit on existing links.
+
+    With ``chain`` (see :func:`legacy_mode_note`) a note on how the robot turns under ROS 1's
+    ``<legacyMode>`` is added to the warnings."""
     dd = tags.diff_drive
     if dd is not None:
         for role, name in (("left", dd.left_joint), ("right", dd.right_joint)):
@@ -374,6 +430,10 @@ def check_plugin_joints(tags: GazeboTags, joints: dict[str, str], links: dict[st
             if joints[name] not in ("continuous", "revolute"):
                 raise DescriptionError(f"{source}: diff-drive plugin: {role} joint {name!r} is {joints[name]}, "
                                        "expected continuous or revolute")
+        if chain is not None:
+            note = legacy_mode_note(dd, chain, legacy_given)
+            if note:
+                tags.warnings.append(f"{source}: diff-drive plugin: {note}")
     for imu in tags.imus:
         if imu.link not in links:
             raise DescriptionError(f"{source}: imu plugin {imu.name!r}: body {imu.link!r} is not a link")

@@ -7,9 +7,10 @@ import xml.etree.ElementTree as ET
 from collections.abc import Iterable, Mapping
 from pathlib import Path
 
+from navlab import resources
 from navlab.description.errors import DescriptionError
 from navlab.description.gazebo import check_plugin_joints, read_gazebo_tags
-from navlab.description.meshes import prepare_mesh
+from navlab.description.meshes import prepare_mesh, up_axis_warning
 from navlab.description.model import RobotModel
 from navlab.description.packages import PackageIndex
 from navlab.description.urdf import parse_urdf
@@ -44,14 +45,26 @@ def _moving_mass_check(model: RobotModel, source: str) -> None:
             )
 
 
+def robot_path(name_or_path: str | os.PathLike[str], search_paths: Iterable[str | os.PathLike[str]] = ()) -> Path:
+    """The description file a shipped name (``mybot``), a ``package://pkg/urdf/x.xacro`` URI (found
+    through ``search_paths`` and ``ROS_PACKAGE_PATH``), a ``file://`` URI or a path names."""
+    text = str(name_or_path).strip()
+    if text.startswith(("package://", "file://")):
+        return PackageIndex(search_paths).resolve_uri(text, base_dir=Path.cwd()).expanduser().resolve()
+    path = Path(text).expanduser()
+    if not path.exists() and not path.suffix and "/" not in text:
+        return resources.robot(text)  # ResourceError lists the shipped robots
+    return path.resolve()
+
+
 def load_robot(
     path: str | os.PathLike[str],
     *,
     search_paths: Iterable[str | os.PathLike[str]] = (),
     args: Mapping[str, str] | None = None,
 ) -> RobotModel:
-    """Load a robot description (``.xacro`` or ``.urdf``, a path or ``package://pkg/...``) with its
-    Gazebo plugin tags.
+    """Load a robot description (``.xacro`` or ``.urdf``: a path, ``package://pkg/...`` or a shipped
+    name, see :func:`robot_path`) with its Gazebo plugin tags.
 
     ``search_paths``: directories holding ROS packages (or package directories) for ``$(find pkg)``
     and ``package://pkg/...``; ``ROS_PACKAGE_PATH``, the packages enclosing ``path`` and navlab's
@@ -60,12 +73,10 @@ def load_robot(
     plugins, sensors and tags become ``RobotModel.warnings``.
     """
     search_paths = list(search_paths)
-    text = str(path)
-    if text.startswith("package://"):  # a description named by its package, e.g. package://pkg/urdf/x.xacro
-        path = PackageIndex(search_paths).resolve_uri(text, base_dir=Path.cwd())
-    path = Path(path).expanduser().resolve()
+    path = robot_path(path, search_paths)
     index = PackageIndex(search_paths, near=path)
     urdf_xml, warnings = expand(path, index, args)
+    warnings = list(warnings)
     source = str(path)
     try:
         root = ET.fromstring(urdf_xml)
@@ -73,16 +84,25 @@ def load_robot(
         raise DescriptionError(f"{source}: expanded URDF is not XML ({exc})") from None
 
     def resolve_mesh(filename: str, where: str) -> tuple[Path, float, Path]:
-        named = index.resolve_uri(filename, base_dir=path.parent)
+        try:
+            named = index.resolve_uri(filename, base_dir=path.parent)
+        except DescriptionError as exc:
+            raise type(exc)(f"{where}: {exc}") from None
         sim_path, unit = prepare_mesh(named, where)
+        warning = up_axis_warning(named, where)
+        if warning:
+            warnings.append(warning)
         return sim_path, unit, named
 
-    name, links, joints, root_link = parse_urdf(root, source, resolve_mesh)
+    name, links, joints, root_link = parse_urdf(root, source, resolve_mesh, warnings=warnings)
     model = RobotModel(name=name, links=links, joints=joints, root_link=root_link, source=path,
-                       urdf_xml=urdf_xml, warnings=list(warnings))
+                       urdf_xml=urdf_xml, warnings=warnings)
     _moving_mass_check(model, source)
     tags = read_gazebo_tags(root, links, {j.name for j in joints}, source)
-    check_plugin_joints(tags, {j.name: j.type for j in joints}, links, source)
+    parent_joint = {j.child: j.name for j in joints}
+    chain = {j.name: (parent_joint.get(j.parent, ""), j.origin) for j in joints}
+    check_plugin_joints(tags, {j.name: j.type for j in joints}, links, source, chain,
+                        legacy_given=tags.legacy_mode_given)
     model.diff_drive = tags.diff_drive
     model.lidars = tags.lidars
     model.imus = tags.imus

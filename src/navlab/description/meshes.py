@@ -2,8 +2,10 @@
 
 MuJoCo reads STL and OBJ only, so a COLLADA ``.dae`` file is converted once to an OBJ in a cache
 directory (``$NAVLAB_CACHE`` or ``~/.cache/navlab``, under ``meshes/``). The COLLADA node transforms
-and ``<up_axis>`` are applied to the vertices; the ``<unit meter=...>`` scale is returned so callers
-fold it into the mesh scale (the model's ``mesh_scale`` then includes it).
+are applied to the vertices; the ``<unit meter=...>`` scale is returned so callers fold it into the
+mesh scale (the model's ``mesh_scale`` then includes it). ``<up_axis>`` is ignored, as Gazebo classic
+ignores it (TurtleBot3's world meshes declare ``Y_UP`` but are modelled Z-up);
+:func:`collada_up_axis` lets ``navlab check`` warn about files that declare another axis than Z.
 """
 
 from __future__ import annotations
@@ -17,10 +19,11 @@ from pathlib import Path
 
 import numpy as np
 
-from navlab.description.errors import DescriptionError
+from navlab.description.errors import DescriptionError, NotFoundError
 from navlab.io.files import write_text_atomic
 
 MESH_SUFFIXES = (".stl", ".obj", ".dae")
+_DAE_VERSION = "2"  # bump when the conversion changes (v2: <up_axis> ignored, as in Gazebo classic)
 
 
 def cache_dir() -> Path:
@@ -188,21 +191,48 @@ def _geometry_triangles(geom: ET.Element, path: Path) -> tuple[np.ndarray, np.nd
     return positions, tri
 
 
+def collada_up_axis(path: Path) -> str | None:
+    """The ``<asset><up_axis>`` a COLLADA file declares (``Y_UP``...), None if it declares none or is
+    unreadable. Gazebo classic, and navlab, do not rotate by it."""
+    try:
+        for _event, elem in ET.iterparse(path, events=("end",)):
+            name = _local(elem.tag)
+            if name == "up_axis":
+                return (elem.text or "").strip() or None
+            if name == "asset":
+                return None
+    except (ET.ParseError, OSError):
+        return None
+    return None
+
+
+def up_axis_warning(path: Path, where: str) -> str | None:
+    """A warning for a COLLADA mesh that declares an up axis other than Z (None otherwise)."""
+    if path.suffix.lower() != ".dae":
+        return None
+    up = collada_up_axis(path)
+    if up is None or up.upper() == "Z_UP":
+        return None
+    return (f"{where}: mesh {path} declares <up_axis>{up}</up_axis>; Gazebo classic ignores it (and so "
+            "does navlab): the vertices are used as Z-up. Re-export the mesh if it looks rotated")
+
+
 def read_dae(path: Path) -> tuple[np.ndarray, np.ndarray, float]:
-    """Vertices (node transforms and up axis applied, in the file's units), triangles, and unit meters."""
+    """Vertices (node transforms applied, in the file's units; ``<up_axis>`` ignored as Gazebo classic
+    does), triangles, and unit meters."""
     try:
         root = ET.parse(path).getroot()
     except ET.ParseError as exc:
         raise DescriptionError(f"{path}: malformed COLLADA file ({exc})") from None
     asset = _child(root, "asset")
-    unit, up = 1.0, "Y_UP"
+    unit = 1.0
     if asset is not None:
         u = _child(asset, "unit")
         if u is not None and u.get("meter"):
-            unit = float(u.get("meter", "1"))
-        ua = _child(asset, "up_axis")
-        if ua is not None and ua.text:
-            up = ua.text.strip()
+            try:
+                unit = float(u.get("meter", "1"))
+            except ValueError:
+                raise DescriptionError(f"{path}: <unit meter={u.get('meter')!r}>: expected a number") from None
     geoms = {g.get("id"): g for lib in _children(root, "library_geometries") for g in _children(lib, "geometry")}
     lib_nodes = {n.get("id"): n for lib in _children(root, "library_nodes") for n in _children(lib, "node")}
     scenes = {s.get("id"): s for lib in _children(root, "library_visual_scenes")
@@ -243,11 +273,6 @@ def read_dae(path: Path) -> tuple[np.ndarray, np.ndarray, float]:
         offset += len(v)
     verts = np.concatenate(all_v) if all_v else np.zeros((0, 3))
     faces = np.concatenate(all_f) if all_f else np.zeros((0, 3), dtype=int)
-    if up == "Y_UP":
-        verts = verts[:, [0, 2, 1]] * np.array([1.0, -1.0, 1.0])  # y up -> z up (+90° about x)
-    elif up == "X_UP":
-        verts = verts[:, [1, 0, 2]] * np.array([-1.0, 1.0, 1.0])
-        verts = verts[:, [0, 2, 1]] * np.array([1.0, -1.0, 1.0])
     if len(faces) == 0:
         raise DescriptionError(f"{path}: COLLADA file has no triangles")
     return verts, faces, unit
@@ -256,7 +281,7 @@ def read_dae(path: Path) -> tuple[np.ndarray, np.ndarray, float]:
 def dae_to_obj(path: Path) -> tuple[Path, float]:
     """Convert a COLLADA file to a cached OBJ (converted once per file version); return it and unit meters."""
     stat = path.stat()
-    key = hashlib.sha1(f"{path.resolve()}|{stat.st_mtime_ns}|{stat.st_size}".encode()).hexdigest()[:16]
+    key = hashlib.sha1(f"{_DAE_VERSION}|{path.resolve()}|{stat.st_mtime_ns}|{stat.st_size}".encode()).hexdigest()[:16]
     verts, faces, unit = read_dae(path)
     out = cache_dir() / f"{path.stem}-{key}.obj"
     if not out.exists():
@@ -274,7 +299,7 @@ def prepare_mesh(path: Path, where: str) -> tuple[Path, float]:
     COLLADA unit as the factor; STL/OBJ come back unchanged with factor 1.
     """
     if not path.is_file():
-        raise DescriptionError(f"{where}: mesh file {path} not found")
+        raise NotFoundError(f"{where}: mesh file {path} not found")
     suffix = path.suffix.lower()
     if suffix not in MESH_SUFFIXES:
         raise DescriptionError(f"{where}: mesh {path} has unsupported type {suffix!r} (expected .stl/.obj/.dae)")

@@ -155,9 +155,11 @@ class DiffDriveConfig:
     odometry_source: Literal["encoder", "world"] = "world"
     publish_tf: bool = True
     publish_wheel_tf: bool = False
-    cmd_timeout: float = 0.5  # s without cmd_vel before the wheels are stopped
+    # navlab extension (not a Gazebo tag; gazebo node parameter cmd_timeout): s without cmd_vel before the
+    # wheels are stopped; 0 = off, as in ROS 1's plugin (the last command holds until a new one)
+    cmd_timeout: float = 0.0
     namespace: str = ""
-    legacy_mode: bool = False  # ROS 1 <legacyMode> true: left/right wheel speeds swapped when turning
+    legacy_mode: bool = False  # ROS 1 <legacyMode> (default true there): the joints' turning roles swapped
     # navlab extension (not a Gazebo tag): relative error of each wheel's encoder scale, drawn once per
     # run from N(0, odometry_noise) with the run's seed; 0 = exact encoders. Makes odometry drift.
     odometry_noise: float = 0.0

@@ -11,7 +11,7 @@ import xml.etree.ElementTree as ET
 from collections.abc import Callable
 from pathlib import Path
 
-from navlab.description.errors import DescriptionError
+from navlab.description.errors import DescriptionError, NotFoundError
 from navlab.description.model import (
     Geometry,
     Inertial,
@@ -127,12 +127,21 @@ def parse_inertial(el: ET.Element, where: str) -> Inertial:
 
 
 def _shapes(link_el: ET.Element, tag: str, where: str, resolve_mesh: MeshResolver,
-            materials: dict[str, tuple[float, float, float, float]]) -> list[Shape]:
+            materials: dict[str, tuple[float, float, float, float]], warnings: list[str] | None) -> list[Shape]:
+    """The link's ``<collision>`` or ``<visual>`` elements. A visual whose mesh file is missing is
+    skipped with a warning when ``warnings`` is given (Gazebo loads the robot without it)."""
     out = []
     for i, el in enumerate(link_el.findall(tag)):
         w = f"{where}/<{tag}{' name=' + repr(el.get('name')) if el.get('name') else ''}>[{i}]"
+        try:
+            geometry = parse_geometry(el.find("geometry"), w, resolve_mesh)
+        except NotFoundError as exc:
+            if tag != "visual" or warnings is None:
+                raise
+            warnings.append(f"{exc}; visual skipped (Gazebo shows the link without it)")
+            continue
         out.append(Shape(
-            geometry=parse_geometry(el.find("geometry"), w, resolve_mesh),
+            geometry=geometry,
             origin=parse_origin(el.find("origin"), w),
             rgba=_rgba(el, materials, w) if tag == "visual" else None,
             name=el.get("name", ""),
@@ -141,14 +150,14 @@ def _shapes(link_el: ET.Element, tag: str, where: str, resolve_mesh: MeshResolve
 
 
 def parse_link(el: ET.Element, where: str, resolve_mesh: MeshResolver,
-               materials: dict[str, tuple[float, float, float, float]]) -> Link:
-    """One ``<link>``."""
+               materials: dict[str, tuple[float, float, float, float]], warnings: list[str] | None = None) -> Link:
+    """One ``<link>`` (``warnings``: where skipped visuals are reported; None: a missing visual mesh is an error)."""
     inertial_el = el.find("inertial")
     return Link(
         name=el.get("name", ""),
         inertial=parse_inertial(inertial_el, where) if inertial_el is not None else None,
-        collisions=_shapes(el, "collision", where, resolve_mesh, materials),
-        visuals=_shapes(el, "visual", where, resolve_mesh, materials),
+        collisions=_shapes(el, "collision", where, resolve_mesh, materials, warnings),
+        visuals=_shapes(el, "visual", where, resolve_mesh, materials, warnings),
     )
 
 
@@ -196,10 +205,12 @@ def parse_joint(el: ET.Element, where: str) -> Joint:
     )
 
 
-def parse_urdf(root: ET.Element, source: str, resolve_mesh: MeshResolver) -> tuple[
-        str, dict[str, Link], list[Joint], str]:
+def parse_urdf(root: ET.Element, source: str, resolve_mesh: MeshResolver, *,
+               warnings: list[str] | None = None) -> tuple[str, dict[str, Link], list[Joint], str]:
     """Parse a ``<robot>`` element; return (robot name, links, joints, root link).
 
+    ``warnings``: a list that collects what loads with a warning (a visual whose mesh is missing is
+    skipped); without it every missing mesh is an error.
     Checks that names are unique, joints name existing links, and the links form one tree.
     """
     if root.tag != "robot":
@@ -221,7 +232,7 @@ def parse_urdf(root: ET.Element, source: str, resolve_mesh: MeshResolver) -> tup
         where = f'{source}: <link name="{lname}">'
         if lname in links:
             raise DescriptionError(f"{where}: duplicate link name")
-        links[lname] = parse_link(el, where, resolve_mesh, materials)
+        links[lname] = parse_link(el, where, resolve_mesh, materials, warnings)
     if not links:
         raise DescriptionError(f"{source}: <robot name=\"{name}\"> has no <link>")
     joints: list[Joint] = []

@@ -2,6 +2,15 @@
 
 Frames: the robot base frame has x forward, y left (REP-103); odometry is in the odometry frame,
 which starts at the base frame's pose when the odometry is (re)set.
+
+ROS 1's ``gazebo_ros_diff_drive`` semantics kept here:
+
+- ``legacyMode`` (ROS 1 default **true**): the joint named in ``<leftJoint>`` gets the speed the
+  *right* wheel needs when turning (``v + w b/2``) and ``<rightJoint>`` the left's, and encoder
+  odometry turns the other way to match. Robots written for it name their wheels "the other way
+  round" and turn correctly only so; ``legacyMode false`` is the textbook assignment.
+- No command timeout: the last ``cmd_vel`` applies until another arrives (one ``rostopic pub -1``
+  keeps the robot going). navlab's ``cmd_timeout`` (s, off unless set) is a watchdog on top.
 """
 
 from __future__ import annotations
@@ -21,11 +30,24 @@ def _check_geometry(separation: float, diameter: float) -> None:
                        "expected finite numbers > 0")
 
 
-def wheel_speeds(v: float, w: float, separation: float, diameter: float) -> tuple[float, float]:
-    """(left, right) wheel angular velocities (rad/s) for body speed ``v`` (m/s) and yaw rate ``w`` (rad/s)."""
+def wheel_speeds(v: float, w: float, separation: float, diameter: float, *,
+                 legacy_mode: bool = False) -> tuple[float, float]:
+    """(left joint, right joint) angular velocities (rad/s) for body speed ``v`` (m/s) and yaw rate ``w``
+    (rad/s). ``legacy_mode`` (ROS 1's ``<legacyMode>``): the two joints' turning terms are swapped."""
     _check_geometry(separation, diameter)
     r = diameter / 2.0
-    return (v - w * separation / 2.0) / r, (v + w * separation / 2.0) / r
+    turn = w * separation / 2.0
+    if legacy_mode:
+        return (v + turn) / r, (v - turn) / r
+    return (v - turn) / r, (v + turn) / r
+
+
+def command_in_force(now_ns: int, last_cmd_ns: int | None, timeout: float) -> bool:
+    """Whether the last ``cmd_vel`` still applies at ``now_ns``: always with ``timeout`` <= 0 (ROS 1's
+    plugin: the last command holds until a new one), else for ``timeout`` s after it arrived."""
+    if timeout <= 0:
+        return True
+    return last_cmd_ns is not None and now_ns - last_cmd_ns <= timeout * 1e9
 
 
 def ramp(current: float, target: float, max_accel: float, dt: float) -> float:
@@ -47,6 +69,7 @@ class EncoderOdometry:
 
     separation: float
     diameter: float
+    legacy_mode: bool = False  # ROS 1 <legacyMode>: the yaw change is (left - right) / separation
     x: float = 0.0
     y: float = 0.0
     yaw: float = 0.0
@@ -71,7 +94,7 @@ class EncoderOdometry:
         sr = (right - self._right) * r
         self._left, self._right = left, right
         ds = 0.5 * (sl + sr)
-        dyaw = (sr - sl) / self.separation
+        dyaw = ((sl - sr) if self.legacy_mode else (sr - sl)) / self.separation
         mid = self.yaw + 0.5 * dyaw
         self.x += ds * math.cos(mid)
         self.y += ds * math.sin(mid)

@@ -17,28 +17,17 @@ from navlab.world.model import ModelSpec, WorldModel
 
 
 def load_robot_named(name_or_path: str) -> RobotModel:
-    """A robot from a shipped name (``mybot``) or a .xacro/.urdf path."""
-    from navlab import resources
+    """A robot from a shipped name (``mybot``), a ``package://`` URI or a .xacro/.urdf path."""
     from navlab.description import load_robot
 
-    path = Path(name_or_path).expanduser()
-    if not path.suffix and not path.exists():
-        path = resources.robot(name_or_path)
-    return load_robot(path)
+    return load_robot(name_or_path)  # one resolver: navlab.description.loader.robot_path
 
 
 def load_world_named(name_or_path: str) -> WorldModel:
-    """A world from a shipped name (``room``, ``room_obstacles``) or a .world/.sdf path."""
-    from navlab import resources
+    """A world from a shipped name (``room``, ``room_obstacles``), a ``package://`` URI or a .world/.sdf path."""
+    from navlab.world import load_world
 
-    try:
-        from navlab.world import load_world
-    except ImportError:
-        raise SimError("loading .world files needs navlab.world.load_world, which is not available") from None
-    path = Path(name_or_path).expanduser()
-    if not path.suffix and not path.exists():
-        path = resources.world(name_or_path)
-    return load_world(path)
+    return load_world(name_or_path)  # one resolver: navlab.world.sdf.world_path
 
 
 class GazeboSim(Node):
@@ -47,6 +36,8 @@ class GazeboSim(Node):
     ``max_step_size``), ``joint_state_rate`` and ``ground_truth_rate`` (Hz; 0 = off), ``seed``
     (sensor noise seed; -1 = the executor's), ``visuals`` (build render-only geoms; default off, faster).
     ``odometry_noise`` (relative std dev of each wheel encoder's scale error; navlab extension, default 0).
+    ``cmd_timeout`` (s; navlab's diff-drive watchdog: stop the wheels when no cmd_vel came for this long;
+    default 0 = off, as ROS 1's gazebo_ros_diff_drive, where the last command holds until a new one).
     ``robot_model``/``world_model`` replace the files."""
 
     def __init__(self, executor: Executor, *, name: str = "gazebo", parameters: dict[str, Any] | None = None,
@@ -63,6 +54,7 @@ class GazeboSim(Node):
         seed = self.declare_parameter("seed", -1)
         visuals = self.declare_parameter("visuals", False)
         odometry_noise = self.declare_parameter("odometry_noise", 0.0)
+        cmd_timeout = float(self.declare_parameter("cmd_timeout", 0.0))
         robot = robot_model if robot_model is not None else load_robot_named(robot_name)
         world = world_model if world_model is not None else load_world_named(world_name)
         for warning in [*robot.warnings, *world.warnings]:
@@ -77,6 +69,8 @@ class GazeboSim(Node):
         if robot.diff_drive is not None:
             if odometry_noise > 0:
                 robot.diff_drive.odometry_noise = odometry_noise
+            if cmd_timeout > 0:
+                robot.diff_drive.cmd_timeout = cmd_timeout
             self.plugins.append(DiffDrivePlugin(executor, namespace=namespace, sim=self.sim, config=robot.diff_drive))
         self.plugins += [LidarPlugin(executor, namespace=namespace, sim=self.sim, index=i)
                          for i in range(len(robot.lidars))]

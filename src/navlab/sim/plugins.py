@@ -19,7 +19,7 @@ from navlab import msgs
 from navlab.core import Executor, Node
 from navlab.description.model import DiffDriveConfig, ImuConfig, LidarConfig, Origin
 from navlab.geometry import Vec, qmul, qrotate, quat_from_rpy, quat_from_yaw
-from navlab.sim.diffdrive import ODOM_COVARIANCE_DIAG, EncoderOdometry, ramp, wheel_speeds
+from navlab.sim.diffdrive import ODOM_COVARIANCE_DIAG, EncoderOdometry, command_in_force, ramp, wheel_speeds
 from navlab.sim.simulation import Simulation, lidar_angles
 
 _ODOM_COV = msgs.covariance(ODOM_COVARIANCE_DIAG)
@@ -50,7 +50,8 @@ def base_frame_link(sim: Simulation, frame: str) -> str:
 class DiffDrivePlugin(Node):
     """``libgazebo_ros_diff_drive``: ``cmd_vel`` → wheel velocity targets (torque-limited), odometry and tf.
 
-    Every ``1/update_rate`` s: stop the wheels if no command came within ``cmd_timeout`` s, set the
+    Every ``1/update_rate`` s: stop the wheels if navlab's ``cmd_timeout`` watchdog is set (s > 0) and no
+    command came within it (ROS 1's plugin has none: the last command holds), set the
     wheel targets (ramped by ``max_accel`` in m/s² of the wheel rim, as Gazebo's plugin code applies
     ``wheelAcceleration``), then publish ``nav_msgs/Odometry`` on ``odometry_topic`` in
     ``odometry_frame`` — integrated from the wheel encoders, or with ``odometry_source: world`` the
@@ -72,7 +73,7 @@ class DiffDrivePlugin(Node):
         self.last_cmd_ns: int | None = None
         self.wheel_targets = (0.0, 0.0)
         self.max_wheel_accel = config.max_accel / (config.wheel_diameter / 2)  # rad/s² of the wheel joints
-        self.odometry = EncoderOdometry(config.wheel_separation, config.wheel_diameter)
+        self.odometry = EncoderOdometry(config.wheel_separation, config.wheel_diameter, config.legacy_mode)
         # Encoder scale errors (navlab's odometry_noise): wheel angles are read as if the wheels were
         # slightly larger or smaller than described, so encoder odometry drifts as a real robot's does.
         noise = config.odometry_noise
@@ -102,9 +103,9 @@ class DiffDrivePlugin(Node):
         self.last_ns = now
         cfg = self.cfg
         v, w = self.cmd
-        if cfg.cmd_timeout > 0 and (self.last_cmd_ns is None or now - self.last_cmd_ns > cfg.cmd_timeout * 1e9):
+        if not command_in_force(now, self.last_cmd_ns, cfg.cmd_timeout):
             v, w = 0.0, 0.0
-        left, right = wheel_speeds(v, w, cfg.wheel_separation, cfg.wheel_diameter)
+        left, right = wheel_speeds(v, w, cfg.wheel_separation, cfg.wheel_diameter, legacy_mode=cfg.legacy_mode)
         self.wheel_targets = (
             ramp(self.wheel_targets[0], left, self.max_wheel_accel, dt),
             ramp(self.wheel_targets[1], right, self.max_wheel_accel, dt),

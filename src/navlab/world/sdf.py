@@ -16,8 +16,9 @@ from collections.abc import Iterable
 from pathlib import Path
 
 from navlab import resources
-from navlab.description.errors import DescriptionError
-from navlab.description.meshes import is_convex, prepare_mesh, read_mesh
+from navlab.description.errors import DescriptionError, NotFoundError
+from navlab.description.materials import gazebo_material
+from navlab.description.meshes import is_convex, prepare_mesh, read_mesh, up_axis_warning
 from navlab.description.model import Geometry, Inertial, Link, Origin, Shape
 from navlab.description.packages import PackageIndex
 from navlab.geometry import compose6
@@ -25,13 +26,6 @@ from navlab.world.errors import WorldError
 from navlab.world.model import ModelSpec, Pose6, WorldModel
 
 SUPPORTED_VERSIONS = ("1.4", "1.5", "1.6", "1.7")
-_COLORS = {  # Gazebo material script names -> rgba
-    "Gazebo/Grey": (0.7, 0.7, 0.7, 1.0), "Gazebo/DarkGrey": (0.35, 0.35, 0.35, 1.0),
-    "Gazebo/White": (1.0, 1.0, 1.0, 1.0), "Gazebo/Black": (0.05, 0.05, 0.05, 1.0),
-    "Gazebo/Red": (0.8, 0.1, 0.1, 1.0), "Gazebo/Green": (0.1, 0.7, 0.1, 1.0),
-    "Gazebo/Blue": (0.1, 0.1, 0.8, 1.0), "Gazebo/Yellow": (0.9, 0.9, 0.1, 1.0),
-    "Gazebo/Orange": (1.0, 0.5, 0.05, 1.0), "Gazebo/Wood": (0.55, 0.4, 0.25, 1.0),
-}
 _IGNORED_WORLD_TAGS = ("light", "scene", "gui", "audio", "wind", "atmosphere", "spherical_coordinates",
                        "magnetic_field", "physics", "gravity", "state", "road", "frame")
 
@@ -99,14 +93,13 @@ class _Loader:
     # ------------------------------------------------------------------------------- includes
     def find_model_dir(self, uri: str, base_dir: Path, where: str) -> Path:
         """The directory of an included model (``model://name``, ``file://dir`` or a path)."""
-        if uri.startswith("model://"):
-            name = uri[len("model://") :].strip("/")
-            for root in self.model_paths:
-                if (root / name).is_dir():
-                    return root / name
-            raise WorldError(f"{where}: model {uri!r} not found in the model path "
-                             f"({', '.join(str(p) for p in self.model_paths) or 'empty'}); add its parent "
-                             "directory to model_path / GAZEBO_MODEL_PATH")
+        if uri.startswith("model://") or uri.startswith("package://"):
+            try:
+                if uri.startswith("package://"):
+                    return self.index.resolve_uri(uri, base_dir=base_dir)
+                return self.index.find_model(uri.rstrip("/"), self.model_paths)
+            except DescriptionError as exc:
+                raise WorldError(f"{where}: {exc}") from None
         path = Path(uri[len("file://") :] if uri.startswith("file://") else uri)
         path = path if path.is_absolute() else base_dir / path
         if not path.exists():
@@ -263,7 +256,10 @@ class _Loader:
         elif g.tag == "sphere":
             geometry = Geometry("sphere", size=(_num(g, "radius", gw, 0.0),))
         elif g.tag == "mesh":
-            geometry = self.mesh(g, file, gw, collision)
+            mesh = self.mesh(g, file, gw, collision)
+            if mesh is None:
+                return None
+            geometry = mesh
         else:
             self.warnings.append(f"{gw}: geometry <{g.tag}> is not supported (box, cylinder, sphere, mesh, "
                                  "plane); ignored")
@@ -274,8 +270,9 @@ class _Loader:
         return Shape(geometry=geometry, origin=Origin(xyz=p[:3], rpy=p[3:]), name=el.get("name", ""),
                      rgba=None if collision else self.rgba(el, where))
 
-    def mesh(self, g: ET.Element, file: Path, where: str, collision: bool) -> Geometry:
-        """A ``<mesh><uri>`` resolved through the model path; DAE converted; convexity checked."""
+    def mesh(self, g: ET.Element, file: Path, where: str, collision: bool) -> Geometry | None:
+        """A ``<mesh><uri>`` resolved through the model path; DAE converted; convexity checked.
+        None: a visual whose mesh is not found (skipped with a warning, as Gazebo does)."""
         uri = (g.findtext("uri") or "").strip()
         if not uri:
             raise WorldError(f"{where}: missing <uri>")
@@ -286,8 +283,16 @@ class _Loader:
             named = self.index.resolve_uri(uri, base_dir=file.parent, model_paths=self.model_paths)
             sim_path, unit = prepare_mesh(named, where)
             convex = is_convex(*read_mesh(sim_path)) if collision else None
+        except NotFoundError as exc:
+            if collision:
+                raise WorldError(str(exc) if str(exc).startswith(where) else f"{where}: {exc}") from None
+            self.warnings.append(f"{where}: {exc}; visual skipped (Gazebo shows the model without it)")
+            return None
         except DescriptionError as exc:
             raise WorldError(str(exc)) from None
+        warning = up_axis_warning(named, where)
+        if warning and warning not in self.warnings:
+            self.warnings.append(warning)
         return Geometry("mesh", mesh_path=sim_path, mesh_scale=(scale[0] * unit, scale[1] * unit, scale[2] * unit),
                         mesh_source=named, convex=convex)
 
@@ -300,7 +305,7 @@ class _Loader:
             if text and len(text.split()) in (3, 4):
                 v = _floats(text, len(text.split()), f"{where}/<material>/<{tag}>")
                 return (v[0], v[1], v[2], v[3] if len(v) == 4 else 1.0)
-        return _COLORS.get((mat.findtext("script/name") or "").strip())
+        return gazebo_material(mat.findtext("script/name") or "")
 
 
 def default_model_paths(model_path: Iterable[str | os.PathLike[str]], world_file: Path) -> list[Path]:
@@ -311,6 +316,21 @@ def default_model_paths(model_path: Iterable[str | os.PathLike[str]], world_file
     return paths
 
 
+def world_path(name_or_path: str | os.PathLike[str]) -> Path:
+    """The world file a shipped name (``room``), a ``package://pkg/worlds/x.world`` URI (found through
+    ``ROS_PACKAGE_PATH``), a ``file://`` URI or a path names."""
+    text = str(name_or_path).strip()
+    if text.startswith(("package://", "file://")):
+        try:
+            return PackageIndex().resolve_uri(text, base_dir=Path.cwd()).resolve()
+        except DescriptionError as exc:
+            raise WorldError(f"world {text!r}: {exc}") from None
+    path = Path(text).expanduser()
+    if not path.exists() and not path.suffix and "/" not in text:
+        return resources.world(text)  # ResourceError lists the shipped worlds
+    return path.resolve()
+
+
 def load_world(path: str | os.PathLike[str], *, model_path: Iterable[str | os.PathLike[str]] = ()) -> WorldModel:
     """Load a Gazebo-classic ``.world`` SDF file.
 
@@ -318,7 +338,7 @@ def load_world(path: str | os.PathLike[str], *, model_path: Iterable[str | os.Pa
     before ``GAZEBO_MODEL_PATH``, a ``models/`` directory beside the world and navlab's shipped models
     (``ground_plane``, ``sun``). Raises WorldError naming the file and element on bad input.
     """
-    file = Path(path).expanduser().resolve()
+    file = world_path(path)
     root = _parse_xml(file, "world file")
     if root.tag != "sdf":
         raise WorldError(f"{file}: top element is <{root.tag}>, expected <sdf>")

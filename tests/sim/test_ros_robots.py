@@ -1,0 +1,94 @@
+"""Issue 13: a ROS 1 tutorial robot behaves in navlab as in Gazebo classic (tests/fixtures/tutorial_bot_description).
+
+Its wheel joints are named the other way round, its diff-drive plugin leaves ``legacyMode`` to ROS 1's
+default, it sends its scans to /tutorial_bot/laser/scan and paints its chassis Gazebo/Orange.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+from conftest import make_room
+
+from navlab import msgs
+from navlab.core import Executor, Node
+from navlab.description import load_robot
+from navlab.sim import launch_sim
+
+PKG = Path(__file__).parents[1] / "fixtures" / "tutorial_bot_description"
+XACRO = PKG / "urdf" / "tutorial_bot.urdf.xacro"
+
+
+def _drive(robot: object, twists: list[tuple[float, float, float]], duration: float,
+           **params: object) -> tuple[Executor, object]:
+    """Run the robot in the test room; publish each (t, v, w) once at time t."""
+    ex = Executor(seed=0)
+    gazebo = launch_sim(ex, world=make_room(), robot=robot, **params)  # type: ignore[arg-type]
+    node = Node(ex, name="rostopic_pub")
+    pub = node.create_publisher(msgs.Twist, "cmd_vel", 10)
+    for t, v, w in twists:
+        holder: dict[str, object] = {}
+
+        def fire(v: float = v, w: float = w, holder: dict[str, object] = holder) -> None:
+            holder["timer"].cancel()  # type: ignore[attr-defined]
+            pub.publish(msgs.twist(v, w))
+
+        holder["timer"] = node.create_timer(t, fire)
+    ex.run(duration)
+    return ex, gazebo
+
+
+@pytest.mark.parametrize(("legacy", "turns_ccw"), [("unset", True), ("true", True), ("false", False)])
+def test_swapped_wheel_names_turn_as_in_gazebo(legacy: str, turns_ccw: bool) -> None:
+    robot = load_robot(XACRO, args={"legacy": legacy})
+    assert robot.diff_drive is not None and robot.diff_drive.legacy_mode is (legacy != "false")
+    _, gazebo = _drive(robot, [(0.05, 0.0, 1.0)], 1.0)
+    yaw = gazebo.sim.base_pose2d("base_link")[2]  # type: ignore[attr-defined]
+    assert abs(yaw) > 0.5
+    assert (yaw > 0) is turns_ccw
+
+
+def test_legacy_mode_encoder_odometry_follows_the_wheels() -> None:
+    robot = load_robot(XACRO, args={"odometry_source": "encoder"})
+    ex, gazebo = _drive(robot, [(0.05, 0.1, 0.8)], 1.5)
+    odom_yaw = ex.tf.lookup_pose2d("odom", "base_link")[2]
+    true_yaw = gazebo.sim.base_pose2d("base_link")[2]  # type: ignore[attr-defined]
+    assert true_yaw > 0.8 and odom_yaw == pytest.approx(true_yaw, abs=0.1)
+
+
+def test_one_cmd_vel_keeps_a_ros1_robot_going() -> None:
+    """``rostopic pub -1 cmd_vel ...``: ROS 1's plugin applies the last command until a new one."""
+    robot = load_robot(XACRO, args={"legacy": "true"})
+    _, gazebo = _drive(robot, [(0.1, 0.4, 0.0)], 3.0)
+    x = gazebo.sim.base_pose2d("base_link")[0]  # type: ignore[attr-defined]
+    assert x == pytest.approx(0.4 * 2.9, abs=0.15)
+
+
+def test_cmd_timeout_watchdog_is_a_navlab_parameter() -> None:
+    robot = load_robot(XACRO, args={"legacy": "true"})
+    _, gazebo = _drive(robot, [(0.1, 0.4, 0.0)], 3.0, cmd_timeout=0.5)
+    x = gazebo.sim.base_pose2d("base_link")[0]  # type: ignore[attr-defined]
+    assert 0.1 < x < 0.4  # moved for 0.5 s (and coasted), then stopped
+
+
+def test_gazebo_material_colours_the_rendered_chassis() -> None:
+    from navlab.sim import Simulation
+    from navlab.sim.errors import SimError
+    from navlab.sim.render import render_image
+
+    robot = load_robot(XACRO)
+    sim = Simulation(robot, make_room(), visuals=True)
+    try:
+        image = render_image(sim, width=160, height=120, elevation=-89.0, distance=1.2,
+                             lookat=(0.0, 0.0, 0.0)).astype(int)
+    except SimError as exc:
+        pytest.skip(f"no offscreen OpenGL here: {exc}")
+    r, g, b = image[..., 0], image[..., 1], image[..., 2]
+    orange = (r > 200) & (g <= r) & (r - b > 100)  # lit orange: red full, blue low
+    blue = (b > r + 60) & (b > g + 60)
+    assert orange.mean() > 0.05  # Gazebo/Orange from <gazebo reference="base_link"><material>
+    assert blue.mean() < 0.005  # not the URDF's own blue material
+    assert math.isfinite(float(np.mean(image)))
