@@ -15,3 +15,7 @@ NODES: dict[str, str] = {
     "route_follower": "navlab.mapping.teleop:RouteFollower",
     "move_base": "navlab.navigation.move_base:MoveBase",
 }
+
+#: launch files' ``$(robot KEY)``: a function of the ``robot`` argument (shipped name, file or
+#: package:// URI) returning its base frame, scan topic and odom frame from its plugin tags
+ROBOT_LAUNCH_VALUES = "navlab.description.loader:robot_launch_values"

@@ -92,3 +92,20 @@ def test_gazebo_material_colours_the_rendered_chassis() -> None:
     assert orange.mean() > 0.05  # Gazebo/Orange from <gazebo reference="base_link"><material>
     assert blue.mean() < 0.005  # not the URDF's own blue material
     assert math.isfinite(float(np.mean(image)))
+
+
+def test_mapping_launch_takes_base_frame_and_scan_topic_from_the_robot() -> None:
+    """The shipped mapping launch with another robot: base_link and /tutorial_bot/laser/scan, not mybot's."""
+    import navlab
+
+    session = navlab.launch("mapping", robot=str(XACRO), explore="false")
+    assert session.args["base_frame"] == "base_link"
+    assert session.args["scan_topic"] == "/tutorial_bot/laser/scan"
+    node = Node(session.executor, name="drv")
+    pub = node.create_publisher(msgs.Twist, "cmd_vel", 10)
+    node.create_timer(0.1, lambda: pub.publish(msgs.twist(0.0, 0.6)))
+    session.run(4.0)
+    slam = session.node("slam_gmapping")
+    grid = slam.current_map()  # type: ignore[attr-defined]
+    assert slam.scans_processed >= 5 and grid is not None  # type: ignore[attr-defined]
+    assert int((grid.data >= 65).sum()) > 100  # the room's walls are in the map

@@ -274,3 +274,7 @@ def start(
         raise LaunchError(f"{file}: parameters given for {', '.join(map(repr, unknown))}, but the launch starts no "
                           f"such node (nodes: {', '.join(sorted(started))})")
     return session
+
+#: launch files' ``$(robot KEY)``: a function of the ``robot`` argument (shipped name, file or
+#: package:// URI) returning its base frame, scan topic and odom frame from its plugin tags
+ROBOT_LAUNCH_VALUES = "navlab.description.loader:robot_launch_values"

@@ -111,3 +111,16 @@ def load_robot(
         model.warnings.append(f"{source}: no libgazebo_ros_diff_drive.so plugin; cmd_vel will not move "
                               "the robot")
     return model
+
+
+def robot_launch_values(name_or_path: str | os.PathLike[str]) -> dict[str, str]:
+    """What launch files take from a robot's plugin tags (``$(robot KEY)``): ``base_frame`` (the
+    diff-drive plugin's ``robotBaseFrame``, else the root link), ``odom_frame`` and ``scan_topic`` (the
+    first laser's topic, else ``scan``)."""
+    model = load_robot(name_or_path)
+    dd = model.diff_drive
+    return {
+        "base_frame": dd.robot_base_frame if dd else model.root_link,
+        "odom_frame": dd.odometry_frame if dd else "odom",
+        "scan_topic": model.lidars[0].topic if model.lidars else "scan",
+    }
