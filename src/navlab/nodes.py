@@ -14,6 +14,8 @@ NODES: dict[str, str] = {
     "teleop_twist_keyboard": "navlab.mapping.teleop:TeleopKeyboard",
     "route_follower": "navlab.mapping.teleop:RouteFollower",
     "move_base": "navlab.navigation.move_base:MoveBase",
+    "ekf_node": "navlab.localization.ekf_node:EkfNode",
+    "ekf_localization_node": "navlab.localization.ekf_node:EkfNode",
 }
 
 #: launch files' ``$(robot KEY)``: a function of the ``robot`` argument (shipped name, file or
