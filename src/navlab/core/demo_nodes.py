@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from typing import Any
 
+from navlab.core.errors import ParameterError
 from navlab.core.executor import Executor
 from navlab.core.node import Node
 from navlab.msgs import String
@@ -17,6 +18,8 @@ class Talker(Node):
     ) -> None:
         super().__init__(executor, name=name, parameters=parameters, namespace=namespace)
         rate = self.declare_parameter("rate", 1.0)
+        if not 0 < rate < float("inf"):
+            raise ParameterError(f"node {self.fully_qualified_name}: parameter 'rate': expected Hz > 0, got {rate!r}")
         self.count = 0
         self.pub = self.create_publisher(String, "chatter", 10)
         self.create_timer(1.0 / rate, self._tick)

@@ -16,8 +16,9 @@ launch:
 ```
 
 Substitutions: ``$(var NAME)``, ``$(env NAME [default])``, ``$(find-pkg-share PKG)`` (``navlab`` is
-the package's ``resources`` folder). ``exec`` names a node in ``navlab.nodes.NODES`` or, for user
-code, ``module:Class``.
+the package's ``resources`` folder), and navlab's ``$(robot KEY)``: ``base_frame``, ``scan_topic`` or
+``odom_frame`` from the plugin tags of the robot named by the ``robot`` argument. ``exec`` names a
+node in ``navlab.nodes.NODES`` or, for user code, ``module:Class``.
 """
 
 from __future__ import annotations
@@ -30,10 +31,11 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
-from navlab.core.errors import LaunchError
+from navlab.core.errors import LaunchError, ParameterError
 from navlab.core.executor import Executor
 from navlab.core.node import Node
-from navlab.core.params import load_params, merge_params, read_yaml
+from navlab.core.params import load_params, merge_params, parse_yaml, read_yaml
+from navlab.errors import NavlabError
 
 _SUBST = re.compile(r"\$\((\S+)(?:\s+([^)]*))?\)")
 
@@ -65,9 +67,12 @@ def load_node_class(exec_name: str) -> type[Node]:
         raise LaunchError(f"unknown node executable {exec_name!r} (navlab provides: {', '.join(sorted(NODES))})")
     module, cls = target.split(":", 1)
     try:
-        return getattr(importlib.import_module(module), cls)
-    except (ImportError, AttributeError) as exc:
+        found = getattr(importlib.import_module(module), cls)
+    except (ImportError, AttributeError, ValueError) as exc:
         raise LaunchError(f"node executable {exec_name!r}: cannot load {target} ({exc})") from None
+    if not (isinstance(found, type) and issubclass(found, Node)):
+        raise LaunchError(f"node executable {exec_name!r}: {target} is not a navlab Node class")
+    return found
 
 
 @dataclass
@@ -95,6 +100,21 @@ class _Context:
     def __init__(self, file: Path, args: dict[str, str]) -> None:
         self.file = file
         self.vars: dict[str, str] = dict(args)
+        self.robot_values: dict[str, dict[str, str]] = {}  # robot -> its $(robot KEY) values
+
+    def robot_value(self, key: str, where: str) -> str:
+        """``$(robot KEY)`` (navlab): ``base_frame``, ``scan_topic`` or ``odom_frame`` from the plugin tags
+        of the launch's ``robot`` argument, through the function ``navlab.nodes.ROBOT_LAUNCH_VALUES`` names."""
+        from navlab.nodes import ROBOT_LAUNCH_VALUES
+
+        robot = self.vars.get("robot", "mybot")
+        if robot not in self.robot_values:
+            module, func = ROBOT_LAUNCH_VALUES.split(":", 1)
+            self.robot_values[robot] = getattr(importlib.import_module(module), func)(robot)
+        values = self.robot_values[robot]
+        if key not in values:
+            raise LaunchError(f"{self.file}: {where}: $(robot {key}): expected one of {', '.join(sorted(values))}")
+        return values[key]
 
     def subst(self, value: Any, where: str) -> Any:
         if isinstance(value, list):
@@ -112,12 +132,17 @@ class _Context:
                     raise LaunchError(f"{self.file}: {where}: $(var {arg}) is not defined (args: {known})")
                 return self.vars[arg]
             if kind == "env":
-                name, _, default = arg.partition(" ")
-                return os.environ.get(name, default)
+                name, sep, default = arg.partition(" ")
+                if name not in os.environ and not sep:  # ROS 2: an unset variable without a default is an error
+                    raise LaunchError(f"{self.file}: {where}: environment variable {name!r} is not set and "
+                                      f"$(env {name}) gives no default (write $(env {name} DEFAULT))")
+                return os.environ.get(name, default.strip("'\""))
             if kind == "find-pkg-share":
                 if arg == "navlab":
                     return str(resources_dir())
                 raise LaunchError(f"{self.file}: {where}: unknown package {arg!r} in $(find-pkg-share)")
+            if kind == "robot":
+                return self.robot_value(arg, where)
             raise LaunchError(f"{self.file}: {where}: unknown substitution $({kind})")
 
         out = _SUBST.sub(repl, value)
@@ -126,11 +151,9 @@ class _Context:
 
 def _typed(text: str) -> Any:
     """Substituted text as YAML would read it (numbers, booleans) so parameters keep their type."""
-    import yaml
-
     try:
-        return yaml.safe_load(text) if text.strip() else text
-    except yaml.YAMLError:
+        return parse_yaml(text, "<substitution>") if text.strip() else text
+    except ParameterError:
         return text
 
 
@@ -141,15 +164,42 @@ def _entries(file: Path) -> list[dict[str, Any]]:
     return data["launch"]
 
 
-def _node_params(ctx: _Context, spec: dict[str, Any], where: str) -> dict[str, Any]:
+def _items(ctx: _Context, spec: dict[str, Any], key: str, where: str, needs: tuple[str, ...]) -> list[dict[str, Any]]:
+    """The list ``spec[key]`` (param, remap, arg of an include), each item a mapping with the ``needs`` keys."""
+    items = spec.get(key) or []
+    if not isinstance(items, list):
+        raise LaunchError(f"{ctx.file}: {where}: '{key}' must be a list of mappings, got {items!r}")
+    for k, item in enumerate(items):
+        missing = [n for n in needs if not isinstance(item, dict) or n not in item]
+        if missing:
+            raise LaunchError(f"{ctx.file}: {where}: {key}[{k}] needs {' and '.join(map(repr, needs))}, got {item!r}")
+    return items
+
+
+def _text(ctx: _Context, spec: dict[str, Any], key: str, where: str) -> str:
+    """``spec[key]`` (required) substituted, as a non-empty string."""
+    if key not in spec:
+        raise LaunchError(f"{ctx.file}: {where}: missing '{key}'")
+    value = ctx.subst(spec[key], where)
+    if not isinstance(value, str | int | float) or isinstance(value, bool) or str(value) == "":
+        raise LaunchError(f"{ctx.file}: {where}: '{key}' must be a non-empty string, got {value!r}")
+    return str(value)
+
+
+def _node_params(ctx: _Context, spec: dict[str, Any], where: str) -> tuple[dict[str, Any], list[str]]:
+    """The node's parameters and the files they came from."""
     params: dict[str, Any] = {}
-    for item in spec.get("param", []) or []:
+    files: list[str] = []
+    for item in _items(ctx, spec, "param", where, ()):
         item = ctx.subst(item, where)
+        if not isinstance(item, dict):
+            raise LaunchError(f"{ctx.file}: {where}: a param entry must be a mapping, got {item!r}")
         if "from" in item:
             path = Path(str(item["from"]))
             if not path.is_absolute():
                 path = ctx.file.parent / path
-            loaded = load_params(path, node=spec.get("name") or None)
+            loaded = load_params(path, node=str(spec.get("name") or "") or None)
+            files.append(path.name)
             ns = str(item.get("ns") or "").strip("/")
             for part in reversed(ns.split("/") if ns else []):  # rosparam load's ns=: nest under it
                 loaded = {part: loaded}
@@ -158,20 +208,26 @@ def _node_params(ctx: _Context, spec: dict[str, Any], where: str) -> dict[str, A
             params = merge_params(params, {str(item["name"]): item.get("value")})
         else:
             raise LaunchError(f"{ctx.file}: {where}: a param entry needs 'name'+'value' or 'from'")
-    return params
+    return params, files
 
 
-def _truthy(value: Any) -> bool:
-    return str(value).strip().lower() in ("true", "1", "yes", "on")
+def _truthy(ctx: _Context, value: Any, key: str, where: str) -> bool:
+    """A condition's value: true/false/1/0 (any case) as ROS 2 launch accepts them; anything else is an error."""
+    text = str(value).strip().lower() if isinstance(value, str | bool | int) else None
+    if text in ("true", "1"):
+        return True
+    if text in ("false", "0"):
+        return False
+    raise LaunchError(f"{ctx.file}: {where}: '{key}' is {value!r}; expected true or false (or 1/0)")
 
 
 def _condition(ctx: _Context, spec: Any, where: str) -> bool:
     """ROS 2 launch's ``if:`` / ``unless:`` attributes."""
     if not isinstance(spec, dict):
         raise LaunchError(f"{ctx.file}: {where}: expected a mapping of attributes")
-    if "if" in spec and not _truthy(ctx.subst(spec["if"], where)):
+    if "if" in spec and not _truthy(ctx, ctx.subst(spec["if"], where), "if", where):
         return False
-    return not ("unless" in spec and _truthy(ctx.subst(spec["unless"], where)))
+    return not ("unless" in spec and _truthy(ctx, ctx.subst(spec["unless"], where), "unless", where))
 
 
 def _run_entries(ctx: _Context, session: Session, depth: int) -> None:
@@ -186,42 +242,62 @@ def _run_entries(ctx: _Context, session: Session, depth: int) -> None:
             continue
         if kind == "arg":
             name = spec.get("name")
-            if not name:
-                raise LaunchError(f"{ctx.file}: {where}: an arg needs a 'name'")
+            if not name or not isinstance(name, str):
+                raise LaunchError(f"{ctx.file}: {where}: an arg needs a 'name' (a string)")
             if name not in ctx.vars:
                 if "default" not in spec:
                     raise LaunchError(f"{ctx.file}: argument {name!r} has no default; pass {name}:=VALUE")
                 ctx.vars[name] = str(ctx.subst(spec["default"], where))
         elif kind == "let":
-            ctx.vars[spec["name"]] = str(ctx.subst(spec["value"], where))
+            name = _text(ctx, spec, "name", where)
+            if "value" not in spec:
+                raise LaunchError(f"{ctx.file}: {where}: a let needs a 'value'")
+            ctx.vars[name] = str(ctx.subst(spec["value"], where))
         elif kind == "include":
-            path = Path(str(ctx.subst(spec.get("file", ""), where)))
+            path = Path(_text(ctx, spec, "file", where))
             if not path.is_absolute():
                 path = ctx.file.parent / path
             if not path.is_file():
                 raise LaunchError(f"{ctx.file}: {where}: included file {path} does not exist")
-            sub_args = {a["name"]: str(ctx.subst(a["value"], where)) for a in spec.get("arg", []) or []}
+            sub_args = {str(a["name"]): str(ctx.subst(a["value"], where))
+                        for a in _items(ctx, spec, "arg", where, ("name", "value"))}
             _run_entries(_Context(path, sub_args), session, depth + 1)
         elif kind == "node":
             exec_name = spec.get("exec")
-            if not exec_name:
-                raise LaunchError(f"{ctx.file}: {where}: a node needs 'exec'")
-            cls = load_node_class(str(exec_name))
-            remaps = {r["from"]: ctx.subst(r["to"], where) for r in spec.get("remap", []) or []}
-            params = _node_params(ctx, spec, where)
-            node_name = str(spec.get("name") or exec_name)
+            if not exec_name or not isinstance(exec_name, str):
+                raise LaunchError(f"{ctx.file}: {where}: a node needs 'exec' (a node name or module:Class)")
+            try:
+                cls = load_node_class(exec_name)
+            except LaunchError as exc:
+                raise LaunchError(f"{ctx.file}: {where}: {exc}") from None
+            remaps = {str(ctx.subst(r["from"], where)): _text(ctx, r, "to", where)
+                      for r in _items(ctx, spec, "remap", where, ("from", "to"))}
+            params, files = _node_params(ctx, spec, where)
+            node_name = _text(ctx, spec, "name", where) if "name" in spec else exec_name
             if node_name in session.overrides:  # like `ros2 launch ... --ros-args -p`: applied last
                 params = merge_params(params, session.overrides[node_name])
             kwargs: dict[str, Any] = {"parameters": params}
-            if spec.get("name"):
-                kwargs["name"] = spec["name"]
+            if "name" in spec:
+                kwargs["name"] = node_name
             if spec.get("namespace"):
-                kwargs["namespace"] = ctx.subst(spec["namespace"], where)
-            with session.executor.node_context(remappings=remaps):
-                node = cls(session.executor, **kwargs)
+                kwargs["namespace"] = _text(ctx, spec, "namespace", where)
+            try:
+                with session.executor.node_context(remappings=remaps):
+                    node = cls(session.executor, **kwargs)
+            except NavlabError as exc:  # name the launch file and the parameter files, as the user wrote them
+                source = f" (parameters from {', '.join(files)})" if files else ""
+                raise _prefixed(exc, f"{ctx.file}: {where} {node_name!r}{source}") from None
             session.nodes[node.fully_qualified_name] = node
         else:
             raise LaunchError(f"{ctx.file}: {where}: unknown entry {kind!r} (expected arg, let, include or node)")
+
+
+def _prefixed(exc: NavlabError, prefix: str) -> NavlabError:
+    """``exc`` (same class where it can be rebuilt from a message) with ``prefix: `` before its message."""
+    try:
+        return type(exc)(f"{prefix}: {exc}")
+    except Exception:  # an error class with another constructor
+        return LaunchError(f"{prefix}: {exc}")
 
 
 def _check_args(file: Path, args: dict[str, Any]) -> None:
@@ -274,7 +350,3 @@ def start(
         raise LaunchError(f"{file}: parameters given for {', '.join(map(repr, unknown))}, but the launch starts no "
                           f"such node (nodes: {', '.join(sorted(started))})")
     return session
-
-#: launch files' ``$(robot KEY)``: a function of the ``robot`` argument (shipped name, file or
-#: package:// URI) returning its base frame, scan topic and odom frame from its plugin tags
-ROBOT_LAUNCH_VALUES = "navlab.description.loader:robot_launch_values"

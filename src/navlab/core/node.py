@@ -109,6 +109,8 @@ def _coerce(name: str, value: Any, default: Any) -> Any:
     if default is None or value is None:
         return value
     kind = type(default)
+    if isinstance(value, float) and value != value:  # NaN: never a usable parameter value
+        raise ParameterError(f"parameter {name!r}: expected a number, got nan")
     if kind is float and isinstance(value, int) and not isinstance(value, bool):
         return float(value)
     if kind is bool and not isinstance(value, bool):
@@ -184,6 +186,9 @@ class Node:
 
     def create_timer(self, period: float, callback: Callable[[], None], *, priority: int = 0) -> Timer:
         """Call ``callback()`` every ``period`` simulated seconds (lower ``priority`` runs first on ties)."""
+        if isinstance(period, bool) or not isinstance(period, int | float) or not 0 < period < 1e9:
+            raise ParameterError(f"node {self.fully_qualified_name}: timer period {period!r} s: expected a "
+                                 "finite number > 0 (is a rate parameter 0, negative or not a number?)")
         timer = Timer(self.executor, seconds_to_ns(period), callback, priority, self.executor.now_ns)
         self.timers.append(timer)
         return timer

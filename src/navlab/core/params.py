@@ -10,6 +10,7 @@ Two layouts are read:
 from __future__ import annotations
 
 import difflib
+import math
 from dataclasses import fields, is_dataclass
 from pathlib import Path
 from typing import Any, TypeVar
@@ -17,25 +18,93 @@ from typing import Any, TypeVar
 import yaml
 
 from navlab.core.errors import ParameterError
+from navlab.io.errors import IoError
+from navlab.io.files import read_text_checked
 
 T = TypeVar("T")
 
 
-def read_yaml(path: str | Path) -> Any:
-    """Parse a YAML file; a syntax error names the file, line and column."""
-    p = Path(path)
+MAX_YAML_BYTES = 16 << 20  # a parameter, launch, route or scenario file is never this large
+MAX_YAML_DEPTH = 64  # nesting levels (ROS parameter files use a handful)
+MAX_YAML_NODES = 200_000  # values after aliases are expanded (an alias bomb expands to billions)
+
+
+class _BoundedLoader(yaml.SafeLoader):
+    """PyYAML's safe loader with bounded nesting and bounded alias expansion (``&a``/``*a``, ``<<: *a``)."""
+
+    def __init__(self, stream: str) -> None:
+        super().__init__(stream)
+        self._depth = 0
+
+    def compose_node(self, parent: Any, index: Any) -> Any:
+        if self._depth >= MAX_YAML_DEPTH:
+            mark = self.peek_event().start_mark
+            raise yaml.composer.ComposerError(None, None, f"nested deeper than {MAX_YAML_DEPTH} levels", mark)
+        self._depth += 1
+        try:
+            return super().compose_node(parent, index)
+        finally:
+            self._depth -= 1
+
+    def get_single_node(self) -> Any:
+        node = super().get_single_node()
+        if node is not None:
+            sizes: dict[int, int] = {}
+
+            def size(n: Any) -> int:  # values the document expands to, each shared node counted per use
+                if id(n) not in sizes:
+                    sizes[id(n)] = 1  # a recursive alias counts once instead of looping
+                    if isinstance(n, yaml.SequenceNode):
+                        sizes[id(n)] = 1 + sum(size(c) for c in n.value)
+                    elif isinstance(n, yaml.MappingNode):
+                        sizes[id(n)] = 1 + sum(size(k) + size(v) for k, v in n.value)
+                return min(sizes[id(n)], MAX_YAML_NODES + 1)
+
+            if size(node) > MAX_YAML_NODES:
+                raise yaml.composer.ComposerError(
+                    None, None, f"aliases (*name) expand to more than {MAX_YAML_NODES} values (an alias bomb?)",
+                    node.start_mark)
+        return node
+
+
+def parse_yaml(text: str, source: str | Path) -> Any:
+    """Parse YAML ``text`` read from ``source`` with bounded nesting and alias expansion.
+
+    Errors are ``ParameterError`` naming ``source``, line and column.
+    """
     try:
-        text = p.read_text()
-    except OSError as exc:
-        raise ParameterError(f"{p}: cannot read ({exc.strerror})") from None
+        loader = _BoundedLoader(text)
+    except yaml.reader.ReaderError as exc:  # a control character such as NUL, before parsing starts
+        line = text[: exc.position].count("\n") + 1
+        col = exc.position - (text.rfind("\n", 0, exc.position) + 1) + 1
+        raise ParameterError(f"{source}:{line}:{col}: malformed YAML: character #x{exc.character:04x} is not "
+                             "allowed in YAML") from None
     try:
-        return yaml.safe_load(text)
+        return loader.get_single_data()
     except yaml.MarkedYAMLError as exc:
         mark = exc.problem_mark or exc.context_mark
         where = f":{mark.line + 1}:{mark.column + 1}" if mark else ""
-        raise ParameterError(f"{p}{where}: malformed YAML: {exc.problem or exc.context}") from None
+        raise ParameterError(f"{source}{where}: malformed YAML: {exc.problem or exc.context}") from None
     except yaml.YAMLError as exc:
-        raise ParameterError(f"{p}: malformed YAML: {exc}") from None
+        raise ParameterError(f"{source}: malformed YAML: {str(exc).splitlines()[0]}") from None
+    except RecursionError:
+        raise ParameterError(f"{source}: malformed YAML: nested too deeply") from None
+    finally:
+        loader.dispose()
+
+
+def read_yaml(path: str | Path) -> Any:
+    """Parse a YAML file; a syntax error names the file, line and column.
+
+    Only regular UTF-8 files up to ``MAX_YAML_BYTES`` are read; nesting deeper than ``MAX_YAML_DEPTH``
+    and aliases that expand to more than ``MAX_YAML_NODES`` values are refused.
+    """
+    p = Path(path)
+    try:
+        text = read_text_checked(p, what="YAML file", max_bytes=MAX_YAML_BYTES)
+    except IoError as exc:
+        raise ParameterError(str(exc)) from None
+    return parse_yaml(text, p)
 
 
 def is_nav2_layout(data: Any) -> bool:
@@ -95,7 +164,16 @@ def dataclass_from_dict(cls: type[T], values: dict[str, Any] | None, *, what: st
             close = difflib.get_close_matches(key, names, n=1)
             hint = f"; did you mean '{close[0]}'?" if close else ""
             raise error(f"unknown {what} parameter '{key}'{hint}")
-        setattr(out, key, type(getattr(out, key))(val))
+        kind = type(getattr(out, key))
+        try:
+            if val is None or (isinstance(val, bool) and kind is not bool) or isinstance(val, dict | list):
+                raise TypeError
+            cast = kind(val)
+        except (TypeError, ValueError):
+            raise error(f"{what} parameter '{key}': expected {kind.__name__}, got {val!r}") from None
+        if isinstance(cast, float) and not math.isfinite(cast):
+            raise error(f"{what} parameter '{key}': expected a finite number, got {val!r}")
+        setattr(out, key, cast)
     return out
 
 

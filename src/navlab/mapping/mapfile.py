@@ -17,22 +17,30 @@ atomically.
 
 from __future__ import annotations
 
+import contextlib
 import difflib
 import math
 import os
+import re
+import secrets
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-import yaml
 
+from navlab.core.errors import ParameterError
+from navlab.core.params import parse_yaml
 from navlab.grid import GridMap
-from navlab.io.files import write_bytes_atomic, write_text_atomic
+from navlab.io.errors import IoError
+from navlab.io.files import read_bytes_checked, read_text_checked, write_bytes_atomic, write_text_atomic
 from navlab.mapping.errors import MappingError
 
 MODES = ("trinary", "scale", "raw")
 _KNOWN_KEYS = ("image", "resolution", "origin", "negate", "occupied_thresh", "free_thresh", "mode")
-_OPTIONAL_KEYS = ("load_time", "frame_id")
+_OPTIONAL_KEYS = ("load_time", "frame_id", "image_size")
+MAX_IMAGE_BYTES = 1 << 30  # a map image file (bytes)
+MAX_IMAGE_PIXELS = 400_000_000  # 20 km x 20 km at 1 mm... a map of more cells than this is refused
+MAX_YAML_BYTES = 1 << 20
 
 
 # --- image reading --------------------------------------------------------------------------------
@@ -69,6 +77,9 @@ def _read_pnm(path: Path, buf: bytes) -> np.ndarray:
     (width, height, maxval), pos = _pnm_tokens(buf, 3, path)
     if width <= 0 or height <= 0:
         raise MappingError(f"{path}: image size {width}x{height}, expected positive width and height")
+    if width * height > MAX_IMAGE_PIXELS:
+        raise MappingError(f"{path}: image of {width} x {height} pixels; a map image may have at most "
+                           f"{MAX_IMAGE_PIXELS}")
     if not 0 < maxval < 65536:
         raise MappingError(f"{path}: PNM maxval {maxval}, expected 1..65535")
     count = width * height * channels
@@ -101,15 +112,23 @@ def read_image(path: str | os.PathLike[str]) -> tuple[np.ndarray, bool]:
     """
     p = Path(path)
     try:
-        buf = p.read_bytes()
-    except OSError as exc:
-        raise MappingError(f"cannot read map image {p}: {exc.strerror or exc}") from None
+        buf = read_bytes_checked(p, what="map image", max_bytes=MAX_IMAGE_BYTES)
+    except IoError as exc:
+        raise MappingError(str(exc)) from None
     if buf[:2] in (b"P2", b"P3", b"P5", b"P6"):
         return _read_pnm(p, buf), False
+    if buf[:2] in (b"P1", b"P4"):
+        raise MappingError(f"{p}: a PBM bitmap ({buf[:2].decode()}); expected a greyscale PGM (P2/P5), a PPM "
+                           "(P3/P6) or a PNG")
     try:
+        import io
+
         from PIL import Image, UnidentifiedImageError
 
-        with Image.open(p) as img:
+        with Image.open(io.BytesIO(buf)) as img:
+            if img.width * img.height > MAX_IMAGE_PIXELS:
+                raise MappingError(f"{p}: image of {img.width} x {img.height} pixels; a map image may have at "
+                                   f"most {MAX_IMAGE_PIXELS} (a decompression bomb?)")
             has_alpha = img.mode in ("LA", "RGBA", "PA") or "transparency" in img.info
             grey_modes = ("L", "1", "I", "I;16", "F")
             if has_alpha:
@@ -117,7 +136,7 @@ def read_image(path: str | os.PathLike[str]) -> tuple[np.ndarray, bool]:
             else:
                 target = "L" if img.mode in grey_modes else "RGB"
             arr = np.asarray(img.convert(target), dtype=np.uint8)
-    except (UnidentifiedImageError, OSError) as exc:
+    except (UnidentifiedImageError, OSError, ValueError, Image.DecompressionBombError, SyntaxError) as exc:
         raise MappingError(f"{p}: not a readable image (PGM, PPM or PNG expected): {exc}") from None
     if arr.ndim == 2:
         arr = arr[:, :, None]
@@ -216,13 +235,11 @@ def read_map_yaml(yaml_path: str | os.PathLike[str]) -> dict[str, Any]:
     """The validated contents of a map YAML: image (absolute Path), resolution, origin, negate, thresholds, mode."""
     path = Path(yaml_path)
     try:
-        text = path.read_text()
-    except OSError as exc:
-        raise MappingError(f"cannot read map file {path}: {exc.strerror or exc}") from None
-    try:
-        doc = yaml.safe_load(text)
-    except yaml.YAMLError as exc:
-        raise MappingError(f"{path}: not valid YAML: {str(exc).splitlines()[0]}") from None
+        doc = parse_yaml(read_text_checked(path, what="map YAML file", max_bytes=MAX_YAML_BYTES), path)
+    except IoError as exc:
+        raise MappingError(str(exc)) from None
+    except ParameterError as exc:
+        raise MappingError(str(exc).replace("malformed YAML", "not valid YAML", 1)) from None
     if not isinstance(doc, dict):
         raise MappingError(f"{path}: expected a mapping with keys image, resolution, origin, ...")
     for key in doc:
@@ -246,9 +263,13 @@ def read_map_yaml(yaml_path: str | os.PathLike[str]) -> dict[str, Any]:
     if (
         not isinstance(origin, list)
         or len(origin) != 3
-        or not all(isinstance(v, int | float) and not isinstance(v, bool) for v in origin)
+        or not all(isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v) for v in origin)
     ):
-        raise _key_error(path, "origin", "[x, y, yaw] (three numbers)", origin)
+        raise _key_error(path, "origin", "[x, y, yaw] (three finite numbers)", origin)
+    size = doc.get("image_size")
+    if size is not None and not (isinstance(size, list) and len(size) == 2 and all(
+            isinstance(v, int) and not isinstance(v, bool) and v > 0 for v in size)):
+        raise _key_error(path, "image_size", "[width, height] in pixels (written by navlab's map saver)", size)
     negate = doc.get("negate", 0)
     if isinstance(negate, bool):
         negate = int(negate)
@@ -272,6 +293,7 @@ def read_map_yaml(yaml_path: str | os.PathLike[str]) -> dict[str, Any]:
         "occupied_thresh": occ,
         "free_thresh": free,
         "mode": mode.lower(),
+        "image_size": None if size is None else (int(size[0]), int(size[1])),
     }
 
 
@@ -279,6 +301,11 @@ def load_map(yaml_path: str | os.PathLike[str], *, frame_id: str = "map") -> Gri
     """Load a map_server map (YAML + image) as a ``GridMap`` (grid row 0 = the image's bottom row)."""
     meta = read_map_yaml(yaml_path)
     pixels, has_alpha = read_image(meta["image"])
+    if meta["image_size"] is not None and meta["image_size"] != (pixels.shape[1], pixels.shape[0]):
+        w, h = meta["image_size"]
+        raise MappingError(
+            f"{yaml_path}: image {meta['image'].name} is {pixels.shape[1]} x {pixels.shape[0]} pixels but the YAML "
+            f"records image_size [{w}, {h}]: the pair is not from one save (an interrupted save, or a copied image?)")
     values = _pixels_to_values(
         pixels,
         has_alpha,
@@ -356,8 +383,9 @@ def save_map(
         ypath.parent.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise MappingError(f"save_map: cannot create directory {ypath.parent}: {exc.strerror or exc}") from None
+    previous = _referenced_image(ypath)
     if image_name is None:
-        image_name = ypath.stem + (".png" if mode == "scale" else ".pgm")
+        image_name = _fresh_image_name(ypath, ".png" if mode == "scale" else ".pgm")
     ipath = Path(image_name) if Path(image_name).is_absolute() else ypath.parent / image_name
     data = grid.data.astype(np.int64)
     if mode == "trinary":
@@ -378,7 +406,7 @@ def save_map(
         payload = head.encode("ascii") + grey.tobytes()
     else:
         raise MappingError(f"save_map: image {ipath.name}: expected a .pgm or .png file name")
-    write_bytes_atomic(ipath, payload)
+    write_bytes_atomic(ipath, payload)  # a new name (see _fresh_image_name): the old YAML still names the old image
     ox, oy, oyaw = grid.origin
     image_field = image_name if not Path(image_name).is_absolute() else str(ipath)
     text = (
@@ -389,6 +417,34 @@ def save_map(
         f"occupied_thresh: {occupied_thresh:g}\n"
         f"free_thresh: {free_thresh:g}\n"
         f"mode: {mode}\n"
+        f"image_size: [{grid.width}, {grid.height}]\n"
     )
-    write_text_atomic(ypath, text)
+    write_text_atomic(ypath, text)  # the switch from the old pair to the new one
+    if (previous is not None and previous != ipath.resolve() and previous.parent == ypath.parent.resolve()
+            and re.fullmatch(rf"{re.escape(ypath.stem)}(\.[0-9a-f]{{8}})?\.(pgm|png)", previous.name)):
+        with contextlib.suppress(OSError):
+            previous.unlink()  # the old pair's image, no longer named by any YAML this save wrote
     return ipath
+
+
+def _referenced_image(ypath: Path) -> Path | None:
+    """The image an existing map YAML names (resolved), or None (no YAML, or one that cannot be read)."""
+    try:
+        return Path(read_map_yaml(ypath)["image"]).resolve()
+    except (MappingError, OSError):
+        return None
+
+
+def _fresh_image_name(ypath: Path, suffix: str) -> str:
+    """``<stem><suffix>`` unless a file of that name exists, else ``<stem>.<8 hex digits><suffix>``.
+
+    Saving over an existing pair writes the new image under a name no YAML uses yet and replaces the
+    YAML last, so a save interrupted at any point leaves the old pair or the new one, never a mix.
+    """
+    plain = f"{ypath.stem}{suffix}"
+    if not (ypath.parent / plain).exists():
+        return plain
+    while True:
+        name = f"{ypath.stem}.{secrets.token_hex(4)}{suffix}"
+        if not (ypath.parent / name).exists():
+            return name
