@@ -149,10 +149,12 @@ def _cmd_render(args: argparse.Namespace) -> int:
     from navlab.sim.gazebo import load_robot_named, load_world_named
     from navlab.sim.render import render_image, save_png
     from navlab.sim.simulation import Simulation
-    from navlab.sim.spawn import parse_spawn_spec
+    from navlab.sim.spawn import check_start_pose, parse_spawn_spec
 
     world = load_world_named(args.world)
     robot = None if args.no_robot else load_robot_named(args.robot)
+    if robot is not None:
+        check_start_pose(robot, world, (args.x, args.y, args.yaw))
     sim = Simulation(robot, world, robot_pose=(args.x, args.y, args.yaw), visuals=True)
     for i, spec in enumerate(args.spawn):
         sim.spawn(parse_spawn_spec(spec, default_name=f"spawned_{i}")[0])

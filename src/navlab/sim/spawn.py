@@ -1,4 +1,5 @@
-"""Models to spawn at run time: primitives (box, cylinder, sphere), SDF models, and the CLI's spec strings.
+"""Models to spawn at run time: primitives (box, cylinder, sphere), SDF models, and the CLI's spec strings;
+and the check that a robot's start pose is free (:func:`check_start_pose`).
 
 A spec string is ``KIND:key=value,...``, e.g. ``box:name=crate,x=2,y=1,size=0.5`` or
 ``cylinder:x=1,radius=0.2,length=1,static=false`` or ``sdf:file=model.sdf,x=1``. Keys: ``name``,
@@ -12,9 +13,11 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from navlab.description.model import Geometry, Inertial, Link, Shape, is_geometry_kind
+import numpy as np
+
+from navlab.description.model import Geometry, Inertial, Link, RobotModel, Shape, is_geometry_kind
 from navlab.sim.errors import SimError
-from navlab.world.model import ModelSpec
+from navlab.world.model import ModelSpec, WorldModel
 
 KINDS = ("box", "cylinder", "sphere", "sdf")
 _KEYS = {"name", "x", "y", "z", "yaw", "static", "mass", "size", "sx", "sy", "sz", "radius", "length", "t",
@@ -136,3 +139,92 @@ def load_sdf_model(
     mz = model.pose[2] if z is None else z
     model.pose = (x, y, mz, model.pose[3], model.pose[4], yaw)
     return model
+
+
+# ------------------------------------------------------------------------------------- start poses
+def robot_outline(robot: RobotModel) -> tuple[np.ndarray, float, float]:
+    """The robot's collision geometry at zero joint angles in its root link's frame: xy points (k, 2)
+    whose convex hull covers it, and its lowest and highest z (m)."""
+    parent_joint = {j.child: j for j in robot.joints}
+
+    def root_T_link(name: str) -> np.ndarray:
+        m = np.eye(4)
+        while name in parent_joint:
+            joint = parent_joint[name]
+            m = joint.origin.matrix() @ m
+            name = joint.parent
+        return m
+
+    pts = [_corners(shape, root_T_link(link.name) @ shape.origin.matrix())
+           for link in robot.links.values() for shape in link.collisions]
+    if not pts:
+        return np.zeros((1, 2)), 0.0, 0.0
+    allp = np.vstack(pts)
+    return allp[:, :2], float(allp[:, 2].min()), float(allp[:, 2].max())
+
+
+def _corners(shape: Shape, root_T_shape: np.ndarray) -> np.ndarray:
+    """Points (k, 3) in the root frame whose convex hull covers the shape (boxes around round shapes)."""
+    g = shape.geometry
+    if g.kind == "mesh" and g.mesh_path is not None:
+        from navlab.description.meshes import read_mesh
+
+        local = read_mesh(g.mesh_path)[0] * np.asarray(g.mesh_scale)
+    else:
+        if g.kind == "box":
+            half = np.asarray(g.size, dtype=float) / 2
+        elif g.kind == "cylinder":
+            half = np.array([g.size[0], g.size[0], g.size[1] / 2])
+        else:
+            half = np.full(3, g.size[0] if g.size else 0.0)
+        local = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)]) * half
+    return local @ root_T_shape[:3, :3].T + root_T_shape[:3, 3]
+
+
+def check_start_pose(robot: RobotModel, world: WorldModel, pose: tuple[float, float, float], *,
+                     margin: float = 0.02, resolution: float = 0.02) -> None:
+    """Refuse a start pose (x, y, yaw: m, m, rad, the root link in the world) at which the robot's
+    collision outline (its convex hull seen from above, shrunk by ``margin`` m so that touching is
+    allowed) overlaps a world model within the robot's height. SimError names the models; started
+    there, the contact solver would throw the robot metres away."""
+    from navlab.world.occupancy import occupancy, shape_footprints
+
+    xy, z_lo, z_hi = robot_outline(robot)
+    x, y, yaw = pose
+    c, s = np.cos(yaw), np.sin(yaw)
+    world_xy = xy @ np.array([[c, s], [-s, c]]) + np.array([x, y])
+    height = max(z_hi - z_lo, 0.05)
+    band = (margin, height - margin) if height > 3 * margin else (0.0, height)  # above the floor contact
+    lo, hi = world_xy.min(axis=0) - resolution, world_xy.max(axis=0) + resolution
+    bounds = (float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1]))
+    occ = occupancy(world, resolution, bounds, z_min=band[0], z_max=band[1])
+    if not occ.any():
+        return
+    from scipy.spatial import ConvexHull, QhullError
+
+    try:
+        hull = ConvexHull(world_xy)
+        eq = hull.equations  # a x + b y + c <= 0 inside
+    except (QhullError, ValueError):  # a degenerate outline: a disc around its centre
+        centre = world_xy.mean(axis=0)
+        r = float(np.linalg.norm(world_xy - centre, axis=1).max())
+        eq = None
+    iy, ix = np.nonzero(occ)
+    cells = np.column_stack([bounds[0] + (ix + 0.5) * resolution, bounds[1] + (iy + 0.5) * resolution])
+    if eq is not None:
+        inside = (cells @ eq[:, :2].T + eq[:, 2] <= -margin).all(axis=1)
+    else:
+        inside = np.linalg.norm(cells - centre, axis=1) <= r - margin
+    if not inside.any():
+        return
+    hit = cells[inside]
+    names = sorted({fp.name.split("::")[0] for fp in shape_footprints(world, z_min=band[0], z_max=band[1])
+                    if _overlaps(fp.bounds(), hit)})
+    raise SimError(f"start pose x={x:g} y={y:g} yaw={yaw:g} puts robot {robot.name!r} inside "
+                   f"{', '.join(map(repr, names)) or 'an obstacle'} of world {world.name!r}; started there, "
+                   "the contact solver would throw it away. Pick a free pose (--x/--y/--yaw, or x:= y:= yaw:=)")
+
+
+def _overlaps(bounds: tuple[float, float, float, float], pts: np.ndarray) -> bool:
+    x0, y0, x1, y1 = bounds
+    return bool(((pts[:, 0] >= x0) & (pts[:, 0] <= x1) & (pts[:, 1] >= y0) & (pts[:, 1] <= y1)).any())
