@@ -1,7 +1,9 @@
 """The paper's mapping step in simulation: the ``mapping`` launch (sim + slam_gmapping [+ explore]) with a
 driver (exploration, teleop or a route), then the saved map scored against the world's truth.
 
-``run_mapping`` is the Python API behind ``navlab map``; the map frame is the robot's start pose.
+``run_mapping`` is the Python API behind ``navlab map``. The map frame is SLAM's odom frame at the start:
+the world frame for world-source odometry (Gazebo's default), the robot's start pose for encoder
+odometry (see ``experiments.truth.world_T_map``); scores and truth overlays are taken in it.
 """
 
 from __future__ import annotations
@@ -16,14 +18,15 @@ from navlab.experiments.metrics import free_coverage, score_map, trajectory_erro
 from navlab.experiments.monitors import PoseMonitor
 from navlab.experiments.plots import Track, plot_run
 from navlab.experiments.session import Run, rounded, start_run
-from navlab.experiments.truth import true_occupancy
+from navlab.experiments.truth import true_occupancy, world_T_map
 from navlab.geometry import inverse_transform_points2, wrap_angle
 from navlab.grid import GridMap
 from navlab.mapping.errors import MappingError
 from navlab.mapping.mapfile import save_map
 
 DRIVERS = ("explore", "teleop", "route")
-TRAJECTORY_HEADER = "# t x y theta true_x true_y true_theta  (s, m, rad; map frame = the robot's start pose)"
+TRAJECTORY_HEADER = ("# t x y theta true_x true_y true_theta  (s, m, rad; map frame = the odom frame at the start: "
+                     "the world for world odometry, the start pose for encoder odometry)")
 
 
 @dataclass
@@ -109,21 +112,24 @@ def run_mapping(
     save_map(grid, map_yaml)
     result = MappingResult(map_yaml, grid, run.timing["sim_s"], bool(is_done()))
     truth = true_occupancy(run.sim.world, grid)
+    map_in_world = world_T_map(run.sim.robot, pose)
     scores: dict[str, Any] = {
         **run.figures(),
         "finished": result.finished,
         "scans_processed": slam.scans_processed,
-        **score_map(grid, truth, world_T_map=pose),
-        "coverage": free_coverage(grid, truth, world_T_map=pose),
+        "map_frame_in_world": list(map_in_world),
+        **score_map(grid, truth, world_T_map=map_in_world),
+        "coverage": free_coverage(grid, truth, world_T_map=map_in_world),
     }
     s = monitor.samples()
     if len(s["t"]):
-        # the estimate is in the map frame = the spawn pose; bring the truth into it
+        # the estimate is in the map frame; bring the truth into it
         tru = s["truth"]
-        tru_map = np.column_stack([inverse_transform_points2(pose, tru[:, :2]), wrap_angle(tru[:, 2] - pose[2])])
+        tru_map = np.column_stack([inverse_transform_points2(map_in_world, tru[:, :2]),
+                                   wrap_angle(tru[:, 2] - map_in_world[2])])
         est = s["estimate"]
         scores.update(trajectory_error(est, tru_map))
-        odom_err = trajectory_error(s["odometry"], tru_map)  # raw odometry starts at the spawn pose too
+        odom_err = trajectory_error(s["odometry"], tru_map)  # raw odometry is in the odom frame = the map frame
         scores["odometry_position_error_mean_m"] = odom_err["position_error_mean_m"]
         scores["odometry_yaw_error_mean_deg"] = odom_err["yaw_error_mean_deg"]
         write_trajectory(out_dir / "trajectory.txt", s["t"], est, tru_map)

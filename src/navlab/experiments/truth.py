@@ -14,6 +14,16 @@ from scipy import ndimage
 from navlab.grid import Grid, GridMap
 
 
+def world_T_map(robot: Any, spawn_pose: tuple[float, float, float]) -> tuple[float, float, float]:
+    """Where a SLAM map's frame lies in the world (x, y, yaw): SLAM starts with map = odom, and the odom
+    frame is the world frame when the diff-drive plugin's odometry is the true pose (``odometrySource
+    world``, Gazebo's default) but the spawn pose when it integrates the wheel encoders."""
+    dd = getattr(robot, "diff_drive", None)
+    if dd is not None and dd.odometry_source == "world":
+        return (0.0, 0.0, 0.0)
+    return (float(spawn_pose[0]), float(spawn_pose[1]), float(spawn_pose[2]))
+
+
 def truth_grid(occupied: np.ndarray, resolution: float, origin_xy: tuple[float, float]) -> Grid:
     """The world's true occupancy at lidar height as a boolean ``Grid`` in the world frame."""
     return Grid(np.asarray(occupied, dtype=bool), resolution, (origin_xy[0], origin_xy[1], 0.0), "world")
