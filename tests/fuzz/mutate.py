@@ -426,22 +426,24 @@ def _xacro(fmt: str, seed: Seed, rng: np.random.Generator) -> Case:
     main = seed.main
     data = seed.files[main]
     close = data.rfind(b"</robot>")
-    kind = ["code_import", "code_open", "code_subclass", "code_lambda", "load_yaml_outside", "include_outside",
-            "self_include", "macro_recursion", "find_escape", "undefined_property"][int(rng.integers(10))]
+    kind = ["code_import", "code_open", "code_subclass", "code_vars", "code_format", "load_yaml_outside",
+            "include_outside", "self_include", "macro_recursion", "find_escape"][int(rng.integers(10))]
     marker = "navlab_fuzz_escape_marker"
-    snippets = {
-        "code_import": f"<xacro:property name=\"fz\" value=\"${{__import__('os').system('touch {marker}')}}\"/>",
-        "code_open": f"<xacro:property name=\"fz\" value=\"${{open('{marker}', 'w').write('x')}}\"/>",
-        "code_subclass": ("<xacro:property name=\"fz\" value=\"${[c for c in ().__class__.__base__.__subclasses__() "
-                          f"if c.__name__ == 'Popen'][0](['touch', '{marker}'])}}\"/>"),
-        "code_lambda": (f"<xacro:property name=\"fz\" value=\"${{(lambda: exec(\\\"open('{marker}','w')\\\"))()}}\"/>"),
-        "load_yaml_outside": "<xacro:property name=\"fz\" value=\"${xacro.load_yaml('/etc/passwd')}\"/>",
+    snippets = {  # each evaluated where it stands (an unused xacro:property would never be evaluated)
+        "code_import": f"<fuzz v=\"${{__import__('os').system('touch {marker}')}}\"/>",
+        "code_open": f"<fuzz v=\"${{open('{marker}', 'w').write('x')}}\"/>",
+        "code_subclass": ("<fuzz v=\"${[c for c in python.type(python.type).mro(python.type)[-1]."
+                          "__subclasses__() if c.__name__ == 'Popen'][0](['touch', '" + marker + "'])}\"/>"),
+        "code_vars": ("<fuzz v=\"${python.vars(python.type(python.vars(python.type(xacro.fatal))['__globals__']))"
+                      "['__get__'](python.vars(python.type(xacro.fatal))['__globals__'], xacro.fatal)['os']"
+                      f".system('touch {marker}')}}\"/>"),
+        "code_format": "<fuzz v=\"${'{0.__class__.__base__.__subclasses__}'.format(1)}\"/>",
+        "load_yaml_outside": "<fuzz v=\"${xacro.load_yaml('/etc/passwd')}\"/>",
         "include_outside": "<xacro:include filename=\"/etc/hostname\"/>",
         "self_include": f"<xacro:include filename=\"{main.rsplit('/', 1)[-1]}\"/>",
         "macro_recursion": ("<xacro:macro name=\"fzr\" params=\"n\"><xacro:fzr n=\"${n+1}\"/></xacro:macro>"
                             "<xacro:fzr n=\"0\"/>"),
         "find_escape": "<xacro:include filename=\"$(find navlab_tb3_burger_description)/../../../../etc/hostname\"/>",
-        "undefined_property": "<link name=\"${nowhere_defined}\"/>",
     }
     body = data[:close] + snippets[kind].encode() + b"\n" + data[close:]
     return Case(fmt, f"xacro:{kind}", True, {**seed.files, main: body}, main, {"marker": marker})
