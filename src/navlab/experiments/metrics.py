@@ -25,8 +25,8 @@ from navlab.io.poses import read_poses, read_table, write_poses
 from navlab.mapping.errors import MappingError
 
 __all__ = [
-    "ate", "free_coverage", "read_poses", "read_relations", "relations_error", "score_map", "settled_after",
-    "trajectory_error", "write_poses",
+    "ate", "distance_to_path", "free_coverage", "read_poses", "read_relations", "relations_error", "score_map",
+    "settled_after", "trajectory_error", "write_poses",
 ]  # pose files live in navlab.io.poses
 
 
@@ -190,3 +190,21 @@ def settled_after(t: np.ndarray, err: np.ndarray, t0: float, threshold: float) -
         return float(tt[0]) if tt.size else None
     k = bad[-1] + 1
     return float(tt[k]) if k < tt.size else None
+
+
+def distance_to_path(points: np.ndarray, path: np.ndarray) -> np.ndarray:
+    """Distance (m) from each point (N, 2) to the polyline ``path`` (M, >=2; x y in the same frame): the
+    path tracking error of a driven path against the global plan (issue 15)."""
+    pts = np.asarray(points, dtype=np.float64).reshape(-1, 2)
+    poly = np.asarray(path, dtype=np.float64)[:, :2]
+    if len(poly) == 0:
+        return np.full(len(pts), np.nan)
+    if len(poly) == 1:
+        return np.hypot(pts[:, 0] - poly[0, 0], pts[:, 1] - poly[0, 1])
+    a, b = poly[:-1], poly[1:]
+    ab = b - a
+    length2 = np.maximum((ab**2).sum(axis=1), 1e-18)
+    rel = pts[:, None, :] - a[None, :, :]  # (N, M-1, 2)
+    t = np.clip((rel * ab[None]).sum(axis=2) / length2[None], 0.0, 1.0)
+    nearest = a[None] + t[..., None] * ab[None]
+    return np.sqrt(((pts[:, None, :] - nearest) ** 2).sum(axis=2)).min(axis=1)

@@ -20,6 +20,7 @@ import numpy as np
 from navlab import msgs
 from navlab.core import Executor, Node, TfError
 from navlab.core.record import Recorder
+from navlab.experiments.metrics import distance_to_path
 from navlab.experiments.plots import NavSnapshot
 from navlab.experiments.session import Run, rounded, start_run
 from navlab.experiments.truth import true_map
@@ -57,6 +58,7 @@ class NavMonitor(Node):
         self.estimate_frame = str(self.declare_parameter("estimate_frame", "map"))
         self.localization_error: list[float] = []  # |estimate - truth| (m) at each sample, where there is one
         self.cmd: list[tuple[float, float]] = []  # (t s, linear x m/s) of every cmd_vel
+        self.tracking: list[float] = []  # distance (m) of the true pose to move_base's current plan, per sample
         self.create_subscription(msgs.Twist, "cmd_vel", self._on_cmd, 10)
         self.create_subscription(msgs.String, "/collisions", lambda _m: self.contacts.append(self.now_s()), 10)
         self.create_subscription(msgs.LaserScan, "scan", self._on_scan, 5)
@@ -87,6 +89,9 @@ class NavMonitor(Node):
                 pass
         self.clearance.append(self._nearest - self.radius)
         self._nearest = math.inf
+        plan = getattr(self.move_base, "global_plan", None)  # in the map frame: the world's with a true map
+        ok = self.estimate_frame == "map" and plan is not None and len(plan)
+        self.tracking.append(float(distance_to_path(np.array([[x, y]]), plan)[0]) if ok else math.nan)
 
     def scan_points(self) -> np.ndarray | None:
         """The last scan's returns (N, 2) in the world frame (from the true pose), or None."""
@@ -157,7 +162,15 @@ def _drive_goal(run: Run, mon: NavMonitor, goal: Pose, frame: str, timeout: floa
         "min_clearance_m": min(mon.clearance[k0:], default=math.inf),
         "collisions": _episodes(mon.contacts, t0, t1),
         "final_error_m": math.dist(final[:2], compose2(world_T_frame, goal)[:2]),
+        "tracking_error_m": _nanmean(mon.tracking[k0:]),
     }
+
+
+def _nanmean(values: Sequence[float]) -> float | None:
+    """Mean of the finite values (None if there are none)."""
+    a = np.asarray(values, dtype=np.float64)
+    a = a[np.isfinite(a)]
+    return float(a.mean()) if a.size else None
 
 
 def run_navigation(
@@ -176,6 +189,9 @@ def run_navigation(
     record: str | Path | None = None,
     snapshots: bool = False,
     mapless: bool = False,
+    wheel_controller: str = "gazebo_ros_diff_drive",
+    ekf: str | Path | None = None,
+    disturbances: dict[str, Any] | None = None,
 ) -> NavigateResult:
     """Navigate to ``goals`` (x, y, yaw in the map frame) in turn; see ``NavigateResult``.
 
@@ -185,6 +201,9 @@ def run_navigation(
     running (or a function of the simulation that returns one, to place it relative to the robot then).
     ``snapshots``: keep what the per-goal pictures need. ``mapless``: no map, no amcl — the global costmap
     is a rolling window in ``odom`` built from scans, and ``goals`` are in ``odom`` (the start pose).
+    ``wheel_controller``: ``gazebo_ros_diff_drive`` (the robot's plugin) or ``diff_drive_controller`` (or a
+    ros_control YAML file: see ``sim.wheel_control``); ``ekf``: a robot_localization parameter file (``default``:
+    the shipped params/ekf.yaml) — the EKF then owns tf odom → base; ``disturbances``: see ``sim.disturbances``.
     """
     from navlab.mapping.mapfile import load_map, save_map
     from navlab.sim.gazebo import load_world_named
@@ -197,6 +216,7 @@ def run_navigation(
     overrides: dict[str, Any] = dict(move_base_params or {})
     if controller:
         overrides["base_local_planner"] = CONTROLLERS.get(controller, controller)
+    gazebo = sim_parameters(wheel_controller, ekf, disturbances)
     launch_args: dict[str, Any] = {}
     if params_dir is not None:
         launch_args["params"] = str(params_dir)
@@ -209,10 +229,12 @@ def run_navigation(
         grid = load_map(served)
         if mapless:
             run = start_run("navigation_mapless", world=world, robot=robot, pose=pose, seed=seed,
-                            overrides={"move_base": overrides}, **launch_args)  # fmt: skip
+                            overrides={"move_base": overrides, **gazebo}, **launch_args)  # fmt: skip
         else:
             run = start_run("navigation", world=world, robot=robot, pose=pose, seed=seed, map=str(served),
-                            overrides={"move_base": overrides}, **launch_args)  # fmt: skip
+                            overrides={"move_base": overrides, **gazebo}, **launch_args)  # fmt: skip
+    if ekf:
+        add_ekf(run, ekf)
     mb = _move_base(run)
     radius = mb.local_costmap.layered.circumscribed_radius
     mon = run.add(NavMonitor, parameters={"robot_radius": radius, "base_frame": run.base_frame,
@@ -246,6 +268,49 @@ def run_navigation(
         **({"record": str(bag)} if bag else {}),
     })  # fmt: skip
     return NavigateResult(results, summary, grid, shots)
+
+
+WHEEL_CONTROLLERS = ("gazebo_ros_diff_drive", "diff_drive_controller")
+
+
+def sim_parameters(wheel_controller: str, ekf: str | Path | None,
+                   disturbances: dict[str, Any] | None) -> dict[str, dict[str, Any]]:  # fmt: skip
+    """The ``gazebo`` node's parameter overrides for a wheel controller, an EKF and disturbances (issue 15)."""
+    from navlab import resources
+    from navlab.core.params import load_params
+
+    params: dict[str, Any] = {}
+    if wheel_controller != "gazebo_ros_diff_drive":
+        path = resources.root() / "params" / "mybot" / "diff_drive_controller.yaml"
+        if wheel_controller != "diff_drive_controller":
+            path = Path(wheel_controller)
+            if not path.is_file():
+                known = " or ".join(WHEEL_CONTROLLERS)
+                raise NavigationError(f"wheel_controller {wheel_controller!r}: expected {known} or a ros_control "
+                                      "YAML file")  # fmt: skip
+        params = load_params(path)
+        if ekf:  # the EKF owns odom -> base
+            params.setdefault("mobile_base_controller", {})["enable_odom_tf"] = False
+    elif ekf:
+        raise NavigationError("ekf needs wheel_controller: diff_drive_controller (whose enable_odom_tf is turned "
+                              "off so that the EKF owns the tf odom -> base)")  # fmt: skip
+    if disturbances:
+        params["disturbances"] = dict(disturbances)
+    return {"gazebo": params} if params else {}
+
+
+def add_ekf(run: Run, ekf: str | Path) -> Any:
+    """Start robot_localization's ekf_node (parameters from ``ekf``; ``default``: the shipped params/ekf.yaml)
+    on the run, in the robot's base and odometry frames."""
+    from navlab import resources
+    from navlab.core.params import load_params
+    from navlab.localization.ekf_node import EkfNode
+
+    path = resources.root() / "params" / "ekf.yaml" if str(ekf) in ("default", "true", "True") else Path(ekf)
+    params = {**load_params(path, node="ekf_se"), "base_link_frame": run.base_frame, "odom_frame": run.odom_frame}
+    if params.get("world_frame", "odom") != "map":
+        params["world_frame"] = run.odom_frame
+    return run.add(EkfNode, name="ekf_se", parameters=params)
 
 
 def _at(run: Run, t: float, fn: Any) -> None:

@@ -15,6 +15,9 @@ goals: [[4.3, 1.0, 0.0], [-3.5, -0.5, 3.14]]      # map frame (odom with map: no
 trials: 20                   # trial k runs with seed + k
 seed: 0
 time_limit: 90.0             # s per goal
+wheel_controller: diff_drive_controller   # gazebo_ros_diff_drive (default) | diff_drive_controller | a ros_control YAML
+ekf: true                    # robot_localization's ekf_node (true: params/ekf.yaml; or a file); needs the controller
+disturbances: {wheel_radius_error: [0.03, 0.0], slip_patches: [{x: 1.0, y: 0.0, radius: 0.5, mu: 0.05}]}
 ```
 Unknown keys get "did you mean"; bad values one line naming the key.
 """
@@ -50,6 +53,9 @@ class Scenario:
     trials: int = 1
     seed: int = 0
     time_limit: float = 90.0
+    wheel_controller: str = "gazebo_ros_diff_drive"
+    ekf: str | None = None
+    disturbances: dict[str, Any] = field(default_factory=dict)
     path: Path | None = None
 
     def resolve(self, value: str | None) -> str | None:
@@ -58,6 +64,11 @@ class Scenario:
             return value
         candidate = self.path.parent / value
         return str(candidate) if candidate.exists() else value
+
+    def navigation_options(self) -> dict[str, Any]:
+        """``run_navigation``'s wheel controller, EKF and disturbances keywords (issue 15)."""
+        return {"wheel_controller": self.resolve(self.wheel_controller) or self.wheel_controller,
+                "ekf": self.resolve(self.ekf), "disturbances": dict(self.disturbances)}  # fmt: skip
 
 
 def _pose(value: Any, where: str) -> tuple[float, float, float]:
@@ -121,7 +132,30 @@ def scenario_from_dict(data: Any, *, where: str = "scenario", path: Path | None 
         if isinstance(v, bool) or not isinstance(v, int | float) or not (math.isfinite(v) and v > 0):
             raise ExperimentError(f"{where}: time_limit: expected seconds > 0, got {v!r}")
         sc.time_limit = float(v)
+    _future_work_keys(sc, data, where)
     return sc
+
+
+def _future_work_keys(sc: Scenario, data: dict[str, Any], where: str) -> None:
+    """wheel_controller, ekf and disturbances (issue 15), checked here so a bad value fails before any trial."""
+    from navlab.errors import NavlabError
+    from navlab.sim.disturbances import parse_disturbances
+
+    if "wheel_controller" in data:
+        if not isinstance(data["wheel_controller"], str) or not data["wheel_controller"]:
+            raise ExperimentError(f"{where}: wheel_controller: expected gazebo_ros_diff_drive, diff_drive_controller "
+                                  f"or a ros_control YAML file, got {data['wheel_controller']!r}")  # fmt: skip
+        sc.wheel_controller = data["wheel_controller"]
+    ekf = data.get("ekf")
+    sc.ekf = ("default" if ekf else None) if isinstance(ekf, bool) or ekf is None else str(ekf)
+    if sc.ekf and sc.wheel_controller == "gazebo_ros_diff_drive":
+        raise ExperimentError(f"{where}: ekf needs wheel_controller: diff_drive_controller (the EKF owns odom -> base)")
+    dist = data.get("disturbances") or {}
+    try:
+        parse_disturbances(dist if isinstance(dist, dict) else {"": dist}, where=f"{where}: disturbances")
+    except NavlabError as exc:
+        raise ExperimentError(str(exc)) from None
+    sc.disturbances = dict(dist)
 
 
 def load_scenario(name_or_path: str | Path) -> Scenario:

@@ -75,7 +75,8 @@ def run_trial(sc: Scenario, index: int) -> dict[str, Any]:
             map_yaml = sc.resolve(sc.map)
         r = run_navigation(sc.goals, world=world, map_yaml=map_yaml, robot=sc.robot, pose=sc.start,
                            controller=sc.controller, params_dir=sc.resolve(sc.params), move_base_params=sc.overrides,
-                           spawn=spawns, goal_timeout=sc.time_limit, seed=seed, mapless=sc.map == "none")  # fmt: skip
+                           spawn=spawns, goal_timeout=sc.time_limit, seed=seed, mapless=sc.map == "none",
+                           **sc.navigation_options())  # fmt: skip
     goals = r.goals
     failed = next((g for g in goals if g["outcome"] != "succeeded" or g["collisions"]), None)
     success = failed is None
@@ -92,6 +93,7 @@ def run_trial(sc: Scenario, index: int) -> dict[str, Any]:
         "localization_error_mean_m": r.summary.get("localization_error_mean_m"),
         "localization_error_max_m": r.summary.get("localization_error_max_m"),
         "cmd_jerk_mean": r.summary.get("cmd_jerk_mean"), "sim_s": r.summary["sim_s"], "wall_s": r.summary["wall_s"],
+        "tracking_error_m": _mean(goals, "tracking_error_m"), "final_error_m": _mean(goals, "final_error_m"),
         "per_goal": goals,
     })  # fmt: skip
 
@@ -146,6 +148,8 @@ def summarize_trials(results: list[dict[str, Any]]) -> dict[str, Any]:
         "min_clearance_m": min((r["min_clearance_m"] for r in results), default=None),
         "localization_error_mean_m": _mean(results, "localization_error_mean_m"),
         "cmd_jerk_mean": _mean(results, "cmd_jerk_mean"),
+        "tracking_error_mean_m": _mean(results, "tracking_error_m"),
+        "final_error_mean_m": _mean(results, "final_error_m"),
     })  # fmt: skip
 
 
