@@ -69,3 +69,23 @@ def test_reads_real_log_header(dataset):
     assert len(log.scans) == 1988 and not log.skipped
     assert log.duration == pytest.approx(424.0, abs=0.5)
     assert np.all(np.diff([s.timestamp for s in log.scans]) > 0)
+
+
+def test_lines_whose_counts_disagree_go_backwards_or_are_huge_are_skipped(tmp_path):
+    """Issue 14: a count that disagrees with the readings would shift every field; such lines are skipped."""
+    good = [_flaser(181, 2.0, (0.1 * k, 0.0, 0.0), 100.0 + k) for k in range(3)]
+    tok = good[1].split()
+    tok[1] = str(int(tok[1]) - 1)  # one reading fewer announced than given: x would be read from a range
+    shifted = " ".join(tok) + "\n"
+    backwards = _flaser(181, 2.0, (0.5, 0.0, 0.0), 50.0)
+    huge = "FLASER 200000 " + "1 " * 200_000 + "0 0 0 0 0 0 103.0 host 103.0\n"
+    giant = "FLASER 2000000 " + "1.0 " * 2_000_000 + "0 0 0 0 0 0 103.0 host 103.0\n"
+    path = tmp_path / "bad.clf"
+    path.write_text(good[0] + shifted + good[2] + backwards + huge + giant)
+    log = read_carmen(path)
+    assert [s.timestamp for s in log.scans] == [100.0, 102.0]
+    reasons = " | ".join(log.skipped)
+    assert "bad.clf:2" in reasons and "fields, but its counts make" in reasons
+    assert "bad.clf:4" in reasons and "backwards" in reasons
+    assert "bad.clf:5" in reasons and "200000: expected a whole number" in reasons
+    assert "bad.clf:6: skipped a line longer than" in reasons

@@ -20,6 +20,8 @@ from navlab.geometry import wrap_angle
 from navlab.io.errors import IoError
 
 NO_RETURN = 81.9  # SICK "no return" in CARMEN logs (81.91 m); such ranges carry no hit
+MAX_READINGS = 100_000  # readings per scan line; more is not a laser scan
+MAX_LINE = 4 << 20  # characters per line (a 100,000-reading line has under 1 MiB)
 
 
 @dataclass
@@ -92,10 +94,26 @@ def _floats(tokens: list[str], start: int, count: int, what: str) -> list[float]
     return vals
 
 
+def _count(tok: list[str], index: int, what: str) -> int:
+    """A count field: a whole number 0..MAX_READINGS."""
+    value = _floats(tok, index, 1, what)[0]
+    if value != int(value) or not 0 <= value <= MAX_READINGS:
+        raise _Bad(f"{what} {tok[index]}: expected a whole number 0..{MAX_READINGS}")
+    return int(value)
+
+
+def _fields(tok: list[str], expected: int, what: str) -> None:
+    """A line must have exactly the fields its counts announce (with or without host and logger time)."""
+    if len(tok) not in (expected, expected - 2):
+        raise _Bad(f"{what}: {len(tok)} fields, but its counts make {expected} (a count that disagrees with "
+                   "its readings would shift every field after them)")
+
+
 def _parse_flaser(tok: list[str]) -> LaserScan2D:
-    n = int(_floats(tok, 1, 1, "FLASER count")[0])
+    n = _count(tok, 1, "FLASER count")
     if n <= 1:
         raise _Bad(f"FLASER with {n} readings")
+    _fields(tok, n + 11, f"FLASER with {n} readings")
     ranges = _floats(tok, 2, n, f"FLASER with {n} readings")
     x, y, t, ox, oy, ot, ts = _floats(tok, 2 + n, 7, f"FLASER with {n} readings")
     inc = math.pi / (n - 1) if n % 2 == 1 else math.pi / n  # 361 -> 0.5°, 180 -> 1°
@@ -105,9 +123,12 @@ def _parse_flaser(tok: list[str]) -> LaserScan2D:
 def _parse_robotlaser1(tok: list[str]) -> LaserScan2D:
     head = _floats(tok, 1, 8, "ROBOTLASER1 header")
     _ltype, start, _fov, res, max_range, _acc, _rmode, n_f = head
+    if n_f != int(n_f) or not 1 < n_f <= MAX_READINGS:
+        raise _Bad(f"ROBOTLASER1 count {tok[8]}: expected a whole number 2..{MAX_READINGS}")
     n = int(n_f)
     ranges = _floats(tok, 9, n, f"ROBOTLASER1 with {n} readings")
-    n_rem = int(_floats(tok, 9 + n, 1, "ROBOTLASER1 remission count")[0])
+    n_rem = _count(tok, 9 + n, "ROBOTLASER1 remission count")
+    _fields(tok, n + n_rem + 24, f"ROBOTLASER1 with {n} readings and {n_rem} remissions")
     base = 10 + n + n_rem
     lx, ly, lt, rx, ry, rt = _floats(tok, base, 6, "ROBOTLASER1 poses")
     ts = _floats(tok, base + 11, 1, "ROBOTLASER1 timestamp")[0]
@@ -125,23 +146,40 @@ def read_carmen(path: str | os.PathLike[str], *, max_skipped_report: int = 5) ->
     """Read a CARMEN log; raise ``IoError`` if it cannot be read or holds no laser scan."""
     p = Path(path)
     try:
+        if p.exists() and not p.is_file():
+            raise IoError(f"cannot read CARMEN log {p}: not a regular file")
         fh = p.open("r", errors="replace")
     except OSError as exc:
         raise IoError(f"cannot read CARMEN log {p}: {exc.strerror or exc}") from None
     log = CarmenLog(p)
+    last = {"scan": -math.inf, "odom": -math.inf}  # the latest timestamp of each stream
     with fh:
-        for lineno, line in enumerate(fh, 1):
-            tok = line.split()
+        lineno = 0
+        while line := fh.readline(MAX_LINE):
+            lineno += 1
+            if len(line) >= MAX_LINE and not line.endswith("\n"):
+                while (rest := fh.readline(MAX_LINE)) and not rest.endswith("\n"):
+                    pass  # the rest of an over-long line
+                log.skipped.append(f"{p.name}:{lineno}: skipped a line longer than {MAX_LINE} characters")
+                continue
+            tok = line.split(maxsplit=MAX_READINGS + 64)
             if not tok or tok[0].startswith("#"):
                 continue
             kind = tok[0]
             try:
-                if kind == "FLASER":
-                    log.scans.append(_parse_flaser(tok))
-                elif kind == "ROBOTLASER1":
-                    log.scans.append(_parse_robotlaser1(tok))
-                elif kind == "ODOM":
-                    log.odometry.append(_parse_odom(tok))
+                if kind in ("FLASER", "ROBOTLASER1", "ODOM"):
+                    rec: LaserScan2D | OdomRecord
+                    rec = (_parse_flaser(tok) if kind == "FLASER" else _parse_robotlaser1(tok) if kind != "ODOM"
+                           else _parse_odom(tok))
+                    stream = "odom" if kind == "ODOM" else "scan"
+                    if rec.timestamp < last[stream]:
+                        raise _Bad(f"timestamp {rec.timestamp} is before the previous {stream} "
+                                   f"({last[stream]}); timestamps must not go backwards")
+                    last[stream] = rec.timestamp
+                    if isinstance(rec, OdomRecord):
+                        log.odometry.append(rec)
+                    else:
+                        log.scans.append(rec)
                 else:
                     log.ignored_types[kind] = log.ignored_types.get(kind, 0) + 1
             except (_Bad, ValueError) as exc:
