@@ -23,6 +23,7 @@ COMMAND_MODULES = (  # in the order of the paper's pipeline, then the ROS-style 
     "navlab.mapping.cli",
     "navlab.experiments.cli",
     "navlab.core.cli",
+    "navlab.viz.cli",
     "navlab.bench",
 )
 

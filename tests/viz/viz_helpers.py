@@ -1,0 +1,37 @@
+"""Helpers of the viewer's browser tests: opening a page, reading canvas pixels, world <-> page coordinates."""
+
+from __future__ import annotations
+
+from typing import Any
+
+
+def open_page(browser: Any, url: str) -> Any:
+    """A page on ``url`` whose JavaScript errors fail the test, once the viewer has its first state."""
+    page = browser.new_page(viewport={"width": 1100, "height": 760})
+    errors: list[str] = []
+    page.on("pageerror", lambda exc: errors.append(str(exc)))
+    page.goto(url)
+    page.wait_for_function("() => window.navlab && window.navlab.store.state !== null", timeout=15000)
+    page.js_errors = errors  # type: ignore[attr-defined]
+    return page
+
+
+def pixel(page: Any, x: float, y: float) -> tuple[int, int, int, int]:
+    """RGBA of the canvas at CSS pixel (x, y) of the canvas."""
+    return tuple(page.evaluate("""([x, y]) => {
+        const c = document.getElementById('view'), d = devicePixelRatio;
+        return Array.from(c.getContext('2d').getImageData(Math.round(x * d), Math.round(y * d), 1, 1).data);
+    }""", [x, y]))  # fmt: skip
+
+
+def to_screen(page: Any, x: float, y: float) -> tuple[float, float]:
+    """Page coordinates of the fixed-frame point (x, y) m."""
+    sx, sy = page.evaluate("([x, y]) => window.navlab.view.toScreen(x, y)", [x, y])
+    box = page.locator("#view").bounding_box()
+    return box["x"] + sx, box["y"] + sy
+
+
+def canvas_xy(page: Any, x: float, y: float) -> tuple[float, float]:
+    """Canvas coordinates (CSS px) of the fixed-frame point (x, y) m."""
+    sx, sy = page.evaluate("([x, y]) => window.navlab.view.toScreen(x, y)", [x, y])
+    return sx, sy
