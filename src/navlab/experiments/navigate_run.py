@@ -90,8 +90,9 @@ class NavMonitor(Node):
         self.clearance.append(self._nearest - self.radius)
         self._nearest = math.inf
         plan = getattr(self.move_base, "global_plan", None)  # in the map frame: the world's with a true map
-        ok = self.estimate_frame == "map" and plan is not None and len(plan)
-        self.tracking.append(float(distance_to_path(np.array([[x, y]]), plan)[0]) if ok else math.nan)
+        ok = self.estimate_frame == "map" and plan is not None and len(plan) > 0
+        self.tracking.append(float(distance_to_path(np.array([[x, y]]), plan)[0]) if ok and plan is not None
+                             else math.nan)  # fmt: skip
 
     def scan_points(self) -> np.ndarray | None:
         """The last scan's returns (N, 2) in the world frame (from the true pose), or None."""
