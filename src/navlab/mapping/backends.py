@@ -30,6 +30,8 @@ from navlab.mapping.errors import MappingError
 from navlab.mapping.gmapping import GMapping, GMappingParams
 from navlab.mapping.graph_slam import GraphSlam, GraphSlamParams
 from navlab.mapping.occupancy import build_map
+from navlab.mapping.refine import RefineParams, refine_poses
+from navlab.mapping.scanmatch import ScanPoints, scan_points
 
 
 def _int_stats(obj: object) -> dict[str, int]:
@@ -51,6 +53,9 @@ class GMappingBackend:
     def __init__(self, params: dict[str, Any] | None = None, *, rng: np.random.Generator) -> None:
         self.params = GMappingParams.from_dict(params)
         self.slam = GMapping(self.params, rng=rng)
+        self._points: list[ScanPoints] = []  # every scan's points, for the final refinement
+        self.refine_edges = 0
+        self.refine_rejected = 0
 
     @classmethod
     def parameters(cls) -> dict[str, Any]:
@@ -82,6 +87,9 @@ class GMappingBackend:
             if p.maxRange <= 0:
                 p.maxRange = range_max - 0.01
                 p.maxUrange = min(p.maxUrange, p.maxRange)
+        if self.params.refine:
+            self._points.append(scan_points(r, angle_min, angle_increment, range_max=min(self.params.maxUrange, 30.0),
+                                            voxel=0.04))  # fmt: skip
         first = not self.slam.particles
         before = self.slam.updates
         stamp = None if stamp_ns is None else stamp_ns * 1e-9
@@ -100,12 +108,18 @@ class GMappingBackend:
         return self.slam.map(frame_id=frame_id) if self.slam.particles else None
 
     def finish(self) -> np.ndarray:
-        """Laser poses (N, 3) of every scan added (see ``GMapping.finish``)."""
-        return self.slam.finish()
+        """Laser poses (N, 3) of every scan added (see ``GMapping.finish``), refined with dense verified
+        scan-to-scan constraints (``refine``, :func:`~navlab.mapping.refine.refine_poses`)."""
+        poses = self.slam.finish()
+        if self.params.refine and len(self._points) == len(poses) > 2:
+            # no front end has linked neighbouring scans here: match against the nearest ones too
+            poses, stats = refine_poses(poses, self._points, RefineParams(min_travel=0.0, neighbours=6))
+            self.refine_edges, self.refine_rejected = stats["refine_edges"], stats["refine_rejected"]
+        return poses
 
     def stats(self) -> dict[str, int]:
-        """GMapping's counters (updates, resamples)."""
-        return _int_stats(self.slam)
+        """GMapping's counters (updates, resamples) and the refinement's."""
+        return {**_int_stats(self.slam), **_int_stats(self)}
 
 
 class GraphBackend:

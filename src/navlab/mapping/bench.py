@@ -1,19 +1,29 @@
-"""``navlab bench slam``: graph SLAM over the MIT CSAIL log, real-time factor on this machine."""
+"""``navlab bench slam``: graph SLAM over the MIT CSAIL log (real-time factor on this machine, relations
+error); ``navlab bench slam-office``: both SLAM modes on sparse simulator logs of the generated office
+floor (ATE and map precision against the true walls, over 5 seeds)."""
 
 from __future__ import annotations
 
 import argparse
+import tempfile
 import time
+from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 CSAIL = "mit-csail/mit-csail.clf"  # under NAVLAB_DATA (default ../shared/datasets beside the repository)
+RELATIONS = "mit-csail/mit-csail.relations"
+OFFICE_SEEDS = 5
 
 
 def run(args: argparse.Namespace) -> dict[str, Any]:
-    """Time ``run_offline`` (graph mode, including the final map) on the CSAIL log.
+    """Time ``run_offline`` (graph mode, including the final map) on the CSAIL log and score its poses
+    with the relations metric.
 
     A missing log raises ``DatasetNotFoundError`` saying where it was looked for and how to provide it.
     """
+    from navlab.experiments.metrics import read_relations, relations_error
     from navlab.io.carmen import read_carmen
     from navlab.io.datasets import dataset
     from navlab.mapping.scanmatch import warmup
@@ -22,8 +32,9 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
     log = read_carmen(dataset(CSAIL))
     warmup()  # numba compilation is not part of the figure (it is cached on disk after the first run)
     t0, c0 = time.perf_counter(), time.process_time()
-    run_offline(log, mode="graph", seed=getattr(args, "seed", 0))
+    result = run_offline(log, mode="graph", seed=getattr(args, "seed", 0))
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
+    rel = relations_error(result.timestamps, result.poses, read_relations(dataset(RELATIONS)))
     # cpu_s is this process's CPU time: on a busy machine it shows what one free core would take
     return {
         "log_s": round(log.duration, 3),
@@ -31,4 +42,71 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
         "rtf": round(log.duration / wall, 2),
         "cpu_s": round(cpu, 3),
         "rtf_cpu": round(log.duration / cpu, 2),
+        "relations_scored": rel["n_scored"],
+        "relations_trans_m": round(float(rel["trans_abs_mean"]), 4),
+        "relations_rot_deg": round(float(rel["rot_abs_mean_deg"]), 3),
     }
+
+
+def office_truth(resolution: float = 0.05) -> Any:
+    """The default office floor's true occupancy (a boolean ``Grid``, world frame)."""
+    from navlab.experiments.truth import truth_grid
+    from navlab.world import load_world, occupancy
+    from navlab.world.office import generate_office
+
+    office = generate_office()
+    with tempfile.TemporaryDirectory(prefix="navlab-office-") as tmp:
+        world = load_world(office.write_world(Path(tmp) / "office.world"))
+    bounds = (-1.0, -1.0, office.width + 1.0, office.depth + 1.0)
+    occ = occupancy(world, resolution, bounds, static_only=True)
+    return truth_grid(occ, resolution, (bounds[0], bounds[1]))
+
+
+def office_scores(sim_log: Any, result: Any, truth: Any) -> dict[str, float]:
+    """ATE of a SLAM ``result``'s robot poses against the log's truth, and the map's precision and recall
+    against ``truth`` (``office_truth``) with the map placed by the same rigid alignment (a map's gauge,
+    its first pose, is free)."""
+    from navlab.experiments.metrics import score_map
+    from navlab.experiments.trajectory import apply_se2, ate
+    from navlab.geometry import compose2, inverse2
+
+    truth_in_map = apply_se2(tuple(inverse2(sim_log.start)), sim_log.truth)  # map frame = the start pose
+    a = ate(result.poses, truth_in_map)
+    world_T_map = compose2(sim_log.start, (a["align_x"], a["align_y"], a["align_yaw"]))
+    m = score_map(result.grid, truth, world_T_map=(float(world_T_map[0]), float(world_T_map[1]), float(world_T_map[2])))
+    return {"ate_rmse_m": a["rmse_m"], "ate_max_m": a["max_m"], "ate_share_over_0.5m": a["share_over_far"],
+            "precision": float(m["precision"]), "recall": float(m["recall"])}  # fmt: skip
+
+
+def run_office(args: argparse.Namespace) -> dict[str, Any]:
+    """Both SLAM modes on the office floor's sparse logs (seeds ``seed`` .. ``seed + 4``): per mode the
+    worst and mean ATE RMSE, the worst ATE max, the worst map precision, and SLAM's CPU time per log."""
+    from navlab.mapping.scanmatch import warmup
+    from navlab.mapping.simlog import office_log
+    from navlab.mapping.slam import run_offline
+
+    warmup()
+    seed0 = getattr(args, "seed", 0)
+    truth = office_truth()
+    rows: dict[str, list[dict[str, float]]] = {"graph": [], "gmapping": []}
+    log_s = 0.0
+    for seed in range(seed0, seed0 + OFFICE_SEEDS):
+        sim_log = office_log(seed)
+        log_s = sim_log.log.duration
+        for mode, out in rows.items():
+            c0 = time.process_time()
+            result = run_offline(sim_log.log, mode=mode, seed=seed)
+            out.append({**office_scores(sim_log, result, truth), "cpu_s": time.process_time() - c0})
+    summary: dict[str, Any] = {"seeds": OFFICE_SEEDS, "scans": len(sim_log.log.scans), "log_s": round(log_s, 1)}
+    for mode, out in rows.items():
+        col = {k: np.array([r[k] for r in out]) for k in out[0]}
+        summary[mode] = {
+            "ate_rmse_m_max": round(float(col["ate_rmse_m"].max()), 4),
+            "ate_rmse_m_mean": round(float(col["ate_rmse_m"].mean()), 4),
+            "ate_max_m_max": round(float(col["ate_max_m"].max()), 4),
+            "share_over_0.5m_max": round(float(col["ate_share_over_0.5m"].max()), 4),
+            "precision_min": round(float(col["precision"].min()), 4),
+            "recall_mean": round(float(col["recall"].mean()), 4),
+            "cpu_s_mean": round(float(col["cpu_s"].mean()), 2),
+        }
+    return summary

@@ -66,6 +66,11 @@ class GMappingParams:
     lasamplerange: float = 0.005
     lasamplestep: float = 0.005
     occ_thresh: float = 0.25
+    # navlab: at the end, match every scan that fell between map updates against the best particle's map
+    # (its pose otherwise comes from the odometry since the last update; sparse logs skip many scans)
+    refineSkipped: bool = True
+    # navlab: then refine all poses with dense verified scan-to-scan constraints (mapping.refine)
+    refine: bool = True
 
     @classmethod
     def from_dict(cls, values: dict | None) -> GMappingParams:
@@ -232,6 +237,7 @@ class GMapping:
         self._scan_ref: list[tuple[int, np.ndarray]] = []  # per scan: (last updated scan, odom step since)
         self._last_update_scan = -1
         self._odom_by_scan: dict[int, np.ndarray] = {}
+        self._scan_data: dict[int, tuple[np.ndarray, np.ndarray, float]] = {}  # scans between updates (refineSkipped)
 
     # --- map bookkeeping ----------------------------------------------------------------------------
 
@@ -319,6 +325,8 @@ class GMapping:
             self._time_at_update = self._time
         else:
             self._scan_ref.append((self._last_update_scan, between2(self._odom_by_scan[self._last_update_scan], odom)))
+            if p.refineSkipped:
+                self._scan_data[k] = (r, ang, max_urange)
         return self.best().pose.copy()
 
     def _init(self, odom: np.ndarray, r: np.ndarray, ang: np.ndarray, max_urange: float, max_range: float) -> None:
@@ -421,7 +429,22 @@ class GMapping:
             if base is None:  # before resampling histories joined; fall back on odometry
                 base = self._odom_by_scan[ref]
             out[k] = compose2(base, step)
+            scan = self._scan_data.get(k)
+            if scan is not None and k not in traj:  # a scan between updates: matched against the best map
+                out[k] = self._refine(self.best().grid, out[k], *scan)
         return out
+
+    def _refine(
+        self, grid: np.ndarray, pose: np.ndarray, r: np.ndarray, ang: np.ndarray, max_urange: float
+    ) -> np.ndarray:
+        """``pose`` improved by the scan matcher against ``grid`` (unchanged if the match scores too low)."""
+        p = self.p
+        ox, oy, oi, oj = self._lattice()
+        x, y, t, score = _optimize(
+            grid, ox, oy, oi, oj, p.delta, pose[0], pose[1], pose[2], r, ang, max_urange,
+            p.kernelSize, p.sigma, p.lsigma, p.lskip, p.lstep, p.astep, p.iterations,
+        )  # fmt: skip
+        return np.array([x, y, wrap_angle(t)]) if score > p.minimumScore else pose
 
     def map(self, *, frame_id: str = "map") -> GridMap:
         """The best particle's occupancy grid."""

@@ -19,8 +19,10 @@ from navlab.core.params import dataclass_from_dict
 from navlab.geometry import between2, compose2, inverse2, rotate_vectors2, transform_points2
 from navlab.mapping.errors import MappingError
 from navlab.mapping.posegraph import PoseGraph
+from navlab.mapping.refine import refine_poses
 from navlab.mapping.scanmatch import (
     LookupField,
+    ScanPoints,
     correlative_search,
     icp_point_to_line,
     scan_points,
@@ -66,6 +68,8 @@ class GraphSlamParams:
     loop_confirm_ang: float = math.radians(2.0)
     loop_kernel: float = 3.0  # Cauchy kernel width (Mahalanobis)
     loop_reject: float = 6.0  # drop a loop edge whose optimised Mahalanobis error exceeds this
+    refine: bool = False  # finish with dense verified scan-to-scan constraints (mapping.refine); off: measured
+    # no gain on the CSAIL log (0.0271 -> 0.0266 m) or the office logs, at +70 % CPU
 
     @classmethod
     def from_dict(cls, values: dict[str, float] | None) -> GraphSlamParams:
@@ -88,6 +92,8 @@ class GraphSlam:
         self.frontend_failures = 0
         self.loop_implausible = 0
         self.odom_jumps = 0
+        self.refine_edges = 0
+        self.refine_rejected = 0
         self.loop_log: list[tuple[int, int, float, float, float, float]] = []
         self._last_loop_node = -(10**9)
         self._travel_at_loop = -math.inf
@@ -269,6 +275,12 @@ class GraphSlam:
         return True
 
     def finish(self, iterations: int = 20) -> np.ndarray:
-        """Final optimisation of the whole graph; returns the poses (N, 3)."""
+        """Final optimisation of the whole graph, then (``refine``) the dense verified refinement of
+        :func:`~navlab.mapping.refine.refine_poses`; returns the poses (N, 3)."""
         self.graph.optimize(iterations=iterations, kernel=self.p.loop_kernel)
+        if self.p.refine and len(self.node_xy) > 2:
+            scans = [ScanPoints(xy, nrm) for xy, nrm in zip(self.node_xy, self.node_normals, strict=True)]
+            poses, stats = refine_poses(self.graph.poses, scans)
+            self.graph.poses = poses
+            self.refine_edges, self.refine_rejected = stats["refine_edges"], stats["refine_rejected"]
         return self.graph.poses.copy()

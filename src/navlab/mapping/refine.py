@@ -1,0 +1,116 @@
+"""A final, globally consistent refinement of SLAM poses: dense verified scan-to-scan constraints, optimised.
+
+Given laser poses that are already globally consistent to a few decimetres (what a SLAM mode's loop
+closures give), every scan is matched by point-to-line ICP against the scans of its nearest neighbours
+in space (up to ``neighbours`` nodes within ``radius`` m, heading within ``max_heading`` rad, at least
+``min_travel`` m back along the path), starting
+from their current relative pose. A match enters the pose graph only if it is verified: enough of the
+scan overlaps (``min_inliers``), the residual is small (``max_rms``) and the correction it implies is
+small (``max_correction`` m / ``max_correction_ang`` rad: these are not loop *searches*, so a large
+jump is a wrong match, never accepted). Consecutive scans are always linked (by their match, or by the
+current relative pose, weakly, when it cannot be verified). All non-consecutive edges carry a Cauchy
+kernel, and an edge the optimised graph still disagrees with by more than ``reject`` (Mahalanobis) is
+dropped before a last optimisation (switching off inconsistent constraints).
+
+Pure: numpy in, poses out; no topics, no clock. Poses (x, y, theta) m, rad.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from navlab.geometry import between2, wrap_angle
+from navlab.mapping.posegraph import PoseGraph
+from navlab.mapping.scanmatch import ScanPoints, icp_point_to_line
+
+
+@dataclass
+class RefineParams:
+    """Parameters of :func:`refine_poses` (m, rad)."""
+
+    radius: float = 4.0
+    neighbours: int = 4
+    min_travel: float = 1.5  # only nodes this far back along the path (nearer ones: the front end's job)
+    max_heading: float = math.radians(100.0)
+    min_inliers: float = 0.5
+    max_rms: float = 0.03
+    max_correction: float = 0.5
+    max_correction_ang: float = math.radians(6.0)
+    icp_max_dist: float = 0.4
+    icp_min_dist: float = 0.06
+    icp_iterations: int = 14
+    sigma_xy: float = 0.02
+    sigma_theta: float = math.radians(0.4)
+    weak_sigma_xy: float = 0.2
+    weak_sigma_theta: float = math.radians(3.0)
+    kernel: float = 2.0
+    reject: float = 5.0
+    rounds: int = 3
+
+
+def _match(
+    a: ScanPoints, b: ScanPoints, rel: np.ndarray, p: RefineParams
+) -> tuple[np.ndarray, bool]:
+    """Pose of scan ``b`` in scan ``a``'s frame, refined by ICP from ``rel``, and whether it is verified."""
+    if len(a.xy) < 20 or len(b.xy) < 20:
+        return rel, False
+    res = icp_point_to_line(a.xy, a.normals, b.xy, rel, max_dist=p.icp_max_dist, min_dist=p.icp_min_dist,
+                            iterations=p.icp_iterations)  # fmt: skip
+    corr = res.pose - rel
+    ok = (
+        res.inlier_fraction >= p.min_inliers
+        and res.rms <= p.max_rms
+        and math.hypot(corr[0], corr[1]) <= p.max_correction
+        and abs(wrap_angle(corr[2])) <= p.max_correction_ang
+    )
+    return res.pose, ok
+
+
+def refine_poses(
+    poses: np.ndarray, scans: list[ScanPoints], params: RefineParams | None = None
+) -> tuple[np.ndarray, dict[str, int]]:
+    """Refined laser poses (N, 3) for ``scans`` (laser-frame points with normals) taken at ``poses``, and
+    counters (``refine_edges``: verified constraints kept, ``refine_rejected``: matches that failed
+    verification or were switched off by the optimiser)."""
+    p = params or RefineParams()
+    cur = np.array(poses, dtype=np.float64).reshape(-1, 3)
+    n = len(cur)
+    stats = {"refine_edges": 0, "refine_rejected": 0}
+    if n < 3:
+        return cur, stats
+    strong = np.diag([p.sigma_xy**-2, p.sigma_xy**-2, p.sigma_theta**-2])
+    weak = np.diag([p.weak_sigma_xy**-2, p.weak_sigma_xy**-2, p.weak_sigma_theta**-2])
+    for _ in range(p.rounds):
+        steps = np.hypot(np.diff(cur[:, 0]), np.diff(cur[:, 1]))
+        travel = np.concatenate([[0.0], np.cumsum(steps)])
+        g = PoseGraph(poses=cur.copy())
+        kept = rejected = 0
+        for k in range(1, n):
+            rel = between2(cur[k - 1], cur[k])
+            z, ok = _match(scans[k - 1], scans[k], rel, p)
+            g.add_edge(k - 1, k, z if ok else rel, strong if ok else weak)
+            # nearest earlier nodes in space, not the previous one
+            d = np.hypot(cur[: k - 1, 0] - cur[k, 0], cur[: k - 1, 1] - cur[k, 1])
+            dth = np.abs(wrap_angle(cur[: k - 1, 2] - cur[k, 2]))
+            back = travel[k] - travel[: k - 1]
+            cand = np.flatnonzero((d < p.radius) & (dth < p.max_heading) & (back >= p.min_travel))
+            for j in cand[np.argsort(d[cand])][: p.neighbours]:
+                z, ok = _match(scans[j], scans[k], between2(cur[j], cur[k]), p)
+                if ok:
+                    g.add_edge(int(j), k, z, strong, robust=True)
+                    kept += 1
+                else:
+                    rejected += 1
+        g.optimize(iterations=15, kernel=p.kernel)
+        # switch off the constraints the optimised graph still disagrees with, then optimise again
+        bad = np.flatnonzero((g.edge_distances() > p.reject) & np.asarray(g.edges_robust, dtype=bool))
+        for e in bad[::-1]:
+            g.remove_edge(int(e))
+        if len(bad):
+            g.optimize(iterations=10, kernel=p.kernel)
+        cur = g.poses.copy()
+        stats = {"refine_edges": kept - len(bad), "refine_rejected": rejected + len(bad)}
+    return cur, stats

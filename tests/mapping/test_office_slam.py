@@ -1,0 +1,51 @@
+"""Global consistency on sparse data: both SLAM modes on simulator logs of the generated office floor
+(scans every 1 m / 0.5 rad, 180 beams over 180 degrees, odometry with 5 % scale errors and heading
+drift), scored against the truth: ATE RMSE <= 0.10 m, max <= 0.30 m, map precision >= 0.95 (no doubled
+walls). ``navlab bench slam-office`` gives the figures over 5 seeds."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from navlab.experiments.trajectory import ate
+from navlab.mapping.bench import office_scores, office_truth
+from navlab.mapping.simlog import OdometryNoise, office_log, route_poses
+from navlab.mapping.slam import run_offline
+
+
+@pytest.fixture(scope="module")
+def truth():
+    return office_truth()
+
+
+def test_route_scans_are_sparse():
+    t, poses = route_poses(np.array([[0.0, 0.0], [5.0, 0.0], [5.0, 3.0]]))
+    steps = np.hypot(*np.diff(poses[:, :2], axis=0).T)
+    turns = np.abs(np.diff(poses[:, 2]))
+    assert steps.max() <= 1.0 + 1e-6 and turns.max() <= 0.5 + 1e-6
+    assert np.all((steps > 0.98) | (turns > 0.49) | (np.arange(len(steps)) == len(steps) - 1))
+    assert np.all(np.diff(t) > 0)
+
+
+@pytest.mark.parametrize("seed", [1, 2])
+def test_both_modes_globally_consistent_on_sparse_office_logs(seed, truth):
+    sim_log = office_log(seed)
+    scans = sim_log.log.scans
+    assert len(scans) > 150 and len(scans[0].ranges) in (180, 181)
+    # the odometry really is bad: metres off after the loops
+    odom = np.array([s.odom_pose for s in scans])
+    assert ate(odom, sim_log.truth)["max_m"] > 2.0
+    for mode in ("graph", "gmapping"):
+        result = run_offline(sim_log.log, mode=mode, seed=seed)
+        got = office_scores(sim_log, result, truth)
+        assert got["ate_rmse_m"] <= 0.10, (mode, got)
+        assert got["ate_max_m"] <= 0.30, (mode, got)
+        assert got["precision"] >= 0.95, (mode, got)
+
+
+def test_noise_is_seeded():
+    a = office_log(3, noise=OdometryNoise(scale=0.05))
+    b = office_log(3, noise=OdometryNoise(scale=0.05))
+    assert np.array_equal(a.log.scans[40].ranges, b.log.scans[40].ranges)
+    assert a.log.scans[40].odom_pose == b.log.scans[40].odom_pose
