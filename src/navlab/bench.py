@@ -15,6 +15,7 @@ from typing import Any
 BENCHES: dict[str, str] = {
     "mapping": "navlab.experiments.mapping_run:bench",
     "slam": "navlab.mapping.bench:run",
+    "slam-office": "navlab.mapping.bench:run_office",
     "core": "navlab.core.bench:run",
     "amcl": "navlab.localization.bench:run",
     "description": "navlab.description.bench:run",
