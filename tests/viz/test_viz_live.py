@@ -29,9 +29,10 @@ def live() -> Iterator[tuple[Run, Viewer]]:
     thread = threading.Thread(target=lambda: run.run(3600.0, quiet=True), daemon=True)
     thread.start()
     yield run, viewer
-    viewer.close()
+    viewer.node.close()  # a paused run goes on
     run.executor.stop()
     thread.join(10)
+    viewer.close()
 
 
 @pytest.fixture(scope="module")

@@ -24,6 +24,7 @@ from navlab.core.graph import Graph
 from navlab.core.launch import Session, start
 from navlab.core.runner import parse_launch_args, run_for
 from navlab.io.files import write_text_atomic
+from navlab.viz.cli import add_view_arguments
 
 
 def _add_source(p: argparse.ArgumentParser) -> None:
@@ -142,7 +143,9 @@ def _cmd_launch(args: argparse.Namespace) -> int:
     # `navlab topic/node/graph` in another shell look into this launch while it runs; SIGTERM ends it
     # cleanly like Ctrl-C (the recording is closed, the socket removed)
     signal.signal(signal.SIGTERM, lambda *_: ex.post(ex.stop))
-    with IntrospectionServer(ex, name=args.file), contextlib.suppress(KeyboardInterrupt):
+    from navlab.viz.cli import viewing
+
+    with IntrospectionServer(ex, name=args.file), contextlib.suppress(KeyboardInterrupt), viewing(args, ex):
         run_for(ex, duration, record=args.record, quiet=args.quiet, desc=Path(args.file).stem)
     topics = {name: t.count for name, t in sorted(ex.topics.items())}
     summary: dict[str, Any] = {"sim_s": round(ex.now_ns / 1e9, 3), "nodes": sorted(ex.nodes), "topics": topics}
@@ -271,6 +274,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
+    add_view_arguments(p)
     p.add_argument("-s", "--show-args", action="store_true",
                    help="list the launch's arguments (name, description, default) and exit")
     p.set_defaults(func=_cmd_launch)

@@ -9,6 +9,7 @@ import sys
 from typing import Any
 
 from navlab.cli_common import add_pose_arguments, add_set_argument, parse_sets, positive_seconds, start_pose
+from navlab.viz.cli import add_view_arguments, viewing
 
 _SPAWN_HELP = (
     "spawn a model, KIND:key=value,... with KIND box|cylinder|sphere|sdf, e.g. 'box:name=crate,x=2,y=1,size=0.5', "
@@ -47,6 +48,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--record", default=None, metavar="DIR", help="record all topics to a rosbag2 in DIR")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.add_argument("--json", action="store_true", help="print the summary as one JSON object")
+    add_view_arguments(p)
     p.set_defaults(func=_cmd_sim)
 
     r = sub.add_parser(
@@ -108,7 +110,8 @@ def _cmd_sim(args: argparse.Namespace) -> int:
         helper.create_timer(0.1, lambda: pub.publish(msgs.twist(*cmd_vel)))
         pub.publish(msgs.twist(*cmd_vel))
     start = gazebo.sim.base_pose2d()
-    run.run(args.duration, record=args.record, quiet=args.quiet, desc="sim")
+    with viewing(args, ex):
+        run.run(args.duration, record=args.record, quiet=args.quiet, desc="sim")
     bag = run.bag
     end = gazebo.sim.base_pose2d()
     summary: dict[str, Any] = {

@@ -40,8 +40,10 @@ class Viewer:
         return self.server.url
 
     def close(self) -> None:
-        """Stop serving (the executor keeps running, unpaced)."""
+        """Stop serving and remove the viewer's node. Call it from the executor's thread or once it stopped
+        running (a run in another thread: ``node.close()`` first, which releases a paused run)."""
         self.node.close()
+        self.node.destroy_node()
         self.server.close()
         if self.foxglove is not None:
             self.foxglove.close()

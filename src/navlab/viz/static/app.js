@@ -82,6 +82,7 @@ function updateStatus(s) {
     $("outcome").textContent = `goal (${out.goal.map((v) => v.toFixed(2)).join(", ")}): ${out.state}${out.reason ? " — " + out.reason : ""}`;
     $("outcome").className = out.state === "SUCCEEDED" ? "good" : "bad";
   }
+  document.body.classList.toggle("replay", !!s.replay);
   if (s.replay) {
     $("timeline").hidden = false;
     const seek = $("seek");
@@ -129,8 +130,10 @@ function draw() {
   }
 }
 
+const MIN_FRAME_MS = 1000 / 40; // draw at most 40 frames/s: smooth, and leaves the CPU to the simulation
+let lastDraw = 0;
 function frame(now) {
-  if (dirty) { dirty = false; draw(); stats.frames++; framesThisSecond++; }
+  if (dirty && now - lastDraw >= MIN_FRAME_MS) { dirty = false; lastDraw = now; draw(); stats.frames++; framesThisSecond++; }
   if (now - fpsMark >= 1000) { stats.fps = (framesThisSecond * 1000) / (now - fpsMark); framesThisSecond = 0; fpsMark = now; }
   stats.bytes = link.bytes;
   requestAnimationFrame(frame);

@@ -1,0 +1,43 @@
+"""``--view`` on other verbs: the viewer is served while the run lasts, and the verb's output is unchanged."""
+
+from __future__ import annotations
+
+import argparse
+import json
+
+import pytest
+from websockets.sync.client import connect
+
+from navlab.cli import main
+from navlab.experiments.session import start_run
+from navlab.viz.cli import viewing
+
+
+def test_sim_and_launch_take_view(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["sim", "--duration", "0.2", "--json", "--view", "--view-port", "0", "--no-browser"]) == 0
+    out = capsys.readouterr()
+    assert "viewer: http://127.0.0.1:" in out.err and json.loads(out.out)["sim_s"] == pytest.approx(0.2)
+    assert main(["launch", "sim", "--duration", "0.2", "--json", "--view", "--view-port", "0", "--no-browser"]) == 0
+    out = capsys.readouterr()
+    assert (
+        "viewer: http://127.0.0.1:" in out.err and "/initialpose" in json.loads(out.out)["topics"]
+    )  # the viewer publishes it
+
+
+def test_viewing_serves_while_the_block_runs_and_warns_off_loopback(capsys: pytest.CaptureFixture[str]) -> None:
+    run = start_run("sim", world="room")
+    args = argparse.Namespace(view=True, view_host="127.0.0.1", view_port=0, no_browser=True, foxglove=None)
+    with viewing(args, run.executor) as viewer:
+        run.run(0.2)
+        with connect(viewer.url.replace("http", "ws")) as ws:
+            state = json.loads(ws.recv(timeout=5))
+        assert state["k"] == "state" and state["t"] == pytest.approx(0.2, abs=0.02) and state["base"] == "chassis"
+    with pytest.raises(OSError), connect(viewer.url.replace("http", "ws"), open_timeout=1):
+        pass  # closed with the block
+    args.view = False
+    with viewing(args, run.executor) as none:
+        assert none is None
+    args = argparse.Namespace(view=True, view_host="0.0.0.0", view_port=0, no_browser=True, foxglove=None)
+    with viewing(args, run.executor):
+        pass
+    assert "warning: the viewer listens on 0.0.0.0" in capsys.readouterr().err
