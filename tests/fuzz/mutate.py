@@ -72,8 +72,8 @@ RULES: dict[str, dict[str, str]] = {
     "urdf": {
         **dict.fromkeys(("mass@value", "box@size", "cylinder@radius", "cylinder@length", "sphere@radius",
                          "samples", "wheelSeparation", "wheelDiameter"), POS),
-        **dict.fromkeys(("inertia@ixx", "inertia@iyy", "inertia@izz", "mu1", "mu2", "kp", "kd", "updateRate",
-                         "update_rate", "wheelTorque", "limit@effort", "limit@velocity"), NONNEG),
+        **dict.fromkeys(("inertia@ixx", "inertia@iyy", "inertia@izz", "mu1", "mu2", "kp", "kd", "wheelTorque",
+                         "limit@effort", "limit@velocity"), NONNEG),  # Gazebo: update rates <= 0 mean "every step"
     },
     "world": {
         **dict.fromkeys(("size", "radius", "length", "mass", "max_step_size"), POS),
@@ -81,6 +81,19 @@ RULES: dict[str, dict[str, str]] = {
     },
 }
 RULES["robot"] = RULES["urdf"]
+
+# XML numbers the loaders read (a NaN in a light's colour that nothing reads is not an accepted invalid value)
+READ_XML: dict[str, frozenset[str]] = {
+    "urdf": frozenset({"origin@xyz", "origin@rpy", "mass@value", "inertia@ixx", "inertia@iyy", "inertia@izz",
+                       "inertia@ixy", "inertia@ixz", "inertia@iyz", "box@size", "cylinder@radius", "cylinder@length",
+                       "sphere@radius", "mesh@scale", "limit@lower", "limit@upper", "limit@effort", "limit@velocity",
+                       "axis@xyz", "mu1", "mu2", "updateRate", "update_rate", "samples", "min_angle", "max_angle",
+                       "min", "max", "wheelSeparation", "wheelDiameter", "wheelTorque", "wheelAcceleration",
+                       "pose"}),
+    "world": frozenset({"pose", "size", "radius", "length", "mass", "mu", "mu2", "ixx", "iyy", "izz", "ixy", "ixz",
+                        "iyz", "max_step_size", "real_time_update_rate"}),
+}
+READ_XML["robot"] = READ_XML["urdf"]
 
 PAIRS: dict[str, list[tuple[str, str]]] = {
     "amcl": [("min_particles", "max_particles"), ("laser_min_range", "laser_max_range")],
@@ -215,6 +228,10 @@ def _yaml_value(fmt: str, seed: Seed, rng: np.random.Generator) -> Case:
     else:
         value = True
         invalid = numeric and fmt != "launch"
+    if fmt == "map" and _key_of(path) == "negate" and kind == "bool":
+        invalid = False  # navlab reads negate: true/false as 1/0 (documented leniency)
+    if fmt == "move_base" and path and path[0] in ("DWAPlannerROS", "MPPIController"):
+        invalid = False  # parameters of planners this configuration does not select are not read (as in ROS)
     _set(doc, path, value)
     label = f"yaml:{kind}" + (f"@{_key_of(path)}" if _key_of(path) else "")
     return Case(fmt, label, invalid, {**seed.files, name: _dump(doc)}, seed.main)
@@ -278,7 +295,8 @@ def _yaml_structure(fmt: str, seed: Seed, rng: np.random.Generator) -> Case:
     key = list(d)[int(rng.integers(len(d)))]
     if kind == "unknown_key" and isinstance(key, str):
         d[_typo(key, rng)] = d[key]
-        top = fmt in STRICT_KEYS and not (fmt == "move_base" and path and path[-1] in ("laser_scan_sensor",))
+        top = fmt in STRICT_KEYS and not (fmt == "move_base" and path and path[0] in (
+            "laser_scan_sensor", "DWAPlannerROS", "MPPIController"))
         # a typo of a key that the format leaves open (plugin sub-namespaces) is not wrong by construction
         return Case(fmt, f"yaml:unknown_key@{key}", (top and fmt != "scenario") or (fmt == "scenario" and not path),
                     {**seed.files, name: _dump(doc)}, seed.main)
@@ -322,8 +340,8 @@ def _launch(fmt: str, seed: Seed, rng: np.random.Generator) -> Case:
     elif kind == "include_self":
         by_kind["include"]["file"] = seed.main
     elif kind.startswith("rate_"):
-        by_kind["arg"]["default"] = {"rate_zero": "0", "rate_negative": "-2.0", "rate_nan": ".nan",
-                                     "rate_text": "fast"}[kind]
+        rate_arg = next(e["arg"] for e in entries if "arg" in e and e["arg"].get("name") == "rate")
+        rate_arg["default"] = {"rate_zero": "0", "rate_negative": "-2.0", "rate_nan": ".nan", "rate_text": "fast"}[kind]
     elif kind == "exec_function":
         node["exec"] = "os:getcwd"
     elif kind == "exec_missing":
@@ -335,7 +353,7 @@ def _launch(fmt: str, seed: Seed, rng: np.random.Generator) -> Case:
     elif kind == "undefined_var":
         node["name"] = "$(var nowhere)"
     elif kind == "arg_no_name":
-        del by_kind["arg"]["name"]
+        del next(e["arg"] for e in entries if "arg" in e)["name"]
     else:
         by_kind["include"]["file"] = "missing.launch.yaml"
     return Case(fmt, f"launch:{kind}", invalid, {**seed.files, seed.main: _dump(doc)}, seed.main)
@@ -371,8 +389,8 @@ def _xml_value(fmt: str, seed: Seed, rng: np.random.Generator) -> Case:
     old = float(tokens[t]) if re.fullmatch(rb"[-+]?[0-9.]+(e[-+]?[0-9]+)?", tokens[t], re.I) else 1.0
     new = {"nan": b"nan", "inf": b"inf", "negative": repr(-abs(old) - 1.0).encode(), "zero": b"0",
            "word": b"abc", "huge": b"1e308"}[kind]
-    invalid = kind in ("nan", "inf", "word") or (kind == "negative" and rule in (POS, NONNEG)) or (
-        kind == "zero" and rule == POS)
+    invalid = key in READ_XML[fmt] and (kind in ("nan", "inf", "word") or (
+        kind == "negative" and rule in (POS, NONNEG)) or (kind == "zero" and rule == POS))
     tokens[t] = new
     body = data[:start] + b" ".join(tokens) + data[end:]
     return Case(fmt, f"xml:{kind}@{key}", invalid, {**seed.files, name: body}, seed.main)

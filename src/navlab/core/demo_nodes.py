@@ -18,7 +18,7 @@ class Talker(Node):
     ) -> None:
         super().__init__(executor, name=name, parameters=parameters, namespace=namespace)
         rate = self.declare_parameter("rate", 1.0)
-        if not 0 < rate < float("inf"):
+        if not isinstance(rate, int | float) or not 0 < rate < float("inf"):
             raise ParameterError(f"node {self.fully_qualified_name}: parameter 'rate': expected Hz > 0, got {rate!r}")
         self.count = 0
         self.pub = self.create_publisher(String, "chatter", 10)

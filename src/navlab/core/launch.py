@@ -83,6 +83,7 @@ class Session:
     nodes: dict[str, Node] = field(default_factory=dict)
     args: dict[str, str] = field(default_factory=dict)
     overrides: dict[str, dict[str, Any]] = field(default_factory=dict)
+    origins: dict[str, str] = field(default_factory=dict)  # node name -> "launch file: entry (parameter files)"
 
     def run(self, duration: float) -> None:
         """Advance simulated time by ``duration`` seconds."""
@@ -281,13 +282,15 @@ def _run_entries(ctx: _Context, session: Session, depth: int) -> None:
                 kwargs["name"] = node_name
             if spec.get("namespace"):
                 kwargs["namespace"] = _text(ctx, spec, "namespace", where)
+            source = f" (parameters from {', '.join(files)})" if files else ""
+            origin = f"{ctx.file}: {where} {node_name!r}{source}"
             try:
                 with session.executor.node_context(remappings=remaps):
                     node = cls(session.executor, **kwargs)
             except NavlabError as exc:  # name the launch file and the parameter files, as the user wrote them
-                source = f" (parameters from {', '.join(files)})" if files else ""
-                raise _prefixed(exc, f"{ctx.file}: {where} {node_name!r}{source}") from None
+                raise _prefixed(exc, origin) from None
             session.nodes[node.fully_qualified_name] = node
+            session.origins[node.fully_qualified_name] = origin
         else:
             raise LaunchError(f"{ctx.file}: {where}: unknown entry {kind!r} (expected arg, let, include or node)")
 
@@ -343,6 +346,11 @@ def start(
                       overrides={k.lstrip("/"): dict(v) for k, v in (overrides or {}).items()})
     ctx = _Context(file, session.args)
     _run_entries(ctx, session, 0)
+    for name, node in session.nodes.items():  # unknown parameters, named with the file that set them
+        try:
+            node.check_parameters()
+        except NavlabError as exc:
+            raise _prefixed(exc, session.origins.get(name, str(file))) from None
     session.args = ctx.vars
     started = {name.rsplit("/", 1)[-1] for name in session.nodes}
     unknown = sorted(set(session.overrides) - started)

@@ -106,8 +106,10 @@ def dataclass_parameters(cls: type, *, prefix: str = "") -> dict[str, Any]:
 
 def _coerce(name: str, value: Any, default: Any) -> Any:
     """Check ``value`` against the type of ``default`` (ints are accepted for floats)."""
-    if default is None or value is None:
+    if default is None:
         return value
+    if value is None:
+        raise ParameterError(f"parameter {name!r}: expected {type(default).__name__}, got null")
     kind = type(default)
     if isinstance(value, float) and value != value:  # NaN: never a usable parameter value
         raise ParameterError(f"parameter {name!r}: expected a number, got nan")

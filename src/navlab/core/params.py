@@ -166,7 +166,9 @@ def dataclass_from_dict(cls: type[T], values: dict[str, Any] | None, *, what: st
             raise error(f"unknown {what} parameter '{key}'{hint}")
         kind = type(getattr(out, key))
         try:
-            if val is None or (isinstance(val, bool) and kind is not bool) or isinstance(val, dict | list):
+            scalar = kind in (int, float, str, bool)
+            if val is None or (isinstance(val, bool) and kind is not bool) or (
+                    scalar and isinstance(val, dict | list)):
                 raise TypeError
             cast = kind(val)
         except (TypeError, ValueError):

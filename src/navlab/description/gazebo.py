@@ -141,6 +141,8 @@ def parse_diff_drive(plugin: ET.Element, where: str, warnings: list[str]) -> Dif
             v = floats(raw, 1, where, f"{key} value")[0]
             if key in ("wheel_separation", "wheel_diameter") and v <= 0:
                 raise DescriptionError(f"{w}: must be positive, got {v}")
+            if key in ("max_torque", "max_accel") and v < 0:
+                raise DescriptionError(f"{w}: must be >= 0, got {v}")
             setattr(cfg, key, _rate(v) if key == "update_rate" else v)
         elif key in BOOL_FIELDS:
             setattr(cfg, key, _bool(raw, where + f" ({key})"))
@@ -304,7 +306,10 @@ def read_gazebo_tags(root: ET.Element, links: dict[str, Link], joint_names: set[
             if not isinstance(child.tag, str):
                 continue
             if ref is not None and child.tag in ("mu1", "mu2"):
-                setattr(links[ref], child.tag, _num(child, f"{where}/<{child.tag}>", 0.0))
+                mu = _num(child, f"{where}/<{child.tag}>", 0.0)
+                if mu < 0:
+                    raise DescriptionError(f"{where}/<{child.tag}>: friction {mu}: expected >= 0")
+                setattr(links[ref], child.tag, mu)
             elif ref is not None and child.tag == "material":
                 _apply_material(links[ref], child, f"{where}/<material>", out.warnings)
             elif ref is not None and child.tag == "sensor":

@@ -123,6 +123,9 @@ def parse_inertial(el: ET.Element, where: str) -> Inertial:
     vals = {k: 0.0 for k in keys}
     if inertia is not None:
         vals = {k: _attr_float(inertia, k, where + "/<inertia>", 0.0) for k in keys}
+        for k in ("ixx", "iyy", "izz"):
+            if vals[k] < 0:
+                raise DescriptionError(f"{where}/<inertia>: {k} must be >= 0 kg m^2, got {vals[k]}")
     return Inertial(mass=mass, origin=parse_origin(el.find("origin"), where), **vals)
 
 
@@ -189,6 +192,9 @@ def parse_joint(el: ET.Element, where: str) -> Joint:
         upper = _attr_float(limit, "upper", w, 0.0)
         effort = _attr_float(limit, "effort", w, 0.0) if limit.get("effort") is not None else None
         velocity = _attr_float(limit, "velocity", w, 0.0) if limit.get("velocity") is not None else None
+        for name, value in (("effort", effort), ("velocity", velocity)):
+            if value is not None and value < 0:
+                raise DescriptionError(f"{w}: {name} must be >= 0, got {value}")
         if jtype == "continuous":
             lower = upper = None
     elif jtype in ("revolute", "prismatic"):

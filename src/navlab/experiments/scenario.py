@@ -73,6 +73,8 @@ class Scenario:
 
 def _pose(value: Any, where: str) -> tuple[float, float, float]:
     try:
+        if isinstance(value, str | bytes) or any(isinstance(v, bool | str) for v in value):
+            raise TypeError
         x, y, yaw = (float(v) for v in value)
     except (TypeError, ValueError):
         raise ExperimentError(f"{where}: expected [x, y, yaw] numbers, got {value!r}") from None
@@ -118,7 +120,8 @@ def scenario_from_dict(data: Any, *, where: str = "scenario", path: Path | None 
         if not isinstance(ob, dict) or set(ob) != {"t", "spec"} or not isinstance(ob["spec"], str):
             raise ExperimentError(f"{where}: obstacles[{k}]: expected {{t: seconds, spec: 'cylinder:x=..,y=..'}}, "
                                   f"got {ob!r}")  # fmt: skip
-        if not (isinstance(ob["t"], int | float) and math.isfinite(ob["t"]) and ob["t"] >= 0):
+        t = ob["t"]
+        if isinstance(t, bool) or not (isinstance(t, int | float) and math.isfinite(t) and t >= 0):
             raise ExperimentError(f"{where}: obstacles[{k}].t: expected a time >= 0 s, got {ob['t']!r}")
         sc.obstacles.append(dict(ob))
     for key, low in (("trials", 1), ("seed", 0)):

@@ -85,8 +85,19 @@ class AmclParams:
             raise LocalizationError(f"amcl parameter resample_interval: expected >= 1, got {self.resample_interval}")
         if self.laser_max_beams < 1:
             raise LocalizationError(f"amcl parameter laser_max_beams: expected >= 1, got {self.laser_max_beams}")
-        if self.laser_sigma_hit <= 0:
-            raise LocalizationError(f"amcl parameter laser_sigma_hit: expected > 0, got {self.laser_sigma_hit}")
+        for name in ("laser_sigma_hit", "laser_lambda_short", "laser_likelihood_max_dist"):
+            if getattr(self, name) <= 0:
+                raise LocalizationError(f"amcl parameter {name}: expected > 0, got {getattr(self, name)}")
+        if not 0 < self.kld_z < 1:
+            raise LocalizationError(f"amcl parameter kld_z: expected 0 < kld_z < 1, got {self.kld_z}")
+        for name in ("update_min_d", "update_min_a", "laser_z_hit", "laser_z_short", "laser_z_max", "laser_z_rand",
+                     "odom_alpha1", "odom_alpha2", "odom_alpha3", "odom_alpha4", "initial_cov_xx", "initial_cov_yy",
+                     "initial_cov_aa"):
+            if getattr(self, name) < 0:
+                raise LocalizationError(f"amcl parameter {name}: expected >= 0, got {getattr(self, name)}")
+        if 0 < self.laser_max_range <= self.laser_min_range:
+            raise LocalizationError(f"amcl parameters laser_min_range={self.laser_min_range}, laser_max_range="
+                                    f"{self.laser_max_range}: expected laser_min_range < laser_max_range")
         self.motion_model()
         self.laser_model()
         for name in ("recovery_alpha_slow", "recovery_alpha_fast"):

@@ -52,6 +52,10 @@ class Amcl(Node):
         self.params.validate()
         self.odom_alpha5 = self.declare_parameter("odom_alpha5", 0.2, aliases=("alpha5",))  # omni model only
         self.transform_tolerance = self.declare_parameter("transform_tolerance", 0.1)
+        for pname, value in (("odom_alpha5", self.odom_alpha5), ("transform_tolerance", self.transform_tolerance)):
+            if not 0 <= value < float("inf"):
+                raise LocalizationError(f"node {self.fully_qualified_name}: parameter {pname}: expected a finite "
+                                        f"number >= 0, got {value!r}")
         self.initial_pose = (
             self.declare_parameter("initial_pose_x", 0.0),
             self.declare_parameter("initial_pose_y", 0.0),
@@ -64,8 +68,10 @@ class Amcl(Node):
         self.first_map_only = self.declare_parameter("first_map_only", False)
         # navlab always reads the latched map topic (what map_server's static_map service would return).
         self.declare_parameter("use_map_topic", False)
-        self.declare_parameter("gui_publish_rate", -1.0)
-        self.declare_parameter("save_pose_rate", 0.5)
+        for pname, default in (("gui_publish_rate", -1.0), ("save_pose_rate", 0.5)):  # read, not used
+            if not abs(self.declare_parameter(pname, default)) < float("inf"):
+                raise LocalizationError(f"node {self.fully_qualified_name}: parameter {pname}: expected a finite "
+                                        "number (<= 0: off)")
         self.check_parameters()
 
         self.filter: pf.Amcl | None = None

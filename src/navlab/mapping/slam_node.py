@@ -22,6 +22,28 @@ from navlab.grid import GridMap
 from navlab.mapping.errors import MappingError
 from navlab.plugins import PluginError, SlamBackend, load_plugin
 
+# slam_gmapping parameters that must be > 0 or >= 0, and (min, max) pairs (issue 14: refused, not run with)
+_POSITIVE = ("map_update_interval", "transform_publish_period", "throttle_scans", "maxUrange", "sigma", "lstep",
+             "astep", "lsigma", "ogain", "particles", "delta", "llsamplerange", "llsamplestep", "lasamplerange",
+             "lasamplestep", "occ_thresh", "resampleThreshold")
+_NON_NEGATIVE = ("maxRange", "kernelSize", "iterations", "lskip", "minimumScore", "srr", "srt", "str", "stt",
+                 "linearUpdate", "angularUpdate")
+
+
+def _check_values(node: str, values: dict[str, Any]) -> None:
+    """Refuse non-finite numbers, non-positive sizes and rates, negative gates and xmin >= xmax / ymin >= ymax."""
+    for key, v in values.items():
+        if isinstance(v, float) and not np.isfinite(v):
+            raise MappingError(f"node {node}: parameter {key!r}: expected a finite number, got {v!r}")
+        if isinstance(v, int | float) and not isinstance(v, bool):
+            if key in _POSITIVE and v <= 0:
+                raise MappingError(f"node {node}: parameter {key!r}: expected > 0, got {v!r}")
+            if key in _NON_NEGATIVE and v < 0:
+                raise MappingError(f"node {node}: parameter {key!r}: expected >= 0, got {v!r}")
+    for lo, hi in (("xmin", "xmax"), ("ymin", "ymax")):
+        if lo in values and hi in values and not values[lo] < values[hi]:
+            raise MappingError(f"node {node}: parameters {lo}={values[lo]}, {hi}={values[hi]}: expected {lo} < {hi}")
+
 
 class SlamGMapping(Node):
     """slam_gmapping: the ``mode``'s SLAM backend (a ``SlamBackend`` plugin) driven by scans and tf odometry."""
@@ -44,6 +66,9 @@ class SlamGMapping(Node):
         except PluginError as exc:
             raise MappingError(f"node {self.fully_qualified_name}: {exc}") from None
         values = self.declare_parameters(backend.parameters())
+        _check_values(self.fully_qualified_name, {"map_update_interval": self.map_update_interval,
+                                                  "transform_publish_period": self.transform_publish_period,
+                                                  "throttle_scans": self.throttle_scans, **values})
         self.slam: SlamBackend = backend(values, rng=self.rng)
         self.params = self.slam.params
         self.check_parameters()

@@ -122,16 +122,26 @@ def load_route(path: str | Path) -> tuple[list[tuple[float, float, float]], np.n
     if not isinstance(data, dict) or not ({"segments", "waypoints"} & set(data)):
         raise MappingError(f"{path}: a route file needs 'segments' and/or 'waypoints'")
     segments = []
-    for k, seg in enumerate(data.get("segments") or []):
+    raw_segments = data.get("segments") or []
+    if not isinstance(raw_segments, list):
+        raise MappingError(f"{path}: segments: expected a list of {{linear, angular, duration}}, got {raw_segments!r}")
+    for k, seg in enumerate(raw_segments):
         try:
-            segments.append((float(seg.get("linear", 0.0)), float(seg.get("angular", 0.0)), float(seg["duration"])))
+            values = [seg.get("linear", 0.0), seg.get("angular", 0.0), seg["duration"]]
+            if any(isinstance(v, bool) or not isinstance(v, int | float) for v in values):
+                raise TypeError
+            lin, ang, dur = (float(v) for v in values)
         except (KeyError, TypeError, ValueError, AttributeError):
             raise MappingError(f"{path}: segments[{k}]: expected {{linear, angular, duration}} numbers") from None
-    try:
-        waypoints = np.array(data.get("waypoints") or [], dtype=float).reshape(-1, 2)
-    except ValueError:
-        raise MappingError(f"{path}: waypoints: expected a list of [x, y] pairs") from None
-    return segments, waypoints
+        if not (math.isfinite(lin) and math.isfinite(ang) and math.isfinite(dur) and dur > 0):
+            raise MappingError(f"{path}: segments[{k}]: expected finite speeds and a duration > 0 s, got {seg!r}")
+        segments.append((lin, ang, dur))
+    raw = data.get("waypoints") or []
+    if not isinstance(raw, list) or not all(
+            isinstance(w, list) and len(w) == 2 and all(isinstance(v, int | float) and not isinstance(v, bool)
+                                                       and math.isfinite(v) for v in w) for w in raw):
+        raise MappingError(f"{path}: waypoints: expected a list of [x, y] pairs of finite numbers, got {raw!r}")
+    return segments, np.array(raw, dtype=float).reshape(-1, 2)
 
 
 class RouteFollower(Node):

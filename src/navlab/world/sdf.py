@@ -36,8 +36,8 @@ def _floats(text: str | None, n: int, where: str) -> tuple[float, ...]:
         vals = tuple(float(p) for p in parts)
     except ValueError:
         raise WorldError(f"{where}: expected {n} numbers, got {text!r}") from None
-    if len(vals) != n or not all(math.isfinite(v) for v in vals):
-        raise WorldError(f"{where}: expected {n} finite numbers, got {text!r}")
+    if len(vals) != n or not all(math.isfinite(v) and abs(v) < 1e9 for v in vals):
+        raise WorldError(f"{where}: expected {n} finite numbers (|v| < 1e9), got {text!r}")
     return vals
 
 

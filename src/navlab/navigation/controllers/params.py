@@ -96,8 +96,8 @@ class TrajectoryPlannerParams(_Periodic):
         """Raise ``NavigationError`` naming the first bad parameter."""
         check_finite(TP, self)
         _positive(TP, self, "acc_lim_x", "acc_lim_theta", "sim_time", "sim_granularity", "controller_frequency",
-                  "max_vel_x")
-        _at_least(TP, self, 0.0, "min_in_place_vel_theta", "pdist_scale", "gdist_scale", "occdist_scale",
+                  "max_vel_x", "max_vel_theta")
+        _at_least(TP, self, 0.0, "acc_lim_y", "min_in_place_vel_theta", "pdist_scale", "gdist_scale", "occdist_scale",
                   "heading_lookahead", "oscillation_reset_dist", "xy_goal_tolerance", "yaw_goal_tolerance",
                   "escape_reset_dist", "escape_reset_theta", "min_vel_x")
         _at_least(TP, self, 1, "vx_samples", "vtheta_samples")
