@@ -101,3 +101,10 @@ def test_navlab_view_bag_serves_the_replay(bag: Path, capsys: pytest.CaptureFixt
     assert "viewer: http://127.0.0.1:" in capsys.readouterr().err
     assert main(["view", "--bag", str(bag.parent / "nothing"), "--port", "0", "--no-browser"]) == 2
     assert "not a rosbag2 recording" in capsys.readouterr().err
+
+
+def test_recording_is_mcap_with_ros2_schemas_as_foxglove_opens_it(bag: Path) -> None:
+    (mcap,) = bag.glob("*.mcap")
+    data = mcap.read_bytes()
+    assert data.startswith(b"\x89MCAP0\r\n") and data.endswith(b"\x89MCAP0\r\n")
+    assert b"ros2msg" in data and b"cdr" in data and b"sensor_msgs/msg/LaserScan" in data
