@@ -56,13 +56,14 @@ RULES: dict[str, dict[str, str]] = {
                          "stt", "linearUpdate", "angularUpdate"), NONNEG),
     },
     "move_base": {
-        **dict.fromkeys(("max_vel_x", "max_vel_theta", "acc_lim_x", "acc_lim_theta", "acc_lim_y", "robot_radius",
-                         "obstacle_range", "raytrace_range", "width", "height", "resolution",
+        **dict.fromkeys(("max_vel_x", "max_vel_theta", "acc_lim_x", "acc_lim_theta", "robot_radius",
+                         "width", "height", "resolution",
                          "controller_frequency", "vx_max", "wz_max", "vx_std", "prune_distance"), POS),
         **dict.fromkeys(("xy_goal_tolerance", "yaw_goal_tolerance", "inflation_radius", "cost_scaling_factor",
                          "update_frequency", "publish_frequency", "transform_tolerance", "planner_frequency",
                          "planner_patience", "controller_patience", "oscillation_timeout", "oscillation_distance",
-                         "conservative_reset_dist", "occdist_scale", "min_in_place_vel_theta"), NONNEG),
+                         "conservative_reset_dist", "occdist_scale", "min_in_place_vel_theta",
+                         "obstacle_range", "raytrace_range", "acc_lim_y"), NONNEG),  # ROS: 0 range = mark nothing
     },
     "map": {"resolution": POS},
     "route": {"duration": POS},
