@@ -247,6 +247,19 @@ def _cmd_graph(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_bag(args: argparse.Namespace) -> int:
+    from navlab.io.rosbag import reindex_bag
+
+    res = reindex_bag(args.dir)
+    if args.json:
+        print(json.dumps(res))
+    else:
+        print(f"reindexed {res['path']}: {res['messages']} messages on {len(res['topics'])} topics")
+        for name, count in sorted(res["topics"].items()):
+            print(f"  {name}: {count}")
+    return 0
+
+
 def _shipped_launches() -> list[str]:
     from navlab.core.launch import resources_dir
 
@@ -278,6 +291,18 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("-s", "--show-args", action="store_true",
                    help="list the launch's arguments (name, description, default) and exit")
     p.set_defaults(func=_cmd_launch)
+
+    p = sub.add_parser(
+        "bag",
+        help="recordings: reindex a recording that was killed (ros2 bag reindex)",
+        description="`navlab bag reindex DIR` rebuilds a rosbag2 (MCAP) recording whose process was killed before "
+        "it closed the bag (no metadata.yaml; navlab leaves it in .DIR.partial/DIR): every message written before "
+        "the kill is kept and the bag is moved to DIR with its metadata.",
+    )
+    p.add_argument("action", choices=["reindex"], help="what to do")
+    p.add_argument("dir", metavar="DIR", help="the recording's directory (or the name it was recorded under)")
+    p.add_argument("--json", action="store_true", help="print the result as JSON")
+    p.set_defaults(func=_cmd_bag)
 
     p = sub.add_parser(
         "topic",

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import json
 import shutil
+import struct
 from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import Any
@@ -21,7 +22,7 @@ from rosbags.rosbag2.errors import ReaderError, WriterError
 from navlab.io.errors import BagError
 from navlab.msgs import TYPESTORE, type_name
 
-__all__ = ["GRAPH_KEY", "BagError", "BagWriter", "bag_graph", "bag_topics", "read_bag"]
+__all__ = ["GRAPH_KEY", "BagError", "BagWriter", "bag_graph", "bag_topics", "read_bag", "reindex_bag"]
 
 GRAPH_KEY = "navlab.graph"  # custom-data key of the node/topic graph a navlab recording stores
 
@@ -110,3 +111,113 @@ def bag_graph(path: str | Path) -> dict[str, Any] | None:
         raise BagError(f"{meta}: cannot read bag metadata ({exc})") from None
     raw = (info.get("custom_data") or {}).get(GRAPH_KEY)
     return json.loads(raw) if raw else None
+
+
+# --- recovering a recording that was killed (ros2 bag reindex) -------------------------------------------
+
+_MCAP_MAGIC = b"\x89MCAP0\r\n"
+
+
+def _records(buf: bytes | memoryview, pos: int = 0) -> Iterator[tuple[int, memoryview]]:
+    """MCAP records ``(opcode, content)`` from ``pos`` until the data ends or a record is cut off."""
+    view = memoryview(buf)
+    while pos + 9 <= len(view):
+        op = view[pos]
+        (length,) = struct.unpack_from("<Q", view, pos + 1)
+        if op in (0x02, 0x0F) or pos + 9 + length > len(view):  # footer / data end, or truncated by the kill
+            return
+        yield op, view[pos + 9 : pos + 9 + length]
+        pos += 9 + length
+
+
+def _string(rec: memoryview, pos: int) -> tuple[str, int]:
+    (n,) = struct.unpack_from("<I", rec, pos)
+    return bytes(rec[pos + 4 : pos + 4 + n]).decode(), pos + 4 + n
+
+
+def _scan_mcap(path: Path) -> tuple[dict[int, tuple[str, str]], list[tuple[int, int, bytes]]]:
+    """Channels ``{id: (topic, schema name)}`` and messages ``(channel, log_time ns, cdr)`` of a possibly
+    truncated MCAP file (no summary needed): every complete record up to where the file was cut."""
+    from rosbags.rosbag2.storage_mcap import DECOMPRESSORS
+
+    buf = path.read_bytes()
+    if not buf.startswith(_MCAP_MAGIC):
+        raise BagError(f"{path}: not an MCAP file")
+    schemas: dict[int, str] = {}
+    channels: dict[int, tuple[str, str]] = {}
+    messages: list[tuple[int, int, bytes]] = []
+
+    def take(records: Iterator[tuple[int, memoryview]]) -> None:
+        for op, rec in records:
+            if op == 0x03:  # schema: id, name, encoding, data
+                (sid,) = struct.unpack_from("<H", rec, 0)
+                schemas[sid] = _string(rec, 2)[0]
+            elif op == 0x04:  # channel: id, schema id, topic, encoding, metadata
+                cid, sid = struct.unpack_from("<HH", rec, 0)
+                channels[cid] = (_string(rec, 4)[0], schemas.get(sid, ""))
+            elif op == 0x05:  # message: channel, sequence, log time, publish time, data
+                cid, _seq, log_time, _pub = struct.unpack_from("<HIQQ", rec, 0)
+                messages.append((cid, log_time, bytes(rec[22:])))
+            elif op == 0x06:  # chunk: start, end, uncompressed size, crc, compression, records
+                size = struct.unpack_from("<Q", rec, 16)[0]
+                compression, pos = _string(rec, 28)
+                (n,) = struct.unpack_from("<Q", rec, pos)
+                data = bytes(rec[pos + 8 : pos + 8 + n])
+                try:
+                    raw = DECOMPRESSORS[compression](data, size) if compression else data
+                except Exception as exc:  # a corrupt chunk: keep what came before it
+                    raise BagError(f"{path}: chunk cannot be decompressed ({exc})") from None
+                take(_records(raw))
+
+    take(_records(buf, len(_MCAP_MAGIC)))
+    return channels, messages
+
+
+def reindex_bag(path: str | Path) -> dict[str, Any]:
+    """Rebuild a rosbag2 (MCAP) recording that was killed before it was closed, as ``ros2 bag reindex`` does.
+
+    ``path`` is the recording's directory, or the name it would have had: a killed ``BagWriter`` leaves
+    its files in ``.<name>.partial/<name>`` beside it. Every complete message written before the kill is
+    kept (the last, unwritten chunk is lost); the bag is rewritten with its metadata and moved to its
+    name. Returns ``{"path", "topics", "messages"}``.
+    """
+    target = Path(path)
+    source = target
+    if not any(target.glob("*.mcap")):
+        source = target.parent / f".{target.name}.partial" / target.name
+        if not any(source.glob("*.mcap")):
+            raise BagError(f"{target}: no MCAP file here nor in {source} (nothing to reindex)")
+    channels: dict[int, tuple[str, str]] = {}
+    messages: list[tuple[int, int, bytes]] = []
+    for mcap in sorted(source.glob("*.mcap")):
+        ch, msgs = _scan_mcap(mcap)
+        channels.update(ch)
+        messages += msgs
+    unknown = sorted({t for t in channels.values() if t[1] not in TYPESTORE.types})
+    if unknown:
+        raise BagError(f"{source}: message types navlab does not know: {', '.join(f'{a} [{b}]' for a, b in unknown)}")
+    rebuilt = target.parent / f".{target.name}.reindex"
+    shutil.rmtree(rebuilt, ignore_errors=True)
+    rebuilt.mkdir(parents=True)
+    try:
+        writer = Writer(rebuilt / target.name, version=8, storage_plugin=StoragePlugin.MCAP)
+        writer.open()
+        conns = {cid: writer.add_connection(topic, msgtype, typestore=TYPESTORE)
+                 for cid, (topic, msgtype) in sorted(channels.items())}
+        for cid, t_ns, data in sorted(messages, key=lambda m: m[1]):
+            if cid in conns:
+                writer.write(conns[cid], t_ns, data)
+        writer.close()
+    except (OSError, WriterError) as exc:
+        shutil.rmtree(rebuilt, ignore_errors=True)
+        raise BagError(f"{target}: cannot rewrite the recording ({exc})") from None
+    if target.exists():
+        shutil.rmtree(target)
+    (rebuilt / target.name).rename(target)
+    rebuilt.rmdir()
+    if source != target:
+        shutil.rmtree(source.parent, ignore_errors=True)
+    counts: dict[str, int] = {}
+    for cid, _t, _d in messages:
+        counts[channels[cid][0]] = counts.get(channels[cid][0], 0) + 1
+    return {"path": str(target), "topics": counts, "messages": len(messages)}
