@@ -131,8 +131,8 @@ def _cmd_experiment(args: argparse.Namespace) -> int:
     if args.action == "sweep":
         from navlab.experiments.sweep import parse_params, run_sweep
 
-        rows = run_sweep(sc, parse_params(args.param), out, trials=args.trials, workers=args.workers,
-                         progress=not args.quiet and sys.stderr.isatty())  # fmt: skip
+        rows = run_sweep(sc, parse_params(args.param), out, trials=args.trials, seed=args.seed, workers=args.workers,
+                         backend=args.backend, progress=not args.quiet and sys.stderr.isatty())  # fmt: skip
         if not args.json:
             print(f"{len(rows)} combinations of {sc.name}: {out}/sweep.md (+ sweep.csv, a PNG per parameter)")
             print((Path(out) / "sweep.md").read_text())
@@ -141,7 +141,7 @@ def _cmd_experiment(args: argparse.Namespace) -> int:
         return 0
     if args.param:
         raise ExperimentError("--param is for `navlab experiment sweep`")
-    summary = run_experiment(sc, out, trials=args.trials, seed=args.seed, workers=args.workers,
+    summary = run_experiment(sc, out, trials=args.trials, seed=args.seed, workers=args.workers, backend=args.backend,
                              progress=not args.quiet and sys.stderr.isatty())  # fmt: skip
     if not args.json:
         print(f"{summary['trials']} trials of {sc.name}: results in {out}/results.jsonl, summary in {out}/summary.json")
@@ -302,7 +302,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         "Prints (and writes DIR/summary.json) the success rate with a 95 % Wilson interval, collisions, failures "
         "by kind, time quartiles, SPL, clearance, localization error and command jerk. navlab experiment sweep FILE "
         "--param name=v1,v2 [--param ...]: the same for every combination, with DIR/sweep.md, sweep.csv and a plot "
-        "per parameter.",
+        "per parameter. --backend ray runs the trials as Ray tasks (a cluster at $RAY_ADDRESS or a local instance).",
     )
     p.add_argument("action", choices=["run", "sweep"],
                    help="run: the scenario's trials; sweep: the trials for every combination of --param values")
@@ -310,7 +310,11 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--trials", type=int, default=None, help="how many trials (default: the scenario's)")
     p.add_argument("--seed", type=int, default=None,
                    help="seed of trial 0; trial k uses seed + k (default: the scenario's)")
-    p.add_argument("--workers", type=int, default=1, help="parallel processes (default 1)")
+    p.add_argument("--workers", type=int, default=None,
+                   help="parallel processes (local: default 1), or the CPUs of a local Ray instance (default all)")
+    p.add_argument("--backend", choices=["local", "ray"], default="local",
+                   help="local: worker processes on this machine (default); ray: Ray tasks on the cluster at "
+                   "$RAY_ADDRESS, or on a local Ray instance when it is not set (same results for the same seeds)")
     p.add_argument("--param", action="append", default=[], metavar="NAME=V1,V2,...",
                    help="sweep: a move_base parameter (or controller) and its values, e.g. "
                    "local_costmap.update_frequency=0.5,1,2,5 (repeatable: the grid of all combinations)")

@@ -18,9 +18,9 @@ import yaml
 
 from navlab.experiments.errors import ExperimentError
 from navlab.experiments.scenario import Scenario
-from navlab.experiments.trials import run_experiment
+from navlab.experiments.trials import run_experiments
 
-COLUMNS = ("success_rate", "success_ci95", "collisions", "median_time_s", "spl_mean", "min_clearance_m")
+COLUMNS = ("success_rate", "success_ci95", "collisions", "median_time_s", "spl_mean", "min_clearance_m", "score_mean")
 
 
 def parse_params(items: list[str]) -> dict[str, list[Any]]:
@@ -43,20 +43,28 @@ def combinations(params: dict[str, list[Any]]) -> list[dict[str, Any]]:
 
 
 def run_sweep(sc: Scenario, params: dict[str, list[Any]], out: str | Path, *, trials: int | None = None,
-              workers: int = 1, progress: bool = False) -> list[dict[str, Any]]:  # fmt: skip
-    """Run the scenario for every combination; write the table and the plots; return the rows."""
+              seed: int | None = None, workers: int | None = 1, backend: str = "local",
+              progress: bool = False) -> list[dict[str, Any]]:  # fmt: skip
+    """Run the scenario for every combination (all their trials share the ``workers``, or Ray with
+    ``backend="ray"``); write the table and the plots; return the rows."""
     folder = Path(out)
-    rows = []
-    for combo in combinations(params):
+    combos = combinations(params)
+    jobs = []
+    for combo in combos:
         variant = copy.deepcopy(sc)
         for name, value in combo.items():
             if name == "controller":
                 variant.controller = str(value)
             else:
                 variant.overrides[name] = value
-        tag = ",".join(f"{k}={v}" for k, v in combo.items())
-        summary = run_experiment(variant, folder / tag, trials=trials, workers=workers, progress=progress)
-        rows.append({**combo, **{c: summary.get(c) for c in COLUMNS}})
+        if trials is not None:
+            variant.trials = trials
+        if seed is not None:
+            variant.seed = seed
+        jobs.append((variant, folder / ",".join(f"{k}={v}" for k, v in combo.items())))
+    summaries = run_experiments(jobs, workers=workers, backend=backend, progress=progress, desc=f"{sc.name} sweep")
+    columns = [c for c in COLUMNS if c != "score_mean" or any(s.get(c) is not None for s in summaries)]
+    rows = [{**combo, **{c: s.get(c) for c in columns}} for combo, s in zip(combos, summaries, strict=True)]
     write_table(rows, list(params), folder)
     plot_sweep(rows, list(params), folder)
     return rows
@@ -66,7 +74,7 @@ def write_table(rows: list[dict[str, Any]], names: list[str], folder: Path) -> N
     """``sweep.csv`` and ``sweep.md``: one row per combination."""
     from navlab.io.files import write_text_atomic
 
-    header = [*names, *COLUMNS]
+    header = [*names, *(c for c in COLUMNS if rows and c in rows[0])]
 
     def cell(v: Any) -> str:
         return "/".join(str(x) for x in v) if isinstance(v, list) else str(v)

@@ -150,6 +150,7 @@ def summarize_trials(results: list[dict[str, Any]]) -> dict[str, Any]:
         "cmd_jerk_mean": _mean(results, "cmd_jerk_mean"),
         "tracking_error_mean_m": _mean(results, "tracking_error_m"),
         "final_error_mean_m": _mean(results, "final_error_m"),
+        **({"score_mean": _mean(results, "score")} if any("score" in r for r in results) else {}),  # BARN
     })  # fmt: skip
 
 
@@ -168,43 +169,57 @@ def _trial_in_worker(args: tuple[Scenario, int]) -> dict[str, Any]:
 
 
 def run_experiment(sc: Scenario, out: str | Path, *, trials: int | None = None, seed: int | None = None,
-                   workers: int = 1, progress: bool = False) -> dict[str, Any]:  # fmt: skip
-    """Run the scenario's trials not yet in ``out``/results.jsonl (in ``workers`` processes), append each as it
-    finishes, and return (and write ``summary.json``) the summary over all of them."""
-    from tqdm import tqdm
-
-    from navlab.io.files import write_text_atomic
-
+                   workers: int | None = 1, backend: str = "local",
+                   progress: bool = False) -> dict[str, Any]:  # fmt: skip
+    """Run the scenario's trials not yet in ``out``/results.jsonl (in ``workers`` processes, or on Ray with
+    ``backend="ray"``), append each as it finishes, and return (and write ``summary.json``) the summary over
+    all of them."""
     if trials is not None:
         sc.trials = trials
     if seed is not None:
         sc.seed = seed
-    if sc.trials < 1 or workers < 1:
-        raise ExperimentError(f"trials and workers must be >= 1, got {sc.trials} and {workers}")
-    folder = Path(out)
-    folder.mkdir(parents=True, exist_ok=True)
-    results_path = folder / "results.jsonl"
-    done = {int(r["trial"]): r for r in read_results(results_path) if r.get("seed") == sc.seed + int(r["trial"])}
-    todo = [k for k in range(sc.trials) if k not in done]
-    bar = tqdm(total=sc.trials, initial=sc.trials - len(todo), desc=sc.name, unit="trial", file=sys.stderr,
+    return run_experiments([(sc, Path(out))], workers=workers, backend=backend, progress=progress, desc=sc.name)[0]
+
+
+def run_experiments(jobs: list[tuple[Scenario, Path]], *, workers: int | None = 1, backend: str = "local",
+                    progress: bool = False, desc: str = "trials") -> list[dict[str, Any]]:  # fmt: skip
+    """Several experiments (scenario, results folder) at once: every unfinished trial of every one goes to the
+    same workers (see ``backends.run_tasks``); the driver appends each trial's line to its folder's
+    results.jsonl as it finishes, then writes each ``summary.json``. Returns the summaries in order."""
+    from tqdm import tqdm
+
+    from navlab.experiments.backends import run_tasks
+    from navlab.io.files import write_text_atomic
+
+    done: list[dict[int, dict[str, Any]]] = []
+    tasks: list[tuple[Scenario, int]] = []
+    owner: list[int] = []
+    for j, (sc, folder) in enumerate(jobs):
+        if sc.trials < 1:
+            raise ExperimentError(f"trials: expected an integer >= 1, got {sc.trials}")
+        folder.mkdir(parents=True, exist_ok=True)
+        finished = {int(r["trial"]): r for r in read_results(folder / "results.jsonl")
+                    if r.get("seed") == sc.seed + int(r["trial"])}  # fmt: skip
+        done.append(finished)
+        for k in range(sc.trials):
+            if k not in finished:
+                tasks.append((sc, k))
+                owner.append(j)
+    total = sum(sc.trials for sc, _ in jobs)
+    bar = tqdm(total=total, initial=total - len(tasks), desc=desc, unit="trial", file=sys.stderr,
                disable=not progress)  # fmt: skip
     try:
-        if workers == 1 or len(todo) <= 1:
-            for k in todo:
-                done[k] = run_trial(sc, k)
-                _append_line(results_path, done[k])
-                bar.update(1)
-        else:
-            import multiprocessing
-
-            with multiprocessing.get_context("spawn").Pool(min(workers, len(todo))) as pool:
-                for rec in pool.imap_unordered(_trial_in_worker, [(sc, k) for k in todo]):
-                    done[int(rec["trial"])] = rec
-                    _append_line(results_path, rec)
-                    bar.update(1)
+        for i, rec in run_tasks(_trial_in_worker, tasks, backend=backend, workers=workers):
+            j = owner[i]
+            done[j][int(rec["trial"])] = rec
+            _append_line(jobs[j][1] / "results.jsonl", rec)
+            bar.update(1)
     finally:
         bar.close()
-    results = [done[k] for k in sorted(done) if k < sc.trials]
-    summary = {"scenario": sc.name, **summarize_trials(results)}
-    write_text_atomic(folder / "summary.json", json.dumps(summary, indent=1) + "\n")
-    return summary
+    summaries = []
+    for (sc, folder), finished in zip(jobs, done, strict=True):
+        results = [finished[k] for k in sorted(finished) if k < sc.trials]
+        summary = {"scenario": sc.name, **summarize_trials(results)}
+        write_text_atomic(folder / "summary.json", json.dumps(summary, indent=1) + "\n")
+        summaries.append(summary)
+    return summaries

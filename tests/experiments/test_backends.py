@@ -1,0 +1,52 @@
+"""Sweep backends: local worker processes and Ray give the same trials for the same seeds."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from navlab.experiments.backends import run_tasks
+from navlab.experiments.errors import ExperimentError
+from navlab.experiments.scenario import scenario_from_dict
+from navlab.experiments.sweep import run_sweep
+
+TINY = {"name": "tiny", "world": "room", "goals": [[1.2, 0.3, 0.0]], "trials": 1, "seed": 3, "time_limit": 30}
+
+
+def _trials(folder: Path) -> dict[str, list[dict[str, object]]]:
+    out = {}
+    for f in sorted(folder.glob("*/results.jsonl")):
+        rows = [json.loads(line) for line in f.read_text().splitlines()]
+        for r in rows:
+            r.pop("wall_s")  # the only figure that is not simulated
+        out[f.parent.name] = rows
+    return out
+
+
+def test_ray_runs_a_sweep_with_the_same_results_as_local_workers(tmp_path: Path,
+                                                                  monkeypatch: pytest.MonkeyPatch) -> None:  # fmt: skip
+    monkeypatch.delenv("RAY_ADDRESS", raising=False)  # a local Ray instance, started and stopped here
+    params = {"local_costmap.update_frequency": [1.0, 5.0]}
+    local = run_sweep(scenario_from_dict(TINY), params, tmp_path / "local", workers=2)
+    ray = run_sweep(scenario_from_dict(TINY), params, tmp_path / "ray", workers=2, backend="ray")
+    assert ray == local and all(r["success_rate"] == 1.0 for r in ray), ray
+    a, b = _trials(tmp_path / "local"), _trials(tmp_path / "ray")
+    assert len(a) == 2 and a == b  # every metric of every trial, bit for bit
+    assert (tmp_path / "ray" / "sweep.md").read_text() == (tmp_path / "local" / "sweep.md").read_text()
+
+
+def test_an_unreachable_ray_address_is_a_clear_error(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("RAY_ADDRESS", "127.0.0.1:9")
+    with pytest.raises(ExperimentError, match=r"RAY_ADDRESS='127\.0\.0\.1:9' is unreachable"):
+        list(run_tasks(abs, [1, -2], backend="ray"))
+    monkeypatch.setenv("RAY_ADDRESS", "nonsense")
+    with pytest.raises(ExperimentError, match="expected host:port"):
+        list(run_tasks(abs, [1], backend="ray"))
+    with pytest.raises(ExperimentError, match="backend: expected one of local, ray"):
+        list(run_tasks(abs, [1], backend="dask"))
+
+
+def test_local_workers_return_every_item_once() -> None:
+    assert sorted(run_tasks(abs, [-3, 1, -2], workers=1)) == [(0, 3), (1, 1), (2, 2)]
