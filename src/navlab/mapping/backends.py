@@ -54,6 +54,8 @@ class GMappingBackend:
         self.params = GMappingParams.from_dict(params)
         self.slam = GMapping(self.params, rng=rng)
         self._points: list[ScanPoints] = []  # every scan's points, for the final refinement
+        # kept only when set (run_offline does): a live node never finishes and would only pile them up
+        self.keep_scans = False
         self.refine_edges = 0
         self.refine_rejected = 0
 
@@ -87,7 +89,8 @@ class GMappingBackend:
             if p.maxRange <= 0:
                 p.maxRange = range_max - 0.01
                 p.maxUrange = min(p.maxUrange, p.maxRange)
-        if self.params.refine:
+        self.slam.keep_scans = self.keep_scans
+        if self.params.refine and self.keep_scans:
             self._points.append(scan_points(r, angle_min, angle_increment, range_max=min(self.params.maxUrange, 30.0),
                                             voxel=0.04))  # fmt: skip
         first = not self.slam.particles

@@ -238,6 +238,7 @@ class GMapping:
         self._last_update_scan = -1
         self._odom_by_scan: dict[int, np.ndarray] = {}
         self._scan_data: dict[int, tuple[np.ndarray, np.ndarray, float]] = {}  # scans between updates (refineSkipped)
+        self.keep_scans = False  # keep scans between updates for ``finish`` (offline; a live node never finishes)
 
     # --- map bookkeeping ----------------------------------------------------------------------------
 
@@ -325,7 +326,7 @@ class GMapping:
             self._time_at_update = self._time
         else:
             self._scan_ref.append((self._last_update_scan, between2(self._odom_by_scan[self._last_update_scan], odom)))
-            if p.refineSkipped:
+            if p.refineSkipped and self.keep_scans:
                 self._scan_data[k] = (r, ang, max_urange)
         return self.best().pose.copy()
 

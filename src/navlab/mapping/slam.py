@@ -68,6 +68,8 @@ def run_offline(
 
     scans = log.scans[:max_scans] if max_scans else log.scans
     slam = make_slam(mode, params, seed=seed)
+    if hasattr(slam, "keep_scans"):  # offline, the mode may refine every scan's pose at the end
+        slam.keep_scans = True
     for s in tqdm(scans, desc=f"slam ({mode})", unit="scan", disable=not progress, file=sys.stderr):
         slam.add_scan(s.ranges, s.angle_min, s.angle_increment, s.laser_pose)
     laser = np.asarray(slam.finish(), dtype=np.float64)
