@@ -59,7 +59,7 @@ def _robot(body: str) -> str:
     (f'<link name="a">{INERTIA}</link><link name="b">{INERTIA}</link>', r"one root; roots found: \['a', 'b'\]"),
     # negative mass
     ('<link name="a"><inertial><mass value="-2"/></inertial></link>', r"<inertial>/<mass>: mass must be >= 0"),
-    # a missing collision mesh (a missing visual mesh only warns, as in Gazebo: tests/description/test_ros_robots.py)
+    # a missing collision mesh (a missing visual mesh only warns, as in Gazebo: tests/description/test_ros_files.py)
     (f'<link name="a">{INERTIA}<collision><geometry><mesh filename="meshes/gone.stl"/></geometry></collision>'
      '</link>', r'<link name="a">/<collision>\[0\]/<geometry>/<mesh>: mesh file .*gone\.stl not found'),
 ])
