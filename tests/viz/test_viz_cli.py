@@ -41,3 +41,11 @@ def test_viewing_serves_while_the_block_runs_and_warns_off_loopback(capsys: pyte
     with viewing(args, run.executor):
         pass
     assert "warning: the viewer listens on 0.0.0.0" in capsys.readouterr().err
+
+
+def test_navlab_view_starts_a_launch_with_ros_style_arguments(capsys: pytest.CaptureFixture[str]) -> None:
+    argv = ["view", "--launch", "sim", "world:=room", "x:=0.5", "--speed", "0", "--duration", "0.2", "--port", "0"]
+    assert main([*argv, "--no-browser"]) == 0
+    assert "viewer: http://127.0.0.1:" in capsys.readouterr().err
+    assert main(["view", "--launch", "sim", "wrold:=room", "--port", "0", "--no-browser"]) == 2
+    assert "did you mean 'world'" in capsys.readouterr().err

@@ -4,8 +4,9 @@ The paper's obstacle experiment (room mapped empty, navigation in room_obstacles
 20 s, goals there and back) runs as fast as possible for the same simulated time twice without a viewer
 and twice with the viewer and a page connected (Debian's chromium through Playwright, a dev dependency).
 Figures: ``fps`` (frames the page drew per wall-clock s), ``bytes_per_s`` (what the server sent per s),
-``sim_slowdown`` (1 - real-time factor with the page / without; the best of each pair) and the screenshot
-taken in the middle of the drive.
+``sim_slowdown`` (1 - real-time factor with the page / without; the best of each pair), ``python_cpu_overhead``
+(the navlab process's CPU time with the viewer / without, - 1: the viewer's own cost, the browser's excluded)
+and the screenshot taken in the middle of the drive.
 """
 
 from __future__ import annotations
@@ -42,22 +43,23 @@ def _drive(map_yaml: str, *, seed: int, browser: Any = None, shot: Path | None =
         page.wait_for_function("() => navlab.view.fitted", timeout=30000)
     goals = list(GOALS)
     handle = mb.send_goal(*goals.pop(0))  # type: ignore[attr-defined]
-    wall = frames = sent = 0.0
+    wall = cpu = frames = sent = 0.0
     spawned = False
     t_end = run.executor.now_ns / 1e9 + SIM_S
     while run.executor.now_ns / 1e9 < t_end - 1e-9:
         before = page.evaluate("navlab.stats.frames") if page is not None else 0
         bytes0 = viewer.hub.bytes_sent if viewer is not None else 0
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         run.run(min(5.0, t_end - run.executor.now_ns / 1e9), until=handle.done, quiet=True, chunk=5.0)
         wall += time.perf_counter() - t0
+        cpu += time.process_time() - c0
         if page is not None and viewer is not None:
             frames += page.evaluate("navlab.stats.frames") - before
             sent += viewer.hub.bytes_sent - bytes0
         if not spawned and run.executor.now_ns >= 20e9:
             gz.spawn_primitive("cylinder", "late", (0.15, 0.6), x=-1.0, y=-0.45)  # type: ignore[attr-defined]
             spawned = True
-        if page is not None and shot is not None and spawned and not shot.exists():
+        if page is not None and shot is not None and run.executor.now_ns >= 25e9 and not shot.exists():
             page.wait_for_timeout(300)
             page.screenshot(path=str(shot))
         if handle.done() and goals:
@@ -66,7 +68,7 @@ def _drive(map_yaml: str, *, seed: int, browser: Any = None, shot: Path | None =
         viewer.close()
         page.close()
     run.executor.stop()
-    return {"wall_s": wall, "sim_s": SIM_S, "frames": frames, "bytes": sent}
+    return {"wall_s": wall, "cpu_s": cpu, "sim_s": SIM_S, "frames": frames, "bytes": sent}
 
 
 def run(args: Any) -> dict[str, Any]:
@@ -99,6 +101,7 @@ def run(args: Any) -> dict[str, Any]:
         "fps": round(v["frames"] / v["wall_s"], 1),
         "bytes_per_s": round(v["bytes"] / v["wall_s"]),
         "sim_slowdown": round(1.0 - rtf_view / rtf_base, 3),
+        "python_cpu_overhead": round(min(r["cpu_s"] for r in seen) / min(r["cpu_s"] for r in base) - 1.0, 3),
         "rtf_without_viewer": round(rtf_base, 1),
         "rtf_with_viewer": round(rtf_view, 1),
         "screenshot": str(shot),

@@ -119,12 +119,14 @@ def _cmd_view(args: argparse.Namespace) -> int:
     from navlab.experiments.session import start_run
 
     launch_args: dict[str, Any] = parse_launch_args(args.args)
+    world, robot = launch_args.pop("world", args.world), launch_args.pop("robot", args.robot)  # name:=value wins
+    x, y, yaw = (float(launch_args.pop(k, v)) for k, v in zip(["x", "y", "yaw"], start_pose(args), strict=True))
+    pose = (x, y, yaw)
     declared = {str(a.get("name")) for a in declared_args(args.launch)}
     with tempfile.TemporaryDirectory(prefix="navlab-view-") as tmp:
         if "map" in declared and "map" not in launch_args:
-            launch_args["map"] = args.map or _true_map(args.world, start_pose(args), Path(tmp))
-        run = start_run(args.launch, world=args.world, robot=args.robot, pose=start_pose(args), seed=args.seed,
-                        **launch_args)  # fmt: skip
+            launch_args["map"] = args.map or _true_map(world, pose, Path(tmp))
+        run = start_run(args.launch, world=world, robot=robot, pose=pose, seed=args.seed, **launch_args)
     viewer = start_viewer(args, run.executor, host=args.host, port=args.port, speed=args.speed)
     try:
         run.run(args.duration or math.inf, record=args.record, quiet=True, desc="view")

@@ -33,7 +33,7 @@ from navlab.viz.hub import ClientStream, Hub
 
 LOOPBACK = ("127.0.0.1", "localhost", "::1")
 MAX_MESSAGE = 64 * 1024  # bytes: the largest input a page may send
-SEND_HZ = 60.0  # how often each client's streams are checked for due frames
+SEND_HZ = 30.0  # how often each client's streams are checked for due frames
 _TYPES = {".js": "text/javascript", ".mjs": "text/javascript", ".css": "text/css", ".html": "text/html",
           ".svg": "image/svg+xml", ".png": "image/png", ".json": "application/json"}  # fmt: skip
 _log = logging.getLogger("navlab.viz.server")

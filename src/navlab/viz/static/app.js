@@ -101,14 +101,12 @@ function draw() {
   if (canvas.width !== Math.round(W * d) || canvas.height !== Math.round(H * d)) {
     canvas.width = Math.round(W * d); canvas.height = Math.round(H * d);
   }
-  ctx.setTransform(1, 0, 0, 1, 0, 0);
-  ctx.fillStyle = "#303030"; ctx.fillRect(0, 0, canvas.width, canvas.height);
   const s = store.state;
-  if (!s) return;
+  ctx.setTransform(1, 0, 0, 1, 0, 0);
+  if (!s) { ctx.fillStyle = "#303030"; ctx.fillRect(0, 0, canvas.width, canvas.height); return; }
   const tf = s.tf;
-  for (const t of Object.keys(store.grids).sort((a, b) => gridOrder(a) - gridOrder(b))) {
-    if (layerOn(t)) store.grids[t].draw(ctx, view, tf, t.includes("costmap") ? 0.7 : 1.0);
-  }
+  drawBackground(tf);
+  ctx.drawImage(bg, 0, 0);
   const traceColor = (t) => (t.includes("ground_truth") ? "#fff" : "#f90");
   for (const [t, f] of Object.entries(store.traces)) if (layerOn("trace " + t)) R.drawPolyline(ctx, view, tf[f.frame], f.data, traceColor(t), 1.5);
   for (const [t, f] of Object.entries(store.paths)) if (layerOn(t)) R.drawPolyline(ctx, view, tf[f.frame], f.data, pathColor(t), 2.5);
@@ -132,6 +130,24 @@ function draw() {
 
 const MIN_FRAME_MS = 1000 / 40; // draw at most 40 frames/s: smooth, and leaves the CPU to the simulation
 let lastDraw = 0;
+// The grids change a few times a second: they are drawn into a background canvas only when they, the view,
+// the layers or their frames' poses changed, and each frame starts from a copy of it.
+const bg = document.createElement("canvas");
+const bgCtx = bg.getContext("2d");
+let bgKey = "";
+function drawBackground(tf) {
+  const order = Object.keys(store.grids).sort((a, b) => gridOrder(a) - gridOrder(b)).filter((t) => layerOn(t));
+  const frames = order.map((t) => store.grids[t].geo && tf[store.grids[t].geo.frame]);
+  const key = JSON.stringify([canvas.width, canvas.height, view.cx, view.cy, view.scale, order,
+    order.map((t) => store.grids[t].version), frames.map((T) => T && T.map((v) => v.toFixed(3)))]);
+  if (key === bgKey) return;
+  bgKey = key;
+  if (bg.width !== canvas.width || bg.height !== canvas.height) { bg.width = canvas.width; bg.height = canvas.height; }
+  bgCtx.setTransform(1, 0, 0, 1, 0, 0);
+  bgCtx.fillStyle = "#303030"; bgCtx.fillRect(0, 0, bg.width, bg.height);
+  for (const t of order) store.grids[t].draw(bgCtx, view, tf, t.includes("costmap") ? 0.7 : 1.0);
+}
+
 function frame(now) {
   if (dirty && now - lastDraw >= MIN_FRAME_MS) { dirty = false; lastDraw = now; draw(); stats.frames++; framesThisSecond++; }
   if (now - fpsMark >= 1000) { stats.fps = (framesThisSecond * 1000) / (now - fpsMark); framesThisSecond = 0; fpsMark = now; }

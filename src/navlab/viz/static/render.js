@@ -27,9 +27,10 @@ export function costmapPalette() {
 }
 
 export class GridLayer {
-  constructor(palette) { this.palette = palette; this.canvas = null; this.geo = null; }
+  constructor(palette) { this.palette = palette; this.canvas = null; this.geo = null; this.version = 0; }
 
   apply(f) {
+    this.version++;
     const same = this.geo && this.geo.w === f.w && this.geo.h === f.h;
     if (f.k === "grid" || !same) {
       if (f.k === "tiles" && !same) return; // tiles for a grid we never saw whole: wait for a whole one
