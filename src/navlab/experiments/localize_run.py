@@ -120,10 +120,19 @@ def run_localization(
             served = Path(map_yaml)
             grid = load_map(served)
         else:  # serve the world's true map through a map file, as map_server would
+            from navlab.world import shape_footprints
+
             served = Path(tmp) / "true_map.yaml"
-            grid = true_map(load_world_named(world), (pose[0], pose[1]))
+            world_model = load_world_named(world)
+            if not shape_footprints(world_model):
+                raise LocalizationError(f"world {world}: nothing stands at the lidar's height (an empty world); AMCL "
+                                        "needs walls or obstacles to localize against")
+            grid = true_map(world_model, (pose[0], pose[1]))
             save_map(grid, served)
         name = str(map_yaml or f"true map of {world}")
+        if not np.any(grid.data >= 65):
+            raise LocalizationError(f"map {name} has no occupied cell; AMCL needs walls or obstacles to localize "
+                                    "against")
         fld = field_from_map(grid, name=name)  # refuse a bad map before running
         init = initial if initial is not None else pose
         if not fld.contains(init[0], init[1]):
@@ -154,6 +163,7 @@ def run_localization(
         "mode": "global" if global_localization else "tracking",
         **_errors(res, kidnapper.event if kidnapper else {}, global_localization),
         "updates": node.filter.n_updates if node.filter else 0,
+        "scans": node.scans_received, "scans_invalid": node.scans_invalid,
         "particles_final": node.filter.n_particles if node.filter else 0,
         **run.figures(),
     })  # fmt: skip
@@ -173,11 +183,16 @@ def _errors(res: LocalizeResult, kidnap: dict[str, float], global_mode: bool) ->
     figures = trajectory_error(res.estimate[use], res.truth[use])
     out.update({k: figures[k] for k in ("position_error_mean_m", "position_error_max_m", "yaw_error_mean_deg")})
     out["position_error_final_m"] = float(err[-1]) if t.size else None
+    whole = np.isfinite(err)  # the whole run, kidnap and recovery included (NaN: no estimate yet)
+    out["position_error_mean_whole_run_m"] = float(err[whole].mean()) if whole.any() else None
+    out["position_error_max_whole_run_m"] = float(err[whole].max()) if whole.any() else None
+    out["estimate_missing_share"] = float(1.0 - whole.mean()) if t.size else None
     if kidnap:
         out["kidnap_s"] = kidnap["t"]
         out["kidnap_distance_m"] = kidnap["distance"]
         rec = settled_after(t, err, kidnap["t"] + 0.05, CONVERGED_M)
         out["recovered_after_s"] = None if rec is None else rec - kidnap["t"]
+        out["recovered"] = rec is not None  # False: the estimate never came back within CONVERGED_M
     return out
 
 

@@ -8,6 +8,7 @@ odometry (see ``experiments.truth.world_T_map``); scores and truth overlays are 
 
 from __future__ import annotations
 
+import logging
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -117,9 +118,11 @@ def run_mapping(
         **run.figures(),
         "finished": result.finished,
         "scans_processed": slam.scans_processed,
+        "scans_invalid": slam.scans_invalid,
+        "map_empty": not bool(np.any(grid.data >= 65)),
         "map_frame_in_world": list(map_in_world),
-        **score_map(grid, truth, world_T_map=map_in_world),
-        "coverage": free_coverage(grid, truth, world_T_map=map_in_world),
+        **score_map(grid, truth, world_T_map=map_in_world, start_xy=pose[:2]),
+        "coverage": free_coverage(grid, truth, world_T_map=map_in_world, start_xy=pose[:2]),
     }
     s = monitor.samples()
     if len(s["t"]):
@@ -135,6 +138,11 @@ def run_mapping(
         write_trajectory(out_dir / "trajectory.txt", s["t"], est, tru_map)
         plot_run(grid, [Track(tru_map, "ground truth", "g-", width=1.5), Track(est, "SLAM estimate", "b--")],
                  out_dir / "map.png")  # fmt: skip
+    if scores["map_empty"]:
+        scores["finished"] = False  # nothing was mapped, whatever the driver says
+        scores["warning"] = (f"the map is empty: no obstacle was seen ({slam.scans_invalid} of {slam.scans_received} "
+                             "scans had no reading within the lidar's range)")
+        logging.getLogger("navlab.mapping").warning(scores["warning"])
     result.scores = rounded(scores)
     return result
 

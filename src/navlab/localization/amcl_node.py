@@ -75,6 +75,9 @@ class Amcl(Node):
         self.check_parameters()
 
         self.filter: pf.Amcl | None = None
+        self.scans_received = 0
+        self.scans_invalid = 0  # scans without one reading in [range_min, range_max)
+        self._invalid_logged_ns: int | None = None
         self.last_error: str | None = None
         self._map_to_odom: tuple[float, float, float] | None = None
         self._pending_global = False
@@ -167,11 +170,26 @@ class Amcl(Node):
         self._odom_failures = 0
         return odom, laser
 
+    def _count_invalid(self, msg: Any, t_ns: int) -> None:
+        """Count a scan without one reading in [range_min, range_max) and say so, at most every 10 s."""
+        r = np.asarray(msg.ranges, dtype=np.float64)
+        with np.errstate(invalid="ignore"):
+            if np.any((r >= float(msg.range_min)) & (r < float(msg.range_max))):
+                return
+        self.scans_invalid += 1
+        if self._invalid_logged_ns is None or t_ns - self._invalid_logged_ns >= 10_000_000_000:
+            self._invalid_logged_ns = t_ns
+            self.get_logger().warning(
+                f"scan has no valid reading (all beyond range or not finite): {self.scans_invalid} of "
+                f"{self.scans_received} scans so far; the laser cannot correct the pose, only odometry moves it")
+
     def _on_scan(self, msg: Any) -> None:
+        self.scans_received += 1
+        t_ns = msgs.stamp_ns(msg)
+        self._count_invalid(msg, t_ns)
         f = self.filter
         if f is None or f.n_particles == 0:
             return
-        t_ns = msgs.stamp_ns(msg)
         poses = self._poses(msg)
         if poses is None:
             return

@@ -30,6 +30,9 @@ _NON_NEGATIVE = ("maxRange", "kernelSize", "iterations", "lskip", "minimumScore"
                  "linearUpdate", "angularUpdate")
 
 
+INVALID_LOG_PERIOD_NS = 10_000_000_000  # at most one "scans without readings" warning per 10 simulated s
+
+
 def _check_values(node: str, values: dict[str, Any]) -> None:
     """Refuse non-finite numbers, non-positive sizes and rates, negative gates and xmin >= xmax / ymin >= ymax."""
     for key, v in values.items():
@@ -82,6 +85,8 @@ class SlamGMapping(Node):
         self.grid: GridMap | None = None
         self.scans_received = 0
         self.scans_processed = 0
+        self.scans_invalid = 0  # scans without one reading in [range_min, range_max) (all inf/NaN: sees nothing)
+        self._invalid_logged_ns: int | None = None
         self._stamps: list[int] = []  # stamp (ns) of each processed scan
         self._last_map_ns: int | None = None
 
@@ -105,8 +110,24 @@ class SlamGMapping(Node):
             return None
         return compose2(odom, laser)
 
+    def _count_invalid(self, msg: Any) -> None:
+        """Count a scan without one reading in [range_min, range_max) and say so, at most every 10 s."""
+        r = np.asarray(msg.ranges, dtype=np.float64)
+        with np.errstate(invalid="ignore"):
+            if np.any((r >= float(msg.range_min)) & (r < float(msg.range_max))):
+                return
+        self.scans_invalid += 1
+        t_ns = msgs.stamp_ns(msg)
+        if self._invalid_logged_ns is None or t_ns - self._invalid_logged_ns >= INVALID_LOG_PERIOD_NS:
+            self._invalid_logged_ns = t_ns
+            self.get_logger().warning(
+                f"scan on {self.resolve_topic_name(self.scan_topic)} has no valid reading (all beyond range or "
+                f"not finite): {self.scans_invalid} of {self.scans_received} scans so far; the map stays empty "
+                "where the lidar sees nothing")
+
     def _on_scan(self, msg: Any) -> None:
         self.scans_received += 1
+        self._count_invalid(msg)
         if (self.scans_received - 1) % max(self.throttle_scans, 1):
             return
         t_ns = msgs.stamp_ns(msg)
