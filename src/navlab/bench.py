@@ -20,6 +20,7 @@ BENCHES: dict[str, str] = {
     "amcl": "navlab.localization.bench:run",
     "description": "navlab.description.bench:run",
     "sim": "navlab.sim.bench:run",
+    "decompose": "navlab.sim.decompose_bench:run",
     "controller": "navlab.navigation.bench:run_controller",
     "planner": "navlab.navigation.bench:run_planner",
     "nav": "navlab.experiments.navigate_run:bench",

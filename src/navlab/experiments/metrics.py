@@ -101,11 +101,13 @@ def score_map(
     world_T_map: tuple[float, float, float] = (0.0, 0.0, 0.0),
     tolerance_cells: int = 1,
     occupied_threshold: int = 65,
+    start_xy: tuple[float, float] | None = None,
 ) -> dict[str, float | int]:
     """Occupied-cell precision and recall of ``grid`` against ``truth`` (a boolean ``Grid``, world frame).
 
     Precision: map-occupied cells with a true occupied cell within the tolerance. Recall: true visible
-    wall cells (see ``truth.visible_surface``) with a map-occupied cell within the tolerance. Also the
+    wall cells (see ``truth.visible_surface``, seen from ``start_xy``: the robot's start in the world,
+    default ``world_T_map``'s position) with a map-occupied cell within the tolerance. Also the
     mean distance (m) from each map-occupied cell to the nearest true occupied cell.
     """
     jj, ii = np.nonzero(grid.data >= occupied_threshold)
@@ -121,7 +123,8 @@ def score_map(
     # distance from a map cell centre to the nearest true cell *edge* is at most half a truth cell less.
     precision = float(np.mean(d <= tol_m + 0.5 * truth.resolution))
 
-    spts = truth.centers(visible_surface(truth, (world_T_map[0], world_T_map[1])))
+    seen_from = (world_T_map[0], world_T_map[1]) if start_xy is None else start_xy
+    spts = truth.centers(visible_surface(truth, seen_from))
     in_map = grid.world_to_cell(inverse_transform_points2(world_T_map, spts))
     map_occ = grid.data >= occupied_threshold
     dist_to_map = ndimage.distance_transform_edt(~map_occ) * grid.resolution
@@ -144,10 +147,11 @@ def free_coverage(
     *,
     world_T_map: tuple[float, float, float] = (0.0, 0.0, 0.0),
     robot_radius: float = 0.2,
+    start_xy: tuple[float, float] | None = None,
 ) -> float:
     """Fraction of the true free space reachable by a robot of ``robot_radius`` from the start
-    (``world_T_map``'s position) that the map marks known (free or occupied)."""
-    start_xy = (world_T_map[0], world_T_map[1])
+    (``start_xy`` in the world, default ``world_T_map``'s position) that the map marks known."""
+    start_xy = (world_T_map[0], world_T_map[1]) if start_xy is None else start_xy
     free = ~truth.data
     clearance = ndimage.distance_transform_edt(free) * truth.resolution
     labels, _ = ndimage.label(clearance > robot_radius)

@@ -188,6 +188,9 @@ def build_spec(
     _add_scenery(spec, world)
     if robot is not None:
         add_robot(spec, robot, info, robot_pose)
+    from navlab.sim.decompose import decompose_world
+
+    decompose_world(world)  # uncached concave meshes: decomposed in parallel (progress bar), then cached
     for model in world.models:
         add_world_model(spec, model, info)
     return spec, info

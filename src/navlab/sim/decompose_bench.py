@@ -1,0 +1,149 @@
+"""``navlab bench decompose``: the first load of a furnished world (many concave meshes) before and
+after issue 13, on a generated world, each with a cold cache.
+
+- ``before``: CoACD at its default effort, one mesh after another (navlab before issue 13);
+- ``after``: bounded effort (``decompose.EFFORTS["bounded"]``) in parallel worker processes;
+- ``warm``: the same load again, everything from the content-keyed cache.
+
+Figures are wall seconds of ``Simulation(None, world)`` (load + decomposition + build), the CPU
+seconds of the decomposition (all processes), and the parts per mesh. The world is
+:func:`furnished_world`: L-shaped counters, U-shaped sofas, open shelves and T-shaped tables of
+seeded random sizes (every mesh different, so the cache cannot share them).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import resource
+import struct
+import tempfile
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+MESHES = 8  # concave meshes in the generated world
+
+
+def _box(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """Triangles (12, 3, 3) of an axis-aligned box, outward-facing."""
+    c = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+    quads = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
+    return np.array([[c[a], c[b], c[d]] for q in quads for a, b, d in ((q[0], q[1], q[2]), (q[0], q[2], q[3]))])
+
+
+def _piece(kind: str, rng: np.random.Generator) -> list[tuple[list[float], list[float]]]:
+    """Boxes (lo, hi) of one piece of furniture, metres, standing on z = 0."""
+    t = float(rng.uniform(0.03, 0.06))
+    if kind == "counter":  # L
+        a, b, d, h = rng.uniform(1.2, 2.2), rng.uniform(0.8, 1.6), rng.uniform(0.5, 0.7), rng.uniform(0.8, 0.95)
+        return [([0, 0, 0], [a, d, h]), ([0, d, 0], [d, b, h])]
+    if kind == "sofa":  # U seen from above
+        w, d, h = rng.uniform(1.5, 2.4), rng.uniform(0.8, 1.0), rng.uniform(0.7, 0.9)
+        return [([0, 0, 0], [w, 0.2, h]), ([0, 0.2, 0], [0.2, d, h * 0.7]), ([w - 0.2, 0.2, 0], [w, d, h * 0.7]),
+                ([0.2, 0.2, 0], [w - 0.2, d, 0.4])]
+    if kind == "shelf":  # open shelf: sides, back and boards
+        w, d, h = rng.uniform(0.8, 1.4), rng.uniform(0.3, 0.45), rng.uniform(0.8, 1.8)
+        boxes = [([0, 0, 0], [t, d, h]), ([w - t, 0, 0], [w, d, h]), ([0, d - t, 0], [w, d, h])]
+        return boxes + [([0, 0, z], [w, d, z + t]) for z in np.linspace(0, h - t, 3)]
+    w, d, h = rng.uniform(0.8, 1.6), rng.uniform(0.6, 1.0), rng.uniform(0.7, 0.8)  # table: top on a pedestal
+    return [([0, 0, h - t], [w, d, h]), ([w / 2 - 0.1, d / 2 - 0.1, 0], [w / 2 + 0.1, d / 2 + 0.1, h - t])]
+
+
+def _write_stl(path: Path, tris: np.ndarray) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    rec = np.zeros(len(tris), dtype=np.dtype([("n", "<f4", 3), ("v", "<f4", (3, 3)), ("a", "<u2")]))
+    rec["v"] = tris
+    path.write_bytes(b"\0" * 80 + struct.pack("<I", len(tris)) + rec.tobytes())
+
+
+KINDS = ("counter", "sofa", "shelf", "table")
+
+
+def furnished_world(folder: Path, n: int = MESHES, seed: int = 0, kinds: tuple[str, ...] = KINDS) -> Path:
+    """Write a world of ``n`` concave furniture meshes (STL models under ``folder/models``), taking the
+    ``kinds`` in turn (counter: L, sofa: U, shelf, table: T); returns the ``.world`` file."""
+    rng = np.random.default_rng(seed)
+    includes = []
+    for i in range(n):
+        name = f"piece_{i}"
+        boxes = _piece(kinds[i % len(kinds)], rng)
+        tris = np.concatenate([_box(np.array(lo, float), np.array(hi, float)) for lo, hi in boxes])
+        model = folder / "models" / name
+        _write_stl(model / "meshes" / f"{name}.stl", tris)
+        (model / "model.config").write_text(f"<model><name>{name}</name><sdf version='1.6'>model.sdf</sdf></model>")
+        (model / "model.sdf").write_text(
+            f'<sdf version="1.6"><model name="{name}"><static>true</static><link name="link">'
+            f'<collision name="c"><geometry><mesh><uri>model://{name}/meshes/{name}.stl</uri></mesh></geometry>'
+            f'</collision><visual name="v"><geometry><mesh><uri>model://{name}/meshes/{name}.stl</uri></mesh>'
+            "</geometry></visual></link></model></sdf>")
+        x, y = 3.0 * (i % 4), 3.0 * (i // 4)
+        includes.append(f"<include><uri>model://{name}</uri><pose>{x} {y} 0 0 0 0</pose></include>")
+    world = folder / "furnished.world"
+    world.write_text('<sdf version="1.6"><world name="furnished"><include><uri>model://ground_plane</uri>'
+                     f"</include>{''.join(includes)}</world></sdf>")
+    return world
+
+
+def _children_cpu() -> float:
+    r = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return r.ru_utime + r.ru_stime
+
+
+def _self_cpu() -> float:
+    r = resource.getrusage(resource.RUSAGE_SELF)
+    return r.ru_utime + r.ru_stime
+
+
+def _first_load(world_file: Path, cache: Path, effort: str, workers: int) -> dict[str, Any]:
+    """Load the world and build its simulation with a cold cache at ``cache``."""
+    from navlab.sim import decompose
+    from navlab.sim.simulation import Simulation
+    from navlab.world import load_world
+
+    os.environ["NAVLAB_CACHE"] = str(cache)
+    os.environ["NAVLAB_DECOMPOSE_WORKERS"] = str(workers)
+    saved = decompose.DEFAULT_EFFORT
+    decompose.DEFAULT_EFFORT = effort
+    try:
+        wall0, cpu0, child0 = time.perf_counter(), _self_cpu(), _children_cpu()
+        world = load_world(world_file)
+        meshes = decompose.concave_meshes(world)
+        decompose.decompose_meshes(meshes, workers=workers, progress=False, effort=effort)
+        sim = Simulation(None, world, visuals=False)
+        wall = time.perf_counter() - wall0
+        cpu = _self_cpu() - cpu0 + _children_cpu() - child0
+        parts = [len(decompose.convex_parts(p, s, effort=effort)) for p, s in meshes]
+    finally:
+        decompose.DEFAULT_EFFORT = saved
+    return {"wall_s": round(wall, 1), "cpu_s": round(cpu, 1), "meshes": len(meshes),
+            "parts_per_mesh": round(float(np.mean(parts)), 1), "geoms": int(sim.model.ngeom), "workers": workers}
+
+
+def run(args: argparse.Namespace) -> dict[str, Any]:
+    """Measure and return {"before", "after", "warm_s", ...} (see the module docstring)."""
+    from navlab.sim import decompose
+
+    seed = int(getattr(args, "seed", 0))
+    saved = {k: os.environ.get(k) for k in ("NAVLAB_CACHE", "NAVLAB_DECOMPOSE_WORKERS")}
+    try:
+        with tempfile.TemporaryDirectory() as tmp:
+            folder = Path(tmp)
+            world = furnished_world(folder / "world", MESHES, seed)
+            after = _first_load(world, folder / "cache_after", "bounded", decompose.default_workers())
+            t0 = time.perf_counter()
+            warm = _first_load(world, folder / "cache_after", "bounded", 1)
+            warm_s = time.perf_counter() - t0
+            before = _first_load(world, folder / "cache_before", "full", 1)
+    finally:
+        for key, value in saved.items():
+            if value is None:
+                os.environ.pop(key, None)
+            else:
+                os.environ[key] = value
+    return {"before": before, "after": after, "warm_s": round(warm_s, 2), "warm_wall_s": warm["wall_s"],
+            "speedup_wall": round(before["wall_s"] / max(after["wall_s"], 1e-9), 1),
+            "speedup_cpu": round(before["cpu_s"] / max(after["cpu_s"], 1e-9), 1),
+            "note": "cold caches; wall time on a shared machine depends on its load"}
