@@ -118,8 +118,28 @@ def test_teleop_keys_move_the_robot_and_k_stops_it(live: tuple[Run, Viewer], pag
     assert math.dist(_true_pose(run)[:2], (x1, y1)) - moved < 0.02  # and stopped
 
 
+def _assert_scan_on_walls(page: Any, costmap: Any) -> None:
+    """The scan the page holds, placed at the pose it carries, falls on the costmap's lethal cells."""
+    f = page.evaluate(
+        "() => { const f = Object.values(navlab.store.scans)[0]; return {...f, data: Array.from(f.data)}; }"
+    )
+    r = np.array(f["data"])
+    a = f["a0"] + f["da"] * np.arange(len(r))
+    ok = (r >= f["rmin"]) & (r < f["rmax"])
+    x, y, yaw = f["pose"]
+    px, py = x + r[ok] * np.cos(a[ok] + yaw), y + r[ok] * np.sin(a[ok] + yaw)
+    info = costmap.info
+    cells = np.asarray(costmap.data).reshape(info.height, info.width)
+    col = ((px - info.origin.position.x) / info.resolution).astype(int)
+    row = ((py - info.origin.position.y) / info.resolution).astype(int)
+    inside = (col >= 0) & (col < info.width) & (row >= 0) & (row < info.height)
+    assert inside.mean() > 0.9
+    on_wall = cells[row[inside], col[inside]] >= 99
+    assert on_wall.mean() > 0.8, on_wall.mean()
+
+
 def test_nav_goal_drag_sends_the_robot_there(live: tuple[Run, Viewer], page: Any, artifacts: Path) -> None:
-    run, _ = live
+    run, viewer = live
     goal = (-1.5, 0.0)
     page.click("[data-tool=goal]")
     gx, gy = to_screen(page, *goal)
@@ -131,7 +151,13 @@ def test_nav_goal_drag_sends_the_robot_there(live: tuple[Run, Viewer], page: Any
     assert _wait(lambda: mb.handle is not None and tuple(mb.handle.goal[:2]) == pytest.approx(goal, abs=0.05), 5)
     assert mb.handle.frame_id == "map"
     assert abs(math.remainder(mb.handle.goal[2] - math.pi, math.tau)) < 0.1
+    # the page gets navfn's plan (drawn blue) ending at the goal
+    plan_end = """() => { const p = navlab.store.paths['/move_base/NavfnROS/plan'];
+        return p && p.n > 2 ? [p.data[2 * p.n - 2], p.data[2 * p.n - 1]] : null; }"""
+    page.wait_for_function(f"() => ({plan_end})() !== null", timeout=10000)
+    assert page.evaluate(plan_end) == pytest.approx(goal, abs=0.1)
     page.screenshot(path=str(artifacts / "nav_goal_driving.png"))
+    _assert_scan_on_walls(page, viewer.hub.slots["/move_base/global_costmap/costmap"].msg)  # placed while turning
     assert _wait(lambda: mb.handle.done(), timeout=40), mb.state
     assert mb.handle.state == "SUCCEEDED", mb.handle.reason
     assert math.dist(_true_pose(run)[:2], goal) < 0.3

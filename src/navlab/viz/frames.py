@@ -111,13 +111,17 @@ def changed_tiles(old: np.ndarray, new: np.ndarray, tile: int) -> np.ndarray:
     return diff.reshape(th, tile, tw, tile).any(axis=(1, 3))
 
 
-def scan_frame(topic: str, msg: Any, *, frame: str | None = None) -> bytes:
-    """A ``LaserScan``'s ranges as ``float32`` with its angles and range limits."""
+def scan_frame(
+    topic: str, msg: Any, *, frame: str | None = None, pose: list[float] | None = None, fixed: str = ""
+) -> bytes:
+    """A ``LaserScan``'s ranges as ``float32`` with its angles and range limits (and, if known, the sensor's
+    ``pose`` x, y, yaw in the ``fixed`` frame at the scan's stamp)."""
     ranges = np.asarray(msg.ranges, dtype=np.float32)
     header = {
         "k": "scan", "topic": topic, "frame": frame or str(msg.header.frame_id).lstrip("/"),
         "a0": float(msg.angle_min), "da": float(msg.angle_increment),
         "rmin": float(msg.range_min), "rmax": float(msg.range_max), "n": len(ranges),
+        "pose": pose, "fixed": fixed,
     }  # fmt: skip
     return pack(header, ranges.tobytes())
 

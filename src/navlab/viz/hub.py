@@ -34,6 +34,8 @@ class Slot:
     msg: Any
     seq: int
     frame: str = ""
+    pose: list[float] | None = None  # a scan's sensor pose in the fixed frame at its stamp (set by the producer)
+    fixed: str = ""
 
 
 @dataclass
@@ -72,10 +74,20 @@ class Hub:
         self.bytes_sent = 0  # everything every client was sent (bench)
         self.frames_sent = 0
 
-    def put(self, topic: str, kind: str, msg: Any, frame: str = "") -> None:
+    def put(self, topic: str, kind: str, msg: Any, frame: str = "") -> Slot:
         """The newest message of ``topic`` (producer thread; a reference, not a copy)."""
         self._seq += 1
-        self.slots[topic] = Slot(kind, msg, self._seq, frame)
+        slot = self.slots[topic] = Slot(kind, msg, self._seq, frame)
+        return slot
+
+    def place_scans(self, fixed: str, lookup: Callable[[str, int], list[float] | None]) -> None:
+        """Give each new scan its sensor's pose in ``fixed`` at its stamp: ``lookup(frame, t_ns)`` (producer
+        thread). A scan is drawn where the robot was when it was taken, not where it is when drawn."""
+        for slot in list(self.slots.values()):
+            if slot.kind == "scan" and slot.pose is None:
+                msg = slot.msg
+                stamp = int(msg.header.stamp.sec) * 1_000_000_000 + int(msg.header.stamp.nanosec)
+                slot.pose, slot.fixed = lookup(str(msg.header.frame_id).lstrip("/"), stamp), fixed
 
     def trace(self, name: str, frame: str, x: float, y: float) -> None:
         """Extend a trace (producer thread)."""
@@ -142,6 +154,8 @@ class ClientStream:
             kind = _rate_kind(topic, slot.kind)
             if self._sent.get(topic) == slot.seq or not self._due(topic, kind, now):
                 continue
+            if slot.kind == "scan" and slot.pose is None:
+                continue  # not placed yet: the next snapshot places it
             frame = self._convert(topic, slot)
             self._sent[topic] = slot.seq
             self._last[topic] = now
@@ -175,7 +189,7 @@ class ClientStream:
             return differ.frame(topic, msg)
         frame = slot.frame or str(msg.header.frame_id).lstrip("/")
         if slot.kind == "scan":
-            return fr.scan_frame(topic, msg, frame=frame)
+            return fr.scan_frame(topic, msg, frame=frame, pose=slot.pose, fixed=slot.fixed)
         if slot.kind == "path":
             return fr.path_frame(topic, frame, fr.path_xy(msg))
         if slot.kind == "poses":

@@ -113,6 +113,7 @@ class ViewerNode(Node):
         super().__init__(executor, name=name, parameters=parameters, namespace=namespace)
         self.hub = hub if hub is not None else Hub()
         self.pacer = pacer if pacer is not None else Pacer(executor.rate or 1.0)
+        self._rate = executor.rate
         executor.rate = 0.0  # the pacer keeps the pace from now on (it can pause and change speed)
         self.fixed_frame = str(self.declare_parameter("fixed_frame", ""))
         self.base_frame = str(self.declare_parameter("base_frame", ""))
@@ -234,12 +235,20 @@ class ViewerNode(Node):
             except TfError:
                 continue
         tf.setdefault("world", [0.0, 0.0, 0.0])  # ground truth: the world is the map (or odom's start)
+        self.hub.place_scans(fixed, self._pose_at)
         self.hub.set_state({
             "t": ex.now_ns / 1e9, "rtf": round(self.rtf, 2), "paused": self.pacer.paused, "speed": self.pacer.speed,
             "fixed": fixed, "base": self._base(), "tf": tf, "move_base": self._move_base_state(),
             "obstacles": [{"name": k, **v} for k, v in self.obstacles.items()], "replay": False,
             "teleop": {"speed": round(self.teleop.speed, 3), "turn": round(self.teleop.turn, 3)},
         })  # fmt: skip
+
+    def _pose_at(self, frame: str, t_ns: int) -> list[float] | None:
+        """(x, y, yaw) of ``frame`` in the fixed frame at ``t_ns`` (the latest if tf has none then)."""
+        try:
+            return [round(v, 5) for v in self.executor.tf.lookup_pose2d_or_latest(self._fixed(), frame, t_ns)]
+        except TfError:
+            return None
 
     def _fixed(self) -> str:
         if self.fixed_frame:
@@ -373,6 +382,7 @@ class ViewerNode(Node):
         """Stop pacing for good (a paused run finishes)."""
         self.pacer.close()
         self.hub.handler = None
+        self.executor.rate = self._rate
 
 
 __all__ = ["INITIALPOSE_COV", "MOVE_BINDINGS", "SPEEDS", "SPEED_BINDINGS", "Pacer", "ViewerNode"]

@@ -172,11 +172,18 @@ class BagPlayer:
             except TfError:
                 continue
         tf.setdefault("world", [0.0, 0.0, 0.0])  # ground truth: the world is the map (or odom's start)
+        hub.place_scans(fixed, lambda frame, stamp: self._pose_at(fixed, frame, stamp))
         hub.set_state({
             "t": (t_ns - rec.t0) / 1e9, "t0": 0.0, "t1": (rec.t1 - rec.t0) / 1e9, "rtf": self.speed,
             "paused": self.paused, "speed": self.speed, "fixed": fixed, "base": rec.base_frame, "tf": tf,
             "move_base": None, "obstacles": [], "replay": True,
         })  # fmt: skip
+
+    def _pose_at(self, fixed: str, frame: str, t_ns: int) -> list[float] | None:
+        try:
+            return [round(v, 5) for v in self.rec.tf.lookup_pose2d_or_latest(fixed, frame, t_ns)]
+        except TfError:
+            return None
 
 
 def play_bag(path: str | Path, hub: Hub, *, speed: float = 1.0) -> BagPlayer:

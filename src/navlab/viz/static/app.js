@@ -110,7 +110,9 @@ function draw() {
   const traceColor = (t) => (t.includes("ground_truth") ? "#fff" : "#f90");
   for (const [t, f] of Object.entries(store.traces)) if (layerOn("trace " + t)) R.drawPolyline(ctx, view, tf[f.frame], f.data, traceColor(t), 1.5);
   for (const [t, f] of Object.entries(store.paths)) if (layerOn(t)) R.drawPolyline(ctx, view, tf[f.frame], f.data, pathColor(t), 2.5);
-  for (const [t, f] of Object.entries(store.scans)) if (layerOn(t)) R.drawScan(ctx, view, tf[f.frame], f, "#f33");
+  for (const [t, f] of Object.entries(store.scans)) {
+    if (layerOn(t)) R.drawScan(ctx, view, f.pose && f.fixed === s.fixed ? f.pose : tf[f.frame], f, "#f33");
+  }
   for (const [t, f] of Object.entries(store.poses)) {
     if (t.endsWith("current_goal")) { if (layerOn(t) && f.n) R.drawArrow(ctx, view, R.compose(tf[f.frame] || [0, 0, 0], [...f.data]), "#f0f", 0.5); }
     else if (layerOn(t)) R.drawArrows(ctx, view, tf[f.frame], f.data, "#f55", 8);
