@@ -44,6 +44,29 @@ def start_pose(args: argparse.Namespace) -> tuple[float, float, float]:
     return float(args.x), float(args.y), float(args.yaw)
 
 
+def add_resource_path_arguments(p: argparse.ArgumentParser) -> None:
+    """``--package-path DIR`` and ``--model-path DIR`` (repeatable): where ``package://``/``$(find pkg)``
+    and ``model://`` are looked up, before ``ROS_PACKAGE_PATH`` and ``GAZEBO_MODEL_PATH``."""
+    p.add_argument("--package-path", action="append", default=[], metavar="DIR",
+                   help="a folder holding ROS packages for package:// and $(find pkg) (repeatable; searched "
+                   "before ROS_PACKAGE_PATH)")
+    p.add_argument("--model-path", action="append", default=[], metavar="DIR",
+                   help="a folder holding Gazebo models for model:// (repeatable; searched before "
+                   "GAZEBO_MODEL_PATH)")
+
+
+def apply_resource_paths(args: argparse.Namespace) -> None:
+    """Put :func:`add_resource_path_arguments`' folders in front of ``ROS_PACKAGE_PATH`` and
+    ``GAZEBO_MODEL_PATH`` of this process, so every loader of the run (and its workers) finds them."""
+    import os
+    from pathlib import Path
+
+    for attr, var in (("package_path", "ROS_PACKAGE_PATH"), ("model_path", "GAZEBO_MODEL_PATH")):
+        dirs = [str(Path(d).expanduser().resolve()) for d in getattr(args, attr, None) or []]
+        if dirs:
+            os.environ[var] = os.pathsep.join([*dirs, *filter(None, [os.environ.get(var, "")])])
+
+
 def add_set_argument(p: argparse.ArgumentParser, node: str, example: str) -> None:
     """``--set NAME=VALUE`` (repeatable): one parameter of ``node``, parsed as YAML."""
     p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",

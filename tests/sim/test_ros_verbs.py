@@ -52,3 +52,17 @@ def test_start_pose_inside_a_wall_is_refused_with_a_message(argv, tmp_path, monk
     err = capsys.readouterr().err
     assert "start pose x=4.95" in err and "inside 'room_walls'" in err and "Traceback" not in err
     assert not (tmp_path / "never.png").exists()
+
+
+def test_package_and_model_path_options(tmp_path, monkeypatch, capsys):
+    monkeypatch.setenv("ROS_PACKAGE_PATH", "")
+    monkeypatch.setenv("GAZEBO_MODEL_PATH", "")
+    world = tmp_path / "w.world"
+    world.write_text('<sdf version="1.6"><world name="w"><include><uri>model://ground_plane</uri></include>'
+                     "<include><uri>model:///pillar</uri><pose>2 0 0 0 0 0</pose></include></world></sdf>")
+    models = FIX / "tutorial_bot_description" / "models"
+    assert main(["sim", "--robot", ROBOT, "--world", str(world), "--duration", "0.2", "--quiet", "--json"]) == 2
+    assert "tutorial_bot_description" in capsys.readouterr().err  # the package is named in the error
+    assert main(["sim", "--robot", ROBOT, "--world", str(world), "--package-path", str(FIX), "--model-path",
+                 str(models), "--duration", "0.2", "--quiet", "--json"]) == 0
+    assert "pillar" in json.loads(capsys.readouterr().out)["models"]

@@ -8,7 +8,15 @@ import math
 import sys
 from typing import Any
 
-from navlab.cli_common import add_pose_arguments, add_set_argument, parse_sets, positive_seconds, start_pose
+from navlab.cli_common import (
+    add_pose_arguments,
+    add_resource_path_arguments,
+    add_set_argument,
+    apply_resource_paths,
+    parse_sets,
+    positive_seconds,
+    start_pose,
+)
 from navlab.viz.cli import add_view_arguments, viewing
 
 _SPAWN_HELP = (
@@ -21,8 +29,10 @@ _SPAWN_HELP = (
 def _add_common(p: argparse.ArgumentParser) -> None:
     p.add_argument("--world", default="room", help="shipped world (room, room_obstacles) or a .world file "
                    "(default: room)")
-    p.add_argument("--robot", default="mybot", help="shipped robot (mybot) or a .xacro/.urdf file (default: mybot)")
+    p.add_argument("--robot", default="mybot", help="shipped robot (mybot), a .xacro/.urdf file or a "
+                   "package://pkg/urdf/robot.xacro URI (default: mybot)")
     add_pose_arguments(p)
+    add_resource_path_arguments(p)
     p.add_argument("--spawn", action="append", default=[], metavar="SPEC", help=_SPAWN_HELP)
 
 
@@ -33,7 +43,9 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="run the MuJoCo simulation of a robot in a world with Gazebo's plugins",
         description="Simulate a robot (xacro/URDF with <gazebo> plugin tags) in a Gazebo world: physics, "
         "diff_drive (cmd_vel -> odom + tf), lidar, imu, joint_states and /ground_truth/odom, in "
-        "simulated time. Prints a summary; --record leaves a rosbag2 (MCAP) of every topic.",
+        "simulated time. Prints a summary; --record leaves a rosbag2 (MCAP) of every topic. As ROS 1's "
+        "gazebo_ros_diff_drive, the last cmd_vel holds until a new one arrives; --set cmd_timeout=0.5 adds "
+        "navlab's watchdog (stop the wheels 0.5 s after the last command; default 0 = off).",
     )
     _add_common(p)
     p.add_argument("--duration", type=positive_seconds, default=10.0, help="simulated seconds to run (default 10)")
@@ -86,6 +98,7 @@ def _cmd_sim(args: argparse.Namespace) -> int:
     from navlab.experiments.session import start_run
     from navlab.sim.spawn import parse_spawn_spec
 
+    apply_resource_paths(args)
     cmd_vel = _parse_cmd_vel(args.cmd_vel)
     spawns = [parse_spawn_spec(s, default_name=f"spawned_{i}") for i, s in enumerate(args.spawn)]
     run = start_run("sim", world=args.world, robot=args.robot, pose=start_pose(args), seed=args.seed,
@@ -154,6 +167,7 @@ def _cmd_render(args: argparse.Namespace) -> int:
     from navlab.sim.simulation import Simulation
     from navlab.sim.spawn import check_start_pose, parse_spawn_spec
 
+    apply_resource_paths(args)
     world = load_world_named(args.world)
     robot = None if args.no_robot else load_robot_named(args.robot)
     if robot is not None:

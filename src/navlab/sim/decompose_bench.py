@@ -19,6 +19,7 @@ import resource
 import struct
 import tempfile
 import time
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -34,7 +35,10 @@ def _box(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
     return np.array([[c[a], c[b], c[d]] for q in quads for a, b, d in ((q[0], q[1], q[2]), (q[0], q[2], q[3]))])
 
 
-def _piece(kind: str, rng: np.random.Generator) -> list[tuple[list[float], list[float]]]:
+Box = tuple[Sequence[float], Sequence[float]]
+
+
+def _piece(kind: str, rng: np.random.Generator) -> list[Box]:
     """Boxes (lo, hi) of one piece of furniture, metres, standing on z = 0."""
     t = float(rng.uniform(0.03, 0.06))
     if kind == "counter":  # L
@@ -46,8 +50,8 @@ def _piece(kind: str, rng: np.random.Generator) -> list[tuple[list[float], list[
                 ([0.2, 0.2, 0], [w - 0.2, d, 0.4])]
     if kind == "shelf":  # open shelf: sides, back and boards
         w, d, h = rng.uniform(0.8, 1.4), rng.uniform(0.3, 0.45), rng.uniform(0.8, 1.8)
-        boxes = [([0, 0, 0], [t, d, h]), ([w - t, 0, 0], [w, d, h]), ([0, d - t, 0], [w, d, h])]
-        return boxes + [([0, 0, z], [w, d, z + t]) for z in np.linspace(0, h - t, 3)]
+        boxes: list[Box] = [([0, 0, 0], [t, d, h]), ([w - t, 0, 0], [w, d, h]), ([0, d - t, 0], [w, d, h])]
+        return boxes + [([0, 0, float(z)], [w, d, float(z) + t]) for z in np.linspace(0, h - t, 3)]
     w, d, h = rng.uniform(0.8, 1.6), rng.uniform(0.6, 1.0), rng.uniform(0.7, 0.8)  # table: top on a pedestal
     return [([0, 0, h - t], [w, d, h]), ([w / 2 - 0.1, d / 2 - 0.1, 0], [w / 2 + 0.1, d / 2 + 0.1, h - t])]
 
