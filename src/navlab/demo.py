@@ -19,6 +19,8 @@ import time
 from pathlib import Path
 from typing import Any
 
+from navlab.viz.cli import add_view_arguments
+
 
 def _say(text: str, quiet: bool) -> None:
     if not quiet:
@@ -26,7 +28,7 @@ def _say(text: str, quiet: bool) -> None:
 
 
 def run_demo(out: str | Path = "navlab-demo", *, seed: int = 0, quiet: bool = False, render: bool = True,
-             record: bool = True) -> dict[str, Any]:  # fmt: skip
+             record: bool = True, on_start: Any = None) -> dict[str, Any]:  # fmt: skip
     """Run the four steps, writing the report folder ``out``; returns the figures (also in report.json)."""
     from navlab.experiments.localize_run import plot_result, run_localization
     from navlab.experiments.mapping_run import run_mapping
@@ -42,16 +44,18 @@ def run_demo(out: str | Path = "navlab-demo", *, seed: int = 0, quiet: bool = Fa
         _say("[1/4] rendering the robot in room_obstacles.world ...", quiet)
         summary["render"] = _render(out / "world.png")
     _say("[2/4] mapping room.world with slam_gmapping while the robot explores ...", quiet)
-    mapping = run_mapping(world="room", out=out / "map", driver="explore", duration=300, seed=seed, quiet=quiet)
+    mapping = run_mapping(world="room", out=out / "map", driver="explore", duration=300, seed=seed, quiet=quiet,
+                          on_start=on_start)  # fmt: skip
     summary["mapping"] = {"map": str(mapping.map_yaml), "picture": str(out / "map" / "map.png"), **mapping.scores}
     _say("[3/4] AMCL on the saved map, in the room with new obstacles (room_obstacles.world) ...", quiet)
-    loc = run_localization("room_obstacles", mapping.map_yaml, duration=60.0, seed=seed, progress=not quiet)
+    loc = run_localization("room_obstacles", mapping.map_yaml, duration=60.0, seed=seed, progress=not quiet,
+                           on_start=on_start)  # fmt: skip
     summary["localization"] = {**loc.summary, "picture": str(plot_result(loc, out / "localize.png"))}
     _say("[4/4] move_base on the saved map, to goals among the new obstacles and one more cylinder ...", quiet)
     late = primitive_model("cylinder", "late_cylinder", (0.15, 0.6), x=-1.0, y=-0.45)
     nav = run_navigation(DEMO_GOALS, world="room_obstacles", map_yaml=mapping.map_yaml, spawn=[(20.0, late)],
                          seed=seed, goal_timeout=90, snapshots=True,
-                         record=out / "recording" if record else None)  # fmt: skip
+                         record=out / "recording" if record else None, on_start=on_start)  # fmt: skip
     (out / "navigate").mkdir(exist_ok=True)
     for k, (goal, shot) in enumerate(zip(nav.goals, nav.snapshots, strict=True), 1):
         title = f"goal {k} {tuple(goal['goal'])}: {goal['outcome']} in {goal['time_s']} s"
@@ -114,8 +118,11 @@ def _render(path: Path) -> str:
 
 
 def _cmd(args: argparse.Namespace) -> int:
-    summary = run_demo(args.out, seed=args.seed, quiet=args.quiet, render=not args.no_render,
-                       record=not args.no_record)
+    from navlab.viz.cli import view_hook
+
+    with view_hook(args) as on_start:
+        summary = run_demo(args.out, seed=args.seed, quiet=args.quiet, render=not args.no_render,
+                           record=not args.no_record, on_start=on_start)  # fmt: skip
     if args.json:
         print(json.dumps(summary))
         return 0
@@ -157,4 +164,5 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--no-render", action="store_true", help="skip the rendered picture (no OpenGL needed)")
     p.add_argument("--quiet", action="store_true", help="no progress output")
     p.add_argument("--json", action="store_true", help="print the figures as JSON")
+    add_view_arguments(p)
     p.set_defaults(func=_cmd)

@@ -49,3 +49,10 @@ def test_navlab_view_starts_a_launch_with_ros_style_arguments(capsys: pytest.Cap
     assert "viewer: http://127.0.0.1:" in capsys.readouterr().err
     assert main(["view", "--launch", "sim", "wrold:=room", "--port", "0", "--no-browser"]) == 2
     assert "did you mean 'world'" in capsys.readouterr().err
+
+
+def test_navigate_takes_view(capsys: pytest.CaptureFixture[str]) -> None:
+    argv = ["navigate", "--goal", "1.0", "0.0", "0.0", "--timeout", "0.5", "--json", "--view", "--view-port", "0"]
+    assert main([*argv, "--no-browser"]) == 0
+    out = capsys.readouterr()
+    assert "viewer: http://127.0.0.1:" in out.err and json.loads(out.out)["goals"][0]["goal"] == [1.0, 0.0, 0.0]

@@ -16,6 +16,7 @@ from navlab.cli_common import (
     print_figures,
     start_pose,
 )
+from navlab.viz.cli import add_view_arguments, view_hook
 
 
 def _cmd_map(args: argparse.Namespace) -> int:
@@ -24,11 +25,12 @@ def _cmd_map(args: argparse.Namespace) -> int:
     from navlab.experiments.mapping_run import run_mapping
 
     driver = "teleop" if args.teleop else "route" if args.route else "explore"
-    result = run_mapping(
-        world=args.world, robot=args.robot, pose=start_pose(args), out=args.out, driver=driver, route=args.route,
-        duration=args.duration, mode=args.mode, seed=args.seed, rate=args.rate, record=args.record,
-        quiet=args.quiet, slam_params=parse_sets(args.set),
-    )  # fmt: skip
+    with view_hook(args) as on_start:
+        result = run_mapping(
+            world=args.world, robot=args.robot, pose=start_pose(args), out=args.out, driver=driver, route=args.route,
+            duration=args.duration, mode=args.mode, seed=args.seed, rate=args.rate, record=args.record,
+            quiet=args.quiet, slam_params=parse_sets(args.set), on_start=on_start,
+        )  # fmt: skip
     if not args.json:
         print(f"saved {result.map_yaml} (+ map.pgm, map.png) after {result.sim_s:.1f} simulated s")
     print_figures(result.scores, args.json)
@@ -80,12 +82,14 @@ def _amcl_params(path: str | None, sets: list[str]) -> dict[str, Any]:
 def _cmd_localize(args: argparse.Namespace) -> int:
     from navlab.experiments.localize_run import plot_result, run_localization
 
-    result = run_localization(
-        args.world, args.map, initial=tuple(args.initial) if args.initial else None,
-        global_localization=args.global_localization, duration=args.duration, seed=args.seed,
-        kidnap_at=args.kidnap, amcl_params=_amcl_params(args.params, args.set), robot=args.robot,
-        pose=start_pose(args), progress=not args.quiet and sys.stderr.isatty(), record=args.record,
-    )  # fmt: skip
+    with view_hook(args) as on_start:
+        result = run_localization(
+            args.world, args.map, initial=tuple(args.initial) if args.initial else None,
+            global_localization=args.global_localization, duration=args.duration, seed=args.seed,
+            kidnap_at=args.kidnap, amcl_params=_amcl_params(args.params, args.set), robot=args.robot,
+            pose=start_pose(args), progress=not args.quiet and sys.stderr.isatty(), record=args.record,
+            on_start=on_start,
+        )  # fmt: skip
     summary = dict(result.summary)
     if args.out:
         summary["png"] = str(plot_result(result, args.out))
@@ -102,11 +106,13 @@ def _cmd_navigate(args: argparse.Namespace) -> int:
     for i, spec in enumerate(args.spawn):
         model, t = parse_spawn_spec(spec, default_name=f"spawned_{i}")
         spawns.append((t, model))
-    result = run_navigation(
-        [tuple(g) for g in args.goal], world=args.world, map_yaml=args.map, robot=args.robot, pose=start_pose(args),
-        controller=args.controller, params_dir=args.params, move_base_params=parse_sets(args.set), spawn=spawns,
-        goal_timeout=args.timeout, seed=args.seed, record=args.record, snapshots=bool(args.out), mapless=args.mapless,
-    )  # fmt: skip
+    with view_hook(args) as on_start:
+        result = run_navigation(
+            [tuple(g) for g in args.goal], world=args.world, map_yaml=args.map, robot=args.robot,
+            pose=start_pose(args), controller=args.controller, params_dir=args.params,
+            move_base_params=parse_sets(args.set), spawn=spawns, goal_timeout=args.timeout, seed=args.seed,
+            record=args.record, snapshots=bool(args.out), mapless=args.mapless, on_start=on_start,
+        )  # fmt: skip
     figures: dict[str, Any] = {"goals": result.goals, **result.summary}
     if args.out:
         out = Path(args.out)
@@ -146,6 +152,18 @@ def _cmd_experiment(args: argparse.Namespace) -> int:
     if not args.json:
         print(f"{summary['trials']} trials of {sc.name}: results in {out}/results.jsonl, summary in {out}/summary.json")
     print_figures(summary, args.json)
+    return 0
+
+
+def _cmd_report(args: argparse.Namespace) -> int:
+    from navlab.experiments.report import render_report
+
+    out = render_report(args.dir)
+    if not args.json:
+        print(f"{out['kind']} report: {out['html']} (one self-contained page) and {out['markdown']}, "
+              f"{len(out['figures'])} figures")
+    else:
+        print_figures(out, True)
     return 0
 
 
@@ -198,7 +216,7 @@ def _add_world_robot(p: argparse.ArgumentParser, world: str) -> None:
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    """Add ``map``, ``localize``, ``navigate`` and ``experiment``."""
+    """Add ``map``, ``localize``, ``navigate``, ``experiment`` and ``report``."""
     p = sub.add_parser(
         "map",
         help="build a map with SLAM in simulation (exploration, teleop or a route) and save it",
@@ -227,6 +245,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--pid", type=int, help="save: which running navlab launch, when several run")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.add_argument("--json", action="store_true", help="print the scores as JSON")
+    add_view_arguments(p)
     p.set_defaults(func=_cmd_map)
 
     p = sub.add_parser(
@@ -258,6 +277,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--json", action="store_true", help="print the figures as one JSON object")
     p.add_argument("--record", metavar="DIR", help="also write every topic to a rosbag2 (MCAP) in DIR")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+    add_view_arguments(p)
     p.set_defaults(func=_cmd_localize)
 
     p = sub.add_parser(
@@ -291,6 +311,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--out", metavar="DIR", default=None, help="save one PNG per goal into DIR")
     p.add_argument("--record", metavar="DIR", help="also write every topic to a rosbag2 (MCAP) in DIR")
     p.add_argument("--json", action="store_true", help="print the figures as one JSON object")
+    add_view_arguments(p)
     p.set_defaults(func=_cmd_navigate)
 
     p = sub.add_parser(
@@ -322,3 +343,14 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.add_argument("--json", action="store_true", help="print the summary as one JSON object")
     p.set_defaults(func=_cmd_experiment)
+
+    p = sub.add_parser(
+        "report",
+        help="re-render a results folder (experiment run, sweep or demo) as Markdown, PNGs and one HTML page",
+        description="Reads DIR — an `navlab experiment run` folder (results.jsonl), an `navlab experiment sweep` "
+        "folder (sweep.csv) or a `navlab demo` folder (report.json) — and writes DIR/report.md with its PNG "
+        "figures and DIR/report.html, a single self-contained page (images inlined) to open in any browser.",
+    )
+    p.add_argument("dir", help="the results folder")
+    p.add_argument("--json", action="store_true", help="print what was written as JSON")
+    p.set_defaults(func=_cmd_report)

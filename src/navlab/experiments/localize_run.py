@@ -98,6 +98,7 @@ def run_localization(
     route: Sequence[tuple[float, float]] = DEFAULT_ROUTE,
     progress: bool = False,
     record: str | Path | None = None,
+    on_start: Any = None,
 ) -> LocalizeResult:
     """Run the robot along ``route`` for ``duration`` simulated seconds with AMCL; see ``LocalizeResult``.
 
@@ -141,7 +142,7 @@ def run_localization(
                                     f"(x {x0:.2f}..{x1:.2f}, y {y0:.2f}..{y1:.2f})")  # fmt: skip
         amcl = {"initial_pose_x": init[0], "initial_pose_y": init[1], "initial_pose_a": init[2], **(amcl_params or {})}
         run = start_run("localization", world=world, robot=robot, pose=pose, seed=seed, map=str(served),
-                        overrides={"amcl": amcl})  # fmt: skip
+                        overrides={"amcl": amcl}, on_start=on_start)  # fmt: skip
         if global_localization:
             run.executor.call_service("/global_localization")
         follower = run.add(RouteFollower, parameters={"waypoints": [list(w) for w in route], "loop": True,

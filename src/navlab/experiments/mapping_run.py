@@ -82,6 +82,7 @@ def run_mapping(
     quiet: bool = False,
     slam_params: dict[str, Any] | None = None,
     sim_params: dict[str, Any] | None = None,
+    on_start: Any = None,
 ) -> MappingResult:
     """Map ``world`` with SLAM while ``driver`` (explore | teleop | route) drives; save ``out``/map.yaml.
 
@@ -96,7 +97,7 @@ def run_mapping(
         overrides["gazebo"] = dict(sim_params)
     run = start_run("mapping", world=world, robot=robot, pose=pose, seed=seed,
                     pace=1.0 if driver == "teleop" and rate == 0 else rate, overrides=overrides,
-                    explore=str(driver == "explore").lower())  # fmt: skip
+                    explore=str(driver == "explore").lower(), on_start=on_start)  # fmt: skip
     is_done = _add_driver(run, driver, route)
     monitor = run.add(PoseMonitor, parameters={"base_frame": run.base_frame, "odom_frame": run.odom_frame})
     run.run(duration, until=is_done, record=record, quiet=quiet, desc=f"mapping {world}")

@@ -193,6 +193,7 @@ def run_navigation(
     wheel_controller: str = "gazebo_ros_diff_drive",
     ekf: str | Path | None = None,
     disturbances: dict[str, Any] | None = None,
+    on_start: Any = None,
 ) -> NavigateResult:
     """Navigate to ``goals`` (x, y, yaw in the map frame) in turn; see ``NavigateResult``.
 
@@ -230,10 +231,10 @@ def run_navigation(
         grid = load_map(served)
         if mapless:
             run = start_run("navigation_mapless", world=world, robot=robot, pose=pose, seed=seed,
-                            overrides={"move_base": overrides, **gazebo}, **launch_args)  # fmt: skip
+                            overrides={"move_base": overrides, **gazebo}, on_start=on_start, **launch_args)  # fmt: skip
         else:
             run = start_run("navigation", world=world, robot=robot, pose=pose, seed=seed, map=str(served),
-                            overrides={"move_base": overrides, **gazebo}, **launch_args)  # fmt: skip
+                            overrides={"move_base": overrides, **gazebo}, on_start=on_start, **launch_args)  # fmt: skip
     if ekf:
         add_ekf(run, ekf)
     mb = _move_base(run)

@@ -101,12 +101,14 @@ def start_run(
     seed: int = 0,
     pace: float = 0.0,
     overrides: dict[str, dict[str, Any]] | None = None,
+    on_start: Callable[[Run], None] | None = None,
     **launch_args: Any,
 ) -> Run:
     """Start ``launch`` (a shipped name or a file with the sim's ``world``/``robot``/``x``/``y``/``yaw``
     arguments, plus ``base_frame``/``scan_topic`` when it declares them) and return the ``Run``.
 
-    ``overrides`` maps node names to parameters applied after the launch file's (``--set``).
+    ``overrides`` maps node names to parameters applied after the launch file's (``--set``); ``on_start(run)``
+    is called once the launch started (``--view`` attaches the viewer there).
     """
     from navlab.core.launch import declared_args
 
@@ -118,7 +120,10 @@ def start_run(
             args[key] = value
     args.update(launch_args)
     session = start(launch, seed=seed, pace=pace, launch_args=args, overrides=overrides)
-    return Run(session, session.node("gazebo"), base, odom, scan)
+    run = Run(session, session.node("gazebo"), base, odom, scan)
+    if on_start is not None:
+        on_start(run)
+    return run
 
 
 def rounded(figures: dict[str, Any], digits: int = 4) -> dict[str, Any]:

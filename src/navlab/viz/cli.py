@@ -76,6 +76,27 @@ def viewing(args: argparse.Namespace, executor: Any) -> Iterator[Any]:
         viewer.close()
 
 
+@contextlib.contextmanager
+def view_hook(args: argparse.Namespace) -> Iterator[Any]:
+    """With ``--view``: an ``on_start(run)`` for ``start_run`` (and the run functions that take one) that
+    serves the viewer on each run it starts (the previous run's viewer closes); None without ``--view``."""
+    if not getattr(args, "view", False):
+        yield None
+        return
+    viewers: list[Any] = []
+
+    def on_start(run: Any) -> None:
+        while viewers:
+            viewers.pop().close()  # the previous run has finished: its page reconnects to this one
+        viewers.append(start_viewer(args, run.executor, host=args.view_host, port=args.view_port))
+
+    try:
+        yield on_start
+    finally:
+        for viewer in viewers:
+            viewer.close()
+
+
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the ``view`` verb."""
     p = sub.add_parser(
