@@ -42,12 +42,16 @@ def test_foxglove_client_gets_map_and_scan_and_its_goal_reaches_move_base() -> N
             ws.send(json.dumps({"op": "subscribe", "subscriptions": [
                 {"id": k, "channelId": channels[t]["id"]} for k, t in subs.items()]}))  # fmt: skip
             got: dict[str, object] = {}
-            while len(got) < 2:
+            sim_times: list[int] = []
+            while len(got) < 2 or not sim_times:
                 msg = ws.recv(timeout=10)
+                if isinstance(msg, bytes) and msg[0] == 0x02:  # time: the simulated clock
+                    sim_times.append(struct.unpack_from("<Q", msg, 1)[0])
                 if isinstance(msg, bytes) and msg[0] == 0x01:  # messageData: sub id, log time, payload
                     sub_id, _t = struct.unpack_from("<IQ", msg, 1)
                     topic = subs[sub_id]
                     got[topic] = msgs.TYPESTORE.deserialize_cdr(msg[13:], str(channels[topic]["schemaName"]))
+            assert 0 < sim_times[-1] <= run.executor.now_ns
             assert got["/map"].info.width > 100 and len(got["/mybot/laser/scan"].ranges) > 100  # type: ignore[attr-defined]
             # publish a goal as Foxglove's 3D panel does: advertise a client channel, then binary messages
             ws.send(json.dumps({"op": "advertise", "channels": [{"id": 7, "topic": "/move_base_simple/goal",

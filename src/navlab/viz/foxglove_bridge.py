@@ -85,6 +85,7 @@ class FoxgloveBridge(ServerListener):
         self.received = 0  # messages published by clients
         self._advertise()
         self.node.create_timer(1.0, self._advertise)
+        self.node.create_timer(0.1, self.server_time)
         try:
             self.server = foxglove.start_server(
                 name="navlab", host=host, port=port, capabilities=[Capability.ClientPublish, Capability.Time],
@@ -110,7 +111,6 @@ class FoxgloveBridge(ServerListener):
             schema = self._foxglove.Schema(name=typename, encoding="ros2msg", data=ros2_schema(typename))
             self.channels[name] = self._foxglove.Channel(name, schema=schema, message_encoding="cdr",
                                                          context=self.ctx)  # fmt: skip
-        self.server_time()
 
     def server_time(self) -> None:
         """Tell clients the simulated time (Foxglove's ``time`` capability)."""
