@@ -32,8 +32,6 @@ def run_clutter_world(
     workdir: str | Path | None = None,
 ) -> dict[str, Any]:
     """One BARN trial in ``world`` (a ``world.clutter.ClutterWorld``); returns its figures."""
-    from navlab.world.clutter import barn_score
-
     with tempfile.TemporaryDirectory(prefix="navlab-clutter-", dir=workdir) as tmp:
         path = world.write_world(Path(tmp) / f"{world.name}.world")
         gx, gy, gyaw = (float(v) for v in between2(world.start, world.goal))  # the goal in odom (= the start)
@@ -42,15 +40,41 @@ def run_clutter_world(
         r = run_navigation([(gx, gy, gyaw)], world=str(path), pose=(sx, sy, syaw), mapless=True, controller=controller,
                            move_base_params=params, seed=seed, goal_timeout=timeout)  # fmt: skip
     g = r.goals[0]
-    success = g["collisions"] == 0 and g["final_error_m"] is not None and g["final_error_m"] <= SUCCESS_M
-    missed = "missed" if g["outcome"] == "succeeded" else g["outcome"]  # move_base's tolerance is not BARN's
-    failure = "" if success else ("collision" if g["collisions"] else missed)
     return rounded({
-        "world": world.name, "difficulty": world.difficulty, "success": success, "failure": failure,
-        "reason": g["reason"], "time_s": g["time_s"], "t_opt_s": world.t_opt(),
-        "score": barn_score(success, g["time_s"], world.t_opt()), "collisions": g["collisions"],
+        **barn_outcome(world, [g]), "reason": g["reason"], "time_s": g["time_s"], "collisions": g["collisions"],
         "path_m": g["path_m"], "min_clearance_m": g["min_clearance_m"], "wall_s": r.summary["wall_s"],
     })  # fmt: skip
+
+
+def barn_outcome(world: Any, goals: list[dict[str, Any]]) -> dict[str, Any]:
+    """BARN's judgement of a drive through ``world`` (its goals' figures from ``run_navigation``): success (the
+    last goal ended within 1 m, no collision on the way), failure, score, T_opt, the world and its difficulty."""
+    from navlab.world.clutter import barn_score
+
+    g = goals[-1]
+    collisions = sum(x["collisions"] for x in goals)
+    time_s = sum(x["time_s"] for x in goals)
+    success = collisions == 0 and g["final_error_m"] is not None and g["final_error_m"] <= SUCCESS_M
+    missed = "missed" if g["outcome"] == "succeeded" else g["outcome"]  # move_base's tolerance is not BARN's
+    failure = "" if success else ("collision" if collisions else missed)
+    return {"world": world.name, "difficulty": world.difficulty, "success": success, "failure": failure,
+            "t_opt_s": world.t_opt(), "score": barn_score(success, time_s, world.t_opt())}  # fmt: skip
+
+
+def clutter_for_trial(world: str, index: int) -> Any:
+    """The generated world of trial ``index`` for a scenario's ``world`` (``clutter:...`` the same world every
+    trial; ``clutter_suite:n=N,seed=S`` world ``index mod N`` of ``clutter_suite(N, S)``), None for a file."""
+    from navlab.experiments.scenario import clutter_world_spec
+    from navlab.world.clutter import generate_clutter, suite_parameters
+
+    spec = clutter_world_spec(world)
+    if spec is None:
+        return None
+    if spec["kind"] == "clutter":
+        return generate_clutter(spec.get("seed", 0), fill=spec["fill"], smooth=spec["smooth"])
+    n, k = spec.get("n", 50), index % spec.get("n", 50)
+    fill, smooth = suite_parameters(n)[k]
+    return generate_clutter(spec.get("seed", 0) * 1000 + k, fill=fill, smooth=smooth)  # as clutter_suite(n, seed)
 
 
 def run_clutter_suite(

@@ -2,7 +2,10 @@
 
 ```yaml
 name: obstacles_after_mapping
-world: room_obstacles        # shipped name or .world file (relative paths: beside this file)
+world: room_obstacles        # shipped name or .world file (relative paths: beside this file), or generated:
+                             #   "clutter:seed=3,fill=0.3,smooth=2" one BARN-style clutter world (world.clutter),
+                             #   "clutter_suite:n=50,seed=0" trial i drives world i (mod n) of the graded suite;
+                             #   clutter worlds are mapless, start and goal (10 m ahead, in odom) are the world's
 map: map_first               # true (the world's true map) | map_first (SLAM in map_world first) | none | FILE
 map_world: room              # the world mapped first: the obstacles come after mapping
 robot: mybot
@@ -11,6 +14,8 @@ controller: trajectory       # trajectory | dwa | mppi | a ROS plugin name (defa
 params: null                 # folder of move_base's ROS 1 parameter files (default: the shipped robot's)
 overrides: {local_costmap.update_frequency: 5.0}   # move_base parameters
 obstacles: [{t: 20.0, spec: "cylinder:x=-1.0,y=-0.45,radius=0.15,length=0.6"}]   # added while running
+#   t: [lo, hi] draws the time per trial (from the trial's seed); frame: robot places x, y (and yaw) in the
+#   robot's frame at that time (e.g. x=0.7: 0.7 m ahead of it), frame: world (default) in the world
 goals: [[4.3, 1.0, 0.0], [-3.5, -0.5, 3.14]]      # map frame (odom with map: none)
 trials: 20                   # trial k runs with seed + k
 seed: 0
@@ -33,6 +38,7 @@ from typing import Any
 from navlab.experiments.errors import ExperimentError
 
 MAP_MODES = ("true", "map_first", "none")
+CLUTTER_KEYS = {"clutter": {"seed": int, "fill": float, "smooth": int}, "clutter_suite": {"n": int, "seed": int}}
 
 
 @dataclass
@@ -83,6 +89,55 @@ def _pose(value: Any, where: str) -> tuple[float, float, float]:
     return x, y, yaw
 
 
+def _time(t: Any, where: str) -> float:
+    if isinstance(t, bool) or not (isinstance(t, int | float) and math.isfinite(t) and t >= 0):
+        raise ExperimentError(f"{where}: expected a time >= 0 s, got {t!r}")
+    return float(t)
+
+
+def _obstacle(ob: Any, where: str) -> dict[str, Any]:
+    """``{t, spec[, frame]}`` with ``t`` seconds or ``[lo, hi]`` and ``frame`` world (default) or robot."""
+    if not isinstance(ob, dict) or not {"t", "spec"} <= set(ob) <= {"t", "spec", "frame"} or \
+            not isinstance(ob["spec"], str):  # fmt: skip
+        raise ExperimentError(f"{where}: expected {{t: seconds, spec: 'cylinder:x=..,y=..'[, frame: world|robot]}}, "
+                              f"got {ob!r}")  # fmt: skip
+    t = ob["t"]
+    if isinstance(t, list):
+        if len(t) != 2 or _time(t[0], f"{where}.t") > _time(t[1], f"{where}.t"):
+            raise ExperimentError(f"{where}.t: expected seconds or [lo, hi] with lo <= hi, got {t!r}")
+    else:
+        _time(t, f"{where}.t")
+    if ob.get("frame", "world") not in ("world", "robot"):
+        raise ExperimentError(f"{where}.frame: expected world or robot, got {ob['frame']!r}")
+    return dict(ob)
+
+
+def clutter_world_spec(world: str, *, where: str = "world") -> dict[str, Any] | None:
+    """``{"kind": "clutter" | "clutter_suite", ...options}`` for a generated clutter world (see the module
+    docstring), None for a file or shipped name."""
+    kind, sep, rest = world.partition(":")
+    if not sep or kind not in CLUTTER_KEYS:
+        return None
+    spec: dict[str, Any] = {"kind": kind}
+    for item in filter(None, (p.strip() for p in rest.split(","))):
+        key, eq, value = item.partition("=")
+        types = CLUTTER_KEYS[kind]
+        if not eq or key not in types:
+            close = difflib.get_close_matches(key, list(types), n=1)
+            hint = f"; did you mean '{close[0]}'?" if close else ""
+            raise ExperimentError(f"{where}: {world!r}: {item!r} is not one of {', '.join(types)}=value{hint}")
+        try:
+            spec[key] = types[key](value)
+        except ValueError:
+            raise ExperimentError(f"{where}: {world!r}: {key}={value!r} is not {types[key].__name__}") from None
+    if kind == "clutter" and not {"fill", "smooth"} <= set(spec):
+        raise ExperimentError(f"{where}: {world!r}: clutter needs fill=0..1 and smooth=rounds (seed=S optional)")
+    if not 0.0 <= spec.get("fill", 0.0) <= 1.0 or min(spec.get("smooth", 0), spec.get("seed", 0)) < 0 or \
+            spec.get("n", 1) < 1:  # fmt: skip
+        raise ExperimentError(f"{where}: {world!r}: expected fill in [0, 1], smooth and seed >= 0, n >= 1")
+    return spec
+
+
 def scenario_from_dict(data: Any, *, where: str = "scenario", path: Path | None = None) -> Scenario:
     """A validated ``Scenario`` from parsed YAML."""
     if not isinstance(data, dict):
@@ -109,6 +164,13 @@ def scenario_from_dict(data: Any, *, where: str = "scenario", path: Path | None 
     if "start" in data:
         sc.start = _pose(data["start"], f"{where}: start")
     goals = data.get("goals")
+    clutter = clutter_world_spec(sc.world, where=f"{where}: world")
+    if clutter is not None:
+        if "start" in data or data.get("map", "none") != "none":
+            raise ExperimentError(f"{where}: a clutter world sets its own start and is mapless: leave out 'start' "
+                                  "and 'map' (or write map: none)")  # fmt: skip
+        sc.map = "none"
+        goals = goals if goals is not None else [[10.0, 0.0, 0.0]]  # the world's goal, in odom (= the start)
     if not isinstance(goals, list) or not goals:
         raise ExperimentError(f"{where}: goals: expected a list of [x, y, yaw], got {goals!r}")
     sc.goals = [_pose(g, f"{where}: goals[{k}]") for k, g in enumerate(goals)]
@@ -116,14 +178,10 @@ def scenario_from_dict(data: Any, *, where: str = "scenario", path: Path | None 
     if not isinstance(overrides, dict):
         raise ExperimentError(f"{where}: overrides: expected a mapping of move_base parameters, got {overrides!r}")
     sc.overrides = dict(overrides)
-    for k, ob in enumerate(data.get("obstacles") or []):
-        if not isinstance(ob, dict) or set(ob) != {"t", "spec"} or not isinstance(ob["spec"], str):
-            raise ExperimentError(f"{where}: obstacles[{k}]: expected {{t: seconds, spec: 'cylinder:x=..,y=..'}}, "
-                                  f"got {ob!r}")  # fmt: skip
-        t = ob["t"]
-        if isinstance(t, bool) or not (isinstance(t, int | float) and math.isfinite(t) and t >= 0):
-            raise ExperimentError(f"{where}: obstacles[{k}].t: expected a time >= 0 s, got {ob['t']!r}")
-        sc.obstacles.append(dict(ob))
+    obstacles = data.get("obstacles") or []
+    if not isinstance(obstacles, list):
+        raise ExperimentError(f"{where}: obstacles: expected a list of {{t: seconds, spec: ...}}, got {obstacles!r}")
+    sc.obstacles = [_obstacle(ob, f"{where}: obstacles[{k}]") for k, ob in enumerate(obstacles)]
     for key, low in (("trials", 1), ("seed", 0)):
         if key in data:
             v = data[key]

@@ -2,7 +2,9 @@
 
 Each combination runs as its own experiment in ``DIR/<name>=<value>,...`` (resumable like any experiment).
 ``DIR/sweep.csv`` and ``DIR/sweep.md`` hold one row per combination (success with its Wilson interval,
-collisions, median time), and ``DIR/<param>.png`` plots success, collisions and time against each parameter.
+collisions, median time; BARN's mean score in clutter worlds), and ``DIR/<param>.png`` plots them against each
+parameter. All trials of all combinations share the workers: local processes, or Ray tasks
+(``backend="ray"``, see ``backends``), with identical results for the same seeds.
 Parameter names are move_base parameters (``local_costmap.update_frequency``, ``max_vel_x`` for the local
 planner's section is written ``TrajectoryPlannerROS.max_vel_x``) or the scenario's ``controller``.
 """
@@ -98,7 +100,8 @@ def plot_sweep(rows: list[dict[str, Any]], names: list[str], folder: Path) -> li
     out = []
     for name in names:
         values = sorted({r[name] for r in rows}, key=str)
-        fig, axes = plt.subplots(1, 3, figsize=(13, 3.6))
+        score = any(r.get("score_mean") is not None for r in rows)  # BARN's score in clutter worlds
+        fig, axes = plt.subplots(1, 4 if score else 3, figsize=(17 if score else 13, 3.6))
         for others, group in itertools.groupby(sorted(rows, key=lambda r: str([r[n] for n in names if n != name])),
                                                key=lambda r: [r[n] for n in names if n != name]):  # fmt: skip
             g = sorted(group, key=lambda r: values.index(r[name]))
@@ -110,7 +113,10 @@ def plot_sweep(rows: list[dict[str, Any]], names: list[str], folder: Path) -> li
                              marker="o", capsize=3, label=label)  # fmt: skip
             axes[1].plot(xs, [r["collisions"] for r in g], marker="o", label=label)
             axes[2].plot(xs, [r["median_time_s"] for r in g], marker="o", label=label)
-        for ax, title in zip(axes, ("success rate (95 % CI)", "collisions", "median time (s)"), strict=True):
+            if score:
+                axes[3].plot(xs, [r.get("score_mean") for r in g], marker="o", label=label)
+        titles = ("success rate (95 % CI)", "collisions", "median time (s)", "mean BARN score")
+        for ax, title in zip(axes, titles, strict=False):
             ax.set_xticks(range(len(values)), [str(v) for v in values])
             ax.set_xlabel(name)
             ax.set_title(title)

@@ -55,27 +55,54 @@ def shortest_length(world: str, start: tuple[float, float, float], goals: list[t
     return total
 
 
+def _spawns(sc: Scenario, seed: int) -> list[tuple[float, Any]]:
+    """The scenario's obstacles as ``run_navigation``'s (time s, model or function of the simulation): a
+    ``[lo, hi]`` time drawn from ``seed``; ``frame: robot`` placed from the robot's true pose at that time."""
+    from dataclasses import replace
+
+    from navlab.geometry import compose2
+    from navlab.sim.spawn import parse_spawn_spec
+
+    rng = np.random.default_rng([seed, 0x0B57])  # its own stream: the run's seed stays the simulator's
+    out: list[tuple[float, Any]] = []
+    for k, ob in enumerate(sc.obstacles):
+        model = parse_spawn_spec(ob["spec"], default_name=f"obstacle_{k}")[0]
+        t = float(rng.uniform(*ob["t"])) if isinstance(ob["t"], list) else float(ob["t"])
+        if ob.get("frame", "world") == "robot":
+            def place(sim: Any, m: Any = model) -> Any:
+                x, y, yaw = compose2(sim.base_pose2d(), (m.pose[0], m.pose[1], m.pose[5]))
+                return replace(m, pose=(x, y, m.pose[2], m.pose[3], m.pose[4], yaw))
+
+            out.append((t, place))
+        else:
+            out.append((t, model))
+    return out
+
+
 def run_trial(sc: Scenario, index: int) -> dict[str, Any]:
-    """Trial ``index`` of ``sc`` (seed = sc.seed + index); its figures."""
+    """Trial ``index`` of ``sc`` (seed = sc.seed + index); its figures (plus BARN's in a clutter world)."""
+    from navlab.experiments.clutter_run import CLUTTER_PARAMS, barn_outcome, clutter_for_trial
     from navlab.experiments.mapping_run import run_mapping
     from navlab.experiments.navigate_run import run_navigation
-    from navlab.sim.spawn import parse_spawn_spec
 
     seed = sc.seed + index
     world = sc.resolve(sc.world) or sc.world
-    spawns = [(float(ob["t"]), parse_spawn_spec(ob["spec"], default_name=f"obstacle_{k}")[0])
-              for k, ob in enumerate(sc.obstacles)]  # fmt: skip
+    clutter = clutter_for_trial(sc.world, index)
+    start, overrides = sc.start, sc.overrides
     with tempfile.TemporaryDirectory(prefix="navlab-trial-") as tmp:
         map_yaml: str | Path | None = None
+        if clutter is not None:
+            world = str(clutter.write_world(Path(tmp) / f"{clutter.name}.world"))
+            start, overrides = clutter.start, {**CLUTTER_PARAMS, **sc.overrides}
         if sc.map == "map_first":
             mapped = run_mapping(world=sc.resolve(sc.map_world) or sc.map_world or world, robot=sc.robot,
-                                 pose=sc.start, out=Path(tmp) / "map", seed=seed, quiet=True)  # fmt: skip
+                                 pose=start, out=Path(tmp) / "map", seed=seed, quiet=True)  # fmt: skip
             map_yaml = mapped.map_yaml
         elif sc.map not in ("true", "none"):
             map_yaml = sc.resolve(sc.map)
-        r = run_navigation(sc.goals, world=world, map_yaml=map_yaml, robot=sc.robot, pose=sc.start,
-                           controller=sc.controller, params_dir=sc.resolve(sc.params), move_base_params=sc.overrides,
-                           spawn=spawns, goal_timeout=sc.time_limit, seed=seed, mapless=sc.map == "none",
+        r = run_navigation(sc.goals, world=world, map_yaml=map_yaml, robot=sc.robot, pose=start,
+                           controller=sc.controller, params_dir=sc.resolve(sc.params), move_base_params=overrides,
+                           spawn=_spawns(sc, seed), goal_timeout=sc.time_limit, seed=seed, mapless=sc.map == "none",
                            **sc.navigation_options())  # fmt: skip
     goals = r.goals
     failed = next((g for g in goals if g["outcome"] != "succeeded" or g["collisions"]), None)
@@ -83,6 +110,11 @@ def run_trial(sc: Scenario, index: int) -> dict[str, Any]:
     failure = "" if failed is None else ("collision" if failed["collisions"] else failed["outcome"])
     path_m = sum(g["path_m"] for g in goals)
     shortest = shortest_length(world, sc.start, sc.goals) if sc.map != "none" else None
+    barn: dict[str, Any] = {}
+    if clutter is not None:
+        barn = barn_outcome(clutter, goals)
+        success, failure = barn.pop("success"), barn.pop("failure")
+        shortest = clutter.reference_path_m if len(goals) == 1 else None
     spl = (float(success) * shortest / max(path_m, shortest)) if shortest else None
     return rounded({
         "trial": index, "seed": seed, "success": success, "failure": failure,
@@ -94,7 +126,7 @@ def run_trial(sc: Scenario, index: int) -> dict[str, Any]:
         "localization_error_max_m": r.summary.get("localization_error_max_m"),
         "cmd_jerk_mean": r.summary.get("cmd_jerk_mean"), "sim_s": r.summary["sim_s"], "wall_s": r.summary["wall_s"],
         "tracking_error_m": _mean(goals, "tracking_error_m"), "final_error_m": _mean(goals, "final_error_m"),
-        "per_goal": goals,
+        **barn, "per_goal": goals,
     })  # fmt: skip
 
 

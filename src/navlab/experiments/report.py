@@ -1,0 +1,258 @@
+"""``navlab report DIR``: a results folder re-rendered as ``report.md``, PNG figures and one self-contained
+``report.html`` (every image inlined as a base64 data URI, no external link: it opens anywhere, offline).
+
+The folder is one of: an experiment run (``results.jsonl``, from ``navlab experiment run``), a sweep
+(``sweep.csv`` and one run folder per combination, from ``navlab experiment sweep``) or a demo report
+(``report.json``, from ``navlab demo``). A report is a list of blocks — headings, paragraphs, tables and
+images — written once as Markdown and once as HTML.
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from navlab.experiments.errors import ExperimentError
+
+TRIAL_COLUMNS = ("trial", "seed", "success", "failure", "time_s", "path_m", "spl", "min_clearance_m", "collisions",
+                 "localization_error_mean_m", "score", "world")  # fmt: skip
+
+
+@dataclass
+class Report:
+    """A report's title and blocks: ``("h", text)``, ``("p", text)``, ``("table", header, rows)``,
+    ``("img", path, caption)`` (paths relative to the folder)."""
+
+    title: str
+    blocks: list[tuple[Any, ...]] = field(default_factory=list)
+
+    def heading(self, text: str) -> None:
+        """A section heading."""
+        self.blocks.append(("h", text))
+
+    def text(self, text: str) -> None:
+        """A paragraph."""
+        self.blocks.append(("p", text))
+
+    def table(self, header: list[str], rows: list[list[Any]]) -> None:
+        """A table of cells (numbers, strings, lists)."""
+        self.blocks.append(("table", header, rows))
+
+    def image(self, path: str, caption: str) -> None:
+        """A PNG in the folder."""
+        self.blocks.append(("img", path, caption))
+
+
+def _cell(v: Any) -> str:
+    if isinstance(v, list | tuple):
+        return "[" + ", ".join(_cell(x) for x in v) + "]"
+    if isinstance(v, float):
+        return f"{v:.4g}"
+    if isinstance(v, dict):
+        return ", ".join(f"{k}: {_cell(x)}" for k, x in v.items()) or "-"
+    return "-" if v is None or v == "" else str(v)
+
+
+def to_markdown(rep: Report) -> str:
+    """The report as Markdown (images linked by their relative paths)."""
+    out = [f"# {rep.title}", ""]
+    for block in rep.blocks:
+        kind = block[0]
+        if kind == "h":
+            out += [f"## {block[1]}", ""]
+        elif kind == "p":
+            out += [block[1], ""]
+        elif kind == "table":
+            header, rows = block[1], block[2]
+            out += ["| " + " | ".join(header) + " |", "|" + " --- |" * len(header)]
+            out += ["| " + " | ".join(_cell(c).replace("|", "/") for c in row) + " |" for row in rows] + [""]
+        else:
+            out += [f"![{block[2]}]({block[1]})", ""]
+    return "\n".join(out)
+
+
+def to_html(rep: Report, folder: Path) -> str:
+    """The report as one HTML page with its images inlined (data URIs): nothing outside the file is needed."""
+    e = html.escape
+    body = [f"<h1>{e(rep.title)}</h1>"]
+    for block in rep.blocks:
+        kind = block[0]
+        if kind == "h":
+            body.append(f"<h2>{e(block[1])}</h2>")
+        elif kind == "p":
+            body.append(f"<p>{e(block[1]).replace('`', '')}</p>")
+        elif kind == "table":
+            head = "".join(f"<th>{e(h)}</th>" for h in block[1])
+            rows = "".join("<tr>" + "".join(f"<td>{e(_cell(c))}</td>" for c in row) + "</tr>" for row in block[2])
+            body.append(f"<table><thead><tr>{head}</tr></thead><tbody>{rows}</tbody></table>")
+        else:
+            data = base64.b64encode((folder / block[1]).read_bytes()).decode("ascii")
+            body.append(f'<figure><img alt="{e(block[2])}" src="data:image/png;base64,{data}">'
+                        f"<figcaption>{e(block[2])}</figcaption></figure>")  # fmt: skip
+    style = ("body{font-family:sans-serif;max-width:1200px;margin:2em auto;padding:0 1em;color:#222}"
+             "table{border-collapse:collapse;margin:1em 0;font-size:90%}td,th{border:1px solid #bbb;padding:3px 8px;"
+             "text-align:right}th{background:#eee}img{max-width:100%}figcaption{color:#555;font-size:90%}")  # fmt: skip
+    return ("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
+            f"<title>{e(rep.title)}</title><style>{style}</style></head>\n<body>\n" + "\n".join(body)
+            + "\n</body></html>\n")  # fmt: skip
+
+
+def folder_kind(folder: Path) -> str:
+    """``sweep``, ``run`` or ``demo``, from the files the folder holds."""
+    if (folder / "sweep.csv").is_file():
+        return "sweep"
+    if (folder / "results.jsonl").is_file():
+        return "run"
+    if (folder / "report.json").is_file():
+        return "demo"
+    raise ExperimentError(f"{folder}: not a results folder (expected results.jsonl from `navlab experiment run`, "
+                          "sweep.csv from `navlab experiment sweep` or report.json from `navlab demo`)")  # fmt: skip
+
+
+def render_report(folder: str | Path) -> dict[str, Any]:
+    """Re-render ``folder``'s report: ``report.md``, its PNG figures and ``report.html``; returns what it wrote."""
+    from navlab.io.files import write_text_atomic
+
+    folder = Path(folder)
+    if not folder.is_dir():
+        raise ExperimentError(f"{folder}: no such results folder")
+    kind = folder_kind(folder)
+    rep = {"sweep": _sweep_report, "run": _run_report, "demo": _demo_report}[kind](folder)
+    write_text_atomic(folder / "report.md", to_markdown(rep))
+    write_text_atomic(folder / "report.html", to_html(rep, folder))
+    figures = [b[1] for b in rep.blocks if b[0] == "img"]
+    return {"kind": kind, "markdown": str(folder / "report.md"), "html": str(folder / "report.html"),
+            "figures": [str(folder / f) for f in figures]}  # fmt: skip
+
+
+# ----------------------------------------------------------------------------------------------- runs
+def _summary_rows(summary: dict[str, Any]) -> list[list[Any]]:
+    return [[k, v] for k, v in summary.items() if k != "scenario"]
+
+
+def _run_report(folder: Path) -> Report:
+    from navlab.experiments.trials import read_results, summarize_trials
+
+    results = sorted(read_results(folder / "results.jsonl"), key=lambda r: int(r["trial"]))
+    if not results:
+        raise ExperimentError(f"{folder}/results.jsonl: no finished trial to report")
+    name = _scenario_name(folder)
+    summary = summarize_trials(results)
+    rep = Report(f"Experiment {name}: {len(results)} trials")
+    ok = sum(bool(r["success"]) for r in results)
+    lo, hi = summary["success_ci95"]
+    rep.text(f"{ok} of {len(results)} trials succeeded ({ok / len(results):.0%}, 95 % Wilson interval "
+             f"{lo:.0%}–{hi:.0%}); {summary['collisions']} collisions.")  # fmt: skip
+    rep.heading("Summary")
+    rep.table(["figure", "value"], _summary_rows(summary))
+    rep.heading("Trials")
+    plot_trials(results, folder / "trials.png", title=name)
+    rep.image("trials.png", "time to goal per trial (green: success, red: failure) and minimum clearance")
+    cols = [c for c in TRIAL_COLUMNS if any(c in r for r in results)]
+    rep.table(cols, [[r.get(c) for c in cols] for r in results])
+    return rep
+
+
+def _scenario_name(folder: Path) -> str:
+    try:
+        return str(json.loads((folder / "summary.json").read_text())["scenario"])
+    except (OSError, ValueError, KeyError):
+        return folder.name
+
+
+def plot_trials(results: list[dict[str, Any]], path: Path, *, title: str = "") -> Path:
+    """Two panels against the trial number: time (s) coloured by outcome, and minimum clearance (m)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.ticker import MaxNLocator
+
+    from navlab.io.files import save_figure_atomic
+
+    trials = [int(r["trial"]) for r in results]
+    colours = ["tab:green" if r["success"] else "tab:red" for r in results]
+    fig, (a, b) = plt.subplots(1, 2, figsize=(12, 3.6))
+    a.bar(trials, [r.get("time_s") or 0.0 for r in results], color=colours)
+    for ax in (a, b):
+        ax.xaxis.set_major_locator(MaxNLocator(integer=True))
+    a.set_xlabel("trial")
+    a.set_ylabel("time (s)")
+    a.set_title(f"{title}: time to goal" if title else "time to goal")
+    b.plot(trials, [r.get("min_clearance_m") for r in results], "o-", color="tab:blue")
+    b.axhline(0.0, color="k", lw=0.8)
+    b.set_xlabel("trial")
+    b.set_ylabel("minimum clearance (m)")
+    b.set_title("closest approach to an obstacle")
+    fig.tight_layout()
+    try:
+        save_figure_atomic(fig, path, dpi=100)
+    finally:
+        plt.close(fig)
+    return path
+
+
+# --------------------------------------------------------------------------------------------- sweeps
+def _sweep_report(folder: Path) -> Report:
+    import yaml
+
+    from navlab.experiments.sweep import COLUMNS, plot_sweep
+
+    lines = (folder / "sweep.csv").read_text().splitlines()
+    header = lines[0].split(",")
+    names = header[: next((k for k, h in enumerate(header) if h in COLUMNS), len(header))]
+    rows = []
+    for line in lines[1:]:
+        cells = line.split(",")
+        row: dict[str, Any] = {}
+        for h, c in zip(header, cells, strict=False):
+            value = None if c in ("", "None") else yaml.safe_load(c)
+            row[h] = [float(x) for x in c.split("/")] if h == "success_ci95" and c not in ("", "None") else value
+        rows.append(row)
+    rep = Report(f"Sweep of {', '.join(names)} ({len(rows)} combinations)")
+    rep.text(f"Folder `{folder}`: one experiment per combination, in the subfolders named after it.")
+    rep.heading("Table")
+    rep.table(header, [[r.get(h) for h in header] for r in rows])
+    rep.heading("Figures")
+    for path in plot_sweep(rows, names, folder):
+        rep.image(path.name, f"success (95 % CI), collisions and median time against {path.stem}")
+    failures = []
+    for sub in sorted(p for p in folder.iterdir() if (p / "summary.json").is_file()):
+        s = json.loads((sub / "summary.json").read_text())
+        failures.append([sub.name, s.get("trials"), s.get("failures") or {}])
+    if failures:
+        rep.heading("Failures by kind")
+        rep.table(["combination", "trials", "failures"], failures)
+    return rep
+
+
+# ----------------------------------------------------------------------------------------------- demo
+def _demo_report(folder: Path) -> Report:
+    data = json.loads((folder / "report.json").read_text())
+    rep = Report("navlab demo: the paper's pipeline in simulation")
+    if "wall_s" in data:
+        rep.text(f"Total {data['wall_s']} s wall.")
+    pictures = {"mapping": ["map.png"], "localization": ["localize.png"]}
+    for section, figures in data.items():
+        if not isinstance(figures, dict):
+            continue
+        rep.heading(section.capitalize())
+        goals = figures.get("goals") if isinstance(figures.get("goals"), list) else []
+        rep.table(["figure", "value"], [[k, v] for k, v in figures.items() if k != "goals" and k != "picture"])
+        for png in pictures.get(section, []):
+            if (folder / png).is_file():
+                rep.image(png, section)
+        if goals:
+            cols = ["goal", "outcome", "time_s", "path_m", "min_clearance_m", "collisions", "reason"]
+            rep.table(cols, [[g.get(c) for c in cols] for g in goals])
+            for k, g in enumerate(goals, 1):
+                png = Path("navigate") / f"goal_{k}.png"
+                if (folder / png).is_file():
+                    rep.image(str(png), f"goal {k} {g.get('goal')}: {g.get('outcome')}")
+    if (folder / "world.png").is_file():
+        rep.image("world.png", "the robot in its world")
+    return rep
