@@ -130,3 +130,40 @@ def plot_sweep(rows: list[dict[str, Any]], names: list[str], folder: Path) -> li
             plt.close(fig)
         out.append(path)
     return out
+
+
+def bench(args: Any) -> dict[str, Any]:
+    """``navlab bench sweep``: wall time of one small sweep (2 combinations x 2 trials in the empty room) with 1
+    local worker, 2 local workers and 2 CPUs of a local Ray instance (started before timing: ``ray_start_s``)."""
+    import os
+    import tempfile
+    import time
+
+    from navlab.experiments.backends import _import_ray, init_ray
+    from navlab.experiments.scenario import scenario_from_dict
+    from navlab.experiments.trials import run_trial
+
+    sc = scenario_from_dict({"name": "bench_sweep", "world": "room", "goals": [[3.0, 1.0, 0.0]], "trials": 2,
+                             "seed": int(getattr(args, "seed", 0) or 0), "time_limit": 60})  # fmt: skip
+    params = {"controller": ["trajectory", "dwa"]}
+    run_trial(sc, 0)  # warm-up: Numba's caches, imports
+    out: dict[str, Any] = {"trials": 4, "cpus": os.cpu_count(), "load_1min": round(os.getloadavg()[0], 2)}
+    with tempfile.TemporaryDirectory(prefix="navlab-bench-sweep-") as tmp:
+        for key, workers, backend in (("workers_1_s", 1, "local"), ("workers_2_s", 2, "local")):
+            t0 = time.perf_counter()
+            run_sweep(sc, params, Path(tmp) / key, workers=workers, backend=backend)
+            out[key] = round(time.perf_counter() - t0, 2)
+        ray = _import_ray()
+        os.environ.pop("RAY_ADDRESS", None)  # a local instance: the figure is about this machine
+        t0 = time.perf_counter()
+        init_ray(ray, 2)
+        out["ray_start_s"] = round(time.perf_counter() - t0, 2)
+        try:
+            t0 = time.perf_counter()
+            run_sweep(sc, params, Path(tmp) / "ray", workers=2, backend="ray")
+            out["ray_2_s"] = round(time.perf_counter() - t0, 2)
+        finally:
+            ray.shutdown()
+    out["speedup_2"] = round(out["workers_1_s"] / out["workers_2_s"], 2)
+    out["speedup_ray"] = round(out["workers_1_s"] / out["ray_2_s"], 2)
+    return out
