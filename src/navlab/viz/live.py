@@ -33,6 +33,7 @@ INITIALPOSE_COV = (0.25, 0.25, 0.0, 0.0, 0.0, 0.06853891945200942)
 KINDS = {msgs.OccupancyGrid: "grid", msgs.LaserScan: "scan", msgs.Path: "path", msgs.PoseArray: "poses",
          msgs.PolygonStamped: "polygon"}  # fmt: skip
 PEEK_PERIOD = 0.2  # wall-clock s between copies of the plans and the particle cloud
+ALL_FRAMES_PERIOD = 0.5  # wall-clock s between poses of every tf frame (the others: every snapshot)
 SPEEDS = (0.0, 0.5, 1.0, 2.0, 5.0)  # 0 = as fast as possible
 
 
@@ -132,6 +133,7 @@ class ViewerNode(Node):
         self._counts: dict[str, tuple[int, int]] = {}  # topic -> (count, t_ns) at the last graph
         self._direct: dict[str, tuple[str, Any]] | None = None
         self._last_peek = -1e9
+        self._last_all_frames = -1e9
         self._discover()
         self.create_timer(float(self.declare_parameter("pace_period", 0.01)), self._tick, priority=-10)
         self.create_timer(float(self.declare_parameter("graph_period", 1.0)), self._on_graph_timer)
@@ -229,7 +231,10 @@ class ViewerNode(Node):
             self._rtf_mark = (ex.now_ns, wall)
         fixed = self._fixed()
         tf = {}
-        for frame in ex.tf.frames():
+        every = wall - self._last_all_frames >= ALL_FRAMES_PERIOD  # the tf display's other frames, now and then
+        if every:
+            self._last_all_frames = wall
+        for frame in ex.tf.frames() if every else self._drawn_frames(fixed):
             try:
                 tf[frame] = [round(v, 4) for v in ex.tf.lookup_pose2d(fixed, frame)]
             except TfError:
@@ -249,6 +254,15 @@ class ViewerNode(Node):
             return [round(v, 5) for v in self.executor.tf.lookup_pose2d_or_latest(self._fixed(), frame, t_ns)]
         except TfError:
             return None
+
+    def _drawn_frames(self, fixed: str) -> set[str]:
+        """The frames the page places something in: the fixed and base frames, and every stream's frame."""
+        frames = {fixed, self._base(), "odom"}
+        for slot in list(self.hub.slots.values()):
+            frames.add(slot.frame or str(getattr(getattr(slot.msg, "header", None), "frame_id", "")).lstrip("/"))
+        frames.update(tr.frame for tr in list(self.hub.traces.values()))
+        frames.discard("")
+        return frames
 
     def _fixed(self) -> str:
         if self.fixed_frame:
