@@ -8,7 +8,8 @@ A furnished world has dozens of concave meshes, and CoACD at its default effort 
 shelf, so the first load of such a world was a long wait. Here:
 
 - the effort is bounded (``EFFORTS["bounded"]``: a coarser voxel pre-pass and a shallower tree
-  search than CoACD's defaults; about 6x less CPU per mesh, the notches stay free);
+  search than CoACD's defaults; about 5x less CPU per mesh, the notches stay free;
+  ``NAVLAB_DECOMPOSE_EFFORT=full`` restores CoACD's defaults);
 - :func:`decompose_world` decomposes every uncached concave mesh of a world before the scene is
   built, in parallel worker processes, with a progress bar and its time estimate (tqdm's, on a
   terminal);
@@ -40,7 +41,7 @@ EFFORTS: dict[str, dict[str, Any]] = {
     "bounded": {"preprocess_resolution": 30, "resolution": 500, "mcts_nodes": 6, "mcts_iterations": 20,
                 "mcts_max_depth": 2},
 }
-DEFAULT_EFFORT = "bounded"
+DEFAULT_EFFORT = "bounded"  # unless $NAVLAB_DECOMPOSE_EFFORT names another of EFFORTS
 _VERSION = "1"  # bump when the way parts are computed changes (invalidates the cache)
 
 Parts = list[tuple[np.ndarray, np.ndarray]]
@@ -61,6 +62,11 @@ def weld(verts: np.ndarray, faces: np.ndarray, tol: float = 1e-9) -> tuple[np.nd
     return verts[index], inverse.reshape(-1)[faces]
 
 
+def default_effort() -> str:
+    """``$NAVLAB_DECOMPOSE_EFFORT`` (``bounded`` or ``full``), else :data:`DEFAULT_EFFORT`."""
+    return os.environ.get("NAVLAB_DECOMPOSE_EFFORT", "").strip() or DEFAULT_EFFORT
+
+
 def _options(effort: str, threshold: float) -> dict[str, Any]:
     if effort not in EFFORTS:
         raise SimError(f"convex decomposition effort {effort!r}: expected one of {', '.join(EFFORTS)}")
@@ -68,8 +74,10 @@ def _options(effort: str, threshold: float) -> dict[str, Any]:
 
 
 def cache_file(path: Path, scale: tuple[float, float, float] = (1.0, 1.0, 1.0), *, threshold: float = THRESHOLD,
-               seed: int = 0, effort: str = DEFAULT_EFFORT) -> Path:
-    """Where the parts of this mesh (by content), scale and options are cached."""
+               seed: int = 0, effort: str | None = None) -> Path:
+    """Where the parts of this mesh (by content), scale and options are cached (``effort`` None:
+    :func:`default_effort`)."""
+    effort = effort or default_effort()
     try:
         data = Path(path).read_bytes()
     except OSError as exc:
@@ -115,12 +123,13 @@ def _store(cached: Path, parts: Parts) -> None:
 
 def convex_parts(
     path: Path, scale: tuple[float, float, float] = (1.0, 1.0, 1.0), *, threshold: float = THRESHOLD,
-    seed: int = 0, effort: str = DEFAULT_EFFORT,
+    seed: int = 0, effort: str | None = None,
 ) -> Parts:
     """Convex parts (vertices (n, 3) in m, triangles (m, 3)) of the mesh file scaled by ``scale``.
 
     Results are cached under the navlab cache directory, keyed by the file's bytes and the options.
     """
+    effort = effort or default_effort()
     cached = cache_file(path, scale, threshold=threshold, seed=seed, effort=effort)
     if cached.is_file():
         return _load(cached)
@@ -161,10 +170,11 @@ def default_workers() -> int:
 
 def decompose_meshes(meshes: Sequence[MeshKey] | Iterable[MeshKey], *, workers: int | None = None,
                      progress: bool | None = None, threshold: float = THRESHOLD, seed: int = 0,
-                     effort: str = DEFAULT_EFFORT) -> int:
+                     effort: str | None = None) -> int:
     """Fill the cache for every (mesh, scale) not in it yet, ``workers`` processes at a time (default:
     :func:`default_workers`), with a progress bar and time estimate (``progress`` None: on a terminal).
     Returns how many meshes were decomposed."""
+    effort = effort or default_effort()
     todo = [(p, s) for p, s in meshes
             if not cache_file(p, s, threshold=threshold, seed=seed, effort=effort).is_file()]
     if not todo:

@@ -1,7 +1,8 @@
 """``navlab bench decompose``: the first load of a furnished world (many concave meshes) before and
 after issue 13, on a generated world, each with a cold cache.
 
-- ``before``: CoACD at its default effort, one mesh after another (navlab before issue 13);
+- ``before``: CoACD at its default effort, one mesh after another in this process (navlab before
+  issue 13);
 - ``after``: bounded effort (``decompose.EFFORTS["bounded"]``) in parallel worker processes;
 - ``warm``: the same load again, everything from the content-keyed cache.
 
@@ -109,19 +110,14 @@ def _first_load(world_file: Path, cache: Path, effort: str, workers: int) -> dic
 
     os.environ["NAVLAB_CACHE"] = str(cache)
     os.environ["NAVLAB_DECOMPOSE_WORKERS"] = str(workers)
-    saved = decompose.DEFAULT_EFFORT
-    decompose.DEFAULT_EFFORT = effort
-    try:
-        wall0, cpu0, child0 = time.perf_counter(), _self_cpu(), _children_cpu()
-        world = load_world(world_file)
-        meshes = decompose.concave_meshes(world)
-        decompose.decompose_meshes(meshes, workers=workers, progress=False, effort=effort)
-        sim = Simulation(None, world, visuals=False)
-        wall = time.perf_counter() - wall0
-        cpu = _self_cpu() - cpu0 + _children_cpu() - child0
-        parts = [len(decompose.convex_parts(p, s, effort=effort)) for p, s in meshes]
-    finally:
-        decompose.DEFAULT_EFFORT = saved
+    os.environ["NAVLAB_DECOMPOSE_EFFORT"] = effort  # what the scene builder's decompose_world uses
+    wall0, cpu0, child0 = time.perf_counter(), _self_cpu(), _children_cpu()
+    world = load_world(world_file)
+    sim = Simulation(None, world, visuals=False)  # decomposes (in parallel), then builds
+    wall = time.perf_counter() - wall0
+    cpu = _self_cpu() - cpu0 + _children_cpu() - child0
+    meshes = decompose.concave_meshes(world)
+    parts = [len(decompose.convex_parts(p, s)) for p, s in meshes]
     return {"wall_s": round(wall, 1), "cpu_s": round(cpu, 1), "meshes": len(meshes),
             "parts_per_mesh": round(float(np.mean(parts)), 1), "geoms": int(sim.model.ngeom), "workers": workers}
 
@@ -131,7 +127,7 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
     from navlab.sim import decompose
 
     seed = int(getattr(args, "seed", 0))
-    saved = {k: os.environ.get(k) for k in ("NAVLAB_CACHE", "NAVLAB_DECOMPOSE_WORKERS")}
+    saved = {k: os.environ.get(k) for k in ("NAVLAB_CACHE", "NAVLAB_DECOMPOSE_WORKERS", "NAVLAB_DECOMPOSE_EFFORT")}
     try:
         with tempfile.TemporaryDirectory() as tmp:
             folder = Path(tmp)
