@@ -318,7 +318,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         "experiment",
         help="run a scenario's trials headless and summarize them, or sweep parameters (the paper's Section V)",
         description="navlab experiment run FILE: run the trials of a scenario YAML (or a shipped one: empty_room, "
-        "obstacles_after_mapping) headless, each with its own seed, in parallel processes with --workers. Each "
+        "obstacles_after_mapping, refresh_rate, clutter_suite) headless, each with its own seed, in parallel "
+        "processes with --workers. Each "
         "finished trial is appended whole to DIR/results.jsonl; running again resumes and skips finished trials. "
         "Prints (and writes DIR/summary.json) the success rate with a 95 % Wilson interval, collisions, failures "
         "by kind, time quartiles, SPL, clearance, localization error and command jerk. navlab experiment sweep FILE "

@@ -250,9 +250,9 @@ def _demo_report(folder: Path) -> Report:
             cols = ["goal", "outcome", "time_s", "path_m", "min_clearance_m", "collisions", "reason"]
             rep.table(cols, [[g.get(c) for c in cols] for g in goals])
             for k, g in enumerate(goals, 1):
-                png = Path("navigate") / f"goal_{k}.png"
+                png = f"navigate/goal_{k}.png"
                 if (folder / png).is_file():
-                    rep.image(str(png), f"goal {k} {g.get('goal')}: {g.get('outcome')}")
+                    rep.image(png, f"goal {k} {g.get('goal')}: {g.get('outcome')}")
     if (folder / "world.png").is_file():
         rep.image("world.png", "the robot in its world")
     return rep

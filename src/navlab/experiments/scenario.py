@@ -38,7 +38,8 @@ from typing import Any
 from navlab.experiments.errors import ExperimentError
 
 MAP_MODES = ("true", "map_first", "none")
-CLUTTER_KEYS = {"clutter": {"seed": int, "fill": float, "smooth": int}, "clutter_suite": {"n": int, "seed": int}}
+CLUTTER_KEYS: dict[str, dict[str, type]] = {"clutter": {"seed": int, "fill": float, "smooth": int},
+                                             "clutter_suite": {"n": int, "seed": int}}
 
 
 @dataclass
@@ -220,7 +221,8 @@ def _future_work_keys(sc: Scenario, data: dict[str, Any], where: str) -> None:
 
 
 def load_scenario(name_or_path: str | Path) -> Scenario:
-    """A scenario file, or a shipped one by name (``empty_room``, ``obstacles_after_mapping``)."""
+    """A scenario file, or a shipped one by name (``empty_room``, ``obstacles_after_mapping``, ``refresh_rate``,
+    ``clutter_suite``)."""
     from navlab import resources
     from navlab.core.params import read_yaml
 
