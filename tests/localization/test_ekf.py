@@ -34,6 +34,17 @@ def test_prediction_follows_body_velocities() -> None:
     assert f.state[2] == 0.0 and f.covariance[2, 2] == 0.0  # two_d_mode pins z
 
 
+def test_compiled_prediction_matches_the_vectorised_model() -> None:
+    f = ekf.Ekf()
+    f.state = np.random.default_rng(0).normal(size=15) * 0.3
+    f.covariance = np.eye(15) * 0.1
+    s0, p0 = f.state.copy(), f.covariance.copy()
+    f.predict(0.05)
+    j = ekf.jacobian(s0, 0.05)
+    assert f.state == pytest.approx(ekf.transition(s0, 0.05), abs=1e-12)
+    assert f.covariance == pytest.approx(j @ p0 @ j.T + f.process_noise * 0.05, abs=1e-8)
+
+
 def test_correction_weighs_by_covariance_and_rejects_outliers() -> None:
     f = ekf.Ekf(initial_covariance=[1.0] * 15)
     f.initialized = True

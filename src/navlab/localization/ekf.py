@@ -20,6 +20,7 @@ from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
+from numba import njit
 
 from navlab.geometry import matrix_from_pose6, matrix_from_rpy, rpy_from_matrix
 from navlab.localization.errors import LocalizationError
@@ -28,6 +29,7 @@ STATE = ("x", "y", "z", "roll", "pitch", "yaw", "vx", "vy", "vz", "vroll", "vpit
 N = 15
 ANGLES = (3, 4, 5)
 TWO_D_FIXED = (2, 3, 4, 8, 9, 10, 14)  # z roll pitch vz vroll vpitch az
+_FIXED = np.array(TWO_D_FIXED)
 #: robot_localization's default process noise (diagonal) and initial estimate covariance
 DEFAULT_PROCESS_NOISE = (0.05, 0.05, 0.06, 0.03, 0.03, 0.06, 0.025, 0.025, 0.04, 0.01, 0.01, 0.02, 0.01, 0.01, 0.015)
 DEFAULT_INITIAL_COVARIANCE = (1e-9,) * N
@@ -86,6 +88,88 @@ def jacobian(state: np.ndarray, dt: float, eps: float = 1e-6) -> np.ndarray:
     return (diff / (2 * eps)).T
 
 
+@njit(cache=True)
+def _step(s: np.ndarray, dt: float, out: np.ndarray) -> None:
+    """``transition`` of one state (the compiled twin of the vectorised function above)."""
+    for i in range(N):
+        out[i] = s[i]
+    r, p, y = s[3], s[4], s[5]
+    cr, sr, cp, sp, cy, sy = math.cos(r), math.sin(r), math.cos(p), math.sin(p), math.cos(y), math.sin(y)
+    d0 = s[6] * dt + 0.5 * s[12] * dt * dt
+    d1 = s[7] * dt + 0.5 * s[13] * dt * dt
+    d2 = s[8] * dt + 0.5 * s[14] * dt * dt
+    out[0] += cy * cp * d0 + (cy * sp * sr - sy * cr) * d1 + (cy * sp * cr + sy * sr) * d2
+    out[1] += sy * cp * d0 + (sy * sp * sr + cy * cr) * d1 + (sy * sp * cr - cy * sr) * d2
+    out[2] += -sp * d0 + cp * sr * d1 + cp * cr * d2
+    cps = cp if abs(cp) >= 1e-9 else 1e-9
+    tp = sp / cps
+    out[3] += (s[9] + sr * tp * s[10] + cr * tp * s[11]) * dt
+    out[4] += (cr * s[10] - sr * s[11]) * dt
+    out[5] += (sr / cps * s[10] + cr / cps * s[11]) * dt
+    for i in range(3):
+        out[6 + i] += s[12 + i] * dt
+        out[3 + i] = math.atan2(math.sin(out[3 + i]), math.cos(out[3 + i]))
+
+
+@njit(cache=True)
+def _predict(state: np.ndarray, cov: np.ndarray, q: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray]:
+    """(f(x), J P Jᵀ + Q·dt) with J by central differences."""
+    eps = 1e-6
+    j = np.empty((N, N))
+    plus, minus, work = np.empty(N), np.empty(N), state.copy()
+    for k in range(N):
+        work[k] = state[k] + eps
+        _step(work, dt, plus)
+        work[k] = state[k] - eps
+        _step(work, dt, minus)
+        work[k] = state[k]
+        for i in range(N):
+            d = plus[i] - minus[i]
+            if 3 <= i <= 5:
+                d = math.atan2(math.sin(d), math.cos(d))
+            j[i, k] = d / (2 * eps)
+    out = np.empty(N)
+    _step(state, dt, out)
+    return out, j @ cov @ j.T + q * dt
+
+
+@njit(cache=True)
+def _correct(state: np.ndarray, cov: np.ndarray, z: np.ndarray, r: np.ndarray, idx: np.ndarray,
+             threshold: float) -> tuple[bool, np.ndarray, np.ndarray]:  # fmt: skip
+    """Kalman update on the entries ``idx``: (accepted, state, covariance); Joseph form."""
+    m = idx.size
+    innov = np.empty(m)
+    s = np.empty((m, m))
+    rr = np.empty((m, m))
+    for a in range(m):
+        ia = idx[a]
+        d = z[ia] - state[ia]
+        if 3 <= ia <= 5:
+            d = math.atan2(math.sin(d), math.cos(d))
+        innov[a] = d
+        for b in range(m):
+            rr[a, b] = r[ia, idx[b]]
+        rr[a, a] = max(rr[a, a], 1e-9)
+        for b in range(m):
+            s[a, b] = cov[ia, idx[b]] + rr[a, b]
+    s_inv = np.linalg.inv(s)
+    if threshold < np.inf and innov @ s_inv @ innov > threshold * threshold:
+        return False, state, cov
+    pht = np.empty((N, m))
+    for i in range(N):
+        for b in range(m):
+            pht[i, b] = cov[i, idx[b]]
+    k = pht @ s_inv
+    new = state + k @ innov
+    for i in range(3, 6):
+        new[i] = math.atan2(math.sin(new[i]), math.cos(new[i]))
+    ikh = np.eye(N)
+    for i in range(N):
+        for b in range(m):
+            ikh[i, idx[b]] -= k[i, b]
+    return True, new, ikh @ cov @ ikh.T + k @ rr @ k.T
+
+
 class Ekf:
     """The filter: ``state`` (15,), ``covariance`` (15, 15); ``predict(dt)`` and ``correct(z, R, mask)``."""
 
@@ -107,57 +191,41 @@ class Ekf:
 
     def _pin(self) -> None:
         if self.two_d_mode:
-            k = list(TWO_D_FIXED)
-            self.state[k] = 0.0
-            self.covariance[k, :] = 0.0
-            self.covariance[:, k] = 0.0
+            self.state[_FIXED] = 0.0
+            self.covariance[_FIXED, :] = 0.0
+            self.covariance[:, _FIXED] = 0.0
 
     def predict(self, dt: float) -> None:
         """Advance ``dt`` s: x = f(x), P = J P Jᵀ + Q·dt (``dt`` <= 0: nothing)."""
         if not (dt > 0 and math.isfinite(dt)):
             return
-        j = jacobian(self.state, dt)
-        self.state = transition(self.state, dt)
-        self.covariance = j @ self.covariance @ j.T + self.process_noise * dt
+        self.state, self.covariance = _predict(self.state, self.covariance, self.process_noise, float(dt))
         self._pin()
 
     def correct(self, z: np.ndarray, r: np.ndarray, mask: np.ndarray, threshold: float = math.inf) -> bool:
         """Fuse the masked entries of measurement ``z`` (15,) with covariance ``r`` (15, 15); False when
         rejected (Mahalanobis distance of the innovation > ``threshold``) or nothing is fused."""
         self.last_rejected = False
-        mask = np.asarray(mask, dtype=bool).copy()
+        z, r = np.asarray(z, dtype=np.float64), np.asarray(r, dtype=np.float64)
+        mask = np.asarray(mask, dtype=bool) & np.isfinite(z)
         if self.two_d_mode:
-            mask[list(TWO_D_FIXED)] = False
-        mask &= np.isfinite(z)
+            mask[_FIXED] = False
         idx = np.flatnonzero(mask)
         if idx.size == 0:
             return False
-        z, r = np.asarray(z, dtype=np.float64), np.asarray(r, dtype=np.float64)
         if not self.initialized:  # robot_localization starts from the first measurement's values
             self.state[idx] = z[idx]
             self.initialized = True
             self._pin()
             return True
-        innov = z[idx] - self.state[idx]
-        ang = np.isin(idx, ANGLES)
-        innov[ang] = np.arctan2(np.sin(innov[ang]), np.cos(innov[ang]))
-        rr = r[np.ix_(idx, idx)].copy()
-        rr[np.diag_indices_from(rr)] = np.maximum(np.diag(rr), 1e-9)  # as robot_localization: no zero variance
-        p = self.covariance
-        s = p[np.ix_(idx, idx)] + rr
         try:
-            s_inv = np.linalg.inv(s)
-        except np.linalg.LinAlgError:
+            ok, state, cov = _correct(self.state, self.covariance, z, r, idx, float(threshold))
+        except np.linalg.LinAlgError:  # a singular innovation covariance: nothing fused
             return False
-        if math.isfinite(threshold) and float(innov @ s_inv @ innov) > threshold * threshold:
+        if not ok:
             self.last_rejected = True
             return False
-        k = p[:, idx] @ s_inv  # P Hᵀ S⁻¹ with H the rows idx of the identity
-        self.state = self.state + k @ innov
-        self.state[3:6] = np.arctan2(np.sin(self.state[3:6]), np.cos(self.state[3:6]))
-        ikh = np.eye(N)
-        ikh[:, idx] -= k
-        self.covariance = ikh @ p @ ikh.T + k @ rr @ k.T  # Joseph form
+        self.state, self.covariance = state, cov
         self._pin()
         return True
 
@@ -188,42 +256,34 @@ def twist_measurement(twist6: Sequence[float] | np.ndarray, cov6: np.ndarray) ->
     return measurement({6 + i: float(v) for i, v in enumerate(twist6)}, np.asarray(cov6).reshape(6, 6), 6)
 
 
-def merge(*parts: tuple[np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
-    """One measurement from several (entries given in a later part win)."""
-    z, r = np.full(N, np.nan), np.zeros((N, N))
-    for zi, ri in parts:
-        ok = np.isfinite(zi)
-        z[ok] = zi[ok]
-        blk = np.ix_(ok, ok)
-        r[blk] = ri[blk]
-    return z, r
-
-
 def imu_measurement(base_R_imu: np.ndarray, *, orientation_rpy: Sequence[float] | None, orientation_cov: np.ndarray,
                     angular_velocity: Sequence[float], angular_velocity_cov: np.ndarray,
                     linear_acceleration: Sequence[float], linear_acceleration_cov: np.ndarray,
-                    remove_gravity: bool = False,
-                    gravity: float = 9.80665) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+                    remove_gravity: bool = False, gravity: float = 9.80665,
+                    parts: tuple[bool, bool, bool] = (True, True, True)) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
     """An IMU reading (in the IMU frame) as a base-frame measurement: orientation (the IMU frame's in the
     world, turned into the base's), angular velocity and linear acceleration rotated into the base frame;
-    with ``remove_gravity`` the gravity the accelerometer reads is subtracted (using the orientation)."""
+    with ``remove_gravity`` the gravity the accelerometer reads is subtracted (using the orientation).
+    ``parts``: which of (orientation, angular velocity, acceleration) to fill (the others stay NaN)."""
     rot = np.asarray(base_R_imu, dtype=np.float64)
-    parts = []
+    z, r = np.full(N, np.nan), np.zeros((N, N))
     world_R_base = None
     if orientation_rpy is not None and all(math.isfinite(v) for v in orientation_rpy):
         world_R_base = matrix_from_rpy(*orientation_rpy) @ rot.T
-        oc = rot @ np.asarray(orientation_cov).reshape(3, 3) @ rot.T
-        parts.append(measurement(dict(zip((3, 4, 5), rpy_from_matrix(world_R_base), strict=True)), oc, 3))
-    w = rot @ np.asarray(angular_velocity, dtype=np.float64)
-    parts.append(measurement(dict(zip((9, 10, 11), w, strict=True)),
-                             rot @ np.asarray(angular_velocity_cov).reshape(3, 3) @ rot.T, 9))  # fmt: skip
-    a = rot @ np.asarray(linear_acceleration, dtype=np.float64)
-    if remove_gravity:
-        up = world_R_base.T @ np.array([0.0, 0.0, gravity]) if world_R_base is not None else np.array([0, 0, gravity])
-        a = a - up
-    parts.append(measurement(dict(zip((12, 13, 14), a, strict=True)),
-                             rot @ np.asarray(linear_acceleration_cov).reshape(3, 3) @ rot.T, 12))  # fmt: skip
-    return merge(*parts)
+        if parts[0]:
+            z[3:6] = rpy_from_matrix(world_R_base)
+            r[3:6, 3:6] = rot @ np.asarray(orientation_cov, dtype=np.float64).reshape(3, 3) @ rot.T
+    if parts[1]:
+        z[9:12] = rot @ np.asarray(angular_velocity, dtype=np.float64)
+        r[9:12, 9:12] = rot @ np.asarray(angular_velocity_cov, dtype=np.float64).reshape(3, 3) @ rot.T
+    if parts[2]:
+        a = rot @ np.asarray(linear_acceleration, dtype=np.float64)
+        if remove_gravity:
+            up = np.array([0.0, 0.0, gravity])
+            a = a - (world_R_base.T @ up if world_R_base is not None else up)
+        z[12:15] = a
+        r[12:15, 12:15] = rot @ np.asarray(linear_acceleration_cov, dtype=np.float64).reshape(3, 3) @ rot.T
+    return z, r
 
 
 class PoseInput:

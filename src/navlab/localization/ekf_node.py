@@ -106,6 +106,7 @@ class EkfNode(Node):
                 raise LocalizationError(f"{self.fully_qualified_name}: {pname} {value!r}: expected a distance > 0")
             spec[f"{key}_threshold"] = value
         if kind == "imu":
+            spec["imu_parts"] = (bool(mask[3:6].any()), bool(mask[9:12].any()), bool(mask[12:15].any()))
             spec["remove_gravity"] = bool(d(f"{name}_remove_gravitational_acceleration", False))
         return spec
 
@@ -192,7 +193,7 @@ class EkfNode(Node):
             angular_velocity=(w.x, w.y, w.z), angular_velocity_cov=np.asarray(msg.angular_velocity_covariance),
             linear_acceleration=(a.x, a.y, a.z),
             linear_acceleration_cov=np.asarray(msg.linear_acceleration_covariance),
-            remove_gravity=spec["remove_gravity"], gravity=self.gravity)  # fmt: skip
+            remove_gravity=spec["remove_gravity"], gravity=self.gravity, parts=spec["imu_parts"])  # fmt: skip
         mask = spec["mask"]
         groups = ((3, 6, "pose"), (9, 12, "twist"), (12, 15, "linear_acceleration"))
         for lo, hi, key in groups:
