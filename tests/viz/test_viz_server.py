@@ -118,3 +118,10 @@ def test_survives_malformed_messages_and_mid_frame_disconnects(server: ViewerSer
                 break
         assert "ack" in kinds
     assert {"op": "cancel"} in server.received  # type: ignore[attr-defined]
+
+
+def test_a_port_in_use_is_a_clear_error(server: ViewerServer) -> None:
+    from navlab.viz.errors import VizError
+
+    with pytest.raises(VizError, match=f"cannot serve the viewer on 127.0.0.1:{server.port}"):
+        ViewerServer(Hub(), port=server.port).start()
