@@ -56,3 +56,24 @@ def test_navigate_takes_view(capsys: pytest.CaptureFixture[str]) -> None:
     assert main([*argv, "--no-browser"]) == 0
     out = capsys.readouterr()
     assert "viewer: http://127.0.0.1:" in out.err and json.loads(out.out)["goals"][0]["goal"] == [1.0, 0.0, 0.0]
+
+
+def test_view_hook_moves_the_page_to_each_new_run_on_the_same_port() -> None:
+    import socket
+
+    from navlab.viz.cli import view_hook
+
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    args = argparse.Namespace(view=True, view_host="127.0.0.1", view_port=port, no_browser=True, foxglove=None)
+    with view_hook(args) as on_start:
+        first = start_run("sim", world="room", on_start=on_start)
+        first.run(0.1)
+        second = start_run("sim", world="room", on_start=on_start)
+        assert "/navlab_viewer" not in first.executor.nodes and "/navlab_viewer" in second.executor.nodes
+        second.run(0.4)
+        with connect(f"ws://127.0.0.1:{port}/ws") as ws:
+            state = json.loads(ws.recv(timeout=5))
+        assert state["t"] == pytest.approx(0.4, abs=0.05)  # the second run's clock
+    assert "/navlab_viewer" not in second.executor.nodes
