@@ -17,6 +17,7 @@ BENCHES: dict[str, str] = {
     "slam": "navlab.mapping.bench:run",
     "slam-office": "navlab.mapping.bench:run_office",
     "core": "navlab.core.bench:run",
+    "soak": "navlab.core.bench:run_soak",
     "amcl": "navlab.localization.bench:run",
     "description": "navlab.description.bench:run",
     "sim": "navlab.sim.bench:run",
@@ -36,7 +37,7 @@ def _run_one(name: str, args: argparse.Namespace) -> dict[str, Any]:
 
 
 def _cmd(args: argparse.Namespace) -> int:
-    names = list(BENCHES) if args.name == "all" else [args.name]
+    names = [n for n in BENCHES if n != "soak"] if args.name == "all" else [args.name]  # soak: minutes, alone
     results = {name: _run_one(name, args) for name in names}
     out = results[names[0]] if len(names) == 1 else results
     if args.json:
@@ -63,4 +64,6 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--controller", default=None,
                    help="clutter: local planner to drive with (trajectory, dwa, mppi; default mppi)")
     p.add_argument("--worlds", type=int, default=50, help="clutter: how many generated worlds (default 50)")
+    p.add_argument("--minutes", type=float, default=60.0,
+                   help="soak: simulated minutes of the mapping launch (default 60); RSS after 1 and at the end")
     p.set_defaults(func=_cmd)

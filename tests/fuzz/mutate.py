@@ -49,11 +49,11 @@ RULES: dict[str, dict[str, str]] = {
                          "odom_alpha5", "transform_tolerance"), NONNEG),
     },
     "gmapping": {
-        **dict.fromkeys(("map_update_interval", "transform_publish_period", "throttle_scans", "maxUrange", "sigma",
+        **dict.fromkeys(("transform_publish_period", "throttle_scans", "maxUrange", "sigma",
                          "lstep", "astep", "lsigma", "ogain", "particles", "delta", "llsamplerange",
                          "llsamplestep", "lasamplerange", "lasamplestep", "occ_thresh", "resampleThreshold"), POS),
-        **dict.fromkeys(("maxRange", "kernelSize", "iterations", "lskip", "minimumScore", "srr", "srt", "str",
-                         "stt", "linearUpdate", "angularUpdate"), NONNEG),
+        **dict.fromkeys(("map_update_interval", "maxRange", "kernelSize", "iterations", "lskip", "minimumScore",
+                         "srr", "srt", "str", "stt", "linearUpdate", "angularUpdate"), NONNEG),
     },
     "move_base": {
         **dict.fromkeys(("max_vel_x", "max_vel_theta", "acc_lim_x", "acc_lim_theta", "robot_radius",

@@ -53,3 +53,34 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
         "events": events,
         "wall_s": round(wall, 3),
     }
+
+
+def _rss_mb() -> float:
+    """Resident set size of this process (MB, from /proc/self/status)."""
+    with open("/proc/self/status") as fh:
+        for line in fh:
+            if line.startswith("VmRSS:"):
+                return int(line.split()[1]) / 1024.0
+    return float("nan")
+
+
+def run_soak(args: argparse.Namespace) -> dict[str, Any]:
+    """``navlab bench soak``: a mapping launch (sim + slam_gmapping + exploration) for ``--minutes`` simulated
+    minutes; RSS (MB) after the first simulated minute and at the end, and every 10 minutes between."""
+    import gc
+
+    from navlab.core.launch import start
+
+    minutes = float(getattr(args, "minutes", None) or 60.0)
+    session = start("mapping", seed=getattr(args, "seed", 0))
+    t0 = time.perf_counter()
+    samples: dict[str, float] = {}
+    for minute in range(1, int(minutes) + 1):
+        session.run(60.0)
+        if minute == 1 or minute % 10 == 0 or minute == int(minutes):
+            gc.collect()
+            samples[str(minute)] = round(_rss_mb(), 1)
+    first, last = samples["1"], samples[str(int(minutes))]
+    return {"sim_min": int(minutes), "rss_mb_after_1_min": first, "rss_mb_end": last,
+            "growth_mb": round(last - first, 1), "rss_mb_by_minute": samples,
+            "wall_s": round(time.perf_counter() - t0, 1)}

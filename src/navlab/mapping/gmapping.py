@@ -239,6 +239,7 @@ class GMapping:
         self._odom_by_scan: dict[int, np.ndarray] = {}
         self._scan_data: dict[int, tuple[np.ndarray, np.ndarray, float]] = {}  # scans between updates (refineSkipped)
         self.keep_scans = False  # keep scans between updates for ``finish`` (offline; a live node never finishes)
+        self.keep_history = True  # per-scan odometry for ``finish``; the live node turns it off (bounded memory)
 
     # --- map bookkeeping ----------------------------------------------------------------------------
 
@@ -300,7 +301,8 @@ class GMapping:
         self._time = stamp if stamp is not None else self._time + 1.0
         k = self._scan_count
         self._scan_count += 1
-        self._odom_by_scan[k] = odom
+        if self.keep_history:  # finish() needs every scan's odometry; a live node never finishes
+            self._odom_by_scan[k] = odom
         if not self.particles:
             self._init(odom, r, ang, max_urange, max_range)
             self._odom_last = odom
@@ -324,7 +326,7 @@ class GMapping:
             self._update(k, r, ang, max_urange, max_range)
             self._odom_at_update = odom
             self._time_at_update = self._time
-        else:
+        elif self.keep_history:  # live, these per-scan records would grow by 40 a second without being read
             self._scan_ref.append((self._last_update_scan, between2(self._odom_by_scan[self._last_update_scan], odom)))
             if p.refineSkipped and self.keep_scans:
                 self._scan_data[k] = (r, ang, max_urange)
@@ -360,7 +362,8 @@ class GMapping:
         return float(self._anchor[0]), float(self._anchor[1]), int(self._offset[0]), int(self._offset[1])
 
     def _mark_update(self, k: int) -> None:
-        self._scan_ref.append((k, np.zeros(3)))
+        if self.keep_history:
+            self._scan_ref.append((k, np.zeros(3)))
         self._last_update_scan = k
 
     def _update(self, k: int, r: np.ndarray, ang: np.ndarray, max_urange: float, max_range: float) -> None:

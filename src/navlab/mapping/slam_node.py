@@ -23,11 +23,11 @@ from navlab.mapping.errors import MappingError
 from navlab.plugins import PluginError, SlamBackend, load_plugin
 
 # slam_gmapping parameters that must be > 0 or >= 0, and (min, max) pairs (issue 14: refused, not run with)
-_POSITIVE = ("map_update_interval", "transform_publish_period", "throttle_scans", "maxUrange", "sigma", "lstep",
+_POSITIVE = ("transform_publish_period", "throttle_scans", "maxUrange", "sigma", "lstep",
              "astep", "lsigma", "ogain", "particles", "delta", "llsamplerange", "llsamplestep", "lasamplerange",
              "lasamplestep", "occ_thresh", "resampleThreshold")
-_NON_NEGATIVE = ("maxRange", "kernelSize", "iterations", "lskip", "minimumScore", "srr", "srt", "str", "stt",
-                 "linearUpdate", "angularUpdate")
+_NON_NEGATIVE = ("map_update_interval", "maxRange", "kernelSize", "iterations", "lskip", "minimumScore", "srr",
+                 "srt", "str", "stt", "linearUpdate", "angularUpdate")
 
 
 INVALID_LOG_PERIOD_NS = 10_000_000_000  # at most one "scans without readings" warning per 10 simulated s
@@ -73,6 +73,9 @@ class SlamGMapping(Node):
                                                   "transform_publish_period": self.transform_publish_period,
                                                   "throttle_scans": self.throttle_scans, **values})
         self.slam: SlamBackend = backend(values, rng=self.rng)
+        inner: Any = getattr(self.slam, "slam", None)
+        if inner is not None and hasattr(inner, "keep_history"):  # a live node never calls finish(): no per-scan
+            inner.keep_history = False  # history (issue 14: it grew the process by ~45 MB per simulated hour)
         self.params = self.slam.params
         self.check_parameters()
 
