@@ -173,12 +173,15 @@ def test_added_obstacle_appears_in_scan_and_local_costmap(live: tuple[Run, Viewe
     x, y, yaw = _true_pose(run)
     ox, oy = x + 1.0 * math.cos(yaw), y + 1.0 * math.sin(yaw)
     scan_ahead = _range_ahead(page)
+    t_paused = run.executor.now_ns
     page.click("[data-tool=box]")
     page.mouse.click(*to_screen(page, ox, oy))
-    page.click("#pause")
+    # placed while paused: the executor steps to its next event (10 simulated ms at most) to apply it
     assert _wait(lambda: any(m.startswith("viewer_box") for m in run.sim.model_names()), 5)
-    name = next(m for m in run.sim.model_names() if m.startswith("viewer_box"))
     page.wait_for_function("() => navlab.store.state.obstacles.length === 1")
+    assert run.executor.now_ns - t_paused <= 30_000_000
+    name = next(m for m in run.sim.model_names() if m.startswith("viewer_box"))
+    page.click("#pause")
     # the lidar sees it: ~1 m ahead minus half the 0.4 m box minus the laser's offset
     assert _wait(lambda: _range_ahead(page) < min(0.95, scan_ahead - 0.2), 10), (scan_ahead, _range_ahead(page))
     # and the local costmap marks its face lethal: purple (costmap 100) where the scan hits it (scan dots hidden)

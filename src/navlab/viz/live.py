@@ -7,7 +7,8 @@ poses of every frame in the fixed frame, move_base's state and last outcome, the
 
 Inputs arrive from the server's thread as JSON objects; they are checked there and applied in the
 executor's thread through its inbox (:meth:`Executor.post`). Only pause/resume and speed act on the
-:class:`Pacer` directly (thread-safe flags): a paused executor cannot read its inbox.
+:class:`Pacer` directly (thread-safe flags); while paused, each input lets the executor step to its next
+event (at most one pacing period, 10 simulated ms), where it reads its inbox.
 """
 
 from __future__ import annotations
@@ -38,12 +39,17 @@ SPEEDS = (0.0, 0.5, 1.0, 2.0, 5.0)  # 0 = as fast as possible
 
 
 class Pacer:
-    """Keeps simulated time at ``speed`` × wall-clock time (0: as fast as possible) and pauses; thread-safe."""
+    """Keeps simulated time at ``speed`` × wall-clock time (0: as fast as possible) and pauses; thread-safe.
+
+    While paused, :meth:`step` lets the executor go on to its next event (at most one pacing period of
+    simulated time): that is how an input queued in its inbox is applied during a pause.
+    """
 
     def __init__(self, speed: float = 1.0) -> None:
         self._lock = threading.Lock()
         self._resume = threading.Event()
         self._resume.set()
+        self._step = threading.Event()
         self.closed = False
         self.speed = float(speed)
         self._anchor: tuple[int, float] | None = None
@@ -61,6 +67,7 @@ class Pacer:
 
     def pause(self) -> None:
         """Hold simulated time at the next pacing tick."""
+        self._step.clear()
         self._resume.clear()
 
     def resume(self) -> None:
@@ -68,18 +75,27 @@ class Pacer:
         with self._lock:
             self._anchor = None
         self._resume.set()
+        self._step.set()
+
+    def step(self) -> None:
+        """While paused: let the executor reach its next event (an input waits in its inbox)."""
+        self._step.set()
 
     def close(self) -> None:
         """Release a paused executor for good."""
         self.closed = True
         self._resume.set()
+        self._step.set()
 
     def tick(self, now_ns: int, idle: Callable[[], None] | None = None) -> None:
         """Called every few simulated ms in the executor's thread: wait while paused (calling ``idle`` every
-        50 ms) or while ahead of the pace."""
-        while not self._resume.wait(0.05):
-            if self.closed:
-                return
+        50 ms, returning early on :meth:`step`) or while ahead of the pace."""
+        while self.paused and not self.closed:
+            if self._step.wait(0.05):
+                self._step.clear()
+                if self.paused:
+                    return  # one step for an input, then held again at the next tick
+                break
             if idle is not None:
                 idle()
         with self._lock:
@@ -319,6 +335,7 @@ class ViewerNode(Node):
             self.pacer.set_speed(args["value"])
         else:
             self.executor.post(functools.partial(self._apply, op, args))
+            self.pacer.step()  # applied at once, even while paused
         return None
 
     def _apply(self, op: str, a: dict[str, Any]) -> None:
