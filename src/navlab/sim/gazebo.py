@@ -10,7 +10,9 @@ from navlab.core import Executor, Node
 from navlab.description.model import RobotModel
 from navlab.sim.contacts import CollisionPlugin
 from navlab.sim.errors import SimError
-from navlab.sim.plugins import DiffDrivePlugin, GroundTruthPlugin, ImuPlugin, JointStatePlugin, LidarPlugin
+from navlab.sim.extensions import SimExtensions
+from navlab.sim.imu import ImuSensorPlugin
+from navlab.sim.plugins import DiffDrivePlugin, GroundTruthPlugin, JointStatePlugin, LidarPlugin
 from navlab.sim.simulation import Simulation
 from navlab.sim.spawn import check_start_pose, load_sdf_model, parse_spawn_spec, primitive_model
 from navlab.world.model import ModelSpec, WorldModel
@@ -57,6 +59,8 @@ class GazeboSim(Node):
         cmd_timeout = float(self.declare_parameter("cmd_timeout", 0.0))
         robot = robot_model if robot_model is not None else load_robot_named(robot_name)
         world = world_model if world_model is not None else load_world_named(world_name)
+        extensions = SimExtensions(self)  # wheel controller and disturbances (navlab.sim.extensions)
+        robot = extensions.robot(robot)
         for warning in [*robot.warnings, *world.warnings]:
             self.get_logger().warning(warning)
         check_start_pose(robot, world, pose)  # a start inside an obstacle is refused, not thrown 7 m
@@ -72,10 +76,12 @@ class GazeboSim(Node):
                 robot.diff_drive.odometry_noise = odometry_noise
             if cmd_timeout > 0:
                 robot.diff_drive.cmd_timeout = cmd_timeout
-            self.plugins.append(DiffDrivePlugin(executor, namespace=namespace, sim=self.sim, config=robot.diff_drive))
+            drive = extensions.drive_plugin(executor, namespace, self.sim)
+            self.plugins.append(drive or DiffDrivePlugin(executor, namespace=namespace, sim=self.sim,
+                                                         config=robot.diff_drive))
         self.plugins += [LidarPlugin(executor, namespace=namespace, sim=self.sim, index=i)
                          for i in range(len(robot.lidars))]
-        self.plugins += [ImuPlugin(executor, namespace=namespace, sim=self.sim, index=i)
+        self.plugins += [ImuSensorPlugin(executor, namespace=namespace, sim=self.sim, index=i)
                          for i in range(len(robot.imus))]
         self.plugins.append(JointStatePlugin(executor, parameters={"publish_frequency": js_rate}, namespace=namespace,
                                              sim=self.sim))
@@ -83,6 +89,7 @@ class GazeboSim(Node):
             base = robot.diff_drive.robot_base_frame if robot.diff_drive else robot.root_link
             self.plugins.append(GroundTruthPlugin(executor, parameters={"bodyName": base, "updateRate": gt_rate},
                                                  namespace=namespace, sim=self.sim))
+        self.plugins += extensions.plugins(executor, namespace, self.sim)
         if robot is not None:  # Gazebo's bumper: what the robot touches, on /collisions
             self.plugins.append(CollisionPlugin(executor, namespace=namespace, sim=self.sim))
         if seed >= 0:
