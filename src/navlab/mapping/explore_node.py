@@ -47,6 +47,7 @@ class Explore(Node):
         self.path: np.ndarray | None = None
         self.blacklist: list[np.ndarray] = []
         self._front_range = math.inf
+        self._sectors: tuple[tuple[float, float, int], np.ndarray, np.ndarray] | None = None
         self._rear_range = math.inf
         self._no_frontier = 0
         self._last_progress = (0, math.inf)  # (time ns, distance to goal)
@@ -62,10 +63,13 @@ class Explore(Node):
 
     def _on_scan(self, msg: Any) -> None:
         r = np.asarray(msg.ranges, dtype=float)
-        a = msg.angle_min + msg.angle_increment * np.arange(len(r))
-        rel = np.abs(np.arctan2(np.sin(a), np.cos(a)))
+        key = (float(msg.angle_min), float(msg.angle_increment), len(r))
+        if self._sectors is None or self._sectors[0] != key:  # the beams ahead and behind, once per scan layout
+            a = msg.angle_min + msg.angle_increment * np.arange(len(r))
+            rel = np.abs(np.arctan2(np.sin(a), np.cos(a)))
+            self._sectors = (key, rel < 0.5, rel > math.pi - 0.6)
         ok = np.isfinite(r) & (r >= msg.range_min)
-        front, rear = ok & (rel < 0.5), ok & (rel > math.pi - 0.6)
+        front, rear = ok & self._sectors[1], ok & self._sectors[2]
         self._front_range = float(r[front].min()) if front.any() else math.inf
         self._rear_range = float(r[rear].min()) if rear.any() else math.inf
 

@@ -93,7 +93,8 @@ def _score(
     py: float,
     pt: float,
     ranges: np.ndarray,
-    angles: np.ndarray,
+    cb: np.ndarray,
+    sb: np.ndarray,
     max_urange: float,
     kernel: int,
     sigma: float,
@@ -103,8 +104,9 @@ def _score(
     """GMapping's score and log-likelihood of a scan at a pose: for each beam endpoint, the nearest
     occupied cell within ``kernel`` cells whose cell one step back along the beam is free. ``grid`` holds
     the lattice cells from (``oi``, ``oj``) on (lattice anchored at ``ox``, ``oy``); cells outside it are
-    unknown."""
+    unknown. ``cb``, ``sb``: cosine and sine of the beam angles (laser frame)."""
     h, w = grid.shape
+    ct, st = math.cos(pt), math.sin(pt)
     s = 0.0
     lik = 0.0
     n = 0
@@ -113,8 +115,8 @@ def _score(
         r = ranges[k]
         if not (r > 0.0) or r >= max_urange:
             continue
-        a = pt + angles[k]
-        ca, sa = math.cos(a), math.sin(a)
+        ca = ct * cb[k] - st * sb[k]  # cos, sin of (pt + beam angle)
+        sa = st * cb[k] + ct * sb[k]
         ex, ey = px + r * ca, py + r * sa
         fx, fy = ex - res * ca, ey - res * sa  # a point one cell back along the beam
         ei = math.floor((ex - ox) / res) - oi
@@ -123,11 +125,14 @@ def _score(
         fj = math.floor((fy - oy) / res) - oj
         best = 1e9
         found = False
+        # both kernel windows inside the array (nearly always): no per-cell bounds checks
+        inside = (min(ei, fi) >= kernel and min(ej, fj) >= kernel and max(ei, fi) < w - kernel
+                  and max(ej, fj) < h - kernel)  # fmt: skip
         for dj in range(-kernel, kernel + 1):
             for di in range(-kernel, kernel + 1):
                 i, j = ei + di, ej + dj
                 i2, j2 = fi + di, fj + dj
-                if i < 0 or j < 0 or i >= w or j >= h or i2 < 0 or j2 < 0 or i2 >= w or j2 >= h:
+                if not inside and (i < 0 or j < 0 or i >= w or j >= h or i2 < 0 or j2 < 0 or i2 >= w or j2 >= h):
                     continue
                 if grid[j, i] > 0.0 and grid[j2, i2] < 0.0:
                     cx = ox + (i + oi + 0.5) * res
@@ -157,7 +162,8 @@ def _optimize(
     y0: float,
     t0: float,
     ranges: np.ndarray,
-    angles: np.ndarray,
+    cb: np.ndarray,
+    sb: np.ndarray,
     max_urange: float,
     kernel: int,
     sigma: float,
@@ -170,7 +176,7 @@ def _optimize(
     """GMapping's hill climbing: try ±lstep in x, y and ±astep in theta; halve the steps when no move
     improves the score, ``iterations`` times."""
     cx, cy, ct = x0, y0, t0
-    cur = _score(grid, ox, oy, oi, oj, res, cx, cy, ct, ranges, angles, max_urange, kernel, sigma, lsigma, skip)[0]
+    cur = _score(grid, ox, oy, oi, oj, res, cx, cy, ct, ranges, cb, sb, max_urange, kernel, sigma, lsigma, skip)[0]
     ld, ad = lstep, astep
     refinement = 0
     best = -1.0
@@ -198,7 +204,7 @@ def _optimize(
             else:
                 nt -= ad
             sc, _lik, _n = _score(
-                grid, ox, oy, oi, oj, res, nx, ny, nt, ranges, angles, max_urange, kernel, sigma, lsigma, skip
+                grid, ox, oy, oi, oj, res, nx, ny, nt, ranges, cb, sb, max_urange, kernel, sigma, lsigma, skip
             )
             if sc > cur:
                 cur = sc
@@ -371,15 +377,16 @@ class GMapping:
         self.updates += 1
         ox, oy, oi, oj = self._lattice()
         res = p.delta
+        cb, sb = np.cos(ang), np.sin(ang)
         for part in self.particles:
             x, y, t, score = _optimize(
-                part.grid, ox, oy, oi, oj, res, part.pose[0], part.pose[1], part.pose[2], r, ang, max_urange,
+                part.grid, ox, oy, oi, oj, res, part.pose[0], part.pose[1], part.pose[2], r, cb, sb, max_urange,
                 p.kernelSize, p.sigma, p.lsigma, p.lskip, p.lstep, p.astep, p.iterations,
             )  # fmt: skip
             if score > p.minimumScore:
                 part.pose = np.array([x, y, wrap_angle(t)])
             _s, lik, _n = _score(
-                part.grid, ox, oy, oi, oj, res, part.pose[0], part.pose[1], part.pose[2], r, ang, max_urange,
+                part.grid, ox, oy, oi, oj, res, part.pose[0], part.pose[1], part.pose[2], r, cb, sb, max_urange,
                 p.kernelSize, p.sigma, p.lsigma, p.lskip,
             )  # fmt: skip
             part.weight += lik
@@ -445,7 +452,7 @@ class GMapping:
         p = self.p
         ox, oy, oi, oj = self._lattice()
         x, y, t, score = _optimize(
-            grid, ox, oy, oi, oj, p.delta, pose[0], pose[1], pose[2], r, ang, max_urange,
+            grid, ox, oy, oi, oj, p.delta, pose[0], pose[1], pose[2], r, np.cos(ang), np.sin(ang), max_urange,
             p.kernelSize, p.sigma, p.lsigma, p.lskip, p.lstep, p.astep, p.iterations,
         )  # fmt: skip
         return np.array([x, y, wrap_angle(t)]) if score > p.minimumScore else pose
