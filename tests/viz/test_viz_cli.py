@@ -75,5 +75,5 @@ def test_view_hook_moves_the_page_to_each_new_run_on_the_same_port() -> None:
         second.run(0.4)
         with connect(f"ws://127.0.0.1:{port}/ws") as ws:
             state = json.loads(ws.recv(timeout=5))
-        assert state["t"] == pytest.approx(0.4, abs=0.05)  # the second run's clock
+        assert 0.2 < state["t"] <= 0.4 + 1e-9  # the second run's clock (the first stopped at 0.1 s)
     assert "/navlab_viewer" not in second.executor.nodes
