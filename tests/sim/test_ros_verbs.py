@@ -66,3 +66,35 @@ def test_package_and_model_path_options(tmp_path, monkeypatch, capsys):
     assert main(["sim", "--robot", ROBOT, "--world", str(world), "--package-path", str(FIX), "--model-path",
                  str(models), "--duration", "0.2", "--quiet", "--json"]) == 0
     assert "pillar" in json.loads(capsys.readouterr().out)["models"]
+
+
+def test_map_with_package_and_model_path_options(tmp_path, monkeypatch, capsys):
+    """A package:// robot and a model:/// world through ``navlab map`` with --package-path and
+    --model-path only (nothing in ROS_PACKAGE_PATH / GAZEBO_MODEL_PATH)."""
+    monkeypatch.setenv("ROS_PACKAGE_PATH", "")
+    monkeypatch.setenv("GAZEBO_MODEL_PATH", "")
+    models = tmp_path / "models"
+    (models / "crate").mkdir(parents=True)  # a model no package exports: found through --model-path only
+    pillar = FIX / "tutorial_bot_description" / "models" / "pillar"
+    (models / "crate" / "model.config").write_text((pillar / "model.config").read_text().replace("pillar", "crate"))
+    (models / "crate" / "model.sdf").write_text((pillar / "model.sdf").read_text().replace("pillar", "crate"))
+    world = tmp_path / "w.world"
+    world.write_text('<sdf version="1.6"><world name="w"><include><uri>model://ground_plane</uri></include>'
+                     "<include><uri>model:///crate</uri><pose>1.5 0 0 0 0 0</pose></include></world></sdf>")
+    argv = ["map", "--robot", ROBOT, "--world", str(world), "--duration", "2", "--out", str(tmp_path / "m"),
+            "--quiet", "--json"]
+    assert main(argv) == 2
+    assert "tutorial_bot_description" in capsys.readouterr().err  # not found without the options
+    assert main([*argv, "--package-path", str(FIX), "--model-path", str(models)]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["scans_processed"] > 0 and not out["map_empty"]  # the laser saw the crate
+
+
+@pytest.mark.parametrize("verb", [["navigate", "--goal", "1", "0", "0"], ["localize"], ["launch", "mapping"],
+                                  ["view"], ["experiment", "run", "empty_room"], ["eval", "map", "m.yaml",
+                                  "--world", "room"]])  # fmt: skip
+def test_every_robot_verb_takes_the_path_options(verb):
+    from navlab.cli import build_parser
+
+    args = build_parser().parse_args([*verb, "--package-path", "/p", "--model-path", "/m"])
+    assert args.package_path == ["/p"] and args.model_path == ["/m"]

@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from navlab.cli_common import positive_seconds
+from navlab.cli_common import add_resource_path_arguments, apply_resource_paths, positive_seconds
 from navlab.core.errors import CoreError
 from navlab.core.graph import Graph
 from navlab.core.launch import Session, start
@@ -133,6 +133,7 @@ def _show_args(file: str) -> int:
 def _cmd_launch(args: argparse.Namespace) -> int:
     if args.show_args:
         return _show_args(args.file)
+    apply_resource_paths(args)  # --package-path / --model-path for robot:= and world:=
     # Like roslaunch, a launch without --duration runs in real time until Ctrl-C.
     rate = args.rate if args.rate is not None else (1.0 if args.duration is None else 0.0)
     session = start(args.file, seed=args.seed, pace=rate, launch_args=parse_launch_args(args.args))
@@ -288,6 +289,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
     add_view_arguments(p)
+    add_resource_path_arguments(p)
     p.add_argument("-s", "--show-args", action="store_true",
                    help="list the launch's arguments (name, description, default) and exit")
     p.set_defaults(func=_cmd_launch)

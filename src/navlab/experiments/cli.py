@@ -10,7 +10,9 @@ from typing import Any
 
 from navlab.cli_common import (
     add_pose_arguments,
+    add_resource_path_arguments,
     add_set_argument,
+    apply_resource_paths,
     parse_sets,
     positive_seconds,
     print_figures,
@@ -20,6 +22,7 @@ from navlab.viz.cli import add_view_arguments, view_hook
 
 
 def _cmd_map(args: argparse.Namespace) -> int:
+    apply_resource_paths(args)  # --package-path / --model-path, for this process and its workers
     if args.action == "save":
         return _cmd_map_save(args)
     from navlab.experiments.mapping_run import run_mapping
@@ -80,6 +83,7 @@ def _amcl_params(path: str | None, sets: list[str]) -> dict[str, Any]:
 
 
 def _cmd_localize(args: argparse.Namespace) -> int:
+    apply_resource_paths(args)  # --package-path / --model-path, for this process and its workers
     from navlab.experiments.localize_run import plot_result, run_localization
 
     with view_hook(args) as on_start:
@@ -98,6 +102,7 @@ def _cmd_localize(args: argparse.Namespace) -> int:
 
 
 def _cmd_navigate(args: argparse.Namespace) -> int:
+    apply_resource_paths(args)  # --package-path / --model-path, for this process and its workers
     from navlab.experiments.navigate_run import run_navigation
     from navlab.experiments.plots import plot_navigation
     from navlab.sim.spawn import parse_spawn_spec
@@ -128,6 +133,7 @@ def _cmd_navigate(args: argparse.Namespace) -> int:
 
 
 def _cmd_experiment(args: argparse.Namespace) -> int:
+    apply_resource_paths(args)  # --package-path / --model-path, for this process and its workers
     from navlab.experiments.errors import ExperimentError
     from navlab.experiments.scenario import load_scenario
     from navlab.experiments.trials import run_experiment
@@ -172,15 +178,18 @@ def cmd_eval_map(args: argparse.Namespace) -> int:
     from navlab.experiments.mapping_run import read_trajectory
     from navlab.experiments.metrics import free_coverage, score_map, trajectory_error
     from navlab.experiments.session import rounded
-    from navlab.experiments.truth import true_occupancy
+    from navlab.experiments.truth import true_occupancy, world_T_map
     from navlab.mapping.mapfile import load_map
-    from navlab.sim.gazebo import load_world_named
+    from navlab.sim.gazebo import load_robot_named, load_world_named
 
+    apply_resource_paths(args)
     grid = load_map(args.map)
     truth = true_occupancy(load_world_named(args.world), grid)
     start = start_pose(args)
-    scores: dict[str, Any] = dict(score_map(grid, truth, world_T_map=start))
-    scores["coverage"] = free_coverage(grid, truth, world_T_map=start)
+    map_in_world = world_T_map(load_robot_named(args.robot), start)  # the odometry source decides
+    scores: dict[str, Any] = {"map_frame_in_world": list(map_in_world)}
+    scores.update(score_map(grid, truth, world_T_map=map_in_world, start_xy=start[:2]))
+    scores["coverage"] = free_coverage(grid, truth, world_T_map=map_in_world, start_xy=start[:2])
     traj = Path(args.trajectory) if args.trajectory else Path(args.map).with_name("trajectory.txt")
     if args.trajectory or traj.is_file():
         est, true = read_trajectory(traj)
@@ -197,11 +206,17 @@ def add_eval_map(esub: argparse._SubParsersAction) -> None:
         description="Occupied-cell precision and recall (a match within one cell), mean wall error and "
         "free-space coverage of a map_server map against the world's true occupancy at lidar height, and the "
         "SLAM trajectory's error against ground truth when a trajectory file is there. "
-        "The map frame is the robot's start pose in the world (--x --y --yaw), so no alignment is searched.",
+        "The map frame is SLAM's odom frame at the start, decided by the robot's odometry source as navlab map "
+        "does: the world frame for <odometrySource>world (Gazebo's default), the start pose (--x --y --yaw) for "
+        "encoder odometry; so no alignment is searched.",
     )
     m.add_argument("map", help="map_server YAML file")
     m.add_argument("--world", required=True, help="world file or shipped name (room, room_obstacles)")
-    add_pose_arguments(m, "robot start (= the map frame)")
+    m.add_argument("--robot", default="mybot",
+                   help="the robot that mapped: .xacro/.urdf or shipped name (default mybot); its diff-drive "
+                   "odometry source decides the map frame")  # fmt: skip
+    add_pose_arguments(m, "robot start")
+    add_resource_path_arguments(m)
     m.add_argument("--trajectory", metavar="FILE",
                    help="SLAM vs true trajectory to score too (default: trajectory.txt beside the map, "
                    "as navlab map writes it)")  # fmt: skip
@@ -213,6 +228,7 @@ def _add_world_robot(p: argparse.ArgumentParser, world: str) -> None:
     p.add_argument("--world", default=world, help=f"world file or shipped name (default {world})")
     p.add_argument("--robot", default="mybot", help="robot .xacro/.urdf or shipped name (default mybot)")
     add_pose_arguments(p)
+    add_resource_path_arguments(p)
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -343,6 +359,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--out", metavar="DIR", default=None, help="results folder (default runs/<scenario name>)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.add_argument("--json", action="store_true", help="print the summary as one JSON object")
+    add_resource_path_arguments(p)
     p.set_defaults(func=_cmd_experiment)
 
     p = sub.add_parser(

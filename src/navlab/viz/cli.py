@@ -15,7 +15,13 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
-from navlab.cli_common import add_pose_arguments, positive_seconds, start_pose
+from navlab.cli_common import (
+    add_pose_arguments,
+    add_resource_path_arguments,
+    apply_resource_paths,
+    positive_seconds,
+    start_pose,
+)
 
 DEFAULT_PORT = 8765
 
@@ -129,12 +135,14 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     p.add_argument("--record", default=None, metavar="DIR", help="record every topic to a rosbag2 in DIR")
     add_server_arguments(p)
+    add_resource_path_arguments(p)
     p.set_defaults(func=_cmd_view)
 
 
 def _cmd_view(args: argparse.Namespace) -> int:
     if args.bag:
         return _replay(args)
+    apply_resource_paths(args)
     from navlab.core.launch import declared_args
     from navlab.core.runner import parse_launch_args
     from navlab.experiments.session import start_run
