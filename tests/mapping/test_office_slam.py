@@ -49,3 +49,22 @@ def test_noise_is_seeded():
     b = office_log(3, noise=OdometryNoise(scale=0.05))
     assert np.array_equal(a.log.scans[40].ranges, b.log.scans[40].ranges)
     assert a.log.scans[40].odom_pose == b.log.scans[40].odom_pose
+
+
+def test_cli_records_an_office_log_that_eval_reads(tmp_path, capsys):
+    import json
+
+    from navlab.cli import main
+    from navlab.io.carmen import read_carmen
+
+    args = ["world", "office", "--out", str(tmp_path / "office.world"), "--log", str(tmp_path / "office.clf"),
+            "--truth", str(tmp_path / "truth.txt"), "--seed", "4", "--json"]  # fmt: skip
+    assert main(args) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["rooms"] >= 20 and out["scans"] > 150
+    log = read_carmen(tmp_path / "office.clf")
+    assert len(log.scans) == out["scans"] and not log.skipped
+    # the log's own odometry against the truth: metres off, as raw odometry is
+    assert main(["eval", "trajectory", str(tmp_path / "office.clf"), str(tmp_path / "truth.txt"), "--json"]) == 0
+    ate_odom = json.loads(capsys.readouterr().out)
+    assert ate_odom["poses"] == out["scans"] and ate_odom["max_m"] > 1.0

@@ -245,3 +245,58 @@ def register(sub: argparse._SubParsersAction) -> None:
     t.add_argument("--json", action="store_true", help="print one JSON object")
     t.set_defaults(func=_cmd_eval_trajectory)
     add_eval_map(esub)
+
+
+def _cmd_world_office(args: argparse.Namespace) -> int:
+    from navlab.experiments.session import rounded
+    from navlab.io.carmen import write_carmen
+    from navlab.io.poses import write_poses
+    from navlab.mapping.simlog import OdometryNoise, record_log
+    from navlab.world.office import generate_office
+
+    office = generate_office()
+    world = office.write_world(args.out)
+    summary: dict = {"world": str(world), "width_m": office.width, "depth_m": office.depth, "rooms": office.rooms,
+                     "start": list(office.start)}  # fmt: skip
+    if args.log:
+        rec = record_log(world, office.route(), seed=args.seed, noise=OdometryNoise(scale=args.odom_scale,
+                         heading_drift=args.heading_drift))  # fmt: skip
+        write_carmen(args.log, rec.log, comment=f"navlab office log, seed {args.seed}: odometry frame = the true "
+                     f"start pose {rec.start} in {world.name}")  # fmt: skip
+        summary.update(log=str(args.log), scans=len(rec.log.scans), log_s=rec.log.duration)
+        if args.truth:
+            from navlab.experiments.trajectory import apply_se2
+            from navlab.geometry import inverse2
+
+            # the truth in the log's odometry frame (the start pose), as the SLAM output is
+            write_poses(args.truth, rec.timestamps, apply_se2(tuple(inverse2(rec.start)), rec.truth))
+            summary["truth"] = str(args.truth)
+    print_figures(rounded(summary), args.json)
+    return 0
+
+
+def add_world_office(verbs: argparse._SubParsersAction) -> None:
+    """``navlab world office``: the generated office floor, and a sparse log recorded in it."""
+    o = verbs.add_parser(
+        "office",
+        help="an office floor (30 x 20.5 m, 28 alike rooms, corridors closing two loops) and a sparse log in it",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+        description="Writes the generated office floor as a .world file. With --log, drives the robot around "
+        "both loops\n(and into two rooms) in the simulator and records a sparse laser log: a scan every 1 m "
+        "or 0.5 rad,\n181 beams over 180 degrees, wheel odometry with --odom-scale scale errors and heading "
+        "drift.\nThe log's odometry frame is the robot's true start pose; --truth writes the true poses in it.",
+        epilog="examples:\n"
+        "  navlab world office --out office.world --log office.clf --truth truth.txt --seed 1\n"
+        "  navlab slam --log office.clf --out office_map --mode gmapping\n"
+        "  navlab eval trajectory office_map/poses.txt truth.txt",
+    )
+    o.add_argument("--out", required=True, metavar="FILE.world", help="the .world file to write")
+    o.add_argument("--log", metavar="FILE.clf", help="also record a sparse CARMEN log in it")
+    o.add_argument("--truth", metavar="FILE.txt", help="with --log: the true poses ('t x y theta', log frame)")
+    o.add_argument("--seed", type=int, default=0, help="random seed of the lidar and odometry noise (default 0)")
+    o.add_argument("--odom-scale", type=float, default=0.05,
+                   help="std. dev. of the odometry's scale errors and per-step noise (default 0.05: 5 %%)")
+    o.add_argument("--heading-drift", type=float, default=0.02,
+                   help="std. dev. of the odometry's heading drift rate, rad/m (default 0.02)")
+    o.add_argument("--json", action="store_true", help="print the summary as one JSON object")
+    o.set_defaults(func=_cmd_world_office)

@@ -125,4 +125,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     c.add_argument("--png", default=None, metavar="FILE.png", help="also draw the world and the reference path")
     c.add_argument("--json", action="store_true", help="print the summary as one JSON object")
     c.set_defaults(func=_cmd_clutter)
+    from navlab.mapping.cli import add_world_office  # the office floor and its recorded logs
+
+    add_world_office(verbs)
 
