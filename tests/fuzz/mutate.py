@@ -229,6 +229,8 @@ def _yaml_value(fmt: str, seed: Seed, rng: np.random.Generator) -> Case:
     else:
         value = True
         invalid = numeric and fmt != "launch"
+    if fmt == "scenario" and _key_of(path) == "t" and kind == "list":
+        invalid = False  # an obstacle's time may be a [lo, hi] range drawn per trial
     if fmt == "map" and _key_of(path) == "negate" and kind == "bool":
         invalid = False  # navlab reads negate: true/false as 1/0 (documented leniency)
     if fmt == "move_base" and path and path[0] in ("DWAPlannerROS", "MPPIController"):
