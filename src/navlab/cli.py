@@ -60,6 +60,10 @@ def main(argv: list[str] | None = None) -> int:
     except NavlabError as exc:
         print(f"navlab: error: {exc}", file=sys.stderr)
         return 2
+    except OSError as exc:  # a file the user named cannot be read or written (permissions, full disk, ...)
+        where = f"{exc.filename}: " if exc.filename else ""
+        print(f"navlab: error: {where}{exc.strerror or exc}", file=sys.stderr)
+        return 2
     except KeyboardInterrupt:
         print("navlab: interrupted", file=sys.stderr)
         return 130

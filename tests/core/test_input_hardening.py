@@ -71,3 +71,13 @@ def test_node_parameter_errors_name_the_launch_and_parameter_file(tmp_path: Path
     with pytest.raises(ParameterError, match=r"p\.launch\.yaml: entry 1 \(node\) 'talker' \(parameters from "
                                              r"talk\.yaml\): parameter 'rate': expected float"):
         start(str(launch))
+
+
+def test_an_unwritable_output_is_one_line_and_exit_2(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    from navlab.cli import main
+
+    blocker = tmp_path / "file"
+    blocker.write_text("not a folder")
+    code = main(["graph", "--launch", "talker_listener", "--duration", "0.2", "--out", str(blocker / "sub" / "g")])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1 and err[0].startswith("navlab: error: ") and "file" in err[0]
