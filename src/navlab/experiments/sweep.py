@@ -133,7 +133,7 @@ def plot_sweep(rows: list[dict[str, Any]], names: list[str], folder: Path) -> li
 
 
 def bench(args: Any) -> dict[str, Any]:
-    """``navlab bench sweep``: wall time of one small sweep (2 combinations x 2 trials in the empty room) with 1
+    """``navlab bench sweep``: wall time of one small sweep (2 combinations x 3 trials in the empty room) with 1
     local worker, 2 local workers and 2 CPUs of a local Ray instance (started before timing: ``ray_start_s``)."""
     import os
     import tempfile
@@ -143,11 +143,11 @@ def bench(args: Any) -> dict[str, Any]:
     from navlab.experiments.scenario import scenario_from_dict
     from navlab.experiments.trials import run_trial
 
-    sc = scenario_from_dict({"name": "bench_sweep", "world": "room", "goals": [[3.0, 1.0, 0.0]], "trials": 2,
-                             "seed": int(getattr(args, "seed", 0) or 0), "time_limit": 60})  # fmt: skip
+    sc = scenario_from_dict({"name": "bench_sweep", "world": "room", "goals": [[3.5, 3.0, 1.57], [-3.5, 0.0, -1.57]],
+                             "trials": 3, "seed": int(getattr(args, "seed", 0) or 0), "time_limit": 60})  # fmt: skip
     params = {"controller": ["trajectory", "dwa"]}
     run_trial(sc, 0)  # warm-up: Numba's caches, imports
-    out: dict[str, Any] = {"trials": 4, "cpus": os.cpu_count(), "load_1min": round(os.getloadavg()[0], 2)}
+    out: dict[str, Any] = {"trials": 6, "cpus": os.cpu_count(), "load_1min": round(os.getloadavg()[0], 2)}
     with tempfile.TemporaryDirectory(prefix="navlab-bench-sweep-") as tmp:
         for key, workers, backend in (("workers_1_s", 1, "local"), ("workers_2_s", 2, "local")):
             t0 = time.perf_counter()
