@@ -205,7 +205,8 @@ def run_navigation(
     is a rolling window in ``odom`` built from scans, and ``goals`` are in ``odom`` (the start pose).
     ``wheel_controller``: ``gazebo_ros_diff_drive`` (the robot's plugin) or ``diff_drive_controller`` (or a
     ros_control YAML file: see ``sim.wheel_control``); ``ekf``: a robot_localization parameter file (``default``:
-    the shipped params/ekf.yaml) — the EKF then owns tf odom → base; ``disturbances``: see ``sim.disturbances``.
+    the shipped params/ekf.yaml) — the EKF then owns tf odom → base; both go to the launch as its
+    ``wheel_controller``/``ekf`` arguments (``sim_launch_args``); ``disturbances``: see ``sim.disturbances``.
     """
     from navlab.mapping.mapfile import load_map, save_map
     from navlab.sim.gazebo import load_world_named
@@ -218,8 +219,8 @@ def run_navigation(
     overrides: dict[str, Any] = dict(move_base_params or {})
     if controller:
         overrides["base_local_planner"] = CONTROLLERS.get(controller, controller)
-    gazebo = sim_parameters(wheel_controller, ekf, disturbances)
-    launch_args: dict[str, Any] = {}
+    gazebo = {"gazebo": {"disturbances": dict(disturbances)}} if disturbances else {}
+    launch_args: dict[str, Any] = sim_launch_args(wheel_controller, ekf)
     if params_dir is not None:
         launch_args["params"] = str(params_dir)
     with tempfile.TemporaryDirectory(prefix="navlab-navigate-") as tmp:
@@ -235,8 +236,6 @@ def run_navigation(
         else:
             run = start_run("navigation", world=world, robot=robot, pose=pose, seed=seed, map=str(served),
                             overrides={"move_base": overrides, **gazebo}, on_start=on_start, **launch_args)  # fmt: skip
-    if ekf:
-        add_ekf(run, ekf)
     mb = _move_base(run)
     radius = mb.local_costmap.layered.circumscribed_radius
     mon = run.add(NavMonitor, parameters={"robot_radius": radius, "base_frame": run.base_frame,
@@ -275,44 +274,24 @@ def run_navigation(
 WHEEL_CONTROLLERS = ("gazebo_ros_diff_drive", "diff_drive_controller")
 
 
-def sim_parameters(wheel_controller: str, ekf: str | Path | None,
-                   disturbances: dict[str, Any] | None) -> dict[str, dict[str, Any]]:  # fmt: skip
-    """The ``gazebo`` node's parameter overrides for a wheel controller, an EKF and disturbances (issue 15)."""
-    from navlab import resources
-    from navlab.core.params import load_params
-
-    params: dict[str, Any] = {}
+def sim_launch_args(wheel_controller: str, ekf: str | Path | None) -> dict[str, str]:
+    """The shipped launches' arguments for a wheel controller and an EKF (issue 15): ``wheel_controller:=true``
+    (+ ``controller_params:=FILE`` for a ros_control YAML), ``ekf:=true`` (+ ``ekf_params:=FILE`` unless
+    ``default``/``true``: the shipped params/ekf.yaml)."""
+    args: dict[str, str] = {}
     if wheel_controller != "gazebo_ros_diff_drive":
-        path = resources.root() / "params" / "mybot" / "diff_drive_controller.yaml"
+        args["wheel_controller"] = "true"
         if wheel_controller != "diff_drive_controller":
-            path = Path(wheel_controller)
-            if not path.is_file():
+            if not Path(wheel_controller).is_file():
                 known = " or ".join(WHEEL_CONTROLLERS)
                 raise NavigationError(f"wheel_controller {wheel_controller!r}: expected {known} or a ros_control "
                                       "YAML file")  # fmt: skip
-        params = load_params(path)
-        if ekf:  # the EKF owns odom -> base
-            params.setdefault("mobile_base_controller", {})["enable_odom_tf"] = False
-    elif ekf:
-        raise NavigationError("ekf needs wheel_controller: diff_drive_controller (whose enable_odom_tf is turned "
-                              "off so that the EKF owns the tf odom -> base)")  # fmt: skip
-    if disturbances:
-        params["disturbances"] = dict(disturbances)
-    return {"gazebo": params} if params else {}
-
-
-def add_ekf(run: Run, ekf: str | Path) -> Any:
-    """Start robot_localization's ekf_node (parameters from ``ekf``; ``default``: the shipped params/ekf.yaml)
-    on the run, in the robot's base and odometry frames."""
-    from navlab import resources
-    from navlab.core.params import load_params
-    from navlab.localization.ekf_node import EkfNode
-
-    path = resources.root() / "params" / "ekf.yaml" if str(ekf) in ("default", "true", "True") else Path(ekf)
-    params = {**load_params(path, node="ekf_se"), "base_link_frame": run.base_frame, "odom_frame": run.odom_frame}
-    if params.get("world_frame", "odom") != "map":
-        params["world_frame"] = run.odom_frame
-    return run.add(EkfNode, name="ekf_se", parameters=params)
+            args["controller_params"] = str(Path(wheel_controller).resolve())
+    if ekf:
+        args["ekf"] = "true"
+        if str(ekf) not in ("default", "true", "True"):
+            args["ekf_params"] = str(Path(ekf).resolve())
+    return args
 
 
 def _at(run: Run, t: float, fn: Any) -> None:

@@ -40,6 +40,8 @@ class GazeboSim(Node):
     ``odometry_noise`` (relative std dev of each wheel encoder's scale error; navlab extension, default 0).
     ``cmd_timeout`` (s; navlab's diff-drive watchdog: stop the wheels when no cmd_vel came for this long;
     default 0 = off, as ROS 1's gazebo_ros_diff_drive, where the last command holds until a new one).
+    ``publish_odom_tf`` (default true: as the robot's plugin tags / the controller's ``enable_odom_tf`` say;
+    false: neither the diff-drive plugin nor the wheel controller sends tf odom → base, an EKF owns it).
     ``robot_model``/``world_model`` replace the files."""
 
     def __init__(self, executor: Executor, *, name: str = "gazebo", parameters: dict[str, Any] | None = None,
@@ -57,6 +59,7 @@ class GazeboSim(Node):
         visuals = self.declare_parameter("visuals", False)
         odometry_noise = self.declare_parameter("odometry_noise", 0.0)
         cmd_timeout = float(self.declare_parameter("cmd_timeout", 0.0))
+        publish_odom_tf = bool(self.declare_parameter("publish_odom_tf", True))
         robot = robot_model if robot_model is not None else load_robot_named(robot_name)
         world = world_model if world_model is not None else load_world_named(world_name)
         extensions = SimExtensions(self)  # wheel controller and disturbances (navlab.sim.extensions)
@@ -76,6 +79,10 @@ class GazeboSim(Node):
                 robot.diff_drive.odometry_noise = odometry_noise
             if cmd_timeout > 0:
                 robot.diff_drive.cmd_timeout = cmd_timeout
+            if not publish_odom_tf:  # an EKF owns odom -> base
+                robot.diff_drive.publish_tf = False
+                if extensions.controller:
+                    extensions.controller["enable_odom_tf"] = False
             drive = extensions.drive_plugin(executor, namespace, self.sim)
             self.plugins.append(drive or DiffDrivePlugin(executor, namespace=namespace, sim=self.sim,
                                                          config=robot.diff_drive))
