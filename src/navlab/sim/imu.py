@@ -158,7 +158,10 @@ class ImuSensorPlugin(Node):
         return np.array(xyzw_from_wxyz(quat)), gyro, accel
 
     def update(self) -> None:
-        """Read the IMU and publish."""
+        """Read the IMU and publish, when anyone subscribes or listens (a recorder, ``topic echo``): a 100 Hz
+        message nobody reads cost ~6 % of a navigation run's CPU (navlab bench nav)."""
+        if not (self.pub.get_subscription_count() or self.executor.has_listeners):
+            return
         quat, gyro, accel = self.read()
         self.pub.publish(msgs.Imu(
             header=msgs.header(self.get_clock().now_ns(), self.frame_id),
