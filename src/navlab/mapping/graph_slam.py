@@ -98,6 +98,7 @@ class GraphSlam:
         self._last_loop_node = -(10**9)
         self._travel_at_loop = -math.inf
         self._pending: tuple[int, int, np.ndarray, np.ndarray] | None = None
+        self._world_cache: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}  # node -> (pose, xy, normals)
 
     @property
     def poses(self) -> np.ndarray:
@@ -105,33 +106,55 @@ class GraphSlam:
         return self.graph.poses
 
     def _cloud(self, idx: range | list[int]) -> tuple[np.ndarray, np.ndarray]:
+        """Map-frame points and normals of nodes ``idx`` at their current poses (cached per node until its
+        pose changes: only an optimisation moves old nodes)."""
         xy, nrm = [], []
         for k in idx:
             pose = self.graph.poses[k]
-            xy.append(transform_points2(pose, self.node_xy[k]))
-            nrm.append(rotate_vectors2(pose[2], self.node_normals[k]))
+            hit = self._world_cache.get(k)
+            if hit is None or not np.array_equal(hit[0], pose):
+                world = transform_points2(pose, self.node_xy[k])
+                hit = (pose.copy(), world, rotate_vectors2(pose[2], self.node_normals[k]))
+                self._world_cache[k] = hit
+            xy.append(hit[1])
+            nrm.append(hit[2])
         return np.concatenate(xy), np.concatenate(nrm)
 
     def _match(
-        self, cloud: tuple[np.ndarray, np.ndarray], pts: np.ndarray, prior: np.ndarray, lin: float, ang: float
+        self,
+        cloud: tuple[np.ndarray, np.ndarray],
+        pts: np.ndarray,
+        prior: np.ndarray,
+        lin: float,
+        ang: float,
+        fields: dict[tuple[float, float], LookupField] | None = None,
     ) -> tuple[np.ndarray, float, float, float]:
-        """Correlative search then ICP; returns (pose, correlative score, ICP inlier fraction, ICP rms)."""
+        """Correlative search then ICP; returns (pose, correlative score, ICP inlier fraction, ICP rms).
+        ``fields``: lookup fields of this ``cloud`` by (resolution, sigma), filled and reused across calls."""
         map_xy, map_n = cloud
         p = self.p
+        cache: dict[tuple[float, float], LookupField] = {} if fields is None else fields
+
+        def field(res: float, sigma: float) -> LookupField:
+            f = cache.get((res, sigma))
+            if f is None:
+                f = cache[(res, sigma)] = LookupField(map_xy, resolution=res, sigma=sigma)
+            return f
+
         sub = pts[:: max(1, len(pts) // 120)]
         if lin > 1.0:  # very wide (loop closure) windows start on a 0.2 m grid
-            coarse = LookupField(map_xy, resolution=0.2, sigma=0.2)
+            coarse = field(0.2, 0.2)
             prior, _ = correlative_search(
                 coarse, sub, prior, lin_window=lin, ang_window=ang, ang_step=math.radians(1.0)
             )
             lin, ang = 0.3, math.radians(2.0)
         if lin > 0.2 or ang > math.radians(4.0):  # coarse-to-fine for wide windows
-            coarse = LookupField(map_xy, resolution=0.1, sigma=0.1)
+            coarse = field(0.1, 0.1)
             prior, _ = correlative_search(
                 coarse, sub, prior, lin_window=lin, ang_window=ang, ang_step=math.radians(1.0)
             )
             lin, ang = 0.15, math.radians(1.5)
-        fine = LookupField(map_xy, resolution=p.field_resolution, sigma=p.field_sigma)
+        fine = field(p.field_resolution, p.field_sigma)
         pose, score = correlative_search(fine, pts, prior, lin_window=lin, ang_window=ang, ang_step=p.search_ang_step)
         res = icp_point_to_line(
             map_xy,
@@ -177,8 +200,9 @@ class GraphSlam:
                             priors += [compose2(self.graph.poses[-1], last), self.graph.poses[-1].copy()]
                             self.odom_jumps += 1
                     best = None
+                    fields: dict[tuple[float, float], LookupField] = {}
                     for pr in priors:
-                        cand, score, inl, _rms = self._match(cloud, sp.xy, pr, p.search_lin, p.search_ang)
+                        cand, score, inl, _rms = self._match(cloud, sp.xy, pr, p.search_lin, p.search_ang, fields)
                         if best is None or (inl, score) > (best[2], best[1]):
                             best = (cand, score, inl)
                     assert best is not None
