@@ -88,6 +88,7 @@ class BuildInfo:
     world_parts: dict[str, tuple[list[str], list[str]]] = field(default_factory=dict)
     model_poses: dict[str, tuple[float, ...]] = field(default_factory=dict)  # model name -> SDF pose
     visuals: bool = True  # build visual geoms (rendering only)
+    decompose_reach: float | None = None  # m above the floor up to which concave meshes get convex parts
     warnings: list[str] = field(default_factory=list)
 
 

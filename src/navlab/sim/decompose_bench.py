@@ -3,11 +3,15 @@ after issue 13, on a generated world, each with a cold cache.
 
 - ``before``: CoACD at its default effort, one mesh after another in this process (navlab before
   issue 13);
-- ``after``: bounded effort (``decompose.EFFORTS["bounded"]``) in parallel worker processes;
+- ``after_whole``: bounded effort (``decompose.EFFORTS["bounded"]``) in parallel worker processes,
+  whole meshes;
+- ``after``: the same, decomposed only up to the reach of mybot (``decompose.robot_reach``): parts
+  above it are one hull each;
 - ``warm``: the same load again, everything from the content-keyed cache.
 
-Figures are wall seconds of ``Simulation(None, world)`` (load + decomposition + build), the CPU
-seconds of the decomposition (all processes), and the parts per mesh. The world is
+Each load runs in a fresh process. Figures are wall seconds of ``Simulation(None, world)`` (load +
+decomposition + build), the CPU seconds of the decomposition (all processes), the parts per mesh,
+and peak memory: ``ru_maxrss`` (MB) of the loading process and of its largest worker. The world is
 :func:`furnished_world`: L-shaped counters, U-shaped sofas, open shelves and T-shaped tables of
 seeded random sizes (every mesh different, so the cache cannot share them).
 """
@@ -27,6 +31,7 @@ from typing import Any
 import numpy as np
 
 MESHES = 8  # concave meshes in the generated world
+ROBOT = "mybot"  # whose reach bounds the decomposition in ``after``
 
 
 def _box(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
@@ -102,48 +107,60 @@ def _self_cpu() -> float:
     return r.ru_utime + r.ru_stime
 
 
-def _first_load(world_file: Path, cache: Path, effort: str, workers: int) -> dict[str, Any]:
-    """Load the world and build its simulation with a cold cache at ``cache``."""
+def _load_here(world_file: str, cache: str, effort: str, workers: int, reach: str) -> dict[str, Any]:
+    """Load the world and build its simulation with the cache at ``cache`` (in a fresh process)."""
     from navlab.sim import decompose
     from navlab.sim.simulation import Simulation
     from navlab.world import load_world
 
-    os.environ["NAVLAB_CACHE"] = str(cache)
+    os.environ["NAVLAB_CACHE"] = cache
     os.environ["NAVLAB_DECOMPOSE_WORKERS"] = str(workers)
     os.environ["NAVLAB_DECOMPOSE_EFFORT"] = effort  # what the scene builder's decompose_world uses
+    os.environ["NAVLAB_DECOMPOSE_REACH"] = reach  # no robot in the scene: the reach is given
     wall0, cpu0, child0 = time.perf_counter(), _self_cpu(), _children_cpu()
     world = load_world(world_file)
     sim = Simulation(None, world, visuals=False)  # decomposes (in parallel), then builds
     wall = time.perf_counter() - wall0
     cpu = _self_cpu() - cpu0 + _children_cpu() - child0
-    meshes = decompose.concave_meshes(world)
-    parts = [len(decompose.convex_parts(p, s)) for p, s in meshes]
+    meshes = decompose.concave_meshes(world, decompose.default_reach())
+    parts = [len(decompose.convex_parts(p, s, cut=c)) for p, s, c in meshes]
+    mb = 1024.0 if os.uname().sysname != "Darwin" else 1024.0 * 1024.0  # ru_maxrss: KiB on Linux, bytes on macOS
     return {"wall_s": round(wall, 1), "cpu_s": round(cpu, 1), "meshes": len(meshes),
-            "parts_per_mesh": round(float(np.mean(parts)), 1), "geoms": int(sim.model.ngeom), "workers": workers}
+            "parts_per_mesh": round(float(np.mean(parts)), 1), "geoms": int(sim.model.ngeom), "workers": workers,
+            "peak_rss_mb": round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / mb),
+            "peak_worker_rss_mb": round(resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / mb)}
+
+
+def _first_load(world_file: Path, cache: Path, effort: str, workers: int, reach: str = "off") -> dict[str, Any]:
+    """:func:`_load_here` in a fresh process, so its peak memory is its own."""
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
+    with ProcessPoolExecutor(1, mp_context=multiprocessing.get_context("spawn")) as pool:
+        return pool.submit(_load_here, str(world_file), str(cache), effort, workers, reach).result()
 
 
 def run(args: argparse.Namespace) -> dict[str, Any]:
     """Measure and return {"before", "after", "warm_s", ...} (see the module docstring)."""
     from navlab.sim import decompose
+    from navlab.sim.gazebo import load_robot_named
 
     seed = int(getattr(args, "seed", 0))
-    saved = {k: os.environ.get(k) for k in ("NAVLAB_CACHE", "NAVLAB_DECOMPOSE_WORKERS", "NAVLAB_DECOMPOSE_EFFORT")}
-    try:
-        with tempfile.TemporaryDirectory() as tmp:
-            folder = Path(tmp)
-            world = furnished_world(folder / "world", MESHES, seed)
-            after = _first_load(world, folder / "cache_after", "bounded", decompose.default_workers())
-            t0 = time.perf_counter()
-            warm = _first_load(world, folder / "cache_after", "bounded", 1)
-            warm_s = time.perf_counter() - t0
-            before = _first_load(world, folder / "cache_before", "full", 1)
-    finally:
-        for key, value in saved.items():
-            if value is None:
-                os.environ.pop(key, None)
-            else:
-                os.environ[key] = value
-    return {"before": before, "after": after, "warm_s": round(warm_s, 2), "warm_wall_s": warm["wall_s"],
+    reach = decompose.robot_reach(load_robot_named(ROBOT)) if not os.environ.get("NAVLAB_DECOMPOSE_REACH") else None
+    reach_s = str(reach if reach is not None else decompose.default_reach() or "off")
+    workers = decompose.default_workers()
+    with tempfile.TemporaryDirectory() as tmp:
+        folder = Path(tmp)
+        world = furnished_world(folder / "world", MESHES, seed)
+        after = _first_load(world, folder / "cache_after", "bounded", workers, reach_s)
+        t0 = time.perf_counter()
+        warm = _first_load(world, folder / "cache_after", "bounded", 1, reach_s)
+        warm_s = time.perf_counter() - t0
+        whole = _first_load(world, folder / "cache_whole", "bounded", workers, "off")
+        before = _first_load(world, folder / "cache_before", "full", 1, "off")
+    return {"before": before, "after_whole": whole, "after": after, "reach_m": reach_s, "robot": ROBOT,
+            "warm_s": round(warm_s, 2), "warm_wall_s": warm["wall_s"],
             "speedup_wall": round(before["wall_s"] / max(after["wall_s"], 1e-9), 1),
             "speedup_cpu": round(before["cpu_s"] / max(after["cpu_s"], 1e-9), 1),
-            "note": "cold caches; wall time on a shared machine depends on its load"}
+            "reach_speedup_cpu": round(whole["cpu_s"] / max(after["cpu_s"], 1e-9), 2),
+            "note": "cold caches, each load in a fresh process; wall time on a shared machine depends on its load"}

@@ -79,8 +79,11 @@ def add_world_model(spec: mujoco.MjSpec, model: ModelSpec, info: BuildInfo) -> l
                 geom_names.append(f"{scoped}::ray{i}")
                 hull_props = {**props, "group": GROUP_WORLD_HULL}
                 if getattr(shape.geometry, "convex", None) is False:
+                    from navlab.sim.decompose import local_cut
+
+                    cut = local_cut(place(shape).origin if model.static else None, info.decompose_reach)
                     _add_convex_parts(spec, body, place(shape), cwhere, f"{scoped}::collision{i}", hull_props,
-                                      extra, geom_names)
+                                      extra, geom_names, cut)
                     continue
                 geoms.add(body, place(shape), cwhere, **hull_props, **extra)
             else:
@@ -102,13 +105,15 @@ def add_world_model(spec: mujoco.MjSpec, model: ModelSpec, info: BuildInfo) -> l
 
 
 def _add_convex_parts(spec: mujoco.MjSpec, body: mujoco.MjsBody, shape: Shape, where: str, name: str,
-                      props: dict[str, object], extra: dict[str, object], names: list[str]) -> None:
-    """Collide a concave mesh as its convex parts (see navlab.sim.decompose)."""
+                      props: dict[str, object], extra: dict[str, object], names: list[str],
+                      cut: float | None = None) -> None:
+    """Collide a concave mesh as its convex parts, decomposed below ``cut`` (m in the mesh's frame;
+    None: whole) only (see navlab.sim.decompose)."""
     from navlab.sim.decompose import convex_parts
 
     g = shape.geometry
     assert g.mesh_path is not None
-    parts = convex_parts(g.mesh_path, g.mesh_scale)
+    parts = convex_parts(g.mesh_path, g.mesh_scale, cut=cut)
     extra = dict(extra)
     mass = extra.get("mass")
     if isinstance(mass, float):
@@ -188,9 +193,11 @@ def build_spec(
     _add_scenery(spec, world)
     if robot is not None:
         add_robot(spec, robot, info, robot_pose)
-    from navlab.sim.decompose import decompose_world
+    from navlab.sim.decompose import decompose_world, robot_reach
 
-    decompose_world(world)  # uncached concave meshes: decomposed in parallel (progress bar), then cached
+    info.decompose_reach = robot_reach(robot)  # convex parts only where the robot can touch
+    # uncached concave meshes: decomposed in parallel (progress bar), then cached
+    decompose_world(world, reach=info.decompose_reach)
     for model in world.models:
         add_world_model(spec, model, info)
     return spec, info
