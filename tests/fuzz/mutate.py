@@ -92,7 +92,7 @@ READ_XML: dict[str, frozenset[str]] = {
                        "min", "max", "wheelSeparation", "wheelDiameter", "wheelTorque", "wheelAcceleration",
                        "pose"}),
     "world": frozenset({"pose", "size", "radius", "length", "mass", "mu", "mu2", "ixx", "iyy", "izz", "ixy", "ixz",
-                        "iyz", "max_step_size", "real_time_update_rate"}),
+                        "iyz", "max_step_size"}),
 }
 READ_XML["robot"] = READ_XML["urdf"]
 
