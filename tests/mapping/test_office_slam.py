@@ -44,6 +44,19 @@ def test_both_modes_globally_consistent_on_sparse_office_logs(seed, truth):
         assert got["precision"] >= 0.95, (mode, got)
 
 
+def test_graph_mode_survives_larger_steps_in_corridors(truth, tmp_path):
+    """1.6 m / 0.9 rad between scans: after a turn, 'standing still' fits the recent scans as well as the
+    true step does along a corridor; the front end must not take it (it used to: ATE 0.5-0.8 m)."""
+    from navlab.mapping.simlog import record_log
+    from navlab.world.office import generate_office
+
+    office = generate_office()
+    sim_log = record_log(office.write_world(tmp_path / "office.world"), office.route(), seed=1, linear_step=1.6,
+                         angular_step=0.9)  # fmt: skip
+    got = office_scores(sim_log, run_offline(sim_log.log, mode="graph"), truth)
+    assert got["ate_rmse_m"] <= 0.10 and got["ate_max_m"] <= 0.30 and got["precision"] >= 0.95, got
+
+
 def test_noise_is_seeded():
     a = office_log(3, noise=OdometryNoise(scale=0.05))
     b = office_log(3, noise=OdometryNoise(scale=0.05))

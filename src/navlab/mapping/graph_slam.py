@@ -1,7 +1,9 @@
 """Graph SLAM: scan-to-local-map matching, loop closure and sparse pose-graph optimisation.
 
 Every scan becomes a node. The front end predicts the scan's pose from odometry, finds it with a
-correlative search on a smoothed hit grid of the recent scans, and refines it by point-to-line ICP.
+coarse-to-fine correlative search on smoothed hit grids of the recent scans (a window grown with the
+odometry step: sparse logs move up to 1 m and 30 degrees between scans), and refines it by point-to-line
+ICP.
 Every ``loop_every`` nodes, the back end looks for old nodes (far along the path, near in space),
 matches the scan against their scans with a coarse-to-fine correlative search and ICP, and, if the
 match is good, adds a robust edge and re-optimises the whole graph; an edge the optimised graph
@@ -39,6 +41,12 @@ class GraphSlamParams:
     search_lin: float = 0.3  # correlative search half-window around the odometry prediction (m)
     search_ang: float = math.radians(15.0)
     search_ang_step: float = math.radians(0.5)
+    # the window grows with the odometry step's uncertainty: half-widths of at least these fractions of
+    # the step (m per m travelled, m per rad turned; rad per rad turned, rad per m travelled)
+    search_lin_per_m: float = 0.25
+    search_lin_per_rad: float = 0.25
+    search_ang_per_rad: float = 0.3
+    search_ang_per_m: float = math.radians(5.0)
     field_resolution: float = 0.05
     field_sigma: float = 0.05
     icp_max_dist: float = 0.3
@@ -46,6 +54,9 @@ class GraphSlamParams:
     icp_iterations: int = 12
     odom_jump_lin: float = 0.1  # odometry step this far from the last estimated step -> try other priors
     odom_jump_ang: float = math.radians(8.0)
+    odom_still_lin: float = 0.5  # standing still is tried only for odometry steps under these (m, rad)
+    odom_still_ang: float = 0.5
+    odom_jump_margin: float = 0.0  # ... and a non-odometry prior wins only with this much more ICP overlap
     min_inliers: float = 0.3  # below this the front end trusts odometry instead of the match
     seq_sigma_xy: float = 0.02  # std. dev. of a sequential edge (m)
     seq_sigma_theta: float = math.radians(0.5)
@@ -197,13 +208,23 @@ class GraphSlam:
                         last = between2(self.graph.poses[-2], self.graph.poses[-1])
                         jump = step - last
                         if math.hypot(jump[0], jump[1]) > p.odom_jump_lin or abs(jump[2]) > p.odom_jump_ang:
-                            priors += [compose2(self.graph.poses[-1], last), self.graph.poses[-1].copy()]
+                            priors.append(compose2(self.graph.poses[-1], last))
+                            # standing still only competes with a small odometry step: after a real step
+                            # it would often fit the recent scans better than the true pose does
+                            if math.hypot(step[0], step[1]) < p.odom_still_lin and abs(step[2]) < p.odom_still_ang:
+                                priors.append(self.graph.poses[-1].copy())
                             self.odom_jumps += 1
                     best = None
                     fields: dict[tuple[float, float], LookupField] = {}
-                    for pr in priors:
-                        cand, score, inl, _rms = self._match(cloud, sp.xy, pr, p.search_lin, p.search_ang, fields)
-                        if best is None or (inl, score) > (best[2], best[1]):
+                    dist, turn = math.hypot(step[0], step[1]), abs(math.remainder(step[2], 2 * math.pi))
+                    lin = max(p.search_lin, p.search_lin_per_m * dist + p.search_lin_per_rad * turn)
+                    ang = max(p.search_ang, p.search_ang_per_rad * turn + p.search_ang_per_m * dist)
+                    for m, pr in enumerate(priors):
+                        cand, score, inl, _rms = self._match(cloud, sp.xy, pr, lin, ang, fields)
+                        # another prior must fit clearly better than the odometry's: in a corridor, standing
+                        # still fits as well as the true step (aliasing along its length)
+                        margin = 0.0 if m == 0 else p.odom_jump_margin
+                        if best is None or (inl - margin, score) > (best[2], best[1]):
                             best = (cand, score, inl)
                     assert best is not None
                     if best[2] >= p.min_inliers:
