@@ -8,7 +8,7 @@ CHROMIUM := /usr/bin/chromium
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 export MUJOCO_GL ?= egl
 
-.PHONY: install demo test lint bench clean
+.PHONY: install demo test lint bench clean fuzz
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -31,6 +31,10 @@ test: $(STAMP) $(CHROMIUM)
 	$(BIN)/python tools/check_layers.py
 	$(BIN)/mypy
 	$(BIN)/python -m pytest
+
+# the full fuzz campaign (>= 2,000 malformed inputs); a 330-case subset runs in `make test`
+fuzz: $(STAMP)
+	$(BIN)/python -m tests.fuzz --cases 2200
 
 lint: $(STAMP)
 	$(BIN)/ruff check src tests
