@@ -395,24 +395,29 @@ class GMapping:
         w = np.exp((lw - lw.max()) / (p.ogain * len(lw)))
         w /= w.sum()
         neff = 1.0 / float(np.sum(w**2))
+        copy_of = list(range(len(self.particles)))  # particle n's map is particle copy_of[n]'s (resampling)
         if neff < p.resampleThreshold * len(w):
             self.resamples += 1
             # systematic resampling
             pos = (self.rng.random() + np.arange(len(w))) / len(w)
             idx = np.minimum(np.searchsorted(np.cumsum(w), pos), len(w) - 1)
-            used: set[int] = set()
+            first: dict[int, int] = {}
             new = []
-            for i in idx:
+            for n, i in enumerate(idx):
                 src = self.particles[int(i)]
-                grid = src.grid if int(i) not in used else src.grid.copy()
-                used.add(int(i))
-                new.append(_Particle(src.pose.copy(), grid, src.node, 0.0))
+                # a copy of a particle drawn before shares its map until that one has integrated the scan
+                # (same map, same pose: the same result), then takes a copy of it
+                copy_of[n] = first.setdefault(int(i), n)
+                new.append(_Particle(src.pose.copy(), src.grid, src.node, 0.0))
             self.particles = new
         # grow the maps (rarely: by at least half their size) to hold this scan from every particle
         self._cover(np.array([q.pose for q in self.particles]), r, ang, max_urange, max_range)
-        for part in self.particles:
+        for n, part in enumerate(self.particles):
             part.node = (k, part.pose.copy(), part.node)
-            self._integrate(part.grid, part.pose, r, ang, max_urange, max_range)
+            if copy_of[n] != n:
+                part.grid = self.particles[copy_of[n]].grid.copy()
+            else:
+                self._integrate(part.grid, part.pose, r, ang, max_urange, max_range)
         self._mark_update(k)
 
     # --- results ------------------------------------------------------------------------------------
