@@ -48,6 +48,7 @@ def test_a_slow_local_costmap_hits_the_cylinder_that_a_fast_one_avoids() -> None
     """refresh_rate.yaml: the same trial (cylinder 0.7 m ahead at the same drawn time) at 0.5 Hz and 5 Hz."""
     sc = load_scenario("refresh_rate")
     assert sc.obstacles[0]["frame"] == "robot" and sc.overrides["planner_frequency"] == 0.0
+    sc.time_limit = 15.0  # the cylinder appears within 8 s: enough to see who hits it
     sc.overrides["local_costmap.update_frequency"] = 0.5
     slow = run_trial(sc, 1)
     sc.overrides["local_costmap.update_frequency"] = 5.0
