@@ -50,7 +50,7 @@ EFFORTS: dict[str, dict[str, Any]] = {
 }
 DEFAULT_EFFORT = "bounded"  # unless $NAVLAB_DECOMPOSE_EFFORT names another of EFFORTS
 _VERSION = "1"  # bump when the way parts are computed changes (invalidates the cache)
-_REACH_VERSION = "1"  # the same for the clipping at the reach height
+_REACH_VERSION = "2"  # the same for the clipping at the reach height
 
 #: clearance (m) added to the robot's height for the reach of :func:`robot_reach`
 REACH_MARGIN = 0.1
@@ -207,7 +207,12 @@ def _worker(path: str, scale: tuple[float, float, float], threshold: float, seed
 
 
 def _volume(verts: np.ndarray, faces: np.ndarray) -> float:
-    """The volume (m³) a closed triangle mesh encloses (divergence theorem; any consistent winding)."""
+    """The volume (m³) a closed triangle mesh encloses (divergence theorem; any consistent winding);
+    0 for an open mesh (an edge not shared by exactly two triangles), whose volume means nothing."""
+    edges = np.sort(faces[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1)
+    _e, counts = np.unique(edges, axis=0, return_counts=True)
+    if len(faces) == 0 or (counts != 2).any():
+        return 0.0
     v0, v1, v2 = verts[faces[:, 0]], verts[faces[:, 1]], verts[faces[:, 2]]
     return abs(float(np.einsum("ij,ij->i", v0, np.cross(v1, v2)).sum()) / 6.0)
 
