@@ -104,12 +104,14 @@ class PoseGraph:
             d2 = np.einsum("mi,mij,mj->m", e, info, e)
             w = np.where(robust, 1.0 / (1.0 + d2 / kernel**2), 1.0)
             om = info * w[:, None, None]
-            # blocks of H and b
-            haa = np.einsum("mki,mkl,mlj->mij", a, om, a)
-            hab = np.einsum("mki,mkl,mlj->mij", a, om, b)
-            hbb = np.einsum("mki,mkl,mlj->mij", b, om, b)
-            ga = np.einsum("mki,mkl,ml->mi", a, om, e)
-            gb = np.einsum("mki,mkl,ml->mi", b, om, e)
+            # blocks of H and b (batched matrix products: A^T Om A, A^T Om B, B^T Om B, A^T Om e, B^T Om e)
+            at_om = a.transpose(0, 2, 1) @ om
+            bt_om = b.transpose(0, 2, 1) @ om
+            haa = at_om @ a
+            hab = at_om @ b
+            hbb = bt_om @ b
+            ga = (at_om @ e[:, :, None])[:, :, 0]
+            gb = (bt_om @ e[:, :, None])[:, :, 0]
             r3 = np.arange(3)
             rows, cols, vals = [], [], []
             for blk, bi, bj in ((haa, i, i), (hab, i, j), (hab.transpose(0, 2, 1), j, i), (hbb, j, j)):
