@@ -45,7 +45,7 @@ def test_spawn_specs() -> None:
 
 
 def test_render_writes_a_png(tmp_path: os.PathLike[str]) -> None:
-    from conftest import make_mybot, make_room
+    from sim_helpers import make_mybot, make_room
 
     from navlab.sim import Simulation
     from navlab.sim.render import render_image, save_png

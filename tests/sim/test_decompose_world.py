@@ -54,7 +54,7 @@ def test_decomposed_only_up_to_the_robots_reach_and_the_robot_still_cannot_drive
     """Above the robot's reach nothing is decomposed: an L counter's top is left out of physics, a
     table top is one hull; below it the L keeps its notch, and the robot drives into the counter and
     stops at it."""
-    from conftest import make_mybot
+    from sim_helpers import make_mybot
 
     from navlab.description.meshes import read_mesh
     from navlab.sim import Simulation

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from conftest import make_mybot, make_room
+from sim_helpers import make_mybot, make_room
 
 from navlab import msgs
 from navlab.core import Executor, Node

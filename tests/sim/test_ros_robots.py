@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import make_room
+from sim_helpers import make_room
 
 from navlab import msgs
 from navlab.core import Executor, Node

@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 import pytest
-from conftest import make_room
+from sim_helpers import make_room
 
 from navlab import msgs, resources
 from navlab.core import Executor, Node

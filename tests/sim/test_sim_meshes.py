@@ -6,7 +6,7 @@ import math
 from pathlib import Path
 
 import pytest
-from conftest import make_mybot
+from sim_helpers import make_mybot
 
 from navlab.description.model import Geometry, Link, Shape
 from navlab.sim import Simulation

@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 import pytest
-from conftest import box_model, make_mybot, make_room
+from sim_helpers import box_model, make_mybot, make_room
 
 from navlab.sim import SimError, Simulation
 from navlab.sim.simulation import lidar_angles

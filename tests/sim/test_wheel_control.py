@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 import pytest
-from conftest import make_mybot, make_room
+from sim_helpers import make_mybot, make_room
 
 from navlab import msgs
 from navlab.core import Executor, Node
