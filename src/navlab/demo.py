@@ -68,35 +68,17 @@ def run_demo(out: str | Path = "navlab-demo", *, seed: int = 0, quiet: bool = Fa
 
 
 def write_report(summary: dict[str, Any], out: Path) -> None:
-    """``report.json`` (every figure) and ``report.md`` (the same, to read), and ``map.png`` (Fig. 7) on top."""
+    """``report.json`` (every figure), ``map.png`` (Fig. 7) on top, and ``report.md`` + ``report.html`` rendered
+    from them by ``navlab report``'s renderer."""
     import shutil
 
+    from navlab.experiments.report import render_report
     from navlab.io.files import write_text_atomic
 
-    m, loc, nav = summary["mapping"], summary["localization"], summary["navigation"]
-    if Path(m["picture"]).is_file():
-        shutil.copyfile(m["picture"], out / "map.png")
+    if Path(summary["mapping"]["picture"]).is_file():
+        shutil.copyfile(summary["mapping"]["picture"], out / "map.png")
     write_text_atomic(out / "report.json", json.dumps(summary, indent=1) + "\n")
-    bag = f"; recording `{nav['record']}`" if nav.get("record") else ""
-    lines = [
-        "# navlab demo: the paper's pipeline in simulation", "",
-        f"Total {summary['wall_s']} s wall. Pictures: `map.png` (Fig. 7), `localize.png`, `navigate/goal_N.png` "
-        "(Figs. 9–12)" + (f", `{Path(summary['render']).name}` (Figs. 4–5)" if "render" in summary else "") + ".", "",
-        "## 1. Mapping: slam_gmapping while the robot explores room.world", "",
-        "| figure | value |", "| --- | --- |",
-        *(f"| {k} | {v} |" for k, v in m.items() if k not in ("map", "picture")), "",
-        "## 2. Localization: AMCL on the saved map, in room_obstacles.world", "",
-        "| figure | value |", "| --- | --- |",
-        *(f"| {k} | {v} |" for k, v in loc.items() if k != "picture"), "",
-        "## 3. Navigation: move_base on the saved map, obstacles added after mapping", "",
-        "| goal | outcome | time (s) | path (m) | closest (m) | collisions | reason |",
-        "| --- | --- | --- | --- | --- | --- | --- |",
-        *(f"| {tuple(g['goal'])} | {g['outcome']} | {g['time_s']} | {g['path_m']} | {g['min_clearance_m']} | "
-          f"{g['collisions']} | {g['reason']} |" for g in nav["goals"]),
-        "", f"{nav['goals_succeeded']} of {len(nav['goals'])} goals reached, {nav['collisions']} collisions; "
-        f"{nav['sim_s']} simulated s at {nav['rtf']}x real time{bag}.", "",
-    ]  # fmt: skip
-    write_text_atomic(out / "report.md", "\n".join(lines))
+    render_report(out)
 
 
 # Goals across room_obstacles (map frame = the world frame: the robot mapped from the origin).
@@ -127,7 +109,7 @@ def _cmd(args: argparse.Namespace) -> int:
         print(json.dumps(summary))
         return 0
     m, loc = summary["mapping"], summary["localization"]
-    print(f"\nnavlab demo — report in {summary['out']}/report.md (+ report.json, pictures, recording)")
+    print(f"\nnavlab demo — report in {summary['out']}/report.md and report.html (+ report.json, pictures, recording)")
     if "render" in summary:
         print(f"  robot in its world:  {summary['render']}")
     print(f"  map:                 {m['map']} (+ map.pgm), picture {m['picture']}")

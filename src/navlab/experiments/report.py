@@ -232,27 +232,36 @@ def _sweep_report(folder: Path) -> Report:
 
 # ----------------------------------------------------------------------------------------------- demo
 def _demo_report(folder: Path) -> Report:
+    """The demo's report: the paper's three steps with their figures and pictures (``navlab demo`` writes it
+    with this too, so a re-render gives the same page)."""
     data = json.loads((folder / "report.json").read_text())
+    m, loc, nav = (data.get(k) if isinstance(data.get(k), dict) else {} for k in ("mapping", "localization",
+                                                                                 "navigation"))  # fmt: skip
     rep = Report("navlab demo: the paper's pipeline in simulation")
     if "wall_s" in data:
-        rep.text(f"Total {data['wall_s']} s wall.")
-    pictures = {"mapping": ["map.png"], "localization": ["localize.png"]}
-    for section, figures in data.items():
-        if not isinstance(figures, dict):
-            continue
-        rep.heading(section.capitalize())
-        goals = figures.get("goals") if isinstance(figures.get("goals"), list) else []
-        rep.table(["figure", "value"], [[k, v] for k, v in figures.items() if k != "goals" and k != "picture"])
-        for png in pictures.get(section, []):
-            if (folder / png).is_file():
-                rep.image(png, section)
-        if goals:
-            cols = ["goal", "outcome", "time_s", "path_m", "min_clearance_m", "collisions", "reason"]
-            rep.table(cols, [[g.get(c) for c in cols] for g in goals])
-            for k, g in enumerate(goals, 1):
-                png = f"navigate/goal_{k}.png"
-                if (folder / png).is_file():
-                    rep.image(png, f"goal {k} {g.get('goal')}: {g.get('outcome')}")
+        rep.text(f"Total {data['wall_s']} s wall. Pictures: `map.png` (Fig. 7), `localize.png`, "
+                 "`navigate/goal_N.png` (Figs. 9–12)" + (", `world.png` (Figs. 4–5)" if (folder / "world.png").is_file()
+                                                        else "") + ".")  # fmt: skip
+    rep.heading("1. Mapping: slam_gmapping while the robot explores room.world")
+    rep.table(["figure", "value"], [[k, v] for k, v in m.items() if k not in ("map", "picture")])
+    if (folder / "map.png").is_file():
+        rep.image("map.png", "the saved map (the paper's Fig. 7)")
+    rep.heading("2. Localization: AMCL on the saved map, in room_obstacles.world")
+    rep.table(["figure", "value"], [[k, v] for k, v in loc.items() if k != "picture"])
+    if (folder / "localize.png").is_file():
+        rep.image("localize.png", "AMCL's estimate against the ground truth")
+    rep.heading("3. Navigation: move_base on the saved map, obstacles added after mapping")
+    goals = nav.get("goals") if isinstance(nav.get("goals"), list) else []
+    cols = ["goal", "outcome", "time_s", "path_m", "min_clearance_m", "collisions", "reason"]
+    rep.table(cols, [[g.get(c) for c in cols] for g in goals])
+    if "goals_succeeded" in nav:
+        bag = f"; recording `{Path(nav['record']).name}/`" if nav.get("record") else ""
+        rep.text(f"{nav['goals_succeeded']} of {len(goals)} goals reached, {nav.get('collisions')} collisions; "
+                 f"{nav.get('sim_s')} simulated s at {nav.get('rtf')}x real time{bag}.")  # fmt: skip
+    for k, g in enumerate(goals, 1):
+        png = f"navigate/goal_{k}.png"
+        if (folder / png).is_file():
+            rep.image(png, f"goal {k} {g.get('goal')}: {g.get('outcome')}")
     if (folder / "world.png").is_file():
         rep.image("world.png", "the robot in its world")
     return rep
