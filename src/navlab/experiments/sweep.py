@@ -133,7 +133,7 @@ def plot_sweep(rows: list[dict[str, Any]], names: list[str], folder: Path) -> li
 
 
 def bench(args: Any) -> dict[str, Any]:
-    """``navlab bench sweep``: wall time of one small sweep (2 combinations x 3 trials of two goals in the empty
+    """``navlab bench sweep``: wall time of one small sweep (2 combinations x 6 trials of two goals in the empty
     room), each run as a user runs it — a fresh ``navlab experiment sweep`` process (imports, Numba's caches,
     worker or Ray start-up included) — with 1 local worker, 2 local workers and a local Ray instance of 2 CPUs;
     each twice (in the order A B C C B A), the faster of the two."""
@@ -145,8 +145,8 @@ def bench(args: Any) -> dict[str, Any]:
     import time
 
     scenario = {"name": "bench_sweep", "world": "room", "goals": [[3.5, 3.0, 1.57], [-3.5, 0.0, -1.57]],
-                "trials": 3, "seed": int(getattr(args, "seed", 0) or 0), "time_limit": 60}  # fmt: skip
-    out: dict[str, Any] = {"trials": 6, "cpus": os.cpu_count(), "load_1min": round(os.getloadavg()[0], 2)}
+                "trials": 6, "seed": int(getattr(args, "seed", 0) or 0), "time_limit": 60}  # fmt: skip
+    out: dict[str, Any] = {"trials": 12, "cpus": os.cpu_count(), "load_1min": round(os.getloadavg()[0], 2)}
     env = {k: v for k, v in os.environ.items() if k != "RAY_ADDRESS"}  # a local instance: this machine's figure
     with tempfile.TemporaryDirectory(prefix="navlab-bench-sweep-") as tmp:
         path = Path(tmp) / "bench_sweep.yaml"
