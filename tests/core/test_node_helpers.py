@@ -17,9 +17,10 @@ from navlab.nodes import NODES
 
 def _node_classes() -> list[type]:
     from navlab.sim import plugins as sim_plugins
+    from navlab.sim.imu import ImuSensorPlugin
 
     classes = [getattr(importlib.import_module(m), c) for m, c in (t.split(":") for t in NODES.values())]
-    classes += [sim_plugins.DiffDrivePlugin, sim_plugins.LidarPlugin, sim_plugins.ImuPlugin,
+    classes += [sim_plugins.DiffDrivePlugin, sim_plugins.LidarPlugin, ImuSensorPlugin,
                 sim_plugins.JointStatePlugin, sim_plugins.GroundTruthPlugin, Node]  # fmt: skip
     return classes
 

@@ -174,35 +174,6 @@ class LidarPlugin(Node):
         ))
 
 
-class ImuPlugin(Node):
-    """``gazebo_ros_imu_sensor``: ``sensor_msgs/Imu`` (orientation in world, rates and accelerations in
-    the IMU frame, with the configured noise) for the robot's IMU number ``index``."""
-
-    def __init__(self, executor: Executor, *, name: str = "", parameters: dict[str, Any] | None = None,
-                 namespace: str = "", sim: Simulation, index: int) -> None:
-        assert sim.robot is not None
-        cfg: ImuConfig = sim.robot.imus[index]
-        super().__init__(executor, name=name or f"{cfg.name}_plugin", parameters=parameters, namespace=namespace)
-        self.sim, self.index, self.cfg = sim, index, cfg
-        self.frame_id = cfg.frame_id or cfg.link
-        self.pub = self.create_publisher(msgs.Imu, cfg.topic, 10)
-        self.create_timer(1.0 / cfg.update_rate, self.update)
-        g2, a2 = cfg.gyro_noise_stddev**2, cfg.accel_noise_stddev**2
-        self.cov = (np.zeros(9), np.diag([g2, g2, g2]).ravel(), np.diag([a2, a2, a2]).ravel())
-
-    def update(self) -> None:
-        """Read the IMU and publish."""
-        quat, gyro, accel = self.sim.imu(self.index, rng=self.rng)
-        self.pub.publish(msgs.Imu(
-            header=msgs.header(self.get_clock().now_ns(), self.frame_id),
-            orientation=msgs.quaternion_msg(quat), orientation_covariance=self.cov[0].copy(),
-            angular_velocity=msgs.Vector3(x=float(gyro[0]), y=float(gyro[1]), z=float(gyro[2])),
-            angular_velocity_covariance=self.cov[1].copy(),
-            linear_acceleration=msgs.Vector3(x=float(accel[0]), y=float(accel[1]), z=float(accel[2])),
-            linear_acceleration_covariance=self.cov[2].copy(),
-        ))
-
-
 class JointStatePlugin(Node):
     """``gazebo_ros_joint_state_publisher`` + ``robot_state_publisher``: ``/joint_states`` of the moving
     joints and their tf (parent link → child link) every ``1/publish_frequency`` s (Hz, default 30; 0 = none);
