@@ -33,6 +33,7 @@ from navlab.viz.inputs import check_input
 INITIALPOSE_COV = (0.25, 0.25, 0.0, 0.0, 0.0, 0.06853891945200942)
 KINDS = {msgs.OccupancyGrid: "grid", msgs.LaserScan: "scan", msgs.Path: "path", msgs.PoseArray: "poses",
          msgs.PolygonStamped: "polygon"}  # fmt: skip
+ODOM_PERIOD_NS = 50_000_000  # simulated ns between odometry samples kept for the traces (20 Hz at most)
 PEEK_PERIOD = 0.2  # wall-clock s between copies of the plans and the particle cloud
 ALL_FRAMES_PERIOD = 0.5  # wall-clock s between poses of every tf frame (the others: every snapshot)
 SPEEDS = (0.0, 0.5, 1.0, 2.0, 5.0)  # 0 = as fast as possible
@@ -147,6 +148,7 @@ class ViewerNode(Node):
         self.obstacles: dict[str, dict[str, Any]] = {}  # placed from the page: name -> kind, dims, x, y
         self.last_outcome: dict[str, Any] = {}
         self._counts: dict[str, tuple[int, int]] = {}  # topic -> (count, t_ns) at the last graph
+        self._odom_due: dict[str, int] = {}  # topic -> simulated ns of its next trace sample
         self._direct: dict[str, tuple[str, Any]] | None = None
         self._last_peek = -1e9
         self._last_all_frames = -1e9
@@ -212,6 +214,11 @@ class ViewerNode(Node):
         self.hub.put(topic, kind, msg)
 
     def _on_odom(self, topic: str, msg: Any) -> None:
+        """A trace sample, throttled in simulated time (as fast as possible, odometry comes ~1000 times/s)."""
+        now = self.executor.now_ns
+        if now < self._odom_due.get(topic, 0):
+            return
+        self._odom_due[topic] = now + ODOM_PERIOD_NS
         p = msg.pose.pose.position
         self.hub.trace(topic, str(msg.header.frame_id).lstrip("/") or "odom", float(p.x), float(p.y))
 

@@ -144,8 +144,11 @@ class ViewerServer:
 
     async def _main(self) -> None:
         self._stop = asyncio.get_running_loop().create_future()
+        # permessage-deflate costs this process's CPU (and the page's) on every frame: only worth it off loopback
+        compression = None if self.host in LOOPBACK else "deflate"
         async with serve(self._client, self.host, self.port, process_request=self._http, max_size=MAX_MESSAGE,
-                         ping_interval=20, ping_timeout=20, logger=_log) as server:  # fmt: skip
+                         ping_interval=20, ping_timeout=20, logger=_log,
+                         compression=compression) as server:  # fmt: skip
             sock = next(iter(server.sockets))
             self.port = int(sock.getsockname()[1])
             self._ready.set()
@@ -210,12 +213,16 @@ class ViewerServer:
         return {"k": "ack", "op": op if isinstance(op, str) else None, "error": error}
 
     async def _send_loop(self, ws: ServerConnection, stream: ClientStream) -> None:
+        """Every 1/SEND_HZ wall-clock s: encode what is due and send it, unless the page has not taken the
+        previous batch yet (bytes still in the socket's buffer): then nothing is encoded this time."""
         period = 1.0 / SEND_HZ
+        transport = ws.transport
         while True:
-            for frame in stream.frames():
-                await ws.send(frame)  # waits while the socket is full: the stream skips, never queues
-                self.hub.bytes_sent += len(frame)
-            self.hub.frames_sent += 1
+            if transport is None or transport.get_write_buffer_size() == 0:
+                for frame in stream.frames():
+                    await ws.send(frame)  # waits while the socket is full: the stream skips, never queues
+                    self.hub.bytes_sent += len(frame)
+                self.hub.frames_sent += 1
             await asyncio.sleep(period)
 
 

@@ -130,7 +130,8 @@ function draw() {
   }
 }
 
-const MIN_FRAME_MS = 1000 / 40; // draw at most 40 frames/s: smooth, and leaves the CPU to the simulation
+// draw at most maxFps frames/s (and only when something changed): smooth, and leaves the CPU to the simulation
+const settings = { maxFps: 30 };
 let lastDraw = 0;
 // The grids change a few times a second: they are drawn into a background canvas only when they, the view,
 // the layers or their frames' poses changed, and each frame starts from a copy of it.
@@ -151,7 +152,7 @@ function drawBackground(tf) {
 }
 
 function frame(now) {
-  if (dirty && now - lastDraw >= MIN_FRAME_MS) { dirty = false; lastDraw = now; draw(); stats.frames++; framesThisSecond++; }
+  if (dirty && now - lastDraw >= 1000 / settings.maxFps - 2) { dirty = false; lastDraw = now; draw(); stats.frames++; framesThisSecond++; }
   if (now - fpsMark >= 1000) { stats.fps = (framesThisSecond * 1000) / (now - fpsMark); framesThisSecond = 0; fpsMark = now; }
   stats.bytes = link.bytes;
   requestAnimationFrame(frame);
@@ -254,4 +255,4 @@ $("play").onclick = () => link.send({ op: store.state?.paused ? "play" : "pause"
 $("rspeed").onchange = () => link.send({ op: "speed", value: Number($("rspeed").value) });
 
 // for tests and scripts: the view's transform, what was received and drawn
-window.navlab = { view, store, stats, layers, send: (o) => link.send(o), fit, setTool };
+window.navlab = { view, store, stats, layers, settings, send: (o) => link.send(o), fit, setTool };
