@@ -12,6 +12,7 @@ import math
 
 import numba
 import numpy as np
+from scipy.ndimage import maximum_filter
 
 from navlab.grid import COST_INSCRIBED, COST_LETHAL, COST_UNKNOWN
 from navlab.navigation.controllers.common import footprint_outline
@@ -112,33 +113,7 @@ def outline_reach_max(cost: np.ndarray, resolution: float, outline: np.ndarray) 
     the ``outline``'s points can fall in while the robot's centre is in each cell: where it equals the centre
     cell's cost, no edge can cost more (the footprint cost needs no edge lookups)."""
     reach = math.ceil(float(np.hypot(outline[:, 0], outline[:, 1]).max()) / resolution) + 1
-    out = np.empty(cost.shape, dtype=np.uint8)
-    _box_max(np.ascontiguousarray(cost, dtype=np.uint8), reach, out)
-    return out
-
-
-@numba.njit(cache=True)
-def _box_max(grid: np.ndarray, reach: int, out: np.ndarray) -> None:  # pragma: no cover - compiled
-    h, w = grid.shape
-    rows = np.empty((h, w), dtype=np.uint8)
-    for j in range(h):
-        for i in range(w):
-            m = grid[j, i]
-            if i - reach < 0 or i + reach >= w:
-                m = COST_UNKNOWN
-            else:
-                for k in range(i - reach, i + reach + 1):
-                    m = max(m, grid[j, k])
-            rows[j, i] = m
-    for j in range(h):
-        for i in range(w):
-            m = rows[j, i]
-            if j - reach < 0 or j + reach >= h:
-                m = COST_UNKNOWN
-            else:
-                for k in range(j - reach, j + reach + 1):
-                    m = max(m, rows[k, i])
-            out[j, i] = m
+    return maximum_filter(np.asarray(cost, dtype=np.uint8), size=2 * reach + 1, mode="constant", cval=COST_UNKNOWN)
 
 
 def _pose_costs(cost: np.ndarray, resolution: float, poses: np.ndarray, outline: np.ndarray | None,
