@@ -7,10 +7,11 @@ from pathlib import Path
 
 import pytest
 
-from navlab.experiments.backends import run_tasks
+from navlab.experiments.backends import run_tasks, wait_for_shutdown
 from navlab.experiments.errors import ExperimentError
 from navlab.experiments.scenario import scenario_from_dict
 from navlab.experiments.sweep import run_sweep
+from navlab.geometry import wrap_angle
 
 TINY = {"name": "tiny", "world": "room", "goals": [[1.2, 0.3, 0.0]], "trials": 1, "seed": 3, "time_limit": 30}
 
@@ -35,6 +36,13 @@ def test_ray_runs_a_sweep_with_the_same_results_as_local_workers(tmp_path: Path,
     a, b = _trials(tmp_path / "local"), _trials(tmp_path / "ray")
     assert len(a) == 2 and a == b  # every metric of every trial, bit for bit
     assert (tmp_path / "ray" / "sweep.md").read_text() == (tmp_path / "local" / "sweep.md").read_text()
+    # that instance stops in the background: the next one starts once it has stopped, and stops in turn
+    angles = [0.5, 7.0, -4.0]
+    assert sorted(run_tasks(wrap_angle, angles, backend="ray", workers=1)) == sorted(run_tasks(wrap_angle, angles))
+    wait_for_shutdown()
+    import ray as ray_module
+
+    assert not ray_module.is_initialized()
 
 
 def test_an_unreachable_ray_address_is_a_clear_error(monkeypatch: pytest.MonkeyPatch) -> None:
