@@ -3,11 +3,12 @@
 from __future__ import annotations
 
 import json
+import socket
 from pathlib import Path
 
 import pytest
 
-from navlab.experiments.backends import run_tasks, wait_for_shutdown
+from navlab.experiments.backends import init_ray, run_tasks, wait_for_shutdown
 from navlab.experiments.errors import ExperimentError
 from navlab.experiments.scenario import scenario_from_dict
 from navlab.experiments.sweep import run_sweep
@@ -54,6 +55,25 @@ def test_an_unreachable_ray_address_is_a_clear_error(monkeypatch: pytest.MonkeyP
         list(run_tasks(abs, [1], backend="ray"))
     with pytest.raises(ExperimentError, match="backend: expected one of local, ray"):
         list(run_tasks(abs, [1], backend="dask"))
+
+
+def test_a_refused_connection_names_the_cluster_and_token_authentication(monkeypatch: pytest.MonkeyPatch) -> None:
+    class TokenCluster:  # a cluster that answers on its port but refuses a driver without its token
+        @staticmethod
+        def init(**kwargs: object) -> None:
+            raise ConnectionError(f"Failed to connect to Ray cluster at {kwargs['address']}")
+
+    with socket.create_server(("127.0.0.1", 0)) as server:
+        address = f"127.0.0.1:{server.getsockname()[1]}"
+        monkeypatch.setenv("RAY_ADDRESS", address)
+        monkeypatch.delenv("RAY_AUTH_MODE", raising=False)
+        refused = r"could not start or reach the cluster at RAY_ADDRESS=.*ConnectionError: .*RAY_AUTH_MODE=token"
+        with pytest.raises(ExperimentError, match=refused):
+            init_ray(TokenCluster, 2)
+        monkeypatch.setenv("RAY_AUTH_MODE", "token")  # already set: no hint
+        with pytest.raises(ExperimentError) as err:
+            init_ray(TokenCluster, 2)
+        assert "RAY_AUTH_MODE" not in str(err.value)
 
 
 def test_local_workers_return_every_item_once() -> None:

@@ -113,9 +113,11 @@ def init_ray(ray: Any, workers: int | None) -> None:
                      logging_level=logging.WARNING)
     except Exception as exc:  # Ray raises ConnectionError, RuntimeError, ValueError, ... by cause
         where = f"the cluster at RAY_ADDRESS={address!r}" if address else "a local Ray instance"
+        hint = ("; a cluster with token authentication (which `ray start` turns on when ~/.ray/auth_token exists) "
+                "needs RAY_AUTH_MODE=token here too" if address and not os.environ.get("RAY_AUTH_MODE") else "")
         raise ExperimentError(f"--backend ray: could not start or reach {where}: "
                               f"{type(exc).__name__}: {str(exc).strip().splitlines()[0] if str(exc).strip() else ''}"
-                              ) from exc  # fmt: skip
+                              f"{hint}") from exc  # fmt: skip
 
 
 def check_reachable(address: str, timeout: float = 5.0) -> None:
