@@ -11,8 +11,8 @@ results file looks the same whichever backend ran the trials. ``fn`` must be a m
   of one CPU. Ray is imported only here, only for this backend. An instance started here is shut down at
   the end, in a background thread (``ray-shutdown``: Ray's shutdown waits ~1.3 s for its processes), so the
   caller writes its tables and plots meanwhile; the interpreter waits for that thread before it exits, and the
-  next local instance is started only after it has finished. One already initialised by the caller is used as
-  it is.
+  next local instance is started only after it has finished (code that calls ``ray.init`` itself right after a
+  run calls ``wait_for_shutdown()`` first). One already initialised by the caller is used as it is.
 """
 
 from __future__ import annotations
