@@ -3,14 +3,16 @@
 from __future__ import annotations
 
 import json
+import socket
 from pathlib import Path
 
 import pytest
 
-from navlab.experiments.backends import run_tasks
+from navlab.experiments.backends import init_ray, run_tasks, wait_for_shutdown
 from navlab.experiments.errors import ExperimentError
 from navlab.experiments.scenario import scenario_from_dict
 from navlab.experiments.sweep import run_sweep
+from navlab.geometry import wrap_angle
 
 TINY = {"name": "tiny", "world": "room", "goals": [[1.2, 0.3, 0.0]], "trials": 1, "seed": 3, "time_limit": 30}
 
@@ -35,6 +37,13 @@ def test_ray_runs_a_sweep_with_the_same_results_as_local_workers(tmp_path: Path,
     a, b = _trials(tmp_path / "local"), _trials(tmp_path / "ray")
     assert len(a) == 2 and a == b  # every metric of every trial, bit for bit
     assert (tmp_path / "ray" / "sweep.md").read_text() == (tmp_path / "local" / "sweep.md").read_text()
+    # that instance stops in the background: the next one starts once it has stopped, and stops in turn
+    angles = [0.5, 7.0, -4.0]
+    assert sorted(run_tasks(wrap_angle, angles, backend="ray", workers=1)) == sorted(run_tasks(wrap_angle, angles))
+    wait_for_shutdown()
+    import ray as ray_module
+
+    assert not ray_module.is_initialized()
 
 
 def test_an_unreachable_ray_address_is_a_clear_error(monkeypatch: pytest.MonkeyPatch) -> None:
@@ -46,6 +55,25 @@ def test_an_unreachable_ray_address_is_a_clear_error(monkeypatch: pytest.MonkeyP
         list(run_tasks(abs, [1], backend="ray"))
     with pytest.raises(ExperimentError, match="backend: expected one of local, ray"):
         list(run_tasks(abs, [1], backend="dask"))
+
+
+def test_a_refused_connection_names_the_cluster_and_token_authentication(monkeypatch: pytest.MonkeyPatch) -> None:
+    class TokenCluster:  # a cluster that answers on its port but refuses a driver without its token
+        @staticmethod
+        def init(**kwargs: object) -> None:
+            raise ConnectionError(f"Failed to connect to Ray cluster at {kwargs['address']}")
+
+    with socket.create_server(("127.0.0.1", 0)) as server:
+        address = f"127.0.0.1:{server.getsockname()[1]}"
+        monkeypatch.setenv("RAY_ADDRESS", address)
+        monkeypatch.delenv("RAY_AUTH_MODE", raising=False)
+        refused = r"could not start or reach the cluster at RAY_ADDRESS=.*ConnectionError: .*RAY_AUTH_MODE=token"
+        with pytest.raises(ExperimentError, match=refused):
+            init_ray(TokenCluster, 2)
+        monkeypatch.setenv("RAY_AUTH_MODE", "token")  # already set: no hint
+        with pytest.raises(ExperimentError) as err:
+            init_ray(TokenCluster, 2)
+        assert "RAY_AUTH_MODE" not in str(err.value)
 
 
 def test_local_workers_return_every_item_once() -> None:

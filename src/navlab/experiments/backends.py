@@ -9,7 +9,10 @@ results file looks the same whichever backend ran the trials. ``fn`` must be a m
 - ``ray``: ``ray.init(address=$RAY_ADDRESS)`` when the variable is set (a cluster whose nodes have navlab
   installed), else a local instance with ``workers`` CPUs (default: every core); each item is one Ray task
   of one CPU. Ray is imported only here, only for this backend. An instance started here is shut down at
-  the end; one already initialised by the caller is used as it is.
+  the end, in a background thread (``ray-shutdown``: Ray's shutdown waits ~1.3 s for its processes), so the
+  caller writes its tables and plots meanwhile; the interpreter waits for that thread before it exits, and the
+  next local instance is started only after it has finished (code that calls ``ray.init`` itself right after a
+  run calls ``wait_for_shutdown()`` first). One already initialised by the caller is used as it is.
 """
 
 from __future__ import annotations
@@ -17,12 +20,14 @@ from __future__ import annotations
 import functools
 import logging
 import os
+import threading
 from collections.abc import Callable, Iterator, Sequence
 from typing import Any, TypeVar
 
 from navlab.experiments.errors import ExperimentError
 
 BACKENDS = ("local", "ray")
+SHUTDOWN_THREAD = "ray-shutdown"  # the name of the thread stopping a local Ray instance started here
 T = TypeVar("T")
 R = TypeVar("R")
 
@@ -57,6 +62,7 @@ def run_tasks(fn: Callable[[T], R], items: Sequence[T], *, backend: str = "local
 
 def _run_ray(fn: Callable[[T], R], items: Sequence[T], workers: int | None) -> Iterator[tuple[int, R]]:
     ray = _import_ray()
+    wait_for_shutdown()
     started = not ray.is_initialized()
     if started:
         init_ray(ray, workers)
@@ -74,8 +80,16 @@ def _run_ray(fn: Callable[[T], R], items: Sequence[T], workers: int | None) -> I
                 raise ExperimentError(f"item {i} was lost on Ray ({type(exc).__name__}): {exc}") from exc
             yield i, result
     finally:
-        if started:
-            ray.shutdown()
+        if started:  # not a daemon thread: the interpreter waits for it at exit
+            threading.Thread(target=ray.shutdown, name=SHUTDOWN_THREAD, daemon=False).start()
+
+
+def wait_for_shutdown() -> None:
+    """Wait until a local Ray instance started by ``run_tasks`` has stopped (its shutdown runs in the
+    background)."""
+    for thread in threading.enumerate():
+        if thread.name == SHUTDOWN_THREAD:
+            thread.join()
 
 
 def _import_ray() -> Any:
@@ -99,9 +113,11 @@ def init_ray(ray: Any, workers: int | None) -> None:
                      logging_level=logging.WARNING)
     except Exception as exc:  # Ray raises ConnectionError, RuntimeError, ValueError, ... by cause
         where = f"the cluster at RAY_ADDRESS={address!r}" if address else "a local Ray instance"
+        hint = ("; a cluster with token authentication (which `ray start` turns on when ~/.ray/auth_token exists) "
+                "needs RAY_AUTH_MODE=token here too" if address and not os.environ.get("RAY_AUTH_MODE") else "")
         raise ExperimentError(f"--backend ray: could not start or reach {where}: "
                               f"{type(exc).__name__}: {str(exc).strip().splitlines()[0] if str(exc).strip() else ''}"
-                              ) from exc  # fmt: skip
+                              f"{hint}") from exc  # fmt: skip
 
 
 def check_reachable(address: str, timeout: float = 5.0) -> None:
