@@ -230,24 +230,28 @@ def correlative_search(
 
 
 @numba.njit(cache=True)
-def _build_hash(pts: np.ndarray, cell: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, float, float, int, int]:
-    """Bucket points into a dense grid of ``cell``-sized bins: (order, start, count, ox, oy, w, h)."""
+def _build_hash(pts: np.ndarray, cell: float) -> tuple[np.ndarray, np.ndarray, float, float, int, int]:
+    """Bucket points into a dense grid of ``cell``-sized bins (a counting sort: ascending index within a bin):
+    (order, start, ox, oy, w, h); bin ``c`` holds ``order[start[c]:start[c + 1]]``."""
     n = pts.shape[0]
-    ox = pts[:, 0].min() - cell
-    oy = pts[:, 1].min() - cell
-    w = int((pts[:, 0].max() - ox) / cell) + 2
-    h = int((pts[:, 1].max() - oy) / cell) + 2
+    x0, y0, x1, y1 = _bounds(pts)
+    ox = x0 - cell
+    oy = y0 - cell
+    w = int((x1 - ox) / cell) + 2
+    h = int((y1 - oy) / cell) + 2
     keys = np.empty(n, dtype=np.int64)
-    for k in range(n):
-        keys[k] = int((pts[k, 1] - oy) / cell) * w + int((pts[k, 0] - ox) / cell)
-    order = np.argsort(keys)
     start = np.zeros(w * h + 1, dtype=np.int64)
     for k in range(n):
+        keys[k] = int((pts[k, 1] - oy) / cell) * w + int((pts[k, 0] - ox) / cell)
         start[keys[k] + 1] += 1
-    count = start[1:].copy()
     for c in range(w * h):
         start[c + 1] += start[c]
-    return order, start, count, ox, oy, w, h
+    fill = start[:-1].copy()
+    order = np.empty(n, dtype=np.int64)
+    for k in range(n):
+        order[fill[keys[k]]] = k
+        fill[keys[k]] += 1
+    return order, start, ox, oy, w, h
 
 
 @numba.njit(cache=True)
@@ -263,7 +267,10 @@ def _icp(
     iterations: int,
     huber: float,
 ) -> tuple[float, float, float, float, float, np.ndarray]:
-    order, start, count, ox, oy, w, h = _build_hash(map_xy, max_dist)
+    # the nearest map point within the search radius (at most max_dist), from the bins of half max_dist that
+    # reach within the radius (equally near points: the first in bin order)
+    cell = max_dist / 2.0
+    order, start, ox, oy, w, h = _build_hash(map_xy, cell)
     x, y, t = x0, y0, t0
     n = scan.shape[0]
     half = max(iterations // 2, 1)
@@ -272,7 +279,7 @@ def _icp(
     hess = np.zeros((3, 3))
     for it in range(iterations):
         dmax = max_dist * ratio ** min(it, half - 1)
-        reach = dmax * (1.0 + 1e-9) + 1e-12
+        reach = dmax * (1.0 + 1e-9) + 1e-12  # bins reaching within dmax of the point (slack for rounding)
         c, s = math.cos(t), math.sin(t)
         hess = np.zeros((3, 3))
         g = np.zeros(3)
@@ -282,20 +289,16 @@ def _icp(
         for k in range(n):
             px = x + c * scan[k, 0] - s * scan[k, 1]
             py = y + s * scan[k, 0] + c * scan[k, 1]
-            ci = int((px - ox) / max_dist)
-            cj = int((py - oy) / max_dist)
             best = dmax * dmax
             bi = -1
-            # only the cells (of the 3 x 3 around the point's) that reach within dmax of it: the same candidates
-            # in the same order as the full 3 x 3, less those that cannot be nearer than dmax (slack for rounding)
-            i_lo = max(ci - 1, 0, math.floor((px - reach - ox) / max_dist))
-            i_hi = min(ci + 1, w - 1, math.floor((px + reach - ox) / max_dist))
-            j_lo = max(cj - 1, 0, math.floor((py - reach - oy) / max_dist))
-            j_hi = min(cj + 1, h - 1, math.floor((py + reach - oy) / max_dist))
+            i_lo = max(0, math.floor((px - reach - ox) / cell))
+            i_hi = min(w - 1, math.floor((px + reach - ox) / cell))
+            j_lo = max(0, math.floor((py - reach - oy) / cell))
+            j_hi = min(h - 1, math.floor((py + reach - oy) / cell))
             for j in range(j_lo, j_hi + 1):
                 for i in range(i_lo, i_hi + 1):
-                    cell = j * w + i
-                    for q in range(start[cell], start[cell] + count[cell]):
+                    b = j * w + i
+                    for q in range(start[b], start[b + 1]):
                         m = order[q]
                         d2 = (map_xy[m, 0] - px) ** 2 + (map_xy[m, 1] - py) ** 2
                         if d2 < best:
