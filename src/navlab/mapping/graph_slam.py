@@ -109,7 +109,7 @@ class GraphSlam:
         self._last_loop_node = -(10**9)
         self._travel_at_loop = -math.inf
         self._pending: tuple[int, int, np.ndarray, np.ndarray] | None = None
-        self._world_cache: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}  # node -> (pose, xy, normals)
+        self._world_cache: dict[int, tuple[list[float], np.ndarray, np.ndarray]] = {}  # node -> (pose, xy, normals)
 
     @property
     def poses(self) -> np.ndarray:
@@ -122,10 +122,11 @@ class GraphSlam:
         xy, nrm = [], []
         for k in idx:
             pose = self.graph.poses[k]
+            key = pose.tolist()  # comparing three floats is much cheaper than np.array_equal
             hit = self._world_cache.get(k)
-            if hit is None or not np.array_equal(hit[0], pose):
+            if hit is None or hit[0] != key:
                 world = transform_points2(pose, self.node_xy[k])
-                hit = (pose.copy(), world, rotate_vectors2(pose[2], self.node_normals[k]))
+                hit = (key, world, rotate_vectors2(pose[2], self.node_normals[k]))
                 self._world_cache[k] = hit
             xy.append(hit[1])
             nrm.append(hit[2])

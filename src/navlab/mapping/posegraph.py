@@ -17,7 +17,8 @@ from navlab.geometry import wrap_angle
 
 @dataclass
 class PoseGraph:
-    """Poses (N, 3) and edges; ``optimize`` updates ``poses`` in place."""
+    """Poses (N, 3) and edges; ``optimize`` updates ``poses`` in place. Edges change only through
+    ``add_edge`` and ``remove_edge`` (their arrays are kept stacked for the optimiser)."""
 
     poses: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
     edges_i: list[int] = field(default_factory=list)
@@ -25,6 +26,11 @@ class PoseGraph:
     edges_z: list[np.ndarray] = field(default_factory=list)
     edges_info: list[np.ndarray] = field(default_factory=list)
     edges_robust: list[bool] = field(default_factory=list)
+    # stacked edge arrays (i, j, z, info) with spare rows; the first ``_stacked_n`` rows mirror the lists
+    _stacked: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None = field(
+        default=None, init=False, repr=False, compare=False
+    )
+    _stacked_n: int = field(default=-1, init=False, repr=False, compare=False)
 
     def add_node(self, pose: np.ndarray) -> int:
         """Append a node; returns its index."""
@@ -38,12 +44,33 @@ class PoseGraph:
         self.edges_z.append(np.asarray(z, dtype=np.float64))
         self.edges_info.append(np.asarray(info, dtype=np.float64))
         self.edges_robust.append(robust)
+        m = len(self.edges_i) - 1
+        st = self._stacked
+        if st is not None and self._stacked_n == m and m < len(st[0]):
+            st[0][m], st[1][m], st[2][m], st[3][m] = i, j, self.edges_z[-1], self.edges_info[-1]
+            self._stacked_n = m + 1
+
+    def _edge_arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Edges' i, j (M,), z (M, 3) and info (M, 3, 3) as arrays (rebuilt from the lists when stale)."""
+        m = len(self.edges_i)
+        st = self._stacked
+        if st is None or self._stacked_n != m:
+            cap = 2 * m + 64
+            st = (
+                np.zeros(cap, dtype=np.int64),
+                np.zeros(cap, dtype=np.int64),
+                np.zeros((cap, 3)),
+                np.zeros((cap, 3, 3)),
+            )
+            if m:
+                st[0][:m], st[1][:m] = self.edges_i, self.edges_j
+                st[2][:m], st[3][:m] = self.edges_z, self.edges_info
+            self._stacked, self._stacked_n = st, m
+        return st[0][:m], st[1][:m], st[2][:m], st[3][:m]
 
     def residuals(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Edge errors e (M, 3) and Jacobians A = de/dxi, B = de/dxj (M, 3, 3), plus index arrays."""
-        i = np.asarray(self.edges_i)
-        j = np.asarray(self.edges_j)
-        z = np.asarray(self.edges_z)
+        i, j, z, _ = self._edge_arrays()
         xi, xj = self.poses[i], self.poses[j]
         ci, si = np.cos(xi[:, 2]), np.sin(xi[:, 2])
         dx, dy = xj[:, 0] - xi[:, 0], xj[:, 1] - xi[:, 1]
@@ -74,19 +101,20 @@ class PoseGraph:
         if not self.edges_i:
             return np.zeros(0)
         e = self.residuals()[0]
-        return np.sqrt(np.einsum("mi,mij,mj->m", e, np.asarray(self.edges_info), e))
+        return np.sqrt(np.einsum("mi,mij,mj->m", e, self._edge_arrays()[3], e))
 
     def remove_edge(self, k: int) -> None:
         """Drop edge ``k``."""
         for lst in (self.edges_i, self.edges_j, self.edges_z, self.edges_info, self.edges_robust):
             del lst[k]
+        self._stacked_n = -1
 
     def chi2(self) -> float:
         """Sum of squared Mahalanobis edge errors (no robust kernel)."""
         if not self.edges_i:
             return 0.0
         e = self.residuals()[0]
-        info = np.asarray(self.edges_info)
+        info = self._edge_arrays()[3]
         return float(np.einsum("mi,mij,mj->", e, info, e))
 
     def optimize(self, *, iterations: int = 10, kernel: float = 3.0, tol: float = 1e-6) -> int:
@@ -97,8 +125,16 @@ class PoseGraph:
         n = len(self.poses)
         if n < 2 or not self.edges_i:
             return 0
-        info = np.asarray(self.edges_info)
+        i, j, _, info = self._edge_arrays()
         robust = np.asarray(self.edges_robust)
+        # the sparsity pattern of H's 3 x 3 blocks (i, i), (i, j), (j, i), (j, j) of every edge
+        r3 = np.arange(3)
+        rows = np.concatenate(
+            [(3 * bi[:, None, None] + r3[None, :, None]).repeat(3, axis=2).ravel() for bi in (i, i, j, j)]
+        )
+        cols = np.concatenate(
+            [(3 * bj[:, None, None] + r3[None, None, :]).repeat(3, axis=1).ravel() for bj in (i, j, i, j)]
+        )
         for it in range(iterations):
             e, a, b, i, j = self.residuals()
             d2 = np.einsum("mi,mij,mj->m", e, info, e)
@@ -112,15 +148,8 @@ class PoseGraph:
             hbb = bt_om @ b
             ga = (at_om @ e[:, :, None])[:, :, 0]
             gb = (bt_om @ e[:, :, None])[:, :, 0]
-            r3 = np.arange(3)
-            rows, cols, vals = [], [], []
-            for blk, bi, bj in ((haa, i, i), (hab, i, j), (hab.transpose(0, 2, 1), j, i), (hbb, j, j)):
-                rows.append((3 * bi[:, None, None] + r3[None, :, None]).repeat(3, axis=2).ravel())
-                cols.append((3 * bj[:, None, None] + r3[None, None, :]).repeat(3, axis=1).ravel())
-                vals.append(blk.ravel())
-            h = sp.coo_matrix(
-                (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(3 * n, 3 * n)
-            ).tocsr()
+            vals = np.concatenate([blk.ravel() for blk in (haa, hab, hab.transpose(0, 2, 1), hbb)])
+            h = sp.coo_matrix((vals, (rows, cols)), shape=(3 * n, 3 * n)).tocsr()
             g = np.zeros(3 * n)
             np.add.at(g, (3 * i[:, None] + r3[None, :]).ravel(), ga.ravel())
             np.add.at(g, (3 * j[:, None] + r3[None, :]).ravel(), gb.ravel())

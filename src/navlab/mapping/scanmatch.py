@@ -70,12 +70,36 @@ def scan_points(
 
 
 @numba.njit(cache=True)
+def _bounds(pts: np.ndarray) -> tuple[float, float, float, float]:
+    """(min x, min y, max x, max y) of points (N, 2), N >= 1 (numpy's axis-0 reductions are slow on (N, 2))."""
+    x0 = x1 = pts[0, 0]
+    y0 = y1 = pts[0, 1]
+    for n in range(1, pts.shape[0]):
+        x, y = pts[n, 0], pts[n, 1]
+        x0 = min(x0, x)
+        x1 = max(x1, x)
+        y0 = min(y0, y)
+        y1 = max(y1, y)
+    return x0, y0, x1, y1
+
+
+@numba.njit(cache=True)
 def _splat(pts: np.ndarray, ox: float, oy: float, res: float, w: int, h: int, kernel: np.ndarray) -> np.ndarray:
     grid = np.zeros((h, w), dtype=np.float32)
     k = kernel.shape[0] // 2
+    # a point whose cell already holds the kernel's peak adds nothing (its cell was splatted before): skip it,
+    # which is exact when the peak is the centre and every other kernel value is below it
+    peak = np.float32(kernel[k, k])
+    dedup = True
+    for dj in range(-k, k + 1):
+        for di in range(-k, k + 1):
+            if (dj != 0 or di != 0) and np.float32(kernel[dj + k, di + k]) >= peak:
+                dedup = False
     for n in range(pts.shape[0]):
         ci = math.floor((pts[n, 0] - ox) / res)
         cj = math.floor((pts[n, 1] - oy) / res)
+        if dedup and 0 <= ci < w and 0 <= cj < h and grid[cj, ci] >= peak:
+            continue
         for dj in range(-k, k + 1):
             j = cj + dj
             if j < 0 or j >= h:
@@ -94,8 +118,10 @@ class LookupField:
     """Max-of-Gaussians hit likelihood on a grid covering ``points`` (world frame) plus a margin."""
 
     def __init__(self, points: np.ndarray, *, resolution: float = 0.05, sigma: float = 0.05, margin: float = 1.0):
-        lo = points.min(axis=0) - margin
-        hi = points.max(axis=0) + margin
+        pts = np.ascontiguousarray(points, dtype=np.float64)
+        x0, y0, x1, y1 = _bounds(pts)
+        lo = (x0 - margin, y0 - margin)
+        hi = (x1 + margin, y1 + margin)
         self.resolution = resolution
         self.origin = (float(lo[0]), float(lo[1]))
         self.width = math.ceil((hi[0] - lo[0]) / resolution) + 1
@@ -104,7 +130,7 @@ class LookupField:
         d = np.arange(-k, k + 1) * resolution
         kernel = np.exp(-(d[None, :] ** 2 + d[:, None] ** 2) / (2 * sigma**2))
         self.grid = _splat(
-            np.ascontiguousarray(points, dtype=np.float64),
+            pts,
             self.origin[0],
             self.origin[1],
             resolution,
@@ -135,21 +161,34 @@ def _correlative(
     n = pts.shape[0]
     ri = np.empty(n, dtype=np.int64)
     rj = np.empty(n, dtype=np.int64)
+    side = 2 * nlin + 1
+    acc = np.empty(side * side)
+    acc2 = acc.reshape(side, side)  # a view: acc2[dj + nlin, di + nlin] is offset (di, dj)'s sum
     for a in range(-nang, nang + 1):
         th = t0 + a * ang_step
         c, s = math.cos(th), math.sin(th)
         for k in range(n):
             ri[k] = math.floor((x0 + c * pts[k, 0] - s * pts[k, 1] - ox) / res)
             rj[k] = math.floor((y0 + s * pts[k, 0] + c * pts[k, 1] - oy) / res)
+        # every offset's sum over the points, accumulated point by point (each sum adds the same values in
+        # the same order as a sum per offset would: identical results, but reading the grid patch row by row)
+        acc[:] = 0.0
+        for k in range(n):
+            i_lo = max(-nlin, -ri[k])
+            i_hi = min(nlin, w - 1 - ri[k])
+            if i_lo > i_hi:
+                continue
+            rk = ri[k]
+            for dj in range(max(-nlin, -rj[k]), min(nlin, h - 1 - rj[k]) + 1):
+                # row slices: the compiler vectorises the row's additions (each sum still adds in point order)
+                grow = grid[rj[k] + dj, rk + i_lo : rk + i_hi + 1]
+                arow = acc2[dj + nlin, nlin + i_lo : nlin + i_hi + 1]
+                for q in range(grow.shape[0]):
+                    arow[q] += grow[q]
         # a linear penalty keeps ties near the prior
         for dj in range(-nlin, nlin + 1):
             for di in range(-nlin, nlin + 1):
-                tot = 0.0
-                for k in range(n):
-                    i = ri[k] + di
-                    j = rj[k] + dj
-                    if 0 <= i < w and 0 <= j < h:
-                        tot += grid[j, i]
+                tot = acc[(dj + nlin) * side + di + nlin]
                 if tot > best:
                     best = tot
                     bx = x0 + di * lin_step
@@ -194,24 +233,28 @@ def correlative_search(
 
 
 @numba.njit(cache=True)
-def _build_hash(pts: np.ndarray, cell: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, float, float, int, int]:
-    """Bucket points into a dense grid of ``cell``-sized bins: (order, start, count, ox, oy, w, h)."""
+def _build_hash(pts: np.ndarray, cell: float) -> tuple[np.ndarray, np.ndarray, float, float, int, int]:
+    """Bucket points into a dense grid of ``cell``-sized bins (a counting sort: ascending index within a bin):
+    (order, start, ox, oy, w, h); bin ``c`` holds ``order[start[c]:start[c + 1]]``."""
     n = pts.shape[0]
-    ox = pts[:, 0].min() - cell
-    oy = pts[:, 1].min() - cell
-    w = int((pts[:, 0].max() - ox) / cell) + 2
-    h = int((pts[:, 1].max() - oy) / cell) + 2
+    x0, y0, x1, y1 = _bounds(pts)
+    ox = x0 - cell
+    oy = y0 - cell
+    w = int((x1 - ox) / cell) + 2
+    h = int((y1 - oy) / cell) + 2
     keys = np.empty(n, dtype=np.int64)
-    for k in range(n):
-        keys[k] = int((pts[k, 1] - oy) / cell) * w + int((pts[k, 0] - ox) / cell)
-    order = np.argsort(keys)
     start = np.zeros(w * h + 1, dtype=np.int64)
     for k in range(n):
+        keys[k] = int((pts[k, 1] - oy) / cell) * w + int((pts[k, 0] - ox) / cell)
         start[keys[k] + 1] += 1
-    count = start[1:].copy()
     for c in range(w * h):
         start[c + 1] += start[c]
-    return order, start, count, ox, oy, w, h
+    fill = start[:-1].copy()
+    order = np.empty(n, dtype=np.int64)
+    for k in range(n):
+        order[fill[keys[k]]] = k
+        fill[keys[k]] += 1
+    return order, start, ox, oy, w, h
 
 
 @numba.njit(cache=True)
@@ -227,7 +270,10 @@ def _icp(
     iterations: int,
     huber: float,
 ) -> tuple[float, float, float, float, float, np.ndarray]:
-    order, start, count, ox, oy, w, h = _build_hash(map_xy, max_dist)
+    # the nearest map point within the search radius (at most max_dist), from the bins of half max_dist that
+    # reach within the radius (equally near points: the first in bin order)
+    cell = max_dist / 2.0
+    order, start, ox, oy, w, h = _build_hash(map_xy, cell)
     x, y, t = x0, y0, t0
     n = scan.shape[0]
     half = max(iterations // 2, 1)
@@ -236,6 +282,7 @@ def _icp(
     hess = np.zeros((3, 3))
     for it in range(iterations):
         dmax = max_dist * ratio ** min(it, half - 1)
+        reach = dmax * (1.0 + 1e-9) + 1e-12  # bins reaching within dmax of the point (slack for rounding)
         c, s = math.cos(t), math.sin(t)
         hess = np.zeros((3, 3))
         g = np.zeros(3)
@@ -245,20 +292,16 @@ def _icp(
         for k in range(n):
             px = x + c * scan[k, 0] - s * scan[k, 1]
             py = y + s * scan[k, 0] + c * scan[k, 1]
-            ci = int((px - ox) / max_dist)
-            cj = int((py - oy) / max_dist)
             best = dmax * dmax
             bi = -1
-            for dj in range(-1, 2):
-                j = cj + dj
-                if j < 0 or j >= h:
-                    continue
-                for di in range(-1, 2):
-                    i = ci + di
-                    if i < 0 or i >= w:
-                        continue
-                    cell = j * w + i
-                    for q in range(start[cell], start[cell] + count[cell]):
+            i_lo = max(0, math.floor((px - reach - ox) / cell))
+            i_hi = min(w - 1, math.floor((px + reach - ox) / cell))
+            j_lo = max(0, math.floor((py - reach - oy) / cell))
+            j_hi = min(h - 1, math.floor((py + reach - oy) / cell))
+            for j in range(j_lo, j_hi + 1):
+                for i in range(i_lo, i_hi + 1):
+                    b = j * w + i
+                    for q in range(start[b], start[b + 1]):
                         m = order[q]
                         d2 = (map_xy[m, 0] - px) ** 2 + (map_xy[m, 1] - py) ** 2
                         if d2 < best:
