@@ -16,7 +16,7 @@ SEEN_POSES = 256  # poses whose score one hill climb remembers (it re-visits nei
 
 
 @numba.njit(cache=True, inline="always")
-def _score(
+def _score_above(
     grid: np.ndarray,
     ox: float,
     oy: float,
@@ -34,16 +34,24 @@ def _score(
     sigma: float,
     lsigma: float,
     skip: int,
+    bound: float,
+    n_valid: int,
 ) -> tuple[float, float, int]:
     """GMapping's score and log-likelihood of a scan at a pose: for each beam endpoint, the nearest
     occupied cell within ``kernel`` cells whose cell one step back along the beam is free. ``cb``, ``sb``:
-    cosine and sine of the beam angles (laser frame)."""
+    cosine and sine of the beam angles (laser frame).
+
+    ``n_valid``: how many beams (of every ``skip + 1``-th) have a range in (0, ``max_urange``). A beam adds
+    at most 1 to the score, so once the score so far plus one per beam left cannot exceed ``bound``
+    (rounding included), this returns (-1, 0, -1) without scoring the rest: the hill climb only needs to
+    know that such a pose is no better. ``bound`` < 0 scores every beam."""
     h, w = grid.shape
     ct, st = math.cos(pt), math.sin(pt)
     s = 0.0
     lik = 0.0
     n = 0
     null_l = -0.5 / lsigma  # GMapping: nullLikelihood = -0.5
+    left = n_valid
     for k in range(0, ranges.shape[0], skip + 1):
         r = ranges[k]
         if not (r > 0.0) or r >= max_urange:
@@ -92,7 +100,36 @@ def _score(
             n += 1
         else:
             lik += null_l
+        left -= 1
+        # each later term is in [0, 1] and each rounding adds < 1e-16 relatively (<= 720 beams): a safe bound
+        if (s + left) * (1.0 + 1e-12) <= bound:
+            return -1.0, 0.0, -1
     return s, lik, n
+
+
+@numba.njit(cache=True)
+def _score(
+    grid: np.ndarray,
+    ox: float,
+    oy: float,
+    oi: int,
+    oj: int,
+    res: float,
+    px: float,
+    py: float,
+    pt: float,
+    ranges: np.ndarray,
+    cb: np.ndarray,
+    sb: np.ndarray,
+    max_urange: float,
+    kernel: int,
+    sigma: float,
+    lsigma: float,
+    skip: int,
+) -> tuple[float, float, int]:
+    """(score, log-likelihood, matched beams) of the scan at pose (``px``, ``py``, ``pt``): see ``_score_above``."""
+    return _score_above(grid, ox, oy, oi, oj, res, px, py, pt, ranges, cb, sb, max_urange, kernel, sigma, lsigma,
+                        skip, -1.0, ranges.shape[0])  # fmt: skip
 
 
 @numba.njit(cache=True)
@@ -122,11 +159,16 @@ def _optimize(
     improves the score, ``iterations`` times. Returns the pose, its score and its log-likelihood.
 
     A pose already scored in this climb (bit for bit: the one just left, a neighbour tried before) is
-    not scored again; the result is the same as scoring every candidate."""
-    seen = np.empty((SEEN_POSES, 5))  # x, y, theta, score, log-likelihood
+    not scored again, and a candidate's scoring stops once it cannot beat the best so far; the result is
+    the same as scoring every candidate in full."""
+    n_valid = 0
+    for k in range(0, ranges.shape[0], skip + 1):
+        if ranges[k] > 0.0 and ranges[k] < max_urange:
+            n_valid += 1
+    seen = np.empty((SEEN_POSES, 5))  # x, y, theta, score (-1: no better than the pose it was tried from), lik
     cx, cy, ct = x0, y0, t0
-    cur, cur_lik, _n = _score(grid, ox, oy, oi, oj, res, cx, cy, ct, ranges, cb, sb, max_urange, kernel, sigma,
-                              lsigma, skip)  # fmt: skip
+    cur, cur_lik, _n = _score_above(grid, ox, oy, oi, oj, res, cx, cy, ct, ranges, cb, sb, max_urange, kernel, sigma,
+                                    lsigma, skip, -1.0, n_valid)  # fmt: skip
     seen[0, 0], seen[0, 1], seen[0, 2], seen[0, 3], seen[0, 4] = cx, cy, ct, cur, cur_lik
     n_seen = 1
     ld, ad = lstep, astep
@@ -161,8 +203,8 @@ def _optimize(
             if q < n_seen:
                 sc, lik = seen[q, 3], seen[q, 4]
             else:
-                sc, lik, _n = _score(grid, ox, oy, oi, oj, res, nx, ny, nt, ranges, cb, sb, max_urange, kernel,
-                                     sigma, lsigma, skip)  # fmt: skip
+                sc, lik, _n = _score_above(grid, ox, oy, oi, oj, res, nx, ny, nt, ranges, cb, sb, max_urange,
+                                           kernel, sigma, lsigma, skip, cur, n_valid)  # fmt: skip
                 if n_seen < SEEN_POSES:
                     seen[n_seen, 0], seen[n_seen, 1], seen[n_seen, 2] = nx, ny, nt
                     seen[n_seen, 3], seen[n_seen, 4] = sc, lik
