@@ -169,15 +169,13 @@ class GMapping:
         p = self.p
         odom = np.asarray(odom_pose, dtype=np.float64)
         r = np.ascontiguousarray(ranges, dtype=np.float64)
-        ang = angle_min + angle_increment * np.arange(len(r))
-        max_range = p.maxRange if p.maxRange > 0 else float(np.nanmax(np.where(np.isfinite(r), r, 0))) + 1e-3
-        max_urange = min(p.maxUrange, max_range)
         self._time = stamp if stamp is not None else self._time + 1.0
         k = self._scan_count
         self._scan_count += 1
         if self.keep_history:  # finish() needs every scan's odometry; a live node never finishes
             self._odom_by_scan[k] = odom
         if not self.particles:
+            ang, max_range, max_urange = self._beams(r, angle_min, angle_increment)
             self._init(odom, r, ang, max_urange, max_range)
             self._odom_last = odom
             self._odom_at_update = odom
@@ -197,14 +195,24 @@ class GMapping:
             or (p.temporalUpdate >= 0 and self._time - self._time_at_update > p.temporalUpdate)
         )
         if due:
+            ang, max_range, max_urange = self._beams(r, angle_min, angle_increment)
             self._update(k, r, ang, max_urange, max_range)
             self._odom_at_update = odom
             self._time_at_update = self._time
         elif self.keep_history:  # live, these per-scan records would grow by 40 a second without being read
             self._scan_ref.append((self._last_update_scan, between2(self._odom_by_scan[self._last_update_scan], odom)))
             if p.refineSkipped and self.keep_scans:
+                ang, _max_range, max_urange = self._beams(r, angle_min, angle_increment)
                 self._scan_data[k] = (r, ang, max_urange)
         return self.best().pose.copy()
+
+    def _beams(self, r: np.ndarray, angle_min: float, angle_increment: float) -> tuple[np.ndarray, float, float]:
+        """(beam angles, maxRange, maxUrange) of a scan; a ``maxRange`` of 0 is its longest finite reading.
+        Only scans that are integrated or kept need them (not the ~40 a second between map updates)."""
+        p = self.p
+        ang = angle_min + angle_increment * np.arange(len(r))
+        max_range = p.maxRange if p.maxRange > 0 else float(np.nanmax(np.where(np.isfinite(r), r, 0))) + 1e-3
+        return ang, max_range, min(p.maxUrange, max_range)
 
     def _init(self, odom: np.ndarray, r: np.ndarray, ang: np.ndarray, max_urange: float, max_range: float) -> None:
         p = self.p
@@ -293,8 +301,9 @@ class GMapping:
     # --- results ------------------------------------------------------------------------------------
 
     def best(self) -> _Particle:
-        """The particle with the highest accumulated weight."""
-        return max(self.particles, key=lambda q: q.weight)
+        """The particle with the highest accumulated weight (the first of equals)."""
+        weights = [q.weight for q in self.particles]
+        return self.particles[weights.index(max(weights))]
 
     def trajectory(self) -> dict[int, np.ndarray]:
         """Best particle's pose at every updated scan (scan index -> laser pose)."""
