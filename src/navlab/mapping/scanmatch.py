@@ -76,6 +76,15 @@ def _splat(pts: np.ndarray, ox: float, oy: float, res: float, w: int, h: int, ke
     for n in range(pts.shape[0]):
         ci = math.floor((pts[n, 0] - ox) / res)
         cj = math.floor((pts[n, 1] - oy) / res)
+        if k <= ci < w - k and k <= cj < h - k:  # the whole kernel inside (nearly always): no per-cell checks
+            for dj in range(-k, k + 1):
+                j = numba.uint64(cj + dj)
+                for di in range(-k, k + 1):
+                    i = numba.uint64(ci + di)
+                    v = kernel[dj + k, di + k]
+                    if v > grid[j, i]:
+                        grid[j, i] = v
+            continue
         for dj in range(-k, k + 1):
             j = cj + dj
             if j < 0 or j >= h:
@@ -135,21 +144,33 @@ def _correlative(
     n = pts.shape[0]
     ri = np.empty(n, dtype=np.int64)
     rj = np.empty(n, dtype=np.int64)
+    flat = np.empty(n, dtype=np.int64)
+    cells = grid.ravel()  # the same (C-contiguous) memory
     for a in range(-nang, nang + 1):
         th = t0 + a * ang_step
         c, s = math.cos(th), math.sin(th)
         for k in range(n):
             ri[k] = math.floor((x0 + c * pts[k, 0] - s * pts[k, 1] - ox) / res)
             rj[k] = math.floor((y0 + s * pts[k, 0] + c * pts[k, 1] - oy) / res)
+        # every shifted point inside the grid (the usual case): flat indices, no per-point checks
+        inside = n > 0 and ri.min() >= nlin and rj.min() >= nlin and ri.max() < w - nlin and rj.max() < h - nlin
+        if inside:
+            for k in range(n):
+                flat[k] = rj[k] * w + ri[k]
         # a linear penalty keeps ties near the prior
         for dj in range(-nlin, nlin + 1):
             for di in range(-nlin, nlin + 1):
                 tot = 0.0
-                for k in range(n):
-                    i = ri[k] + di
-                    j = rj[k] + dj
-                    if 0 <= i < w and 0 <= j < h:
-                        tot += grid[j, i]
+                if inside:
+                    shift = dj * w + di
+                    for k in range(n):
+                        tot += cells[numba.uint64(flat[k] + shift)]
+                else:
+                    for k in range(n):
+                        i = ri[k] + di
+                        j = rj[k] + dj
+                        if 0 <= i < w and 0 <= j < h:
+                            tot += grid[j, i]
                 if tot > best:
                     best = tot
                     bx = x0 + di * lin_step
@@ -174,7 +195,7 @@ def correlative_search(
     nlin = max(0, round(lin_window / field.resolution))
     nang = max(0, round(ang_window / ang_step))
     bx, by, bt, score = _correlative(
-        field.grid,
+        np.ascontiguousarray(field.grid),
         field.origin[0],
         field.origin[1],
         field.resolution,
