@@ -99,12 +99,35 @@ def _splat(pts: np.ndarray, ox: float, oy: float, res: float, w: int, h: int, ke
     return grid
 
 
+@numba.njit(cache=True)
+def _bounds(pts: np.ndarray) -> tuple[np.ndarray, np.ndarray, bool]:
+    """Per-column minimum and maximum of (N >= 1, 2) points in one pass (numpy's axis-0 min and max of a
+    thin array cost ~0.1 ms each), and whether every point is finite."""
+    lo = pts[0].copy()
+    hi = pts[0].copy()
+    finite = True
+    for n in range(pts.shape[0]):
+        for c in range(2):
+            v = pts[n, c]
+            finite = finite and abs(v) < math.inf
+            if v < lo[c]:
+                lo[c] = v
+            if v > hi[c]:
+                hi[c] = v
+    return lo, hi, finite
+
+
 class LookupField:
     """Max-of-Gaussians hit likelihood on a grid covering ``points`` (world frame) plus a margin."""
 
     def __init__(self, points: np.ndarray, *, resolution: float = 0.05, sigma: float = 0.05, margin: float = 1.0):
-        lo = points.min(axis=0) - margin
-        hi = points.max(axis=0) + margin
+        points = np.ascontiguousarray(points, dtype=np.float64)
+        finite = False
+        if len(points):
+            lo, hi, finite = _bounds(points)
+        if not finite:  # numpy's semantics (an empty set raises, NaN propagates)
+            lo, hi = points.min(axis=0), points.max(axis=0)
+        lo, hi = lo - margin, hi + margin
         self.resolution = resolution
         self.origin = (float(lo[0]), float(lo[1]))
         self.width = math.ceil((hi[0] - lo[0]) / resolution) + 1
@@ -113,7 +136,7 @@ class LookupField:
         d = np.arange(-k, k + 1) * resolution
         kernel = np.exp(-(d[None, :] ** 2 + d[:, None] ** 2) / (2 * sigma**2))
         self.grid = _splat(
-            np.ascontiguousarray(points, dtype=np.float64),
+            points,
             self.origin[0],
             self.origin[1],
             resolution,
