@@ -28,6 +28,7 @@ from navlab.geometry import between2
 from navlab.grid import GridMap
 from navlab.mapping.errors import MappingError
 from navlab.mapping.gmapping import GMapping, GMappingParams
+from navlab.mapping.gmapping_match import warmup as gmapping_warmup
 from navlab.mapping.graph_slam import GraphSlam, GraphSlamParams
 from navlab.mapping.occupancy import build_map
 from navlab.mapping.refine import RefineParams, refine_poses
@@ -53,6 +54,7 @@ class GMappingBackend:
     def __init__(self, params: dict[str, Any] | None = None, *, rng: np.random.Generator) -> None:
         self.params = GMappingParams.from_dict(params)
         self.slam = GMapping(self.params, rng=rng)
+        gmapping_warmup()  # the kernels' one-time load at start-up, not at the first map update
         self._points: list[ScanPoints] = []  # every scan's points, for the final refinement
         # kept only when set (run_offline does): a live node never finishes and would only pile them up
         self.keep_scans = False

@@ -11,14 +11,13 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numba
 import numpy as np
 from scipy import ndimage, sparse
 from scipy.sparse.csgraph import dijkstra
 
 from navlab.grid import COST_INSCRIBED, COST_LETHAL, COST_UNKNOWN, Grid, GridMap
 from navlab.mapping.errors import MappingError
-
-_NEIGHBOURS = ((0, 1, 1.0), (1, 0, 1.0), (1, 1, math.sqrt(2.0)), (1, -1, math.sqrt(2.0)))
 
 
 @dataclass(frozen=True)
@@ -159,6 +158,43 @@ class GridDijkstraPlanner:
         return costmap.cell_to_world(extract_path(pred, costmap.width, (gi, gj)))
 
 
+@numba.njit(cache=True)
+def _grid_graph(mask: np.ndarray, cell_cost: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """CSR arrays (indptr, indices, data) of the 8-connected graph over ``mask``'s cells, columns sorted
+    in each row (as scipy builds it from the edge list): a step costs its length in cells times the
+    mean of ``cell_cost`` at both ends."""
+    h, w = mask.shape
+    n_edges = 0
+    for j in range(h):
+        for i in range(w):
+            if mask[j, i]:
+                for dj in range(-1, 2):
+                    for di in range(-1, 2):
+                        j2, i2 = j + dj, i + di
+                        if (dj or di) and 0 <= j2 < h and 0 <= i2 < w and mask[j2, i2]:
+                            n_edges += 1
+    indptr = np.zeros(h * w + 1, dtype=np.int32)
+    indices = np.empty(n_edges, dtype=np.int32)
+    data = np.empty(n_edges)
+    diag = math.sqrt(2.0)
+    e = 0
+    for j in range(h):
+        for i in range(w):
+            a = j * w + i
+            if mask[j, i]:
+                for dj in range(-1, 2):  # flat index order: rows above, this row, rows below
+                    for di in range(-1, 2):
+                        j2, i2 = j + dj, i + di
+                        if (dj or di) and 0 <= j2 < h and 0 <= i2 < w and mask[j2, i2]:
+                            b = j2 * w + i2
+                            length = diag if dj and di else 1.0
+                            indices[e] = b
+                            data[e] = length * 0.5 * (cell_cost[a] + cell_cost[b])
+                            e += 1
+            indptr[a + 1] = e
+    return indptr, indices, data
+
+
 def grid_distances(
     mask: np.ndarray, start: tuple[int, int], cell_cost: np.ndarray | None = None
 ) -> tuple[np.ndarray, np.ndarray]:
@@ -169,20 +205,9 @@ def grid_distances(
     Returns (distance in cells, shape of mask, inf where unreachable; predecessor flat index, -9999 if none).
     """
     h, w = mask.shape
-    jj, ii = np.nonzero(mask)
-    rows, cols, costs = [], [], []
-    for dj, di, cost in _NEIGHBOURS:
-        j2, i2 = jj + dj, ii + di
-        ok = (j2 >= 0) & (j2 < h) & (i2 >= 0) & (i2 < w)
-        ok[ok] = mask[j2[ok], i2[ok]]
-        a, b = jj[ok] * w + ii[ok], j2[ok] * w + i2[ok]
-        c = np.full(len(a), cost) if cell_cost is None else cost * 0.5 * (cell_cost.flat[a] + cell_cost.flat[b])
-        rows += [a, b]
-        cols += [b, a]
-        costs += [c, c]
-    graph = sparse.csr_matrix(
-        (np.concatenate(costs), (np.concatenate(rows), np.concatenate(cols))), shape=(h * w, h * w)
-    )
+    cost = np.ones(h * w) if cell_cost is None else np.ascontiguousarray(cell_cost, dtype=np.float64).ravel()
+    indptr, indices, data = _grid_graph(np.ascontiguousarray(mask, dtype=np.bool_), cost)
+    graph = sparse.csr_matrix((data, indices, indptr), shape=(h * w, h * w))
     s = start[1] * w + start[0]
     dist, pred = dijkstra(graph, directed=True, indices=s, return_predecessors=True)
     return dist.reshape(h, w), pred

@@ -18,13 +18,13 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-import numba
 import numpy as np
 
 from navlab.core.params import dataclass_from_dict
 from navlab.geometry import between2, compose2, wrap_angle
 from navlab.grid import GridMap
 from navlab.mapping.errors import MappingError
+from navlab.mapping.gmapping_match import _optimize, _score
 from navlab.mapping.occupancy import L_CLAMP, L_FREE, L_OCC, _raycast, grow_window, logodds_to_grid, scan_cells
 
 MAP_MARGIN_CELLS = 20  # unknown cells kept around what a scan reaches when a map is allocated or grown
@@ -79,138 +79,6 @@ class GMappingParams:
         if out.particles < 1:
             raise MappingError(f"gmapping parameter 'particles' must be >= 1, got {out.particles}")
         return out
-
-
-@numba.njit(cache=True)
-def _score(
-    grid: np.ndarray,
-    ox: float,
-    oy: float,
-    oi: int,
-    oj: int,
-    res: float,
-    px: float,
-    py: float,
-    pt: float,
-    ranges: np.ndarray,
-    cb: np.ndarray,
-    sb: np.ndarray,
-    max_urange: float,
-    kernel: int,
-    sigma: float,
-    lsigma: float,
-    skip: int,
-) -> tuple[float, float, int]:
-    """GMapping's score and log-likelihood of a scan at a pose: for each beam endpoint, the nearest
-    occupied cell within ``kernel`` cells whose cell one step back along the beam is free. ``grid`` holds
-    the lattice cells from (``oi``, ``oj``) on (lattice anchored at ``ox``, ``oy``); cells outside it are
-    unknown. ``cb``, ``sb``: cosine and sine of the beam angles (laser frame)."""
-    h, w = grid.shape
-    ct, st = math.cos(pt), math.sin(pt)
-    s = 0.0
-    lik = 0.0
-    n = 0
-    null_l = -0.5 / lsigma  # GMapping: nullLikelihood = -0.5
-    for k in range(0, ranges.shape[0], skip + 1):
-        r = ranges[k]
-        if not (r > 0.0) or r >= max_urange:
-            continue
-        ca = ct * cb[k] - st * sb[k]  # cos, sin of (pt + beam angle)
-        sa = st * cb[k] + ct * sb[k]
-        ex, ey = px + r * ca, py + r * sa
-        fx, fy = ex - res * ca, ey - res * sa  # a point one cell back along the beam
-        ei = math.floor((ex - ox) / res) - oi
-        ej = math.floor((ey - oy) / res) - oj
-        fi = math.floor((fx - ox) / res) - oi
-        fj = math.floor((fy - oy) / res) - oj
-        best = 1e9
-        found = False
-        # both kernel windows inside the array (nearly always): no per-cell bounds checks
-        inside = (min(ei, fi) >= kernel and min(ej, fj) >= kernel and max(ei, fi) < w - kernel
-                  and max(ej, fj) < h - kernel)  # fmt: skip
-        for dj in range(-kernel, kernel + 1):
-            for di in range(-kernel, kernel + 1):
-                i, j = ei + di, ej + dj
-                i2, j2 = fi + di, fj + dj
-                if not inside and (i < 0 or j < 0 or i >= w or j >= h or i2 < 0 or j2 < 0 or i2 >= w or j2 >= h):
-                    continue
-                if grid[j, i] > 0.0 and grid[j2, i2] < 0.0:
-                    cx = ox + (i + oi + 0.5) * res
-                    cy = oy + (j + oj + 0.5) * res
-                    d2 = (cx - ex) ** 2 + (cy - ey) ** 2
-                    if d2 < best:
-                        best = d2
-                        found = True
-        if found:
-            s += math.exp(-best / sigma)
-            lik += -best / lsigma
-            n += 1
-        else:
-            lik += null_l
-    return s, lik, n
-
-
-@numba.njit(cache=True)
-def _optimize(
-    grid: np.ndarray,
-    ox: float,
-    oy: float,
-    oi: int,
-    oj: int,
-    res: float,
-    x0: float,
-    y0: float,
-    t0: float,
-    ranges: np.ndarray,
-    cb: np.ndarray,
-    sb: np.ndarray,
-    max_urange: float,
-    kernel: int,
-    sigma: float,
-    lsigma: float,
-    skip: int,
-    lstep: float,
-    astep: float,
-    iterations: int,
-) -> tuple[float, float, float, float]:
-    """GMapping's hill climbing: try ±lstep in x, y and ±astep in theta; halve the steps when no move
-    improves the score, ``iterations`` times."""
-    cx, cy, ct = x0, y0, t0
-    cur = _score(grid, ox, oy, oi, oj, res, cx, cy, ct, ranges, cb, sb, max_urange, kernel, sigma, lsigma, skip)[0]
-    ld, ad = lstep, astep
-    refinement = 0
-    best = -1.0
-    for _ in range(200):
-        if best >= cur:
-            refinement += 1
-            ld *= 0.5
-            ad *= 0.5
-        if not (cur > best or refinement < iterations):
-            break
-        best = cur
-        bx, by, bt = cx, cy, ct
-        for move in range(6):
-            nx, ny, nt = cx, cy, ct
-            if move == 0:
-                nx += ld
-            elif move == 1:
-                nx -= ld
-            elif move == 2:
-                ny += ld
-            elif move == 3:
-                ny -= ld
-            elif move == 4:
-                nt += ad
-            else:
-                nt -= ad
-            sc, _lik, _n = _score(
-                grid, ox, oy, oi, oj, res, nx, ny, nt, ranges, cb, sb, max_urange, kernel, sigma, lsigma, skip
-            )
-            if sc > cur:
-                cur = sc
-                bx, by, bt = nx, ny, nt
-        cx, cy, ct = bx, by, bt
-    return cx, cy, ct, cur
 
 
 class _Particle:
@@ -301,15 +169,13 @@ class GMapping:
         p = self.p
         odom = np.asarray(odom_pose, dtype=np.float64)
         r = np.ascontiguousarray(ranges, dtype=np.float64)
-        ang = angle_min + angle_increment * np.arange(len(r))
-        max_range = p.maxRange if p.maxRange > 0 else float(np.nanmax(np.where(np.isfinite(r), r, 0))) + 1e-3
-        max_urange = min(p.maxUrange, max_range)
         self._time = stamp if stamp is not None else self._time + 1.0
         k = self._scan_count
         self._scan_count += 1
         if self.keep_history:  # finish() needs every scan's odometry; a live node never finishes
             self._odom_by_scan[k] = odom
         if not self.particles:
+            ang, max_range, max_urange = self._beams(r, angle_min, angle_increment)
             self._init(odom, r, ang, max_urange, max_range)
             self._odom_last = odom
             self._odom_at_update = odom
@@ -329,14 +195,24 @@ class GMapping:
             or (p.temporalUpdate >= 0 and self._time - self._time_at_update > p.temporalUpdate)
         )
         if due:
+            ang, max_range, max_urange = self._beams(r, angle_min, angle_increment)
             self._update(k, r, ang, max_urange, max_range)
             self._odom_at_update = odom
             self._time_at_update = self._time
         elif self.keep_history:  # live, these per-scan records would grow by 40 a second without being read
             self._scan_ref.append((self._last_update_scan, between2(self._odom_by_scan[self._last_update_scan], odom)))
             if p.refineSkipped and self.keep_scans:
+                ang, _max_range, max_urange = self._beams(r, angle_min, angle_increment)
                 self._scan_data[k] = (r, ang, max_urange)
         return self.best().pose.copy()
+
+    def _beams(self, r: np.ndarray, angle_min: float, angle_increment: float) -> tuple[np.ndarray, float, float]:
+        """(beam angles, maxRange, maxUrange) of a scan; a ``maxRange`` of 0 is its longest finite reading.
+        Only scans that are integrated or kept need them (not the ~40 a second between map updates)."""
+        p = self.p
+        ang = angle_min + angle_increment * np.arange(len(r))
+        max_range = p.maxRange if p.maxRange > 0 else float(np.nanmax(np.where(np.isfinite(r), r, 0))) + 1e-3
+        return ang, max_range, min(p.maxUrange, max_range)
 
     def _init(self, odom: np.ndarray, r: np.ndarray, ang: np.ndarray, max_urange: float, max_range: float) -> None:
         p = self.p
@@ -379,16 +255,18 @@ class GMapping:
         res = p.delta
         cb, sb = np.cos(ang), np.sin(ang)
         for part in self.particles:
-            x, y, t, score = _optimize(
+            x, y, t, score, lik = _optimize(
                 part.grid, ox, oy, oi, oj, res, part.pose[0], part.pose[1], part.pose[2], r, cb, sb, max_urange,
                 p.kernelSize, p.sigma, p.lsigma, p.lskip, p.lstep, p.astep, p.iterations,
             )  # fmt: skip
-            if score > p.minimumScore:
+            matched = score > p.minimumScore
+            if matched:
                 part.pose = np.array([x, y, wrap_angle(t)])
-            _s, lik, _n = _score(
-                part.grid, ox, oy, oi, oj, res, part.pose[0], part.pose[1], part.pose[2], r, cb, sb, max_urange,
-                p.kernelSize, p.sigma, p.lsigma, p.lskip,
-            )  # fmt: skip
+            if not matched or part.pose[2] != t:  # the weight takes the log-likelihood at another pose
+                _s, lik, _n = _score(
+                    part.grid, ox, oy, oi, oj, res, part.pose[0], part.pose[1], part.pose[2], r, cb, sb, max_urange,
+                    p.kernelSize, p.sigma, p.lsigma, p.lskip,
+                )  # fmt: skip
             part.weight += lik
         # normalise (GMapping: gain 1 / (ogain * N)) and resample on N_eff
         lw = np.array([q.weight for q in self.particles])
@@ -423,8 +301,9 @@ class GMapping:
     # --- results ------------------------------------------------------------------------------------
 
     def best(self) -> _Particle:
-        """The particle with the highest accumulated weight."""
-        return max(self.particles, key=lambda q: q.weight)
+        """The particle with the highest accumulated weight (the first of equals)."""
+        weights = [q.weight for q in self.particles]
+        return self.particles[weights.index(max(weights))]
 
     def trajectory(self) -> dict[int, np.ndarray]:
         """Best particle's pose at every updated scan (scan index -> laser pose)."""
@@ -456,7 +335,7 @@ class GMapping:
         """``pose`` improved by the scan matcher against ``grid`` (unchanged if the match scores too low)."""
         p = self.p
         ox, oy, oi, oj = self._lattice()
-        x, y, t, score = _optimize(
+        x, y, t, score, _lik = _optimize(
             grid, ox, oy, oi, oj, p.delta, pose[0], pose[1], pose[2], r, np.cos(ang), np.sin(ang), max_urange,
             p.kernelSize, p.sigma, p.lsigma, p.lskip, p.lstep, p.astep, p.iterations,
         )  # fmt: skip

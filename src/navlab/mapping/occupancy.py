@@ -46,6 +46,7 @@ def _raycast(
     h, w = logodds.shape
     i0 = math.floor((px - ox) / res) - oi
     j0 = math.floor((py - oy) / res) - oj
+    start_inside = 0 <= i0 < w and 0 <= j0 < h
     for k in range(ranges.shape[0]):
         r = ranges[k]
         if not (r > 0.0) or r >= max_range:
@@ -65,6 +66,17 @@ def _raycast(
         sj = 1 if j1 > j0 else -1
         err = di - dj
         i, j = i0, j0
+        if start_inside and 0 <= i1 < w and 0 <= j1 < h:  # the whole line is inside: no per-cell checks
+            while i != i1 or j != j1:
+                v = logodds[numba.uint64(j), numba.uint64(i)] + l_free
+                logodds[numba.uint64(j), numba.uint64(i)] = v if v > -clamp else -clamp
+                e2 = 2 * err
+                if e2 > -dj:
+                    err -= dj
+                    i += si
+                if e2 < di:
+                    err += di
+                    j += sj
         while i != i1 or j != j1:
             if 0 <= i < w and 0 <= j < h:
                 v = logodds[j, i] + l_free

@@ -126,21 +126,23 @@ class DiffDrivePlugin(Node):
             position = np.array([x, y, 0.0])
             quat = quat_from_yaw(yaw)
             lin, ang = np.array([v, 0.0, 0.0]), np.array([0.0, 0.0, w])
-        odom = msgs.Odometry(
-            header=msgs.header(now, cfg.odometry_frame),
-            child_frame_id=cfg.robot_base_frame,
-            pose=msgs.PoseWithCovariance(
-                pose=msgs.Pose(position=msgs.Point(x=float(position[0]), y=float(position[1]),
-                                                   z=float(position[2])), orientation=msgs.quaternion_msg(quat)),
-                covariance=_ODOM_COV.copy(),
-            ),
-            twist=msgs.TwistWithCovariance(
-                twist=msgs.Twist(linear=msgs.Vector3(x=float(lin[0]), y=float(lin[1]), z=float(lin[2])),
-                                 angular=msgs.Vector3(x=float(ang[0]), y=float(ang[1]), z=float(ang[2]))),
-                covariance=_ODOM_COV.copy(),
-            ),
-        )
-        self.odom_pub.publish(odom)
+        # the message only when anyone reads it (the mapping launch's nodes take odometry from tf)
+        if self.odom_pub.get_subscription_count() or self.executor.has_listeners:
+            odom = msgs.Odometry(
+                header=msgs.header(now, cfg.odometry_frame),
+                child_frame_id=cfg.robot_base_frame,
+                pose=msgs.PoseWithCovariance(
+                    pose=msgs.Pose(position=msgs.Point(x=float(position[0]), y=float(position[1]),
+                                                       z=float(position[2])), orientation=msgs.quaternion_msg(quat)),
+                    covariance=_ODOM_COV.copy(),
+                ),
+                twist=msgs.TwistWithCovariance(
+                    twist=msgs.Twist(linear=msgs.Vector3(x=float(lin[0]), y=float(lin[1]), z=float(lin[2])),
+                                     angular=msgs.Vector3(x=float(ang[0]), y=float(ang[1]), z=float(ang[2]))),
+                    covariance=_ODOM_COV.copy(),
+                ),
+            )
+            self.odom_pub.publish(odom)
         if cfg.publish_tf:
             self.send_transform(_transform(now, cfg.odometry_frame, cfg.robot_base_frame, position, quat))
 
@@ -194,12 +196,13 @@ class JointStatePlugin(Node):
             self.create_timer(1.0 / rate, self.update)
 
     def update(self) -> None:
-        """Publish joint states (and the moving joints' tf)."""
+        """Publish joint states when anyone subscribes or listens, and the moving joints' tf."""
         now = self.get_clock().now_ns()
         pos = np.array([self.sim.joint_position(j.name) for j in self.joints])
-        vel = np.array([self.sim.joint_velocity(j.name) for j in self.joints])
-        self.pub.publish(msgs.JointState(header=msgs.header(now, ""), name=[j.name for j in self.joints],
-                                         position=pos, velocity=vel, effort=np.zeros(len(pos))))
+        if self.pub.get_subscription_count() or self.executor.has_listeners:
+            vel = np.array([self.sim.joint_velocity(j.name) for j in self.joints])
+            self.pub.publish(msgs.JointState(header=msgs.header(now, ""), name=[j.name for j in self.joints],
+                                             position=pos, velocity=vel, effort=np.zeros(len(pos))))
         if self.publish_tf:
             self.send_transform([
                 _transform(now, joint.parent, joint.child, *joint_motion(joint, float(q)))

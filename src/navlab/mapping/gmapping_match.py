@@ -1,0 +1,229 @@
+"""GMapping's scan matcher (numba): the beam-endpoint score of a scan against a particle's log-odds map
+and the hill climbing over (x, y, theta) that maximises it (``ScanMatcher::score`` / ``optimize``).
+
+Lattice conventions as in ``mapping.occupancy``: ``grid`` holds the cells of a fixed lattice anchored at
+(``ox``, ``oy``) from lattice cell (``oi``, ``oj``) on; cells outside it read as unknown.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+
+SEEN_POSES = 256  # poses whose score one hill climb remembers (it re-visits neighbours it scored before)
+
+
+@numba.njit(cache=True, inline="always")
+def _score_above(
+    grid: np.ndarray,
+    ox: float,
+    oy: float,
+    oi: int,
+    oj: int,
+    res: float,
+    px: float,
+    py: float,
+    pt: float,
+    ranges: np.ndarray,
+    cb: np.ndarray,
+    sb: np.ndarray,
+    max_urange: float,
+    kernel: int,
+    sigma: float,
+    lsigma: float,
+    skip: int,
+    bound: float,
+    n_valid: int,
+) -> tuple[float, float, int]:
+    """GMapping's score and log-likelihood of a scan at a pose: for each beam endpoint, the nearest
+    occupied cell within ``kernel`` cells whose cell one step back along the beam is free. ``cb``, ``sb``:
+    cosine and sine of the beam angles (laser frame).
+
+    ``n_valid``: how many beams (of every ``skip + 1``-th) have a range in (0, ``max_urange``). A beam adds
+    at most 1 to the score, so once the score so far plus one per beam left cannot exceed ``bound``
+    (rounding included), this returns (-1, 0, -1) without scoring the rest: the hill climb only needs to
+    know that such a pose is no better. ``bound`` < 0 scores every beam."""
+    h, w = grid.shape
+    ct, st = math.cos(pt), math.sin(pt)
+    s = 0.0
+    lik = 0.0
+    n = 0
+    null_l = -0.5 / lsigma  # GMapping: nullLikelihood = -0.5
+    left = n_valid
+    for k in range(0, ranges.shape[0], skip + 1):
+        r = ranges[k]
+        if not (r > 0.0) or r >= max_urange:
+            continue
+        ca = ct * cb[k] - st * sb[k]  # cos, sin of (pt + beam angle)
+        sa = st * cb[k] + ct * sb[k]
+        ex, ey = px + r * ca, py + r * sa
+        fx, fy = ex - res * ca, ey - res * sa  # a point one cell back along the beam
+        ei = math.floor((ex - ox) / res) - oi
+        ej = math.floor((ey - oy) / res) - oj
+        fi = math.floor((fx - ox) / res) - oi
+        fj = math.floor((fy - oy) / res) - oj
+        best = 1e9  # the nearest match's squared distance: a minimum, so the cells' order does not matter
+        found = False
+        # both kernel windows inside the array (nearly always): no per-cell bounds checks, unsigned indices
+        # (no negative-index wrap-around) and no branches (which cell matches is unpredictable)
+        if (min(ei, fi) >= kernel and min(ej, fj) >= kernel and max(ei, fi) < w - kernel
+                and max(ej, fj) < h - kernel):  # fmt: skip
+            for dj in range(-kernel, kernel + 1):
+                j, j2 = numba.uint64(ej + dj), numba.uint64(fj + dj)
+                cy = oy + (ej + dj + oj + 0.5) * res
+                for di in range(-kernel, kernel + 1):
+                    ok = (grid[j, numba.uint64(ei + di)] > 0.0) & (grid[j2, numba.uint64(fi + di)] < 0.0)
+                    cx = ox + (ei + di + oi + 0.5) * res
+                    d2 = (cx - ex) ** 2 + (cy - ey) ** 2
+                    d2 = d2 if ok else 1e9
+                    best = d2 if d2 < best else best
+                    found = found | ok
+        else:
+            for dj in range(-kernel, kernel + 1):
+                for di in range(-kernel, kernel + 1):
+                    i, j = ei + di, ej + dj
+                    i2, j2 = fi + di, fj + dj
+                    if i < 0 or j < 0 or i >= w or j >= h or i2 < 0 or j2 < 0 or i2 >= w or j2 >= h:
+                        continue
+                    if grid[j, i] > 0.0 and grid[j2, i2] < 0.0:
+                        cx = ox + (i + oi + 0.5) * res
+                        cy = oy + (j + oj + 0.5) * res
+                        d2 = (cx - ex) ** 2 + (cy - ey) ** 2
+                        if d2 < best:
+                            best = d2
+                            found = True
+        if found:
+            s += math.exp(-best / sigma)
+            lik += -best / lsigma
+            n += 1
+        else:
+            lik += null_l
+        left -= 1
+        # each later term is in [0, 1] and each rounding adds < 1e-16 relatively (<= 720 beams): a safe bound
+        if (s + left) * (1.0 + 1e-12) <= bound:
+            return -1.0, 0.0, -1
+    return s, lik, n
+
+
+@numba.njit(cache=True)
+def _score(
+    grid: np.ndarray,
+    ox: float,
+    oy: float,
+    oi: int,
+    oj: int,
+    res: float,
+    px: float,
+    py: float,
+    pt: float,
+    ranges: np.ndarray,
+    cb: np.ndarray,
+    sb: np.ndarray,
+    max_urange: float,
+    kernel: int,
+    sigma: float,
+    lsigma: float,
+    skip: int,
+) -> tuple[float, float, int]:
+    """(score, log-likelihood, matched beams) of the scan at pose (``px``, ``py``, ``pt``): see ``_score_above``."""
+    return _score_above(grid, ox, oy, oi, oj, res, px, py, pt, ranges, cb, sb, max_urange, kernel, sigma, lsigma,
+                        skip, -1.0, ranges.shape[0])  # fmt: skip
+
+
+@numba.njit(cache=True)
+def _optimize(
+    grid: np.ndarray,
+    ox: float,
+    oy: float,
+    oi: int,
+    oj: int,
+    res: float,
+    x0: float,
+    y0: float,
+    t0: float,
+    ranges: np.ndarray,
+    cb: np.ndarray,
+    sb: np.ndarray,
+    max_urange: float,
+    kernel: int,
+    sigma: float,
+    lsigma: float,
+    skip: int,
+    lstep: float,
+    astep: float,
+    iterations: int,
+) -> tuple[float, float, float, float, float]:
+    """GMapping's hill climbing: try ±lstep in x, y and ±astep in theta; halve the steps when no move
+    improves the score, ``iterations`` times. Returns the pose, its score and its log-likelihood.
+
+    A pose already scored in this climb (bit for bit: the one just left, a neighbour tried before) is
+    not scored again, and a candidate's scoring stops once it cannot beat the best so far; the result is
+    the same as scoring every candidate in full."""
+    n_valid = 0
+    for k in range(0, ranges.shape[0], skip + 1):
+        if ranges[k] > 0.0 and ranges[k] < max_urange:
+            n_valid += 1
+    seen = np.empty((SEEN_POSES, 5))  # x, y, theta, score (-1: no better than the pose it was tried from), lik
+    cx, cy, ct = x0, y0, t0
+    cur, cur_lik, _n = _score_above(grid, ox, oy, oi, oj, res, cx, cy, ct, ranges, cb, sb, max_urange, kernel, sigma,
+                                    lsigma, skip, -1.0, n_valid)  # fmt: skip
+    seen[0, 0], seen[0, 1], seen[0, 2], seen[0, 3], seen[0, 4] = cx, cy, ct, cur, cur_lik
+    n_seen = 1
+    ld, ad = lstep, astep
+    refinement = 0
+    best = -1.0
+    for _ in range(200):
+        if best >= cur:
+            refinement += 1
+            ld *= 0.5
+            ad *= 0.5
+        if not (cur > best or refinement < iterations):
+            break
+        best = cur
+        bx, by, bt = cx, cy, ct
+        for move in range(6):
+            nx, ny, nt = cx, cy, ct
+            if move == 0:
+                nx += ld
+            elif move == 1:
+                nx -= ld
+            elif move == 2:
+                ny += ld
+            elif move == 3:
+                ny -= ld
+            elif move == 4:
+                nt += ad
+            else:
+                nt -= ad
+            q = 0
+            while q < n_seen and not (seen[q, 0] == nx and seen[q, 1] == ny and seen[q, 2] == nt):
+                q += 1
+            if q < n_seen:
+                sc, lik = seen[q, 3], seen[q, 4]
+            else:
+                sc, lik, _n = _score_above(grid, ox, oy, oi, oj, res, nx, ny, nt, ranges, cb, sb, max_urange,
+                                           kernel, sigma, lsigma, skip, cur, n_valid)  # fmt: skip
+                if n_seen < SEEN_POSES:
+                    seen[n_seen, 0], seen[n_seen, 1], seen[n_seen, 2] = nx, ny, nt
+                    seen[n_seen, 3], seen[n_seen, 4] = sc, lik
+                    n_seen += 1
+            if sc > cur:
+                cur, cur_lik = sc, lik
+                bx, by, bt = nx, ny, nt
+        cx, cy, ct = bx, by, bt
+    return cx, cy, ct, cur, cur_lik
+
+
+def warmup() -> None:
+    """Load the matcher's and the map integration's kernels (numba: compiled once, then read from its disk
+    cache, ~0.25 s) on a tiny input, with the argument types GMapping passes; without it that load would
+    stall the first map update (a live run's simulation at its first second)."""
+    from navlab.mapping.occupancy import L_CLAMP, L_FREE, L_OCC, _raycast
+
+    grid = np.zeros((4, 4), dtype=np.float32)
+    r, c = np.ones(2), np.ones(2)
+    _optimize(grid, 0.0, 0.0, 0, 0, 0.05, 0.1, 0.1, 0.0, r, c, c, 1.0, 1, 0.05, 0.075, 0, 0.05, 0.05, 1)
+    _score(grid, 0.0, 0.0, 0, 0, 0.05, 0.1, 0.1, 0.0, r, c, c, 1.0, 1, 0.05, 0.075, 0)
+    _raycast(grid, 0.0, 0.0, 0, 0, 0.05, 0.1, 0.1, 0.0, r, c, 1.0, 2.0, L_OCC, L_FREE, L_CLAMP)
