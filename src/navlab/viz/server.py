@@ -147,8 +147,10 @@ class ViewerServer:
         self._stop = asyncio.get_running_loop().create_future()
         # permessage-deflate costs this process's CPU (and the page's) on every frame: only worth it off loopback
         compression = None if self.host in LOOPBACK else "deflate"
+        # close_timeout: on close, a page that does not answer the closing handshake is dropped after 1 s (the
+        # default 10 s outlasts close()'s 5 s join)
         async with serve(self._client, self.host, self.port, process_request=self._http, max_size=MAX_MESSAGE,
-                         ping_interval=20, ping_timeout=20, logger=_log,
+                         ping_interval=20, ping_timeout=20, close_timeout=1.0, logger=_log,
                          compression=compression) as server:  # fmt: skip
             sock = next(iter(server.sockets))
             self.port = int(sock.getsockname()[1])
