@@ -6,6 +6,7 @@ import argparse
 import json
 
 import pytest
+from viz_helpers import next_state
 from websockets.sync.client import connect
 
 from navlab.cli import main
@@ -30,7 +31,7 @@ def test_viewing_serves_while_the_block_runs_and_warns_off_loopback(capsys: pyte
     with viewing(args, run.executor) as viewer:
         run.run(0.2)
         with connect(viewer.url.replace("http", "ws")) as ws:
-            state = json.loads(ws.recv(timeout=5))
+            state = next_state(ws)
         assert state["k"] == "state" and 0.0 < state["t"] <= 0.2 + 1e-9 and state["base"] == "chassis"
     with pytest.raises(OSError), connect(viewer.url.replace("http", "ws"), open_timeout=1):
         pass  # closed with the block
@@ -74,6 +75,6 @@ def test_view_hook_moves_the_page_to_each_new_run_on_the_same_port() -> None:
         assert "/navlab_viewer" not in first.executor.nodes and "/navlab_viewer" in second.executor.nodes
         second.run(0.4)
         with connect(f"ws://127.0.0.1:{port}/ws") as ws:
-            state = json.loads(ws.recv(timeout=5))
+            state = next_state(ws)
         assert 0.2 < state["t"] <= 0.4 + 1e-9  # the second run's clock (the first stopped at 0.1 s)
     assert "/navlab_viewer" not in second.executor.nodes

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import math
 
 import numpy as np
@@ -43,6 +44,17 @@ def test_costmap_sends_only_changed_tiles_then_whole_when_geometry_changes() -> 
     assert header["tiles"] == [[96, 96, 4, 4]]
     header, _ = fr.unpack(differ.frame("/c", _grid_msg(data, origin=(0.5, 0.0, 0.0))))  # the window rolled
     assert header["k"] == "grid"
+
+
+def test_a_batch_carries_frames_and_json_each_at_a_multiple_of_4_bytes() -> None:
+    grid = fr.grid_frame("/map", _grid_msg(np.ones((3, 5), dtype=np.int8)))  # 15 cells: not a multiple of 4
+    path = fr.path_frame("/plan", "map", np.array([[1.0, 2.0], [3.0, 4.0]]))
+    message = fr.batch([json.dumps({"k": "state", "t": 1.5}), grid, path])
+    frames = fr.unbatch(message)
+    assert frames[1:] == [grid, path] and fr.unpack(frames[0]) == ({"k": "state", "t": 1.5}, b"")
+    offsets = [message.index(f) for f in frames]
+    assert all(off % 4 == 0 for off in offsets) and len(message) % 4 == 0
+    assert fr.unbatch(fr.batch([])) == []
 
 
 def test_scan_frame_carries_float32_ranges_and_angles() -> None:

@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+import json
 from typing import Any
+
+from navlab.viz import frames as fr
 
 
 def open_page(browser: Any, url: str) -> Any:
@@ -35,3 +38,20 @@ def canvas_xy(page: Any, x: float, y: float) -> tuple[float, float]:
     """Canvas coordinates (CSS px) of the fixed-frame point (x, y) m."""
     sx, sy = page.evaluate("([x, y]) => window.navlab.view.toScreen(x, y)", [x, y])
     return sx, sy
+
+
+def headers(ws: Any, timeout: float = 5.0) -> list[dict[str, Any]]:
+    """The JSON of the viewer WebSocket's next message: a text reply, or every frame's header of a batch."""
+    msg = ws.recv(timeout=timeout)
+    if isinstance(msg, str):
+        return [json.loads(msg)]
+    return [fr.unpack(f)[0] for f in fr.unbatch(msg)]
+
+
+def next_state(ws: Any, timeout: float = 5.0) -> dict[str, Any]:
+    """The next state the viewer sends (simulated time, tf, move_base, ...)."""
+    for _ in range(50):
+        for h in headers(ws, timeout):
+            if h["k"] == "state":
+                return h
+    raise AssertionError("no state in 50 messages")

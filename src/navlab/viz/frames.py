@@ -3,7 +3,12 @@
 A binary frame is ``[u32 n][n bytes of JSON header][padding to 4 bytes][payload]`` (little endian). The
 header names the kind (``grid``, ``tiles``, ``scan``, ``path``, ``poses``), the topic and the frame the data
 is in; the payload is raw: ``uint8`` cells for grids (an ``int8`` OccupancyGrid value -1 is sent as 255),
-``float32`` ranges for scans, ``float32`` x,y pairs for paths and x,y,yaw triples for pose sets.
+``float32`` ranges for scans, ``float32`` x,y pairs for paths and x,y,yaw triples for pose sets. A JSON
+message (the state, the graph) travels as a frame that is all header.
+
+Everything due for a page at one moment goes as one WebSocket message, a *batch*: ``[u32 m][m bytes: a
+frame][padding to 4 bytes]`` repeated (:func:`batch`, :func:`unbatch`). Every frame starts at a multiple of
+4 bytes, so the page reads the ``float32`` payloads in place.
 
 Costmaps change little from one publication to the next: :class:`GridDiffer` sends only the changed
 square tiles (``tiles``) while the grid's size, resolution and origin stay, and a whole ``grid`` otherwise.
@@ -26,6 +31,27 @@ def pack(header: dict[str, Any], payload: bytes | memoryview = b"") -> bytes:
     head = json.dumps(header, separators=(",", ":")).encode()
     pad = (-(4 + len(head))) % 4
     return b"".join((struct.pack("<I", len(head)), head, _PAD[:pad], payload))
+
+
+def batch(frames: list[bytes | str]) -> bytes:
+    """One WebSocket message carrying ``frames`` (binary frames, or JSON texts sent as header-only frames)."""
+    parts: list[bytes] = []
+    for f in frames:
+        if isinstance(f, str):
+            text = f.encode()
+            f = b"".join((struct.pack("<I", len(text)), text))
+        parts += (struct.pack("<I", len(f)), f, _PAD[: (-len(f)) % 4])
+    return b"".join(parts)
+
+
+def unbatch(message: bytes) -> list[bytes]:
+    """The frames of a :func:`batch` (tests and the Python clients)."""
+    out, off = [], 0
+    while off + 4 <= len(message):
+        (m,) = struct.unpack_from("<I", message, off)
+        out.append(message[off + 4 : off + 4 + m])
+        off += 4 + m + (-m) % 4
+    return out
 
 
 def unpack(frame: bytes) -> tuple[dict[str, Any], bytes]:

@@ -34,9 +34,11 @@ INITIALPOSE_COV = (0.25, 0.25, 0.0, 0.0, 0.0, 0.06853891945200942)
 KINDS = {msgs.OccupancyGrid: "grid", msgs.LaserScan: "scan", msgs.Path: "path", msgs.PoseArray: "poses",
          msgs.PolygonStamped: "polygon"}  # fmt: skip
 ODOM_PERIOD_NS = 50_000_000  # simulated ns between odometry samples kept for the traces (20 Hz at most)
+GRAPH_WALL_PERIOD = 1.0  # wall-clock s between refreshes of the node graph (at most)
 PEEK_PERIOD = 0.2  # wall-clock s between copies of the plans and the particle cloud
 ALL_FRAMES_PERIOD = 0.5  # wall-clock s between poses of every tf frame (the others: every snapshot)
 SPEEDS = (0.0, 0.5, 1.0, 2.0, 5.0)  # 0 = as fast as possible
+FAST_TICK_HZ = 100.0  # as fast as possible: the fewest pacing ticks per wall-clock s (snapshots are 30/s at most)
 
 
 class Pacer:
@@ -122,7 +124,9 @@ class ViewerNode(Node):
     """rviz in a node: subscribes what it draws, publishes ``initialpose``, goals and ``cmd_vel``.
 
     Parameters: ``fixed_frame`` (default ``map`` when tf knows it, else ``odom``), ``base_frame``
-    (default: the simulated robot's), ``pace_period`` (simulated s between pacing ticks, 0.01),
+    (default: the simulated robot's), ``pace_period`` (simulated s between pacing ticks, 0.01; as fast as
+    possible, the ticks only take snapshots: up to ``max_pace_period``, 0.1, so that they still come
+    ``FAST_TICK_HZ`` times per wall-clock s),
     ``frame_hz`` (most state snapshots per wall-clock s, 30), ``graph_period`` (simulated s, 1.0).
     """
 
@@ -151,9 +155,13 @@ class ViewerNode(Node):
         self._odom_due: dict[str, int] = {}  # topic -> simulated ns of its next trace sample
         self._direct: dict[str, tuple[str, Any]] | None = None
         self._last_peek = -1e9
+        self._last_graph = -1e9
+        self._n_topics = len(executor.topics)
         self._last_all_frames = -1e9
         self._discover()
-        self.create_timer(float(self.declare_parameter("pace_period", 0.01)), self._tick, priority=-10)
+        self._pace_period = float(self.declare_parameter("pace_period", 0.01))
+        self._max_pace_period = max(self._pace_period, float(self.declare_parameter("max_pace_period", 0.1)))
+        self._pace_timer = self.create_timer(self._pace_period, self._tick, priority=-10)
         self.create_timer(float(self.declare_parameter("graph_period", 1.0)), self._on_graph_timer)
         self.hub.handler = self.submit
         self._snapshot(force=True)
@@ -161,8 +169,16 @@ class ViewerNode(Node):
     # --- what to draw -------------------------------------------------------------------------------
 
     def _on_graph_timer(self) -> None:
-        self._discover()
-        self._publish_graph()
+        """Every ``graph_period`` simulated s: subscribe the topics that appeared, and refresh the graph at most
+        once per ``GRAPH_WALL_PERIOD`` wall-clock s (as fast as possible, simulated seconds come many times a
+        wall-clock second; the page takes the graph every 2 s)."""
+        if len(self.executor.topics) != self._n_topics:
+            self._n_topics = len(self.executor.topics)
+            self._discover()
+        wall = time.perf_counter()
+        if wall - self._last_graph >= GRAPH_WALL_PERIOD:
+            self._last_graph = wall
+            self._publish_graph()
 
     def _discover(self) -> None:
         """Subscribe every drawable topic that appeared since the last look."""
@@ -238,6 +254,20 @@ class ViewerNode(Node):
     def _tick(self) -> None:
         self.pacer.tick(self.executor.now_ns, idle=lambda: self._snapshot(force=True))
         self._snapshot()
+        period = self._tick_period()
+        if abs(period - self._pace_timer.period_ns / 1e9) > 1e-9:  # the pace changed: a new period from now
+            self._pace_timer.cancel()
+            self.timers.remove(self._pace_timer)
+            self._pace_timer = self.create_timer(period, self._tick, priority=-10)
+
+    def _tick_period(self) -> float:
+        """``pace_period`` while paced or paused. As fast as possible a tick only takes the snapshots, so it
+        comes every ``FAST_TICK_HZ``-th of a wall-clock s at the measured pace (whole ``pace_period``s, at
+        most ``max_pace_period``): the simulation pays for fewer events."""
+        if self.pacer.speed > 0 or self.pacer.paused or self.rtf <= 0:
+            return self._pace_period
+        k = int(self.rtf / FAST_TICK_HZ / self._pace_period)
+        return min(self._max_pace_period, max(1, k) * self._pace_period)
 
     def _snapshot(self, *, force: bool = False) -> None:
         wall = time.perf_counter()

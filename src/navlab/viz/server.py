@@ -29,6 +29,7 @@ from websockets.exceptions import ConnectionClosed
 from websockets.http11 import Request, Response
 
 from navlab.viz.errors import VizError
+from navlab.viz.frames import batch
 from navlab.viz.hub import ClientStream, Hub
 
 LOOPBACK = ("127.0.0.1", "localhost", "::1")
@@ -146,8 +147,10 @@ class ViewerServer:
         self._stop = asyncio.get_running_loop().create_future()
         # permessage-deflate costs this process's CPU (and the page's) on every frame: only worth it off loopback
         compression = None if self.host in LOOPBACK else "deflate"
+        # close_timeout: on close, a page that does not answer the closing handshake is dropped after 1 s (the
+        # default 10 s outlasts close()'s 5 s join)
         async with serve(self._client, self.host, self.port, process_request=self._http, max_size=MAX_MESSAGE,
-                         ping_interval=20, ping_timeout=20, logger=_log,
+                         ping_interval=20, ping_timeout=20, close_timeout=1.0, logger=_log,
                          compression=compression) as server:  # fmt: skip
             sock = next(iter(server.sockets))
             self.port = int(sock.getsockname()[1])
@@ -213,16 +216,20 @@ class ViewerServer:
         return {"k": "ack", "op": op if isinstance(op, str) else None, "error": error}
 
     async def _send_loop(self, ws: ServerConnection, stream: ClientStream) -> None:
-        """Every 1/SEND_HZ wall-clock s: encode what is due and send it, unless the page has not taken the
-        previous batch yet (bytes still in the socket's buffer): then nothing is encoded this time."""
+        """Every 1/SEND_HZ wall-clock s: encode what is due and send it as one message (a batch), unless the
+        page has not taken the previous one yet (bytes still in the socket's buffer): then nothing is encoded
+        this time, and the page gets the newest of everything once it has."""
         period = 1.0 / SEND_HZ
         transport = ws.transport
+        hub = self.hub
         while True:
             if transport is None or transport.get_write_buffer_size() == 0:
-                for frame in stream.frames():
-                    await ws.send(frame)  # waits while the socket is full: the stream skips, never queues
-                    self.hub.bytes_sent += len(frame)
-                self.hub.frames_sent += 1
+                frames = stream.frames()
+                if frames:
+                    message = batch(frames)
+                    await ws.send(message)  # waits while the socket is full: the stream skips, never queues
+                    hub.bytes_sent += len(message)
+                hub.frames_sent += 1
             await asyncio.sleep(period)
 
 

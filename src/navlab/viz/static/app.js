@@ -5,7 +5,7 @@ import { drawGraph } from "./graph.js";
 
 const $ = (id) => document.getElementById(id);
 const canvas = $("view");
-const ctx = canvas.getContext("2d");
+const ctx = canvas.getContext("2d", { alpha: false });
 const TELEOP_KEYS = "uiojklm,.qzwxec";
 const MAP_PAL = R.mapPalette(), COST_PAL = R.costmapPalette();
 
@@ -20,7 +20,7 @@ const view = {
 const store = { state: null, grids: {}, scans: {}, paths: {}, poses: {}, polygons: {}, traces: {}, graph: null };
 const layers = {}; // name -> visible
 const stats = { fps: 0, frames: 0, bytes: 0, acks: [], errors: [] };
-let dirty = true, tool = "pan", drag = null, framesThisSecond = 0, fpsMark = performance.now();
+let dirty = false, tool = "pan", drag = null, framesThisSecond = 0, fpsMark = performance.now();
 
 function layerOn(name, dflt = true) {
   if (!(name in layers)) {
@@ -28,7 +28,7 @@ function layerOn(name, dflt = true) {
     const label = document.createElement("label");
     const box = document.createElement("input");
     box.type = "checkbox"; box.checked = dflt; box.dataset.layer = name;
-    box.onchange = () => { layers[name] = box.checked; dirty = true; };
+    box.onchange = () => { layers[name] = box.checked; invalidate(); };
     label.append(box, " " + name);
     $("layers").append(label);
   }
@@ -53,7 +53,7 @@ function onMessage(m) {
     case "ack": stats.acks.push(m); if (m.error) { stats.errors.push(m.error); flash(m.error); } break;
     case "error": stats.errors.push(m.error); flash(m.error); break;
   }
-  dirty = true;
+  invalidate();
 }
 
 function flash(text) { $("outcome").textContent = text; $("outcome").className = "bad"; }
@@ -67,30 +67,49 @@ function fit() {
   const w = g.w * g.res, h = g.h * g.res;
   view.cx = g.ox + w / 2; view.cy = g.oy + h / 2;
   view.scale = Math.max(5, Math.min(canvas.clientWidth / w, canvas.clientHeight / h) * 0.95);
-  view.fitted = true; dirty = true;
+  view.fitted = true; invalidate();
+}
+
+// The status bar: text is written only when it changed, and the clock and RTF (new in every state) at most
+// STATUS_HZ times a second: each change of the page's text costs the browser a layout, a paint and a frame.
+const STATUS_HZ = 5;
+let statusMark = -1e9, statusTimer = 0;
+function setText(id, text, cls) {
+  const e = $(id);
+  if (e.textContent !== text) e.textContent = text;
+  if (cls !== undefined && e.className !== cls) e.className = cls;
 }
 
 function updateStatus(s) {
-  $("simtime").textContent = `t = ${s.t.toFixed(1)} s`;
-  $("rtf").textContent = s.replay ? `replay ${s.speed}x` : `RTF ${s.rtf.toFixed(2)} (${s.speed > 0 ? s.speed + "x" : "max"})`;
-  $("pause").textContent = s.paused ? "Resume" : "Pause";
-  if (!s.replay && document.activeElement !== $("speed")) $("speed").value = String(s.speed);
-  const mb = s.move_base;
-  $("mbstate").textContent = mb ? `move_base: ${mb.state}` : "";
-  const out = mb && mb.outcome;
-  if (out) {
-    $("outcome").textContent = `goal (${out.goal.map((v) => v.toFixed(2)).join(", ")}): ${out.state}${out.reason ? " — " + out.reason : ""}`;
-    $("outcome").className = out.state === "SUCCEEDED" ? "good" : "bad";
-  }
-  document.body.classList.toggle("replay", !!s.replay);
+  if (document.body.classList.contains("replay") !== !!s.replay) document.body.classList.toggle("replay", !!s.replay);
   if (s.replay) {
     $("timeline").hidden = false;
     const seek = $("seek");
-    seek.min = s.t0; seek.max = s.t1;
-    if (!seekDragging) seek.value = s.t;
-    $("ttime").textContent = `${s.t.toFixed(2)} / ${s.t1.toFixed(2)} s`;
-    $("play").textContent = s.paused ? "Play" : "Pause";
+    if (seek.min !== String(s.t0)) seek.min = s.t0;
+    if (seek.max !== String(s.t1)) seek.max = s.t1;
   }
+  const now = performance.now();
+  if (now - statusMark >= 1000 / STATUS_HZ) {
+    statusMark = now;
+    setText("simtime", `t = ${s.t.toFixed(1)} s`);
+    setText("rtf", s.replay ? `replay ${s.speed}x` : `RTF ${s.rtf.toFixed(2)} (${s.speed > 0 ? s.speed + "x" : "max"})`);
+    if (s.replay) {
+      if (!seekDragging) $("seek").value = s.t;
+      setText("ttime", `${s.t.toFixed(2)} / ${s.t1.toFixed(2)} s`);
+    }
+  } else if (!statusTimer) {
+    statusTimer = setTimeout(() => { statusTimer = 0; updateStatus(store.state); }, statusMark + 1000 / STATUS_HZ - now);
+  }
+  setText("pause", s.paused ? "Resume" : "Pause");
+  if (!s.replay && document.activeElement !== $("speed") && $("speed").value !== String(s.speed)) $("speed").value = String(s.speed);
+  const mb = s.move_base;
+  setText("mbstate", mb ? `move_base: ${mb.state}` : "");
+  const out = mb && mb.outcome;
+  if (out) {
+    setText("outcome", `goal (${out.goal.map((v) => v.toFixed(2)).join(", ")}): ${out.state}${out.reason ? " — " + out.reason : ""}`,
+      out.state === "SUCCEEDED" ? "good" : "bad");
+  }
+  if (s.replay) setText("play", s.paused ? "Play" : "Pause");
 }
 
 function gridOrder(t) { return t.includes("local_costmap") ? 2 : t.includes("costmap") ? 1 : 0; }
@@ -105,8 +124,9 @@ function draw() {
   ctx.setTransform(1, 0, 0, 1, 0, 0);
   if (!s) { ctx.fillStyle = "#303030"; ctx.fillRect(0, 0, canvas.width, canvas.height); return; }
   const tf = s.tf;
-  drawBackground(tf);
+  const moving = drawBackground(tf, s.fixed);
   ctx.drawImage(bg, 0, 0);
+  for (const t of moving) store.grids[t].draw(ctx, view, tf, t.includes("costmap") ? 0.7 : 1.0);
   const traceColor = (t) => (t.includes("ground_truth") ? "#fff" : "#f90");
   for (const [t, f] of Object.entries(store.traces)) if (layerOn("trace " + t)) R.drawPolyline(ctx, view, tf[f.frame], f.data, traceColor(t), 1.5);
   for (const [t, f] of Object.entries(store.paths)) if (layerOn(t)) R.drawPolyline(ctx, view, tf[f.frame], f.data, pathColor(t), 2.5);
@@ -133,31 +153,50 @@ function draw() {
 // draw at most maxFps frames/s (and only when something changed): smooth, and leaves the CPU to the simulation
 const settings = { maxFps: 30 };
 let lastDraw = 0;
-// The grids change a few times a second: they are drawn into a background canvas only when they, the view,
-// the layers or their frames' poses changed, and each frame starts from a copy of it.
+// The grids in the fixed frame (the map, the global costmap) change a few times a second: they are drawn into
+// a background canvas only when they, the view or the layers changed, and each frame starts from a copy of
+// it. Grids in a moving frame (the local costmap in odom, placed by tf) are drawn over it in every frame.
 const bg = document.createElement("canvas");
-const bgCtx = bg.getContext("2d");
+const bgCtx = bg.getContext("2d", { alpha: false });
 let bgKey = "";
-function drawBackground(tf) {
+function drawBackground(tf, fixed) {
   const order = Object.keys(store.grids).sort((a, b) => gridOrder(a) - gridOrder(b)).filter((t) => layerOn(t));
-  const frames = order.map((t) => store.grids[t].geo && tf[store.grids[t].geo.frame]);
-  const key = JSON.stringify([canvas.width, canvas.height, view.cx, view.cy, view.scale, order,
-    order.map((t) => store.grids[t].version), frames.map((T) => T && T.map((v) => v.toFixed(3)))]);
-  if (key === bgKey) return;
-  bgKey = key;
-  if (bg.width !== canvas.width || bg.height !== canvas.height) { bg.width = canvas.width; bg.height = canvas.height; }
-  bgCtx.setTransform(1, 0, 0, 1, 0, 0);
-  bgCtx.fillStyle = "#303030"; bgCtx.fillRect(0, 0, bg.width, bg.height);
-  for (const t of order) store.grids[t].draw(bgCtx, view, tf, t.includes("costmap") ? 0.7 : 1.0);
+  let n = 0;
+  while (n < order.length && store.grids[order[n]].geo?.frame === fixed) n++;
+  const still = order.slice(0, n);
+  const key = JSON.stringify([canvas.width, canvas.height, view.cx, view.cy, view.scale, fixed, still,
+    still.map((t) => store.grids[t].version)]);
+  if (key !== bgKey) {
+    bgKey = key;
+    if (bg.width !== canvas.width || bg.height !== canvas.height) { bg.width = canvas.width; bg.height = canvas.height; }
+    bgCtx.setTransform(1, 0, 0, 1, 0, 0);
+    bgCtx.fillStyle = "#303030"; bgCtx.fillRect(0, 0, bg.width, bg.height);
+    for (const t of still) store.grids[t].draw(bgCtx, view, tf, t.includes("costmap") ? 0.7 : 1.0);
+  }
+  return order.slice(n);
 }
 
+// A frame is requested only when something changed, and no sooner than 1/maxFps after the last one: an idle
+// page asks the browser for no frames at all (a requestAnimationFrame loop costs the browser every vsync).
+let scheduled = false;
+function invalidate() {
+  dirty = true;
+  if (scheduled) return;
+  scheduled = true;
+  const wait = lastDraw + 1000 / settings.maxFps - performance.now();
+  if (wait > 1) setTimeout(() => requestAnimationFrame(frame), wait);
+  else requestAnimationFrame(frame);
+}
 function frame(now) {
-  if (dirty && now - lastDraw >= 1000 / settings.maxFps - 2) { dirty = false; lastDraw = now; draw(); stats.frames++; framesThisSecond++; }
+  scheduled = false;
+  if (!dirty) return;
+  dirty = false; lastDraw = now;
+  draw();
+  stats.frames++; framesThisSecond++;
   if (now - fpsMark >= 1000) { stats.fps = (framesThisSecond * 1000) / (now - fpsMark); framesThisSecond = 0; fpsMark = now; }
   stats.bytes = link.bytes;
-  requestAnimationFrame(frame);
 }
-requestAnimationFrame(frame);
+invalidate();
 
 // --- tools --------------------------------------------------------------------------------------
 
@@ -189,7 +228,7 @@ canvas.addEventListener("pointerdown", (ev) => {
     drag = o ? { tool: "pan", obstacle: o.name, x: o.x, y: o.y, dx: o.x - x, dy: o.y - y }
       : { tool: "pan", sx: ev.clientX, sy: ev.clientY, cx: view.cx, cy: view.cy };
   }
-  dirty = true;
+  invalidate();
 });
 
 canvas.addEventListener("pointermove", (ev) => {
@@ -200,7 +239,7 @@ canvas.addEventListener("pointermove", (ev) => {
     if (Math.hypot(x - drag.x, y - drag.y) > 1e-3) drag.yaw = Math.atan2(y - drag.y, x - drag.x);
   } else if (drag.obstacle) { drag.x = x + drag.dx; drag.y = y + drag.dy; }
   else { view.cx = drag.cx - (ev.clientX - drag.sx) / view.scale; view.cy = drag.cy + (ev.clientY - drag.sy) / view.scale; }
-  dirty = true;
+  invalidate();
 });
 
 canvas.addEventListener("pointerup", () => {
@@ -209,7 +248,7 @@ canvas.addEventListener("pointerup", () => {
   if (drag.tool === "goal") link.send({ op: "goal", x: drag.x, y: drag.y, yaw: drag.yaw, frame: frameId });
   else if (drag.tool === "pose") link.send({ op: "initialpose", x: drag.x, y: drag.y, yaw: drag.yaw, frame: frameId });
   else if (drag.obstacle) link.send({ op: "move", name: drag.obstacle, x: drag.x, y: drag.y });
-  drag = null; dirty = true;
+  drag = null; invalidate();
 });
 
 canvas.addEventListener("wheel", (ev) => {
@@ -218,10 +257,10 @@ canvas.addEventListener("wheel", (ev) => {
   const k = Math.exp(-ev.deltaY * 0.0015);
   view.scale = Math.min(2000, Math.max(2, view.scale * k));
   const [x2, y2] = eventWorld(ev);
-  view.cx += x - x2; view.cy += y - y2; dirty = true;
+  view.cx += x - x2; view.cy += y - y2; invalidate();
 }, { passive: false });
 
-window.addEventListener("resize", () => { dirty = true; });
+window.addEventListener("resize", () => { invalidate(); });
 
 // --- buttons, keys, teleop ------------------------------------------------------------------------
 
@@ -232,7 +271,7 @@ $("fit").onclick = fit;
 $("graphbtn").onclick = () => {
   $("graph").hidden = !$("graph").hidden;
   if (!$("graph").hidden && store.graph) drawGraph($("graphbody"), store.graph);
-  dirty = true;
+  invalidate();
 };
 for (const k of "uiojklm,.") {
   const b = document.createElement("button");
@@ -243,7 +282,7 @@ for (const k of "uiojklm,.") {
 document.addEventListener("keydown", (ev) => {
   if (ev.ctrlKey || ev.metaKey || ev.altKey || ev.target.tagName === "INPUT" || ev.target.tagName === "SELECT") return;
   if (TELEOP_KEYS.includes(ev.key)) { link.send({ op: "key", key: ev.key }); ev.preventDefault(); }
-  else if (ev.key === "Escape") { drag = null; setTool("pan"); dirty = true; }
+  else if (ev.key === "Escape") { drag = null; setTool("pan"); invalidate(); }
 });
 
 // --- replay timeline --------------------------------------------------------------------------------

@@ -1,14 +1,30 @@
-// The WebSocket to navlab's viewer server: binary frames ([u32 n][JSON header][pad to 4][payload]) and JSON.
+// The WebSocket to navlab's viewer server: batches of frames ([u32 n][JSON header][pad to 4][payload]), and
+// JSON text (replies to inputs).
 
-export function decodeFrame(buf) {
-  const dv = new DataView(buf);
+const UTF8 = new TextDecoder();
+
+// One frame at byte `off` (a multiple of 4) of `buf`, `len` bytes long: its header, and its payload as a view
+// (no copy): `cells` (uint8) for grids, `data` (float32) for the others. A JSON message is a frame of header only.
+export function decodeFrame(buf, off = 0, len = buf.byteLength - off) {
+  const dv = new DataView(buf, off, len);
   const n = dv.getUint32(0, true);
-  const header = JSON.parse(new TextDecoder().decode(new Uint8Array(buf, 4, n)));
-  const start = 4 + n + ((4 - ((4 + n) % 4)) % 4);
+  const header = JSON.parse(UTF8.decode(new Uint8Array(buf, off + 4, n)));
+  const start = off + 4 + n + ((4 - ((4 + n) % 4)) % 4), end = off + len;
   const k = header.k;
-  if (k === "grid" || k === "tiles") header.cells = new Uint8Array(buf, start);
-  else header.data = new Float32Array(buf, start, (buf.byteLength - start) / 4);
+  const at = Math.min(start, buf.byteLength), size = Math.max(0, end - start);
+  if (k === "grid" || k === "tiles") header.cells = new Uint8Array(buf, at, size);
+  else if (k !== "state" && k !== "graph") header.data = new Float32Array(buf, at, size / 4);
   return header;
+}
+
+// The frames of one message (a batch): [u32 m][m bytes: a frame][padding to 4] repeated.
+export function decodeBatch(buf, onFrame) {
+  const dv = new DataView(buf);
+  for (let off = 0; off + 4 <= buf.byteLength;) {
+    const m = dv.getUint32(off, true);
+    onFrame(decodeFrame(buf, off + 4, m));
+    off += 4 + m + ((4 - (m % 4)) % 4);
+  }
 }
 
 export class Link {
@@ -33,7 +49,7 @@ export class Link {
         this.onMessage(JSON.parse(ev.data));
       } else {
         this.bytes += ev.data.byteLength;
-        this.onMessage(decodeFrame(ev.data));
+        decodeBatch(ev.data, this.onMessage);
       }
     };
   }

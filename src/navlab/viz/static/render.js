@@ -104,19 +104,27 @@ export function drawPolyline(ctx, view, T, data, color, px, closed = false) {
   });
 }
 
+// Each return is a 3 or 4 px square placed in screen space on whole device pixels: one path of axis-aligned,
+// pixel-aligned rectangles rasterizes several times faster than the same squares in the scan's frame.
 export function drawScan(ctx, view, T, f, color) {
   if (!T) return;
-  const r = view.scale < 40 ? 1.5 : 2;
-  strokeIn(ctx, view, T, color, 1, () => {
-    const d = 2 * r / view.scale;
-    for (let i = 0; i < f.data.length; i++) {
-      const range = f.data[i];
-      if (!(range >= f.rmin && range < f.rmax)) continue;
-      const a = f.a0 + i * f.da;
-      ctx.rect(range * Math.cos(a) - d / 2, range * Math.sin(a) - d / 2, d, d);
-    }
-    ctx.fill();
-  });
+  const d = devicePixelRatio, k = view.scale * d;
+  const size = Math.round((view.scale < 40 ? 3 : 4) * d), h = size / 2;
+  const c = Math.cos(T[2]), s = Math.sin(T[2]);
+  const ox = ctx.canvas.width / 2 + (T[0] - view.cx) * k - h, oy = ctx.canvas.height / 2 - (T[1] - view.cy) * k - h;
+  const data = f.data;
+  ctx.save();
+  ctx.setTransform(1, 0, 0, 1, 0, 0);
+  ctx.fillStyle = color;
+  ctx.beginPath();
+  for (let i = 0; i < data.length; i++) {
+    const r = data[i];
+    if (!(r >= f.rmin && r < f.rmax)) continue;
+    const a = f.a0 + i * f.da, lx = r * Math.cos(a), ly = r * Math.sin(a);
+    ctx.rect(Math.round(ox + (c * lx - s * ly) * k), Math.round(oy - (s * lx + c * ly) * k), size, size);
+  }
+  ctx.fill();
+  ctx.restore();
 }
 
 export function drawArrows(ctx, view, T, data, color, lengthPx) {
