@@ -12,6 +12,8 @@ import math
 import numba
 import numpy as np
 
+from navlab.mapping.occupancy import L_CLAMP, L_FREE, L_OCC, _raycast
+
 SEEN_POSES = 256  # poses whose score one hill climb remembers (it re-visits neighbours it scored before)
 
 
@@ -220,8 +222,6 @@ def warmup() -> None:
     """Load the matcher's and the map integration's kernels (numba: compiled once, then read from its disk
     cache, ~0.25 s) on a tiny input, with the argument types GMapping passes; without it that load would
     stall the first map update (a live run's simulation at its first second)."""
-    from navlab.mapping.occupancy import L_CLAMP, L_FREE, L_OCC, _raycast
-
     grid = np.zeros((4, 4), dtype=np.float32)
     r, c = np.ones(2), np.ones(2)
     _optimize(grid, 0.0, 0.0, 0, 0, 0.05, 0.1, 0.1, 0.0, r, c, c, 1.0, 1, 0.05, 0.075, 0, 0.05, 0.05, 1)
