@@ -17,6 +17,25 @@ from navlab.mapping.occupancy import L_CLAMP, L_FREE, L_OCC, _raycast
 SEEN_POSES = 256  # poses whose score one hill climb remembers (it re-visits neighbours it scored before)
 
 
+@numba.njit(cache=True)
+def _valid_beams(
+    ranges: np.ndarray, cb: np.ndarray, sb: np.ndarray, max_urange: float, skip: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(range, cos, sin) of the beams the matcher scores, in order: every ``skip + 1``-th, with a range in
+    (0, ``max_urange``)."""
+    n = 0
+    for k in range(0, ranges.shape[0], skip + 1):
+        if ranges[k] > 0.0 and ranges[k] < max_urange:
+            n += 1
+    rv, cv, sv = np.empty(n), np.empty(n), np.empty(n)
+    n = 0
+    for k in range(0, ranges.shape[0], skip + 1):
+        if ranges[k] > 0.0 and ranges[k] < max_urange:
+            rv[n], cv[n], sv[n] = ranges[k], cb[k], sb[k]
+            n += 1
+    return rv, cv, sv
+
+
 @numba.njit(cache=True, inline="always")
 def _score_above(
     grid: np.ndarray,
@@ -28,38 +47,32 @@ def _score_above(
     px: float,
     py: float,
     pt: float,
-    ranges: np.ndarray,
-    cb: np.ndarray,
-    sb: np.ndarray,
-    max_urange: float,
+    rv: np.ndarray,
+    cv: np.ndarray,
+    sv: np.ndarray,
     kernel: int,
     sigma: float,
     lsigma: float,
-    skip: int,
     bound: float,
-    n_valid: int,
 ) -> tuple[float, float, int]:
     """GMapping's score and log-likelihood of a scan at a pose: for each beam endpoint, the nearest
-    occupied cell within ``kernel`` cells whose cell one step back along the beam is free. ``cb``, ``sb``:
-    cosine and sine of the beam angles (laser frame).
+    occupied cell within ``kernel`` cells whose cell one step back along the beam is free. ``rv``, ``cv``,
+    ``sv``: range, cosine and sine (laser frame) of the beams to score (``_valid_beams``).
 
-    ``n_valid``: how many beams (of every ``skip + 1``-th) have a range in (0, ``max_urange``). A beam adds
-    at most 1 to the score, so once the score so far plus one per beam left cannot exceed ``bound``
-    (rounding included), this returns (-1, 0, -1) without scoring the rest: the hill climb only needs to
-    know that such a pose is no better. ``bound`` < 0 scores every beam."""
+    A beam adds at most 1 to the score, so once the score so far plus one per beam left cannot exceed
+    ``bound`` (rounding included), this returns (-1, 0, -1) without scoring the rest: the hill climb only
+    needs to know that such a pose is no better. ``bound`` < 0 scores every beam."""
     h, w = grid.shape
     ct, st = math.cos(pt), math.sin(pt)
     s = 0.0
     lik = 0.0
     n = 0
     null_l = -0.5 / lsigma  # GMapping: nullLikelihood = -0.5
-    left = n_valid
-    for k in range(0, ranges.shape[0], skip + 1):
-        r = ranges[k]
-        if not (r > 0.0) or r >= max_urange:
-            continue
-        ca = ct * cb[k] - st * sb[k]  # cos, sin of (pt + beam angle)
-        sa = st * cb[k] + ct * sb[k]
+    left = rv.shape[0]
+    for k in range(rv.shape[0]):
+        r = rv[k]
+        ca = ct * cv[k] - st * sv[k]  # cos, sin of (pt + beam angle)
+        sa = st * cv[k] + ct * sv[k]
         ex, ey = px + r * ca, py + r * sa
         fx, fy = ex - res * ca, ey - res * sa  # a point one cell back along the beam
         ei = math.floor((ex - ox) / res) - oi
@@ -70,8 +83,27 @@ def _score_above(
         found = False
         # both kernel windows inside the array (nearly always): no per-cell bounds checks, unsigned indices
         # (no negative-index wrap-around) and no branches (which cell matches is unpredictable)
-        if (min(ei, fi) >= kernel and min(ej, fj) >= kernel and max(ei, fi) < w - kernel
-                and max(ej, fj) < h - kernel):  # fmt: skip
+        inside = (min(ei, fi) >= kernel and min(ej, fj) >= kernel and max(ei, fi) < w - kernel
+                  and max(ej, fj) < h - kernel)  # fmt: skip
+        if inside and kernel == 1:  # GMapping's default kernel, unrolled: each cell's x and y term once
+            bi, bj = ei + oi, ej + oj
+            x0 = (ox + (bi - 1 + 0.5) * res - ex) ** 2
+            x1 = (ox + (bi + 0.5) * res - ex) ** 2
+            x2 = (ox + (bi + 1 + 0.5) * res - ex) ** 2
+            for dj in range(3):
+                j, j2 = numba.uint64(ej - 1 + dj), numba.uint64(fj - 1 + dj)
+                yy = (oy + (bj - 1 + dj + 0.5) * res - ey) ** 2
+                ok0 = (grid[j, numba.uint64(ei - 1)] > 0.0) & (grid[j2, numba.uint64(fi - 1)] < 0.0)
+                ok1 = (grid[j, numba.uint64(ei)] > 0.0) & (grid[j2, numba.uint64(fi)] < 0.0)
+                ok2 = (grid[j, numba.uint64(ei + 1)] > 0.0) & (grid[j2, numba.uint64(fi + 1)] < 0.0)
+                d2 = x0 + yy if ok0 else 1e9
+                best = d2 if d2 < best else best
+                d2 = x1 + yy if ok1 else 1e9
+                best = d2 if d2 < best else best
+                d2 = x2 + yy if ok2 else 1e9
+                best = d2 if d2 < best else best
+                found = found | ok0 | ok1 | ok2
+        elif inside:
             for dj in range(-kernel, kernel + 1):
                 j, j2 = numba.uint64(ej + dj), numba.uint64(fj + dj)
                 cy = oy + (ej + dj + oj + 0.5) * res
@@ -129,9 +161,11 @@ def _score(
     lsigma: float,
     skip: int,
 ) -> tuple[float, float, int]:
-    """(score, log-likelihood, matched beams) of the scan at pose (``px``, ``py``, ``pt``): see ``_score_above``."""
-    return _score_above(grid, ox, oy, oi, oj, res, px, py, pt, ranges, cb, sb, max_urange, kernel, sigma, lsigma,
-                        skip, -1.0, ranges.shape[0])  # fmt: skip
+    """(score, log-likelihood, matched beams) of the scan at pose (``px``, ``py``, ``pt``), scoring every
+    ``skip + 1``-th beam with a range in (0, ``max_urange``); ``cb``, ``sb``: cosine and sine of the beam
+    angles (laser frame). See ``_score_above``."""
+    rv, cv, sv = _valid_beams(ranges, cb, sb, max_urange, skip)
+    return _score_above(grid, ox, oy, oi, oj, res, px, py, pt, rv, cv, sv, kernel, sigma, lsigma, -1.0)
 
 
 @numba.njit(cache=True)
@@ -163,14 +197,10 @@ def _optimize(
     A pose already scored in this climb (bit for bit: the one just left, a neighbour tried before) is
     not scored again, and a candidate's scoring stops once it cannot beat the best so far; the result is
     the same as scoring every candidate in full."""
-    n_valid = 0
-    for k in range(0, ranges.shape[0], skip + 1):
-        if ranges[k] > 0.0 and ranges[k] < max_urange:
-            n_valid += 1
+    rv, cv, sv = _valid_beams(ranges, cb, sb, max_urange, skip)
     seen = np.empty((SEEN_POSES, 5))  # x, y, theta, score (-1: no better than the pose it was tried from), lik
     cx, cy, ct = x0, y0, t0
-    cur, cur_lik, _n = _score_above(grid, ox, oy, oi, oj, res, cx, cy, ct, ranges, cb, sb, max_urange, kernel, sigma,
-                                    lsigma, skip, -1.0, n_valid)  # fmt: skip
+    cur, cur_lik, _n = _score_above(grid, ox, oy, oi, oj, res, cx, cy, ct, rv, cv, sv, kernel, sigma, lsigma, -1.0)
     seen[0, 0], seen[0, 1], seen[0, 2], seen[0, 3], seen[0, 4] = cx, cy, ct, cur, cur_lik
     n_seen = 1
     ld, ad = lstep, astep
@@ -205,8 +235,8 @@ def _optimize(
             if q < n_seen:
                 sc, lik = seen[q, 3], seen[q, 4]
             else:
-                sc, lik, _n = _score_above(grid, ox, oy, oi, oj, res, nx, ny, nt, ranges, cb, sb, max_urange,
-                                           kernel, sigma, lsigma, skip, cur, n_valid)  # fmt: skip
+                sc, lik, _n = _score_above(grid, ox, oy, oi, oj, res, nx, ny, nt, rv, cv, sv, kernel, sigma, lsigma,
+                                           cur)  # fmt: skip
                 if n_seen < SEEN_POSES:
                     seen[n_seen, 0], seen[n_seen, 1], seen[n_seen, 2] = nx, ny, nt
                     seen[n_seen, 3], seen[n_seen, 4] = sc, lik

@@ -47,6 +47,7 @@ def _raycast(
     i0 = math.floor((px - ox) / res) - oi
     j0 = math.floor((py - oy) / res) - oj
     start_inside = 0 <= i0 < w and 0 <= j0 < h
+    flat = logodds.reshape(-1)  # a view (C-contiguous): the fast path below walks it by flat index
     for k in range(ranges.shape[0]):
         r = ranges[k]
         if not (r > 0.0) or r >= max_range:
@@ -66,17 +67,22 @@ def _raycast(
         sj = 1 if j1 > j0 else -1
         err = di - dj
         i, j = i0, j0
-        if start_inside and 0 <= i1 < w and 0 <= j1 < h:  # the whole line is inside: no per-cell checks
-            while i != i1 or j != j1:
-                v = logodds[numba.uint64(j), numba.uint64(i)] + l_free
-                logodds[numba.uint64(j), numba.uint64(i)] = v if v > -clamp else -clamp
+        if start_inside and 0 <= i1 < w and 0 <= j1 < h:
+            # the whole line is inside: no per-cell checks; a flat index; and a known step count (this
+            # Bresenham steps along the major axis every time: max(di, dj) cells before the end cell)
+            idx = j * w + i
+            sjw = sj * w
+            for _ in range(max(di, dj)):
+                v = flat[numba.uint64(idx)] + l_free
+                flat[numba.uint64(idx)] = v if v > -clamp else -clamp
                 e2 = 2 * err
                 if e2 > -dj:
                     err -= dj
-                    i += si
+                    idx += si
                 if e2 < di:
                     err += di
-                    j += sj
+                    idx += sjw
+            i, j = i1, j1
         while i != i1 or j != j1:
             if 0 <= i < w and 0 <= j < h:
                 v = logodds[j, i] + l_free
@@ -104,7 +110,9 @@ def integrate_scan(
     max_urange: float,
     max_range: float,
 ) -> None:
-    """Add one scan (laser at ``laser_pose`` in the map frame) to a log-odds grid in place."""
+    """Add one scan (laser at ``laser_pose`` in the map frame) to a log-odds grid (C-contiguous) in place."""
+    if not logodds.flags.c_contiguous:
+        raise ValueError("integrate_scan: the log-odds grid must be C-contiguous (it is updated in place)")
     _raycast(
         logodds,
         float(origin[0]),
