@@ -24,7 +24,7 @@ from navlab.core.params import dataclass_from_dict
 from navlab.geometry import between2, compose2, wrap_angle
 from navlab.grid import GridMap
 from navlab.mapping.errors import MappingError
-from navlab.mapping.gmapping_match import _optimize, _score
+from navlab.mapping.gmapping_match import _draw_motion, _optimize, _score
 from navlab.mapping.occupancy import L_CLAMP, L_FREE, L_OCC, _raycast, grow_window, logodds_to_grid, scan_cells
 
 MAP_MARGIN_CELLS = 20  # unknown cells kept around what a scan reaches when a map is allocated or grown
@@ -82,13 +82,24 @@ class GMappingParams:
 
 
 class _Particle:
-    __slots__ = ("grid", "node", "pose", "weight")
+    """A particle's map, trajectory and weight (its pose is row n of ``GMapping.poses``)."""
 
-    def __init__(self, pose: np.ndarray, grid: np.ndarray, node: tuple | None, weight: float = 0.0) -> None:
-        self.pose = pose
+    __slots__ = ("grid", "node", "weight")
+
+    def __init__(self, grid: np.ndarray, node: tuple | None, weight: float = 0.0) -> None:
         self.grid = grid
         self.node = node  # trajectory: (scan index, pose, parent node)
         self.weight = weight
+
+
+def _between(a: np.ndarray, b: np.ndarray) -> tuple[float, float, float]:
+    """``geometry.between2(a, b)`` with the same arithmetic (bit for bit), as floats: it runs on every scan."""
+    a0, a1, a2 = float(a[0]), float(a[1]), float(a[2])
+    c, s = math.cos(a2), math.sin(a2)
+    i0, i1, i2 = -c * a0 - s * a1, s * a0 - c * a1, -a2
+    c, s = math.cos(i2), math.sin(i2)
+    b0, b1, b2 = float(b[0]), float(b[1]), float(b[2])
+    return i0 + c * b0 - s * b1, i1 + s * b0 + c * b1, (i2 + b2 + math.pi) % (2.0 * math.pi) - math.pi
 
 
 class GMapping:
@@ -98,6 +109,8 @@ class GMapping:
         self.p = params or GMappingParams()
         self.rng = rng if rng is not None else np.random.default_rng(0)
         self.particles: list[_Particle] = []
+        self.poses = np.zeros((0, 3))  # the particles' laser poses (N, 3), row n particle n's
+        self._best = 0  # index of the particle with the highest weight (weights change at map updates only)
         self._anchor = np.zeros(2)  # map-frame corner (m) of lattice cell (0, 0)
         self._offset = np.zeros(2, dtype=np.int64)  # lattice (column, row) of every map array's cell (0, 0)
         self.resamples = 0
@@ -139,22 +152,14 @@ class GMapping:
 
     # --- the filter ---------------------------------------------------------------------------------
 
-    def _sample_motion_all(self, poses: np.ndarray, step: np.ndarray) -> np.ndarray:
-        """GMapping's MotionModel::drawFromMotion for all particles (N, 3): noise scaled by the step's
-        translation and rotation (srr, srt, str, stt)."""
+    def _sample_motion_all(self, step: tuple[float, float, float]) -> None:
+        """GMapping's MotionModel::drawFromMotion for all particles (in place): the odometry step plus noise
+        scaled by its translation and rotation (srr, srt, str, stt)."""
         p = self.p
         dist = math.hypot(step[0], step[1])
         rot = abs(math.atan2(math.sin(step[2]), math.cos(step[2])))
-        sig = np.array(
-            [p.srr * abs(step[0]) + p.str * rot, p.srr * abs(step[1]) + p.str * rot, p.stt * rot + p.srt * dist]
-        )
-        noisy = step[None, :] + self.rng.normal(0.0, 1.0, poses.shape) * sig[None, :]
-        c, s_ = np.cos(poses[:, 2]), np.sin(poses[:, 2])
-        out = np.empty_like(poses)
-        out[:, 0] = poses[:, 0] + c * noisy[:, 0] - s_ * noisy[:, 1]
-        out[:, 1] = poses[:, 1] + s_ * noisy[:, 0] + c * noisy[:, 1]
-        out[:, 2] = wrap_angle(poses[:, 2] + noisy[:, 2])
-        return out
+        sig = (p.srr * abs(step[0]) + p.str * rot, p.srr * abs(step[1]) + p.str * rot, p.stt * rot + p.srt * dist)
+        _draw_motion(self.poses, self.rng.normal(0.0, 1.0, self.poses.shape), *step, *sig)
 
     def add_scan(
         self,
@@ -168,13 +173,13 @@ class GMapping:
         """Process one scan with the laser at ``odom_pose`` (odometry frame); returns the best particle's pose."""
         p = self.p
         odom = np.asarray(odom_pose, dtype=np.float64)
-        r = np.ascontiguousarray(ranges, dtype=np.float64)
         self._time = stamp if stamp is not None else self._time + 1.0
         k = self._scan_count
         self._scan_count += 1
         if self.keep_history:  # finish() needs every scan's odometry; a live node never finishes
             self._odom_by_scan[k] = odom
         if not self.particles:
+            r = np.ascontiguousarray(ranges, dtype=np.float64)
             ang, max_range, max_urange = self._beams(r, angle_min, angle_increment)
             self._init(odom, r, ang, max_urange, max_range)
             self._odom_last = odom
@@ -183,18 +188,16 @@ class GMapping:
             self._mark_update(k)
             return odom.copy()
         assert self._odom_last is not None and self._odom_at_update is not None  # set with the first particles
-        step = between2(self._odom_last, odom)
+        self._sample_motion_all(_between(self._odom_last, odom))
         self._odom_last = odom
-        poses = self._sample_motion_all(np.array([q.pose for q in self.particles]), step)
-        for part, pose in zip(self.particles, poses, strict=True):
-            part.pose = pose
-        moved = between2(self._odom_at_update, odom)
+        moved = _between(self._odom_at_update, odom)
         due = (
             math.hypot(moved[0], moved[1]) >= p.linearUpdate
             or abs(moved[2]) >= p.angularUpdate
             or (p.temporalUpdate >= 0 and self._time - self._time_at_update > p.temporalUpdate)
         )
         if due:
+            r = np.ascontiguousarray(ranges, dtype=np.float64)
             ang, max_range, max_urange = self._beams(r, angle_min, angle_increment)
             self._update(k, r, ang, max_urange, max_range)
             self._odom_at_update = odom
@@ -202,9 +205,10 @@ class GMapping:
         elif self.keep_history:  # live, these per-scan records would grow by 40 a second without being read
             self._scan_ref.append((self._last_update_scan, between2(self._odom_by_scan[self._last_update_scan], odom)))
             if p.refineSkipped and self.keep_scans:
+                r = np.ascontiguousarray(ranges, dtype=np.float64)
                 ang, _max_range, max_urange = self._beams(r, angle_min, angle_increment)
                 self._scan_data[k] = (r, ang, max_urange)
-        return self.best().pose.copy()
+        return self.poses[self._best].copy()
 
     def _beams(self, r: np.ndarray, angle_min: float, angle_increment: float) -> tuple[np.ndarray, float, float]:
         """(beam angles, maxRange, maxUrange) of a scan; a ``maxRange`` of 0 is its longest finite reading.
@@ -228,7 +232,9 @@ class GMapping:
         grid = np.zeros((h, w), dtype=np.float32)
         self._integrate(grid, odom, r, ang, max_urange, max_range)
         node = (0, odom.copy(), None)
-        self.particles = [_Particle(odom.copy(), grid.copy(), node) for _ in range(p.particles)]
+        self.particles = [_Particle(grid.copy(), node) for _ in range(p.particles)]
+        self.poses = np.tile(odom, (p.particles, 1))
+        self._best = 0
 
     def _integrate(
         self, grid: np.ndarray, pose: np.ndarray, r: np.ndarray, ang: np.ndarray, max_urange: float, max_range: float
@@ -254,17 +260,18 @@ class GMapping:
         ox, oy, oi, oj = self._lattice()
         res = p.delta
         cb, sb = np.cos(ang), np.sin(ang)
-        for part in self.particles:
+        poses = self.poses
+        for part, pose in zip(self.particles, poses, strict=True):
             x, y, t, score, lik = _optimize(
-                part.grid, ox, oy, oi, oj, res, part.pose[0], part.pose[1], part.pose[2], r, cb, sb, max_urange,
+                part.grid, ox, oy, oi, oj, res, pose[0], pose[1], pose[2], r, cb, sb, max_urange,
                 p.kernelSize, p.sigma, p.lsigma, p.lskip, p.lstep, p.astep, p.iterations,
             )  # fmt: skip
             matched = score > p.minimumScore
             if matched:
-                part.pose = np.array([x, y, wrap_angle(t)])
-            if not matched or part.pose[2] != t:  # the weight takes the log-likelihood at another pose
+                pose[:] = x, y, wrap_angle(t)
+            if not matched or pose[2] != t:  # the weight takes the log-likelihood at another pose
                 _s, lik, _n = _score(
-                    part.grid, ox, oy, oi, oj, res, part.pose[0], part.pose[1], part.pose[2], r, cb, sb, max_urange,
+                    part.grid, ox, oy, oi, oj, res, pose[0], pose[1], pose[2], r, cb, sb, max_urange,
                     p.kernelSize, p.sigma, p.lsigma, p.lskip,
                 )  # fmt: skip
             part.weight += lik
@@ -286,24 +293,30 @@ class GMapping:
                 # a copy of a particle drawn before shares its map until that one has integrated the scan
                 # (same map, same pose: the same result), then takes a copy of it
                 copy_of[n] = first.setdefault(int(i), n)
-                new.append(_Particle(src.pose.copy(), src.grid, src.node, 0.0))
+                new.append(_Particle(src.grid, src.node, 0.0))
             self.particles = new
+            self.poses = self.poses[idx]  # a copy
         # grow the maps (rarely: by at least half their size) to hold this scan from every particle
-        self._cover(np.array([q.pose for q in self.particles]), r, ang, max_urange, max_range)
+        self._cover(self.poses, r, ang, max_urange, max_range)
         for n, part in enumerate(self.particles):
-            part.node = (k, part.pose.copy(), part.node)
+            part.node = (k, self.poses[n].copy(), part.node)
             if copy_of[n] != n:
                 part.grid = self.particles[copy_of[n]].grid.copy()
             else:
-                self._integrate(part.grid, part.pose, r, ang, max_urange, max_range)
+                self._integrate(part.grid, self.poses[n], r, ang, max_urange, max_range)
+        weights = [q.weight for q in self.particles]
+        self._best = weights.index(max(weights))
         self._mark_update(k)
 
     # --- results ------------------------------------------------------------------------------------
 
     def best(self) -> _Particle:
         """The particle with the highest accumulated weight (the first of equals)."""
-        weights = [q.weight for q in self.particles]
-        return self.particles[weights.index(max(weights))]
+        return self.particles[self._best]
+
+    def best_pose(self) -> np.ndarray:
+        """The best particle's laser pose (a copy)."""
+        return self.poses[self._best].copy()
 
     def trajectory(self) -> dict[int, np.ndarray]:
         """Best particle's pose at every updated scan (scan index -> laser pose)."""

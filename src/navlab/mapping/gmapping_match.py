@@ -1,5 +1,6 @@
-"""GMapping's scan matcher (numba): the beam-endpoint score of a scan against a particle's log-odds map
-and the hill climbing over (x, y, theta) that maximises it (``ScanMatcher::score`` / ``optimize``).
+"""GMapping's numba kernels: the scan matcher — the beam-endpoint score of a scan against a particle's log-odds
+map and the hill climbing over (x, y, theta) that maximises it (``ScanMatcher::score`` / ``optimize``) — and
+the motion model's draw for all particles at once (``MotionModel::drawFromMotion``).
 
 Lattice conventions as in ``mapping.occupancy``: ``grid`` holds the cells of a fixed lattice anchored at
 (``ox``, ``oy``) from lattice cell (``oi``, ``oj``) on; cells outside it read as unknown.
@@ -248,12 +249,30 @@ def _optimize(
     return cx, cy, ct, cur, cur_lik
 
 
+@numba.njit(cache=True)
+def _draw_motion(
+    poses: np.ndarray, noise: np.ndarray, dx: float, dy: float, dt: float, sx: float, sy: float, st: float
+) -> None:
+    """GMapping's MotionModel::drawFromMotion for every particle, in place: pose n (row of ``poses``, (N, 3))
+    moves by the odometry step (``dx``, ``dy``, ``dt``) in its own frame plus ``noise[n]`` (standard normal
+    draws) scaled by (``sx``, ``sy``, ``st``); the heading is wrapped to [-pi, pi)."""
+    for n in range(poses.shape[0]):
+        nx = dx + noise[n, 0] * sx
+        ny = dy + noise[n, 1] * sy
+        nt = dt + noise[n, 2] * st
+        c, s = math.cos(poses[n, 2]), math.sin(poses[n, 2])
+        poses[n, 0] = poses[n, 0] + c * nx - s * ny
+        poses[n, 1] = poses[n, 1] + s * nx + c * ny
+        poses[n, 2] = (poses[n, 2] + nt + math.pi) % (2.0 * math.pi) - math.pi
+
+
 def warmup() -> None:
-    """Load the matcher's and the map integration's kernels (numba: compiled once, then read from its disk
-    cache, ~0.25 s) on a tiny input, with the argument types GMapping passes; without it that load would
-    stall the first map update (a live run's simulation at its first second)."""
+    """Load the matcher's, the motion model's and the map integration's kernels (numba: compiled once, then
+    read from its disk cache, ~0.25 s) on a tiny input, with the argument types GMapping passes; without it
+    that load would stall the first map update (a live run's simulation at its first second)."""
     grid = np.zeros((4, 4), dtype=np.float32)
     r, c = np.ones(2), np.ones(2)
     _optimize(grid, 0.0, 0.0, 0, 0, 0.05, 0.1, 0.1, 0.0, r, c, c, 1.0, 1, 0.05, 0.075, 0, 0.05, 0.05, 1)
     _score(grid, 0.0, 0.0, 0, 0, 0.05, 0.1, 0.1, 0.0, r, c, c, 1.0, 1, 0.05, 0.075, 0)
     _raycast(grid, 0.0, 0.0, 0, 0, 0.05, 0.1, 0.1, 0.0, r, c, 1.0, 2.0, L_OCC, L_FREE, L_CLAMP)
+    _draw_motion(np.zeros((2, 3)), np.zeros((2, 3)), 0.1, 0.0, 0.0, 0.1, 0.1, 0.1)
