@@ -13,7 +13,7 @@ import math
 import numba
 import numpy as np
 
-from navlab.mapping.occupancy import L_CLAMP, L_FREE, L_OCC, _raycast
+from navlab.mapping.occupancy import L_CLAMP, L_FREE, L_OCC, _raycast, scan_cells
 
 SEEN_POSES = 256  # poses whose score one hill climb remembers (it re-visits neighbours it scored before)
 
@@ -38,6 +38,48 @@ def _valid_beams(
 
 
 @numba.njit(cache=True, inline="always")
+def _endpoints(
+    ox: float,
+    oy: float,
+    oi: int,
+    oj: int,
+    res: float,
+    px: float,
+    py: float,
+    pt: float,
+    rv: np.ndarray,
+    cv: np.ndarray,
+    sv: np.ndarray,
+    fw: np.ndarray,
+    iw: np.ndarray,
+) -> None:
+    """For every beam at pose (``px``, ``py``, ``pt``), into ``fw`` (8, n): its end point (x, y) and the
+    squared x distances from it to the centres of the end cell's column and its two neighbours, then the
+    squared y distances to the row and its neighbours; into ``iw`` (4, n): the end cell (i, j) and the cell
+    one step back along the beam (i, j), as array indices. One branch-free loop (the compiler vectorises
+    it); ``_score_above`` then reads them beam by beam."""
+    ct, st = math.cos(pt), math.sin(pt)
+    for k in range(rv.shape[0]):
+        r = rv[k]
+        ca = ct * cv[k] - st * sv[k]  # cos, sin of (pt + beam angle)
+        sa = st * cv[k] + ct * sv[k]
+        ex, ey = px + r * ca, py + r * sa
+        fx, fy = ex - res * ca, ey - res * sa  # a point one cell back along the beam
+        bi = math.floor((ex - ox) / res)  # lattice cell
+        bj = math.floor((ey - oy) / res)
+        fw[0, k], fw[1, k] = ex, ey
+        fw[2, k] = (ox + (bi - 1 + 0.5) * res - ex) ** 2
+        fw[3, k] = (ox + (bi + 0.5) * res - ex) ** 2
+        fw[4, k] = (ox + (bi + 1 + 0.5) * res - ex) ** 2
+        fw[5, k] = (oy + (bj - 1 + 0.5) * res - ey) ** 2
+        fw[6, k] = (oy + (bj + 0.5) * res - ey) ** 2
+        fw[7, k] = (oy + (bj + 1 + 0.5) * res - ey) ** 2
+        iw[0, k], iw[1, k] = bi - oi, bj - oj
+        iw[2, k] = math.floor((fx - ox) / res) - oi
+        iw[3, k] = math.floor((fy - oy) / res) - oj
+
+
+@numba.njit(cache=True, inline="always")
 def _score_above(
     grid: np.ndarray,
     ox: float,
@@ -55,31 +97,27 @@ def _score_above(
     sigma: float,
     lsigma: float,
     bound: float,
+    fw: np.ndarray,
+    iw: np.ndarray,
 ) -> tuple[float, float, int]:
     """GMapping's score and log-likelihood of a scan at a pose: for each beam endpoint, the nearest
     occupied cell within ``kernel`` cells whose cell one step back along the beam is free. ``rv``, ``cv``,
-    ``sv``: range, cosine and sine (laser frame) of the beams to score (``_valid_beams``).
+    ``sv``: range, cosine and sine (laser frame) of the beams to score (``_valid_beams``); ``fw`` (8, n),
+    ``iw`` (4, n): work arrays (``_endpoints``).
 
     A beam adds at most 1 to the score, so once the score so far plus one per beam left cannot exceed
     ``bound`` (rounding included), this returns (-1, 0, -1) without scoring the rest: the hill climb only
     needs to know that such a pose is no better. ``bound`` < 0 scores every beam."""
     h, w = grid.shape
-    ct, st = math.cos(pt), math.sin(pt)
+    _endpoints(ox, oy, oi, oj, res, px, py, pt, rv, cv, sv, fw, iw)
     s = 0.0
     lik = 0.0
     n = 0
     null_l = -0.5 / lsigma  # GMapping: nullLikelihood = -0.5
     left = rv.shape[0]
     for k in range(rv.shape[0]):
-        r = rv[k]
-        ca = ct * cv[k] - st * sv[k]  # cos, sin of (pt + beam angle)
-        sa = st * cv[k] + ct * sv[k]
-        ex, ey = px + r * ca, py + r * sa
-        fx, fy = ex - res * ca, ey - res * sa  # a point one cell back along the beam
-        ei = math.floor((ex - ox) / res) - oi
-        ej = math.floor((ey - oy) / res) - oj
-        fi = math.floor((fx - ox) / res) - oi
-        fj = math.floor((fy - oy) / res) - oj
+        ex, ey = fw[0, k], fw[1, k]
+        ei, ej, fi, fj = iw[0, k], iw[1, k], iw[2, k], iw[3, k]
         best = 1e9  # the nearest match's squared distance: a minimum, so the cells' order does not matter
         found = False
         # both kernel windows inside the array (nearly always): no per-cell bounds checks, unsigned indices
@@ -87,13 +125,10 @@ def _score_above(
         inside = (min(ei, fi) >= kernel and min(ej, fj) >= kernel and max(ei, fi) < w - kernel
                   and max(ej, fj) < h - kernel)  # fmt: skip
         if inside and kernel == 1:  # GMapping's default kernel, unrolled: each cell's x and y term once
-            bi, bj = ei + oi, ej + oj
-            x0 = (ox + (bi - 1 + 0.5) * res - ex) ** 2
-            x1 = (ox + (bi + 0.5) * res - ex) ** 2
-            x2 = (ox + (bi + 1 + 0.5) * res - ex) ** 2
+            x0, x1, x2 = fw[2, k], fw[3, k], fw[4, k]
             for dj in range(3):
                 j, j2 = numba.uint64(ej - 1 + dj), numba.uint64(fj - 1 + dj)
-                yy = (oy + (bj - 1 + dj + 0.5) * res - ey) ** 2
+                yy = fw[5 + dj, k]
                 ok0 = (grid[j, numba.uint64(ei - 1)] > 0.0) & (grid[j2, numba.uint64(fi - 1)] < 0.0)
                 ok1 = (grid[j, numba.uint64(ei)] > 0.0) & (grid[j2, numba.uint64(fi)] < 0.0)
                 ok2 = (grid[j, numba.uint64(ei + 1)] > 0.0) & (grid[j2, numba.uint64(fi + 1)] < 0.0)
@@ -166,7 +201,8 @@ def _score(
     ``skip + 1``-th beam with a range in (0, ``max_urange``); ``cb``, ``sb``: cosine and sine of the beam
     angles (laser frame). See ``_score_above``."""
     rv, cv, sv = _valid_beams(ranges, cb, sb, max_urange, skip)
-    return _score_above(grid, ox, oy, oi, oj, res, px, py, pt, rv, cv, sv, kernel, sigma, lsigma, -1.0)
+    fw, iw = np.empty((8, rv.shape[0])), np.empty((4, rv.shape[0]), dtype=np.int64)
+    return _score_above(grid, ox, oy, oi, oj, res, px, py, pt, rv, cv, sv, kernel, sigma, lsigma, -1.0, fw, iw)
 
 
 @numba.njit(cache=True)
@@ -199,9 +235,11 @@ def _optimize(
     not scored again, and a candidate's scoring stops once it cannot beat the best so far; the result is
     the same as scoring every candidate in full."""
     rv, cv, sv = _valid_beams(ranges, cb, sb, max_urange, skip)
+    fw, iw = np.empty((8, rv.shape[0])), np.empty((4, rv.shape[0]), dtype=np.int64)
     seen = np.empty((SEEN_POSES, 5))  # x, y, theta, score (-1: no better than the pose it was tried from), lik
     cx, cy, ct = x0, y0, t0
-    cur, cur_lik, _n = _score_above(grid, ox, oy, oi, oj, res, cx, cy, ct, rv, cv, sv, kernel, sigma, lsigma, -1.0)
+    cur, cur_lik, _n = _score_above(grid, ox, oy, oi, oj, res, cx, cy, ct, rv, cv, sv, kernel, sigma, lsigma, -1.0,
+                                    fw, iw)  # fmt: skip
     seen[0, 0], seen[0, 1], seen[0, 2], seen[0, 3], seen[0, 4] = cx, cy, ct, cur, cur_lik
     n_seen = 1
     ld, ad = lstep, astep
@@ -237,7 +275,7 @@ def _optimize(
                 sc, lik = seen[q, 3], seen[q, 4]
             else:
                 sc, lik, _n = _score_above(grid, ox, oy, oi, oj, res, nx, ny, nt, rv, cv, sv, kernel, sigma, lsigma,
-                                           cur)  # fmt: skip
+                                           cur, fw, iw)  # fmt: skip
                 if n_seen < SEEN_POSES:
                     seen[n_seen, 0], seen[n_seen, 1], seen[n_seen, 2] = nx, ny, nt
                     seen[n_seen, 3], seen[n_seen, 4] = sc, lik
@@ -276,3 +314,4 @@ def warmup() -> None:
     _score(grid, 0.0, 0.0, 0, 0, 0.05, 0.1, 0.1, 0.0, r, c, c, 1.0, 1, 0.05, 0.075, 0)
     _raycast(grid, 0.0, 0.0, 0, 0, 0.05, 0.1, 0.1, 0.0, r, c, 1.0, 2.0, L_OCC, L_FREE, L_CLAMP)
     _draw_motion(np.zeros((2, 3)), np.zeros((2, 3)), 0.1, 0.0, 0.0, 0.1, 0.1, 0.1)
+    scan_cells(np.zeros((2, 3)), r, c, (0.0, 0.0), 0.05, max_urange=1.0, max_range=2.0)

@@ -133,6 +133,27 @@ def integrate_scan(
     )
 
 
+@numba.njit(cache=True)
+def _scan_extent(
+    poses: np.ndarray, ranges: np.ndarray, angles: np.ndarray, max_urange: float, max_range: float
+) -> tuple[float, float, float, float]:
+    """(x min, x max, y min, y max) of the poses (N, 3) and of the scan's beam end points from each."""
+    xmin, xmax, ymin, ymax = math.inf, -math.inf, math.inf, -math.inf
+    for n in range(poses.shape[0]):
+        px, py, pt = poses[n, 0], poses[n, 1], poses[n, 2]
+        xmin, xmax, ymin, ymax = min(xmin, px), max(xmax, px), min(ymin, py), max(ymax, py)
+        for k in range(ranges.shape[0]):
+            r = ranges[k]
+            if not (r > 0.0 and r < max_range):
+                continue
+            rr = r if r < max_urange else max_urange
+            a = pt + angles[k]
+            x = px + rr * math.cos(a)
+            y = py + rr * math.sin(a)
+            xmin, xmax, ymin, ymax = min(xmin, x), max(xmax, x), min(ymin, y), max(ymax, y)
+    return xmin, xmax, ymin, ymax
+
+
 def scan_cells(
     poses: np.ndarray,
     ranges: np.ndarray,
@@ -146,15 +167,15 @@ def scan_cells(
     """Lattice cell range ``(lo, hi)`` (int (2,) each, ``hi`` inclusive, (column, row)) that integrating the scan
     from each laser pose in ``poses`` (N, 3) can touch: the poses and the beams' end points (no-returns
     excluded, long returns cut at ``max_urange``), exactly as the ray caster treats them."""
-    poses = np.asarray(poses, dtype=np.float64).reshape(-1, 3)
-    r = np.asarray(ranges, dtype=np.float64)
-    ok = (r > 0.0) & (r < max_range)
-    rr = np.minimum(r[ok], max_urange)
-    a = poses[:, 2:3] + np.asarray(angles, dtype=np.float64)[ok][None, :]
-    xs = np.concatenate([poses[:, 0], (poses[:, 0:1] + rr * np.cos(a)).ravel()])
-    ys = np.concatenate([poses[:, 1], (poses[:, 1:2] + rr * np.sin(a)).ravel()])
-    lo = np.array([math.floor((xs.min() - anchor[0]) / resolution), math.floor((ys.min() - anchor[1]) / resolution)])
-    hi = np.array([math.floor((xs.max() - anchor[0]) / resolution), math.floor((ys.max() - anchor[1]) / resolution)])
+    xmin, xmax, ymin, ymax = _scan_extent(
+        np.ascontiguousarray(poses, dtype=np.float64).reshape(-1, 3),
+        np.ascontiguousarray(ranges, dtype=np.float64),
+        np.ascontiguousarray(angles, dtype=np.float64),
+        float(max_urange),
+        float(max_range),
+    )
+    lo = np.array([math.floor((xmin - anchor[0]) / resolution), math.floor((ymin - anchor[1]) / resolution)])
+    hi = np.array([math.floor((xmax - anchor[0]) / resolution), math.floor((ymax - anchor[1]) / resolution)])
     return lo.astype(np.int64), hi.astype(np.int64)
 
 
