@@ -92,6 +92,12 @@ class _Particle:
         self.weight = weight
 
 
+def _readings(ranges: np.ndarray, no_return: float | None) -> np.ndarray:
+    """Ranges as contiguous float64, non-finite readings replaced by ``no_return`` (if given)."""
+    r = np.asarray(ranges, dtype=np.float64)
+    return np.ascontiguousarray(r if no_return is None else np.where(np.isfinite(r), r, no_return))
+
+
 def _between(a: np.ndarray, b: np.ndarray) -> tuple[float, float, float]:
     """``geometry.between2(a, b)`` with the same arithmetic (bit for bit), as floats: it runs on every scan."""
     a0, a1, a2 = float(a[0]), float(a[1]), float(a[2])
@@ -169,8 +175,11 @@ class GMapping:
         odom_pose: np.ndarray | tuple[float, float, float],
         *,
         stamp: float | None = None,
+        no_return: float | None = None,
     ) -> np.ndarray:
-        """Process one scan with the laser at ``odom_pose`` (odometry frame); returns the best particle's pose."""
+        """Process one scan with the laser at ``odom_pose`` (odometry frame); returns the best particle's pose.
+        ``no_return``: the range a non-finite reading counts as (slam_gmapping: the scan's ``range_max``);
+        the ranges are read only by the scans that update the map (or are kept for ``finish``)."""
         p = self.p
         odom = np.asarray(odom_pose, dtype=np.float64)
         self._time = stamp if stamp is not None else self._time + 1.0
@@ -179,7 +188,7 @@ class GMapping:
         if self.keep_history:  # finish() needs every scan's odometry; a live node never finishes
             self._odom_by_scan[k] = odom
         if not self.particles:
-            r = np.ascontiguousarray(ranges, dtype=np.float64)
+            r = _readings(ranges, no_return)
             ang, max_range, max_urange = self._beams(r, angle_min, angle_increment)
             self._init(odom, r, ang, max_urange, max_range)
             self._odom_last = odom
@@ -197,7 +206,7 @@ class GMapping:
             or (p.temporalUpdate >= 0 and self._time - self._time_at_update > p.temporalUpdate)
         )
         if due:
-            r = np.ascontiguousarray(ranges, dtype=np.float64)
+            r = _readings(ranges, no_return)
             ang, max_range, max_urange = self._beams(r, angle_min, angle_increment)
             self._update(k, r, ang, max_urange, max_range)
             self._odom_at_update = odom
@@ -205,7 +214,7 @@ class GMapping:
         elif self.keep_history:  # live, these per-scan records would grow by 40 a second without being read
             self._scan_ref.append((self._last_update_scan, between2(self._odom_by_scan[self._last_update_scan], odom)))
             if p.refineSkipped and self.keep_scans:
-                r = np.ascontiguousarray(ranges, dtype=np.float64)
+                r = _readings(ranges, no_return)
                 ang, _max_range, max_urange = self._beams(r, angle_min, angle_increment)
                 self._scan_data[k] = (r, ang, max_urange)
         return self.poses[self._best].copy()

@@ -113,14 +113,9 @@ class SlamGMapping(Node):
             return None
         return compose2(odom, laser)
 
-    def _count_invalid(self, msg: Any) -> None:
+    def _count_invalid(self, t_ns: int) -> None:
         """Count a scan without one reading in [range_min, range_max) and say so, at most every 10 s."""
-        r = np.asarray(msg.ranges, dtype=np.float64)
-        with np.errstate(invalid="ignore"):
-            if np.any((r >= float(msg.range_min)) & (r < float(msg.range_max))):
-                return
         self.scans_invalid += 1
-        t_ns = msgs.stamp_ns(msg)
         if self._invalid_logged_ns is None or t_ns - self._invalid_logged_ns >= INVALID_LOG_PERIOD_NS:
             self._invalid_logged_ns = t_ns
             self.get_logger().warning(
@@ -130,16 +125,18 @@ class SlamGMapping(Node):
 
     def _on_scan(self, msg: Any) -> None:
         self.scans_received += 1
-        self._count_invalid(msg)
+        t_ns = msgs.stamp_ns(msg)
+        ranges = np.asarray(msg.ranges, dtype=np.float64)
+        returned = ranges >= float(msg.range_min)  # False for NaN and -inf (numpy compares NaN without a warning)
+        if not np.any(returned & (ranges < float(msg.range_max))):
+            self._count_invalid(t_ns)
         if (self.scans_received - 1) % max(self.throttle_scans, 1):
             return
-        t_ns = msgs.stamp_ns(msg)
         odom_laser = self._odom_laser(msg)
         if odom_laser is None or not self.slam.due(odom_laser, t_ns):
             return
-        r = np.asarray(msg.ranges, dtype=np.float64).copy()
-        # slam_gmapping: readings below range_min count as no return, like non-finite ones
-        r[~np.isfinite(r) | (r < float(msg.range_min))] = np.inf
+        # slam_gmapping: readings below range_min count as no return, like non-finite ones (+inf stays inf)
+        r = np.where(returned, ranges, np.inf)
         pose = self.slam.add_scan(
             r, float(msg.angle_min), float(msg.angle_increment), odom_laser, range_max=float(msg.range_max),
             stamp_ns=t_ns,
