@@ -72,16 +72,26 @@ def _raycast(
             # Bresenham steps along the major axis every time: max(di, dj) cells before the end cell)
             idx = j * w + i
             sjw = sj * w
-            for _ in range(max(di, dj)):
-                v = flat[numba.uint64(idx)] + l_free
-                flat[numba.uint64(idx)] = v if v > -clamp else -clamp
-                e2 = 2 * err
-                if e2 > -dj:
+            if di >= dj:  # so each step moves along i, and along j when the error term says
+                for _ in range(di):
+                    v = flat[numba.uint64(idx)] + l_free
+                    flat[numba.uint64(idx)] = v if v > -clamp else -clamp
+                    e2 = 2 * err
                     err -= dj
                     idx += si
-                if e2 < di:
+                    if e2 < di:
+                        err += di
+                        idx += sjw
+            else:  # each step moves along j
+                for _ in range(dj):
+                    v = flat[numba.uint64(idx)] + l_free
+                    flat[numba.uint64(idx)] = v if v > -clamp else -clamp
+                    e2 = 2 * err
                     err += di
                     idx += sjw
+                    if e2 > -dj:
+                        err -= dj
+                        idx += si
             i, j = i1, j1
         while i != i1 or j != j1:
             if 0 <= i < w and 0 <= j < h:

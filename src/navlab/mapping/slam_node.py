@@ -96,15 +96,20 @@ class SlamGMapping(Node):
     # --- inputs ---------------------------------------------------------------------------------
 
     def _odom_laser(self, msg: Any) -> np.ndarray | None:
-        """The laser's pose in the odom frame at the scan's stamp (tf odom→base ∘ base→laser), or None."""
+        """The laser's pose in the odom frame at the scan's stamp, or the latest one (tf odom→base ∘ base→laser),
+        or None."""
         frame = str(msg.header.frame_id).lstrip("/") or self.base_frame
         try:
             laser = self.sensor_pose(self.base_frame, frame)
         except TfError as exc:
             self.get_logger().warning(f"no transform {self.base_frame} → {frame}: {exc}")
             return None
+        stamp = msgs.stamp_ns(msg)
+        # A scan stamped now (as live) is level with or ahead of the newest odometry, where the lookup at its
+        # stamp gives the latest transform or fails over to it: ask for the latest at once, not via a TfError.
+        at = None if stamp >= self.get_clock().now_ns() else stamp
         try:
-            odom = self.pose_at(self.odom_frame, self.base_frame, msgs.stamp_ns(msg))
+            odom = self.pose_at(self.odom_frame, self.base_frame, at)
         except TfError as exc:
             # Before the first processed scan this is the start-up order (a scan ahead of the first odometry),
             # which slam_gmapping's tf message filter drops silently.
