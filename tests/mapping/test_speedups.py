@@ -1,15 +1,20 @@
 """The mapping stack's shortcuts give the results of the plain computations they replace: GMapping's hill
-climb (no re-scoring, early-stopped candidates), the Dijkstra graph built in one pass, the lookup field's
+climb (no re-scoring, early-stopped candidates), its score (two passes, kernel 1 unrolled), its motion draw
+(one numba call), the ray caster's unchecked walk, the Dijkstra graph built in one pass, the lookup field's
 bounds and unchecked loops."""
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
+import pytest
 from scipy import sparse
 
+from navlab.geometry import wrap_angle
 from navlab.mapping.explore import _grid_graph
-from navlab.mapping.gmapping_match import _optimize, _score
-from navlab.mapping.occupancy import integrate_scan
+from navlab.mapping.gmapping_match import _draw_motion, _optimize, _score
+from navlab.mapping.occupancy import L_CLAMP, L_FREE, L_OCC, _raycast, integrate_scan
 from navlab.mapping.scanmatch import LookupField, correlative_search
 
 
@@ -64,6 +69,79 @@ def test_the_hill_climb_equals_gmappings_plain_climb() -> None:
             want = _plain_climb(grid, args, x0, y0, t0, 0.05, 0.05, 5)
             assert got[:4] == want, (skip, k)
             assert got[4] == _score(grid, *args[:5], *got[:3], *args[5:])[1]  # the log-likelihood at the result
+
+
+def _plain_score(grid, ox, oy, res, x, y, t, r, ang, max_urange, kernel, sigma, lsigma, skip):
+    """GMapping's ScanMatcher::score beam by beam, every cell bounds-checked (the reference)."""
+    h, w = grid.shape
+    s, lik, n = 0.0, 0.0, 0
+    ct, st = math.cos(t), math.sin(t)
+    for k in range(0, len(r), skip + 1):
+        if not 0.0 < r[k] < max_urange:
+            continue
+        cb, sb = math.cos(ang[k]), math.sin(ang[k])
+        ca, sa = ct * cb - st * sb, st * cb + ct * sb
+        ex, ey = x + r[k] * ca, y + r[k] * sa
+        fx, fy = ex - res * ca, ey - res * sa
+        ei, ej = math.floor((ex - ox) / res), math.floor((ey - oy) / res)
+        fi, fj = math.floor((fx - ox) / res), math.floor((fy - oy) / res)
+        best = None
+        for dj in range(-kernel, kernel + 1):
+            for di in range(-kernel, kernel + 1):
+                i, j, i2, j2 = ei + di, ej + dj, fi + di, fj + dj
+                if 0 <= i < w and 0 <= j < h and 0 <= i2 < w and 0 <= j2 < h and grid[j, i] > 0 and grid[j2, i2] < 0:
+                    d2 = (ox + (i + 0.5) * res - ex) ** 2 + (oy + (j + 0.5) * res - ey) ** 2
+                    best = d2 if best is None else min(best, d2)
+        if best is None:
+            lik += -0.5 / lsigma
+        else:
+            s += math.exp(-best / sigma)
+            lik += -best / lsigma
+            n += 1
+    return s, lik, n
+
+
+def test_the_score_equals_gmappings_plain_score_for_every_kernel_and_near_the_edges() -> None:
+    rng = np.random.default_rng(6)
+    grid, r, ang = _room_map(rng)
+    cb, sb = np.cos(ang), np.sin(ang)
+    # poses in the room, and near the map's edge (beams end outside it: the checked path)
+    for x, y, t in ((2.5, 2.0, 0.1), (2.2, 1.7, -0.4), (0.3, 0.2, 0.0), (5.2, 4.2, 2.0)):
+        for kernel in (0, 1, 2):
+            for skip in (0, 3):
+                got = _score(grid, 0.0, 0.0, 0, 0, 0.05, x, y, t, r, cb, sb, 8.0, kernel, 0.05, 0.075, skip)
+                want = _plain_score(grid, 0.0, 0.0, 0.05, x, y, t, r, ang, 8.0, kernel, 0.05, 0.075, skip)
+                assert got == want, (x, y, t, kernel, skip)
+
+
+def test_the_motion_draw_equals_the_vectorised_motion_model() -> None:
+    rng = np.random.default_rng(7)
+    poses = rng.normal(0.0, 2.0, (40, 3))
+    noise = rng.normal(0.0, 1.0, (40, 3))
+    step, sig = (0.03, -0.01, 0.02), (0.004, 0.003, 0.006)
+    noisy = np.asarray(step)[None, :] + noise * np.asarray(sig)[None, :]
+    c, s = np.cos(poses[:, 2]), np.sin(poses[:, 2])
+    want = np.column_stack([poses[:, 0] + c * noisy[:, 0] - s * noisy[:, 1],
+                            poses[:, 1] + s * noisy[:, 0] + c * noisy[:, 1], wrap_angle(poses[:, 2] + noisy[:, 2])])
+    _draw_motion(poses, noise, *step, *sig)
+    np.testing.assert_array_equal(poses, want)
+
+
+def test_the_unchecked_ray_walk_equals_the_checked_one() -> None:
+    """A window of the lattice that does not hold the laser (every beam on the checked path) ends with the
+    cells of a grid that holds the whole scan (every beam on the unchecked path)."""
+    rng = np.random.default_rng(8)
+    _grid, r, ang = _room_map(rng)
+    args = (0.05, 2.5, 2.0, 0.1, r, ang, 8.0, 10.0, L_OCC, L_FREE, L_CLAMP)
+    whole = np.zeros((90, 110), dtype=np.float32)
+    _raycast(whole, 0.0, 0.0, 0, 0, *args)
+    for oi, oj, w, h in ((60, 10, 50, 80), (0, 0, 40, 30), (30, 50, 80, 40)):
+        part = np.zeros((h, w), dtype=np.float32)
+        _raycast(part, 0.0, 0.0, oi, oj, *args)
+        np.testing.assert_array_equal(part, whole[oj:oj + h, oi:oi + w])
+    with pytest.raises(ValueError, match="C-contiguous"):
+        integrate_scan(np.zeros((20, 20))[:, ::2], (0.0, 0.0), 0.05, np.zeros(3), r, ang, max_urange=8.0,
+                       max_range=10.0)  # fmt: skip
 
 
 def test_the_one_pass_dijkstra_graph_equals_scipys_from_the_edge_list() -> None:
