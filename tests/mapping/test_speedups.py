@@ -14,7 +14,7 @@ from scipy import sparse
 from navlab.geometry import wrap_angle
 from navlab.mapping.explore import _grid_graph
 from navlab.mapping.gmapping_match import _draw_motion, _optimize, _score
-from navlab.mapping.occupancy import L_CLAMP, L_FREE, L_OCC, _raycast, integrate_scan
+from navlab.mapping.occupancy import FAST_WALK_CELLS, L_CLAMP, L_FREE, L_OCC, _raycast, integrate_scan
 from navlab.mapping.scanmatch import LookupField, correlative_search
 
 
@@ -133,12 +133,25 @@ def test_the_unchecked_ray_walk_equals_the_checked_one() -> None:
     rng = np.random.default_rng(8)
     _grid, r, ang = _room_map(rng)
     args = (0.05, 2.5, 2.0, 0.1, r, ang, 8.0, 10.0, L_OCC, L_FREE, L_CLAMP)
-    whole = np.zeros((90, 110), dtype=np.float32)
+    for dtype in (np.float32, np.float64):  # GMapping's particle maps; build_map's
+        whole = np.zeros((90, 110), dtype=dtype)
+        _raycast(whole, 0.0, 0.0, 0, 0, *args)
+        _raycast(whole, 0.0, 0.0, 0, 0, *args)  # twice: cells near the clamp
+        for oi, oj, w, h in ((60, 10, 50, 80), (0, 0, 40, 30), (30, 50, 80, 40)):
+            part = np.zeros((h, w), dtype=dtype)
+            _raycast(part, 0.0, 0.0, oi, oj, *args)
+            _raycast(part, 0.0, 0.0, oi, oj, *args)
+            np.testing.assert_array_equal(part, whole[oj:oj + h, oi:oi + w])
+    # lines longer than the fixed-point walk takes (FAST_WALK_CELLS) walk by the error term
+    r_long = np.array([FAST_WALK_CELLS * 0.05 + 3.0, 150.0, 40.0])
+    ang_long = np.array([0.0, 0.002, -0.004])
+    args = (0.05, 0.26, 0.3, 0.0, r_long, ang_long, 300.0, 400.0, L_OCC, L_FREE, L_CLAMP)
+    whole = np.zeros((12, FAST_WALK_CELLS + 80), dtype=np.float32)
     _raycast(whole, 0.0, 0.0, 0, 0, *args)
-    for oi, oj, w, h in ((60, 10, 50, 80), (0, 0, 40, 30), (30, 50, 80, 40)):
-        part = np.zeros((h, w), dtype=np.float32)
-        _raycast(part, 0.0, 0.0, oi, oj, *args)
-        np.testing.assert_array_equal(part, whole[oj:oj + h, oi:oi + w])
+    part = np.zeros((12, FAST_WALK_CELLS + 70), dtype=np.float32)
+    _raycast(part, 0.0, 0.0, 10, 0, *args)
+    np.testing.assert_array_equal(part, whole[:, 10:])
+    assert np.count_nonzero(whole) > FAST_WALK_CELLS
     with pytest.raises(ValueError, match="C-contiguous"):
         integrate_scan(np.zeros((20, 20))[:, ::2], (0.0, 0.0), 0.05, np.zeros(3), r, ang, max_urange=8.0,
                        max_range=10.0)  # fmt: skip

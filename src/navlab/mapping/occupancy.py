@@ -22,6 +22,7 @@ from navlab.grid import GridMap
 L_OCC = 0.85  # log-odds increment of a hit
 L_FREE = -0.4  # log-odds increment of a traversed cell
 L_CLAMP = 5.0
+FAST_WALK_CELLS = 4096  # lines shorter than this (in cells along their major axis) take the fixed-point walk
 
 
 @numba.njit(cache=True)
@@ -67,31 +68,21 @@ def _raycast(
         sj = 1 if j1 > j0 else -1
         err = di - dj
         i, j = i0, j0
-        if start_inside and 0 <= i1 < w and 0 <= j1 < h:
-            # the whole line is inside: no per-cell checks; a flat index; and a known step count (this
-            # Bresenham steps along the major axis every time: max(di, dj) cells before the end cell)
+        dmaj, dmin = max(di, dj), min(di, dj)
+        if start_inside and 0 <= i1 < w and 0 <= j1 < h and dmaj < FAST_WALK_CELLS:
+            # The whole line is inside: no per-cell checks, a flat index, and no error term: this Bresenham
+            # steps along the major axis every time, so its cell n (of dmaj) is n steps along it and
+            # ceil((2 dmin n - dmaj) / (2 dmaj)) along the minor one, here an exact fixed-point division
+            # (x * mul >> 40 = x // (2 dmaj) while x * 2 dmaj < 2**40), so no step waits on the one before.
             idx = j * w + i
-            sjw = sj * w
-            if di >= dj:  # so each step moves along i, and along j when the error term says
-                for _ in range(di):
-                    v = flat[numba.uint64(idx)] + l_free
-                    flat[numba.uint64(idx)] = v if v > -clamp else -clamp
-                    e2 = 2 * err
-                    err -= dj
-                    idx += si
-                    if e2 < di:
-                        err += di
-                        idx += sjw
-            else:  # each step moves along j
-                for _ in range(dj):
-                    v = flat[numba.uint64(idx)] + l_free
-                    flat[numba.uint64(idx)] = v if v > -clamp else -clamp
-                    e2 = 2 * err
-                    err += di
-                    idx += sjw
-                    if e2 > -dj:
-                        err -= dj
-                        idx += si
+            smaj, smin = (si, sj * w) if di >= dj else (sj * w, si)
+            mul = ((1 << 40) + 2 * dmaj - 1) // (2 * dmaj) if dmaj else 0
+            x = dmaj - 1
+            for n in range(dmaj):
+                c = numba.uint64(idx + n * smaj + ((x * mul) >> 40) * smin)
+                v = flat[c] + l_free
+                flat[c] = v if v > -clamp else -clamp
+                x += 2 * dmin
             i, j = i1, j1
         while i != i1 or j != j1:
             if 0 <= i < w and 0 <= j < h:
