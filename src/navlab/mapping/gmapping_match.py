@@ -99,23 +99,27 @@ def _score_above(
     bound: float,
     fw: np.ndarray,
     iw: np.ndarray,
+    order: np.ndarray,
 ) -> tuple[float, float, int]:
     """GMapping's score and log-likelihood of a scan at a pose: for each beam endpoint, the nearest
     occupied cell within ``kernel`` cells whose cell one step back along the beam is free. ``rv``, ``cv``,
-    ``sv``: range, cosine and sine (laser frame) of the beams to score (``_valid_beams``); ``fw`` (8, n),
-    ``iw`` (4, n): work arrays (``_endpoints``).
+    ``sv``: range, cosine and sine (laser frame) of the beams to score (``_valid_beams``); ``fw`` (10, n),
+    ``iw`` (4, n): work arrays (``_endpoints``; rows 8 and 9 of ``fw`` get each beam's score term and
+    its match's squared distance, -1 if none).
 
     A beam adds at most 1 to the score, so once the score so far plus one per beam left cannot exceed
     ``bound`` (rounding included), this returns (-1, 0, -1) without scoring the rest: the hill climb only
-    needs to know that such a pose is no better. ``bound`` < 0 scores every beam."""
+    needs to know that such a pose is no better. ``bound`` < 0 scores every beam. The beams are visited in
+    ``order`` (a permutation: the hill climb puts first those that scored worst at the pose it climbs from,
+    which stops a worse neighbour sooner); the score and log-likelihood are summed in beam order all the
+    same, so the order changes nothing but when a pose is given up."""
     h, w = grid.shape
     _endpoints(ox, oy, oi, oj, res, px, py, pt, rv, cv, sv, fw, iw)
     s = 0.0
-    lik = 0.0
-    n = 0
     null_l = -0.5 / lsigma  # GMapping: nullLikelihood = -0.5
     left = rv.shape[0]
-    for k in range(rv.shape[0]):
+    for q in range(rv.shape[0]):
+        k = order[q]
         ex, ey = fw[0, k], fw[1, k]
         ei, ej, fi, fj = iw[0, k], iw[1, k], iw[2, k], iw[3, k]
         best = 1e9  # the nearest match's squared distance: a minimum, so the cells' order does not matter
@@ -164,17 +168,46 @@ def _score_above(
                         if d2 < best:
                             best = d2
                             found = True
-        if found:
-            s += math.exp(-best / sigma)
-            lik += -best / lsigma
+        term = math.exp(-best / sigma) if found else 0.0
+        fw[8, k] = term
+        fw[9, k] = best if found else -1.0
+        s += term
+        left -= 1
+        # each later term is in [0, 1] and each rounding adds < 1e-16 relatively (<= 720 beams, in any order):
+        # a safe bound
+        if (s + left) * (1.0 + 1e-12) <= bound:
+            return -1.0, 0.0, -1
+    if s * (1.0 + 1e-12) <= bound:  # no better, whatever the order of the sum
+        return -1.0, 0.0, -1
+    s = 0.0  # the sums in beam order (a zero term leaves a sum unchanged)
+    lik = 0.0
+    n = 0
+    for k in range(rv.shape[0]):
+        s += fw[8, k]
+        if fw[9, k] >= 0.0:
+            lik += -fw[9, k] / lsigma
             n += 1
         else:
             lik += null_l
-        left -= 1
-        # each later term is in [0, 1] and each rounding adds < 1e-16 relatively (<= 720 beams): a safe bound
-        if (s + left) * (1.0 + 1e-12) <= bound:
-            return -1.0, 0.0, -1
     return s, lik, n
+
+
+@numba.njit(cache=True, inline="always")
+def _worst_first(terms: np.ndarray, order: np.ndarray, counts: np.ndarray) -> None:
+    """``order``: the beams by their score terms (in [0, 1]) in 64 bins, lowest first (a counting sort)."""
+    nbins = counts.shape[0]
+    counts[:] = 0
+    for k in range(terms.shape[0]):
+        counts[min(int(terms[k] * nbins), nbins - 1)] += 1
+    start = 0
+    for b in range(nbins):
+        c = counts[b]
+        counts[b] = start
+        start += c
+    for k in range(terms.shape[0]):
+        b = min(int(terms[k] * nbins), nbins - 1)
+        order[counts[b]] = k
+        counts[b] += 1
 
 
 @numba.njit(cache=True)
@@ -201,8 +234,10 @@ def _score(
     ``skip + 1``-th beam with a range in (0, ``max_urange``); ``cb``, ``sb``: cosine and sine of the beam
     angles (laser frame). See ``_score_above``."""
     rv, cv, sv = _valid_beams(ranges, cb, sb, max_urange, skip)
-    fw, iw = np.empty((8, rv.shape[0])), np.empty((4, rv.shape[0]), dtype=np.int64)
-    return _score_above(grid, ox, oy, oi, oj, res, px, py, pt, rv, cv, sv, kernel, sigma, lsigma, -1.0, fw, iw)
+    nb = rv.shape[0]
+    fw, iw = np.empty((10, nb)), np.empty((4, nb), dtype=np.int64)
+    return _score_above(grid, ox, oy, oi, oj, res, px, py, pt, rv, cv, sv, kernel, sigma, lsigma, -1.0, fw, iw,
+                        np.arange(nb))  # fmt: skip
 
 
 @numba.njit(cache=True)
@@ -232,14 +267,19 @@ def _optimize(
     improves the score, ``iterations`` times. Returns the pose, its score and its log-likelihood.
 
     A pose already scored in this climb (bit for bit: the one just left, a neighbour tried before) is
-    not scored again, and a candidate's scoring stops once it cannot beat the best so far; the result is
-    the same as scoring every candidate in full."""
+    not scored again, and a candidate's scoring stops once it cannot beat the best so far (its beams
+    visited worst first, as they scored at the pose climbed from); the result is the same as scoring every
+    candidate in full."""
     rv, cv, sv = _valid_beams(ranges, cb, sb, max_urange, skip)
-    fw, iw = np.empty((8, rv.shape[0])), np.empty((4, rv.shape[0]), dtype=np.int64)
+    nb = rv.shape[0]
+    fw, iw = np.empty((10, nb)), np.empty((4, nb), dtype=np.int64)
+    order, counts = np.arange(nb), np.empty(64, dtype=np.int64)
+    terms = np.empty(nb)  # the score terms of the best pose found in this step of the climb
     seen = np.empty((SEEN_POSES, 5))  # x, y, theta, score (-1: no better than the pose it was tried from), lik
     cx, cy, ct = x0, y0, t0
     cur, cur_lik, _n = _score_above(grid, ox, oy, oi, oj, res, cx, cy, ct, rv, cv, sv, kernel, sigma, lsigma, -1.0,
-                                    fw, iw)  # fmt: skip
+                                    fw, iw, order)  # fmt: skip
+    _worst_first(fw[8], order, counts)
     seen[0, 0], seen[0, 1], seen[0, 2], seen[0, 3], seen[0, 4] = cx, cy, ct, cur, cur_lik
     n_seen = 1
     ld, ad = lstep, astep
@@ -275,14 +315,18 @@ def _optimize(
                 sc, lik = seen[q, 3], seen[q, 4]
             else:
                 sc, lik, _n = _score_above(grid, ox, oy, oi, oj, res, nx, ny, nt, rv, cv, sv, kernel, sigma, lsigma,
-                                           cur, fw, iw)  # fmt: skip
+                                           cur, fw, iw, order)  # fmt: skip
                 if n_seen < SEEN_POSES:
                     seen[n_seen, 0], seen[n_seen, 1], seen[n_seen, 2] = nx, ny, nt
                     seen[n_seen, 3], seen[n_seen, 4] = sc, lik
                     n_seen += 1
+                if sc > cur:  # (a pose remembered from before never beats the best so far)
+                    terms[:] = fw[8]
             if sc > cur:
                 cur, cur_lik = sc, lik
                 bx, by, bt = nx, ny, nt
+        if bx != cx or by != cy or bt != ct:
+            _worst_first(terms, order, counts)
         cx, cy, ct = bx, by, bt
     return cx, cy, ct, cur, cur_lik
 
