@@ -239,6 +239,99 @@ def nearest_traversable(mask: np.ndarray, cell: tuple[int, int], max_cells: int 
     return int(ii[k] + i0), int(jj[k] + j0)
 
 
+@numba.njit(cache=True)
+def _heap_push(keys: np.ndarray, nodes: np.ndarray, size: int, key: float, node: int) -> int:
+    """Push onto a binary min-heap held in ``keys``/``nodes`` (``size`` entries); returns the new size."""
+    k = size
+    while k > 0:
+        parent = (k - 1) >> 1
+        if keys[parent] <= key:
+            break
+        keys[k] = keys[parent]
+        nodes[k] = nodes[parent]
+        k = parent
+    keys[k] = key
+    nodes[k] = node
+    return size + 1
+
+
+@numba.njit(cache=True)
+def _heap_pop(keys: np.ndarray, nodes: np.ndarray, size: int) -> int:
+    """Remove the root of the heap (read it before); returns the new size."""
+    size -= 1
+    key, node = keys[size], nodes[size]
+    k = 0
+    while True:
+        child = 2 * k + 1
+        if child >= size:
+            break
+        if child + 1 < size and keys[child + 1] < keys[child]:
+            child += 1
+        if keys[child] >= key:
+            break
+        keys[k] = keys[child]
+        nodes[k] = nodes[child]
+        k = child
+    keys[k] = key
+    nodes[k] = node
+    return size
+
+
+@numba.njit(cache=True)
+def _frontier_dijkstra(
+    mask: np.ndarray, cell_cost: np.ndarray, start: int, bonus: np.ndarray, resolution: float, max_bonus: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """Dijkstra over the 8-connected cells of ``mask`` (steps cost as in :func:`grid_distances`) from flat
+    cell ``start``, stopped once no unsettled cell can be a cheaper frontier goal than one already settled.
+
+    ``bonus`` (flat) is the size bonus (m) of each goal cell (NaN: not a goal); a goal at distance d
+    (cells) costs ``d * resolution - bonus``; ``max_bonus`` is the largest bonus. Returns (distance in
+    cells, inf where not settled; predecessor flat index, -9999 if none), as exact as a full search
+    for every settled cell.
+    """
+    h, w = mask.shape
+    n = h * w
+    dist = np.full(n, np.inf)
+    pred = np.full(n, -9999, dtype=np.int32)
+    done = np.zeros(n, dtype=np.bool_)
+    cap = 8 * n + 1
+    keys = np.empty(cap)
+    nodes = np.empty(cap, dtype=np.int32)
+    dist[start] = 0.0
+    size = _heap_push(keys, nodes, 0, 0.0, start)
+    best = np.inf
+    diag = math.sqrt(2.0)
+    while size > 0:
+        d = keys[0]
+        a = nodes[0]
+        size = _heap_pop(keys, nodes, size)
+        if done[a]:
+            continue
+        if d * resolution - max_bonus > best:
+            break  # every unsettled goal costs more than the best settled one
+        done[a] = True
+        if not math.isnan(bonus[a]):
+            best = min(best, d * resolution - bonus[a])
+        j, i = a // w, a % w
+        for dj in range(-1, 2):
+            for di in range(-1, 2):
+                j2, i2 = j + dj, i + di
+                if (dj or di) and 0 <= j2 < h and 0 <= i2 < w and mask[j2, i2]:
+                    b = j2 * w + i2
+                    if done[b]:
+                        continue
+                    length = diag if dj and di else 1.0
+                    nd = d + length * 0.5 * (cell_cost[a] + cell_cost[b])
+                    if nd < dist[b]:
+                        dist[b] = nd
+                        pred[b] = a
+                        size = _heap_push(keys, nodes, size, nd, b)
+    for a in range(n):
+        if not done[a]:
+            dist[a] = np.inf
+    return dist, pred
+
+
 def plan_to_frontier(
     grid: GridMap,
     robot_xy: tuple[float, float],
@@ -250,31 +343,55 @@ def plan_to_frontier(
     """A path (N, 2) in metres from the robot to the cheapest reachable frontier, or None if none is left.
 
     The cost of a frontier is its path length minus a small bonus for its size (explore_lite's idea).
-    Frontiers whose centroid lies within 0.5 m of a blacklisted point are skipped.
+    Frontiers whose centroid lies within 0.5 m of a blacklisted point are skipped. The Dijkstra from the
+    robot stops once no cell left can be a cheaper goal (a bounded search, exact for the chosen goal).
     """
     grid = grid.crop_to_known()
     planner = GridDijkstraPlanner()
-    found = planner.distances(clearance_costmap(grid, robot_radius), robot_xy)
-    if found is None:
+    costmap = clearance_costmap(grid, robot_radius)
+    mask = planner.traversable(costmap)
+    ci, cj = costmap.world_to_cell(np.array([robot_xy]))[0]
+    start = nearest_traversable(mask, (int(ci), int(cj)), planner.start_search_cells)
+    if start is None:
         return None
-    dist, pred = found
-    best, best_cost = None, math.inf
+    mask[start[1], start[0]] = True
     banned = np.array(blacklist).reshape(-1, 2) if blacklist else np.zeros((0, 2))
-    for f in find_frontiers(grid, min_cells=min_frontier_cells):
-        # Go to the frontier cell that is cheapest to reach (cells inside the inflation are unreachable),
-        # skipping cells near goals that were reached or given up on before.
-        d = dist[f.cells[:, 1], f.cells[:, 0]]
+    frontiers = find_frontiers(grid, min_cells=min_frontier_cells)
+    # the goal cells (not near a banned point) and their size bonus, for the bounded search
+    goal_cells = []
+    for f in frontiers:
+        ok = np.ones(len(f.cells), dtype=bool)
         if len(banned):
             xy = grid.cell_to_world(f.cells)
             near = np.hypot(xy[:, None, 0] - banned[None, :, 0], xy[:, None, 1] - banned[None, :, 1]).min(axis=1)
-            d = np.where(near < 0.5, np.inf, d)
+            ok = near >= 0.5
+        goal_cells.append(ok)
+    bonus = np.full(grid.width * grid.height, np.nan)
+    max_bonus = -np.inf
+    for f, ok in zip(frontiers, goal_cells, strict=True):
+        if ok.any():
+            b = 0.02 * f.size * grid.resolution
+            bonus[f.cells[ok, 1] * grid.width + f.cells[ok, 0]] = b
+            max_bonus = max(max_bonus, b)
+    if max_bonus == -np.inf:
+        return None
+    cost = np.where(costmap.data < COST_INSCRIBED, costmap.data, 0).astype(np.float64)
+    cell_cost = (1.0 + planner.weight * cost / 252.0).ravel()
+    flat_dist, pred = _frontier_dijkstra(mask, cell_cost, start[1] * grid.width + start[0], bonus,
+                                         float(grid.resolution), float(max_bonus))  # fmt: skip
+    dist = flat_dist.reshape(grid.height, grid.width)
+    best, best_cost = None, math.inf
+    for f, ok in zip(frontiers, goal_cells, strict=True):
+        # Go to the frontier cell that is cheapest to reach (cells inside the inflation are unreachable),
+        # skipping cells near goals that were reached or given up on before.
+        d = np.where(ok, dist[f.cells[:, 1], f.cells[:, 0]], np.inf)
         reach = np.isfinite(d)
         if not reach.any():
             continue
         k = int(np.argmin(d))
-        cost = d[k] * grid.resolution - 0.02 * f.size * grid.resolution
-        if cost < best_cost:
-            best, best_cost = (int(f.cells[k, 0]), int(f.cells[k, 1])), cost
+        cost_f = d[k] * grid.resolution - 0.02 * f.size * grid.resolution
+        if cost_f < best_cost:
+            best, best_cost = (int(f.cells[k, 0]), int(f.cells[k, 1])), cost_f
     if best is None:
         return None
     cells = extract_path(pred, grid.width, best)

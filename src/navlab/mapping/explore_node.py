@@ -49,6 +49,8 @@ class Explore(Node):
         self._front_range = math.inf
         self._sectors: tuple[tuple[float, float, int], np.ndarray, np.ndarray] | None = None
         self._rear_range = math.inf
+        self._scan: Any = None  # the latest scan, and the one the ranges above come from
+        self._ranges_of: Any = None
         self._no_frontier = 0
         self._last_progress = (0, math.inf)  # (time ns, distance to goal)
         self.pub = self.create_publisher(msgs.Twist, "cmd_vel", 1)
@@ -62,6 +64,14 @@ class Explore(Node):
         self.grid = GridMap.from_msg(msg)
 
     def _on_scan(self, msg: Any) -> None:
+        self._scan = msg  # read by the next control cycle (10 Hz), not at the scan rate (40 Hz)
+
+    def _update_ranges(self) -> None:
+        """Nearest readings ahead and behind, from the latest scan (once per scan)."""
+        msg = self._scan
+        if msg is None or msg is self._ranges_of:
+            return
+        self._ranges_of = msg
         r = np.asarray(msg.ranges, dtype=float)
         key = (float(msg.angle_min), float(msg.angle_increment), len(r))
         if self._sectors is None or self._sectors[0] != key:  # the beams ahead and behind, once per scan layout
@@ -135,6 +145,7 @@ class Explore(Node):
             self.path = None
             self.pub.publish(msgs.twist(0.0, 0.0))
             return
+        self._update_ranges()
         self.follower.min_front_range = self._front_range
         v, w = self.follower.compute_velocity(pose)
         if v == 0.0 and self._front_range < 0.35 and self._rear_range > 0.4:
