@@ -202,8 +202,9 @@ class TfBuffer:
         of the newest odometry still gets a pose. Raises the latest lookup's ``TfError`` if both fail.
         """
         if t_ns is not None:
-            try:
+            # without raising and catching (a scan stamped after the newest odometry is the common case)
+            edges_t, edges_s = self._chain(target.lstrip("/"), source.lstrip("/"))
+            tol = self.tolerance_ns
+            if all(e.static or e.times[0] - tol <= t_ns <= e.times[-1] + tol for _, e in (*edges_t, *edges_s)):
                 return self.lookup_pose2d(target, source, t_ns)
-            except TfError:
-                pass
         return self.lookup_pose2d(target, source, None)
