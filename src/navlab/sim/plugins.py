@@ -117,17 +117,21 @@ class DiffDrivePlugin(Node):
         """Odometry message and odom → base tf at time ``now``."""
         cfg = self.cfg
         quat: Vec  # (x, y, z, w)
-        if cfg.odometry_source == "world":
+        position: Vec
+        world = cfg.odometry_source == "world"
+        if world:
             pose = self.sim.link_pose(self.base_link)
-            lin, ang = self.sim.link_velocity(self.base_link)
             position, quat = pose.position, pose.quaternion
         else:
             x, y, yaw, v, w = self.odometry.update(*self._encoders(), dt)
-            position = np.array([x, y, 0.0])
+            position = (x, y, 0.0)
             quat = quat_from_yaw(yaw)
-            lin, ang = np.array([v, 0.0, 0.0]), np.array([0.0, 0.0, w])
         # the message only when anyone reads it (the mapping launch's nodes take odometry from tf)
         if self.odom_pub.get_subscription_count() or self.executor.has_listeners:
+            if world:
+                lin, ang = self.sim.link_velocity(self.base_link)
+            else:
+                lin, ang = np.array([v, 0.0, 0.0]), np.array([0.0, 0.0, w])
             odom = msgs.Odometry(
                 header=msgs.header(now, cfg.odometry_frame),
                 child_frame_id=cfg.robot_base_frame,
@@ -190,6 +194,7 @@ class JointStatePlugin(Node):
         self.publish_tf = self.declare_parameter("publish_tf", True)
         robot = sim.robot
         self.joints = [j for j in robot.joints if j.name in set(sim.joint_names())]
+        self._motion = [_joint_constants(tuple(j.origin.rpy), tuple(j.origin.xyz), tuple(j.axis)) for j in self.joints]
         self.pub = self.create_publisher(msgs.JointState, "joint_states", 10)
         self.send_static_transform(static_transforms(sim, executor.now_ns))
         if rate > 0 and self.joints:
@@ -205,17 +210,22 @@ class JointStatePlugin(Node):
                                              position=pos, velocity=vel, effort=np.zeros(len(pos))))
         if self.publish_tf:
             self.send_transform([
-                _transform(now, joint.parent, joint.child, *joint_motion(joint, float(q)))
-                for joint, q in zip(self.joints, pos, strict=True)
+                _transform(now, joint.parent, joint.child, *_motion(joint.type, consts, float(q)))
+                for joint, consts, q in zip(self.joints, self._motion, pos, strict=True)
             ])
 
 
 def joint_motion(joint: Any, q: float) -> tuple[tuple[float, float, float], tuple[float, float, float, float]]:
     """Pose (xyz, quaternion x y z w) of a joint's child frame in its parent link at joint position ``q``."""
-    q0, (ox, oy, oz), (ax, ay, az) = _joint_constants(
-        tuple(joint.origin.rpy), tuple(joint.origin.xyz), tuple(joint.axis)
-    )
-    if joint.type == "prismatic":  # translate along the axis, expressed in the parent via the origin
+    consts = _joint_constants(tuple(joint.origin.rpy), tuple(joint.origin.xyz), tuple(joint.axis))
+    return _motion(joint.type, consts, q)
+
+
+def _motion(kind: str, consts: tuple[tuple, tuple, tuple],
+            q: float) -> tuple[tuple[float, float, float], tuple[float, float, float, float]]:
+    """:func:`joint_motion` from a joint's type and :func:`_joint_constants`."""
+    q0, (ox, oy, oz), (ax, ay, az) = consts
+    if kind == "prismatic":  # translate along the axis, expressed in the parent via the origin
         tx, ty, tz = qrotate(q0, (ax * q, ay * q, az * q))
         return (ox + tx, oy + ty, oz + tz), q0
     c, s = math.cos(q / 2), math.sin(q / 2)
