@@ -332,6 +332,29 @@ def _frontier_dijkstra(
     return dist, pred
 
 
+@dataclass(frozen=True)
+class FrontierSearch:
+    """What a frontier plan needs from one map, whatever the robot's pose: the map cropped to its known
+    part, the planner's costmap, its traversable cells, step costs and the frontiers (largest first)."""
+
+    grid: GridMap
+    costmap: Grid
+    mask: np.ndarray  # (H, W) bool, cells a plan may cross
+    cell_cost: np.ndarray  # (H * W,) step cost factor per cell
+    frontiers: list[Frontier]
+
+
+def prepare_frontier_search(grid: GridMap, *, robot_radius: float = 0.3, min_frontier_cells: int = 5) -> FrontierSearch:
+    """The pose-independent part of :func:`plan_to_frontier` (reusable while the map does not change)."""
+    grid = grid.crop_to_known()
+    planner = GridDijkstraPlanner()
+    costmap = clearance_costmap(grid, robot_radius)
+    cost = np.where(costmap.data < COST_INSCRIBED, costmap.data, 0).astype(np.float64)
+    cell_cost = (1.0 + planner.weight * cost / 252.0).ravel()
+    return FrontierSearch(grid, costmap, planner.traversable(costmap), cell_cost,
+                          find_frontiers(grid, min_cells=min_frontier_cells))  # fmt: skip
+
+
 def plan_to_frontier(
     grid: GridMap,
     robot_xy: tuple[float, float],
@@ -339,24 +362,25 @@ def plan_to_frontier(
     robot_radius: float = 0.3,
     min_frontier_cells: int = 5,
     blacklist: list[np.ndarray] | None = None,
+    prepared: FrontierSearch | None = None,
 ) -> np.ndarray | None:
     """A path (N, 2) in metres from the robot to the cheapest reachable frontier, or None if none is left.
 
     The cost of a frontier is its path length minus a small bonus for its size (explore_lite's idea).
     Frontiers whose centroid lies within 0.5 m of a blacklisted point are skipped. The Dijkstra from the
     robot stops once no cell left can be a cheaper goal (a bounded search, exact for the chosen goal).
+    ``prepared``: :func:`prepare_frontier_search` of this ``grid`` with these parameters, if the caller has it.
     """
-    grid = grid.crop_to_known()
-    planner = GridDijkstraPlanner()
-    costmap = clearance_costmap(grid, robot_radius)
-    mask = planner.traversable(costmap)
-    ci, cj = costmap.world_to_cell(np.array([robot_xy]))[0]
-    start = nearest_traversable(mask, (int(ci), int(cj)), planner.start_search_cells)
+    if prepared is None:
+        prepared = prepare_frontier_search(grid, robot_radius=robot_radius, min_frontier_cells=min_frontier_cells)
+    grid, frontiers = prepared.grid, prepared.frontiers
+    ci, cj = prepared.costmap.world_to_cell(np.array([robot_xy]))[0]
+    start = nearest_traversable(prepared.mask, (int(ci), int(cj)), GridDijkstraPlanner().start_search_cells)
     if start is None:
         return None
+    mask = prepared.mask.copy()
     mask[start[1], start[0]] = True
     banned = np.array(blacklist).reshape(-1, 2) if blacklist else np.zeros((0, 2))
-    frontiers = find_frontiers(grid, min_cells=min_frontier_cells)
     # the goal cells (not near a banned point) and their size bonus, for the bounded search
     goal_cells = []
     for f in frontiers:
@@ -375,9 +399,7 @@ def plan_to_frontier(
             max_bonus = max(max_bonus, b)
     if max_bonus == -np.inf:
         return None
-    cost = np.where(costmap.data < COST_INSCRIBED, costmap.data, 0).astype(np.float64)
-    cell_cost = (1.0 + planner.weight * cost / 252.0).ravel()
-    flat_dist, pred = _frontier_dijkstra(mask, cell_cost, start[1] * grid.width + start[0], bonus,
+    flat_dist, pred = _frontier_dijkstra(mask, prepared.cell_cost, start[1] * grid.width + start[0], bonus,
                                          float(grid.resolution), float(max_bonus))  # fmt: skip
     dist = flat_dist.reshape(grid.height, grid.width)
     best, best_cost = None, math.inf
