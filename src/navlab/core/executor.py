@@ -195,12 +195,9 @@ class Executor:
     # --- running ---------------------------------------------------------------------------------
 
     def _drain_inbox(self) -> None:
-        while True:
-            try:
-                fn = self._inbox.get_nowait()
-            except queue.Empty:
-                return
-            fn()
+        inbox = self._inbox
+        while not inbox.empty():  # this thread is the only consumer: non-empty means get() returns at once
+            inbox.get_nowait()()
 
     def _drain(self) -> None:
         deliveries = self._deliveries
@@ -252,6 +249,9 @@ class Executor:
         while heap and heap[0][0] <= end and not self._stop:
             t_ns, _, _, timer = heapq.heappop(heap)
             if timer.cancelled:
+                continue
+            if timer.idle is not None and timer.idle():  # nothing to do then: no physics step up to it either
+                timer.skip()
                 continue
             if t_ns > self.now_ns:
                 if self.rate > 0:
