@@ -167,17 +167,17 @@ class LidarPlugin(Node):
         self.pub = self.create_publisher(msgs.LaserScan, cfg.topic, 10)
         self.create_timer(1.0 / cfg.update_rate, self.update)
         self._empty = np.zeros(0, dtype=np.float32)
+        # the scan's fixed fields, converted once
+        self._fields = {"angle_min": float(cfg.min_angle), "angle_max": float(cfg.max_angle),
+                        "angle_increment": self.angle_increment, "time_increment": 0.0,
+                        "scan_time": 1.0 / cfg.update_rate, "range_min": float(cfg.range_min),
+                        "range_max": float(cfg.range_max)}  # fmt: skip
 
     def update(self) -> None:
         """Cast the rays and publish the scan."""
-        cfg = self.cfg
         ranges = self.sim.scan(self.index, rng=self.rng)
-        self.pub.publish(msgs.LaserScan(
-            header=msgs.header(self.get_clock().now_ns(), self.frame_id),
-            angle_min=float(cfg.min_angle), angle_max=float(cfg.max_angle), angle_increment=self.angle_increment,
-            time_increment=0.0, scan_time=1.0 / cfg.update_rate, range_min=float(cfg.range_min),
-            range_max=float(cfg.range_max), ranges=ranges, intensities=self._empty,
-        ))
+        self.pub.publish(msgs.LaserScan(header=msgs.header(self.executor.now_ns, self.frame_id), ranges=ranges,
+                                        intensities=self._empty, **self._fields))
 
 
 class JointStatePlugin(Node):
