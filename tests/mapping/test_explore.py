@@ -93,3 +93,18 @@ def test_bounded_search_picks_the_goal_of_a_full_search():
         goal = _full_search_goal(grid, start)
         assert path is not None and goal is not None
         assert np.allclose(path[-1], goal)
+
+
+def test_clearance_is_scipys_euclidean_distance_transform():
+    from scipy import ndimage
+
+    from navlab.mapping.explore import clearance
+
+    rng = np.random.default_rng(5)
+    for _ in range(300):
+        h, w = (int(v) for v in rng.integers(1, 50, 2))
+        data = np.where(rng.random((h, w)) < rng.random() ** 3, 100, 0).astype(np.int8)
+        data[rng.integers(h), rng.integers(w)] = 100
+        grid = GridMap(data, 0.05, (0.0, 0.0, 0.0))
+        assert np.array_equal(clearance(grid), ndimage.distance_transform_edt(data < 65) * 0.05)
+    assert np.isinf(clearance(GridMap(np.zeros((4, 5), dtype=np.int8), 0.05, (0.0, 0.0, 0.0)))).all()

@@ -81,7 +81,52 @@ def clearance(grid: GridMap, *, occupied_threshold: int = 65) -> np.ndarray:
     occ = grid.data >= occupied_threshold
     if not occ.any():
         return np.full(occ.shape, np.inf)
-    return ndimage.distance_transform_edt(~occ) * grid.resolution
+    return np.sqrt(_squared_edt(occ).astype(np.float64)) * grid.resolution
+
+
+@numba.njit(cache=True)
+def _squared_edt(occ: np.ndarray) -> np.ndarray:
+    """Squared Euclidean distance (in cells², exact integers) from each cell to the nearest True cell of
+    ``occ`` (at least one): Meijster, Roerdink & Hesselink's two-pass algorithm (as ``distance_transform_edt``
+    of ``~occ``, squared)."""
+    h, w = occ.shape
+    far = h + w  # farther than any cell (a column without a True cell)
+    g = np.empty((h, w), dtype=np.int64)
+    for i in range(w):  # per column: distance to the nearest True cell in it
+        g[0, i] = 0 if occ[0, i] else far
+        for j in range(1, h):
+            g[j, i] = 0 if occ[j, i] else g[j - 1, i] + 1
+        for j in range(h - 2, -1, -1):
+            if g[j + 1, i] < g[j, i]:
+                g[j, i] = g[j + 1, i] + 1
+    out = np.empty((h, w), dtype=np.int64)
+    s = np.zeros(w, dtype=np.int64)  # per row: the lower envelope of the parabolas (x - i)² + g[i]²
+    t = np.zeros(w, dtype=np.int64)
+    f = np.empty(w, dtype=np.int64)
+    for j in range(h):
+        for i in range(w):
+            f[i] = g[j, i] * g[j, i]
+        q = 0
+        s[0] = 0
+        t[0] = 0
+        for u in range(1, w):
+            while q >= 0 and (t[q] - s[q]) * (t[q] - s[q]) + f[s[q]] > (t[q] - u) * (t[q] - u) + f[u]:
+                q -= 1
+            if q < 0:
+                q = 0
+                s[0] = u
+            else:
+                i = s[q]
+                sep = 1 + (u * u - i * i + f[u] - f[i]) // (2 * (u - i))
+                if sep < w:
+                    q += 1
+                    s[q] = u
+                    t[q] = sep
+        for u in range(w - 1, -1, -1):
+            out[j, u] = (u - s[q]) * (u - s[q]) + f[s[q]]
+            if u == t[q]:
+                q -= 1
+    return out
 
 
 def clearance_costmap(
