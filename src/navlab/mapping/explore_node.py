@@ -118,13 +118,14 @@ class Explore(Node):
         self.follower.set_plan(path)
         if goal_changed:
             self._last_progress = (self.executor.now_ns, math.inf)
-        now = self.executor.now_ns
-        self.plan_pub.publish(
-            msgs.Path(
-                header=msgs.header(now, self.global_frame),
-                poses=[msgs.pose_stamped(now, self.global_frame, x, y, 0.0) for x, y in path[::4]],
+        if self.plan_pub.get_subscription_count() or self.executor.has_listeners:  # built only for a reader
+            now = self.executor.now_ns
+            self.plan_pub.publish(
+                msgs.Path(
+                    header=msgs.header(now, self.global_frame),
+                    poses=[msgs.pose_stamped(now, self.global_frame, x, y, 0.0) for x, y in path[::4]],
+                )
             )
-        )
 
     def _control(self) -> None:
         if self.done or self.path is None:
