@@ -180,8 +180,6 @@ def test_fixed_links_keep_their_frames() -> None:
 
 
 def test_planar_caster_sees_the_floor_up_to_the_cutoff_and_not_beyond() -> None:
-    import math
-
     from navlab.sim.raycast import PLANE, cast_planar
 
     n, h, cutoff = 360, 0.2, 10.0
@@ -201,3 +199,14 @@ def test_planar_caster_sees_the_floor_up_to_the_cutoff_and_not_beyond() -> None:
         assert np.isfinite(out).any() == (far < 1.0)
         np.testing.assert_allclose(out[np.isfinite(expect)], expect[np.isfinite(expect)], rtol=1e-12)
         assert np.array_equal(np.isinf(out), np.isinf(expect))
+
+
+def test_link_state_is_link_pose_and_link_velocity() -> None:
+    sim = Simulation(make_mybot(), make_room(), seed=0, robot_pose=(1.0, 2.0, 0.7))
+    _drive(sim, 0.3, 0.8, 0.5)
+    for link in ("chassis", "laser"):  # the body's own frame, and a link fused into it
+        position, quaternion, lin, ang = sim.link_state(link)
+        pose = sim.link_pose(link)
+        v, w = sim.link_velocity(link)
+        assert position == tuple(pose.position) and quaternion == tuple(pose.quaternion)
+        assert lin == tuple(v) and ang == tuple(w)

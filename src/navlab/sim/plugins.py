@@ -275,20 +275,17 @@ class GroundTruthPlugin(Node):
 
     def update(self) -> None:
         """Publish the true pose."""
-        pose = self.sim.link_pose(self.link)
-        lin, ang = self.sim.link_velocity(self.link)
-        p = pose.position
+        (px, py, pz), (qx, qy, qz, qw), (vx, vy, vz), (wx, wy, wz) = self.sim.link_state(self.link)
         self.pub.publish(msgs.Odometry(
-            header=msgs.header(self.get_clock().now_ns(), self.frame),
+            header=msgs.header(self.executor.now_ns, self.frame),
             child_frame_id=self.base_frame,
             pose=msgs.PoseWithCovariance(
-                pose=msgs.Pose(position=msgs.Point(x=float(p[0]), y=float(p[1]), z=float(p[2])),
-                               orientation=msgs.quaternion_msg(pose.quaternion)),
+                pose=msgs.Pose(position=msgs.Point(x=px, y=py, z=pz),
+                               orientation=msgs.Quaternion(x=qx, y=qy, z=qz, w=qw)),
                 covariance=np.zeros(36),
             ),
             twist=msgs.TwistWithCovariance(
-                twist=msgs.Twist(linear=msgs.Vector3(x=float(lin[0]), y=float(lin[1]), z=float(lin[2])),
-                                 angular=msgs.Vector3(x=float(ang[0]), y=float(ang[1]), z=float(ang[2]))),
+                twist=msgs.Twist(linear=msgs.Vector3(x=vx, y=vy, z=vz), angular=msgs.Vector3(x=wx, y=wy, z=wz)),
                 covariance=np.zeros(36),
             ),
-        ))
+        ))  # fmt: skip

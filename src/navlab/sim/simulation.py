@@ -83,6 +83,7 @@ class Simulation:
         self._synced = True
         self._lidar_dirs: dict[int, np.ndarray] = {}  # lidar -> (2, n) cos, sin of its beams
         self._no_noise = np.zeros(0)
+        self._vel6 = np.zeros(6)  # mj_objectVelocity's output, reused
         self._refresh_ids()
         if robot is not None:
             self._place_on_floor()
@@ -260,6 +261,23 @@ class Simulation:
         mujoco.mju_quat2Mat(rot, quat)
         rot_t = rot.reshape(3, 3).T
         return rot_t @ lin, rot_t @ vel[:3]
+
+    def link_state(self, link: str | None = None) -> tuple[tuple[float, ...], tuple[float, ...], tuple[float, ...],
+                                                          tuple[float, ...]]:
+        """(position xyz, quaternion xyzw, linear velocity, angular velocity) of a robot link as floats: the
+        values of :meth:`link_pose` and :meth:`link_velocity`, read at once (ground truth at 50 Hz)."""
+        b, _, _, own = self._link_frame(link)
+        if not own:
+            pose = self.link_pose(link)
+            lin, ang = self.link_velocity(link)
+            return (tuple(pose.position.tolist()), tuple(float(v) for v in pose.quaternion), tuple(lin.tolist()),
+                    tuple(ang.tolist()))  # fmt: skip
+        self._sync()
+        d = self.data
+        vel = self._vel6
+        mujoco.mj_objectVelocity(self.model, d, mujoco.mjtObj.mjOBJ_XBODY, b, vel, 1)
+        v = vel.tolist()
+        return tuple(d.xpos[b].tolist()), xyzw_from_wxyz(d.xquat[b]), (v[3], v[4], v[5]), (v[0], v[1], v[2])
 
     def _link_frame(self, link: str | None) -> tuple[int, np.ndarray, np.ndarray, bool]:
         """(body id, offset xyz, offset quat, whether the link is the body's own frame) of a robot link."""
