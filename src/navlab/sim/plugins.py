@@ -202,15 +202,15 @@ class JointStatePlugin(Node):
 
     def update(self) -> None:
         """Publish joint states when anyone subscribes or listens, and the moving joints' tf."""
-        now = self.get_clock().now_ns()
-        pos = np.array([self.sim.joint_position(j.name) for j in self.joints])
+        now = self.executor.now_ns
+        pos = [self.sim.joint_position(j.name) for j in self.joints]
         if self.pub.get_subscription_count() or self.executor.has_listeners:
             vel = np.array([self.sim.joint_velocity(j.name) for j in self.joints])
             self.pub.publish(msgs.JointState(header=msgs.header(now, ""), name=[j.name for j in self.joints],
-                                             position=pos, velocity=vel, effort=np.zeros(len(pos))))
+                                             position=np.array(pos), velocity=vel, effort=np.zeros(len(pos))))
         if self.publish_tf:
             self.send_transform([
-                _transform(now, joint.parent, joint.child, *_motion(joint.type, consts, float(q)))
+                _transform(now, joint.parent, joint.child, *_motion(joint.type, consts, q))
                 for joint, consts, q in zip(self.joints, self._motion, pos, strict=True)
             ])
 
