@@ -108,3 +108,21 @@ def test_clearance_is_scipys_euclidean_distance_transform():
         grid = GridMap(data, 0.05, (0.0, 0.0, 0.0))
         assert np.array_equal(clearance(grid), ndimage.distance_transform_edt(data < 65) * 0.05)
     assert np.isinf(clearance(GridMap(np.zeros((4, 5), dtype=np.int8), 0.05, (0.0, 0.0, 0.0)))).all()
+
+
+def test_clearance_costmap_follows_its_formula():
+    from navlab.grid import COST_INSCRIBED, COST_LETHAL, COST_UNKNOWN
+    from navlab.mapping.explore import clearance, clearance_costmap
+
+    rng = np.random.default_rng(7)
+    for _ in range(200):
+        h, w = (int(v) for v in rng.integers(1, 40, 2))
+        data = rng.choice(np.array([-1, 0, 30, 64, 65, 100], dtype=np.int8), size=(h, w))
+        grid = GridMap(data, 0.05, (0.0, 0.0, 0.0))
+        radius, comfort = float(rng.uniform(0.05, 0.5)), float(rng.uniform(0.05, 0.8))
+        dist = clearance(grid)
+        expect = np.rint(252.0 * np.clip((radius + comfort - dist) / comfort, 0.0, 1.0) ** 2).astype(np.uint8)
+        expect[dist <= radius] = COST_INSCRIBED
+        expect[data < 0] = COST_UNKNOWN
+        expect[data >= 65] = COST_LETHAL
+        assert np.array_equal(clearance_costmap(grid, radius, comfort=comfort).data, expect)

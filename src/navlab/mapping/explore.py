@@ -136,12 +136,30 @@ def clearance_costmap(
     ``robot_radius`` of one, 255 on unknown cells, and 0..252 growing as clearance falls from
     ``robot_radius + comfort`` to the radius (quadratically), so plans keep to the middle of free space."""
     dist = clearance(grid, occupied_threshold=occupied_threshold)
-    excess = np.clip((robot_radius + comfort - dist) / comfort, 0.0, 1.0)
-    cost = np.rint(252.0 * excess**2).astype(np.uint8)
-    cost[dist <= robot_radius] = COST_INSCRIBED
-    cost[grid.data < 0] = COST_UNKNOWN
-    cost[grid.data >= occupied_threshold] = COST_LETHAL
+    cost = np.empty(dist.shape, dtype=np.uint8)
+    _clearance_costs(dist, grid.data, float(robot_radius), float(comfort), int(occupied_threshold), cost)
     return Grid(cost, grid.resolution, grid.origin, grid.frame_id)
+
+
+@numba.njit(cache=True)
+def _clearance_costs(dist: np.ndarray, data: np.ndarray, robot_radius: float, comfort: float,
+                     occupied_threshold: int, out: np.ndarray) -> None:
+    """:func:`clearance_costmap`'s costs, cell by cell: ``rint(252 clip((r + comfort - dist) / comfort, 0, 1)²)``,
+    then 253 within the radius, 255 unknown, 254 occupied."""
+    reach = robot_radius + comfort
+    for j in range(dist.shape[0]):
+        for i in range(dist.shape[1]):
+            d = dist[j, i]
+            v = data[j, i]
+            if v >= occupied_threshold:
+                out[j, i] = COST_LETHAL
+            elif v < 0:
+                out[j, i] = COST_UNKNOWN
+            elif d <= robot_radius:
+                out[j, i] = COST_INSCRIBED
+            else:
+                e = min(max((reach - d) / comfort, 0.0), 1.0)
+                out[j, i] = np.uint8(np.rint(252.0 * (e * e)))
 
 
 class ClearanceLayer:
