@@ -195,11 +195,13 @@ class GridMap(Grid):
 
         SLAM maps are allocated larger than what they have seen; planning and saving use this.
         """
-        jj, ii = np.nonzero(self.data >= 0)
-        if len(ii) == 0:
+        known = self.data >= 0
+        jj = np.flatnonzero(known.any(axis=1))  # rows and columns holding a known cell
+        if len(jj) == 0:
             return self
+        ii = np.flatnonzero(known.any(axis=0))
         m = margin_cells
-        return self.crop(int(ii.min()) - m, int(jj.min()) - m, int(ii.max()) + m + 1, int(jj.max()) + m + 1)
+        return self.crop(int(ii[0]) - m, int(jj[0]) - m, int(ii[-1]) + m + 1, int(jj[-1]) + m + 1)
 
     def copy(self) -> GridMap:
         """A deep copy."""

@@ -152,3 +152,24 @@ def test_stop_from_another_thread_ends_chunked_runs():
     threading.Timer(0.05, lambda: ex.post(ex.stop)).start()
     run_for(ex, 100.0, quiet=True, chunk=0.2)  # 10 s of wall time if the stop were lost
     assert ex.stopped and ex.now_ns < 2_000_000_000
+
+
+def test_idle_timer_firings_run_nothing_and_step_no_physics() -> None:
+    ex = Executor()
+    steps: list[int] = []
+
+    class Stepper:
+        def advance_to(self, t_ns: int) -> None:
+            steps.append(t_ns)
+
+    ex.add_stepper(Stepper())
+    node = Node(ex, name="sensor")
+    readers: list[int] = []
+    fired: list[int] = []
+    node.create_timer(0.01, lambda: fired.append(ex.now_ns), idle=lambda: not readers)
+    node.create_timer(0.05, lambda: None)
+    ex.run(0.1)
+    assert fired == [] and steps == [50_000_000, 100_000_000]  # only the busy timer's times
+    readers.append(1)
+    ex.run(0.03)
+    assert fired == [110_000_000, 120_000_000, 130_000_000]  # on the same 10 ms grid once read

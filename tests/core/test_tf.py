@@ -76,3 +76,14 @@ def test_edges_above_the_common_ancestor_do_not_limit_lookups():
     assert buf.lookup_pose2d("odom", "chassis")[0] == pytest.approx(1.0)
     with pytest.raises(TfError, match="past"):
         buf.lookup("map", "chassis", 500_000_000)
+
+
+def test_pose_at_a_stamp_falls_back_on_the_latest_only_outside_the_history():
+    buf = _buf()
+    assert buf.lookup_pose2d_or_latest("map", "laser", 500_000_000) == buf.lookup_pose2d("map", "laser", 500_000_000)
+    latest = buf.lookup_pose2d("map", "laser")
+    assert buf.lookup_pose2d_or_latest("map", "laser", 1_200_000_000) == latest  # after the newest odometry
+    buf.tolerance_ns = 300_000_000
+    assert buf.lookup_pose2d_or_latest("map", "laser", 1_200_000_000) == latest  # within tolerance: the newest
+    with pytest.raises(TfError, match="base_link"):
+        buf.lookup_pose2d_or_latest("map", "base_link", 0)

@@ -177,3 +177,36 @@ def test_fixed_links_keep_their_frames() -> None:
     np.testing.assert_allclose(sim.data.site_xpos[sim._lidar_site[0]], laser.position, atol=1e-9)
     with pytest.raises(SimError, match="no link 'nope'"):
         sim.link_pose("nope")
+
+
+def test_planar_caster_sees_the_floor_up_to_the_cutoff_and_not_beyond() -> None:
+    from navlab.sim.raycast import PLANE, cast_planar
+
+    n, h, cutoff = 360, 0.2, 10.0
+    a = np.linspace(-math.pi, math.pi, n, endpoint=False)
+    for far in (0.999, 1.001):  # the floor's nearest hit just inside, then just beyond the cutoff
+        tilt = math.asin(h / (far * cutoff))  # the scan plane pitched down about its y axis
+        c, s = math.cos(tilt), math.sin(tilt)
+        rot = np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])  # columns: sensor axes in the world
+        out = np.empty(n)
+        cast_planar(np.array([0.0, 0.0, h]), rot, np.cos(a), np.sin(a), -math.pi, 2 * math.pi / n,
+                    np.array([0], dtype=np.int32), np.array([PLANE]), np.zeros((1, 3)), np.zeros((1, 3)),
+                    np.eye(3).reshape(1, 9), 0.05, cutoff, out)
+        dz = -s * np.cos(a)  # world z of each beam direction
+        with np.errstate(divide="ignore"):
+            expect = np.where(dz < 0, h / -dz, np.inf)
+        expect[expect > cutoff] = np.inf
+        assert np.isfinite(out).any() == (far < 1.0)
+        np.testing.assert_allclose(out[np.isfinite(expect)], expect[np.isfinite(expect)], rtol=1e-12)
+        assert np.array_equal(np.isinf(out), np.isinf(expect))
+
+
+def test_link_state_is_link_pose_and_link_velocity() -> None:
+    sim = Simulation(make_mybot(), make_room(), seed=0, robot_pose=(1.0, 2.0, 0.7))
+    _drive(sim, 0.3, 0.8, 0.5)
+    for link in ("chassis", "laser"):  # the body's own frame, and a link fused into it
+        position, quaternion, lin, ang = sim.link_state(link)
+        pose = sim.link_pose(link)
+        v, w = sim.link_velocity(link)
+        assert position == tuple(pose.position) and quaternion == tuple(pose.quaternion)
+        assert lin == tuple(v) and ang == tuple(w)

@@ -195,12 +195,9 @@ class Executor:
     # --- running ---------------------------------------------------------------------------------
 
     def _drain_inbox(self) -> None:
-        while True:
-            try:
-                fn = self._inbox.get_nowait()
-            except queue.Empty:
-                return
-            fn()
+        inbox = self._inbox
+        while not inbox.empty():  # this thread is the only consumer: non-empty means get() returns at once
+            inbox.get_nowait()()
 
     def _drain(self) -> None:
         deliveries = self._deliveries
@@ -244,24 +241,28 @@ class Executor:
         end = self.now_ns + timeout_ns
         sim0, wall0 = self.now_ns, time.perf_counter()
         self._stop = self.stopped = False
-        heap = self._heap
+        heap, deliveries, inbox, heappop = self._heap, self._deliveries, self._inbox, heapq.heappop
         self._drain_inbox()
         self._drain()
         if predicate is not None and predicate():
             return True
         while heap and heap[0][0] <= end and not self._stop:
-            t_ns, _, _, timer = heapq.heappop(heap)
+            t_ns, _, _, timer = heappop(heap)
             if timer.cancelled:
+                continue
+            if timer.idle is not None and timer.idle():  # nothing to do then: no physics step up to it either
+                timer.skip()
                 continue
             if t_ns > self.now_ns:
                 if self.rate > 0:
                     self._pace(t_ns, sim0, wall0)
-                else:
+                elif not inbox.empty():
                     self._drain_inbox()
                 self._advance(t_ns)
             self.events += 1
             timer.fire()
-            self._drain()
+            if deliveries:
+                self._drain()
             if predicate is not None and predicate():
                 return True
         if not self._stop and end > self.now_ns:

@@ -186,12 +186,17 @@ class Node:
         self.subscriptions.append(sub)
         return sub
 
-    def create_timer(self, period: float, callback: Callable[[], None], *, priority: int = 0) -> Timer:
-        """Call ``callback()`` every ``period`` simulated seconds (lower ``priority`` runs first on ties)."""
+    def create_timer(self, period: float, callback: Callable[[], None], *, priority: int = 0,
+                     idle: Callable[[], bool] | None = None) -> Timer:  # fmt: skip
+        """Call ``callback()`` every ``period`` simulated seconds (lower ``priority`` runs first on ties).
+
+        ``idle()`` (navlab extension), if given, returns True when the callback would do nothing at this
+        firing (e.g. a sensor nobody reads); the firing is then skipped, physics included.
+        """
         if isinstance(period, bool) or not isinstance(period, int | float) or not 0 < period < 1e9:
             raise ParameterError(f"node {self.fully_qualified_name}: timer period {period!r} s: expected a "
                                  "finite number > 0 (is a rate parameter 0, negative or not a number?)")
-        timer = Timer(self.executor, seconds_to_ns(period), callback, priority, self.executor.now_ns)
+        timer = Timer(self.executor, seconds_to_ns(period), callback, priority, self.executor.now_ns, idle)
         self.timers.append(timer)
         return timer
 

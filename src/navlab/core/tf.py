@@ -49,6 +49,9 @@ class TfBuffer:
         self.tolerance_ns = tolerance_ns
         self._edges: dict[str, _Edge] = {}
         self._parents: set[str] = set()
+        self._version = 0  # bumped whenever the tree's shape changes (an edge added or re-parented)
+        # (target, source) -> (version, target's edges up to the common ancestor, source's edges up to it)
+        self._chains: dict[tuple[str, str], tuple[int, list[tuple[str, _Edge]], list[tuple[str, _Edge]]]] = {}
 
     def frames(self) -> list[str]:
         """Every frame seen, as parent or child."""
@@ -69,6 +72,7 @@ class TfBuffer:
         if e is None or e.parent != parent or e.static != static:
             e = self._edges[child] = _Edge(parent, static)
             self._parents.add(parent)
+            self._version += 1
         if static:
             e.times, e.values = [t_ns], [tf]
             return
@@ -128,36 +132,16 @@ class TfBuffer:
             chain.append(frame)
         return chain
 
-    def _up_to(self, frame: str, stop: str, t_ns: int | None) -> Tf:
-        """``stop_T_frame``: compose the edges from ``frame`` up to its ancestor ``stop``."""
-        out: Tf = IDENTITY_TF
-        while frame != stop:
-            e = self._edges[frame]
-            out = compose3(self._edge_at(frame, e, t_ns), out)
-            frame = e.parent
-        return out
-
-    def _latest_common(self, target: str, source: str) -> int | None:
-        """The newest time every dynamic edge between the two frames has (None if all are static)."""
-        up_s, up_t = self._ancestors(source), self._ancestors(target)
-        common = set(up_s) & set(up_t)
-        newest = None
-        for f in (*up_s, *up_t):
-            e = self._edges.get(f)
-            if e is None or f in common or e.static:
-                continue
-            newest = e.times[-1] if newest is None else min(newest, e.times[-1])
-        return newest
-
-    def lookup(self, target: str, source: str, t_ns: int | None = None) -> Tf:
-        """``target_T_source`` at ``t_ns`` (None: the latest time every edge on the path has)."""
-        target, source = target.lstrip("/"), source.lstrip("/")
+    def _chain(self, target: str, source: str) -> tuple[list[tuple[str, _Edge]], list[tuple[str, _Edge]]]:
+        """The edges (child frame, edge) from ``target`` and from ``source`` up to their common ancestor,
+        bottom first; remembered until the tree's shape changes."""
+        hit = self._chains.get((target, source))
+        if hit is not None and hit[0] == self._version:
+            return hit[1], hit[2]
         for f in (target, source):
             if f not in self._edges and f not in self._parents:
                 known = ", ".join(self.frames()) or "none"
                 raise TfError(f"frame {f!r} does not exist (known frames: {known})")
-        if t_ns is None:
-            t_ns = self._latest_common(target, source)
         up_s, up_t = self._ancestors(source), self._ancestors(target)
         if up_s[-1] != up_t[-1]:
             raise TfError(f"frames {target!r} and {source!r} are not connected (roots {up_t[-1]!r} and {up_s[-1]!r})")
@@ -165,7 +149,26 @@ class TfBuffer:
         common = next(f for f in up_s if f in in_target)
         # Only the edges below the common ancestor are evaluated, so an edge above it (map->odom while
         # looking up odom->base) never limits the lookup time.
-        return compose3(inverse3(self._up_to(target, common, t_ns)), self._up_to(source, common, t_ns))
+        edges_t = [(f, self._edges[f]) for f in up_t[: up_t.index(common)]]
+        edges_s = [(f, self._edges[f]) for f in up_s[: up_s.index(common)]]
+        self._chains[(target, source)] = (self._version, edges_t, edges_s)
+        return edges_t, edges_s
+
+    def _compose(self, edges: list[tuple[str, _Edge]], t_ns: int | None) -> Tf:
+        """``ancestor_T_frame``: compose a chain of edges (bottom first) up to its top."""
+        out: Tf = IDENTITY_TF
+        for child, e in edges:
+            out = compose3(self._edge_at(child, e, t_ns), out)
+        return out
+
+    def lookup(self, target: str, source: str, t_ns: int | None = None) -> Tf:
+        """``target_T_source`` at ``t_ns`` (None: the latest time every edge on the path has)."""
+        edges_t, edges_s = self._chain(target.lstrip("/"), source.lstrip("/"))
+        if t_ns is None:  # the newest time every dynamic edge between the two frames has (None if all static)
+            for _, e in (*edges_s, *edges_t):
+                if not e.static:
+                    t_ns = e.times[-1] if t_ns is None else min(t_ns, e.times[-1])
+        return compose3(inverse3(self._compose(edges_t, t_ns)), self._compose(edges_s, t_ns))
 
     def can_transform(self, target: str, source: str, t_ns: int | None = None) -> bool:
         """Whether :meth:`lookup` would succeed."""
@@ -199,8 +202,9 @@ class TfBuffer:
         of the newest odometry still gets a pose. Raises the latest lookup's ``TfError`` if both fail.
         """
         if t_ns is not None:
-            try:
+            # without raising and catching (a scan stamped after the newest odometry is the common case)
+            edges_t, edges_s = self._chain(target.lstrip("/"), source.lstrip("/"))
+            tol = self.tolerance_ns
+            if all(e.static or e.times[0] - tol <= t_ns <= e.times[-1] + tol for _, e in (*edges_t, *edges_s)):
                 return self.lookup_pose2d(target, source, t_ns)
-            except TfError:
-                pass
         return self.lookup_pose2d(target, source, None)

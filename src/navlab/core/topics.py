@@ -78,16 +78,22 @@ class Publisher:
 
 
 class Timer:
-    """Calls ``callback`` every ``period_ns`` of simulated time, at ``start + k·period``."""
+    """Calls ``callback`` every ``period_ns`` of simulated time, at ``start + k·period``.
+
+    ``idle`` (optional) tells, at a firing time, that the callback would do nothing now (a sensor nobody
+    reads): the executor then skips that firing without running it or integrating physics up to it.
+    """
 
     def __init__(
-        self, queue: TimerQueue, period_ns: int, callback: Callable[[], None], priority: int, start_ns: int
-    ) -> None:
+        self, queue: TimerQueue, period_ns: int, callback: Callable[[], None], priority: int, start_ns: int,
+        idle: Callable[[], bool] | None = None,
+    ) -> None:  # fmt: skip
         if period_ns <= 0:
             raise CoreError(f"timer period must be > 0 s, got {period_ns / 1e9}")
         self._queue = queue
         self.period_ns = period_ns
         self.callback = callback
+        self.idle = idle
         self.priority = priority
         self.cancelled = False
         self._start = start_ns
@@ -99,6 +105,11 @@ class Timer:
         self._k += 1
         self._queue.schedule(self, self._start + self._k * self.period_ns)
         self.callback()
+
+    def skip(self) -> None:
+        """Schedule the next firing without running the callback (an idle firing)."""
+        self._k += 1
+        self._queue.schedule(self, self._start + self._k * self.period_ns)
 
     def cancel(self) -> None:
         """Stop the timer."""

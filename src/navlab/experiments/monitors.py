@@ -26,13 +26,13 @@ class PoseMonitor(Node):
         self.odom_frame = self.declare_parameter("odom_frame", "odom")
         truth_topic = self.declare_parameter("truth_topic", "/ground_truth/odom")
         rate = self.declare_parameter("rate", 2.0)
-        self._truth: tuple[float, float, float] | None = None
+        self._truth: Any = None  # the latest truth message (converted when sampled, not at 50 Hz)
         self._rows: list[tuple[float, ...]] = []
         self.create_subscription(msgs.Odometry, truth_topic, self._on_truth, 1)
         self.create_timer(1.0 / rate, self._sample)
 
     def _on_truth(self, msg: Any) -> None:
-        self._truth = msgs.pose2d(msg.pose.pose)
+        self._truth = msg
 
     def _lookup(self, frame: str) -> tuple[float, float, float]:
         try:
@@ -43,7 +43,7 @@ class PoseMonitor(Node):
     def _sample(self) -> None:
         if self._truth is None:
             return
-        row = (self.executor.now_ns / 1e9, *self._truth, *self._lookup(self.estimate_frame),
+        row = (self.executor.now_ns / 1e9, *msgs.pose2d(self._truth.pose.pose), *self._lookup(self.estimate_frame),
                *self._lookup(self.odom_frame))  # fmt: skip
         self._rows.append(row)
 

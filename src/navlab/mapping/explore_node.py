@@ -10,7 +10,7 @@ import numpy as np
 from navlab import msgs
 from navlab.core import Executor, Node, TfError
 from navlab.grid import GridMap
-from navlab.mapping.explore import plan_to_frontier
+from navlab.mapping.explore import FrontierSearch, plan_to_frontier, prepare_frontier_search
 from navlab.mapping.follow import PurePursuit
 
 
@@ -47,9 +47,12 @@ class Explore(Node):
         self.path: np.ndarray | None = None
         self.blacklist: list[np.ndarray] = []
         self._front_range = math.inf
-        self._sectors: tuple[tuple[float, float, int], np.ndarray, np.ndarray] | None = None
+        self._sectors: tuple[tuple[float, float, int], np.ndarray, np.ndarray] | None = None  # beam indices
         self._rear_range = math.inf
+        self._scan: Any = None  # the latest scan, and the one the ranges above come from
+        self._ranges_of: Any = None
         self._no_frontier = 0
+        self._search: tuple[GridMap, FrontierSearch] | None = None  # the last map's pose-independent planning
         self._last_progress = (0, math.inf)  # (time ns, distance to goal)
         self.pub = self.create_publisher(msgs.Twist, "cmd_vel", 1)
         self.plan_pub = self.create_publisher(msgs.Path, "explore/plan", 1)
@@ -62,16 +65,28 @@ class Explore(Node):
         self.grid = GridMap.from_msg(msg)
 
     def _on_scan(self, msg: Any) -> None:
-        r = np.asarray(msg.ranges, dtype=float)
-        key = (float(msg.angle_min), float(msg.angle_increment), len(r))
+        self._scan = msg  # read by the next control cycle (10 Hz), not at the scan rate (40 Hz)
+
+    def _update_ranges(self) -> None:
+        """Nearest readings ahead and behind, from the latest scan (once per scan)."""
+        msg = self._scan
+        if msg is None or msg is self._ranges_of:
+            return
+        self._ranges_of = msg
+        key = (float(msg.angle_min), float(msg.angle_increment), len(msg.ranges))
         if self._sectors is None or self._sectors[0] != key:  # the beams ahead and behind, once per scan layout
-            a = msg.angle_min + msg.angle_increment * np.arange(len(r))
+            a = msg.angle_min + msg.angle_increment * np.arange(len(msg.ranges))
             rel = np.abs(np.arctan2(np.sin(a), np.cos(a)))
-            self._sectors = (key, rel < 0.5, rel > math.pi - 0.6)
-        ok = np.isfinite(r) & (r >= msg.range_min)
-        front, rear = ok & self._sectors[1], ok & self._sectors[2]
-        self._front_range = float(r[front].min()) if front.any() else math.inf
-        self._rear_range = float(r[rear].min()) if rear.any() else math.inf
+            self._sectors = (key, np.flatnonzero(rel < 0.5), np.flatnonzero(rel > math.pi - 0.6))
+        self._front_range = self._nearest(msg, self._sectors[1])
+        self._rear_range = self._nearest(msg, self._sectors[2])
+
+    @staticmethod
+    def _nearest(msg: Any, beams: np.ndarray) -> float:
+        """The nearest valid reading (m) among ``beams`` of a scan, inf if none."""
+        r = np.asarray(msg.ranges)[beams].astype(np.float64)
+        r = r[np.isfinite(r) & (r >= msg.range_min)]
+        return float(r.min()) if len(r) else math.inf
 
     def _pose(self) -> tuple[float, float, float] | None:
         try:
@@ -83,13 +98,12 @@ class Explore(Node):
         pose = self._pose()
         if self.grid is None or pose is None or self.done:
             return
-        path = plan_to_frontier(
-            self.grid,
-            pose[:2],
-            robot_radius=self.robot_radius,
-            min_frontier_cells=max(1, round(self.min_frontier_size / self.grid.resolution)),
-            blacklist=self.blacklist,
-        )
+        min_cells = max(1, round(self.min_frontier_size / self.grid.resolution))
+        if self._search is None or self._search[0] is not self.grid:  # a new map since the last plan
+            search = prepare_frontier_search(self.grid, robot_radius=self.robot_radius, min_frontier_cells=min_cells)
+            self._search = (self.grid, search)
+        path = plan_to_frontier(self.grid, pose[:2], robot_radius=self.robot_radius, min_frontier_cells=min_cells,
+                                blacklist=self.blacklist, prepared=self._search[1])  # fmt: skip
         if path is None:
             self._no_frontier += 1
             self.path = None
@@ -104,13 +118,14 @@ class Explore(Node):
         self.follower.set_plan(path)
         if goal_changed:
             self._last_progress = (self.executor.now_ns, math.inf)
-        now = self.executor.now_ns
-        self.plan_pub.publish(
-            msgs.Path(
-                header=msgs.header(now, self.global_frame),
-                poses=[msgs.pose_stamped(now, self.global_frame, x, y, 0.0) for x, y in path[::4]],
+        if self.plan_pub.get_subscription_count() or self.executor.has_listeners:  # built only for a reader
+            now = self.executor.now_ns
+            self.plan_pub.publish(
+                msgs.Path(
+                    header=msgs.header(now, self.global_frame),
+                    poses=[msgs.pose_stamped(now, self.global_frame, x, y, 0.0) for x, y in path[::4]],
+                )
             )
-        )
 
     def _control(self) -> None:
         if self.done or self.path is None:
@@ -135,6 +150,7 @@ class Explore(Node):
             self.path = None
             self.pub.publish(msgs.twist(0.0, 0.0))
             return
+        self._update_ranges()
         self.follower.min_front_range = self._front_range
         v, w = self.follower.compute_velocity(pose)
         if v == 0.0 and self._front_range < 0.35 and self._rear_range > 0.4:

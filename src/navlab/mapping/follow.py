@@ -41,7 +41,7 @@ def follow_path(
     c, s = math.cos(yaw), math.sin(yaw)
     lx, ly = c * dx + s * dy, -s * dx + c * dy
     heading_err = math.atan2(ly, lx)
-    w = float(np.clip(2.0 * heading_err, -max_w, max_w))
+    w = float(min(max(2.0 * heading_err, -max_w), max_w))  # np.clip's value, without its cost on a scalar
     if abs(heading_err) > 1.0:
         return 0.0, w, nearest
     v = max_v * max(0.0, math.cos(heading_err))

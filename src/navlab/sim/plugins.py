@@ -117,17 +117,21 @@ class DiffDrivePlugin(Node):
         """Odometry message and odom → base tf at time ``now``."""
         cfg = self.cfg
         quat: Vec  # (x, y, z, w)
-        if cfg.odometry_source == "world":
+        position: Vec
+        world = cfg.odometry_source == "world"
+        if world:
             pose = self.sim.link_pose(self.base_link)
-            lin, ang = self.sim.link_velocity(self.base_link)
             position, quat = pose.position, pose.quaternion
         else:
             x, y, yaw, v, w = self.odometry.update(*self._encoders(), dt)
-            position = np.array([x, y, 0.0])
+            position = (x, y, 0.0)
             quat = quat_from_yaw(yaw)
-            lin, ang = np.array([v, 0.0, 0.0]), np.array([0.0, 0.0, w])
         # the message only when anyone reads it (the mapping launch's nodes take odometry from tf)
         if self.odom_pub.get_subscription_count() or self.executor.has_listeners:
+            if world:
+                lin, ang = self.sim.link_velocity(self.base_link)
+            else:
+                lin, ang = np.array([v, 0.0, 0.0]), np.array([0.0, 0.0, w])
             odom = msgs.Odometry(
                 header=msgs.header(now, cfg.odometry_frame),
                 child_frame_id=cfg.robot_base_frame,
@@ -163,17 +167,17 @@ class LidarPlugin(Node):
         self.pub = self.create_publisher(msgs.LaserScan, cfg.topic, 10)
         self.create_timer(1.0 / cfg.update_rate, self.update)
         self._empty = np.zeros(0, dtype=np.float32)
+        # the scan's fixed fields, converted once
+        self._fields = {"angle_min": float(cfg.min_angle), "angle_max": float(cfg.max_angle),
+                        "angle_increment": self.angle_increment, "time_increment": 0.0,
+                        "scan_time": 1.0 / cfg.update_rate, "range_min": float(cfg.range_min),
+                        "range_max": float(cfg.range_max)}  # fmt: skip
 
     def update(self) -> None:
         """Cast the rays and publish the scan."""
-        cfg = self.cfg
         ranges = self.sim.scan(self.index, rng=self.rng)
-        self.pub.publish(msgs.LaserScan(
-            header=msgs.header(self.get_clock().now_ns(), self.frame_id),
-            angle_min=float(cfg.min_angle), angle_max=float(cfg.max_angle), angle_increment=self.angle_increment,
-            time_increment=0.0, scan_time=1.0 / cfg.update_rate, range_min=float(cfg.range_min),
-            range_max=float(cfg.range_max), ranges=ranges, intensities=self._empty,
-        ))
+        self.pub.publish(msgs.LaserScan(header=msgs.header(self.executor.now_ns, self.frame_id), ranges=ranges,
+                                        intensities=self._empty, **self._fields))
 
 
 class JointStatePlugin(Node):
@@ -190,6 +194,7 @@ class JointStatePlugin(Node):
         self.publish_tf = self.declare_parameter("publish_tf", True)
         robot = sim.robot
         self.joints = [j for j in robot.joints if j.name in set(sim.joint_names())]
+        self._motion = [_joint_constants(tuple(j.origin.rpy), tuple(j.origin.xyz), tuple(j.axis)) for j in self.joints]
         self.pub = self.create_publisher(msgs.JointState, "joint_states", 10)
         self.send_static_transform(static_transforms(sim, executor.now_ns))
         if rate > 0 and self.joints:
@@ -197,25 +202,30 @@ class JointStatePlugin(Node):
 
     def update(self) -> None:
         """Publish joint states when anyone subscribes or listens, and the moving joints' tf."""
-        now = self.get_clock().now_ns()
-        pos = np.array([self.sim.joint_position(j.name) for j in self.joints])
+        now = self.executor.now_ns
+        pos = [self.sim.joint_position(j.name) for j in self.joints]
         if self.pub.get_subscription_count() or self.executor.has_listeners:
             vel = np.array([self.sim.joint_velocity(j.name) for j in self.joints])
             self.pub.publish(msgs.JointState(header=msgs.header(now, ""), name=[j.name for j in self.joints],
-                                             position=pos, velocity=vel, effort=np.zeros(len(pos))))
+                                             position=np.array(pos), velocity=vel, effort=np.zeros(len(pos))))
         if self.publish_tf:
             self.send_transform([
-                _transform(now, joint.parent, joint.child, *joint_motion(joint, float(q)))
-                for joint, q in zip(self.joints, pos, strict=True)
+                _transform(now, joint.parent, joint.child, *_motion(joint.type, consts, q))
+                for joint, consts, q in zip(self.joints, self._motion, pos, strict=True)
             ])
 
 
 def joint_motion(joint: Any, q: float) -> tuple[tuple[float, float, float], tuple[float, float, float, float]]:
     """Pose (xyz, quaternion x y z w) of a joint's child frame in its parent link at joint position ``q``."""
-    q0, (ox, oy, oz), (ax, ay, az) = _joint_constants(
-        tuple(joint.origin.rpy), tuple(joint.origin.xyz), tuple(joint.axis)
-    )
-    if joint.type == "prismatic":  # translate along the axis, expressed in the parent via the origin
+    consts = _joint_constants(tuple(joint.origin.rpy), tuple(joint.origin.xyz), tuple(joint.axis))
+    return _motion(joint.type, consts, q)
+
+
+def _motion(kind: str, consts: tuple[tuple, tuple, tuple],
+            q: float) -> tuple[tuple[float, float, float], tuple[float, float, float, float]]:
+    """:func:`joint_motion` from a joint's type and :func:`_joint_constants`."""
+    q0, (ox, oy, oz), (ax, ay, az) = consts
+    if kind == "prismatic":  # translate along the axis, expressed in the parent via the origin
         tx, ty, tz = qrotate(q0, (ax * q, ay * q, az * q))
         return (ox + tx, oy + ty, oz + tz), q0
     c, s = math.cos(q / 2), math.sin(q / 2)
@@ -265,20 +275,17 @@ class GroundTruthPlugin(Node):
 
     def update(self) -> None:
         """Publish the true pose."""
-        pose = self.sim.link_pose(self.link)
-        lin, ang = self.sim.link_velocity(self.link)
-        p = pose.position
+        (px, py, pz), (qx, qy, qz, qw), (vx, vy, vz), (wx, wy, wz) = self.sim.link_state(self.link)
         self.pub.publish(msgs.Odometry(
-            header=msgs.header(self.get_clock().now_ns(), self.frame),
+            header=msgs.header(self.executor.now_ns, self.frame),
             child_frame_id=self.base_frame,
             pose=msgs.PoseWithCovariance(
-                pose=msgs.Pose(position=msgs.Point(x=float(p[0]), y=float(p[1]), z=float(p[2])),
-                               orientation=msgs.quaternion_msg(pose.quaternion)),
+                pose=msgs.Pose(position=msgs.Point(x=px, y=py, z=pz),
+                               orientation=msgs.Quaternion(x=qx, y=qy, z=qz, w=qw)),
                 covariance=np.zeros(36),
             ),
             twist=msgs.TwistWithCovariance(
-                twist=msgs.Twist(linear=msgs.Vector3(x=float(lin[0]), y=float(lin[1]), z=float(lin[2])),
-                                 angular=msgs.Vector3(x=float(ang[0]), y=float(ang[1]), z=float(ang[2]))),
+                twist=msgs.Twist(linear=msgs.Vector3(x=vx, y=vy, z=vz), angular=msgs.Vector3(x=wx, y=wy, z=wz)),
                 covariance=np.zeros(36),
             ),
-        ))
+        ))  # fmt: skip

@@ -141,8 +141,11 @@ def cast_planar(
         full = True
         centre = 0.0
         half = 0.0
-        if kind == PLANE and abs(u[2]) + abs(v[2]) < 1e-12:
-            continue  # the scan plane is parallel to this plane
+        if kind == PLANE:
+            if abs(u[2]) + abs(v[2]) < 1e-12:
+                continue  # the scan plane is parallel to this plane
+            if abs(p_loc[2]) > cutoff * math.sqrt(u[2] * u[2] + v[2] * v[2]) * (1.0 + 1e-9):
+                continue  # every beam meets this plane beyond the cutoff (a nearly level scan over the floor)
         if kind != PLANE:
             # centre of the geom in the sensor frame
             cx = -(rot[0, 0] * rel[0] + rot[1, 0] * rel[1] + rot[2, 0] * rel[2])
