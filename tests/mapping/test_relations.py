@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from navlab.cli import main
-from navlab.experiments.metrics import read_relations, relations_error
+from navlab.experiments.metrics import read_relations, relations_closure, relations_error
 from navlab.io.errors import IoError
 from navlab.io.poses import write_poses
 from navlab.mapping import MappingError
@@ -46,6 +46,22 @@ def test_perfect_poses_score_zero_and_known_offset_scores_it():
     assert relations_error(t, r, rel)["trans_abs_mean"] < 1e-9
 
 
+def test_closure_of_exact_relations_is_zero_and_of_noisy_ones_gives_their_error():
+    t, p = _traj(400)
+    pairs = [(k, k + 1) for k in range(399)] + [(k, k + 2) for k in range(398)]  # 398 triangles
+    rel = _relations(t, p, pairs)
+    exact = relations_closure(rel)
+    assert exact["n_triangles"] == 398 and exact["closure_mean_m"] < 1e-9 and exact["noise_floor_m"] < 1e-9
+    noisy = rel.copy()
+    noisy[:, 2:4] += np.random.default_rng(0).normal(0.0, 0.02, (len(rel), 2))  # 2 cm per axis
+    out = relations_closure(noisy)
+    # one relation's mean translational error is 0.02 * sqrt(pi / 2) = 0.0251 m; the floor estimates it from
+    # the triangles alone, and an estimator with the true poses scores it
+    assert out["noise_floor_m"] == pytest.approx(0.02 * math.sqrt(math.pi / 2), rel=0.1)
+    assert relations_error(t, p, noisy)["trans_abs_mean"] == pytest.approx(out["noise_floor_m"], rel=0.1)
+    assert relations_closure(_relations(t, p, [(0, 1), (2, 3)]))["n_triangles"] == 0
+
+
 def test_unmatched_timestamps_counted_and_all_unmatched_is_error():
     t, p = _traj()
     rel = _relations(t, p, [(0, 1), (1, 2)])
@@ -75,8 +91,15 @@ def test_raw_odometry_of_csail_scores_published_value(tmp_path, capsys, dataset)
         "rot_abs_mean_deg",
         "rot_abs_std_deg",
         "rot_sq_mean_deg2",
+        "reference_n_triangles",
+        "reference_closure_median_m",
+        "reference_closure_mean_m",
+        "reference_noise_floor_m",
     }
     assert out["n_relations"] == 1172 and out["n_scored"] == 1172
+    # the reference's own 54 triangles close to 4.4 cm median: poses without error would score about 2.7 cm
+    assert out["reference_n_triangles"] == 54
+    assert out["reference_noise_floor_m"] == pytest.approx(0.0265, abs=0.001)
     assert out["trans_abs_mean"] == pytest.approx(1.68, abs=0.01)
     assert out["trans_abs_std"] == pytest.approx(5.29, abs=0.01)
     assert out["rot_abs_mean_deg"] == pytest.approx(5.07, abs=0.01)

@@ -91,6 +91,39 @@ def relations_error(
     return out
 
 
+def relations_closure(relations: np.ndarray, *, time_tolerance: float = 1e-3) -> dict[str, float | int]:
+    """How well a relations file agrees with itself: every triangle of relations (a→b, b→c, a→c) should close,
+    a→b ∘ b→c = a→c. Returns ``n_triangles``, the translational closure's median and mean (m) and
+    ``noise_floor_m``: if the relations' errors were independent, isotropic and Gaussian, the mean translational
+    error of one relation against the truth (mean closure / √3): the score an estimator without error would get.
+    ``noise_floor_m`` is NaN without triangles."""
+    rel = np.asarray(relations, dtype=np.float64)
+    key = np.round(np.concatenate([rel[:, 0], rel[:, 1]]) / time_tolerance).astype(np.int64)
+    a, b = key[: len(rel)], key[len(rel) :]
+    index = {(int(i), int(j)): k for k, (i, j) in enumerate(zip(a, b, strict=True))}
+    after: dict[int, list[int]] = {}
+    for k, i in enumerate(a):
+        after.setdefault(int(i), []).append(k)
+    closure = []
+    for ab, (i, j) in enumerate(zip(a, b, strict=True)):
+        for bc in after.get(int(j), []):
+            ac = index.get((int(i), int(b[bc])))
+            if ac is None:
+                continue
+            x, y, yaw = rel[ab, 2:5]
+            c, s = np.cos(yaw), np.sin(yaw)
+            end = (x + c * rel[bc, 2] - s * rel[bc, 3], y + s * rel[bc, 2] + c * rel[bc, 3])
+            closure.append(np.hypot(end[0] - rel[ac, 2], end[1] - rel[ac, 3]))
+    err = np.asarray(closure)
+    if not len(err):
+        return {"n_triangles": 0, "closure_median_m": float("nan"), "closure_mean_m": float("nan"),
+                "noise_floor_m": float("nan")}  # fmt: skip
+    # the closure is the sum of three relations' errors: per axis sigma * sqrt(3), so its mean 2D norm is
+    # sqrt(3) times one relation's
+    return {"n_triangles": len(err), "closure_median_m": float(np.median(err)), "closure_mean_m": float(err.mean()),
+            "noise_floor_m": float(err.mean() / np.sqrt(3.0))}  # fmt: skip
+
+
 # --- maps and trajectories against a simulated world's truth ------------------------------------
 
 

@@ -23,7 +23,7 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
 
     A missing log raises ``DatasetNotFoundError`` saying where it was looked for and how to provide it.
     """
-    from navlab.experiments.metrics import read_relations, relations_error
+    from navlab.experiments.metrics import read_relations, relations_closure, relations_error
     from navlab.io.carmen import read_carmen
     from navlab.io.datasets import dataset
     from navlab.mapping.scanmatch import warmup
@@ -34,7 +34,8 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
     t0, c0 = time.perf_counter(), time.process_time()
     result = run_offline(log, mode="graph", seed=getattr(args, "seed", 0))
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
-    rel = relations_error(result.timestamps, result.poses, read_relations(dataset(RELATIONS)))
+    relations = read_relations(dataset(RELATIONS))
+    rel = relations_error(result.timestamps, result.poses, relations)
     # cpu_s is this process's CPU time: on a busy machine it shows what one free core would take
     return {
         "log_s": round(log.duration, 3),
@@ -45,6 +46,8 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
         "relations_scored": rel["n_scored"],
         "relations_trans_m": round(float(rel["trans_abs_mean"]), 4),
         "relations_rot_deg": round(float(rel["rot_abs_mean_deg"]), 3),
+        # what poses without error would score, from the relations' own triangles (their error, not ours)
+        "relations_noise_floor_m": round(relations_closure(relations)["noise_floor_m"], 4),
     }
 
 

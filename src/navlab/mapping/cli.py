@@ -121,18 +121,24 @@ def _cmd_teleop(args: argparse.Namespace) -> int:
 
 
 def _cmd_eval_relations(args: argparse.Namespace) -> int:
-    from navlab.experiments.metrics import read_relations, relations_error
+    from navlab.experiments.metrics import read_relations, relations_closure, relations_error
     from navlab.experiments.trajectory import read_trajectory
 
     ts, poses = read_trajectory(args.poses, carmen=args.carmen)
     rel = read_relations(args.relations)
     out = relations_error(ts, poses, rel, time_tolerance=args.tolerance)
+    closure = relations_closure(rel, time_tolerance=args.tolerance)
+    out.update({f"reference_{k}": v for k, v in closure.items()})
     if args.json:
         print_figures(out, True)
     else:
         print(f"relations scored: {out['n_scored']} of {out['n_relations']}")
         print(f"translation: {out['trans_abs_mean']:.4f} ± {out['trans_abs_std']:.4f} m")
         print(f"rotation:    {out['rot_abs_mean_deg']:.3f} ± {out['rot_abs_std_deg']:.3f} deg")
+        if closure["n_triangles"]:
+            n, median, floor = closure["n_triangles"], closure["closure_median_m"], closure["noise_floor_m"]
+            print(f"the relations' own {n} triangles close to {median:.4f} m median: with independent errors, "
+                  f"poses without error would score about {floor:.4f} m")  # fmt: skip
     return 0
 
 
@@ -211,7 +217,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="relations metric: POSES (timestamp x y theta) vs RELATIONS (t1 t2 x y z roll pitch yaw)",
         description="For each relation, error = relation ⊖ (pose(t1)^-1 ∘ pose(t2)); prints mean ± std of "
         "absolute translational (m) and rotational (deg) errors and the means of their squares. Relations "
-        "whose timestamps match no pose are counted as not scored.",
+        "whose timestamps match no pose are counted as not scored. Also how far the relations' own triangles "
+        "(a→b, b→c, a→c) fail to close, and the score that implies for poses without error (reference_*).",
     )
     r.add_argument("poses", help="poses file: 'timestamp x y theta' per line, a TUM file, or a CARMEN log "
                    "(its own odometry: see --carmen)")
