@@ -28,8 +28,10 @@ export function decodeBatch(buf, onFrame) {
 }
 
 export class Link {
-  constructor(onMessage, onStatus) {
+  // onBatch(buffer), if given, gets each binary message before its frames are decoded
+  constructor(onMessage, onStatus, onBatch = null) {
     this.onMessage = onMessage;
+    this.onBatch = onBatch;
     this.onStatus = onStatus;
     this.bytes = 0;
     this.ws = null;
@@ -49,6 +51,7 @@ export class Link {
         this.onMessage(JSON.parse(ev.data));
       } else {
         this.bytes += ev.data.byteLength;
+        if (this.onBatch) this.onBatch(ev.data);
         decodeBatch(ev.data, this.onMessage);
       }
     };
