@@ -1,10 +1,11 @@
 """Where a viewer page's CPU goes: one drive of ``navlab bench view``'s scenario watched by headless chromium.
 
-Prints the drive's real-time factor and the page's frames per s, chromium's CPU per process (browser, renderer,
-gpu-process, utility) and per thread of the renderer and gpu processes (cores: CPU s per wall-clock s of the
-drive), the page's CDP ``Performance`` metrics (main thread only) and how often the scene's caches were drawn
-anew. A figure for finding what to speed up, not a benchmark: ``navlab bench view`` gives those. Run it under
-the CPU lock::
+The page is the bench's (:class:`navlab.viz.headless.HeadlessPage`: a user's browser, no automation domain
+enabled). Prints the drive's real-time factor and the page's frames per s, chromium's CPU per process (browser,
+renderer, gpu-process, utility) and per thread of the renderer and gpu processes (cores: CPU s per wall-clock s
+of the drive), with ``--cdp`` the page's ``Performance`` metrics (main thread only), and how often the scene's
+caches were drawn anew. A figure for finding what to speed up, not a benchmark (``navlab bench view`` gives
+those). Run it under the CPU lock::
 
     PYTHONPATH=$PWD/src python tools/viz_profile.py --sim 100
     PYTHONPATH=$PWD/src python tools/viz_profile.py --setup "() => { navlab.settings.maxFps = 0.5; }"
@@ -70,35 +71,33 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--sim", type=float, default=100.0, help="simulated s to drive (default 100)")
     ap.add_argument("--setup", default="", help="JavaScript run in the page before the drive")
+    ap.add_argument("--cdp", action="store_true", help="also the page's CDP Performance metrics (main thread)")
     args = ap.parse_args()
-    from playwright.sync_api import sync_playwright
-
     from navlab.experiments.session import start_run
     from navlab.viz import bench
     from navlab.viz.cli import _true_map
+    from navlab.viz.headless import HeadlessPage
     from navlab.viz.viewer import attach
 
     map_yaml = _true_map("room", (0.0, 0.0, 0.0), Path(tempfile.mkdtemp(prefix="navlab-viz-profile-")))
     bench._drive(map_yaml, seed=0)  # warm-up: Numba's caches, imports
-    with sync_playwright() as pw:
-        browser = pw.chromium.launch(executable_path=bench.CHROMIUM, args=bench.CHROMIUM_ARGS)
-        run = start_run("navigation", world="room_obstacles", map=map_yaml, seed=0)
-        viewer = attach(run.executor, port=0, speed=0.0)
-        page = browser.new_page(viewport={"width": 1280, "height": 800})
-        page.goto(viewer.url)
-        page.wait_for_function("() => window.navlab && navlab.store.state", timeout=30000)
-        cdp = page.context.new_cdp_session(page)
-        cdp.send("Performance.enable")
+    run = start_run("navigation", world="room_obstacles", map=map_yaml, seed=0)
+    viewer = attach(run.executor, port=0, speed=0.0)
+    page = HeadlessPage(viewer.url, width=1280, height=800)
+    try:
+        page.wait_for("window.navlab && navlab.store.state")
         run.run(1.0)
-        page.wait_for_function("() => navlab.view.fitted", timeout=30000)
+        page.wait_for("navlab.view.fitted")
         if args.setup:
             page.evaluate(args.setup)
+        if args.cdp:
+            page.call("Performance.enable")
         mb, gz = run.node("move_base"), run.node("gazebo")
         goals = list(bench.GOALS)
         handle: Any = mb.send_goal(*goals.pop(0))  # type: ignore[attr-defined]
 
         def metrics() -> dict[str, float]:
-            return {m["name"]: m["value"] for m in cdp.send("Performance.getMetrics")["metrics"]}
+            return {m["name"]: m["value"] for m in page.call("Performance.getMetrics")["metrics"]} if args.cdp else {}
 
         m0, p0, f0 = metrics(), chromium_processes(), page.evaluate("navlab.stats.frames")
         th0 = {pid: threads(pid) for pid, (kind, _) in p0.items() if kind in ("renderer", "gpu-process")}
@@ -114,8 +113,10 @@ def main() -> None:
                 handle = mb.send_goal(*goals.pop(0))  # type: ignore[attr-defined]
         wall, cpu = time.perf_counter() - t0, time.process_time() - c0
         m1, p1, f1 = metrics(), chromium_processes(), page.evaluate("navlab.stats.frames")
-        print(f"drive: {args.sim:.0f} simulated s in {wall:.2f} s wall (RTF {args.sim / wall:.1f}), navlab "
-              f"{cpu / wall:.2f} cores, page {(f1 - f0) / wall:.1f} frames/s, {viewer.hub.bytes_sent / wall:.0f} B/s")
+        print(
+            f"drive: {args.sim:.0f} simulated s in {wall:.2f} s wall (RTF {args.sim / wall:.1f}), navlab "
+            f"{cpu / wall:.2f} cores, page {(f1 - f0) / wall:.1f} frames/s, {viewer.hub.bytes_sent / wall:.0f} B/s"
+        )
         total = 0.0
         for pid, (kind, cpu1) in sorted(p1.items(), key=lambda kv: kv[1][0]):
             used = (cpu1 - p0.get(pid, (kind, 0.0))[1]) / wall
@@ -130,10 +131,10 @@ def main() -> None:
             if key.endswith("Duration"):
                 print(f"  cdp {key:26s} {(m1[key] - m0.get(key, 0.0)) / wall:.4f} s/s (main thread)")
         print("  caches drawn anew:", page.evaluate("navlab.renders()"), f"in {f1 - f0} frames")
+    finally:
         page.close()
         viewer.close()
         run.executor.stop()
-        browser.close()
 
 
 if __name__ == "__main__":

@@ -45,7 +45,10 @@ function makeRenderer() {
     worker.postMessage({ canvas: off, set: { view: viewNow(), maxFps } }, [off]);
     return {
       worker: true,
-      batch: (buf) => worker.postMessage({ batch: buf }), // a copy: this thread keeps its own views of it
+      // the message is moved to the worker, not copied (a copy costs this thread ~1 ms a message): what this
+      // thread keeps of it (a scan's ranges, a path's points) was copied out of it when decoded
+      batch: (buf) => worker.postMessage({ batch: buf }, [buf]),
+      keep: (m) => { if (m.data) m.data = m.data.slice(); },
       frame: () => {},
       set: (o) => worker.postMessage({ set: o }),
       pixel: (x, y) => ask("pixel", { x, y }),
@@ -54,7 +57,7 @@ function makeRenderer() {
   }
   const scene = new Scene(canvas, countFrames);
   scene.set({ view: viewNow(), maxFps });
-  return { worker: false, batch: () => {}, frame: (m) => scene.receive(m), set: (o) => scene.set(o),
+  return { worker: false, batch: () => {}, keep: () => {}, frame: (m) => scene.receive(m), set: (o) => scene.set(o),
     pixel: async (x, y) => scene.pixel(x, y), renders: async () => scene.renders() };
 }
 
@@ -70,6 +73,7 @@ function display(name, dflt) {
 }
 
 function onMessage(m) {
+  renderer.keep(m);
   switch (m.k) {
     case "state":
       if (!store.state) for (const [name, on] of FIXED_DISPLAYS) display(name, on);

@@ -28,7 +28,7 @@ export function decodeBatch(buf, onFrame) {
 }
 
 export class Link {
-  // onBatch(buffer), if given, gets each binary message before its frames are decoded
+  // onBatch(buffer), if given, gets each binary message after its frames were handed to onMessage
   constructor(onMessage, onStatus, onBatch = null) {
     this.onMessage = onMessage;
     this.onBatch = onBatch;
@@ -51,8 +51,8 @@ export class Link {
         this.onMessage(JSON.parse(ev.data));
       } else {
         this.bytes += ev.data.byteLength;
-        if (this.onBatch) this.onBatch(ev.data);
         decodeBatch(ev.data, this.onMessage);
+        if (this.onBatch) this.onBatch(ev.data);
       }
     };
   }
