@@ -29,9 +29,12 @@ CHROMIUM_ARGS = ["--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-
 
 
 class HeadlessPage:
-    """``url`` in a new headless chromium, a ``width`` × ``height`` CSS px viewport; :meth:`close` ends it."""
+    """A new headless chromium showing ``url``, a ``width`` × ``height`` CSS px viewport; :meth:`goto` shows another
+    address in the same tab, :meth:`close` ends the browser."""
 
-    def __init__(self, url: str, *, width: int = 1280, height: int = 800, executable: str = CHROMIUM) -> None:
+    def __init__(
+        self, url: str = "about:blank", *, width: int = 1280, height: int = 800, executable: str = CHROMIUM
+    ) -> None:
         self.dir = Path(tempfile.mkdtemp(prefix="navlab-chromium-"))
         cmd = [executable, "--headless", "--remote-debugging-port=0", f"--user-data-dir={self.dir}",
                f"--window-size={width},{height}", *CHROMIUM_ARGS, "about:blank"]  # fmt: skip
@@ -50,10 +53,14 @@ class HeadlessPage:
             # the page's viewport exactly (the window also holds the browser's own bar), as Playwright sets it
             metrics = {"width": width, "height": height, "deviceScaleFactor": 1, "mobile": False}
             self.call("Emulation.setDeviceMetricsOverride", **metrics)
-            self.call("Page.navigate", url=url)
+            self.goto(url)
         except BaseException:
             self.close()
             raise
+
+    def goto(self, url: str) -> None:
+        """Show ``url`` (returns once the navigation started; see :meth:`wait_for`)."""
+        self.call("Page.navigate", url=url)
 
     def _port(self, deadline: float) -> int:
         """The DevTools port chromium wrote into its profile folder once it listens."""
