@@ -71,6 +71,7 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--sim", type=float, default=100.0, help="simulated s to drive (default 100)")
     ap.add_argument("--setup", default="", help="JavaScript run in the page before the drive")
+    ap.add_argument("--speed", type=float, default=0.0, help="the viewer's pace (0: as fast as possible, 1: real time)")
     ap.add_argument("--cdp", action="store_true", help="also the page's CDP Performance metrics (main thread)")
     args = ap.parse_args()
     from navlab.experiments.session import start_run
@@ -82,7 +83,7 @@ def main() -> None:
     map_yaml = _true_map("room", (0.0, 0.0, 0.0), Path(tempfile.mkdtemp(prefix="navlab-viz-profile-")))
     bench._drive(map_yaml, seed=0)  # warm-up: Numba's caches, imports
     run = start_run("navigation", world="room_obstacles", map=map_yaml, seed=0)
-    viewer = attach(run.executor, port=0, speed=0.0)
+    viewer = attach(run.executor, port=0, speed=args.speed)
     page = HeadlessPage(viewer.url, width=1280, height=800)
     try:
         page.wait_for("window.navlab && navlab.store.state")
@@ -130,7 +131,7 @@ def main() -> None:
         for key in sorted(m1):
             if key.endswith("Duration"):
                 print(f"  cdp {key:26s} {(m1[key] - m0.get(key, 0.0)) / wall:.4f} s/s (main thread)")
-        print("  caches drawn anew:", page.evaluate("navlab.renders()"), f"in {f1 - f0} frames")
+        print("  caches drawn anew:", page.evaluate("navlab.renders ? navlab.renders() : null"), f"in {f1 - f0} frames")
     finally:
         page.close()
         viewer.close()
