@@ -10,6 +10,7 @@ second, ``navlab bench view`` through Playwright measured chromium at 0.21-0.24 
 from __future__ import annotations
 
 import base64
+import contextlib
 import json
 import shutil
 import subprocess
@@ -44,12 +45,13 @@ class HeadlessPage:
             shutil.rmtree(self.dir, ignore_errors=True)
             raise VizError(f"cannot start chromium at {executable}: {exc}") from None
         self._id = 0
+        self._ws = contextlib.ExitStack()
         try:
             port = self._port(time.monotonic() + 30.0)
             with urllib.request.urlopen(f"http://127.0.0.1:{port}/json/list", timeout=10) as resp:
                 targets = json.loads(resp.read())
             page = next(t for t in targets if t.get("type") == "page")
-            self.ws = connect(page["webSocketDebuggerUrl"], max_size=None, open_timeout=10)
+            self.ws = self._ws.enter_context(connect(page["webSocketDebuggerUrl"], max_size=None, open_timeout=10))
             # the page's viewport exactly (the window also holds the browser's own bar), as Playwright sets it
             metrics = {"width": width, "height": height, "deviceScaleFactor": 1, "mobile": False}
             self.call("Emulation.setDeviceMetricsOverride", **metrics)
@@ -108,9 +110,7 @@ class HeadlessPage:
 
     def close(self) -> None:
         """End the browser and remove its profile folder."""
-        ws = getattr(self, "ws", None)
-        if ws is not None:
-            ws.close()
+        self._ws.close()
         self.proc.terminate()
         try:
             self.proc.wait(10)
