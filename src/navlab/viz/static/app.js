@@ -116,8 +116,9 @@ function fit() {
   view.fitted = true; viewChanged();
 }
 
-// The status bar: text is written only when it changed, and the clock and RTF (new in every state) at most
-// STATUS_HZ times a second: each change of the page's text costs the browser a layout, a paint and a frame.
+// The status bar: text is written only when it changed (each change of the page's text costs the browser a
+// layout, a paint and a frame of its own). The clock and the RTF, new in every state, are drawn in the canvas's
+// corner with the scene; the replay's timeline follows at most STATUS_HZ times a second.
 const STATUS_HZ = 5;
 let statusMark = -1e9, statusTimer = 0;
 function setText(id, text, cls) {
@@ -133,18 +134,14 @@ function updateStatus(s) {
     const seek = $("seek");
     if (seek.min !== String(s.t0)) seek.min = s.t0;
     if (seek.max !== String(s.t1)) seek.max = s.t1;
-  }
-  const now = performance.now();
-  if (now - statusMark >= 1000 / STATUS_HZ) {
-    statusMark = now;
-    setText("simtime", `t = ${s.t.toFixed(1)} s`);
-    setText("rtf", s.replay ? `replay ${s.speed}x` : `RTF ${s.rtf.toFixed(2)} (${s.speed > 0 ? s.speed + "x" : "max"})`);
-    if (s.replay) {
+    const now = performance.now();
+    if (now - statusMark >= 1000 / STATUS_HZ) {
+      statusMark = now;
       if (!seekDragging) $("seek").value = s.t;
       setText("ttime", `${s.t.toFixed(2)} / ${s.t1.toFixed(2)} s`);
+    } else if (!statusTimer) {
+      statusTimer = setTimeout(() => { statusTimer = 0; updateStatus(store.state); }, statusMark + 1000 / STATUS_HZ - now);
     }
-  } else if (!statusTimer) {
-    statusTimer = setTimeout(() => { statusTimer = 0; updateStatus(store.state); }, statusMark + 1000 / STATUS_HZ - now);
   }
   setText("pause", s.paused ? "Resume" : "Pause");
   if (!s.replay && document.activeElement !== $("speed") && $("speed").value !== String(s.speed)) $("speed").value = String(s.speed);

@@ -286,6 +286,21 @@ export function drawAxes(ctx, view, T, name, labels) {
   }
 }
 
+// simulated time, the real-time factor and the pace, in the canvas's bottom-left corner
+export function drawClock(ctx, view, s) {
+  const text = `t = ${s.t.toFixed(1)} s   ` + (s.replay ? `replay ${s.speed}x` : `RTF ${s.rtf.toFixed(2)} (${s.speed > 0 ? s.speed + "x" : "max"})`);
+  const d = view.d;
+  ctx.save();
+  ctx.setTransform(d, 0, 0, d, 0, 0);
+  ctx.font = "13px system-ui, sans-serif";
+  const w = ctx.measureText(text).width;
+  ctx.fillStyle = "rgba(37, 37, 37, 0.85)";
+  ctx.fillRect(0, view.H - 22, w + 16, 22);
+  ctx.fillStyle = "#ddd";
+  ctx.fillText(text, 8, view.H - 7);
+  ctx.restore();
+}
+
 export function drawObstacle(ctx, view, o, color) {
   strokeIn(ctx, view, [o.x, o.y, o.yaw || 0], color, 2, () => {
     if (o.kind === "cylinder") ctx.arc(0, 0, o.dims[0], 0, 2 * Math.PI);

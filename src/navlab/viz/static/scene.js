@@ -153,6 +153,7 @@ export class Scene {
       const o = (s.obstacles || []).find((q) => q.name === drag.obstacle);
       if (o) R.drawObstacle(ctx, view, { ...o, x: drag.x, y: drag.y }, "#fff");
     }
+    R.drawClock(ctx, view, s);
   }
 
   // how often the caches were drawn anew (for scripts and the docs' figures)
