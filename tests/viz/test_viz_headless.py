@@ -35,6 +35,8 @@ def test_headless_page_shows_the_viewer_and_closes_cleanly(tmp_path: Path) -> No
         finally:
             page.close()
     assert page.proc.poll() is not None and not page.dir.exists()
+    with pytest.raises(ProcessLookupError):
+        os.killpg(page.proc.pid, 0)  # no chromium process of its group is left
 
 
 def test_headless_page_names_a_missing_browser() -> None:

@@ -12,7 +12,9 @@ from __future__ import annotations
 import base64
 import contextlib
 import json
+import os
 import shutil
+import signal
 import subprocess
 import tempfile
 import time
@@ -40,7 +42,9 @@ class HeadlessPage:
         cmd = [executable, "--headless", "--remote-debugging-port=0", f"--user-data-dir={self.dir}",
                f"--window-size={width},{height}", *CHROMIUM_ARGS, "about:blank"]  # fmt: skip
         try:
-            self.proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+            # its own process group: closing ends every chromium process it started, not only the first
+            out = subprocess.DEVNULL
+            self.proc = subprocess.Popen(cmd, stdout=out, stderr=out, start_new_session=True)
         except OSError as exc:
             shutil.rmtree(self.dir, ignore_errors=True)
             raise VizError(f"cannot start chromium at {executable}: {exc}") from None
@@ -111,10 +115,26 @@ class HeadlessPage:
     def close(self) -> None:
         """End the browser and remove its profile folder."""
         self._ws.close()
-        self.proc.terminate()
-        try:
-            self.proc.wait(10)
-        except subprocess.TimeoutExpired:
-            self.proc.kill()
-            self.proc.wait()
+        group = self.proc.pid  # the group's id is the id of the process that leads it
+        for sig in (signal.SIGTERM, signal.SIGKILL):
+            try:
+                os.killpg(group, sig)
+            except ProcessLookupError:
+                break
+            deadline = time.monotonic() + 10.0
+            while time.monotonic() < deadline and _group_alive(group, self.proc):
+                time.sleep(0.05)
+            if not _group_alive(group, self.proc):
+                break
+        self.proc.wait()
         shutil.rmtree(self.dir, ignore_errors=True)
+
+
+def _group_alive(group: int, leader: subprocess.Popen[bytes]) -> bool:
+    """Whether a process of the group is left (the leader is reaped first, so it is not counted as a zombie)."""
+    leader.poll()
+    try:
+        os.killpg(group, 0)
+    except ProcessLookupError:
+        return False
+    return True
