@@ -11,6 +11,7 @@ import pytest
 from navlab import msgs
 from navlab.grid import GridMap
 from navlab.viz import frames as fr
+from navlab.viz.hub import ClientStream, Hub
 from navlab.viz.inputs import check_input
 from navlab.viz.live import INITIALPOSE_COV
 
@@ -74,6 +75,29 @@ def test_scan_frame_carries_float32_ranges_and_angles() -> None:
     assert header["frame"] == "laser" and header["n"] == 3 and header["a0"] == pytest.approx(-1.5)
     ranges = np.frombuffer(payload, dtype=np.float32)
     assert ranges[0] == 1.0 and math.isinf(ranges[1]) and ranges[2] == 2.5
+
+
+def test_a_page_gets_the_newest_placed_scan_while_a_newer_one_waits_for_its_pose() -> None:
+    """Faster than real time a new scan replaces the slot between two snapshots: pages still get scans."""
+    hub = Hub()
+
+    def scan(t_ns: int, r: float) -> object:
+        return msgs.LaserScan(header=msgs.header(t_ns, "laser"), angle_min=0.0, angle_max=0.0, angle_increment=0.01,
+                              time_increment=0.0, scan_time=0.0, range_min=0.1, range_max=10.0,
+                              ranges=np.array([r], dtype=np.float32), intensities=np.zeros(0, np.float32))  # fmt: skip
+
+    hub.put("/scan", "scan", scan(1_000_000, 1.0))
+    hub.place_scans("map", lambda frame, t_ns: [t_ns / 1e9, 0.0, 0.0])
+    hub.put("/scan", "scan", scan(2_000_000, 2.0))  # not placed yet
+    stream = ClientStream(hub)
+    sent = [fr.unpack(f) for f in stream.frames(now=1.0) if isinstance(f, bytes)]
+    assert len(sent) == 1
+    header, payload = sent[0]
+    assert header["pose"] == [0.001, 0.0, 0.0] and np.frombuffer(payload, np.float32)[0] == 1.0
+    assert stream.frames(now=2.0) == []  # the same placed scan is not sent twice
+    hub.place_scans("map", lambda frame, t_ns: [t_ns / 1e9, 0.0, 0.0])
+    ((header, payload),) = (fr.unpack(f) for f in stream.frames(now=3.0) if isinstance(f, bytes))
+    assert header["pose"] == [0.002, 0.0, 0.0] and np.frombuffer(payload, np.float32)[0] == 2.0
 
 
 def test_pose_array_yaw_from_quaternions() -> None:

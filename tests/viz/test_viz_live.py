@@ -77,6 +77,23 @@ def test_page_draws_map_costmaps_and_robot(live: tuple[Run, Viewer], page: Any, 
     wall = pixel(page, *canvas_xy(page, wx, wy))
     assert wall[0] > 140 and wall[2] > 140 and wall[1] < 60, wall
     page.check("input[data-layer='/particlecloud']")
+    assert page.evaluate("navlab.worker")  # chromium draws in a worker, on the canvas handed over
+
+
+def test_page_draws_on_its_own_thread_without_a_worker(live: tuple[Run, Viewer], chromium: Any) -> None:
+    """``?worker=0`` (and browsers that cannot hand a canvas to a worker) draw the same scene on the page's thread."""
+    run, viewer = live
+    p = open_page(chromium, viewer.url + "?worker=0")
+    try:
+        p.wait_for_function("() => navlab.view.fitted && navlab.stats.frames > 10", timeout=15000)
+        assert not p.evaluate("navlab.worker")
+        x, y, _ = _true_pose(run)
+        sx, sy = canvas_xy(p, x, y)
+        ring = [pixel(p, sx + dx, sy + dy) for dx, dy in [(12, 0), (-12, 0), (0, 12), (0, -12), (8, 8), (-8, -8)]]
+        assert any(r > 200 and g > 200 and b < 80 for r, g, b, _a in ring), ring
+        assert not p.js_errors, p.js_errors
+    finally:
+        p.close()
 
 
 def _wall_cell(msg: Any) -> tuple[float, float]:

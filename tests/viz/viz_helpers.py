@@ -20,11 +20,8 @@ def open_page(browser: Any, url: str) -> Any:
 
 
 def pixel(page: Any, x: float, y: float) -> tuple[int, int, int, int]:
-    """RGBA of the canvas at CSS pixel (x, y) of the canvas."""
-    return tuple(page.evaluate("""([x, y]) => {
-        const c = document.getElementById('view'), d = devicePixelRatio;
-        return Array.from(c.getContext('2d').getImageData(Math.round(x * d), Math.round(y * d), 1, 1).data);
-    }""", [x, y]))  # fmt: skip
+    """RGBA of the canvas at CSS pixel (x, y) of the canvas (read where the canvas is drawn: the page's worker)."""
+    return tuple(page.evaluate("([x, y]) => window.navlab.pixel(x, y)", [x, y]))
 
 
 def to_screen(page: Any, x: float, y: float) -> tuple[float, float]:

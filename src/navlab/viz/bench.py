@@ -2,7 +2,8 @@
 
 The paper's obstacle experiment (room mapped empty, navigation in room_obstacles, a cylinder dropped in at
 20 s, goals there and back) runs as fast as possible for the same simulated time twice without a viewer
-and twice with the viewer and a page connected (Debian's chromium through Playwright, a dev dependency).
+and twice with the viewer and a page connected (Debian's headless chromium, driven as a user's browser: see
+:mod:`navlab.viz.headless`).
 Drives alternate (without, with, with, without, ...: a shared machine's load drifts) ``ROUNDS`` times each.
 Figures: ``fps`` (frames the page drew per wall-clock s), ``bytes_per_s`` (what the server sent per s),
 ``sim_slowdown`` (1 - real-time factor with the page / without, the median of each), ``python_cpu_overhead``
@@ -23,38 +24,48 @@ from pathlib import Path
 from typing import Any
 
 from navlab.viz.errors import VizError
+from navlab.viz.headless import CHROMIUM, HeadlessPage
 
 GOALS = [(4.3, 1.0, 0.0), (-3.5, -0.5, 3.14), (1.5, -2.5, 0.0)]
 SIM_S = 40.0  # simulated s measured per drive
 ROUNDS = 3  # drives with and without the page each
-CHROMIUM = "/usr/bin/chromium"
-CHROMIUM_ARGS = ["--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run", "--disable-background-networking",
-                 "--disable-component-update", "--disable-sync"]  # fmt: skip
 
 
 def _drive(
-    map_yaml: str, *, seed: int, browser: Any = None, shot: Path | None = None, setup: str = ""
+    map_yaml: str, *, seed: int, page: HeadlessPage | None = None, shot: Path | None = None, setup: str = ""
 ) -> dict[str, float]:
-    """One drive of SIM_S simulated s; with ``browser``, watched by a page (``setup``: JavaScript run in it once
-    it drew the map, e.g. ``navlab.settings.maxFps = 20``). Wall time excludes the screenshot."""
+    """One drive of SIM_S simulated s; with ``page``, watched by it (the browser's tab opens the viewer, and a
+    blank page after the drive; ``setup``: JavaScript run in it once it drew the map, e.g.
+    ``navlab.settings.maxFps = 20``). Wall time excludes the screenshot."""
     from navlab.experiments.session import start_run
     from navlab.viz.viewer import attach
 
     run = start_run("navigation", world="room_obstacles", map=map_yaml, seed=seed)
-    viewer = page = None
-    if browser is not None:
-        viewer = attach(run.executor, port=0, speed=0.0)
-        page = browser.new_page(viewport={"width": 1280, "height": 800})
-        page.goto(viewer.url)
-        page.wait_for_function("() => window.navlab && navlab.store.state", timeout=30000)
+    viewer = None
+    try:
+        if page is not None:
+            viewer = attach(run.executor, port=0, speed=0.0)
+            page.goto(viewer.url)
+            page.wait_for("window.navlab && navlab.store.state")
+        run.run(1.0)
+        if page is not None:
+            page.wait_for("navlab.view.fitted")
+            if setup:
+                page.evaluate(setup)
+        return _measure(run, viewer, page, shot)
+    finally:
+        if page is not None:
+            page.goto("about:blank")
+        if viewer is not None:
+            viewer.close()
+        run.executor.stop()
+
+
+def _measure(run: Any, viewer: Any, page: HeadlessPage | None, shot: Path | None) -> dict[str, float]:
+    """The drive itself: goals one after the other, the cylinder dropped in at 20 s, in chunks of 5 simulated s."""
     mb, gz = run.node("move_base"), run.node("gazebo")
-    run.run(1.0)
-    if page is not None:
-        page.wait_for_function("() => navlab.view.fitted", timeout=30000)
-        if setup:
-            page.evaluate(setup)
     goals = list(GOALS)
-    handle = mb.send_goal(*goals.pop(0))  # type: ignore[attr-defined]
+    handle = mb.send_goal(*goals.pop(0))
     wall = cpu = frames = sent = browser_cpu = 0.0
     spawned = False
     t_end = run.executor.now_ns / 1e9 + SIM_S
@@ -72,17 +83,13 @@ def _drive(
             frames += page.evaluate("navlab.stats.frames") - before
             sent += viewer.hub.bytes_sent - bytes0
         if not spawned and run.executor.now_ns >= 20e9:
-            gz.spawn_primitive("cylinder", "late", (0.15, 0.6), x=-1.0, y=-0.45)  # type: ignore[attr-defined]
+            gz.spawn_primitive("cylinder", "late", (0.15, 0.6), x=-1.0, y=-0.45)
             spawned = True
         if page is not None and shot is not None and run.executor.now_ns >= 25e9 and not shot.exists():
-            page.wait_for_timeout(300)
-            page.screenshot(path=str(shot))
+            time.sleep(0.3)
+            page.screenshot(shot)
         if handle.done() and goals:
-            handle = mb.send_goal(*goals.pop(0))  # type: ignore[attr-defined]
-    if viewer is not None and page is not None:
-        page.close()
-        viewer.close()
-    run.executor.stop()
+            handle = mb.send_goal(*goals.pop(0))
     return {"wall_s": wall, "cpu_s": cpu, "sim_s": SIM_S, "frames": frames, "bytes": sent, "browser_cpu_s": browser_cpu}
 
 
@@ -123,13 +130,10 @@ def _load() -> float | None:
 
 def run(args: Any) -> dict[str, Any]:
     """Run the benchmark; see the module docstring."""
-    try:
-        from playwright.sync_api import sync_playwright
-    except ImportError:
-        raise VizError("navlab bench view needs playwright (a dev dependency: pip install playwright) and "
-                       f"chromium at {CHROMIUM}") from None  # fmt: skip
     from navlab.viz.cli import _true_map
 
+    if not Path(CHROMIUM).exists():
+        raise VizError(f"navlab bench view needs chromium at {CHROMIUM}")
     seed = int(getattr(args, "seed", 0))
     folder = Path(tempfile.mkdtemp(prefix="navlab-bench-view-"))
     map_yaml = _true_map("room", (0.0, 0.0, 0.0), folder)
@@ -139,17 +143,16 @@ def run(args: Any) -> dict[str, Any]:
     base: list[dict[str, float]] = []
     seen: list[dict[str, float]] = []
     load0 = _load()
-    with sync_playwright() as pw:
-        browser = pw.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
-        try:
-            for k in range(rounds):
-                if k % 2 == 0:
-                    base.append(_drive(map_yaml, seed=seed))
-                seen.append(_drive(map_yaml, seed=seed, browser=browser, shot=shot if k == 0 else None))
-                if k % 2 == 1:
-                    base.append(_drive(map_yaml, seed=seed))
-        finally:
-            browser.close()
+    page = HeadlessPage(width=1280, height=800)  # one browser, as a user's: its start-up is not measured
+    try:
+        for k in range(rounds):
+            if k % 2 == 0:
+                base.append(_drive(map_yaml, seed=seed))
+            seen.append(_drive(map_yaml, seed=seed, page=page, shot=shot if k == 0 else None))
+            if k % 2 == 1:
+                base.append(_drive(map_yaml, seed=seed))
+    finally:
+        page.close()
 
     def med(rows: list[dict[str, float]], key: str) -> float:
         return statistics.median(r[key] for r in rows)

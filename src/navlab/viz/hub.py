@@ -64,6 +64,7 @@ class Hub:
     def __init__(self) -> None:
         self.lock = threading.Lock()
         self.slots: dict[str, Slot] = {}
+        self.placed: dict[str, Slot] = {}  # topic -> the newest scan given its sensor pose (what pages are sent)
         self.traces: dict[str, Trace] = {}
         self.state: dict[str, Any] = {}
         self.state_seq = 0
@@ -82,12 +83,15 @@ class Hub:
 
     def place_scans(self, fixed: str, lookup: Callable[[str, int], list[float] | None]) -> None:
         """Give each new scan its sensor's pose in ``fixed`` at its stamp: ``lookup(frame, t_ns)`` (producer
-        thread). A scan is drawn where the robot was when it was taken, not where it is when drawn."""
-        for slot in list(self.slots.values()):
+        thread). A scan is drawn where the robot was when it was taken, not where it is when drawn. Pages are sent
+        the newest placed scan: faster than real time, a newer unplaced scan is almost always waiting."""
+        for topic, slot in list(self.slots.items()):
             if slot.kind == "scan" and slot.pose is None:
                 msg = slot.msg
                 stamp = int(msg.header.stamp.sec) * 1_000_000_000 + int(msg.header.stamp.nanosec)
                 slot.pose, slot.fixed = lookup(str(msg.header.frame_id).lstrip("/"), stamp), fixed
+                if slot.pose is not None:
+                    self.placed[topic] = slot
 
     def trace(self, name: str, frame: str, x: float, y: float) -> None:
         """Extend a trace (producer thread)."""
@@ -150,12 +154,13 @@ class ClientStream:
         out_state = self._state(now)
         if out_state is not None:
             out.append(out_state)
-        for topic, slot in list(hub.slots.items()):
+        for topic, newest in list(hub.slots.items()):
+            slot = hub.placed.get(topic) if newest.kind == "scan" else newest
+            if slot is None:
+                continue  # no scan placed yet: the next snapshot places one
             kind = _rate_kind(topic, slot.kind)
             if self._sent.get(topic) == slot.seq or not self._due(topic, kind, now):
                 continue
-            if slot.kind == "scan" and slot.pose is None:
-                continue  # not placed yet: the next snapshot places it
             frame = self._convert(topic, slot)
             self._sent[topic] = slot.seq
             self._last[topic] = now

@@ -28,8 +28,10 @@ export function decodeBatch(buf, onFrame) {
 }
 
 export class Link {
-  constructor(onMessage, onStatus) {
+  // onBatch(buffer), if given, gets each binary message after its frames were handed to onMessage
+  constructor(onMessage, onStatus, onBatch = null) {
     this.onMessage = onMessage;
+    this.onBatch = onBatch;
     this.onStatus = onStatus;
     this.bytes = 0;
     this.ws = null;
@@ -50,6 +52,7 @@ export class Link {
       } else {
         this.bytes += ev.data.byteLength;
         decodeBatch(ev.data, this.onMessage);
+        if (this.onBatch) this.onBatch(ev.data);
       }
     };
   }

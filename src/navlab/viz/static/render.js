@@ -1,6 +1,14 @@
 // Drawing: rviz's map and costmap palettes, grids as offscreen canvases, scans, paths, poses, robot, tf.
 // Everything is drawn in the fixed frame: a layer in frame F is placed with F's pose from tf (state.tf[F]).
 
+// a canvas that is not shown: an OffscreenCanvas where there is one (the only kind a worker has)
+export function makeCanvas(w, h) {
+  if (typeof OffscreenCanvas === "function") return new OffscreenCanvas(w, h);
+  const c = document.createElement("canvas");
+  c.width = w; c.height = h;
+  return c;
+}
+
 function rgba(r, g, b, a) { return (a << 24) | (b << 16) | (g << 8) | r; } // little-endian ImageData word
 
 // rviz's "map" palette: 0..100 from white to black, -1 (255) a grey-green, anything else flagged
@@ -34,8 +42,7 @@ export class GridLayer {
     const same = this.geo && this.geo.w === f.w && this.geo.h === f.h;
     if (f.k === "grid" || !same) {
       if (f.k === "tiles" && !same) return; // tiles for a grid we never saw whole: wait for a whole one
-      this.canvas = document.createElement("canvas");
-      this.canvas.width = f.w; this.canvas.height = f.h;
+      this.canvas = makeCanvas(f.w, f.h);
       this.geo = f;
       this.paint(0, 0, f.w, f.h, f.cells);
       return;
@@ -77,6 +84,117 @@ export class GridLayer {
   }
 }
 
+// A grid in a moving frame (the local costmap in odom, placed by tf) is rendered at the screen's scale and
+// rotation into its own canvas only when its cells, the view or its placement changed, and each frame copies
+// it at a whole-pixel offset (a plain copy is ~10 times cheaper than a rotated, scaled image). The placement
+// counts as unchanged while the cached copy stays within SUBPIXEL device px of where the grid belongs.
+const SUBPIXEL = 0.5;
+export class MovingGrid {
+  constructor() { this.canvas = makeCanvas(1, 1); this.key = null; this.renders = 0; }
+
+  draw(ctx, view, layer, tf, alpha) {
+    const g = layer.geo;
+    const T = g && layer.canvas && tf[g.frame];
+    if (!T) return;
+    const P = compose(T, [g.ox, g.oy, g.oyaw]);
+    const d = view.d, k = view.scale * d;
+    const [sx0, sy0] = view.toScreen(P[0], P[1]);
+    const sx = sx0 * d, sy = sy0 * d, ext = Math.hypot(g.w, g.h) * g.res * k;
+    const c = this.key;
+    let dx = 0, dy = 0, stale = !c || c.layer !== layer || c.version !== layer.version || c.k !== k;
+    if (!stale) {
+      dx = Math.round(sx - c.sx); dy = Math.round(sy - c.sy);
+      stale = Math.abs(sx - c.sx - dx) > SUBPIXEL || Math.abs(sy - c.sy - dy) > SUBPIXEL
+        || Math.abs(P[2] - c.yaw) * ext > SUBPIXEL || (c.clipped && (dx !== 0 || dy !== 0)); // a cut copy cannot move
+    }
+    if (stale) {
+      this.render(layer, P, sx, sy, k, ctx.canvas.width, ctx.canvas.height);
+      dx = dy = 0;
+    }
+    ctx.save();
+    ctx.setTransform(1, 0, 0, 1, 0, 0);
+    ctx.globalAlpha = alpha;
+    ctx.drawImage(this.canvas, this.key.x0 + dx, this.key.y0 + dy);
+    ctx.restore();
+  }
+
+  // the grid's bounding box on screen, cut to the view (a zoomed-in map would need a huge canvas)
+  render(layer, P, sx, sy, k, viewW, viewH) {
+    const g = layer.geo, W = g.w * g.res, H = g.h * g.res;
+    const a = k * Math.cos(P[2]), b = -k * Math.sin(P[2]); // metres in the grid's frame -> device px (y down)
+    const xs = [0, a * W, b * H, a * W + b * H], ys = [0, b * W, -a * H, b * W - a * H];
+    const bx0 = Math.floor(sx + Math.min(...xs)) - 1, by0 = Math.floor(sy + Math.min(...ys)) - 1;
+    const bx1 = Math.ceil(sx + Math.max(...xs)) + 1, by1 = Math.ceil(sy + Math.max(...ys)) + 1;
+    const x0 = Math.max(bx0, 0), y0 = Math.max(by0, 0);
+    const w = Math.max(1, Math.min(bx1, viewW) - x0), h = Math.max(1, Math.min(by1, viewH) - y0);
+    const clipped = x0 !== bx0 || y0 !== by0 || bx1 > viewW || by1 > viewH;
+    const cv = this.canvas;
+    if (cv.width !== w || cv.height !== h) { cv.width = w; cv.height = h; }
+    const c = cv.getContext("2d");
+    c.setTransform(1, 0, 0, 1, 0, 0);
+    c.clearRect(0, 0, w, h);
+    c.setTransform(a, b, b, -a, sx - x0, sy - y0);
+    c.transform(g.res, 0, 0, -g.res, 0, g.h * g.res);
+    c.imageSmoothingEnabled = false;
+    c.drawImage(layer.canvas, 0, 0);
+    this.key = { layer, version: layer.version, k, sx, sy, yaw: P[2], x0, y0, clipped };
+    this.renders++;
+  }
+}
+
+// A trace (odometry, ground truth) only grows: it is stroked into a transparent canvas of the view's size, its
+// new segments only, and each frame copies the part of that canvas it covers (a copy is several times cheaper
+// than stroking hundreds of segments). It is stroked anew when the view changed, the trace was replaced (a
+// replay's seek, the oldest points dropped) or its frame's pose in the fixed frame (localization corrects
+// odom's) moved it by more than SUBPIXEL device px.
+export class Trace {
+  constructor() { this.canvas = makeCanvas(1, 1); this.key = ""; this.was = null; this.box = null; this.renders = 0; }
+
+  draw(ctx, view, T, f, color) {
+    if (!T || f.n < 2) return;
+    const k = view.scale * view.d, cv = this.canvas, data = f.data, key = [ctx.canvas.width, ctx.canvas.height, view.cx, view.cy, view.scale].join();
+    const was = this.was, n = was ? was.n : 0;
+    const fresh = key !== this.key || !was || f.n < n || data[0] !== was.first[0] || data[1] !== was.first[1]
+      || data[2 * n - 2] !== was.last[0] || data[2 * n - 1] !== was.last[1]
+      || Math.hypot(T[0] - was.T[0], T[1] - was.T[1]) * k + Math.abs(T[2] - was.T[2]) * was.reach * k > SUBPIXEL;
+    const c = cv.getContext("2d");
+    if (fresh) {
+      if (cv.width !== ctx.canvas.width || cv.height !== ctx.canvas.height) { cv.width = ctx.canvas.width; cv.height = ctx.canvas.height; }
+      c.setTransform(1, 0, 0, 1, 0, 0);
+      c.clearRect(0, 0, cv.width, cv.height);
+      this.key = key; this.was = null; this.box = null; this.renders++;
+    }
+    const from = this.was ? n - 1 : 0;
+    if (from < f.n - 1) {
+      const P = this.was ? this.was.T : T, pts = data.subarray(2 * from, 2 * f.n);
+      drawPolyline(c, view, P, pts, color, 1.5);
+      let reach2 = this.was ? this.was.reach ** 2 : 0, x0 = Infinity, y0 = Infinity, x1 = -Infinity, y1 = -Infinity;
+      for (let i = 0; i < pts.length; i += 2) {
+        const x = pts[i], y = pts[i + 1];
+        if (x < x0) x0 = x; if (x > x1) x1 = x; if (y < y0) y0 = y; if (y > y1) y1 = y;
+        if (x * x + y * y > reach2) reach2 = x * x + y * y;
+      }
+      const cs = Math.cos(P[2]), sn = Math.sin(P[2]);
+      for (const [u, v] of [[x0, y0], [x1, y0], [x0, y1], [x1, y1]]) { // the new points' box, on screen
+        const [x, y] = view.toScreen(P[0] + cs * u - sn * v, P[1] + sn * u + cs * v);
+        this.grow(x * view.d, y * view.d);
+      }
+      this.was = { n: f.n, T: P, reach: Math.sqrt(reach2), first: [data[0], data[1]], last: [data[2 * f.n - 2], data[2 * f.n - 1]] };
+    }
+    const b = this.box;
+    if (!b) return;
+    const x0 = Math.max(0, Math.floor(b[0]) - 3), y0 = Math.max(0, Math.floor(b[1]) - 3);
+    const x1 = Math.min(cv.width, Math.ceil(b[2]) + 3), y1 = Math.min(cv.height, Math.ceil(b[3]) + 3);
+    if (x1 > x0 && y1 > y0) ctx.drawImage(cv, x0, y0, x1 - x0, y1 - y0, x0, y0, x1 - x0, y1 - y0);
+  }
+
+  grow(x, y) {
+    const b = this.box;
+    if (!b) this.box = [x, y, x, y];
+    else { if (x < b[0]) b[0] = x; if (y < b[1]) b[1] = y; if (x > b[2]) b[2] = x; if (y > b[3]) b[3] = y; }
+  }
+}
+
 export function place(ctx, [x, y, yaw]) {
   const c = Math.cos(yaw), s = Math.sin(yaw);
   ctx.transform(c, s, -s, c, x, y);
@@ -108,7 +226,7 @@ export function drawPolyline(ctx, view, T, data, color, px, closed = false) {
 // pixel-aligned rectangles rasterizes several times faster than the same squares in the scan's frame.
 export function drawScan(ctx, view, T, f, color) {
   if (!T) return;
-  const d = devicePixelRatio, k = view.scale * d;
+  const d = view.d, k = view.scale * d;
   const size = Math.round((view.scale < 40 ? 3 : 4) * d), h = size / 2;
   const c = Math.cos(T[2]), s = Math.sin(T[2]);
   const ox = ctx.canvas.width / 2 + (T[0] - view.cx) * k - h, oy = ctx.canvas.height / 2 - (T[1] - view.cy) * k - h;
@@ -166,6 +284,21 @@ export function drawAxes(ctx, view, T, name, labels) {
     const [sx, sy] = view.toScreen(T[0], T[1]);
     ctx.fillStyle = "#ccc"; ctx.font = "10px sans-serif"; ctx.fillText(name, sx + 4, sy - 4);
   }
+}
+
+// simulated time, the real-time factor and the pace, in the canvas's bottom-left corner
+export function drawClock(ctx, view, s) {
+  const text = `t = ${s.t.toFixed(1)} s   ` + (s.replay ? `replay ${s.speed}x` : `RTF ${s.rtf.toFixed(2)} (${s.speed > 0 ? s.speed + "x" : "max"})`);
+  const d = view.d;
+  ctx.save();
+  ctx.setTransform(d, 0, 0, d, 0, 0);
+  ctx.font = "13px system-ui, sans-serif";
+  const w = ctx.measureText(text).width;
+  ctx.fillStyle = "rgba(37, 37, 37, 0.85)";
+  ctx.fillRect(0, view.H - 22, w + 16, 22);
+  ctx.fillStyle = "#ddd";
+  ctx.fillText(text, 8, view.H - 7);
+  ctx.restore();
 }
 
 export function drawObstacle(ctx, view, o, color) {
