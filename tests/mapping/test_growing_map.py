@@ -93,3 +93,30 @@ def test_slam_map_saves_cropped_to_what_was_seen(synth_world, odometry_noise, tm
     # free and occupied cells are still free and occupied, at the same place
     np.testing.assert_array_equal(saved.value_at(grid.centers(grid.free_mask())), 0)
     np.testing.assert_array_equal(saved.value_at(grid.centers(grid.occupied_mask())), 100)
+
+
+def test_resampled_maps_are_exact_copies_and_blank_outside_the_written_box(synth_world, odometry_noise, monkeypatch):
+    # copies after resampling go into dropped particles' maps and cover only the box of written cells: check that
+    # after every update a copy equals its source everywhere, and that no map holds anything outside the box
+    update = GMapping._update
+    checked = {"resampled": 0, "grown": 0}
+
+    def checking(self: GMapping, *args: object) -> None:
+        resamples, resizes = self.resamples, self.map_resizes
+        update(self, *args)
+        rows, cols = self._seen_box()
+        for part in self.particles:
+            outside = part.grid.copy()
+            outside[rows, cols] = 0.0
+            assert not outside.any()
+        if self.resamples > resamples:
+            checked["resampled"] += 1
+            checked["grown"] += self.map_resizes > resizes
+            for a in range(len(self.particles)):
+                for b in range(a):
+                    if np.array_equal(self.poses[a], self.poses[b]):  # drawn from the same particle
+                        np.testing.assert_array_equal(self.particles[a].grid, self.particles[b].grid)
+
+    monkeypatch.setattr(GMapping, "_update", checking)
+    _run(synth_world, odometry_noise, maxUrange=1.5, maxRange=30.0)
+    assert checked["resampled"] >= 3 and checked["grown"] >= 1, checked  # also copies into maps of a new size

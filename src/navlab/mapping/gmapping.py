@@ -119,6 +119,8 @@ class GMapping:
         self._best = 0  # index of the particle with the highest weight (weights change at map updates only)
         self._anchor = np.zeros(2)  # map-frame corner (m) of lattice cell (0, 0)
         self._offset = np.zeros(2, dtype=np.int64)  # lattice (column, row) of every map array's cell (0, 0)
+        # lattice (column, row) box holding every cell any particle has written: maps are zero outside it
+        self._seen = (np.zeros(2, dtype=np.int64), np.zeros(2, dtype=np.int64))
         self.resamples = 0
         self.updates = 0
         self.map_resizes = 0
@@ -141,18 +143,38 @@ class GMapping:
         """Map-frame (x, y) (m) of the lower-left corner of the particles' maps (they share one window)."""
         return self._anchor + self._offset * self.p.delta
 
-    def _cover(self, poses: np.ndarray, r: np.ndarray, ang: np.ndarray, max_urange: float, max_range: float) -> None:
-        """Grow every particle's map (padding, cells stay put) to hold the scan integrated from ``poses``."""
+    def _seen_box(self) -> tuple[slice, slice]:
+        """The maps' (row, column) slices holding every cell written so far (zero outside)."""
+        (c0, r0), (c1, r1) = (self._seen[0] - self._offset).tolist(), (self._seen[1] - self._offset + 1).tolist()
+        return slice(r0, r1), slice(c0, c1)
+
+    def _cover(
+        self, poses: np.ndarray, r: np.ndarray, ang: np.ndarray, max_urange: float, max_range: float,
+        copy_of: list[int], spare: list[np.ndarray],
+    ) -> None:
+        """Grow every particle's map (padding, cells stay put) to hold the scan integrated from ``poses``; a
+        particle n with ``copy_of[n] != n`` is skipped: its map is about to be replaced by a copy. Growing
+        empties ``spare`` (maps of the old size, no use any more) first."""
         lo, hi = scan_cells(
             poses, r, ang, (float(self._anchor[0]), float(self._anchor[1])), self.p.delta,
             max_urange=max_urange, max_range=max_range,
         )  # fmt: skip
+        rows, cols = self._seen_box()
+        self._seen = (np.minimum(self._seen[0], lo), np.maximum(self._seen[1], hi))
         add = grow_window(self._offset, self.particles[0].grid.shape, lo, hi, margin=MAP_MARGIN_CELLS)
         if add is None:
             return
         left, right, bottom, top = add
-        for part in self.particles:
-            part.grid = np.pad(part.grid, ((bottom, top), (left, right)))
+        spare.clear()
+        for n, part in enumerate(self.particles):
+            if copy_of[n] == n:
+                # zeros, then the cells written so far (np.pad writes every cell): untouched pages stay so
+                h, w = part.grid.shape
+                grown = np.zeros((h + bottom + top, w + left + right), dtype=part.grid.dtype)
+                grown[rows.start + bottom : rows.stop + bottom, cols.start + left : cols.stop + left] = part.grid[
+                    rows, cols
+                ]
+                part.grid = grown
         self._offset = self._offset - np.array([left, bottom])
         self.map_resizes += 1
 
@@ -237,6 +259,7 @@ class GMapping:
             max_urange=max_urange, max_range=max_range,
         )  # fmt: skip
         self._offset = cells_lo - MAP_MARGIN_CELLS
+        self._seen = (cells_lo, cells_hi)
         w, h = (cells_hi - cells_lo + 1 + 2 * MAP_MARGIN_CELLS).tolist()
         grid = np.zeros((h, w), dtype=np.float32)
         self._integrate(grid, odom, r, ang, max_urange, max_range)
@@ -290,6 +313,7 @@ class GMapping:
         w /= w.sum()
         neff = 1.0 / float(np.sum(w**2))
         copy_of = list(range(len(self.particles)))  # particle n's map is particle copy_of[n]'s (resampling)
+        spare: list[np.ndarray] = []  # maps of particles resampling dropped: reused for the copies
         if neff < p.resampleThreshold * len(w):
             self.resamples += 1
             # systematic resampling
@@ -303,14 +327,22 @@ class GMapping:
                 # (same map, same pose: the same result), then takes a copy of it
                 copy_of[n] = first.setdefault(int(i), n)
                 new.append(_Particle(src.grid, src.node, 0.0))
+            drawn = {int(i) for i in idx}
+            spare = [q.grid for i, q in enumerate(self.particles) if i not in drawn]
             self.particles = new
             self.poses = self.poses[idx]  # a copy
         # grow the maps (rarely: by at least half their size) to hold this scan from every particle
-        self._cover(self.poses, r, ang, max_urange, max_range)
+        self._cover(self.poses, r, ang, max_urange, max_range, copy_of, spare)
+        box = self._seen_box()
         for n, part in enumerate(self.particles):
             part.node = (k, self.poses[n].copy(), part.node)
             if copy_of[n] != n:
-                part.grid = self.particles[copy_of[n]].grid.copy()
+                # into a dropped particle's map where one of this size is left (a large map's fresh allocation
+                # costs more, in page faults, than the copy), else into np.zeros (not zeros_like, which writes
+                # every cell): pages outside the box of written cells stay untouched
+                of = self.particles[copy_of[n]].grid
+                part.grid = spare.pop() if spare and spare[-1].shape == of.shape else np.zeros(of.shape, of.dtype)
+                part.grid[box] = of[box]  # outside the box both are zero
             else:
                 self._integrate(part.grid, self.poses[n], r, ang, max_urange, max_range)
         weights = [q.weight for q in self.particles]
