@@ -438,15 +438,17 @@ class TrajectoryPlannerROS(RolloutController):
         vxs = np.linspace(vmin, vmax, p.vx_samples) if p.vx_samples > 1 else np.array([vmin])
         ws = np.linspace(wmin, wmax, p.vtheta_samples) if p.vtheta_samples > 1 else np.array([wmin])
         dw = (wmax - wmin) / (p.vtheta_samples - 1) if p.vtheta_samples > 1 else 0.0
-        fwd_w = np.concatenate([[0.0], ws[:-1]]) if len(ws) > 1 else np.array([0.0])
-        forward = np.stack([np.repeat(vxs, len(fwd_w)), np.tile(fwd_w, len(vxs))], axis=1)
         spin = np.where(ws > 0, np.maximum(ws, p.min_in_place_vel_theta), np.minimum(ws, -p.min_in_place_vel_theta))
-        in_place = np.stack([np.zeros_like(spin), spin], axis=1)
-        targets = np.vstack([forward, in_place, [[p.escape_vel, 0.0]]])
+        # rows: forward (each speed: w 0, then ws[:-1]), in place (0, spin), escape (escape_vel, 0); one array
+        nw, nf, ni = len(ws), len(vxs) * len(ws), len(ws)
+        targets = np.zeros((nf + ni + 1, 2))
+        targets[:nf, 0] = np.repeat(vxs, nw)
+        targets[:nf].reshape(len(vxs), nw, 2)[:, 1:, 1] = ws[:-1]  # a view: targets[:nf] is contiguous
+        targets[nf:nf + ni, 1] = spin
+        targets[-1, 0] = p.escape_vel
         traj = rollout(scene.pose, velocity, targets, self._steps(targets), p.sim_time, (p.acc_lim_x, p.acc_lim_theta),
                        accelerate=True)
         costs = self._score(scene, traj)
-        nf, ni = len(forward), len(in_place)
         best = -1
         if not self._escaping:
             ok = costs[:nf] >= 0
@@ -459,12 +461,15 @@ class TrajectoryPlannerROS(RolloutController):
         head_dist, head_in = lookup(scene.goal_dist, scene.resolution, hx, hy)
         allowed = self._spin.allowed(ws)
         best_heading = math.inf
+        # Python floats and bools of the same values: the loop reads them without numpy scalar lookups
+        cost_l, ws_l, dist_l = costs.tolist(), ws.tolist(), head_dist.tolist()
+        in_l, allowed_l = head_in.tolist(), allowed.tolist()
         for k in range(ni):
-            c = costs[nf + k]
-            if c < 0 or not (best < 0 or c <= costs[best]) or abs(ws[k]) <= dw or not head_in[k] or not allowed[k]:
+            c = cost_l[nf + k]
+            if c < 0 or not (best < 0 or c <= cost_l[best]) or abs(ws_l[k]) <= dw or not in_l[k] or not allowed_l[k]:
                 continue
-            if head_dist[k] < best_heading:
-                best, best_heading = nf + k, float(head_dist[k])
+            if dist_l[k] < best_heading:
+                best, best_heading = nf + k, dist_l[k]
         if best >= 0:
             self._spin.update(pose, float(targets[best, 0]), float(targets[best, 1]))
             self._end_escape(pose)
