@@ -81,6 +81,10 @@ class FoxgloveBridge(ServerListener):
         self._subs: dict[str, Subscription] = {}
         self._client_channels: dict[tuple[int, int], tuple[str, str, str]] = {}  # -> topic, encoding, type
         self._lock = threading.Lock()
+        # the SDK's server object may not be used from two threads at once (stop() in the caller's thread, the
+        # time broadcast in the executor's: "Already mutably borrowed")
+        self._server_lock = threading.Lock()
+        self._closed = False
         self._clients: dict[str, int] = {}  # topic -> how many clients subscribe it
         self.received = 0  # messages published by clients
         self._advertise()
@@ -98,7 +102,9 @@ class FoxgloveBridge(ServerListener):
 
     def close(self) -> None:
         """Stop the Foxglove server and this bridge's subscriptions."""
-        self.server.stop()
+        with self._server_lock:
+            self._closed = True
+            self.server.stop()
         self.executor.post(self.node.destroy_node)
 
     # --- channels (executor thread) -------------------------------------------------------------------
@@ -115,8 +121,9 @@ class FoxgloveBridge(ServerListener):
     def server_time(self) -> None:
         """Tell clients the simulated time (Foxglove's ``time`` capability)."""
         server = getattr(self, "server", None)
-        if server is not None:
-            server.broadcast_time(self.executor.now_ns)
+        with self._server_lock:
+            if server is not None and not self._closed:
+                server.broadcast_time(self.executor.now_ns)
 
     def _subscribe(self, topic: str) -> None:
         t = self.executor.topics.get(topic)
