@@ -17,6 +17,7 @@ import queue
 import threading
 import time
 from collections.abc import Callable
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -27,7 +28,7 @@ from navlab.msgs import type_name
 from navlab.ros1.errors import Ros1Error
 from navlab.ros1.master import Master
 from navlab.ros1.net import LOG, XmlRpcServer, binding, call, master_uri, proxy
-from navlab.ros1.types import Ros1Types
+from navlab.ros1.types import Ros1Types, WireType
 from navlab.ros1.wire import Incoming, Publication, TcpRosServer
 
 BRIDGE_NAME = "/navlab"
@@ -54,6 +55,16 @@ def connect_or_start_master(uri: str | None = None) -> tuple[str, Master | None]
     return master.uri, master
 
 
+@dataclass
+class WireSubscription:
+    """A topic navlab reads from the wire: its type, the node it subscribes as, and one connection per publisher."""
+
+    wtype: WireType
+    caller_id: str
+    deliver: Callable[[bytes], None]
+    connections: dict[str, Incoming] = field(default_factory=dict)
+
+
 class RosBridge:
     """Offer the run of ``executor`` on the ROS 1 master at ``master``; ``close()`` unregisters everything."""
 
@@ -68,23 +79,26 @@ class RosBridge:
         self.tcpros = TcpRosServer(bind.bind, bind.advertise, name)
         self.xmlrpc = XmlRpcServer(self._slave_api(), bind.bind, bind.advertise)
         self.uri = self.xmlrpc.uri
-        self.subs: dict[str, tuple[str, str, dict[str, Incoming]]] = {}  # topic -> (ros2 type, caller, api->conn)
+        self.subs: dict[str, WireSubscription] = {}
+        self._from_run: dict[str, Publication] = {}  # the run's topics offered on the wire
         self._jobs: queue.SimpleQueue[Callable[[], None] | None] = queue.SimpleQueue()
         self._injecting = False
         self._warned: set[str] = set()
         self._closed = False
         threading.Thread(target=self._registrar, name="ros1-registrar", daemon=True).start()
         self._set_params(params or {})
-        self._offer("/clock", "rosgraph_msgs/msg/Clock", name)
-        self._offer("/rosout", "rosgraph_msgs/msg/Log", name)
+        self.offer("/clock", "rosgraph_msgs/msg/Clock", name)
+        self.offer("/rosout", "rosgraph_msgs/msg/Log", name)
         self._clock = Timer(executor, CLOCK_PERIOD_NS, self._tick_clock, -100, executor.now_ns,
                             idle=lambda: not self.tcpros.publications["/clock"].connections)
         self._log_handler = _RosoutHandler(self)
         logging.getLogger("navlab").addHandler(self._log_handler)
         executor.add_listener(self._on_publish)
+        from navlab.ros1.actionlib import offer_move_base
         from navlab.ros1.services import offer_services
 
         offer_services(self)
+        offer_move_base(self)
         self.sync()
         self._syncer = threading.Thread(target=self._sync_loop, name="ros1-sync", daemon=True)
         self._syncer.start()
@@ -110,7 +124,7 @@ class RosBridge:
             if safe is not None:
                 self._jobs.put(lambda k=key, v=safe: self._master("setParam", self.name, k, v))
 
-    def _offer(self, topic: str, ros1_type: str, caller_id: str, latched: Callable[[], list[bytes]] | None = None
+    def offer(self, topic: str, ros1_type: str, caller_id: str, latched: Callable[[], list[bytes]] | None = None
                ) -> Publication:
         pub = Publication(topic, self.types.wire_type(ros1_type), caller_id, latched or (lambda: []))
         self.tcpros.publications[topic] = pub
@@ -129,12 +143,17 @@ class RosBridge:
                     LOG.info("ros1: %s (%s) has no ROS 1 type: not bridged", name, type_name(topic.msgtype))
                 continue
             if topic.publishers and name not in self.tcpros.publications:
-                self._offer(name, ros1, topic.publishers[0], self._latched_of(name, ros1))
+                self._from_run[name] = self.offer(name, ros1, topic.publishers[0], self._latched_of(name, ros1))
             readers = [s.node for s in topic.subscriptions]
             if readers and name not in self.subs:
                 caller = next((r for r in readers if not r.startswith(INTERNAL)), self.name)
-                self.subs[name] = (type_name(topic.msgtype), caller, {})
-                self._jobs.put(lambda n=name, c=caller, r=ros1: self._subscribe(n, c, r))
+                self.subscribe(name, ros1, caller, self._deliverer(name, ros1, type_name(topic.msgtype)))
+
+    def flush(self, timeout: float = 10.0) -> bool:
+        """Wait until every registration queued so far reached the master (False on timeout)."""
+        done = threading.Event()
+        self._jobs.put(done.set)
+        return done.wait(timeout)
 
     def _sync_loop(self) -> None:
         while not self._closed:
@@ -149,21 +168,26 @@ class RosBridge:
 
         return latched
 
-    def _subscribe(self, topic: str, caller: str, ros1: str) -> None:
-        pubs = self._master("registerSubscriber", caller, topic, self.types.wire_type(ros1).wire, self.uri)
-        self._update_publishers(topic, pubs)
+    def subscribe(self, topic: str, ros1: str, caller: str, deliver: Callable[[bytes], None]) -> None:
+        """Subscribe on the wire to ``topic`` as node ``caller``; ``deliver`` gets each message's bytes
+        (in a connection thread)."""
+        sub = self.subs[topic] = WireSubscription(self.types.wire_type(ros1), caller, deliver)
+
+        def register() -> None:
+            self._update_publishers(topic, self._master("registerSubscriber", caller, topic, sub.wtype.wire,
+                                                        self.uri))
+
+        self._jobs.put(register)
 
     def _update_publishers(self, topic: str, apis: list[str]) -> None:
-        entry = self.subs.get(topic)
-        if entry is None or self._closed:
+        sub = self.subs.get(topic)
+        if sub is None or self._closed:
             return
-        ros2, caller, conns = entry
-        ros1 = self.types.ros1_type_of(ros2) or ros2
-        wtype = self.types.wire_type(ros1)
+        conns = sub.connections
         for api in apis:
             if api != self.uri and (api not in conns or conns[api].closed):
-                conns[api] = Incoming(api, topic, wtype, caller, self._deliverer(topic, ros1, ros2),
-                                      lambda c, t=topic: self.subs.get(t, ("", "", {}))[2].pop(c.api, None))
+                conns[api] = Incoming(api, topic, sub.wtype, sub.caller_id, sub.deliver,
+                                      lambda c: conns.pop(c.api, None))
         for api in list(conns):
             if api not in apis:
                 conns.pop(api).close()
@@ -186,7 +210,7 @@ class RosBridge:
     # --- the executor's side ---------------------------------------------------------------------------
 
     def _on_publish(self, topic: str, msg: Any, t_ns: int) -> None:
-        pub = self.tcpros.publications.get(topic)
+        pub = self._from_run.get(topic)  # not the bridge's own (/clock, actionlib's status on move_base's name)
         if pub is None or not pub.connections or self._injecting:
             return
         ros1 = pub.wtype.typename
@@ -209,8 +233,8 @@ class RosBridge:
             rows: list[list[Any]] = []
             for i, (t, p) in enumerate(self.tcpros.publications.items()):
                 rows += [[i, c.peer, "o", "TCPROS", t, True] for c in p.connections]
-            for t, (_, _, conns) in self.subs.items():
-                rows += [[0, api, "i", "TCPROS", t, True] for api in conns]
+            for t, sub in self.subs.items():
+                rows += [[0, api, "i", "TCPROS", t, True] for api in sub.connections]
             return [1, "bus info", rows]
 
         def request_topic(caller_id: str, topic: str, protocols: list[Any]) -> list[Any]:
@@ -236,8 +260,8 @@ class RosBridge:
             "getMasterUri": lambda caller_id: [1, "master", self.master_uri],
             "shutdown": shutdown,
             "getPid": lambda caller_id: [1, "pid", os.getpid()],
-            "getSubscriptions": lambda caller_id: [1, "subscriptions", [[t, self.types.wire_type(
-                self.types.ros1_type_of(r2) or r2).wire] for t, (r2, _, _) in self.subs.items()]],
+            "getSubscriptions": lambda caller_id: [1, "subscriptions", [[t, s.wtype.wire]
+                                                                         for t, s in self.subs.items()]],
             "getPublications": lambda caller_id: [1, "publications", pubs()],
             "paramUpdate": lambda caller_id, key, value: [1, "ok", 0],
             "publisherUpdate": publisher_update,
@@ -261,10 +285,10 @@ class RosBridge:
             for topic, pub in self.tcpros.publications.items():
                 _quiet(lambda t=topic, c=pub.caller_id: call(self.master_uri, "unregisterPublisher", c, t, self.uri,
                                                            timeout=1.0))
-            for topic, (_, caller, conns) in self.subs.items():
-                _quiet(lambda t=topic, c=caller: call(self.master_uri, "unregisterSubscriber", c, t, self.uri,
-                                                      timeout=1.0))
-                for conn in list(conns.values()):
+            for topic, sub in self.subs.items():
+                _quiet(lambda t=topic, c=sub.caller_id: call(self.master_uri, "unregisterSubscriber", c, t, self.uri,
+                                                             timeout=1.0))
+                for conn in list(sub.connections.values()):
                     conn.close()
             for srv in self.tcpros.services.values():
                 _quiet(lambda s=srv: call(self.master_uri, "unregisterService", s.caller_id, s.name, self.tcpros.uri,

@@ -44,8 +44,6 @@ EXTRA_SRVS: dict[str, tuple[str, str]] = {
         "string model_name\nstring model_xml\nstring robot_namespace\ngeometry_msgs/Pose initial_pose\n"
         "string reference_frame", "bool success\nstring status_message"),
 }
-# navlab's ROS 2 type -> the ROS 1 type on the wire, where the names differ
-ROS2_TO_ROS1 = {"action_msgs/msg/GoalStatusArray": "actionlib_msgs/msg/GoalStatusArray"}
 
 
 def wire_name(typename: str) -> str:
@@ -139,8 +137,7 @@ class Ros1Types:
 
     def ros1_type_of(self, ros2_typename: str) -> str | None:
         """The ROS 1 type carrying navlab's ROS 2 type ``ros2_typename`` on the wire (None: no counterpart)."""
-        name = ROS2_TO_ROS1.get(ros2_typename, ros2_typename)
-        return name if name in self.store.fielddefs else None
+        return ros2_typename if ros2_typename in self.store.fielddefs else None
 
     # --- bytes -----------------------------------------------------------------------------------------
 

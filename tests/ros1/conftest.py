@@ -1,0 +1,122 @@
+"""The real ROS 1 Noetic tools (Debian's packages, run by the system Python) as the peers of navlab's bridge.
+
+They are required, not optional: `make install` installs them with apt; a missing one fails the test with
+the package to install, instead of skipping it silently.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import socket
+import subprocess
+import threading
+import time
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+
+SYSTEM_PYTHON = "/usr/bin/python3"
+TOOLS = {"rosmaster": "python3-rosmaster", "rostopic": "python3-rostopic", "rosbag": "python3-rosbag",
+         "rosservice": "python3-rosservice", "rosparam": "python3-rosparam", "rosnode": "python3-rosnode"}
+
+
+def require(tool: str) -> str:
+    path = shutil.which(tool)
+    if path is None:
+        pytest.fail(f"{tool} is missing: `make install` installs it (apt-get install {TOOLS.get(tool, tool)})")
+    return path
+
+
+def free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return int(s.getsockname()[1])
+
+
+@pytest.fixture(scope="session")
+def ros_env(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, str]]:
+    """A real ``rosmaster`` on a free loopback port; the environment for ROS tools to reach it."""
+    for tool in TOOLS:
+        require(tool)
+    port = free_port()
+    env = {**os.environ, "ROS_MASTER_URI": f"http://127.0.0.1:{port}/", "ROS_IP": "127.0.0.1",
+           "ROS_HOME": str(tmp_path_factory.mktemp("ros_home")), "PYTHONPATH": ""}
+    env.pop("VIRTUAL_ENV", None)
+    env["PATH"] = "/usr/bin:/bin"
+    master = subprocess.Popen([require("rosmaster"), "--core", "-p", str(port)], env=env,
+                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    deadline = time.monotonic() + 10
+    while time.monotonic() < deadline:
+        with socket.socket() as s:
+            if s.connect_ex(("127.0.0.1", port)) == 0:
+                break
+        time.sleep(0.1)
+    try:
+        yield env
+    finally:
+        master.terminate()
+        master.wait(5)
+
+
+def ros(env: dict[str, str], *cmd: str, timeout: float = 30.0, ok: tuple[int, ...] = (0,)) -> str:
+    """Run a ROS command line tool; its stdout (the test fails with its stderr if it fails)."""
+    done = subprocess.run([require(cmd[0]), *cmd[1:]], env=env, capture_output=True, text=True, timeout=timeout)
+    assert done.returncode in ok, f"{' '.join(cmd)} failed ({done.returncode}): {done.stderr[-2000:]}"
+    return done.stdout
+
+
+def rospy(env: dict[str, str], code: str, timeout: float = 60.0) -> str:
+    """Run a rospy script under the system Python (where ROS lives); its stdout."""
+    done = subprocess.run([SYSTEM_PYTHON, "-c", code], env=env, capture_output=True, text=True, timeout=timeout)
+    assert done.returncode == 0, f"rospy script failed ({done.returncode}): {done.stderr[-2000:]}"
+    return done.stdout
+
+
+class Running:
+    """A launch session run in real time in a background thread, offered on ROS by a bridge."""
+
+    def __init__(self, session: object, bridge: object) -> None:
+        self.session = session
+        self.ex = session.executor  # type: ignore[attr-defined]
+        self.bridge = bridge
+        self.thread = threading.Thread(target=self.ex.spin, daemon=True)
+        self.thread.start()
+        while self.ex.now_ns < 2_000_000_000:  # every node has published once (tf publishers appear lazily)
+            time.sleep(0.05)
+        self.call(bridge.sync)  # type: ignore[attr-defined]
+        bridge.flush()  # type: ignore[attr-defined]
+
+    def call(self, fn: object, timeout: float = 10.0) -> object:
+        """Run ``fn()`` in the executor thread; its value."""
+        out: list[object] = []
+        done = threading.Event()
+        self.ex.post(lambda: (out.append(fn()), done.set()))  # type: ignore[operator]
+        assert done.wait(timeout), "the executor did not answer"
+        return out[0]
+
+    def close(self) -> None:
+        self.ex.post(self.ex.stop)
+        self.thread.join(10)
+        self.bridge.close()  # type: ignore[attr-defined]
+
+
+def run_with_ros(env: dict[str, str], launch: str, **args: str) -> Running:
+    from navlab.core.launch import start
+    from navlab.ros1 import RosBridge, session_params
+
+    session = start(launch, pace=1.0, **args)
+    bridge = RosBridge(session.executor, master=env["ROS_MASTER_URI"], params=session_params(session.nodes))
+    return Running(session, bridge)
+
+
+@pytest.fixture(scope="session")
+def room_map(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    from navlab.experiments.truth import true_map
+    from navlab.mapping.mapfile import save_map
+    from navlab.sim.gazebo import load_world_named
+
+    path = tmp_path_factory.mktemp("map") / "room.yaml"
+    save_map(true_map(load_world_named("room"), (0.0, 0.0)), path)
+    return path

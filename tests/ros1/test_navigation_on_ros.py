@@ -1,0 +1,110 @@
+"""navlab's navigation stack on a real ROS 1 graph: real rostopic, rosparam, rosservice, tf2 and actionlib
+peers (Debian's Noetic tools) read it and drive it through a real rosmaster. One run serves every test."""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+from conftest import Running, ros, rospy, run_with_ros
+
+
+@pytest.fixture(scope="module")
+def nav(ros_env: dict[str, str], room_map: Path) -> Iterator[Running]:
+    run = run_with_ros(ros_env, "navigation", world="room", map=str(room_map))
+    try:
+        yield run
+    finally:
+        run.close()
+
+
+def test_rostopic_lists_the_runs_topics_with_ros1_types_and_hz_holds_the_scan_rate(
+        nav: Running, ros_env: dict[str, str]) -> None:
+    listed = ros(ros_env, "rostopic", "list").split()
+    for topic in ("/mybot/laser/scan", "/odom", "/tf", "/tf_static", "/map", "/clock", "/cmd_vel",
+                  "/move_base/goal", "/move_base/status", "/amcl_pose"):
+        assert topic in listed
+    assert ros(ros_env, "rostopic", "type", "/odom").strip() == "nav_msgs/Odometry"
+    assert ros(ros_env, "rostopic", "type", "/tf").strip() == "tf2_msgs/TFMessage"
+    out = ros(ros_env, "timeout", "-s", "INT", "5", "rostopic", "hz", "/mybot/laser/scan", ok=(124,))
+    rates = [float(r) for r in re.findall(r"average rate: ([0-9.]+)", out)]
+    assert rates and 34.0 < rates[-1] < 46.0, out  # 40 Hz in real time
+
+
+def test_the_map_is_latched_and_echoed_with_its_size(nav: Running, ros_env: dict[str, str]) -> None:
+    out = ros(ros_env, "rostopic", "echo", "-n", "1", "/map/info")
+    grid = nav.call(lambda: nav.session.node("map_server").grid)  # type: ignore[attr-defined]
+    assert f"width: {grid.width}" in out and f"height: {grid.height}" in out
+
+
+def test_parameters_and_robot_description_are_on_the_parameter_server(nav: Running, ros_env: dict[str, str]) -> None:
+    ours = nav.session.node("move_base").get_parameter("controller_frequency")  # type: ignore[attr-defined]
+    assert float(ros(ros_env, "rosparam", "get", "/move_base/controller_frequency")) == ours
+    assert float(ros(ros_env, "rosparam", "get", "/move_base/local_costmap/inflation_radius")) > 0
+    assert "<robot" in ros(ros_env, "rosparam", "get", "/robot_description")
+
+
+def test_tf2_looks_up_map_to_chassis_as_navlab_does(nav: Running, ros_env: dict[str, str]) -> None:
+    out = rospy(ros_env, """
+import rospy, tf2_ros
+rospy.init_node('tf_probe')
+buf = tf2_ros.Buffer(); tf2_ros.TransformListener(buf)
+t = buf.lookup_transform('map', 'chassis', rospy.Time(0), rospy.Duration(10)).transform.translation
+print(t.x, t.y)
+""")
+    x, y = map(float, out.split())
+    nx, ny, _ = nav.call(lambda: nav.ex.tf.lookup_pose2d("map", "chassis", None))  # type: ignore[misc]
+    assert abs(x - nx) < 0.05 and abs(y - ny) < 0.05
+
+
+def test_services_clear_costmaps_static_map_and_make_plan(nav: Running, ros_env: dict[str, str]) -> None:
+    ros(ros_env, "rosservice", "call", "/move_base/clear_costmaps")
+    assert ros(ros_env, "rosservice", "type", "/static_map").strip() == "nav_msgs/GetMap"
+    out = rospy(ros_env, """
+import rospy
+from nav_msgs.srv import GetMap, GetPlan
+from geometry_msgs.msg import PoseStamped
+rospy.init_node('srv_probe')
+rospy.wait_for_service('/static_map', 10)
+m = rospy.ServiceProxy('/static_map', GetMap)().map
+goal = PoseStamped(); goal.header.frame_id = 'map'; goal.pose.position.x = 2.0; goal.pose.orientation.w = 1.0
+plan = rospy.ServiceProxy('/move_base/make_plan', GetPlan)(start=PoseStamped(), goal=goal, tolerance=0.0).plan
+print(m.info.width, len(plan.poses), plan.poses[-1].pose.position.x)
+""")
+    width, n, last_x = out.split()
+    assert int(width) > 0 and int(n) > 5 and abs(float(last_x) - 2.0) < 0.1
+
+
+def test_a_use_sim_time_node_follows_the_clock(nav: Running, ros_env: dict[str, str]) -> None:
+    out = rospy(ros_env, """
+import rospy
+rospy.set_param('/use_sim_time', True)
+rospy.init_node('clock_probe')
+rospy.sleep(0.5)  # sleeps on /clock: returns only if the clock runs
+print(rospy.get_time())
+rospy.delete_param('/use_sim_time')
+""")
+    now = nav.ex.now_ns / 1e9
+    assert 0.5 < float(out) <= now + 0.1 and now - float(out) < 5.0
+
+
+def test_a_simple_action_client_drives_move_base_to_its_goal(nav: Running, ros_env: dict[str, str]) -> None:
+    out = rospy(ros_env, """
+import rospy, actionlib
+from move_base_msgs.msg import MoveBaseAction, MoveBaseGoal
+rospy.init_node('goal_sender')
+client = actionlib.SimpleActionClient('move_base', MoveBaseAction)
+assert client.wait_for_server(rospy.Duration(15)), 'no move_base action server'
+goal = MoveBaseGoal()
+goal.target_pose.header.frame_id = 'map'
+goal.target_pose.pose.position.x = 1.0
+goal.target_pose.pose.orientation.w = 1.0
+client.send_goal(goal)
+client.wait_for_result(rospy.Duration(60))
+print(client.get_state())
+""", timeout=90)
+    assert out.strip() == "3"  # actionlib_msgs/GoalStatus SUCCEEDED
+    x, y, _ = nav.call(lambda: nav.ex.tf.lookup_pose2d("map", "chassis", None))  # type: ignore[misc]
+    assert abs(x - 1.0) < 0.3 and abs(y) < 0.3
