@@ -44,7 +44,8 @@ def test_rostopic_pub_cmd_vel_drives_the_robot_the_commanded_distance(sim: Runni
     assert abs(math.hypot(x1 - x0, y1 - y0) - commanded) < 0.15 * commanded
 
 
-def test_rosbag_records_the_run_with_its_counts_and_types(sim: Running, ros_env: dict[str, str], tmp_path: Path) -> None:
+def test_rosbag_records_the_run_with_its_counts_and_types(sim: Running, ros_env: dict[str, str],
+                                                          tmp_path: Path) -> None:
     bag = tmp_path / "run.bag"
     ros(ros_env, "rosbag", "record", "-O", str(bag), "--duration=4", "/odom", "/mybot/laser/scan", "/tf",
         timeout=60)

@@ -120,7 +120,7 @@ class MoveBaseActionServer:
     def _feedback(self, key: str, pose: Any) -> None:
         if not self.feedback_pub.connections or key not in self.goals:
             return
-        gid, handle = self.goals[key]
+        _gid, handle = self.goals[key]
         position = self.types.to_ros1(msgs.pose_stamped(self.bridge.ex.now_ns, handle.frame_id, *pose),
                                       "geometry_msgs/msg/PoseStamped")
         msg = self.store["move_base_msgs/msg/MoveBaseActionFeedback"](

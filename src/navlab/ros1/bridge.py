@@ -11,6 +11,7 @@ happens in background threads; the executor thread only converts and serializes 
 from __future__ import annotations
 
 import contextlib
+import functools
 import logging
 import os
 import queue
@@ -18,7 +19,7 @@ import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -44,7 +45,7 @@ def connect_or_start_master(uri: str | None = None) -> tuple[str, Master | None]
     try:
         proxy(uri, 1.0).getUri(BRIDGE_NAME)
         return uri, None
-    except (OSError, Exception):  # noqa: BLE001 - nothing answers: start one
+    except (OSError, Exception):
         pass
     host, port = host_port(uri)
     if host not in ("localhost", "127.0.0.1", binding().advertise):
@@ -122,7 +123,7 @@ class RosBridge:
         for key, value in params.items():
             safe = _xmlrpc_value(value)
             if safe is not None:
-                self._jobs.put(lambda k=key, v=safe: self._master("setParam", self.name, k, v))
+                self._jobs.put(functools.partial(self._master, "setParam", self.name, key, safe))
 
     def offer(self, topic: str, ros1_type: str, caller_id: str, latched: Callable[[], list[bytes]] | None = None
                ) -> Publication:
@@ -187,7 +188,7 @@ class RosBridge:
         for api in apis:
             if api != self.uri and (api not in conns or conns[api].closed):
                 conns[api] = Incoming(api, topic, sub.wtype, sub.caller_id, sub.deliver,
-                                      lambda c: conns.pop(c.api, None))
+                                      lambda c: _discard(conns, c.api))
         for api in list(conns):
             if api not in apis:
                 conns.pop(api).close()
@@ -283,16 +284,13 @@ class RosBridge:
 
         def unregister() -> None:
             for topic, pub in self.tcpros.publications.items():
-                _quiet(lambda t=topic, c=pub.caller_id: call(self.master_uri, "unregisterPublisher", c, t, self.uri,
-                                                           timeout=1.0))
+                _quiet("unregisterPublisher", self.master_uri, pub.caller_id, topic, self.uri)
             for topic, sub in self.subs.items():
-                _quiet(lambda t=topic, c=sub.caller_id: call(self.master_uri, "unregisterSubscriber", c, t, self.uri,
-                                                             timeout=1.0))
+                _quiet("unregisterSubscriber", self.master_uri, sub.caller_id, topic, self.uri)
                 for conn in list(sub.connections.values()):
                     conn.close()
             for srv in self.tcpros.services.values():
-                _quiet(lambda s=srv: call(self.master_uri, "unregisterService", s.caller_id, s.name, self.tcpros.uri,
-                                          timeout=1.0))
+                _quiet("unregisterService", self.master_uri, srv.caller_id, srv.name, self.tcpros.uri)
             done.set()
 
         self._jobs.put(unregister)
@@ -304,11 +302,14 @@ class RosBridge:
             self.own_master.close()
 
 
-def _quiet(fn: Callable[[], Any]) -> None:
-    try:
-        fn()
-    except Ros1Error:
-        pass
+def _quiet(method: str, uri: str, *args: Any) -> None:
+    """A master call whose failure does not matter (unregistering while shutting down)."""
+    with contextlib.suppress(Ros1Error):
+        call(uri, method, *args, timeout=1.0)
+
+
+def _discard(conns: dict[str, Incoming], api: str) -> None:
+    conns.pop(api, None)
 
 
 def _xmlrpc_value(value: Any) -> Any:
@@ -333,7 +334,8 @@ def _xmlrpc_value(value: Any) -> Any:
 class _RosoutHandler(logging.Handler):
     """navlab's log lines as ``rosgraph_msgs/Log`` on ``/rosout`` (level, node name, text)."""
 
-    LEVELS = {logging.DEBUG: 1, logging.INFO: 2, logging.WARNING: 4, logging.ERROR: 8, logging.CRITICAL: 16}
+    LEVELS: ClassVar[dict[int, int]] = {logging.DEBUG: 1, logging.INFO: 2, logging.WARNING: 4, logging.ERROR: 8,
+                                        logging.CRITICAL: 16}
 
     def __init__(self, bridge: RosBridge) -> None:
         super().__init__(logging.INFO)

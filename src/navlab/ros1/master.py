@@ -135,7 +135,7 @@ class Master:
         def run() -> None:
             try:
                 getattr(proxy(api, 2.0), method)(*args)
-            except Exception as exc:  # noqa: BLE001 - a dead node must not stop the master
+            except Exception as exc:
                 LOG.info("master: %s on %s failed: %s", method, api, exc)
 
         self._notify.submit(run)
@@ -145,19 +145,19 @@ class Master:
         for api in self.subscribers.get(topic, {}).values():
             self._send(api, "publisherUpdate", MASTER_ID, topic, pubs)
 
-    def registerService(self, caller_id: str, service: str, service_api: str, caller_api: str) -> Reply:  # noqa: N802
+    def registerService(self, caller_id: str, service: str, service_api: str, caller_api: str) -> Reply:
         with self._lock:
             self._node(caller_id, caller_api)
             self.services.setdefault(resolve(caller_id, service), {})[caller_id] = (service_api, caller_api)
         return [1, f"registered {service}", 0]
 
-    def unregisterService(self, caller_id: str, service: str, service_api: str) -> Reply:  # noqa: N802
+    def unregisterService(self, caller_id: str, service: str, service_api: str) -> Reply:
         with self._lock:
             entry = self.services.get(resolve(caller_id, service), {})
             n = 1 if entry.pop(caller_id, None) else 0
         return [1, f"unregistered {n}", n]
 
-    def registerSubscriber(self, caller_id: str, topic: str, topic_type: str, caller_api: str) -> Reply:  # noqa: N802
+    def registerSubscriber(self, caller_id: str, topic: str, topic_type: str, caller_api: str) -> Reply:
         topic = resolve(caller_id, topic)
         with self._lock:
             self._node(caller_id, caller_api)
@@ -167,12 +167,12 @@ class Master:
             pubs = list(self.publishers.get(topic, {}).values())
         return [1, f"subscribed to {topic}", pubs]
 
-    def unregisterSubscriber(self, caller_id: str, topic: str, caller_api: str) -> Reply:  # noqa: N802
+    def unregisterSubscriber(self, caller_id: str, topic: str, caller_api: str) -> Reply:
         with self._lock:
             n = 1 if self.subscribers.get(resolve(caller_id, topic), {}).pop(caller_id, None) else 0
         return [1, f"unregistered {n}", n]
 
-    def registerPublisher(self, caller_id: str, topic: str, topic_type: str, caller_api: str) -> Reply:  # noqa: N802
+    def registerPublisher(self, caller_id: str, topic: str, topic_type: str, caller_api: str) -> Reply:
         topic = resolve(caller_id, topic)
         with self._lock:
             self._node(caller_id, caller_api)
@@ -182,7 +182,7 @@ class Master:
             self._publisher_update(topic)
         return [1, f"registered {caller_id} as publisher of {topic}", subs]
 
-    def unregisterPublisher(self, caller_id: str, topic: str, caller_api: str) -> Reply:  # noqa: N802
+    def unregisterPublisher(self, caller_id: str, topic: str, caller_api: str) -> Reply:
         topic = resolve(caller_id, topic)
         with self._lock:
             n = 1 if self.publishers.get(topic, {}).pop(caller_id, None) else 0
@@ -192,37 +192,37 @@ class Master:
 
     # --- lookups ---------------------------------------------------------------------------------------
 
-    def lookupNode(self, caller_id: str, node_name: str) -> Reply:  # noqa: N802
+    def lookupNode(self, caller_id: str, node_name: str) -> Reply:
         api = self.nodes.get(resolve(caller_id, node_name))
         return [1, "node api", api] if api else [-1, f"unknown node {node_name}", ""]
 
-    def lookupService(self, caller_id: str, service: str) -> Reply:  # noqa: N802
+    def lookupService(self, caller_id: str, service: str) -> Reply:
         entry = self.services.get(resolve(caller_id, service))
         if not entry:
             return [-1, f"no provider for {service}", ""]
         return [1, "rosrpc URI", next(iter(entry.values()))[0]]
 
-    def getPublishedTopics(self, caller_id: str, subgraph: str) -> Reply:  # noqa: N802
+    def getPublishedTopics(self, caller_id: str, subgraph: str) -> Reply:
         with self._lock:
             rows = [[t, self.topic_types.get(t, "*")] for t, p in self.publishers.items()
                     if p and t.startswith(subgraph or "")]
         return [1, "published topics", rows]
 
-    def getTopicTypes(self, caller_id: str) -> Reply:  # noqa: N802
+    def getTopicTypes(self, caller_id: str) -> Reply:
         with self._lock:
             return [1, "topic types", [[t, k] for t, k in self.topic_types.items()]]
 
-    def getSystemState(self, caller_id: str) -> Reply:  # noqa: N802
+    def getSystemState(self, caller_id: str) -> Reply:
         with self._lock:
             pubs = [[t, list(p)] for t, p in self.publishers.items() if p]
             subs = [[t, list(s)] for t, s in self.subscribers.items() if s]
             srvs = [[s, list(p)] for s, p in self.services.items() if p]
         return [1, "system state", [pubs, subs, srvs]]
 
-    def getUri(self, caller_id: str) -> Reply:  # noqa: N802
+    def getUri(self, caller_id: str) -> Reply:
         return [1, "master uri", self.uri]
 
-    def getPid(self, caller_id: str) -> Reply:  # noqa: N802
+    def getPid(self, caller_id: str) -> Reply:
         return [1, "pid", os.getpid()]
 
     def shutdown(self, caller_id: str, msg: str = "") -> Reply:
@@ -232,7 +232,7 @@ class Master:
 
     # --- parameter server ------------------------------------------------------------------------------
 
-    def setParam(self, caller_id: str, key: str, value: Any) -> Reply:  # noqa: N802
+    def setParam(self, caller_id: str, key: str, value: Any) -> Reply:
         key = resolve(caller_id, key)
         with self._lock:
             self.params.set(key, value)
@@ -249,7 +249,7 @@ class Master:
         except KeyError:
             return {}
 
-    def getParam(self, caller_id: str, key: str) -> Reply:  # noqa: N802
+    def getParam(self, caller_id: str, key: str) -> Reply:
         key = resolve(caller_id, key)
         with self._lock:
             try:
@@ -257,7 +257,7 @@ class Master:
             except KeyError:
                 return [-1, f"Parameter [{key}] is not set", 0]
 
-    def deleteParam(self, caller_id: str, key: str) -> Reply:  # noqa: N802
+    def deleteParam(self, caller_id: str, key: str) -> Reply:
         key = resolve(caller_id, key)
         with self._lock:
             try:
@@ -266,12 +266,12 @@ class Master:
                 return [-1, f"parameter [{key}] is not set", 0]
         return [1, f"parameter {key} deleted", 0]
 
-    def hasParam(self, caller_id: str, key: str) -> Reply:  # noqa: N802
+    def hasParam(self, caller_id: str, key: str) -> Reply:
         key = resolve(caller_id, key)
         with self._lock:
             return [1, key, self.params.has(key)]
 
-    def searchParam(self, caller_id: str, key: str) -> Reply:  # noqa: N802
+    def searchParam(self, caller_id: str, key: str) -> Reply:
         """The closest ``key`` in the caller's namespace or above (ROS's upward search on the first part)."""
         first, _, rest = key.lstrip("~/").partition("/")
         ns = namespace_of(caller_id)
@@ -284,17 +284,17 @@ class Master:
                     return [-1, f"cannot find parameter [{key}]", ""]
                 ns = namespace_of(ns.rstrip("/"))
 
-    def subscribeParam(self, caller_id: str, caller_api: str, key: str) -> Reply:  # noqa: N802
+    def subscribeParam(self, caller_id: str, caller_api: str, key: str) -> Reply:
         key = resolve(caller_id, key)
         with self._lock:
             self.param_subscribers.setdefault(key, {})[caller_id] = caller_api
             return [1, f"subscribed to {key}", self._get_or_empty(key)]
 
-    def unsubscribeParam(self, caller_id: str, caller_api: str, key: str) -> Reply:  # noqa: N802
+    def unsubscribeParam(self, caller_id: str, caller_api: str, key: str) -> Reply:
         with self._lock:
             n = 1 if self.param_subscribers.get(resolve(caller_id, key), {}).pop(caller_id, None) else 0
         return [1, f"unsubscribed {n}", n]
 
-    def getParamNames(self, caller_id: str) -> Reply:  # noqa: N802
+    def getParamNames(self, caller_id: str) -> Reply:
         with self._lock:
             return [1, "parameter names", self.params.names()]

@@ -41,7 +41,7 @@ def binding(environ: dict[str, str] | None = None) -> Binding:
         return Binding(ip, ip, f"ROS_IP={ip}")
     if host:
         loop = host in ("localhost", "127.0.0.1")
-        return Binding("127.0.0.1" if loop else "0.0.0.0", host, f"ROS_HOSTNAME={host}")  # noqa: S104
+        return Binding("127.0.0.1" if loop else "0.0.0.0", host, f"ROS_HOSTNAME={host}")
     return Binding("127.0.0.1", "127.0.0.1", "loopback only; set ROS_IP or ROS_HOSTNAME to reach other machines")
 
 
@@ -60,7 +60,7 @@ def host_port(uri: str) -> tuple[str, int]:
 
 
 class _Quiet(SimpleXMLRPCRequestHandler):
-    def log_message(self, format: str, *args: Any) -> None:  # noqa: A002 - the base class's signature
+    def log_message(self, format: str, *args: Any) -> None:
         pass
 
 

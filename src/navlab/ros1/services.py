@@ -7,6 +7,7 @@ ROS 1 request into that call and its result into the ROS 1 response.
 
 from __future__ import annotations
 
+import functools
 import tempfile
 import threading
 from collections.abc import Callable
@@ -48,8 +49,8 @@ def offer_services(bridge: RosBridge) -> None:
         adapter = _ADAPTERS[stype_name]
         srv = Service(wire_name, stype, caller, _handler(bridge, name, stype.request, stype.response, adapter))
         bridge.tcpros.services[wire_name] = srv
-        bridge._jobs.put(lambda s=srv: bridge._master(  # noqa: SLF001 - the bridge's own registrar
-            "registerService", s.caller_id, s.name, bridge.tcpros.uri, bridge.uri))
+        bridge._jobs.put(functools.partial(bridge._master,
+                                           "registerService", srv.caller_id, srv.name, bridge.tcpros.uri, bridge.uri))
 
 
 Adapter = Callable[["RosBridge", Callable[[Any], Any], Any, Any], Any]
@@ -65,7 +66,7 @@ def _handler(bridge: RosBridge, name: str, req_type: str, res_type: str, adapter
             try:
                 result.append(adapter(bridge, lambda r: bridge.ex.call_service(name, r), request,
                                       bridge.types.store.types[res_type]))
-            except Exception as exc:  # noqa: BLE001 - returned to the caller as the service's error
+            except Exception as exc:
                 result.append(exc)
             finally:
                 done.set()

@@ -27,7 +27,8 @@ EXTRA_MSGS: dict[str, str] = {
     "move_base_msgs/msg/MoveBaseGoal": "geometry_msgs/PoseStamped target_pose",
     "move_base_msgs/msg/MoveBaseResult": "",
     "move_base_msgs/msg/MoveBaseFeedback": "geometry_msgs/PoseStamped base_position",
-    "move_base_msgs/msg/MoveBaseActionGoal": "Header header\nactionlib_msgs/GoalID goal_id\nmove_base_msgs/MoveBaseGoal goal",
+    "move_base_msgs/msg/MoveBaseActionGoal":
+        "Header header\nactionlib_msgs/GoalID goal_id\nmove_base_msgs/MoveBaseGoal goal",
     "move_base_msgs/msg/MoveBaseActionResult":
         "Header header\nactionlib_msgs/GoalStatus status\nmove_base_msgs/MoveBaseResult result",
     "move_base_msgs/msg/MoveBaseActionFeedback":
@@ -99,7 +100,7 @@ class Ros1Types:
         self._convert: dict[tuple[int, str], Callable[[Any], Any]] = {}
         self._lock = threading.Lock()
         for name, srv in list(self.services.items()):
-            digest = md5((self._hashtext(srv.request) + self._hashtext(srv.response)).encode()).hexdigest()  # noqa: S324
+            digest = md5((self._hashtext(srv.request) + self._hashtext(srv.response)).encode()).hexdigest()
             self.services[name] = ServiceType(name, srv.request, srv.response, digest)
 
     # --- definitions -----------------------------------------------------------------------------------
@@ -117,11 +118,14 @@ class Ros1Types:
                 sub = str(desc[1])
                 lines.append(f"{_ROS1_TIME.get(sub) or self.wire_type(sub).md5sum} {name}")
             else:
-                (kind, sub), num = desc[1]
+                (kind, element), num = desc[1]
                 count = "" if num == 0 else str(num)
-                inner = sub[0] if kind == Nodetype.BASE else _ROS1_TIME.get(sub) or self.wire_type(sub).md5sum
-                lines.append(f"{inner}[{count}] {name}" if kind == Nodetype.BASE or sub in _ROS1_TIME
-                             else f"{inner} {name}")
+                if kind == Nodetype.BASE:
+                    lines.append(f"{element[0]}[{count}] {name}")
+                elif str(element) in _ROS1_TIME:
+                    lines.append(f"{_ROS1_TIME[str(element)]}[{count}] {name}")
+                else:  # a nested message array: its md5sum, no brackets (genmsg's md5 text)
+                    lines.append(f"{self.wire_type(str(element)).md5sum} {name}")
         return "\n".join(lines)
 
     def wire_type(self, typename: str) -> WireType:

@@ -8,6 +8,7 @@ sends garbage is dropped with a log line.
 
 from __future__ import annotations
 
+import contextlib
 import socket
 import threading
 from collections import deque
@@ -60,10 +61,8 @@ class Outgoing:
         with self.cond:
             self.closed = True
             self.cond.notify()
-        try:
+        with contextlib.suppress(OSError):
             self.sock.close()
-        except OSError:
-            pass
 
 
 @dataclass
@@ -192,7 +191,7 @@ class TcpRosServer:
                 return
             try:
                 response, ok = srv.handle(request), b"\x01"
-            except Exception as exc:  # noqa: BLE001 - the caller gets the error text, as ROS does
+            except Exception as exc:
                 response, ok = str(exc).encode(), b"\x00"
             sock.sendall(ok + frame(response))
             if not persistent:
@@ -233,17 +232,15 @@ class Incoming:
         except (Ros1Error, OSError) as exc:
             if not self.closed:
                 LOG.warning("ros1: dropped publisher %s of %s: %s", self.api, self.topic, exc)
-        except Exception as exc:  # noqa: BLE001 - a message that does not deserialize is garbage: drop the peer
+        except Exception as exc:
             LOG.warning("ros1: dropped publisher %s of %s: garbage message (%s)", self.api, self.topic, exc)
         finally:
             self.close()
 
     def close(self) -> None:
         if self.sock is not None:
-            try:
+            with contextlib.suppress(OSError):
                 self.sock.close()
-            except OSError:
-                pass
         if not self.closed:
             self.closed = True
             self._on_close(self)
