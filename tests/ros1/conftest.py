@@ -102,12 +102,14 @@ class Running:
         self.bridge.close()  # type: ignore[attr-defined]
 
 
-def run_with_ros(env: dict[str, str], launch: str, **args: str) -> Running:
+def run_with_ros(env: dict[str, str], launch: str, *, follow_clock: bool = False, **args: str) -> Running:
+    """``launch`` started here and offered on the master of ``env`` (real time, or following /clock)."""
     from navlab.core.launch import start
     from navlab.ros1 import RosBridge, session_params
 
-    session = start(launch, pace=1.0, **args)
-    bridge = RosBridge(session.executor, master=env["ROS_MASTER_URI"], params=session_params(session.nodes))
+    session = start(launch, pace=0.0 if follow_clock else 1.0, **args)
+    bridge = RosBridge(session.executor, master=env["ROS_MASTER_URI"], params=session_params(session.nodes),
+                       follow_clock=follow_clock)
     return Running(session, bridge)
 
 

@@ -7,6 +7,7 @@ import math
 import socket
 import struct
 import subprocess
+import sys
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -70,7 +71,7 @@ def test_a_peer_sending_garbage_is_dropped_and_the_run_goes_on(sim: Running, ros
 def test_navlab_roscore_serves_real_rospy_nodes_and_rosparam(ros_env: dict[str, str], tmp_path: Path) -> None:
     port = free_port()
     env = {**ros_env, "ROS_MASTER_URI": f"http://127.0.0.1:{port}/"}
-    core = subprocess.Popen([str(Path(__import__("sys").executable).parent / "navlab"), "roscore", "-p", str(port)],
+    core = subprocess.Popen([str(Path(sys.executable).parent / "navlab"), "roscore", "-p", str(port)],
                             stdout=subprocess.PIPE, text=True)
     try:
         assert "ROS master at" in (core.stdout.readline() if core.stdout else "")

@@ -136,11 +136,13 @@ def _cmd_launch(args: argparse.Namespace) -> int:
         return _show_args(args.file)
     apply_resource_paths(args)  # --package-path / --model-path for robot:= and world:=
     # Like roslaunch, a launch without --duration runs in real time until Ctrl-C.
-    from navlab.ros1.cli import pop_ros_arg, ros_bridge
+    from navlab.ros1.cli import follows_clock, pop_ros_arg, ros_bridge
 
     launch_args = parse_launch_args(args.args)
     ros = pop_ros_arg(launch_args) or args.ros  # outside nodes cannot follow 100x: real time unless --rate
     rate = args.rate if args.rate is not None else (1.0 if args.duration is None or ros else 0.0)
+    follow_clock = ros and follows_clock(launch_args)  # hardware in the loop: the robot's /clock paces the run
+    rate = 0.0 if follow_clock else rate
     session = start(args.file, seed=args.seed, pace=rate, launch_args=launch_args)
     ex = session.executor
     duration = math.inf if args.duration is None else args.duration
@@ -152,7 +154,7 @@ def _cmd_launch(args: argparse.Namespace) -> int:
     from navlab.viz.cli import viewing
 
     with IntrospectionServer(ex, name=args.file), contextlib.suppress(KeyboardInterrupt), viewing(args, ex), \
-            ros_bridge(ros, ex, session.nodes):
+            ros_bridge(ros, ex, session.nodes, follow_clock=follow_clock):
         run_for(ex, duration, record=args.record, quiet=args.quiet, desc=Path(args.file).stem)
     topics = {name: t.count for name, t in sorted(ex.topics.items())}
     summary: dict[str, Any] = {"sim_s": round(ex.now_ns / 1e9, 3), "nodes": sorted(ex.nodes), "topics": topics}

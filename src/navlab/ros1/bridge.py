@@ -23,16 +23,18 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from navlab import msgs
 from navlab.core.executor import Executor
 from navlab.core.topics import Timer
-from navlab.msgs import type_name
+from navlab.msgs import TFMessage, type_name
+from navlab.ros1.clock import ClockFollower
 from navlab.ros1.errors import Ros1Error
 from navlab.ros1.master import Master
 from navlab.ros1.net import LOG, XmlRpcServer, binding, call, master_uri, proxy
 from navlab.ros1.types import Ros1Types, WireType
 from navlab.ros1.wire import Incoming, Publication, TcpRosServer
 
-BRIDGE_NAME = "/navlab"
+BRIDGE_NAME = "/navlab"  # + "_<pid>", as rospy names anonymous nodes: two navlab runs can share a graph
 INTERNAL = "/_"  # navlab-internal subscribers (the tf buffer) and topics
 CLOCK_PERIOD_NS = 10_000_000  # /clock every 10 ms of simulated time
 
@@ -70,9 +72,10 @@ class RosBridge:
     """Offer the run of ``executor`` on the ROS 1 master at ``master``; ``close()`` unregisters everything."""
 
     def __init__(self, executor: Executor, *, master: str | None = None, params: dict[str, Any] | None = None,
-                 name: str = BRIDGE_NAME) -> None:
+                 name: str | None = None, follow_clock: bool = False) -> None:
         self.ex = executor
-        self.name = name
+        self.name = name or f"{BRIDGE_NAME}_{os.getpid()}"
+        name = self.name
         self.types = Ros1Types()
         self.master_uri, self.own_master = connect_or_start_master(master)
         bind = binding()
@@ -88,10 +91,20 @@ class RosBridge:
         self._closed = False
         threading.Thread(target=self._registrar, name="ros1-registrar", daemon=True).start()
         self._set_params(params or {})
-        self.offer("/clock", "rosgraph_msgs/msg/Clock", name)
         self.offer("/rosout", "rosgraph_msgs/msg/Log", name)
-        self._clock = Timer(executor, CLOCK_PERIOD_NS, self._tick_clock, -100, executor.now_ns,
-                            idle=lambda: not self.tcpros.publications["/clock"].connections)
+        for tf_topic in ("/tf", "/tf_static"):  # read from the graph even before a node of the run publishes tf
+            executor.topic(tf_topic, TFMessage)
+        self.follower: ClockFollower | None = None
+        self._clock: Timer | None = None
+        if follow_clock:  # the graph owns the time: no /clock of our own
+            follower = self.follower = ClockFollower(executor)
+            clock_type = "rosgraph_msgs/msg/Clock"
+            self.subscribe("/clock", clock_type, name, lambda raw: follower.tick(
+                msgs.ns_from_time(self.types.deserialize(raw, clock_type).clock)))
+        else:
+            clock = self.offer("/clock", "rosgraph_msgs/msg/Clock", name)
+            self._clock = Timer(executor, CLOCK_PERIOD_NS, self._tick_clock, -100, executor.now_ns,
+                                idle=lambda: not clock.connections)
         self._log_handler = _RosoutHandler(self)
         logging.getLogger("navlab").addHandler(self._log_handler)
         executor.add_listener(self._on_publish)
@@ -218,11 +231,9 @@ class RosBridge:
         pub.send(self.types.serialize(self.types.to_ros1(msg, ros1), ros1))
 
     def _tick_clock(self) -> None:
-        from navlab.msgs import time_from_ns
-
         clock_type = self.types.store.types["rosgraph_msgs/msg/Clock"]
         self.tcpros.publications["/clock"].send(
-            self.types.serialize(clock_type(clock=time_from_ns(self.ex.now_ns)), "rosgraph_msgs/msg/Clock"))
+            self.types.serialize(clock_type(clock=msgs.time_from_ns(self.ex.now_ns)), "rosgraph_msgs/msg/Clock"))
 
     # --- the slave API ---------------------------------------------------------------------------------
 
@@ -276,7 +287,10 @@ class RosBridge:
         if self._closed:
             return
         self._closed = True
-        self._clock.cancel()
+        if self._clock is not None:
+            self._clock.cancel()
+        if self.follower is not None:
+            self.follower.close()
         logging.getLogger("navlab").removeHandler(self._log_handler)
         with contextlib.suppress(ValueError):
             self.ex.remove_listener(self._on_publish)

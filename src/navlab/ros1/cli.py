@@ -48,16 +48,22 @@ def pop_ros_arg(launch_args: dict[str, str]) -> bool:
     return str(launch_args.pop("ros", "false")).strip().lower() in TRUE
 
 
+def follows_clock(launch_args: dict[str, str]) -> bool:
+    """Whether a run takes its time from the graph's ``/clock``: ``sim:=false`` (hardware in the loop)."""
+    return str(launch_args.get("sim", "true")).strip().lower() not in TRUE
+
+
 @contextlib.contextmanager
-def ros_bridge(enabled: bool, executor: Any, nodes: dict[str, Any]) -> Iterator[Any]:
-    """With ``enabled``: the run offered on ROS 1 while the block runs (None otherwise)."""
+def ros_bridge(enabled: bool, executor: Any, nodes: dict[str, Any], *, follow_clock: bool = False) -> Iterator[Any]:
+    """With ``enabled``: the run offered on ROS 1 while the block runs (None otherwise); ``follow_clock``:
+    its time follows the graph's ``/clock``."""
     if not enabled:
         yield None
         return
     from navlab.ros1.bridge import RosBridge, session_params
 
     logging.getLogger("navlab.ros1").setLevel(logging.INFO)
-    bridge = RosBridge(executor, params=session_params(nodes))
+    bridge = RosBridge(executor, params=session_params(nodes), follow_clock=follow_clock)
     try:
         yield bridge
     finally:
