@@ -9,17 +9,19 @@ from __future__ import annotations
 import os
 import shutil
 import socket
+import struct
 import subprocess
 import threading
 import time
 from collections.abc import Iterator
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 SYSTEM_PYTHON = "/usr/bin/python3"
-TOOLS = {"rosmaster": "python3-rosmaster", "rostopic": "python3-rostopic", "rosbag": "python3-rosbag",
-         "rosservice": "python3-rosservice", "rosparam": "python3-rosparam", "rosnode": "python3-rosnode"}
+TOOLS = {"Xvfb": "xvfb", "rviz": "rviz", "rosmaster": "python3-rosmaster", "rostopic": "python3-rostopic",
+         "rosbag": "python3-rosbag", "rosservice": "python3-rosservice", "rosparam": "python3-rosparam", "rosnode": "python3-rosnode"}
 
 
 def require(tool: str) -> str:
@@ -122,3 +124,34 @@ def room_map(tmp_path_factory: pytest.TempPathFactory) -> Path:
     path = tmp_path_factory.mktemp("map") / "room.yaml"
     save_map(true_map(load_world_named("room"), (0.0, 0.0)), path)
     return path
+
+
+def read_xwd(path: Path) -> np.ndarray:
+    """The RGB pixels (H, W, 3) of an X window dump, as Xvfb writes its screen with ``-fbdir`` (32-bit TrueColor)."""
+    raw = path.read_bytes()
+    fields = struct.unpack(">25I", raw[:100])
+    header_size, width, height, bytes_per_line, ncolors = fields[0], fields[4], fields[5], fields[12], fields[19]
+    offset = header_size + 12 * ncolors
+    rows = np.frombuffer(raw, dtype=np.uint8, count=bytes_per_line * height, offset=offset).reshape(height, -1)
+    return rows[:, : width * 4].reshape(height, width, 4)[..., [2, 1, 0]].copy()  # BGRX in memory
+
+
+class Screen:
+    """A virtual X display (Xvfb) whose framebuffer is readable as a file."""
+
+    def __init__(self, folder: Path, width: int = 800, height: int = 600) -> None:
+        self.folder = folder
+        self.display = f":{free_port() % 500 + 100}"
+        self.proc = subprocess.Popen([require("Xvfb"), self.display, "-screen", "0", f"{width}x{height}x24",
+                                      "-fbdir", str(folder), "-nolisten", "tcp"],
+                                     stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        deadline = time.monotonic() + 10
+        while not (folder / "Xvfb_screen0").exists() and time.monotonic() < deadline:
+            time.sleep(0.1)
+
+    def grab(self) -> np.ndarray:
+        return read_xwd(self.folder / "Xvfb_screen0")
+
+    def close(self) -> None:
+        self.proc.terminate()
+        self.proc.wait(5)

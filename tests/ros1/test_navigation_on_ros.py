@@ -4,11 +4,17 @@ peers (Debian's Noetic tools) read it and drive it through a real rosmaster. One
 from __future__ import annotations
 
 import re
+import subprocess
+import time
 from collections.abc import Iterator
 from pathlib import Path
 
+import numpy as np
 import pytest
-from conftest import Running, ros, rospy, run_with_ros
+from conftest import Running, Screen, require, ros, rospy, run_with_ros
+from PIL import Image
+
+from navlab.core.launch import resources_dir
 
 
 @pytest.fixture(scope="module")
@@ -108,3 +114,81 @@ print(client.get_state())
     assert out.strip() == "3"  # actionlib_msgs/GoalStatus SUCCEEDED
     x, y, _ = nav.call(lambda: nav.ex.tf.lookup_pose2d("map", "chassis", None))  # type: ignore[misc]
     assert abs(x - 1.0) < 0.3 and abs(y) < 0.3
+
+
+SCALE = 30.0  # pixels per metre of the saved config's top-down view
+
+
+def _near(mask: np.ndarray, pts: np.ndarray, radius: int) -> np.ndarray:
+    """For each pixel (col, row) of ``pts``: whether ``mask`` is set within ``radius`` pixels."""
+    h, w = mask.shape
+    out = np.zeros(len(pts), dtype=bool)
+    for k, (c, r) in enumerate(pts.astype(int)):
+        out[k] = mask[max(r - radius, 0):min(r + radius + 1, h), max(c - radius, 0):min(c + radius + 1, w)].any()
+    return out
+
+
+def test_real_rviz_shows_the_map_scan_robot_and_plan_where_navlab_has_them(
+        nav: Running, ros_env: dict[str, str], tmp_path: Path) -> None:
+    """Runs last in this module (it freezes the run): rviz with a saved config, compared by pixels with where
+    navlab has the map's walls, the last scan, the robot and the global plan (projected with the view's scale)."""
+    scans: list[object] = []
+    nav.call(lambda: nav.ex.add_listener(lambda t, m, ns: scans.append(m) if t == "/mybot/laser/scan" else None))
+    nav.call(lambda: nav.session.node("move_base").send_goal(-2.5, 1.0, 0.0))  # type: ignore[attr-defined]
+    ros(ros_env, "rosparam", "set", "/use_sim_time", "true")  # rviz keeps the run's time (from /clock)
+    screen = Screen(tmp_path)
+    env = {**ros_env, "DISPLAY": screen.display, "LIBGL_ALWAYS_SOFTWARE": "1",
+           "ROS_PACKAGE_PATH": str(resources_dir() / "robots")}  # package://mybot_description meshes
+    viewer = subprocess.Popen([require("rviz"), "-d", str(Path(__file__).parent / "data" / "navlab.rviz")], env=env,
+                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        red = lambda img: (img[..., 0] > 200) & (img[..., 1] < 60) & (img[..., 2] < 60)  # noqa: E731
+        green = lambda img: (img[..., 1] > 200) & (img[..., 0] < 60) & (img[..., 2] < 60)  # noqa: E731
+        deadline = time.monotonic() + 60
+        while time.monotonic() < deadline:
+            time.sleep(1.0)
+            img = screen.grab()
+            if red(img).sum() > 200 and green(img).sum() > 50:
+                break
+        nav.call(lambda: nav.ex.stop())  # freeze the run: rviz keeps showing its last messages
+        time.sleep(2.0)
+        img = screen.grab()
+    finally:
+        viewer.terminate()
+        viewer.wait(10)
+        screen.close()
+        ros(ros_env, "rosparam", "delete", "/use_sim_time")
+    Image.fromarray(img).save(tmp_path / "rviz.png")
+    ex = nav.ex
+    rx, ry, _ryaw = ex.tf.lookup_pose2d("map", "chassis", None)
+    orange = (img[..., 0] > 200) & (img[..., 1] > 60) & (img[..., 1] < 180) & (img[..., 2] < 60)
+    rows, cols = np.nonzero(orange)
+    assert len(rows) > 30, "no robot model drawn"
+    center = np.array([cols.mean(), rows.mean()])  # the robot's chassis: where map point (rx, ry) is drawn
+
+    def to_px(xy: np.ndarray) -> np.ndarray:
+        return center + np.column_stack([(xy[:, 0] - rx) * SCALE, -(xy[:, 1] - ry) * SCALE])
+
+    def inside(px: np.ndarray) -> np.ndarray:
+        return np.hypot(*(px - center).T) < 170
+
+    scan = scans[-1]
+    angles = scan.angle_min + scan.angle_increment * np.arange(len(scan.ranges))  # type: ignore[attr-defined]
+    ranges = np.asarray(scan.ranges)  # type: ignore[attr-defined]
+    ok = np.isfinite(ranges) & (ranges < scan.range_max)  # type: ignore[attr-defined]
+    lx, ly, lyaw = ex.tf.lookup_pose2d("map", scan.header.frame_id, None)  # type: ignore[attr-defined]
+    hits = np.column_stack([lx + ranges[ok] * np.cos(lyaw + angles[ok]), ly + ranges[ok] * np.sin(lyaw + angles[ok])])
+    px = to_px(hits)
+    px = px[inside(px)]
+    assert len(px) > 50 and _near(red(img), px, 4).mean() > 0.8, "the scan is not where navlab measured it"
+
+    grid = nav.session.node("map_server").grid  # type: ignore[attr-defined]
+    px = to_px(grid.cell_to_world(np.argwhere(np.asarray(grid.data) > 50)[:, ::-1]))  # (col, row) cells
+    px = px[inside(px)]
+    dark = img.max(axis=2) < 80
+    assert len(px) > 50 and _near(dark | red(img), px, 3).mean() > 0.8, "the map's walls are not drawn"
+
+    (plan,) = ex.topics["/move_base/NavfnROS/plan"].latched.values()
+    px = to_px(np.array([[p.pose.position.x, p.pose.position.y] for p in plan.poses]))
+    px = px[inside(px) & (np.hypot(*(px - center).T) > 15)]  # the robot model covers the plan's end
+    assert len(px) > 5 and _near(green(img), px, 4).mean() > 0.8, "the global plan is not drawn"
