@@ -21,7 +21,8 @@ import pytest
 
 SYSTEM_PYTHON = "/usr/bin/python3"
 TOOLS = {"Xvfb": "xvfb", "rviz": "rviz", "rosmaster": "python3-rosmaster", "rostopic": "python3-rostopic",
-         "rosbag": "python3-rosbag", "rosservice": "python3-rosservice", "rosparam": "python3-rosparam", "rosnode": "python3-rosnode"}
+         "rosbag": "python3-rosbag", "rosservice": "python3-rosservice", "rosparam": "python3-rosparam",
+         "rosnode": "python3-rosnode"}
 
 
 def require(tool: str) -> str:
