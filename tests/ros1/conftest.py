@@ -11,13 +11,14 @@ import shutil
 import socket
 import struct
 import subprocess
-import threading
 import time
 from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
 import pytest
+
+from navlab.ros1.live import LiveRun
 
 SYSTEM_PYTHON = "/usr/bin/python3"
 TOOLS = {"Xvfb": "xvfb", "rviz": "rviz", "rosmaster": "python3-rosmaster", "rostopic": "python3-rostopic",
@@ -77,43 +78,9 @@ def rospy(env: dict[str, str], code: str, timeout: float = 60.0) -> str:
     return done.stdout
 
 
-class Running:
-    """A launch session run in real time in a background thread, offered on ROS by a bridge."""
-
-    def __init__(self, session: object, bridge: object) -> None:
-        self.session = session
-        self.ex = session.executor  # type: ignore[attr-defined]
-        self.bridge = bridge
-        self.thread = threading.Thread(target=self.ex.spin, daemon=True)
-        self.thread.start()
-        while self.ex.now_ns < 2_000_000_000:  # every node has published once (tf publishers appear lazily)
-            time.sleep(0.05)
-        self.call(bridge.sync)  # type: ignore[attr-defined]
-        bridge.flush()  # type: ignore[attr-defined]
-
-    def call(self, fn: object, timeout: float = 10.0) -> object:
-        """Run ``fn()`` in the executor thread; its value."""
-        out: list[object] = []
-        done = threading.Event()
-        self.ex.post(lambda: (out.append(fn()), done.set()))  # type: ignore[operator]
-        assert done.wait(timeout), "the executor did not answer"
-        return out[0]
-
-    def close(self) -> None:
-        self.ex.post(self.ex.stop)
-        self.thread.join(10)
-        self.bridge.close()  # type: ignore[attr-defined]
-
-
-def run_with_ros(env: dict[str, str], launch: str, *, follow_clock: bool = False, **args: str) -> Running:
+def run_with_ros(env: dict[str, str], launch: str, *, follow_clock: bool = False, **args: str) -> LiveRun:
     """``launch`` started here and offered on the master of ``env`` (real time, or following /clock)."""
-    from navlab.core.launch import start
-    from navlab.ros1 import RosBridge, session_params
-
-    session = start(launch, pace=0.0 if follow_clock else 1.0, **args)
-    bridge = RosBridge(session.executor, master=env["ROS_MASTER_URI"], params=session_params(session.nodes),
-                       follow_clock=follow_clock)
-    return Running(session, bridge)
+    return LiveRun(launch, master=env["ROS_MASTER_URI"], follow_clock=follow_clock, **args)
 
 
 @pytest.fixture(scope="session")

@@ -12,7 +12,9 @@ from pathlib import Path
 
 import pytest
 import yaml
-from conftest import Running, ros, rospy, run_with_ros
+from conftest import ros, rospy, run_with_ros
+
+from navlab.ros1.live import LiveRun
 
 
 @pytest.fixture(scope="module")
@@ -30,7 +32,7 @@ def robot(ros_env: dict[str, str]) -> Iterator[subprocess.Popen[bytes]]:
 
 
 @pytest.fixture(scope="module")
-def hil(ros_env: dict[str, str], room_map: Path, robot: subprocess.Popen[bytes]) -> Iterator[Running]:
+def hil(ros_env: dict[str, str], room_map: Path, robot: subprocess.Popen[bytes]) -> Iterator[LiveRun]:
     run = run_with_ros(ros_env, "navigation", map=str(room_map), sim="false", follow_clock=True)
     try:
         yield run
@@ -38,7 +40,7 @@ def hil(ros_env: dict[str, str], room_map: Path, robot: subprocess.Popen[bytes])
         run.close()
 
 
-def test_move_base_drives_the_robot_of_another_process_to_the_goal(hil: Running, ros_env: dict[str, str]) -> None:
+def test_move_base_drives_the_robot_of_another_process_to_the_goal(hil: LiveRun, ros_env: dict[str, str]) -> None:
     assert "/gazebo" not in hil.ex.nodes  # no simulator in this run
     out = rospy(ros_env, """
 import rospy, actionlib

@@ -11,14 +11,15 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import Running, Screen, require, ros, rospy, run_with_ros
+from conftest import Screen, require, ros, rospy, run_with_ros
 from PIL import Image
 
 from navlab.core.launch import resources_dir
+from navlab.ros1.live import LiveRun
 
 
 @pytest.fixture(scope="module")
-def nav(ros_env: dict[str, str], room_map: Path) -> Iterator[Running]:
+def nav(ros_env: dict[str, str], room_map: Path) -> Iterator[LiveRun]:
     run = run_with_ros(ros_env, "navigation", world="room", map=str(room_map))
     try:
         yield run
@@ -27,7 +28,7 @@ def nav(ros_env: dict[str, str], room_map: Path) -> Iterator[Running]:
 
 
 def test_rostopic_lists_the_runs_topics_with_ros1_types_and_hz_holds_the_scan_rate(
-        nav: Running, ros_env: dict[str, str]) -> None:
+        nav: LiveRun, ros_env: dict[str, str]) -> None:
     listed = ros(ros_env, "rostopic", "list").split()
     for topic in ("/mybot/laser/scan", "/odom", "/tf", "/tf_static", "/map", "/clock", "/cmd_vel",
                   "/move_base/goal", "/move_base/status", "/amcl_pose"):
@@ -39,20 +40,20 @@ def test_rostopic_lists_the_runs_topics_with_ros1_types_and_hz_holds_the_scan_ra
     assert rates and 34.0 < rates[-1] < 46.0, out  # 40 Hz in real time
 
 
-def test_the_map_is_latched_and_echoed_with_its_size(nav: Running, ros_env: dict[str, str]) -> None:
+def test_the_map_is_latched_and_echoed_with_its_size(nav: LiveRun, ros_env: dict[str, str]) -> None:
     out = ros(ros_env, "rostopic", "echo", "-n", "1", "/map/info")
-    grid = nav.call(lambda: nav.session.node("map_server").grid)  # type: ignore[attr-defined]
+    grid = nav.call(lambda: nav.session.node("map_server").grid)
     assert f"width: {grid.width}" in out and f"height: {grid.height}" in out
 
 
-def test_parameters_and_robot_description_are_on_the_parameter_server(nav: Running, ros_env: dict[str, str]) -> None:
-    ours = nav.session.node("move_base").get_parameter("controller_frequency")  # type: ignore[attr-defined]
+def test_parameters_and_robot_description_are_on_the_parameter_server(nav: LiveRun, ros_env: dict[str, str]) -> None:
+    ours = nav.session.node("move_base").get_parameter("controller_frequency")
     assert float(ros(ros_env, "rosparam", "get", "/move_base/controller_frequency")) == ours
     assert float(ros(ros_env, "rosparam", "get", "/move_base/local_costmap/inflation_radius")) > 0
     assert "<robot" in ros(ros_env, "rosparam", "get", "/robot_description")
 
 
-def test_tf2_looks_up_map_to_chassis_as_navlab_does(nav: Running, ros_env: dict[str, str]) -> None:
+def test_tf2_looks_up_map_to_chassis_as_navlab_does(nav: LiveRun, ros_env: dict[str, str]) -> None:
     out = rospy(ros_env, """
 import rospy, tf2_ros
 rospy.init_node('tf_probe')
@@ -61,11 +62,11 @@ t = buf.lookup_transform('map', 'chassis', rospy.Time(0), rospy.Duration(10)).tr
 print(t.x, t.y)
 """)
     x, y = map(float, out.split())
-    nx, ny, _ = nav.call(lambda: nav.ex.tf.lookup_pose2d("map", "chassis", None))  # type: ignore[misc]
+    nx, ny, _ = nav.call(lambda: nav.ex.tf.lookup_pose2d("map", "chassis", None))
     assert abs(x - nx) < 0.05 and abs(y - ny) < 0.05
 
 
-def test_services_clear_costmaps_static_map_and_make_plan(nav: Running, ros_env: dict[str, str]) -> None:
+def test_services_clear_costmaps_static_map_and_make_plan(nav: LiveRun, ros_env: dict[str, str]) -> None:
     ros(ros_env, "rosservice", "call", "/move_base/clear_costmaps")
     assert ros(ros_env, "rosservice", "type", "/static_map").strip() == "nav_msgs/GetMap"
     out = rospy(ros_env, """
@@ -83,7 +84,7 @@ print(m.info.width, len(plan.poses), plan.poses[-1].pose.position.x)
     assert int(width) > 0 and int(n) > 5 and abs(float(last_x) - 2.0) < 0.1
 
 
-def test_a_use_sim_time_node_follows_the_clock(nav: Running, ros_env: dict[str, str]) -> None:
+def test_a_use_sim_time_node_follows_the_clock(nav: LiveRun, ros_env: dict[str, str]) -> None:
     out = rospy(ros_env, """
 import rospy
 rospy.set_param('/use_sim_time', True)
@@ -96,7 +97,7 @@ rospy.delete_param('/use_sim_time')
     assert 0.5 < float(out) <= now + 0.1 and now - float(out) < 5.0
 
 
-def test_a_simple_action_client_drives_move_base_to_its_goal(nav: Running, ros_env: dict[str, str]) -> None:
+def test_a_simple_action_client_drives_move_base_to_its_goal(nav: LiveRun, ros_env: dict[str, str]) -> None:
     out = rospy(ros_env, """
 import rospy, actionlib
 from move_base_msgs.msg import MoveBaseAction, MoveBaseGoal
@@ -112,7 +113,7 @@ client.wait_for_result(rospy.Duration(60))
 print(client.get_state())
 """, timeout=90)
     assert out.strip() == "3"  # actionlib_msgs/GoalStatus SUCCEEDED
-    x, y, _ = nav.call(lambda: nav.ex.tf.lookup_pose2d("map", "chassis", None))  # type: ignore[misc]
+    x, y, _ = nav.call(lambda: nav.ex.tf.lookup_pose2d("map", "chassis", None))
     assert abs(x - 1.0) < 0.3 and abs(y) < 0.3
 
 
@@ -129,12 +130,12 @@ def _near(mask: np.ndarray, pts: np.ndarray, radius: int) -> np.ndarray:
 
 
 def test_real_rviz_shows_the_map_scan_robot_and_plan_where_navlab_has_them(
-        nav: Running, ros_env: dict[str, str], tmp_path: Path) -> None:
+        nav: LiveRun, ros_env: dict[str, str], tmp_path: Path) -> None:
     """Runs last in this module (it freezes the run): rviz with a saved config, compared by pixels with where
     navlab has the map's walls, the last scan, the robot and the global plan (projected with the view's scale)."""
     scans: list[object] = []
     nav.call(lambda: nav.ex.add_listener(lambda t, m, ns: scans.append(m) if t == "/mybot/laser/scan" else None))
-    nav.call(lambda: nav.session.node("move_base").send_goal(-2.5, 1.0, 0.0))  # type: ignore[attr-defined]
+    nav.call(lambda: nav.session.node("move_base").send_goal(-2.5, 1.0, 0.0))
     ros(ros_env, "rosparam", "set", "/use_sim_time", "true")  # rviz keeps the run's time (from /clock)
     screen = Screen(tmp_path)
     env = {**ros_env, "DISPLAY": screen.display, "LIBGL_ALWAYS_SOFTWARE": "1",
@@ -173,16 +174,16 @@ def test_real_rviz_shows_the_map_scan_robot_and_plan_where_navlab_has_them(
         return np.hypot(*(px - center).T) < 170
 
     scan = scans[-1]
-    angles = scan.angle_min + scan.angle_increment * np.arange(len(scan.ranges))  # type: ignore[attr-defined]
-    ranges = np.asarray(scan.ranges)  # type: ignore[attr-defined]
-    ok = np.isfinite(ranges) & (ranges < scan.range_max)  # type: ignore[attr-defined]
-    lx, ly, lyaw = ex.tf.lookup_pose2d("map", scan.header.frame_id, None)  # type: ignore[attr-defined]
+    angles = scan.angle_min + scan.angle_increment * np.arange(len(scan.ranges))
+    ranges = np.asarray(scan.ranges)
+    ok = np.isfinite(ranges) & (ranges < scan.range_max)
+    lx, ly, lyaw = ex.tf.lookup_pose2d("map", scan.header.frame_id, None)
     hits = np.column_stack([lx + ranges[ok] * np.cos(lyaw + angles[ok]), ly + ranges[ok] * np.sin(lyaw + angles[ok])])
     px = to_px(hits)
     px = px[inside(px)]
     assert len(px) > 50 and _near(red(img), px, 4).mean() > 0.8, "the scan is not where navlab measured it"
 
-    grid = nav.session.node("map_server").grid  # type: ignore[attr-defined]
+    grid = nav.session.node("map_server").grid
     px = to_px(grid.cell_to_world(np.argwhere(np.asarray(grid.data) > 50)[:, ::-1]))  # (col, row) cells
     px = px[inside(px)]
     dark = img.max(axis=2) < 80

@@ -13,11 +13,13 @@ from pathlib import Path
 
 import pytest
 import yaml
-from conftest import Running, free_port, ros, rospy, run_with_ros
+from conftest import free_port, ros, rospy, run_with_ros
+
+from navlab.ros1.live import LiveRun
 
 
 @pytest.fixture(scope="module")
-def sim(ros_env: dict[str, str]) -> Iterator[Running]:
+def sim(ros_env: dict[str, str]) -> Iterator[LiveRun]:
     run = run_with_ros(ros_env, "sim", world="room")
     try:
         yield run
@@ -25,12 +27,12 @@ def sim(ros_env: dict[str, str]) -> Iterator[Running]:
         run.close()
 
 
-def _truth(run: Running) -> tuple[float, float]:
-    pose = run.call(lambda: run.session.node("gazebo").sim.base_pose2d())  # type: ignore[attr-defined]
-    return float(pose[0]), float(pose[1])  # type: ignore[index]
+def _truth(run: LiveRun) -> tuple[float, float]:
+    pose = run.call(lambda: run.session.node("gazebo").sim.base_pose2d())
+    return float(pose[0]), float(pose[1])
 
 
-def test_rostopic_pub_cmd_vel_drives_the_robot_the_commanded_distance(sim: Running, ros_env: dict[str, str]) -> None:
+def test_rostopic_pub_cmd_vel_drives_the_robot_the_commanded_distance(sim: LiveRun, ros_env: dict[str, str]) -> None:
     got: list[tuple[int, float]] = []
     sim.call(lambda: sim.ex.add_listener(lambda t, m, ns: got.append((ns, m.linear.x)) if t == "/cmd_vel" else None))
     x0, y0 = _truth(sim)
@@ -45,7 +47,7 @@ def test_rostopic_pub_cmd_vel_drives_the_robot_the_commanded_distance(sim: Runni
     assert abs(math.hypot(x1 - x0, y1 - y0) - commanded) < 0.15 * commanded
 
 
-def test_rosbag_records_the_run_with_its_counts_and_types(sim: Running, ros_env: dict[str, str],
+def test_rosbag_records_the_run_with_its_counts_and_types(sim: LiveRun, ros_env: dict[str, str],
                                                           tmp_path: Path) -> None:
     bag = tmp_path / "run.bag"
     ros(ros_env, "rosbag", "record", "-O", str(bag), "--duration=4", "/odom", "/mybot/laser/scan", "/tf",
@@ -58,9 +60,9 @@ def test_rosbag_records_the_run_with_its_counts_and_types(sim: Running, ros_env:
     assert 100 < topics["/mybot/laser/scan"]["messages"] < 200  # 40 Hz for ~4 s of real time
 
 
-def test_a_peer_sending_garbage_is_dropped_and_the_run_goes_on(sim: Running, ros_env: dict[str, str],
+def test_a_peer_sending_garbage_is_dropped_and_the_run_goes_on(sim: LiveRun, ros_env: dict[str, str],
                                                               caplog: pytest.LogCaptureFixture) -> None:
-    port = sim.bridge.tcpros.port  # type: ignore[attr-defined]
+    port = sim.bridge.tcpros.port
     with socket.create_connection(("127.0.0.1", port)) as s:
         s.sendall(struct.pack("<I", 12) + b"\xff" * 12)
         assert s.recv(100) == b""  # closed on us

@@ -12,15 +12,17 @@ import tempfile
 import threading
 from collections.abc import Callable
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, TypeVar
 
 from navlab import msgs
+from navlab.core.executor import Executor
 from navlab.ros1.errors import Ros1Error
 from navlab.ros1.wire import Service
 
 if TYPE_CHECKING:
     from navlab.ros1.bridge import RosBridge
 
+T = TypeVar("T")
 CALL_TIMEOUT = 30.0  # wall seconds a service call waits for the executor
 
 # navlab service (last name part) -> (ROS 1 name it is offered under, or None for the same, ROS 1 service type)
@@ -53,30 +55,37 @@ def offer_services(bridge: RosBridge) -> None:
                                            "registerService", srv.caller_id, srv.name, bridge.tcpros.uri, bridge.uri))
 
 
+def call_in_executor(executor: Executor, fn: Callable[[], T], timeout: float = 30.0) -> T:
+    """Run ``fn()`` in the executor's thread (through its inbox) and return its value or raise its error."""
+    out: list[Any] = []
+    done = threading.Event()
+
+    def run() -> None:
+        try:
+            out.append(fn())
+        except Exception as exc:
+            out.append(exc)
+        finally:
+            done.set()
+
+    executor.post(run)
+    if not done.wait(timeout):
+        raise Ros1Error(f"the run did not answer within {timeout:.0f} s (is it paused?)")
+    if isinstance(out[0], Exception):
+        raise out[0]
+    return out[0]
+
+
 Adapter = Callable[["RosBridge", Callable[[Any], Any], Any, Any], Any]
 
 
 def _handler(bridge: RosBridge, name: str, req_type: str, res_type: str, adapter: Adapter) -> Callable[[bytes], bytes]:
     def handle(raw: bytes) -> bytes:
         request = bridge.types.deserialize(raw, req_type)
-        result: list[Any] = []
-        done = threading.Event()
-
-        def run() -> None:
-            try:
-                result.append(adapter(bridge, lambda r: bridge.ex.call_service(name, r), request,
-                                      bridge.types.store.types[res_type]))
-            except Exception as exc:
-                result.append(exc)
-            finally:
-                done.set()
-
-        bridge.ex.post(run)
-        if not done.wait(CALL_TIMEOUT):
-            raise Ros1Error(f"service {name}: no answer within {CALL_TIMEOUT:.0f} s (is the run paused?)")
-        if isinstance(result[0], Exception):
-            raise result[0]
-        return bridge.types.serialize(result[0], res_type)
+        response = bridge.types.store.types[res_type]
+        result = call_in_executor(bridge.ex, lambda: adapter(bridge, lambda r: bridge.ex.call_service(name, r),
+                                                              request, response), CALL_TIMEOUT)
+        return bridge.types.serialize(result, res_type)
 
     return handle
 
