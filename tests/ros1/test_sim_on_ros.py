@@ -8,6 +8,7 @@ import socket
 import struct
 import subprocess
 import sys
+import time
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -97,3 +98,22 @@ print(got[0], rospy.search_param('gain') or '')
     finally:
         core.terminate()
         core.wait(5)
+
+
+def test_navlab_sim_ros_starts_its_own_master_when_none_answers(ros_env: dict[str, str]) -> None:
+    env = {**ros_env, "ROS_MASTER_URI": f"http://127.0.0.1:{free_port()}/"}  # nothing listens there
+    env.pop("ROS_IP")  # and nothing says where to listen: loopback
+    proc = subprocess.Popen([str(Path(sys.executable).parent / "navlab"), "sim", "--ros", "--duration", "60",
+                             "--quiet"], env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    try:
+        deadline = time.monotonic() + 30
+        listed = ""
+        while "/odom" not in listed and time.monotonic() < deadline:
+            time.sleep(0.5)
+            done = subprocess.run(["/usr/bin/rostopic", "list"], env=env, capture_output=True, text=True, timeout=10)
+            listed = done.stdout
+        assert "/odom" in listed and "/mybot/laser/scan" in listed
+    finally:
+        proc.terminate()
+        _, err = proc.communicate(timeout=15)
+    assert "started navlab's own" in err and "loopback only" in err
