@@ -117,3 +117,22 @@ def test_navlab_sim_ros_starts_its_own_master_when_none_answers(ros_env: dict[st
         proc.terminate()
         _, err = proc.communicate(timeout=15)
     assert "started navlab's own" in err and "loopback only" in err
+
+
+def test_a_subscriber_that_never_reads_does_not_slow_the_run(sim: LiveRun) -> None:
+    """A TCPROS subscriber that stops reading: its queue drops the oldest scans, the run keeps real time."""
+    from navlab.ros1.tcpros import encode_header, recv_header
+
+    pub = sim.bridge.tcpros.publications["/mybot/laser/scan"]
+    with socket.socket() as s:
+        s.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)  # before connecting: a small receive window
+        s.connect(("127.0.0.1", sim.bridge.tcpros.port))
+        s.sendall(encode_header({"callerid": "/stuck", "topic": "/mybot/laser/scan", "md5sum": "*",
+                                 "type": "sensor_msgs/LaserScan"}))
+        assert recv_header(s)["type"] == "sensor_msgs/LaserScan"
+        sim0, wall0 = sim.ex.now_ns, time.monotonic()
+        time.sleep(5.0)  # 200 scans of ~6 kB: far more than the small window and the queue (100) hold
+        ratio = (sim.ex.now_ns - sim0) / 1e9 / (time.monotonic() - wall0)
+        stuck = next(c for c in pub.connections if c.peer.startswith("/stuck"))
+        assert stuck.dropped > 0
+    assert 0.9 < ratio < 1.1

@@ -21,6 +21,7 @@ from navlab.ros1.tcpros import encode_header, frame, recv_frame, recv_header
 from navlab.ros1.types import ServiceType, WireType
 
 QUEUE_SIZE = 100  # messages per outgoing connection before the oldest is dropped
+SEND_BUFFER = 128 * 1024  # bytes of kernel send buffer per outgoing connection (Linux doubles it)
 
 
 class Outgoing:
@@ -159,6 +160,8 @@ class TcpRosServer:
             "message_definition": pub.wtype.definition, "latching": "1" if latched else "0"}))
         if header.get("tcp_nodelay") == "1":
             sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        # a small kernel buffer: a subscriber that stops reading backs up into its bounded queue, not into megabytes
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_SNDBUF, SEND_BUFFER)
         sock.settimeout(None)
         conn = Outgoing(sock, f"{header.get('callerid', '?')} ({peer})", topic)
         for payload in latched:
