@@ -10,6 +10,15 @@ from __future__ import annotations
 import threading
 
 from navlab.core.executor import Executor
+from navlab.core.topics import Timer
+from navlab.ros1.net import LOG
+
+MAX_JUMP_NS = 3600 * 1_000_000_000
+HEARTBEAT_NS = 10_000_000
+
+
+def _nothing() -> None:
+    pass
 
 
 class ClockFollower:
@@ -19,11 +28,22 @@ class ClockFollower:
         self.latest_ns = -1
         self._cond = threading.Condition()
         self._closed = False
+        self._warned = False
         executor.add_stepper(self)
+        # a heartbeat event every 10 ms: time moves in clock-sized steps even when no node has a timer
+        # (map_server + amcl only wait for messages); otherwise the executor would wait for its run's end time
+        self._heartbeat = Timer(executor, HEARTBEAT_NS, _nothing, 0, executor.now_ns)
 
     def tick(self, t_ns: int) -> None:
-        """A ``/clock`` message arrived (any thread)."""
+        """A ``/clock`` message arrived (any thread); a jump of more than an hour is refused (wall-clock time
+        such as ``rosbag play --clock`` of a bag recorded without /clock would fire every timer in between)."""
         with self._cond:
+            if self.latest_ns >= 0 and t_ns - self.latest_ns > MAX_JUMP_NS:
+                if not self._warned:
+                    self._warned = True
+                    LOG.error("ros1: /clock jumped %.0f s ahead: ignored (follow a simulator's /clock or play a "
+                              "bag that recorded /clock, without --clock)", (t_ns - self.latest_ns) / 1e9)
+                return
             if t_ns > self.latest_ns:
                 self.latest_ns = t_ns
                 self._cond.notify_all()
@@ -35,6 +55,7 @@ class ClockFollower:
 
     def close(self) -> None:
         """Stop waiting (the run is ending)."""
+        self._heartbeat.cancel()
         with self._cond:
             self._closed = True
             self._cond.notify_all()

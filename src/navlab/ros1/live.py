@@ -37,5 +37,7 @@ class LiveRun:
 
     def close(self) -> None:
         self.ex.post(self.ex.stop)
+        if self.bridge.follower is not None:  # the graph's clock may have stopped: do not wait for it
+            self.bridge.follower.close()
         self.thread.join(10)
         self.bridge.close()
