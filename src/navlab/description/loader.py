@@ -113,6 +113,12 @@ def load_robot(
     return model
 
 
+def xacro_text(path: str | os.PathLike[str], args: Mapping[str, str] | None = None) -> str:
+    """The URDF text ``xacro FILE name:=value`` prints (a launch file's ``<param command="xacro ...">``)."""
+    file = robot_path(path)
+    return expand(file, PackageIndex(near=file), args)[0]
+
+
 def robot_launch_values(name_or_path: str | os.PathLike[str]) -> dict[str, str]:
     """What launch files take from a robot's plugin tags (``$(robot KEY)``): ``base_frame`` (the
     diff-drive plugin's ``robotBaseFrame``, else the root link), ``odom_frame`` and ``scan_topic`` (the
