@@ -78,13 +78,15 @@ def test_ros2_namespace_prefixes_relative_topics(tmp_path):
     assert dd.namespace == "/demo" and dd.command_topic == "/demo/cmd_demo"
 
 
-def test_ros1_torque_spelling_and_missing_legacy_mode(tmp_path):
+def test_noetic_ignores_torque_and_legacy_mode_and_says_which_tag_it_reads(tmp_path):
     tag = ROS1.replace("<wheelTorque>4</wheelTorque>", "<torque>15</torque>").replace(
-        "<legacyMode>false</legacyMode>", "")
+        "<legacyMode>false</legacyMode>", "<legacyMode>true</legacyMode>")
     robot = _robot(tmp_path, tag)
-    assert robot.diff_drive.max_torque == 15
-    assert robot.diff_drive.legacy_mode is True  # ROS 1's default
-    assert any("legacyMode" in w for w in robot.warnings)
+    assert robot.diff_drive.max_torque == 5.0  # Noetic's wheelTorque default, not the ignored <torque>
+    assert robot.diff_drive.legacy_mode is False  # Noetic has no legacy mode
+    (torque,) = [w for w in robot.warnings if "<torque>" in w]
+    assert "<wheelTorque>" in torque and "5 N m" in torque
+    assert any("<legacyMode> was removed" in w for w in robot.warnings)
 
 
 RAY = """<ray><scan><horizontal><samples>{n}</samples><resolution>1</resolution>

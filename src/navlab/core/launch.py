@@ -353,8 +353,15 @@ def _check_args(files: list[Path], args: dict[str, Any]) -> None:
 
 
 def declared_args(name_or_path: str) -> list[dict[str, Any]]:
-    """The ``arg`` entries of a launch file (for ``--help``-like listings)."""
-    return [e["arg"] for e in _entries(find_launch_file(name_or_path)) if isinstance(e, dict) and "arg" in e]
+    """The ``arg`` entries of a launch file (for ``--help``-like listings); a ROS 1 .launch's ``<arg>``
+    elements with ``doc`` as the description and ``value=`` ones (fixed) left out."""
+    file = find_launch_file(name_or_path)
+    from navlab.core.roslaunch import declared_args as xml_args
+    from navlab.core.roslaunch import is_xml_launch
+
+    if is_xml_launch(file):
+        return xml_args(file)
+    return [e["arg"] for e in _entries(file) if isinstance(e, dict) and "arg" in e]
 
 
 def start(

@@ -448,7 +448,7 @@ class _Loader:
         if depth > MAX_INCLUDE_DEPTH:
             raise LaunchError(f"{path}: includes nest deeper than {MAX_INCLUDE_DEPTH} levels (an include loop?)")
         root = _parse(path)
-        declared = {str(e.get("name")) for e in root.iter("arg") if e.get("name")}
+        declared = _declared(root)
         unused = sorted(set(passed) - declared)
         if unused and not pass_all:
             raise LaunchError(f"{outer.file}: unused args [{', '.join(unused)}] for include of [{path}] "
@@ -575,6 +575,17 @@ def _parse(file: Path) -> ET.Element:
     return root
 
 
+def _declared(el: ET.Element) -> set[str]:
+    """The args a file declares (``<arg>`` in ``<launch>`` and its groups, not those passed to includes)."""
+    out: set[str] = set()
+    for child in el:
+        if child.tag == "arg" and child.get("name"):
+            out.add(str(child.get("name")))
+        elif child.tag == "group":
+            out |= _declared(child)
+    return out
+
+
 def is_xml_launch(path: str | os.PathLike[str]) -> bool:
     """Whether a file is a ROS 1 XML launch (by suffix ``.launch``/``.xml``, else by its first tag)."""
     p = Path(path)
@@ -596,7 +607,7 @@ def load(files: list[Path], args: Mapping[str, str], *, seed: int = 0, allow_com
     loader = _Loader(config, seed)
     for file in files:
         root = _parse(file)
-        config.declared |= {str(e.get("name")) for e in root.iter("arg") if e.get("name")}
+        config.declared |= _declared(root)
     for name in args:
         if name not in config.declared:
             close = difflib.get_close_matches(name, sorted(config.declared), n=1)
@@ -608,3 +619,16 @@ def load(files: list[Path], args: Mapping[str, str], *, seed: int = 0, allow_com
         scope = _Scope(file, {})
         loader.block(root, scope, {k: v for k, v in args.items()}, 0)
     return config
+
+
+def declared_args(file: Path) -> list[dict[str, str]]:
+    """The overridable ``<arg>``s of a .launch file: name, description (``doc``) and default, if any."""
+    out: list[dict[str, str]] = []
+    root = _parse(file)
+    for el in [e for e in root.iter("arg") if e.get("name") in _declared(root)]:
+        if el.get("name") and "value" not in el.attrib and el.get("name") not in [a["name"] for a in out]:
+            row = {"name": str(el.get("name")), "description": el.get("doc", "")}
+            if "default" in el.attrib:
+                row["default"] = str(el.get("default"))
+            out.append(row)
+    return out

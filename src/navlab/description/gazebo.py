@@ -36,12 +36,18 @@ LINK_TAGS = ("mu1", "mu2", "material", "kp", "kd", "minDepth", "maxVel", "fdir1"
 
 DD_KEYS_ROS1 = {
     "leftJoint": "left_joint", "rightJoint": "right_joint", "wheelSeparation": "wheel_separation",
-    "wheelDiameter": "wheel_diameter", "torque": "max_torque", "wheelTorque": "max_torque",
+    "wheelDiameter": "wheel_diameter", "wheelTorque": "max_torque",
     "wheelAcceleration": "max_accel", "updateRate": "update_rate", "commandTopic": "command_topic",
     "odometryTopic": "odometry_topic", "odometryFrame": "odometry_frame",
     "robotBaseFrame": "robot_base_frame", "odometrySource": "odometry_source", "publishTf": "publish_tf",
     "publishOdomTF": "publish_tf", "publishWheelTF": "publish_wheel_tf", "robotNamespace": "namespace",
-    "legacyMode": "legacy_mode",
+}
+#: tags older ROS 1 releases read that Noetic's gazebo_ros_diff_drive does not: the warning names what it reads
+DD_NOT_IN_NOETIC = {
+    "torque": "<torque> is not read by ROS Noetic's gazebo_ros_diff_drive (ignored since Hydro); it reads "
+              "<wheelTorque> (default 5 N m), which applies",
+    "legacyMode": "<legacyMode> was removed from gazebo_ros_diff_drive in Melodic (gazebo_ros_pkgs PR #707); "
+                  "Noetic drives the <leftJoint> joint as the left wheel and <rightJoint> as the right one",
 }
 DD_KEYS_ROS2 = {
     "left_joint": "left_joint", "right_joint": "right_joint", "wheel_separation": "wheel_separation",
@@ -55,7 +61,7 @@ DD_KEYS_ROS2 = {
 DD_IGNORED = ("alwaysOn", "rosDebugLevel", "publishWheelJointState", "publishOdom", "publish_odom",
               "ros", "num_wheel_pairs", "covariance_x", "covariance_y", "covariance_yaw", "odometryRate")
 FLOAT_FIELDS = ("wheel_separation", "wheel_diameter", "max_torque", "max_accel", "update_rate")
-BOOL_FIELDS = ("publish_tf", "publish_wheel_tf", "legacy_mode")
+BOOL_FIELDS = ("publish_tf", "publish_wheel_tf")
 GAZEBO_DEFAULT_RATE = 1000.0  # Hz: Gazebo's default physics rate; a plugin rate of 0 means every step
 
 
@@ -67,7 +73,6 @@ class GazeboTags:
     lidars: list[LidarConfig] = field(default_factory=list)
     imus: list[ImuConfig] = field(default_factory=list)
     warnings: list[str] = field(default_factory=list)
-    legacy_mode_given: bool = True  # the diff-drive plugin wrote <legacyMode> (else ROS 1's default applied)
 
 
 def _bool(text: str, where: str) -> bool:
@@ -125,14 +130,15 @@ def parse_diff_drive(plugin: ET.Element, where: str, warnings: list[str]) -> Dif
         if not isinstance(child.tag, str):
             continue
         key = DD_KEYS_ROS1.get(child.tag) or DD_KEYS_ROS2.get(child.tag)
-        if key is not None:
+        if child.tag == "legacyMode" and (child.text or "").strip().lower() in ("false", "0"):
+            pass  # what Noetic does anyway: nothing to say
+        elif child.tag in DD_NOT_IN_NOETIC:
+            warnings.append(f"{where}: {DD_NOT_IN_NOETIC[child.tag]}")
+        elif key is not None:
             values[key] = (child.text or "").strip()
         elif child.tag not in DD_IGNORED:
             warnings.append(f"{where}: unknown diff-drive parameter <{child.tag}> ignored"
                             f"{_did_you_mean(child.tag, known)}")
-    ros2 = any(c.tag in DD_KEYS_ROS2 for c in plugin) or plugin.find("ros") is not None
-    if "legacy_mode" not in values and not ros2:
-        cfg.legacy_mode = True  # ROS 1's default; what it does to this robot is reported by check_plugin_joints
     if "odometry_source" not in values:
         cfg.odometry_source = "world"  # both plugins default to the true pose
     for key, raw in values.items():
@@ -373,7 +379,6 @@ def _read_model_plugin(plugin: ET.Element, where: str, out: GazeboTags) -> None:
             out.warnings.append(f"{w}: a second diff-drive plugin; the first one is used")
         else:
             out.diff_drive = parse_diff_drive(plugin, w, out.warnings)
-            out.legacy_mode_given = plugin.find("legacyMode") is not None
     elif fname in IMU_MODEL_PLUGINS:
         body = (plugin.findtext("bodyName") or "").strip()
         if not body:
@@ -397,35 +402,24 @@ def _side(joint: str, chain: dict[str, tuple[str, Origin]]) -> float:
     return pose.xyz[1]
 
 
-def legacy_mode_note(dd: DiffDriveConfig, chain: dict[str, tuple[str, Origin]], given: bool) -> str | None:
-    """What ROS 1's ``<legacyMode>`` does to this robot, or None when it changes nothing worth saying.
+def swapped_joints_note(dd: DiffDriveConfig, chain: dict[str, tuple[str, Origin]]) -> str | None:
+    """How the robot turns when ``<leftJoint>`` names the wheel on the right, else None.
 
     ``chain``: joint name -> (its parent link's parent joint name or "", its origin), to find on which
-    side (+y: left) each wheel sits. With legacy mode the joint named in ``<leftJoint>`` is driven
-    as the right wheel, so only a robot whose ``<leftJoint>`` is physically on the right turns
-    the way cmd_vel asks."""
-    left_y, right_y = _side(dd.left_joint, chain), _side(dd.right_joint, chain)
-    swapped = left_y < right_y  # <leftJoint> names the wheel on the right
-    how = "<legacyMode> not given: ROS 1's default true applies" if not given else "<legacyMode> true"
-    if dd.legacy_mode and not swapped:
-        return (f"{how}; <leftJoint> {dd.left_joint!r} (on the left) is driven as the right wheel, so the "
-                "robot turns the opposite way to cmd_vel's angular.z, as it does in Gazebo; odometry "
-                "follows the wheels (legacyMode false gives REP-103 turning)")
-    if dd.legacy_mode and swapped:
-        return (f"{how}; <leftJoint> {dd.left_joint!r} is the wheel on the right, and legacy mode drives "
-                "it as the right wheel: the robot turns as cmd_vel asks, as it does in Gazebo")
-    if swapped:
-        return (f"<legacyMode> false but <leftJoint> {dd.left_joint!r} is the wheel on the right: the robot "
-                "turns the opposite way to cmd_vel's angular.z, as it does in Gazebo")
-    return None
+    side (+y: left) each wheel sits. ROS Noetic's plugin drives the ``<leftJoint>`` joint as the left
+    wheel whatever side it is on, so such a robot turns the opposite way to cmd_vel, in Gazebo and here."""
+    if dd.legacy_mode or _side(dd.left_joint, chain) >= _side(dd.right_joint, chain):
+        return None
+    return (f"<leftJoint> {dd.left_joint!r} is the wheel on the right: ROS Noetic's plugin drives it as the left "
+            "wheel, so the robot turns the opposite way to cmd_vel's angular.z, as it does in Gazebo")
 
 
 def check_plugin_joints(tags: GazeboTags, joints: dict[str, str], links: dict[str, Link], source: str,
-                        chain: dict[str, tuple[str, Origin]] | None = None, *, legacy_given: bool = True) -> None:
+                        chain: dict[str, tuple[str, Origin]] | None = None) -> None:
     """The diff-drive joints must be continuous/revolute joints; sensors must sit on existing links.
 
-    With ``chain`` (see :func:`legacy_mode_note`) a note on how the robot turns under ROS 1's
-    ``<legacyMode>`` is added to the warnings."""
+    With ``chain`` (see :func:`swapped_joints_note`) a note on a robot whose left and right joints are
+    named the other way round is added to the warnings."""
     dd = tags.diff_drive
     if dd is not None:
         for role, name in (("left", dd.left_joint), ("right", dd.right_joint)):
@@ -436,7 +430,7 @@ def check_plugin_joints(tags: GazeboTags, joints: dict[str, str], links: dict[st
                 raise DescriptionError(f"{source}: diff-drive plugin: {role} joint {name!r} is {joints[name]}, "
                                        "expected continuous or revolute")
         if chain is not None:
-            note = legacy_mode_note(dd, chain, legacy_given)
+            note = swapped_joints_note(dd, chain)
             if note:
                 tags.warnings.append(f"{source}: diff-drive plugin: {note}")
     for imu in tags.imus:

@@ -101,8 +101,7 @@ def load_robot(
     tags = read_gazebo_tags(root, links, {j.name for j in joints}, source)
     parent_joint = {j.child: j.name for j in joints}
     chain = {j.name: (parent_joint.get(j.parent, ""), j.origin) for j in joints}
-    check_plugin_joints(tags, {j.name: j.type for j in joints}, links, source, chain,
-                        legacy_given=tags.legacy_mode_given)
+    check_plugin_joints(tags, {j.name: j.type for j in joints}, links, source, chain)
     model.diff_drive = tags.diff_drive
     model.lidars = tags.lidars
     model.imus = tags.imus

@@ -159,7 +159,9 @@ class DiffDriveConfig:
     # wheels are stopped; 0 = off, as in ROS 1's plugin (the last command holds until a new one)
     cmd_timeout: float = 0.0
     namespace: str = ""
-    legacy_mode: bool = False  # ROS 1 <legacyMode> (default true there): the joints' turning roles swapped
+    # Kinetic's <legacyMode> (the joints' turning roles swapped); Noetic's plugin has no such option, so the
+    # tags never set it (a <legacyMode> tag is ignored with a warning); kept for Python callers
+    legacy_mode: bool = False
     # navlab extension (not a Gazebo tag): relative error of each wheel's encoder scale, drawn once per
     # run from N(0, odometry_noise) with the run's seed; 0 = exact encoders. Makes odometry drift.
     odometry_noise: float = 0.0
