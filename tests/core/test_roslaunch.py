@@ -114,14 +114,16 @@ def test_bad_launch_files_get_one_clear_error(tmp_path: Path, body: str, args: d
 
 
 def test_eval_runs_in_the_sandbox(tmp_path: Path) -> None:
-    pytest.importorskip("navlab.core.safe_eval")
     file = _write(tmp_path / "e.launch", """<launch>
   <arg name="radius" default="0.5"/>
   <param name="twice" value="$(eval 2 * float(radius))"/>
   <param name="picked" value="$(eval arg('radius') == '0.5')"/>
+  <group if="$(eval float(radius) &gt; 0.4 and optenv('NAVLAB_T_UNSET', 'x') == 'x')">
+    <param name="big" value="$(eval find('my_slam').endswith('my_slam'))"/>
+  </group>
 </launch>""")
     config = load([file], {})
-    assert config.params["/twice"] == 1.0 and config.params["/picked"] is True
+    assert config.params["/twice"] == 1.0 and config.params["/picked"] is True and config.params["/big"] is True
     bad = _write(tmp_path / "b.launch", '<launch><param name="x" value="$(eval __import__(\'os\'))"/></launch>')
     with pytest.raises(LaunchError, match=r"\$\(eval __import__"):
         load([bad], {})

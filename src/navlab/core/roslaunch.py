@@ -41,6 +41,8 @@ XACRO_TEXT = "navlab.description.loader:xacro_text"
 
 _SUB = re.compile(r"\$\(([a-z]+)((?:\s+[^()]*)?)\)")
 _IGNORED_TAGS = ("machine", "test", "master")
+_EVAL_BUILTINS: dict[str, Callable[..., Any]] = {
+    f.__name__: f for f in (int, float, str, bool, abs, min, max, round, len)}
 MAX_INCLUDE_DEPTH = 20
 MAX_LAUNCH_BYTES = 4 << 20
 
@@ -217,20 +219,16 @@ class _Loader:
 
     def eval(self, expr: str, scope: _Scope, where: str) -> str:
         """``$(eval EXPR)``: args are names, ``arg()``/``env()``/``optenv()``/``find()``/``anon()``/
-        ``dirname()`` are functions, evaluated in navlab's sandbox; the result as text."""
-        try:
-            from navlab.core.safe_eval import UnsafeExpressionError, safe_eval
-        except ImportError:  # pragma: no cover - the sandbox ships with navlab
-            raise LaunchError(f"{where}: $(eval) needs navlab.core.safe_eval, which this navlab lacks") from None
+        ``dirname()`` and Python's ``int float str bool abs min max round len`` are functions, evaluated in
+        navlab's expression sandbox (never Python's ``eval``); the result as text."""
+        from navlab.core.safe_eval import ExpressionError, safe_eval
+
         names: dict[str, Any] = {"true": True, "false": False, "True": True, "False": False, **scope.args}
+        functions: dict[str, Callable[..., Any]] = {**_EVAL_BUILTINS, **self.functions(scope, where)}
         try:
-            value = safe_eval(expr, names, functions=self.functions(scope, where))
-        except UnsafeExpressionError as exc:
+            value = safe_eval(expr, names, functions=functions)
+        except ExpressionError as exc:
             raise LaunchError(f"{where}: $(eval {expr}): {exc}") from None
-        except LaunchError:
-            raise
-        except Exception as exc:  # a runtime error of the expression (1/0, 'a' + 1, ...)
-            raise LaunchError(f"{where}: $(eval {expr}): {type(exc).__name__}: {exc}") from None
         return str(value)
 
     # --- attributes -----------------------------------------------------------------------------
