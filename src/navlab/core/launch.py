@@ -26,7 +26,7 @@ from __future__ import annotations
 import importlib
 import os
 import re
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
@@ -160,7 +160,13 @@ class _Context:
             module, func = ROBOT_LAUNCH_VALUES.split(":", 1)
             self.robot_values[robot] = getattr(importlib.import_module(module), func)(robot)
         values = self.robot_values[robot]
-        if key not in values:
+        note = values.get(f"{key}_note")
+        if note:  # said once per launch, when the value is used
+            import logging
+
+            logging.getLogger("navlab.launch").warning(note)
+            values.pop(f"{key}_note")
+        if key not in values or key.endswith("_note"):
             raise LaunchError(f"{self.file}: {where}: $(robot {key}): expected one of {', '.join(sorted(values))}")
         return values[key]
 
@@ -172,8 +178,7 @@ class _Context:
         if not isinstance(value, str):
             return value
 
-        def repl(m: re.Match[str]) -> str:
-            kind, arg = m.group(1), (m.group(2) or "").strip()
+        def repl(kind: str, arg: str) -> str:
             if kind == "var":
                 if arg not in self.vars:
                     known = ", ".join(self.vars) or "none"
@@ -191,10 +196,42 @@ class _Context:
                 raise LaunchError(f"{self.file}: {where}: unknown package {arg!r} in $(find-pkg-share)")
             if kind == "robot":
                 return self.robot_value(arg, where)
+            if kind == "eval":  # ROS 2's PythonExpression, in navlab's sandbox
+                from navlab.core.safe_eval import ExpressionError, safe_eval
+
+                try:
+                    return str(safe_eval(arg, {"true": True, "false": False}, functions=_EVAL_FUNCTIONS))
+                except ExpressionError as exc:
+                    raise LaunchError(f"{self.file}: {where}: $(eval {arg}): {exc}") from None
             raise LaunchError(f"{self.file}: {where}: unknown substitution $({kind})")
 
-        out = _SUBST.sub(repl, value)
+        out = _expand(value, repl, f"{self.file}: {where}")
         return _typed(out) if out != value else value
+
+
+_EVAL_FUNCTIONS = {f.__name__: f for f in (int, float, str, bool, abs, min, max, round, len)}
+
+
+def _expand(text: str, resolve: Callable[[str, str], str], where: str) -> str:
+    """``text`` with each ``$(KIND ARG)`` replaced by ``resolve(KIND, ARG)``, innermost first (as ROS 2 launch
+    nests substitutions: ``$(eval '$(var a)' == 'x')``)."""
+    out: list[str] = []
+    i = 0
+    while (j := text.find("$(", i)) >= 0:
+        out.append(text[i:j])
+        depth, k = 0, j + 1
+        while k < len(text):
+            depth += {"(": 1, ")": -1}.get(text[k], 0)
+            if depth == 0:
+                break
+            k += 1
+        if k >= len(text):
+            raise LaunchError(f"{where}: unterminated substitution in {text!r}")
+        kind, _, arg = _expand(text[j + 2:k], resolve, where).strip().partition(" ")
+        out.append(resolve(kind, arg.strip()))
+        i = k + 1
+    out.append(text[i:])
+    return "".join(out)
 
 
 def _typed(text: str) -> Any:
@@ -239,7 +276,10 @@ def _node_params(ctx: _Context, spec: dict[str, Any], where: str) -> tuple[dict[
     params: dict[str, Any] = {}
     files: list[str] = []
     for item in _items(ctx, spec, "param", where, ()):
-        item = ctx.subst(item, where)
+        if isinstance(item, dict) and not _condition(ctx, item, where):  # a param entry's if/unless
+            continue
+        item = ctx.subst({k: v for k, v in item.items() if k not in ("if", "unless")} if isinstance(item, dict)
+                         else item, where)
         if not isinstance(item, dict):
             raise LaunchError(f"{ctx.file}: {where}: a param entry must be a mapping, got {item!r}")
         if "from" in item:
