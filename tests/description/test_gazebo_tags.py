@@ -176,3 +176,27 @@ def test_diff_drive_joint_must_exist(tmp_path):
 def test_diff_drive_bad_value_names_element(tmp_path):
     with pytest.raises(DescriptionError, match=r"r\.urdf.*<plugin name=\"dd\".*wheel_separation"):
         _robot(tmp_path, ROS1.replace("<wheelSeparation>0.3<", "<wheelSeparation>wide<"))
+
+
+def test_noetic_laser_defaults_and_ignored_tags(tmp_path):
+    """ROS Noetic's gazebo_ros_laser: no <topicName> publishes on /world, no <frameName> stamps frame /world;
+    <gaussianNoise>/<hokuyoMinIntensity>/<updateRate> are not read (the sensor's <noise>/<update_rate> are)."""
+    plugin = ('<plugin name="laser" filename="libgazebo_ros_laser.so"><gaussianNoise>0.5</gaussianNoise>'
+              "<hokuyoMinIntensity>101</hokuyoMinIntensity><updateRate>40</updateRate></plugin>")
+    tag = (f'<gazebo reference="scan_link"><sensor type="ray" name="front_laser"><update_rate>15</update_rate>'
+           f"{RAY.format(n=181)}{plugin}</sensor></gazebo>")
+    robot = _robot(tmp_path, ROS1, tag)
+    (lidar,) = robot.lidars
+    assert (lidar.topic, lidar.frame_id, lidar.update_rate, lidar.noise_stddev) == ("/world", "world", 15, 0.03)
+    said = " | ".join(robot.warnings)
+    for words in ("no <topicName>", "'/world'", "no <frameName>", "<gaussianNoise> is not read",
+                  "<ray><noise>", "<hokuyoMinIntensity> is not read", "<updateRate> is not read",
+                  "<update_rate>"):
+        assert words in said
+
+
+def test_noetic_imu_model_plugin_default_topic(tmp_path):
+    tag = ('<gazebo><plugin name="imu" filename="libgazebo_ros_imu.so"><bodyName>imu_link</bodyName>'
+           "<updateRate>50</updateRate></plugin></gazebo>")
+    (imu,) = _robot(tmp_path, ROS1, tag).imus
+    assert imu.topic == "/default_imu" and imu.frame_id == "imu_link"  # Noetic's gazebo_ros_imu defaults

@@ -113,3 +113,22 @@ def test_mapping_launch_takes_base_frame_and_scan_topic_from_the_robot() -> None
     grid = slam.current_map()  # type: ignore[attr-defined]
     assert slam.scans_processed >= 5 and grid is not None  # type: ignore[attr-defined]
     assert int((grid.data >= 65).sum()) > 100  # the room's walls are in the map
+
+
+def test_a_torque_tag_drives_as_noetic_drives_it_with_wheel_torque_5(tmp_path: Path) -> None:
+    """Noetic's plugin reads <wheelTorque> (default 5 N m), not <torque>: a robot whose file says <torque>0.001</torque>
+    drives exactly as one with <wheelTorque>5</wheelTorque>, while <wheelTorque>0.001</wheelTorque> barely moves it."""
+    import shutil
+
+    src = Path(__file__).parents[1] / "fixtures" / "ros_ws" / "my_description"
+    x_after: dict[str, float] = {}
+    for label, tag in (("torque", "<torque>0.001</torque>"), ("default", "<wheelTorque>5</wheelTorque>"),
+                       ("weak", "<wheelTorque>0.001</wheelTorque>")):
+        pkg = tmp_path / label / "my_description"
+        shutil.copytree(src, pkg)
+        gz = pkg / "urdf" / "my_robot.gazebo.xacro"
+        gz.write_text(gz.read_text().replace("<wheelTorque>10</wheelTorque>", tag))
+        _, gazebo = _drive(load_robot(pkg / "urdf" / "my_robot.urdf.xacro"), [(0.05, 0.2, 0.0)], 2.0)
+        x_after[label] = gazebo.sim.base_pose2d()[0]  # type: ignore[attr-defined]
+    assert x_after["torque"] == x_after["default"] and x_after["default"] > 0.3
+    assert x_after["weak"] < 0.5 * x_after["default"]

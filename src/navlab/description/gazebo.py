@@ -58,6 +58,12 @@ DD_KEYS_ROS2 = {
     "publish_wheel_tf": "publish_wheel_tf", "command_topic": "command_topic",
     "odometry_topic": "odometry_topic",
 }
+#: tags older laser plugins (or other ones) read that Noetic's gazebo_ros_laser does not: what applies instead
+LASER_NOT_IN_NOETIC = {
+    "gaussianNoise": "the sensor's <ray><noise> (gaussian, stddev)",
+    "hokuyoMinIntensity": "the sensor's intensities as Gazebo computes them",
+    "updateRate": "the sensor's <update_rate>",
+}
 DD_IGNORED = ("alwaysOn", "rosDebugLevel", "publishWheelJointState", "publishOdom", "publish_odom",
               "ros", "num_wheel_pairs", "covariance_x", "covariance_y", "covariance_yaw", "odometryRate")
 FLOAT_FIELDS = ("wheel_separation", "wheel_diameter", "max_torque", "max_accel", "update_rate")
@@ -172,6 +178,15 @@ def parse_diff_drive(plugin: ET.Element, where: str, warnings: list[str]) -> Dif
     return cfg
 
 
+def _noetic_default(plugin: ET.Element, tag: str, default: str, what: str, where: str, warnings: list[str]) -> str:
+    """``<tag>`` of a ROS 1 plugin, or Noetic's default for it (with a warning naming the tag and the default)."""
+    text = plugin.findtext(tag)
+    if text is None:
+        warnings.append(f"{where}: no <{tag}>: ROS Noetic's {what} then uses {default!r}, and so does navlab")
+        return default
+    return text.strip()
+
+
 def _noise(el: ET.Element | None, where: str) -> tuple[float, float]:
     """(mean, stddev) of a ``<noise>`` element (gaussian only; others warn-free zero)."""
     if el is None:
@@ -214,10 +229,13 @@ def parse_lidar(sensor: ET.Element, link: str, where: str, plugin: ET.Element,
     ns, remaps = _remaps(plugin)
     name = plugin.get("name", "")
     ros2 = plugin.find("ros") is not None or _plugin_file(plugin) == "libgazebo_ros_ray_sensor.so"
-    if not ros2:  # ROS 1: <topicName> (default "scan" here), <frameName>, <robotNamespace>
+    if not ros2:  # ROS 1: <topicName>, <frameName>, <robotNamespace>, with Noetic's defaults
         ns = (plugin.findtext("robotNamespace") or "").strip()
-        topic = (plugin.findtext("topicName") or "scan").strip()
-        frame = (plugin.findtext("frameName") or "").strip()
+        topic = _noetic_default(plugin, "topicName", "/world", "gazebo_ros_laser", where, warnings)
+        frame = _noetic_default(plugin, "frameName", "/world", "gazebo_ros_laser", where, warnings)
+        for tag, read in LASER_NOT_IN_NOETIC.items():
+            if plugin.find(tag) is not None:
+                warnings.append(f"{where}: <{tag}> is not read by ROS Noetic's gazebo_ros_laser; {read} applies")
     else:  # ROS 2: node named after the plugin publishes ~/out unless remapped
         topic = remaps.get("~/out") or remaps.get("out") or f"{name or 'ray_sensor'}/out"
         frame = (plugin.findtext("frame_name") or plugin.findtext("frameName") or "").strip()
@@ -272,7 +290,8 @@ def parse_imu(plugin: ET.Element, link: str, where: str, sensor: ET.Element | No
     ns, remaps = _remaps(plugin)
     if plugin.find("ros") is None:  # ROS 1: <topicName>, <frameName>/<bodyName>, <robotNamespace>
         ns = (plugin.findtext("robotNamespace") or "").strip()
-        topic = (plugin.findtext("topicName") or "imu").strip()
+        topic = (_noetic_default(plugin, "topicName", "/default_imu", "gazebo_ros_imu", where, [])
+                 if _plugin_file(plugin) in IMU_MODEL_PLUGINS else (plugin.findtext("topicName") or "imu").strip())
         frame = (plugin.findtext("frameName") or plugin.findtext("bodyName") or link).strip()
     else:
         topic = remaps.get("~/out") or remaps.get("out") or f"{plugin.get('name') or 'imu'}/out"
