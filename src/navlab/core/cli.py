@@ -196,6 +196,38 @@ def _cmd_launch(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_run(args: argparse.Namespace) -> int:
+    """``navlab run FILE.py``: an rclpy-style node file, unchanged, in a launch's simulation."""
+    import runpy
+    import sys
+
+    from navlab.core import rclpy_api
+    from navlab.core.ros_imports import install
+
+    apply_resource_paths(args)
+    install()
+    files, items = (_split_files(args.launch, args.args) if args.launch else ([], args.args))
+    if files:
+        session = start(files, seed=args.seed, launch_args=parse_launch_args(items))
+        ctx = rclpy_api.Context(session.executor, session, args.duration, prepared=True)
+    else:
+        ctx = rclpy_api.Context(duration=args.duration, prepared=True)
+    rclpy_api.init(context=ctx)
+    argv = sys.argv
+    sys.argv = [args.file]
+    try:
+        runpy.run_path(args.file, run_name="__main__")
+    finally:
+        sys.argv = argv
+        rclpy_api.shutdown(context=ctx)
+    ex = ctx.executor
+    summary = {"sim_s": round(ex.now_ns / 1e9, 3), "nodes": sorted(ex.nodes),
+               "topics": {name: t.count for name, t in sorted(ex.topics.items())}}
+    if args.json:
+        print(json.dumps(summary))
+    return 0
+
+
 def _cmd_topic(args: argparse.Namespace) -> int:
     if args.action == "list":
         if args.bag:
@@ -335,6 +367,25 @@ def register(sub: argparse._SubParsersAction) -> None:
         p.add_argument("-s", "--show-args", action="store_true",
                        help="list the launch's arguments (name, description, default) and exit")
         p.set_defaults(func=_cmd_launch if verb == "launch" else _cmd_roslaunch)
+
+    p = sub.add_parser(
+        "run",
+        help="run an rclpy-style node file unchanged in a launch's simulation",
+        description="Run a Python file written against rclpy (import rclpy; from rclpy.node import Node; from "
+        "geometry_msgs.msg import Twist; rclpy.init(); rclpy.spin(node)) unchanged, on navlab: `import rclpy` and "
+        "the message packages come from navlab unless a real ROS 2 installation provides them. With --launch, "
+        "the file's rclpy.init() joins that launch (e.g. `navlab run driver.py --launch sim world:=room "
+        "--duration 10`); rclpy.spin() runs --duration simulated seconds.",
+    )
+    p.add_argument("file", help="the Python file")
+    p.add_argument("--launch", metavar="FILE", help="a launch (file or shipped name) to start for the node")
+    p.add_argument("args", nargs="*", metavar="name:=value", help="launch arguments")
+    p.add_argument("--duration", type=positive_seconds, default=None,
+                   help="simulated seconds rclpy.spin() runs (default: until the file calls rclpy.shutdown())")
+    p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    p.add_argument("--json", action="store_true", help="print the topics' message counts as JSON")
+    add_resource_path_arguments(p)
+    p.set_defaults(func=_cmd_run)
 
     p = sub.add_parser(
         "bag",
