@@ -484,7 +484,11 @@ def _start_xml(session: Session, files: list[Path], args: dict[str, str], *, ros
         from navlab.core.processes import ProcessGroup
 
         ex = session.executor
-        group = ProcessGroup(on_required_exit=lambda why: (log.error(why), ex.post(ex.stop)))
+        def required_exit(why: str) -> None:  # roslaunch: a required process that dies ends the launch
+            log.error(why)
+            ex.post(ex.stop)
+
+        group = ProcessGroup(on_required_exit=required_exit)
         session.processes = group
         try:
             for node in plan.processes:

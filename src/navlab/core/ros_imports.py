@@ -58,7 +58,7 @@ def message_class(msgtype: str) -> type:
     fields = TYPESTORE.fielddefs[msgtype][1]
 
     def __init__(self: Any, *args: Any, **kwargs: Any) -> None:
-        names = [f.name for f in dataclasses.fields(base)]
+        names = [f.name for f in dataclasses.fields(base)]  # type: ignore[arg-type]
         kwargs.update(zip(names, args, strict=False))
         for name, node in fields:
             if name not in kwargs:

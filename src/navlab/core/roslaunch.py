@@ -186,7 +186,7 @@ class _Loader:
 
         return {
             "arg": arg, "env": env,
-            "optenv": lambda name, default="": os.environ.get(name, default),
+            "optenv": lambda name, default="": os.environ.get(name) or default,
             "find": lambda pkg: self.find(pkg, where),
             "anon": self.anon_name,
             "dirname": lambda: str(scope.file.parent),

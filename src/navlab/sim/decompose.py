@@ -331,11 +331,12 @@ def _main_not_reimported() -> Iterator[None]:
     script without an ``if __name__ == "__main__":`` guard would then start workers of its own and crash.
     The workers need only navlab's own modules."""
     main = sys.modules.get("__main__")
-    saved = {k: main.__dict__[k] for k in ("__file__", "__spec__") if main is not None and k in main.__dict__}
+    saved: dict[str, Any] = {k: main.__dict__[k] for k in ("__file__", "__spec__")
+                             if main is not None and k in main.__dict__}
     try:
         if main is not None:
             main.__dict__.pop("__file__", None)
-            main.__spec__ = None  # type: ignore[assignment]
+            main.__spec__ = None
         yield
     finally:
         if main is not None:
