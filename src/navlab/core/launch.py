@@ -475,8 +475,10 @@ def _start_xml(session: Session, files: list[Path], args: dict[str, str], *, ros
     plan = roslaunch_nodes.plan(config, ros=ros)
     log = logging.getLogger("navlab.launch")
     for note in plan.notes:
-        log.warning(note)
-    session.notes = plan.notes
+        log.info(note)
+    for warning in plan.warnings:
+        log.warning(warning)
+    session.notes = plan.notes + plan.warnings
     session.params = config.params
     for spec in plan.nodes:
         start_node(session, spec)

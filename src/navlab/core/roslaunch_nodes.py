@@ -51,11 +51,13 @@ _SPAWN_FLOATS = {"-x": "x", "-y": "y", "-z": "z", "-R": "roll", "-P": "pitch", "
 
 @dataclass
 class Plan:
-    """What to start: navlab nodes in launch order, processes, and notes for the user."""
+    """What to start: navlab nodes in launch order, processes, and what to tell the user (``notes``: what
+    navlab covers another way, logged as info; ``warnings``: what does not run)."""
 
     nodes: list[NodeSpec] = field(default_factory=list)
     processes: list[RosNode] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
+    warnings: list[str] = field(default_factory=list)
 
 
 def _remaps(node: RosNode) -> dict[str, str]:
@@ -121,7 +123,7 @@ def _gazebo_world(node: RosNode) -> tuple[str, bool]:
 
 def plan(config: RosConfig, *, ros: bool) -> Plan:
     """Map ``config``'s nodes to navlab's; with ``ros`` other nodes become processes, else notes."""
-    out = Plan(notes=list(config.notes))
+    out = Plan(warnings=list(config.notes))
     gazebo: NodeSpec | None = None
     spawns: list[RosNode] = []
     for node in config.nodes:
@@ -133,7 +135,7 @@ def plan(config: RosConfig, *, ros: bool) -> Plan:
                 raise LaunchError(f"{node.where}: a second Gazebo server; navlab runs one world per launch")
             world, paused = _gazebo_world(node)
             if paused:
-                out.notes.append(f"{node.where}: paused:=true: navlab's simulation starts running (time still "
+                out.warnings.append(f"{node.where}: paused:=true: navlab's simulation starts running (time still "
                                  "advances only as the launch runs)")
             gazebo = NodeSpec("gazebo", node.name, node.namespace, {"world": world}, _remaps(node), origin)
             out.nodes.append(gazebo)
@@ -158,7 +160,7 @@ def plan(config: RosConfig, *, ros: bool) -> Plan:
         elif ros:
             out.processes.append(node)
         else:
-            out.notes.append(f"{node.where}: node {node.fqn!r} ({node.pkg}/{node.type}) is not one navlab runs; "
+            out.warnings.append(f"{node.where}: node {node.fqn!r} ({node.pkg}/{node.type}) is not one navlab runs; "
                              "with the ROS bridge on (ros:=true) it is started as a process")
     if spawns:
         if gazebo is None:
