@@ -19,49 +19,12 @@ from navlab.core.node import Parameter
 
 DOC = Path(__file__).parents[2] / "docs" / "core-api.md"
 
-DRIVER = '''
-import rclpy
-from rclpy.node import Node
-from rclpy.qos import QoSProfile
-from geometry_msgs.msg import Twist
-from sensor_msgs.msg import LaserScan
-
-
-class Driver(Node):
-    def __init__(self):
-        super().__init__("driver")
-        self.declare_parameter("speed", 0.3)
-        self.speed = self.get_parameter("speed").get_parameter_value().double_value
-        self.pub = self.create_publisher(Twist, "cmd_vel", QoSProfile(depth=10))
-        self.sub = self.create_subscription(LaserScan, "/mybot/laser/scan", self.on_scan, 10)
-        self.timer = self.create_timer(0.1, self.tick)
-        self.closest = float("inf")
-
-    def on_scan(self, msg):
-        self.closest = float(min(msg.ranges))
-
-    def tick(self):
-        msg = Twist()
-        msg.linear.x = self.speed if self.closest > 0.6 else 0.0
-        self.pub.publish(msg)
-
-
-def main(args=None):
-    rclpy.init(args=args)
-    node = Driver()
-    rclpy.spin(node)
-    node.destroy_node()
-    rclpy.shutdown()
-
-
-if __name__ == "__main__":
-    main()
-'''
+DRIVER = Path(__file__).parents[2] / "examples" / "07_rclpy_node" / "driver.py"  # written for rclpy only
 
 
 def test_an_rclpy_node_file_runs_unchanged(tmp_path: Path) -> None:
     file = tmp_path / "driver.py"
-    file.write_text(DRIVER)
+    file.write_text(DRIVER.read_text())
     done = subprocess.run([sys.executable, "-m", "navlab.cli", "run", str(file), "--launch", "sim", "world:=room",
                            "--duration", "2", "--json"], capture_output=True, text=True, timeout=300, check=False,
                           cwd=tmp_path)

@@ -16,117 +16,43 @@ A launch file is data: nothing runs unless a ``<node>`` or a ``command=`` names 
 from __future__ import annotations
 
 import difflib
-import importlib
 import os
 import re
 import shlex
 import socket
 import xml.etree.ElementTree as ET
 import zlib
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from navlab.core.errors import LaunchError, ParameterError
 from navlab.core.params import parse_yaml
-from navlab.io.errors import IoError
-from navlab.io.files import read_text_checked
+from navlab.core.roslaunch_config import (
+    FIND_PACKAGE,
+    XACRO_TEXT,
+    RosConfig,
+    RosNode,
+    boolean,
+    call,
+    convert_value,
+    declared_names,
+    name_attr,
+    ns_join,
+    number,
+    parse_launch,
+    push_ns,
+    read_text,
+)
 
-#: ``$(find PKG)``: a function ``(package) -> directory`` (ROS_PACKAGE_PATH, then navlab's shipped
-#: packages), and xacro's expansion ``(file, {arg: value}) -> URDF text``; strings, so core does not
-#: import the description layer
-FIND_PACKAGE = "navlab.description.packages:find_package"
-XACRO_TEXT = "navlab.description.loader:xacro_text"
+__all__ = ["FIND_PACKAGE", "RosConfig", "RosNode", "call", "declared_args", "is_xml_launch", "load", "ns_join"]
 
 _SUB = re.compile(r"\$\(([a-z]+)((?:\s+[^()]*)?)\)")
 _IGNORED_TAGS = ("machine", "test", "master")
 _EVAL_BUILTINS: dict[str, Callable[..., Any]] = {
     f.__name__: f for f in (int, float, str, bool, abs, min, max, round, len)}
 MAX_INCLUDE_DEPTH = 20
-MAX_LAUNCH_BYTES = 4 << 20
-
-
-def call(target: str, *args: Any) -> Any:
-    """Call a ``module:function`` named by a registry string."""
-    module, func = target.split(":", 1)
-    return getattr(importlib.import_module(module), func)(*args)
-
-
-def ns_join(ns: str, name: str) -> str:
-    """roslaunch's ``ns_join``: ``name`` under namespace ``ns`` (absolute names stay; ``~`` kept)."""
-    if name.startswith(("/", "~")):
-        return name
-    return ns.rstrip("/") + "/" + name if name else ns
-
-
-@dataclass
-class RosNode:
-    """A ``<node>`` as roslaunch holds it (names absolute)."""
-
-    pkg: str
-    type: str
-    name: str
-    namespace: str  # absolute, ends with "/"
-    args: str = ""
-    remaps: list[tuple[str, str]] = field(default_factory=list)
-    env: dict[str, str] = field(default_factory=dict)
-    respawn: bool = False
-    respawn_delay: float = 0.0
-    required: bool = False
-    output: str = "log"
-    cwd: str = ""
-    launch_prefix: str = ""
-    where: str = ""  # "FILE: <node name=...>"
-
-    @property
-    def fqn(self) -> str:
-        """The node's absolute name (``/ns/name``)."""
-        return self.namespace + self.name
-
-
-@dataclass
-class RosConfig:
-    """What a set of launch files asks for: parameters, nodes, and what was skipped."""
-
-    params: dict[str, Any] = field(default_factory=dict)  # absolute name -> value (leaves)
-    param_origin: dict[str, str] = field(default_factory=dict)  # absolute name -> file it came from
-    sources: dict[str, tuple[Path, dict[str, str]]] = field(default_factory=dict)  # param -> xacro/urdf file
-    nodes: list[RosNode] = field(default_factory=list)
-    notes: list[str] = field(default_factory=list)
-    declared: set[str] = field(default_factory=set)  # args the top-level files declare
-    allow_commands: bool = False  # command= other than xacro runs only with the ROS bridge on
-
-    def set_param(self, name: str, value: Any, origin: str) -> None:
-        """Set ``name`` (absolute); a dict sets each leaf below it, as ``rosparam load`` does."""
-        if isinstance(value, dict) and value:
-            for key, sub in value.items():
-                self.set_param(ns_join(name + "/", str(key)), sub, origin)
-            return
-        prefix = name.rstrip("/") + "/"
-        for key in [k for k in self.params if k.startswith(prefix)]:  # a value replaces a namespace
-            del self.params[key]
-        self.params[name.rstrip("/") or "/"] = value
-        self.param_origin[name] = origin
-
-    def delete_param(self, name: str) -> None:
-        """``rosparam delete``: the name and everything below it."""
-        prefix = name.rstrip("/") + "/"
-        for key in [k for k in self.params if k == name.rstrip("/") or k.startswith(prefix)]:
-            del self.params[key]
-
-    def params_under(self, ns: str) -> dict[str, Any]:
-        """The parameters below namespace ``ns`` (``/move_base``) as a nested dict."""
-        prefix = ns.rstrip("/") + "/"
-        out: dict[str, Any] = {}
-        for key, value in self.params.items():
-            if key.startswith(prefix):
-                *parents, leaf = key[len(prefix):].split("/")
-                here = out
-                for part in parents:
-                    here = here.setdefault(part, {})
-                here[leaf] = value
-        return out
 
 
 @dataclass
@@ -244,7 +170,7 @@ class _Loader:
 
     def flag(self, el: ET.Element, key: str, scope: _Scope, where: str, default: bool = False) -> bool:
         value = self.attr(el, key, scope, where)
-        return default if value is None else _boolean(value, f"{where}: {key}")
+        return default if value is None else boolean(value, f"{where}: {key}")
 
     def active(self, el: ET.Element, scope: _Scope, where: str) -> bool:
         """roslaunch's ``if``/``unless`` (true/1, false/0, any case; both at once is an error)."""
@@ -263,7 +189,7 @@ class _Loader:
         for el in parent:
             if not isinstance(el.tag, str):  # a comment
                 continue
-            where = f"{scope.file}: <{el.tag}{_name_attr(el)}>"
+            where = f"{scope.file}: <{el.tag}{name_attr(el)}>"
             if el.tag == "arg":  # arg's if/unless are read with the args set so far
                 if self.active(el, scope, where):
                     self.arg(el, scope, given, where)
@@ -272,19 +198,12 @@ class _Loader:
                 continue
             if el.tag == "group":
                 ns = self.attr(el, "ns", scope, where)
-                inner = scope.child(ns=_push_ns(scope.ns, ns) if ns else scope.ns)
+                inner = scope.child(ns=push_ns(scope.ns, ns) if ns else scope.ns)
                 if self.flag(el, "clear_params", scope, where) and ns:
                     self.config.delete_param(inner.ns)
                 self.block(el, inner, given, depth)  # args are file-wide, even inside a group (shared dict)
-            elif el.tag == "param":
-                self.param(el, scope, where)
-            elif el.tag == "rosparam":
-                self.rosparam(el, scope, where)
-            elif el.tag == "remap":
-                scope.remaps.append(self.remap(el, scope, where))
-            elif el.tag == "env":
-                scope.env[str(self.attr(el, "name", scope, where, required=True))] = str(
-                    self.attr(el, "value", scope, where, required=True))
+            elif self.common(el, scope, where, scope.remaps, scope.env):
+                pass
             elif el.tag == "include":
                 self.include(el, scope, where, depth)
             elif el.tag == "node":
@@ -296,6 +215,31 @@ class _Loader:
                                                            "node", "env", "machine", "test"], n=1)
                 hint = f"; did you mean <{close[0]}>?" if close else ""
                 raise LaunchError(f"{where}: unknown tag <{el.tag}>{hint}")
+
+    def children(self, el: ET.Element, scope: _Scope, where: str) -> Iterator[tuple[ET.Element, str]]:
+        """The child elements of ``el`` whose if/unless hold, each with its place for messages."""
+        for child in el:
+            if isinstance(child.tag, str):
+                cwhere = f"{where}: <{child.tag}{name_attr(child)}>"
+                if self.active(child, scope, cwhere):
+                    yield child, cwhere
+
+    def common(self, el: ET.Element, scope: _Scope, where: str, remaps: list[tuple[str, str]],
+               env: dict[str, str]) -> bool:
+        """``<param>``, ``<rosparam>``, ``<remap>`` and ``<env>``, which launch, group and node share (remaps
+        and env go to the lists given); False for any other tag."""
+        if el.tag == "param":
+            self.param(el, scope, where)
+        elif el.tag == "rosparam":
+            self.rosparam(el, scope, where)
+        elif el.tag == "remap":
+            remaps.append(self.remap(el, scope, where))
+        elif el.tag == "env":
+            env[str(self.attr(el, "name", scope, where, required=True))] = str(
+                self.attr(el, "value", scope, where, required=True))
+        else:
+            return False
+        return True
 
     def arg(self, el: ET.Element, scope: _Scope, given: dict[str, str], where: str) -> None:
         name = el.get("name")
@@ -336,17 +280,17 @@ class _Loader:
                               f"(got {', '.join(sources) or 'none'})")
         origin = str(scope.file)
         if "value" in el.attrib:
-            value: Any = _convert(str(self.attr(el, "value", scope, where)), kind, where)
+            value: Any = convert_value(str(self.attr(el, "value", scope, where)), kind, where)
         elif "textfile" in el.attrib:
             path = Path(str(self.attr(el, "textfile", scope, where)))
-            value = _read(path, where)
+            value = read_text(path, where)
             self.config.sources[name] = (path, {})
         elif "binfile" in el.attrib:
             raise LaunchError(f"{where}: binfile= parameters are not supported by navlab")
         else:
             value = self.command(str(self.attr(el, "command", scope, where)), name, where)
             if kind != "auto":
-                value = _convert(value, kind, where)
+                value = convert_value(value, kind, where)
         self.config.set_param(name, value, origin)
 
     def command(self, cmd: str, name: str, where: str) -> str:
@@ -397,7 +341,7 @@ class _Loader:
         if cmd != "load":
             raise LaunchError(f"{where}: rosparam command {cmd!r}: expected load, delete or dump")
         file = self.attr(el, "file", scope, where)
-        text = _read(Path(file), where) if file else (el.text or "")
+        text = read_text(Path(file), where) if file else (el.text or "")
         source = file or str(scope.file)
         if self.flag(el, "subst_value", scope, where):
             text = self.subst(text, scope, where)
@@ -418,26 +362,18 @@ class _Loader:
         if not path.is_file():
             raise LaunchError(f"{where}: included file {path} does not exist")
         ns = self.attr(el, "ns", scope, where)
-        inner_ns = _push_ns(scope.ns, ns) if ns else scope.ns
+        inner_ns = push_ns(scope.ns, ns) if ns else scope.ns
         if self.flag(el, "clear_params", scope, where) and ns:
             self.config.delete_param(inner_ns)
         pass_all = self.flag(el, "pass_all_args", scope, where)
         passed: dict[str, str] = dict(scope.args) if pass_all else {}
         env = dict(scope.env)
-        for child in el:
-            if not isinstance(child.tag, str):
-                continue
-            cwhere = f"{where}: <{child.tag}{_name_attr(child)}>"
-            if not self.active(child, scope, cwhere):
-                continue
+        for child, cwhere in self.children(el, scope, where):
             if child.tag == "arg":
                 name = str(self.attr(child, "name", scope, cwhere, required=True))
                 key = "value" if "value" in child.attrib else "default"
                 passed[name] = str(self.attr(child, key, scope, cwhere, required=True))
-            elif child.tag == "env":
-                env[str(self.attr(child, "name", scope, cwhere, required=True))] = str(
-                    self.attr(child, "value", scope, cwhere, required=True))
-            else:
+            elif child.tag != "env" or not self.common(child, scope, cwhere, [], env):
                 raise LaunchError(f"{cwhere}: <include> takes only <arg> and <env> children")
         self.load_file_in(path, passed, scope.child(ns=inner_ns, env=env), depth + 1, pass_all)
 
@@ -445,8 +381,8 @@ class _Loader:
         """An included file: its own args, the includer's namespace, remaps and env."""
         if depth > MAX_INCLUDE_DEPTH:
             raise LaunchError(f"{path}: includes nest deeper than {MAX_INCLUDE_DEPTH} levels (an include loop?)")
-        root = _parse(path)
-        declared = _declared(root)
+        root = parse_launch(path)
+        declared = declared_names(root)
         unused = sorted(set(passed) - declared)
         if unused and not pass_all:
             raise LaunchError(f"{outer.file}: unused args [{', '.join(unused)}] for include of [{path}] "
@@ -461,11 +397,11 @@ class _Loader:
         if "/" in name or not name:
             raise LaunchError(f"{where}: node name {name!r} must be a base name (use ns= for namespaces)")
         ns_attr = self.attr(el, "ns", scope, where)
-        ns = _push_ns(scope.ns, ns_attr) if ns_attr else scope.ns
+        ns = push_ns(scope.ns, ns_attr) if ns_attr else scope.ns
         node = RosNode(pkg, typ, name, ns, args=self.attr(el, "args", scope, where, default="") or "",
                        remaps=list(scope.remaps), env=dict(scope.env),
                        respawn=self.flag(el, "respawn", scope, where),
-                       respawn_delay=_number(self.attr(el, "respawn_delay", scope, where, default="0"), where),
+                       respawn_delay=number(self.attr(el, "respawn_delay", scope, where, default="0"), where),
                        required=self.flag(el, "required", scope, where),
                        output=self.attr(el, "output", scope, where, default="log") or "log",
                        cwd=self.attr(el, "cwd", scope, where, default="") or "",
@@ -474,114 +410,13 @@ class _Loader:
         if self.flag(el, "clear_params", scope, where):
             self.config.delete_param(node.fqn)
         inner = scope.child(ns=ns, node=node.fqn)
-        for child in el:
-            if not isinstance(child.tag, str):
-                continue
-            cwhere = f"{where}: <{child.tag}{_name_attr(child)}>"
-            if not self.active(child, scope, cwhere):
-                continue
-            if child.tag == "param":
-                self.param(child, inner, cwhere)
-            elif child.tag == "rosparam":
-                self.rosparam(child, inner, cwhere)
-            elif child.tag == "remap":
-                node.remaps.append(self.remap(child, inner, cwhere))
-            elif child.tag == "env":
-                node.env[str(self.attr(child, "name", scope, cwhere, required=True))] = str(
-                    self.attr(child, "value", scope, cwhere, required=True))
-            else:
+        for child, cwhere in self.children(el, scope, where):
+            if not self.common(child, inner, cwhere, node.remaps, node.env):
                 raise LaunchError(f"{cwhere}: <node> takes <param>, <rosparam>, <remap> and <env> children")
         if any(n.fqn == node.fqn for n in self.config.nodes):
             raise LaunchError(f"{where}: a node named {node.fqn!r} is already in this launch "
                               "(roslaunch refuses duplicate node names)")
         self.config.nodes.append(node)
-
-
-def _name_attr(el: ET.Element) -> str:
-    for key in ("name", "file", "ns"):
-        if el.get(key):
-            return f' {key}="{el.get(key)}"'
-    return ""
-
-
-def _push_ns(ns: str, sub: str) -> str:
-    """Namespace ``sub`` (relative or absolute) inside ``ns``; always ends with ``/``."""
-    full = sub if sub.startswith("/") else ns.rstrip("/") + "/" + sub
-    return "/" + "/".join(p for p in full.split("/") if p) + "/" if full.strip("/") else "/"
-
-
-def _boolean(value: str, where: str) -> bool:
-    low = value.strip().lower()
-    if low in ("true", "1"):
-        return True
-    if low in ("false", "0"):
-        return False
-    raise LaunchError(f"{where}: {value!r} is not a boolean (expected true/false or 1/0)")
-
-
-def _number(value: str | None, where: str) -> float:
-    try:
-        return float(value or 0)
-    except ValueError:
-        raise LaunchError(f"{where}: expected a number, got {value!r}") from None
-
-
-def _convert(value: str, kind: str, where: str) -> Any:
-    """roslaunch's ``convert_value``: ``auto`` tries int, float, then true/false; else the text."""
-    if kind == "auto":
-        for cast in (int, float):
-            try:
-                return cast(value)
-            except ValueError:
-                pass
-        low = value.strip().lower()
-        return low == "true" if low in ("true", "false") else value
-    if kind in ("str", "string"):
-        return value
-    if kind == "int":
-        try:
-            return int(value)
-        except ValueError:
-            raise LaunchError(f"{where}: {value!r} is not an int") from None
-    if kind == "double":
-        return _number(value, where)
-    if kind in ("bool", "boolean"):
-        return _boolean(value, where)
-    if kind == "yaml":
-        try:
-            return parse_yaml(value, where)
-        except ParameterError as exc:
-            raise LaunchError(str(exc)) from None
-    raise LaunchError(f"{where}: unknown param type {kind!r} (expected str, int, double, bool, yaml or auto)")
-
-
-def _read(path: Path, where: str) -> str:
-    try:
-        return read_text_checked(path, what="file", max_bytes=MAX_LAUNCH_BYTES)
-    except IoError as exc:
-        raise LaunchError(f"{where}: {exc}") from None
-
-
-def _parse(file: Path) -> ET.Element:
-    text = _read(file, str(file))
-    try:
-        root = ET.fromstring(text)
-    except ET.ParseError as exc:
-        raise LaunchError(f"{file}: malformed XML ({exc})") from None
-    if root.tag != "launch":
-        raise LaunchError(f"{file}: top element is <{root.tag}>, expected <launch>")
-    return root
-
-
-def _declared(el: ET.Element) -> set[str]:
-    """The args a file declares (``<arg>`` in ``<launch>`` and its groups, not those passed to includes)."""
-    out: set[str] = set()
-    for child in el:
-        if child.tag == "arg" and child.get("name"):
-            out.add(str(child.get("name")))
-        elif child.tag == "group":
-            out |= _declared(child)
-    return out
 
 
 def is_xml_launch(path: str | os.PathLike[str]) -> bool:
@@ -604,8 +439,8 @@ def load(files: list[Path], args: Mapping[str, str], *, seed: int = 0, allow_com
     config = RosConfig(allow_commands=allow_commands)
     loader = _Loader(config, seed)
     for file in files:
-        root = _parse(file)
-        config.declared |= _declared(root)
+        root = parse_launch(file)
+        config.declared |= declared_names(root)
     for name in args:
         if name not in config.declared:
             close = difflib.get_close_matches(name, sorted(config.declared), n=1)
@@ -613,7 +448,7 @@ def load(files: list[Path], args: Mapping[str, str], *, seed: int = 0, allow_com
             raise LaunchError(f"{', '.join(map(str, files))}: unknown launch argument {name!r} ({hint}arguments: "
                               f"{', '.join(sorted(config.declared)) or 'none'})")
     for file in files:
-        root = _parse(file)
+        root = parse_launch(file)
         scope = _Scope(file, {})
         loader.block(root, scope, {k: v for k, v in args.items()}, 0)
     return config
@@ -622,8 +457,8 @@ def load(files: list[Path], args: Mapping[str, str], *, seed: int = 0, allow_com
 def declared_args(file: Path) -> list[dict[str, str]]:
     """The overridable ``<arg>``s of a .launch file: name, description (``doc``) and default, if any."""
     out: list[dict[str, str]] = []
-    root = _parse(file)
-    for el in [e for e in root.iter("arg") if e.get("name") in _declared(root)]:
+    root = parse_launch(file)
+    for el in [e for e in root.iter("arg") if e.get("name") in declared_names(root)]:
         if el.get("name") and "value" not in el.attrib and el.get("name") not in [a["name"] for a in out]:
             row = {"name": str(el.get("name")), "description": el.get("doc", "")}
             if "default" in el.attrib:
