@@ -96,3 +96,24 @@ def test_my_navigation_reaches_a_goal_with_the_models_costmap_files(tmp_path: Pa
         return math.hypot(x - goal[0], y - goal[1]) < 0.2
 
     assert session.executor.run_until(arrived, timeout=30.0)
+
+
+def test_several_launch_files_in_one_call_and_map_saver_writes_the_map(tmp_path: Path,
+                                                                      capsys: pytest.CaptureFixture[str]) -> None:
+    """`navlab launch A.launch B.launch name:=value` (roslaunch a.launch b.launch): the world, gmapping and
+    map_saver in one process; map_saver -f writes the first map it receives, as map_server's map_saver does."""
+    saver = tmp_path / "save.launch"
+    saver.write_text("""<launch>
+  <arg name="out"/>
+  <include file="$(find my_slam)/launch/my_slam.launch"/>
+  <node pkg="map_server" type="map_saver" name="map_saver" args="-f $(arg out)"/>
+</launch>""")
+    out = tmp_path / "maps" / "room"
+    out.parent.mkdir()
+    assert main(["launch", str(WORLD), str(saver), f"out:={out}", "--duration", "3", "--json", "--quiet"]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert {"/gazebo", "/my_slam_gmapping", "/map_saver"} <= set(summary["nodes"]) and summary["topics"]["/map"] >= 1
+    from navlab.mapping.mapfile import load_map
+
+    grid = load_map(out.with_suffix(".yaml"))
+    assert grid.resolution == pytest.approx(0.05) and out.with_suffix(".pgm").is_file()
