@@ -132,3 +132,28 @@ def test_a_torque_tag_drives_as_noetic_drives_it_with_wheel_torque_5(tmp_path: P
         x_after[label] = gazebo.sim.base_pose2d()[0]  # type: ignore[attr-defined]
     assert x_after["torque"] == x_after["default"] and x_after["default"] > 0.3
     assert x_after["weak"] < 0.5 * x_after["default"]
+
+
+def test_p3d_plugins_publish_where_noetic_publishes(tmp_path: Path) -> None:
+    """A p3d plugin with <bodyName> and <topicName> publishes the true pose there (frame default world); one
+    without <topicName> does not load, as in Noetic, and says so."""
+    import shutil
+
+    pkg = tmp_path / "my_description"
+    shutil.copytree(Path(__file__).parents[1] / "fixtures" / "ros_ws" / "my_description", pkg)
+    gz = pkg / "urdf" / "my_robot.gazebo.xacro"
+    gz.write_text(gz.read_text().replace("</robot>", """
+  <gazebo><plugin name="truth" filename="libgazebo_ros_p3d.so"><bodyName>base_link</bodyName>
+    <topicName>truth/odom</topicName><robotNamespace>my_robot</robotNamespace><updateRate>20</updateRate></plugin></gazebo>
+  <gazebo><plugin name="broken" filename="libgazebo_ros_p3d.so"><bodyName>base_link</bodyName></plugin></gazebo>
+</robot>"""))
+    robot = load_robot(pkg / "urdf" / "my_robot.urdf.xacro")
+    assert [(p.link, p.topic, p.frame_id, p.update_rate) for p in robot.ground_truths] == [
+        ("base_link", "/my_robot/truth/odom", "world", 20.0)]
+    assert any("no <topicName>" in w and "does not load" in w for w in robot.warnings)
+    ex, _ = _drive(robot, [(0.05, 0.2, 0.0)], 0.05)
+    got: list[object] = []
+    Node(ex, name="listener").create_subscription(msgs.Odometry, "/my_robot/truth/odom", got.append, 10)
+    ex.run(1.0)
+    assert len(got) == 20 and got[-1].header.frame_id == "world"  # type: ignore[attr-defined]
+    assert got[-1].pose.pose.position.x > 0.05  # type: ignore[attr-defined]

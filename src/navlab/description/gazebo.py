@@ -16,7 +16,7 @@ from typing import Literal
 
 from navlab.description.errors import DescriptionError
 from navlab.description.materials import gazebo_material
-from navlab.description.model import DiffDriveConfig, ImuConfig, LidarConfig, Link, Origin
+from navlab.description.model import DiffDriveConfig, ImuConfig, LidarConfig, Link, Origin, P3dConfig
 from navlab.description.urdf import floats
 
 DIFF_DRIVE_PLUGINS = ("libgazebo_ros_diff_drive.so",)
@@ -27,7 +27,8 @@ LASER_PLUGIN_NAMES = ("gazebo_ros_laser", "gazebo_ros_ray_sensor", "gazebo_ros_h
 IMU_SENSOR_PLUGINS = ("libgazebo_ros_imu_sensor.so",)
 IMU_MODEL_PLUGINS = ("libgazebo_ros_imu.so",)
 #: plugins whose job navlab's simulator does anyway (joint states, ground truth): no warning
-BUILTIN_PLUGINS = ("libgazebo_ros_joint_state_publisher.so", "libgazebo_ros_p3d.so")
+BUILTIN_PLUGINS = ("libgazebo_ros_joint_state_publisher.so",)
+P3D_PLUGINS = ("libgazebo_ros_p3d.so",)
 #: <gazebo reference="link"> tags understood or harmless to ignore (rendering, ODE contact tuning)
 LINK_TAGS = ("mu1", "mu2", "material", "kp", "kd", "minDepth", "maxVel", "fdir1", "selfCollide",
              "self_collide", "turnGravityOff", "gravity", "maxContacts", "dampingFactor", "sensor",
@@ -78,6 +79,7 @@ class GazeboTags:
     diff_drive: DiffDriveConfig | None = None
     lidars: list[LidarConfig] = field(default_factory=list)
     imus: list[ImuConfig] = field(default_factory=list)
+    ground_truths: list[P3dConfig] = field(default_factory=list)
     warnings: list[str] = field(default_factory=list)
 
 
@@ -308,6 +310,23 @@ def parse_imu(plugin: ET.Element, link: str, where: str, sensor: ET.Element | No
     )
 
 
+def parse_p3d(plugin: ET.Element, where: str, warnings: list[str]) -> P3dConfig | None:
+    """A ROS 1 ``libgazebo_ros_p3d`` plugin as Noetic reads it: ``bodyName`` and ``topicName`` required (without
+    them the plugin does not load: a warning, and nothing published), ``frameName`` default ``world``,
+    ``updateRate`` default 0 (every physics step), ``robotNamespace`` in front of a relative topic."""
+    missing = [t for t in ("bodyName", "topicName") if not (plugin.findtext(t) or "").strip()]
+    if missing:
+        warnings.append(f"{where}: no <{missing[0]}>: ROS Noetic's gazebo_ros_p3d does not load without it; "
+                        "nothing is published")
+        return None
+    ns = (plugin.findtext("robotNamespace") or "").strip()
+    return P3dConfig(link=str(plugin.findtext("bodyName")).strip(),
+                     topic=_scoped(ns, str(plugin.findtext("topicName")).strip()),
+                     frame_id=(plugin.findtext("frameName") or "world").strip().lstrip("/") or "world",
+                     update_rate=_rate(_num(plugin.find("updateRate"), where, 0.0)),
+                     name=plugin.get("name") or "p3d")
+
+
 def _plugin_file(plugin: ET.Element) -> str:
     return (plugin.get("filename") or "").rsplit("/", 1)[-1]
 
@@ -403,6 +422,10 @@ def _read_model_plugin(plugin: ET.Element, where: str, out: GazeboTags) -> None:
         if not body:
             raise DescriptionError(f"{w}: missing <bodyName> (the IMU's link)")
         out.imus.append(parse_imu(plugin, body, w, None))
+    elif fname in P3D_PLUGINS:
+        p3d = parse_p3d(plugin, w, out.warnings)
+        if p3d is not None:
+            out.ground_truths.append(p3d)
     elif fname not in BUILTIN_PLUGINS:
         out.warnings.append(f"{w}: unknown plugin, ignored (navlab simulates libgazebo_ros_diff_drive, "
                             "laser/ray-sensor and imu plugins)")
@@ -455,6 +478,11 @@ def check_plugin_joints(tags: GazeboTags, joints: dict[str, str], links: dict[st
     for imu in tags.imus:
         if imu.link not in links:
             raise DescriptionError(f"{source}: imu plugin {imu.name!r}: body {imu.link!r} is not a link")
+    for p3d in list(tags.ground_truths):
+        if p3d.link not in links:  # Noetic: "bodyName: X does not exist", the plugin does not load
+            tags.warnings.append(f"{source}: p3d plugin {p3d.name!r}: bodyName {p3d.link!r} is not a link of the "
+                                 "robot; as in ROS Noetic the plugin does not load")
+            tags.ground_truths.remove(p3d)
     for lidar in tags.lidars:
         if not math.isfinite(lidar.max_angle - lidar.min_angle) or lidar.max_angle < lidar.min_angle:
             raise DescriptionError(f"{source}: lidar {lidar.name!r}: max_angle < min_angle")

@@ -105,6 +105,7 @@ def load_robot(
     model.diff_drive = tags.diff_drive
     model.lidars = tags.lidars
     model.imus = tags.imus
+    model.ground_truths = tags.ground_truths
     model.warnings += tags.warnings
     if model.diff_drive is None:
         model.warnings.append(f"{source}: no libgazebo_ros_diff_drive.so plugin; cmd_vel will not move "

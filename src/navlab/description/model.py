@@ -202,6 +202,17 @@ class ImuConfig:
 
 
 @dataclass
+class P3dConfig:
+    """A ``libgazebo_ros_p3d`` plugin: the true pose of ``link`` as nav_msgs/Odometry on ``topic``."""
+
+    link: str
+    topic: str
+    frame_id: str = "world"
+    update_rate: float = 1000.0  # Hz (0 in the tag: every physics step)
+    name: str = "p3d"
+
+
+@dataclass
 class RobotModel:
     """A whole robot: links by name, joints in file order, the root link, and its plugins."""
 
@@ -212,6 +223,7 @@ class RobotModel:
     diff_drive: DiffDriveConfig | None = None
     lidars: list[LidarConfig] = field(default_factory=list)
     imus: list[ImuConfig] = field(default_factory=list)
+    ground_truths: list[P3dConfig] = field(default_factory=list)  # p3d plugins
     warnings: list[str] = field(default_factory=list)
     source: Path | None = None
     urdf_xml: str = ""  # the expanded URDF (after xacro), for robot_description

@@ -96,10 +96,14 @@ class GazeboSim(Node):
                          for i in range(len(robot.imus))]
         self.plugins.append(JointStatePlugin(executor, parameters={"publish_frequency": js_rate}, namespace=namespace,
                                              sim=self.sim))
-        if gt_rate > 0:
+        p3d_topics = {p.topic for p in robot.ground_truths}
+        if gt_rate > 0 and "/ground_truth/odom" not in p3d_topics:  # navlab's own, for evaluation
             base = robot.diff_drive.robot_base_frame if robot.diff_drive else robot.root_link
             self.plugins.append(GroundTruthPlugin(executor, parameters={"bodyName": base, "updateRate": gt_rate},
                                                  namespace=namespace, sim=self.sim))
+        self.plugins += [GroundTruthPlugin(executor, name=p.name, namespace=namespace, sim=self.sim, parameters={
+            "bodyName": p.link, "topicName": p.topic, "frameName": p.frame_id, "updateRate": p.update_rate})
+            for p in robot.ground_truths]  # the robot's own p3d plugins
         self.plugins += extensions.plugins(executor, namespace, self.sim)
         if robot is not None:  # Gazebo's bumper: what the robot touches, on /collisions
             self.plugins.append(CollisionPlugin(executor, namespace=namespace, sim=self.sim))
