@@ -47,6 +47,8 @@ def test_rclpy_constructor_parameters_and_spin() -> None:
         node.create_timer(0.25, lambda: ticks.append(1))
         navlab.spin_once(node, timeout_sec=1.0)
         assert len(ticks) == 4 and ctx.executor.now_ns == 1_000_000_000
+        now = node.get_clock().now()  # rclpy's Time
+        assert now.nanoseconds == 1_000_000_000 and now.to_msg().sec == 1 and now.seconds_nanoseconds() == (1, 0)
         assert navlab.ok()
     finally:
         navlab.shutdown()
@@ -68,7 +70,10 @@ def test_the_old_constructor_still_works_with_a_deprecation_warning() -> None:
 def test_message_classes_default_their_fields_as_rclpy_does() -> None:
     navlab.install_ros_imports()
     from geometry_msgs.msg import PoseWithCovarianceStamped, Twist
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.time import Time
 
+    assert SingleThreadedExecutor().add_node(object()) and Time(seconds=1.5).nanoseconds == 1_500_000_000
     msg = Twist()
     msg.linear.x = 0.2
     assert (msg.linear.x, msg.angular.z, msg.__msgtype__) == (0.2, 0.0, "geometry_msgs/msg/Twist")

@@ -7,7 +7,8 @@ nothing else provides are served:
 - ``PKG.msg`` for every package of rosbags' ROS 2 typestore: message classes that take keyword
   arguments and default the rest as rclpy's do (``Twist()``, then ``msg.linear.x = 0.2``);
 - ``rclpy`` (``init``, ``shutdown``, ``ok``, ``spin``, ``spin_once``, ``create_node``), ``rclpy.node``
-  (``Node``), ``rclpy.parameter`` (``Parameter``) and ``rclpy.qos`` (``QoSProfile`` and its policies),
+  (``Node``), ``rclpy.parameter`` (``Parameter``), ``rclpy.qos`` (``QoSProfile`` and its policies),
+  ``rclpy.time`` (``Time``) and ``rclpy.executors`` (``SingleThreadedExecutor``, ``MultiThreadedExecutor``),
   all navlab's (see docs/core-api.md).
 """
 
@@ -102,15 +103,67 @@ class QoSProfile:
     durability: DurabilityPolicy = DurabilityPolicy.VOLATILE
 
 
+class SingleThreadedExecutor:
+    """``rclpy.executors.SingleThreadedExecutor``: spins its nodes in the context's simulated time (every
+    node of a context shares its one executor, so this only keeps the node list rclpy code expects)."""
+
+    def __init__(self, *, context: Any = None) -> None:
+        self.nodes: list[Any] = []
+
+    def add_node(self, node: Any) -> bool:
+        """Add a node (rclpy returns whether it was added)."""
+        if node in self.nodes:
+            return False
+        self.nodes.append(node)
+        return True
+
+    def remove_node(self, node: Any) -> None:
+        """Forget a node."""
+        if node in self.nodes:
+            self.nodes.remove(node)
+
+    def get_nodes(self) -> list[Any]:
+        """The nodes added."""
+        return list(self.nodes)
+
+    def spin(self) -> None:
+        """Run simulated time until shutdown (or ``navlab run``'s ``--duration``)."""
+        from navlab.core import rclpy_api
+
+        if self.nodes:
+            rclpy_api.spin(self.nodes[0])
+
+    def spin_once(self, timeout_sec: float | None = None) -> None:
+        """Run simulated time for ``timeout_sec`` (default: to the next event)."""
+        from navlab.core import rclpy_api
+
+        if self.nodes:
+            rclpy_api.spin_once(self.nodes[0], timeout_sec=timeout_sec)
+
+    def shutdown(self, timeout_sec: float | None = None) -> bool:
+        """Nothing to stop here; rclpy returns True when done."""
+        return True
+
+
+class MultiThreadedExecutor(SingleThreadedExecutor):
+    """``rclpy.executors.MultiThreadedExecutor``: the same one simulated-time executor (callbacks stay ordered)."""
+
+    def __init__(self, num_threads: int | None = None, *, context: Any = None) -> None:
+        super().__init__(context=context)
+
+
 def _rclpy_modules() -> dict[str, dict[str, Any]]:
     from navlab.core import rclpy_api
-    from navlab.core.node import Node, Parameter
+    from navlab.core.node import Node, Parameter, Time
 
     api = {n: getattr(rclpy_api, n) for n in ("init", "shutdown", "ok", "spin", "spin_once", "create_node")}
     return {
         "rclpy": api,
         "rclpy.node": {"Node": Node},
         "rclpy.parameter": {"Parameter": Parameter},
+        "rclpy.time": {"Time": Time},
+        "rclpy.executors": {"SingleThreadedExecutor": SingleThreadedExecutor,
+                            "MultiThreadedExecutor": MultiThreadedExecutor},
         "rclpy.qos": {"QoSProfile": QoSProfile, "DurabilityPolicy": DurabilityPolicy,
                       "ReliabilityPolicy": ReliabilityPolicy, "HistoryPolicy": HistoryPolicy,
                       "qos_profile_sensor_data": QoSProfile(depth=5, reliability=ReliabilityPolicy.BEST_EFFORT)},
@@ -127,7 +180,7 @@ class _Finder(importlib.abc.MetaPathFinder, importlib.abc.Loader):
 
     def find_spec(self, fullname: str, path: Any = None, target: Any = None) -> importlib.machinery.ModuleSpec | None:
         head, _, rest = fullname.partition(".")
-        if fullname in ("rclpy", "rclpy.node", "rclpy.parameter", "rclpy.qos"):
+        if fullname in ("rclpy", "rclpy.node", "rclpy.parameter", "rclpy.qos", "rclpy.time", "rclpy.executors"):
             return importlib.util.spec_from_loader(fullname, self, is_package=fullname == "rclpy")
         if head in _packages() and rest in ("", "msg"):
             return importlib.util.spec_from_loader(fullname, self, is_package=not rest)
