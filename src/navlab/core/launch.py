@@ -197,19 +197,17 @@ class _Context:
             if kind == "robot":
                 return self.robot_value(arg, where)
             if kind == "eval":  # ROS 2's PythonExpression, in navlab's sandbox
+                from navlab.core.roslaunch_config import EVAL_BUILTINS
                 from navlab.core.safe_eval import ExpressionError, safe_eval
 
                 try:
-                    return str(safe_eval(arg, {"true": True, "false": False}, functions=_EVAL_FUNCTIONS))
+                    return str(safe_eval(arg, {"true": True, "false": False}, functions=EVAL_BUILTINS))
                 except ExpressionError as exc:
                     raise LaunchError(f"{self.file}: {where}: $(eval {arg}): {exc}") from None
             raise LaunchError(f"{self.file}: {where}: unknown substitution $({kind})")
 
         out = _expand(value, repl, f"{self.file}: {where}")
         return _typed(out) if out != value else value
-
-
-_EVAL_FUNCTIONS = {f.__name__: f for f in (int, float, str, bool, abs, min, max, round, len)}
 
 
 def _expand(text: str, resolve: Callable[[str, str], str], where: str) -> str:

@@ -30,6 +30,7 @@ from typing import Any
 from navlab.core.errors import LaunchError, ParameterError
 from navlab.core.params import parse_yaml
 from navlab.core.roslaunch_config import (
+    EVAL_BUILTINS,
     FIND_PACKAGE,
     XACRO_TEXT,
     RosConfig,
@@ -50,8 +51,6 @@ __all__ = ["FIND_PACKAGE", "RosConfig", "RosNode", "call", "declared_args", "is_
 
 _SUB = re.compile(r"\$\(([a-z]+)((?:\s+[^()]*)?)\)")
 _IGNORED_TAGS = ("machine", "test", "master")
-_EVAL_BUILTINS: dict[str, Callable[..., Any]] = {
-    f.__name__: f for f in (int, float, str, bool, abs, min, max, round, len)}
 MAX_INCLUDE_DEPTH = 20
 
 
@@ -150,7 +149,7 @@ class _Loader:
         from navlab.core.safe_eval import ExpressionError, safe_eval
 
         names: dict[str, Any] = {"true": True, "false": False, "True": True, "False": False, **scope.args}
-        functions: dict[str, Callable[..., Any]] = {**_EVAL_BUILTINS, **self.functions(scope, where)}
+        functions: dict[str, Callable[..., Any]] = {**EVAL_BUILTINS, **self.functions(scope, where)}
         try:
             value = safe_eval(expr, names, functions=functions)
         except ExpressionError as exc:

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import importlib
 import xml.etree.ElementTree as ET
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -22,6 +23,9 @@ FIND_PACKAGE = "navlab.description.packages:find_package"
 XACRO_TEXT = "navlab.description.loader:xacro_text"
 
 MAX_LAUNCH_BYTES = 4 << 20
+#: what ``$(eval ...)`` may call besides a launch format's own functions (both launch formats)
+EVAL_BUILTINS: dict[str, Callable[..., Any]] = {
+    f.__name__: f for f in (int, float, str, bool, abs, min, max, round, len)}
 
 
 def call(target: str, *args: Any) -> Any:
