@@ -34,7 +34,7 @@ ROS1 = """
       <wheelTorque>4</wheelTorque><wheelAcceleration>2.5</wheelAcceleration><updateRate>50</updateRate>
       <commandTopic>cmd_demo</commandTopic><odometryTopic>odom_demo</odometryTopic>
       <odometryFrame>odom</odometryFrame><robotBaseFrame>base_link</robotBaseFrame>
-      <odometrySource>1</odometrySource><publishTf>0</publishTf><publishWheelTF>true</publishWheelTF>
+      <odometrySource>1</odometrySource><publishOdomTF>0</publishOdomTF><publishWheelTF>true</publishWheelTF>
     </plugin>
   </gazebo>
 """

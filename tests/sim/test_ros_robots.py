@@ -157,3 +157,23 @@ def test_p3d_plugins_publish_where_noetic_publishes(tmp_path: Path) -> None:
     ex.run(1.0)
     assert len(got) == 20 and got[-1].header.frame_id == "world"  # type: ignore[attr-defined]
     assert got[-1].pose.pose.position.x > 0.05  # type: ignore[attr-defined]
+
+
+@pytest.mark.parametrize(("tag", "odom", "tf"), [("<publishTf>false</publishTf>", False, False),
+                                                 ("<publishOdomTF>false</publishOdomTF>", True, False),
+                                                 ("", True, True)])
+def test_publish_tf_and_publish_odom_tf_as_noetic(tmp_path: Path, tag: str, odom: bool, tf: bool) -> None:
+    """Noetic: <publishTf>false publishes no odometry at all; <publishOdomTF>false keeps the topic, drops the tf."""
+    import shutil
+
+    pkg = tmp_path / "my_description"
+    shutil.copytree(Path(__file__).parents[1] / "fixtures" / "ros_ws" / "my_description", pkg)
+    gz = pkg / "urdf" / "my_robot.gazebo.xacro"
+    gz.write_text(gz.read_text().replace("<publishOdomTF>true</publishOdomTF>", tag))
+    ex = Executor(seed=0)
+    launch_sim(ex, world=make_room(), robot=load_robot(pkg / "urdf" / "my_robot.urdf.xacro"))
+    got: list[object] = []
+    Node(ex, name="listener").create_subscription(msgs.Odometry, "/odom", got.append, 10)
+    ex.run(0.5)
+    assert bool(got) is odom
+    assert ex.tf.can_transform("odom", "base_footprint") is tf

@@ -40,7 +40,7 @@ DD_KEYS_ROS1 = {
     "wheelDiameter": "wheel_diameter", "wheelTorque": "max_torque",
     "wheelAcceleration": "max_accel", "updateRate": "update_rate", "commandTopic": "command_topic",
     "odometryTopic": "odometry_topic", "odometryFrame": "odometry_frame",
-    "robotBaseFrame": "robot_base_frame", "odometrySource": "odometry_source", "publishTf": "publish_tf",
+    "robotBaseFrame": "robot_base_frame", "odometrySource": "odometry_source", "publishTf": "publish_odom",
     "publishOdomTF": "publish_tf", "publishWheelTF": "publish_wheel_tf", "robotNamespace": "namespace",
 }
 #: tags older ROS 1 releases read that Noetic's gazebo_ros_diff_drive does not: the warning names what it reads
@@ -68,7 +68,7 @@ LASER_NOT_IN_NOETIC = {
 DD_IGNORED = ("alwaysOn", "rosDebugLevel", "publishWheelJointState", "publishOdom", "publish_odom",
               "ros", "num_wheel_pairs", "covariance_x", "covariance_y", "covariance_yaw", "odometryRate")
 FLOAT_FIELDS = ("wheel_separation", "wheel_diameter", "max_torque", "max_accel", "update_rate")
-BOOL_FIELDS = ("publish_tf", "publish_wheel_tf")
+BOOL_FIELDS = ("publish_tf", "publish_odom", "publish_wheel_tf")
 GAZEBO_DEFAULT_RATE = 1000.0  # Hz: Gazebo's default physics rate; a plugin rate of 0 means every step
 
 

@@ -153,7 +153,8 @@ class DiffDriveConfig:
     odometry_frame: str = "odom"
     robot_base_frame: str = "base_footprint"
     odometry_source: Literal["encoder", "world"] = "world"
-    publish_tf: bool = True
+    publish_tf: bool = True  # <publishOdomTF>: tf odom -> base
+    publish_odom: bool = True  # Noetic's <publishTf>: false publishes neither the odometry topic nor its tf
     publish_wheel_tf: bool = False
     # navlab extension (not a Gazebo tag; gazebo node parameter cmd_timeout): s without cmd_vel before the
     # wheels are stopped; 0 = off, as in ROS 1's plugin (the last command holds until a new one)

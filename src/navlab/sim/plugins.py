@@ -126,6 +126,8 @@ class DiffDrivePlugin(Node):
             x, y, yaw, v, w = self.odometry.update(*self._encoders(), dt)
             position = (x, y, 0.0)
             quat = quat_from_yaw(yaw)
+        if not cfg.publish_odom:  # Noetic's <publishTf>false: no odometry topic and no tf
+            return
         # the message only when anyone reads it (the mapping launch's nodes take odometry from tf)
         if self.odom_pub.get_subscription_count() or self.executor.has_listeners:
             if world:
