@@ -177,3 +177,15 @@ def test_publish_tf_and_publish_odom_tf_as_noetic(tmp_path: Path, tag: str, odom
     ex.run(0.5)
     assert bool(got) is odom
     assert ex.tf.can_transform("odom", "base_footprint") is tf
+
+
+def test_wheel_acceleration_follows_noetics_rule() -> None:
+    """gazebo_ros_diff_drive (Noetic): each wheel's instructed speed moves by its measured error, at most
+    wheelAcceleration x dt; when either wheel is within 0.01 m/s of its target, both get their targets at once."""
+    from navlab.sim.diffdrive import noetic_wheel_commands
+
+    cmd, instr = noetic_wheel_commands((1.0, 1.0), (0.0, 0.0), (0.0, 0.0), 2.0, 0.1, near=0.01)
+    assert cmd == instr == pytest.approx((0.2, 0.2))
+    cmd, _ = noetic_wheel_commands((1.0, -1.0), (0.995, 0.0), (0.4, 0.0), 2.0, 0.1, near=0.01)
+    assert cmd == (1.0, -1.0)  # the left wheel is near its target: the right one jumps too, as in Gazebo
+    assert noetic_wheel_commands((1.0, 1.0), (0.0, 0.0), (0.0, 0.0), 0.0, 0.1, near=0.01)[0] == (1.0, 1.0)
