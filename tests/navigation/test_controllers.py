@@ -442,3 +442,30 @@ def test_mppi_parameters():
             assert word in str(err.value)
     with pytest.raises(NavigationError, match="rng"):
         MPPIController()
+
+
+def test_a_rollouts_first_failure_in_time_decides_its_code() -> None:
+    """``generateTrajectory`` checks poses in time order and returns at the first failure: -1 when the footprint
+    is blocked (or off the map), -2 when the cell has no path to the goal. The code matters: only a -2 escape
+    rollout keeps TrajectoryPlanner out of escape mode."""
+    from navlab.navigation.controllers.rollout import _rollout_scores
+
+    res, n = 0.1, 5
+    grid = np.zeros((n, n), dtype=np.uint8)
+    grid[2, 3] = COST_LETHAL  # cell (i=3, j=2)
+    path_dist = np.ones((n, n))
+    goal_dist = np.ones((n, n))
+    goal_dist[2, 1] = n * n  # cell (1, 2): cut off from the goal
+    cells = {"no_path": (1, 2), "free": (2, 2), "lethal": (3, 2)}
+
+    def score(*names: str) -> float:
+        traj = np.array([[[(cells[k][0] + 0.5) * res, (cells[k][1] + 0.5) * res, 0.0] for k in names]])
+        out = np.empty(1)
+        zeros = np.zeros(traj.shape[:2])
+        _rollout_scores(grid, grid, path_dist, goal_dist, 1.0 / res, traj, zeros, zeros, np.zeros(0), np.zeros(0),
+                        False, False, np.array([1.0, 0.6, 0.8, 0.01]), float(n * n), out)
+        return float(out[0])
+
+    assert score("no_path", "free", "lethal") == -2.0  # no path first (the old kernel said -1: blocked anywhere)
+    assert score("lethal", "free", "no_path") == -1.0
+    assert score("free", "free") == pytest.approx(0.6 + 0.8)

@@ -188,13 +188,13 @@ def _rollout_scores(grid: np.ndarray, near: np.ndarray, path_dist: np.ndarray, g
                     traj: np.ndarray, c: np.ndarray, s: np.ndarray, ox: np.ndarray, oy: np.ndarray, polygon: bool,
                     use_near: bool, weights: np.ndarray, impossible: float,
                     out: np.ndarray) -> None:  # pragma: no cover - compiled
-    """TrajectoryPlanner's cost of each rollout (S, n, 3): ``weights`` = (scale, pdist, gdist, occdist);
-    -1 when a pose is blocked, else -2 when a pose has no path to the plan or goal."""
+    """TrajectoryPlanner's cost of each rollout (S, n, 3): ``weights`` = (scale, pdist, gdist, occdist). As
+    ``generateTrajectory``, the poses are checked in time order and the first failure decides: -1 when the pose
+    is off the map or its footprint blocked, -2 when its cell has no path to the plan or goal."""
     h, w = path_dist.shape
     for r in range(traj.shape[0]):
         top = -math.inf
-        blocked = False
-        no_path = False
+        fail = 0.0
         fp = 0.0
         pd = gd = 0.0
         for k in range(traj.shape[1]):
@@ -202,28 +202,23 @@ def _rollout_scores(grid: np.ndarray, near: np.ndarray, path_dist: np.ndarray, g
             i, j = math.floor(x * inv), math.floor(y * inv)
             inside = 0 <= i < w and 0 <= j < h
             pd, gd = (path_dist[j, i], goal_dist[j, i]) if inside else (path_dist[0, 0], goal_dist[0, 0])
-            if pd >= impossible or gd >= impossible:
-                no_path = True
-            if blocked:
-                continue
+            skip = False
             if use_near and polygon and inside:
                 bound = near[j, i]  # no edge of this pose costs more: it cannot raise the rollout's cost
-                if bound < COST_LETHAL and bound <= top:
-                    continue
-            same = k > 0 and x == traj[r, k - 1, 0] and y == traj[r, k - 1, 1] and (
-                not polygon or (c[r, k] == c[r, k - 1] and s[r, k] == s[r, k - 1]))
-            if not same:  # a rollout's last pose repeated has the same cost
-                fp = _pose_cost(grid, near, inv, x, y, c[r, k], s[r, k], ox, oy, polygon, use_near, True)
-            if fp < 0:
-                blocked = True
-            elif fp > top:
-                top = fp
-        if blocked:
-            out[r] = -1.0
-        elif no_path:
-            out[r] = -2.0
-        else:
-            out[r] = weights[0] * (weights[1] * pd + weights[2] * gd + weights[3] * top)
+                skip = bound < COST_LETHAL and bound <= top
+            if not skip:
+                same = k > 0 and x == traj[r, k - 1, 0] and y == traj[r, k - 1, 1] and (
+                    not polygon or (c[r, k] == c[r, k - 1] and s[r, k] == s[r, k - 1]))
+                if not same:  # a rollout's last pose repeated has the same cost
+                    fp = _pose_cost(grid, near, inv, x, y, c[r, k], s[r, k], ox, oy, polygon, use_near, True)
+                if fp < 0:
+                    fail = -1.0
+                    break
+                top = max(top, fp)
+            if pd >= impossible or gd >= impossible:
+                fail = -2.0
+                break
+        out[r] = fail if fail < 0 else weights[0] * (weights[1] * pd + weights[2] * gd + weights[3] * top)
 
 
 def footprint_cells(shape: tuple[int, int], resolution: float, pose: tuple[float, float, float],
