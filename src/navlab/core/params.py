@@ -19,6 +19,7 @@ from typing import Any, TypeVar
 import yaml
 
 from navlab.core.errors import ParameterError
+from navlab.errors import NavlabError
 from navlab.io.errors import IoError
 from navlab.io.files import read_text_checked
 
@@ -27,8 +28,9 @@ T = TypeVar("T")
 TYPO_CUTOFF = 0.85  # difflib ratio at or above which an unknown key is taken for a misspelling of a known one
 
 
-class ParameterWarning(UserWarning):
-    """An unknown parameter key that ROS would ignore: ``key`` is its name (the launch names its file)."""
+class ParameterWarning(NavlabError, UserWarning):
+    """An unknown parameter key that ROS would ignore (a warning, not raised): ``key`` is its name (the launch
+    names its file)."""
 
     def __init__(self, message: str, key: str) -> None:
         super().__init__(message)
