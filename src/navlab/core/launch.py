@@ -24,8 +24,10 @@ node in ``navlab.nodes.NODES`` or, for user code, ``module:Class``.
 from __future__ import annotations
 
 import importlib
+import logging
 import os
 import re
+import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from importlib import resources
@@ -34,8 +36,8 @@ from typing import Any
 
 from navlab.core.errors import LaunchError, ParameterError
 from navlab.core.executor import Executor
-from navlab.core.node import Node
-from navlab.core.params import load_params, merge_params, parse_yaml, read_yaml
+from navlab.core.node import Node, flatten_params
+from navlab.core.params import ParameterWarning, load_params, merge_params, parse_yaml, read_yaml
 from navlab.errors import NavlabError
 
 _SUBST = re.compile(r"\$\((\S+)(?:\s+([^)]*))?\)")
@@ -118,6 +120,7 @@ class NodeSpec:
     params: dict[str, Any] = field(default_factory=dict)
     remaps: dict[str, str] = field(default_factory=dict)
     origin: str = ""  # "launch file: entry 'name' (parameter files)", prefixed to its errors
+    files: dict[str, set[str]] = field(default_factory=dict)  # parameter file name -> the key names in it
 
 
 def start_node(session: Session, spec: NodeSpec) -> Node:
@@ -135,10 +138,12 @@ def start_node(session: Session, spec: NodeSpec) -> Node:
     if spec.namespace.strip("/"):
         kwargs["namespace"] = spec.namespace
     try:
-        with session.executor.node_context(remappings=spec.remaps):
+        with session.executor.node_context(remappings=spec.remaps), warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", ParameterWarning)
             node = cls(session.executor, **kwargs)
     except NavlabError as exc:  # name the launch file and the parameter files, as the user wrote them
         raise _prefixed(exc, spec.origin) from None
+    _warn_unknown_keys(caught, spec.files, spec.origin)
     session.nodes[node.fully_qualified_name] = node
     session.origins[node.fully_qualified_name] = spec.origin
     return node
@@ -269,10 +274,10 @@ def _text(ctx: _Context, spec: dict[str, Any], key: str, where: str) -> str:
     return str(value)
 
 
-def _node_params(ctx: _Context, spec: dict[str, Any], where: str) -> tuple[dict[str, Any], list[str]]:
-    """The node's parameters and the files they came from."""
+def _node_params(ctx: _Context, spec: dict[str, Any], where: str) -> tuple[dict[str, Any], dict[str, set[str]]]:
+    """The node's parameters and the files they came from (file name -> every key name in it, at any depth)."""
     params: dict[str, Any] = {}
-    files: list[str] = []
+    files: dict[str, set[str]] = {}
     for item in _items(ctx, spec, "param", where, ()):
         if isinstance(item, dict) and not _condition(ctx, item, where):  # a param entry's if/unless
             continue
@@ -285,7 +290,7 @@ def _node_params(ctx: _Context, spec: dict[str, Any], where: str) -> tuple[dict[
             if not path.is_absolute():
                 path = ctx.file.parent / path
             loaded = load_params(path, node=str(spec.get("name") or "") or None)
-            files.append(path.name)
+            files.setdefault(path.name, set()).update(k.rsplit(".", 1)[-1] for k in flatten_params(loaded))
             ns = str(item.get("ns") or "").strip("/")
             for part in reversed(ns.split("/") if ns else []):  # rosparam load's ns=: nest under it
                 loaded = {part: loaded}
@@ -359,9 +364,22 @@ def _run_entries(ctx: _Context, session: Session, depth: int) -> None:
             namespace = _text(ctx, spec, "namespace", where) if spec.get("namespace") else ""
             source = f" (parameters from {', '.join(files)})" if files else ""
             start_node(session, NodeSpec(exec_name, node_name, namespace, params, remaps,
-                                         f"{ctx.file}: {where} {node_name or exec_name!r}{source}"))
+                                         f"{ctx.file}: {where} {node_name or exec_name!r}{source}", files))
         else:
             raise LaunchError(f"{ctx.file}: {where}: unknown entry {kind!r} (expected arg, let, include or node)")
+
+
+def _warn_unknown_keys(caught: list[warnings.WarningMessage], files: dict[str, set[str]], origin: str) -> None:
+    """Log each ignored parameter key (``ParameterWarning``) naming the parameter file that holds it; other
+    warnings go on as they came."""
+    for w in caught:
+        if not isinstance(w.message, ParameterWarning):
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+            continue
+        leaf = w.message.key.rsplit(".", 1)[-1]
+        held = [name for name, keys in files.items() if leaf in keys]
+        where = ", ".join(held) if held else origin
+        logging.getLogger("navlab.launch").warning("%s: %s", where, w.message)
 
 
 def _prefixed(exc: NavlabError, prefix: str) -> NavlabError:
