@@ -181,3 +181,16 @@ def test_without_the_bridge_an_unknown_node_is_named_not_run(tmp_path: Path) -> 
     assert not out.exists() and session.processes is None
     (note,) = [n for n in session.notes if "/robot1/rec" in n]
     assert "my_tools/recorder" in note and "ros:=true" in note
+
+
+def test_an_unknown_harmless_key_warns_naming_the_parameter_file(tmp_path: Path,
+                                                                 caplog: pytest.LogCaptureFixture) -> None:
+    _write(tmp_path / "amcl_params.yaml", "min_particles: 200\nuse_map_topic: true\nfancy_new_option: 3\n")
+    file = _write(tmp_path / "amcl.launch", """<launch>
+  <node pkg="amcl" type="amcl" name="amcl"><rosparam file="$(dirname)/amcl_params.yaml" command="load"/></node>
+</launch>""")
+    with caplog.at_level("WARNING", logger="navlab.launch"):
+        session = start(file)
+    assert session.node("amcl").get_parameter("min_particles") == 200
+    (msg,) = [r.getMessage() for r in caplog.records if "fancy_new_option" in r.getMessage()]
+    assert msg.startswith("amcl_params.yaml: ")

@@ -96,6 +96,15 @@ class RosConfig:
         for key in [k for k in self.params if k == name.rstrip("/") or k.startswith(prefix)]:
             del self.params[key]
 
+    def files_under(self, ns: str) -> dict[str, set[str]]:
+        """The files that set the parameters below ``ns``: file name -> the key names (leaves) it set."""
+        prefix = ns.rstrip("/") + "/"
+        out: dict[str, set[str]] = {}
+        for key, origin in self.param_origin.items():
+            if key.startswith(prefix) and key in self.params:
+                out.setdefault(Path(origin).name, set()).add(key.rsplit("/", 1)[-1])
+        return out
+
     def params_under(self, ns: str) -> dict[str, Any]:
         """The parameters below namespace ``ns`` (``/move_base``) as a nested dict."""
         prefix = ns.rstrip("/") + "/"

@@ -129,6 +129,7 @@ def plan(config: RosConfig, *, ros: bool) -> Plan:
     for node in config.nodes:
         key = (node.pkg, node.type)
         params = config.params_under(node.fqn)
+        files = config.files_under(node.fqn)  # unknown keys are reported naming the file that set them
         origin = f"{node.where} ({node.pkg}/{node.type})"
         if key in GAZEBO:
             if gazebo is not None:
@@ -142,17 +143,17 @@ def plan(config: RosConfig, *, ros: bool) -> Plan:
         elif key == ("gazebo_ros", "spawn_model"):
             spawns.append(node)
         elif key in DIRECT:
-            out.nodes.append(NodeSpec(DIRECT[key], node.name, node.namespace, params, _remaps(node), origin))
+            out.nodes.append(NodeSpec(DIRECT[key], node.name, node.namespace, params, _remaps(node), origin, files))
         elif key == ("map_server", "map_server"):
             words = shlex.split(node.args)
             if words:
                 params = {**params, "yaml_filename": words[0]}
-            out.nodes.append(NodeSpec("map_server", node.name, node.namespace, params, _remaps(node), origin))
+            out.nodes.append(NodeSpec("map_server", node.name, node.namespace, params, _remaps(node), origin, files))
         elif key == ("map_server", "map_saver"):
             out.nodes.append(NodeSpec("map_saver", node.name, node.namespace,
                                       {**params, **_saver_args(node)}, _remaps(node), origin))
         elif node.pkg == "navlab":
-            out.nodes.append(NodeSpec(node.type, node.name, node.namespace, params, _remaps(node), origin))
+            out.nodes.append(NodeSpec(node.type, node.name, node.namespace, params, _remaps(node), origin, files))
         elif key in COVERED:
             out.notes.append(f"{node.where}: {node.pkg}/{node.type}: {COVERED[key]}")
         elif key in VIEWERS and not (ros and key == ("rviz", "rviz")):
