@@ -10,6 +10,7 @@ import re
 import subprocess
 import sys
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -65,6 +66,31 @@ def test_the_old_constructor_still_works_with_a_deprecation_warning() -> None:
     with pytest.warns(DeprecationWarning, match="Node\\(executor, name=...\\) is deprecated"):
         node = Node(Executor(), name="old", parameters={"gain": 2.0})
     assert node.declare_parameter("gain", 1.0) == 2.0 and node.get_parameter("gain") == 2.0  # plain values
+
+
+def test_the_previous_keyword_names_still_work_with_a_deprecation_warning() -> None:
+    from navlab.msgs import Twist, twist
+
+    navlab.init(seed=0)
+    try:
+        node = Node("old_kw")
+        with pytest.warns(DeprecationWarning, match=r"create_publisher\(msgtype=..., qos=...\) is deprecated"):
+            pub = node.create_publisher(msgtype=Twist, topic="cmd_vel", qos=10)
+        got: list[Any] = []
+        with pytest.warns(DeprecationWarning, match=r"create_subscription\(qos=...\)"):
+            node.create_subscription(Twist, "cmd_vel", got.append, qos=10)
+        ticks: list[int] = []
+        with pytest.warns(DeprecationWarning, match=r"create_timer\(period=...\)"):
+            node.create_timer(period=0.5, callback=lambda: ticks.append(1))
+        with pytest.warns(DeprecationWarning, match=r"declare_parameter\(default=...\)"):
+            assert node.declare_parameter("gain", default=3.0).value == 3.0
+        pub.publish(twist(0.1))
+        navlab.spin_once(node, timeout_sec=1.0)
+        assert len(got) == 1 and len(ticks) == 2
+        with pytest.raises(TypeError, match="both 'qos' and 'qos_profile'"):
+            node.create_publisher(Twist, "cmd_vel", qos=10, qos_profile=10)
+    finally:
+        navlab.shutdown()
 
 
 def test_message_classes_default_their_fields_as_rclpy_does() -> None:

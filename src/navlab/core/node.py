@@ -9,6 +9,7 @@ from __future__ import annotations
 import dataclasses
 import difflib
 import enum
+import functools
 import logging
 import sys
 import warnings
@@ -34,6 +35,29 @@ __all__ = [
     "flatten_params",
     "resolve_name",
 ]
+
+
+def _renamed_keywords(**renames: str) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
+    """Accept a method's keyword names of the previous release (``old="new"``) for one more release, with a
+    ``DeprecationWarning`` (the rclpy-shaped names replaced them)."""
+
+    def wrap(method: Callable[..., Any]) -> Callable[..., Any]:
+        @functools.wraps(method)
+        def call(*args: Any, **kwargs: Any) -> Any:
+            used = [old for old in renames if old in kwargs]
+            for old in used:
+                if renames[old] in kwargs:
+                    raise TypeError(f"{method.__name__}() got both {old!r} and {renames[old]!r}")
+                kwargs[renames[old]] = kwargs.pop(old)
+            if used:
+                warnings.warn(f"{method.__name__}({'=..., '.join(used)}=...) is deprecated and goes in the next "
+                              f"release: write {'=..., '.join(renames[o] for o in used)}=... (rclpy's names)",
+                              DeprecationWarning, stacklevel=2)
+            return method(*args, **kwargs)
+
+        return call
+
+    return wrap
 
 
 def resolve_name(name: str, namespace: str) -> str:
@@ -247,6 +271,7 @@ class Node:
 
     # --- communication ---------------------------------------------------------------------------
 
+    @_renamed_keywords(msgtype="msg_type", qos="qos_profile")
     def create_publisher(self, msg_type: type, topic: str, qos_profile: Any = 10, *, latched: bool = False,
                          callback_group: Any = None, event_callbacks: Any = None) -> Publisher:
         """Publisher of ``msg_type`` on ``topic`` (``latched``, or a ``qos_profile`` whose durability is
@@ -259,6 +284,7 @@ class Node:
         self.publishers.append(pub)
         return pub
 
+    @_renamed_keywords(msgtype="msg_type", qos="qos_profile")
     def create_subscription(
         self, msg_type: type, topic: str, callback: Callable[[Any], None], qos_profile: Any = 10, *,
         callback_group: Any = None, event_callbacks: Any = None, raw: bool = False,
@@ -269,6 +295,7 @@ class Node:
         self.subscriptions.append(sub)
         return sub
 
+    @_renamed_keywords(period="timer_period_sec")
     def create_timer(self, timer_period_sec: float, callback: Callable[[], None], callback_group: Any = None,
                      clock: Any = None, *, priority: int = 0, idle: Callable[[], bool] | None = None) -> Timer:
         """Call ``callback()`` every ``timer_period_sec`` simulated seconds (rclpy's signature; lower
@@ -350,6 +377,7 @@ class Node:
 
     # --- parameters ------------------------------------------------------------------------------
 
+    @_renamed_keywords(default="value")
     def declare_parameter(self, name: str, value: Any = None, descriptor: Any = None, ignore_override: bool = False,
                           *, aliases: Sequence[str] = ()) -> Any:
         """Declare a parameter (rclpy's signature) and return it: the override given at construction, or
