@@ -78,6 +78,27 @@ def rospy(env: dict[str, str], code: str, timeout: float = 60.0) -> str:
     return done.stdout
 
 
+def send_move_base_goal(env: dict[str, str], x: float, y: float, timeout: float = 60.0) -> int:
+    """A rospy ``SimpleActionClient('move_base', MoveBaseAction)`` sends (x, y) in map; the final goal state
+    (actionlib_msgs/GoalStatus: 3 is SUCCEEDED)."""
+    out = rospy(env, f"""
+import rospy, actionlib
+from move_base_msgs.msg import MoveBaseAction, MoveBaseGoal
+rospy.init_node('goal_sender', anonymous=True)
+client = actionlib.SimpleActionClient('move_base', MoveBaseAction)
+assert client.wait_for_server(rospy.Duration(15)), 'no move_base action server'
+goal = MoveBaseGoal()
+goal.target_pose.header.frame_id = 'map'
+goal.target_pose.pose.position.x = {x}
+goal.target_pose.pose.position.y = {y}
+goal.target_pose.pose.orientation.w = 1.0
+client.send_goal(goal)
+client.wait_for_result(rospy.Duration({timeout}))
+print(client.get_state())
+""", timeout=timeout + 30)
+    return int(out.strip())
+
+
 def run_with_ros(env: dict[str, str], launch: str, *, follow_clock: bool = False, **args: str) -> LiveRun:
     """``launch`` started here and offered on the master of ``env`` (real time, or following /clock)."""
     return LiveRun(launch, master=env["ROS_MASTER_URI"], follow_clock=follow_clock, **args)

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 import yaml
-from conftest import free_port, require, ros, rospy, run_with_ros
+from conftest import free_port, require, ros, run_with_ros, send_move_base_goal
 
 from navlab.ros1.live import LiveRun
 
@@ -62,21 +62,7 @@ def recording(ros_env: dict[str, str], tmp_path_factory: pytest.TempPathFactory)
 def test_move_base_drives_the_robot_of_another_process_to_the_goal(hil: LiveRun, ros_env: dict[str, str],
                                                                   recording: Callable[[], Path]) -> None:
     assert "/gazebo" not in hil.ex.nodes  # no simulator in this run
-    out = rospy(ros_env, """
-import rospy, actionlib
-from move_base_msgs.msg import MoveBaseAction, MoveBaseGoal
-rospy.init_node('hil_goal_sender')
-client = actionlib.SimpleActionClient('move_base', MoveBaseAction)
-assert client.wait_for_server(rospy.Duration(15)), 'no move_base action server'
-goal = MoveBaseGoal()
-goal.target_pose.header.frame_id = 'map'
-goal.target_pose.pose.position.x = 1.5
-goal.target_pose.pose.orientation.w = 1.0
-client.send_goal(goal)
-client.wait_for_result(rospy.Duration(90))
-print(client.get_state())
-""", timeout=120)
-    assert out.strip() == "3"  # SUCCEEDED
+    assert send_move_base_goal(ros_env, 1.5, 0.0, timeout=90) == 3  # SUCCEEDED
     truth = yaml.safe_load(ros(ros_env, "rostopic", "echo", "-n", "1", "/ground_truth/odom/pose/pose/position")
                            .split("---")[0])
     assert math.hypot(truth["x"] - 1.5, truth["y"]) < 0.3  # where the robot really is, in its own process

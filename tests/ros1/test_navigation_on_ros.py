@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import Screen, require, ros, rospy, run_with_ros
+from conftest import Screen, require, ros, rospy, run_with_ros, send_move_base_goal
 from PIL import Image
 
 from navlab.core.launch import resources_dir
@@ -98,21 +98,7 @@ rospy.delete_param('/use_sim_time')
 
 
 def test_a_simple_action_client_drives_move_base_to_its_goal(nav: LiveRun, ros_env: dict[str, str]) -> None:
-    out = rospy(ros_env, """
-import rospy, actionlib
-from move_base_msgs.msg import MoveBaseAction, MoveBaseGoal
-rospy.init_node('goal_sender')
-client = actionlib.SimpleActionClient('move_base', MoveBaseAction)
-assert client.wait_for_server(rospy.Duration(15)), 'no move_base action server'
-goal = MoveBaseGoal()
-goal.target_pose.header.frame_id = 'map'
-goal.target_pose.pose.position.x = 1.0
-goal.target_pose.pose.orientation.w = 1.0
-client.send_goal(goal)
-client.wait_for_result(rospy.Duration(60))
-print(client.get_state())
-""", timeout=90)
-    assert out.strip() == "3"  # actionlib_msgs/GoalStatus SUCCEEDED
+    assert send_move_base_goal(ros_env, 1.0, 0.0, timeout=60) == 3  # SUCCEEDED
     x, y, _ = nav.call(lambda: nav.ex.tf.lookup_pose2d("map", "chassis", None))
     assert abs(x - 1.0) < 0.3 and abs(y) < 0.3
 

@@ -17,6 +17,7 @@ import os
 import queue
 import threading
 import time
+import xmlrpc.client
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any, ClassVar
@@ -30,7 +31,7 @@ from navlab.msgs import TFMessage, type_name
 from navlab.ros1.clock import ClockFollower
 from navlab.ros1.errors import Ros1Error
 from navlab.ros1.master import Master
-from navlab.ros1.net import LOG, XmlRpcServer, binding, call, master_uri, proxy
+from navlab.ros1.net import LOG, XmlRpcServer, binding, call, host_port, master_uri, proxy
 from navlab.ros1.types import Ros1Types, WireType
 from navlab.ros1.wire import Incoming, Publication, TcpRosServer
 
@@ -41,13 +42,11 @@ CLOCK_PERIOD_NS = 10_000_000  # /clock every 10 ms of simulated time
 
 def connect_or_start_master(uri: str | None = None) -> tuple[str, Master | None]:
     """The master at ``uri`` (default ``$ROS_MASTER_URI``) when one answers, else navlab's own started there."""
-    from navlab.ros1.net import host_port
-
     uri = uri or master_uri()
     try:
         proxy(uri, 1.0).getUri(BRIDGE_NAME)
         return uri, None
-    except (OSError, Exception):
+    except (OSError, xmlrpc.client.Error):  # nothing answers (or not a master): start one
         pass
     host, port = host_port(uri)
     if host not in ("localhost", "127.0.0.1", binding().advertise):
