@@ -18,6 +18,7 @@ from navlab.cli_common import (
     print_figures,
     start_pose,
 )
+from navlab.ros1.cli import add_ros_argument, pace, ros_hook
 from navlab.viz.cli import add_view_arguments, view_hook
 
 
@@ -28,10 +29,10 @@ def _cmd_map(args: argparse.Namespace) -> int:
     from navlab.experiments.mapping_run import run_mapping
 
     driver = "teleop" if args.teleop else "route" if args.route else "explore"
-    with view_hook(args) as on_start:
+    with view_hook(args) as view, ros_hook(args, view) as on_start:
         result = run_mapping(
             world=args.world, robot=args.robot, pose=start_pose(args), out=args.out, driver=driver, route=args.route,
-            duration=args.duration, mode=args.mode, seed=args.seed, rate=args.rate, record=args.record,
+            duration=args.duration, mode=args.mode, seed=args.seed, rate=args.rate or 0.0, record=args.record,
             quiet=args.quiet, slam_params=parse_sets(args.set), on_start=on_start,
         )  # fmt: skip
     if not args.json:
@@ -86,7 +87,7 @@ def _cmd_localize(args: argparse.Namespace) -> int:
     apply_resource_paths(args)  # --package-path / --model-path, for this process and its workers
     from navlab.experiments.localize_run import plot_result, run_localization
 
-    with view_hook(args) as on_start:
+    with view_hook(args) as view, ros_hook(args, view) as on_start:
         result = run_localization(
             args.world, args.map, initial=tuple(args.initial) if args.initial else None,
             global_localization=args.global_localization, duration=args.duration, seed=args.seed,
@@ -111,7 +112,7 @@ def _cmd_navigate(args: argparse.Namespace) -> int:
     for i, spec in enumerate(args.spawn):
         model, t = parse_spawn_spec(spec, default_name=f"spawned_{i}")
         spawns.append((t, model))
-    with view_hook(args) as on_start:
+    with view_hook(args) as view, ros_hook(args, view) as on_start:
         result = run_navigation(
             [tuple(g) for g in args.goal], world=args.world, map_yaml=args.map, robot=args.robot,
             pose=start_pose(args), controller=args.controller, params_dir=args.params,
@@ -252,7 +253,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="SLAM mode: gmapping, the paper's RBPF (default), or graph (pose graph)")  # fmt: skip
     add_set_argument(p, "slam_gmapping", "particles=50")
     p.add_argument("--duration", type=positive_seconds, default=600.0, help="at most this many simulated s (600)")
-    p.add_argument("--rate", type=float, default=0.0, help="pacing: 0 = as fast as possible, 1 = real time")
+    p.add_argument("--rate", type=pace, default=None,
+                   help="pacing: 0 = as fast as possible (default; real time with --ros), 1 = real time")
     p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     p.add_argument("--record", metavar="DIR", help="also write every topic to a rosbag2 (MCAP) in DIR")
     p.add_argument("--launch", nargs="+", metavar="FILE [name:=value]",
@@ -262,6 +264,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.add_argument("--json", action="store_true", help="print the scores as JSON")
     add_view_arguments(p)
+    add_ros_argument(p)
     p.set_defaults(func=_cmd_map)
 
     p = sub.add_parser(
@@ -294,6 +297,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--record", metavar="DIR", help="also write every topic to a rosbag2 (MCAP) in DIR")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     add_view_arguments(p)
+    add_ros_argument(p, rate=True)
     p.set_defaults(func=_cmd_localize)
 
     p = sub.add_parser(
@@ -331,6 +335,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--record", metavar="DIR", help="also write every topic to a rosbag2 (MCAP) in DIR")
     p.add_argument("--json", action="store_true", help="print the figures as one JSON object")
     add_view_arguments(p)
+    add_ros_argument(p, rate=True)
     p.set_defaults(func=_cmd_navigate)
 
     p = sub.add_parser(

@@ -6,7 +6,7 @@ import argparse
 import contextlib
 import logging
 import signal
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from typing import Any
 
 TRUE = ("true", "1", "yes", "on")
@@ -36,11 +36,27 @@ def _cmd_roscore(args: argparse.Namespace) -> int:
     return 0
 
 
-def add_ros_argument(p: argparse.ArgumentParser) -> None:
-    """``--ros``: offer the run on a ROS 1 master (``$ROS_MASTER_URI``, or navlab's own)."""
+def add_ros_argument(p: argparse.ArgumentParser, *, rate: bool = False) -> None:
+    """``--ros``: offer the run on a ROS 1 master (``$ROS_MASTER_URI``, or navlab's own); with ``rate``, also
+    ``--rate`` (for verbs that have no pace option of their own)."""
     p.add_argument("--ros", action="store_true",
                    help="join the ROS 1 graph at $ROS_MASTER_URI (or start navlab's own master): real rostopic, "
                         "rviz, rosbag and rospy nodes see and drive the run; runs in real time unless --rate")
+    if rate:
+        p.add_argument("--rate", type=pace, default=None,
+                       help="pacing: 0 = as fast as possible (default; real time with --ros), 1 = real time, "
+                            "r = r x real time")
+
+
+def pace(text: str) -> float:
+    """argparse type of ``--rate``: a finite number >= 0 (simulated s per wall-clock s; 0 = as fast as possible)."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = -1.0
+    if not 0 <= value < float("inf"):
+        raise argparse.ArgumentTypeError(f"expected a number >= 0 (0 = as fast as possible), got {text!r}")
+    return value
 
 
 def pop_ros_arg(launch_args: dict[str, str]) -> bool:
@@ -60,11 +76,44 @@ def ros_bridge(enabled: bool, executor: Any, nodes: dict[str, Any], *, follow_cl
     if not enabled:
         yield None
         return
-    from navlab.ros1.bridge import RosBridge, session_params
-
-    logging.getLogger("navlab.ros1").setLevel(logging.INFO)
-    bridge = RosBridge(executor, params=session_params(nodes), follow_clock=follow_clock)
+    bridge = _open_bridge(executor, nodes, follow_clock=follow_clock)
     try:
         yield bridge
     finally:
         bridge.close()
+
+
+@contextlib.contextmanager
+def ros_hook(args: argparse.Namespace, then: Callable[[Any], None] | None = None) -> Iterator[Any]:
+    """With ``--ros`` (or ``--rate``): an ``on_start(run)`` for ``start_run`` and the run functions that take one.
+    It paces each run it starts — ``--rate``, else real time with ``--ros`` (outside nodes cannot follow 100x),
+    else the run's own pace — then calls ``then(run)`` (``view_hook``'s viewer, which takes that pace) and, with
+    ``--ros``, offers the run on ROS 1 (the previous run's bridge closes). Neither given: ``then`` itself."""
+    ros, rate = bool(getattr(args, "ros", False)), getattr(args, "rate", None)
+    if not ros and rate is None:
+        yield then
+        return
+    bridges: list[Any] = []
+
+    def on_start(run: Any) -> None:
+        while bridges:
+            bridges.pop().close()  # the previous run has finished
+        ex = run.executor
+        ex.rate = float(rate) if rate is not None else (ex.rate or 1.0) if ros else ex.rate
+        if then is not None:
+            then(run)
+        if ros:
+            bridges.append(_open_bridge(ex, run.session.nodes))
+
+    try:
+        yield on_start
+    finally:
+        for bridge in bridges:
+            bridge.close()
+
+
+def _open_bridge(executor: Any, nodes: dict[str, Any], *, follow_clock: bool = False) -> Any:
+    from navlab.ros1.bridge import RosBridge, session_params
+
+    logging.getLogger("navlab.ros1").setLevel(logging.INFO)
+    return RosBridge(executor, params=session_params(nodes), follow_clock=follow_clock)

@@ -22,6 +22,7 @@ from navlab.cli_common import (
     positive_seconds,
     start_pose,
 )
+from navlab.ros1.cli import add_ros_argument, ros_bridge
 
 DEFAULT_PORT = 8765
 
@@ -136,11 +137,16 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--record", default=None, metavar="DIR", help="record every topic to a rosbag2 in DIR")
     add_server_arguments(p)
     add_resource_path_arguments(p)
+    add_ros_argument(p)  # paced by --speed (default real time)
     p.set_defaults(func=_cmd_view)
 
 
 def _cmd_view(args: argparse.Namespace) -> int:
     if args.bag:
+        if args.ros:
+            from navlab.viz.errors import VizError
+
+            raise VizError("--ros serves a live launch, not a --bag replay (play the recording with `rosbag play`)")
         return _replay(args)
     apply_resource_paths(args)
     from navlab.core.launch import declared_args
@@ -158,7 +164,8 @@ def _cmd_view(args: argparse.Namespace) -> int:
         run = start_run(args.launch, world=world, robot=robot, pose=pose, seed=args.seed, **launch_args)
     viewer = start_viewer(args, run.executor, host=args.host, port=args.port, speed=args.speed)
     try:
-        run.run(args.duration or math.inf, record=args.record, quiet=True, desc="view")
+        with ros_bridge(args.ros, run.executor, run.session.nodes):
+            run.run(args.duration or math.inf, record=args.record, quiet=True, desc="view")
     finally:
         viewer.close()
     return 0
