@@ -36,12 +36,12 @@ def _cmd_roscore(args: argparse.Namespace) -> int:
     return 0
 
 
-def add_ros_argument(p: argparse.ArgumentParser, *, rate: bool = False) -> None:
+def add_ros_argument(p: argparse.ArgumentParser, *, rate: bool = False, pace_option: str = "--rate") -> None:
     """``--ros``: offer the run on a ROS 1 master (``$ROS_MASTER_URI``, or navlab's own); with ``rate``, also
-    ``--rate`` (for verbs that have no pace option of their own)."""
+    ``--rate`` (for verbs that have no pace option of their own); ``pace_option``: the verb's pace option."""
     p.add_argument("--ros", action="store_true",
                    help="join the ROS 1 graph at $ROS_MASTER_URI (or start navlab's own master): real rostopic, "
-                        "rviz, rosbag and rospy nodes see and drive the run; runs in real time unless --rate")
+                        f"rviz, rosbag and rospy nodes see and drive the run; runs in real time unless {pace_option}")
     if rate:
         p.add_argument("--rate", type=pace, default=None,
                        help="pacing: 0 = as fast as possible (default; real time with --ros), 1 = real time, "
@@ -99,7 +99,10 @@ def ros_hook(args: argparse.Namespace, then: Callable[[Any], None] | None = None
         while bridges:
             bridges.pop().close()  # the previous run has finished
         ex = run.executor
-        ex.rate = float(rate) if rate is not None else (ex.rate or 1.0) if ros else ex.rate
+        if rate is not None:
+            ex.rate = float(rate)
+        elif ros:
+            ex.rate = ex.rate or 1.0
         if then is not None:
             then(run)
         if ros:

@@ -137,7 +137,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--record", default=None, metavar="DIR", help="record every topic to a rosbag2 in DIR")
     add_server_arguments(p)
     add_resource_path_arguments(p)
-    add_ros_argument(p)  # paced by --speed (default real time)
+    add_ros_argument(p, pace_option="--speed")
     p.set_defaults(func=_cmd_view)
 
 
