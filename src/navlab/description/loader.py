@@ -104,10 +104,11 @@ def load_robot(
     check_plugin_joints(tags, {j.name: j.type for j in joints}, links, source, chain,
                         legacy_given=tags.legacy_mode_given)
     model.diff_drive = tags.diff_drive
+    model.ros_control = tags.ros_control
     model.lidars = tags.lidars
     model.imus = tags.imus
     model.warnings += tags.warnings
-    if model.diff_drive is None:
+    if model.diff_drive is None and model.ros_control is None:
         model.warnings.append(f"{source}: no libgazebo_ros_diff_drive.so plugin; cmd_vel will not move "
                               "the robot")
     return model

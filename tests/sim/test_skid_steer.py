@@ -1,0 +1,100 @@
+"""Four-wheel skid-steer robots: the gazebo_ros_control + diff_drive_controller shape (a control YAML with
+``left_wheel: [front, rear]``), libgazebo_ros_skid_steer_drive.so, and how fast they really turn.
+
+The yaw-rate figure by construction: four wheels at (+-a, +-b/2) carrying equal load, driven at the rim speeds
+``+-u`` with isotropic Coulomb friction, turn in place at the rate where the wheels' friction moments balance:
+every wheel slides along ``(w b/2 - u, w a)``, and its moment about the centre vanishes when
+``w (a^2 + (b/2)^2) = u b/2``, so ``w / w_cmd = m (b/2)^2 / (a^2 + (b/2)^2)`` for a controller whose
+``wheel_separation_multiplier`` is ``m`` (it commands ``u = w_cmd m b/2``). The friction coefficient cancels.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from navlab import msgs
+from navlab.core import Executor, Node
+from navlab.core.node import flatten_params
+from navlab.description import load_robot
+from navlab.sim.gazebo import launch_sim
+
+FIXTURE = Path(__file__).parents[1] / "fixtures" / "skidbot_description"
+XACRO = FIXTURE / "urdf" / "skidbot.urdf.xacro"
+A, HALF_B = 0.10, 0.15  # skidbot's half wheelbase and half track (m)
+
+
+def coulomb_ratio(multiplier: float, a: float = A, half_b: float = HALF_B) -> float:
+    """Achieved / commanded in-place yaw rate of a four-wheel skid-steer robot (see the module docstring)."""
+    return multiplier * half_b**2 / (a**2 + half_b**2)
+
+
+def _yaw(sim: object) -> float:
+    q = sim.link_pose("base_link").quaternion  # type: ignore[attr-defined]
+    return math.atan2(2 * (q[3] * q[2] + q[0] * q[1]), 1 - 2 * (q[1] ** 2 + q[2] ** 2))
+
+
+def drive(v: float, w: float, *, drive_kind: str = "ros_control", multiplier: float = 1.0, mu: float = 0.3,
+          settle: float = 1.0, duration: float = 2.0) -> dict[str, float]:  # fmt: skip
+    """Command (v, w) on skidbot; the true speed and yaw rate over ``duration`` s after ``settle`` s, and the
+    odometry's."""
+    ex = Executor(seed=0)
+    robot = load_robot(XACRO, args={"drive": drive_kind, "mu": str(mu)})
+    params: dict = {}
+    if drive_kind == "ros_control":
+        params = flatten_params(yaml.safe_load((FIXTURE / "config" / "control.yaml").read_text()))
+        params["skidbot_velocity_controller.wheel_separation_multiplier"] = multiplier
+    gz = launch_sim(ex, world="room", robot=robot, ground_truth_rate=0.0, **params)
+    node = Node(ex, name="driver")
+    pub = node.create_publisher(msgs.Twist, "cmd_vel")
+    odom: list = []
+    node.create_subscription(msgs.Odometry, "odom", odom.append, 10)
+    node.create_timer(0.05, lambda: pub.publish(msgs.twist(v, w)))
+    ex.run(settle)
+    y0, p0, turned = _yaw(gz.sim), gz.sim.link_pose("base_link").position.copy(), 0.0
+    for _ in range(int(duration / 0.05)):
+        last = _yaw(gz.sim)
+        ex.run(0.05)
+        turned += (_yaw(gz.sim) - last + math.pi) % (2 * math.pi) - math.pi
+    p1 = gz.sim.link_pose("base_link").position
+    o = odom[-1]
+    return {"w": turned / duration, "v": float(np.linalg.norm(p1[:2] - p0[:2])) / duration,
+            "odom_w": o.twist.twist.angular.z, "odom_v": o.twist.twist.linear.x, "z": float(p1[2]),
+            "odom_x": o.pose.pose.position.x, "true_x": float(p1[0]), "y0": y0}  # fmt: skip
+
+
+def test_shipped_jackal_skid_has_the_public_shape() -> None:
+    robot = load_robot("jackal_skid")
+    assert robot.ros_control is not None and robot.diff_drive is None  # the drive comes from control.yaml
+    wheel = robot.links["front_left_wheel_link"]
+    assert wheel.mu1 == wheel.mu2 == 0.3 and wheel.contact is not None and wheel.contact.kp == 1e6
+    skid = load_robot("jackal_skid", args={"drive": "skid_steer"}).diff_drive
+    assert skid is not None and skid.drive == "gazebo_ros_skid_steer_drive"
+    assert skid.wheel_joints() == (("front_left_wheel", "rear_left_wheel"), ("front_right_wheel", "rear_right_wheel"))
+    assert skid.odometry_source == "world" and skid.publish_tf  # the plugin's odometry is the true pose
+
+
+def test_ros_control_drives_straight_with_odometry_from_the_wheels() -> None:
+    r = drive(0.5, 0.0)
+    assert r["v"] == pytest.approx(0.5, rel=0.03)  # rolling straight, the tyres hardly slip
+    assert r["odom_v"] == pytest.approx(0.5, rel=0.02) and abs(r["w"]) < 0.01
+    assert abs(r["z"]) < 0.01  # on its wheels, not hopping
+
+
+@pytest.mark.parametrize("multiplier", [1.0, 1.5])
+def test_in_place_yaw_rate_is_the_coulomb_figure(multiplier: float) -> None:
+    r = drive(0.0, 1.0, multiplier=multiplier)
+    assert r["w"] == pytest.approx(coulomb_ratio(multiplier), rel=0.12)
+    # diff_drive_controller's odometry reads the wheels: it reports the command, not the slower turn
+    assert r["odom_w"] == pytest.approx(1.0, rel=0.05)
+
+
+def test_skid_steer_plugin_drives_an_arc_and_reports_the_true_pose() -> None:
+    r = drive(0.4, 0.5, drive_kind="skid_steer")
+    assert 0.3 < r["w"] / 0.5 < 1.0  # the tyres scrub: slower than the wheels ask
+    assert r["odom_w"] == pytest.approx(r["w"], abs=0.05)  # gazebo_ros_skid_steer_drive's odometry: the model's pose
+    assert r["odom_x"] == pytest.approx(r["true_x"], abs=1e-3)
