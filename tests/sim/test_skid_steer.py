@@ -98,3 +98,13 @@ def test_skid_steer_plugin_drives_an_arc_and_reports_the_true_pose() -> None:
     assert 0.3 < r["w"] / 0.5 < 1.0  # the tyres scrub: slower than the wheels ask
     assert r["odom_w"] == pytest.approx(r["w"], abs=0.05)  # gazebo_ros_skid_steer_drive's odometry: the model's pose
     assert r["odom_x"] == pytest.approx(r["true_x"], abs=1e-3)
+
+
+@pytest.mark.parametrize("mu", [0.05, 0.3])
+def test_friction_tags_set_the_slip_when_starting(mu: float) -> None:
+    """Coulomb friction lets four driven wheels push the robot at most ``mu g``: the wheels spin up at the
+    controller's 5 m/s² while the robot follows at ``min(mu g, 5)``, so by the time both run at v the wheel
+    odometry has counted ``v²/2 (1/(mu g) - 1/5)`` m the robot never drove."""
+    r = drive(1.0, 0.0, mu=mu, settle=0.0, duration=2.5)
+    expected = 0.5 * (1.0 / min(mu * 9.81, 5.0) - 1.0 / 5.0)
+    assert r["odom_x"] - r["true_x"] == pytest.approx(expected, rel=0.25, abs=0.02)

@@ -28,7 +28,7 @@ ODE_STEP = 0.001  # s: Gazebo's default max_step_size, the step whose implicit E
 #: the robot turning at 0.09 of its command). A softer contact — impedance from 0.5, time constant >= 20 ms,
 #: critically damped, its impedance ramp >= 2 mm wide — keeps all four down and turns at the Coulomb figure
 #: (see tests/sim/test_skid_steer.py).
-SKID_SOLREF_MIN = (0.02, 1.0)
+SKID_SOLREF_MIN = (0.03, 1.0)
 SKID_SOLIMP_D0 = 0.5
 SKID_SOLIMP_WIDTH = 0.002  # m: the impedance ramp's least width (1 mm still lets the robot hop)
 
