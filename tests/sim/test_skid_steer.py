@@ -108,3 +108,28 @@ def test_friction_tags_set_the_slip_when_starting(mu: float) -> None:
     r = drive(1.0, 0.0, mu=mu, settle=0.0, duration=2.5)
     expected = 0.5 * (1.0 / min(mu * 9.81, 5.0) - 1.0 / 5.0)
     assert r["odom_x"] - r["true_x"] == pytest.approx(expected, rel=0.25, abs=0.02)
+
+
+def test_robot_files_turn_on_the_controller_and_the_ekf_by_default() -> None:
+    """jackal_skid ships config/control.yaml and a robot_localization YAML beside it: the shipped sim launch starts
+    its diff_drive_controller and robot_localization's EKF without being asked; the EKF alone sends odom -> base."""
+    from navlab.core.launch import start
+    from navlab.description.loader import robot_launch_values
+
+    values = robot_launch_values("jackal_skid")
+    assert (values["wheel_controller"], values["ekf"]) == ("true", "true")
+    assert values["controller_params"].endswith("jackal_skid/config/control.yaml")
+    assert robot_launch_values("mybot")["ekf"] == "false"  # mybot asks for neither
+    s = start("sim", launch_args={"robot": "jackal_skid"})
+    senders: set[str] = set()
+    filtered: list = []
+    watch = Node(s.executor, name="watch")
+    watch.create_subscription(msgs.TFMessage, "/tf", lambda m: senders.update(
+        t.header.frame_id + ">" + t.child_frame_id for t in m.transforms), 100)
+    watch.create_subscription(msgs.Odometry, "/odometry/filtered", filtered.append, 100)
+    cmd = watch.create_publisher(msgs.Twist, "/cmd_vel", 1)
+    watch.create_timer(0.1, lambda: cmd.publish(msgs.twist(0.3, 0.5)))
+    s.run(1.5)
+    assert "jackal_velocity_controller" in {p.name for p in s.nodes["/gazebo"].plugins} and "/ekf_se" in s.nodes
+    assert "odom>base_link" in senders and len(filtered) >= 60  # 50 Hz
+    assert filtered[-1].twist.twist.angular.z > 0.2  # turning left, as the IMU says

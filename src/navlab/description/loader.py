@@ -115,13 +115,26 @@ def load_robot(
 
 
 def robot_launch_values(name_or_path: str | os.PathLike[str]) -> dict[str, str]:
-    """What launch files take from a robot's plugin tags (``$(robot KEY)``): ``base_frame`` (the
-    diff-drive plugin's ``robotBaseFrame``, else the root link), ``odom_frame`` and ``scan_topic`` (the
-    first laser's topic, else ``scan``)."""
+    """What launch files take from a robot's files (``$(robot KEY)``): ``base_frame`` (the drive plugin's
+    ``robotBaseFrame``, else the root link), ``odom_frame`` and ``scan_topic`` (the first laser's topic, else
+    ``scan``); from its package's own configuration (:mod:`navlab.description.robot_files`):
+    ``wheel_controller`` (``true`` when a ``gazebo_ros_control`` robot has a control YAML), ``controller_params``
+    (that YAML, else navlab's ``params/<robot>/diff_drive_controller.yaml``), ``ekf`` (``true`` when a
+    robot_localization YAML sits beside it) and ``ekf_params`` (that YAML, else navlab's ``params/ekf.yaml``)."""
+    from navlab.description.robot_files import robot_files
+
     model = load_robot(name_or_path)
     dd = model.diff_drive
+    own = robot_files(model.source) if model.source is not None else None
+    control = own.control if own is not None and model.ros_control is not None else None
+    ekf = own.ekf if own is not None else None
     return {
         "base_frame": dd.robot_base_frame if dd else model.root_link,
         "odom_frame": dd.odometry_frame if dd else "odom",
         "scan_topic": model.lidars[0].topic if model.lidars else "scan",
+        "wheel_controller": "true" if control is not None else "false",
+        "controller_params": str(control or resources.root() / "params" / str(name_or_path) /
+                                 "diff_drive_controller.yaml"),
+        "ekf": "true" if ekf is not None else "false",
+        "ekf_params": str(ekf or resources.path("params/ekf.yaml")),
     }
