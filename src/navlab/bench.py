@@ -26,6 +26,7 @@ BENCHES: dict[str, str] = {
     "planner": "navlab.navigation.bench:run_planner",
     "nav": "navlab.experiments.navigate_run:bench",
     "clutter": "navlab.experiments.clutter_run:bench",
+    "odom": "navlab.experiments.odom_run:bench",
     "sweep": "navlab.experiments.sweep:bench",
     "view": "navlab.viz.bench:run",
 }
