@@ -36,8 +36,8 @@ def run_clutter_world(
     params/<robot>, where navlab ships some); returns its figures."""
     from navlab import resources
 
-    params_dir = resources.root() / "params" / robot
-    params_dir = params_dir if params_dir.is_dir() else None
+    shipped = resources.root() / "params" / robot
+    params_dir = shipped if shipped.is_dir() else None
     with tempfile.TemporaryDirectory(prefix="navlab-clutter-", dir=workdir) as tmp:
         path = world.write_world(Path(tmp) / f"{world.name}.world")
         gx, gy, gyaw = (float(v) for v in between2(world.start, world.goal))  # the goal in odom (= the start)
