@@ -68,10 +68,11 @@ def find_controllers(params: dict[str, Any]) -> Controllers:
     return out
 
 
-def _names(value: Any, key: str) -> tuple[str, ...]:
-    names = [value] if isinstance(value, str) else list(value or ())
+def wheel_names(value: Any, where: str) -> tuple[str, ...]:
+    """A ``left_wheel``/``right_wheel`` value (a joint name or a list of them) as a tuple."""
+    names = [value] if isinstance(value, str) else list(value) if isinstance(value, list | tuple) else []
     if not names or not all(isinstance(n, str) and n for n in names):
-        raise SimError(f"diff_drive_controller {key}: expected a joint name or a list of joint names, got {value!r}")
+        raise SimError(f"{where}: expected a joint name or a list of joint names, got {value!r}")
     return tuple(names)
 
 
@@ -100,7 +101,8 @@ def _wheel_radius(robot: RobotModel, joint: str) -> float:
 
 def drive_from_controller(robot: RobotModel, params: dict[str, Any]) -> DiffDriveConfig:
     """The drive a diff-drive controller's parameters describe on a ``gazebo_ros_control`` robot."""
-    lefts, rights = _names(params.get("left_wheel"), "left_wheel"), _names(params.get("right_wheel"), "right_wheel")
+    lefts = wheel_names(params.get("left_wheel"), "diff_drive_controller left_wheel")
+    rights = wheel_names(params.get("right_wheel"), "diff_drive_controller right_wheel")
     separation = float(params.get("wheel_separation") or 0.0)
     if not separation:
         separation = float(np.linalg.norm((_joint_xyz(robot, lefts[0]) - _joint_xyz(robot, rights[0]))[:2]))

@@ -35,6 +35,7 @@ from navlab.core import Executor, Node
 from navlab.description.model import DiffDriveConfig
 from navlab.sim.errors import SimError
 from navlab.sim.pid import Pid, PidGains
+from navlab.sim.ros_control import wheel_names
 from navlab.sim.simulation import Simulation
 
 CONTROLLER_TYPE = "diff_drive_controller/DiffDriveController"
@@ -210,8 +211,8 @@ class DiffDriveController(Node):
             raise SimError(f"{where}: type {p['type']!r}: navlab simulates {CONTROLLER_TYPE!r}")
         self.sim, self.cfg, self.p = sim, config, p
         lefts, rights = config.wheel_joints()
-        self.sides = (_joint_list(p["left_wheel"], lefts, f"{where} left_wheel"),
-                      _joint_list(p["right_wheel"], rights, f"{where} right_wheel"))
+        self.sides = (wheel_names(p["left_wheel"], f"{where} left_wheel") if p["left_wheel"] else lefts,
+                      wheel_names(p["right_wheel"], f"{where} right_wheel") if p["right_wheel"] else rights)
         if (len(self.sides[0]), len(self.sides[1])) != (len(lefts), len(rights)):
             raise SimError(f"{where}: left_wheel {list(self.sides[0])} and right_wheel {list(self.sides[1])}: the "
                            f"robot drives {len(lefts)} + {len(rights)} wheels")
@@ -312,16 +313,6 @@ class DiffDriveController(Node):
         ))  # fmt: skip
         if self.p["enable_odom_tf"]:
             self.send_transform(msgs.transform_stamped(now, self.odom_frame, self.base_frame, o.x, o.y, o.yaw))
-
-
-def _joint_list(value: Any, default: tuple[str, ...], where: str) -> tuple[str, ...]:
-    """A ``left_wheel``/``right_wheel`` value (a joint name or a list of them) as a tuple; ``default`` if empty."""
-    if not value:
-        return default
-    names = [value] if isinstance(value, str) else list(value) if isinstance(value, list | tuple) else None
-    if not names or not all(isinstance(n, str) and n for n in names):
-        raise SimError(f"{where}: expected a joint name or a list of joint names, got {value!r}")
-    return tuple(names)
 
 
 def _axis(p: dict[str, Any], prefix: str) -> dict[str, Any]:
