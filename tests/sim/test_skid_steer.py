@@ -143,3 +143,17 @@ def test_ekf_keeps_drift_within_two_percent_on_a_clutter_course() -> None:
     r = run_drift("jackal_skid", "clutter", ekf=True)
     assert r["completed"] and r["distance_m"] > 10.0 and r["turned_rad"] > 3.0  # a winding course, driven to its end
     assert r["error_per_m"] <= 0.02 and r["max_error_m"] <= 0.2
+
+
+def test_controllers_are_found_by_type() -> None:
+    from navlab.sim.ros_control import find_controllers
+
+    found = find_controllers({
+        "base.type": "diff_drive_controller/DiffDriveController", "base.left_wheel": ["a", "b"],
+        "arm.type": "position_controllers/JointTrajectoryController", "arm.joints": ["j1"],
+        "joints.type": "joint_state_controller/JointStateController", "joints.publish_rate": 20,
+    })  # fmt: skip
+    assert (found.diff_drive, found.joint_state_rate) == ("base", 20.0)
+    assert set(found.names) == {"base", "arm", "joints"}  # their keys are the YAML's, not unknown parameters
+    assert found.ignored == ("arm (position_controllers/JointTrajectoryController)",)
+    assert find_controllers({"mobile_base_controller.left_wheel": "w"}).diff_drive == "mobile_base_controller"

@@ -49,6 +49,8 @@ class SimExtensions:
         ros_control = node.get_parameters_by_prefix("gazebo_ros_control")
         for prefix in (*PREFIXES, *self.controllers.names):
             node.accept_parameters(prefix)
+        for ctrl in self.controllers.ignored:
+            node.get_logger().warning(f"ros_control controller {ctrl} is not simulated; ignored")
         where = f"node {node.fully_qualified_name}"
         self.control_period = float(ros_control.pop("control_period", 0.01))
         gains = _nest(ros_control)

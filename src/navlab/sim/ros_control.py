@@ -39,12 +39,13 @@ class Controllers:
     diff_drive: str | None = None
     joint_state_rate: float | None = None
     names: tuple[str, ...] = ()
+    ignored: tuple[str, ...] = ()  # controllers of other types (``name (type)``): navlab does not simulate them
 
 
 def find_controllers(params: dict[str, Any]) -> Controllers:
     """Controllers among flattened parameters (``ctrl.type`` keys)."""
     out = Controllers()
-    found = []
+    found, ignored = [], []
     names = list(params)
     for key in names:
         ctrl, dot, leaf = key.rpartition(".")
@@ -58,13 +59,15 @@ def find_controllers(params: dict[str, Any]) -> Controllers:
             if not rate > 0:
                 raise SimError(f"{ctrl}.publish_rate {rate!r}: expected Hz > 0")
             out.joint_state_rate = rate
+        elif isinstance(kind, str) and "/" in kind:  # a ros_control type navlab does not simulate
+            ignored.append(f"{ctrl} ({kind})")
         else:
             continue
         found.append(ctrl)
     if out.diff_drive is None and any(k.startswith(LEGACY_NAME + ".") for k in names):
         out.diff_drive = LEGACY_NAME
         found.append(LEGACY_NAME)
-    out.names = tuple(found)
+    out.names, out.ignored = tuple(found), tuple(ignored)
     return out
 
 
