@@ -34,12 +34,8 @@ def run_clutter_world(
     workdir: str | Path | None = None,
     robot: str = "mybot",
 ) -> dict[str, Any]:
-    """One BARN trial in ``world`` (a ``world.clutter.ClutterWorld``) with ``robot`` (its shipped move_base files,
-    params/<robot>, where navlab ships some); returns its figures."""
-    from navlab import resources
-
-    shipped = resources.root() / "params" / robot
-    params_dir = shipped if shipped.is_dir() else None
+    """One BARN trial in ``world`` (a ``world.clutter.ClutterWorld``) with ``robot`` (and the move_base files the
+    launch picks for it: navlab's params/<robot> where it ships some); returns its figures."""
     with tempfile.TemporaryDirectory(prefix="navlab-clutter-", dir=workdir) as tmp:
         path = world.write_world(Path(tmp) / f"{world.name}.world")
         gx, gy, gyaw = (float(v) for v in between2(world.start, world.goal))  # the goal in odom (= the start)
@@ -47,7 +43,7 @@ def run_clutter_world(
         params = {**CLUTTER_PARAMS, **(move_base_params or {})}
         r = run_navigation([(gx, gy, gyaw)], world=str(path), pose=(sx, sy, syaw), mapless=True, controller=controller,
                            move_base_params=params, seed=seed, goal_timeout=timeout, goal_tolerance=SUCCESS_M,
-                           robot=robot, params_dir=params_dir)  # fmt: skip
+                           robot=robot)  # fmt: skip
     g = r.goals[0]
     return rounded({
         **barn_outcome(world, [g]), "reason": g["reason"], "time_s": g["time_s"], "collisions": g["collisions"],
