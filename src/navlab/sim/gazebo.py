@@ -68,6 +68,7 @@ class GazeboSim(Node):
         world = world_model if world_model is not None else load_world_named(world_name)
         extensions = SimExtensions(self)  # wheel controller and disturbances (navlab.sim.extensions)
         robot = extensions.robot(robot)
+        js_rate = extensions.controllers.joint_state_rate or js_rate  # joint_state_controller's publish_rate
         for warning in [*robot.warnings, *world.warnings]:
             self.get_logger().warning(warning)
         check_start_pose(robot, world, pose)  # a start inside an obstacle is refused, not thrown 7 m
