@@ -9,9 +9,12 @@ executor is ``navlab.core.record.Recorder``, built on it.
 
 from __future__ import annotations
 
+import contextlib
 import json
+import os
 import shutil
 import struct
+import tempfile
 from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import Any
@@ -40,9 +43,10 @@ class BagWriter:
             raise BagError(f"{self.path}: already exists; choose a new directory for the recording")
         self._staging = self.path.parent / f".{self.path.name}.partial"
         self._tmp = self._staging / self.path.name
+        if self._staging.exists() or self._staging.is_symlink():  # a killed recording: never removed for a new one
+            raise BagError(f"{self.path}: {self._staging} holds a recording that was killed; recover it with "
+                           f"`navlab bag reindex {self.path}` (or move it away) before recording under this name")
         try:
-            if self._staging.exists():  # left behind by a crashed run
-                shutil.rmtree(self._staging)
             self._staging.mkdir(parents=True)
             self._writer = Writer(self._tmp, version=8, storage_plugin=StoragePlugin.MCAP)
             self._writer.open()
@@ -69,8 +73,12 @@ class BagWriter:
         if not self.closed:
             self.closed = True
             self._writer.close()
-            self._tmp.rename(self.path)
-            self._staging.rmdir()
+            try:
+                os.rename(self._tmp, self.path)  # refuses to replace anything but an empty folder
+                self._staging.rmdir()
+            except OSError as exc:
+                raise BagError(f"{self.path}: cannot move the finished recording from {self._tmp} into place "
+                               f"({exc.strerror or exc}); it is kept there") from None
         return self.path
 
     def __enter__(self) -> BagWriter:
@@ -173,13 +181,24 @@ def _scan_mcap(path: Path) -> tuple[dict[int, tuple[str, str]], list[tuple[int, 
     return channels, messages
 
 
-def reindex_bag(path: str | Path) -> dict[str, Any]:
+def _free_name(path: Path) -> Path:
+    """``path``, or ``path.1``, ``path.2``, ... : the first name that does not exist."""
+    k = 0
+    while (candidate := path.with_name(path.name + (f".{k}" if k else ""))).exists() or candidate.is_symlink():
+        k += 1
+    return candidate
+
+
+def reindex_bag(path: str | Path, out: str | Path | None = None) -> dict[str, Any]:
     """Rebuild a rosbag2 (MCAP) recording that was killed before it was closed, as ``ros2 bag reindex`` does.
 
     ``path`` is the recording's directory, or the name it would have had: a killed ``BagWriter`` leaves
     its files in ``.<name>.partial/<name>`` beside it. Every complete message written before the kill is
-    kept (the last, unwritten chunk is lost); the bag is rewritten with its metadata and moved to its
-    name. Returns ``{"path", "topics", "messages"}``.
+    kept (the last, unwritten chunk is lost). The rebuilt bag is written in a staging folder of its own and
+    then moved: into ``out`` (a new directory; ``path`` is left untouched), else into ``path`` — only the
+    bag's own ``<name>.mcap`` and ``metadata.yaml`` are renamed into place, the damaged MCAP files are kept
+    beside them as ``<file>.damaged``, and nothing else in the folder is touched. Returns
+    ``{"path", "topics", "messages", "kept"}``.
     """
     target = Path(path)
     source = target
@@ -187,20 +206,27 @@ def reindex_bag(path: str | Path) -> dict[str, Any]:
         source = target.parent / f".{target.name}.partial" / target.name
         if not any(source.glob("*.mcap")):
             raise BagError(f"{target}: no MCAP file here nor in {source} (nothing to reindex)")
+    dest = Path(out) if out is not None else target
+    if out is not None and (dest.exists() or dest.is_symlink()):
+        raise BagError(f"{dest}: already exists; --out must name a new directory")
     channels: dict[int, tuple[str, str]] = {}
     messages: list[tuple[int, int, bytes]] = []
-    for mcap in sorted(source.glob("*.mcap")):
+    damaged = sorted(source.glob("*.mcap"))
+    for mcap in damaged:
         ch, msgs = _scan_mcap(mcap)
         channels.update(ch)
         messages += msgs
     unknown = sorted({t for t in channels.values() if t[1] not in TYPESTORE.types})
     if unknown:
         raise BagError(f"{source}: message types navlab does not know: {', '.join(f'{a} [{b}]' for a, b in unknown)}")
-    rebuilt = target.parent / f".{target.name}.reindex"
-    shutil.rmtree(rebuilt, ignore_errors=True)
-    rebuilt.mkdir(parents=True)
     try:
-        writer = Writer(rebuilt / target.name, version=8, storage_plugin=StoragePlugin.MCAP)
+        dest.parent.mkdir(parents=True, exist_ok=True)
+        staging = Path(tempfile.mkdtemp(prefix=f".{dest.name}.reindex-", dir=dest.parent))  # ours alone
+    except OSError as exc:
+        raise BagError(f"{dest}: cannot write the rebuilt recording ({exc.strerror or exc})") from None
+    rebuilt = staging / dest.name
+    try:
+        writer = Writer(rebuilt, version=8, storage_plugin=StoragePlugin.MCAP)
         writer.open()
         conns = {cid: writer.add_connection(topic, msgtype, typestore=TYPESTORE)
                  for cid, (topic, msgtype) in sorted(channels.items())}
@@ -208,16 +234,37 @@ def reindex_bag(path: str | Path) -> dict[str, Any]:
             if cid in conns:
                 writer.write(conns[cid], t_ns, data)
         writer.close()
+        kept = _move_into_place(rebuilt, dest, damaged if out is None else [])
     except (OSError, WriterError) as exc:
-        shutil.rmtree(rebuilt, ignore_errors=True)
-        raise BagError(f"{target}: cannot rewrite the recording ({exc})") from None
-    if target.exists():
-        shutil.rmtree(target)
-    (rebuilt / target.name).rename(target)
-    rebuilt.rmdir()
-    if source != target:
-        shutil.rmtree(source.parent, ignore_errors=True)
+        raise BagError(f"{dest}: cannot rewrite the recording ({exc})") from None
+    finally:
+        shutil.rmtree(staging, ignore_errors=True)
+    if out is None and source != target:  # the killed writer's staging folders, if now empty
+        for folder in (source, source.parent):
+            with contextlib.suppress(OSError):
+                folder.rmdir()
     counts: dict[str, int] = {}
     for cid, _t, _d in messages:
         counts[channels[cid][0]] = counts.get(channels[cid][0], 0) + 1
-    return {"path": str(target), "topics": counts, "messages": len(messages)}
+    return {"path": str(dest), "topics": counts, "messages": len(messages), "kept": [str(k) for k in kept]}
+
+
+def _move_into_place(rebuilt: Path, dest: Path, damaged: list[Path]) -> list[Path]:
+    """Move the rebuilt bag's files into ``dest`` (renamed whole when ``dest`` does not exist), keeping each
+    ``damaged`` file as ``<dest>/<name>.damaged``; returns where the damaged files were kept."""
+    if not dest.exists():
+        kept = []
+        for f in damaged:  # out of the killed writer's staging folder, into the rebuilt bag
+            kept.append(_free_name(rebuilt / f"{f.name}.damaged"))
+            os.replace(f, kept[-1])
+        rebuilt.rename(dest)
+        return [dest / k.name for k in kept]
+    if not dest.is_dir():
+        raise BagError(f"{dest}: is not a directory")
+    kept = []
+    for f in damaged:
+        kept.append(_free_name(dest / f"{f.name}.damaged"))
+        os.replace(f, kept[-1])
+    for f in sorted(rebuilt.iterdir()):  # <name>.mcap and metadata.yaml, each renamed atomically
+        os.replace(f, dest / f.name)
+    return kept
