@@ -63,6 +63,14 @@ def save_figure_atomic(fig: Any, path: str | os.PathLike[str], **savefig_kwargs:
         fig.savefig(tmp, **savefig_kwargs)
 
 
+def machine_memory_bytes() -> int:
+    """The machine's physical memory in bytes (the figure that memory ceilings are computed from)."""
+    try:
+        return int(os.sysconf("SC_PAGE_SIZE")) * int(os.sysconf("SC_PHYS_PAGES"))
+    except (ValueError, OSError, AttributeError):
+        return 8 << 30
+
+
 def _kind(mode: int) -> str:
     for test, name in ((stat.S_ISDIR, "a directory"), (stat.S_ISFIFO, "a named pipe"), (stat.S_ISCHR, "a device"),
                        (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket")):

@@ -20,13 +20,15 @@ from pathlib import Path
 from typing import Any
 
 from rosbags.rosbag2 import Reader, StoragePlugin, Writer
-from rosbags.rosbag2.errors import ReaderError, WriterError
+from rosbags.rosbag2.errors import WriterError
 
-from navlab.io.errors import BagError
+from navlab.io.errors import BagError, IoError
+from navlab.io.files import machine_memory_bytes, read_bytes_checked, read_text_checked
 from navlab.msgs import TYPESTORE, type_name
 
 __all__ = ["GRAPH_KEY", "BagError", "BagWriter", "bag_graph", "bag_topics", "read_bag", "reindex_bag"]
 
+MAX_METADATA_BYTES = 16 << 20  # a rosbag2 metadata.yaml
 GRAPH_KEY = "navlab.graph"  # custom-data key of the node/topic graph a navlab recording stores
 
 
@@ -88,37 +90,112 @@ class BagWriter:
         self.close()
 
 
+def damaged(path: str | Path, what: str) -> BagError:
+    """The one error of every recording reader: ``DIR: damaged recording: what, where; try reindex``."""
+    return BagError(f"{path}: damaged recording: {' '.join(what.split())[:300]}; try `navlab bag reindex {path}`")
+
+
+def _what(exc: BaseException) -> str:
+    if isinstance(exc, MemoryError):
+        return "a size field claims more memory than the machine has (MemoryError)"
+    text = str(exc) if not isinstance(exc, OSError) else (exc.strerror or str(exc))
+    return f"{type(exc).__name__}: {text}" if text else type(exc).__name__
+
+
+def _check_bag_dir(path: Path) -> None:
+    """Refuse what is not a rosbag2 directory of regular files before rosbags opens anything (a named pipe
+    would block it, a device never end): the folder, its metadata.yaml and every storage file it names."""
+    import yaml
+
+    if not path.is_dir():
+        if path.exists() or path.is_symlink():
+            kind = "a regular file" if path.is_file() else "not a regular file (a pipe, device or socket)"
+            raise BagError(f"{path}: is {kind}; expected a rosbag2 directory (the folder holding metadata.yaml)")
+        raise BagError(f"{path}: no such rosbag2 directory")
+    names = {p.name for p in path.iterdir() if p.suffix in (".mcap", ".db3", ".yaml")}
+    meta = path / "metadata.yaml"
+    if meta.exists() or meta.is_symlink():
+        try:
+            info = yaml.safe_load(read_text_checked(meta, what="rosbag2 metadata.yaml", max_bytes=MAX_METADATA_BYTES))
+            files = info["rosbag2_bagfile_information"]["relative_file_paths"]
+            names |= {str(f) for f in files}
+        except IoError as exc:
+            raise damaged(path, str(exc)) from None
+        except (RecursionError, MemoryError) as exc:
+            raise damaged(path, f"metadata.yaml: {_what(exc)}") from None
+        except Exception:  # malformed YAML or layout: rosbags' reader names it below (a damaged recording)
+            pass
+    root = path.resolve()
+    for name in sorted(names):
+        f = path / name
+        if not (f.exists() or f.is_symlink()):
+            continue
+        real = f.resolve()
+        if root not in real.parents:
+            raise damaged(path, f"{name} is outside the recording's folder")
+        if not real.is_file():
+            raise damaged(path, f"{name} is not a regular file (a pipe, device, socket or folder)")
+
+
+def _reader(path: Path) -> Reader:
+    _check_bag_dir(path)
+    return Reader(path)
+
+
 def read_bag(path: str | Path, *, topics: Sequence[str] = ()) -> Iterator[tuple[str, int, Any]]:
-    """Yield ``(topic, t_ns, msg)`` from a rosbag2 directory, deserialised to navlab messages."""
+    """Yield ``(topic, t_ns, msg)`` from a rosbag2 directory, deserialised to navlab messages.
+
+    Every failure — rosbags', the file system's, a message that does not deserialise — is a BagError
+    naming the recording (and the topic where one is known)."""
+    where = ""
     try:
-        with Reader(Path(path)) as reader:
+        with _reader(Path(path)) as reader:
             conns = [c for c in reader.connections if not topics or c.topic in topics]
             for conn, t_ns, raw in reader.messages(connections=conns):
+                where = f" (a {conn.msgtype} message on {conn.topic} at t={t_ns} ns)"
                 yield conn.topic, t_ns, TYPESTORE.deserialize_cdr(raw, conn.msgtype)
-    except (ReaderError, FileNotFoundError) as exc:
-        raise BagError(f"{path}: cannot read as a rosbag2 directory ({exc})") from None
+    except BagError:
+        raise
+    except Exception as exc:  # the reader's boundary: rosbags, zstd, serde, struct, OS, Unicode errors
+        raise damaged(path, _what(exc) + where) from None
 
 
 def bag_topics(path: str | Path) -> dict[str, tuple[str, int]]:
     """``{topic: (type, message count)}`` of a rosbag2 directory."""
     try:
-        with Reader(Path(path)) as reader:
+        with _reader(Path(path)) as reader:
             return {c.topic: (c.msgtype, c.msgcount) for c in reader.connections}
-    except (ReaderError, FileNotFoundError) as exc:
-        raise BagError(f"{path}: cannot read as a rosbag2 directory ({exc})") from None
+    except BagError:
+        raise
+    except Exception as exc:  # the reader's boundary
+        raise damaged(path, _what(exc)) from None
 
 
 def bag_graph(path: str | Path) -> dict[str, Any] | None:
     """The node/topic graph a navlab recording stored in its metadata (None for other bags)."""
     import yaml
 
+    _check_bag_dir(Path(path))
     meta = Path(path) / "metadata.yaml"
     try:
-        info = yaml.safe_load(meta.read_text())["rosbag2_bagfile_information"]
-    except (OSError, KeyError, TypeError, yaml.YAMLError) as exc:
-        raise BagError(f"{meta}: cannot read bag metadata ({exc})") from None
-    raw = (info.get("custom_data") or {}).get(GRAPH_KEY)
-    return json.loads(raw) if raw else None
+        info = yaml.safe_load(read_text_checked(meta, what="rosbag2 metadata.yaml", max_bytes=MAX_METADATA_BYTES))
+        raw = (info["rosbag2_bagfile_information"].get("custom_data") or {}).get(GRAPH_KEY)
+        graph = json.loads(raw) if raw else None
+    except Exception as exc:  # the reader's boundary
+        raise damaged(path, f"metadata.yaml: {_what(exc)}") from None
+    if graph is not None and not _graph_shaped(graph):
+        raise damaged(path, f"metadata.yaml: {GRAPH_KEY} is not a graph "
+                      "({nodes: [names], topics: {name: {pub: [names], sub: [names]}}})")
+    return graph
+
+
+def _graph_shaped(graph: Any) -> bool:
+    def names(v: Any) -> bool:
+        return isinstance(v, list) and all(isinstance(x, str) for x in v)
+
+    topics = graph.get("topics", {}) if isinstance(graph, dict) else None
+    return isinstance(topics, dict) and names(graph.get("nodes", [])) and all(
+        isinstance(v, dict) and names(v.get("pub")) and names(v.get("sub")) for v in topics.values())
 
 
 # --- recovering a recording that was killed (ros2 bag reindex) -------------------------------------------
@@ -148,7 +225,7 @@ def _scan_mcap(path: Path) -> tuple[dict[int, tuple[str, str]], list[tuple[int, 
     truncated MCAP file (no summary needed): every complete record up to where the file was cut."""
     from rosbags.rosbag2.storage_mcap import DECOMPRESSORS
 
-    buf = path.read_bytes()
+    buf = read_bytes_checked(path, what="MCAP file", max_bytes=machine_memory_bytes() // 4)
     if not buf.startswith(_MCAP_MAGIC):
         raise BagError(f"{path}: not an MCAP file")
     schemas: dict[int, str] = {}
@@ -171,13 +248,20 @@ def _scan_mcap(path: Path) -> tuple[dict[int, tuple[str, str]], list[tuple[int, 
                 compression, pos = _string(rec, 28)
                 (n,) = struct.unpack_from("<Q", rec, pos)
                 data = bytes(rec[pos + 8 : pos + 8 + n])
+                if size > machine_memory_bytes() // 4:
+                    raise BagError(f"{path}: cannot be recovered: a chunk claims {size} bytes uncompressed")
                 try:
                     raw = DECOMPRESSORS[compression](data, size) if compression else data
                 except Exception as exc:  # a corrupt chunk: keep what came before it
                     raise BagError(f"{path}: chunk cannot be decompressed ({exc})") from None
                 take(_records(raw))
 
-    take(_records(buf, len(_MCAP_MAGIC)))
+    try:
+        take(_records(buf, len(_MCAP_MAGIC)))
+    except BagError:
+        raise
+    except Exception as exc:  # a record that lies about its layout: keep nothing rather than guess
+        raise BagError(f"{path}: cannot be recovered: a malformed MCAP record ({_what(exc)})") from None
     return channels, messages
 
 
