@@ -317,6 +317,17 @@ def _check_args(file: Path, args: dict[str, Any]) -> None:
             raise LaunchError(f"{file}: unknown launch argument {name!r} ({hint}arguments: {', '.join(sorted(known))})")
 
 
+def _from_cwd(value: Any) -> Any:
+    """A launch argument given by the caller (the command line, Python) that names an existing file or folder
+    relative to the current folder, as an absolute path: ROS resolves command-line paths against the current
+    folder, and a path inside a launch file against that file's folder (``from:``/``file:``), so
+    ``params:=my_params`` must not be looked for beside the shipped launch file."""
+    text = str(value) if isinstance(value, str | os.PathLike) else ""
+    if text and not os.path.isabs(text) and "$(" not in text and os.path.exists(text):
+        return os.path.abspath(text)
+    return value
+
+
 def declared_args(name_or_path: str) -> list[dict[str, Any]]:
     """The ``arg`` entries of a launch file (for ``--help``-like listings)."""
     return [e["arg"] for e in _entries(find_launch_file(name_or_path)) if isinstance(e, dict) and "arg" in e]
@@ -340,7 +351,7 @@ def start(
     after the launch file's own (``{"amcl": {"laser_max_beams": 60}}``); a name no node has is refused.
     """
     file = find_launch_file(name_or_path)
-    all_args = {**(launch_args or {}), **args}
+    all_args = {k: _from_cwd(v) for k, v in {**(launch_args or {}), **args}.items()}
     _check_args(file, all_args)
     session = Session(executor or Executor(seed=seed, rate=pace), args={k: str(v) for k, v in all_args.items()},
                       overrides={k.lstrip("/"): dict(v) for k, v in (overrides or {}).items()})

@@ -79,6 +79,17 @@ def _kind(mode: int) -> str:
     return "not a regular file"
 
 
+def check_regular_file(path: str | os.PathLike[str], *, what: str) -> None:
+    """Refuse ``path`` unless it is a regular file (named pipes, devices, sockets and folders are refused
+    without being opened: a FIFO would block the reader, a device never end). Raises ``IoError``."""
+    try:
+        st = os.stat(path)
+    except OSError as exc:
+        raise IoError(f"{path}: cannot read the {what} ({exc.strerror or exc})") from None
+    if not stat.S_ISREG(st.st_mode):
+        raise IoError(f"{path}: is {_kind(st.st_mode)}; expected a {what} (a regular file)")
+
+
 def read_bytes_checked(path: str | os.PathLike[str], *, what: str, max_bytes: int = MAX_TEXT_BYTES) -> bytes:
     """The bytes of the regular file ``path`` (a ``what``, named in errors), at most ``max_bytes`` of them.
 
