@@ -35,6 +35,7 @@ import numba
 import numpy as np
 from scipy.signal import savgol_coeffs
 
+from navlab.core.limits import check_ceiling
 from navlab.grid import COST_INSCRIBED, Grid
 from navlab.navigation.controllers import mppi_critics as critics
 from navlab.navigation.controllers.common import (
@@ -143,6 +144,9 @@ class MppiParams:
             raise bad(WHAT, "ax_min", self.ax_min, "<= 0 (a deceleration)")
         if self.vx_min > self.vx_max:
             raise bad(WHAT, "vx_min", self.vx_min, f"<= vx_max ({self.vx_max})")
+        check_ceiling(NavigationError, WHAT, "controller_frequency", self.controller_frequency, "rate")
+        check_ceiling(NavigationError, WHAT, "batch_size x time_steps x iteration_count",
+                      self.batch_size * self.time_steps * self.iteration_count, "rollout_poses")
         if self.motion_model != "DiffDrive":
             raise bad(WHAT, "motion_model", self.motion_model, "'DiffDrive' (navlab's controllers drive (v, w))")
         for name in self.critics:
