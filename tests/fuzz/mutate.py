@@ -572,7 +572,9 @@ def mutators(fmt: str) -> list[Mutator]:
         out += [_carmen, _carmen]
     if fmt == "map":
         out += [_pgm, _pgm]
-    return out
+    from .mutate_nav import mutators_nav
+
+    return mutators_nav(fmt) or out
 
 
 def generate(fmt: str, seed: Seed, rng: np.random.Generator) -> Case:

@@ -6,18 +6,20 @@ far above any configuration a ROS user runs (the ROS defaults are in parentheses
 machine can hold: memory ceilings are computed from its physical memory (one structure may take at most
 a quarter of it). The error names the key, the value and the product that is too big.
 
-===================  ==========================================================  ===========================
-ceiling              what it bounds                                              limit
-===================  ==========================================================  ===========================
-``rate``             any frequency: costmap update/publish, controller, planner  1,000 Hz (5-20 Hz)
-``grid_cells``       cells of one costmap or SLAM grid (width x height / res²)   memory / 4 / 16 B
-``rollout_poses``    poses simulated per control cycle: DWA/TrajectoryPlanner    memory / 4 / 256 B,
-                     samples x steps, MPPI batch_size x time_steps x iterations  at most 50,000,000
-``footprint_m``      a footprint point's distance from the robot's centre        100 m
-``polygon_points``   points of a footprint polygon                               1,000
-``particles``        AMCL max_particles, gmapping particles                      1,000,000 (5,000 / 30)
-``slam_particle_cells`` gmapping particles x map cells (each particle has a map)  memory / 4 / 4 B
-===================  ==========================================================  ===========================
+=======================  ==========================================================  ======================
+ceiling                  what it bounds                                              limit
+=======================  ==========================================================  ======================
+``rate``                 any frequency: costmap update/publish, controller, planner  1,000 Hz (5-20 Hz)
+``grid_cells``           cells of one costmap (width x height / resolution²)         memory / 4 / 16 B
+``rollout_poses``        poses simulated per control cycle: DWA/TrajectoryPlanner    memory / 4 / 256 B,
+                         samples x steps, MPPI batch_size x time_steps x iterations  at most 50,000,000
+``footprint_m``          a footprint point's distance from the robot's centre        100 m
+``polygon_points``       points of a footprint polygon                               1,000
+``particles``            AMCL max_particles, gmapping particles                      1,000,000 (5,000 / 30)
+``coordinate_m``         a start pose, goal or spawned model's coordinate            1,000,000 m
+``model_m``              a spawned model's size (box edge, radius, length)           10,000 m
+``slam_particle_cells``  gmapping particles x map cells (each particle has a map)    memory / 4 / 4 B
+=======================  ==========================================================  ======================
 """
 
 from __future__ import annotations
@@ -54,6 +56,8 @@ def ceilings() -> dict[str, Ceiling]:
         "footprint_m": Ceiling(100.0, "m", "a footprint reaching further than 100 m is not a robot"),
         "polygon_points": Ceiling(1000.0, "points", "a footprint is a polygon of a few points"),
         "particles": Ceiling(1e6, "particles", "each particle is updated on every scan"),
+        "coordinate_m": Ceiling(1e6, "m", "start poses, goals and spawned models further out lose all precision"),
+        "model_m": Ceiling(1e4, "m", "a model larger than 10 km is not an obstacle"),
         "slam_particle_cells": Ceiling(_memory(4), "cells", f"every particle's map must fit in {memory}"),
     }
 

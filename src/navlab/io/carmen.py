@@ -234,7 +234,7 @@ def _without_outliers(log: CarmenLog, records: list[Any], poses: list[list[tuple
     dev = np.zeros(len(t))
     for kind in poses:
         xy = np.array([p[:2] for p in kind], dtype=np.float64)
-        med = np.stack([median_filter(xy[:, k], size=2 * OUTLIER_WINDOW + 1, mode="nearest") for k in range(2)], 1)
+        med = np.stack([median_filter(xy[:, k], size=2 * OUTLIER_WINDOW + 1, mode="mirror") for k in range(2)], 1)
         dev = np.maximum(dev, np.hypot(*(xy - med).T))
     bad = dev > OUTLIER_SLACK + OUTLIER_SPEED * span
     name = log.path.name if log.path is not None else "log"

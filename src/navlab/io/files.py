@@ -64,11 +64,16 @@ def save_figure_atomic(fig: Any, path: str | os.PathLike[str], **savefig_kwargs:
 
 
 def machine_memory_bytes() -> int:
-    """The machine's physical memory in bytes (the figure that memory ceilings are computed from)."""
+    """The memory this process may use in bytes (the figure memory ceilings are computed from): the machine's
+    physical memory, or the process's address-space limit (``ulimit -v``) if that is lower."""
+    import resource
+
     try:
-        return int(os.sysconf("SC_PAGE_SIZE")) * int(os.sysconf("SC_PHYS_PAGES"))
+        physical = int(os.sysconf("SC_PAGE_SIZE")) * int(os.sysconf("SC_PHYS_PAGES"))
     except (ValueError, OSError, AttributeError):
-        return 8 << 30
+        physical = 8 << 30
+    soft, _hard = resource.getrlimit(resource.RLIMIT_AS)
+    return min(physical, soft) if soft != resource.RLIM_INFINITY and soft > 0 else physical
 
 
 def _kind(mode: int) -> str:
@@ -109,7 +114,7 @@ def read_bytes_checked(path: str | os.PathLike[str], *, what: str, max_bytes: in
         if st.st_size > max_bytes:
             raise IoError(f"{p}: {st.st_size} bytes; a {what} may have at most {max_bytes}")
         try:
-            data = fh.read(max_bytes + 1)
+            data = fh.read(min(st.st_size, max_bytes) + 1)  # not max_bytes: read() allocates what it is asked
         except OSError as exc:
             raise IoError(f"{p}: cannot read the {what} ({exc.strerror or exc})") from None
     if len(data) > max_bytes:

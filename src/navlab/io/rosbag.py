@@ -300,6 +300,7 @@ def reindex_bag(path: str | Path, out: str | Path | None = None) -> dict[str, An
         ch, msgs = _scan_mcap(mcap)
         channels.update(ch)
         messages += msgs
+    messages = [m for m in messages if m[0] in channels]  # a message of a channel never declared has no type
     unknown = sorted({t for t in channels.values() if t[1] not in TYPESTORE.types})
     if unknown:
         raise BagError(f"{source}: message types navlab does not know: {', '.join(f'{a} [{b}]' for a, b in unknown)}")
@@ -315,8 +316,7 @@ def reindex_bag(path: str | Path, out: str | Path | None = None) -> dict[str, An
         conns = {cid: writer.add_connection(topic, msgtype, typestore=TYPESTORE)
                  for cid, (topic, msgtype) in sorted(channels.items())}
         for cid, t_ns, data in sorted(messages, key=lambda m: m[1]):
-            if cid in conns:
-                writer.write(conns[cid], t_ns, data)
+            writer.write(conns[cid], t_ns, data)
         writer.close()
         kept = _move_into_place(rebuilt, dest, damaged if out is None else [])
     except (OSError, WriterError) as exc:

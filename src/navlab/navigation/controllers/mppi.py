@@ -142,6 +142,8 @@ class MppiParams:
             raise bad(WHAT, "noise_correlation", self.noise_correlation, "0 <= value < 1")
         if self.ax_min > 0:
             raise bad(WHAT, "ax_min", self.ax_min, "<= 0 (a deceleration)")
+        if not self.vx_max > 0:
+            raise bad(WHAT, "vx_max", self.vx_max, "> 0 (a forward speed)")
         if self.vx_min > self.vx_max:
             raise bad(WHAT, "vx_min", self.vx_min, f"<= vx_max ({self.vx_max})")
         check_ceiling(NavigationError, WHAT, "controller_frequency", self.controller_frequency, "rate")
