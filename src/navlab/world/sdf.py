@@ -78,6 +78,8 @@ def _parse_xml(path: Path, what: str) -> ET.Element:
     if path.is_dir():
         raise WorldError(f"{path}: is a directory; expected a {what}")
     if not path.is_file():
+        if path.exists():  # a named pipe would block the parser, a device never end
+            raise WorldError(f"{path}: is not a regular file (a pipe, device or socket); expected a {what}")
         raise WorldError(f"{path}: {what} not found")
     try:
         return ET.parse(path).getroot()
