@@ -38,3 +38,20 @@ def test_navigate_refuses_a_goal_beyond_the_coordinate_ceiling(capsys: pytest.Ca
     with pytest.raises(SystemExit):
         main(["navigate", "--goal", "1e308", "0", "0"])
     assert "argument --goal: expected a coordinate within" in capsys.readouterr().err
+
+
+def test_sensor_rates_above_the_physics_rate_update_once_per_step(tmp_path, capsys) -> None:
+    """Gazebo updates a sensor at most once per physics step: rates of 1e9 Hz run, they do not hang."""
+    import json
+    import re
+    import shutil
+
+    from navlab import resources
+
+    pkg = tmp_path / "mybot"
+    shutil.copytree(resources.robot("mybot").parent, pkg)
+    gz = pkg / "mybot.gazebo"
+    gz.write_text(re.sub(r"<(updateRate|update_rate|updateRateHZ)>[^<]*</\1>", r"<\1>1e9</\1>", gz.read_text()))
+    assert main(["sim", "--robot", str(pkg / "mybot.xacro"), "--duration", "0.1", "--quiet", "--json"]) == 0
+    messages = json.loads(capsys.readouterr().out)["messages"]
+    assert 40 <= messages["/mybot/laser/scan"] <= 51  # one per 2 ms step

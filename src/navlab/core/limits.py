@@ -16,6 +16,7 @@ ceiling                  what it bounds                                         
 ``footprint_m``          a footprint point's distance from the robot's centre        100 m
 ``polygon_points``       points of a footprint polygon                               1,000
 ``particles``            AMCL max_particles, gmapping particles                      1,000,000 (5,000 / 30)
+``lidar_samples``        a ray sensor's horizontal <samples>                         100,000
 ``coordinate_m``         a start pose, goal or spawned model's coordinate            1,000,000 m
 ``model_m``              a spawned model's size (box edge, radius, length)           10,000 m
 ``slam_particle_cells``  gmapping particles x map cells (each particle has a map)    memory / 4 / 4 B
@@ -56,6 +57,7 @@ def ceilings() -> dict[str, Ceiling]:
         "footprint_m": Ceiling(100.0, "m", "a footprint reaching further than 100 m is not a robot"),
         "polygon_points": Ceiling(1000.0, "points", "a footprint is a polygon of a few points"),
         "particles": Ceiling(1e6, "particles", "each particle is updated on every scan"),
+        "lidar_samples": Ceiling(1e5, "samples", "a planar lidar has at most a few thousand beams"),
         "coordinate_m": Ceiling(1e6, "m", "start poses, goals and spawned models further out lose all precision"),
         "model_m": Ceiling(1e4, "m", "a model larger than 10 km is not an obstacle"),
         "slam_particle_cells": Ceiling(_memory(4), "cells", f"every particle's map must fit in {memory}"),

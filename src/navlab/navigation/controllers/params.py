@@ -173,7 +173,7 @@ class DWAPlannerParams(_Periodic):
         """Raise ``NavigationError`` naming the first bad parameter."""
         check_finite(DWA, self)
         _positive(DWA, self, "acc_lim_x", "acc_lim_theta", "sim_time", "sim_granularity", "angular_sim_granularity",
-                  "controller_frequency", "max_vel_trans")
+                  "controller_frequency", "max_vel_trans", "max_vel_x")
         _at_least(DWA, self, 0.0, "min_vel_trans", "min_vel_theta", "max_vel_theta", "path_distance_bias",
                   "goal_distance_bias", "occdist_scale", "twirling_scale", "forward_point_distance",
                   "oscillation_reset_dist", "xy_goal_tolerance", "yaw_goal_tolerance", "trans_stopped_vel",
