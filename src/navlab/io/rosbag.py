@@ -153,7 +153,9 @@ def read_bag(path: str | Path, *, topics: Sequence[str] = ()) -> Iterator[tuple[
             conns = [c for c in reader.connections if not topics or c.topic in topics]
             for conn, t_ns, raw in reader.messages(connections=conns):
                 where = f" (a {conn.msgtype} message on {conn.topic} at t={t_ns} ns)"
-                yield conn.topic, t_ns, TYPESTORE.deserialize_cdr(raw, conn.msgtype)
+                msg = TYPESTORE.deserialize_cdr(raw, conn.msgtype)
+                where = f" (after the message at t={t_ns} ns)"
+                yield conn.topic, t_ns, msg
     except BagError:
         raise
     except Exception as exc:  # the reader's boundary: rosbags, zstd, serde, struct, OS, Unicode errors
