@@ -9,6 +9,7 @@ unsupported geometry are reported in ``WorldModel.warnings``.
 
 from __future__ import annotations
 
+import collections
 import contextlib
 import math
 import os
@@ -405,8 +406,7 @@ def load_world(path: str | os.PathLike[str], *, model_path: Iterable[str | os.Pa
             world.gravity = _vec3(chosen.findtext("gravity"), pw + "/<gravity>")
     if world_el.find("gravity") is not None:
         world.gravity = _vec3(world_el.findtext("gravity"), f"{where}/<gravity>")
-    names = [m.name for m in world.models]
-    dup = {n for n in names if names.count(n) > 1}
+    dup = {n for n, k in collections.Counter(m.name for m in world.models).items() if k > 1}  # linear: BARN worlds
     if dup:
         raise WorldError(f"{where}: duplicate model names {sorted(dup)}")
     state = world_el.find("state")
