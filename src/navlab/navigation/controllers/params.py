@@ -16,6 +16,7 @@ footprint is not scaled with speed).
 
 from __future__ import annotations
 
+import logging
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -91,6 +92,7 @@ class TrajectoryPlannerParams(_Periodic):
         out = params_from(cls, values, what=TP, ignored=_VIEW_ONLY, aliases={
             "backup_vel": "escape_vel", "acc_lim_th": "acc_lim_theta", "path_distance_bias": "pdist_scale",
             "goal_distance_bias": "gdist_scale", "vth_samples": "vtheta_samples"})
+        _clamp_samples(TP, out, "vx_samples", "vtheta_samples")
         out.validate()
         return out
 
@@ -165,6 +167,7 @@ class DWAPlannerParams(_Periodic):
             "min_rot_vel": "min_vel_theta", "acc_lim_th": "acc_lim_theta", "rot_stopped_vel": "theta_stopped_vel",
             "pdist_scale": "path_distance_bias", "gdist_scale": "goal_distance_bias",
             "vtheta_samples": "vth_samples", "dwa": "use_dwa"})
+        _clamp_samples(DWA, out, "vx_samples", "vy_samples", "vth_samples")
         out.validate()
         return out
 
@@ -192,6 +195,17 @@ def _sized(what: str, obj: Any, steps: float, *sample_keys: str) -> None:
     samples = math.prod(getattr(obj, k) for k in sample_keys)
     check_ceiling(NavigationError, what, f"{' x '.join(sample_keys)} x steps (sim_time / sim_granularity)",
                   samples * steps, "rollout_poses")
+
+
+def _clamp_samples(what: str, obj: Any, *keys: str) -> None:
+    """A sample count <= 0 becomes 1 with a warning, as both ROS 1 planners do (``vy_samples: 0`` is in
+    TurtleBot3's DWA files: a differential robot samples no y speed)."""
+    for key in keys:
+        if getattr(obj, key) <= 0:
+            logging.getLogger("navlab.navigation").warning(
+                f"{what}: {key} is {getattr(obj, key)}; at least one value is sampled, so {key} is set to 1 "
+                "(as ROS does)")
+            setattr(obj, key, 1)
 
 
 def _positive(what: str, obj: Any, *keys: str) -> None:
