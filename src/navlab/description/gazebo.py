@@ -14,6 +14,7 @@ import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field, replace
 from typing import Literal
 
+from navlab.core.limits import check_ceiling
 from navlab.description.errors import DescriptionError
 from navlab.description.materials import gazebo_material
 from navlab.description.model import DiffDriveConfig, ImuConfig, LidarConfig, Link, Origin, P3dConfig, RosControlConfig
@@ -227,6 +228,7 @@ def parse_lidar(sensor: ET.Element, link: str, where: str, plugin: ET.Element,
     samples = int(_num(hor.find("samples"), where + "/<horizontal>", 640))
     if samples < 1:
         raise DescriptionError(f"{where}/<horizontal>/<samples>: must be >= 1, got {samples}")
+    check_ceiling(DescriptionError, f"{where}/<horizontal>", "<samples>", samples, "lidar_samples")
     vert = ray.find("scan/vertical/samples")
     if vert is not None and int(float(vert.text or "1")) > 1:
         warnings.append(f"{where}: {vert.text} vertical samples; only the horizontal plane is simulated")
