@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 import yaml
-from conftest import free_port, require, ros, run_with_ros, send_move_base_goal
+from ros1_helpers import free_port, require, ros, run_with_ros, send_move_base_goal
 
 from navlab.ros1.live import LiveRun
 

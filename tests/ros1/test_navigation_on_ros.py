@@ -11,8 +11,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import Screen, require, ros, rospy, run_with_ros, send_move_base_goal
 from PIL import Image
+from ros1_helpers import Screen, require, ros, rospy, run_with_ros, send_move_base_goal
 
 from navlab.core.launch import resources_dir
 from navlab.ros1.live import LiveRun

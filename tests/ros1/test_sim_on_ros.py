@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pytest
 import yaml
-from conftest import free_port, ros, rospy, run_with_ros
+from ros1_helpers import free_port, ros, rospy, run_with_ros
 
 from navlab.ros1.live import LiveRun
 

@@ -10,7 +10,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from conftest import SYSTEM_PYTHON
+from ros1_helpers import SYSTEM_PYTHON
 
 NAVLAB = str(Path(sys.executable).parent / "navlab")
 
