@@ -137,8 +137,8 @@ def robot_launch_values(name_or_path: str | os.PathLike[str]) -> dict[str, str]:
     else the generic ROS-default one (``params_note`` then says so); ``footprint``: the rectangle around its
     collision geometry (``[[x, y], ...]``, m, in the base frame). From its package's own configuration
     (:mod:`navlab.description.robot_files`): ``wheel_controller`` (``true`` when a ``gazebo_ros_control`` robot
-    has a control YAML), ``controller_params`` (that YAML, else ``diff_drive_controller.yaml`` in ``params``), ``own_controller_params``
-    (that YAML, else empty),
+    has a control YAML), ``controller_params`` (that YAML, else ``diff_drive_controller.yaml`` in ``params``),
+    ``own_controller_params`` (that YAML, else empty),
     ``ekf`` (``true`` when a robot_localization YAML sits beside it) and ``ekf_params`` (that YAML, else
     navlab's ``params/ekf.yaml``)."""
     from navlab.description.robot_files import robot_files
