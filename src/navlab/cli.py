@@ -7,8 +7,10 @@ so this file only assembles them and turns ``NavlabError`` into a one-line messa
 from __future__ import annotations
 
 import argparse
+import difflib
 import importlib
 import logging
+import re
 import sys
 from typing import NoReturn
 
@@ -33,6 +35,13 @@ class _Parser(argparse.ArgumentParser):
 
     def error(self, message: str) -> NoReturn:
         verb = self.prog.removeprefix("navlab").strip()
+        wrong = re.match(r"argument (\S+): invalid choice: '([^']*)' \(choose from (.*)\)$", message)
+        if wrong:  # a mistyped verb or choice: the closest one, as git does
+            choices = re.findall(r"'([^']*)'", wrong.group(3))
+            close = difflib.get_close_matches(wrong.group(2), choices, n=1, cutoff=0.5)
+            what = "verb" if wrong.group(1) == "VERB" else wrong.group(1)
+            hint = f"; did you mean {close[0]!r}?" if close else f" (one of: {', '.join(choices)})"
+            message = f"unknown {what} {wrong.group(2)!r}{hint}"
         self.exit(2, f"navlab: error: {verb + ': ' if verb else ''}{message} (see `{self.prog} --help`)\n")
 
 
@@ -53,7 +62,12 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``navlab`` console script; returns the exit code."""
     parser = build_parser()
-    args = parser.parse_args(argv)
+    args, extra = parser.parse_known_args(argv)
+    if extra:  # `navlab launch mapping --duration 60 world:=room`: launch arguments may follow options, as in ROS
+        target = next((a for a in ("args", "launch") if isinstance(getattr(args, a, None), list)), None)
+        if target is None or not all(":=" in e and not e.startswith("-") for e in extra):
+            parser.error(f"unrecognized arguments: {' '.join(extra)}")
+        getattr(args, target).extend(extra)
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING, format="%(levelname)s %(message)s")
     try:
         return int(args.func(args) or 0)

@@ -282,25 +282,26 @@ def _run_entries(ctx: _Context, session: Session, depth: int) -> None:
                 kwargs["name"] = node_name
             if spec.get("namespace"):
                 kwargs["namespace"] = _text(ctx, spec, "namespace", where)
-            source = f" (parameters from {', '.join(files)})" if files else ""
-            origin = f"{ctx.file}: {where} {node_name!r}{source}"
+            files = [*files, *(["--set/overrides"] if session.overrides.get(node_name) else [])]
+            source = f"; parameters from {', '.join(files)}" if files else ""
+            origin = f"{ctx.file}: {where} {node_name!r}"
             try:
                 with session.executor.node_context(remappings=remaps):
                     node = cls(session.executor, **kwargs)
-            except NavlabError as exc:  # name the launch file and the parameter files, as the user wrote them
-                raise _prefixed(exc, origin) from None
+            except NavlabError as exc:  # the problem first, then the launch file and parameter files it came from
+                raise _located(exc, f"node {node_name!r}{source}; {ctx.file} {where}") from None
             session.nodes[node.fully_qualified_name] = node
             session.origins[node.fully_qualified_name] = origin
         else:
             raise LaunchError(f"{ctx.file}: {where}: unknown entry {kind!r} (expected arg, let, include or node)")
 
 
-def _prefixed(exc: NavlabError, prefix: str) -> NavlabError:
-    """``exc`` (same class where it can be rebuilt from a message) with ``prefix: `` before its message."""
+def _located(exc: NavlabError, where: str) -> NavlabError:
+    """``exc`` (same class where it can be rebuilt from a message) with `` (in WHERE)`` after its message."""
     try:
-        return type(exc)(f"{prefix}: {exc}")
+        return type(exc)(f"{exc} (in {where})")
     except Exception:  # an error class with another constructor
-        return LaunchError(f"{prefix}: {exc}")
+        return LaunchError(f"{exc} (in {where})")
 
 
 def _check_args(file: Path, args: dict[str, Any]) -> None:
@@ -350,7 +351,7 @@ def start(
         try:
             node.check_parameters()
         except NavlabError as exc:
-            raise _prefixed(exc, session.origins.get(name, str(file))) from None
+            raise _located(exc, session.origins.get(name, str(file))) from None
     session.args = ctx.vars
     started = {name.rsplit("/", 1)[-1] for name in session.nodes}
     unknown = sorted(set(session.overrides) - started)

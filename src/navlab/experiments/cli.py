@@ -103,8 +103,7 @@ def _cmd_localize(args: argparse.Namespace) -> int:
 
 def _cmd_navigate(args: argparse.Namespace) -> int:
     apply_resource_paths(args)  # --package-path / --model-path, for this process and its workers
-    from navlab.experiments.navigate_run import run_navigation
-    from navlab.experiments.plots import plot_navigation
+    from navlab.experiments.navigate_run import run_navigation, save_goal_pictures
     from navlab.sim.spawn import parse_spawn_spec
 
     spawns = []
@@ -117,18 +116,17 @@ def _cmd_navigate(args: argparse.Namespace) -> int:
             pose=start_pose(args), controller=args.controller, params_dir=args.params,
             move_base_params=parse_sets(args.set), spawn=spawns, goal_timeout=args.timeout, seed=args.seed,
             record=args.record, snapshots=bool(args.out), mapless=args.mapless, on_start=on_start,
+            progress=None if args.quiet else lambda text: print(text, file=sys.stderr, flush=True),
         )  # fmt: skip
     figures: dict[str, Any] = {"goals": result.goals, **result.summary}
     if args.out:
-        out = Path(args.out)
-        out.mkdir(parents=True, exist_ok=True)
-        pictures = []
-        for k, (goal, shot) in enumerate(zip(result.goals, result.snapshots, strict=True), 1):
-            title = f"goal {k} {tuple(goal['goal'])}: {goal['outcome']} in {goal['time_s']} s"
-            pictures.append(str(plot_navigation(result.grid, shot, out / f"goal_{k}.png", title=title,
-                                                goal=goal["goal"])))  # fmt: skip
-        figures["pictures"] = pictures
+        figures["pictures"] = save_goal_pictures(result, args.out)
     print_figures(figures, args.json)
+    failed = [g for g in result.goals if g["outcome"] != "succeeded"]
+    if failed:  # as a script would want it: 0 only when every goal succeeded
+        print(f"navlab: {len(failed)} of {len(result.goals)} goals not reached "
+              f"({', '.join(sorted({g['outcome'] for g in failed}))})", file=sys.stderr)
+        return 1
     return 0
 
 
@@ -302,8 +300,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         description="The paper's navigation launch (simulator, map_server, amcl and move_base with the ROS 1 "
         "parameter files of --params) drives the robot to each --goal in turn. Prints each goal's outcome "
         "(succeeded, aborted with move_base's reason, or timeout), time, path length, minimum clearance and "
-        "collisions (from the simulator's contacts), and with --out DIR saves one picture per goal: map, "
-        "inflation shadow, global plan (blue), local plan (green), robot (orange), laser (red).",
+        "collisions (contact episodes from the simulator), and with --out DIR saves two labelled pictures per goal "
+        "(at its end and mid-drive) with a legend. Exits 0 only when every goal succeeded (1 otherwise).",
     )
     _add_world_robot(p, "room_obstacles")
     p.add_argument("--map", metavar="MAP.yaml", default=None,
@@ -324,8 +322,10 @@ def register(sub: argparse._SubParsersAction) -> None:
                    "(see navlab sim --help; repeatable)")  # fmt: skip
     p.add_argument("--timeout", type=positive_seconds, default=90.0, help="simulated s allowed per goal (90)")
     p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
-    p.add_argument("--out", metavar="DIR", default=None, help="save one PNG per goal into DIR")
+    p.add_argument("--out", metavar="DIR", default=None,
+                   help="save two pictures per goal into DIR: goal_N.png when it ended, goal_N_mid.png mid-drive")
     p.add_argument("--record", metavar="DIR", help="also write every topic to a rosbag2 (MCAP) in DIR")
+    p.add_argument("--quiet", action="store_true", help="no progress lines")
     p.add_argument("--json", action="store_true", help="print the figures as one JSON object")
     add_view_arguments(p)
     p.set_defaults(func=_cmd_navigate)
