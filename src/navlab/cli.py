@@ -74,6 +74,11 @@ def main(argv: list[str] | None = None) -> int:
     except NavlabError as exc:
         print(f"navlab: error: {exc}", file=sys.stderr)
         return 2
+    except BrokenPipeError:  # `navlab topic echo /odom | head`: the reader left; stop quietly, as rostopic does
+        import os
+
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # no second error when Python flushes
+        return 0
     except OSError as exc:  # a file the user named cannot be read or written (permissions, full disk, ...)
         where = f"{exc.filename}: " if exc.filename else ""
         print(f"navlab: error: {where}{exc.strerror or exc}", file=sys.stderr)
