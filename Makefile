@@ -5,6 +5,8 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 # Debian's Chromium drives the viewer's browser tests (Playwright with executable_path; no browser download)
 CHROMIUM := /usr/bin/chromium
+# Debian's Graphviz lays out `navlab graph` (rqt_graph's layered picture)
+DOT := /usr/bin/dot
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 export MUJOCO_GL ?= egl
 
@@ -21,12 +23,15 @@ $(STAMP): pyproject.toml | $(BIN)/python
 $(CHROMIUM):
 	$(SUDO) apt-get install -y -q chromium || ($(SUDO) apt-get update -q && $(SUDO) apt-get install -y -q chromium)
 
-install: $(STAMP) $(CHROMIUM)
+$(DOT):
+	$(SUDO) apt-get install -y -q graphviz || ($(SUDO) apt-get update -q && $(SUDO) apt-get install -y -q graphviz)
+
+install: $(STAMP) $(CHROMIUM) $(DOT)
 
 demo: $(STAMP)
 	$(BIN)/navlab demo
 
-test: $(STAMP) $(CHROMIUM)
+test: $(STAMP) $(CHROMIUM) $(DOT)
 	$(BIN)/ruff check src tests
 	$(BIN)/python tools/check_layers.py
 	$(BIN)/mypy

@@ -12,6 +12,7 @@ import contextlib
 import json
 import math
 import signal
+import sys
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -221,9 +222,16 @@ def _cmd_node(args: argparse.Namespace) -> int:
 def _cmd_graph(args: argparse.Namespace) -> int:
     graph = _graph_of(args)
     out = Path(args.out)
-    write_text_atomic(out.with_suffix(".dot"), graph.to_dot())
-    graph.write_svg(out.with_suffix(".svg"))
-    print(f"wrote {out.with_suffix('.dot')} and {out.with_suffix('.svg')}")
+    if out.suffix in (".dot", ".svg"):  # --out was a file stem until 0.x; now a folder, as on every verb
+        print(f"navlab: DeprecationWarning: --out {args.out}: --out now names a folder that gets graph.dot and "
+              "graph.svg; a file name is accepted until the next release", file=sys.stderr)
+        dot, svg = out.with_suffix(".dot"), out.with_suffix(".svg")
+    else:
+        out.mkdir(parents=True, exist_ok=True)
+        dot, svg = out / "graph.dot", out / "graph.svg"
+    write_text_atomic(dot, graph.to_dot())
+    graph.write_svg(svg)
+    print(f"wrote {dot} and {svg}")
     return 0
 
 
@@ -320,9 +328,11 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="write the node/topic graph as DOT and SVG (rqt_graph)",
         description="rqt_graph as files: the nodes and topics of a running `navlab launch` (the default), of "
         "a launch started here (--launch, run for --duration simulated seconds) or of a recording (--bag), "
-        "written as OUT.dot and OUT.svg (node -> topic -> node).",
+        "written as DIR/graph.dot and DIR/graph.svg: nodes as ellipses, topics as boxes, publisher -> topic -> "
+        "subscriber, laid out left to right by Graphviz's dot (Debian package graphviz).",
     )
     _add_source(p)
-    p.add_argument("--out", default="graph", help="output path without suffix (writes .dot and .svg)")
+    p.add_argument("--out", default="graph", metavar="DIR",
+                   help="output folder: DIR/graph.dot and DIR/graph.svg (default ./graph)")
     p.set_defaults(func=_cmd_graph)
 

@@ -1,12 +1,13 @@
-"""The node/topic graph (rqt_graph's picture) as data, Graphviz DOT, and SVG drawn with matplotlib."""
+"""The node/topic graph (rqt_graph's picture) as data, Graphviz DOT, and SVG laid out by Graphviz's ``dot``."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from navlab.core.errors import CoreError
 from navlab.core.executor import Executor
-from navlab.io.files import save_figure_atomic
+from navlab.io.files import write_text_atomic
 
 HIDDEN_NODES = ("/_tf_buffer",)
 
@@ -42,71 +43,40 @@ class Graph:
         )
 
     def to_dot(self) -> str:
-        """Graphviz DOT: nodes as ellipses, topics as boxes, edges publisher → topic → subscriber."""
-        lines = ["digraph navlab {", "  rankdir=LR;", '  node [fontname="Helvetica"];']
+        """Graphviz DOT as rqt_graph draws it: nodes as ellipses, topics as boxes, edges publisher → topic →
+        subscriber, left to right. A node and a topic of the same name stay two vertices (ids ``n:``/``t:``)."""
+
+        def q(text: str) -> str:
+            return '"' + text.replace("\\", "\\\\").replace('"', '\\"') + '"'
+
+        lines = ["digraph navlab {", "  rankdir=LR;", '  node [fontname="Helvetica", fontsize=10];',
+                 '  edge [color="#555555"];']  # fmt: skip
         for n in self.nodes:
-            lines.append(f'  "{n}" [shape=ellipse];')
+            lines.append(f"  {q('n:' + n)} [label={q(n)}, shape=ellipse];")
         for t, (pubs, subs) in self.topics.items():
-            lines.append(f'  "{t}" [shape=box];')
-            lines += [f'  "{p}" -> "{t}";' for p in pubs]
-            lines += [f'  "{t}" -> "{s}";' for s in subs]
+            lines.append(f"  {q('t:' + t)} [label={q(t)}, shape=box];")
+            lines += [f"  {q('n:' + p)} -> {q('t:' + t)};" for p in pubs]
+            lines += [f"  {q('t:' + t)} -> {q('n:' + s)};" for s in subs]
         lines.append("}")
         return "\n".join(lines) + "\n"
 
-    def layers(self) -> dict[str, int]:
-        """A left-to-right layer for every graph vertex (longest path from sources, cycles cut)."""
-        succ: dict[str, list[str]] = {v: [] for v in [*self.nodes, *self.topics]}
-        for t, (pubs, subs) in self.topics.items():
-            for p in pubs:
-                succ.setdefault(p, []).append(t)
-            succ[t] += subs
-            for s in subs:
-                succ.setdefault(s, [])
-        layer = dict.fromkeys(succ, 0)
-        for _ in range(len(succ)):  # Bellman-Ford-like relaxation, bounded so cycles terminate
-            changed = False
-            for v, outs in succ.items():
-                for w in outs:
-                    if layer[w] < layer[v] + 1 and layer[v] + 1 < len(succ):
-                        layer[w] = layer[v] + 1
-                        changed = True
-            if not changed:
-                break
-        return layer
-
     def write_svg(self, path: str | Path) -> None:
-        """Draw the graph (matplotlib, no Graphviz needed) and write it as SVG atomically."""
-        import matplotlib
+        """Lay the graph out with Graphviz's ``dot`` (layered, cycles handled, as rqt_graph does) and write the
+        SVG atomically. Raises CoreError when ``dot`` is not installed."""
+        svg = self.to_svg()
+        write_text_atomic(Path(path), svg)
 
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
+    def to_svg(self) -> str:
+        """The SVG text of :meth:`to_dot` laid out by Graphviz's ``dot``."""
+        import shutil
+        import subprocess
 
-        layer = self.layers()
-        columns: dict[int, list[str]] = {}
-        for v in sorted(layer, key=lambda v: (layer[v], v)):
-            columns.setdefault(layer[v], []).append(v)
-        pos = {v: (c * 3.0, -r * 0.8) for c, vs in columns.items() for r, v in enumerate(vs)}
-        height = max((len(v) for v in columns.values()), default=1)
-        fig, ax = plt.subplots(figsize=(3 + 3 * len(columns), 1 + 0.6 * height))
-        boxes = {}
-        for v, (x, y) in pos.items():
-            is_topic = v in self.topics
-            boxes[v] = ax.text(
-                x, y, v, ha="center", va="center", fontsize=8, zorder=2,
-                bbox={"boxstyle": "square" if is_topic else "round", "fc": "#e8f0ff" if is_topic else "#fff2cc"},
-            )  # fmt: skip
-        for t, (pubs, subs) in self.topics.items():
-            for a, b in [*((p, t) for p in pubs), *((t, s) for s in subs)]:
-                forward = pos[b][0] >= pos[a][0]  # arrows leave the right edge and enter the left edge
-                ax.annotate(
-                    "", xy=(0.0 if forward else 1.0, 0.5), xycoords=boxes[b],
-                    xytext=(1.0 if forward else 0.0, 0.5), textcoords=boxes[a],
-                    arrowprops={"arrowstyle": "-|>", "color": "0.35", "shrinkA": 3, "shrinkB": 3}, zorder=1,
-                )  # fmt: skip
-        ax.set_axis_off()
-        xs = [p[0] for p in pos.values()] or [0.0]
-        ys = [p[1] for p in pos.values()] or [0.0]
-        ax.set_xlim(min(xs) - 1.5, max(xs) + 1.5)
-        ax.set_ylim(min(ys) - 0.6, max(ys) + 0.6)
-        save_figure_atomic(fig, path, bbox_inches="tight")
-        plt.close(fig)
+        dot = shutil.which("dot")
+        if dot is None:
+            raise CoreError("Graphviz's `dot` is not installed, so the graph cannot be laid out "
+                            "(Debian: sudo apt-get install graphviz); the .dot file is written")  # fmt: skip
+        proc = subprocess.run([dot, "-Tsvg"], input=self.to_dot(), capture_output=True, text=True, timeout=60,
+                              check=False)  # fmt: skip
+        if proc.returncode != 0:
+            raise CoreError(f"dot failed to lay out the graph: {proc.stderr.strip()}")
+        return proc.stdout
