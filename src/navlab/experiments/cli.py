@@ -244,7 +244,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     drive = p.add_mutually_exclusive_group()
     drive.add_argument("--explore", action="store_true", help="frontier exploration (the default)")
     drive.add_argument("--teleop", action="store_true", help="drive with the keyboard, in real time")
-    drive.add_argument("--route", metavar="FILE", help="a route YAML: segments and/or waypoints")
+    drive.add_argument("--route", metavar="FILE",
+                       help="a route YAML (segments and/or waypoints) or a shipped route's name (room)")
     p.add_argument("--out", default="map", metavar="DIR", help="output folder (default ./map)")
     p.add_argument("--mode", default="gmapping",
                    help="SLAM mode: gmapping, the paper's RBPF (default), or graph (pose graph)")  # fmt: skip

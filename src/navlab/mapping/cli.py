@@ -10,7 +10,7 @@ from pathlib import Path
 
 import yaml
 
-from navlab.cli_common import add_pose_arguments, print_figures, start_pose
+from navlab.cli_common import add_pose_arguments, add_set_argument, parse_sets, print_figures, start_pose
 from navlab.experiments.cli import add_eval_map
 
 
@@ -47,7 +47,7 @@ def _cmd_slam(args: argparse.Namespace) -> int:
     result = run_offline(
         log,
         mode=args.mode,
-        params=_params_file(args.params),
+        params={**_params_file(args.params), **parse_sets(args.set)},
         seed=args.seed,
         resolution=args.resolution,
         max_scans=args.max_scans,
@@ -120,6 +120,11 @@ def _cmd_teleop(args: argparse.Namespace) -> int:
     return 0
 
 
+# relations_error's keys -> the CLI's JSON keys with unit suffixes (the old keys are printed too, deprecated)
+DEPRECATED_RELATION_KEYS = {"trans_abs_mean": "trans_abs_mean_m", "trans_abs_std": "trans_abs_std_m",
+                            "trans_sq_mean": "trans_sq_mean_m2"}
+
+
 def _cmd_eval_relations(args: argparse.Namespace) -> int:
     from navlab.experiments.metrics import read_relations, relations_closure, relations_error
     from navlab.experiments.trajectory import read_trajectory
@@ -129,6 +134,9 @@ def _cmd_eval_relations(args: argparse.Namespace) -> int:
     out = relations_error(ts, poses, rel, time_tolerance=args.tolerance)
     closure = relations_closure(rel, time_tolerance=args.tolerance)
     out.update({f"reference_{k}": v for k, v in closure.items()})
+    for old, new in DEPRECATED_RELATION_KEYS.items():  # unit suffixes as everywhere; the old names stay one release
+        if old in out:
+            out[new] = out[old]
     if args.json:
         print_figures(out, True)
     else:
@@ -199,6 +207,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument("--params", metavar="YAML", help="SLAM parameters: slam_gmapping's names (graph mode's own "
                    "under 'graph:')")
+    add_set_argument(p, "slam_gmapping", "particles=50")
     p.add_argument("--resolution", type=float, default=0.05, help="map resolution in m/cell (default 0.05)")
     p.add_argument("--max-scans", type=int, default=None, help="only the first N scans")
     p.add_argument("--seed", type=int, default=0, help="random seed (gmapping mode; default 0)")
@@ -218,7 +227,9 @@ def register(sub: argparse._SubParsersAction) -> None:
         description="For each relation, error = relation ⊖ (pose(t1)^-1 ∘ pose(t2)); prints mean ± std of "
         "absolute translational (m) and rotational (deg) errors and the means of their squares. Relations "
         "whose timestamps match no pose are counted as not scored. Also how far the relations' own triangles "
-        "(a→b, b→c, a→c) fail to close, and the score that implies for poses without error (reference_*).",
+        "(a→b, b→c, a→c) fail to close, and the score that implies for poses without error (reference_*). "
+        "JSON keys carry their units (trans_abs_mean_m, rot_abs_mean_deg, ...); trans_abs_mean, trans_abs_std "
+        "and trans_sq_mean are deprecated aliases kept for one release.",
     )
     r.add_argument("poses", help="poses file: 'timestamp x y theta' per line, a TUM file, or a CARMEN log "
                    "(its own odometry: see --carmen)")

@@ -65,6 +65,14 @@ def robot(name: str) -> Path:
     return full
 
 
+def route(name: str) -> Path:
+    """A shipped mapping route by name (``"room"``: a loop through room.world for ``navlab map --route``)."""
+    full = path(f"routes/{name if name.endswith('.yaml') else name + '.yaml'}", must_exist=False)
+    if not full.is_file():
+        raise _unknown("route", name, sorted(p.stem for p in (root() / "routes").glob("*.yaml")))
+    return full
+
+
 def _unknown(kind: str, name: str, shipped: list[str]) -> ResourceError:
     """One line: ``world 'rooom': no such file here and no shipped world of that name; did you mean 'room'?``"""
     import difflib
