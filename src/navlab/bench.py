@@ -55,8 +55,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "bench",
         help="measure performance and print the figures (JSON with --json)",
-        description="Run a benchmark and print its figures. Targets are in DESIGN.md's performance "
-        "budget; run on an idle machine for stable numbers.",
+        description="Run a benchmark and print its figures (sim_s, wall_s, rtf and each benchmark's own, units "
+        "as key suffixes). Run on an idle machine for stable numbers; the figures measured so far are in the "
+        "docs (docs/mapping.md, docs/navigation.md, docs/viewer.md).",
     )
     p.add_argument("name", choices=[*BENCHES, "all"], help="which benchmark to run")
     p.add_argument("--json", action="store_true", help="print one JSON object")

@@ -229,6 +229,13 @@ def _add_world_robot(p: argparse.ArgumentParser, world: str) -> None:
     add_resource_path_arguments(p)
 
 
+def _shipped_scenarios() -> list[str]:
+    """The scenario names in the shipped resources folder (for --help)."""
+    from navlab import resources
+
+    return sorted(f.stem for f in (resources.root() / "scenarios").glob("*.yaml"))
+
+
 def register(sub: argparse._SubParsersAction) -> None:
     """Add ``map``, ``localize``, ``navigate``, ``experiment`` and ``report``."""
     p = sub.add_parser(
@@ -334,9 +341,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "experiment",
         help="run a scenario's trials headless and summarize them, or sweep parameters (the paper's Section V)",
-        description="navlab experiment run FILE: run the trials of a scenario YAML (or a shipped one: empty_room, "
-        "obstacles_after_mapping, refresh_rate, clutter_suite) headless, each with its own seed, in parallel "
-        "processes with --workers. Each "
+        description="navlab experiment run FILE: run the trials of a scenario YAML (or a shipped one: "
+        f"{', '.join(_shipped_scenarios())}) headless, each with its own seed, in parallel processes with "
+        "--workers. Each "
         "finished trial is appended whole to DIR/results.jsonl; running again resumes and skips finished trials. "
         "Prints (and writes DIR/summary.json) the success rate with a 95 % Wilson interval, collisions, failures "
         "by kind, time quartiles, SPL, clearance, localization error and command jerk. navlab experiment sweep FILE "

@@ -144,13 +144,12 @@ def plot_run(
     return out
 
 
-def plot_navigation(grid: GridMap, shot: NavSnapshot, path: str | Path, *, title: str = "",
-                    goal: Sequence[float] | None = None) -> Path:  # fmt: skip
+def navigation_figure(grid: GridMap, shot: NavSnapshot, *, title: str = "", goal: Sequence[float] | None = None) -> Any:
     """A picture in the style of the paper's Figs. 9–12, with a legend: the map, the global costmap's inflation
     as a blue shadow, obstacles the map lacks (added after mapping) in purple, dropped-in models marked, the
     driven path, the global plan (blue), the local plan (green), the robot's footprint (orange) with a heading
     arrow, the last laser scan (red points), near misses and collisions, and the goal with its heading.
-    ``shot`` is from ``navigate_run``."""
+    ``shot`` is from ``navigate_run``; returns the matplotlib figure (the caller closes it)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -158,7 +157,6 @@ def plot_navigation(grid: GridMap, shot: NavSnapshot, path: str | Path, *, title
     from matplotlib.patches import Patch
 
     from navlab.geometry import compose2, transform_points2
-    from navlab.io.files import save_figure_atomic
 
     fig, ax = plt.subplots(figsize=(9, 7))
     x0, y0, x1, y1 = grid.bounds()
@@ -240,6 +238,17 @@ def plot_navigation(grid: GridMap, shot: NavSnapshot, path: str | Path, *, title
               title_fontsize=8)  # fmt: skip
     if title:
         ax.set_title(title, fontsize=10)
+    return fig
+
+
+def plot_navigation(grid: GridMap, shot: NavSnapshot, path: str | Path, *, title: str = "",
+                    goal: Sequence[float] | None = None) -> Path:  # fmt: skip
+    """Save :func:`navigation_figure` as a PNG at ``path`` (atomically); returns the path."""
+    import matplotlib.pyplot as plt
+
+    from navlab.io.files import save_figure_atomic
+
+    fig = navigation_figure(grid, shot, title=title, goal=goal)
     out = Path(path)
     try:
         save_figure_atomic(fig, out, format="png", dpi=110, bbox_inches="tight")
