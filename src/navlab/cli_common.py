@@ -7,6 +7,7 @@ import argparse
 import json
 import math
 from collections.abc import Sequence
+from pathlib import Path
 from typing import Any
 
 
@@ -98,3 +99,19 @@ def print_figures(figures: dict[str, Any], as_json: bool) -> None:
     else:
         for key, value in figures.items():
             print(f"  {key}: {value}")
+
+
+def out_file(out: str, name: str, *, old_suffixes: tuple[str, ...]) -> Path:
+    """Where a verb writes ``name`` under ``--out DIR`` (the folder is created). Deprecated until the next
+    release: an ``--out`` ending in one of ``old_suffixes`` (a file, as that verb once took) is used as the file
+    itself, with a one-line DeprecationWarning on stderr."""
+    import sys
+
+    path = Path(out)
+    if path.suffix.lower() in old_suffixes:
+        print(f"navlab: DeprecationWarning: --out {out}: --out names a folder now (it gets {name}); a file name is "
+              "accepted until the next release", file=sys.stderr)  # fmt: skip
+        path.parent.mkdir(parents=True, exist_ok=True)
+        return path
+    path.mkdir(parents=True, exist_ok=True)
+    return path / name

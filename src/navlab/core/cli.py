@@ -12,14 +12,13 @@ import contextlib
 import json
 import math
 import signal
-import sys
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from navlab.cli_common import add_resource_path_arguments, apply_resource_paths, positive_seconds
+from navlab.cli_common import add_resource_path_arguments, apply_resource_paths, out_file, positive_seconds
 from navlab.core.errors import CoreError
 from navlab.core.graph import Graph
 from navlab.core.launch import Session, start
@@ -221,14 +220,8 @@ def _cmd_node(args: argparse.Namespace) -> int:
 
 def _cmd_graph(args: argparse.Namespace) -> int:
     graph = _graph_of(args)
-    out = Path(args.out)
-    if out.suffix in (".dot", ".svg"):  # --out was a file stem until 0.x; now a folder, as on every verb
-        print(f"navlab: DeprecationWarning: --out {args.out}: --out now names a folder that gets graph.dot and "
-              "graph.svg; a file name is accepted until the next release", file=sys.stderr)
-        dot, svg = out.with_suffix(".dot"), out.with_suffix(".svg")
-    else:
-        out.mkdir(parents=True, exist_ok=True)
-        dot, svg = out / "graph.dot", out / "graph.svg"
+    svg = out_file(args.out, "graph.svg", old_suffixes=(".dot", ".svg"))
+    dot = svg.with_suffix(".dot")
     write_text_atomic(dot, graph.to_dot())
     graph.write_svg(svg)
     print(f"wrote {dot} and {svg}")

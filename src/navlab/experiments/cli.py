@@ -13,6 +13,7 @@ from navlab.cli_common import (
     add_resource_path_arguments,
     add_set_argument,
     apply_resource_paths,
+    out_file,
     parse_sets,
     positive_seconds,
     print_figures,
@@ -96,7 +97,7 @@ def _cmd_localize(args: argparse.Namespace) -> int:
         )  # fmt: skip
     summary = dict(result.summary)
     if args.out:
-        summary["png"] = str(plot_result(result, args.out))
+        summary["png"] = str(plot_result(result, out_file(args.out, "localize.png", old_suffixes=(".png",))))
     print_figures(summary, args.json)
     return 0
 
@@ -294,8 +295,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="amcl parameter file (ROS 1 layout, or Nav2 layout with an 'amcl' node)")
     add_set_argument(p, "amcl", "recovery_alpha_fast=0.1")
     p.add_argument("--seed", type=int, default=0, help="random seed of the run (default 0)")
-    p.add_argument("--out", default="localize.png", metavar="FILE.png",
-                   help="where to save the truth-vs-estimate figure (default localize.png; '' for none)")
+    p.add_argument("--out", default=".", metavar="DIR",
+                   help="folder for the truth-vs-estimate figure DIR/localize.png (default: the current folder; "
+                   "'' for none; a FILE.png is deprecated but still works this release)")
     p.add_argument("--json", action="store_true", help="print the figures as one JSON object")
     p.add_argument("--record", metavar="DIR", help="also write every topic to a rosbag2 (MCAP) in DIR")
     p.add_argument("--quiet", action="store_true", help="no progress bar")

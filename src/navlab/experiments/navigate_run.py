@@ -23,7 +23,7 @@ from navlab.core.record import Recorder
 from navlab.experiments.metrics import distance_to_path
 from navlab.experiments.plots import NavSnapshot
 from navlab.experiments.session import Run, rounded, start_run
-from navlab.experiments.truth import true_map
+from navlab.experiments.truth import true_map, unmapped_obstacles
 from navlab.geometry import compose2, transform_points2
 from navlab.grid import Grid, GridMap
 from navlab.navigation.errors import NavigationError
@@ -266,7 +266,7 @@ def run_navigation(
     results: list[dict[str, Any]] = []
     shots: list[NavSnapshot] = []
     arrivals: list[NavSnapshot] = []
-    new_obstacles = _new_obstacles(load_world_named(world), grid, pose) if snapshots and not mapless else None
+    new_obstacles = unmapped_obstacles(load_world_named(world), grid, pose[:2]) if snapshots and not mapless else None
     recorder = Recorder(run.executor, record) if record else None  # the whole run, every goal, in one bag
     run.run(1.0, quiet=True)  # amcl's first update, the costmaps' first maps
     frame = run.odom_frame if mapless else "map"
@@ -352,23 +352,6 @@ def _collision_points(mon: NavMonitor) -> np.ndarray:
     t = np.array([p[0] for p in mon.path])
     starts = [c for k, c in enumerate(mon.contacts) if k == 0 or c - mon.contacts[k - 1] > 0.25]
     return np.array([mon.path[int(np.argmin(np.abs(t - c)))][1:] for c in starts], dtype=np.float64).reshape(-1, 2)
-
-
-def _new_obstacles(world: Any, grid: GridMap, pose: Pose) -> np.ndarray:
-    """World points (N, 2; m) of obstacles the world has but the map ``grid`` does not (cells the map calls free
-    more than two cells from any of its walls): what was added after mapping."""
-    from scipy import ndimage
-
-    truth = true_map(world, pose[:2], resolution=grid.resolution)
-    jj, ii = np.nonzero(truth.data == 100)
-    xy = np.stack([truth.origin[0] + (ii + 0.5) * truth.resolution, truth.origin[1] + (jj + 0.5) * truth.resolution], 1)
-    walls = ndimage.binary_dilation(grid.occupied_mask(), iterations=2)
-    cells = grid.world_to_cell(xy)
-    inside = (cells[:, 0] >= 0) & (cells[:, 0] < grid.width) & (cells[:, 1] >= 0) & (cells[:, 1] < grid.height)
-    keep = np.zeros(len(xy), dtype=bool)
-    ci, cj = cells[inside, 0], cells[inside, 1]
-    keep[inside] = grid.free_mask()[cj, ci] & ~walls[cj, ci]
-    return xy[keep]
 
 
 WHEEL_CONTROLLERS = ("gazebo_ros_diff_drive", "diff_drive_controller")

@@ -34,7 +34,7 @@ class ErrorPanel:
 
     t: np.ndarray
     values: np.ndarray
-    ylabel: str = "position error (cm)"
+    ylabel: str = "position error (cm, log scale)"
     title: str = ""
     threshold: float | None = None
     events: dict[str, float] = field(default_factory=dict)  # label -> time (s), drawn as dashed lines
@@ -88,10 +88,12 @@ def plot_run(
     error: ErrorPanel | None = None,
     crop: bool = True,
     dpi: int = 120,
+    marks: Sequence[tuple[np.ndarray, str, str]] = (),
 ) -> Path:
     """Save the map with ``tracks`` (and ``error`` beside it) as a PNG at ``path``; returns the path.
 
-    ``crop`` limits the view to the part of the map that is known (plus 0.5 m)."""
+    ``crop`` limits the view to the part of the map that is known (plus 0.5 m); ``marks``: (points (N, 2),
+    legend label, colour) drawn as small squares, e.g. obstacles the map does not have."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -107,6 +109,8 @@ def plot_run(
     x0, y0, x1, y1 = grid.bounds()
     ax.imshow(map_image(grid), cmap="gray", vmin=0, vmax=1, origin="lower", extent=(x0, x1, y0, y1),
               interpolation="nearest")  # fmt: skip
+    for pts, label, color in marks:
+        ax.scatter(pts[:, 0], pts[:, 1], s=2, marker="s", c=color, label=label)
     for tr in tracks:
         xy = np.asarray(tr.xy, dtype=np.float64)
         if len(xy):
@@ -119,17 +123,18 @@ def plot_run(
     ax.set_aspect("equal")
     ax.set_xlabel(f"x [m] ({grid.frame_id} frame)")
     ax.set_ylabel("y [m]")
-    if tracks:
+    if tracks or marks:
         ax.legend(loc="upper right", fontsize=8)
     if title:
         ax.set_title(title)
     if ax2 is not None and error is not None:
         ax2.plot(error.t, np.asarray(error.values) * 100, color="tab:red")
         if error.threshold is not None:
-            ax2.axhline(error.threshold * 100, color="gray", ls=":", lw=1)
+            ax2.axhline(error.threshold * 100, color="gray", ls=":", lw=1,
+                        label=f"converged below {error.threshold * 100:g} cm")
         for label, t in error.events.items():
             ax2.axvline(t, color="black", ls="--", lw=1, label=label)
-        if error.events:
+        if error.events or error.threshold is not None:
             ax2.legend(fontsize=8)
         ax2.set_yscale("log")
         ax2.set_xlabel("time (s)")
