@@ -33,7 +33,8 @@ def test_a_run_and_a_sweep_are_reported_as_markdown_pngs_and_one_html_page(
     md = (tmp_path / "run" / "report.md").read_text()
     assert "2 of 2 trials succeeded" in md and "![" in md and "| trial | seed | success |" in md
     pngs = _self_contained((tmp_path / "run" / "report.html").read_text())
-    assert len(pngs) == 1 and pngs[0] == (tmp_path / "run" / "trials.png").read_bytes()
+    assert pngs == [(tmp_path / "run" / name).read_bytes() for name in ("trials.png", "paths.png")]
+    assert "every trial's true path" in md
 
     run_sweep(scenario_from_dict({**TINY, "trials": 1}), {"controller": ["trajectory", "dwa"]}, tmp_path / "sweep")
     (tmp_path / "sweep" / "controller.png").unlink()  # re-rendered from the results

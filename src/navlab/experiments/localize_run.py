@@ -20,7 +20,7 @@ import numpy as np
 from navlab.core import Node
 from navlab.experiments.metrics import settled_after, trajectory_error
 from navlab.experiments.monitors import PoseMonitor
-from navlab.experiments.plots import ErrorPanel, Track, plot_run
+from navlab.experiments.plots import ErrorPanel, Marks, Track, plot_run
 from navlab.experiments.session import rounded, start_run
 from navlab.experiments.truth import true_map, unmapped_obstacles
 from navlab.geometry import wrap_angle
@@ -208,8 +208,8 @@ def plot_result(res: LocalizeResult, path: str | Path) -> Path:
         truth, est = np.insert(truth, k, np.nan, axis=0), np.insert(est, k, np.nan, axis=0)
         events["kidnapped"] = res.summary["kidnap_s"]
     mean = res.summary.get("position_error_mean_m")
-    marks = [] if res.unmapped is None or not len(res.unmapped) else [(res.unmapped, "obstacle not in the map",
-                                                                       "tab:purple")]  # fmt: skip
+    marks = [] if res.unmapped is None or not len(res.unmapped) else [Marks(res.unmapped, "obstacle not in the map",
+                                                                            "tab:purple")]  # fmt: skip
     return plot_run(
         res.grid,
         [Track(truth, "ground truth", "-", "tab:green", 2.0), Track(est, "AMCL estimate", "--", "tab:red")],

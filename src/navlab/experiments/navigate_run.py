@@ -119,6 +119,7 @@ class NavigateResult:
     grid: GridMap
     snapshots: list[NavSnapshot] = field(default_factory=list)  # per goal, the middle of the drive
     arrivals: list[NavSnapshot] = field(default_factory=list)  # per goal, when it ended (arrival or give-up)
+    path: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))  # the true path: (t s, x m, y m) at 10 Hz
 
 
 def _move_base(run: Run) -> MoveBase:
@@ -303,7 +304,7 @@ def run_navigation(
         **run.figures(),
         **({"record": str(bag)} if bag else {}),
     })  # fmt: skip
-    return NavigateResult(results, summary, grid, shots, arrivals)
+    return NavigateResult(results, summary, grid, shots, arrivals, np.array(mon.path, dtype=np.float64).reshape(-1, 3))
 
 
 def save_goal_pictures(result: NavigateResult, folder: str | Path) -> list[str]:

@@ -29,6 +29,17 @@ class Track:
 
 
 @dataclass
+class Marks:
+    """Points to draw over a map: (N, 2) in the map's frame, a legend label, a colour, a marker and its size."""
+
+    xy: np.ndarray
+    label: str
+    color: str
+    marker: str = "s"
+    size: float = 2.0
+
+
+@dataclass
 class ErrorPanel:
     """An error-over-time panel: ``t`` (s), ``values`` (m), drawn in cm on a log scale."""
 
@@ -88,12 +99,12 @@ def plot_run(
     error: ErrorPanel | None = None,
     crop: bool = True,
     dpi: int = 120,
-    marks: Sequence[tuple[np.ndarray, str, str]] = (),
+    marks: Sequence[Marks] = (),
 ) -> Path:
     """Save the map with ``tracks`` (and ``error`` beside it) as a PNG at ``path``; returns the path.
 
-    ``crop`` limits the view to the part of the map that is known (plus 0.5 m); ``marks``: (points (N, 2),
-    legend label, colour) drawn as small squares, e.g. obstacles the map does not have."""
+    ``crop`` limits the view to the part of the map that is known (plus 0.5 m); ``marks``: points such as
+    obstacles the map does not have, a start or goals."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -109,13 +120,13 @@ def plot_run(
     x0, y0, x1, y1 = grid.bounds()
     ax.imshow(map_image(grid), cmap="gray", vmin=0, vmax=1, origin="lower", extent=(x0, x1, y0, y1),
               interpolation="nearest")  # fmt: skip
-    for pts, label, color in marks:
-        ax.scatter(pts[:, 0], pts[:, 1], s=2, marker="s", c=color, label=label)
+    for m in marks:
+        ax.scatter(m.xy[:, 0], m.xy[:, 1], s=m.size, marker=m.marker, c=m.color, label=m.label, zorder=3)
     for tr in tracks:
         xy = np.asarray(tr.xy, dtype=np.float64)
         if len(xy):
             style: dict[str, Any] = {"color": tr.color} if tr.color else {}  # None would override tr.style's colour
-            ax.plot(xy[:, 0], xy[:, 1], tr.style, lw=tr.width, label=tr.label, **style)
+            ax.plot(xy[:, 0], xy[:, 1], tr.style, lw=tr.width, label=tr.label or None, **style)
     known = grid.known_bounds() if crop else None
     if known is not None:
         ax.set_xlim(known[0], known[2])

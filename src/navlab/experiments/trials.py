@@ -127,7 +127,20 @@ def run_trial(sc: Scenario, index: int) -> dict[str, Any]:
         "cmd_jerk_mean": r.summary.get("cmd_jerk_mean"), "sim_s": r.summary["sim_s"], "wall_s": r.summary["wall_s"],
         "tracking_error_m": _mean(goals, "tracking_error_m"), "final_error_m": _mean(goals, "final_error_m"),
         **barn, "per_goal": goals,
+        "world": str(world) if clutter is None else None, "start": list(start),
+        "path_xy": _thin(r.path[:, 1:]),  # for the report's trajectory picture
     })  # fmt: skip
+
+
+def _thin(xy: np.ndarray, step: float = 0.05) -> list[list[float]]:
+    """A path (N, 2; m) with points at least ``step`` m apart (the last kept), rounded to mm, as lists."""
+    keep: list[np.ndarray] = []
+    for p in xy:
+        if not keep or np.hypot(*(p - keep[-1])) >= step:
+            keep.append(p)
+    if len(xy) and (not keep or keep[-1] is not xy[-1]):
+        keep.append(xy[-1])
+    return [[round(float(a), 3), round(float(b), 3)] for a, b in keep]
 
 
 def _append_line(path: Path, record: dict[str, Any]) -> None:
@@ -158,7 +171,8 @@ def read_results(path: Path) -> list[dict[str, Any]]:
 
 
 def summarize_trials(results: list[dict[str, Any]]) -> dict[str, Any]:
-    """Success rate with a 95 % Wilson interval, collisions, failures by kind, medians and quartiles."""
+    """Success rate with a 95 % Wilson interval, collisions (``collisions``: contact episodes over all trials;
+    ``trials_with_collision``: trials, as ``failures`` counts trials by kind), medians and quartiles."""
     n = len(results)
     ok = sum(bool(r["success"]) for r in results)
     lo, hi = wilson_interval(ok, n)
@@ -174,7 +188,9 @@ def summarize_trials(results: list[dict[str, Any]]) -> dict[str, Any]:
             failures[r["failure"]] = failures.get(r["failure"], 0) + 1
     return rounded({
         "trials": n, "success_rate": ok / n if n else None, "success_ci95": [lo, hi],
-        "collisions": sum(r["collisions"] for r in results), "failures": failures,
+        "collisions": sum(r["collisions"] for r in results),  # contact episodes (events), over all trials
+        "trials_with_collision": sum(bool(r["collisions"]) for r in results),  # trials, as "failures" counts
+        "failures": failures,
         "median_time_s": times[1] if times else None, "time_s_quartiles": times,
         "median_path_m": _median(results, "path_m"), "spl_mean": _mean(results, "spl"),
         "min_clearance_m": min((r["min_clearance_m"] for r in results), default=None),
