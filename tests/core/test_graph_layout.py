@@ -55,6 +55,10 @@ def test_navigation_graph_has_every_vertex_and_no_overlaps(room_map: Path, tmp_p
     assert {f"n:{n}" for n in nodes} | {f"t:{t}" for t in topics} == set(shapes)
     assert all(shapes[f"n:{n}"][0] == "ellipse" for n in nodes) and all(shapes[f"t:{t}"][0] == "box" for t in topics)
     assert "n:/collisions" in shapes and "t:/collisions" in shapes  # the same name, two vertices, no self-loop
+    # as in ROS: robot_state_publisher subscribes /joint_states; amcl and move_base read /tf (TransformListeners)
+    assert '"n:/joint_state_publisher" -> "t:/joint_states"' in dot
+    assert '"t:/joint_states" -> "n:/robot_state_publisher"' in dot
+    assert '"t:/tf" -> "n:/amcl"' in dot and '"t:/tf" -> "n:/move_base"' in dot
     for (a, (_, ba)), (b, (_, bb)) in itertools.combinations(shapes.items(), 2):
         overlap = ba[0] < bb[2] and bb[0] < ba[2] and ba[1] < bb[3] and bb[1] < ba[3]
         assert not overlap, f"{a} overlaps {b}"
