@@ -126,5 +126,6 @@ def test_readme_teleop_drives_from_a_terminal(tmp_path: Path) -> None:
     os.close(master)
     assert proc.returncode == 0, err
     assert "stopped at" in out and "Traceback" not in err
+    assert "sending linear.x +0.50 m/s" in err  # it shows what it sends
     moved = re.search(r"stopped at x=(-?[\d.]+)", out)
     assert moved and float(moved.group(1)) > 0.05  # the 'i' key drove it forward

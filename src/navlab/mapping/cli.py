@@ -7,6 +7,7 @@ import contextlib
 import sys
 import time
 from pathlib import Path
+from typing import Any
 
 import yaml
 
@@ -110,6 +111,7 @@ def _cmd_teleop(args: argparse.Namespace) -> int:
         teleop = TeleopKeyboard(ex, parameters={"speed": args.speed, "turn": args.turn})
         print(HELP)
         terminal_keys(teleop, ex)
+        teleop.create_timer(0.25, lambda: _show_teleop(teleop, gazebo))
     with contextlib.suppress(KeyboardInterrupt):
         ex.spin()
     if remote is not None:
@@ -123,6 +125,19 @@ def _cmd_teleop(args: argparse.Namespace) -> int:
 # relations_error's keys -> the CLI's JSON keys with unit suffixes (the old keys are printed too, deprecated)
 DEPRECATED_RELATION_KEYS = {"trans_abs_mean": "trans_abs_mean_m", "trans_abs_std": "trans_abs_std_m",
                             "trans_sq_mean": "trans_sq_mean_m2"}
+
+
+def _show_teleop(teleop: Any, gazebo: Any) -> None:
+    """One status line, rewritten in place on stderr: simulated time, the command being sent, the speeds (and
+    the robot's pose when the simulator runs here), as teleop_twist_keyboard prints its 'currently:' line."""
+    st, tw = teleop.state, teleop.state.twist()
+    where = ""
+    if gazebo is not None:
+        x, y, yaw = gazebo.sim.base_pose2d()
+        where = f"  robot at ({x:.2f}, {y:.2f}, {yaw:.2f} rad)"
+    sys.stderr.write(f"\rt={teleop.executor.now_ns / 1e9:7.1f} s  sending linear.x {tw.linear.x:+.2f} m/s  angular.z "
+                     f"{tw.angular.z:+.2f} rad/s  (currently: speed {st.speed:.2f} turn {st.turn:.2f}){where}  ")
+    sys.stderr.flush()
 
 
 def _cmd_eval_relations(args: argparse.Namespace) -> int:
