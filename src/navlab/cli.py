@@ -14,6 +14,7 @@ import re
 import sys
 from typing import NoReturn
 
+from navlab.cli_common import check_named_inputs
 from navlab.errors import NavlabError
 
 # Modules that define ``register(subparsers: argparse._SubParsersAction) -> None``.
@@ -70,6 +71,7 @@ def main(argv: list[str] | None = None) -> int:
         getattr(args, target).extend(extra)
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING, format="%(levelname)s %(message)s")
     try:
+        check_named_inputs(args)  # a missing world or robot in one line, before MuJoCo and Numba load
         return int(args.func(args) or 0)
     except NavlabError as exc:
         print(f"navlab: error: {exc}", file=sys.stderr)

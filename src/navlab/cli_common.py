@@ -115,3 +115,24 @@ def out_file(out: str, name: str, *, old_suffixes: tuple[str, ...]) -> Path:
         return path
     path.mkdir(parents=True, exist_ok=True)
     return path / name
+
+
+def check_named_inputs(args: argparse.Namespace) -> None:
+    """Refuse a ``--world``/``--robot`` that names neither a file nor a shipped world/robot, in one line and
+    before any heavy import (MuJoCo, Numba): the loaders would say the same seconds later. ``package://`` and
+    ``file://`` URIs are left to the loaders."""
+    from navlab import resources
+    from navlab.errors import NavlabError
+
+    for attr, kind, suffixes in (("world", "world", (".world", ".sdf")), ("robot", "robot", (".xacro", ".urdf"))):
+        text = getattr(args, attr, None)
+        if not isinstance(text, str) or not text.strip() or "://" in text:
+            continue
+        path = Path(text).expanduser()
+        if path.exists():
+            continue
+        if not path.suffix and "/" not in text:
+            (resources.world if kind == "world" else resources.robot)(text)  # one line, with a suggestion
+        else:
+            hint = "" if path.suffix in suffixes else f" (a {kind} is a {' or '.join(suffixes)} file or a shipped name)"
+            raise NavlabError(f"{kind} file not found: {path.absolute()}{hint}")

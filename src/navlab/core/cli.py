@@ -30,7 +30,7 @@ from navlab.viz.cli import add_view_arguments
 def _add_source(p: argparse.ArgumentParser) -> None:
     src = p.add_mutually_exclusive_group()
     src.add_argument(
-        "--launch", nargs="+", metavar="FILE [name:=value]",
+        "--launch", nargs="+", metavar=("FILE", "name:=value"),
         help="start this launch (file or shipped name, then its arguments) here and watch it",
     )
     src.add_argument("--bag", metavar="DIR", help="read a rosbag2 recording instead")

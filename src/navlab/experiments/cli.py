@@ -262,7 +262,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--rate", type=float, default=0.0, help="pacing: 0 = as fast as possible, 1 = real time")
     p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     p.add_argument("--record", metavar="DIR", help="also write every topic to a rosbag2 (MCAP) in DIR")
-    p.add_argument("--launch", nargs="+", metavar="FILE [name:=value]",
+    p.add_argument("--launch", nargs="+", metavar=("FILE", "name:=value"),
                    help="save: start this launch here and save its /map after --duration (default: save the "
                    "/map of the `navlab launch` running in another shell)")  # fmt: skip
     p.add_argument("--pid", type=int, help="save: which running navlab launch, when several run")
