@@ -171,10 +171,10 @@ def plot_trial_paths(results: list[dict[str, Any]], path: Path, *, title: str = 
     from navlab.experiments.plots import Marks, Track, plot_run
     from navlab.grid import GridMap
 
-    world = results[0].get("world")
+    world = results[0].get("world_file")
     start = results[0].get("start") or [0.0, 0.0, 0.0]
     grid: GridMap | None = None
-    if world and all(r.get("world") == world for r in results):
+    if world and all(r.get("world_file") == world for r in results):
         from navlab.experiments.truth import true_map
         from navlab.sim.gazebo import load_world_named
 

@@ -127,7 +127,7 @@ def run_trial(sc: Scenario, index: int) -> dict[str, Any]:
         "cmd_jerk_mean": r.summary.get("cmd_jerk_mean"), "sim_s": r.summary["sim_s"], "wall_s": r.summary["wall_s"],
         "tracking_error_m": _mean(goals, "tracking_error_m"), "final_error_m": _mean(goals, "final_error_m"),
         **barn, "per_goal": goals,
-        "world": str(world) if clutter is None else None, "start": list(start),
+        "world_file": str(world) if clutter is None else None, "start": list(start),
         "path_xy": _thin(r.path[:, 1:]),  # for the report's trajectory picture
     })  # fmt: skip
 
