@@ -32,8 +32,17 @@ BENCHES: dict[str, str] = {
 
 
 def _run_one(name: str, args: argparse.Namespace) -> dict[str, Any]:
+    import sys
+    import time
+
     module, func = BENCHES[name].split(":")
-    return getattr(importlib.import_module(module), func)(args)
+    if not args.quiet:  # benchmarks take seconds to minutes: say what runs, and when it is done
+        print(f"bench {name}: running ...", file=sys.stderr, flush=True)
+    t0 = time.perf_counter()
+    out = getattr(importlib.import_module(module), func)(args)
+    if not args.quiet:
+        print(f"bench {name}: done in {time.perf_counter() - t0:.1f} s wall", file=sys.stderr, flush=True)
+    return out
 
 
 def _cmd(args: argparse.Namespace) -> int:
@@ -61,6 +70,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument("name", choices=[*BENCHES, "all"], help="which benchmark to run")
     p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.add_argument("--quiet", action="store_true", help="no 'running ...' lines on stderr")
     p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     p.add_argument("--controller", default=None,
                    help="clutter: local planner to drive with (trajectory, dwa, mppi; default mppi)")

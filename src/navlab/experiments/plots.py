@@ -134,8 +134,11 @@ def plot_run(
     ax.set_aspect("equal")
     ax.set_xlabel(f"x [m] ({grid.frame_id} frame)")
     ax.set_ylabel("y [m]")
-    if tracks or marks:
-        ax.legend(loc="upper right", fontsize=8)
+    from matplotlib.patches import Patch
+
+    key = [Patch(facecolor="black", label="map: occupied"), Patch(facecolor="0.8", label="map: unknown")]
+    lines, _labels = ax.get_legend_handles_labels()
+    ax.legend(handles=key + lines, loc="upper right", fontsize=8, framealpha=0.85)
     if title:
         ax.set_title(title)
     if ax2 is not None and error is not None:

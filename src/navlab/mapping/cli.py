@@ -38,9 +38,10 @@ def _cmd_slam(args: argparse.Namespace) -> int:
     from navlab.experiments.plots import Track, plot_run
     from navlab.experiments.session import rounded
     from navlab.io.carmen import read_carmen, skipped_summary
+    from navlab.io.datasets import data_file
     from navlab.mapping.slam import run_offline, write_outputs
 
-    log = read_carmen(args.log)
+    log = read_carmen(data_file(args.log))
     note = skipped_summary(log)
     if note:
         print(f"navlab slam: warning: {note}", file=sys.stderr)
@@ -145,7 +146,9 @@ def _cmd_eval_relations(args: argparse.Namespace) -> int:
     from navlab.experiments.trajectory import read_trajectory
 
     ts, poses = read_trajectory(args.poses, carmen=args.carmen)
-    rel = read_relations(args.relations)
+    from navlab.io.datasets import data_file
+
+    rel = read_relations(data_file(args.relations))
     out = relations_error(ts, poses, rel, time_tolerance=args.tolerance)
     closure = relations_closure(rel, time_tolerance=args.tolerance)
     out.update({f"reference_{k}": v for k, v in closure.items()})
@@ -212,7 +215,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         "DIR/map.pgm (map_server format), DIR/poses.txt (one 'timestamp x y theta' line per scan, robot "
         "pose in the map frame) and DIR/map.png (map and trajectory).",
     )
-    p.add_argument("--log", required=True, metavar="FILE.clf", help="CARMEN log file")
+    p.add_argument("--log", required=True, metavar="FILE.clf",
+                   help="CARMEN log file, or its path inside $NAVLAB_DATA (e.g. mit-csail/mit-csail.clf)")
     p.add_argument("--out", required=True, metavar="DIR", help="output directory (created if missing)")
     p.add_argument(
         "--mode",
@@ -251,7 +255,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     r.add_argument("--carmen", choices=("flaser", "odom", "laser"), default="flaser",
                    help="poses of a CARMEN log: flaser = the robot's odometry pose of each scan (default), "
                    "odom = ODOM lines, laser = the laser's pose of each scan")
-    r.add_argument("relations", help="relations file: 't1 t2 x y z roll pitch yaw' per line")
+    r.add_argument("relations", help="relations file: 't1 t2 x y z roll pitch yaw' per line, or its path inside "
+                   "$NAVLAB_DATA (e.g. mit-csail/mit-csail.relations)")
     r.add_argument("--tolerance", type=float, default=1e-3, help="timestamp match tolerance in s (default 0.001)")
     r.add_argument("--json", action="store_true", help="print one JSON object")
     r.set_defaults(func=_cmd_eval_relations)
