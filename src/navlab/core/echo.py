@@ -119,16 +119,35 @@ def echo_live(path: Path, topic: str, out: Printer, duration: float) -> int:
 
     start = float(request(path, "info")["sim_time"])
     inbox: queue.Queue[Any] = queue.Queue()
+    stop = threading.Event()
 
     def pump() -> None:
-        try:
-            for _t, msg in subscribe(path, topic):
-                inbox.put(("msg", msg))
-        except Exception as exc:  # the launch ended or refused the topic
-            inbox.put(("error", exc))
-        inbox.put(("end", None))
+        while not stop.is_set():
+            try:
+                for _t, msg in subscribe(path, topic):
+                    inbox.put(("msg", msg))
+            except CoreError as exc:
+                if not str(exc).startswith("no topic"):
+                    inbox.put(("error", exc))
+                    return
+                stop.wait(0.5)  # not published yet: ask again, as rostopic waits for the topic to appear
+                continue
+            except OSError:  # the launch went away
+                pass
+            inbox.put(("end", None))
+            return
 
     threading.Thread(target=pump, daemon=True, name="echo-subscribe").start()
+    try:
+        return _echo_until(path, topic, out, duration, start, inbox)
+    finally:
+        stop.set()
+
+
+def _echo_until(path: Path, topic: str, out: Printer, duration: float, start: float, inbox: queue.Queue[Any]) -> int:
+    """The loop of :func:`echo_live`: print what arrives, watch the launch's clock for the duration's end."""
+    from navlab.core.introspect import request
+
     warned = False
     while not out.done:
         try:
@@ -147,7 +166,7 @@ def echo_live(path: Path, topic: str, out: Printer, duration: float) -> int:
         if kind == "msg":
             out(item)
         elif kind == "error":
-            raise CoreError(str(item)) if isinstance(item, CoreError) else item
+            raise item
         else:
             return _short_of(out, topic, "the launch ended")
     return 0
