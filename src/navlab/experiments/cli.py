@@ -122,7 +122,14 @@ def _cmd_navigate(args: argparse.Namespace) -> int:
     figures: dict[str, Any] = {"goals": result.goals, **result.summary}
     if args.out:
         figures["pictures"] = save_goal_pictures(result, args.out)
-    print_figures(figures, args.json)
+    if args.json:
+        print_figures(figures, True)
+    else:  # one readable line per goal, then the run's figures
+        for k, g in enumerate(result.goals, 1):
+            print(f"goal {k} ({', '.join(f'{v:g}' for v in g['goal'])}): {g['outcome']} in {g['time_s']} s, path "
+                  f"{g['path_m']} m, closest {g['min_clearance_m']} m, {g['collisions']} collisions"
+                  + (f" ({g['reason']})" if g["reason"] else ""))  # fmt: skip
+        print_figures({k: v for k, v in figures.items() if k != "goals"}, False)
     failed = [g for g in result.goals if g["outcome"] != "succeeded"]
     if failed:  # as a script would want it: 0 only when every goal succeeded
         print(f"navlab: {len(failed)} of {len(result.goals)} goals not reached "
