@@ -4,9 +4,9 @@ Uses the xacro processor that ``xacrodoc`` ships. xacro keeps its look-up functi
 module globals; they are swapped in for the duration of one expansion and restored afterwards.
 
 A robot description is data, not code: while navlab expands one, ``${...}`` and ``$(eval ...)``
-expressions are checked before they are evaluated (no names or attributes starting with ``_``, no
-``vars``/``type``/``format``/``mro``/``open``/..., no ``__`` in strings) and see no Python builtins
-beyond xacro's arithmetic helpers; ``xacro:include`` and ``xacro.load_yaml`` read only files inside the
+expressions are evaluated by :func:`navlab.core.safe_eval.safe_eval` (an interpreter of what xacro
+documents, never Python's ``eval``) over xacro's symbols without ``python.type``/``python.vars``;
+``xacro:include`` and ``xacro.load_yaml`` read only files inside the
 described package (the folder with the description's ``package.xml``, else its own folder) or a
 package that ``$(find pkg)`` resolved, never a file that includes itself; DOCTYPE/ENTITY declarations
 are refused, and every file read is a regular UTF-8 file of bounded size.
@@ -14,7 +14,6 @@ are refused, and every file read is a regular UTF-8 file of bounded size.
 
 from __future__ import annotations
 
-import ast
 import contextlib
 import io
 import os
@@ -26,53 +25,68 @@ from typing import Any
 import xacro
 from xacro import substitution_args
 
+from navlab.core.safe_eval import MATH_NAMES, ExpressionError, safe_eval
 from navlab.description.errors import DescriptionError
 from navlab.description.packages import PackageIndex
 from navlab.io.errors import IoError
-from navlab.io.files import read_text_checked
+from navlab.io.files import read_bytes_checked, read_text_checked
 
-#: names an expression may not use, as a name, an attribute or a string (reflection, I/O, evaluation)
-_BLOCKED = frozenset({"vars", "type", "format", "format_map", "mro", "getattr", "setattr", "delattr", "eval", "exec",
-                      "compile", "open", "globals", "locals", "breakpoint", "input", "memoryview", "object", "super",
-                      "dir", "help", "subclasses", "system", "popen"})
 MAX_INCLUDE_DEPTH = 32
 MAX_DESCRIPTION_BYTES = 16 << 20
+#: builtins xacro exposes in its ``python`` namespace that a description may not have (reflection)
+_REFLECTION = frozenset({"type", "vars"})
 
 
-def check_expression(expr: str) -> ast.Expression:
-    """Parse a xacro expression and refuse what could escape the sandbox; raises ``xacro.XacroException``."""
-    try:
-        tree = ast.parse(expr.strip(), mode="eval")
-    except SyntaxError:
-        raise xacro.XacroException(f"invalid expression: {expr}") from None
-    for node in ast.walk(tree):
-        name = node.id if isinstance(node, ast.Name) else node.attr if isinstance(node, ast.Attribute) else None
-        if name is not None and (name.startswith("_") or name in _BLOCKED):
-            raise xacro.XacroException(f"expression ${{{expr.strip()}}} uses {name!r}, which a robot description "
-                                       "may not use (descriptions are data, not code)")
-        if isinstance(node, ast.Constant) and isinstance(node.value, str) and (
-                "__" in node.value or node.value in _BLOCKED):
-            raise xacro.XacroException(f"expression ${{{expr.strip()}}}: the string {node.value!r} is not allowed "
-                                       "in a robot description")
-    return tree
+class _Sandbox:
+    """xacro's global symbols without reflection, and the callables in them (the only ones an expression
+    may call); ``xacro.load_yaml`` reads only regular files of bounded size."""
+
+    def __init__(self, original: Mapping[str, Any]) -> None:
+        self.original_load_yaml = xacro.load_yaml
+        self.symbols: dict[str, Any] = {}
+        for key, value in original.items():
+            if isinstance(value, xacro.NameSpace):
+                ns = xacro.NameSpace()
+                dict.update(ns, {k: self.checked(v) for k, v in value.items() if k not in _REFLECTION})
+                value = ns
+            if key not in _REFLECTION:
+                self.symbols[key] = self.checked(value)
+        self.functions: dict[str, Any] = {}  # "sin", "math.sin", "xacro.load_yaml", ...
+        for key, value in self.symbols.items():
+            members = value.items() if isinstance(value, xacro.NameSpace) else [("", value)]
+            self.functions.update({f"{key}.{k}".rstrip("."): fn for k, fn in members if callable(fn)})
+
+    def checked(self, value: Any) -> Any:
+        return self.load_yaml if value is xacro.load_yaml else value
+
+    def load_yaml(self, filename: str) -> Any:
+        read_bytes_checked(xacro.abs_filename_spec(filename), what="YAML file", max_bytes=MAX_DESCRIPTION_BYTES)
+        return self.original_load_yaml(filename)
+
+    def eval(self, expr: str, symbols: Mapping[str, Any]) -> Any:
+        """xacro's ``safe_eval(expr, symbols)``, by navlab's interpreter instead of Python's ``eval``."""
+        return safe_eval(expr, symbols, functions=self.functions)
 
 
-def _safe_eval(expr: str, symbols: Any, local_symbols: Any = None) -> Any:
-    """xacro's ``safe_eval`` with the expression checked first and no builtins."""
-    code = compile(check_expression(expr), "<expression>", "eval")
-    symbols.update(__builtins__={})
-    return eval(code, symbols, local_symbols)
+class _EvalNames(Mapping[str, Any]):
+    """The names of a ``$(eval ...)`` (roslaunch's): ``true``/``false``, then the args as typed values."""
 
+    def __init__(self, args: Mapping[str, str], functions: Mapping[str, Any]) -> None:
+        self.args = args
+        self.functions = functions
 
-def _sandboxed_symbols(symbols: dict[str, Any]) -> dict[str, Any]:
-    """A copy of xacro's global symbols without the reflective helpers (``vars``, ``type``, ...)."""
-    out = {k: v for k, v in symbols.items() if k not in _BLOCKED}
-    for key, value in out.items():
-        if isinstance(value, xacro.NameSpace) and any(k in _BLOCKED for k in value):
-            ns = xacro.NameSpace()
-            dict.update(ns, {k: v for k, v in value.items() if k not in _BLOCKED})
-            out[key] = ns
-    return out
+    def __getitem__(self, key: str) -> Any:
+        if key in ("true", "True", "false", "False"):
+            return key in ("true", "True")
+        if key in self.functions:
+            raise KeyError(key)
+        return substitution_args.convert_value(self.args[key], "auto")
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self.args)
+
+    def __len__(self) -> int:
+        return len(self.args)
 
 
 def _package_root(path: Path) -> Path:
@@ -123,13 +137,14 @@ def _find_through(index: PackageIndex, top: Path) -> Iterator[None]:
                                        "in a robot description")
         return original_parse(inp, filename)
 
-    def eval_extension(s: str, context: dict[str, Any]) -> str:  # $(eval ...) without builtins
+    def eval_extension(s: str, context: dict[str, Any]) -> str:  # roslaunch's $(eval ...), by the safe interpreter
         context.setdefault("arg", {})
-        functions = {"arg": lambda name: substitution_args.convert_value(
-            substitution_args._eval_arg(name, args=context["arg"]), "auto"), "find": find}
-        functions.update({k: v for k, v in substitution_args._eval_dict.items() if not k.startswith("_")})
-        code = compile(check_expression(s), "<eval>", "eval")
-        return str(eval(code, {"__builtins__": {}}, substitution_args._DictWrapper(context["arg"], functions)))
+        functions: dict[str, Any] = {
+            "arg": lambda name: substitution_args.convert_value(substitution_args._eval_arg(name, args=context["arg"]),
+                                                                "auto"),
+            "find": find, "env": substitution_args._eval_env, "optenv": substitution_args._eval_optenv,
+            **MATH_NAMES, "list": list, "dict": dict, "map": map, "str": str, "float": float, "int": int}
+        return str(safe_eval(s, _EvalNames(context["arg"], functions), functions=functions))
 
     saved = {name: getattr(xacro, name) for name in ("safe_eval", "abs_filename_spec", "parse", "_global_symbols")}
     saved_fn = substitution_args._eval_find
@@ -138,10 +153,11 @@ def _find_through(index: PackageIndex, top: Path) -> Iterator[None]:
     substitution_args._eval_find = find
     substitution_args._eval_dict["find"] = find
     substitution_args._eval = eval_extension
-    xacro.safe_eval = _safe_eval
+    sandbox = _Sandbox(saved["_global_symbols"])
+    xacro.safe_eval = sandbox.eval
     xacro.abs_filename_spec = abs_filename_spec
     xacro.parse = parse
-    xacro._global_symbols = _sandboxed_symbols(saved["_global_symbols"])
+    xacro._global_symbols = sandbox.symbols
     try:
         yield
     finally:
@@ -150,6 +166,15 @@ def _find_through(index: PackageIndex, top: Path) -> Iterator[None]:
         substitution_args._eval = saved_eval
         for name, value in saved.items():
             setattr(xacro, name, value)
+
+
+def _xacro_message(exc: xacro.XacroException) -> str:
+    """One line: the expression error inside xacro's wrapping if there is one, else xacro's message."""
+    inner: BaseException | None = exc
+    while isinstance(inner, xacro.XacroException):
+        inner = inner.exc
+    text = str(inner if isinstance(inner, ExpressionError) else exc)
+    return "; ".join(line.strip() for line in text.splitlines() if line.strip())
 
 
 def _current_file(default: Path) -> str:
@@ -180,7 +205,7 @@ def expand(path: Path, index: PackageIndex, args: Mapping[str, str] | None = Non
     except xml.parsers.expat.ExpatError as exc:
         raise DescriptionError(f"{_current_file(path)}: malformed XML: {exc}") from None
     except xacro.XacroException as exc:
-        raise DescriptionError(f"{_current_file(path)}: xacro error: {exc}") from None
+        raise DescriptionError(f"{_current_file(path)}: xacro error: {_xacro_message(exc)}") from None
     except substitution_args.ArgException as exc:
         raise DescriptionError(
             f"{_current_file(path)}: xacro error: $(arg {exc}) is not set and has no default "
