@@ -24,8 +24,10 @@ node in ``navlab.nodes.NODES`` or, for user code, ``module:Class``.
 from __future__ import annotations
 
 import importlib
+import logging
 import os
 import re
+import warnings
 from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
@@ -33,8 +35,8 @@ from typing import Any
 
 from navlab.core.errors import LaunchError, ParameterError
 from navlab.core.executor import Executor
-from navlab.core.node import Node
-from navlab.core.params import load_params, merge_params, parse_yaml, read_yaml
+from navlab.core.node import Node, flatten_params
+from navlab.core.params import ParameterWarning, load_params, merge_params, parse_yaml, read_yaml
 from navlab.errors import NavlabError
 
 _SUBST = re.compile(r"\$\((\S+)(?:\s+([^)]*))?\)")
@@ -187,10 +189,10 @@ def _text(ctx: _Context, spec: dict[str, Any], key: str, where: str) -> str:
     return str(value)
 
 
-def _node_params(ctx: _Context, spec: dict[str, Any], where: str) -> tuple[dict[str, Any], list[str]]:
-    """The node's parameters and the files they came from."""
+def _node_params(ctx: _Context, spec: dict[str, Any], where: str) -> tuple[dict[str, Any], dict[str, set[str]]]:
+    """The node's parameters and the files they came from (file name -> every key name in it, at any depth)."""
     params: dict[str, Any] = {}
-    files: list[str] = []
+    files: dict[str, set[str]] = {}
     for item in _items(ctx, spec, "param", where, ()):
         item = ctx.subst(item, where)
         if not isinstance(item, dict):
@@ -200,7 +202,7 @@ def _node_params(ctx: _Context, spec: dict[str, Any], where: str) -> tuple[dict[
             if not path.is_absolute():
                 path = ctx.file.parent / path
             loaded = load_params(path, node=str(spec.get("name") or "") or None)
-            files.append(path.name)
+            files.setdefault(path.name, set()).update(k.rsplit(".", 1)[-1] for k in flatten_params(loaded))
             ns = str(item.get("ns") or "").strip("/")
             for part in reversed(ns.split("/") if ns else []):  # rosparam load's ns=: nest under it
                 loaded = {part: loaded}
@@ -282,18 +284,33 @@ def _run_entries(ctx: _Context, session: Session, depth: int) -> None:
                 kwargs["name"] = node_name
             if spec.get("namespace"):
                 kwargs["namespace"] = _text(ctx, spec, "namespace", where)
-            files = [*files, *(["--set/overrides"] if session.overrides.get(node_name) else [])]
-            source = f"; parameters from {', '.join(files)}" if files else ""
+            sources = [*files, *(["--set/overrides"] if session.overrides.get(node_name) else [])]
+            source = f"; parameters from {', '.join(sources)}" if sources else ""
             origin = f"{ctx.file}: {where} {node_name!r}"
             try:
-                with session.executor.node_context(remappings=remaps):
+                with session.executor.node_context(remappings=remaps), warnings.catch_warnings(record=True) as caught:
+                    warnings.simplefilter("always", ParameterWarning)
                     node = cls(session.executor, **kwargs)
             except NavlabError as exc:  # the problem first, then the launch file and parameter files it came from
                 raise _located(exc, f"node {node_name!r}{source}; {ctx.file} {where}") from None
+            _warn_unknown_keys(caught, files, origin)
             session.nodes[node.fully_qualified_name] = node
             session.origins[node.fully_qualified_name] = origin
         else:
             raise LaunchError(f"{ctx.file}: {where}: unknown entry {kind!r} (expected arg, let, include or node)")
+
+
+def _warn_unknown_keys(caught: list[warnings.WarningMessage], files: dict[str, set[str]], origin: str) -> None:
+    """Log each ignored parameter key (``ParameterWarning``) naming the parameter file that holds it; other
+    warnings go on as they came."""
+    for w in caught:
+        if not isinstance(w.message, ParameterWarning):
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+            continue
+        leaf = w.message.key.rsplit(".", 1)[-1]
+        held = [name for name, keys in files.items() if leaf in keys]
+        where = ", ".join(held) if held else origin
+        logging.getLogger("navlab.launch").warning("%s: %s", where, w.message)
 
 
 def _located(exc: NavlabError, where: str) -> NavlabError:

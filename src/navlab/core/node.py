@@ -9,11 +9,13 @@ from __future__ import annotations
 import dataclasses
 import difflib
 import logging
+import warnings
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 from navlab.core.errors import ParameterError
 from navlab.core.executor import Executor
+from navlab.core.params import TYPO_CUTOFF, ParameterWarning
 from navlab.core.tf import Pose2
 from navlab.core.topics import Publisher, Subscription, Timer, seconds_to_ns
 from navlab.msgs import TFMessage, time_from_ns
@@ -320,12 +322,15 @@ class Node:
         if self._params_checked:
             return
         self._params_checked = True
-        unknown = [k for k in self._overrides if k not in self._declared]
-        if unknown:
-            lines = []
-            for key in unknown:
-                close = difflib.get_close_matches(key, list(self._declared), n=1)
-                lines.append(f"{key!r}" + (f" (did you mean {close[0]!r}?)" if close else ""))
+        lines = []
+        for key in (k for k in self._overrides if k not in self._declared):  # policy: params.check_unknown_key
+            close = difflib.get_close_matches(key, list(self._declared), n=1, cutoff=TYPO_CUTOFF)
+            if close:
+                lines.append(f"{key!r} (did you mean {close[0]!r}?)")
+            else:
+                warnings.warn(ParameterWarning(f"node {self.fully_qualified_name}: unknown parameter {key!r} "
+                                               "ignored (ROS ignores what it does not read)", key), stacklevel=2)
+        if lines:
             raise ParameterError(f"node {self.fully_qualified_name}: unknown parameter " + ", ".join(lines))
 
     def destroy_node(self) -> None:

@@ -126,7 +126,10 @@ def _cmd_navigate(args: argparse.Namespace) -> int:
         print_figures(figures, True)
     else:  # one readable line per goal, then the run's figures
         for k, g in enumerate(result.goals, 1):
-            print(f"goal {k} ({', '.join(f'{v:g}' for v in g['goal'])}): {g['outcome']} in {g['time_s']} s, path "
+            mb = g.get("move_base_outcome", g["outcome"])
+            said = f" (move_base: {mb})" if mb != g["outcome"] else ""
+            print(f"goal {k} ({', '.join(f'{v:g}' for v in g['goal'])}): {g['outcome']}{said} in {g['time_s']} s, "
+                  f"path "
                   f"{g['path_m']} m, closest {g['min_clearance_m']} m, {g['collisions']} collisions"
                   + (f" ({g['reason']})" if g["reason"] else ""))  # fmt: skip
         print_figures({k: v for k, v in figures.items() if k != "goals"}, False)
@@ -315,10 +318,13 @@ def register(sub: argparse._SubParsersAction) -> None:
         "navigate",
         help="navigate to goals with move_base on a map, as in the paper's experiments (Figs. 9-12)",
         description="The paper's navigation launch (simulator, map_server, amcl and move_base with the ROS 1 "
-        "parameter files of --params) drives the robot to each --goal in turn. Prints each goal's outcome "
-        "(succeeded, aborted with move_base's reason, or timeout), time, path length, minimum clearance and "
-        "collisions (contact episodes from the simulator), and with --out DIR saves two labelled pictures per goal "
-        "(at its end and mid-drive) with a legend. Exits 0 only when every goal succeeded (1 otherwise).",
+        "parameter files of --params) drives the robot to each --goal in turn. Prints each goal's outcome, judged "
+        "by the simulator's truth (succeeded: the robot truly ended within 0.3 m of the goal; else aborted with "
+        "move_base's reason, preempted, timeout, or not_reached when move_base reported success from its own "
+        "estimate), move_base's own verdict beside it, time, path length, final error, minimum clearance (the "
+        "robot's collision geometry to the world's) and collisions (contact episodes from the simulator), and with "
+        "--out DIR saves two labelled pictures per goal (at its end and mid-drive) with a legend. Exits 0 only "
+        "when every goal succeeded (1 otherwise).",
     )
     _add_world_robot(p, "room_obstacles")
     p.add_argument("--map", metavar="MAP.yaml", default=None,

@@ -23,8 +23,8 @@ from navlab.experiments.scenario import Scenario
 from navlab.experiments.trials import run_experiments
 
 # "trials_with_collision" counts trials (as success and failures do); "collisions" counts contact episodes
-COLUMNS = ("success_rate", "success_ci95", "trials_with_collision", "collisions", "median_time_s", "spl_mean",
-           "min_clearance_m", "score_mean")
+COLUMNS = ("success_rate", "success_ci95", "move_base_success_rate", "false_success", "trials_with_collision",
+           "collisions", "median_time_s", "spl_mean", "min_clearance_m", "score_mean")
 
 
 def parse_params(items: list[str]) -> dict[str, list[Any]]:

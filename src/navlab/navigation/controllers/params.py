@@ -105,9 +105,8 @@ class TrajectoryPlannerParams(_Periodic):
         _ordered(TP, self, "min_vel_theta", "max_vel_theta")
         if self.escape_vel > 0.0:
             raise bad(TP, "escape_vel", self.escape_vel, "<= 0 (a backward speed)")
-        for key in ("heading_scoring", "simple_attractor"):
-            if getattr(self, key):
-                raise bad(TP, key, True, "false (navlab scores trajectories by path and goal distance only)")
+        if self.simple_attractor:
+            raise bad(TP, "simple_attractor", True, "false (navlab scores trajectories by path and goal distance)")
 
 
 @dataclass
