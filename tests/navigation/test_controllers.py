@@ -322,11 +322,22 @@ def test_scoring_weights_change_the_choice():
     assert picks[0] != picks[1]
 
 
+@pytest.mark.parametrize("cls, key", [(DWAPlannerROS, "vx_samples"), (DWAPlannerROS, "vy_samples"),
+                                      (DWAPlannerROS, "vth_samples"), (TrajectoryPlannerROS, "vx_samples"),
+                                      (TrajectoryPlannerROS, "vtheta_samples")])
+def test_sample_counts_below_one_warn_and_become_one_as_in_ros(cls, key, caplog):
+    """dwa_local_planner and base_local_planner warn and sample one value (TurtleBot3's files set vy_samples: 0)."""
+    with caplog.at_level("WARNING", logger="navlab.navigation"):
+        ctrl = cls({key: 0})
+    assert getattr(ctrl.params, key) == 1
+    (msg,) = [r.getMessage() for r in caplog.records]
+    assert f"{key} is 0" in msg and "set to 1" in msg
+
+
 @pytest.mark.parametrize("cls, params, words", [
     (DWAPlannerROS, {"max_vel_x": 0.5, "max_vel_trans": 0.5, "path_distance_bais": 1.0},
      ["path_distance_bais", "did you mean", "path_distance_bias"]),
     (TrajectoryPlannerROS, {"pdist_scal": 1.0}, ["pdist_scal", "did you mean", "pdist_scale"]),
-    (DWAPlannerROS, {"vx_samples": 0}, ["vx_samples=0", ">= 1"]),
     (DWAPlannerROS, {"min_vel_x": 0.6}, ["min_vel_x=0.6", "max_vel_x"]),
     (TrajectoryPlannerROS, {"min_vel_theta": 2.0}, ["min_vel_theta=2.0", "max_vel_theta"]),
     (TrajectoryPlannerROS, {"sim_time": 0.0}, ["sim_time=0.0", "> 0"]),
