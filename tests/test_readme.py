@@ -28,6 +28,7 @@ SHORTER = {
     "navigate --mapless": ["--timeout", "3"],
     "slam": ["--max-scans", "120"],  # 25 s of the log: enough for relations to match
     "launch mapping": ["--duration", "3"],
+    "launch navigation": ["--duration", "2"],  # without --duration it runs until Ctrl-C, as roslaunch
     "run": ["--duration", "3"],
     "topic": ["--duration", "2"],
     "graph": ["--duration", "1"],
