@@ -117,6 +117,16 @@ def out_file(out: str, name: str, *, old_suffixes: tuple[str, ...]) -> Path:
     return path / name
 
 
+def optional_out(value: str | None, folder: Path, name: str) -> Path | None:
+    """An optional extra output (``nargs="?"``, ``const=""``): None when not asked for, ``folder/name`` when
+    given without a value, else the file named (its folder created)."""
+    if value is None:
+        return None
+    path = folder / name if value == "" else Path(value)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    return path
+
+
 def check_named_inputs(args: argparse.Namespace) -> None:
     """Refuse a ``--world``/``--robot`` that names neither a file nor a shipped world/robot, in one line and
     before any heavy import (MuJoCo, Numba): the loaders would say the same seconds later. ``package://`` and

@@ -160,11 +160,13 @@ def _run_report(folder: Path) -> Report:
     rep.image("trials.png", "time to goal per trial (green: success, red: failure) and minimum clearance")
     if any(r.get("path_xy") for r in results):
         plot_trial_paths(results, folder / "paths.png", title=name)
-        rep.image("paths.png", "every trial's true path on the world's true map (green: success, red: failure), "
-                  "start and goals")
+        rep.image("paths.png", PATHS_CAPTION)
     cols = [c for c in TRIAL_COLUMNS if any(c in r for r in results)]
     rep.table(cols, [[r.get(c) for c in cols] for r in results])
     return rep
+
+
+PATHS_CAPTION = "every trial's true path on the world's true map (green: success, red: failure), start and goals"
 
 
 def plot_trial_paths(results: list[dict[str, Any]], path: Path, *, title: str = "") -> Path:
@@ -250,6 +252,7 @@ def _sweep_report(folder: Path) -> Report:
     import yaml
 
     from navlab.experiments.sweep import COLUMNS, plot_sweep
+    from navlab.experiments.trials import read_results
 
     lines = (folder / "sweep.csv").read_text().splitlines()
     header = lines[0].split(",")
@@ -269,13 +272,21 @@ def _sweep_report(folder: Path) -> Report:
     rep.heading("Figures")
     for path in plot_sweep(rows, names, folder):
         rep.image(path.name, f"success (95 % CI), collisions and median time against {path.stem}")
-    failures = []
+    failures, pictures = [], []
     for sub in sorted(p for p in folder.iterdir() if (p / "summary.json").is_file()):
         s = json.loads((sub / "summary.json").read_text())
         failures.append([sub.name, s.get("trials"), s.get("failures") or {}])
+        results = read_results(sub / "results.jsonl") if (sub / "results.jsonl").is_file() else []
+        if any(r.get("path_xy") for r in results):  # as the combination's own run report draws them
+            plot_trial_paths(sorted(results, key=lambda r: int(r["trial"])), sub / "paths.png", title=sub.name)
+            pictures.append(f"{sub.name}/paths.png")
     if failures:
         rep.heading("Failures by kind")
         rep.table(["combination", "trials", "failures"], failures)
+    if pictures:
+        rep.heading("Paths per combination")
+        for picture in pictures:
+            rep.image(picture, f"{Path(picture).parent.name}: {PATHS_CAPTION}")
     return rep
 
 

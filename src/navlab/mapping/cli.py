@@ -286,6 +286,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def _cmd_world_office(args: argparse.Namespace) -> int:
+    from navlab.cli_common import optional_out, out_file
     from navlab.experiments.session import rounded
     from navlab.io.carmen import write_carmen
     from navlab.io.poses import write_poses
@@ -293,22 +294,24 @@ def _cmd_world_office(args: argparse.Namespace) -> int:
     from navlab.world.office import generate_office
 
     office = generate_office()
-    world = office.write_world(args.out)
+    world = office.write_world(out_file(args.out, "office.world", old_suffixes=(".world", ".sdf")))
+    log = optional_out(args.log, world.parent, "office.clf")
+    truth = optional_out(args.truth, world.parent, "truth.txt")
     summary: dict = {"world": str(world), "width_m": office.width, "depth_m": office.depth, "rooms": office.rooms,
                      "start": list(office.start)}  # fmt: skip
-    if args.log:
+    if log:
         rec = record_log(world, office.route(), seed=args.seed, noise=OdometryNoise(scale=args.odom_scale,
                          heading_drift=args.heading_drift))  # fmt: skip
-        write_carmen(args.log, rec.log, comment=f"navlab office log, seed {args.seed}: odometry frame = the true "
+        write_carmen(log, rec.log, comment=f"navlab office log, seed {args.seed}: odometry frame = the true "
                      f"start pose {rec.start} in {world.name}")  # fmt: skip
-        summary.update(log=str(args.log), scans=len(rec.log.scans), log_s=rec.log.duration)
-        if args.truth:
+        summary.update(log=str(log), scans=len(rec.log.scans), log_s=rec.log.duration)
+        if truth:
             from navlab.experiments.trajectory import apply_se2
             from navlab.geometry import inverse2
 
             # the truth in the log's odometry frame (the start pose), as the SLAM output is
-            write_poses(args.truth, rec.timestamps, apply_se2(tuple(inverse2(rec.start)), rec.truth))
-            summary["truth"] = str(args.truth)
+            write_poses(truth, rec.timestamps, apply_se2(tuple(inverse2(rec.start)), rec.truth))
+            summary["truth"] = str(truth)
     print_figures(rounded(summary), args.json)
     return 0
 
@@ -324,13 +327,16 @@ def add_world_office(verbs: argparse._SubParsersAction) -> None:
         "or 0.5 rad,\n181 beams over 180 degrees, wheel odometry with --odom-scale scale errors and heading "
         "drift.\nThe log's odometry frame is the robot's true start pose; --truth writes the true poses in it.",
         epilog="examples:\n"
-        "  navlab world office --out office.world --log office.clf --truth truth.txt --seed 1\n"
-        "  navlab slam --log office.clf --out office_map --mode gmapping\n"
-        "  navlab eval trajectory office_map/poses.txt truth.txt",
+        "  navlab world office --out office --log --truth --seed 1   # office/office.world, office.clf, truth.txt\n"
+        "  navlab slam --log office/office.clf --out office_map --mode gmapping\n"
+        "  navlab eval trajectory office_map/poses.txt office/truth.txt",
     )
-    o.add_argument("--out", required=True, metavar="FILE.world", help="the .world file to write")
-    o.add_argument("--log", metavar="FILE.clf", help="also record a sparse CARMEN log in it")
-    o.add_argument("--truth", metavar="FILE.txt", help="with --log: the true poses ('t x y theta', log frame)")
+    o.add_argument("--out", required=True, metavar="DIR",
+                   help="folder to write office.world in (a FILE.world still works this release, deprecated)")
+    o.add_argument("--log", nargs="?", const="", metavar="FILE.clf",
+                   help="also record a sparse CARMEN log: in FILE.clf, or DIR/office.clf without a value")
+    o.add_argument("--truth", nargs="?", const="", metavar="FILE.txt",
+                   help="with --log: the true poses ('t x y theta', log frame) in FILE.txt, or DIR/truth.txt")
     o.add_argument("--seed", type=int, default=0, help="random seed of the lidar and odometry noise (default 0)")
     o.add_argument("--odom-scale", type=float, default=0.05,
                    help="std. dev. of the odometry's scale errors and per-step noise (default 0.05: 5 %%)")
