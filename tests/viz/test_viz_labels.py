@@ -39,7 +39,8 @@ def test_tf_labels_at_one_place_are_joined_and_long_display_names_keep_their_end
             page.goto(server.url + "?worker=0")
             page.wait_for_selector(f'input[data-layer="trace {TRUTH}"]')
             labels = page.eval_on_selector_all(
-                "#layers label", "ls => ls.map(l => [l.querySelector('input').dataset.layer, l.textContent, l.title])")
+                "#layers label", "ls => ls.map(l => [l.querySelector('input').dataset.layer, l.textContent, l.title])"
+            )
             shown = {layer: (text.strip(), title) for layer, text, title in labels}
             odom, truth = shown[f"trace {ODOM}"], shown[f"trace {TRUTH}"]
             assert odom[0] != truth[0] and odom[0].endswith("odometry/filtered") and truth[0].endswith("truth/odom")
