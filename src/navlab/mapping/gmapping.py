@@ -20,6 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from navlab.core.limits import check_ceiling
 from navlab.core.params import dataclass_from_dict
 from navlab.geometry import between2, compose2, wrap_angle
 from navlab.grid import GridMap
@@ -78,6 +79,7 @@ class GMappingParams:
         out = dataclass_from_dict(cls, values, what="gmapping", error=MappingError)
         if out.particles < 1:
             raise MappingError(f"gmapping parameter 'particles' must be >= 1, got {out.particles}")
+        check_ceiling(MappingError, "gmapping", "particles", out.particles, "particles")
         return out
 
 
@@ -165,6 +167,8 @@ class GMapping:
         if add is None:
             return
         left, right, bottom, top = add
+        h, w = self.particles[0].grid.shape
+        self._check_size(h + bottom + top, w + left + right)
         spare.clear()
         for n, part in enumerate(self.particles):
             if copy_of[n] == n:
@@ -249,6 +253,11 @@ class GMapping:
         max_range = p.maxRange if p.maxRange > 0 else float(np.nanmax(np.where(np.isfinite(r), r, 0))) + 1e-3
         return ang, max_range, min(p.maxUrange, max_range)
 
+    def _check_size(self, rows: int, cols: int) -> None:
+        """Every particle holds a map: refuse maps that together would not fit the machine's memory."""
+        check_ceiling(MappingError, "gmapping", "particles x map cells (the map spans the scans' reach at delta)",
+                      float(self.p.particles) * rows * cols, "slam_particle_cells")
+
     def _init(self, odom: np.ndarray, r: np.ndarray, ang: np.ndarray, max_urange: float, max_range: float) -> None:
         p = self.p
         reach = min(max_urange, 30.0) + 2.0
@@ -261,6 +270,7 @@ class GMapping:
         self._offset = cells_lo - MAP_MARGIN_CELLS
         self._seen = (cells_lo, cells_hi)
         w, h = (cells_hi - cells_lo + 1 + 2 * MAP_MARGIN_CELLS).tolist()
+        self._check_size(h, w)
         grid = np.zeros((h, w), dtype=np.float32)
         self._integrate(grid, odom, r, ang, max_urange, max_range)
         node = (0, odom.copy(), None)
