@@ -34,8 +34,17 @@ BENCHES: dict[str, str] = {
 
 
 def _run_one(name: str, args: argparse.Namespace) -> dict[str, Any]:
+    import sys
+    import time
+
     module, func = BENCHES[name].split(":")
-    return getattr(importlib.import_module(module), func)(args)
+    if not args.quiet:  # benchmarks take seconds to minutes: say what runs, and when it is done
+        print(f"bench {name}: running ...", file=sys.stderr, flush=True)
+    t0 = time.perf_counter()
+    out = getattr(importlib.import_module(module), func)(args)
+    if not args.quiet:
+        print(f"bench {name}: done in {time.perf_counter() - t0:.1f} s wall", file=sys.stderr, flush=True)
+    return out
 
 
 def _cmd(args: argparse.Namespace) -> int:
@@ -58,11 +67,13 @@ def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "bench",
         help="measure performance and print the figures (JSON with --json)",
-        description="Run a benchmark and print its figures. Targets are in DESIGN.md's performance "
-        "budget; run on an idle machine for stable numbers.",
+        description="Run a benchmark and print its figures (sim_s, wall_s, rtf and each benchmark's own, units "
+        "as key suffixes). Run on an idle machine for stable numbers; the figures measured so far are in the "
+        "docs (docs/mapping.md, docs/navigation.md, docs/viewer.md).",
     )
     p.add_argument("name", choices=[*BENCHES, "all"], help="which benchmark to run")
     p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.add_argument("--quiet", action="store_true", help="no 'running ...' lines on stderr")
     p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     p.add_argument("--controller", default=None,
                    help="clutter: local planner to drive with (trajectory, dwa, mppi; default mppi)")

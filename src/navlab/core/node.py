@@ -334,12 +334,19 @@ class Node:
 
     # --- tf ---------------------------------------------------------------------------------------
 
+    def listen_tf(self) -> None:
+        """Declare that this node reads tf, as a ROS node does by creating a ``tf2_ros.TransformListener``: the
+        graph (``navlab graph``, rqt_graph) then shows it subscribing ``/tf`` and ``/tf_static``. The transforms
+        themselves are in the executor's one buffer (``executor.tf``)."""
+        self.executor.tf_listeners.add(self.fully_qualified_name)
+
     def pose_at(self, target: str, source: str, t_ns: int | None) -> Pose2:
         """(x, y, yaw) of ``source`` in ``target`` at ``t_ns`` (a message's stamp), else the latest.
 
         Falls back on the latest transform when tf has none at ``t_ns`` yet (a scan stamped just after
         the last odometry). Raises ``TfError`` when the frames are not connected at all.
         """
+        self.listen_tf()
         return self.executor.tf.lookup_pose2d_or_latest(target, source, t_ns)
 
     def sensor_pose(self, base_frame: str, sensor_frame: str) -> Pose2:
@@ -350,6 +357,7 @@ class Node:
         key = (base_frame, sensor_frame)
         pose = self._sensor_poses.get(key)
         if pose is None:
+            self.listen_tf()
             pose = self._sensor_poses[key] = self.executor.tf.lookup_pose2d(base_frame, sensor_frame)
         return pose
 

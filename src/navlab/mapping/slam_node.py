@@ -56,6 +56,7 @@ class SlamGMapping(Node):
         namespace: str = "",
     ) -> None:  # fmt: skip
         super().__init__(executor, name=name, parameters=parameters, namespace=namespace)
+        self.listen_tf()  # a tf2 TransformListener, as in ROS: the graph shows it reading /tf
         self.base_frame = self.declare_parameter("base_frame", "base_link")
         self.odom_frame = self.declare_parameter("odom_frame", "odom")
         self.map_frame = self.declare_parameter("map_frame", "map")
