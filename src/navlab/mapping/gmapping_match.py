@@ -2,8 +2,9 @@
 map and the hill climbing over (x, y, theta) that maximises it (``ScanMatcher::score`` / ``optimize``) — and
 the motion model's draw for all particles at once (``MotionModel::drawFromMotion``).
 
-Lattice conventions as in ``mapping.occupancy``: ``grid`` holds the cells of a fixed lattice anchored at
-(``ox``, ``oy``) from lattice cell (``oi``, ``oj``) on; cells outside it read as unknown.
+A particle's map is a tiled copy-on-write map (``mapping.gmapping_tiles``: ``tiles``, ``table``) whose cells
+follow the lattice conventions of ``mapping.occupancy``: a fixed lattice anchored at (``ox``, ``oy``) from
+lattice cell (``oi``, ``oj``) on; cells outside it read as unknown.
 """
 
 from __future__ import annotations
@@ -13,7 +14,8 @@ import math
 import numba
 import numpy as np
 
-from navlab.mapping.occupancy import L_CLAMP, L_FREE, L_OCC, _raycast, scan_cells
+from navlab.mapping.gmapping_tiles import MASK, SHIFT, TILE, cell, from_dense, raycast_tiles
+from navlab.mapping.occupancy import L_CLAMP, L_FREE, L_OCC, scan_cells
 
 SEEN_POSES = 256  # poses whose score one hill climb remembers (it re-visits neighbours it scored before)
 
@@ -80,8 +82,24 @@ def _endpoints(
 
 
 @numba.njit(cache=True, inline="always")
+def _window(tiles: np.ndarray, table: np.ndarray, i: int, j: int, win: np.ndarray, at: int) -> None:
+    """Into ``win[at : at + 9]``: the 3 x 3 map cells around (``i``, ``j``) (all inside the map), by rows."""
+    li, lj = i & MASK, j & MASK
+    if 1 <= li < MASK and 1 <= lj < MASK:  # one tile holds them all (nearly always)
+        t = table[j >> SHIFT, i >> SHIFT]
+        for dj in range(3):
+            for di in range(3):
+                win[at + 3 * dj + di] = tiles[t, numba.uint64(lj - 1 + dj), numba.uint64(li - 1 + di)]
+    else:
+        for dj in range(3):
+            for di in range(3):
+                win[at + 3 * dj + di] = cell(tiles, table, j - 1 + dj, i - 1 + di)
+
+
+@numba.njit(cache=True, inline="always")
 def _score_above(
-    grid: np.ndarray,
+    tiles: np.ndarray,
+    table: np.ndarray,
     ox: float,
     oy: float,
     oi: int,
@@ -100,12 +118,13 @@ def _score_above(
     fw: np.ndarray,
     iw: np.ndarray,
     order: np.ndarray,
+    win: np.ndarray,
 ) -> tuple[float, float, int]:
     """GMapping's score and log-likelihood of a scan at a pose: for each beam endpoint, the nearest
     occupied cell within ``kernel`` cells whose cell one step back along the beam is free. ``rv``, ``cv``,
     ``sv``: range, cosine and sine (laser frame) of the beams to score (``_valid_beams``); ``fw`` (10, n),
     ``iw`` (4, n): work arrays (``_endpoints``; rows 8 and 9 of ``fw`` get each beam's score term and
-    its match's squared distance, -1 if none).
+    its match's squared distance, -1 if none); ``win`` (18,): work array (``_window``).
 
     A beam adds at most 1 to the score, so once the score so far plus one per beam left cannot exceed
     ``bound`` (rounding included), this returns (-1, 0, -1) without scoring the rest: the hill climb only
@@ -113,7 +132,8 @@ def _score_above(
     ``order`` (a permutation: the hill climb puts first those that scored worst at the pose it climbs from,
     which stops a worse neighbour sooner); the score and log-likelihood are summed in beam order all the
     same, so the order changes nothing but when a pose is given up."""
-    h, w = grid.shape
+    th, tw = table.shape
+    h, w = th * TILE, tw * TILE
     _endpoints(ox, oy, oi, oj, res, px, py, pt, rv, cv, sv, fw, iw)
     s = 0.0
     null_l = -0.5 / lsigma  # GMapping: nullLikelihood = -0.5
@@ -124,18 +144,17 @@ def _score_above(
         ei, ej, fi, fj = iw[0, k], iw[1, k], iw[2, k], iw[3, k]
         best = 1e9  # the nearest match's squared distance: a minimum, so the cells' order does not matter
         found = False
-        # both kernel windows inside the array (nearly always): no per-cell bounds checks, unsigned indices
-        # (no negative-index wrap-around) and no branches (which cell matches is unpredictable)
         inside = (min(ei, fi) >= kernel and min(ej, fj) >= kernel and max(ei, fi) < w - kernel
                   and max(ej, fj) < h - kernel)  # fmt: skip
         if inside and kernel == 1:  # GMapping's default kernel, unrolled: each cell's x and y term once
+            _window(tiles, table, ei, ej, win, 0)  # the end cell's 3 x 3 cells, then the back cell's
+            _window(tiles, table, fi, fj, win, 9)
             x0, x1, x2 = fw[2, k], fw[3, k], fw[4, k]
             for dj in range(3):
-                j, j2 = numba.uint64(ej - 1 + dj), numba.uint64(fj - 1 + dj)
                 yy = fw[5 + dj, k]
-                ok0 = (grid[j, numba.uint64(ei - 1)] > 0.0) & (grid[j2, numba.uint64(fi - 1)] < 0.0)
-                ok1 = (grid[j, numba.uint64(ei)] > 0.0) & (grid[j2, numba.uint64(fi)] < 0.0)
-                ok2 = (grid[j, numba.uint64(ei + 1)] > 0.0) & (grid[j2, numba.uint64(fi + 1)] < 0.0)
+                ok0 = (win[3 * dj] > 0.0) & (win[9 + 3 * dj] < 0.0)
+                ok1 = (win[3 * dj + 1] > 0.0) & (win[10 + 3 * dj] < 0.0)
+                ok2 = (win[3 * dj + 2] > 0.0) & (win[11 + 3 * dj] < 0.0)
                 d2 = x0 + yy if ok0 else 1e9
                 best = d2 if d2 < best else best
                 d2 = x1 + yy if ok1 else 1e9
@@ -143,17 +162,6 @@ def _score_above(
                 d2 = x2 + yy if ok2 else 1e9
                 best = d2 if d2 < best else best
                 found = found | ok0 | ok1 | ok2
-        elif inside:
-            for dj in range(-kernel, kernel + 1):
-                j, j2 = numba.uint64(ej + dj), numba.uint64(fj + dj)
-                cy = oy + (ej + dj + oj + 0.5) * res
-                for di in range(-kernel, kernel + 1):
-                    ok = (grid[j, numba.uint64(ei + di)] > 0.0) & (grid[j2, numba.uint64(fi + di)] < 0.0)
-                    cx = ox + (ei + di + oi + 0.5) * res
-                    d2 = (cx - ex) ** 2 + (cy - ey) ** 2
-                    d2 = d2 if ok else 1e9
-                    best = d2 if d2 < best else best
-                    found = found | ok
         else:
             for dj in range(-kernel, kernel + 1):
                 for di in range(-kernel, kernel + 1):
@@ -161,7 +169,7 @@ def _score_above(
                     i2, j2 = fi + di, fj + dj
                     if i < 0 or j < 0 or i >= w or j >= h or i2 < 0 or j2 < 0 or i2 >= w or j2 >= h:
                         continue
-                    if grid[j, i] > 0.0 and grid[j2, i2] < 0.0:
+                    if cell(tiles, table, j, i) > 0.0 and cell(tiles, table, j2, i2) < 0.0:
                         cx = ox + (i + oi + 0.5) * res
                         cy = oy + (j + oj + 0.5) * res
                         d2 = (cx - ex) ** 2 + (cy - ey) ** 2
@@ -212,7 +220,8 @@ def _worst_first(terms: np.ndarray, order: np.ndarray, counts: np.ndarray) -> No
 
 @numba.njit(cache=True)
 def _score(
-    grid: np.ndarray,
+    tiles: np.ndarray,
+    table: np.ndarray,
     ox: float,
     oy: float,
     oi: int,
@@ -236,13 +245,14 @@ def _score(
     rv, cv, sv = _valid_beams(ranges, cb, sb, max_urange, skip)
     nb = rv.shape[0]
     fw, iw = np.empty((10, nb)), np.empty((4, nb), dtype=np.int64)
-    return _score_above(grid, ox, oy, oi, oj, res, px, py, pt, rv, cv, sv, kernel, sigma, lsigma, -1.0, fw, iw,
-                        np.arange(nb))  # fmt: skip
+    return _score_above(tiles, table, ox, oy, oi, oj, res, px, py, pt, rv, cv, sv, kernel, sigma, lsigma, -1.0, fw, iw,
+                        np.arange(nb), np.empty(18, dtype=np.float32))  # fmt: skip
 
 
 @numba.njit(cache=True)
 def _optimize(
-    grid: np.ndarray,
+    tiles: np.ndarray,
+    table: np.ndarray,
     ox: float,
     oy: float,
     oi: int,
@@ -274,11 +284,12 @@ def _optimize(
     nb = rv.shape[0]
     fw, iw = np.empty((10, nb)), np.empty((4, nb), dtype=np.int64)
     order, counts = np.arange(nb), np.empty(64, dtype=np.int64)
+    win = np.empty(18, dtype=np.float32)
     terms = np.empty(nb)  # the score terms of the best pose found in this step of the climb
     seen = np.empty((SEEN_POSES, 5))  # x, y, theta, score (-1: no better than the pose it was tried from), lik
     cx, cy, ct = x0, y0, t0
-    cur, cur_lik, _n = _score_above(grid, ox, oy, oi, oj, res, cx, cy, ct, rv, cv, sv, kernel, sigma, lsigma, -1.0,
-                                    fw, iw, order)  # fmt: skip
+    cur, cur_lik, _n = _score_above(tiles, table, ox, oy, oi, oj, res, cx, cy, ct, rv, cv, sv, kernel, sigma, lsigma,
+                                    -1.0, fw, iw, order, win)  # fmt: skip
     _worst_first(fw[8], order, counts)
     seen[0, 0], seen[0, 1], seen[0, 2], seen[0, 3], seen[0, 4] = cx, cy, ct, cur, cur_lik
     n_seen = 1
@@ -314,8 +325,8 @@ def _optimize(
             if q < n_seen:
                 sc, lik = seen[q, 3], seen[q, 4]
             else:
-                sc, lik, _n = _score_above(grid, ox, oy, oi, oj, res, nx, ny, nt, rv, cv, sv, kernel, sigma, lsigma,
-                                           cur, fw, iw, order)  # fmt: skip
+                sc, lik, _n = _score_above(tiles, table, ox, oy, oi, oj, res, nx, ny, nt, rv, cv, sv, kernel, sigma,
+                                           lsigma, cur, fw, iw, order, win)  # fmt: skip
                 if n_seen < SEEN_POSES:
                     seen[n_seen, 0], seen[n_seen, 1], seen[n_seen, 2] = nx, ny, nt
                     seen[n_seen, 3], seen[n_seen, 4] = sc, lik
@@ -352,10 +363,13 @@ def warmup() -> None:
     """Load the matcher's, the motion model's and the map integration's kernels (numba: compiled once, then
     read from its disk cache, ~0.25 s) on a tiny input, with the argument types GMapping passes; without it
     that load would stall the first map update (a live run's simulation at its first second)."""
-    grid = np.zeros((4, 4), dtype=np.float32)
+    pool, table = from_dense(np.zeros((4, 4), dtype=np.float32))
+    free, used = pool.free(1), np.zeros(1, dtype=np.int64)
+    tiles = pool.tiles  # (after free(), which may grow the pool)
     r, c = np.ones(2), np.ones(2)
-    _optimize(grid, 0.0, 0.0, 0, 0, 0.05, 0.1, 0.1, 0.0, r, c, c, 1.0, 1, 0.05, 0.075, 0, 0.05, 0.05, 1)
-    _score(grid, 0.0, 0.0, 0, 0, 0.05, 0.1, 0.1, 0.0, r, c, c, 1.0, 1, 0.05, 0.075, 0)
-    _raycast(grid, 0.0, 0.0, 0, 0, 0.05, 0.1, 0.1, 0.0, r, c, 1.0, 2.0, L_OCC, L_FREE, L_CLAMP)
+    _optimize(tiles, table, 0.0, 0.0, 0, 0, 0.05, 0.1, 0.1, 0.0, r, c, c, 1.0, 1, 0.05, 0.075, 0, 0.05, 0.05, 1)
+    _score(tiles, table, 0.0, 0.0, 0, 0, 0.05, 0.1, 0.1, 0.0, r, c, c, 1.0, 1, 0.05, 0.075, 0)
+    raycast_tiles(tiles, table, pool.refs, free, used, 0.0, 0.0, 0, 0, 0.05, 0.1, 0.1, 0.0, r, c, 1.0, 2.0, L_OCC,
+                  L_FREE, L_CLAMP)  # fmt: skip
     _draw_motion(np.zeros((2, 3)), np.zeros((2, 3)), 0.1, 0.0, 0.0, 0.1, 0.1, 0.1)
     scan_cells(np.zeros((2, 3)), r, c, (0.0, 0.0), 0.05, max_urange=1.0, max_range=2.0)
