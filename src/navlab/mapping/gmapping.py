@@ -74,6 +74,12 @@ class GMappingParams:
     refineSkipped: bool = True
     # navlab: then refine all poses with dense verified scan-to-scan constraints (mapping.refine)
     refine: bool = True
+    # navlab: a match that scores under ``wideScore`` per scored beam is retried from starts turned by
+    # ``wideStep`` up to ``wideTurn`` rad either way (the hill climb's reach is a few astep; real odometry
+    # can be 20-30 degrees off in a fast turn), and the best-scoring result is kept; 0 turns this off
+    wideScore: float = 0.7
+    wideStep: float = 0.0873
+    wideTurn: float = 0.524
 
     @classmethod
     def from_dict(cls, values: dict | None) -> GMappingParams:
@@ -129,6 +135,7 @@ class GMapping:
         self.resamples = 0
         self.updates = 0
         self.map_resizes = 0
+        self.tiles_in_use = 0  # map tiles held by the particles after the last update (each 64 x 64 float32)
         self._odom_last: np.ndarray | None = None
         self._odom_at_update: np.ndarray | None = None
         self._time = 0.0
@@ -291,10 +298,7 @@ class GMapping:
         poses = self.poses
         tiles = self.pool.tiles
         for part, pose in zip(self.particles, poses, strict=True):
-            x, y, t, score, lik = _optimize(
-                tiles, part.table, ox, oy, oi, oj, res, pose[0], pose[1], pose[2], r, cb, sb, max_urange,
-                p.kernelSize, p.sigma, p.lsigma, p.lskip, p.lstep, p.astep, p.iterations,
-            )  # fmt: skip
+            x, y, t, score, lik = self._match(part.table, pose, r, cb, sb, max_urange)
             matched = score > p.minimumScore
             if matched:
                 pose[:] = x, y, wrap_angle(t)
@@ -338,6 +342,7 @@ class GMapping:
                 self._integrate(part.table, self.poses[n], r, ang, max_urange, max_range)
         weights = [q.weight for q in self.particles]
         self._best = weights.index(max(weights))
+        self.tiles_in_use = self.pool.in_use()
         self._mark_update(k)
 
     # --- results ------------------------------------------------------------------------------------
@@ -378,13 +383,37 @@ class GMapping:
         self, table: np.ndarray, pose: np.ndarray, r: np.ndarray, ang: np.ndarray, max_urange: float
     ) -> np.ndarray:
         """``pose`` improved by the scan matcher against ``grid`` (unchanged if the match scores too low)."""
+        x, y, t, score, _lik = self._match(table, pose, r, np.cos(ang), np.sin(ang), max_urange)
+        return np.array([x, y, wrap_angle(t)]) if score > self.p.minimumScore else pose
+
+    def _match(
+        self, table: np.ndarray, pose: np.ndarray, r: np.ndarray, cb: np.ndarray, sb: np.ndarray, max_urange: float
+    ) -> tuple[float, float, float, float, float]:
+        """GMapping's hill climb of the scan from ``pose`` against the map of ``table``: (x, y, theta, score,
+        log-likelihood). A climb that ends under ``wideScore`` per scored beam (stuck: the start was turned
+        too far for its steps to reach the scan's place) is repeated from starts turned by ``wideStep``,
+        ``2 wideStep``, ... up to ``wideTurn`` either way; a turned result is kept only if it scores higher,
+        so the scan turns away from its odometry only where the map matches it better there."""
         p = self.p
         ox, oy, oi, oj = self._lattice()
-        x, y, t, score, _lik = _optimize(
-            self.pool.tiles, table, ox, oy, oi, oj, p.delta, pose[0], pose[1], pose[2], r, np.cos(ang), np.sin(ang),
-            max_urange, p.kernelSize, p.sigma, p.lsigma, p.lskip, p.lstep, p.astep, p.iterations,
-        )  # fmt: skip
-        return np.array([x, y, wrap_angle(t)]) if score > p.minimumScore else pose
+        args = (r, cb, sb, max_urange, p.kernelSize, p.sigma, p.lsigma, p.lskip, p.lstep, p.astep, p.iterations)
+        best = _optimize(self.pool.tiles, table, ox, oy, oi, oj, p.delta, pose[0], pose[1], pose[2], *args)
+        if p.wideScore <= 0 or p.wideStep <= 0:
+            return best
+        scored = r[:: p.lskip + 1]
+        enough = p.wideScore * np.count_nonzero((scored > 0) & (scored < max_urange))
+        if best[3] >= enough:
+            return best
+        # the nearest turns first; stop at a result that scores well enough
+        for n in range(1, int(p.wideTurn / p.wideStep + 1e-9) + 1):
+            for turn in (n * p.wideStep, -n * p.wideStep):
+                t0 = pose[2] + turn
+                got = _optimize(self.pool.tiles, table, ox, oy, oi, oj, p.delta, pose[0], pose[1], t0, *args)
+                if got[3] > best[3]:
+                    best = got
+            if best[3] >= enough:
+                break
+        return best
 
     def map(self, *, frame_id: str = "map") -> GridMap:
         """The best particle's occupancy grid: the cells any scan reached plus ``MAP_MARGIN_CELLS``."""

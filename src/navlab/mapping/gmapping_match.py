@@ -82,21 +82,6 @@ def _endpoints(
 
 
 @numba.njit(cache=True, inline="always")
-def _window(tiles: np.ndarray, table: np.ndarray, i: int, j: int, win: np.ndarray, at: int) -> None:
-    """Into ``win[at : at + 9]``: the 3 x 3 map cells around (``i``, ``j``) (all inside the map), by rows."""
-    li, lj = i & MASK, j & MASK
-    if 1 <= li < MASK and 1 <= lj < MASK:  # one tile holds them all (nearly always)
-        t = table[j >> SHIFT, i >> SHIFT]
-        for dj in range(3):
-            for di in range(3):
-                win[at + 3 * dj + di] = tiles[t, numba.uint64(lj - 1 + dj), numba.uint64(li - 1 + di)]
-    else:
-        for dj in range(3):
-            for di in range(3):
-                win[at + 3 * dj + di] = cell(tiles, table, j - 1 + dj, i - 1 + di)
-
-
-@numba.njit(cache=True, inline="always")
 def _score_above(
     tiles: np.ndarray,
     table: np.ndarray,
@@ -118,13 +103,12 @@ def _score_above(
     fw: np.ndarray,
     iw: np.ndarray,
     order: np.ndarray,
-    win: np.ndarray,
 ) -> tuple[float, float, int]:
     """GMapping's score and log-likelihood of a scan at a pose: for each beam endpoint, the nearest
     occupied cell within ``kernel`` cells whose cell one step back along the beam is free. ``rv``, ``cv``,
     ``sv``: range, cosine and sine (laser frame) of the beams to score (``_valid_beams``); ``fw`` (10, n),
     ``iw`` (4, n): work arrays (``_endpoints``; rows 8 and 9 of ``fw`` get each beam's score term and
-    its match's squared distance, -1 if none); ``win`` (18,): work array (``_window``).
+    its match's squared distance, -1 if none).
 
     A beam adds at most 1 to the score, so once the score so far plus one per beam left cannot exceed
     ``bound`` (rounding included), this returns (-1, 0, -1) without scoring the rest: the hill climb only
@@ -134,6 +118,7 @@ def _score_above(
     same, so the order changes nothing but when a pose is given up."""
     th, tw = table.shape
     h, w = th * TILE, tw * TILE
+    flat = tiles.reshape(-1)  # a view (C-contiguous)
     _endpoints(ox, oy, oi, oj, res, px, py, pt, rv, cv, sv, fw, iw)
     s = 0.0
     null_l = -0.5 / lsigma  # GMapping: nullLikelihood = -0.5
@@ -146,15 +131,19 @@ def _score_above(
         found = False
         inside = (min(ei, fi) >= kernel and min(ej, fj) >= kernel and max(ei, fi) < w - kernel
                   and max(ej, fj) < h - kernel)  # fmt: skip
-        if inside and kernel == 1:  # GMapping's default kernel, unrolled: each cell's x and y term once
-            _window(tiles, table, ei, ej, win, 0)  # the end cell's 3 x 3 cells, then the back cell's
-            _window(tiles, table, fi, fj, win, 9)
+        # GMapping's default kernel with both 3 x 3 windows inside one tile each (nearly always): unrolled,
+        # each cell's x and y term once, flat unsigned indices (no wrap-around checks) and no branches
+        if (inside and kernel == 1 and 1 <= (ei & MASK) < MASK and 1 <= (ej & MASK) < MASK and 1 <= (fi & MASK) < MASK
+                and 1 <= (fj & MASK) < MASK):  # fmt: skip
+            ce = table[ej >> SHIFT, ei >> SHIFT] * TILE * TILE + (ej & MASK) * TILE + (ei & MASK)
+            cf = table[fj >> SHIFT, fi >> SHIFT] * TILE * TILE + (fj & MASK) * TILE + (fi & MASK)
             x0, x1, x2 = fw[2, k], fw[3, k], fw[4, k]
             for dj in range(3):
+                e, f = ce + (dj - 1) * TILE, cf + (dj - 1) * TILE
                 yy = fw[5 + dj, k]
-                ok0 = (win[3 * dj] > 0.0) & (win[9 + 3 * dj] < 0.0)
-                ok1 = (win[3 * dj + 1] > 0.0) & (win[10 + 3 * dj] < 0.0)
-                ok2 = (win[3 * dj + 2] > 0.0) & (win[11 + 3 * dj] < 0.0)
+                ok0 = (flat[numba.uint64(e - 1)] > 0.0) & (flat[numba.uint64(f - 1)] < 0.0)
+                ok1 = (flat[numba.uint64(e)] > 0.0) & (flat[numba.uint64(f)] < 0.0)
+                ok2 = (flat[numba.uint64(e + 1)] > 0.0) & (flat[numba.uint64(f + 1)] < 0.0)
                 d2 = x0 + yy if ok0 else 1e9
                 best = d2 if d2 < best else best
                 d2 = x1 + yy if ok1 else 1e9
@@ -246,7 +235,7 @@ def _score(
     nb = rv.shape[0]
     fw, iw = np.empty((10, nb)), np.empty((4, nb), dtype=np.int64)
     return _score_above(tiles, table, ox, oy, oi, oj, res, px, py, pt, rv, cv, sv, kernel, sigma, lsigma, -1.0, fw, iw,
-                        np.arange(nb), np.empty(18, dtype=np.float32))  # fmt: skip
+                        np.arange(nb))  # fmt: skip
 
 
 @numba.njit(cache=True)
@@ -284,12 +273,11 @@ def _optimize(
     nb = rv.shape[0]
     fw, iw = np.empty((10, nb)), np.empty((4, nb), dtype=np.int64)
     order, counts = np.arange(nb), np.empty(64, dtype=np.int64)
-    win = np.empty(18, dtype=np.float32)
     terms = np.empty(nb)  # the score terms of the best pose found in this step of the climb
     seen = np.empty((SEEN_POSES, 5))  # x, y, theta, score (-1: no better than the pose it was tried from), lik
     cx, cy, ct = x0, y0, t0
     cur, cur_lik, _n = _score_above(tiles, table, ox, oy, oi, oj, res, cx, cy, ct, rv, cv, sv, kernel, sigma, lsigma,
-                                    -1.0, fw, iw, order, win)  # fmt: skip
+                                    -1.0, fw, iw, order)  # fmt: skip
     _worst_first(fw[8], order, counts)
     seen[0, 0], seen[0, 1], seen[0, 2], seen[0, 3], seen[0, 4] = cx, cy, ct, cur, cur_lik
     n_seen = 1
@@ -326,7 +314,7 @@ def _optimize(
                 sc, lik = seen[q, 3], seen[q, 4]
             else:
                 sc, lik, _n = _score_above(tiles, table, ox, oy, oi, oj, res, nx, ny, nt, rv, cv, sv, kernel, sigma,
-                                           lsigma, cur, fw, iw, order, win)  # fmt: skip
+                                           lsigma, cur, fw, iw, order)  # fmt: skip
                 if n_seen < SEEN_POSES:
                     seen[n_seen, 0], seen[n_seen, 1], seen[n_seen, 2] = nx, ny, nt
                     seen[n_seen, 3], seen[n_seen, 4] = sc, lik
