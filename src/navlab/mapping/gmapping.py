@@ -404,25 +404,15 @@ class GMapping:
         enough = p.wideScore * np.count_nonzero((scored > 0) & (scored < max_urange))
         if best[3] >= enough:
             return best
-        # the nearest turns first, each climbed on every 4th scored beam (a quarter of the cost); stop at one
-        # that scores well enough; then a full climb from the best of them, kept if it beats the first
-        skip = 4 * (p.lskip + 1) - 1
-        coarse = (*args[:7], skip, *args[8:])
-        few = r[::skip + 1]
-        enough_few = p.wideScore * np.count_nonzero((few > 0) & (few < max_urange))
-        top: tuple[float, float, float, float, float] | None = None
+        # the nearest turns first; stop at a result that scores well enough
         for n in range(1, int(p.wideTurn / p.wideStep + 1e-9) + 1):
             for turn in (n * p.wideStep, -n * p.wideStep):
                 t0 = pose[2] + turn
-                got = _optimize(self.pool.tiles, table, ox, oy, oi, oj, p.delta, pose[0], pose[1], t0, *coarse)
-                if top is None or got[3] > top[3]:
-                    top = got
-            if top is not None and top[3] >= enough_few:
+                got = _optimize(self.pool.tiles, table, ox, oy, oi, oj, p.delta, pose[0], pose[1], t0, *args)
+                if got[3] > best[3]:
+                    best = got
+            if best[3] >= enough:
                 break
-        if top is not None:
-            got = _optimize(self.pool.tiles, table, ox, oy, oi, oj, p.delta, top[0], top[1], top[2], *args)
-            if got[3] > best[3]:
-                best = got
         return best
 
     def map(self, *, frame_id: str = "map") -> GridMap:
