@@ -6,8 +6,9 @@ Run:  python examples/00_runtime/run.py
 from pathlib import Path
 from tempfile import mkdtemp
 
+import navlab
 from navlab import msgs
-from navlab.core import Executor, Node
+from navlab.core import Node
 from navlab.core.record import Recorder
 from navlab.io.rosbag import read_bag
 
@@ -15,8 +16,8 @@ from navlab.io.rosbag import read_bag
 class Counter(Node):
     """Publishes a growing number on /count at 5 Hz of simulated time."""
 
-    def __init__(self, executor: Executor) -> None:
-        super().__init__(executor, name="counter")
+    def __init__(self) -> None:
+        super().__init__("counter")  # rclpy's constructor: joins the executor navlab.init() made
         self.n = 0
         self.pub = self.create_publisher(msgs.Float64, "count")
         self.create_timer(0.2, self.tick)
@@ -26,9 +27,10 @@ class Counter(Node):
         self.pub.publish(msgs.Float64(data=float(self.n)))
 
 
-ex = Executor(seed=0, rate=0.0)  # rate=0: as fast as the CPU allows; rate=1.0 would be real time
-Counter(ex)
-printer = Node(ex, name="printer")
+ctx = navlab.init(seed=0, pace=0.0)  # rclpy.init(); pace=0: as fast as the CPU allows, 1.0 would be real time
+ex = ctx.executor
+Counter()
+printer = Node("printer")
 printer.create_subscription(
     msgs.Float64, "count", lambda m: printer.get_logger().warning("heard %s", m.data)
 )

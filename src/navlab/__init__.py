@@ -20,7 +20,11 @@ Top-level names (imported on first use, so ``import navlab`` stays light and loa
   Returns a ``Session``: ``.run(seconds)``, ``.node(name)``, ``.executor`` (``run_until``, ``tf``, ...).
   This is ``navlab.core.launch.start``.
 - ``navlab.Executor`` and ``navlab.Node``: the rclpy-like runtime for your own nodes
-  (``create_publisher``, ``create_subscription``, ``create_timer``; see docs/core-api.md).
+  (``create_publisher``, ``create_subscription``, ``create_timer``; see docs/core-api.md), with rclpy's
+  module functions ``navlab.init`` (``rclpy.init``; ``launch=`` starts a launch in the context),
+  ``navlab.shutdown``, ``navlab.ok``, ``navlab.spin``, ``navlab.spin_once``, ``navlab.create_node`` and
+  ``navlab.Parameter``; ``navlab.install_ros_imports()`` makes ``from geometry_msgs.msg import Twist`` and
+  ``import rclpy`` work without ROS (a real installation is found first).
 - ``navlab.msgs``: the ROS 2 message types (``msgs.Twist``, ``msgs.LaserScan``, ...) and helpers
   (``msgs.twist(v, w)``, ``msgs.pose2d(pose)``).
 - ``navlab.__version__``.
@@ -35,8 +39,12 @@ if TYPE_CHECKING:
     from navlab import msgs
     from navlab.core import Executor, Node
     from navlab.core.launch import start as launch
+    from navlab.core.node import Parameter
+    from navlab.core.rclpy_api import create_node, init, ok, shutdown, spin, spin_once
+    from navlab.core.ros_imports import install as install_ros_imports
 
-__all__ = ["Executor", "Node", "__version__", "launch", "msgs"]
+__all__ = ["Executor", "Node", "Parameter", "__version__", "create_node", "init", "install_ros_imports", "launch",
+           "msgs", "ok", "shutdown", "spin", "spin_once"]
 
 # name -> (module, attribute or None for the module itself)
 _LAZY: dict[str, tuple[str, str | None]] = {
@@ -44,6 +52,14 @@ _LAZY: dict[str, tuple[str, str | None]] = {
     "Executor": ("navlab.core", "Executor"),
     "Node": ("navlab.core", "Node"),
     "msgs": ("navlab.msgs", None),
+    "Parameter": ("navlab.core.node", "Parameter"),
+    "init": ("navlab.core.rclpy_api", "init"),
+    "shutdown": ("navlab.core.rclpy_api", "shutdown"),
+    "ok": ("navlab.core.rclpy_api", "ok"),
+    "spin": ("navlab.core.rclpy_api", "spin"),
+    "spin_once": ("navlab.core.rclpy_api", "spin_once"),
+    "create_node": ("navlab.core.rclpy_api", "create_node"),
+    "install_ros_imports": ("navlab.core.ros_imports", "install"),
 }
 
 

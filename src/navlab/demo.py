@@ -121,11 +121,14 @@ def _cmd(args: argparse.Namespace) -> int:
     print(f"  AMCL on that map with new obstacles: mean error {loc['position_error_mean_m']} m, "
           f"{loc['yaw_error_mean_deg']}° over {loc['sim_s']:.0f} s; picture {loc['picture']}")
     n = summary["navigation"]
-    print(f"  move_base on that map: {n['goals_succeeded']} of {len(n['goals'])} goals reached, "
-          f"{n['collisions']} collisions; pictures in {summary['out']}/navigate/")
+    print(f"  move_base on that map: {n['goals_succeeded']} of {len(n['goals'])} goals reached (the simulator's "
+          f"truth; move_base reported {n['goals_succeeded_move_base']}), {n['collisions']} collisions; pictures in "
+          f"{summary['out']}/navigate/")
     for k, g in enumerate(n["goals"], 1):
-        print(f"    goal {k} {tuple(g['goal'])}: {g['outcome']} in {g['time_s']} s, path {g['path_m']} m, "
-              f"closest {g['min_clearance_m']} m" + (f" ({g['reason']})" if g["reason"] else ""))
+        said = f", move_base: {g['move_base_outcome']}" if g["move_base_outcome"] != g["outcome"] else ""
+        print(f"    goal {k} {tuple(g['goal'])}: {g['outcome']}{said} in {g['time_s']} s, path {g['path_m']} m, "
+              f"{g['final_error_m']} m from the goal, closest {g['min_clearance_m']} m"
+              + (f" ({g['reason']})" if g["reason"] else ""))
     print(f"  total {summary['wall_s']} s wall")
     return 0
 

@@ -8,6 +8,7 @@ NODES: dict[str, str] = {
     "listener": "navlab.core.demo_nodes:Listener",
     "amcl": "navlab.localization.amcl_node:Amcl",
     "map_server": "navlab.mapping.map_server:MapServer",
+    "map_saver": "navlab.mapping.map_saver:MapSaver",
     "slam_gmapping": "navlab.mapping.slam_node:SlamGMapping",
     "gazebo": "navlab.sim.gazebo:GazeboSim",
     "explore": "navlab.mapping.explore_node:Explore",

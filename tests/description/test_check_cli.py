@@ -23,7 +23,7 @@ def test_check_robot_json(capsys):
     assert s["total_mass"] == pytest.approx(15.0, abs=1e-3)
     assert s["links"]["chassis"]["mass"] == 10
     assert {j["name"]: j["type"] for j in s["joints"]}["left_wheel_hinge"] == "continuous"
-    assert s["diff_drive"]["wheel_separation"] == 0.4 and s["diff_drive"]["max_torque"] == 15
+    assert s["diff_drive"]["wheel_separation"] == 0.4 and s["diff_drive"]["max_torque"] == 5.0  # wheelTorque default
     assert s["lidars"][0]["topic"] == "/mybot/laser/scan" and s["lidars"][0]["samples"] == 720
     assert s["warnings"] == []
 

@@ -34,7 +34,7 @@ ROS1 = """
       <wheelTorque>4</wheelTorque><wheelAcceleration>2.5</wheelAcceleration><updateRate>50</updateRate>
       <commandTopic>cmd_demo</commandTopic><odometryTopic>odom_demo</odometryTopic>
       <odometryFrame>odom</odometryFrame><robotBaseFrame>base_link</robotBaseFrame>
-      <odometrySource>1</odometrySource><publishTf>0</publishTf><publishWheelTF>true</publishWheelTF>
+      <odometrySource>1</odometrySource><publishOdomTF>0</publishOdomTF><publishWheelTF>true</publishWheelTF>
     </plugin>
   </gazebo>
 """
@@ -78,13 +78,15 @@ def test_ros2_namespace_prefixes_relative_topics(tmp_path):
     assert dd.namespace == "/demo" and dd.command_topic == "/demo/cmd_demo"
 
 
-def test_ros1_torque_spelling_and_missing_legacy_mode(tmp_path):
+def test_noetic_ignores_torque_and_legacy_mode_and_says_which_tag_it_reads(tmp_path):
     tag = ROS1.replace("<wheelTorque>4</wheelTorque>", "<torque>15</torque>").replace(
-        "<legacyMode>false</legacyMode>", "")
+        "<legacyMode>false</legacyMode>", "<legacyMode>true</legacyMode>")
     robot = _robot(tmp_path, tag)
-    assert robot.diff_drive.max_torque == 15
-    assert robot.diff_drive.legacy_mode is True  # ROS 1's default
-    assert any("legacyMode" in w for w in robot.warnings)
+    assert robot.diff_drive.max_torque == 5.0  # Noetic's wheelTorque default, not the ignored <torque>
+    assert robot.diff_drive.legacy_mode is False  # Noetic has no legacy mode
+    (torque,) = [w for w in robot.warnings if "<torque>" in w]
+    assert "<wheelTorque>" in torque and "5 N m" in torque
+    assert any("<legacyMode> was removed" in w for w in robot.warnings)
 
 
 RAY = """<ray><scan><horizontal><samples>{n}</samples><resolution>1</resolution>
@@ -174,3 +176,27 @@ def test_diff_drive_joint_must_exist(tmp_path):
 def test_diff_drive_bad_value_names_element(tmp_path):
     with pytest.raises(DescriptionError, match=r"r\.urdf.*<plugin name=\"dd\".*wheel_separation"):
         _robot(tmp_path, ROS1.replace("<wheelSeparation>0.3<", "<wheelSeparation>wide<"))
+
+
+def test_noetic_laser_defaults_and_ignored_tags(tmp_path):
+    """ROS Noetic's gazebo_ros_laser: no <topicName> publishes on /world, no <frameName> stamps frame /world;
+    <gaussianNoise>/<hokuyoMinIntensity>/<updateRate> are not read (the sensor's <noise>/<update_rate> are)."""
+    plugin = ('<plugin name="laser" filename="libgazebo_ros_laser.so"><gaussianNoise>0.5</gaussianNoise>'
+              "<hokuyoMinIntensity>101</hokuyoMinIntensity><updateRate>40</updateRate></plugin>")
+    tag = (f'<gazebo reference="scan_link"><sensor type="ray" name="front_laser"><update_rate>15</update_rate>'
+           f"{RAY.format(n=181)}{plugin}</sensor></gazebo>")
+    robot = _robot(tmp_path, ROS1, tag)
+    (lidar,) = robot.lidars
+    assert (lidar.topic, lidar.frame_id, lidar.update_rate, lidar.noise_stddev) == ("/world", "world", 15, 0.03)
+    said = " | ".join(robot.warnings)
+    for words in ("no <topicName>", "'/world'", "no <frameName>", "<gaussianNoise> is not read",
+                  "<ray><noise>", "<hokuyoMinIntensity> is not read", "<updateRate> is not read",
+                  "<update_rate>"):
+        assert words in said
+
+
+def test_noetic_imu_model_plugin_default_topic(tmp_path):
+    tag = ('<gazebo><plugin name="imu" filename="libgazebo_ros_imu.so"><bodyName>imu_link</bodyName>'
+           "<updateRate>50</updateRate></plugin></gazebo>")
+    (imu,) = _robot(tmp_path, ROS1, tag).imus
+    assert imu.topic == "/default_imu" and imu.frame_id == "imu_link"  # Noetic's gazebo_ros_imu defaults

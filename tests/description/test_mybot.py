@@ -88,7 +88,7 @@ def test_diff_drive_plugin_matches_the_paper(mybot):
     assert dd is not None
     assert (dd.left_joint, dd.right_joint) == ("left_wheel_hinge", "right_wheel_hinge")
     assert dd.update_rate == 30 and dd.wheel_separation == 0.4 and dd.wheel_diameter == 0.16
-    assert dd.max_torque == 15
+    assert dd.max_torque == 5.0  # the paper wrote <torque>15</torque>, which Noetic does not read (wheelTorque default)
     assert (dd.command_topic, dd.odometry_topic, dd.odometry_frame) == ("cmd_vel", "odom", "odom")
     assert dd.robot_base_frame == "chassis" and dd.odometry_source == "encoder"
     assert dd.legacy_mode is False
@@ -124,15 +124,15 @@ def test_ros_package_path_is_searched(tmp_path, monkeypatch):
     pkg = tmp_path / "ws" / "mybot_description"
     shutil.copytree(resources.path("robots/mybot"), pkg)
     gz = pkg / "mybot.gazebo"
-    gz.write_text(gz.read_text().replace("<torque>15<", "<torque>7<"))
+    gz.write_text(gz.read_text().replace("<wheelSeparation>0.4<", "<wheelSeparation>0.7<"))
     top = tmp_path / "elsewhere" / "robot.xacro"
     top.parent.mkdir()
     top.write_text('<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">'
                    '<xacro:include filename="$(find mybot_description)/mybot.xacro"/></robot>')
     monkeypatch.setenv("ROS_PACKAGE_PATH", str(tmp_path / "ws"))
-    assert load_robot(top).diff_drive.max_torque == 7
+    assert load_robot(top).diff_drive.wheel_separation == 0.7
     monkeypatch.delenv("ROS_PACKAGE_PATH")
-    assert load_robot(top).diff_drive.max_torque == 15  # falls back to the shipped package
+    assert load_robot(top).diff_drive.wheel_separation == 0.4  # falls back to the shipped package
 
 
 def test_xacro_args(tmp_path):

@@ -71,14 +71,16 @@ def test_package_uri_robot_loads_through_ros_package_path():
     assert robot.diff_drive is not None and robot.diff_drive.robot_base_frame == "base_link"
 
 
-def test_legacy_mode_message_says_what_happens(capsys):
-    assert main(["check", "robot", URI, "--arg", "legacy:=false", "--json"]) == 0
+def test_swapped_joint_and_legacy_mode_messages_say_what_happens(capsys):
+    assert main(["check", "robot", URI, "--arg", "legacy:=true", "--json"]) == 0
     warnings = json.loads(capsys.readouterr().out)["warnings"]
-    (note,) = [w for w in warnings if "legacyMode" in w]
-    assert "turns the opposite way" in note and "as it does in Gazebo" in note and "set <" not in note
-    robot = load_robot(URI)  # legacyMode left to ROS 1's default
-    (note,) = [w for w in robot.warnings if "legacyMode" in w]
-    assert "default true applies" in note and "turns as cmd_vel asks" in note
+    (note,) = [w for w in warnings if "is the wheel on the right" in w]
+    assert "turns the opposite way" in note and "as it does in Gazebo" in note
+    (ignored,) = [w for w in warnings if "<legacyMode>" in w]  # Noetic does not read the tag: named, not used
+    assert "removed" in ignored and "PR #707" in ignored
+    for legacy in ("unset", "false"):  # no <legacyMode>, or false (what Noetic does anyway): only the joint note
+        robot = load_robot(URI, args={"legacy": legacy})
+        assert not any("legacyMode" in w for w in robot.warnings)
 
 
 def test_missing_visual_mesh_warns_and_skips_but_missing_collision_mesh_is_an_error(tmp_path, capsys):

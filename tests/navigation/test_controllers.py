@@ -322,11 +322,22 @@ def test_scoring_weights_change_the_choice():
     assert picks[0] != picks[1]
 
 
+@pytest.mark.parametrize("cls, key", [(DWAPlannerROS, "vx_samples"), (DWAPlannerROS, "vy_samples"),
+                                      (DWAPlannerROS, "vth_samples"), (TrajectoryPlannerROS, "vx_samples"),
+                                      (TrajectoryPlannerROS, "vtheta_samples")])
+def test_sample_counts_below_one_warn_and_become_one_as_in_ros(cls, key, caplog):
+    """dwa_local_planner and base_local_planner warn and sample one value (TurtleBot3's files set vy_samples: 0)."""
+    with caplog.at_level("WARNING", logger="navlab.navigation"):
+        ctrl = cls({key: 0})
+    assert getattr(ctrl.params, key) == 1
+    (msg,) = [r.getMessage() for r in caplog.records]
+    assert f"{key} is 0" in msg and "set to 1" in msg
+
+
 @pytest.mark.parametrize("cls, params, words", [
     (DWAPlannerROS, {"max_vel_x": 0.5, "max_vel_trans": 0.5, "path_distance_bais": 1.0},
      ["path_distance_bais", "did you mean", "path_distance_bias"]),
     (TrajectoryPlannerROS, {"pdist_scal": 1.0}, ["pdist_scal", "did you mean", "pdist_scale"]),
-    (DWAPlannerROS, {"vx_samples": 0}, ["vx_samples=0", ">= 1"]),
     (DWAPlannerROS, {"min_vel_x": 0.6}, ["min_vel_x=0.6", "max_vel_x"]),
     (TrajectoryPlannerROS, {"min_vel_theta": 2.0}, ["min_vel_theta=2.0", "max_vel_theta"]),
     (TrajectoryPlannerROS, {"sim_time": 0.0}, ["sim_time=0.0", "> 0"]),
@@ -442,3 +453,63 @@ def test_mppi_parameters():
             assert word in str(err.value)
     with pytest.raises(NavigationError, match="rng"):
         MPPIController()
+
+
+def test_a_rollouts_first_failure_in_time_decides_its_code() -> None:
+    """``generateTrajectory`` checks poses in time order and returns at the first failure: -1 when the footprint
+    is blocked (or off the map), -2 when the cell has no path to the goal. The code matters: only a -2 escape
+    rollout keeps TrajectoryPlanner out of escape mode."""
+    from navlab.navigation.controllers.rollout import _rollout_scores
+
+    res, n = 0.1, 5
+    grid = np.zeros((n, n), dtype=np.uint8)
+    grid[2, 3] = COST_LETHAL  # cell (i=3, j=2)
+    path_dist = np.ones((n, n))
+    goal_dist = np.ones((n, n))
+    goal_dist[2, 1] = n * n  # cell (1, 2): cut off from the goal
+    cells = {"no_path": (1, 2), "free": (2, 2), "lethal": (3, 2)}
+
+    def score(*names: str) -> float:
+        traj = np.array([[[(cells[k][0] + 0.5) * res, (cells[k][1] + 0.5) * res, 0.0] for k in names]])
+        out = np.empty(1)
+        zeros = np.zeros(traj.shape[:2])
+        _rollout_scores(grid, grid, path_dist, goal_dist, 1.0 / res, traj, zeros, zeros, np.zeros(0), np.zeros(0),
+                        False, False, np.array([1.0, 0.6, 0.8, 0.01]), float(n * n), np.array([-1]), out)
+        return float(out[0])
+
+    assert score("no_path", "free", "lethal") == -2.0  # no path first (the old kernel said -1: blocked anywhere)
+    assert score("lethal", "free", "no_path") == -1.0
+    assert score("free", "free") == pytest.approx(0.6 + 0.8)
+
+
+def test_heading_scoring_scores_one_step_and_the_heading_to_the_visible_plan() -> None:
+    """``heading_scoring: true`` (base_local_planner): every rollout has sim_time / sim_granularity steps, path
+    and goal distances count at the step at heading_scoring_timestep only, and 0.3 x the angle between the
+    heading there and the direction to the last plan point in clear sight is added."""
+    ctrl = TrajectoryPlannerROS({"heading_scoring": True, "dwa": False, "vtheta_samples": 9})
+    plan = straight_plan(0.0, 1.5)
+    ctrl.set_plan(plan)
+    ctrl.compute_velocity((0.0, 0.0, 0.5), (0.0, 0.0), free_map())
+    assert set(ctrl._steps(ctrl.samples).tolist()) == {40}  # 1.0 s / 0.025 s
+    k = ctrl._heading_step(40)
+    assert k == 32  # the first step at >= 0.8 s
+    spin = np.flatnonzero((ctrl.samples[:, 0] == 0) & (ctrl.costs >= 0))
+    assert len(spin) >= 2
+    # the in-place turns share their cell (same distances, no obstacle): they differ by 0.3 x the heading error
+    # to the plan's last point (1.5, 0) at step k, taken from the rollouts themselves
+    poses = ctrl.trajectories[spin, k]
+    aim = np.arctan2(0.0 + 0.025 - poses[:, 1], 1.5 + 0.025 - poses[:, 0])  # the point's cell centre
+    err = np.abs((poses[:, 2] - aim + np.pi) % (2 * np.pi) - np.pi)
+    assert np.allclose(ctrl.costs[spin] - ctrl.costs[spin[0]], 0.3 * (err - err[0]), atol=1e-6)
+    # a wall across the plan hides its end: the heading term aims at the last point still in sight
+    walled = free_map()
+    walled.data[:, round((1.0 + 2.0) / RES)] = COST_LETHAL  # the column of cells at x = 1.0 m
+    ctrl2 = TrajectoryPlannerROS({"heading_scoring": True, "dwa": False, "vtheta_samples": 9})
+    ctrl2.set_plan(plan)
+    ctrl2.compute_velocity((0.0, 0.0, 0.5), (0.0, 0.0), walled)
+    from navlab.navigation.controllers.rollout import heading_diffs
+
+    local = ctrl2._frame.points_in(plan[:, :2])
+    pose = ctrl2._frame.pose_in((0.0, 0.0, 0.0))
+    seen = heading_diffs(walled.data, RES, local, np.array([pose]))[0]
+    assert seen == pytest.approx(abs(math.atan2(0.025, 0.975)), abs=1e-9)  # (0.95, 0) is the last one in sight

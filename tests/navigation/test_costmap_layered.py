@@ -153,12 +153,26 @@ def test_track_unknown_space_fills_unknown() -> None:
     ({"plugins": [{"name": "inf", "type": "costmap_2d::InflationLayr"}]}, "did you mean 'costmap_2d::InflationLayer'"),
     ({"observation_sources": "laser"}, "names 'laser' but there is no"),
     ({"obstacle_layer": {"combination_method": 5}}, "combination_method: expected 0 .* or 1"),
-    ({"laser_scan_sensr": {"topic": "/scan"}}, "unknown costmap parameter 'laser_scan_sensr'"),
+    ({"obstacle_layr": {"enabled": True}}, "unknown costmap parameter 'obstacle_layr'; did you mean 'obstacle_layer'"),
 ])
 def test_bad_parameters_get_one_line_errors(params: dict, match: str) -> None:
     with pytest.raises((NavigationError, PluginError), match=match) as info:
         LayeredCostmap(params)
     assert "\n" not in str(info.value)
+
+
+def test_keys_ros_ignores_warn_and_are_dropped() -> None:
+    """Another plugin's key (TrajectoryPlannerROS's meter_scoring) or section (a layer not in plugins): ROS
+    ignores them, navlab warns (the launch names the file) and builds the costmap as without them."""
+    from navlab.core.params import ParameterWarning
+
+    extra = {"meter_scoring": True, "voxel_layer": {"z_voxels": 4}, "inflation_layer": {"old_key_of_2014": 1}}
+    with pytest.warns(ParameterWarning) as caught:
+        cm = LayeredCostmap({**COMMON, **extra})
+    assert {w.message.key for w in caught if isinstance(w.message, ParameterWarning)} == {
+        "meter_scoring", "voxel_layer", "old_key_of_2014"}
+    plain = LayeredCostmap(COMMON)
+    assert [layer.params for layer in cm.layers] == [layer.params for layer in plain.layers]
 
 
 def test_nav2_and_ros1_range_names_are_the_same_parameter() -> None:

@@ -194,3 +194,26 @@ def test_move_base_publishes_costmaps_plans_and_status_as_ros_does() -> None:
     plan = got["/move_base/NavfnROS/plan"][-1]
     assert plan.header.frame_id == "map" and len(plan.poses) > 10
     assert got["/move_base/status"][-1].status_list[-1].status == msgs.GoalStatus.STATUS_EXECUTING
+
+
+def test_a_key_ros_ignores_warns_naming_the_file_and_a_typo_still_fails(
+        tmp_path: Path, caplog: pytest.LogCaptureFixture) -> None:
+    """ROS reads what it knows and ignores the rest of a namespace: ``meter_scoring`` (TrajectoryPlannerROS's)
+    in costmap_common_params.yaml loads with a warning naming key and file; a misspelt known key is refused."""
+    import shutil
+
+    from navlab import resources
+    from navlab.experiments.session import start_run
+
+    params = tmp_path / "params"
+    shutil.copytree(resources.root() / "params" / "mybot", params)
+    common = params / "costmap_common_params.yaml"
+    common.write_text(common.read_text() + "meter_scoring: true\n")
+    with caplog.at_level("WARNING"):
+        run = start_run("navigation", world="room", map=str(_room_true_map()), params=str(params))
+    warned = [r.getMessage() for r in caplog.records if "meter_scoring" in r.getMessage()]
+    assert warned and all("costmap_common_params.yaml" in m and "ignored" in m for m in warned), warned
+    assert run.node("move_base") is not None
+    common.write_text(common.read_text() + "inflation_raduis: 0.3\n")
+    with pytest.raises(NavlabError, match=r"costmap_common_params\.yaml.*did you mean 'inflation_radius'"):
+        start_run("navigation", world="room", map=str(_room_true_map()), params=str(params))

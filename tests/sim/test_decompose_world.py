@@ -88,3 +88,24 @@ def test_decomposed_only_up_to_the_robots_reach_and_the_robot_still_cannot_drive
     sim.spawn(primitive_model("sphere", "ball", (0.05,), x=3.0 + 0.3, y=0.3, z=top + 0.3, static=False))
     sim.step(600)
     assert sim.model_pose("ball").position[2] == pytest.approx(top + 0.05, abs=0.02)
+
+
+def test_a_script_without_a_main_guard_loads_a_world_with_concave_meshes(tmp_path):
+    """Issue 23 item 5: the decomposition workers never re-import the user's script (spawn would run it
+    again in each worker, which then tries to start workers of its own and crashes)."""
+    import os
+    import subprocess
+    import sys
+
+    world_file = furnished_world(tmp_path / "w", n=2, seed=3, kinds=("sofa",))
+    script = tmp_path / "user_script.py"
+    script.write_text(
+        "from navlab.sim import decompose\n"
+        "from navlab.world import load_world\n"
+        f"world = load_world({str(world_file)!r})\n"
+        "print('decomposed', decompose.decompose_world(world, workers=2, progress=False), flush=True)\n")
+    env = {**os.environ, "NAVLAB_CACHE": str(tmp_path / "cache")}
+    done = subprocess.run([sys.executable, str(script)], env=env, capture_output=True, text=True, timeout=600,
+                          check=False)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert done.stdout.splitlines() == ["decomposed 2"]  # the script ran once: no worker re-ran it

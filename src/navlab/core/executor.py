@@ -105,7 +105,7 @@ class Executor:
             t = self.topics[name] = Topic(name, msgtype)
             if name in ("/tf", "/tf_static"):
                 self._attach_tf(t)
-        elif t.msgtype is not msgtype:
+        elif type_name(t.msgtype) != type_name(msgtype):  # the same type, or navlab's rclpy-style class of it
             raise CoreError(
                 f"topic {name!r} has type {type_name(t.msgtype)}, but {type_name(msgtype)} was asked for"
             )

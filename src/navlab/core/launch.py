@@ -24,8 +24,11 @@ node in ``navlab.nodes.NODES`` or, for user code, ``module:Class``.
 from __future__ import annotations
 
 import importlib
+import logging
 import os
 import re
+import warnings
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
@@ -33,8 +36,8 @@ from typing import Any
 
 from navlab.core.errors import LaunchError, ParameterError
 from navlab.core.executor import Executor
-from navlab.core.node import Node
-from navlab.core.params import load_params, merge_params, parse_yaml, read_yaml
+from navlab.core.node import Node, flatten_params
+from navlab.core.params import ParameterWarning, load_params, merge_params, parse_yaml, read_yaml
 from navlab.errors import NavlabError
 
 _SUBST = re.compile(r"\$\((\S+)(?:\s+([^)]*))?\)")
@@ -84,6 +87,15 @@ class Session:
     args: dict[str, str] = field(default_factory=dict)
     overrides: dict[str, dict[str, Any]] = field(default_factory=dict)
     origins: dict[str, str] = field(default_factory=dict)  # node name -> "launch file: entry (parameter files)"
+    params: dict[str, Any] = field(default_factory=dict)  # ROS 1 launch: the parameter server (absolute names)
+    notes: list[str] = field(default_factory=list)  # what a ROS 1 launch asked for that navlab covers or skips
+    processes: Any = None  # ROS 1 launch with ros:=true: the ProcessGroup of the nodes navlab does not run
+
+    def shutdown(self) -> None:
+        """End the processes this launch started (a ROS 1 launch with the bridge on); safe to call twice."""
+        if self.processes is not None:
+            self.processes.stop()
+            self.processes = None
 
     def run(self, duration: float) -> None:
         """Advance simulated time by ``duration`` seconds."""
@@ -95,6 +107,46 @@ class Session:
             if key in self.nodes:
                 return self.nodes[key]
         raise LaunchError(f"no node {name!r} in this launch (nodes: {', '.join(self.nodes)})")
+
+
+@dataclass
+class NodeSpec:
+    """One node to start, as every launch format describes it: the runtime description that YAML and
+    ROS 1 XML launch files both translate into (one wiring path)."""
+
+    exec: str  # a name in navlab.nodes.NODES or module:Class
+    name: str = ""  # "" = the class's default name
+    namespace: str = ""
+    params: dict[str, Any] = field(default_factory=dict)
+    remaps: dict[str, str] = field(default_factory=dict)
+    origin: str = ""  # "launch file: entry 'name' (parameter files)", prefixed to its errors
+    files: dict[str, set[str]] = field(default_factory=dict)  # parameter file name -> the key names in it
+
+
+def start_node(session: Session, spec: NodeSpec) -> Node:
+    """Construct the node ``spec`` describes in ``session`` (command-line overrides applied last)."""
+    try:
+        cls = load_node_class(spec.exec)
+    except LaunchError as exc:
+        raise LaunchError(f"{spec.origin}: {exc}") from None
+    params = spec.params
+    if (spec.name or spec.exec) in session.overrides:  # like `ros2 launch ... --ros-args -p`: applied last
+        params = merge_params(params, session.overrides[spec.name or spec.exec])
+    kwargs: dict[str, Any] = {"parameters": params}
+    if spec.name:
+        kwargs["name"] = spec.name
+    if spec.namespace.strip("/"):
+        kwargs["namespace"] = spec.namespace
+    try:
+        with session.executor.node_context(remappings=spec.remaps), warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", ParameterWarning)
+            node = cls(session.executor, **kwargs)
+    except NavlabError as exc:  # name the launch file and the parameter files, as the user wrote them
+        raise _prefixed(exc, spec.origin) from None
+    _warn_unknown_keys(caught, spec.files, spec.origin)
+    session.nodes[node.fully_qualified_name] = node
+    session.origins[node.fully_qualified_name] = spec.origin
+    return node
 
 
 class _Context:
@@ -113,7 +165,13 @@ class _Context:
             module, func = ROBOT_LAUNCH_VALUES.split(":", 1)
             self.robot_values[robot] = getattr(importlib.import_module(module), func)(robot)
         values = self.robot_values[robot]
-        if key not in values:
+        note = values.get(f"{key}_note")
+        if note:  # said once per launch, when the value is used
+            import logging
+
+            logging.getLogger("navlab.launch").warning(note)
+            values.pop(f"{key}_note")
+        if key not in values or key.endswith("_note"):
             raise LaunchError(f"{self.file}: {where}: $(robot {key}): expected one of {', '.join(sorted(values))}")
         return values[key]
 
@@ -125,8 +183,7 @@ class _Context:
         if not isinstance(value, str):
             return value
 
-        def repl(m: re.Match[str]) -> str:
-            kind, arg = m.group(1), (m.group(2) or "").strip()
+        def repl(kind: str, arg: str) -> str:
             if kind == "var":
                 if arg not in self.vars:
                     known = ", ".join(self.vars) or "none"
@@ -144,10 +201,40 @@ class _Context:
                 raise LaunchError(f"{self.file}: {where}: unknown package {arg!r} in $(find-pkg-share)")
             if kind == "robot":
                 return self.robot_value(arg, where)
+            if kind == "eval":  # ROS 2's PythonExpression, in navlab's sandbox
+                from navlab.core.roslaunch_config import EVAL_BUILTINS
+                from navlab.core.safe_eval import ExpressionError, safe_eval
+
+                try:
+                    return str(safe_eval(arg, {"true": True, "false": False}, functions=EVAL_BUILTINS))
+                except ExpressionError as exc:
+                    raise LaunchError(f"{self.file}: {where}: $(eval {arg}): {exc}") from None
             raise LaunchError(f"{self.file}: {where}: unknown substitution $({kind})")
 
-        out = _SUBST.sub(repl, value)
+        out = _expand(value, repl, f"{self.file}: {where}")
         return _typed(out) if out != value else value
+
+
+def _expand(text: str, resolve: Callable[[str, str], str], where: str) -> str:
+    """``text`` with each ``$(KIND ARG)`` replaced by ``resolve(KIND, ARG)``, innermost first (as ROS 2 launch
+    nests substitutions: ``$(eval '$(var a)' == 'x')``)."""
+    out: list[str] = []
+    i = 0
+    while (j := text.find("$(", i)) >= 0:
+        out.append(text[i:j])
+        depth, k = 0, j + 1
+        while k < len(text):
+            depth += {"(": 1, ")": -1}.get(text[k], 0)
+            if depth == 0:
+                break
+            k += 1
+        if k >= len(text):
+            raise LaunchError(f"{where}: unterminated substitution in {text!r}")
+        kind, _, arg = _expand(text[j + 2:k], resolve, where).strip().partition(" ")
+        out.append(resolve(kind, arg.strip()))
+        i = k + 1
+    out.append(text[i:])
+    return "".join(out)
 
 
 def _typed(text: str) -> Any:
@@ -187,12 +274,15 @@ def _text(ctx: _Context, spec: dict[str, Any], key: str, where: str) -> str:
     return str(value)
 
 
-def _node_params(ctx: _Context, spec: dict[str, Any], where: str) -> tuple[dict[str, Any], list[str]]:
-    """The node's parameters and the files they came from."""
+def _node_params(ctx: _Context, spec: dict[str, Any], where: str) -> tuple[dict[str, Any], dict[str, set[str]]]:
+    """The node's parameters and the files they came from (file name -> every key name in it, at any depth)."""
     params: dict[str, Any] = {}
-    files: list[str] = []
+    files: dict[str, set[str]] = {}
     for item in _items(ctx, spec, "param", where, ()):
-        item = ctx.subst(item, where)
+        if isinstance(item, dict) and not _condition(ctx, item, where):  # a param entry's if/unless
+            continue
+        item = ctx.subst({k: v for k, v in item.items() if k not in ("if", "unless")} if isinstance(item, dict)
+                         else item, where)
         if not isinstance(item, dict):
             raise LaunchError(f"{ctx.file}: {where}: a param entry must be a mapping, got {item!r}")
         if "from" in item:
@@ -200,7 +290,7 @@ def _node_params(ctx: _Context, spec: dict[str, Any], where: str) -> tuple[dict[
             if not path.is_absolute():
                 path = ctx.file.parent / path
             loaded = load_params(path, node=str(spec.get("name") or "") or None)
-            files.append(path.name)
+            files.setdefault(path.name, set()).update(k.rsplit(".", 1)[-1] for k in flatten_params(loaded))
             ns = str(item.get("ns") or "").strip("/")
             for part in reversed(ns.split("/") if ns else []):  # rosparam load's ns=: nest under it
                 loaded = {part: loaded}
@@ -267,32 +357,29 @@ def _run_entries(ctx: _Context, session: Session, depth: int) -> None:
             exec_name = spec.get("exec")
             if not exec_name or not isinstance(exec_name, str):
                 raise LaunchError(f"{ctx.file}: {where}: a node needs 'exec' (a node name or module:Class)")
-            try:
-                cls = load_node_class(exec_name)
-            except LaunchError as exc:
-                raise LaunchError(f"{ctx.file}: {where}: {exc}") from None
             remaps = {str(ctx.subst(r["from"], where)): _text(ctx, r, "to", where)
                       for r in _items(ctx, spec, "remap", where, ("from", "to"))}
             params, files = _node_params(ctx, spec, where)
-            node_name = _text(ctx, spec, "name", where) if "name" in spec else exec_name
-            if node_name in session.overrides:  # like `ros2 launch ... --ros-args -p`: applied last
-                params = merge_params(params, session.overrides[node_name])
-            kwargs: dict[str, Any] = {"parameters": params}
-            if "name" in spec:
-                kwargs["name"] = node_name
-            if spec.get("namespace"):
-                kwargs["namespace"] = _text(ctx, spec, "namespace", where)
+            node_name = _text(ctx, spec, "name", where) if "name" in spec else ""
+            namespace = _text(ctx, spec, "namespace", where) if spec.get("namespace") else ""
             source = f" (parameters from {', '.join(files)})" if files else ""
-            origin = f"{ctx.file}: {where} {node_name!r}{source}"
-            try:
-                with session.executor.node_context(remappings=remaps):
-                    node = cls(session.executor, **kwargs)
-            except NavlabError as exc:  # name the launch file and the parameter files, as the user wrote them
-                raise _prefixed(exc, origin) from None
-            session.nodes[node.fully_qualified_name] = node
-            session.origins[node.fully_qualified_name] = origin
+            start_node(session, NodeSpec(exec_name, node_name, namespace, params, remaps,
+                                         f"{ctx.file}: {where} {node_name or exec_name!r}{source}", files))
         else:
             raise LaunchError(f"{ctx.file}: {where}: unknown entry {kind!r} (expected arg, let, include or node)")
+
+
+def _warn_unknown_keys(caught: list[warnings.WarningMessage], files: dict[str, set[str]], origin: str) -> None:
+    """Log each ignored parameter key (``ParameterWarning``) naming the parameter file that holds it; other
+    warnings go on as they came."""
+    for w in caught:
+        if not isinstance(w.message, ParameterWarning):
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+            continue
+        leaf = w.message.key.rsplit(".", 1)[-1]
+        held = [name for name, keys in files.items() if leaf in keys]
+        where = ", ".join(held) if held else origin
+        logging.getLogger("navlab.launch").warning("%s: %s", where, w.message)
 
 
 def _prefixed(exc: NavlabError, prefix: str) -> NavlabError:
@@ -303,58 +390,128 @@ def _prefixed(exc: NavlabError, prefix: str) -> NavlabError:
         return LaunchError(f"{prefix}: {exc}")
 
 
-def _check_args(file: Path, args: dict[str, Any]) -> None:
-    """Refuse arguments the file neither declares nor uses (a typo like ``wrold:=room`` would be ignored)."""
+def _check_args(files: list[Path], args: dict[str, Any]) -> None:
+    """Refuse arguments no file declares or uses (a typo like ``wrold:=room`` would be ignored)."""
     import difflib
 
-    entries = [e for e in _entries(file) if isinstance(e, dict) and isinstance(e.get("arg"), dict)]
-    known = {str(e["arg"].get("name")) for e in entries}
-    known |= {m.group(2).strip() for m in _SUBST.finditer(file.read_text()) if m.group(1) == "var" and m.group(2)}
+    known: set[str] = set()
+    for file in files:
+        entries = [e for e in _entries(file) if isinstance(e, dict) and isinstance(e.get("arg"), dict)]
+        known |= {str(e["arg"].get("name")) for e in entries}
+        known |= {m.group(2).strip() for m in _SUBST.finditer(file.read_text()) if m.group(1) == "var" and m.group(2)}
     for name in args:
         if name not in known:
             close = difflib.get_close_matches(name, sorted(known), n=1)
             hint = f"did you mean {close[0]!r}? " if close else ""
-            raise LaunchError(f"{file}: unknown launch argument {name!r} ({hint}arguments: {', '.join(sorted(known))})")
+            where = ", ".join(map(str, files))
+            raise LaunchError(f"{where}: unknown launch argument {name!r} ({hint}arguments: "
+                              f"{', '.join(sorted(known))})")
 
 
 def declared_args(name_or_path: str) -> list[dict[str, Any]]:
-    """The ``arg`` entries of a launch file (for ``--help``-like listings)."""
-    return [e["arg"] for e in _entries(find_launch_file(name_or_path)) if isinstance(e, dict) and "arg" in e]
+    """The ``arg`` entries of a launch file (for ``--help``-like listings); a ROS 1 .launch's ``<arg>``
+    elements with ``doc`` as the description and ``value=`` ones (fixed) left out."""
+    file = find_launch_file(name_or_path)
+    from navlab.core.roslaunch import declared_args as xml_args
+    from navlab.core.roslaunch import is_xml_launch
+
+    if is_xml_launch(file):
+        return xml_args(file)
+    return [e["arg"] for e in _entries(file) if isinstance(e, dict) and "arg" in e]
 
 
 def start(
-    name_or_path: str,
+    name_or_path: str | os.PathLike[str] | Sequence[str | os.PathLike[str]],
     *,
     executor: Executor | None = None,
     seed: int = 0,
     pace: float = 0.0,
     launch_args: dict[str, Any] | None = None,
     overrides: dict[str, dict[str, Any]] | None = None,
+    ros: bool = False,
     **args: Any,
 ) -> Session:
-    """Start a launch (shipped name or file) with arguments; returns the session.
+    """Start a launch (shipped name or file, or several files as ``roslaunch a.launch b.launch``) with
+    arguments; returns the session.
 
     Arguments come as keywords (``start("mapping", world="room")``) or, for names that clash with
     this function's own (``seed``, ``pace``), in ``launch_args``. ``pace`` is the executor's rate
     (0 = as fast as possible, 1 = real time). ``overrides`` maps a node name to parameters applied
     after the launch file's own (``{"amcl": {"laser_max_beams": 60}}``); a name no node has is refused.
+    ROS 1 XML files (``.launch``) are read with roslaunch's semantics (:mod:`navlab.core.roslaunch`);
+    ``ros`` (or the argument ``ros:=true``) starts the nodes navlab does not implement as processes,
+    as roslaunch does, for the ROS bridge. Call :meth:`Session.shutdown` when done.
     """
-    file = find_launch_file(name_or_path)
-    all_args = {**(launch_args or {}), **args}
-    _check_args(file, all_args)
-    session = Session(executor or Executor(seed=seed, rate=pace), args={k: str(v) for k, v in all_args.items()},
+    names = [name_or_path] if isinstance(name_or_path, str | os.PathLike) else list(name_or_path)
+    if not names:
+        raise LaunchError("no launch file given")
+    files = [find_launch_file(str(n)) for n in names]
+    all_args = {k: str(v) for k, v in {**(launch_args or {}), **args}.items()}
+    from navlab.core.roslaunch import is_xml_launch
+
+    xml = [is_xml_launch(f) for f in files]
+    if any(xml) and not all(xml):
+        raise LaunchError(f"{', '.join(map(str, files))}: ROS 1 .launch (XML) and YAML launch files cannot be "
+                          "started together; start them in one format")
+    session = Session(executor or Executor(seed=seed, rate=pace), args=all_args,
                       overrides={k.lstrip("/"): dict(v) for k, v in (overrides or {}).items()})
-    ctx = _Context(file, session.args)
-    _run_entries(ctx, session, 0)
+    if all(xml):
+        if "ros" in all_args:
+            ros = _truthy(_Context(files[0], {}), all_args.pop("ros"), "ros", "argument ros:=")
+        _start_xml(session, files, all_args, ros=ros, seed=seed)
+    else:
+        _check_args(files, all_args)
+        for file in files:
+            ctx = _Context(file, all_args)
+            _run_entries(ctx, session, 0)
+            session.args = {**session.args, **ctx.vars}
     for name, node in session.nodes.items():  # unknown parameters, named with the file that set them
         try:
             node.check_parameters()
         except NavlabError as exc:
-            raise _prefixed(exc, session.origins.get(name, str(file))) from None
-    session.args = ctx.vars
+            session.shutdown()
+            raise _prefixed(exc, session.origins.get(name, str(files[0]))) from None
     started = {name.rsplit("/", 1)[-1] for name in session.nodes}
     unknown = sorted(set(session.overrides) - started)
     if unknown:
-        raise LaunchError(f"{file}: parameters given for {', '.join(map(repr, unknown))}, but the launch starts no "
-                          f"such node (nodes: {', '.join(sorted(started))})")
+        session.shutdown()
+        raise LaunchError(f"{', '.join(map(str, files))}: parameters given for {', '.join(map(repr, unknown))}, but "
+                          f"the launch starts no such node (nodes: {', '.join(sorted(started))})")
     return session
+
+
+def _start_xml(session: Session, files: list[Path], args: dict[str, str], *, ros: bool, seed: int) -> None:
+    """ROS 1 XML launch files: read as roslaunch does, then the known nodes started as navlab nodes (in
+    file order) and, with ``ros``, the others as processes."""
+    import logging
+
+    from navlab.core import roslaunch, roslaunch_nodes
+
+    config = roslaunch.load(files, args, seed=seed, allow_commands=ros)
+    plan = roslaunch_nodes.plan(config, ros=ros)
+    log = logging.getLogger("navlab.launch")
+    for note in plan.notes:
+        log.info(note)
+    for warning in plan.warnings:
+        log.warning(warning)
+    session.notes = plan.notes + plan.warnings
+    session.params = config.params
+    for spec in plan.nodes:
+        start_node(session, spec)
+    if plan.processes:
+        from navlab.core.processes import ProcessGroup
+
+        ex = session.executor
+        def required_exit(why: str) -> None:  # roslaunch: a required process that dies ends the launch
+            log.error(why)
+            ex.post(ex.stop)
+
+        group = ProcessGroup(on_required_exit=required_exit)
+        session.processes = group
+        try:
+            for node in plan.processes:
+                group.start(node)
+                log.info(f"process[{node.fqn}]: started ({node.pkg}/{node.type})")
+        except LaunchError:
+            group.stop()
+            raise

@@ -8,12 +8,17 @@ from __future__ import annotations
 
 import dataclasses
 import difflib
+import enum
+import functools
 import logging
+import sys
+import warnings
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 from navlab.core.errors import ParameterError
 from navlab.core.executor import Executor
+from navlab.core.params import TYPO_CUTOFF, ParameterWarning
 from navlab.core.tf import Pose2
 from navlab.core.topics import Publisher, Subscription, Timer, seconds_to_ns
 from navlab.msgs import TFMessage, time_from_ns
@@ -21,13 +26,38 @@ from navlab.msgs import TFMessage, time_from_ns
 __all__ = [
     "Clock",
     "Node",
+    "Parameter",
     "Publisher",
     "Subscription",
+    "Time",
     "Timer",
     "dataclass_parameters",
     "flatten_params",
     "resolve_name",
 ]
+
+
+def _renamed_keywords(**renames: str) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
+    """Accept a method's keyword names of the previous release (``old="new"``) for one more release, with a
+    ``DeprecationWarning`` (the rclpy-shaped names replaced them)."""
+
+    def wrap(method: Callable[..., Any]) -> Callable[..., Any]:
+        @functools.wraps(method)
+        def call(*args: Any, **kwargs: Any) -> Any:
+            used = [old for old in renames if old in kwargs]
+            for old in used:
+                if renames[old] in kwargs:
+                    raise TypeError(f"{method.__name__}() got both {old!r} and {renames[old]!r}")
+                kwargs[renames[old]] = kwargs.pop(old)
+            if used:
+                warnings.warn(f"{method.__name__}({'=..., '.join(used)}=...) is deprecated and goes in the next "
+                              f"release: write {'=..., '.join(renames[o] for o in used)}=... (rclpy's names)",
+                              DeprecationWarning, stacklevel=2)
+            return method(*args, **kwargs)
+
+        return call
+
+    return wrap
 
 
 def resolve_name(name: str, namespace: str) -> str:
@@ -36,6 +66,36 @@ def resolve_name(name: str, namespace: str) -> str:
         return name
     ns = namespace.strip("/")
     return f"/{ns}/{name}" if ns else f"/{name}"
+
+
+@dataclasses.dataclass(frozen=True)
+class Time:
+    """``rclpy.time.Time``: an instant in (simulated) nanoseconds."""
+
+    nanoseconds: int = 0
+    seconds: dataclasses.InitVar[float | None] = None
+
+    def __post_init__(self, seconds: float | None) -> None:
+        if seconds is not None:
+            object.__setattr__(self, "nanoseconds", self.nanoseconds + round(seconds * 1e9))
+
+    def to_msg(self) -> Any:
+        """As ``builtin_interfaces/Time``."""
+        return time_from_ns(self.nanoseconds)
+
+    def seconds_nanoseconds(self) -> tuple[int, int]:
+        """(whole seconds, remaining nanoseconds)."""
+        return divmod(self.nanoseconds, 1_000_000_000)
+
+    @property
+    def sec(self) -> int:
+        """Whole seconds (the message's field)."""
+        return self.nanoseconds // 1_000_000_000
+
+    @property
+    def nanosec(self) -> int:
+        """Nanoseconds past ``sec`` (the message's field)."""
+        return self.nanoseconds % 1_000_000_000
 
 
 class Clock:
@@ -48,9 +108,10 @@ class Clock:
         """Current simulated time in nanoseconds."""
         return self._executor.now_ns
 
-    def now(self) -> Any:
-        """Current simulated time as ``builtin_interfaces/Time``."""
-        return time_from_ns(self._executor.now_ns)
+    def now(self) -> Time:
+        """Current simulated time, as rclpy's ``Time`` (``.nanoseconds``, ``.to_msg()``; ``.sec``/``.nanosec``
+        as the message has them)."""
+        return Time(nanoseconds=self._executor.now_ns)
 
     def seconds(self) -> float:
         """Current simulated time in seconds."""
@@ -71,6 +132,10 @@ class _SimTimeAdapter(logging.LoggerAdapter[logging.Logger]):
     def warn(self, msg: Any, *args: Any, **kwargs: Any) -> None:
         """rclpy spelling of :meth:`warning`."""
         self.warning(msg, *args, **kwargs)
+
+    def fatal(self, msg: Any, *args: Any, **kwargs: Any) -> None:
+        """rclpy's ``fatal``: logged as critical."""
+        self.critical(msg, *args, **kwargs)
 
 
 def flatten_params(params: dict[str, Any], prefix: str = "") -> dict[str, Any]:
@@ -127,16 +192,51 @@ def _coerce(name: str, value: Any, default: Any) -> Any:
 
 
 class Node:
-    """Base class of every navlab node, shaped like ``rclpy.node.Node``."""
+    """Base class of every navlab node, shaped like ``rclpy.node.Node``.
+
+    ``Node("driver")`` (rclpy's constructor: the name first, then rclpy's keyword options) joins the
+    executor of the context ``navlab.init()`` made, or ``context=``; such a node behaves as an rclpy node
+    (``declare_parameter``/``get_parameter`` return :class:`Parameter` objects). The older form
+    ``Node(executor, name=..., parameters=..., namespace=...)`` keeps working for one release with a
+    ``DeprecationWarning`` (navlab's own nodes use it and return plain values).
+    """
 
     def __init__(
         self,
-        executor: Executor,
+        node_name: str | Executor | None = None,
         *,
-        name: str,
+        context: Any = None,
+        cli_args: Sequence[str] | None = None,
+        namespace: str | None = None,
+        use_global_arguments: bool = True,
+        enable_rosout: bool = True,
+        start_parameter_services: bool = True,
+        parameter_overrides: Sequence[Any] | Mapping[str, Any] | None = None,
+        allow_undeclared_parameters: bool = False,
+        automatically_declare_parameters_from_overrides: bool = False,
+        name: str | None = None,
         parameters: dict[str, Any] | None = None,
-        namespace: str = "",
+        executor: Executor | None = None,
     ) -> None:
+        if isinstance(node_name, Executor) or (executor is not None and node_name is None):
+            executor = node_name if isinstance(node_name, Executor) else executor
+            if not sys._getframe(1).f_globals.get("__name__", "").startswith("navlab."):  # navlab's own: no warning
+                warnings.warn("Node(executor, name=...) is deprecated and goes in the next release: write "
+                              "Node('name', parameter_overrides=...) after navlab.init(), as rclpy does",
+                              DeprecationWarning, stacklevel=2)
+            self._rclpy_style = False
+        else:
+            from navlab.core.rclpy_api import context_executor
+
+            name = node_name if node_name is not None else name
+            executor = context_executor(context)
+            parameters = {**(parameters or {}), **_overrides_dict(parameter_overrides)}
+            self._rclpy_style = True
+        if not name:
+            raise ParameterError("a node needs a name: Node('driver')")
+        assert executor is not None
+        self._allow_undeclared = allow_undeclared_parameters
+        namespace = namespace or ""
         self.name = name
         self.namespace = "/" + namespace.strip("/") if namespace.strip("/") else ""
         self.fully_qualified_name = f"{self.namespace}/{name}"
@@ -156,6 +256,8 @@ class Node:
             self.fully_qualified_name,
         )
         self._sensor_poses: dict[tuple[str, str], Pose2] = {}
+        if automatically_declare_parameters_from_overrides:
+            self._declared.update(self._overrides)
         executor.register_node(self)
 
     # --- names -----------------------------------------------------------------------------------
@@ -169,30 +271,40 @@ class Node:
 
     # --- communication ---------------------------------------------------------------------------
 
-    def create_publisher(self, msgtype: type, topic: str, qos: int = 10, *, latched: bool = False) -> Publisher:
-        """Publisher of ``msgtype`` on ``topic`` (``latched``: ROS transient_local)."""
-        t = self.executor.topic(self.resolve_topic_name(topic), msgtype)
+    @_renamed_keywords(msgtype="msg_type", qos="qos_profile")
+    def create_publisher(self, msg_type: type, topic: str, qos_profile: Any = 10, *, latched: bool = False,
+                         callback_group: Any = None, event_callbacks: Any = None) -> Publisher:
+        """Publisher of ``msg_type`` on ``topic`` (``latched``, or a ``qos_profile`` whose durability is
+        transient_local: ROS's latching). ``callback_group``/``event_callbacks`` are accepted as rclpy's;
+        one executor thread runs every callback."""
+        latched = latched or _transient_local(qos_profile)
+        t = self.executor.topic(self.resolve_topic_name(topic), msg_type)
         t.publishers.append(self.fully_qualified_name)
         pub = Publisher(self.executor, t, latched=latched)
         self.publishers.append(pub)
         return pub
 
+    @_renamed_keywords(msgtype="msg_type", qos="qos_profile")
     def create_subscription(
-        self, msgtype: type, topic: str, callback: Callable[[Any], None], qos: int = 10
+        self, msg_type: type, topic: str, callback: Callable[[Any], None], qos_profile: Any = 10, *,
+        callback_group: Any = None, event_callbacks: Any = None, raw: bool = False,
     ) -> Subscription:
-        """Call ``callback(msg)`` for each message on ``topic``."""
-        sub = Subscription(self.resolve_topic_name(topic), msgtype, callback, self.fully_qualified_name)
-        self.executor.subscribe(sub, msgtype)
+        """Call ``callback(msg)`` for each message on ``topic`` (rclpy's signature)."""
+        sub = Subscription(self.resolve_topic_name(topic), msg_type, callback, self.fully_qualified_name)
+        self.executor.subscribe(sub, msg_type)
         self.subscriptions.append(sub)
         return sub
 
-    def create_timer(self, period: float, callback: Callable[[], None], *, priority: int = 0,
-                     idle: Callable[[], bool] | None = None) -> Timer:  # fmt: skip
-        """Call ``callback()`` every ``period`` simulated seconds (lower ``priority`` runs first on ties).
+    @_renamed_keywords(period="timer_period_sec")
+    def create_timer(self, timer_period_sec: float, callback: Callable[[], None], callback_group: Any = None,
+                     clock: Any = None, *, priority: int = 0, idle: Callable[[], bool] | None = None) -> Timer:
+        """Call ``callback()`` every ``timer_period_sec`` simulated seconds (rclpy's signature; lower
+        ``priority`` runs first on ties).
 
         ``idle()`` (navlab extension), if given, returns True when the callback would do nothing at this
         firing (e.g. a sensor nobody reads); the firing is then skipped, physics included.
         """
+        period = timer_period_sec
         if isinstance(period, bool) or not isinstance(period, int | float) or not 0 < period < 1e9:
             raise ParameterError(f"node {self.fully_qualified_name}: timer period {period!r} s: expected a "
                                  "finite number > 0 (is a rate parameter 0, negative or not a number?)")
@@ -255,22 +367,33 @@ class Node:
         """The node's name (without namespace)."""
         return self.name
 
+    def get_namespace(self) -> str:
+        """The node's namespace (``/`` at the top)."""
+        return self.namespace or "/"
+
+    def get_fully_qualified_name(self) -> str:
+        """``/namespace/name``."""
+        return self.fully_qualified_name
+
     # --- parameters ------------------------------------------------------------------------------
 
-    def declare_parameter(self, name: str, default: Any = None, *, aliases: Sequence[str] = ()) -> Any:
-        """Declare a parameter and return its value: the override given at construction, or ``default``.
+    @_renamed_keywords(default="value")
+    def declare_parameter(self, name: str, value: Any = None, descriptor: Any = None, ignore_override: bool = False,
+                          *, aliases: Sequence[str] = ()) -> Any:
+        """Declare a parameter (rclpy's signature) and return it: the override given at construction, or
+        ``value`` (the default); a :class:`Parameter` for an rclpy-style node, the plain value otherwise.
 
         ``aliases`` are other accepted spellings (e.g. Nav2's name for a ROS 1 parameter).
         """
         key = name.replace("/", ".")
-        value = default
-        for cand in (key, *(a.replace("/", ".") for a in aliases)):
+        default = value
+        for cand in () if ignore_override else (key, *(a.replace("/", ".") for a in aliases)):
             if cand in self._overrides:
                 value = _coerce(cand, self._overrides[cand], default)
                 self._declared[cand] = value
                 break
         self._declared[key] = value
-        return value
+        return Parameter(name, value=value) if self._rclpy_style else value
 
     def declare_parameters(
         self, defaults: Mapping[str, Any], *, aliases: Mapping[str, Sequence[str]] | None = None
@@ -283,17 +406,38 @@ class Node:
         return {k: self.declare_parameter(k, d, aliases=aka.get(k, ())) for k, d in defaults.items()}
 
     def get_parameter(self, name: str) -> Any:
-        """Value of a declared parameter."""
+        """A declared parameter: a :class:`Parameter` (``.value``) for an rclpy-style node, else its value."""
         key = name.replace("/", ".")
+        if key not in self._declared and self._allow_undeclared and key in self._overrides:
+            self._declared[key] = self._overrides[key]
         try:
-            return self._declared[key]
+            value = self._declared[key]
         except KeyError:
             raise ParameterError(f"node {self.fully_qualified_name}: parameter {name!r} was not declared") from None
+        return Parameter(name, value=value) if self._rclpy_style else value
+
+    def get_parameters(self, names: Sequence[str]) -> list[Any]:
+        """rclpy's ``get_parameters``: :meth:`get_parameter` of each name."""
+        return [self.get_parameter(n) for n in names]
+
+    def has_parameter(self, name: str) -> bool:
+        """Whether ``name`` was declared."""
+        return name.replace("/", ".") in self._declared
 
     def set_parameter(self, name: str, value: Any) -> None:
         """Change a declared parameter's value (the node reads it on its next use)."""
         key = name.replace("/", ".")
-        self._declared[key] = _coerce(key, value, self.get_parameter(key))
+        if key not in self._declared:
+            raise ParameterError(f"node {self.fully_qualified_name}: parameter {name!r} was not declared")
+        self._declared[key] = _coerce(key, value, self._declared[key])
+
+    def set_parameters(self, parameters: Sequence[Any]) -> list[Any]:
+        """rclpy's ``set_parameters([Parameter(name, value=...)])``; returns one result (``.successful``) each."""
+        results = []
+        for p in parameters:
+            self.set_parameter(p.name, p.value)
+            results.append(SetParametersResult(successful=True))
+        return results
 
     def get_parameters_by_prefix(self, prefix: str) -> dict[str, Any]:
         """Overrides under ``prefix.`` (undeclared ones too), with the prefix removed."""
@@ -308,16 +452,20 @@ class Node:
                 self._declared.setdefault(k, self._overrides[k])
 
     def check_parameters(self) -> None:
-        """Refuse overrides that no declaration asked for, suggesting the closest names."""
-        if self._params_checked:
+        """Refuse overrides that no declaration asked for, suggesting the closest names (not for a node made
+        with ``allow_undeclared_parameters=True``)."""
+        if self._params_checked or self._allow_undeclared:
             return
         self._params_checked = True
-        unknown = [k for k in self._overrides if k not in self._declared]
-        if unknown:
-            lines = []
-            for key in unknown:
-                close = difflib.get_close_matches(key, list(self._declared), n=1)
-                lines.append(f"{key!r}" + (f" (did you mean {close[0]!r}?)" if close else ""))
+        lines = []
+        for key in (k for k in self._overrides if k not in self._declared):  # policy: params.check_unknown_key
+            close = difflib.get_close_matches(key, list(self._declared), n=1, cutoff=TYPO_CUTOFF)
+            if close:
+                lines.append(f"{key!r} (did you mean {close[0]!r}?)")
+            else:
+                warnings.warn(ParameterWarning(f"node {self.fully_qualified_name}: unknown parameter {key!r} "
+                                               "ignored (ROS ignores what it does not read)", key), stacklevel=2)
+        if lines:
             raise ParameterError(f"node {self.fully_qualified_name}: unknown parameter " + ", ".join(lines))
 
     def destroy_node(self) -> None:
@@ -329,6 +477,74 @@ class Node:
             if topic is not None and sub in topic.subscriptions:
                 topic.subscriptions.remove(sub)
         self.executor.nodes.pop(self.fully_qualified_name, None)
+
+
+@dataclasses.dataclass(frozen=True)
+class SetParametersResult:
+    """rcl_interfaces/SetParametersResult as rclpy returns it."""
+
+    successful: bool
+    reason: str = ""
+
+
+class ParameterValue:
+    """rclpy's ``get_parameter_value()``: the value under its typed field names."""
+
+    def __init__(self, value: Any) -> None:
+        self.bool_value = value if isinstance(value, bool) else False
+        self.integer_value = value if isinstance(value, int) and not isinstance(value, bool) else 0
+        self.double_value = float(value) if isinstance(value, int | float) and not isinstance(value, bool) else 0.0
+        self.string_value = value if isinstance(value, str) else ""
+        is_list = isinstance(value, list | tuple)
+        self.double_array_value = list(value) if is_list and all(isinstance(v, float) for v in value) else []
+        self.integer_array_value = list(value) if is_list and all(isinstance(v, int) for v in value) else []
+        self.string_array_value = list(value) if is_list and all(isinstance(v, str) for v in value) else []
+        self.bool_array_value = list(value) if is_list and all(isinstance(v, bool) for v in value) else []
+
+
+class Parameter:
+    """``rclpy.parameter.Parameter``: ``name``, ``value`` and ``get_parameter_value()``."""
+
+    class Type(enum.Enum):
+        """rclpy's parameter types (``Parameter.Type.DOUBLE``); navlab takes the type from the value."""
+
+        NOT_SET = 0
+        BOOL = 1
+        INTEGER = 2
+        DOUBLE = 3
+        STRING = 4
+        BYTE_ARRAY = 5
+        BOOL_ARRAY = 6
+        INTEGER_ARRAY = 7
+        DOUBLE_ARRAY = 8
+        STRING_ARRAY = 9
+
+    def __init__(self, name: str, type_: Parameter.Type | None = None, value: Any = None) -> None:
+        self.name = name
+        self.value = value
+        self.type_ = type_
+
+    def get_parameter_value(self) -> ParameterValue:
+        """The value under rclpy's typed field names (``double_value``, ``string_value``, ...)."""
+        return ParameterValue(self.value)
+
+    def __repr__(self) -> str:
+        return f"Parameter({self.name!r}, value={self.value!r})"
+
+
+def _transient_local(qos: Any) -> bool:
+    """Whether an rclpy ``QoSProfile`` asks for transient_local durability (ROS 1's latching)."""
+    durability = getattr(qos, "durability", None)
+    return "TRANSIENT_LOCAL" in str(getattr(durability, "name", durability)).upper()
+
+
+def _overrides_dict(overrides: Sequence[Any] | Mapping[str, Any] | None) -> dict[str, Any]:
+    """rclpy's ``parameter_overrides`` (a list of Parameter) or a mapping, as navlab's nested dict."""
+    if overrides is None:
+        return {}
+    if isinstance(overrides, Mapping):
+        return dict(overrides)
+    return {p.name.replace("/", "."): p.value for p in overrides}
 
 
 def _as_list(x: Any | Sequence[Any]) -> list[Any]:

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import difflib
 import math
+import warnings
 from dataclasses import fields, is_dataclass
 from pathlib import Path
 from typing import Any, TypeVar
@@ -18,10 +19,35 @@ from typing import Any, TypeVar
 import yaml
 
 from navlab.core.errors import ParameterError
+from navlab.errors import NavlabError
 from navlab.io.errors import IoError
 from navlab.io.files import read_text_checked
 
 T = TypeVar("T")
+
+TYPO_CUTOFF = 0.85  # difflib ratio at or above which an unknown key is taken for a misspelling of a known one
+
+
+class ParameterWarning(NavlabError, UserWarning):
+    """An unknown parameter key that ROS would ignore (a warning, not raised): ``key`` is its name (the launch
+    names its file)."""
+
+    def __init__(self, message: str, key: str) -> None:
+        super().__init__(message)
+        self.key = key
+
+
+def check_unknown_key(key: str, known: list[str], *, what: str, error: type[Exception]) -> None:
+    """The unknown-key policy, ROS's where it is safe: a ROS node reads the parameters it knows and ignores the
+    rest of its namespace, so a key of another plugin or an older release (``meter_scoring`` in a costmap file)
+    only warns (``ParameterWarning``: "unknown WHAT parameter 'key' ignored"). A key within a letter or two of
+    a known one (difflib ratio >= ``TYPO_CUTOFF``: ``inflation_raduis``) is a misspelling whose value ROS
+    would silently drop, leaving the default in force: that raises ``error`` with "did you mean"."""
+    close = difflib.get_close_matches(key, known, n=1, cutoff=TYPO_CUTOFF)
+    if close:
+        raise error(f"unknown {what} parameter '{key}'; did you mean '{close[0]}'?")
+    warnings.warn(ParameterWarning(f"unknown {what} parameter '{key}' ignored (ROS ignores what it does not "
+                                   "read)", key), stacklevel=3)
 
 
 MAX_YAML_BYTES = 16 << 20  # a parameter, launch, route or scenario file is never this large
@@ -153,7 +179,8 @@ def load_params(path: str | Path, *, node: str | None = None) -> dict[str, Any]:
 def dataclass_from_dict(cls: type[T], values: dict[str, Any] | None, *, what: str, error: type[Exception]) -> T:
     """An instance of dataclass ``cls`` with ``values`` overriding its defaults, each cast to its default's type.
 
-    An unknown name raises ``error``: "unknown WHAT parameter 'key'; did you mean 'closest'?".
+    An unknown name follows ``check_unknown_key``: a likely typo raises ``error`` ("unknown WHAT parameter
+    'key'; did you mean 'closest'?"), any other key warns and is ignored.
     """
     if not is_dataclass(cls):
         raise TypeError(f"dataclass_from_dict needs a dataclass, got {cls!r}")
@@ -161,9 +188,8 @@ def dataclass_from_dict(cls: type[T], values: dict[str, Any] | None, *, what: st
     out = cls()
     for key, val in (values or {}).items():
         if key not in names:
-            close = difflib.get_close_matches(key, names, n=1)
-            hint = f"; did you mean '{close[0]}'?" if close else ""
-            raise error(f"unknown {what} parameter '{key}'{hint}")
+            check_unknown_key(str(key), names, what=what, error=error)
+            continue
         kind = type(getattr(out, key))
         try:
             scalar = kind in (int, float, str, bool)

@@ -16,7 +16,7 @@ from typing import Literal
 
 from navlab.description.errors import DescriptionError
 from navlab.description.materials import gazebo_material
-from navlab.description.model import DiffDriveConfig, ImuConfig, LidarConfig, Link, Origin
+from navlab.description.model import DiffDriveConfig, ImuConfig, LidarConfig, Link, Origin, P3dConfig
 from navlab.description.urdf import floats
 
 DIFF_DRIVE_PLUGINS = ("libgazebo_ros_diff_drive.so",)
@@ -27,7 +27,8 @@ LASER_PLUGIN_NAMES = ("gazebo_ros_laser", "gazebo_ros_ray_sensor", "gazebo_ros_h
 IMU_SENSOR_PLUGINS = ("libgazebo_ros_imu_sensor.so",)
 IMU_MODEL_PLUGINS = ("libgazebo_ros_imu.so",)
 #: plugins whose job navlab's simulator does anyway (joint states, ground truth): no warning
-BUILTIN_PLUGINS = ("libgazebo_ros_joint_state_publisher.so", "libgazebo_ros_p3d.so")
+BUILTIN_PLUGINS = ("libgazebo_ros_joint_state_publisher.so",)
+P3D_PLUGINS = ("libgazebo_ros_p3d.so",)
 #: <gazebo reference="link"> tags understood or harmless to ignore (rendering, ODE contact tuning)
 LINK_TAGS = ("mu1", "mu2", "material", "kp", "kd", "minDepth", "maxVel", "fdir1", "selfCollide",
              "self_collide", "turnGravityOff", "gravity", "maxContacts", "dampingFactor", "sensor",
@@ -36,12 +37,18 @@ LINK_TAGS = ("mu1", "mu2", "material", "kp", "kd", "minDepth", "maxVel", "fdir1"
 
 DD_KEYS_ROS1 = {
     "leftJoint": "left_joint", "rightJoint": "right_joint", "wheelSeparation": "wheel_separation",
-    "wheelDiameter": "wheel_diameter", "torque": "max_torque", "wheelTorque": "max_torque",
+    "wheelDiameter": "wheel_diameter", "wheelTorque": "max_torque",
     "wheelAcceleration": "max_accel", "updateRate": "update_rate", "commandTopic": "command_topic",
     "odometryTopic": "odometry_topic", "odometryFrame": "odometry_frame",
-    "robotBaseFrame": "robot_base_frame", "odometrySource": "odometry_source", "publishTf": "publish_tf",
+    "robotBaseFrame": "robot_base_frame", "odometrySource": "odometry_source", "publishTf": "publish_odom",
     "publishOdomTF": "publish_tf", "publishWheelTF": "publish_wheel_tf", "robotNamespace": "namespace",
-    "legacyMode": "legacy_mode",
+}
+#: tags older ROS 1 releases read that Noetic's gazebo_ros_diff_drive does not: the warning names what it reads
+DD_NOT_IN_NOETIC = {
+    "torque": "<torque> is not read by ROS Noetic's gazebo_ros_diff_drive (ignored since Hydro); it reads "
+              "<wheelTorque> (default 5 N m), which applies",
+    "legacyMode": "<legacyMode> was removed from gazebo_ros_diff_drive in Melodic (gazebo_ros_pkgs PR #707); "
+                  "Noetic drives the <leftJoint> joint as the left wheel and <rightJoint> as the right one",
 }
 DD_KEYS_ROS2 = {
     "left_joint": "left_joint", "right_joint": "right_joint", "wheel_separation": "wheel_separation",
@@ -52,10 +59,16 @@ DD_KEYS_ROS2 = {
     "publish_wheel_tf": "publish_wheel_tf", "command_topic": "command_topic",
     "odometry_topic": "odometry_topic",
 }
+#: tags older laser plugins (or other ones) read that Noetic's gazebo_ros_laser does not: what applies instead
+LASER_NOT_IN_NOETIC = {
+    "gaussianNoise": "the sensor's <ray><noise> (gaussian, stddev)",
+    "hokuyoMinIntensity": "the sensor's intensities as Gazebo computes them",
+    "updateRate": "the sensor's <update_rate>",
+}
 DD_IGNORED = ("alwaysOn", "rosDebugLevel", "publishWheelJointState", "publishOdom", "publish_odom",
               "ros", "num_wheel_pairs", "covariance_x", "covariance_y", "covariance_yaw", "odometryRate")
 FLOAT_FIELDS = ("wheel_separation", "wheel_diameter", "max_torque", "max_accel", "update_rate")
-BOOL_FIELDS = ("publish_tf", "publish_wheel_tf", "legacy_mode")
+BOOL_FIELDS = ("publish_tf", "publish_odom", "publish_wheel_tf")
 GAZEBO_DEFAULT_RATE = 1000.0  # Hz: Gazebo's default physics rate; a plugin rate of 0 means every step
 
 
@@ -66,8 +79,8 @@ class GazeboTags:
     diff_drive: DiffDriveConfig | None = None
     lidars: list[LidarConfig] = field(default_factory=list)
     imus: list[ImuConfig] = field(default_factory=list)
+    ground_truths: list[P3dConfig] = field(default_factory=list)
     warnings: list[str] = field(default_factory=list)
-    legacy_mode_given: bool = True  # the diff-drive plugin wrote <legacyMode> (else ROS 1's default applied)
 
 
 def _bool(text: str, where: str) -> bool:
@@ -125,14 +138,15 @@ def parse_diff_drive(plugin: ET.Element, where: str, warnings: list[str]) -> Dif
         if not isinstance(child.tag, str):
             continue
         key = DD_KEYS_ROS1.get(child.tag) or DD_KEYS_ROS2.get(child.tag)
-        if key is not None:
+        if child.tag == "legacyMode" and (child.text or "").strip().lower() in ("false", "0"):
+            pass  # what Noetic does anyway: nothing to say
+        elif child.tag in DD_NOT_IN_NOETIC:
+            warnings.append(f"{where}: {DD_NOT_IN_NOETIC[child.tag]}")
+        elif key is not None:
             values[key] = (child.text or "").strip()
         elif child.tag not in DD_IGNORED:
             warnings.append(f"{where}: unknown diff-drive parameter <{child.tag}> ignored"
                             f"{_did_you_mean(child.tag, known)}")
-    ros2 = any(c.tag in DD_KEYS_ROS2 for c in plugin) or plugin.find("ros") is not None
-    if "legacy_mode" not in values and not ros2:
-        cfg.legacy_mode = True  # ROS 1's default; what it does to this robot is reported by check_plugin_joints
     if "odometry_source" not in values:
         cfg.odometry_source = "world"  # both plugins default to the true pose
     for key, raw in values.items():
@@ -164,6 +178,15 @@ def parse_diff_drive(plugin: ET.Element, where: str, warnings: list[str]) -> Dif
     cfg.command_topic = _scoped(cfg.namespace, cfg.command_topic)
     cfg.odometry_topic = _scoped(cfg.namespace, cfg.odometry_topic)
     return cfg
+
+
+def _noetic_default(plugin: ET.Element, tag: str, default: str, what: str, where: str, warnings: list[str]) -> str:
+    """``<tag>`` of a ROS 1 plugin, or Noetic's default for it (with a warning naming the tag and the default)."""
+    text = plugin.findtext(tag)
+    if text is None:
+        warnings.append(f"{where}: no <{tag}>: ROS Noetic's {what} then uses {default!r}, and so does navlab")
+        return default
+    return text.strip()
 
 
 def _noise(el: ET.Element | None, where: str) -> tuple[float, float]:
@@ -208,10 +231,13 @@ def parse_lidar(sensor: ET.Element, link: str, where: str, plugin: ET.Element,
     ns, remaps = _remaps(plugin)
     name = plugin.get("name", "")
     ros2 = plugin.find("ros") is not None or _plugin_file(plugin) == "libgazebo_ros_ray_sensor.so"
-    if not ros2:  # ROS 1: <topicName> (default "scan" here), <frameName>, <robotNamespace>
+    if not ros2:  # ROS 1: <topicName>, <frameName>, <robotNamespace>, with Noetic's defaults
         ns = (plugin.findtext("robotNamespace") or "").strip()
-        topic = (plugin.findtext("topicName") or "scan").strip()
-        frame = (plugin.findtext("frameName") or "").strip()
+        topic = _noetic_default(plugin, "topicName", "/world", "gazebo_ros_laser", where, warnings)
+        frame = _noetic_default(plugin, "frameName", "/world", "gazebo_ros_laser", where, warnings)
+        for tag, read in LASER_NOT_IN_NOETIC.items():
+            if plugin.find(tag) is not None:
+                warnings.append(f"{where}: <{tag}> is not read by ROS Noetic's gazebo_ros_laser; {read} applies")
     else:  # ROS 2: node named after the plugin publishes ~/out unless remapped
         topic = remaps.get("~/out") or remaps.get("out") or f"{name or 'ray_sensor'}/out"
         frame = (plugin.findtext("frame_name") or plugin.findtext("frameName") or "").strip()
@@ -266,7 +292,8 @@ def parse_imu(plugin: ET.Element, link: str, where: str, sensor: ET.Element | No
     ns, remaps = _remaps(plugin)
     if plugin.find("ros") is None:  # ROS 1: <topicName>, <frameName>/<bodyName>, <robotNamespace>
         ns = (plugin.findtext("robotNamespace") or "").strip()
-        topic = (plugin.findtext("topicName") or "imu").strip()
+        topic = (_noetic_default(plugin, "topicName", "/default_imu", "gazebo_ros_imu", where, [])
+                 if _plugin_file(plugin) in IMU_MODEL_PLUGINS else (plugin.findtext("topicName") or "imu").strip())
         frame = (plugin.findtext("frameName") or plugin.findtext("bodyName") or link).strip()
     else:
         topic = remaps.get("~/out") or remaps.get("out") or f"{plugin.get('name') or 'imu'}/out"
@@ -281,6 +308,23 @@ def parse_imu(plugin: ET.Element, link: str, where: str, sensor: ET.Element | No
         gyro_noise_stddev=gyro or gaussian, accel_noise_stddev=accel or gaussian,
         name=(sensor.get("name", "imu") if sensor is not None else plugin.get("name", "imu")),
     )
+
+
+def parse_p3d(plugin: ET.Element, where: str, warnings: list[str]) -> P3dConfig | None:
+    """A ROS 1 ``libgazebo_ros_p3d`` plugin as Noetic reads it: ``bodyName`` and ``topicName`` required (without
+    them the plugin does not load: a warning, and nothing published), ``frameName`` default ``world``,
+    ``updateRate`` default 0 (every physics step), ``robotNamespace`` in front of a relative topic."""
+    missing = [t for t in ("bodyName", "topicName") if not (plugin.findtext(t) or "").strip()]
+    if missing:
+        warnings.append(f"{where}: no <{missing[0]}>: ROS Noetic's gazebo_ros_p3d does not load without it; "
+                        "nothing is published")
+        return None
+    ns = (plugin.findtext("robotNamespace") or "").strip()
+    return P3dConfig(link=str(plugin.findtext("bodyName")).strip(),
+                     topic=_scoped(ns, str(plugin.findtext("topicName")).strip()),
+                     frame_id=(plugin.findtext("frameName") or "world").strip().lstrip("/") or "world",
+                     update_rate=_rate(_num(plugin.find("updateRate"), where, 0.0)),
+                     name=plugin.get("name") or "p3d")
 
 
 def _plugin_file(plugin: ET.Element) -> str:
@@ -373,12 +417,15 @@ def _read_model_plugin(plugin: ET.Element, where: str, out: GazeboTags) -> None:
             out.warnings.append(f"{w}: a second diff-drive plugin; the first one is used")
         else:
             out.diff_drive = parse_diff_drive(plugin, w, out.warnings)
-            out.legacy_mode_given = plugin.find("legacyMode") is not None
     elif fname in IMU_MODEL_PLUGINS:
         body = (plugin.findtext("bodyName") or "").strip()
         if not body:
             raise DescriptionError(f"{w}: missing <bodyName> (the IMU's link)")
         out.imus.append(parse_imu(plugin, body, w, None))
+    elif fname in P3D_PLUGINS:
+        p3d = parse_p3d(plugin, w, out.warnings)
+        if p3d is not None:
+            out.ground_truths.append(p3d)
     elif fname not in BUILTIN_PLUGINS:
         out.warnings.append(f"{w}: unknown plugin, ignored (navlab simulates libgazebo_ros_diff_drive, "
                             "laser/ray-sensor and imu plugins)")
@@ -397,35 +444,24 @@ def _side(joint: str, chain: dict[str, tuple[str, Origin]]) -> float:
     return pose.xyz[1]
 
 
-def legacy_mode_note(dd: DiffDriveConfig, chain: dict[str, tuple[str, Origin]], given: bool) -> str | None:
-    """What ROS 1's ``<legacyMode>`` does to this robot, or None when it changes nothing worth saying.
+def swapped_joints_note(dd: DiffDriveConfig, chain: dict[str, tuple[str, Origin]]) -> str | None:
+    """How the robot turns when ``<leftJoint>`` names the wheel on the right, else None.
 
     ``chain``: joint name -> (its parent link's parent joint name or "", its origin), to find on which
-    side (+y: left) each wheel sits. With legacy mode the joint named in ``<leftJoint>`` is driven
-    as the right wheel, so only a robot whose ``<leftJoint>`` is physically on the right turns
-    the way cmd_vel asks."""
-    left_y, right_y = _side(dd.left_joint, chain), _side(dd.right_joint, chain)
-    swapped = left_y < right_y  # <leftJoint> names the wheel on the right
-    how = "<legacyMode> not given: ROS 1's default true applies" if not given else "<legacyMode> true"
-    if dd.legacy_mode and not swapped:
-        return (f"{how}; <leftJoint> {dd.left_joint!r} (on the left) is driven as the right wheel, so the "
-                "robot turns the opposite way to cmd_vel's angular.z, as it does in Gazebo; odometry "
-                "follows the wheels (legacyMode false gives REP-103 turning)")
-    if dd.legacy_mode and swapped:
-        return (f"{how}; <leftJoint> {dd.left_joint!r} is the wheel on the right, and legacy mode drives "
-                "it as the right wheel: the robot turns as cmd_vel asks, as it does in Gazebo")
-    if swapped:
-        return (f"<legacyMode> false but <leftJoint> {dd.left_joint!r} is the wheel on the right: the robot "
-                "turns the opposite way to cmd_vel's angular.z, as it does in Gazebo")
-    return None
+    side (+y: left) each wheel sits. ROS Noetic's plugin drives the ``<leftJoint>`` joint as the left
+    wheel whatever side it is on, so such a robot turns the opposite way to cmd_vel, in Gazebo and here."""
+    if dd.legacy_mode or _side(dd.left_joint, chain) >= _side(dd.right_joint, chain):
+        return None
+    return (f"<leftJoint> {dd.left_joint!r} is the wheel on the right: ROS Noetic's plugin drives it as the left "
+            "wheel, so the robot turns the opposite way to cmd_vel's angular.z, as it does in Gazebo")
 
 
 def check_plugin_joints(tags: GazeboTags, joints: dict[str, str], links: dict[str, Link], source: str,
-                        chain: dict[str, tuple[str, Origin]] | None = None, *, legacy_given: bool = True) -> None:
+                        chain: dict[str, tuple[str, Origin]] | None = None) -> None:
     """The diff-drive joints must be continuous/revolute joints; sensors must sit on existing links.
 
-    With ``chain`` (see :func:`legacy_mode_note`) a note on how the robot turns under ROS 1's
-    ``<legacyMode>`` is added to the warnings."""
+    With ``chain`` (see :func:`swapped_joints_note`) a note on a robot whose left and right joints are
+    named the other way round is added to the warnings."""
     dd = tags.diff_drive
     if dd is not None:
         for role, name in (("left", dd.left_joint), ("right", dd.right_joint)):
@@ -436,12 +472,17 @@ def check_plugin_joints(tags: GazeboTags, joints: dict[str, str], links: dict[st
                 raise DescriptionError(f"{source}: diff-drive plugin: {role} joint {name!r} is {joints[name]}, "
                                        "expected continuous or revolute")
         if chain is not None:
-            note = legacy_mode_note(dd, chain, legacy_given)
+            note = swapped_joints_note(dd, chain)
             if note:
                 tags.warnings.append(f"{source}: diff-drive plugin: {note}")
     for imu in tags.imus:
         if imu.link not in links:
             raise DescriptionError(f"{source}: imu plugin {imu.name!r}: body {imu.link!r} is not a link")
+    for p3d in list(tags.ground_truths):
+        if p3d.link not in links:  # Noetic: "bodyName: X does not exist", the plugin does not load
+            tags.warnings.append(f"{source}: p3d plugin {p3d.name!r}: bodyName {p3d.link!r} is not a link of the "
+                                 "robot; as in ROS Noetic the plugin does not load")
+            tags.ground_truths.remove(p3d)
     for lidar in tags.lidars:
         if not math.isfinite(lidar.max_angle - lidar.min_angle) or lidar.max_angle < lidar.min_angle:
             raise DescriptionError(f"{source}: lidar {lidar.name!r}: max_angle < min_angle")

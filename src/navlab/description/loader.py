@@ -101,11 +101,11 @@ def load_robot(
     tags = read_gazebo_tags(root, links, {j.name for j in joints}, source)
     parent_joint = {j.child: j.name for j in joints}
     chain = {j.name: (parent_joint.get(j.parent, ""), j.origin) for j in joints}
-    check_plugin_joints(tags, {j.name: j.type for j in joints}, links, source, chain,
-                        legacy_given=tags.legacy_mode_given)
+    check_plugin_joints(tags, {j.name: j.type for j in joints}, links, source, chain)
     model.diff_drive = tags.diff_drive
     model.lidars = tags.lidars
     model.imus = tags.imus
+    model.ground_truths = tags.ground_truths
     model.warnings += tags.warnings
     if model.diff_drive is None:
         model.warnings.append(f"{source}: no libgazebo_ros_diff_drive.so plugin; cmd_vel will not move "
@@ -113,14 +113,43 @@ def load_robot(
     return model
 
 
+def xacro_text(path: str | os.PathLike[str], args: Mapping[str, str] | None = None) -> str:
+    """The URDF text ``xacro FILE name:=value`` prints (a launch file's ``<param command="xacro ...">``)."""
+    file = robot_path(path)
+    return expand(file, PackageIndex(near=file), args)[0]
+
+
+def _footprint_or_default(model: RobotModel) -> list[list[float]]:
+    """:func:`robot_footprint`, or costmap_2d's default footprint for a robot of meshes only."""
+    from navlab.description.footprint import robot_footprint
+
+    try:
+        return robot_footprint(model)
+    except DescriptionError:
+        return [[-0.325, -0.325], [-0.325, 0.325], [0.325, 0.325], [0.46, 0.0], [0.325, -0.325]]
+
+
 def robot_launch_values(name_or_path: str | os.PathLike[str]) -> dict[str, str]:
-    """What launch files take from a robot's plugin tags (``$(robot KEY)``): ``base_frame`` (the
-    diff-drive plugin's ``robotBaseFrame``, else the root link), ``odom_frame`` and ``scan_topic`` (the
-    first laser's topic, else ``scan``)."""
+    """What launch files take from a robot (``$(robot KEY)``): ``base_frame`` (the diff-drive plugin's
+    ``robotBaseFrame``, else the root link), ``odom_frame`` and ``scan_topic`` (the first laser's topic,
+    else ``scan``) from its plugin tags; ``params``: the navigation parameter folder navlab ships for it,
+    else the generic ROS-default one (``params_note`` then says so); ``footprint``: the rectangle around its
+    collision geometry (``[[x, y], ...]``, m, in the base frame)."""
     model = load_robot(name_or_path)
     dd = model.diff_drive
-    return {
+    shipped = resources.root() / "params" / model.name
+    own = shipped.is_dir() and model.source is not None and resources.root() in model.source.resolve().parents
+    values = {
         "base_frame": dd.robot_base_frame if dd else model.root_link,
         "odom_frame": dd.odometry_frame if dd else "odom",
         "scan_topic": model.lidars[0].topic if model.lidars else "scan",
+        "params": str(shipped if own else resources.root() / "params" / "generic"),
+        "footprint": str(_footprint_or_default(model)),
     }
+    if not own:
+        values["params_note"] = (
+            f"robot {model.name!r} has no navigation parameters of its own and params:= was not given: move_base "
+            f"uses navlab's generic ROS-default set ({values['params']}) with the footprint {values['footprint']} (m) "
+            "around "
+            "its collision geometry; pass params:=DIR for the robot's tuned files")
+    return values

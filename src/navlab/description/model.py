@@ -153,13 +153,16 @@ class DiffDriveConfig:
     odometry_frame: str = "odom"
     robot_base_frame: str = "base_footprint"
     odometry_source: Literal["encoder", "world"] = "world"
-    publish_tf: bool = True
+    publish_tf: bool = True  # <publishOdomTF>: tf odom -> base
+    publish_odom: bool = True  # Noetic's <publishTf>: false publishes neither the odometry topic nor its tf
     publish_wheel_tf: bool = False
     # navlab extension (not a Gazebo tag; gazebo node parameter cmd_timeout): s without cmd_vel before the
     # wheels are stopped; 0 = off, as in ROS 1's plugin (the last command holds until a new one)
     cmd_timeout: float = 0.0
     namespace: str = ""
-    legacy_mode: bool = False  # ROS 1 <legacyMode> (default true there): the joints' turning roles swapped
+    # Kinetic's <legacyMode> (the joints' turning roles swapped); Noetic's plugin has no such option, so the
+    # tags never set it (a <legacyMode> tag is ignored with a warning); kept for Python callers
+    legacy_mode: bool = False
     # navlab extension (not a Gazebo tag): relative error of each wheel's encoder scale, drawn once per
     # run from N(0, odometry_noise) with the run's seed; 0 = exact encoders. Makes odometry drift.
     odometry_noise: float = 0.0
@@ -200,6 +203,17 @@ class ImuConfig:
 
 
 @dataclass
+class P3dConfig:
+    """A ``libgazebo_ros_p3d`` plugin: the true pose of ``link`` as nav_msgs/Odometry on ``topic``."""
+
+    link: str
+    topic: str
+    frame_id: str = "world"
+    update_rate: float = 1000.0  # Hz (0 in the tag: every physics step)
+    name: str = "p3d"
+
+
+@dataclass
 class RobotModel:
     """A whole robot: links by name, joints in file order, the root link, and its plugins."""
 
@@ -210,6 +224,7 @@ class RobotModel:
     diff_drive: DiffDriveConfig | None = None
     lidars: list[LidarConfig] = field(default_factory=list)
     imus: list[ImuConfig] = field(default_factory=list)
+    ground_truths: list[P3dConfig] = field(default_factory=list)  # p3d plugins
     warnings: list[str] = field(default_factory=list)
     source: Path | None = None
     urdf_xml: str = ""  # the expanded URDF (after xacro), for robot_description

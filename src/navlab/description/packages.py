@@ -210,3 +210,9 @@ class PackageIndex:
             return self.find_model(uri, model_paths, need_file=True)
         path = Path(uri).expanduser()
         return path if path.is_absolute() else base_dir / path
+
+
+def find_package(name: str) -> Path:
+    """``$(find NAME)`` of launch files: the package's directory (``ROS_PACKAGE_PATH``, then the packages
+    navlab ships); DescriptionError naming where it looked when none is found."""
+    return PackageIndex().find(name)

@@ -300,10 +300,13 @@ def register(sub: argparse._SubParsersAction) -> None:
         "navigate",
         help="navigate to goals with move_base on a map, as in the paper's experiments (Figs. 9-12)",
         description="The paper's navigation launch (simulator, map_server, amcl and move_base with the ROS 1 "
-        "parameter files of --params) drives the robot to each --goal in turn. Prints each goal's outcome "
-        "(succeeded, aborted with move_base's reason, or timeout), time, path length, minimum clearance and "
-        "collisions (from the simulator's contacts), and with --out DIR saves one picture per goal: map, "
-        "inflation shadow, global plan (blue), local plan (green), robot (orange), laser (red).",
+        "parameter files of --params) drives the robot to each --goal in turn. Prints each goal's outcome, judged "
+        "by the simulator's truth (succeeded: the robot truly ended within 0.3 m of the goal; else aborted with "
+        "move_base's reason, preempted, timeout, or not_reached when move_base reported success from its own "
+        "estimate), move_base's own verdict beside it, time, path length, final error, minimum clearance (the "
+        "robot's collision geometry to the world's) and collisions (from the simulator's contacts), and with "
+        "--out DIR saves one picture per goal: map, inflation shadow, global plan (blue), local plan (green), "
+        "robot (orange), laser (red).",
     )
     _add_world_robot(p, "room_obstacles")
     p.add_argument("--map", metavar="MAP.yaml", default=None,

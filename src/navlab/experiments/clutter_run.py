@@ -3,7 +3,9 @@
 Each world (``world.clutter``) is written as an SDF ``.world``, the robot starts 2 m before the field and
 drives with ``move_base`` on a rolling global costmap to the goal 10 m ahead (given in ``odom``). A trial
 succeeds when the robot ends within 1 m of the goal without a collision inside ``timeout`` s; its score is
-``success x T_opt / clip(T, 2 T_opt, 8 T_opt)`` with ``T_opt`` = reference path length / 2 m/s.
+``success x T_opt / clip(T, 2 T_opt, 8 T_opt)`` with ``T_opt`` = reference path length / 2 m/s. The judgement
+is the simulator's truth; move_base's own verdict is beside it (``move_base_success``, ``false_success``: it
+reported the goal reached while the robot truly ended more than 1 m away).
 """
 
 from __future__ import annotations
@@ -38,7 +40,8 @@ def run_clutter_world(
         sx, sy, syaw = (float(v) for v in world.start)
         params = {**CLUTTER_PARAMS, **(move_base_params or {})}
         r = run_navigation([(gx, gy, gyaw)], world=str(path), pose=(sx, sy, syaw), mapless=True, controller=controller,
-                           move_base_params=params, seed=seed, goal_timeout=timeout)  # fmt: skip
+                           move_base_params=params, seed=seed, goal_timeout=timeout,
+                           goal_tolerance=SUCCESS_M)  # fmt: skip
     g = r.goals[0]
     return rounded({
         **barn_outcome(world, [g]), "reason": g["reason"], "time_s": g["time_s"], "collisions": g["collisions"],
@@ -58,6 +61,9 @@ def barn_outcome(world: Any, goals: list[dict[str, Any]]) -> dict[str, Any]:
     missed = "missed" if g["outcome"] == "succeeded" else g["outcome"]  # move_base's tolerance is not BARN's
     failure = "" if success else ("collision" if collisions else missed)
     return {"world": world.name, "difficulty": world.difficulty, "success": success, "failure": failure,
+            "move_base_success": collisions == 0 and all(x["move_base_outcome"] == "succeeded" for x in goals),
+            "false_success": sum(x["move_base_outcome"] == "succeeded" and x["final_error_m"] > SUCCESS_M
+                                 for x in goals),
             "t_opt_s": world.t_opt(), "score": barn_score(success, time_s, world.t_opt())}  # fmt: skip
 
 
@@ -109,6 +115,8 @@ def summarize(trials: list[dict[str, Any]]) -> dict[str, Any]:
         "collision": sum(t["failure"] == "collision" for t in trials) / n,
         "timeout": sum(t["failure"] == "timeout" for t in trials) / n,
         "aborted": sum(t["failure"] == "aborted" for t in trials) / n,
+        "move_base_success": sum(t["move_base_success"] for t in trials) / n,
+        "false_success": sum(t["false_success"] for t in trials),
         "score": sum(t["score"] for t in trials) / n,
         "mean_time_s": sum(t["time_s"] for t in trials if t["success"]) / max(1, sum(t["success"] for t in trials)),
     })  # fmt: skip

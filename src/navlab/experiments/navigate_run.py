@@ -1,9 +1,12 @@
 """The paper's navigation step: the ``navigation`` launch (sim + map_server + amcl + move_base), goals sent
 one after another, each scored from ground truth and the simulator's contacts.
 
-``run_navigation`` is the Python API behind ``navlab navigate``; each goal's figures are its outcome
-(``succeeded`` | ``aborted`` | ``timeout``), move_base's reason, time, path length, minimum clearance
-(m between the robot's footprint and anything the lidar's true rays hit) and collisions (contact episodes).
+``run_navigation`` is the Python API behind ``navlab navigate``. Each goal is judged by the simulator's truth:
+``outcome`` is ``succeeded`` when the robot truly ended within ``goal_tolerance`` m of the goal, else move_base's
+failure (``aborted`` | ``preempted`` | ``timeout``) or ``not_reached`` when move_base reported success from its
+own (odometry/AMCL) estimate; ``move_base_outcome`` is move_base's verdict beside it and ``false_success`` marks
+the disagreement. Also move_base's reason, time, path length, minimum clearance (m between the robot's
+collision geometry and the world's, from MuJoCo) and collisions (contact episodes).
 """
 
 from __future__ import annotations
@@ -39,21 +42,22 @@ CONTROLLERS = {
 }
 
 
+GOAL_TOLERANCE_M = 0.3  # the truth's goal region: twice the shipped robots' xy_goal_tolerance (AMCL's error room)
+
+
 class NavMonitor(Node):
-    """Ground truth for the goals: the true path (10 Hz), the closest approach to obstacles (the nearest laser
-    return minus the robot's radius, over every scan) and contact episodes on ``/collisions``; and the last
-    scan's points in the world for the pictures."""
+    """Ground truth for the goals: the true path and the clearance (m between the robot's collision geometry and
+    the world's, ``Simulation.clearance``) at 10 Hz, contact episodes on ``/collisions``; and the last scan's
+    points in the world for the pictures."""
 
     def __init__(self, executor: Executor, *, name: str = "nav_monitor", parameters: dict[str, Any] | None = None,
                  namespace: str = "", sim: Any = None, move_base: Any = None) -> None:  # fmt: skip
         super().__init__(executor, name=name, parameters=parameters, namespace=namespace)
-        self.radius = float(self.declare_parameter("robot_radius", 0.2))
         self.base_frame = str(self.declare_parameter("base_frame", "base_link"))
         self.sim, self.move_base = sim, move_base
         self.path: list[tuple[float, float, float]] = []
         self.clearance: list[float] = []
         self.contacts: list[float] = []  # times (s) of /collisions messages
-        self._nearest = math.inf  # the nearest return since the last sample (m)
         self._scan: Any = None
         self.estimate_frame = str(self.declare_parameter("estimate_frame", "map"))
         self.localization_error: list[float] = []  # |estimate - truth| (m) at each sample, where there is one
@@ -68,10 +72,6 @@ class NavMonitor(Node):
         self.cmd.append((self.now_s(), float(msg.linear.x)))
 
     def _on_scan(self, msg: Any) -> None:
-        r = np.asarray(msg.ranges, dtype=np.float64)
-        ok = np.isfinite(r) & (r >= float(msg.range_min)) & (r < float(msg.range_max))
-        if ok.any():
-            self._nearest = min(self._nearest, float(r[ok].min()))
         self._scan = msg
 
     def now_s(self) -> float:
@@ -87,8 +87,7 @@ class NavMonitor(Node):
                 self.localization_error.append(math.hypot(ex - x, ey - y))
             except TfError:
                 pass
-        self.clearance.append(self._nearest - self.radius)
-        self._nearest = math.inf
+        self.clearance.append(self.sim.clearance())
         plan = getattr(self.move_base, "global_plan", None)  # in the map frame: the world's with a true map
         ok = self.estimate_frame == "map" and plan is not None and len(plan) > 0
         self.tracking.append(float(distance_to_path(np.array([[x, y]]), plan)[0]) if ok and plan is not None
@@ -136,9 +135,11 @@ def _episodes(times: Sequence[float], t0: float, t1: float, gap: float = 0.25) -
 
 
 def _drive_goal(run: Run, mon: NavMonitor, goal: Pose, frame: str, timeout: float,
-                shots: list[NavSnapshot] | None = None, world_T_frame: Pose = (0.0, 0.0, 0.0)) -> dict[str, Any]:
+                shots: list[NavSnapshot] | None = None, world_T_frame: Pose = (0.0, 0.0, 0.0),
+                tolerance: float = GOAL_TOLERANCE_M) -> dict[str, Any]:  # fmt: skip
     """Send one goal (in ``frame``, which sits at ``world_T_frame``) and run until it ends or ``timeout`` s
-    pass; ``shots`` collects a snapshot a second."""
+    pass; ``shots`` collects a snapshot a second. Judged by the truth (within ``tolerance`` m at the end)
+    beside move_base's verdict (see the module docstring)."""
     mb = _move_base(run)
     t0 = mon.now_s()
     k0 = len(mon.path)
@@ -147,22 +148,31 @@ def _drive_goal(run: Run, mon: NavMonitor, goal: Pose, frame: str, timeout: floa
         run.run(min(1.0, timeout - (mon.now_s() - t0)), until=handle.done, quiet=True, chunk=1.0)
         if shots is not None:
             shots.append(_snapshot(run, mon))
+    # actionlib's terminal states; "timeout": navlab stopped waiting (and cancels the goal)
+    verdict = {"SUCCEEDED": "succeeded", "ABORTED": "aborted", "PREEMPTED": "preempted"}.get(handle.state, "timeout")
     if not handle.done():
         mb.cancel_goal()
-    t1 = mon.now_s()
+    t1 = handle.end_s if verdict != "timeout" and handle.end_s is not None else mon.now_s()
     pts = np.array([p[1:] for p in mon.path[k0:]]).reshape(-1, 2)
-    final = run.sim.base_pose2d()
-    outcome = {"SUCCEEDED": "succeeded", "ABORTED": "aborted"}.get(handle.state, "timeout")
-    reasons = {"succeeded": "", "aborted": handle.reason, "timeout": f"not reached in {timeout:g} s"}
+    final_error = math.dist(run.sim.base_pose2d()[:2], compose2(world_T_frame, goal)[:2])
+    reached = final_error <= tolerance
+    false_success = verdict == "succeeded" and not reached
+    outcome = "succeeded" if reached else ("not_reached" if false_success else verdict)
+    reason = {"succeeded": "", "timeout": f"not reached in {timeout:g} s"}.get(verdict, handle.reason)
+    if false_success:
+        reason = f"move_base reported success but the robot is {final_error:.2f} m from the goal (> {tolerance:g} m)"
     return {
         "goal": list(goal),
         "outcome": outcome,
-        "reason": reasons[outcome],
+        "move_base_outcome": verdict,
+        "false_success": false_success,
+        "reason": reason,
         "time_s": t1 - t0,
         "path_m": float(np.linalg.norm(np.diff(pts, axis=0), axis=1).sum()) if len(pts) > 1 else 0.0,
         "min_clearance_m": min(mon.clearance[k0:], default=math.inf),
         "collisions": _episodes(mon.contacts, t0, t1),
-        "final_error_m": math.dist(final[:2], compose2(world_T_frame, goal)[:2]),
+        "final_error_m": final_error,
+        "goal_tolerance_m": tolerance,
         "tracking_error_m": _nanmean(mon.tracking[k0:]),
     }
 
@@ -194,6 +204,7 @@ def run_navigation(
     ekf: str | Path | None = None,
     disturbances: dict[str, Any] | None = None,
     on_start: Any = None,
+    goal_tolerance: float = GOAL_TOLERANCE_M,
 ) -> NavigateResult:
     """Navigate to ``goals`` (x, y, yaw in the map frame) in turn; see ``NavigateResult``.
 
@@ -207,12 +218,16 @@ def run_navigation(
     ros_control YAML file: see ``sim.wheel_control``); ``ekf``: a robot_localization parameter file (``default``:
     the shipped params/ekf.yaml) — the EKF then owns tf odom → base; both go to the launch as its
     ``wheel_controller``/``ekf`` arguments (``sim_launch_args``); ``disturbances``: see ``sim.disturbances``.
+    ``goal_tolerance``: the truth's goal region (m): a goal whose robot truly ends farther away is not reached,
+    whatever move_base says.
     """
     from navlab.mapping.mapfile import load_map, save_map
     from navlab.sim.gazebo import load_world_named
 
     if not goals:
         raise NavigationError("no goals given (e.g. --goal 2.0 1.0 0.0)")
+    if not (math.isfinite(goal_tolerance) and goal_tolerance > 0):
+        raise NavigationError(f"goal_tolerance: expected a distance > 0 m, got {goal_tolerance!r}")
     for g in goals:
         if len(g) != 3 or not all(math.isfinite(float(v)) for v in g):
             raise NavigationError(f"goal {g!r}: expected three finite numbers x y yaw")
@@ -237,8 +252,7 @@ def run_navigation(
             run = start_run("navigation", world=world, robot=robot, pose=pose, seed=seed, map=str(served),
                             overrides={"move_base": overrides, **gazebo}, on_start=on_start, **launch_args)  # fmt: skip
     mb = _move_base(run)
-    radius = mb.local_costmap.layered.circumscribed_radius
-    mon = run.add(NavMonitor, parameters={"robot_radius": radius, "base_frame": run.base_frame,
+    mon = run.add(NavMonitor, parameters={"base_frame": run.base_frame,
                                           "estimate_frame": "" if mapless else "map"},
                   remappings={"scan": run.scan_topic}, sim=run.sim, move_base=mb)
     for t, model in spawn:
@@ -254,13 +268,16 @@ def run_navigation(
     for goal in goals:
         during: list[NavSnapshot] | None = [] if snapshots and not mapless else None
         gx, gy, gyaw = (float(v) for v in goal)
-        results.append(rounded(_drive_goal(run, mon, (gx, gy, gyaw), frame, goal_timeout, during, world_T_frame)))
+        results.append(rounded(_drive_goal(run, mon, (gx, gy, gyaw), frame, goal_timeout, during, world_T_frame,
+                                           goal_tolerance)))
         if during:  # the paper's pictures show the robot on its way: the middle of the drive
             shots.append(during[len(during) // 2])
     bag = recorder.close() if recorder else None
     loc = np.array(mon.localization_error)
     summary = rounded({
-        "goals_succeeded": sum(r["outcome"] == "succeeded" for r in results),
+        "goals_succeeded": sum(r["outcome"] == "succeeded" for r in results),  # the truth's
+        "goals_succeeded_move_base": sum(r["move_base_outcome"] == "succeeded" for r in results),
+        "false_success": sum(r["false_success"] for r in results),
         "collisions": sum(r["collisions"] for r in results),
         "localization_error_mean_m": float(loc.mean()) if loc.size else None,
         "localization_error_max_m": float(loc.max()) if loc.size else None,

@@ -18,8 +18,9 @@ from typing import Any
 
 from navlab.experiments.errors import ExperimentError
 
-TRIAL_COLUMNS = ("trial", "seed", "success", "failure", "time_s", "path_m", "spl", "min_clearance_m", "collisions",
-                 "localization_error_mean_m", "score", "world")  # fmt: skip
+TRIAL_COLUMNS = ("trial", "seed", "success", "move_base_success", "failure", "time_s", "path_m", "spl",
+                 "final_error_m", "min_clearance_m", "collisions", "localization_error_mean_m", "score",
+                 "world")  # fmt: skip
 
 
 @dataclass
@@ -145,8 +146,11 @@ def _run_report(folder: Path) -> Report:
     rep = Report(f"Experiment {name}: {len(results)} trials")
     ok = sum(bool(r["success"]) for r in results)
     lo, hi = summary["success_ci95"]
-    rep.text(f"{ok} of {len(results)} trials succeeded ({ok / len(results):.0%}, 95 % Wilson interval "
-             f"{lo:.0%}–{hi:.0%}); {summary['collisions']} collisions.")  # fmt: skip
+    said = "" if summary.get("move_base_success_rate") is None else (
+        f" move_base reported {summary['move_base_success_rate']:.0%}, with {summary['false_success']} false "
+        "successes (goals it called reached that the robot truly missed).")
+    rep.text(f"{ok} of {len(results)} trials succeeded by the simulator's truth ({ok / len(results):.0%}, 95 % Wilson "
+             f"interval {lo:.0%}–{hi:.0%}); {summary['collisions']} collisions.{said}")  # fmt: skip
     rep.heading("Summary")
     rep.table(["figure", "value"], _summary_rows(summary))
     rep.heading("Trials")
@@ -252,11 +256,13 @@ def _demo_report(folder: Path) -> Report:
         rep.image("localize.png", "AMCL's estimate against the ground truth")
     rep.heading("3. Navigation: move_base on the saved map, obstacles added after mapping")
     goals = nav.get("goals") if isinstance(nav.get("goals"), list) else []
-    cols = ["goal", "outcome", "time_s", "path_m", "min_clearance_m", "collisions", "reason"]
+    cols = ["goal", "outcome", "move_base_outcome", "time_s", "path_m", "final_error_m", "min_clearance_m",
+            "collisions", "reason"]
     rep.table(cols, [[g.get(c) for c in cols] for g in goals])
     if "goals_succeeded" in nav:
         bag = f"; recording `{Path(nav['record']).name}/`" if nav.get("record") else ""
-        rep.text(f"{nav['goals_succeeded']} of {len(goals)} goals reached, {nav.get('collisions')} collisions; "
+        rep.text(f"{nav['goals_succeeded']} of {len(goals)} goals reached (the simulator's truth; move_base reported "
+                 f"{nav.get('goals_succeeded_move_base', '-')}), {nav.get('collisions')} collisions; "
                  f"{nav.get('sim_s')} simulated s at {nav.get('rtf')}x real time{bag}.")  # fmt: skip
     for k, g in enumerate(goals, 1):
         png = f"navigate/goal_{k}.png"

@@ -20,6 +20,7 @@ goals: [[4.3, 1.0, 0.0], [-3.5, -0.5, 3.14]]      # map frame (odom with map: no
 trials: 20                   # trial k runs with seed + k
 seed: 0
 time_limit: 90.0             # s per goal
+goal_tolerance_m: 0.3        # the truth's goal region: a goal is reached when the robot truly ends this close
 wheel_controller: diff_drive_controller   # gazebo_ros_diff_drive (default) | diff_drive_controller | a ros_control YAML
 ekf: true                    # robot_localization's ekf_node (true: params/ekf.yaml; or a file); needs the controller
 disturbances: {wheel_radius_error: [0.03, 0.0], slip_patches: [{x: 1.0, y: 0.0, radius: 0.5, mu: 0.05}]}
@@ -60,6 +61,7 @@ class Scenario:
     trials: int = 1
     seed: int = 0
     time_limit: float = 90.0
+    goal_tolerance_m: float = 0.3
     wheel_controller: str = "gazebo_ros_diff_drive"
     ekf: str | None = None
     disturbances: dict[str, Any] = field(default_factory=dict)
@@ -189,11 +191,12 @@ def scenario_from_dict(data: Any, *, where: str = "scenario", path: Path | None 
             if isinstance(v, bool) or not isinstance(v, int) or v < low:
                 raise ExperimentError(f"{where}: {key}: expected an integer >= {low}, got {v!r}")
             setattr(sc, key, v)
-    if "time_limit" in data:
-        v = data["time_limit"]
-        if isinstance(v, bool) or not isinstance(v, int | float) or not (math.isfinite(v) and v > 0):
-            raise ExperimentError(f"{where}: time_limit: expected seconds > 0, got {v!r}")
-        sc.time_limit = float(v)
+    for key, unit in (("time_limit", "seconds"), ("goal_tolerance_m", "metres")):
+        if key in data:
+            v = data[key]
+            if isinstance(v, bool) or not isinstance(v, int | float) or not (math.isfinite(v) and v > 0):
+                raise ExperimentError(f"{where}: {key}: expected {unit} > 0, got {v!r}")
+            setattr(sc, key, float(v))
     _future_work_keys(sc, data, where)
     return sc
 

@@ -22,7 +22,8 @@ from navlab.experiments.errors import ExperimentError
 from navlab.experiments.scenario import Scenario
 from navlab.experiments.trials import run_experiments
 
-COLUMNS = ("success_rate", "success_ci95", "collisions", "median_time_s", "spl_mean", "min_clearance_m", "score_mean")
+COLUMNS = ("success_rate", "success_ci95", "move_base_success_rate", "false_success", "collisions", "median_time_s",
+           "spl_mean", "min_clearance_m", "score_mean")
 
 
 def parse_params(items: list[str]) -> dict[str, list[Any]]:

@@ -1,10 +1,14 @@
 """Trials of a scenario: each one a headless run with its own seed, its figures one JSON line in
 ``results.jsonl`` (written whole or not at all), so a run that is killed resumes where it stopped.
 
-Per trial: ``success`` (every goal reached with no collision), ``failure`` (collision, timeout, aborted —
-with move_base's reason), ``time_s``, ``path_m``, ``spl`` (success × shortest / max(path, shortest),
-shortest from the true map), ``min_clearance_m``, ``collisions``, localization error (mean, max) and the
-mean |jerk| of cmd_vel. The summary has the success rate with a 95 % Wilson interval, medians and quartiles.
+Per trial, judged by the simulator's truth: ``success`` (every goal truly reached — within the scenario's
+``goal_tolerance_m`` at its end — with no collision), ``failure`` (collision, not_reached, timeout, aborted,
+preempted — with move_base's reason), ``time_s``, ``path_m``, ``spl`` (success × shortest / max(path,
+shortest), shortest from the true map), ``min_clearance_m`` (the robot's collision geometry to the world's),
+``collisions``, localization error (mean, max) and the mean |jerk| of cmd_vel; beside them move_base's own
+verdict, ``move_base_success``, and ``false_success``: goals move_base called reached that the truth did not.
+The summary has the success rate with a 95 % Wilson interval (and move_base's rate and the false successes
+beside it), medians and quartiles.
 """
 
 from __future__ import annotations
@@ -81,7 +85,7 @@ def _spawns(sc: Scenario, seed: int) -> list[tuple[float, Any]]:
 
 def run_trial(sc: Scenario, index: int) -> dict[str, Any]:
     """Trial ``index`` of ``sc`` (seed = sc.seed + index); its figures (plus BARN's in a clutter world)."""
-    from navlab.experiments.clutter_run import CLUTTER_PARAMS, barn_outcome, clutter_for_trial
+    from navlab.experiments.clutter_run import CLUTTER_PARAMS, SUCCESS_M, barn_outcome, clutter_for_trial
     from navlab.experiments.mapping_run import run_mapping
     from navlab.experiments.navigate_run import run_navigation
 
@@ -103,10 +107,12 @@ def run_trial(sc: Scenario, index: int) -> dict[str, Any]:
         r = run_navigation(sc.goals, world=world, map_yaml=map_yaml, robot=sc.robot, pose=start,
                            controller=sc.controller, params_dir=sc.resolve(sc.params), move_base_params=overrides,
                            spawn=_spawns(sc, seed), goal_timeout=sc.time_limit, seed=seed, mapless=sc.map == "none",
+                           goal_tolerance=SUCCESS_M if clutter is not None else sc.goal_tolerance_m,
                            **sc.navigation_options())  # fmt: skip
     goals = r.goals
     failed = next((g for g in goals if g["outcome"] != "succeeded" or g["collisions"]), None)
     success = failed is None
+    move_base_success = all(g["move_base_outcome"] == "succeeded" and not g["collisions"] for g in goals)
     failure = "" if failed is None else ("collision" if failed["collisions"] else failed["outcome"])
     path_m = sum(g["path_m"] for g in goals)
     shortest = shortest_length(world, sc.start, sc.goals) if sc.map != "none" else None
@@ -119,7 +125,9 @@ def run_trial(sc: Scenario, index: int) -> dict[str, Any]:
     return rounded({
         "trial": index, "seed": seed, "success": success, "failure": failure,
         "reason": "" if failed is None else failed["reason"],
+        "move_base_success": move_base_success, "false_success": sum(g["false_success"] for g in goals),
         "goals_succeeded": sum(g["outcome"] == "succeeded" for g in goals), "goals": len(goals),
+        "goals_succeeded_move_base": sum(g["move_base_outcome"] == "succeeded" for g in goals),
         "time_s": sum(g["time_s"] for g in goals), "path_m": path_m, "shortest_m": shortest, "spl": spl,
         "min_clearance_m": min(g["min_clearance_m"] for g in goals), "collisions": sum(g["collisions"] for g in goals),
         "localization_error_mean_m": r.summary.get("localization_error_mean_m"),
@@ -174,6 +182,9 @@ def summarize_trials(results: list[dict[str, Any]]) -> dict[str, Any]:
             failures[r["failure"]] = failures.get(r["failure"], 0) + 1
     return rounded({
         "trials": n, "success_rate": ok / n if n else None, "success_ci95": [lo, hi],
+        # move_base's own verdict beside the truth's (trials recorded before issue 30 have neither key)
+        "move_base_success_rate": _rate(results, "move_base_success"),
+        "false_success": sum(int(r.get("false_success") or 0) for r in results),
         "collisions": sum(r["collisions"] for r in results), "failures": failures,
         "median_time_s": times[1] if times else None, "time_s_quartiles": times,
         "median_path_m": _median(results, "path_m"), "spl_mean": _mean(results, "spl"),
@@ -184,6 +195,12 @@ def summarize_trials(results: list[dict[str, Any]]) -> dict[str, Any]:
         "final_error_mean_m": _mean(results, "final_error_m"),
         **({"score_mean": _mean(results, "score")} if any("score" in r for r in results) else {}),  # BARN
     })  # fmt: skip
+
+
+def _rate(results: list[dict[str, Any]], key: str) -> float | None:
+    """Fraction of the results whose boolean ``key`` is true (None if none has it)."""
+    vals = [bool(r[key]) for r in results if key in r]
+    return sum(vals) / len(vals) if vals else None
 
 
 def _median(results: list[dict[str, Any]], key: str) -> float | None:

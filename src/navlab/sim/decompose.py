@@ -19,6 +19,8 @@ shelf, so the first load of such a world was a long wait. Here:
   collides as one convex hull where that is nearly its shape (a table top, a shelf board) and not
   at all otherwise (the top of a wall). Rays still hit the true triangles.
   ``NAVLAB_DECOMPOSE_REACH=off`` (or metres) overrides the robot's reach;
+- the worker processes never re-run the user's script: a script that loads such a world needs no
+  ``if __name__ == "__main__":`` guard;
 - results are cached under the navlab cache directory keyed by the mesh file's bytes, the scale
   and the options, including the clipping height in the mesh's frame (not the path or time stamps),
   so later loads, and copies of the same mesh, cost nothing.
@@ -26,9 +28,11 @@ shelf, so the first load of such a world was a long wait. Here:
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import os
-from collections.abc import Iterable, Sequence
+import sys
+from collections.abc import Iterable, Iterator, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
 from typing import Any
@@ -320,6 +324,27 @@ def default_workers() -> int:
     return max(1, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1))
 
 
+@contextlib.contextmanager
+def _main_not_reimported() -> Iterator[None]:
+    """While workers start, hide the user's ``__main__`` from multiprocessing's spawn: a spawned worker
+    otherwise re-runs the user's script (or ``-m`` module) before it imports the worker function, and a
+    script without an ``if __name__ == "__main__":`` guard would then start workers of its own and crash.
+    The workers need only navlab's own modules."""
+    main = sys.modules.get("__main__")
+    saved: dict[str, Any] = {k: main.__dict__[k] for k in ("__file__", "__spec__")
+                             if main is not None and k in main.__dict__}
+    try:
+        if main is not None:
+            main.__dict__.pop("__file__", None)
+            main.__spec__ = None
+        yield
+    finally:
+        if main is not None:
+            main.__dict__.update(saved)
+            if "__spec__" not in saved:
+                main.__dict__.pop("__spec__", None)
+
+
 def decompose_meshes(meshes: Sequence[MeshKey] | Iterable[MeshKey], *, workers: int | None = None,
                      progress: bool | None = None, threshold: float = THRESHOLD, seed: int = 0,
                      effort: str | None = None) -> int:
@@ -345,7 +370,7 @@ def decompose_meshes(meshes: Sequence[MeshKey] | Iterable[MeshKey], *, workers: 
         import multiprocessing
 
         ctx = multiprocessing.get_context("spawn")  # no fork of a process that may hold threads
-        with ProcessPoolExecutor(max_workers=n_workers, mp_context=ctx) as pool:
+        with _main_not_reimported(), ProcessPoolExecutor(max_workers=n_workers, mp_context=ctx) as pool:
             # the biggest meshes first, so no long one starts last
             order = sorted(todo, key=lambda item: -Path(item[0]).stat().st_size)
             futures = [pool.submit(_worker, str(p), s, threshold, seed, effort, c) for p, s, c in order]

@@ -58,6 +58,24 @@ def ramp(current: float, target: float, max_accel: float, dt: float) -> float:
     return current + max(-step, min(step, target - current))
 
 
+def noetic_wheel_commands(targets: tuple[float, float], measured: tuple[float, float],
+                          instructed: tuple[float, float], max_accel: float, dt: float,
+                          near: float) -> tuple[tuple[float, float], tuple[float, float]]:
+    """The wheel velocity commands ROS Noetic's gazebo_ros_diff_drive sets with ``wheelAcceleration``.
+
+    All speeds in the same unit (navlab: rad/s of the joints). With no limit (``max_accel`` 0), or when
+    *either* wheel's measured speed is within ``near`` (0.01 m/s at the rim) of its target, both wheels
+    get their targets; otherwise each wheel's instructed speed moves by its measured error, clipped to
+    ``max_accel * dt`` — the plugin's own rule, quirks included (the instructed speed integrates the
+    error, and is not reset when the targets are set directly). Returns (commands, instructed speeds)."""
+    if max_accel <= 0 or abs(targets[0] - measured[0]) < near or abs(targets[1] - measured[1]) < near:
+        return targets, instructed
+    step = max_accel * dt
+    ramped = (instructed[0] + max(-step, min(step, targets[0] - measured[0])),
+              instructed[1] + max(-step, min(step, targets[1] - measured[1])))
+    return ramped, ramped
+
+
 @dataclass
 class EncoderOdometry:
     """Integrates wheel angles into a planar pose (midpoint rule), like Gazebo's ``odometrySource encoder``.

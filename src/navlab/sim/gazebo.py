@@ -18,11 +18,13 @@ from navlab.sim.spawn import check_start_pose, load_sdf_model, parse_spawn_spec,
 from navlab.world.model import ModelSpec, WorldModel
 
 
-def load_robot_named(name_or_path: str) -> RobotModel:
-    """A robot from a shipped name (``mybot``), a ``package://`` URI or a .xacro/.urdf path."""
+def load_robot_named(name_or_path: str, args: list[str] | None = None) -> RobotModel:
+    """A robot from a shipped name (``mybot``), a ``package://`` URI or a .xacro/.urdf path, with xacro
+    arguments ``["name:=value", ...]``."""
     from navlab.description import load_robot
 
-    return load_robot(name_or_path)  # one resolver: navlab.description.loader.robot_path
+    xargs = dict(a.split(":=", 1) for a in args or [] if ":=" in a)
+    return load_robot(name_or_path, args=xargs)  # one resolver: navlab.description.loader.robot_path
 
 
 def load_world_named(name_or_path: str) -> WorldModel:
@@ -34,7 +36,8 @@ def load_world_named(name_or_path: str) -> WorldModel:
 
 class GazeboSim(Node):
     """Gazebo in a node. Parameters: ``world`` (shipped name or file, default ``room``), ``robot``
-    (default ``mybot``), ``x``/``y``/``yaw`` (spawn pose, m/rad), ``timestep`` (s; 0 = 2 ms or the world's larger
+    (default ``mybot``), ``robot_args`` (xacro arguments, ``["name:=value"]``),
+    ``x``/``y``/``yaw`` (spawn pose, m/rad), ``timestep`` (s; 0 = 2 ms or the world's larger
     ``max_step_size``), ``joint_state_rate`` and ``ground_truth_rate`` (Hz; 0 = off), ``seed``
     (sensor noise seed; -1 = the executor's), ``visuals`` (build render-only geoms; default off, faster).
     ``odometry_noise`` (relative std dev of each wheel encoder's scale error; navlab extension, default 0).
@@ -50,6 +53,7 @@ class GazeboSim(Node):
         super().__init__(executor, name=name, parameters=parameters, namespace=namespace)
         world_name = self.declare_parameter("world", "room")
         robot_name = self.declare_parameter("robot", "mybot")
+        robot_args = [str(a) for a in self.declare_parameter("robot_args", [])]
         pose = (self.declare_parameter("x", 0.0), self.declare_parameter("y", 0.0),
                 self.declare_parameter("yaw", 0.0))
         timestep = self.declare_parameter("timestep", 0.0)
@@ -60,7 +64,7 @@ class GazeboSim(Node):
         odometry_noise = self.declare_parameter("odometry_noise", 0.0)
         cmd_timeout = float(self.declare_parameter("cmd_timeout", 0.0))
         publish_odom_tf = bool(self.declare_parameter("publish_odom_tf", True))
-        robot = robot_model if robot_model is not None else load_robot_named(robot_name)
+        robot = robot_model if robot_model is not None else load_robot_named(robot_name, robot_args)
         world = world_model if world_model is not None else load_world_named(world_name)
         extensions = SimExtensions(self)  # wheel controller and disturbances (navlab.sim.extensions)
         robot = extensions.robot(robot)
@@ -92,10 +96,14 @@ class GazeboSim(Node):
                          for i in range(len(robot.imus))]
         self.plugins.append(JointStatePlugin(executor, parameters={"publish_frequency": js_rate}, namespace=namespace,
                                              sim=self.sim))
-        if gt_rate > 0:
+        p3d_topics = {p.topic for p in robot.ground_truths}
+        if gt_rate > 0 and "/ground_truth/odom" not in p3d_topics:  # navlab's own, for evaluation
             base = robot.diff_drive.robot_base_frame if robot.diff_drive else robot.root_link
             self.plugins.append(GroundTruthPlugin(executor, parameters={"bodyName": base, "updateRate": gt_rate},
                                                  namespace=namespace, sim=self.sim))
+        self.plugins += [GroundTruthPlugin(executor, name=p.name, namespace=namespace, sim=self.sim, parameters={
+            "bodyName": p.link, "topicName": p.topic, "frameName": p.frame_id, "updateRate": p.update_rate})
+            for p in robot.ground_truths]  # the robot's own p3d plugins
         self.plugins += extensions.plugins(executor, namespace, self.sim)
         if robot is not None:  # Gazebo's bumper: what the robot touches, on /collisions
             self.plugins.append(CollisionPlugin(executor, namespace=namespace, sim=self.sim))

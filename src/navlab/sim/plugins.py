@@ -19,7 +19,13 @@ from navlab import msgs
 from navlab.core import Executor, Node
 from navlab.description.model import DiffDriveConfig, ImuConfig, LidarConfig, Origin
 from navlab.geometry import Vec, qmul, qrotate, quat_from_rpy, quat_from_yaw
-from navlab.sim.diffdrive import ODOM_COVARIANCE_DIAG, EncoderOdometry, command_in_force, ramp, wheel_speeds
+from navlab.sim.diffdrive import (
+    ODOM_COVARIANCE_DIAG,
+    EncoderOdometry,
+    command_in_force,
+    noetic_wheel_commands,
+    wheel_speeds,
+)
 from navlab.sim.simulation import Simulation, lidar_angles
 
 _ODOM_COV = msgs.covariance(ODOM_COVARIANCE_DIAG)
@@ -52,8 +58,8 @@ class DiffDrivePlugin(Node):
 
     Every ``1/update_rate`` s: stop the wheels if navlab's ``cmd_timeout`` watchdog is set (s > 0) and no
     command came within it (ROS 1's plugin has none: the last command holds), set the
-    wheel targets (ramped by ``max_accel`` in m/s² of the wheel rim, as Gazebo's plugin code applies
-    ``wheelAcceleration``), then publish ``nav_msgs/Odometry`` on ``odometry_topic`` in
+    wheel targets (``max_accel``, m/s² at the wheel rim, applied by Noetic's rule for ``wheelAcceleration``:
+    ``noetic_wheel_commands``), then publish ``nav_msgs/Odometry`` on ``odometry_topic`` in
     ``odometry_frame`` — integrated from the wheel encoders, or with ``odometry_source: world`` the
     true pose — and the tf ``odometry_frame → robot_base_frame``.
     """
@@ -72,6 +78,7 @@ class DiffDrivePlugin(Node):
         self.cmd = (0.0, 0.0)
         self.last_cmd_ns: int | None = None
         self.wheel_targets = (0.0, 0.0)
+        self.instructed = (0.0, 0.0)  # Noetic's wheel_speed_instr_ (rad/s here)
         self.max_wheel_accel = config.max_accel / (config.wheel_diameter / 2)  # rad/s² of the wheel joints
         self.odometry = EncoderOdometry(config.wheel_separation, config.wheel_diameter, config.legacy_mode)
         # Encoder scale errors (navlab's odometry_noise): wheel angles are read as if the wheels were
@@ -106,10 +113,9 @@ class DiffDrivePlugin(Node):
         if not command_in_force(now, self.last_cmd_ns, cfg.cmd_timeout):
             v, w = 0.0, 0.0
         left, right = wheel_speeds(v, w, cfg.wheel_separation, cfg.wheel_diameter, legacy_mode=cfg.legacy_mode)
-        self.wheel_targets = (
-            ramp(self.wheel_targets[0], left, self.max_wheel_accel, dt),
-            ramp(self.wheel_targets[1], right, self.max_wheel_accel, dt),
-        )
+        measured = (self.sim.joint_velocity(cfg.left_joint), self.sim.joint_velocity(cfg.right_joint))
+        self.wheel_targets, self.instructed = noetic_wheel_commands(
+            (left, right), measured, self.instructed, self.max_wheel_accel, dt, near=0.01 / (cfg.wheel_diameter / 2))
         self.sim.set_wheel_velocity_targets(*self.wheel_targets)
         self.publish_odometry(now, dt)
 
@@ -126,6 +132,8 @@ class DiffDrivePlugin(Node):
             x, y, yaw, v, w = self.odometry.update(*self._encoders(), dt)
             position = (x, y, 0.0)
             quat = quat_from_yaw(yaw)
+        if not cfg.publish_odom:  # Noetic's <publishTf>false: no odometry topic and no tf
+            return
         # the message only when anyone reads it (the mapping launch's nodes take odometry from tf)
         if self.odom_pub.get_subscription_count() or self.executor.has_listeners:
             if world:

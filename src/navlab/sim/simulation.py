@@ -109,6 +109,15 @@ class Simulation:
         self._body_frame = {k: not xyz.any() and quat[0] == 1.0 for k, (_, xyz, quat) in self._body.items()}
         self._geom_robot: list[bool] = (m.geom_group == GROUP_ROBOT).tolist()
         self._geom_ground: list[bool] = ((m.geom_contype.astype(np.int64) & GROUND_CONTACT_BIT) != 0).tolist()
+        # clearance(): the robot's collision geoms against the world's (the floor is not an obstacle)
+        collides = (m.geom_contype != 0) | (m.geom_conaffinity != 0)
+        ground = (m.geom_contype.astype(np.int64) & GROUND_CONTACT_BIT) != 0
+        self._clear_world = np.flatnonzero(collides & (m.geom_group != GROUP_ROBOT) & ~ground
+                                           & (m.geom_type != mujoco.mjtGeom.mjGEOM_PLANE))
+        wtype = np.bitwise_or.reduce(m.geom_contype[self._clear_world], initial=0)
+        waff = np.bitwise_or.reduce(m.geom_conaffinity[self._clear_world], initial=0)
+        meets = ((m.geom_contype & waff) | (m.geom_conaffinity & wtype)) != 0  # not the wheels' floor spheres
+        self._clear_robot = np.flatnonzero(meets & (m.geom_group == GROUP_ROBOT))
         self._joints: dict[str, tuple[int, int]] = {}
         if self.robot is not None:
             for joint in self.robot.joints:
@@ -226,6 +235,25 @@ class Simulation:
                     name = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_GEOM, other) or ""
                     out.add(name.split("::")[0] or "world")
         return sorted(out)
+
+    def clearance(self, max_distance: float = 2.0) -> float:
+        """Distance (m) between the robot's collision geometry and the nearest collision geom of the world (the
+        floor excluded), from MuJoCo's ``mj_geomDistance``: negative when they interpenetrate, ``max_distance``
+        when nothing is closer. Cheap: pairs are asked nearest bounding spheres first, and only while their
+        spheres could still be closer than the best distance found."""
+        m, d = self.model, self.data
+        robot, world = self._clear_robot, self._clear_world
+        if not len(robot) or not len(world):
+            return max_distance
+        centres = np.linalg.norm(d.geom_xpos[robot][:, None, :] - d.geom_xpos[world][None, :, :], axis=2)
+        bound = centres - m.geom_rbound[robot][:, None] - m.geom_rbound[world][None, :]  # <= the pair's distance
+        best = max_distance
+        for k in np.argsort(bound, axis=None):
+            i, j = divmod(int(k), len(world))
+            if bound[i, j] >= best:
+                break
+            best = min(best, mujoco.mj_geomDistance(m, d, int(robot[i]), int(world[j]), best, None))
+        return float(best)
 
     def teleport(self, x: float, y: float, yaw: float) -> None:
         """Move the robot's root to (x, y, yaw) in the world (m, rad), at rest: Gazebo's set_model_state

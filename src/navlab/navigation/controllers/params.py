@@ -16,6 +16,7 @@ footprint is not scaled with speed).
 
 from __future__ import annotations
 
+import logging
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -89,6 +90,7 @@ class TrajectoryPlannerParams(_Periodic):
         out = params_from(cls, values, what=TP, ignored=_VIEW_ONLY, aliases={
             "backup_vel": "escape_vel", "acc_lim_th": "acc_lim_theta", "path_distance_bias": "pdist_scale",
             "goal_distance_bias": "gdist_scale", "vth_samples": "vtheta_samples"})
+        _clamp_samples(TP, out, "vx_samples", "vtheta_samples")
         out.validate()
         return out
 
@@ -105,9 +107,8 @@ class TrajectoryPlannerParams(_Periodic):
         _ordered(TP, self, "min_vel_theta", "max_vel_theta")
         if self.escape_vel > 0.0:
             raise bad(TP, "escape_vel", self.escape_vel, "<= 0 (a backward speed)")
-        for key in ("heading_scoring", "simple_attractor"):
-            if getattr(self, key):
-                raise bad(TP, key, True, "false (navlab scores trajectories by path and goal distance only)")
+        if self.simple_attractor:
+            raise bad(TP, "simple_attractor", True, "false (navlab scores trajectories by path and goal distance)")
 
 
 @dataclass
@@ -160,6 +161,7 @@ class DWAPlannerParams(_Periodic):
             "min_rot_vel": "min_vel_theta", "acc_lim_th": "acc_lim_theta", "rot_stopped_vel": "theta_stopped_vel",
             "pdist_scale": "path_distance_bias", "gdist_scale": "goal_distance_bias",
             "vtheta_samples": "vth_samples", "dwa": "use_dwa"})
+        _clamp_samples(DWA, out, "vx_samples", "vy_samples", "vth_samples")
         out.validate()
         return out
 
@@ -176,6 +178,17 @@ class DWAPlannerParams(_Periodic):
         _ordered(DWA, self, "min_vel_x", "max_vel_x")
         _ordered(DWA, self, "min_vel_trans", "max_vel_trans")
         _ordered(DWA, self, "min_vel_theta", "max_vel_theta")
+
+
+def _clamp_samples(what: str, obj: Any, *keys: str) -> None:
+    """A sample count <= 0 becomes 1 with a warning, as both ROS 1 planners do (``vy_samples: 0`` is in
+    TurtleBot3's DWA files: a differential robot samples no y speed)."""
+    for key in keys:
+        if getattr(obj, key) <= 0:
+            logging.getLogger("navlab.navigation").warning(
+                f"{what}: {key} is {getattr(obj, key)}; at least one value is sampled, so {key} is set to 1 "
+                "(as ROS does)")
+            setattr(obj, key, 1)
 
 
 def _positive(what: str, obj: Any, *keys: str) -> None:

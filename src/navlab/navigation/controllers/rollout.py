@@ -186,44 +186,90 @@ def _footprint_pass(grid: np.ndarray, near: np.ndarray, inv: float, x: np.ndarra
 @numba.njit(cache=True)
 def _rollout_scores(grid: np.ndarray, near: np.ndarray, path_dist: np.ndarray, goal_dist: np.ndarray, inv: float,
                     traj: np.ndarray, c: np.ndarray, s: np.ndarray, ox: np.ndarray, oy: np.ndarray, polygon: bool,
-                    use_near: bool, weights: np.ndarray, impossible: float,
+                    use_near: bool, weights: np.ndarray, impossible: float, at: np.ndarray,
                     out: np.ndarray) -> None:  # pragma: no cover - compiled
-    """TrajectoryPlanner's cost of each rollout (S, n, 3): ``weights`` = (scale, pdist, gdist, occdist);
-    -1 when a pose is blocked, else -2 when a pose has no path to the plan or goal."""
+    """TrajectoryPlanner's cost of each rollout (S, n, 3): ``weights`` = (scale, pdist, gdist, occdist). As
+    ``generateTrajectory``, the poses are checked in time order and the first failure decides: -1 when the pose
+    is off the map or its footprint blocked, -2 when its cell has no path to the plan or goal. ``at`` (S,): -1
+    scores (and checks) the distances at every pose, the last one counting; k >= 0 only at pose k, and -2 at no
+    pose (distances 0): ``heading_scoring``'s single scoring step."""
     h, w = path_dist.shape
     for r in range(traj.shape[0]):
         top = -math.inf
-        blocked = False
-        no_path = False
+        fail = 0.0
         fp = 0.0
-        pd = gd = 0.0
+        pd = gd = spd = sgd = 0.0
         for k in range(traj.shape[1]):
             x, y = traj[r, k, 0], traj[r, k, 1]
             i, j = math.floor(x * inv), math.floor(y * inv)
             inside = 0 <= i < w and 0 <= j < h
             pd, gd = (path_dist[j, i], goal_dist[j, i]) if inside else (path_dist[0, 0], goal_dist[0, 0])
-            if pd >= impossible or gd >= impossible:
-                no_path = True
-            if blocked:
-                continue
+            skip = False
             if use_near and polygon and inside:
                 bound = near[j, i]  # no edge of this pose costs more: it cannot raise the rollout's cost
-                if bound < COST_LETHAL and bound <= top:
-                    continue
-            same = k > 0 and x == traj[r, k - 1, 0] and y == traj[r, k - 1, 1] and (
-                not polygon or (c[r, k] == c[r, k - 1] and s[r, k] == s[r, k - 1]))
-            if not same:  # a rollout's last pose repeated has the same cost
-                fp = _pose_cost(grid, near, inv, x, y, c[r, k], s[r, k], ox, oy, polygon, use_near, True)
-            if fp < 0:
-                blocked = True
-            elif fp > top:
-                top = fp
-        if blocked:
-            out[r] = -1.0
-        elif no_path:
-            out[r] = -2.0
-        else:
-            out[r] = weights[0] * (weights[1] * pd + weights[2] * gd + weights[3] * top)
+                skip = bound < COST_LETHAL and bound <= top
+            if not skip:
+                same = k > 0 and x == traj[r, k - 1, 0] and y == traj[r, k - 1, 1] and (
+                    not polygon or (c[r, k] == c[r, k - 1] and s[r, k] == s[r, k - 1]))
+                if not same:  # a rollout's last pose repeated has the same cost
+                    fp = _pose_cost(grid, near, inv, x, y, c[r, k], s[r, k], ox, oy, polygon, use_near, True)
+                if fp < 0:
+                    fail = -1.0
+                    break
+                top = max(top, fp)
+            if at[r] == -1 or at[r] == k:
+                spd, sgd = pd, gd
+                if pd >= impossible or gd >= impossible:
+                    fail = -2.0
+                    break
+        out[r] = fail if fail < 0 else weights[0] * (weights[1] * spd + weights[2] * sgd + weights[3] * top)
+
+
+@numba.njit(cache=True)
+def heading_diffs(cost: np.ndarray, resolution: float, plan: np.ndarray, poses: np.ndarray) -> np.ndarray:
+    """TrajectoryPlanner's ``headingDiff`` at grid-local poses (S, 3): |angle| (rad) between each heading and the
+    direction to the centre of the cell of the last plan point (plan (N, 2), grid-local) in a clear line of sight
+    from the pose's cell (Bresenham, LETHAL/INSCRIBED/unknown cells block); the largest float when none is."""
+    h, w = cost.shape
+    out = np.full(poses.shape[0], np.finfo(np.float64).max)
+    for r in range(poses.shape[0]):
+        x, y, th = poses[r, 0], poses[r, 1], poses[r, 2]
+        cx, cy = math.floor(x / resolution), math.floor(y / resolution)
+        if not (0 <= cx < w and 0 <= cy < h):
+            continue
+        for q in range(plan.shape[0] - 1, -1, -1):
+            gx, gy = math.floor(plan[q, 0] / resolution), math.floor(plan[q, 1] / resolution)
+            if 0 <= gx < w and 0 <= gy < h and _line_clear(cost, cx, gx, cy, gy):
+                v1x, v1y = (gx + 0.5) * resolution - x, (gy + 0.5) * resolution - y
+                v2x, v2y = math.cos(th), math.sin(th)
+                out[r] = abs(math.atan2(v1x * v2y - v1y * v2x, v1x * v2x + v1y * v2y))
+                break
+    return out
+
+
+@numba.njit(cache=True, inline="always")
+def _line_clear(cost: np.ndarray, x0: int, x1: int, y0: int, y1: int) -> bool:  # pragma: no cover - compiled
+    """Whether TrajectoryPlanner's ``lineCost`` (its Bresenham walk) from cell (x0, y0) to (x1, y1) meets no
+    LETHAL, INSCRIBED or unknown cell."""
+    dx, dy = abs(x1 - x0), abs(y1 - y0)
+    sx = 1 if x1 >= x0 else -1
+    sy = 1 if y1 >= y0 else -1
+    if dx >= dy:  # one x step per pixel, y steps when the numerator overflows
+        xi1, xi2, yi1, yi2, den, num, add, pixels = 0, sx, sy, 0, dx, dx // 2, dy, dx
+    else:
+        xi1, xi2, yi1, yi2, den, num, add, pixels = sx, 0, 0, sy, dy, dy // 2, dx, dy
+    x, y = x0, y0
+    for _ in range(pixels + 1):
+        if cost[y, x] >= COST_INSCRIBED:
+            return False
+        num += add
+        if num >= den:
+            num -= den
+            x += xi1
+            y += yi1
+        x += xi2
+        y += yi2
+    return True
 
 
 def footprint_cells(shape: tuple[int, int], resolution: float, pose: tuple[float, float, float],

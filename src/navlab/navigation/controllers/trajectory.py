@@ -19,7 +19,10 @@ best one's velocity:
   Without a polygon or radius the robot is a point: its centre cell, blocked from INSCRIBED up;
 - *TrajectoryPlanner cost* = pdist_scale * path_dist + gdist_scale * goal_dist + occdist_scale *
   max_cost, distances at the rollout's end (in cells, or metres with ``meter_scoring``); a rollout that
-  leaves the map, is blocked, or passes a cell with no path to the plan or goal is rejected. In-place
+  leaves the map, is blocked, or passes a cell with no path to the plan or goal is rejected (the first failure
+  in time decides the code, -1 or -2). With ``heading_scoring`` every rollout has sim_time / sim_granularity
+  steps, the distances count at the step at ``heading_scoring_timestep`` only, and 0.3 x the angle from the
+  heading there to the last plan point in clear sight (``headingDiff``) is added. In-place
   turns (at least ``min_in_place_vel_theta``) win when their cost is no higher than the best forward
   rollout's (an in-place turn ends where the robot is: it wins when no forward rollout gets closer),
   the one whose look-ahead point (``heading_lookahead``) is closest to the goal; with nothing valid it
@@ -79,6 +82,7 @@ from navlab.navigation.controllers.params import TrajectoryPlannerParams
 from navlab.navigation.controllers.rollout import (
     _rollout_scores,
     footprint_cells,
+    heading_diffs,
     lookup,
     outline_reach_max,
     rollout,
@@ -397,12 +401,29 @@ class TrajectoryPlannerROS(RolloutController):
         """``TrajectoryPlanner::generateTrajectory``: round(max(|v| sim_time / sim_granularity, |w| /
         angular_sim_granularity)), at least 1 (ROS leaves sim_time out of the angular term)."""
         p = self.params
+        if p.heading_scoring:  # every sample: sim_time / sim_granularity steps
+            return np.full(len(targets), max(1, int(p.sim_time / p.sim_granularity + 0.5)), dtype=np.int64)
         ang = p.angular_sim_granularity if p.angular_sim_granularity > 0 else p.sim_granularity
         need = np.maximum(np.abs(targets[:, 0]) * p.sim_time / p.sim_granularity, np.abs(targets[:, 1]) / ang)
         return np.maximum(1, np.floor(need + 0.5)).astype(np.int64)
 
+    def _heading_step(self, steps: int) -> int:
+        """With ``heading_scoring``, the one step whose path and goal distances (and heading) are scored: the
+        first whose time (accumulated as ROS adds dt) lies in [heading_scoring_timestep, + dt); -2 when none
+        does (then they count 0). Without it -1: every step, the last one counting."""
+        p = self.params
+        if not p.heading_scoring:
+            return -1
+        dt, t = p.sim_time / steps, 0.0
+        for k in range(steps):
+            if p.heading_scoring_timestep <= t < p.heading_scoring_timestep + dt:
+                return k
+            t += dt
+        return -2
+
     def _score(self, scene: LocalScene, traj: np.ndarray) -> np.ndarray:
-        """Costs (S,): pdist * path_dist + gdist * goal_dist + occdist * max_cost; -1 blocked, -2 no path."""
+        """Costs (S,): pdist * path_dist + gdist * goal_dist + occdist * max_cost (+ 0.3 * heading difference
+        with ``heading_scoring``); -1 blocked, -2 no path."""
         p = self.params
         res = scene.resolution
         traj = np.ascontiguousarray(traj, dtype=np.float64)
@@ -417,9 +438,14 @@ class TrajectoryPlannerROS(RolloutController):
             ox, oy = np.ascontiguousarray(outline[:, 0]), np.ascontiguousarray(outline[:, 1])
         weights = np.array([res if p.meter_scoring else 1.0, p.pdist_scale, p.gdist_scale, p.occdist_scale])
         cost = np.empty(traj.shape[0])
+        at = self._heading_step(traj.shape[1])
         _rollout_scores(grid, grid if near is None else near, np.ascontiguousarray(scene.path_dist),
                         np.ascontiguousarray(scene.goal_dist), 1.0 / res, traj, c, s, ox, oy, outline is not None,
-                        near is not None, weights, scene.impossible, cost)
+                        near is not None, weights, scene.impossible, np.full(len(traj), at, dtype=np.int64), cost)
+        if at >= 0:  # ROS: + 0.3 * headingDiff at the scored step (not scaled by meter_scoring)
+            ok = cost >= 0
+            cost[ok] += 0.3 * heading_diffs(grid, res, np.ascontiguousarray(scene.plan[:, :2]),
+                                            np.ascontiguousarray(traj[ok, at]))
         return cost
 
     def _drive(self, scene: LocalScene, pose: tuple[float, float, float], velocity: tuple[float, float],

@@ -11,12 +11,11 @@ parameters unless its namespace sets it. Distances in metres, frequencies in Hz.
 
 from __future__ import annotations
 
-import difflib
 import math
 from dataclasses import dataclass, field, fields
 from typing import TYPE_CHECKING, Any, TypeVar
 
-from navlab.core.params import dataclass_from_dict
+from navlab.core.params import check_unknown_key, dataclass_from_dict
 from navlab.navigation.errors import NavigationError
 
 if TYPE_CHECKING:
@@ -290,11 +289,10 @@ def costmap_params(values: dict[str, Any] | None = None) -> CostmapParams:
         params.sources[src] = observation_source(raw, params, name=src, layer=_with_aliases(ns, src))
     known = {p.name for p in params.plugins} | set(params.sources)
     for key, ns in namespaces.items():
-        if key not in known:
-            close = difflib.get_close_matches(key, sorted(known) + [f.name for f in fields(CostmapParams)], n=1)
-            hint = f"; did you mean '{close[0]}'?" if close else ""
-            raise NavigationError(f"unknown costmap parameter '{key}' (a namespace that is neither a layer in "
-                                  f"plugins nor an observation source){hint}")
+        if key not in known:  # another plugin's section (ROS ignores it) or a misspelt layer: check_unknown_key
+            check_unknown_key(key, sorted(known) + [f.name for f in fields(CostmapParams)],
+                              what="costmap", error=NavigationError)
+            continue
         params.namespaces[key] = ns
     return params
 
