@@ -5,6 +5,11 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 # Debian's Chromium drives the viewer's browser tests (Playwright with executable_path; no browser download)
 CHROMIUM := /usr/bin/chromium
+# Debian's ROS 1 Noetic tools are the peers of the ROS bridge's tests (navlab itself needs no ROS)
+ROS_TOOLS := /usr/bin/rosservice
+ROS_PACKAGES := python3-rosmaster python3-rospy python3-rostopic python3-rosnode python3-rosbag python3-rosservice \
+	python3-rosparam python3-actionlib python3-move-base-msgs python3-nav-msgs python3-sensor-msgs python3-std-srvs \
+	python3-tf2-ros tf2-tools rviz xvfb
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 export MUJOCO_GL ?= egl
 
@@ -21,12 +26,15 @@ $(STAMP): pyproject.toml | $(BIN)/python
 $(CHROMIUM):
 	$(SUDO) apt-get install -y -q chromium || ($(SUDO) apt-get update -q && $(SUDO) apt-get install -y -q chromium)
 
-install: $(STAMP) $(CHROMIUM)
+$(ROS_TOOLS):
+	$(SUDO) apt-get install -y -q $(ROS_PACKAGES) || ($(SUDO) apt-get update -q && $(SUDO) apt-get install -y -q $(ROS_PACKAGES))
+
+install: $(STAMP) $(CHROMIUM) $(ROS_TOOLS)
 
 demo: $(STAMP)
 	$(BIN)/navlab demo
 
-test: $(STAMP) $(CHROMIUM)
+test: $(STAMP) $(CHROMIUM) $(ROS_TOOLS)
 	$(BIN)/ruff check src tests
 	$(BIN)/python tools/check_layers.py
 	$(BIN)/mypy

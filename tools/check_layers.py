@@ -6,7 +6,7 @@ Layers, bottom to top::
 
     0 leaves       errors msgs geometry grid io resources nodes plugins lazy
     1 core
-    2 description world
+    2 description world ros1
     3 sim mapping localization
     4 navigation
     5 experiments viz
@@ -32,7 +32,7 @@ from pathlib import Path
 LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("leaves", ("errors", "msgs", "geometry", "grid", "io", "resources", "nodes", "plugins", "lazy")),
     ("core", ("core",)),
-    ("description/world", ("description", "world")),
+    ("description/world/ros1", ("description", "world", "ros1")),
     ("sim/mapping/localization", ("sim", "mapping", "localization")),
     ("navigation", ("navigation",)),
     ("experiments/viz", ("experiments", "viz")),

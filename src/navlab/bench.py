@@ -38,6 +38,7 @@ BENCHES: dict[str, str] = {
     "clutter": "navlab.experiments.clutter_run:bench",
     "sweep": "navlab.experiments.sweep:bench",
     "view": "navlab.viz.bench:run",
+    "ros": "navlab.ros1.bench:run",
 }
 
 
@@ -127,7 +128,8 @@ def _cmd(args: argparse.Namespace) -> int:
         return _cmd_compare(args.files)
     if args.files:
         raise NavlabError(f"bench {args.name}: unexpected arguments {' '.join(args.files)} (only compare takes files)")
-    names = [n for n in BENCHES if n != "soak"] if args.name == "all" else [args.name]  # soak: minutes, alone
+    # soak (minutes) and ros (real time, needs the ROS tools) run alone
+    names = [n for n in BENCHES if n not in ("soak", "ros")] if args.name == "all" else [args.name]
     results: dict[str, Any] = {name: _run_one(name, args) for name in names}
     out = results[names[0]] if len(names) == 1 else results
     if args.name == "all":

@@ -24,6 +24,7 @@ COMMAND_MODULES = (  # in the order of the paper's pipeline, then the ROS-style 
     "navlab.experiments.cli",
     "navlab.core.cli",
     "navlab.viz.cli",
+    "navlab.ros1.cli",
     "navlab.bench",
 )
 

@@ -24,6 +24,7 @@ from navlab.core.graph import Graph
 from navlab.core.launch import Session, start
 from navlab.core.runner import parse_launch_args, run_for
 from navlab.io.files import write_text_atomic
+from navlab.ros1.cli import add_ros_argument
 from navlab.viz.cli import add_view_arguments
 
 
@@ -166,9 +167,15 @@ def _cmd_launch(args: argparse.Namespace) -> int:
         return _show_args(args.file)
     apply_resource_paths(args)  # --package-path / --model-path for robot:= and world:=
     # Like roslaunch, a launch without --duration runs in real time until Ctrl-C.
-    rate = args.rate if args.rate is not None else (1.0 if args.duration is None else 0.0)
+    from navlab.ros1.cli import follows_clock, pop_ros_arg, ros_bridge
+
     files, items = _split_files(args.file, args.args)
-    session = start(files, seed=args.seed, pace=rate, launch_args=parse_launch_args(items))
+    launch_args = parse_launch_args(items)
+    ros = pop_ros_arg(launch_args) or args.ros  # outside nodes cannot follow 100x: real time unless --rate
+    rate = args.rate if args.rate is not None else (1.0 if args.duration is None or ros else 0.0)
+    follow_clock = ros and follows_clock(launch_args)  # hardware in the loop: the robot's /clock paces the run
+    rate = 0.0 if follow_clock else rate
+    session = start(files, seed=args.seed, pace=rate, launch_args=launch_args, ros=ros)
     ex = session.executor
     duration = math.inf if args.duration is None else args.duration
     from navlab.core.introspect import IntrospectionServer
@@ -178,7 +185,8 @@ def _cmd_launch(args: argparse.Namespace) -> int:
     signal.signal(signal.SIGTERM, lambda *_: ex.post(ex.stop))
     from navlab.viz.cli import viewing
 
-    with IntrospectionServer(ex, name=args.file), contextlib.suppress(KeyboardInterrupt), viewing(args, ex):
+    with IntrospectionServer(ex, name=args.file), contextlib.suppress(KeyboardInterrupt), viewing(args, ex), \
+            ros_bridge(ros, ex, session.nodes, follow_clock=follow_clock):
         try:
             run_for(ex, duration, record=args.record, quiet=args.quiet, desc=Path(args.file).stem)
         finally:
@@ -363,6 +371,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         p.add_argument("--quiet", action="store_true", help="no progress bar")
         p.add_argument("--json", action="store_true", help="print the summary as JSON")
         add_view_arguments(p)
+        add_ros_argument(p)
         add_resource_path_arguments(p)
         p.add_argument("-s", "--show-args", action="store_true",
                        help="list the launch's arguments (name, description, default) and exit")

@@ -17,6 +17,7 @@ from navlab.cli_common import (
     positive_seconds,
     start_pose,
 )
+from navlab.ros1.cli import add_ros_argument, ros_bridge
 from navlab.viz.cli import add_view_arguments, viewing
 
 _SPAWN_HELP = (
@@ -49,8 +50,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     _add_common(p)
     p.add_argument("--duration", type=positive_seconds, default=10.0, help="simulated seconds to run (default 10)")
-    p.add_argument("--rate", type=float, default=0.0,
-                   help="pacing: 0 = as fast as possible (default), 1 = real time, r = r x real time")
+    p.add_argument("--rate", type=float, default=None,
+                   help="pacing: 0 = as fast as possible (default; real time with --ros), 1 = real time, "
+                        "r = r x real time")
     p.add_argument("--seed", type=int, default=0, help="random seed of sensor noise (default 0)")
     p.add_argument("--timestep", type=float, default=0.0,
                    help="physics step in s, 0.0005-0.002 (default 0.002, or the world's max_step_size if larger)")
@@ -61,6 +63,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.add_argument("--json", action="store_true", help="print the summary as one JSON object")
     add_view_arguments(p)
+    add_ros_argument(p)
     p.set_defaults(func=_cmd_sim)
 
     r = sub.add_parser(
@@ -102,7 +105,8 @@ def _cmd_sim(args: argparse.Namespace) -> int:
     cmd_vel = _parse_cmd_vel(args.cmd_vel)
     spawns = [parse_spawn_spec(s, default_name=f"spawned_{i}") for i, s in enumerate(args.spawn)]
     run = start_run("sim", world=args.world, robot=args.robot, pose=start_pose(args), seed=args.seed,
-                    pace=args.rate, timestep=args.timestep, overrides={"gazebo": parse_sets(args.set)})
+                    pace=args.rate if args.rate is not None else (1.0 if args.ros else 0.0),  # ROS peers: real time
+                    timestep=args.timestep, overrides={"gazebo": parse_sets(args.set)})
     ex, gazebo = run.executor, run.gazebo
     helper = Node(ex, name="sim_cli")
     for model, t in spawns:
@@ -123,7 +127,7 @@ def _cmd_sim(args: argparse.Namespace) -> int:
         helper.create_timer(0.1, lambda: pub.publish(msgs.twist(*cmd_vel)))
         pub.publish(msgs.twist(*cmd_vel))
     start = gazebo.sim.base_pose2d()
-    with viewing(args, ex):
+    with viewing(args, ex), ros_bridge(args.ros, ex, ex.nodes):
         run.run(args.duration, record=args.record, quiet=args.quiet, desc="sim")
     bag = run.bag
     end = gazebo.sim.base_pose2d()
