@@ -36,6 +36,7 @@ BENCHES: dict[str, str] = {
     "planner": "navlab.navigation.bench:run_planner",
     "nav": "navlab.experiments.navigate_run:bench",
     "clutter": "navlab.experiments.clutter_run:bench",
+    "odom": "navlab.experiments.odom_run:bench",
     "sweep": "navlab.experiments.sweep:bench",
     "view": "navlab.viz.bench:run",
     "ros": "navlab.ros1.bench:run",
@@ -163,6 +164,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--controller", default=None,
                    help="clutter: local planner to drive with (trajectory, dwa, mppi; default mppi)")
     p.add_argument("--worlds", type=int, default=50, help="clutter: how many generated worlds (default 50)")
+    p.add_argument("--robot", default=None,
+                   help="clutter: shipped robot (default mybot; e.g. jackal_skid with its own move_base files)")
     p.add_argument("--trials", type=int, default=None,
                    help="sweep: trials per combination (default 10; 2 combinations)")
     p.add_argument("--minutes", type=float, default=60.0,

@@ -32,11 +32,23 @@ def finite_float(text: str) -> float:
     return value
 
 
+def coordinate(text: str) -> float:
+    """argparse ``type=`` for a pose coordinate: a finite number within the ``coordinate_m`` ceiling (m or rad;
+    beyond it poses overflow or lose all precision)."""
+    from navlab.core.limits import ceilings
+
+    value = finite_float(text)
+    limit = ceilings()["coordinate_m"].limit
+    if abs(value) > limit:
+        raise argparse.ArgumentTypeError(f"expected a coordinate within ±{limit:g}, got {text}")
+    return value
+
+
 def add_pose_arguments(p: argparse.ArgumentParser, what: str = "robot start") -> None:
     """``--x --y --yaw``: the robot's start pose in the world (m, m, rad), the same on every verb."""
-    p.add_argument("--x", type=finite_float, default=0.0, help=f"{what} x in the world (m, default 0)")
-    p.add_argument("--y", type=finite_float, default=0.0, help=f"{what} y in the world (m, default 0)")
-    p.add_argument("--yaw", type=finite_float, default=0.0, help=f"{what} heading (rad, default 0)")
+    p.add_argument("--x", type=coordinate, default=0.0, help=f"{what} x in the world (m, default 0)")
+    p.add_argument("--y", type=coordinate, default=0.0, help=f"{what} y in the world (m, default 0)")
+    p.add_argument("--yaw", type=coordinate, default=0.0, help=f"{what} heading (rad, default 0)")
 
 
 def start_pose(args: argparse.Namespace) -> tuple[float, float, float]:

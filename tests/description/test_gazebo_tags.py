@@ -139,13 +139,13 @@ def test_imu_sensor_plugins_ros1_and_ros2(tmp_path):
 
 
 def test_unknown_plugin_and_sensor_warn_and_the_rest_loads(tmp_path):
-    tags = ('<gazebo><plugin name="arm_ctrl" filename="libgazebo_ros_control.so"/></gazebo>'
+    tags = ('<gazebo><plugin name="arm_ctrl" filename="libgazebo_ros_vacuum_gripper.so"/></gazebo>'
             '<gazebo reference="scan_link"><sensor type="camera" name="front_cam"/></gazebo>'
             '<gazebo reference="scan_link"><sensor type="ray" name="sonar">' + RAY.format(n=5)
             + '<plugin name="x" filename="libmy_sonar.so"/></sensor></gazebo>')
     robot = _robot(tmp_path, ROS1, tags)
     text = "\n".join(robot.warnings)
-    assert "libgazebo_ros_control.so" in text and "arm_ctrl" in text
+    assert "libgazebo_ros_vacuum_gripper.so" in text and "arm_ctrl" in text
     assert "front_cam" in text and "camera" in text
     assert "libmy_sonar.so" in text
     assert robot.diff_drive is not None and robot.diff_drive.wheel_separation == 0.3

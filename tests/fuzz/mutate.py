@@ -9,6 +9,7 @@ valid file (truncation, a deleted key) are neutral: only a traceback, a hang or 
 from __future__ import annotations
 
 import copy
+import difflib
 import re
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -16,6 +17,8 @@ from typing import Any
 
 import numpy as np
 import yaml
+
+from navlab.core.params import TYPO_CUTOFF
 
 from .seeds import Seed
 
@@ -297,12 +300,16 @@ def _yaml_structure(fmt: str, seed: Seed, rng: np.random.Generator) -> Case:
     path, d = dicts[int(rng.integers(len(dicts)))]
     key = list(d)[int(rng.integers(len(d)))]
     if kind == "unknown_key" and isinstance(key, str):
-        d[_typo(key, rng)] = d[key]
+        misspelt = _typo(key, rng)
+        d[misspelt] = d[key]
         top = fmt in STRICT_KEYS and not (fmt == "move_base" and path and path[0] in (
             "laser_scan_sensor", "DWAPlannerROS", "MPPIController"))
-        # a typo of a key that the format leaves open (plugin sub-namespaces) is not wrong by construction
-        return Case(fmt, f"yaml:unknown_key@{key}", (top and fmt != "scenario") or (fmt == "scenario" and not path),
-                    {**seed.files, name: _dump(doc)}, seed.main)
+        # a typo of a key that the format leaves open (plugin sub-namespaces) is not wrong by construction; nor,
+        # in ROS parameter files, is a key too far from every known one to be its misspelling: ROS ignores it,
+        # navlab warns (the unknown-key policy, navlab.core.params.check_unknown_key)
+        typo = difflib.SequenceMatcher(None, misspelt, key).ratio() >= TYPO_CUTOFF
+        return Case(fmt, f"yaml:unknown_key@{key}", (top and fmt != "scenario" and typo) or (
+            fmt == "scenario" and not path), {**seed.files, name: _dump(doc)}, seed.main)
     del d[key]
     return Case(fmt, f"yaml:delete_key@{key}", False, {**seed.files, name: _dump(doc)}, seed.main)
 
@@ -572,7 +579,9 @@ def mutators(fmt: str) -> list[Mutator]:
         out += [_carmen, _carmen]
     if fmt == "map":
         out += [_pgm, _pgm]
-    return out
+    from .mutate_nav import mutators_nav
+
+    return mutators_nav(fmt) or out
 
 
 def generate(fmt: str, seed: Seed, rng: np.random.Generator) -> Case:

@@ -27,8 +27,8 @@ from .mutate import FIFO, LINK_PREFIX, Case, generate
 from .seeds import FORMATS, build_seeds
 
 REPO = Path(__file__).resolve().parents[2]
-OUTCOMES = ("clean", "accepted", "vague", "accepted-invalid", "traceback", "hang", "crash", "escape")
-BAD = ("accepted-invalid", "traceback", "hang", "crash", "escape")
+OUTCOMES = ("clean", "accepted", "vague", "accepted-invalid", "traceback", "hang", "crash", "escape", "lost")
+BAD = ("accepted-invalid", "traceback", "hang", "crash", "escape", "lost")
 MEMORY_LIMIT = 3 << 30  # bytes of address space for the worker
 
 
@@ -71,6 +71,10 @@ def _worker() -> None:
             tb = traceback.extract_tb(exc.__traceback__)
             where = f"{Path(tb[-1].filename).name}:{tb[-1].lineno}" if tb else "?"
             reply = {"status": "traceback", "message": f"{type(exc).__name__} at {where}: {str(exc)[:300]}"}
+        lost = [rel for rel, text in (req.get("keep") or {}).items()
+                if not (folder / rel).is_file() or (folder / rel).read_text() != text]
+        if lost:
+            reply = {"status": "lost", "message": f"the user's files are gone or changed: {', '.join(lost)}"}
         marker = req.get("marker")
         if marker and any((p / marker).exists() for p in (folder, Path(tempfile.gettempdir()))):
             reply = {"status": "escape", "message": f"the description created {marker}"}
@@ -139,10 +143,11 @@ class Worker:
 def classify(case: Case, reply: dict[str, Any], folder: Path) -> Result:
     """The outcome class of one case from the worker's reply."""
     status, message = reply["status"], str(reply.get("message", ""))
-    if status in ("traceback", "hang", "crash", "escape"):
+    if status in ("traceback", "hang", "crash", "escape", "lost"):
         return Result(case, status, message)
     if status == "error":
         names = {Path(rel).name for rel in case.files} | {folder.name, Path(case.main).name}
+        names |= set(case.expect.get("names", []))  # command-line cases: the option or value at fault
         named = any(n and n in message for n in names)
         lines = message.count("\n") + 1
         return Result(case, "clean" if named and lines <= 3 else "vague", message[:300])
@@ -171,7 +176,8 @@ def run_cases(todo: list[Case], *, timeout: float = 10.0, progress: bool = False
             folder = root / f"case{k:05d}"
             folder.mkdir()
             _write_case(case, folder)
-            req = {"fmt": case.fmt, "dir": str(folder), "main": case.main, "marker": case.expect.get("marker")}
+            req = {"fmt": case.fmt, "dir": str(folder), "main": case.main, "marker": case.expect.get("marker"),
+                   "keep": case.expect.get("keep")}
             results.append(classify(case, worker.run(req, timeout), folder))
             shutil.rmtree(folder, ignore_errors=True)
             if progress and (k + 1) % 100 == 0:
@@ -207,7 +213,7 @@ def main(argv: list[str] | None = None) -> int:
     import argparse
 
     p = argparse.ArgumentParser(prog="python -m tests.fuzz", description="navlab's input fuzz campaign")
-    p.add_argument("--cases", type=int, default=2200)
+    p.add_argument("--cases", type=int, default=3200)
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--timeout", type=float, default=10.0, help="seconds per case before it counts as a hang")
     p.add_argument("--format", action="append", choices=FORMATS, help="only these formats (repeatable)")

@@ -6,7 +6,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 FORMATS = ("robot", "urdf", "world", "amcl", "gmapping", "move_base", "map", "carmen", "launch", "route",
-           "scenario")
+           "scenario", "navparams", "goal", "bag", "barn", "slam")
 
 
 @dataclass
@@ -139,10 +139,51 @@ def _scenario() -> Seed:
                 "scenario.yaml")
 
 
+def _goal() -> Seed:
+    return Seed({"run.json": b'["sim", "--duration", "0.2", "--quiet", "--json"]'}, "run.json")
+
+
+def _bag() -> Seed:
+    """A small navlab recording (two topics, its node graph) with the user's other files beside it."""
+    import tempfile
+
+    from navlab.io.rosbag import GRAPH_KEY, BagWriter
+    from navlab.msgs import TYPESTORE
+
+    string_t, time_t = TYPESTORE.types["std_msgs/msg/String"], TYPESTORE.types["builtin_interfaces/msg/Time"]
+    clock_t = TYPESTORE.types["rosgraph_msgs/msg/Clock"]
+    with tempfile.TemporaryDirectory() as tmp:
+        with BagWriter(Path(tmp) / "rec") as bag:
+            for k in range(300):
+                bag.write("/chatter", string_t(f"hello {k}"), k * 10_000_000)
+                bag.write("/clock", clock_t(time_t(sec=k // 100, nanosec=k % 100 * 10_000_000)), k * 10_000_000)
+            bag.set_custom_data(GRAPH_KEY, '{"nodes": ["/talker"], "topics": {"/chatter": {"pub": ["/talker"], '
+                                           '"sub": []}}}')
+        files = {f"rec/{p.name}": p.read_bytes() for p in (Path(tmp) / "rec").iterdir()}
+    files.update({"rec/notes.txt": b"my notes", "rec/other/data.txt": b"other data"})
+    return Seed(files, "rec", ["rec/rec.mcap", "rec/metadata.yaml"])
+
+
+def _barn() -> Seed:
+    """A BARN-size world (navlab world clutter: about 200 cylinders and the walls)."""
+    import tempfile
+
+    from navlab.cli import main
+
+    with tempfile.TemporaryDirectory() as tmp:
+        import contextlib
+        import io
+
+        with contextlib.redirect_stdout(io.StringIO()):
+            main(["world", "clutter", "--seed", "3", "--fill", "0.3", "--smooth", "2", "--out", f"{tmp}/barn.world"])
+        return Seed({"barn.world": (Path(tmp) / "barn.world").read_bytes()}, "barn.world")
+
+
 def build_seeds() -> dict[str, Seed]:
     """One valid seed per format in :data:`FORMATS`."""
     return {
         "robot": _robot(), "urdf": _urdf(), "world": _world(), "amcl": _param("amcl"),
         "gmapping": _param("gmapping"), "move_base": _move_base(), "map": _map(), "carmen": _carmen(),
-        "launch": _launch(), "route": _route(), "scenario": _scenario(),
+        "launch": _launch(), "route": _route(), "scenario": _scenario(), "navparams": _move_base(),
+        "goal": _goal(), "bag": _bag(), "barn": _barn(), "slam": _carmen(),
     }

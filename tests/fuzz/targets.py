@@ -91,8 +91,68 @@ def _scenario(path: Path) -> dict[str, Any]:
     return {}
 
 
+def _cli(argv: list[str]) -> dict[str, Any]:
+    """Run ``navlab ARGV`` in this process as the console script would; a non-zero exit is the error it printed,
+    the last line of its output (--json) the accepted run's summary."""
+    import contextlib
+    import io
+    import json
+
+    from navlab.cli import main
+    from navlab.errors import NavlabError
+
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        try:
+            code = main(argv)
+        except SystemExit as exc:  # argparse: a malformed argument
+            code = exc.code if isinstance(exc.code, int) else 2
+    if code != 0:
+        raise NavlabError(err.getvalue().strip() or f"navlab {' '.join(argv)}: exit code {code}")
+    lines = out.getvalue().strip().splitlines()
+    try:
+        summary = json.loads(lines[-1]) if lines else {}
+    except json.JSONDecodeError:
+        summary = {}
+    return summary if isinstance(summary, dict) else {}
+
+
+def _goal(path: Path) -> dict[str, Any]:
+    import json
+
+    _cli(json.loads(path.read_text()))
+    return {}
+
+
+def _bag(folder: Path) -> dict[str, Any]:
+    """Every reader of a recording, then an in-place reindex (the user's other files must survive it)."""
+    from navlab.errors import NavlabError
+
+    errors: list[NavlabError] = []
+    for argv in (["topic", "echo", "/chatter", "--bag", folder.name, "--count", "3"],
+                 ["node", "list", "--bag", folder.name], ["graph", "--bag", folder.name, "--out", "graph"],
+                 ["bag", "reindex", folder.name]):
+        try:
+            _cli(argv)
+        except NavlabError as exc:
+            errors.append(exc)
+    if errors:
+        raise errors[0]
+    return {}
+
+
+def _barn(path: Path) -> dict[str, Any]:
+    _cli(["sim", "--world", path.name, "--model-path", "models", "--duration", "0.05", "--quiet", "--json"])
+    return {}
+
+
+def _slam(path: Path) -> dict[str, Any]:
+    summary = _cli(["slam", "--log", path.name, "--out", "out", "--mode", "gmapping", "--quiet", "--json"])
+    return {"skipped": int(summary.get("skipped_lines", 0))}
+
+
 TARGETS: dict[str, Callable[[Path], dict[str, Any]]] = {
     "robot": _robot, "urdf": _robot, "world": _world, "amcl": _amcl, "gmapping": _gmapping,
     "move_base": _move_base, "map": _map, "carmen": _carmen, "launch": _launch, "route": _route,
-    "scenario": _scenario,
+    "scenario": _scenario, "navparams": _move_base, "goal": _goal, "bag": _bag, "barn": _barn, "slam": _slam,
 }

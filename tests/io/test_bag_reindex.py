@@ -8,6 +8,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 from navlab.cli import main
 from navlab.io.rosbag import bag_topics, read_bag
 
@@ -55,3 +57,59 @@ def test_a_recording_killed_with_sigkill_is_reindexed(tmp_path: Path, capsys) ->
     assert times == sorted(times) and times[0] == 0
     assert not (tmp_path / ".run.partial").exists()
     assert main(["bag", "reindex", str(tmp_path / "nothing")]) == 2
+
+
+def _damaged_bag(folder: Path) -> Path:
+    """A small recording in ``folder`` whose metadata is gone and whose MCAP file was cut short."""
+    from navlab.io.rosbag import BagWriter
+    from navlab.msgs import TYPESTORE
+
+    string_t = TYPESTORE.types["std_msgs/msg/String"]
+    with BagWriter(folder) as bag:
+        for k in range(200):
+            bag.write("/chatter", string_t(f"hello {k}"), k * 1000)
+    (folder / "metadata.yaml").unlink()
+    mcap = folder / f"{folder.name}.mcap"
+    mcap.write_bytes(mcap.read_bytes()[:-300])
+    return mcap
+
+
+def test_reindex_never_removes_what_it_did_not_create(tmp_path: Path, capsys) -> None:
+    """Issue 21: the user's other files and folders in DIR survive a reindex, and so does the damaged file."""
+    folder = tmp_path / "run"
+    mcap = _damaged_bag(folder)
+    damaged = mcap.read_bytes()
+    (folder / "notes.txt").write_text("my notes")
+    (folder / "other_recording").mkdir()
+    (folder / "other_recording" / "data.db3").write_bytes(b"\x00" * 10)
+    (folder / "other.mcap.damaged").write_text("a name the kept copy must not take")
+    assert main(["bag", "reindex", str(folder)]) == 0
+    assert "kept the damaged file" in capsys.readouterr().out
+    assert (folder / "notes.txt").read_text() == "my notes"
+    assert (folder / "other_recording" / "data.db3").read_bytes() == b"\x00" * 10
+    assert (folder / "other.mcap.damaged").read_text().startswith("a name")
+    assert (folder / "run.mcap.damaged").read_bytes() == damaged
+    assert bag_topics(folder)["/chatter"][0] == "std_msgs/msg/String"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["run"]  # no staging folder left behind
+
+
+def test_reindex_out_leaves_the_damaged_folder_as_it_was(tmp_path: Path) -> None:
+    folder = tmp_path / "run"
+    _damaged_bag(folder)
+    before = {p.name: p.read_bytes() for p in folder.iterdir()}
+    assert main(["bag", "reindex", str(folder), "--out", str(tmp_path / "fixed")]) == 0
+    assert {p.name: p.read_bytes() for p in folder.iterdir()} == before
+    assert bag_topics(tmp_path / "fixed")["/chatter"][1] > 0
+    assert main(["bag", "reindex", str(folder), "--out", str(tmp_path / "fixed")]) == 2  # never over a folder
+
+
+def test_a_new_recording_never_removes_a_killed_one(tmp_path: Path) -> None:
+    from navlab.io.errors import BagError
+    from navlab.io.rosbag import BagWriter
+
+    staging = tmp_path / ".run.partial" / "run"
+    staging.mkdir(parents=True)
+    (staging / "run.mcap").write_bytes(b"data of a killed run")
+    with pytest.raises(BagError, match="navlab bag reindex"):
+        BagWriter(tmp_path / "run")
+    assert (staging / "run.mcap").read_bytes() == b"data of a killed run"

@@ -326,11 +326,13 @@ def _cmd_graph(args: argparse.Namespace) -> int:
 def _cmd_bag(args: argparse.Namespace) -> int:
     from navlab.io.rosbag import reindex_bag
 
-    res = reindex_bag(args.dir)
+    res = reindex_bag(args.dir, args.out)
     if args.json:
         print(json.dumps(res))
     else:
         print(f"reindexed {res['path']}: {res['messages']} messages on {len(res['topics'])} topics")
+        for kept in res["kept"]:
+            print(f"  kept the damaged file as {kept}")
         for name, count in sorted(res["topics"].items()):
             print(f"  {name}: {count}")
     return 0
@@ -401,10 +403,13 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="recordings: reindex a recording that was killed (ros2 bag reindex)",
         description="`navlab bag reindex DIR` rebuilds a rosbag2 (MCAP) recording whose process was killed before "
         "it closed the bag (no metadata.yaml; navlab leaves it in .DIR.partial/DIR): every message written before "
-        "the kill is kept and the bag is moved to DIR with its metadata.",
+        "the kill is kept and the bag is moved to DIR with its metadata. Only the bag's own files are renamed into "
+        "DIR (its MCAP file and metadata.yaml); the damaged MCAP files stay beside them as FILE.damaged and nothing "
+        "else in DIR is touched. With --out, the rebuilt bag goes to a new directory and DIR is left as it is.",
     )
     p.add_argument("action", choices=["reindex"], help="what to do")
     p.add_argument("dir", metavar="DIR", help="the recording's directory (or the name it was recorded under)")
+    p.add_argument("--out", metavar="OUT", help="write the rebuilt recording to this new directory instead")
     p.add_argument("--json", action="store_true", help="print the result as JSON")
     p.set_defaults(func=_cmd_bag)
 

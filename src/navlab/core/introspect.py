@@ -90,10 +90,11 @@ def _alive(pid: int) -> bool:
 
 
 def remove_stale_sockets(folder: Path) -> list[Path]:
-    """Remove the sockets of launches that are no longer running; returns what was removed."""
+    """Remove the sockets of launches that are no longer running (``<pid>.sock`` of dead processes,
+    nothing else); returns what was removed."""
     removed = []
     for path in sorted(folder.glob("*.sock")):
-        if not path.stem.isdigit() or not _alive(int(path.stem)):
+        if path.stem.isdigit() and not _alive(int(path.stem)):
             with contextlib.suppress(OSError):
                 path.unlink()
                 removed.append(path)

@@ -408,6 +408,17 @@ def _check_args(files: list[Path], args: dict[str, Any]) -> None:
                               f"{', '.join(sorted(known))})")
 
 
+def _from_cwd(value: Any) -> Any:
+    """A launch argument given by the caller (the command line, Python) that names an existing file or folder
+    relative to the current folder, as an absolute path: ROS resolves command-line paths against the current
+    folder, and a path inside a launch file against that file's folder (``from:``/``file:``), so
+    ``params:=my_params`` must not be looked for beside the shipped launch file."""
+    text = str(value) if isinstance(value, str | os.PathLike) else ""
+    if text and not os.path.isabs(text) and "$(" not in text and os.path.exists(text):
+        return os.path.abspath(text)
+    return value
+
+
 def declared_args(name_or_path: str) -> list[dict[str, Any]]:
     """The ``arg`` entries of a launch file (for ``--help``-like listings); a ROS 1 .launch's ``<arg>``
     elements with ``doc`` as the description and ``value=`` ones (fixed) left out."""
@@ -446,7 +457,7 @@ def start(
     if not names:
         raise LaunchError("no launch file given")
     files = [find_launch_file(str(n)) for n in names]
-    all_args = {k: str(v) for k, v in {**(launch_args or {}), **args}.items()}
+    all_args = {k: str(_from_cwd(v)) for k, v in {**(launch_args or {}), **args}.items()}
     from navlab.core.roslaunch import is_xml_launch
 
     xml = [is_xml_launch(f) for f in files]

@@ -443,6 +443,10 @@ class Node:
         p = prefix.replace("/", ".") + "."
         return {k[len(p) :]: v for k, v in self._overrides.items() if k.startswith(p)}
 
+    def list_parameters(self) -> list[str]:
+        """Names of every parameter given to or declared by this node (rclpy's ``list_parameters``, unfiltered)."""
+        return list(dict.fromkeys([*self._overrides, *self._declared]))
+
     def accept_parameters(self, prefix: str) -> None:
         """Mark every override under ``prefix.`` as known (for sub-objects that read them themselves)."""
         p = prefix.replace("/", ".") + "."

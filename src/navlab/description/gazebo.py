@@ -14,9 +14,18 @@ import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field, replace
 from typing import Literal
 
+from navlab.core.limits import check_ceiling
 from navlab.description.errors import DescriptionError
 from navlab.description.materials import gazebo_material
-from navlab.description.model import DiffDriveConfig, ImuConfig, LidarConfig, Link, Origin, P3dConfig
+from navlab.description.model import DiffDriveConfig, ImuConfig, LidarConfig, Link, Origin, P3dConfig, RosControlConfig
+from navlab.description.skid_steer import (
+    CONTACT_TAGS,
+    ROS_CONTROL_PLUGINS,
+    SKID_STEER_PLUGINS,
+    parse_ros_control,
+    parse_skid_steer,
+    read_contact_tag,
+)
 from navlab.description.urdf import floats
 
 DIFF_DRIVE_PLUGINS = ("libgazebo_ros_diff_drive.so",)
@@ -77,6 +86,7 @@ class GazeboTags:
     """What the ``<gazebo>`` tags of one robot declare."""
 
     diff_drive: DiffDriveConfig | None = None
+    ros_control: RosControlConfig | None = None
     lidars: list[LidarConfig] = field(default_factory=list)
     imus: list[ImuConfig] = field(default_factory=list)
     ground_truths: list[P3dConfig] = field(default_factory=list)
@@ -218,6 +228,7 @@ def parse_lidar(sensor: ET.Element, link: str, where: str, plugin: ET.Element,
     samples = int(_num(hor.find("samples"), where + "/<horizontal>", 640))
     if samples < 1:
         raise DescriptionError(f"{where}/<horizontal>/<samples>: must be >= 1, got {samples}")
+    check_ceiling(DescriptionError, f"{where}/<horizontal>", "<samples>", samples, "lidar_samples")
     vert = ray.find("scan/vertical/samples")
     if vert is not None and int(float(vert.text or "1")) > 1:
         warnings.append(f"{where}: {vert.text} vertical samples; only the horizontal plane is simulated")
@@ -354,6 +365,8 @@ def read_gazebo_tags(root: ET.Element, links: dict[str, Link], joint_names: set[
                 if mu < 0:
                     raise DescriptionError(f"{where}/<{child.tag}>: friction {mu}: expected >= 0")
                 setattr(links[ref], child.tag, mu)
+            elif ref is not None and child.tag in CONTACT_TAGS:
+                links[ref].contact = read_contact_tag(links[ref].contact, child, f"{where}/<{child.tag}>")
             elif ref is not None and child.tag == "material":
                 _apply_material(links[ref], child, f"{where}/<material>", out.warnings)
             elif ref is not None and child.tag == "sensor":
@@ -417,6 +430,13 @@ def _read_model_plugin(plugin: ET.Element, where: str, out: GazeboTags) -> None:
             out.warnings.append(f"{w}: a second diff-drive plugin; the first one is used")
         else:
             out.diff_drive = parse_diff_drive(plugin, w, out.warnings)
+    elif fname in SKID_STEER_PLUGINS:
+        if out.diff_drive is not None:
+            out.warnings.append(f"{w}: a second drive plugin; the first one is used")
+        else:
+            out.diff_drive = parse_skid_steer(plugin, w, out.warnings)
+    elif fname in ROS_CONTROL_PLUGINS:
+        out.ros_control = parse_ros_control(plugin, w, out.warnings)
     elif fname in IMU_MODEL_PLUGINS:
         body = (plugin.findtext("bodyName") or "").strip()
         if not body:
@@ -428,7 +448,7 @@ def _read_model_plugin(plugin: ET.Element, where: str, out: GazeboTags) -> None:
             out.ground_truths.append(p3d)
     elif fname not in BUILTIN_PLUGINS:
         out.warnings.append(f"{w}: unknown plugin, ignored (navlab simulates libgazebo_ros_diff_drive, "
-                            "laser/ray-sensor and imu plugins)")
+                            "skid_steer_drive, gazebo_ros_control, laser/ray-sensor and imu plugins)")
 
 
 def _side(joint: str, chain: dict[str, tuple[str, Origin]]) -> float:
@@ -464,7 +484,8 @@ def check_plugin_joints(tags: GazeboTags, joints: dict[str, str], links: dict[st
     named the other way round is added to the warnings."""
     dd = tags.diff_drive
     if dd is not None:
-        for role, name in (("left", dd.left_joint), ("right", dd.right_joint)):
+        lefts, rights = dd.wheel_joints()
+        for role, name in [*(("left", n) for n in lefts), *(("right", n) for n in rights)]:
             if name not in joints:
                 raise DescriptionError(f"{source}: diff-drive plugin: {role} joint {name!r} is not a joint of "
                                        f"the robot (joints: {', '.join(joints)})")

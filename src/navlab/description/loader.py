@@ -103,11 +103,12 @@ def load_robot(
     chain = {j.name: (parent_joint.get(j.parent, ""), j.origin) for j in joints}
     check_plugin_joints(tags, {j.name: j.type for j in joints}, links, source, chain)
     model.diff_drive = tags.diff_drive
+    model.ros_control = tags.ros_control
     model.lidars = tags.lidars
     model.imus = tags.imus
     model.ground_truths = tags.ground_truths
     model.warnings += tags.warnings
-    if model.diff_drive is None:
+    if model.diff_drive is None and model.ros_control is None:
         model.warnings.append(f"{source}: no libgazebo_ros_diff_drive.so plugin; cmd_vel will not move "
                               "the robot")
     return model
@@ -130,21 +131,37 @@ def _footprint_or_default(model: RobotModel) -> list[list[float]]:
 
 
 def robot_launch_values(name_or_path: str | os.PathLike[str]) -> dict[str, str]:
-    """What launch files take from a robot (``$(robot KEY)``): ``base_frame`` (the diff-drive plugin's
+    """What launch files take from a robot (``$(robot KEY)``): ``base_frame`` (the drive plugin's
     ``robotBaseFrame``, else the root link), ``odom_frame`` and ``scan_topic`` (the first laser's topic,
     else ``scan``) from its plugin tags; ``params``: the navigation parameter folder navlab ships for it,
     else the generic ROS-default one (``params_note`` then says so); ``footprint``: the rectangle around its
-    collision geometry (``[[x, y], ...]``, m, in the base frame)."""
+    collision geometry (``[[x, y], ...]``, m, in the base frame). From its package's own configuration
+    (:mod:`navlab.description.robot_files`): ``wheel_controller`` (``true`` when a ``gazebo_ros_control`` robot
+    has a control YAML), ``controller_params`` (that YAML, else ``diff_drive_controller.yaml`` in ``params``),
+    ``own_controller_params`` (that YAML, else empty),
+    ``ekf`` (``true`` when a robot_localization YAML sits beside it) and ``ekf_params`` (that YAML, else
+    navlab's ``params/ekf.yaml``)."""
+    from navlab.description.robot_files import robot_files
+
     model = load_robot(name_or_path)
     dd = model.diff_drive
     shipped = resources.root() / "params" / model.name
     own = shipped.is_dir() and model.source is not None and resources.root() in model.source.resolve().parents
+    files = robot_files(model.source) if model.source is not None else None
+    control = files.control if files is not None and model.ros_control is not None else None
+    ekf = files.ekf if files is not None else None
+    params = shipped if own else resources.root() / "params" / "generic"
     values = {
         "base_frame": dd.robot_base_frame if dd else model.root_link,
         "odom_frame": dd.odometry_frame if dd else "odom",
         "scan_topic": model.lidars[0].topic if model.lidars else "scan",
-        "params": str(shipped if own else resources.root() / "params" / "generic"),
+        "params": str(params),
         "footprint": str(_footprint_or_default(model)),
+        "wheel_controller": "true" if control is not None else "false",
+        "controller_params": str(control or params / "diff_drive_controller.yaml"),
+        "own_controller_params": str(control or ""),
+        "ekf": "true" if ekf is not None else "false",
+        "ekf_params": str(ekf or resources.path("params/ekf.yaml")),
     }
     if not own:
         values["params_note"] = (

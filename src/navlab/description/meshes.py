@@ -20,7 +20,8 @@ from pathlib import Path
 import numpy as np
 
 from navlab.description.errors import DescriptionError, NotFoundError
-from navlab.io.files import write_text_atomic
+from navlab.io.errors import IoError
+from navlab.io.files import check_regular_file, read_bytes_checked, write_text_atomic
 
 MESH_SUFFIXES = (".stl", ".obj", ".dae")
 _DAE_VERSION = "2"  # bump when the conversion changes (v2: <up_axis> ignored, as in Gazebo classic)
@@ -41,9 +42,13 @@ def cache_dir() -> Path:
 
 
 # ---------------------------------------------------------------------------------------- reading
+MAX_MESH_BYTES = 256 << 20  # the largest mesh file navlab reads
 def read_stl(path: Path) -> tuple[np.ndarray, np.ndarray]:
     """Vertices (n, 3) and triangle indices (m, 3) of a binary or ASCII STL file."""
-    data = path.read_bytes()
+    try:
+        data = read_bytes_checked(path, what="STL mesh", max_bytes=MAX_MESH_BYTES)
+    except IoError as exc:
+        raise DescriptionError(str(exc)) from None
     if len(data) >= 84:
         (count,) = struct.unpack_from("<I", data, 80)
         if 84 + 50 * count == len(data):
@@ -86,6 +91,10 @@ def read_obj(path: Path) -> tuple[np.ndarray, np.ndarray]:
 
 def read_mesh(path: Path) -> tuple[np.ndarray, np.ndarray]:
     """Vertices and triangles of an STL, OBJ or DAE file (DAE: with node transforms, in its own units)."""
+    try:
+        check_regular_file(path, what="mesh file")
+    except IoError as exc:
+        raise DescriptionError(str(exc)) from None
     suffix = path.suffix.lower()
     if suffix == ".stl":
         return read_stl(path)

@@ -101,7 +101,8 @@ class Shape:
 
 @dataclass
 class Link:
-    """A rigid body. ``mu1``/``mu2`` are Gazebo's friction coefficients (None: simulator default)."""
+    """A rigid body. ``mu1``/``mu2`` are Gazebo's friction coefficients (None: simulator default); ``contact``
+    the rest of its ``<gazebo reference>`` ODE contact tags (None: Gazebo's defaults)."""
 
     name: str
     inertial: Inertial | None = None
@@ -109,6 +110,22 @@ class Link:
     visuals: list[Shape] = field(default_factory=list)
     mu1: float | None = None
     mu2: float | None = None
+    contact: ContactTags | None = None
+
+
+@dataclass
+class ContactTags:
+    """Gazebo/ODE contact tags of a link (``<gazebo reference="link">``); None = not given (ODE's default).
+
+    ``kp`` contact stiffness (N/m), ``kd`` contact damping (N s/m), ``min_depth`` penetration allowed before the
+    contact pushes back (m), ``max_vel`` the fastest the contact corrects penetration (m/s), ``fdir1`` the
+    direction of ``mu1`` in the link frame (mu2 acts across it)."""
+
+    kp: float | None = None
+    kd: float | None = None
+    min_depth: float | None = None
+    max_vel: float | None = None
+    fdir1: tuple[float, float, float] | None = None
 
 
 JointType = Literal["fixed", "continuous", "revolute", "prismatic", "floating", "planar"]
@@ -166,6 +183,27 @@ class DiffDriveConfig:
     # navlab extension (not a Gazebo tag): relative error of each wheel's encoder scale, drawn once per
     # run from N(0, odometry_noise) with the run's seed; 0 = exact encoders. Makes odometry drift.
     odometry_noise: float = 0.0
+    # the wheels driven with left_joint / right_joint (a skid-steer robot's rear wheels); empty: none
+    extra_left_joints: tuple[str, ...] = ()
+    extra_right_joints: tuple[str, ...] = ()
+    # what drives the wheels: the gazebo_ros_diff_drive or gazebo_ros_skid_steer_drive plugin, or ros_control's
+    # diff_drive_controller (gazebo_ros_control)
+    drive: Literal["gazebo_ros_diff_drive", "gazebo_ros_skid_steer_drive", "gazebo_ros_control"] = \
+        "gazebo_ros_diff_drive"
+    # odometry covariance diagonal (x, y, yaw) when the plugin names one (skid steer's covariance_x/y/yaw)
+    odom_covariance: tuple[float, float, float] | None = None
+
+    def wheel_joints(self) -> tuple[tuple[str, ...], tuple[str, ...]]:
+        """(left side, right side) joint names: ``left_joint`` + ``extra_left_joints``, likewise right."""
+        return (self.left_joint, *self.extra_left_joints), (self.right_joint, *self.extra_right_joints)
+
+
+@dataclass
+class RosControlConfig:
+    """``libgazebo_ros_control.so``: controllers come from a ros_control YAML loaded into its namespace."""
+
+    namespace: str = "/"
+    control_period: float = 0.0  # s; 0 = every physics step
 
 
 @dataclass
@@ -222,6 +260,7 @@ class RobotModel:
     joints: list[Joint]
     root_link: str
     diff_drive: DiffDriveConfig | None = None
+    ros_control: RosControlConfig | None = None
     lidars: list[LidarConfig] = field(default_factory=list)
     imus: list[ImuConfig] = field(default_factory=list)
     ground_truths: list[P3dConfig] = field(default_factory=list)  # p3d plugins

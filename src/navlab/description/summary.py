@@ -46,6 +46,7 @@ def robot_summary(robot: RobotModel) -> dict[str, Any]:
                     "axis": [round(v, 9) for v in j.axis]}
                    for j in robot.joints],
         "diff_drive": asdict(robot.diff_drive) if robot.diff_drive else None,
+        "ros_control": asdict(robot.ros_control) if robot.ros_control else None,
         "lidars": [{**asdict(lidar), "origin": asdict(lidar.origin)} for lidar in robot.lidars],
         "imus": [{**asdict(imu), "origin": asdict(imu.origin)} for imu in robot.imus],
         "warnings": list(robot.warnings),
@@ -68,10 +69,15 @@ def format_robot(s: dict[str, Any]) -> str:
                      f"axis {j['axis']}")
     dd = s["diff_drive"]
     if dd:
-        lines.append(f"  diff drive: joints {dd['left_joint']}/{dd['right_joint']}, separation "
+        left = "+".join([dd["left_joint"], *dd["extra_left_joints"]])
+        right = "+".join([dd["right_joint"], *dd["extra_right_joints"]])
+        lines.append(f"  diff drive ({dd['drive']}): joints {left}/{right}, separation "
                      f"{dd['wheel_separation']} m, diameter {dd['wheel_diameter']} m, torque {dd['max_torque']} N m, "
                      f"{dd['update_rate']} Hz, {dd['command_topic']} -> {dd['odometry_topic']} "
                      f"({dd['odometry_frame']} -> {dd['robot_base_frame']}, source {dd['odometry_source']})")
+    elif s.get("ros_control"):
+        lines.append(f"  diff drive: from the ros_control YAML (gazebo_ros_control, namespace "
+                     f"{s['ros_control']['namespace']})")
     else:
         lines.append("  diff drive: none")
     for lidar in s["lidars"]:

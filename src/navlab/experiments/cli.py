@@ -13,6 +13,7 @@ from navlab.cli_common import (
     add_resource_path_arguments,
     add_set_argument,
     apply_resource_paths,
+    coordinate,
     parse_sets,
     positive_seconds,
     print_figures,
@@ -314,7 +315,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--mapless", action="store_true",
                    help="no map and no amcl: move_base's global costmap rolls in odom, built from the laser; "
                    "goals are then in odom (the start pose)")  # fmt: skip
-    p.add_argument("--goal", nargs=3, type=float, action="append", required=True, metavar=("X", "Y", "YAW"),
+    p.add_argument("--goal", nargs=3, type=coordinate, action="append", required=True, metavar=("X", "Y", "YAW"),
                    help="a goal in the map frame (odom with --mapless) (m, m, rad); repeat for a sequence")  # fmt: skip
     p.add_argument("--controller", default=None,
                    help="local planner: trajectory (TrajectoryPlannerROS), dwa (DWAPlannerROS), mppi, or a ROS "

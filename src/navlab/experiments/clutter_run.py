@@ -32,16 +32,18 @@ def run_clutter_world(
     seed: int = 0,
     timeout: float = TIMEOUT_S,
     workdir: str | Path | None = None,
+    robot: str = "mybot",
 ) -> dict[str, Any]:
-    """One BARN trial in ``world`` (a ``world.clutter.ClutterWorld``); returns its figures."""
+    """One BARN trial in ``world`` (a ``world.clutter.ClutterWorld``) with ``robot`` (and the move_base files the
+    launch picks for it: navlab's params/<robot> where it ships some); returns its figures."""
     with tempfile.TemporaryDirectory(prefix="navlab-clutter-", dir=workdir) as tmp:
         path = world.write_world(Path(tmp) / f"{world.name}.world")
         gx, gy, gyaw = (float(v) for v in between2(world.start, world.goal))  # the goal in odom (= the start)
         sx, sy, syaw = (float(v) for v in world.start)
         params = {**CLUTTER_PARAMS, **(move_base_params or {})}
         r = run_navigation([(gx, gy, gyaw)], world=str(path), pose=(sx, sy, syaw), mapless=True, controller=controller,
-                           move_base_params=params, seed=seed, goal_timeout=timeout,
-                           goal_tolerance=SUCCESS_M)  # fmt: skip
+                           move_base_params=params, seed=seed, goal_timeout=timeout, goal_tolerance=SUCCESS_M,
+                           robot=robot)  # fmt: skip
     g = r.goals[0]
     return rounded({
         **barn_outcome(world, [g]), "reason": g["reason"], "time_s": g["time_s"], "collisions": g["collisions"],
@@ -90,8 +92,9 @@ def run_clutter_suite(
     controller: str | None = "mppi",
     move_base_params: dict[str, Any] | None = None,
     progress: bool = False,
+    robot: str = "mybot",
 ) -> dict[str, Any]:
-    """The ``clutter_suite(n, seed)`` worlds in turn; the per-world figures and their summary."""
+    """The ``clutter_suite(n, seed)`` worlds in turn with ``robot``; the per-world figures and their summary."""
     import sys
 
     from tqdm import tqdm
@@ -100,7 +103,8 @@ def run_clutter_suite(
 
     trials = []
     for world in tqdm(clutter_suite(n, seed=seed), desc="clutter", unit="world", disable=not progress, file=sys.stderr):
-        trials.append(run_clutter_world(world, controller=controller, move_base_params=move_base_params, seed=seed))
+        trials.append(run_clutter_world(world, controller=controller, move_base_params=move_base_params, seed=seed,
+                                        robot=robot))
     return {"summary": summarize(trials), "trials": trials}
 
 
@@ -123,12 +127,16 @@ def summarize(trials: list[dict[str, Any]]) -> dict[str, Any]:
 
 
 def bench(args: Any) -> dict[str, Any]:
-    """``navlab bench clutter``: mapless navigation over 50 generated clutter worlds of graded difficulty."""
+    """``navlab bench clutter``: mapless navigation over 50 generated clutter worlds of graded difficulty (``--robot``:
+    mybot with MPPI by default; another shipped robot drives with its own params/<robot> planner unless
+    ``--controller`` names one)."""
     import time
 
     n = int(getattr(args, "worlds", 0) or 50)
     t0 = time.perf_counter()
-    out = run_clutter_suite(n, seed=getattr(args, "seed", 0), controller=getattr(args, "controller", None) or "mppi")
+    robot = getattr(args, "robot", None) or "mybot"
+    controller = getattr(args, "controller", None) or ("mppi" if robot == "mybot" else None)  # None: params/<robot>'s
+    out = run_clutter_suite(n, seed=getattr(args, "seed", 0), controller=controller, robot=robot)
     s = dict(out["summary"])
     s["wall_s"] = round(time.perf_counter() - t0, 1)
     s["failed_worlds"] = [t["world"] for t in out["trials"] if not t["success"]]

@@ -22,6 +22,7 @@ from navlab.experiments.session import Run, rounded, start_run
 from navlab.experiments.truth import true_occupancy, world_T_map
 from navlab.geometry import inverse_transform_points2, wrap_angle
 from navlab.grid import GridMap
+from navlab.io.files import check_regular_file
 from navlab.mapping.errors import MappingError
 from navlab.mapping.mapfile import save_map
 
@@ -163,6 +164,7 @@ def write_trajectory(path: Path, t: np.ndarray, est: np.ndarray, truth: np.ndarr
 def read_trajectory(path: Path) -> tuple[np.ndarray, np.ndarray]:
     """(estimate (N, 3), truth (N, 3)) from a file written by :func:`write_trajectory`."""
     try:
+        check_regular_file(path, what="trajectory")
         rows = np.loadtxt(path, comments="#", ndmin=2)
     except (OSError, ValueError) as exc:
         raise MappingError(f"{path}: cannot read a trajectory ({exc}); expected lines of 7 numbers") from None

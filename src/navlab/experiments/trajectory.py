@@ -20,6 +20,7 @@ import numpy as np
 
 from navlab.geometry import wrap_angle
 from navlab.io.errors import IoError
+from navlab.io.files import check_regular_file
 from navlab.io.poses import read_table
 from navlab.mapping.errors import MappingError
 
@@ -114,6 +115,7 @@ def associate(
 
 def _is_carmen(path: Path) -> bool:
     try:
+        check_regular_file(path, what="trajectory")
         with path.open("r", errors="replace") as fh:
             for line in fh:
                 tok = line.split()

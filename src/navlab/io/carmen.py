@@ -13,6 +13,7 @@ import math
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -22,6 +23,11 @@ from navlab.io.errors import IoError
 NO_RETURN = 81.9  # SICK "no return" in CARMEN logs (81.91 m); such ranges carry no hit
 MAX_READINGS = 100_000  # readings per scan line; more is not a laser scan
 MAX_LINE = 4 << 20  # characters per line (a 100,000-reading line has under 1 MiB)
+MAX_LASER_RANGE = 1000.0  # m: a reading or max range beyond this is not a laser's (the longest reach ~300 m)
+MAX_COORDINATE = 1e6  # m: an odometry coordinate beyond this is not a robot's
+OUTLIER_WINDOW = 5  # records each side whose median a pose is compared with
+OUTLIER_SPEED = 20.0  # m/s: a pose further from its neighbours' median than this speed allows is an outlier
+OUTLIER_SLACK = 10.0  # m: ... plus this much
 
 
 @dataclass
@@ -71,6 +77,7 @@ class CarmenLog:
     odometry: list[OdomRecord] = field(default_factory=list)
     skipped: list[str] = field(default_factory=list)
     ignored_types: dict[str, int] = field(default_factory=dict)
+    outlier_poses: int = 0  # records rejected because a pose jumps away from its neighbours (counted in skipped)
 
     @property
     def duration(self) -> float:
@@ -109,6 +116,20 @@ def _fields(tok: list[str], expected: int, what: str) -> None:
                    "its readings would shift every field after them)")
 
 
+def _laser(ranges: list[float], max_range: float, what: str) -> np.ndarray:
+    if not 0.0 < max_range <= MAX_LASER_RANGE:
+        raise _Bad(f"{what}: max range {max_range} m, expected 0 < max range <= {MAX_LASER_RANGE:g} m")
+    r = np.array(ranges, np.float64)
+    if r.size and not np.abs(r).max() <= MAX_LASER_RANGE:
+        raise _Bad(f"{what}: a reading of {np.abs(r).max():g} m, beyond any laser's range ({MAX_LASER_RANGE:g} m)")
+    return r.astype(np.float32)
+
+
+def _poses(*poses: tuple[float, float, float], what: str) -> None:
+    if any(abs(v) > MAX_COORDINATE for pose in poses for v in pose[:2]):
+        raise _Bad(f"{what}: a pose coordinate beyond {MAX_COORDINATE:g} m")
+
+
 def _parse_flaser(tok: list[str]) -> LaserScan2D:
     n = _count(tok, 1, "FLASER count")
     if n <= 1:
@@ -117,7 +138,8 @@ def _parse_flaser(tok: list[str]) -> LaserScan2D:
     ranges = _floats(tok, 2, n, f"FLASER with {n} readings")
     x, y, t, ox, oy, ot, ts = _floats(tok, 2 + n, 7, f"FLASER with {n} readings")
     inc = math.pi / (n - 1) if n % 2 == 1 else math.pi / n  # 361 -> 0.5°, 180 -> 1°
-    return LaserScan2D(ts, np.array(ranges, np.float32), -math.pi / 2, inc, NO_RETURN, (x, y, t), (ox, oy, ot))
+    _poses((x, y, t), (ox, oy, ot), what="FLASER")
+    return LaserScan2D(ts, _laser(ranges, NO_RETURN, "FLASER"), -math.pi / 2, inc, NO_RETURN, (x, y, t), (ox, oy, ot))
 
 
 def _parse_robotlaser1(tok: list[str]) -> LaserScan2D:
@@ -132,13 +154,14 @@ def _parse_robotlaser1(tok: list[str]) -> LaserScan2D:
     base = 10 + n + n_rem
     lx, ly, lt, rx, ry, rt = _floats(tok, base, 6, "ROBOTLASER1 poses")
     ts = _floats(tok, base + 11, 1, "ROBOTLASER1 timestamp")[0]
-    return LaserScan2D(
-        ts, np.array(ranges, np.float32), start, res, max_range, (lx, ly, lt), (rx, ry, rt), kind="ROBOTLASER1"
-    )
+    _poses((lx, ly, lt), (rx, ry, rt), what="ROBOTLASER1")
+    return LaserScan2D(ts, _laser(ranges, max_range, "ROBOTLASER1"), start, res, max_range, (lx, ly, lt), (rx, ry, rt),
+                       kind="ROBOTLASER1")
 
 
 def _parse_odom(tok: list[str]) -> OdomRecord:
     x, y, t, tv, rv, _acc, ts = _floats(tok, 1, 7, "ODOM")
+    _poses((x, y, t), what="ODOM")
     return OdomRecord(ts, (x, y, t), tv, rv)
 
 
@@ -153,6 +176,7 @@ def read_carmen(path: str | os.PathLike[str], *, max_skipped_report: int = 5) ->
         raise IoError(f"cannot read CARMEN log {p}: {exc.strerror or exc}") from None
     log = CarmenLog(p)
     last = {"scan": -math.inf, "odom": -math.inf}  # the latest timestamp of each stream
+    lines: dict[str, list[int]] = {"scan": [], "odom": []}  # each record's line number
     with fh:
         lineno = 0
         while line := fh.readline(MAX_LINE):
@@ -178,16 +202,46 @@ def read_carmen(path: str | os.PathLike[str], *, max_skipped_report: int = 5) ->
                     last[stream] = rec.timestamp
                     if isinstance(rec, OdomRecord):
                         log.odometry.append(rec)
+                        lines["odom"].append(lineno)
                     else:
                         log.scans.append(rec)
+                        lines["scan"].append(lineno)
                 else:
                     log.ignored_types[kind] = log.ignored_types.get(kind, 0) + 1
             except (_Bad, ValueError) as exc:
                 log.skipped.append(f"{p.name}:{lineno}: skipped {kind} line ({exc})")
+    log.scans = _without_outliers(log, log.scans, [[s.odom_pose for s in log.scans], [s.laser_pose for s in log.scans]],
+                                  lines["scan"])
+    log.odometry = _without_outliers(log, log.odometry, [[o.pose for o in log.odometry]], lines["odom"])
     if not log.scans:
         extra = f"; {len(log.skipped)} malformed lines, first: {log.skipped[0]}" if log.skipped else ""
         raise IoError(f"{p}: no FLASER or ROBOTLASER1 scans found{extra}")
     return log
+
+
+def _without_outliers(log: CarmenLog, records: list[Any], poses: list[list[tuple[float, float, float]]],
+                      linenos: list[int]) -> list[Any]:
+    """``records`` without those with a pose (one list per pose kind) further from the median of its
+    ``OUTLIER_WINDOW`` neighbours each side than ``OUTLIER_SLACK`` + ``OUTLIER_SPEED`` x their time span
+    allows (one wild pose would otherwise grow a SLAM map without bound); each rejected record is counted."""
+    if len(records) < 3:
+        return records
+    from scipy.ndimage import median_filter
+
+    t = np.array([r.timestamp for r in records], dtype=np.float64)
+    idx = np.arange(len(t))
+    span = np.maximum(t - t[np.maximum(idx - OUTLIER_WINDOW, 0)], t[np.minimum(idx + OUTLIER_WINDOW, len(t) - 1)] - t)
+    dev = np.zeros(len(t))
+    for kind in poses:
+        xy = np.array([p[:2] for p in kind], dtype=np.float64)
+        med = np.stack([median_filter(xy[:, k], size=2 * OUTLIER_WINDOW + 1, mode="mirror") for k in range(2)], 1)
+        dev = np.maximum(dev, np.hypot(*(xy - med).T))
+    bad = dev > OUTLIER_SLACK + OUTLIER_SPEED * span
+    name = log.path.name if log.path is not None else "log"
+    for k in np.flatnonzero(bad):
+        log.skipped.append(f"{name}:{linenos[k]}: rejected an outlier pose, {dev[k]:g} m from its neighbours' median")
+    log.outlier_poses += int(bad.sum())
+    return [r for r, b in zip(records, bad, strict=True) if not b]
 
 
 def skipped_summary(log: CarmenLog, limit: int = 3) -> str:

@@ -63,12 +63,36 @@ def save_figure_atomic(fig: Any, path: str | os.PathLike[str], **savefig_kwargs:
         fig.savefig(tmp, **savefig_kwargs)
 
 
+def machine_memory_bytes() -> int:
+    """The memory this process may use in bytes (the figure memory ceilings are computed from): the machine's
+    physical memory, or the process's address-space limit (``ulimit -v``) if that is lower."""
+    import resource
+
+    try:
+        physical = int(os.sysconf("SC_PAGE_SIZE")) * int(os.sysconf("SC_PHYS_PAGES"))
+    except (ValueError, OSError, AttributeError):
+        physical = 8 << 30
+    soft, _hard = resource.getrlimit(resource.RLIMIT_AS)
+    return min(physical, soft) if soft != resource.RLIM_INFINITY and soft > 0 else physical
+
+
 def _kind(mode: int) -> str:
     for test, name in ((stat.S_ISDIR, "a directory"), (stat.S_ISFIFO, "a named pipe"), (stat.S_ISCHR, "a device"),
                        (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket")):
         if test(mode):
             return name
     return "not a regular file"
+
+
+def check_regular_file(path: str | os.PathLike[str], *, what: str) -> None:
+    """Refuse ``path`` unless it is a regular file (named pipes, devices, sockets and folders are refused
+    without being opened: a FIFO would block the reader, a device never end). Raises ``IoError``."""
+    try:
+        st = os.stat(path)
+    except OSError as exc:
+        raise IoError(f"{path}: cannot read the {what} ({exc.strerror or exc})") from None
+    if not stat.S_ISREG(st.st_mode):
+        raise IoError(f"{path}: is {_kind(st.st_mode)}; expected a {what} (a regular file)")
 
 
 def read_bytes_checked(path: str | os.PathLike[str], *, what: str, max_bytes: int = MAX_TEXT_BYTES) -> bytes:
@@ -90,7 +114,7 @@ def read_bytes_checked(path: str | os.PathLike[str], *, what: str, max_bytes: in
         if st.st_size > max_bytes:
             raise IoError(f"{p}: {st.st_size} bytes; a {what} may have at most {max_bytes}")
         try:
-            data = fh.read(max_bytes + 1)
+            data = fh.read(min(st.st_size, max_bytes) + 1)  # not max_bytes: read() allocates what it is asked
         except OSError as exc:
             raise IoError(f"{p}: cannot read the {what} ({exc.strerror or exc})") from None
     if len(data) > max_bytes:

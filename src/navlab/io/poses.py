@@ -22,6 +22,8 @@ def read_table(path: str | os.PathLike[str], min_cols: int, what: str) -> np.nda
     """
     p = Path(path)
     try:
+        if p.exists() and not p.is_file():  # a FIFO would block, a device never end
+            raise IoError(f"cannot read {what} file {p}: not a regular file")
         lines = p.read_text().splitlines()
     except OSError as exc:
         raise IoError(f"cannot read {what} file {p}: {exc.strerror or exc}") from None

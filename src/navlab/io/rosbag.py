@@ -9,21 +9,26 @@ executor is ``navlab.core.record.Recorder``, built on it.
 
 from __future__ import annotations
 
+import contextlib
 import json
+import os
 import shutil
 import struct
+import tempfile
 from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
 from rosbags.rosbag2 import Reader, StoragePlugin, Writer
-from rosbags.rosbag2.errors import ReaderError, WriterError
+from rosbags.rosbag2.errors import WriterError
 
-from navlab.io.errors import BagError
+from navlab.io.errors import BagError, IoError
+from navlab.io.files import machine_memory_bytes, read_bytes_checked, read_text_checked
 from navlab.msgs import TYPESTORE, type_name
 
 __all__ = ["GRAPH_KEY", "BagError", "BagWriter", "bag_graph", "bag_topics", "read_bag", "reindex_bag"]
 
+MAX_METADATA_BYTES = 16 << 20  # a rosbag2 metadata.yaml
 GRAPH_KEY = "navlab.graph"  # custom-data key of the node/topic graph a navlab recording stores
 
 
@@ -40,9 +45,10 @@ class BagWriter:
             raise BagError(f"{self.path}: already exists; choose a new directory for the recording")
         self._staging = self.path.parent / f".{self.path.name}.partial"
         self._tmp = self._staging / self.path.name
+        if self._staging.exists() or self._staging.is_symlink():  # a killed recording: never removed for a new one
+            raise BagError(f"{self.path}: {self._staging} holds a recording that was killed; recover it with "
+                           f"`navlab bag reindex {self.path}` (or move it away) before recording under this name")
         try:
-            if self._staging.exists():  # left behind by a crashed run
-                shutil.rmtree(self._staging)
             self._staging.mkdir(parents=True)
             self._writer = Writer(self._tmp, version=8, storage_plugin=StoragePlugin.MCAP)
             self._writer.open()
@@ -69,8 +75,12 @@ class BagWriter:
         if not self.closed:
             self.closed = True
             self._writer.close()
-            self._tmp.rename(self.path)
-            self._staging.rmdir()
+            try:
+                os.rename(self._tmp, self.path)  # refuses to replace anything but an empty folder
+                self._staging.rmdir()
+            except OSError as exc:
+                raise BagError(f"{self.path}: cannot move the finished recording from {self._tmp} into place "
+                               f"({exc.strerror or exc}); it is kept there") from None
         return self.path
 
     def __enter__(self) -> BagWriter:
@@ -80,37 +90,114 @@ class BagWriter:
         self.close()
 
 
+def damaged(path: str | Path, what: str) -> BagError:
+    """The one error of every recording reader: ``DIR: damaged recording: what, where; try reindex``."""
+    return BagError(f"{path}: damaged recording: {' '.join(what.split())[:300]}; try `navlab bag reindex {path}`")
+
+
+def _what(exc: BaseException) -> str:
+    if isinstance(exc, MemoryError):
+        return "a size field claims more memory than the machine has (MemoryError)"
+    text = str(exc) if not isinstance(exc, OSError) else (exc.strerror or str(exc))
+    return f"{type(exc).__name__}: {text}" if text else type(exc).__name__
+
+
+def _check_bag_dir(path: Path) -> None:
+    """Refuse what is not a rosbag2 directory of regular files before rosbags opens anything (a named pipe
+    would block it, a device never end): the folder, its metadata.yaml and every storage file it names."""
+    import yaml
+
+    if not path.is_dir():
+        if path.exists() or path.is_symlink():
+            kind = "a regular file" if path.is_file() else "not a regular file (a pipe, device or socket)"
+            raise BagError(f"{path}: is {kind}; expected a rosbag2 directory (the folder holding metadata.yaml)")
+        raise BagError(f"{path}: no such rosbag2 directory")
+    names = {p.name for p in path.iterdir() if p.suffix in (".mcap", ".db3", ".yaml")}
+    meta = path / "metadata.yaml"
+    if meta.exists() or meta.is_symlink():
+        try:
+            info = yaml.safe_load(read_text_checked(meta, what="rosbag2 metadata.yaml", max_bytes=MAX_METADATA_BYTES))
+            files = info["rosbag2_bagfile_information"]["relative_file_paths"]
+            names |= {str(f) for f in files}
+        except IoError as exc:
+            raise damaged(path, str(exc)) from None
+        except (RecursionError, MemoryError) as exc:
+            raise damaged(path, f"metadata.yaml: {_what(exc)}") from None
+        except Exception:  # malformed YAML or layout: rosbags' reader names it below (a damaged recording)
+            pass
+    root = path.resolve()
+    for name in sorted(names):
+        f = path / name
+        if not (f.exists() or f.is_symlink()):
+            continue
+        real = f.resolve()
+        if root not in real.parents:
+            raise damaged(path, f"{name} is outside the recording's folder")
+        if not real.is_file():
+            raise damaged(path, f"{name} is not a regular file (a pipe, device, socket or folder)")
+
+
+def _reader(path: Path) -> Reader:
+    _check_bag_dir(path)
+    return Reader(path)
+
+
 def read_bag(path: str | Path, *, topics: Sequence[str] = ()) -> Iterator[tuple[str, int, Any]]:
-    """Yield ``(topic, t_ns, msg)`` from a rosbag2 directory, deserialised to navlab messages."""
+    """Yield ``(topic, t_ns, msg)`` from a rosbag2 directory, deserialised to navlab messages.
+
+    Every failure — rosbags', the file system's, a message that does not deserialise — is a BagError
+    naming the recording (and the topic where one is known)."""
+    where = ""
     try:
-        with Reader(Path(path)) as reader:
+        with _reader(Path(path)) as reader:
             conns = [c for c in reader.connections if not topics or c.topic in topics]
             for conn, t_ns, raw in reader.messages(connections=conns):
-                yield conn.topic, t_ns, TYPESTORE.deserialize_cdr(raw, conn.msgtype)
-    except (ReaderError, FileNotFoundError) as exc:
-        raise BagError(f"{path}: cannot read as a rosbag2 directory ({exc})") from None
+                where = f" (a {conn.msgtype} message on {conn.topic} at t={t_ns} ns)"
+                msg = TYPESTORE.deserialize_cdr(raw, conn.msgtype)
+                where = f" (after the message at t={t_ns} ns)"
+                yield conn.topic, t_ns, msg
+    except BagError:
+        raise
+    except Exception as exc:  # the reader's boundary: rosbags, zstd, serde, struct, OS, Unicode errors
+        raise damaged(path, _what(exc) + where) from None
 
 
 def bag_topics(path: str | Path) -> dict[str, tuple[str, int]]:
     """``{topic: (type, message count)}`` of a rosbag2 directory."""
     try:
-        with Reader(Path(path)) as reader:
+        with _reader(Path(path)) as reader:
             return {c.topic: (c.msgtype, c.msgcount) for c in reader.connections}
-    except (ReaderError, FileNotFoundError) as exc:
-        raise BagError(f"{path}: cannot read as a rosbag2 directory ({exc})") from None
+    except BagError:
+        raise
+    except Exception as exc:  # the reader's boundary
+        raise damaged(path, _what(exc)) from None
 
 
 def bag_graph(path: str | Path) -> dict[str, Any] | None:
     """The node/topic graph a navlab recording stored in its metadata (None for other bags)."""
     import yaml
 
+    _check_bag_dir(Path(path))
     meta = Path(path) / "metadata.yaml"
     try:
-        info = yaml.safe_load(meta.read_text())["rosbag2_bagfile_information"]
-    except (OSError, KeyError, TypeError, yaml.YAMLError) as exc:
-        raise BagError(f"{meta}: cannot read bag metadata ({exc})") from None
-    raw = (info.get("custom_data") or {}).get(GRAPH_KEY)
-    return json.loads(raw) if raw else None
+        info = yaml.safe_load(read_text_checked(meta, what="rosbag2 metadata.yaml", max_bytes=MAX_METADATA_BYTES))
+        raw = (info["rosbag2_bagfile_information"].get("custom_data") or {}).get(GRAPH_KEY)
+        graph = json.loads(raw) if raw else None
+    except Exception as exc:  # the reader's boundary
+        raise damaged(path, f"metadata.yaml: {_what(exc)}") from None
+    if graph is not None and not _graph_shaped(graph):
+        raise damaged(path, f"metadata.yaml: {GRAPH_KEY} is not a graph "
+                      "({nodes: [names], topics: {name: {pub: [names], sub: [names]}}})")
+    return graph
+
+
+def _graph_shaped(graph: Any) -> bool:
+    def names(v: Any) -> bool:
+        return isinstance(v, list) and all(isinstance(x, str) for x in v)
+
+    topics = graph.get("topics", {}) if isinstance(graph, dict) else None
+    return isinstance(topics, dict) and names(graph.get("nodes", [])) and all(
+        isinstance(v, dict) and names(v.get("pub")) and names(v.get("sub")) for v in topics.values())
 
 
 # --- recovering a recording that was killed (ros2 bag reindex) -------------------------------------------
@@ -140,7 +227,7 @@ def _scan_mcap(path: Path) -> tuple[dict[int, tuple[str, str]], list[tuple[int, 
     truncated MCAP file (no summary needed): every complete record up to where the file was cut."""
     from rosbags.rosbag2.storage_mcap import DECOMPRESSORS
 
-    buf = path.read_bytes()
+    buf = read_bytes_checked(path, what="MCAP file", max_bytes=machine_memory_bytes() // 4)
     if not buf.startswith(_MCAP_MAGIC):
         raise BagError(f"{path}: not an MCAP file")
     schemas: dict[int, str] = {}
@@ -163,23 +250,41 @@ def _scan_mcap(path: Path) -> tuple[dict[int, tuple[str, str]], list[tuple[int, 
                 compression, pos = _string(rec, 28)
                 (n,) = struct.unpack_from("<Q", rec, pos)
                 data = bytes(rec[pos + 8 : pos + 8 + n])
+                if size > machine_memory_bytes() // 4:
+                    raise BagError(f"{path}: cannot be recovered: a chunk claims {size} bytes uncompressed")
                 try:
                     raw = DECOMPRESSORS[compression](data, size) if compression else data
                 except Exception as exc:  # a corrupt chunk: keep what came before it
                     raise BagError(f"{path}: chunk cannot be decompressed ({exc})") from None
                 take(_records(raw))
 
-    take(_records(buf, len(_MCAP_MAGIC)))
+    try:
+        take(_records(buf, len(_MCAP_MAGIC)))
+    except BagError:
+        raise
+    except Exception as exc:  # a record that lies about its layout: keep nothing rather than guess
+        raise BagError(f"{path}: cannot be recovered: a malformed MCAP record ({_what(exc)})") from None
     return channels, messages
 
 
-def reindex_bag(path: str | Path) -> dict[str, Any]:
+def _free_name(path: Path) -> Path:
+    """``path``, or ``path.1``, ``path.2``, ... : the first name that does not exist."""
+    k = 0
+    while (candidate := path.with_name(path.name + (f".{k}" if k else ""))).exists() or candidate.is_symlink():
+        k += 1
+    return candidate
+
+
+def reindex_bag(path: str | Path, out: str | Path | None = None) -> dict[str, Any]:
     """Rebuild a rosbag2 (MCAP) recording that was killed before it was closed, as ``ros2 bag reindex`` does.
 
     ``path`` is the recording's directory, or the name it would have had: a killed ``BagWriter`` leaves
     its files in ``.<name>.partial/<name>`` beside it. Every complete message written before the kill is
-    kept (the last, unwritten chunk is lost); the bag is rewritten with its metadata and moved to its
-    name. Returns ``{"path", "topics", "messages"}``.
+    kept (the last, unwritten chunk is lost). The rebuilt bag is written in a staging folder of its own and
+    then moved: into ``out`` (a new directory; ``path`` is left untouched), else into ``path`` — only the
+    bag's own ``<name>.mcap`` and ``metadata.yaml`` are renamed into place, the damaged MCAP files are kept
+    beside them as ``<file>.damaged``, and nothing else in the folder is touched. Returns
+    ``{"path", "topics", "messages", "kept"}``.
     """
     target = Path(path)
     source = target
@@ -187,37 +292,65 @@ def reindex_bag(path: str | Path) -> dict[str, Any]:
         source = target.parent / f".{target.name}.partial" / target.name
         if not any(source.glob("*.mcap")):
             raise BagError(f"{target}: no MCAP file here nor in {source} (nothing to reindex)")
+    dest = Path(out) if out is not None else target
+    if out is not None and (dest.exists() or dest.is_symlink()):
+        raise BagError(f"{dest}: already exists; --out must name a new directory")
     channels: dict[int, tuple[str, str]] = {}
     messages: list[tuple[int, int, bytes]] = []
-    for mcap in sorted(source.glob("*.mcap")):
+    damaged = sorted(source.glob("*.mcap"))
+    for mcap in damaged:
         ch, msgs = _scan_mcap(mcap)
         channels.update(ch)
         messages += msgs
+    messages = [m for m in messages if m[0] in channels]  # a message of a channel never declared has no type
     unknown = sorted({t for t in channels.values() if t[1] not in TYPESTORE.types})
     if unknown:
         raise BagError(f"{source}: message types navlab does not know: {', '.join(f'{a} [{b}]' for a, b in unknown)}")
-    rebuilt = target.parent / f".{target.name}.reindex"
-    shutil.rmtree(rebuilt, ignore_errors=True)
-    rebuilt.mkdir(parents=True)
     try:
-        writer = Writer(rebuilt / target.name, version=8, storage_plugin=StoragePlugin.MCAP)
+        dest.parent.mkdir(parents=True, exist_ok=True)
+        staging = Path(tempfile.mkdtemp(prefix=f".{dest.name}.reindex-", dir=dest.parent))  # ours alone
+    except OSError as exc:
+        raise BagError(f"{dest}: cannot write the rebuilt recording ({exc.strerror or exc})") from None
+    rebuilt = staging / dest.name
+    try:
+        writer = Writer(rebuilt, version=8, storage_plugin=StoragePlugin.MCAP)
         writer.open()
         conns = {cid: writer.add_connection(topic, msgtype, typestore=TYPESTORE)
                  for cid, (topic, msgtype) in sorted(channels.items())}
         for cid, t_ns, data in sorted(messages, key=lambda m: m[1]):
-            if cid in conns:
-                writer.write(conns[cid], t_ns, data)
+            writer.write(conns[cid], t_ns, data)
         writer.close()
+        kept = _move_into_place(rebuilt, dest, damaged if out is None else [])
     except (OSError, WriterError) as exc:
-        shutil.rmtree(rebuilt, ignore_errors=True)
-        raise BagError(f"{target}: cannot rewrite the recording ({exc})") from None
-    if target.exists():
-        shutil.rmtree(target)
-    (rebuilt / target.name).rename(target)
-    rebuilt.rmdir()
-    if source != target:
-        shutil.rmtree(source.parent, ignore_errors=True)
+        raise BagError(f"{dest}: cannot rewrite the recording ({exc})") from None
+    finally:
+        shutil.rmtree(staging, ignore_errors=True)
+    if out is None and source != target:  # the killed writer's staging folders, if now empty
+        for folder in (source, source.parent):
+            with contextlib.suppress(OSError):
+                folder.rmdir()
     counts: dict[str, int] = {}
     for cid, _t, _d in messages:
         counts[channels[cid][0]] = counts.get(channels[cid][0], 0) + 1
-    return {"path": str(target), "topics": counts, "messages": len(messages)}
+    return {"path": str(dest), "topics": counts, "messages": len(messages), "kept": [str(k) for k in kept]}
+
+
+def _move_into_place(rebuilt: Path, dest: Path, damaged: list[Path]) -> list[Path]:
+    """Move the rebuilt bag's files into ``dest`` (renamed whole when ``dest`` does not exist), keeping each
+    ``damaged`` file as ``<dest>/<name>.damaged``; returns where the damaged files were kept."""
+    if not dest.exists():
+        kept = []
+        for f in damaged:  # out of the killed writer's staging folder, into the rebuilt bag
+            kept.append(_free_name(rebuilt / f"{f.name}.damaged"))
+            os.replace(f, kept[-1])
+        rebuilt.rename(dest)
+        return [dest / k.name for k in kept]
+    if not dest.is_dir():
+        raise BagError(f"{dest}: is not a directory")
+    kept = []
+    for f in damaged:
+        kept.append(_free_name(dest / f"{f.name}.damaged"))
+        os.replace(f, kept[-1])
+    for f in sorted(rebuilt.iterdir()):  # <name>.mcap and metadata.yaml, each renamed atomically
+        os.replace(f, dest / f.name)
+    return kept

@@ -21,6 +21,7 @@ from typing import Any
 
 import numpy as np
 
+from navlab.core.limits import check_ceiling
 from navlab.geometry import wrap_angle
 from navlab.localization import sampling
 from navlab.localization.errors import LocalizationError
@@ -85,6 +86,7 @@ class AmclParams:
             raise LocalizationError(f"amcl parameter resample_interval: expected >= 1, got {self.resample_interval}")
         if self.laser_max_beams < 1:
             raise LocalizationError(f"amcl parameter laser_max_beams: expected >= 1, got {self.laser_max_beams}")
+        check_ceiling(LocalizationError, "amcl", "max_particles", self.max_particles, "particles")
         for name in ("laser_sigma_hit", "laser_lambda_short", "laser_likelihood_max_dist"):
             if getattr(self, name) <= 0:
                 raise LocalizationError(f"amcl parameter {name}: expected > 0, got {getattr(self, name)}")

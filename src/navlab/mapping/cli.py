@@ -8,8 +8,6 @@ import sys
 import time
 from pathlib import Path
 
-import yaml
-
 from navlab.cli_common import add_pose_arguments, print_figures, start_pose
 from navlab.experiments.cli import add_eval_map
 
@@ -17,13 +15,10 @@ from navlab.experiments.cli import add_eval_map
 def _params_file(path: str | None) -> dict:
     if not path:
         return {}
+    from navlab.core.params import read_yaml
     from navlab.mapping.errors import MappingError
 
-    try:
-        with open(path) as fh:
-            doc = yaml.safe_load(fh) or {}
-    except (OSError, yaml.YAMLError) as exc:
-        raise MappingError(f"cannot read SLAM parameter file {path}: {exc}") from None
+    doc = read_yaml(path) or {}  # a regular UTF-8 file of bounded size and nesting (no FIFO, no alias bomb)
     if not isinstance(doc, dict):
         raise MappingError(f"{path}: expected a mapping of parameter names to values")
     # accept ROS layouts: {node: {ros__parameters: {...}}} or {node: {...}}

@@ -22,6 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from navlab.core.limits import check_ceiling
 from navlab.core.params import dataclass_from_dict
 from navlab.geometry import between2, compose2, wrap_angle
 from navlab.grid import GridMap
@@ -87,6 +88,7 @@ class GMappingParams:
         out = dataclass_from_dict(cls, values, what="gmapping", error=MappingError)
         if out.particles < 1:
             raise MappingError(f"gmapping parameter 'particles' must be >= 1, got {out.particles}")
+        check_ceiling(MappingError, "gmapping", "particles", out.particles, "particles")
         return out
 
 
@@ -170,6 +172,7 @@ class GMapping:
         left, bottom = (max(0, 1 - int(t)) if t < 0 else 0 for t in t_lo)
         right, top = (max(0, int(t) - n + 2) if t >= n else 0 for t, n in zip(t_hi, (tw, th), strict=True))
         if left or right or bottom or top:
+            self._check_size((th + bottom + top) * TILE, (tw + left + right) * TILE)  # (if no tile were shared)
             for part in self.particles:
                 part.table = np.pad(part.table, ((bottom, top), (left, right)))
             self._offset = self._offset - TILE * np.array([left, bottom])
@@ -246,6 +249,11 @@ class GMapping:
         max_range = p.maxRange if p.maxRange > 0 else float(np.nanmax(np.where(np.isfinite(r), r, 0))) + 1e-3
         return ang, max_range, min(p.maxUrange, max_range)
 
+    def _check_size(self, rows: int, cols: int) -> None:
+        """Every particle holds a map: refuse maps that together would not fit the machine's memory."""
+        check_ceiling(MappingError, "gmapping", "particles x map cells (the map spans the scans' reach at delta)",
+                      float(self.p.particles) * rows * cols, "slam_particle_cells")
+
     def _init(self, odom: np.ndarray, r: np.ndarray, ang: np.ndarray, max_urange: float, max_range: float) -> None:
         p = self.p
         reach = min(max_urange, 30.0) + 2.0
@@ -258,6 +266,7 @@ class GMapping:
         self._offset = cells_lo - MAP_MARGIN_CELLS
         self._seen = (cells_lo, cells_hi)
         w, h = (cells_hi - cells_lo + 1 + 2 * MAP_MARGIN_CELLS).tolist()
+        self._check_size(h, w)
         table = np.zeros(tiles_for((h, w)), dtype=np.int64)
         self._scan_tiles = table.size
         self.pool.recount([table])

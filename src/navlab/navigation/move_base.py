@@ -21,6 +21,7 @@ import numpy as np
 
 from navlab import msgs
 from navlab.core import Executor, Node, TfError
+from navlab.core.limits import check_ceiling
 from navlab.geometry import inverse_transform_points2, transform_points2, wrap_angle
 from navlab.navigation.costmap.layers import StaticLayer
 from navlab.navigation.costmap_ros import Costmap2DROS
@@ -75,6 +76,8 @@ class MoveBase(Node):
         for key in ("planner_frequency", "oscillation_timeout", "conservative_reset_dist"):
             if not (math.isfinite(p[key]) and p[key] >= 0):
                 raise NavigationError(f"move_base parameter {key}: expected >= 0, got {p[key]}")
+        for key in ("controller_frequency", "planner_frequency"):
+            check_ceiling(NavigationError, "move_base", key, p[key], "rate")
         raw_recoveries = self.declare_parameter("recovery_behaviors", [dict(r) for r in DEFAULT_RECOVERIES])
         private = self.fully_qualified_name
         self.global_costmap = self._costmap("global_costmap", private)

@@ -17,6 +17,7 @@ _SHIPPED_PACKAGES = (
     ("mybot_description", "robots/mybot"),
     ("navlab_tb3_burger_description", "robots/tb3_burger"),
     ("navlab_jackal_description", "robots/jackal"),
+    ("navlab_jackal_skid_description", "robots/jackal_skid"),
     ("gazebo_ros", "ros/gazebo_ros"),  # stand-ins for a ROS install: empty_world.launch, $(find xacro)
     ("xacro", "ros/xacro"),
 )

@@ -30,6 +30,7 @@ import numpy as np
 from navlab.description.model import Geometry, Joint, Link, Origin, RobotModel, Shape
 from navlab.geometry import matrix_from_rpy, quat_from_rpy, wxyz_from_xyzw
 from navlab.sim.errors import SimError
+from navlab.sim.ode_contact import combined_mu, contact_solimp, contact_solref
 
 GROUP_WORLD = 0
 GROUP_ROBOT = 1
@@ -66,6 +67,11 @@ WHEEL_TAU = 0.005
 ROBOT_SOLREF = (0.005, 1.0)
 ROBOT_SOLIMP = (0.95, 0.99, 0.001, 0.5, 2.0)
 DEFAULT_MU = 1.0  # Gazebo/ODE's friction when a link names none
+#: SKID_ARMATURE: a skid-steer wheel joint gets rotor inertia (MuJoCo ``armature``, kg m²) of this fraction of its
+#: share of the robot's mass at the wheel radius — a geared motor's reflected inertia, which URDF cannot state.
+#: Without it a wheel (0.5 kg) rocks the robot on every speed change (measured, jackal_skid from rest to 0.5 m/s:
+#: its wheels ran 0.08 m ahead of it; with it 0.01 m, the Coulomb figure v^2/2 (1/(mu g) - 1/a) for mu 0.8).
+SKID_ARMATURE = 0.5
 MIN_MASS = 1e-3  # kg given to a moving link that has no <inertial>
 MIN_STEP, MAX_STEP = 0.0005, 0.002  # s; 5 ms tips robots over
 #: DEFAULT_STEP: MuJoCo's implicit integrator is as accurate at 2 ms as at Gazebo/ODE's usual 1 ms for
@@ -83,7 +89,8 @@ class BuildInfo:
     link_bodies: dict[str, str] = field(default_factory=dict)  # URDF link -> MuJoCo body name
     lidar_sites: list[str] = field(default_factory=list)  # one per RobotModel.lidars entry
     imu_sites: list[str] = field(default_factory=list)  # one per RobotModel.imus entry
-    wheel_actuators: tuple[str, str] | None = None  # (left, right) velocity actuators
+    wheel_actuators: tuple[str, ...] | None = None  # velocity actuators: the left side's wheels, then the right's
+    left_wheel_count: int = 1  # how many of wheel_actuators drive the left side
     #: model name -> (free body names, geom names welded to the world)
     world_parts: dict[str, tuple[list[str], list[str]]] = field(default_factory=dict)
     model_poses: dict[str, tuple[float, ...]] = field(default_factory=dict)  # model name -> SDF pose
@@ -209,12 +216,11 @@ def _set_inertial(body: mujoco.MjsBody, link: Link, moving: bool, info: BuildInf
 
 def _link_friction(link: Link, rigid_to_root: bool) -> tuple[float, int]:
     """(mu, condim) of a robot link's contacts under Gazebo semantics (see module docstring)."""
-    if link.mu1 is None and link.mu2 is None:
+    mu = combined_mu(link.mu1, link.mu2)
+    if mu is None:
         return (0.0, 1) if rigid_to_root else (DEFAULT_MU, 3)
-    mus = [m for m in (link.mu1, link.mu2) if m is not None]
-    mu = float(min(mus))
     if mu < 0:
-        raise SimError(f"link {link.name!r}: friction mu1/mu2 must be >= 0, got {mus}")
+        raise SimError(f"link {link.name!r}: friction mu1/mu2 must be >= 0, got {(link.mu1, link.mu2)}")
     return (0.0, 1) if mu <= 1e-6 else (mu, 3)
 
 
@@ -250,14 +256,23 @@ def add_robot(
     info.robot_name = robot.name
     info.root_body = robot.root_link
     contact = {**_contact_props("robot", GROUP_ROBOT), "priority": 1}
-    contact["solref"] = np.array(ROBOT_SOLREF)
-    contact["solimp"] = np.array(ROBOT_SOLIMP)
+    total_mass = sum(lk.inertial.mass for lk in robot.links.values() if lk.inertial is not None)
+    wheels = sum(map(len, robot.diff_drive.wheel_joints())) if robot.diff_drive is not None else 1
+    if wheels > 2:  # skid steer: wheels slide sideways; isotropic Coulomb friction (see navlab.sim.ode_contact)
+        spec.option.cone = mujoco.mjtCone.mjCONE_ELLIPTIC
 
     def fill(body: mujoco.MjsBody, link: Link, axis: np.ndarray | None, rigid_to_root: bool) -> None:
         where = f"robot {robot.name!r} link {link.name!r}"
         info.link_bodies[link.name] = body.name
         _set_inertial(body, link, axis is not None, info, where)
         mu, condim = _link_friction(link, rigid_to_root)
+        # ODE contact tags map onto a skid-steer robot's wheels; two-wheel robots keep the contact their
+        # straight-line and turning tests were measured with (TurtleBot3's kp/kd would slow it by 10 %)
+        skid = wheels > 2 and axis is not None and not rigid_to_root
+        tags = link.contact if skid else None
+        contact["solref"] = np.array(contact_solref(tags, total_mass / wheels, timestep=MAX_STEP,
+                                                    default=ROBOT_SOLREF, skid=skid))
+        contact["solimp"] = np.array(contact_solimp(tags, default=ROBOT_SOLIMP, skid=skid))
         for i, shape in enumerate(link.collisions):
             g = geoms.add(body, shape, f"{where} collision {i}", friction=np.array([mu, 0.005, 0.0001]),
                           condim=condim, **contact)
@@ -304,7 +319,7 @@ def add_robot(
         ):
             spec.add_sensor(name=f"{site}_{suffix}", type=kind, objtype=mujoco.mjtObj.mjOBJ_SITE, objname=site)
     if robot.diff_drive is not None:
-        info.wheel_actuators = _add_wheel_motors(spec, robot)
+        info.wheel_actuators = _add_wheel_motors(spec, robot, info)
 
 
 def _add_joint(body: mujoco.MjsBody, joint: Joint, where: str, info: BuildInfo) -> None:
@@ -367,11 +382,13 @@ def _wheel_inertia(robot: RobotModel, joint: Joint) -> float:
     return max(own + 0.5 * total * (dd.wheel_diameter / 2) ** 2, 1e-6)
 
 
-def _add_wheel_motors(spec: mujoco.MjSpec, robot: RobotModel) -> tuple[str, str]:
+def _add_wheel_motors(spec: mujoco.MjSpec, robot: RobotModel, info: BuildInfo) -> tuple[str, ...]:
     dd = robot.diff_drive
     assert dd is not None
     names = []
-    for jname in (dd.left_joint, dd.right_joint):
+    lefts, rights = dd.wheel_joints()
+    info.left_wheel_count = len(lefts)
+    for jname in (*lefts, *rights):
         joint = next((j for j in robot.joints if j.name == jname), None)
         if joint is None or joint.type not in ("continuous", "revolute"):
             found = "missing" if joint is None else f"a {joint.type} joint"
@@ -379,8 +396,12 @@ def _add_wheel_motors(spec: mujoco.MjSpec, robot: RobotModel) -> tuple[str, str]
                 f"robot {robot.name!r}: diff_drive wheel joint {jname!r} is {found}; expected a continuous joint"
             )
         act = spec.add_actuator(name=f"{jname}::motor", target=jname, trntype=mujoco.mjtTrn.mjTRN_JOINT)
+        if len(lefts) + len(rights) > 2:  # see SKID_ARMATURE
+            total = sum(lk.inertial.mass for lk in robot.links.values() if lk.inertial is not None)
+            share = total / (len(lefts) + len(rights)) * (dd.wheel_diameter / 2) ** 2
+            spec.joint(jname).armature = SKID_ARMATURE * share
         act.set_to_velocity(kv=_wheel_inertia(robot, joint) / WHEEL_TAU)
         act.forcelimited = mujoco.mjtLimited.mjLIMITED_TRUE
         act.forcerange = np.array([-dd.max_torque, dd.max_torque])
         names.append(act.name)
-    return names[0], names[1]
+    return tuple(names)

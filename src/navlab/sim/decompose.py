@@ -40,7 +40,8 @@ from typing import Any
 import numpy as np
 
 from navlab.description.model import Origin
-from navlab.io.files import atomic_path
+from navlab.io.errors import IoError
+from navlab.io.files import MAX_TEXT_BYTES, atomic_path, read_bytes_checked
 from navlab.sim.errors import SimError
 from navlab.world.model import WorldModel
 
@@ -133,8 +134,8 @@ def cache_file(path: Path, scale: tuple[float, float, float] = (1.0, 1.0, 1.0), 
     the mesh's frame, None: whole) are cached (``effort`` None: :func:`default_effort`)."""
     effort = effort or default_effort()
     try:
-        data = Path(path).read_bytes()
-    except OSError as exc:
+        data = read_bytes_checked(path, what="mesh", max_bytes=MAX_TEXT_BYTES * 4)
+    except IoError as exc:
         raise SimError(f"mesh {path}: cannot read it for convex decomposition ({exc})") from None
     opts = sorted(_options(effort, threshold).items())
     key = repr((tuple(float(s) for s in scale), opts, seed, _VERSION))

@@ -14,7 +14,7 @@ from navlab.sim.extensions import SimExtensions
 from navlab.sim.imu import ImuSensorPlugin
 from navlab.sim.plugins import DiffDrivePlugin, GroundTruthPlugin, JointStatePlugin, LidarPlugin
 from navlab.sim.simulation import Simulation
-from navlab.sim.spawn import check_start_pose, load_sdf_model, parse_spawn_spec, primitive_model
+from navlab.sim.spawn import check_spawn_clear, check_start_pose, load_sdf_model, parse_spawn_spec, primitive_model
 from navlab.world.model import ModelSpec, WorldModel
 
 
@@ -68,9 +68,11 @@ class GazeboSim(Node):
         world = world_model if world_model is not None else load_world_named(world_name)
         extensions = SimExtensions(self)  # wheel controller and disturbances (navlab.sim.extensions)
         robot = extensions.robot(robot)
+        js_rate = extensions.controllers.joint_state_rate or js_rate  # joint_state_controller's publish_rate
         for warning in [*robot.warnings, *world.warnings]:
             self.get_logger().warning(warning)
         check_start_pose(robot, world, pose)  # a start inside an obstacle is refused, not thrown 7 m
+        self.robot = robot
         self.sim = Simulation(robot, world, seed=self.rng, timestep=timestep or None, robot_pose=pose,
                               visuals=visuals)
         self.sim.time_ns = executor.now_ns  # started late: physics time begins at the current time
@@ -124,6 +126,7 @@ class GazeboSim(Node):
 
     def spawn(self, model: ModelSpec) -> list[str]:
         """Add a model to the running world; returns its MuJoCo body names."""
+        check_spawn_clear(self.robot, self.sim.base_pose2d(), model)
         bodies = self.sim.spawn(model)
         self.get_logger().info(f"spawned {model.name!r}")
         return bodies

@@ -145,7 +145,8 @@ class ImuSensorPlugin(Node):
         g2, a2 = np.square(gyro.stddev), np.square(accel.stddev)
         self.cov = (np.diag(g2).ravel(), np.diag(g2).ravel(), np.diag(a2).ravel())
         self.pub = self.create_publisher(msgs.Imu, cfg.topic, 10)
-        self.create_timer(1.0 / cfg.update_rate, self.update, idle=self._unread)
+        # Gazebo: a sensor updates at most once per physics step
+        self.create_timer(max(1.0 / cfg.update_rate, sim.timestep), self.update, idle=self._unread)
 
     def read(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(quaternion x y z w in the world, noisy angular velocity rad/s, noisy acceleration m/s²)."""

@@ -89,7 +89,7 @@ class DiffDrivePlugin(Node):
         self.last_ns = executor.now_ns
         self.odom_pub = self.create_publisher(msgs.Odometry, config.odometry_topic, 10)
         self.create_subscription(msgs.Twist, config.command_topic, self.on_cmd_vel, 10)
-        self.create_timer(1.0 / config.update_rate, self.update)
+        self.create_timer(max(1.0 / config.update_rate, sim.timestep), self.update)  # Gazebo: at most every step
 
     def _encoders(self) -> tuple[float, float]:
         """Wheel angles (rad) as the encoders report them."""
@@ -173,7 +173,7 @@ class LidarPlugin(Node):
         n = cfg.samples
         self.angle_increment = float(np.diff(lidar_angles(cfg))[0]) if n > 1 else 0.0
         self.pub = self.create_publisher(msgs.LaserScan, cfg.topic, 10)
-        self.create_timer(1.0 / cfg.update_rate, self.update)
+        self.create_timer(max(1.0 / cfg.update_rate, sim.timestep), self.update)  # Gazebo: at most every step
         self._empty = np.zeros(0, dtype=np.float32)
         # the scan's fixed fields, converted once
         self._fields = {"angle_min": float(cfg.min_angle), "angle_max": float(cfg.max_angle),

@@ -176,8 +176,9 @@ class Simulation:
         """Target angular velocities (rad/s) of the diff-drive wheel joints; torque capped by the motors."""
         if not self._act:
             raise SimError("this robot has no diff_drive wheels to command")
-        self.data.ctrl[self._act[0]] = left
-        self.data.ctrl[self._act[1]] = right
+        n = self.info.left_wheel_count
+        self.data.ctrl[self._act[:n]] = left
+        self.data.ctrl[self._act[n:]] = right
 
     # --- state ------------------------------------------------------------------------------------
 
@@ -334,9 +335,11 @@ class Simulation:
         return self._joints[name]
 
     def wheel_angles(self) -> tuple[float, float]:
-        """(left, right) diff-drive wheel angles (rad), unwrapped."""
-        dd = self._diff_drive()
-        return self.joint_position(dd.left_joint), self.joint_position(dd.right_joint)
+        """(left, right) diff-drive wheel angles (rad), unwrapped: each side's mean over its wheels (a skid-steer
+        robot's front and rear wheels), as diff_drive_controller averages them."""
+        lefts, rights = self._diff_drive().wheel_joints()
+        return (sum(map(self.joint_position, lefts)) / len(lefts),
+                sum(map(self.joint_position, rights)) / len(rights))
 
     def _diff_drive(self) -> DiffDriveConfig:
         if self.robot is None or self.robot.diff_drive is None:

@@ -15,11 +15,13 @@ from typing import Any
 
 import numpy as np
 
+from navlab.core.limits import ceilings
 from navlab.description.model import Geometry, Inertial, Link, RobotModel, Shape, is_geometry_kind
 from navlab.sim.errors import SimError
 from navlab.world.model import ModelSpec, WorldModel
 
 KINDS = ("box", "cylinder", "sphere", "sdf")
+_SIZES = frozenset({"size", "sx", "sy", "sz", "radius", "length", "mass"})
 _KEYS = {"name", "x", "y", "z", "yaw", "static", "mass", "size", "sx", "sy", "sz", "radius", "length", "t",
          "file", "rgba"}
 
@@ -100,14 +102,21 @@ def parse_spawn_spec(text: str, *, default_name: str = "") -> tuple[ModelSpec, f
         if key not in opts:
             return default
         try:
-            return float(opts[key])
+            value = float(opts[key])
         except ValueError:
             raise SimError(f"spawn spec {text!r}: {key}={opts[key]!r} is not a number") from None
+        ceiling = ceilings()["model_m" if key in _SIZES else "coordinate_m"]
+        if not abs(value) <= ceiling.limit:  # NaN and inf fail too
+            raise SimError(f"spawn spec {text!r}: {key}={opts[key]}: expected a finite number within "
+                           f"±{ceiling.limit:g} {ceiling.unit} ({ceiling.why})")
+        return value
 
     name = opts.get("name") or default_name or kind
     place = {"x": num("x", 0.0), "y": num("y", 0.0), "z": num("z"), "yaw": num("yaw", 0.0)}
     static = _bool("static", opts["static"]) if "static" in opts else True
     t = num("t", 0.0)
+    if t < 0:
+        raise SimError(f"spawn spec {text!r}: t={opts['t']}: expected a time >= 0 s")
     if kind == "sdf":
         if "file" not in opts:
             raise SimError(f"spawn spec {text!r}: sdf needs file=PATH")
@@ -185,8 +194,34 @@ def check_start_pose(robot: RobotModel, world: WorldModel, pose: tuple[float, fl
                      margin: float = 0.02, resolution: float = 0.02) -> None:
     """Refuse a start pose (x, y, yaw: m, m, rad, the root link in the world) at which the robot's
     collision outline (its convex hull seen from above, shrunk by ``margin`` m so that touching is
-    allowed) overlaps a world model within the robot's height. SimError names the models; started
-    there, the contact solver would throw the robot metres away."""
+    allowed) overlaps a world model within the robot's height, or that is not a finite pose within the
+    ``coordinate_m`` ceiling. SimError names the world file and the models; started there, the contact
+    solver would throw the robot metres away."""
+    x, y, yaw = pose
+    limit = ceilings()["coordinate_m"].limit
+    if not all(abs(v) <= limit for v in pose):  # NaN fails too
+        raise SimError(f"start pose x={x:g} y={y:g} yaw={yaw:g}: expected finite numbers within ±{limit:g}")
+    names = _overlapping(robot, world, pose, margin=margin, resolution=resolution)
+    if names:
+        shown = ", ".join(map(repr, names[:5])) + (f" and {len(names) - 5} more" if len(names) > 5 else "")
+        where = f"{world.source}: " if world.source is not None else ""
+        raise SimError(f"{where}start pose x={x:g} y={y:g} yaw={yaw:g} puts robot {robot.name!r} inside {shown} "
+                       f"of world {world.name!r}; started there, the contact solver would throw it away. Pick a "
+                       "free pose (--x/--y/--yaw, or x:= y:= yaw:=)")
+
+
+def check_spawn_clear(robot: RobotModel, robot_pose: tuple[float, float, float], model: ModelSpec) -> None:
+    """Refuse to spawn ``model`` where it would overlap the robot at ``robot_pose`` (x, y, yaw of the root
+    link; the contact solver would throw the robot away, or make the simulation unstable)."""
+    if _overlapping(robot, WorldModel(name="spawn", models=[model]), robot_pose):
+        x, y = model.pose[:2]
+        raise SimError(f"spawn {model.name!r} at x={x:g} y={y:g}: it would overlap robot {robot.name!r} at "
+                       f"x={robot_pose[0]:.3f} y={robot_pose[1]:.3f}; spawn it where the robot is not")
+
+
+def _overlapping(robot: RobotModel, world: WorldModel, pose: tuple[float, float, float], *,
+                 margin: float = 0.02, resolution: float = 0.02) -> list[str]:
+    """The models of ``world`` that the robot's outline at ``pose`` overlaps ("an obstacle" if unnamed)."""
     from navlab.world.occupancy import occupancy, shape_footprints
 
     xy, z_lo, z_hi = robot_outline(robot)
@@ -199,7 +234,7 @@ def check_start_pose(robot: RobotModel, world: WorldModel, pose: tuple[float, fl
     bounds = (float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1]))
     occ = occupancy(world, resolution, bounds, z_min=band[0], z_max=band[1])
     if not occ.any():
-        return
+        return []
     from scipy.spatial import ConvexHull, QhullError
 
     try:
@@ -216,13 +251,11 @@ def check_start_pose(robot: RobotModel, world: WorldModel, pose: tuple[float, fl
     else:
         inside = np.linalg.norm(cells - centre, axis=1) <= r - margin
     if not inside.any():
-        return
+        return []
     hit = cells[inside]
     names = sorted({fp.name.split("::")[0] for fp in shape_footprints(world, z_min=band[0], z_max=band[1])
                     if _overlaps(fp.bounds(), hit)})
-    raise SimError(f"start pose x={x:g} y={y:g} yaw={yaw:g} puts robot {robot.name!r} inside "
-                   f"{', '.join(map(repr, names)) or 'an obstacle'} of world {world.name!r}; started there, "
-                   "the contact solver would throw it away. Pick a free pose (--x/--y/--yaw, or x:= y:= yaw:=)")
+    return names or ["an obstacle"]
 
 
 def _overlaps(bounds: tuple[float, float, float, float], pts: np.ndarray) -> bool:

@@ -35,6 +35,7 @@ from navlab.core import Executor, Node
 from navlab.description.model import DiffDriveConfig
 from navlab.sim.errors import SimError
 from navlab.sim.pid import Pid, PidGains
+from navlab.sim.ros_control import wheel_names
 from navlab.sim.simulation import Simulation
 
 CONTROLLER_TYPE = "diff_drive_controller/DiffDriveController"
@@ -48,8 +49,8 @@ _LIMIT_KEYS = {
 #: diff_drive_controller's parameters (ROS 1 names) and navlab's defaults (ROS's where ROS has one)
 CONTROLLER_DEFAULTS: dict[str, Any] = {
     "type": CONTROLLER_TYPE,
-    "left_wheel": "",  # default: the robot's diff-drive left joint
-    "right_wheel": "",
+    "left_wheel": None,  # a joint or a list of joints (a skid-steer side); default: the robot's diff-drive left joint
+    "right_wheel": None,
     "publish_rate": 50.0,
     "pose_covariance_diagonal": [0.001, 0.001, 1000000.0, 1000000.0, 1000000.0, 1000.0],
     "twist_covariance_diagonal": [0.001, 0.001, 1000000.0, 1000000.0, 1000000.0, 1000.0],
@@ -155,7 +156,7 @@ class WheelOdometry:
             self.angular = sum(self._ang) / len(self._ang)
 
 
-def use_effort_actuators(sim: Simulation, max_torque: float) -> tuple[int, int]:
+def use_effort_actuators(sim: Simulation, max_torque: float) -> list[int]:
     """Turn the wheel velocity actuators into torque motors (ctrl = N m, capped at ``max_torque``), in
     the compiled model and in its spec (so a recompile after spawning keeps them); their ids."""
     names = sim.info.wheel_actuators
@@ -180,7 +181,7 @@ def use_effort_actuators(sim: Simulation, max_torque: float) -> tuple[int, int]:
         m.actuator_forcerange[i] = (-max_torque, max_torque)
         sim.data.ctrl[i] = 0.0
         ids.append(i)
-    return ids[0], ids[1]
+    return ids
 
 
 def _diag(values: Any, key: str) -> np.ndarray:
@@ -192,12 +193,16 @@ def _diag(values: Any, key: str) -> np.ndarray:
 
 class DiffDriveController(Node):
     """``diff_drive_controller/DiffDriveController`` with ``gazebo_ros_control``'s per-wheel velocity PID on
-    effort. Subscribes ``cmd_vel`` (the plugin's command topic), publishes ``odom`` and tf; see the module."""
+    effort, or (``velocity_interface``: ``hardware_interface/VelocityJointInterface`` without ``pid_gains``) the
+    joints' velocity motors capped at their effort limit, as DefaultRobotHWSim drives them. Each side may have
+    several wheels (``left_wheel: [front_left_wheel, rear_left_wheel]``): they get the same speed and odometry
+    reads each side's mean position. Subscribes ``cmd_vel`` (the plugin's command topic), publishes ``odom``
+    and tf; see the module."""
 
     def __init__(self, executor: Executor, *, name: str = "mobile_base_controller",
                  parameters: dict[str, Any] | None = None, namespace: str = "", sim: Simulation,
                  config: DiffDriveConfig, pid_gains: dict[str, Any] | None = None,
-                 control_period: float = 0.01) -> None:  # fmt: skip
+                 control_period: float = 0.01, velocity_interface: bool = False) -> None:  # fmt: skip
         super().__init__(executor, name=name, parameters=parameters, namespace=namespace or config.namespace)
         p = self.declare_parameters(CONTROLLER_DEFAULTS)
         self.check_parameters()
@@ -205,7 +210,13 @@ class DiffDriveController(Node):
         if p["type"] != CONTROLLER_TYPE:
             raise SimError(f"{where}: type {p['type']!r}: navlab simulates {CONTROLLER_TYPE!r}")
         self.sim, self.cfg, self.p = sim, config, p
-        self.joints = (p["left_wheel"] or config.left_joint, p["right_wheel"] or config.right_joint)
+        lefts, rights = config.wheel_joints()
+        self.sides = (wheel_names(p["left_wheel"], f"{where} left_wheel") if p["left_wheel"] else lefts,
+                      wheel_names(p["right_wheel"], f"{where} right_wheel") if p["right_wheel"] else rights)
+        if (len(self.sides[0]), len(self.sides[1])) != (len(lefts), len(rights)):
+            raise SimError(f"{where}: left_wheel {list(self.sides[0])} and right_wheel {list(self.sides[1])}: the "
+                           f"robot drives {len(lefts)} + {len(rights)} wheels")
+        self.joints = (*self.sides[0], *self.sides[1])
         for joint in self.joints:
             if joint not in sim.joint_names():
                 raise SimError(f"{where}: wheel joint {joint!r} is not a moving joint of the robot "
@@ -230,9 +241,10 @@ class DiffDriveController(Node):
         unknown = sorted(set(gains) - set(self.joints))
         if unknown:
             raise SimError(f"gazebo_ros_control pid_gains: {unknown} are not the controller's wheels {self.joints}")
+        self.velocity_interface = velocity_interface and not gains
         self.pids = tuple(Pid(PidGains.from_params(gains.get(j, DEFAULT_PID), where=f"pid_gains.{j}"),
                               output_limit=config.max_torque) for j in self.joints)  # fmt: skip
-        self.actuators = use_effort_actuators(sim, config.max_torque)
+        self.actuators = [] if self.velocity_interface else use_effort_actuators(sim, config.max_torque)
         self.period = control_period
         self.cmd = (0.0, 0.0)
         self.last_cmd_ns: int | None = None
@@ -248,7 +260,9 @@ class DiffDriveController(Node):
         self.create_timer(1.0 / p["publish_rate"], self.publish_odometry)
 
     def _angles(self) -> tuple[float, float]:
-        return self.sim.joint_position(self.joints[0]), self.sim.joint_position(self.joints[1])
+        """Each side's mean wheel angle (rad), as diff_drive_controller averages a side's wheels."""
+        pos = self.sim.joint_position
+        return tuple(sum(map(pos, side)) / len(side) for side in self.sides)  # type: ignore[return-value]
 
     def on_cmd_vel(self, msg: Any) -> None:
         """Store the commanded body velocity (m/s, rad/s); non-finite commands are refused, as ROS does."""
@@ -274,8 +288,13 @@ class DiffDriveController(Node):
         self.history = [(v, w), (v0, w0)]
         half = w * self.separation / 2.0
         self.wheel_targets = ((v - half) / self.radii[0], (v + half) / self.radii[1])
-        for target, joint, pid, act in zip(self.wheel_targets, self.joints, self.pids, self.actuators, strict=True):
-            self.sim.data.ctrl[act] = pid.compute(target - self.sim.joint_velocity(joint), dt)
+        if self.velocity_interface:
+            self.sim.set_wheel_velocity_targets(*self.wheel_targets)
+        else:
+            n = len(self.sides[0])
+            targets = [self.wheel_targets[0]] * n + [self.wheel_targets[1]] * (len(self.joints) - n)
+            for target, joint, pid, act in zip(targets, self.joints, self.pids, self.actuators, strict=True):
+                self.sim.data.ctrl[act] = pid.compute(target - self.sim.joint_velocity(joint), dt)
         if self.cmd_pub is not None:
             self.cmd_pub.publish(msgs.twist(v, w))
 

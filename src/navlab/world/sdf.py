@@ -9,10 +9,12 @@ unsupported geometry are reported in ``WorldModel.warnings``.
 
 from __future__ import annotations
 
+import collections
+import contextlib
 import math
 import os
 import xml.etree.ElementTree as ET
-from collections.abc import Iterable
+from collections.abc import Iterable, Iterator
 from pathlib import Path
 
 from navlab import resources
@@ -28,6 +30,9 @@ from navlab.world.model import ModelSpec, Pose6, WorldModel
 SUPPORTED_VERSIONS = ("1.4", "1.5", "1.6", "1.7")
 _IGNORED_WORLD_TAGS = ("light", "scene", "gui", "audio", "wind", "atmosphere", "spherical_coordinates",
                        "magnetic_field", "physics", "gravity", "state", "road", "frame")
+
+
+MAX_NESTING = 32  # models and includes inside each other (xacro's include depth too)
 
 
 def _floats(text: str | None, n: int, where: str) -> tuple[float, ...]:
@@ -74,6 +79,8 @@ def _parse_xml(path: Path, what: str) -> ET.Element:
     if path.is_dir():
         raise WorldError(f"{path}: is a directory; expected a {what}")
     if not path.is_file():
+        if path.exists():  # a named pipe would block the parser, a device never end
+            raise WorldError(f"{path}: is not a regular file (a pipe, device or socket); expected a {what}")
         raise WorldError(f"{path}: {what} not found")
     try:
         return ET.parse(path).getroot()
@@ -89,6 +96,28 @@ class _Loader:
         self.index = PackageIndex(use_env=True)
         self.warnings: list[str] = []
         self.ground_plane = False
+        self.files: list[Path] = []  # the model files being included, outermost first (loops are refused)
+        self.depth = 0  # models and includes nested so far
+
+    @contextlib.contextmanager
+    def _nested(self, where: str, file: Path | None = None) -> Iterator[None]:
+        """One level deeper (a nested model, or an include of ``file``): refuse include loops and nesting
+        beyond ``MAX_NESTING`` (either would recurse until Python's stack runs out)."""
+        real = file.resolve() if file is not None else None
+        if real is not None and real in self.files:
+            chain = " -> ".join(p.name for p in [*self.files[self.files.index(real):], real])
+            raise WorldError(f"{where}: {file} includes itself (include loop {chain})")
+        if self.depth >= MAX_NESTING:
+            raise WorldError(f"{where}: models and includes nest deeper than {MAX_NESTING} levels")
+        self.depth += 1
+        if real is not None:
+            self.files.append(real)
+        try:
+            yield
+        finally:
+            self.depth -= 1
+            if real is not None:
+                self.files.pop()
 
     # ------------------------------------------------------------------------------- includes
     def find_model_dir(self, uri: str, base_dir: Path, where: str) -> Path:
@@ -138,6 +167,10 @@ class _Loader:
             raise WorldError(f"{where}: <include> without <uri>")
         w = f"{where}/<include uri={uri!r}>"
         sdf_file = self.model_sdf_file(self.find_model_dir(uri, base_dir, w), w)
+        with self._nested(w, sdf_file):
+            return self._include_file(el, sdf_file, w)
+
+    def _include_file(self, el: ET.Element, sdf_file: Path, w: str) -> list[ModelSpec]:
         root = _parse_xml(sdf_file, "model SDF")
         model_el = root.find("model")
         if model_el is None:
@@ -178,7 +211,8 @@ class _Loader:
             elif tag == "model":
                 sub = child.get("name", "")
                 w = f'{where}/<model name="{sub}">'
-                self._fill(spec, child, file, w, prefix + sub + "::", compose6(frame, _pose(child, w)))
+                with self._nested(w):
+                    self._fill(spec, child, file, w, prefix + sub + "::", compose6(frame, _pose(child, w)))
             elif tag == "include":
                 for inc in self.include(child, file.parent, where):
                     for link in inc.links:
@@ -372,8 +406,7 @@ def load_world(path: str | os.PathLike[str], *, model_path: Iterable[str | os.Pa
             world.gravity = _vec3(chosen.findtext("gravity"), pw + "/<gravity>")
     if world_el.find("gravity") is not None:
         world.gravity = _vec3(world_el.findtext("gravity"), f"{where}/<gravity>")
-    names = [m.name for m in world.models]
-    dup = {n for n in names if names.count(n) > 1}
+    dup = {n for n, k in collections.Counter(m.name for m in world.models).items() if k > 1}  # linear: BARN worlds
     if dup:
         raise WorldError(f"{where}: duplicate model names {sorted(dup)}")
     state = world_el.find("state")

@@ -35,6 +35,7 @@ import numba
 import numpy as np
 from scipy.signal import savgol_coeffs
 
+from navlab.core.limits import check_ceiling
 from navlab.grid import COST_INSCRIBED, Grid
 from navlab.navigation.controllers import mppi_critics as critics
 from navlab.navigation.controllers.common import (
@@ -141,8 +142,13 @@ class MppiParams:
             raise bad(WHAT, "noise_correlation", self.noise_correlation, "0 <= value < 1")
         if self.ax_min > 0:
             raise bad(WHAT, "ax_min", self.ax_min, "<= 0 (a deceleration)")
+        if not self.vx_max > 0:
+            raise bad(WHAT, "vx_max", self.vx_max, "> 0 (a forward speed)")
         if self.vx_min > self.vx_max:
             raise bad(WHAT, "vx_min", self.vx_min, f"<= vx_max ({self.vx_max})")
+        check_ceiling(NavigationError, WHAT, "controller_frequency", self.controller_frequency, "rate")
+        check_ceiling(NavigationError, WHAT, "batch_size x time_steps x iteration_count",
+                      self.batch_size * self.time_steps * self.iteration_count, "rollout_poses")
         if self.motion_model != "DiffDrive":
             raise bad(WHAT, "motion_model", self.motion_model, "'DiffDrive' (navlab's controllers drive (v, w))")
         for name in self.critics:

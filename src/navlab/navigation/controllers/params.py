@@ -22,7 +22,9 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
+from navlab.core.limits import check_ceiling
 from navlab.navigation.controllers.common import bad, check_finite, params_from
+from navlab.navigation.errors import NavigationError
 
 TP = "TrajectoryPlannerROS"
 DWA = "DWAPlannerROS"
@@ -103,6 +105,10 @@ class TrajectoryPlannerParams(_Periodic):
                   "heading_lookahead", "oscillation_reset_dist", "xy_goal_tolerance", "yaw_goal_tolerance",
                   "escape_reset_dist", "escape_reset_theta", "min_vel_x")
         _at_least(TP, self, 1, "vx_samples", "vtheta_samples")
+        ang = self.angular_sim_granularity if self.angular_sim_granularity > 0 else self.sim_granularity
+        steps = max(max(abs(self.max_vel_x), abs(self.escape_vel)) * self.sim_time / self.sim_granularity,
+                    max(abs(self.max_vel_theta), abs(self.min_vel_theta)) / ang) + 1
+        _sized(TP, self, steps, "vx_samples", "vtheta_samples")
         _ordered(TP, self, "min_vel_x", "max_vel_x")
         _ordered(TP, self, "min_vel_theta", "max_vel_theta")
         if self.escape_vel > 0.0:
@@ -169,15 +175,26 @@ class DWAPlannerParams(_Periodic):
         """Raise ``NavigationError`` naming the first bad parameter."""
         check_finite(DWA, self)
         _positive(DWA, self, "acc_lim_x", "acc_lim_theta", "sim_time", "sim_granularity", "angular_sim_granularity",
-                  "controller_frequency", "max_vel_trans")
+                  "controller_frequency", "max_vel_trans", "max_vel_x")
         _at_least(DWA, self, 0.0, "min_vel_trans", "min_vel_theta", "max_vel_theta", "path_distance_bias",
                   "goal_distance_bias", "occdist_scale", "twirling_scale", "forward_point_distance",
                   "oscillation_reset_dist", "xy_goal_tolerance", "yaw_goal_tolerance", "trans_stopped_vel",
                   "theta_stopped_vel", "stop_time_buffer")
         _at_least(DWA, self, 1, "vx_samples", "vy_samples", "vth_samples")
+        steps = self.sim_time * max(max(abs(self.max_vel_x), abs(self.min_vel_x), self.max_vel_trans)
+                                    / self.sim_granularity, self.max_vel_theta / self.angular_sim_granularity) + 1
+        _sized(DWA, self, steps, "vx_samples", "vth_samples")
         _ordered(DWA, self, "min_vel_x", "max_vel_x")
         _ordered(DWA, self, "min_vel_trans", "max_vel_trans")
         _ordered(DWA, self, "min_vel_theta", "max_vel_theta")
+
+
+def _sized(what: str, obj: Any, steps: float, *sample_keys: str) -> None:
+    """The ceilings of the work one control cycle does (samples x steps poses) and of its rate."""
+    check_ceiling(NavigationError, what, "controller_frequency", obj.controller_frequency, "rate")
+    samples = math.prod(getattr(obj, k) for k in sample_keys)
+    check_ceiling(NavigationError, what, f"{' x '.join(sample_keys)} x steps (sim_time / sim_granularity)",
+                  samples * steps, "rollout_poses")
 
 
 def _clamp_samples(what: str, obj: Any, *keys: str) -> None:

@@ -15,6 +15,7 @@ from typing import Any
 
 import numpy as np
 
+from navlab.core.limits import check_ceiling
 from navlab.grid import Grid
 from navlab.navigation.errors import NavigationError
 
@@ -105,8 +106,10 @@ def parse_polygon(value: Any, *, key: str = "footprint") -> np.ndarray | None:
         if text in ("", "[]"):
             return None
         try:
+            if len(text) > 100_000:
+                raise ValueError("too long")
             raw = ast.literal_eval(text)
-        except (ValueError, SyntaxError):
+        except (ValueError, SyntaxError, TypeError, MemoryError, RecursionError):
             raise NavigationError(f"costmap parameter {key}: expected a list of [x, y] points such as "
                                   f"'[[0.2, 0.2], [0.2, -0.2], [-0.2, -0.2], [-0.2, 0.2]]', got {value!r}") from None
     try:
@@ -121,6 +124,9 @@ def parse_polygon(value: Any, *, key: str = "footprint") -> np.ndarray | None:
         raise NavigationError(f"costmap parameter {key}: a polygon needs at least 3 points, got {len(pts)}")
     if not np.isfinite(pts).all():
         raise NavigationError(f"costmap parameter {key}: points must be finite numbers, got {value!r}")
+    check_ceiling(NavigationError, "costmap", f"{key} (number of points)", len(pts), "polygon_points")
+    check_ceiling(NavigationError, "costmap", f"{key} (a point's distance from the centre)",
+                  float(np.hypot(pts[:, 0], pts[:, 1]).max()), "footprint_m")
     return pts
 
 

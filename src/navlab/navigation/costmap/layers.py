@@ -374,6 +374,7 @@ class InflationLayer(Layer):
         the cells within ``reach`` of a seed that appeared or vanished are recomputed, from the seeds within
         ``reach`` of those (exactly what a transform of the whole grid gives them)."""
         reach = math.ceil(self.params.inflation_radius / master.resolution) + 1
+        reach = min(reach, math.ceil(math.hypot(*seeds.shape)) + 1)  # no cell is further: the table stays grid-sized
         key = (master.origin, master.resolution, seeds.shape)
         cached = self._inflated
         if cached is None or cached[0] != key:

@@ -15,6 +15,7 @@ import math
 from dataclasses import dataclass, field, fields
 from typing import TYPE_CHECKING, Any, TypeVar
 
+from navlab.core.limits import check_ceiling
 from navlab.core.params import check_unknown_key, dataclass_from_dict
 from navlab.navigation.errors import NavigationError
 
@@ -164,6 +165,12 @@ class CostmapParams:
                 raise NavigationError(f"costmap parameter {name}: expected > 0, got {getattr(self, name)}")
         for name in ("origin_x", "origin_y", "robot_radius", "footprint_padding"):
             _finite("costmap", name, getattr(self, name))
+        for name in ("update_frequency", "publish_frequency"):
+            check_ceiling(NavigationError, "costmap", name, getattr(self, name), "rate")
+        check_ceiling(NavigationError, "costmap", "width x height / resolution²",
+                      (self.width / self.resolution) * (self.height / self.resolution), "grid_cells")
+        for name in ("robot_radius", "footprint_padding"):
+            check_ceiling(NavigationError, "costmap", name, abs(getattr(self, name)), "footprint_m")
         if self.map_type not in ("costmap", "voxel"):
             raise NavigationError(f"costmap parameter map_type: expected 'costmap' or 'voxel', got {self.map_type!r}")
 
