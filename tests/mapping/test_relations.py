@@ -94,6 +94,8 @@ def test_raw_odometry_of_csail_scores_published_value(tmp_path, capsys, dataset)
         "rot_abs_mean_deg",
         "rot_abs_std_deg",
         "rot_sq_mean_deg2",
+        "rot_max_deg",
+        "rot_over_5deg",
         "reference_n_triangles",
         "reference_closure_median_m",
         "reference_closure_mean_m",

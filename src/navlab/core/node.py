@@ -7,7 +7,6 @@ needs besides its parameters (the simulation, for a Gazebo plugin) follow as key
 from __future__ import annotations
 
 import dataclasses
-import difflib
 import enum
 import functools
 import logging
@@ -18,7 +17,7 @@ from typing import Any
 
 from navlab.core.errors import ParameterError
 from navlab.core.executor import Executor
-from navlab.core.params import TYPO_CUTOFF, ParameterWarning
+from navlab.core.params import ParameterWarning, likely_typo
 from navlab.core.tf import Pose2
 from navlab.core.topics import Publisher, Subscription, Timer, seconds_to_ns
 from navlab.msgs import TFMessage, time_from_ns
@@ -471,7 +470,7 @@ class Node:
         self._params_checked = True
         lines = []
         for key in (k for k in self._overrides if k not in self._declared):  # policy: params.check_unknown_key
-            close = difflib.get_close_matches(key, list(self._declared), n=1, cutoff=TYPO_CUTOFF)
+            close = likely_typo(key, list(self._declared))
             if close:
                 lines.append(f"{key!r} (did you mean {close[0]!r}?)")
             else:

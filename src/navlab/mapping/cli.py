@@ -30,13 +30,15 @@ def _params_file(path: str | None) -> dict:
 
 
 def _cmd_slam(args: argparse.Namespace) -> int:
-    from navlab.experiments.plots import Track, plot_run
-    from navlab.experiments.session import rounded
     from navlab.io.carmen import read_carmen, skipped_summary
     from navlab.io.datasets import data_file
+
+    log = read_carmen(data_file(args.log))  # a bad log is reported before the SLAM's and the plots' imports
+
+    from navlab.experiments.plots import Track, plot_run
+    from navlab.experiments.session import rounded
     from navlab.mapping.slam import run_offline, write_outputs
 
-    log = read_carmen(data_file(args.log))
     note = skipped_summary(log)
     if note:
         print(f"navlab slam: warning: {note}", file=sys.stderr)
