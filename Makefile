@@ -5,6 +5,8 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 # Debian's Chromium drives the viewer's browser tests (Playwright with executable_path; no browser download)
 CHROMIUM := /usr/bin/chromium
+# Debian's Graphviz lays out `navlab graph` (rqt_graph's layered picture)
+DOT := /usr/bin/dot
 # Debian's ROS 1 Noetic tools are the peers of the ROS bridge's tests (navlab itself needs no ROS)
 ROS_TOOLS := /usr/bin/rosservice
 ROS_PACKAGES := python3-rosmaster python3-rospy python3-rostopic python3-rosnode python3-rosbag python3-rosservice \
@@ -26,15 +28,18 @@ $(STAMP): pyproject.toml | $(BIN)/python
 $(CHROMIUM):
 	$(SUDO) apt-get install -y -q chromium || ($(SUDO) apt-get update -q && $(SUDO) apt-get install -y -q chromium)
 
+$(DOT):
+	$(SUDO) apt-get install -y -q graphviz || ($(SUDO) apt-get update -q && $(SUDO) apt-get install -y -q graphviz)
+
 $(ROS_TOOLS):
 	$(SUDO) apt-get install -y -q $(ROS_PACKAGES) || ($(SUDO) apt-get update -q && $(SUDO) apt-get install -y -q $(ROS_PACKAGES))
 
-install: $(STAMP) $(CHROMIUM) $(ROS_TOOLS)
+install: $(STAMP) $(CHROMIUM) $(DOT) $(ROS_TOOLS)
 
 demo: $(STAMP)
 	$(BIN)/navlab demo
 
-test: $(STAMP) $(CHROMIUM) $(ROS_TOOLS)
+test: $(STAMP) $(CHROMIUM) $(DOT) $(ROS_TOOLS)
 	$(BIN)/ruff check src tests
 	$(BIN)/python tools/check_layers.py
 	$(BIN)/mypy

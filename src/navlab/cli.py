@@ -7,11 +7,14 @@ so this file only assembles them and turns ``NavlabError`` into a one-line messa
 from __future__ import annotations
 
 import argparse
+import difflib
 import importlib
 import logging
+import re
 import sys
 from typing import NoReturn
 
+from navlab.cli_common import check_named_inputs
 from navlab.errors import NavlabError
 
 # Modules that define ``register(subparsers: argparse._SubParsersAction) -> None``.
@@ -34,6 +37,13 @@ class _Parser(argparse.ArgumentParser):
 
     def error(self, message: str) -> NoReturn:
         verb = self.prog.removeprefix("navlab").strip()
+        wrong = re.match(r"argument (\S+): invalid choice: '([^']*)' \(choose from (.*)\)$", message)
+        if wrong:  # a mistyped verb or choice: the closest one, as git does
+            choices = re.findall(r"'([^']*)'", wrong.group(3))
+            close = difflib.get_close_matches(wrong.group(2), choices, n=1, cutoff=0.5)
+            what = "verb" if wrong.group(1) == "VERB" else wrong.group(1)
+            hint = f"; did you mean {close[0]!r}?" if close else f" (one of: {', '.join(choices)})"
+            message = f"unknown {what} {wrong.group(2)!r}{hint}"
         self.exit(2, f"navlab: error: {verb + ': ' if verb else ''}{message} (see `{self.prog} --help`)\n")
 
 
@@ -55,16 +65,24 @@ def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``navlab`` console script; returns the exit code."""
     parser = build_parser()
     args, extra = parser.parse_known_args(argv)
-    if extra:  # `navlab launch FILE --duration 5 name:=value`: launch arguments after the options, as roslaunch
-        if not isinstance(getattr(args, "args", None), list) or any(e.startswith("-") for e in extra):
+    if extra:  # `navlab launch mapping --duration 60 world:=room`: launch arguments may follow options, as in ROS
+        target = next((a for a in ("args", "launch") if isinstance(getattr(args, a, None), list)), None)
+        if (target is None or any(e.startswith("-") for e in extra)
+                or (target == "launch" and not all(":=" in e for e in extra))):
             parser.error(f"unrecognized arguments: {' '.join(extra)}")
-        args.args += extra
+        getattr(args, target).extend(extra)
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING, format="%(levelname)s %(message)s")
     try:
+        check_named_inputs(args)  # a missing world or robot in one line, before MuJoCo and Numba load
         return int(args.func(args) or 0)
     except NavlabError as exc:
         print(f"navlab: error: {exc}", file=sys.stderr)
         return 2
+    except BrokenPipeError:  # `navlab topic echo /odom | head`: the reader left; stop quietly, as rostopic does
+        import os
+
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # no second error when Python flushes
+        return 0
     except OSError as exc:  # a file the user named cannot be read or written (permissions, full disk, ...)
         where = f"{exc.filename}: " if exc.filename else ""
         print(f"navlab: error: {where}{exc.strerror or exc}", file=sys.stderr)

@@ -7,6 +7,7 @@ import argparse
 import json
 import math
 from collections.abc import Sequence
+from pathlib import Path
 from typing import Any
 
 
@@ -110,3 +111,50 @@ def print_figures(figures: dict[str, Any], as_json: bool) -> None:
     else:
         for key, value in figures.items():
             print(f"  {key}: {value}")
+
+
+def out_file(out: str, name: str, *, old_suffixes: tuple[str, ...]) -> Path:
+    """Where a verb writes ``name`` under ``--out DIR`` (the folder is created). Deprecated until the next
+    release: an ``--out`` ending in one of ``old_suffixes`` (a file, as that verb once took) is used as the file
+    itself, with a one-line DeprecationWarning on stderr."""
+    import sys
+
+    path = Path(out)
+    if path.suffix.lower() in old_suffixes:
+        print(f"navlab: DeprecationWarning: --out {out}: --out names a folder now (it gets {name}); a file name is "
+              "accepted until the next release", file=sys.stderr)  # fmt: skip
+        path.parent.mkdir(parents=True, exist_ok=True)
+        return path
+    path.mkdir(parents=True, exist_ok=True)
+    return path / name
+
+
+def optional_out(value: str | None, folder: Path, name: str) -> Path | None:
+    """An optional extra output (``nargs="?"``, ``const=""``): None when not asked for, ``folder/name`` when
+    given without a value, else the file named (its folder created)."""
+    if value is None:
+        return None
+    path = folder / name if value == "" else Path(value)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    return path
+
+
+def check_named_inputs(args: argparse.Namespace) -> None:
+    """Refuse a ``--world``/``--robot`` that names neither a file nor a shipped world/robot, in one line and
+    before any heavy import (MuJoCo, Numba): the loaders would say the same seconds later. ``package://`` and
+    ``file://`` URIs are left to the loaders."""
+    from navlab import resources
+    from navlab.errors import NavlabError
+
+    for attr, kind, suffixes in (("world", "world", (".world", ".sdf")), ("robot", "robot", (".xacro", ".urdf"))):
+        text = getattr(args, attr, None)
+        if not isinstance(text, str) or not text.strip() or "://" in text:
+            continue
+        path = Path(text).expanduser()
+        if path.exists():
+            continue
+        if not path.suffix and "/" not in text:
+            (resources.world if kind == "world" else resources.robot)(text)  # one line, with a suggestion
+        else:
+            hint = "" if path.suffix in suffixes else f" (a {kind} is a {' or '.join(suffixes)} file or a shipped name)"
+            raise NavlabError(f"{kind} file not found: {path.absolute()}{hint}")

@@ -27,13 +27,16 @@ def _say(text: str, quiet: bool) -> None:
         print(text, file=sys.stderr, flush=True)
 
 
+def _progress(text: str) -> None:
+    print(f"      {text}", file=sys.stderr, flush=True)
+
+
 def run_demo(out: str | Path = "navlab-demo", *, seed: int = 0, quiet: bool = False, render: bool = True,
              record: bool = True, on_start: Any = None) -> dict[str, Any]:  # fmt: skip
     """Run the four steps, writing the report folder ``out``; returns the figures (also in report.json)."""
     from navlab.experiments.localize_run import plot_result, run_localization
     from navlab.experiments.mapping_run import run_mapping
-    from navlab.experiments.navigate_run import run_navigation
-    from navlab.experiments.plots import plot_navigation
+    from navlab.experiments.navigate_run import run_navigation, save_goal_pictures
     from navlab.sim.spawn import primitive_model
 
     out = Path(out)
@@ -54,13 +57,11 @@ def run_demo(out: str | Path = "navlab-demo", *, seed: int = 0, quiet: bool = Fa
     _say("[4/4] move_base on the saved map, to goals among the new obstacles and one more cylinder ...", quiet)
     late = primitive_model("cylinder", "late_cylinder", (0.15, 0.6), x=-1.0, y=-0.45)
     nav = run_navigation(DEMO_GOALS, world="room_obstacles", map_yaml=mapping.map_yaml, spawn=[(20.0, late)],
-                         seed=seed, goal_timeout=90, snapshots=True,
+                         seed=seed, goal_timeout=90, snapshots=True, progress=None if quiet else _progress,
                          record=out / "recording" if record else None, on_start=on_start)  # fmt: skip
-    (out / "navigate").mkdir(exist_ok=True)
-    for k, (goal, shot) in enumerate(zip(nav.goals, nav.snapshots, strict=True), 1):
-        title = f"goal {k} {tuple(goal['goal'])}: {goal['outcome']} in {goal['time_s']} s"
-        goal["picture"] = str(plot_navigation(nav.grid, shot, out / "navigate" / f"goal_{k}.png", title=title,
-                                              goal=goal["goal"]))  # fmt: skip
+    pictures = save_goal_pictures(nav, out / "navigate")
+    for k, goal in enumerate(nav.goals):
+        goal["picture"], goal["picture_mid"] = pictures[2 * k], pictures[2 * k + 1]
     summary["navigation"] = {"goals": nav.goals, **nav.summary}
     summary["wall_s"] = round(time.perf_counter() - t0, 1)
     write_report(summary, out)

@@ -48,13 +48,14 @@ def test_deep_nesting_binary_and_pipes_are_errors_not_tracebacks(tmp_path: Path)
     ("- node: {exec: talker, if: maybe}", r"'if' is 'maybe'; expected true or false"),
     ("- node: {exec: talker, name: '$(env NAVLAB_TEST_SURELY_UNSET)'}", r"NAVLAB_TEST_SURELY_UNSET.*not set"),
     ("- node: {exec: 'os:getcwd'}", r"os:getcwd is not a navlab Node class"),
-    ("- node: {exec: talker, param: [{name: rate, value: 0}]}", r"'talker'.*rate.*expected Hz > 0"),
-    ("- node: {exec: talker, param: [{name: rate, value: .nan}]}", r"'talker'.*'rate': expected a number, got nan"),
+    ("- node: {exec: talker, param: [{name: rate, value: 0}]}", r"rate.*expected Hz > 0.*'talker'"),
+    ("- node: {exec: talker, param: [{name: rate, value: .nan}]}", r"'rate': expected a number, got nan.*'talker'"),
 ])
 def test_malformed_launch_entries_name_the_file_and_entry(tmp_path: Path, entries: str, message: str) -> None:
     launch = _write(tmp_path, "bad.launch.yaml", "launch:\n" + entries + "\n")
-    with pytest.raises((LaunchError, ParameterError), match=r"bad\.launch\.yaml: .*" + message):
+    with pytest.raises((LaunchError, ParameterError), match=message) as err:  # the problem, and where it is
         start(str(launch))
+    assert "bad.launch.yaml" in str(err.value)
 
 
 def test_env_with_default_and_boolean_conditions_still_work(tmp_path: Path) -> None:
@@ -68,8 +69,8 @@ def test_env_with_default_and_boolean_conditions_still_work(tmp_path: Path) -> N
 def test_node_parameter_errors_name_the_launch_and_parameter_file(tmp_path: Path) -> None:
     _write(tmp_path, "talk.yaml", "rate: true\n")
     launch = _write(tmp_path, "p.launch.yaml", "launch:\n- node: {exec: talker, param: [{from: talk.yaml}]}\n")
-    with pytest.raises(ParameterError, match=r"p\.launch\.yaml: entry 1 \(node\) 'talker' \(parameters from "
-                                             r"talk\.yaml\): parameter 'rate': expected float"):
+    with pytest.raises(ParameterError, match=r"^parameter 'rate': expected float.* \(in .*p\.launch\.yaml: entry 1 "
+                                             r"\(node\) 'talker' \(parameters from talk\.yaml\)\)$"):
         start(str(launch))
 
 

@@ -42,8 +42,21 @@ def test_tools_see_a_launch_running_in_another_process(running_launch, capsys):
     assert json.loads(capsys.readouterr().out)["average_rate_hz"] == pytest.approx(20.0)
     assert main(["node", "list", "--pid", pid]) == 0
     assert capsys.readouterr().out.split() == ["/listener", "/talker"]
-    assert main(["topic", "echo", "/nope", "--pid", pid]) == 2
-    assert "no topic '/nope'" in capsys.readouterr().err
+    # a topic nobody publishes: echo waits for it, as rostopic does, here bounded by the launch's clock
+    assert main(["topic", "echo", "/nope", "--pid", pid, "--duration", "1.5"]) == 1
+    err = capsys.readouterr().err.splitlines()
+    assert err == ["WARNING: topic [/nope] does not appear to be published yet",
+                   "navlab: no message on /nope: 1.5 simulated s passed"]
+
+
+def test_echo_runs_until_the_launch_ends(running_launch, capsys):
+    import threading
+
+    threading.Timer(1.5, running_launch.send_signal, (signal.SIGTERM,)).start()
+    t0 = time.monotonic()
+    assert main(["topic", "echo", "/chatter", "--pid", str(running_launch.pid)]) == 0
+    assert time.monotonic() - t0 < 15
+    assert capsys.readouterr().out.count("\n---\n") >= 10  # 20 Hz for about a second, then the launch ended
 
 
 def test_sigterm_stops_the_launch_cleanly(running_launch):

@@ -121,9 +121,9 @@ def test_cli_topic_hz_and_graph(tmp_path, capsys):
     hz = json.loads(capsys.readouterr().out)
     assert hz["average_rate_hz"] == pytest.approx(20.0)
     assert main(["graph", "--launch", "talker_listener", "--out", str(tmp_path / "g")]) == 0
-    dot = (tmp_path / "g.dot").read_text()
-    assert '"/talker" -> "/chatter"' in dot and '"/chatter" -> "/listener"' in dot
-    assert (tmp_path / "g.svg").read_text().lstrip().startswith("<?xml")
+    dot = (tmp_path / "g" / "graph.dot").read_text()
+    assert '"n:/talker" -> "t:/chatter"' in dot and '"t:/chatter" -> "n:/listener"' in dot
+    assert (tmp_path / "g" / "graph.svg").read_text().lstrip().startswith("<?xml")
 
 
 def test_cli_error_is_one_line(capsys):

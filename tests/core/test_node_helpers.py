@@ -20,8 +20,8 @@ def _node_classes() -> list[type]:
     from navlab.sim.imu import ImuSensorPlugin
 
     classes = [getattr(importlib.import_module(m), c) for m, c in (t.split(":") for t in NODES.values())]
-    classes += [sim_plugins.DiffDrivePlugin, sim_plugins.LidarPlugin, ImuSensorPlugin,
-                sim_plugins.JointStatePlugin, sim_plugins.GroundTruthPlugin]  # fmt: skip
+    classes += [sim_plugins.DiffDrivePlugin, sim_plugins.LidarPlugin, ImuSensorPlugin, sim_plugins.JointStatePlugin,
+                sim_plugins.RobotStatePublisher, sim_plugins.GroundTruthPlugin]  # fmt: skip
     return classes  # the base Node has rclpy's constructor (issue 23; tests/core/test_rclpy_api.py)
 
 

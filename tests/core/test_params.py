@@ -78,3 +78,12 @@ def test_malformed_yaml_names_file_and_line(tmp_path):
     f.write_text("a: 1\nb: [1, 2\nc: 3\n")
     with pytest.raises(ParameterError, match=r"bad\.yaml:\d+:\d+: malformed YAML"):
         load_params(f)
+
+
+def test_swapped_letters_of_a_short_name_are_a_typo_not_an_ignored_key():
+    # difflib rates lsimga / lsigma at 0.83, under the typo cutoff: the swap would have been dropped silently
+    from navlab.mapping.errors import MappingError
+    from navlab.mapping.gmapping import GMappingParams
+
+    with pytest.raises(MappingError, match="did you mean 'lsigma'"):
+        GMappingParams.from_dict({"lsimga": 0.1})

@@ -115,5 +115,6 @@ def test_cli_launch_and_graph_of_shipped_launches(room_map, tmp_path, capsys):
     assert '"/map"' in capsys.readouterr().out
     assert main(["graph", "--launch", "localization", f"map:={room_map}", "--duration", "1", "--out",
                  str(tmp_path / "g")]) == 0  # fmt: skip
-    dot = (tmp_path / "g.dot").read_text()
-    assert '"/map_server" -> "/map"' in dot and '"/map" -> "/amcl"' in dot and '"/amcl" -> "/amcl_pose"' in dot
+    dot = (tmp_path / "g" / "graph.dot").read_text()
+    assert '"n:/map_server" -> "t:/map"' in dot and '"t:/map" -> "n:/amcl"' in dot
+    assert '"n:/amcl" -> "t:/amcl_pose"' in dot

@@ -54,12 +54,18 @@ def test_kidnapped_robot_recovers_within_30_s_with_recovery_alphas() -> None:
 
 
 def test_localize_cli_prints_json_and_saves_a_picture(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    png = tmp_path / "loc.png"
-    assert main(["localize", "--duration", "4", "--json", "--quiet", "--out", str(png),
+    assert main(["localize", "--duration", "4", "--json", "--quiet", "--out", str(tmp_path / "loc"),
                  "--set", "laser_max_beams=60"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert out["mode"] == "tracking" and out["position_error_mean_m"] < 0.05 and out["updates"] >= 3
-    assert png.stat().st_size > 10_000
+    assert (tmp_path / "loc" / "localize.png").stat().st_size > 10_000 and out["png"].endswith("loc/localize.png")
+
+
+def test_localize_out_as_a_file_is_deprecated_but_works(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    png = tmp_path / "old.png"
+    assert main(["localize", "--duration", "1", "--quiet", "--out", str(png)]) == 0
+    err = capsys.readouterr().err
+    assert png.is_file() and err.startswith("navlab: DeprecationWarning: --out ") and err.count("\n") == 1
     assert main(["localize", "--initial", "50", "0", "0", "--duration", "1", "--out", ""]) == 2
     assert "outside the map" in capsys.readouterr().err
     bad = tmp_path / "amcl.yaml"

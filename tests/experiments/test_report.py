@@ -33,7 +33,8 @@ def test_a_run_and_a_sweep_are_reported_as_markdown_pngs_and_one_html_page(
     md = (tmp_path / "run" / "report.md").read_text()
     assert "2 of 2 trials succeeded" in md and "![" in md and "| trial | seed | success |" in md
     pngs = _self_contained((tmp_path / "run" / "report.html").read_text())
-    assert len(pngs) == 1 and pngs[0] == (tmp_path / "run" / "trials.png").read_bytes()
+    assert pngs == [(tmp_path / "run" / name).read_bytes() for name in ("trials.png", "paths.png")]
+    assert "every trial's true path" in md
 
     run_sweep(scenario_from_dict({**TINY, "trials": 1}), {"controller": ["trajectory", "dwa"]}, tmp_path / "sweep")
     (tmp_path / "sweep" / "controller.png").unlink()  # re-rendered from the results
@@ -42,7 +43,12 @@ def test_a_run_and_a_sweep_are_reported_as_markdown_pngs_and_one_html_page(
     assert out["kind"] == "sweep" and (tmp_path / "sweep" / "controller.png").stat().st_size > 10_000
     md = (tmp_path / "sweep" / "report.md").read_text()
     assert "| controller | success_rate |" in md and "| trajectory | 1 |" in md and "| dwa | 1 |" in md
-    assert len(_self_contained((tmp_path / "sweep" / "report.html").read_text())) == 1
+    # the parameter's plot, then each combination's trajectories on the world's map (the run report's paths.png)
+    combos = [tmp_path / "sweep" / f"controller={c}" for c in ("dwa", "trajectory")]
+    pngs = _self_contained((tmp_path / "sweep" / "report.html").read_text())
+    assert pngs[1:] == [(c / "paths.png").read_bytes() for c in combos] and len(pngs) == 3
+    assert "## Paths per combination" in md and "(controller=dwa/paths.png)" in md
+    assert "controller=trajectory: every trial's true path" in md
 
 
 def test_a_demo_folder_is_reported_and_a_wrong_folder_is_refused(

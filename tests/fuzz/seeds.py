@@ -175,8 +175,8 @@ def _barn() -> Seed:
         import io
 
         with contextlib.redirect_stdout(io.StringIO()):
-            main(["world", "clutter", "--seed", "3", "--fill", "0.3", "--smooth", "2", "--out", f"{tmp}/barn.world"])
-        return Seed({"barn.world": (Path(tmp) / "barn.world").read_bytes()}, "barn.world")
+            main(["world", "clutter", "--seed", "3", "--fill", "0.3", "--smooth", "2", "--out", tmp])
+        return Seed({"barn.world": (Path(tmp) / "clutter.world").read_bytes()}, "barn.world")
 
 
 def build_seeds() -> dict[str, Seed]:

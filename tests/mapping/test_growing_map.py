@@ -8,7 +8,7 @@ import pytest
 
 from navlab.mapping import gmapping, load_map, save_map
 from navlab.mapping.gmapping import GMapping, GMappingParams
-from navlab.mapping.occupancy import grow_window, scan_cells
+from navlab.mapping.occupancy import scan_cells
 
 
 def _run(world, odometry_noise, *, n: int = 230, seed: int = 3, **params) -> tuple[GMapping, np.ndarray]:
@@ -55,15 +55,6 @@ def test_map_starts_at_the_first_scan_and_ends_near_the_room(synth_world, odomet
     assert kx0 < 0.1 and ky0 < 0.1 and kx1 > 7.9 and ky1 > 5.9
 
 
-def test_grow_window_keeps_cells_and_grows_by_at_least_half():
-    offset, shape = np.array([10, -5]), (40, 100)  # columns 10..109, rows -5..34
-    assert grow_window(offset, shape, np.array([10, -5]), np.array([109, 34]), margin=3) is None
-    # one cell past the right edge: that side grows by half the width, the others not at all
-    assert grow_window(offset, shape, np.array([10, -5]), np.array([110, 34]), margin=3) == (0, 50, 0, 0)
-    # far past the bottom: the shortfall plus the margin
-    assert grow_window(offset, shape, np.array([20, -100]), np.array([30, 0]), margin=3) == (0, 0, 98, 0)
-
-
 def test_scan_cells_cover_what_the_ray_caster_touches():
     from navlab.mapping.occupancy import integrate_scan
 
@@ -95,28 +86,27 @@ def test_slam_map_saves_cropped_to_what_was_seen(synth_world, odometry_noise, tm
     np.testing.assert_array_equal(saved.value_at(grid.centers(grid.occupied_mask())), 100)
 
 
-def test_resampled_maps_are_exact_copies_and_blank_outside_the_written_box(synth_world, odometry_noise, monkeypatch):
-    # copies after resampling go into dropped particles' maps and cover only the box of written cells: check that
-    # after every update a copy equals its source everywhere, and that no map holds anything outside the box
+def test_resampled_maps_share_their_tiles_and_reference_counts_hold(synth_world, odometry_noise, monkeypatch):
+    # copy-on-write maps: after every update, particles drawn from one source hold the same tiles, every
+    # tile's reference count is the number of tables holding it, and a tile is written by nobody else
     update = GMapping._update
     checked = {"resampled": 0, "grown": 0}
 
     def checking(self: GMapping, *args: object) -> None:
         resamples, resizes = self.resamples, self.map_resizes
         update(self, *args)
-        rows, cols = self._seen_box()
-        for part in self.particles:
-            outside = part.grid.copy()
-            outside[rows, cols] = 0.0
-            assert not outside.any()
+        tables = [part.table for part in self.particles]
+        counts = np.bincount(np.concatenate([t.ravel() for t in tables]), minlength=len(self.pool.refs))
+        np.testing.assert_array_equal(self.pool.refs[1:], counts[1:])
+        assert not self.pool.tiles[0].any()  # the unknown tile
+        checked["grown"] += self.map_resizes > resizes
         if self.resamples > resamples:
             checked["resampled"] += 1
-            checked["grown"] += self.map_resizes > resizes
             for a in range(len(self.particles)):
                 for b in range(a):
                     if np.array_equal(self.poses[a], self.poses[b]):  # drawn from the same particle
-                        np.testing.assert_array_equal(self.particles[a].grid, self.particles[b].grid)
+                        np.testing.assert_array_equal(self.particles[a].table, self.particles[b].table)
 
     monkeypatch.setattr(GMapping, "_update", checking)
     _run(synth_world, odometry_noise, maxUrange=1.5, maxRange=30.0)
-    assert checked["resampled"] >= 3 and checked["grown"] >= 1, checked  # also copies into maps of a new size
+    assert checked["resampled"] >= 3 and checked["grown"] >= 1, checked

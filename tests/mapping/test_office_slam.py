@@ -70,10 +70,10 @@ def test_cli_records_an_office_log_that_eval_reads(tmp_path, capsys):
     from navlab.cli import main
     from navlab.io.carmen import read_carmen
 
-    args = ["world", "office", "--out", str(tmp_path / "office.world"), "--log", str(tmp_path / "office.clf"),
-            "--truth", str(tmp_path / "truth.txt"), "--seed", "4", "--json"]  # fmt: skip
-    assert main(args) == 0
+    # --out is a folder; --log and --truth without a value write office.clf and truth.txt in it
+    assert main(["world", "office", "--out", str(tmp_path), "--log", "--truth", "--seed", "4", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
+    assert out["world"] == str(tmp_path / "office.world") and out["truth"] == str(tmp_path / "truth.txt")
     assert out["rooms"] >= 20 and out["scans"] > 150
     log = read_carmen(tmp_path / "office.clf")
     assert len(log.scans) == out["scans"] and not log.skipped

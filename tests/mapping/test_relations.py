@@ -85,18 +85,24 @@ def test_raw_odometry_of_csail_scores_published_value(tmp_path, capsys, dataset)
     assert set(out) == {
         "n_relations",
         "n_scored",
-        "trans_abs_mean",
+        "trans_abs_mean_m",
+        "trans_abs_std_m",
+        "trans_sq_mean_m2",
+        "trans_abs_mean",  # deprecated aliases of the three above, kept one release
         "trans_abs_std",
         "trans_sq_mean",
         "rot_abs_mean_deg",
         "rot_abs_std_deg",
         "rot_sq_mean_deg2",
+        "rot_max_deg",
+        "rot_over_5deg",
         "reference_n_triangles",
         "reference_closure_median_m",
         "reference_closure_mean_m",
         "reference_noise_floor_m",
     }
     assert out["n_relations"] == 1172 and out["n_scored"] == 1172
+    assert out["trans_abs_mean_m"] == out["trans_abs_mean"] and out["trans_sq_mean_m2"] == out["trans_sq_mean"]
     # the reference's own 54 triangles close to 4.4 cm median: poses without error would score about 2.7 cm
     assert out["reference_n_triangles"] == 54
     assert out["reference_noise_floor_m"] == pytest.approx(0.0265, abs=0.001)

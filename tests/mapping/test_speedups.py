@@ -14,13 +14,20 @@ from scipy import sparse
 from navlab.geometry import wrap_angle
 from navlab.mapping.explore import _grid_graph
 from navlab.mapping.gmapping_match import _draw_motion, _optimize, _score
+from navlab.mapping.gmapping_tiles import TILE, TilePool, from_dense, raycast_tiles, to_dense
 from navlab.mapping.occupancy import FAST_WALK_CELLS, L_CLAMP, L_FREE, L_OCC, _raycast, integrate_scan
 from navlab.mapping.scanmatch import LookupField, correlative_search
 
 
-def _plain_climb(grid, args, x0, y0, t0, lstep, astep, iterations):
+def _tiled(grid: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(tiles, table) of a dense log-odds grid: the matcher's map argument."""
+    pool, table = from_dense(grid)
+    return pool.tiles, table
+
+
+def _plain_climb(tiled, args, x0, y0, t0, lstep, astep, iterations):
     """GMapping's ScanMatcher::optimize scoring every candidate in full (the reference)."""
-    cur = _score(grid, *args[:5], x0, y0, t0, *args[5:])[0]
+    cur = _score(*tiled, *args[:5], x0, y0, t0, *args[5:])[0]
     cx, cy, ct = x0, y0, t0
     ld, ad, refinement, best = lstep, astep, 0, -1.0
     while True:
@@ -33,7 +40,7 @@ def _plain_climb(grid, args, x0, y0, t0, lstep, astep, iterations):
         bx, by, bt = cx, cy, ct
         for nx, ny, nt in ((cx + ld, cy, ct), (cx - ld, cy, ct), (cx, cy + ld, ct), (cx, cy - ld, ct),
                            (cx, cy, ct + ad), (cx, cy, ct - ad)):  # fmt: skip
-            sc = _score(grid, *args[:5], nx, ny, nt, *args[5:])[0]
+            sc = _score(*tiled, *args[:5], nx, ny, nt, *args[5:])[0]
             if sc > cur:
                 cur, bx, by, bt = sc, nx, ny, nt
         cx, cy, ct = bx, by, bt
@@ -61,14 +68,15 @@ def _room_map(rng: np.random.Generator, res: float = 0.05) -> tuple[np.ndarray, 
 def test_the_hill_climb_equals_gmappings_plain_climb() -> None:
     rng = np.random.default_rng(4)
     grid, r, ang = _room_map(rng)
+    tiled = _tiled(grid)
     for skip in (0, 4):
         for k in range(12):
             x0, y0, t0 = 2.5 + rng.normal(0, 0.08), 2.0 + rng.normal(0, 0.08), 0.1 + rng.normal(0, 0.05)
             args = (0.0, 0.0, 0, 0, 0.05, r, np.cos(ang), np.sin(ang), 8.0, 1, 0.05, 0.075, skip)
-            got = _optimize(grid, *args[:5], x0, y0, t0, *args[5:], 0.05, 0.05, 5)
-            want = _plain_climb(grid, args, x0, y0, t0, 0.05, 0.05, 5)
+            got = _optimize(*tiled, *args[:5], x0, y0, t0, *args[5:], 0.05, 0.05, 5)
+            want = _plain_climb(tiled, args, x0, y0, t0, 0.05, 0.05, 5)
             assert got[:4] == want, (skip, k)
-            assert got[4] == _score(grid, *args[:5], *got[:3], *args[5:])[1]  # the log-likelihood at the result
+            assert got[4] == _score(*tiled, *args[:5], *got[:3], *args[5:])[1]  # the log-likelihood at the result
 
 
 def _plain_score(grid, ox, oy, res, x, y, t, r, ang, max_urange, kernel, sigma, lsigma, skip):
@@ -103,13 +111,14 @@ def _plain_score(grid, ox, oy, res, x, y, t, r, ang, max_urange, kernel, sigma, 
 
 def test_the_score_equals_gmappings_plain_score_for_every_kernel_and_near_the_edges() -> None:
     rng = np.random.default_rng(6)
-    grid, r, ang = _room_map(rng)
+    grid, r, ang = _room_map(rng)  # 90 x 110 cells: the room spans tile borders (64 cells), which the beams cross
+    tiled = _tiled(grid)
     cb, sb = np.cos(ang), np.sin(ang)
     # poses in the room, and near the map's edge (beams end outside it: the checked path)
     for x, y, t in ((2.5, 2.0, 0.1), (2.2, 1.7, -0.4), (0.3, 0.2, 0.0), (5.2, 4.2, 2.0)):
         for kernel in (0, 1, 2):
             for skip in (0, 3):
-                got = _score(grid, 0.0, 0.0, 0, 0, 0.05, x, y, t, r, cb, sb, 8.0, kernel, 0.05, 0.075, skip)
+                got = _score(*tiled, 0.0, 0.0, 0, 0, 0.05, x, y, t, r, cb, sb, 8.0, kernel, 0.05, 0.075, skip)
                 want = _plain_score(grid, 0.0, 0.0, 0.05, x, y, t, r, ang, 8.0, kernel, 0.05, 0.075, skip)
                 assert got == want, (x, y, t, kernel, skip)
 
@@ -155,6 +164,32 @@ def test_the_unchecked_ray_walk_equals_the_checked_one() -> None:
     with pytest.raises(ValueError, match="C-contiguous"):
         integrate_scan(np.zeros((20, 20))[:, ::2], (0.0, 0.0), 0.05, np.zeros(3), r, ang, max_urange=8.0,
                        max_range=10.0)  # fmt: skip
+
+
+def test_the_tiled_ray_cast_writes_the_dense_cells_and_copies_only_shared_tiles() -> None:
+    """Two particles share one map's tiles; one integrates a scan: its map equals the dense ray cast's, the
+    other's is unchanged, and only the tiles the scan wrote were copied."""
+    rng = np.random.default_rng(9)
+    grid, r, ang = _room_map(rng)
+    args = (0.05, 2.5, 2.0, 0.1, r, ang, 8.0, 10.0, L_OCC, L_FREE, L_CLAMP)
+    pool, mine = from_dense(grid)
+    theirs = mine.copy()
+    pool.recount([mine, theirs])
+    in_use = pool.in_use()
+    for _ in range(2):  # the second time every tile written is already private: no copies
+        free = pool.free(mine.size)  # (may grow the pool: its arrays are read after)
+        raycast_tiles(pool.tiles, mine, pool.refs, free, np.zeros(1, dtype=np.int64), 0.0, 0.0, 0, 0, *args)
+    whole = grid.copy()
+    _raycast(whole, 0.0, 0.0, 0, 0, *args)
+    _raycast(whole, 0.0, 0.0, 0, 0, *args)
+    np.testing.assert_array_equal(to_dense(pool.tiles, mine)[:90, :110], whole)
+    np.testing.assert_array_equal(to_dense(pool.tiles, theirs)[:90, :110], grid)
+    written = np.unique(np.argwhere(whole != grid) // TILE, axis=0)
+    assert pool.in_use() == in_use + len(written)
+    assert np.count_nonzero(mine != theirs) == len(written)
+    pool.recount([mine])  # the other particle dropped: its tiles are free again
+    assert pool.in_use() == len(written) + np.count_nonzero((mine == theirs) & (mine > 0))
+    assert len(TilePool(2).free(40)) >= 40  # the pool grows when short of free tiles
 
 
 def test_the_one_pass_dijkstra_graph_equals_scipys_from_the_edge_list() -> None:

@@ -215,5 +215,5 @@ def test_a_key_ros_ignores_warns_naming_the_file_and_a_typo_still_fails(
     assert warned and all("costmap_common_params.yaml" in m and "ignored" in m for m in warned), warned
     assert run.node("move_base") is not None
     common.write_text(common.read_text() + "inflation_raduis: 0.3\n")
-    with pytest.raises(NavlabError, match=r"costmap_common_params\.yaml.*did you mean 'inflation_radius'"):
+    with pytest.raises(NavlabError, match=r"did you mean 'inflation_radius'.*costmap_common_params\.yaml"):
         start_run("navigation", world="room", map=str(_room_true_map()), params=str(params))

@@ -54,9 +54,10 @@ def test_navlab_view_starts_a_launch_with_ros_style_arguments(capsys: pytest.Cap
 
 def test_navigate_takes_view(capsys: pytest.CaptureFixture[str]) -> None:
     argv = ["navigate", "--goal", "1.0", "0.0", "0.0", "--timeout", "0.5", "--json", "--view", "--view-port", "0"]
-    assert main([*argv, "--no-browser"]) == 0
+    assert main([*argv, "--no-browser"]) == 1  # 0.5 s is too short to reach the goal: exit 1, as navigate says
     out = capsys.readouterr()
     assert "viewer: http://127.0.0.1:" in out.err and json.loads(out.out)["goals"][0]["goal"] == [1.0, 0.0, 0.0]
+    assert "navlab: 1 of 1 goals not reached (timeout)" in out.err
 
 
 def test_view_hook_moves_the_page_to_each_new_run_on_the_same_port() -> None:

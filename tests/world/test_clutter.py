@@ -169,9 +169,9 @@ def test_barn_score() -> None:
 
 
 def test_cli_writes_world_png_and_json(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    out, png = tmp_path / "c.world", tmp_path / "c.png"
-    code = main(["world", "clutter", "--seed", "3", "--fill", "0.3", "--smooth", "2", "--out", str(out),
-                 "--png", str(png), "--json"])
+    out, png = tmp_path / "c" / "clutter.world", tmp_path / "c" / "clutter.png"
+    code = main(["world", "clutter", "--seed", "3", "--fill", "0.3", "--smooth", "2", "--out", str(out.parent),
+                 "--png", "--json"])
     assert code == 0
     summary = json.loads(capsys.readouterr().out)
     w = generate_clutter(3, fill=0.3, smooth=2)
@@ -180,9 +180,12 @@ def test_cli_writes_world_png_and_json(tmp_path: Path, capsys: pytest.CaptureFix
     assert summary["reference_path_m"] == pytest.approx(w.reference_path_m, abs=1e-3)
     assert summary["start"] == [-2.0, 0.0, 0.0] and summary["goal"] == [8.0, 0.0, 0.0]
     assert summary["cylinders"] == len(w.cylinders) and summary["world_file"] == str(out)
-    assert main(["world", "clutter", "--out", str(tmp_path / "d.world")]) == 0
-    text = capsys.readouterr().out
-    assert "reference path" in text and "start" in text and "goal" in text
+    # deprecated until the next release: --out FILE.world (and --png FILE.png) as before, with one line saying so
+    assert main(["world", "clutter", "--out", str(tmp_path / "d.world"), "--png", str(tmp_path / "d.png")]) == 0
+    captured = capsys.readouterr()
+    assert "reference path" in captured.out and "start" in captured.out and "goal" in captured.out
+    assert (tmp_path / "d.world").is_file() and (tmp_path / "d.png").is_file()
+    assert captured.err.count("DeprecationWarning") == 1 and "--out names a folder" in captured.err
     with pytest.raises(SystemExit) as exc:
         main(["world", "clutter", "--fill", "2", "--out", str(out)])
     assert exc.value.code == 2

@@ -84,3 +84,22 @@ def run_soak(args: argparse.Namespace) -> dict[str, Any]:
     return {"sim_min": int(minutes), "rss_mb_after_1_min": first, "rss_mb_end": last,
             "growth_mb": round(last - first, 1), "rss_mb_by_minute": samples,
             "wall_s": round(time.perf_counter() - t0, 1)}
+
+
+def run_child(cmd: list[str]) -> dict[str, float]:
+    """Run ``cmd`` to its end (output discarded): its wall and CPU seconds (user + system) and peak RSS (MB),
+    from ``wait4`` (that child alone). A failing command raises ``RuntimeError`` with its last words."""
+    import os
+    import subprocess
+
+    t0 = time.perf_counter()
+    child = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    assert child.stderr is not None
+    err = child.stderr.read().decode(errors="replace")  # (read to the end: a full pipe would block the child)
+    _pid, status, usage = os.wait4(child.pid, 0)
+    wall = time.perf_counter() - t0
+    code = os.waitstatus_to_exitcode(status)
+    child.returncode = code
+    if code:
+        raise RuntimeError(f"{' '.join(cmd[2:4])} failed ({code}): {err.strip()[-500:]}")
+    return {"wall_s": wall, "cpu_s": usage.ru_utime + usage.ru_stime, "peak_rss_mb": usage.ru_maxrss / 1024}

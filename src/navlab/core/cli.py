@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from navlab.cli_common import add_resource_path_arguments, apply_resource_paths, positive_seconds
+from navlab.cli_common import add_resource_path_arguments, apply_resource_paths, out_file, positive_seconds
 from navlab.core.errors import CoreError
 from navlab.core.graph import Graph
 from navlab.core.launch import Session, start
@@ -31,50 +31,25 @@ from navlab.viz.cli import add_view_arguments
 def _add_source(p: argparse.ArgumentParser) -> None:
     src = p.add_mutually_exclusive_group()
     src.add_argument(
-        "--launch", nargs="+", metavar="FILE [name:=value]",
+        "--launch", nargs="+", metavar=("FILE", "name:=value"),
         help="start this launch (file or shipped name, then its arguments) here and watch it",
     )
     src.add_argument("--bag", metavar="DIR", help="read a rosbag2 recording instead")
     src.add_argument("--pid", type=int, help="which running `navlab launch` to watch when several run")
-    p.add_argument("--duration", type=positive_seconds, default=5.0,
-                   help="simulated seconds to watch (default 5)")
+    p.add_argument("--duration", type=positive_seconds, default=None,
+                   help="simulated seconds to watch (default 5; echo: until Ctrl-C or the end of the launch)")
     p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+
+
+def _watch_seconds(args: argparse.Namespace) -> None:
+    """``--duration``'s default: 5 simulated s to collect a list, rate or graph; echo runs until stopped."""
+    if args.duration is None:
+        args.duration = math.inf if getattr(args, "action", "") == "echo" else 5.0
 
 
 def _start(args: argparse.Namespace) -> Session:
     file, *items = args.launch
     return start(file, seed=args.seed, launch_args=parse_launch_args(items))
-
-
-def _msg_to_dict(msg: Any) -> Any:
-    if hasattr(msg, "__dataclass_fields__"):
-        return {k: _msg_to_dict(getattr(msg, k)) for k in msg.__dataclass_fields__ if k != "__msgtype__"}
-    if isinstance(msg, np.ndarray):
-        return msg.tolist()
-    if isinstance(msg, list):
-        return [_msg_to_dict(m) for m in msg]
-    return msg
-
-
-def _format_msg(d: Any, indent: int = 0) -> str:
-    pad = "  " * indent
-    if isinstance(d, dict):
-        lines = []
-        for k, v in d.items():
-            if isinstance(v, dict):
-                lines.append(f"{pad}{k}:\n{_format_msg(v, indent + 1)}")
-            else:
-                lines.append(f"{pad}{k}: {_short(v)}")
-        return "\n".join(lines)
-    return pad + _short(d)
-
-
-def _short(v: Any) -> str:
-    if isinstance(v, list) and len(v) > 12:
-        return "[" + ", ".join(_short(x) for x in v[:10]) + f", ... ({len(v)} items)]"
-    if isinstance(v, float):
-        return f"{v:.6g}"
-    return json.dumps(v) if isinstance(v, list | str) else str(v)
 
 
 def _running(args: argparse.Namespace) -> Path | None:
@@ -84,15 +59,15 @@ def _running(args: argparse.Namespace) -> Path | None:
     return None if args.launch or args.bag else find_running(args.pid)
 
 
-def _live_messages(path: Path, topic: str, duration: float, count: int) -> Iterator[tuple[int, Any]]:
-    """Messages of a running launch until ``count`` arrived or ``duration`` simulated seconds passed."""
+def _live_messages(path: Path, topic: str, duration: float) -> Iterator[tuple[int, Any]]:
+    """Messages of a running launch until ``duration`` simulated seconds passed."""
     from navlab.core.introspect import subscribe
 
     t0 = None
-    for n, (t_ns, msg) in enumerate(subscribe(path, topic), 1):
+    for t_ns, msg in subscribe(path, topic):
         t0 = t_ns if t0 is None else t0
         yield t_ns, msg
-        if (count and n >= count) or (not count and t_ns - t0 >= duration * 1e9):
+        if t_ns - t0 >= duration * 1e9:
             return
 
 
@@ -104,7 +79,7 @@ def _messages(args: argparse.Namespace, topic: str) -> Iterator[tuple[int, Any]]
         return [(t, m) for _, t, m in read_bag(args.bag, topics=[topic])]
     live = _running(args)
     if live is not None:
-        return _live_messages(live, topic, args.duration, getattr(args, "count", 0) if args.action == "echo" else 0)
+        return _live_messages(live, topic, args.duration)
     session = _start(args)
     got: list[tuple[int, Any]] = []
 
@@ -237,6 +212,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
 
 
 def _cmd_topic(args: argparse.Namespace) -> int:
+    _watch_seconds(args)
     if args.action == "list":
         if args.bag:
             from navlab.io.rosbag import bag_topics
@@ -258,14 +234,16 @@ def _cmd_topic(args: argparse.Namespace) -> int:
         return 0
     if not args.topic:
         raise CoreError(f"navlab topic {args.action} needs a TOPIC name")
-    msgs = _messages(args, args.topic)
     if args.action == "echo":
-        for k, (_t_ns, msg) in enumerate(msgs, 1):
-            print(_format_msg(_msg_to_dict(msg)))
-            print("---", flush=True)
-            if args.count and k >= args.count:
-                break
-        return 0
+        from navlab.core import echo
+
+        out = echo.Printer(args.count)
+        if args.bag:
+            return echo.echo_bag(args.bag, args.topic, out, args.duration)
+        if (live := _running(args)) is not None:
+            return echo.echo_live(live, args.topic, out, args.duration)
+        return echo.echo_launch(args.launch, args.topic, out, args.duration, args.seed, run_for)
+    msgs = _messages(args, args.topic)
     # hz
     times = np.array([t for t, _ in msgs], dtype=np.int64)  # simulated time stamps
     if len(times) < 2:
@@ -290,6 +268,7 @@ def _cmd_topic(args: argparse.Namespace) -> int:
 
 
 def _graph_of(args: argparse.Namespace) -> Graph:
+    _watch_seconds(args)
     if args.bag:
         from navlab.io.rosbag import bag_graph, bag_topics
 
@@ -316,10 +295,11 @@ def _cmd_node(args: argparse.Namespace) -> int:
 
 def _cmd_graph(args: argparse.Namespace) -> int:
     graph = _graph_of(args)
-    out = Path(args.out)
-    write_text_atomic(out.with_suffix(".dot"), graph.to_dot())
-    graph.write_svg(out.with_suffix(".svg"))
-    print(f"wrote {out.with_suffix('.dot')} and {out.with_suffix('.svg')}")
+    svg = out_file(args.out, "graph.svg", old_suffixes=(".dot", ".svg"))
+    dot = svg.with_suffix(".dot")
+    write_text_atomic(dot, graph.to_dot())
+    graph.write_svg(svg)
+    print(f"wrote {dot} and {svg}")
     return 0
 
 
@@ -417,13 +397,17 @@ def register(sub: argparse._SubParsersAction) -> None:
         "topic",
         help="list, echo or measure the rate of topics (rostopic)",
         description="rostopic list|echo|hz on a `navlab launch` running in another shell (the default), on a "
-        "launch that this command starts and runs for --duration simulated seconds (--launch), or on a "
-        "rosbag2 recording (--bag). e.g. `navlab topic hz /mybot/laser/scan` next to `navlab launch mapping`.",
+        "launch that this command starts (--launch), or on a rosbag2 recording (--bag). list and hz watch "
+        "--duration simulated seconds (default 5). echo prints each message as YAML followed by ---, as rostopic "
+        "does, until Ctrl-C, the end of the launch or recording, -n N messages, or --duration (a --launch started "
+        "here then runs as fast as possible; without --duration it runs in real time, as roslaunch). "
+        "e.g. `navlab topic hz /mybot/laser/scan` next to `navlab launch mapping`.",
     )
     p.add_argument("action", choices=["list", "echo", "hz"], help="what to do")
     p.add_argument("topic", nargs="?", help="topic name (echo, hz)")
     _add_source(p)
-    p.add_argument("--count", type=int, default=0, help="echo: at most this many messages")
+    p.add_argument("-n", "--count", type=int, default=0,
+                   help="echo: stop after this many messages (exit 1 if the source ends before)")
     p.add_argument("-v", "--verbose", action="store_true", help="list: show message counts")
     p.add_argument("--json", action="store_true", help="hz: print JSON")
     p.set_defaults(func=_cmd_topic)
@@ -444,9 +428,11 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="write the node/topic graph as DOT and SVG (rqt_graph)",
         description="rqt_graph as files: the nodes and topics of a running `navlab launch` (the default), of "
         "a launch started here (--launch, run for --duration simulated seconds) or of a recording (--bag), "
-        "written as OUT.dot and OUT.svg (node -> topic -> node).",
+        "written as DIR/graph.dot and DIR/graph.svg: nodes as ellipses, topics as boxes, publisher -> topic -> "
+        "subscriber, laid out left to right by Graphviz's dot (Debian package graphviz).",
     )
     _add_source(p)
-    p.add_argument("--out", default="graph", help="output path without suffix (writes .dot and .svg)")
+    p.add_argument("--out", default="graph", metavar="DIR",
+                   help="output folder: DIR/graph.dot and DIR/graph.svg (default ./graph)")
     p.set_defaults(func=_cmd_graph)
 

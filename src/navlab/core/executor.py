@@ -58,6 +58,7 @@ class Executor:
         self.topics: dict[str, Topic] = {}
         self.services: dict[str, Callable[[Any], Any]] = {}
         self.tf = TfBuffer(cache_ns=seconds_to_ns(tf_cache_s))
+        self.tf_listeners: set[str] = set()  # nodes that read tf (a tf2 TransformListener each, in ROS)
         self._heap: list[tuple[int, int, int, Timer]] = []
         self._seq = 0
         self._deliveries: deque[tuple[Subscription, Any]] = deque()

@@ -1,12 +1,14 @@
-"""The node/topic graph (rqt_graph's picture) as data, Graphviz DOT, and SVG drawn with matplotlib."""
+"""The node/topic graph (rqt_graph's picture) as data, Graphviz DOT, and SVG laid out by Graphviz's ``dot``."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
+from navlab.core.errors import CoreError
 from navlab.core.executor import Executor
-from navlab.io.files import save_figure_atomic
+from navlab.io.files import write_text_atomic
 
 HIDDEN_NODES = ("/_tf_buffer",)
 
@@ -21,10 +23,11 @@ class Graph:
     @classmethod
     def from_executor(cls, ex: Executor) -> Graph:
         """The live graph of an executor."""
-        topics = {
-            name: (sorted(set(t.publishers)), sorted({s.node for s in t.subscriptions if s.node not in HIDDEN_NODES}))
-            for name, t in sorted(ex.topics.items())
-        }
+        def subscribers(name: str, t: Any) -> list[str]:
+            subs = {s.node for s in t.subscriptions if s.node not in HIDDEN_NODES}
+            return sorted(subs | ex.tf_listeners if name in ("/tf", "/tf_static") else subs)
+
+        topics = {name: (sorted(set(t.publishers)), subscribers(name, t)) for name, t in sorted(ex.topics.items())}
         return cls(nodes=sorted(ex.nodes), topics=topics)
 
     def to_json(self) -> dict[str, object]:
@@ -41,72 +44,92 @@ class Graph:
             topics={k: (list(v["pub"]), list(v["sub"])) for k, v in topics.items()},
         )
 
-    def to_dot(self) -> str:
-        """Graphviz DOT: nodes as ellipses, topics as boxes, edges publisher → topic → subscriber."""
-        lines = ["digraph navlab {", "  rankdir=LR;", '  node [fontname="Helvetica"];']
+    def to_dot(self, *, rate_line: bool = False) -> str:
+        """Graphviz DOT as rqt_graph draws it: nodes as ellipses, topics as boxes, edges publisher → topic →
+        subscriber, left to right. A node and a topic of the same name stay two vertices (ids ``n:``/``t:``).
+        ``rate_line``: topic boxes leave room for a second line (the viewer writes the rate there)."""
+
+        def q(text: str) -> str:
+            return '"' + text.replace("\\", "\\\\").replace('"', '\\"') + '"'
+
+        lines = ["digraph navlab {", "  rankdir=LR;", '  node [fontname="Helvetica", fontsize=10];',
+                 '  edge [color="#555555"];']  # fmt: skip
         for n in self.nodes:
-            lines.append(f'  "{n}" [shape=ellipse];')
+            lines.append(f"  {q('n:' + n)} [label={q(n)}, shape=ellipse];")
         for t, (pubs, subs) in self.topics.items():
-            lines.append(f'  "{t}" [shape=box];')
-            lines += [f'  "{p}" -> "{t}";' for p in pubs]
-            lines += [f'  "{t}" -> "{s}";' for s in subs]
+            label = q(t)[:-1] + '\\n000.00 Hz"' if rate_line else q(t)  # dot's line break: backslash n
+            lines.append(f"  {q('t:' + t)} [label={label}, shape=box];")
+            lines += [f"  {q('n:' + p)} -> {q('t:' + t)};" for p in pubs]
+            lines += [f"  {q('t:' + t)} -> {q('n:' + s)};" for s in subs]
         lines.append("}")
         return "\n".join(lines) + "\n"
 
-    def layers(self) -> dict[str, int]:
-        """A left-to-right layer for every graph vertex (longest path from sources, cycles cut)."""
-        succ: dict[str, list[str]] = {v: [] for v in [*self.nodes, *self.topics]}
-        for t, (pubs, subs) in self.topics.items():
-            for p in pubs:
-                succ.setdefault(p, []).append(t)
-            succ[t] += subs
-            for s in subs:
-                succ.setdefault(s, [])
-        layer = dict.fromkeys(succ, 0)
-        for _ in range(len(succ)):  # Bellman-Ford-like relaxation, bounded so cycles terminate
-            changed = False
-            for v, outs in succ.items():
-                for w in outs:
-                    if layer[w] < layer[v] + 1 and layer[v] + 1 < len(succ):
-                        layer[w] = layer[v] + 1
-                        changed = True
-            if not changed:
-                break
-        return layer
-
     def write_svg(self, path: str | Path) -> None:
-        """Draw the graph (matplotlib, no Graphviz needed) and write it as SVG atomically."""
-        import matplotlib
+        """Lay the graph out with Graphviz's ``dot`` (layered, cycles handled, as rqt_graph does) and write the
+        SVG atomically. Raises CoreError when ``dot`` is not installed."""
+        svg = self.to_svg()
+        write_text_atomic(Path(path), svg)
 
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
+    def without_topics(self, hidden: tuple[str, ...]) -> Graph:
+        """The same graph without the ``hidden`` topics (and topics nobody publishes or subscribes)."""
+        return Graph(nodes=list(self.nodes), topics={t: ps for t, ps in self.topics.items()
+                                                     if t not in hidden and (ps[0] or ps[1])})  # fmt: skip
 
-        layer = self.layers()
-        columns: dict[int, list[str]] = {}
-        for v in sorted(layer, key=lambda v: (layer[v], v)):
-            columns.setdefault(layer[v], []).append(v)
-        pos = {v: (c * 3.0, -r * 0.8) for c, vs in columns.items() for r, v in enumerate(vs)}
-        height = max((len(v) for v in columns.values()), default=1)
-        fig, ax = plt.subplots(figsize=(3 + 3 * len(columns), 1 + 0.6 * height))
-        boxes = {}
-        for v, (x, y) in pos.items():
-            is_topic = v in self.topics
-            boxes[v] = ax.text(
-                x, y, v, ha="center", va="center", fontsize=8, zorder=2,
-                bbox={"boxstyle": "square" if is_topic else "round", "fc": "#e8f0ff" if is_topic else "#fff2cc"},
-            )  # fmt: skip
-        for t, (pubs, subs) in self.topics.items():
-            for a, b in [*((p, t) for p in pubs), *((t, s) for s in subs)]:
-                forward = pos[b][0] >= pos[a][0]  # arrows leave the right edge and enter the left edge
-                ax.annotate(
-                    "", xy=(0.0 if forward else 1.0, 0.5), xycoords=boxes[b],
-                    xytext=(1.0 if forward else 0.0, 0.5), textcoords=boxes[a],
-                    arrowprops={"arrowstyle": "-|>", "color": "0.35", "shrinkA": 3, "shrinkB": 3}, zorder=1,
-                )  # fmt: skip
-        ax.set_axis_off()
-        xs = [p[0] for p in pos.values()] or [0.0]
-        ys = [p[1] for p in pos.values()] or [0.0]
-        ax.set_xlim(min(xs) - 1.5, max(xs) + 1.5)
-        ax.set_ylim(min(ys) - 0.6, max(ys) + 0.6)
-        save_figure_atomic(fig, path, bbox_inches="tight")
-        plt.close(fig)
+    def layout(self) -> dict[str, Any]:
+        """Graphviz ``dot``'s layered layout, for drawing in the viewer: ``width``/``height`` and each vertex's
+        centre and size (``vertices``: name -> {kind, x, y, w, h}) in points, y down; each edge's cubic Bézier
+        control points (``edges``: {tail, head, points}). Raises CoreError without ``dot``."""
+        import shlex
+
+        plain = self._dot("plain", rate_line=True)
+        out: dict[str, Any] = {"width": 0.0, "height": 0.0, "vertices": {}, "edges": []}
+        height = 0.0
+        for line in plain.splitlines():
+            f = shlex.split(line)
+            if not f:
+                continue
+            if f[0] == "graph":
+                out["width"], height = float(f[2]) * 72, float(f[3]) * 72
+                out["height"] = height
+            elif f[0] == "node":
+                kind, name = f[1][0], f[1][2:]
+                out["vertices"][f[1]] = {"name": name, "kind": "topic" if kind == "t" else "node",
+                                         "x": float(f[2]) * 72, "y": height - float(f[3]) * 72,
+                                         "w": float(f[4]) * 72, "h": float(f[5]) * 72}  # fmt: skip
+            elif f[0] == "edge":
+                n = int(f[3])
+                pts = [[float(f[4 + 2 * i]) * 72, height - float(f[5 + 2 * i]) * 72] for i in range(n)]
+                out["edges"].append({"tail": f[1], "head": f[2], "points": pts})
+        return out
+
+    def _dot(self, fmt: str, *, rate_line: bool = False) -> str:
+        """:meth:`to_dot` run through Graphviz's ``dot -T<fmt>``."""
+        import shutil
+        import subprocess
+
+        dot = shutil.which("dot")
+        if dot is None:
+            raise CoreError("Graphviz's `dot` is not installed, so the graph cannot be laid out "
+                            "(Debian: sudo apt-get install graphviz)")  # fmt: skip
+        proc = subprocess.run([dot, f"-T{fmt}"], input=self.to_dot(rate_line=rate_line), capture_output=True,
+                              text=True, timeout=60, check=False)  # fmt: skip
+        if proc.returncode != 0:
+            raise CoreError(f"dot failed to lay out the graph: {proc.stderr.strip()}")
+        return proc.stdout
+
+    def to_svg(self) -> str:
+        """The SVG text of :meth:`to_dot` laid out by Graphviz's ``dot``."""
+        return self._dot("svg")
+
+
+PAGE_HIDDEN_TOPICS = ("/tf_static", "/clock", "/rosout")  # not drawn in the viewer's Graph panel
+
+
+def with_layout(graph: dict[str, Any]) -> dict[str, Any]:
+    """A graph's JSON (:meth:`Graph.to_json`, plus anything else) with ``layout``: dot's layout of it without
+    ``PAGE_HIDDEN_TOPICS``, for the viewer's Graph panel; unchanged when Graphviz is missing (the page then
+    draws its own columns)."""
+    try:
+        return {**graph, "layout": Graph.from_json(graph).without_topics(PAGE_HIDDEN_TOPICS).layout()}
+    except CoreError:
+        return graph

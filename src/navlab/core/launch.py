@@ -130,8 +130,10 @@ def start_node(session: Session, spec: NodeSpec) -> Node:
     except LaunchError as exc:
         raise LaunchError(f"{spec.origin}: {exc}") from None
     params = spec.params
+    origin = spec.origin
     if (spec.name or spec.exec) in session.overrides:  # like `ros2 launch ... --ros-args -p`: applied last
         params = merge_params(params, session.overrides[spec.name or spec.exec])
+        origin += " + --set overrides"
     kwargs: dict[str, Any] = {"parameters": params}
     if spec.name:
         kwargs["name"] = spec.name
@@ -141,8 +143,8 @@ def start_node(session: Session, spec: NodeSpec) -> Node:
         with session.executor.node_context(remappings=spec.remaps), warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", ParameterWarning)
             node = cls(session.executor, **kwargs)
-    except NavlabError as exc:  # name the launch file and the parameter files, as the user wrote them
-        raise _prefixed(exc, spec.origin) from None
+    except NavlabError as exc:  # the problem first, then the launch file and parameter files it came from
+        raise _located(exc, origin) from None
     _warn_unknown_keys(caught, spec.files, spec.origin)
     session.nodes[node.fully_qualified_name] = node
     session.origins[node.fully_qualified_name] = spec.origin
@@ -382,12 +384,12 @@ def _warn_unknown_keys(caught: list[warnings.WarningMessage], files: dict[str, s
         logging.getLogger("navlab.launch").warning("%s: %s", where, w.message)
 
 
-def _prefixed(exc: NavlabError, prefix: str) -> NavlabError:
-    """``exc`` (same class where it can be rebuilt from a message) with ``prefix: `` before its message."""
+def _located(exc: NavlabError, where: str) -> NavlabError:
+    """``exc`` (same class where it can be rebuilt from a message) with `` (in WHERE)`` after its message."""
     try:
-        return type(exc)(f"{prefix}: {exc}")
+        return type(exc)(f"{exc} (in {where})")
     except Exception:  # an error class with another constructor
-        return LaunchError(f"{prefix}: {exc}")
+        return LaunchError(f"{exc} (in {where})")
 
 
 def _check_args(files: list[Path], args: dict[str, Any]) -> None:
@@ -481,7 +483,7 @@ def start(
             node.check_parameters()
         except NavlabError as exc:
             session.shutdown()
-            raise _prefixed(exc, session.origins.get(name, str(files[0]))) from None
+            raise _located(exc, session.origins.get(name, str(files[0]))) from None
     started = {name.rsplit("/", 1)[-1] for name in session.nodes}
     unknown = sorted(set(session.overrides) - started)
     if unknown:

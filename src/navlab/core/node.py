@@ -7,7 +7,6 @@ needs besides its parameters (the simulation, for a Gazebo plugin) follow as key
 from __future__ import annotations
 
 import dataclasses
-import difflib
 import enum
 import functools
 import logging
@@ -18,7 +17,7 @@ from typing import Any
 
 from navlab.core.errors import ParameterError
 from navlab.core.executor import Executor
-from navlab.core.params import TYPO_CUTOFF, ParameterWarning
+from navlab.core.params import ParameterWarning, likely_typo
 from navlab.core.tf import Pose2
 from navlab.core.topics import Publisher, Subscription, Timer, seconds_to_ns
 from navlab.msgs import TFMessage, time_from_ns
@@ -334,12 +333,19 @@ class Node:
 
     # --- tf ---------------------------------------------------------------------------------------
 
+    def listen_tf(self) -> None:
+        """Declare that this node reads tf, as a ROS node does by creating a ``tf2_ros.TransformListener``: the
+        graph (``navlab graph``, rqt_graph) then shows it subscribing ``/tf`` and ``/tf_static``. The transforms
+        themselves are in the executor's one buffer (``executor.tf``)."""
+        self.executor.tf_listeners.add(self.fully_qualified_name)
+
     def pose_at(self, target: str, source: str, t_ns: int | None) -> Pose2:
         """(x, y, yaw) of ``source`` in ``target`` at ``t_ns`` (a message's stamp), else the latest.
 
         Falls back on the latest transform when tf has none at ``t_ns`` yet (a scan stamped just after
         the last odometry). Raises ``TfError`` when the frames are not connected at all.
         """
+        self.listen_tf()
         return self.executor.tf.lookup_pose2d_or_latest(target, source, t_ns)
 
     def sensor_pose(self, base_frame: str, sensor_frame: str) -> Pose2:
@@ -350,6 +356,7 @@ class Node:
         key = (base_frame, sensor_frame)
         pose = self._sensor_poses.get(key)
         if pose is None:
+            self.listen_tf()
             pose = self._sensor_poses[key] = self.executor.tf.lookup_pose2d(base_frame, sensor_frame)
         return pose
 
@@ -463,7 +470,7 @@ class Node:
         self._params_checked = True
         lines = []
         for key in (k for k in self._overrides if k not in self._declared):  # policy: params.check_unknown_key
-            close = difflib.get_close_matches(key, list(self._declared), n=1, cutoff=TYPO_CUTOFF)
+            close = likely_typo(key, list(self._declared))
             if close:
                 lines.append(f"{key!r} (did you mean {close[0]!r}?)")
             else:

@@ -37,13 +37,20 @@ class ParameterWarning(NavlabError, UserWarning):
         self.key = key
 
 
+def likely_typo(key: str, known: list[str]) -> list[str]:
+    """The known name ``key`` misspells, as a one-item list (empty if none): difflib ratio >= ``TYPO_CUTOFF``,
+    or the same letters swapped (``lsimga``: a short name's transposition rates under the cutoff)."""
+    close = difflib.get_close_matches(key, known, n=1, cutoff=TYPO_CUTOFF)
+    return close or [k for k in known if len(k) == len(key) and sorted(k) == sorted(key)][:1]
+
+
 def check_unknown_key(key: str, known: list[str], *, what: str, error: type[Exception]) -> None:
     """The unknown-key policy, ROS's where it is safe: a ROS node reads the parameters it knows and ignores the
     rest of its namespace, so a key of another plugin or an older release (``meter_scoring`` in a costmap file)
     only warns (``ParameterWarning``: "unknown WHAT parameter 'key' ignored"). A key within a letter or two of
     a known one (difflib ratio >= ``TYPO_CUTOFF``: ``inflation_raduis``) is a misspelling whose value ROS
     would silently drop, leaving the default in force: that raises ``error`` with "did you mean"."""
-    close = difflib.get_close_matches(key, known, n=1, cutoff=TYPO_CUTOFF)
+    close = likely_typo(key, known)
     if close:
         raise error(f"unknown {what} parameter '{key}'; did you mean '{close[0]}'?")
     warnings.warn(ParameterWarning(f"unknown {what} parameter '{key}' ignored (ROS ignores what it does not "

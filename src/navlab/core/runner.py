@@ -50,6 +50,9 @@ def run_for(
             done += (ex.now_ns - t0) / 1e9 if reached else step
             bar.update((ex.now_ns - t0) / 1e9)
             if reached or ex.stopped:
+                if not math.isinf(duration):  # the bar ends where the run ended, not at the limit
+                    bar.total = round(bar.n, 3)
+                    bar.refresh()
                 break
     finally:
         bar.close()

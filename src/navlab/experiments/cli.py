@@ -14,6 +14,7 @@ from navlab.cli_common import (
     add_set_argument,
     apply_resource_paths,
     coordinate,
+    out_file,
     parse_sets,
     positive_seconds,
     print_figures,
@@ -98,15 +99,14 @@ def _cmd_localize(args: argparse.Namespace) -> int:
         )  # fmt: skip
     summary = dict(result.summary)
     if args.out:
-        summary["png"] = str(plot_result(result, args.out))
+        summary["png"] = str(plot_result(result, out_file(args.out, "localize.png", old_suffixes=(".png",))))
     print_figures(summary, args.json)
     return 0
 
 
 def _cmd_navigate(args: argparse.Namespace) -> int:
     apply_resource_paths(args)  # --package-path / --model-path, for this process and its workers
-    from navlab.experiments.navigate_run import run_navigation
-    from navlab.experiments.plots import plot_navigation
+    from navlab.experiments.navigate_run import run_navigation, save_goal_pictures
     from navlab.sim.spawn import parse_spawn_spec
 
     spawns = []
@@ -119,18 +119,27 @@ def _cmd_navigate(args: argparse.Namespace) -> int:
             pose=start_pose(args), controller=args.controller, params_dir=args.params,
             move_base_params=parse_sets(args.set), spawn=spawns, goal_timeout=args.timeout, seed=args.seed,
             record=args.record, snapshots=bool(args.out), mapless=args.mapless, on_start=on_start,
+            progress=None if args.quiet else lambda text: print(text, file=sys.stderr, flush=True),
         )  # fmt: skip
     figures: dict[str, Any] = {"goals": result.goals, **result.summary}
     if args.out:
-        out = Path(args.out)
-        out.mkdir(parents=True, exist_ok=True)
-        pictures = []
-        for k, (goal, shot) in enumerate(zip(result.goals, result.snapshots, strict=True), 1):
-            title = f"goal {k} {tuple(goal['goal'])}: {goal['outcome']} in {goal['time_s']} s"
-            pictures.append(str(plot_navigation(result.grid, shot, out / f"goal_{k}.png", title=title,
-                                                goal=goal["goal"])))  # fmt: skip
-        figures["pictures"] = pictures
-    print_figures(figures, args.json)
+        figures["pictures"] = save_goal_pictures(result, args.out)
+    if args.json:
+        print_figures(figures, True)
+    else:  # one readable line per goal, then the run's figures
+        for k, g in enumerate(result.goals, 1):
+            mb = g.get("move_base_outcome", g["outcome"])
+            said = f" (move_base: {mb})" if mb != g["outcome"] else ""
+            print(f"goal {k} ({', '.join(f'{v:g}' for v in g['goal'])}): {g['outcome']}{said} in {g['time_s']} s, "
+                  f"path "
+                  f"{g['path_m']} m, closest {g['min_clearance_m']} m, {g['collisions']} collisions"
+                  + (f" ({g['reason']})" if g["reason"] else ""))  # fmt: skip
+        print_figures({k: v for k, v in figures.items() if k != "goals"}, False)
+    failed = [g for g in result.goals if g["outcome"] != "succeeded"]
+    if failed:  # as a script would want it: 0 only when every goal succeeded
+        print(f"navlab: {len(failed)} of {len(result.goals)} goals not reached "
+              f"({', '.join(sorted({g['outcome'] for g in failed}))})", file=sys.stderr)
+        return 1
     return 0
 
 
@@ -233,6 +242,13 @@ def _add_world_robot(p: argparse.ArgumentParser, world: str) -> None:
     add_resource_path_arguments(p)
 
 
+def _shipped_scenarios() -> list[str]:
+    """The scenario names in the shipped resources folder (for --help)."""
+    from navlab import resources
+
+    return sorted(f.stem for f in (resources.root() / "scenarios").glob("*.yaml"))
+
+
 def register(sub: argparse._SubParsersAction) -> None:
     """Add ``map``, ``localize``, ``navigate``, ``experiment`` and ``report``."""
     p = sub.add_parser(
@@ -248,7 +264,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     drive = p.add_mutually_exclusive_group()
     drive.add_argument("--explore", action="store_true", help="frontier exploration (the default)")
     drive.add_argument("--teleop", action="store_true", help="drive with the keyboard, in real time")
-    drive.add_argument("--route", metavar="FILE", help="a route YAML: segments and/or waypoints")
+    drive.add_argument("--route", metavar="FILE",
+                       help="a route YAML (segments and/or waypoints) or a shipped route's name (room)")
     p.add_argument("--out", default="map", metavar="DIR", help="output folder (default ./map)")
     p.add_argument("--mode", default="gmapping",
                    help="SLAM mode: gmapping, the paper's RBPF (default), or graph (pose graph)")  # fmt: skip
@@ -258,7 +275,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="pacing: 0 = as fast as possible (default; real time with --ros), 1 = real time")
     p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     p.add_argument("--record", metavar="DIR", help="also write every topic to a rosbag2 (MCAP) in DIR")
-    p.add_argument("--launch", nargs="+", metavar="FILE [name:=value]",
+    p.add_argument("--launch", nargs="+", metavar=("FILE", "name:=value"),
                    help="save: start this launch here and save its /map after --duration (default: save the "
                    "/map of the `navlab launch` running in another shell)")  # fmt: skip
     p.add_argument("--pid", type=int, help="save: which running navlab launch, when several run")
@@ -292,8 +309,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="amcl parameter file (ROS 1 layout, or Nav2 layout with an 'amcl' node)")
     add_set_argument(p, "amcl", "recovery_alpha_fast=0.1")
     p.add_argument("--seed", type=int, default=0, help="random seed of the run (default 0)")
-    p.add_argument("--out", default="localize.png", metavar="FILE.png",
-                   help="where to save the truth-vs-estimate figure (default localize.png; '' for none)")
+    p.add_argument("--out", default=".", metavar="DIR",
+                   help="folder for the truth-vs-estimate figure DIR/localize.png (default: the current folder; "
+                   "'' for none; a FILE.png is deprecated but still works this release)")
     p.add_argument("--json", action="store_true", help="print the figures as one JSON object")
     p.add_argument("--record", metavar="DIR", help="also write every topic to a rosbag2 (MCAP) in DIR")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
@@ -309,9 +327,9 @@ def register(sub: argparse._SubParsersAction) -> None:
         "by the simulator's truth (succeeded: the robot truly ended within 0.3 m of the goal; else aborted with "
         "move_base's reason, preempted, timeout, or not_reached when move_base reported success from its own "
         "estimate), move_base's own verdict beside it, time, path length, final error, minimum clearance (the "
-        "robot's collision geometry to the world's) and collisions (from the simulator's contacts), and with "
-        "--out DIR saves one picture per goal: map, inflation shadow, global plan (blue), local plan (green), "
-        "robot (orange), laser (red).",
+        "robot's collision geometry to the world's) and collisions (contact episodes from the simulator), and with "
+        "--out DIR saves two labelled pictures per goal (at its end and mid-drive) with a legend. Exits 0 only "
+        "when every goal succeeded (1 otherwise).",
     )
     _add_world_robot(p, "room_obstacles")
     p.add_argument("--map", metavar="MAP.yaml", default=None,
@@ -332,8 +350,10 @@ def register(sub: argparse._SubParsersAction) -> None:
                    "(see navlab sim --help; repeatable)")  # fmt: skip
     p.add_argument("--timeout", type=positive_seconds, default=90.0, help="simulated s allowed per goal (90)")
     p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
-    p.add_argument("--out", metavar="DIR", default=None, help="save one PNG per goal into DIR")
+    p.add_argument("--out", metavar="DIR", default=None,
+                   help="save two pictures per goal into DIR: goal_N.png when it ended, goal_N_mid.png mid-drive")
     p.add_argument("--record", metavar="DIR", help="also write every topic to a rosbag2 (MCAP) in DIR")
+    p.add_argument("--quiet", action="store_true", help="no progress lines")
     p.add_argument("--json", action="store_true", help="print the figures as one JSON object")
     add_view_arguments(p)
     add_ros_argument(p, rate=True)
@@ -342,9 +362,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "experiment",
         help="run a scenario's trials headless and summarize them, or sweep parameters (the paper's Section V)",
-        description="navlab experiment run FILE: run the trials of a scenario YAML (or a shipped one: empty_room, "
-        "obstacles_after_mapping, refresh_rate, clutter_suite) headless, each with its own seed, in parallel "
-        "processes with --workers. Each "
+        description="navlab experiment run FILE: run the trials of a scenario YAML (or a shipped one: "
+        f"{', '.join(_shipped_scenarios())}) headless, each with its own seed, in parallel processes with "
+        "--workers. Each "
         "finished trial is appended whole to DIR/results.jsonl; running again resumes and skips finished trials. "
         "Prints (and writes DIR/summary.json) the success rate with a 95 % Wilson interval, collisions, failures "
         "by kind, time quartiles, SPL, clearance, localization error and command jerk. navlab experiment sweep FILE "

@@ -20,9 +20,9 @@ import numpy as np
 from navlab.core import Node
 from navlab.experiments.metrics import settled_after, trajectory_error
 from navlab.experiments.monitors import PoseMonitor
-from navlab.experiments.plots import ErrorPanel, Track, plot_run
+from navlab.experiments.plots import ErrorPanel, Marks, Track, plot_run
 from navlab.experiments.session import rounded, start_run
-from navlab.experiments.truth import true_map
+from navlab.experiments.truth import true_map, unmapped_obstacles
 from navlab.geometry import wrap_angle
 from navlab.grid import GridMap
 from navlab.localization.errors import LocalizationError
@@ -44,6 +44,7 @@ class LocalizeResult:
     estimate: np.ndarray
     grid: GridMap
     summary: dict[str, Any] = field(default_factory=dict)
+    unmapped: np.ndarray | None = None  # (N, 2) world points of obstacles the map does not have (m)
 
     @property
     def error(self) -> np.ndarray:
@@ -154,7 +155,8 @@ def run_localization(
             kidnapper = run.add(Kidnapper, parameters={"at": kidnap_at}, sim=run.sim, follower=follower, route=route)
         run.run(duration, record=record, quiet=not progress, chunk=1.0, desc="localize")
     s = monitor.samples()
-    res = LocalizeResult(t=s["t"], truth=s["truth"], estimate=s["estimate"], grid=grid)
+    res = LocalizeResult(t=s["t"], truth=s["truth"], estimate=s["estimate"], grid=grid,
+                         unmapped=None if map_yaml is None else unmapped_obstacles(run.sim.world, grid, pose[:2]))
     from navlab.localization.amcl_node import Amcl
 
     node = run.node("amcl")
@@ -205,12 +207,18 @@ def plot_result(res: LocalizeResult, path: str | Path) -> Path:
         k = int(np.searchsorted(res.t, res.summary["kidnap_s"]))
         truth, est = np.insert(truth, k, np.nan, axis=0), np.insert(est, k, np.nan, axis=0)
         events["kidnapped"] = res.summary["kidnap_s"]
+    mean = res.summary.get("position_error_mean_m")
+    marks = [] if res.unmapped is None or not len(res.unmapped) else [Marks(res.unmapped, "obstacle not in the map",
+                                                                            "tab:purple")]  # fmt: skip
     return plot_run(
         res.grid,
         [Track(truth, "ground truth", "-", "tab:green", 2.0), Track(est, "AMCL estimate", "--", "tab:red")],
         path,
-        title=f"{res.summary.get('world', '')}: {res.summary.get('mode', '')}",
-        error=ErrorPanel(res.t, res.error, title=f"mean {res.summary.get('position_error_mean_m')} m",
+        title=f"AMCL ({res.summary.get('mode', '')}) in {res.summary.get('world', '')} on map "
+              f"{Path(str(res.summary.get('map', ''))).name}",
+        error=ErrorPanel(res.t, res.error, title="position error: AMCL vs truth" + (
+                         f" (mean {100 * mean:.1f} cm)" if mean is not None else ""),
                          threshold=CONVERGED_M, events=events),
+        marks=marks,
         dpi=110,
     )  # fmt: skip

@@ -17,7 +17,7 @@ import numpy as np
 
 from navlab.experiments.metrics import free_coverage, score_map, trajectory_error
 from navlab.experiments.monitors import PoseMonitor
-from navlab.experiments.plots import Track, plot_run
+from navlab.experiments.plots import Marks, Track, plot_run
 from navlab.experiments.session import Run, rounded, start_run
 from navlab.experiments.truth import true_occupancy, world_T_map
 from navlab.geometry import inverse_transform_points2, wrap_angle
@@ -140,8 +140,12 @@ def run_mapping(
         scores["odometry_position_error_mean_m"] = odom_err["position_error_mean_m"]
         scores["odometry_yaw_error_mean_deg"] = odom_err["yaw_error_mean_deg"]
         write_trajectory(out_dir / "trajectory.txt", s["t"], est, tru_map)
+        title = (f"{mode} map of {Path(str(world)).stem} after {float(s['t'][-1]):.0f} simulated s "
+                 f"(SLAM error {scores['position_error_mean_m']:.3f} m mean)")
+        marks = [Marks(tru_map[:1, :2], "start", "black", "o", 40.0),
+                 Marks(tru_map[-1:, :2], "end", "black", "s", 40.0)]
         plot_run(grid, [Track(tru_map, "ground truth", "g-", width=1.5), Track(est, "SLAM estimate", "b--")],
-                 out_dir / "map.png")  # fmt: skip
+                 out_dir / "map.png", title=title, marks=marks)  # fmt: skip
     if scores["map_empty"]:
         scores["finished"] = False  # nothing was mapped, whatever the driver says
         scores["warning"] = (f"the map is empty: no obstacle was seen ({slam.scans_invalid} of {slam.scans_received} "

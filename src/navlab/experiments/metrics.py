@@ -87,6 +87,8 @@ def relations_error(
         rot_abs_mean_deg=float(rot.mean()),
         rot_abs_std_deg=float(rot.std(ddof=ddof)),
         rot_sq_mean_deg2=float((rot**2).mean()),
+        rot_max_deg=float(rot.max()),
+        rot_over_5deg=int(np.count_nonzero(rot > 5.0)),
     )
     return out
 

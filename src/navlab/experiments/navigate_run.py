@@ -26,7 +26,7 @@ from navlab.core.record import Recorder
 from navlab.experiments.metrics import distance_to_path
 from navlab.experiments.plots import NavSnapshot
 from navlab.experiments.session import Run, rounded, start_run
-from navlab.experiments.truth import true_map
+from navlab.experiments.truth import true_map, unmapped_obstacles
 from navlab.geometry import compose2, transform_points2
 from navlab.grid import Grid, GridMap
 from navlab.navigation.errors import NavigationError
@@ -116,7 +116,9 @@ class NavigateResult:
     goals: list[dict[str, Any]]
     summary: dict[str, Any]
     grid: GridMap
-    snapshots: list[NavSnapshot] = field(default_factory=list)
+    snapshots: list[NavSnapshot] = field(default_factory=list)  # per goal, the middle of the drive
+    arrivals: list[NavSnapshot] = field(default_factory=list)  # per goal, when it ended (arrival or give-up)
+    path: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))  # the true path: (t s, x m, y m) at 10 Hz
 
 
 def _move_base(run: Run) -> MoveBase:
@@ -136,18 +138,24 @@ def _episodes(times: Sequence[float], t0: float, t1: float, gap: float = 0.25) -
 
 def _drive_goal(run: Run, mon: NavMonitor, goal: Pose, frame: str, timeout: float,
                 shots: list[NavSnapshot] | None = None, world_T_frame: Pose = (0.0, 0.0, 0.0),
-                tolerance: float = GOAL_TOLERANCE_M) -> dict[str, Any]:  # fmt: skip
+                tolerance: float = GOAL_TOLERANCE_M, *, shot: Any = None, say: Any = None) -> dict[str, Any]:
     """Send one goal (in ``frame``, which sits at ``world_T_frame``) and run until it ends or ``timeout`` s
-    pass; ``shots`` collects a snapshot a second. Judged by the truth (within ``tolerance`` m at the end)
-    beside move_base's verdict (see the module docstring)."""
+    pass; ``shots`` collects ``shot()`` a second; ``say(text)`` gets a progress line every 10 simulated s.
+    Judged by the truth (within ``tolerance`` m at the end) beside move_base's verdict (see the module
+    docstring)."""
     mb = _move_base(run)
     t0 = mon.now_s()
     k0 = len(mon.path)
+    next_say = t0 + 10.0
     handle = mb.send_goal(*goal, frame_id=frame)
     while not handle.done() and mon.now_s() - t0 < timeout - 1e-9:
         run.run(min(1.0, timeout - (mon.now_s() - t0)), until=handle.done, quiet=True, chunk=1.0)
-        if shots is not None:
-            shots.append(_snapshot(run, mon))
+        if shots is not None and shot is not None:
+            shots.append(shot())
+        if say is not None and mon.now_s() >= next_say - 1e-6 and not handle.done():
+            next_say += 10.0
+            x, y, _ = run.sim.base_pose2d()
+            say(f"  t={mon.now_s():.1f} s: {mon.now_s() - t0:.0f} s into this goal, robot at ({x:.2f}, {y:.2f})")
     # actionlib's terminal states; "timeout": navlab stopped waiting (and cancels the goal)
     verdict = {"SUCCEEDED": "succeeded", "ABORTED": "aborted", "PREEMPTED": "preempted"}.get(handle.state, "timeout")
     if not handle.done():
@@ -205,6 +213,7 @@ def run_navigation(
     disturbances: dict[str, Any] | None = None,
     on_start: Any = None,
     goal_tolerance: float = GOAL_TOLERANCE_M,
+    progress: Any = None,
 ) -> NavigateResult:
     """Navigate to ``goals`` (x, y, yaw in the map frame) in turn; see ``NavigateResult``.
 
@@ -220,9 +229,14 @@ def run_navigation(
     ``wheel_controller``/``ekf`` arguments (``sim_launch_args``); ``disturbances``: see ``sim.disturbances``.
     ``goal_tolerance``: the truth's goal region (m): a goal whose robot truly ends farther away is not reached,
     whatever move_base says.
+    ``progress``: a function given one line of text per goal sent/ended and every 10 simulated s (None: silent).
     """
     from navlab.mapping.mapfile import load_map, save_map
     from navlab.sim.gazebo import load_world_named
+
+    def say(text: str) -> None:
+        if progress is not None:
+            progress(text)
 
     if not goals:
         raise NavigationError("no goals given (e.g. --goal 2.0 1.0 0.0)")
@@ -255,9 +269,19 @@ def run_navigation(
     mon = run.add(NavMonitor, parameters={"base_frame": run.base_frame,
                                           "estimate_frame": "" if mapless else "map"},
                   remappings={"scan": run.scan_topic}, sim=run.sim, move_base=mb)
+    dropped: list[tuple[float, float, float, str]] = []  # (x m, y m, t s, name) of what was spawned, world frame
+
+    def drop(model: Any) -> None:
+        spec = model(run.sim) if callable(model) else model
+        run.gazebo.spawn(spec)
+        dropped.append((float(spec.pose[0]), float(spec.pose[1]), mon.now_s(), spec.name))
+
     for t, model in spawn:
-        _at(run, float(t), lambda m=model: run.gazebo.spawn(m(run.sim) if callable(m) else m))
-    results, shots = [], []
+        _at(run, float(t), lambda m=model: drop(m))
+    results: list[dict[str, Any]] = []
+    shots: list[NavSnapshot] = []
+    arrivals: list[NavSnapshot] = []
+    new_obstacles = unmapped_obstacles(load_world_named(world), grid, pose[:2]) if snapshots and not mapless else None
     recorder = Recorder(run.executor, record) if record else None  # the whole run, every goal, in one bag
     run.run(1.0, quiet=True)  # amcl's first update, the costmaps' first maps
     frame = run.odom_frame if mapless else "map"
@@ -265,13 +289,24 @@ def run_navigation(
     dd = run.sim.robot.diff_drive if run.sim.robot is not None else None
     odom_is_world = dd is not None and dd.odometry_source == "world"
     world_T_frame = pose if mapless and not odom_is_world else (0.0, 0.0, 0.0)
-    for goal in goals:
-        during: list[NavSnapshot] | None = [] if snapshots and not mapless else None
+    for k, goal in enumerate(goals, 1):
+        during: list[NavSnapshot] | None = [] if snapshots else None
         gx, gy, gyaw = (float(v) for v in goal)
+        say(f"goal {k}/{len(goals)} ({gx:g}, {gy:g}, {gyaw:g}) sent at t={mon.now_s():.1f} s")
+        shot = (lambda: _snapshot(run, mon, world_T_frame, mapless)) if snapshots else None
         results.append(rounded(_drive_goal(run, mon, (gx, gy, gyaw), frame, goal_timeout, during, world_T_frame,
-                                           goal_tolerance)))
-        if during:  # the paper's pictures show the robot on its way: the middle of the drive
-            shots.append(during[len(during) // 2])
+                                           goal_tolerance, shot=shot, say=say)))  # fmt: skip
+        r = results[-1]
+        say(f"goal {k}/{len(goals)}: {r['outcome']} after {r['time_s']} s (t={mon.now_s():.1f} s)"
+            + (f": {r['reason']}" if r["reason"] else ""))
+        if shot is not None:  # the paper's pictures show the robot on its way (the middle of the drive); + arrival
+            end: NavSnapshot = shot()
+            end["new_obstacles"], end["dropped"] = new_obstacles, list(dropped)
+            end["near_misses"], end["collision_xy"] = _near_misses(mon), _collision_points(mon)
+            mid = NavSnapshot(**(during[len(during) // 2] if during else end))
+            mid["new_obstacles"], mid["dropped"] = new_obstacles, [d for d in dropped if d[2] <= mid.get("t", 0.0)]
+            shots.append(mid)
+            arrivals.append(end)
     bag = recorder.close() if recorder else None
     loc = np.array(mon.localization_error)
     summary = rounded({
@@ -285,7 +320,55 @@ def run_navigation(
         **run.figures(),
         **({"record": str(bag)} if bag else {}),
     })  # fmt: skip
-    return NavigateResult(results, summary, grid, shots)
+    return NavigateResult(results, summary, grid, shots, arrivals, np.array(mon.path, dtype=np.float64).reshape(-1, 3))
+
+
+def save_goal_pictures(result: NavigateResult, folder: str | Path) -> list[str]:
+    """Two labelled pictures per goal in ``folder``: ``goal_N.png`` when the goal ended (arrival or give-up) and
+    ``goal_N_mid.png`` in the middle of the drive (the paper's Figs. 9–12); returns their paths, in that order."""
+    from navlab.experiments.plots import plot_navigation
+
+    out = Path(folder)
+    out.mkdir(parents=True, exist_ok=True)
+    paths = []
+    for k, (goal, mid, end) in enumerate(zip(result.goals, result.snapshots, result.arrivals, strict=True), 1):
+        head = f"goal {k} ({', '.join(f'{v:g}' for v in goal['goal'])}): {goal['outcome']} in {goal['time_s']} s"
+        for shot, name, when in ((end, f"goal_{k}.png", "end of the drive"), (mid, f"goal_{k}_mid.png", "mid-drive")):
+            title = f"{head}\n{when}, t = {shot.get('t', 0.0):.1f} s"
+            paths.append(str(plot_navigation(result.grid, shot, out / name, title=title, goal=goal["goal"])))
+    return paths
+
+
+NEAR_MISS_M = 0.1  # clearance (m) under which a moment of the drive counts as a near miss in the pictures
+
+
+def _near_misses(mon: NavMonitor) -> np.ndarray:
+    """Where (world x, y; m) the true clearance was under ``NEAR_MISS_M`` but not a contact: one point per run of
+    consecutive samples, at its closest moment."""
+    c = np.asarray(mon.clearance[: len(mon.path)], dtype=np.float64)
+    close = (c < NEAR_MISS_M) & (c > 0.0)
+    out = []
+    k = 0
+    while k < len(c):
+        if not close[k]:
+            k += 1
+            continue
+        end = k
+        while end + 1 < len(c) and close[end + 1]:
+            end += 1
+        best = k + int(np.argmin(c[k : end + 1]))
+        out.append(mon.path[best][1:])
+        k = end + 1
+    return np.array(out, dtype=np.float64).reshape(-1, 2)
+
+
+def _collision_points(mon: NavMonitor) -> np.ndarray:
+    """Where (world x, y; m) the robot was at each contact episode's first message."""
+    if not mon.path:
+        return np.zeros((0, 2))
+    t = np.array([p[0] for p in mon.path])
+    starts = [c for k, c in enumerate(mon.contacts) if k == 0 or c - mon.contacts[k - 1] > 0.25]
+    return np.array([mon.path[int(np.argmin(np.abs(t - c)))][1:] for c in starts], dtype=np.float64).reshape(-1, 2)
 
 
 WHEEL_CONTROLLERS = ("gazebo_ros_diff_drive", "diff_drive_controller")
@@ -323,21 +406,25 @@ def _at(run: Run, t: float, fn: Any) -> None:
     holder["timer"] = node.create_timer(max(t - run.executor.now_ns / 1e9, 1e-3), fire)
 
 
-def _snapshot(run: Run, mon: NavMonitor) -> NavSnapshot:
+def _snapshot(run: Run, mon: NavMonitor, world_T_frame: Pose = (0.0, 0.0, 0.0), mapless: bool = False) -> NavSnapshot:
+    """What a picture of this moment needs, in the world (= map) frame; with ``mapless`` the costmap and plans are
+    in odom, which sits at ``world_T_frame``."""
     mb = _move_base(run)
     gc = mb.global_costmap.costmap
     gc = Grid(gc.data.copy(), gc.resolution, gc.origin, gc.frame_id)  # the master changes in place
     plan = mb.global_plan
     local = getattr(mb.controller, "local_plan", None)
-    odom_to_map = None
-    try:
-        odom_to_map = run.executor.tf.lookup_pose2d("map", mb.local_costmap.global_frame)
-    except TfError:  # no tf: no local plan drawn
-        local = None
+    odom_to_map: Pose | None = world_T_frame if mapless else None
+    if not mapless:
+        try:
+            odom_to_map = run.executor.tf.lookup_pose2d("map", mb.local_costmap.global_frame)
+        except TfError:  # no tf: no local plan drawn
+            local = None
     return {"costmap": gc, "plan": None if plan is None else plan.copy(),
             "local_plan": None if local is None else np.asarray(local).copy(), "odom_to_map": odom_to_map,
             "path": np.array([p[1:] for p in mon.path]), "scan_xy": mon.scan_points(), "robot": run.sim.base_pose2d(),
-            "footprint": mb.local_costmap.layered.footprint}  # fmt: skip
+            "footprint": mb.local_costmap.layered.footprint, "t": mon.now_s(),
+            "costmap_in_map": world_T_frame if mapless else None}  # fmt: skip
 
 
 def bench(args: Any) -> dict[str, Any]:

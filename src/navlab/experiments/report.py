@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from navlab.errors import NavlabError
 from navlab.experiments.errors import ExperimentError
 
 TRIAL_COLUMNS = ("trial", "seed", "success", "move_base_success", "failure", "time_s", "path_m", "spl",
@@ -150,15 +151,61 @@ def _run_report(folder: Path) -> Report:
         f" move_base reported {summary['move_base_success_rate']:.0%}, with {summary['false_success']} false "
         "successes (goals it called reached that the robot truly missed).")
     rep.text(f"{ok} of {len(results)} trials succeeded by the simulator's truth ({ok / len(results):.0%}, 95 % Wilson "
-             f"interval {lo:.0%}–{hi:.0%}); {summary['collisions']} collisions.{said}")  # fmt: skip
+             f"interval {lo:.0%}–{hi:.0%}); {summary['trials_with_collision']} trials with a collision "
+             f"({summary['collisions']} contact episodes in all).{said}")  # fmt: skip
     rep.heading("Summary")
     rep.table(["figure", "value"], _summary_rows(summary))
     rep.heading("Trials")
     plot_trials(results, folder / "trials.png", title=name)
     rep.image("trials.png", "time to goal per trial (green: success, red: failure) and minimum clearance")
+    if any(r.get("path_xy") for r in results):
+        plot_trial_paths(results, folder / "paths.png", title=name)
+        rep.image("paths.png", PATHS_CAPTION)
     cols = [c for c in TRIAL_COLUMNS if any(c in r for r in results)]
     rep.table(cols, [[r.get(c) for c in cols] for r in results])
     return rep
+
+
+PATHS_CAPTION = "every trial's true path on the world's true map (green: success, red: failure), start and goals"
+
+
+def plot_trial_paths(results: list[dict[str, Any]], path: Path, *, title: str = "") -> Path:
+    """The trials' true paths over the world's true map (when the trials share a shipped or file world), coloured
+    by outcome, with the start (circle) and the goals (stars with heading)."""
+    import numpy as np
+
+    from navlab.experiments.plots import Marks, Track, plot_run
+    from navlab.grid import GridMap
+
+    world = results[0].get("world_file")
+    start = results[0].get("start") or [0.0, 0.0, 0.0]
+    grid: GridMap | None = None
+    if world and all(r.get("world_file") == world for r in results):
+        from navlab.experiments.truth import true_map
+        from navlab.sim.gazebo import load_world_named
+
+        try:
+            grid = true_map(load_world_named(str(world)), (float(start[0]), float(start[1])))
+        except NavlabError:  # the world file moved since the run: paths without the map
+            grid = None
+    tracks = []
+    for k, r in enumerate(results):
+        xy = np.asarray(r.get("path_xy") or [], dtype=np.float64).reshape(-1, 2)
+        ok = bool(r["success"])
+        label = None
+        if k == next(i for i, q in enumerate(results) if bool(q["success"]) == ok):
+            label = "trial path (succeeded)" if ok else "trial path (failed)"
+        tracks.append(Track(xy, label or "", "-", "tab:green" if ok else "tab:red", 0.9))
+    goals = np.array([g["goal"] for g in results[0].get("per_goal", [])], dtype=np.float64).reshape(-1, 3)
+    if grid is None:  # no map: an empty unknown grid around the paths
+        pts = np.vstack([t.xy for t in tracks if len(t.xy)] + [goals[:, :2], np.array([start[:2]])])
+        lo, hi = pts.min(0) - 1.0, pts.max(0) + 1.0
+        shape = (int((hi[1] - lo[1]) / 0.05) + 1, int((hi[0] - lo[0]) / 0.05) + 1)
+        grid = GridMap(np.full(shape, -1, dtype=np.int8), 0.05, (float(lo[0]), float(lo[1]), 0.0))
+    marks = [Marks(np.array([start[:2]]), "start", "black", "o", 60.0), Marks(goals[:, :2], "goals", "tab:purple",
+                                                                              "*", 180.0)]  # fmt: skip
+    return plot_run(grid, tracks, path, title=f"{title}: {len(results)} trials' true paths", marks=marks, crop=False,
+                    dpi=100)
 
 
 def _scenario_name(folder: Path) -> str:
@@ -205,6 +252,7 @@ def _sweep_report(folder: Path) -> Report:
     import yaml
 
     from navlab.experiments.sweep import COLUMNS, plot_sweep
+    from navlab.experiments.trials import read_results
 
     lines = (folder / "sweep.csv").read_text().splitlines()
     header = lines[0].split(",")
@@ -224,13 +272,21 @@ def _sweep_report(folder: Path) -> Report:
     rep.heading("Figures")
     for path in plot_sweep(rows, names, folder):
         rep.image(path.name, f"success (95 % CI), collisions and median time against {path.stem}")
-    failures = []
+    failures, pictures = [], []
     for sub in sorted(p for p in folder.iterdir() if (p / "summary.json").is_file()):
         s = json.loads((sub / "summary.json").read_text())
         failures.append([sub.name, s.get("trials"), s.get("failures") or {}])
+        results = read_results(sub / "results.jsonl") if (sub / "results.jsonl").is_file() else []
+        if any(r.get("path_xy") for r in results):  # as the combination's own run report draws them
+            plot_trial_paths(sorted(results, key=lambda r: int(r["trial"])), sub / "paths.png", title=sub.name)
+            pictures.append(f"{sub.name}/paths.png")
     if failures:
         rep.heading("Failures by kind")
         rep.table(["combination", "trials", "failures"], failures)
+    if pictures:
+        rep.heading("Paths per combination")
+        for picture in pictures:
+            rep.image(picture, f"{Path(picture).parent.name}: {PATHS_CAPTION}")
     return rep
 
 
@@ -243,9 +299,9 @@ def _demo_report(folder: Path) -> Report:
                                                                                  "navigation"))  # fmt: skip
     rep = Report("navlab demo: the paper's pipeline in simulation")
     if "wall_s" in data:
+        world = ", `world.png` (Figs. 4–5)" if (folder / "world.png").is_file() else ""
         rep.text(f"Total {data['wall_s']} s wall. Pictures: `map.png` (Fig. 7), `localize.png`, "
-                 "`navigate/goal_N.png` (Figs. 9–12)" + (", `world.png` (Figs. 4–5)" if (folder / "world.png").is_file()
-                                                        else "") + ".")  # fmt: skip
+                 f"`navigate/goal_N_mid.png` and `goal_N.png` (Figs. 9–12){world}.")
     rep.heading("1. Mapping: slam_gmapping while the robot explores room.world")
     rep.table(["figure", "value"], [[k, v] for k, v in m.items() if k not in ("map", "picture")])
     if (folder / "map.png").is_file():
@@ -262,12 +318,13 @@ def _demo_report(folder: Path) -> Report:
     if "goals_succeeded" in nav:
         bag = f"; recording `{Path(nav['record']).name}/`" if nav.get("record") else ""
         rep.text(f"{nav['goals_succeeded']} of {len(goals)} goals reached (the simulator's truth; move_base reported "
-                 f"{nav.get('goals_succeeded_move_base', '-')}), {nav.get('collisions')} collisions; "
+                 f"{nav.get('goals_succeeded_move_base', '-')}), {nav.get('collisions')} collisions "
+                 "(contact episodes); "
                  f"{nav.get('sim_s')} simulated s at {nav.get('rtf')}x real time{bag}.")  # fmt: skip
     for k, g in enumerate(goals, 1):
-        png = f"navigate/goal_{k}.png"
-        if (folder / png).is_file():
-            rep.image(png, f"goal {k} {g.get('goal')}: {g.get('outcome')}")
+        for png, when in ((f"navigate/goal_{k}_mid.png", "mid-drive"), (f"navigate/goal_{k}.png", "end of the drive")):
+            if (folder / png).is_file():
+                rep.image(png, f"goal {k} {g.get('goal')}: {g.get('outcome')} — {when}")
     if (folder / "world.png").is_file():
         rep.image("world.png", "the robot in its world")
     return rep

@@ -22,8 +22,9 @@ from navlab.experiments.errors import ExperimentError
 from navlab.experiments.scenario import Scenario
 from navlab.experiments.trials import run_experiments
 
-COLUMNS = ("success_rate", "success_ci95", "move_base_success_rate", "false_success", "collisions", "median_time_s",
-           "spl_mean", "min_clearance_m", "score_mean")
+# "trials_with_collision" counts trials (as success and failures do); "collisions" counts contact episodes
+COLUMNS = ("success_rate", "success_ci95", "move_base_success_rate", "false_success", "trials_with_collision",
+           "collisions", "median_time_s", "spl_mean", "min_clearance_m", "score_mean")
 
 
 def parse_params(items: list[str]) -> dict[str, list[Any]]:
@@ -90,7 +91,8 @@ def write_table(rows: list[dict[str, Any]], names: list[str], folder: Path) -> N
 
 
 def plot_sweep(rows: list[dict[str, Any]], names: list[str], folder: Path) -> list[Path]:
-    """One PNG per parameter: success rate (with its interval), collisions and median time against it."""
+    """One PNG per parameter: success rate (with its interval), trials with a collision and median time against
+    it. Numeric values are joined by lines; categorical ones (controller names) are separate points."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -100,7 +102,9 @@ def plot_sweep(rows: list[dict[str, Any]], names: list[str], folder: Path) -> li
 
     out = []
     for name in names:
-        values = sorted({r[name] for r in rows}, key=str)
+        values = sorted({r[name] for r in rows}, key=_order)
+        numeric = all(isinstance(v, int | float) and not isinstance(v, bool) for v in values)
+        style = {"marker": "o", "linestyle": "-" if numeric else "none"}
         score = any(r.get("score_mean") is not None for r in rows)  # BARN's score in clutter worlds
         fig, axes = plt.subplots(1, 4 if score else 3, figsize=(17 if score else 13, 3.6))
         for others, group in itertools.groupby(sorted(rows, key=lambda r: str([r[n] for n in names if n != name])),
@@ -111,16 +115,22 @@ def plot_sweep(rows: list[dict[str, Any]], names: list[str], folder: Path) -> li
             ci = [r["success_ci95"] or [0, 1] for r in g]
             axes[0].errorbar(xs, [r["success_rate"] for r in g], yerr=[[r["success_rate"] - c[0] for r, c in zip(g, ci,
                              strict=True)], [c[1] - r["success_rate"] for r, c in zip(g, ci, strict=True)]],
-                             marker="o", capsize=3, label=label)  # fmt: skip
-            axes[1].plot(xs, [r["collisions"] for r in g], marker="o", label=label)
-            axes[2].plot(xs, [r["median_time_s"] for r in g], marker="o", label=label)
+                             capsize=3, label=label, **style)  # fmt: skip
+            axes[1].plot(xs, [r.get("trials_with_collision", r["collisions"]) for r in g], label=label, **style)
+            axes[2].plot(xs, [r["median_time_s"] for r in g], label=label, **style)
             if score:
-                axes[3].plot(xs, [r.get("score_mean") for r in g], marker="o", label=label)
-        titles = ("success rate (95 % CI)", "collisions", "median time (s)", "mean BARN score")
+                axes[3].plot(xs, [r.get("score_mean") for r in g], label=label, **style)
+        titles = ("success rate (95 % CI)", "trials with a collision", "median time (s)", "mean BARN score")
         for ax, title in zip(axes, titles, strict=False):
             ax.set_xticks(range(len(values)), [str(v) for v in values])
+            ax.set_xlim(-0.5, len(values) - 0.5)
             ax.set_xlabel(name)
             ax.set_title(title)
+        axes[0].set_ylim(-0.05, 1.05)
+        axes[1].yaxis.get_major_locator().set_params(integer=True)
+        for ax in axes[1:]:  # counts and times start at 0; all-zero data gets a 0..1 axis, not -0.04..0.04
+            top = max(ax.get_ylim()[1], 1.0)
+            ax.set_ylim(-0.04 * top, top)  # a little below 0 so points at 0 are not cut by the frame
         if len(names) > 1:
             axes[0].legend(fontsize=7)
         fig.tight_layout()
@@ -131,6 +141,13 @@ def plot_sweep(rows: list[dict[str, Any]], names: list[str], folder: Path) -> li
             plt.close(fig)
         out.append(path)
     return out
+
+
+def _order(v: Any) -> tuple[int, float, str]:
+    """Numbers by value, then anything else by its text."""
+    if isinstance(v, int | float) and not isinstance(v, bool):
+        return (0, float(v), "")
+    return (1, 0.0, str(v))
 
 
 BENCH_TRIALS = 10  # per combination: 2 x 10 trials, a small real sweep (the shipped sweeps run 20 per value)

@@ -135,7 +135,20 @@ def run_trial(sc: Scenario, index: int) -> dict[str, Any]:
         "cmd_jerk_mean": r.summary.get("cmd_jerk_mean"), "sim_s": r.summary["sim_s"], "wall_s": r.summary["wall_s"],
         "tracking_error_m": _mean(goals, "tracking_error_m"), "final_error_m": _mean(goals, "final_error_m"),
         **barn, "per_goal": goals,
+        "world_file": str(world) if clutter is None else None, "start": list(start),
+        "path_xy": _thin(r.path[:, 1:]),  # for the report's trajectory picture
     })  # fmt: skip
+
+
+def _thin(xy: np.ndarray, step: float = 0.05) -> list[list[float]]:
+    """A path (N, 2; m) with points at least ``step`` m apart (the last kept), rounded to mm, as lists."""
+    keep: list[np.ndarray] = []
+    for p in xy:
+        if not keep or np.hypot(*(p - keep[-1])) >= step:
+            keep.append(p)
+    if len(xy) and (not keep or keep[-1] is not xy[-1]):
+        keep.append(xy[-1])
+    return [[round(float(a), 3), round(float(b), 3)] for a, b in keep]
 
 
 def _append_line(path: Path, record: dict[str, Any]) -> None:
@@ -166,7 +179,8 @@ def read_results(path: Path) -> list[dict[str, Any]]:
 
 
 def summarize_trials(results: list[dict[str, Any]]) -> dict[str, Any]:
-    """Success rate with a 95 % Wilson interval, collisions, failures by kind, medians and quartiles."""
+    """Success rate with a 95 % Wilson interval, collisions (``collisions``: contact episodes over all trials;
+    ``trials_with_collision``: trials, as ``failures`` counts trials by kind), medians and quartiles."""
     n = len(results)
     ok = sum(bool(r["success"]) for r in results)
     lo, hi = wilson_interval(ok, n)
@@ -185,7 +199,9 @@ def summarize_trials(results: list[dict[str, Any]]) -> dict[str, Any]:
         # move_base's own verdict beside the truth's (trials recorded before issue 30 have neither key)
         "move_base_success_rate": _rate(results, "move_base_success"),
         "false_success": sum(int(r.get("false_success") or 0) for r in results),
-        "collisions": sum(r["collisions"] for r in results), "failures": failures,
+        "collisions": sum(r["collisions"] for r in results),  # contact episodes (events), over all trials
+        "trials_with_collision": sum(bool(r["collisions"]) for r in results),  # trials, as "failures" counts
+        "failures": failures,
         "median_time_s": times[1] if times else None, "time_s_quartiles": times,
         "median_path_m": _median(results, "path_m"), "spl_mean": _mean(results, "spl"),
         "min_clearance_m": min((r["min_clearance_m"] for r in results), default=None),

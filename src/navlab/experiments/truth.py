@@ -67,3 +67,18 @@ def visible_surface(truth: Grid, start_xy: tuple[float, float]) -> np.ndarray:
     reachable = labels == labels[j, i] if labels[j, i] > 0 else np.zeros_like(free)
     near_reachable = ndimage.binary_dilation(reachable, structure=ndimage.generate_binary_structure(2, 1))
     return truth.data & near_reachable
+
+
+def unmapped_obstacles(world: Any, grid: GridMap, start_xy: tuple[float, float]) -> np.ndarray:
+    """World points (N, 2; m) of obstacles the world has but the map ``grid`` does not (cells the map calls free
+    more than two cells from any of its walls): what was added after mapping."""
+    truth = true_map(world, start_xy, resolution=grid.resolution)
+    jj, ii = np.nonzero(truth.data == 100)
+    xy = np.stack([truth.origin[0] + (ii + 0.5) * truth.resolution, truth.origin[1] + (jj + 0.5) * truth.resolution], 1)
+    walls = ndimage.binary_dilation(grid.occupied_mask(), iterations=2)
+    cells = grid.world_to_cell(xy)
+    inside = (cells[:, 0] >= 0) & (cells[:, 0] < grid.width) & (cells[:, 1] >= 0) & (cells[:, 1] < grid.height)
+    keep = np.zeros(len(xy), dtype=bool)
+    ci, cj = cells[inside, 0], cells[inside, 1]
+    keep[inside] = grid.free_mask()[cj, ci] & ~walls[cj, ci]
+    return xy[keep]

@@ -54,3 +54,14 @@ def dataset(relpath: str | os.PathLike[str]) -> Path:
             f"{rel.parts[0]}/, or put the data at ../shared/datasets relative to the repository root"
         )
     return path
+
+
+def data_file(text: str | os.PathLike[str]) -> Path:
+    """A file the user named: the path itself when it exists, else the same relative path inside :func:`data_dir`
+    when that exists (``mit-csail/mit-csail.clf`` from any folder), else the path as given (its reader then says
+    it is missing)."""
+    path = Path(text).expanduser()
+    if path.exists() or path.is_absolute():
+        return path
+    inside = data_dir() / path
+    return inside if inside.exists() else path

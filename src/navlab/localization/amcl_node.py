@@ -47,6 +47,7 @@ class Amcl(Node):
         self, executor: Executor, *, name: str = "amcl", parameters: dict[str, Any] | None = None, namespace: str = ""
     ) -> None:
         super().__init__(executor, name=name, parameters=parameters, namespace=namespace)
+        self.listen_tf()  # a tf2 TransformListener, as in ROS: the graph shows it reading /tf
         values = self.declare_parameters(dataclass_parameters(pf.AmclParams), aliases=NAV2_ALIASES)
         self.params = pf.AmclParams(**values)
         self.params.validate()

@@ -35,6 +35,7 @@ class EkfNode(Node):
     def __init__(self, executor: Executor, *, name: str = "ekf_se", parameters: dict[str, Any] | None = None,
                  namespace: str = "") -> None:  # fmt: skip
         super().__init__(executor, name=name, parameters=parameters, namespace=namespace)
+        self.listen_tf()  # a tf2 TransformListener, as in ROS: the graph shows it reading /tf
         d = self.declare_parameter
         self.frequency = float(d("frequency", 30.0))
         if not (math.isfinite(self.frequency) and self.frequency > 0):

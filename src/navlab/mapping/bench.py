@@ -113,3 +113,28 @@ def run_office(args: argparse.Namespace) -> dict[str, Any]:
             "cpu_s_mean": round(float(col["cpu_s"].mean()), 2),
         }
     return summary
+
+
+def run_gmapping(args: argparse.Namespace) -> dict[str, Any]:
+    """``navlab slam --mode gmapping`` on the CSAIL log in a child process: its CPU seconds, peak RSS (MB) and
+    the relations metric of its poses (the filter plus the offline refinement, slam_gmapping's defaults)."""
+    import sys
+
+    from navlab.core.bench import run_child
+    from navlab.experiments.metrics import read_relations, relations_error
+    from navlab.io.datasets import dataset
+
+    clf, relations = dataset(CSAIL), read_relations(dataset(RELATIONS))
+    with tempfile.TemporaryDirectory(prefix="navlab-bench-") as out:
+        cmd = [sys.executable, "-m", "navlab.cli", "slam", "--log", str(clf), "--mode", "gmapping", "--out", out,
+               "--quiet", "--seed", str(getattr(args, "seed", 0))]  # fmt: skip
+        usage = run_child(cmd)
+        poses = np.loadtxt(Path(out) / "poses.txt")
+    rel = relations_error(poses[:, 0], poses[:, 1:4], relations)
+    return {
+        **{k: round(v, 2) for k, v in usage.items()},
+        "relations_trans_m": round(float(rel["trans_abs_mean"]), 4),
+        "relations_rot_deg": round(float(rel["rot_abs_mean_deg"]), 3),
+        "relations_rot_max_deg": round(float(rel["rot_max_deg"]), 2),
+        "relations_over_5deg": rel["rot_over_5deg"],
+    }

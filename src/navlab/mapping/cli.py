@@ -7,8 +7,9 @@ import contextlib
 import sys
 import time
 from pathlib import Path
+from typing import Any
 
-from navlab.cli_common import add_pose_arguments, print_figures, start_pose
+from navlab.cli_common import add_pose_arguments, add_set_argument, parse_sets, print_figures, start_pose
 from navlab.experiments.cli import add_eval_map
 
 
@@ -29,12 +30,15 @@ def _params_file(path: str | None) -> dict:
 
 
 def _cmd_slam(args: argparse.Namespace) -> int:
+    from navlab.io.carmen import read_carmen, skipped_summary
+    from navlab.io.datasets import data_file
+
+    log = read_carmen(data_file(args.log))  # a bad log is reported before the SLAM's and the plots' imports
+
     from navlab.experiments.plots import Track, plot_run
     from navlab.experiments.session import rounded
-    from navlab.io.carmen import read_carmen, skipped_summary
     from navlab.mapping.slam import run_offline, write_outputs
 
-    log = read_carmen(args.log)
     note = skipped_summary(log)
     if note:
         print(f"navlab slam: warning: {note}", file=sys.stderr)
@@ -42,7 +46,7 @@ def _cmd_slam(args: argparse.Namespace) -> int:
     result = run_offline(
         log,
         mode=args.mode,
-        params=_params_file(args.params),
+        params={**_params_file(args.params), **parse_sets(args.set)},
         seed=args.seed,
         resolution=args.resolution,
         max_scans=args.max_scans,
@@ -105,6 +109,7 @@ def _cmd_teleop(args: argparse.Namespace) -> int:
         teleop = TeleopKeyboard(ex, parameters={"speed": args.speed, "turn": args.turn})
         print(HELP)
         terminal_keys(teleop, ex)
+        teleop.create_timer(0.25, lambda: _show_teleop(teleop, gazebo))
     with contextlib.suppress(KeyboardInterrupt):
         ex.spin()
     if remote is not None:
@@ -115,15 +120,38 @@ def _cmd_teleop(args: argparse.Namespace) -> int:
     return 0
 
 
+# relations_error's keys -> the CLI's JSON keys with unit suffixes (the old keys are printed too, deprecated)
+DEPRECATED_RELATION_KEYS = {"trans_abs_mean": "trans_abs_mean_m", "trans_abs_std": "trans_abs_std_m",
+                            "trans_sq_mean": "trans_sq_mean_m2"}
+
+
+def _show_teleop(teleop: Any, gazebo: Any) -> None:
+    """One status line, rewritten in place on stderr: simulated time, the command being sent, the speeds (and
+    the robot's pose when the simulator runs here), as teleop_twist_keyboard prints its 'currently:' line."""
+    st, tw = teleop.state, teleop.state.twist()
+    where = ""
+    if gazebo is not None:
+        x, y, yaw = gazebo.sim.base_pose2d()
+        where = f"  robot at ({x:.2f}, {y:.2f}, {yaw:.2f} rad)"
+    sys.stderr.write(f"\rt={teleop.executor.now_ns / 1e9:7.1f} s  sending linear.x {tw.linear.x:+.2f} m/s  angular.z "
+                     f"{tw.angular.z:+.2f} rad/s  (currently: speed {st.speed:.2f} turn {st.turn:.2f}){where}  ")
+    sys.stderr.flush()
+
+
 def _cmd_eval_relations(args: argparse.Namespace) -> int:
     from navlab.experiments.metrics import read_relations, relations_closure, relations_error
     from navlab.experiments.trajectory import read_trajectory
 
     ts, poses = read_trajectory(args.poses, carmen=args.carmen)
-    rel = read_relations(args.relations)
+    from navlab.io.datasets import data_file
+
+    rel = read_relations(data_file(args.relations))
     out = relations_error(ts, poses, rel, time_tolerance=args.tolerance)
     closure = relations_closure(rel, time_tolerance=args.tolerance)
     out.update({f"reference_{k}": v for k, v in closure.items()})
+    for old, new in DEPRECATED_RELATION_KEYS.items():  # unit suffixes as everywhere; the old names stay one release
+        if old in out:
+            out[new] = out[old]
     if args.json:
         print_figures(out, True)
     else:
@@ -184,7 +212,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         "DIR/map.pgm (map_server format), DIR/poses.txt (one 'timestamp x y theta' line per scan, robot "
         "pose in the map frame) and DIR/map.png (map and trajectory).",
     )
-    p.add_argument("--log", required=True, metavar="FILE.clf", help="CARMEN log file")
+    p.add_argument("--log", required=True, metavar="FILE.clf",
+                   help="CARMEN log file, or its path inside $NAVLAB_DATA (e.g. mit-csail/mit-csail.clf)")
     p.add_argument("--out", required=True, metavar="DIR", help="output directory (created if missing)")
     p.add_argument(
         "--mode",
@@ -194,6 +223,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument("--params", metavar="YAML", help="SLAM parameters: slam_gmapping's names (graph mode's own "
                    "under 'graph:')")
+    add_set_argument(p, "slam_gmapping", "particles=50")
     p.add_argument("--resolution", type=float, default=0.05, help="map resolution in m/cell (default 0.05)")
     p.add_argument("--max-scans", type=int, default=None, help="only the first N scans")
     p.add_argument("--seed", type=int, default=0, help="random seed (gmapping mode; default 0)")
@@ -213,14 +243,17 @@ def register(sub: argparse._SubParsersAction) -> None:
         description="For each relation, error = relation ⊖ (pose(t1)^-1 ∘ pose(t2)); prints mean ± std of "
         "absolute translational (m) and rotational (deg) errors and the means of their squares. Relations "
         "whose timestamps match no pose are counted as not scored. Also how far the relations' own triangles "
-        "(a→b, b→c, a→c) fail to close, and the score that implies for poses without error (reference_*).",
+        "(a→b, b→c, a→c) fail to close, and the score that implies for poses without error (reference_*). "
+        "JSON keys carry their units (trans_abs_mean_m, rot_abs_mean_deg, ...); trans_abs_mean, trans_abs_std "
+        "and trans_sq_mean are deprecated aliases kept for one release.",
     )
     r.add_argument("poses", help="poses file: 'timestamp x y theta' per line, a TUM file, or a CARMEN log "
                    "(its own odometry: see --carmen)")
     r.add_argument("--carmen", choices=("flaser", "odom", "laser"), default="flaser",
                    help="poses of a CARMEN log: flaser = the robot's odometry pose of each scan (default), "
                    "odom = ODOM lines, laser = the laser's pose of each scan")
-    r.add_argument("relations", help="relations file: 't1 t2 x y z roll pitch yaw' per line")
+    r.add_argument("relations", help="relations file: 't1 t2 x y z roll pitch yaw' per line, or its path inside "
+                   "$NAVLAB_DATA (e.g. mit-csail/mit-csail.relations)")
     r.add_argument("--tolerance", type=float, default=1e-3, help="timestamp match tolerance in s (default 0.001)")
     r.add_argument("--json", action="store_true", help="print one JSON object")
     r.set_defaults(func=_cmd_eval_relations)
@@ -250,6 +283,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def _cmd_world_office(args: argparse.Namespace) -> int:
+    from navlab.cli_common import optional_out, out_file
     from navlab.experiments.session import rounded
     from navlab.io.carmen import write_carmen
     from navlab.io.poses import write_poses
@@ -257,22 +291,24 @@ def _cmd_world_office(args: argparse.Namespace) -> int:
     from navlab.world.office import generate_office
 
     office = generate_office()
-    world = office.write_world(args.out)
+    world = office.write_world(out_file(args.out, "office.world", old_suffixes=(".world", ".sdf")))
+    log = optional_out(args.log, world.parent, "office.clf")
+    truth = optional_out(args.truth, world.parent, "truth.txt")
     summary: dict = {"world": str(world), "width_m": office.width, "depth_m": office.depth, "rooms": office.rooms,
                      "start": list(office.start)}  # fmt: skip
-    if args.log:
+    if log:
         rec = record_log(world, office.route(), seed=args.seed, noise=OdometryNoise(scale=args.odom_scale,
                          heading_drift=args.heading_drift))  # fmt: skip
-        write_carmen(args.log, rec.log, comment=f"navlab office log, seed {args.seed}: odometry frame = the true "
+        write_carmen(log, rec.log, comment=f"navlab office log, seed {args.seed}: odometry frame = the true "
                      f"start pose {rec.start} in {world.name}")  # fmt: skip
-        summary.update(log=str(args.log), scans=len(rec.log.scans), log_s=rec.log.duration)
-        if args.truth:
+        summary.update(log=str(log), scans=len(rec.log.scans), log_s=rec.log.duration)
+        if truth:
             from navlab.experiments.trajectory import apply_se2
             from navlab.geometry import inverse2
 
             # the truth in the log's odometry frame (the start pose), as the SLAM output is
-            write_poses(args.truth, rec.timestamps, apply_se2(tuple(inverse2(rec.start)), rec.truth))
-            summary["truth"] = str(args.truth)
+            write_poses(truth, rec.timestamps, apply_se2(tuple(inverse2(rec.start)), rec.truth))
+            summary["truth"] = str(truth)
     print_figures(rounded(summary), args.json)
     return 0
 
@@ -288,13 +324,16 @@ def add_world_office(verbs: argparse._SubParsersAction) -> None:
         "or 0.5 rad,\n181 beams over 180 degrees, wheel odometry with --odom-scale scale errors and heading "
         "drift.\nThe log's odometry frame is the robot's true start pose; --truth writes the true poses in it.",
         epilog="examples:\n"
-        "  navlab world office --out office.world --log office.clf --truth truth.txt --seed 1\n"
-        "  navlab slam --log office.clf --out office_map --mode gmapping\n"
-        "  navlab eval trajectory office_map/poses.txt truth.txt",
+        "  navlab world office --out office --log --truth --seed 1   # office/office.world, office.clf, truth.txt\n"
+        "  navlab slam --log office/office.clf --out office_map --mode gmapping\n"
+        "  navlab eval trajectory office_map/poses.txt office/truth.txt",
     )
-    o.add_argument("--out", required=True, metavar="FILE.world", help="the .world file to write")
-    o.add_argument("--log", metavar="FILE.clf", help="also record a sparse CARMEN log in it")
-    o.add_argument("--truth", metavar="FILE.txt", help="with --log: the true poses ('t x y theta', log frame)")
+    o.add_argument("--out", required=True, metavar="DIR",
+                   help="folder to write office.world in (a FILE.world still works this release, deprecated)")
+    o.add_argument("--log", nargs="?", const="", metavar="FILE.clf",
+                   help="also record a sparse CARMEN log: in FILE.clf, or DIR/office.clf without a value")
+    o.add_argument("--truth", nargs="?", const="", metavar="FILE.txt",
+                   help="with --log: the true poses ('t x y theta', log frame) in FILE.txt, or DIR/truth.txt")
     o.add_argument("--seed", type=int, default=0, help="random seed of the lidar and odometry noise (default 0)")
     o.add_argument("--odom-scale", type=float, default=0.05,
                    help="std. dev. of the odometry's scale errors and per-step noise (default 0.05: 5 %%)")

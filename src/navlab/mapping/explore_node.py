@@ -31,6 +31,7 @@ class Explore(Node):
         namespace: str = "",
     ) -> None:
         super().__init__(executor, name=name, parameters=parameters, namespace=namespace)
+        self.listen_tf()  # a tf2 TransformListener, as in ROS: the graph shows it reading /tf
         self.global_frame = self.declare_parameter("global_frame", "map")
         self.base_frame = self.declare_parameter("robot_base_frame", "chassis")
         self.robot_radius = self.declare_parameter("robot_radius", 0.3)

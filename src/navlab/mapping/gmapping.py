@@ -8,9 +8,11 @@ proposal), its weight gains the scan's log-likelihood, particles are resampled w
 ``resampleThreshold`` * N, and each map integrates the scan. Parameter names and defaults are
 GMapping's. Pure: numpy in, poses and maps out; the random generator is passed in.
 
-The particles' maps grow as GMapping's ``ScanMatcherMap`` does: they start around the first scan and
-grow (by at least half their size, keeping every cell where it is) when a scan to integrate reaches
-past them; cells outside a map read as unknown, which is what an unseen cell inside it holds.
+The particles' maps are copy-on-write tiles in one shared pool (``gmapping_tiles``), as GMapping's
+reference-counted patches are: a resampled particle copies its source's small tile table, and a tile is
+copied only when a particle writes into one it shares. The maps grow as GMapping's ``ScanMatcherMap``
+does: they start around the first scan and gain whole tiles (every cell staying where it is) when a scan
+to integrate reaches past them; cells outside a map read as unknown, which is what an unseen cell holds.
 """
 
 from __future__ import annotations
@@ -26,9 +28,10 @@ from navlab.geometry import between2, compose2, wrap_angle
 from navlab.grid import GridMap
 from navlab.mapping.errors import MappingError
 from navlab.mapping.gmapping_match import _draw_motion, _optimize, _score
-from navlab.mapping.occupancy import L_CLAMP, L_FREE, L_OCC, _raycast, grow_window, logodds_to_grid, scan_cells
+from navlab.mapping.gmapping_tiles import TILE, TilePool, raycast_tiles, tiles_for, to_dense
+from navlab.mapping.occupancy import L_CLAMP, L_FREE, L_OCC, logodds_to_grid, scan_cells
 
-MAP_MARGIN_CELLS = 20  # unknown cells kept around what a scan reaches when a map is allocated or grown
+MAP_MARGIN_CELLS = 20  # unknown cells kept around what the scans reached, in maps allocated, grown or published
 
 
 @dataclass
@@ -72,6 +75,12 @@ class GMappingParams:
     refineSkipped: bool = True
     # navlab: then refine all poses with dense verified scan-to-scan constraints (mapping.refine)
     refine: bool = True
+    # navlab: a match that scores under ``wideScore`` per scored beam is retried from starts turned by
+    # ``wideStep`` up to ``wideTurn`` rad either way (the hill climb's reach is a few astep; real odometry
+    # can be 20-30 degrees off in a fast turn), and the best-scoring result is kept; 0 turns this off
+    wideScore: float = 0.7
+    wideStep: float = 0.0873
+    wideTurn: float = 0.524
 
     @classmethod
     def from_dict(cls, values: dict | None) -> GMappingParams:
@@ -84,12 +93,12 @@ class GMappingParams:
 
 
 class _Particle:
-    """A particle's map, trajectory and weight (its pose is row n of ``GMapping.poses``)."""
+    """A particle's map (its table of tiles), trajectory and weight (its pose is row n of ``GMapping.poses``)."""
 
-    __slots__ = ("grid", "node", "weight")
+    __slots__ = ("node", "table", "weight")
 
-    def __init__(self, grid: np.ndarray, node: tuple | None, weight: float = 0.0) -> None:
-        self.grid = grid
+    def __init__(self, table: np.ndarray, node: tuple | None, weight: float = 0.0) -> None:
+        self.table = table
         self.node = node  # trajectory: (scan index, pose, parent node)
         self.weight = weight
 
@@ -120,12 +129,15 @@ class GMapping:
         self.poses = np.zeros((0, 3))  # the particles' laser poses (N, 3), row n particle n's
         self._best = 0  # index of the particle with the highest weight (weights change at map updates only)
         self._anchor = np.zeros(2)  # map-frame corner (m) of lattice cell (0, 0)
-        self._offset = np.zeros(2, dtype=np.int64)  # lattice (column, row) of every map array's cell (0, 0)
-        # lattice (column, row) box holding every cell any particle has written: maps are zero outside it
+        self._offset = np.zeros(2, dtype=np.int64)  # lattice (column, row) of every map's cell (0, 0)
+        self.pool = TilePool()  # the tiles of every particle's map
+        # lattice (column, row) box holding every cell any particle has written (the published map's extent)
         self._seen = (np.zeros(2, dtype=np.int64), np.zeros(2, dtype=np.int64))
+        self._scan_tiles = 1  # tiles the scan being integrated can touch (at most): free tiles to have at hand
         self.resamples = 0
         self.updates = 0
         self.map_resizes = 0
+        self.tiles_in_use = 0  # map tiles held by the particles after the last update (each 64 x 64 float32)
         self._odom_last: np.ndarray | None = None
         self._odom_at_update: np.ndarray | None = None
         self._time = 0.0
@@ -145,42 +157,26 @@ class GMapping:
         """Map-frame (x, y) (m) of the lower-left corner of the particles' maps (they share one window)."""
         return self._anchor + self._offset * self.p.delta
 
-    def _seen_box(self) -> tuple[slice, slice]:
-        """The maps' (row, column) slices holding every cell written so far (zero outside)."""
-        (c0, r0), (c1, r1) = (self._seen[0] - self._offset).tolist(), (self._seen[1] - self._offset + 1).tolist()
-        return slice(r0, r1), slice(c0, c1)
-
-    def _cover(
-        self, poses: np.ndarray, r: np.ndarray, ang: np.ndarray, max_urange: float, max_range: float,
-        copy_of: list[int], spare: list[np.ndarray],
-    ) -> None:
-        """Grow every particle's map (padding, cells stay put) to hold the scan integrated from ``poses``; a
-        particle n with ``copy_of[n] != n`` is skipped: its map is about to be replaced by a copy. Growing
-        empties ``spare`` (maps of the old size, no use any more) first."""
+    def _cover(self, poses: np.ndarray, r: np.ndarray, ang: np.ndarray, max_urange: float, max_range: float) -> None:
+        """Grow every particle's table by whole tiles (cells stay put) to hold the scan integrated from
+        ``poses``, and note how many tiles that scan can touch."""
         lo, hi = scan_cells(
             poses, r, ang, (float(self._anchor[0]), float(self._anchor[1])), self.p.delta,
             max_urange=max_urange, max_range=max_range,
         )  # fmt: skip
-        rows, cols = self._seen_box()
         self._seen = (np.minimum(self._seen[0], lo), np.maximum(self._seen[1], hi))
-        add = grow_window(self._offset, self.particles[0].grid.shape, lo, hi, margin=MAP_MARGIN_CELLS)
-        if add is None:
-            return
-        left, right, bottom, top = add
-        h, w = self.particles[0].grid.shape
-        self._check_size(h + bottom + top, w + left + right)
-        spare.clear()
-        for n, part in enumerate(self.particles):
-            if copy_of[n] == n:
-                # zeros, then the cells written so far (np.pad writes every cell): untouched pages stay so
-                h, w = part.grid.shape
-                grown = np.zeros((h + bottom + top, w + left + right), dtype=part.grid.dtype)
-                grown[rows.start + bottom : rows.stop + bottom, cols.start + left : cols.stop + left] = part.grid[
-                    rows, cols
-                ]
-                part.grid = grown
-        self._offset = self._offset - np.array([left, bottom])
-        self.map_resizes += 1
+        th, tw = self.particles[0].table.shape
+        t_lo, t_hi = (lo - self._offset) // TILE, (hi - self._offset) // TILE  # (column, row) of tiles
+        self._scan_tiles = int(np.prod(t_hi - t_lo + 1))
+        # a side that grows gains a tile more than it needs (fewer, and still cheap, growths)
+        left, bottom = (max(0, 1 - int(t)) if t < 0 else 0 for t in t_lo)
+        right, top = (max(0, int(t) - n + 2) if t >= n else 0 for t, n in zip(t_hi, (tw, th), strict=True))
+        if left or right or bottom or top:
+            self._check_size((th + bottom + top) * TILE, (tw + left + right) * TILE)  # (if no tile were shared)
+            for part in self.particles:
+                part.table = np.pad(part.table, ((bottom, top), (left, right)))
+            self._offset = self._offset - TILE * np.array([left, bottom])
+            self.map_resizes += 1
 
     # --- the filter ---------------------------------------------------------------------------------
 
@@ -271,20 +267,26 @@ class GMapping:
         self._seen = (cells_lo, cells_hi)
         w, h = (cells_hi - cells_lo + 1 + 2 * MAP_MARGIN_CELLS).tolist()
         self._check_size(h, w)
-        grid = np.zeros((h, w), dtype=np.float32)
-        self._integrate(grid, odom, r, ang, max_urange, max_range)
+        table = np.zeros(tiles_for((h, w)), dtype=np.int64)
+        self._scan_tiles = table.size
+        self.pool.recount([table])
+        self._integrate(table, odom, r, ang, max_urange, max_range)
         node = (0, odom.copy(), None)
-        self.particles = [_Particle(grid.copy(), node) for _ in range(p.particles)]
+        self.particles = [_Particle(table.copy(), node) for _ in range(p.particles)]
+        self.pool.recount([q.table for q in self.particles])
         self.poses = np.tile(odom, (p.particles, 1))
         self._best = 0
 
     def _integrate(
-        self, grid: np.ndarray, pose: np.ndarray, r: np.ndarray, ang: np.ndarray, max_urange: float, max_range: float
+        self, table: np.ndarray, pose: np.ndarray, r: np.ndarray, ang: np.ndarray, max_urange: float, max_range: float
     ) -> None:
+        """Ray-cast the scan into the map of ``table`` (copying the tiles it shares before writing them)."""
         ox, oy, oi, oj = self._lattice()
-        _raycast(
-            grid, ox, oy, oi, oj, self.p.delta, float(pose[0]), float(pose[1]), float(pose[2]), r, ang,
-            max_urange, max_range, L_OCC, L_FREE, L_CLAMP,
+        free = self.pool.free(self._scan_tiles)
+        raycast_tiles(
+            self.pool.tiles, table, self.pool.refs, free, np.zeros(1, dtype=np.int64), ox, oy, oi, oj,
+            self.p.delta, float(pose[0]), float(pose[1]), float(pose[2]), r, ang, max_urange, max_range,
+            L_OCC, L_FREE, L_CLAMP,
         )  # fmt: skip
 
     def _lattice(self) -> tuple[float, float, int, int]:
@@ -303,17 +305,15 @@ class GMapping:
         res = p.delta
         cb, sb = np.cos(ang), np.sin(ang)
         poses = self.poses
+        tiles = self.pool.tiles
         for part, pose in zip(self.particles, poses, strict=True):
-            x, y, t, score, lik = _optimize(
-                part.grid, ox, oy, oi, oj, res, pose[0], pose[1], pose[2], r, cb, sb, max_urange,
-                p.kernelSize, p.sigma, p.lsigma, p.lskip, p.lstep, p.astep, p.iterations,
-            )  # fmt: skip
+            x, y, t, score, lik = self._match(part.table, pose, r, cb, sb, max_urange)
             matched = score > p.minimumScore
             if matched:
                 pose[:] = x, y, wrap_angle(t)
             if not matched or pose[2] != t:  # the weight takes the log-likelihood at another pose
                 _s, lik, _n = _score(
-                    part.grid, ox, oy, oi, oj, res, pose[0], pose[1], pose[2], r, cb, sb, max_urange,
+                    tiles, part.table, ox, oy, oi, oj, res, pose[0], pose[1], pose[2], r, cb, sb, max_urange,
                     p.kernelSize, p.sigma, p.lsigma, p.lskip,
                 )  # fmt: skip
             part.weight += lik
@@ -323,7 +323,6 @@ class GMapping:
         w /= w.sum()
         neff = 1.0 / float(np.sum(w**2))
         copy_of = list(range(len(self.particles)))  # particle n's map is particle copy_of[n]'s (resampling)
-        spare: list[np.ndarray] = []  # maps of particles resampling dropped: reused for the copies
         if neff < p.resampleThreshold * len(w):
             self.resamples += 1
             # systematic resampling
@@ -333,30 +332,26 @@ class GMapping:
             new = []
             for n, i in enumerate(idx):
                 src = self.particles[int(i)]
-                # a copy of a particle drawn before shares its map until that one has integrated the scan
-                # (same map, same pose: the same result), then takes a copy of it
+                # a copy of a particle drawn before takes that one's table once it has integrated the scan
+                # (same map, same pose: the same result); until then it holds only unknown tiles
                 copy_of[n] = first.setdefault(int(i), n)
-                new.append(_Particle(src.grid, src.node, 0.0))
-            drawn = {int(i) for i in idx}
-            spare = [q.grid for i, q in enumerate(self.particles) if i not in drawn]
+                table = src.table.copy() if copy_of[n] == n else np.zeros_like(src.table)
+                new.append(_Particle(table, src.node, 0.0))
             self.particles = new
             self.poses = self.poses[idx]  # a copy
-        # grow the maps (rarely: by at least half their size) to hold this scan from every particle
-        self._cover(self.poses, r, ang, max_urange, max_range, copy_of, spare)
-        box = self._seen_box()
+            self.pool.recount([q.table for q in new])  # the dropped particles' tiles are free
+        # grow the maps (by whole tiles) to hold this scan from every particle
+        self._cover(self.poses, r, ang, max_urange, max_range)
         for n, part in enumerate(self.particles):
             part.node = (k, self.poses[n].copy(), part.node)
             if copy_of[n] != n:
-                # into a dropped particle's map where one of this size is left (a large map's fresh allocation
-                # costs more, in page faults, than the copy), else into np.zeros (not zeros_like, which writes
-                # every cell): pages outside the box of written cells stay untouched
-                of = self.particles[copy_of[n]].grid
-                part.grid = spare.pop() if spare and spare[-1].shape == of.shape else np.zeros(of.shape, of.dtype)
-                part.grid[box] = of[box]  # outside the box both are zero
+                part.table = self.particles[copy_of[n]].table.copy()  # shares every tile
+                np.add.at(self.pool.refs, part.table.ravel(), 1)
             else:
-                self._integrate(part.grid, self.poses[n], r, ang, max_urange, max_range)
+                self._integrate(part.table, self.poses[n], r, ang, max_urange, max_range)
         weights = [q.weight for q in self.particles]
         self._best = weights.index(max(weights))
+        self.tiles_in_use = self.pool.in_use()
         self._mark_update(k)
 
     # --- results ------------------------------------------------------------------------------------
@@ -390,24 +385,53 @@ class GMapping:
             out[k] = compose2(base, step)
             scan = self._scan_data.get(k)
             if scan is not None and k not in traj:  # a scan between updates: matched against the best map
-                out[k] = self._refine(self.best().grid, out[k], *scan)
+                out[k] = self._refine(self.best().table, out[k], *scan)
         return out
 
     def _refine(
-        self, grid: np.ndarray, pose: np.ndarray, r: np.ndarray, ang: np.ndarray, max_urange: float
+        self, table: np.ndarray, pose: np.ndarray, r: np.ndarray, ang: np.ndarray, max_urange: float
     ) -> np.ndarray:
         """``pose`` improved by the scan matcher against ``grid`` (unchanged if the match scores too low)."""
+        x, y, t, score, _lik = self._match(table, pose, r, np.cos(ang), np.sin(ang), max_urange)
+        return np.array([x, y, wrap_angle(t)]) if score > self.p.minimumScore else pose
+
+    def _match(
+        self, table: np.ndarray, pose: np.ndarray, r: np.ndarray, cb: np.ndarray, sb: np.ndarray, max_urange: float
+    ) -> tuple[float, float, float, float, float]:
+        """GMapping's hill climb of the scan from ``pose`` against the map of ``table``: (x, y, theta, score,
+        log-likelihood). A climb that ends under ``wideScore`` per scored beam (stuck: the start was turned
+        too far for its steps to reach the scan's place) is repeated from starts turned by ``wideStep``,
+        ``2 wideStep``, ... up to ``wideTurn`` either way; a turned result is kept only if it scores higher,
+        so the scan turns away from its odometry only where the map matches it better there."""
         p = self.p
         ox, oy, oi, oj = self._lattice()
-        x, y, t, score, _lik = _optimize(
-            grid, ox, oy, oi, oj, p.delta, pose[0], pose[1], pose[2], r, np.cos(ang), np.sin(ang), max_urange,
-            p.kernelSize, p.sigma, p.lsigma, p.lskip, p.lstep, p.astep, p.iterations,
-        )  # fmt: skip
-        return np.array([x, y, wrap_angle(t)]) if score > p.minimumScore else pose
+        args = (r, cb, sb, max_urange, p.kernelSize, p.sigma, p.lsigma, p.lskip, p.lstep, p.astep, p.iterations)
+        best = _optimize(self.pool.tiles, table, ox, oy, oi, oj, p.delta, pose[0], pose[1], pose[2], *args)
+        if p.wideScore <= 0 or p.wideStep <= 0:
+            return best
+        scored = r[:: p.lskip + 1]
+        enough = p.wideScore * np.count_nonzero((scored > 0) & (scored < max_urange))
+        if best[3] >= enough:
+            return best
+        # the nearest turns first; stop at a result that scores well enough
+        for n in range(1, int(p.wideTurn / p.wideStep + 1e-9) + 1):
+            for turn in (n * p.wideStep, -n * p.wideStep):
+                t0 = pose[2] + turn
+                got = _optimize(self.pool.tiles, table, ox, oy, oi, oj, p.delta, pose[0], pose[1], t0, *args)
+                if got[3] > best[3]:
+                    best = got
+            if best[3] >= enough:
+                break
+        return best
 
     def map(self, *, frame_id: str = "map") -> GridMap:
-        """The best particle's occupancy grid."""
-        g = self.best().grid
+        """The best particle's occupancy grid: the cells any scan reached plus ``MAP_MARGIN_CELLS``."""
+        g = to_dense(self.pool.tiles, self.best().table)
+        (c0, r0), (c1, r1) = (self._seen[0] - MAP_MARGIN_CELLS - self._offset).tolist(), (
+            self._seen[1] + MAP_MARGIN_CELLS + 1 - self._offset
+        ).tolist()
+        c0, r0 = max(c0, 0), max(r0, 0)
+        origin = self.origin + np.array([c0, r0]) * self.p.delta
         return logodds_to_grid(
-            g.astype(np.float64), self.p.delta, (float(self.origin[0]), float(self.origin[1])), frame_id=frame_id
+            g[r0:r1, c0:c1].astype(np.float64), self.p.delta, (float(origin[0]), float(origin[1])), frame_id=frame_id
         )

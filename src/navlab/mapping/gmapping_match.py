@@ -2,8 +2,9 @@
 map and the hill climbing over (x, y, theta) that maximises it (``ScanMatcher::score`` / ``optimize``) — and
 the motion model's draw for all particles at once (``MotionModel::drawFromMotion``).
 
-Lattice conventions as in ``mapping.occupancy``: ``grid`` holds the cells of a fixed lattice anchored at
-(``ox``, ``oy``) from lattice cell (``oi``, ``oj``) on; cells outside it read as unknown.
+A particle's map is a tiled copy-on-write map (``mapping.gmapping_tiles``: ``tiles``, ``table``) whose cells
+follow the lattice conventions of ``mapping.occupancy``: a fixed lattice anchored at (``ox``, ``oy``) from
+lattice cell (``oi``, ``oj``) on; cells outside it read as unknown.
 """
 
 from __future__ import annotations
@@ -13,7 +14,8 @@ import math
 import numba
 import numpy as np
 
-from navlab.mapping.occupancy import L_CLAMP, L_FREE, L_OCC, _raycast, scan_cells
+from navlab.mapping.gmapping_tiles import MASK, SHIFT, TILE, cell, from_dense, raycast_tiles
+from navlab.mapping.occupancy import L_CLAMP, L_FREE, L_OCC, scan_cells
 
 SEEN_POSES = 256  # poses whose score one hill climb remembers (it re-visits neighbours it scored before)
 
@@ -81,7 +83,8 @@ def _endpoints(
 
 @numba.njit(cache=True, inline="always")
 def _score_above(
-    grid: np.ndarray,
+    tiles: np.ndarray,
+    table: np.ndarray,
     ox: float,
     oy: float,
     oi: int,
@@ -113,7 +116,9 @@ def _score_above(
     ``order`` (a permutation: the hill climb puts first those that scored worst at the pose it climbs from,
     which stops a worse neighbour sooner); the score and log-likelihood are summed in beam order all the
     same, so the order changes nothing but when a pose is given up."""
-    h, w = grid.shape
+    th, tw = table.shape
+    h, w = th * TILE, tw * TILE
+    flat = tiles.reshape(-1)  # a view (C-contiguous)
     _endpoints(ox, oy, oi, oj, res, px, py, pt, rv, cv, sv, fw, iw)
     s = 0.0
     null_l = -0.5 / lsigma  # GMapping: nullLikelihood = -0.5
@@ -124,18 +129,21 @@ def _score_above(
         ei, ej, fi, fj = iw[0, k], iw[1, k], iw[2, k], iw[3, k]
         best = 1e9  # the nearest match's squared distance: a minimum, so the cells' order does not matter
         found = False
-        # both kernel windows inside the array (nearly always): no per-cell bounds checks, unsigned indices
-        # (no negative-index wrap-around) and no branches (which cell matches is unpredictable)
         inside = (min(ei, fi) >= kernel and min(ej, fj) >= kernel and max(ei, fi) < w - kernel
                   and max(ej, fj) < h - kernel)  # fmt: skip
-        if inside and kernel == 1:  # GMapping's default kernel, unrolled: each cell's x and y term once
+        # GMapping's default kernel with both 3 x 3 windows inside one tile each (nearly always): unrolled,
+        # each cell's x and y term once, flat unsigned indices (no wrap-around checks) and no branches
+        if (inside and kernel == 1 and 1 <= (ei & MASK) < MASK and 1 <= (ej & MASK) < MASK and 1 <= (fi & MASK) < MASK
+                and 1 <= (fj & MASK) < MASK):  # fmt: skip
+            ce = table[ej >> SHIFT, ei >> SHIFT] * TILE * TILE + (ej & MASK) * TILE + (ei & MASK)
+            cf = table[fj >> SHIFT, fi >> SHIFT] * TILE * TILE + (fj & MASK) * TILE + (fi & MASK)
             x0, x1, x2 = fw[2, k], fw[3, k], fw[4, k]
             for dj in range(3):
-                j, j2 = numba.uint64(ej - 1 + dj), numba.uint64(fj - 1 + dj)
+                e, f = ce + (dj - 1) * TILE, cf + (dj - 1) * TILE
                 yy = fw[5 + dj, k]
-                ok0 = (grid[j, numba.uint64(ei - 1)] > 0.0) & (grid[j2, numba.uint64(fi - 1)] < 0.0)
-                ok1 = (grid[j, numba.uint64(ei)] > 0.0) & (grid[j2, numba.uint64(fi)] < 0.0)
-                ok2 = (grid[j, numba.uint64(ei + 1)] > 0.0) & (grid[j2, numba.uint64(fi + 1)] < 0.0)
+                ok0 = (flat[numba.uint64(e - 1)] > 0.0) & (flat[numba.uint64(f - 1)] < 0.0)
+                ok1 = (flat[numba.uint64(e)] > 0.0) & (flat[numba.uint64(f)] < 0.0)
+                ok2 = (flat[numba.uint64(e + 1)] > 0.0) & (flat[numba.uint64(f + 1)] < 0.0)
                 d2 = x0 + yy if ok0 else 1e9
                 best = d2 if d2 < best else best
                 d2 = x1 + yy if ok1 else 1e9
@@ -143,17 +151,6 @@ def _score_above(
                 d2 = x2 + yy if ok2 else 1e9
                 best = d2 if d2 < best else best
                 found = found | ok0 | ok1 | ok2
-        elif inside:
-            for dj in range(-kernel, kernel + 1):
-                j, j2 = numba.uint64(ej + dj), numba.uint64(fj + dj)
-                cy = oy + (ej + dj + oj + 0.5) * res
-                for di in range(-kernel, kernel + 1):
-                    ok = (grid[j, numba.uint64(ei + di)] > 0.0) & (grid[j2, numba.uint64(fi + di)] < 0.0)
-                    cx = ox + (ei + di + oi + 0.5) * res
-                    d2 = (cx - ex) ** 2 + (cy - ey) ** 2
-                    d2 = d2 if ok else 1e9
-                    best = d2 if d2 < best else best
-                    found = found | ok
         else:
             for dj in range(-kernel, kernel + 1):
                 for di in range(-kernel, kernel + 1):
@@ -161,7 +158,7 @@ def _score_above(
                     i2, j2 = fi + di, fj + dj
                     if i < 0 or j < 0 or i >= w or j >= h or i2 < 0 or j2 < 0 or i2 >= w or j2 >= h:
                         continue
-                    if grid[j, i] > 0.0 and grid[j2, i2] < 0.0:
+                    if cell(tiles, table, j, i) > 0.0 and cell(tiles, table, j2, i2) < 0.0:
                         cx = ox + (i + oi + 0.5) * res
                         cy = oy + (j + oj + 0.5) * res
                         d2 = (cx - ex) ** 2 + (cy - ey) ** 2
@@ -212,7 +209,8 @@ def _worst_first(terms: np.ndarray, order: np.ndarray, counts: np.ndarray) -> No
 
 @numba.njit(cache=True)
 def _score(
-    grid: np.ndarray,
+    tiles: np.ndarray,
+    table: np.ndarray,
     ox: float,
     oy: float,
     oi: int,
@@ -236,13 +234,14 @@ def _score(
     rv, cv, sv = _valid_beams(ranges, cb, sb, max_urange, skip)
     nb = rv.shape[0]
     fw, iw = np.empty((10, nb)), np.empty((4, nb), dtype=np.int64)
-    return _score_above(grid, ox, oy, oi, oj, res, px, py, pt, rv, cv, sv, kernel, sigma, lsigma, -1.0, fw, iw,
+    return _score_above(tiles, table, ox, oy, oi, oj, res, px, py, pt, rv, cv, sv, kernel, sigma, lsigma, -1.0, fw, iw,
                         np.arange(nb))  # fmt: skip
 
 
 @numba.njit(cache=True)
 def _optimize(
-    grid: np.ndarray,
+    tiles: np.ndarray,
+    table: np.ndarray,
     ox: float,
     oy: float,
     oi: int,
@@ -277,8 +276,8 @@ def _optimize(
     terms = np.empty(nb)  # the score terms of the best pose found in this step of the climb
     seen = np.empty((SEEN_POSES, 5))  # x, y, theta, score (-1: no better than the pose it was tried from), lik
     cx, cy, ct = x0, y0, t0
-    cur, cur_lik, _n = _score_above(grid, ox, oy, oi, oj, res, cx, cy, ct, rv, cv, sv, kernel, sigma, lsigma, -1.0,
-                                    fw, iw, order)  # fmt: skip
+    cur, cur_lik, _n = _score_above(tiles, table, ox, oy, oi, oj, res, cx, cy, ct, rv, cv, sv, kernel, sigma, lsigma,
+                                    -1.0, fw, iw, order)  # fmt: skip
     _worst_first(fw[8], order, counts)
     seen[0, 0], seen[0, 1], seen[0, 2], seen[0, 3], seen[0, 4] = cx, cy, ct, cur, cur_lik
     n_seen = 1
@@ -314,8 +313,8 @@ def _optimize(
             if q < n_seen:
                 sc, lik = seen[q, 3], seen[q, 4]
             else:
-                sc, lik, _n = _score_above(grid, ox, oy, oi, oj, res, nx, ny, nt, rv, cv, sv, kernel, sigma, lsigma,
-                                           cur, fw, iw, order)  # fmt: skip
+                sc, lik, _n = _score_above(tiles, table, ox, oy, oi, oj, res, nx, ny, nt, rv, cv, sv, kernel, sigma,
+                                           lsigma, cur, fw, iw, order)  # fmt: skip
                 if n_seen < SEEN_POSES:
                     seen[n_seen, 0], seen[n_seen, 1], seen[n_seen, 2] = nx, ny, nt
                     seen[n_seen, 3], seen[n_seen, 4] = sc, lik
@@ -352,10 +351,13 @@ def warmup() -> None:
     """Load the matcher's, the motion model's and the map integration's kernels (numba: compiled once, then
     read from its disk cache, ~0.25 s) on a tiny input, with the argument types GMapping passes; without it
     that load would stall the first map update (a live run's simulation at its first second)."""
-    grid = np.zeros((4, 4), dtype=np.float32)
+    pool, table = from_dense(np.zeros((4, 4), dtype=np.float32))
+    free, used = pool.free(1), np.zeros(1, dtype=np.int64)
+    tiles = pool.tiles  # (after free(), which may grow the pool)
     r, c = np.ones(2), np.ones(2)
-    _optimize(grid, 0.0, 0.0, 0, 0, 0.05, 0.1, 0.1, 0.0, r, c, c, 1.0, 1, 0.05, 0.075, 0, 0.05, 0.05, 1)
-    _score(grid, 0.0, 0.0, 0, 0, 0.05, 0.1, 0.1, 0.0, r, c, c, 1.0, 1, 0.05, 0.075, 0)
-    _raycast(grid, 0.0, 0.0, 0, 0, 0.05, 0.1, 0.1, 0.0, r, c, 1.0, 2.0, L_OCC, L_FREE, L_CLAMP)
+    _optimize(tiles, table, 0.0, 0.0, 0, 0, 0.05, 0.1, 0.1, 0.0, r, c, c, 1.0, 1, 0.05, 0.075, 0, 0.05, 0.05, 1)
+    _score(tiles, table, 0.0, 0.0, 0, 0, 0.05, 0.1, 0.1, 0.0, r, c, c, 1.0, 1, 0.05, 0.075, 0)
+    raycast_tiles(tiles, table, pool.refs, free, used, 0.0, 0.0, 0, 0, 0.05, 0.1, 0.1, 0.0, r, c, 1.0, 2.0, L_OCC,
+                  L_FREE, L_CLAMP)  # fmt: skip
     _draw_motion(np.zeros((2, 3)), np.zeros((2, 3)), 0.1, 0.0, 0.0, 0.1, 0.1, 0.1)
     scan_cells(np.zeros((2, 3)), r, c, (0.0, 0.0), 0.05, max_urange=1.0, max_range=2.0)

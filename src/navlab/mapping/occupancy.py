@@ -6,8 +6,8 @@ are no-returns; returns beyond ``max_urange`` only clear space up to ``max_urang
 
 Growing maps (as GMapping's ``ScanMatcherMap``): cells sit on a fixed lattice, cell ``(I, J)`` covering
 ``[ox + I*res, ox + (I+1)*res) x [oy + J*res, ...)`` for a fixed anchor ``(ox, oy)``; an array holds the
-window of lattice cells starting at ``(oi, oj)``. Growing the window (:func:`grow_window`) pads the array
-and never moves a cell, so cell indices are computed from the same anchor before and after.
+window of lattice cells starting at ``(oi, oj)``. Growing the window pads the array and never moves a
+cell, so cell indices are computed from the same anchor before and after.
 """
 
 from __future__ import annotations
@@ -178,22 +178,6 @@ def scan_cells(
     lo = np.array([math.floor((xmin - anchor[0]) / resolution), math.floor((ymin - anchor[1]) / resolution)])
     hi = np.array([math.floor((xmax - anchor[0]) / resolution), math.floor((ymax - anchor[1]) / resolution)])
     return lo.astype(np.int64), hi.astype(np.int64)
-
-
-def grow_window(
-    offset: np.ndarray, shape: tuple[int, int], lo: np.ndarray, hi: np.ndarray, *, margin: int
-) -> tuple[int, int, int, int] | None:
-    """Cells to add (left, right, bottom, top) so that a window of lattice cells starting at ``offset``
-    ((column, row) of array cell (0, 0)) of ``shape`` (rows, columns) holds cells ``lo``..``hi``
-    (inclusive); ``None`` when it already does. A side that grows gains the shortfall plus ``margin``
-    cells, and at least half the window's size, so a map ``N`` cells wide is copied O(log N) times."""
-    size = np.array([shape[1], shape[0]])
-    end = offset + size  # exclusive
-    if np.all(lo >= offset) and np.all(hi < end):
-        return None
-    add_lo = np.where(lo < offset, np.maximum(offset - lo + margin, size // 2), 0)
-    add_hi = np.where(hi >= end, np.maximum(hi + 1 - end + margin, size // 2), 0)
-    return int(add_lo[0]), int(add_hi[0]), int(add_lo[1]), int(add_hi[1])
 
 
 def logodds_to_grid(

@@ -63,7 +63,10 @@ def run_offline(
 ) -> SlamResult:
     """Run SLAM over the log's scans (all, or the first ``max_scans``) and build the final map.
 
-    Every scan goes to the mode's ``add_scan`` (a node's ``due`` gating is not applied to a log)."""
+    Every scan goes to the mode's ``add_scan`` (a node's ``due`` gating is not applied to a log) with the
+    log's sensor range as the scan's ``range_max``, as slam_gmapping takes a LaserScan's: readings at or
+    beyond it (CARMEN's 81.9 m "no return") are no hits and no free-space rays, and an unset ``maxRange``
+    becomes ``range_max - 0.01``."""
     from tqdm import tqdm
 
     scans = log.scans[:max_scans] if max_scans else log.scans
@@ -71,7 +74,7 @@ def run_offline(
     if hasattr(slam, "keep_scans"):  # offline, the mode may refine every scan's pose at the end
         slam.keep_scans = True
     for s in tqdm(scans, desc=f"slam ({mode})", unit="scan", disable=not progress, file=sys.stderr):
-        slam.add_scan(s.ranges, s.angle_min, s.angle_increment, s.laser_pose)
+        slam.add_scan(s.ranges, s.angle_min, s.angle_increment, s.laser_pose, range_max=s.max_range)
     laser = np.asarray(slam.finish(), dtype=np.float64)
     robot = np.array([compose2(lp, inverse2(s.laser_offset)) for lp, s in zip(laser, scans, strict=True)])
     grid = build_map(

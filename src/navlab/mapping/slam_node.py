@@ -27,7 +27,7 @@ _POSITIVE = ("transform_publish_period", "throttle_scans", "maxUrange", "sigma",
              "astep", "lsigma", "ogain", "particles", "delta", "llsamplerange", "llsamplestep", "lasamplerange",
              "lasamplestep", "occ_thresh", "resampleThreshold")
 _NON_NEGATIVE = ("map_update_interval", "maxRange", "kernelSize", "iterations", "lskip", "minimumScore", "srr",
-                 "srt", "str", "stt", "linearUpdate", "angularUpdate")
+                 "srt", "str", "stt", "linearUpdate", "angularUpdate", "wideScore", "wideStep", "wideTurn")
 
 
 INVALID_LOG_PERIOD_NS = 10_000_000_000  # at most one "scans without readings" warning per 10 simulated s
@@ -56,6 +56,7 @@ class SlamGMapping(Node):
         namespace: str = "",
     ) -> None:  # fmt: skip
         super().__init__(executor, name=name, parameters=parameters, namespace=namespace)
+        self.listen_tf()  # a tf2 TransformListener, as in ROS: the graph shows it reading /tf
         self.base_frame = self.declare_parameter("base_frame", "base_link")
         self.odom_frame = self.declare_parameter("odom_frame", "odom")
         self.map_frame = self.declare_parameter("map_frame", "map")

@@ -117,7 +117,13 @@ def terminal_keys(teleop: TeleopKeyboard, ex: Executor) -> threading.Thread:
 
 
 def load_route(path: str | Path) -> tuple[list[tuple[float, float, float]], np.ndarray]:
-    """A route file: ``segments: [{linear, angular, duration}]`` and/or ``waypoints: [[x, y], ...]``."""
+    """A route file (or a shipped route's name, ``room``): ``segments: [{linear, angular, duration}]`` and/or
+    ``waypoints: [[x, y], ...]``."""
+    text = str(path)
+    if not Path(text).exists() and not Path(text).suffix and "/" not in text:
+        from navlab import resources
+
+        path = resources.route(text)
     data = read_yaml(path)
     if not isinstance(data, dict) or not ({"segments", "waypoints"} & set(data)):
         raise MappingError(f"{path}: a route file needs 'segments' and/or 'waypoints'")

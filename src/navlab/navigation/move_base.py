@@ -68,6 +68,7 @@ class MoveBase(Node):
     def __init__(self, executor: Executor, *, name: str = "move_base", parameters: dict[str, Any] | None = None,
                  namespace: str = "") -> None:  # fmt: skip
         super().__init__(executor, name=name, parameters=parameters, namespace=namespace)
+        self.listen_tf()  # a tf2 TransformListener, as in ROS: the graph shows it reading /tf
         p = {k: self.declare_parameter(k, v) for k, v in _MB_DEFAULTS.items()}
         self.p = p
         for key in ("controller_frequency", "planner_patience", "controller_patience", "oscillation_distance"):

@@ -53,12 +53,37 @@ def package_paths() -> dict[str, Path]:
 
 def world(name: str) -> Path:
     """A shipped world by name (``"room"`` or ``"room.world"``)."""
-    return path(f"worlds/{name if name.endswith('.world') else name + '.world'}")
+    full = path(f"worlds/{name if name.endswith('.world') else name + '.world'}", must_exist=False)
+    if not full.is_file():
+        raise _unknown("world", name, sorted(p.stem for p in (root() / "worlds").glob("*.world")))
+    return full
 
 
 def robot(name: str) -> Path:
     """A shipped robot's top xacro by name (``"mybot"``)."""
-    return path(f"robots/{name}/{name}.xacro")
+    full = path(f"robots/{name}/{name}.xacro", must_exist=False)
+    if not full.is_file():
+        raise _unknown("robot", name, sorted(p.parent.name for p in (root() / "robots").glob("*/*.xacro")
+                                             if p.stem == p.parent.name))  # fmt: skip
+    return full
+
+
+def route(name: str) -> Path:
+    """A shipped mapping route by name (``"room"``: a loop through room.world for ``navlab map --route``)."""
+    full = path(f"routes/{name if name.endswith('.yaml') else name + '.yaml'}", must_exist=False)
+    if not full.is_file():
+        raise _unknown("route", name, sorted(p.stem for p in (root() / "routes").glob("*.yaml")))
+    return full
+
+
+def _unknown(kind: str, name: str, shipped: list[str]) -> ResourceError:
+    """One line: ``world 'rooom': no such file here and no shipped world of that name; did you mean 'room'?``"""
+    import difflib
+
+    close = difflib.get_close_matches(name, shipped, n=1)
+    hint = f"; did you mean {close[0]!r}?" if close else ""
+    return ResourceError(f"{kind} {name!r}: no such file here and no shipped {kind} of that name{hint} "
+                         f"(shipped: {', '.join(shipped)})")
 
 
 def model_path() -> Path:

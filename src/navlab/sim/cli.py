@@ -13,6 +13,7 @@ from navlab.cli_common import (
     add_resource_path_arguments,
     add_set_argument,
     apply_resource_paths,
+    out_file,
     parse_sets,
     positive_seconds,
     start_pose,
@@ -73,7 +74,9 @@ def register(sub: argparse._SubParsersAction) -> None:
         "the paper's Figs. 4 and 5. Spawned models (--spawn) are drawn too.",
     )
     _add_common(r)
-    r.add_argument("--out", default="world.png", help="PNG file to write (default world.png)")
+    r.add_argument("--out", default=".", metavar="DIR",
+                   help="folder for DIR/world.png (default: the current folder; a FILE.png is deprecated but still "
+                   "works this release)")
     r.add_argument("--width", type=int, default=960, help="image width in pixels (default 960)")
     r.add_argument("--height", type=int, default=720, help="image height in pixels (default 720)")
     r.add_argument("--azimuth", type=float, default=135.0, help="camera azimuth in degrees (default 135)")
@@ -182,6 +185,6 @@ def _cmd_render(args: argparse.Namespace) -> int:
     sim.advance_to(200_000_000)  # let the robot and dynamic models settle for 0.2 s
     image = render_image(sim, width=args.width, height=args.height, azimuth=args.azimuth,
                          elevation=args.elevation, distance=args.distance)
-    path = save_png(image, args.out)
+    path = save_png(image, out_file(args.out, "world.png", old_suffixes=(".png",)))
     print(f"wrote {path} ({args.width}x{args.height})", file=sys.stderr)
     return 0

@@ -12,7 +12,7 @@ from navlab.sim.contacts import CollisionPlugin
 from navlab.sim.errors import SimError
 from navlab.sim.extensions import SimExtensions
 from navlab.sim.imu import ImuSensorPlugin
-from navlab.sim.plugins import DiffDrivePlugin, GroundTruthPlugin, JointStatePlugin, LidarPlugin
+from navlab.sim.plugins import DiffDrivePlugin, GroundTruthPlugin, JointStatePlugin, LidarPlugin, RobotStatePublisher
 from navlab.sim.simulation import Simulation
 from navlab.sim.spawn import check_spawn_clear, check_start_pose, load_sdf_model, parse_spawn_spec, primitive_model
 from navlab.world.model import ModelSpec, WorldModel
@@ -98,6 +98,7 @@ class GazeboSim(Node):
                          for i in range(len(robot.imus))]
         self.plugins.append(JointStatePlugin(executor, parameters={"publish_frequency": js_rate}, namespace=namespace,
                                              sim=self.sim))
+        self.plugins.append(RobotStatePublisher(executor, namespace=namespace, sim=self.sim))
         p3d_topics = {p.topic for p in robot.ground_truths}
         if gt_rate > 0 and "/ground_truth/odom" not in p3d_topics:  # navlab's own, for evaluation
             base = robot.diff_drive.robot_base_frame if robot.diff_drive else robot.root_link

@@ -189,38 +189,55 @@ class LidarPlugin(Node):
 
 
 class JointStatePlugin(Node):
-    """``gazebo_ros_joint_state_publisher`` + ``robot_state_publisher``: ``/joint_states`` of the moving
-    joints and their tf (parent link → child link) every ``1/publish_frequency`` s (Hz, default 30; 0 = none);
-    fixed joints and sensor frames once, as static tf. ``publish_tf`` (default true): the moving joints' tf."""
+    """``gazebo_ros_joint_state_publisher``: ``/joint_states`` (position and velocity of the moving joints)
+    every ``1/publish_frequency`` s (Hz, default 30; 0 = none), read from the simulator."""
 
-    def __init__(self, executor: Executor, *, name: str = "robot_state_publisher",
+    def __init__(self, executor: Executor, *, name: str = "joint_state_publisher",
                  parameters: dict[str, Any] | None = None, namespace: str = "", sim: Simulation) -> None:
         super().__init__(executor, name=name, parameters=parameters, namespace=namespace)
         assert sim.robot is not None
         self.sim = sim
         rate = float(self.declare_parameter("publish_frequency", 30.0))
-        self.publish_tf = self.declare_parameter("publish_tf", True)
-        robot = sim.robot
-        self.joints = [j for j in robot.joints if j.name in set(sim.joint_names())]
-        self._motion = [_joint_constants(tuple(j.origin.rpy), tuple(j.origin.xyz), tuple(j.axis)) for j in self.joints]
+        self.joints = [j.name for j in sim.robot.joints if j.name in set(sim.joint_names())]
         self.pub = self.create_publisher(msgs.JointState, "joint_states", 10)
-        self.send_static_transform(static_transforms(sim, executor.now_ns))
         if rate > 0 and self.joints:
             self.create_timer(1.0 / rate, self.update)
 
     def update(self) -> None:
-        """Publish joint states when anyone subscribes or listens, and the moving joints' tf."""
-        now = self.executor.now_ns
-        pos = [self.sim.joint_position(j.name) for j in self.joints]
-        if self.pub.get_subscription_count() or self.executor.has_listeners:
-            vel = np.array([self.sim.joint_velocity(j.name) for j in self.joints])
-            self.pub.publish(msgs.JointState(header=msgs.header(now, ""), name=[j.name for j in self.joints],
-                                             position=np.array(pos), velocity=vel, effort=np.zeros(len(pos))))
-        if self.publish_tf:
-            self.send_transform([
-                _transform(now, joint.parent, joint.child, *_motion(joint.type, consts, q))
-                for joint, consts, q in zip(self.joints, self._motion, pos, strict=True)
-            ])
+        """Publish the joints' state."""
+        pos = np.array([self.sim.joint_position(j) for j in self.joints])
+        vel = np.array([self.sim.joint_velocity(j) for j in self.joints])
+        self.pub.publish(msgs.JointState(header=msgs.header(self.executor.now_ns, ""), name=list(self.joints),
+                                         position=pos, velocity=vel, effort=np.zeros(len(pos))))
+
+
+class RobotStatePublisher(Node):
+    """``robot_state_publisher``: subscribes ``/joint_states`` and publishes each moving joint's tf (parent link →
+    child link) at the message's stamp; fixed joints and sensor frames once, as static tf. ``publish_tf``
+    (default true; navlab's switch): the moving joints' tf."""
+
+    def __init__(self, executor: Executor, *, name: str = "robot_state_publisher",
+                 parameters: dict[str, Any] | None = None, namespace: str = "", sim: Simulation) -> None:
+        super().__init__(executor, name=name, parameters=parameters, namespace=namespace)
+        assert sim.robot is not None
+        self.publish_tf = self.declare_parameter("publish_tf", True)
+        self.joints = {j.name: (j, _joint_constants(tuple(j.origin.rpy), tuple(j.origin.xyz), tuple(j.axis)))
+                       for j in sim.robot.joints if j.type != "fixed"}  # fmt: skip
+        self.send_static_transform(static_transforms(sim, executor.now_ns))
+        self.create_subscription(msgs.JointState, "joint_states", self._on_joint_states, 10)
+
+    def _on_joint_states(self, msg: Any) -> None:
+        if not self.publish_tf:
+            return
+        stamp = msgs.stamp_ns(msg)
+        out = []
+        for name, q in zip(msg.name, msg.position, strict=False):
+            known = self.joints.get(name)
+            if known is not None:
+                joint, consts = known
+                out.append(_transform(stamp, joint.parent, joint.child, *_motion(joint.type, consts, float(q))))
+        if out:
+            self.send_transform(out)
 
 
 def joint_motion(joint: Any, q: float) -> tuple[tuple[float, float, float], tuple[float, float, float, float]]:

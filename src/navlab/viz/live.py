@@ -14,6 +14,7 @@ event (at most one pacing period, 10 simulated ms), where it reads its inbox.
 from __future__ import annotations
 
 import functools
+import json
 import math
 import threading
 import time
@@ -24,7 +25,7 @@ import numpy as np
 
 from navlab import msgs
 from navlab.core import Executor, Node, TfError
-from navlab.core.graph import Graph
+from navlab.core.graph import Graph, with_layout
 from navlab.mapping.teleop import MOVE_BINDINGS, SPEED_BINDINGS, TeleopState
 from navlab.viz.hub import Hub
 from navlab.viz.inputs import check_input
@@ -152,6 +153,7 @@ class ViewerNode(Node):
         self.obstacles: dict[str, dict[str, Any]] = {}  # placed from the page: name -> kind, dims, x, y
         self.last_outcome: dict[str, Any] = {}
         self._counts: dict[str, tuple[int, int]] = {}  # topic -> (count, t_ns) at the last graph
+        self._graph_key, self._layout = "", None  # the last graph's structure and its dot layout
         self._odom_due: dict[str, int] = {}  # topic -> simulated ns of its next trace sample
         self._direct: dict[str, tuple[str, Any]] | None = None
         self._last_peek = -1e9
@@ -246,8 +248,11 @@ class ViewerNode(Node):
             c0, t0 = self._counts.get(name, (topic.count, ex.now_ns))
             rates[name] = round((topic.count - c0) / ((ex.now_ns - t0) / 1e9), 2) if ex.now_ns > t0 else 0.0
             self._counts[name] = (topic.count, ex.now_ns)
-        self.hub.set_graph({**graph, "rates": rates, "types": {n: msgs.type_name(t.msgtype)
-                                                                for n, t in ex.topics.items()}})  # fmt: skip
+        key = json.dumps(graph, sort_keys=True)
+        if key != self._graph_key:  # the structure changed: lay it out again (dot takes ~20 ms)
+            self._graph_key, self._layout = key, with_layout(graph).get("layout")
+        self.hub.set_graph({**graph, "rates": rates, "layout": self._layout,
+                            "types": {n: msgs.type_name(t.msgtype) for n, t in ex.topics.items()}})  # fmt: skip
 
     # --- pace and state -------------------------------------------------------------------------------
 

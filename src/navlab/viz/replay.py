@@ -18,8 +18,9 @@ import numpy as np
 
 from navlab import msgs
 from navlab.core.errors import TfError
+from navlab.core.graph import with_layout
 from navlab.core.tf import TfBuffer
-from navlab.io.rosbag import bag_graph, read_bag
+from navlab.io.rosbag import bag_graph, bag_topics, read_bag
 from navlab.viz.errors import VizError
 from navlab.viz.hub import Hub
 from navlab.viz.inputs import check_input
@@ -40,11 +41,19 @@ class Recording:
     base_frame: str = "base_link"
 
 
-def load_recording(path: str | Path) -> Recording:
-    """Read a rosbag2 directory (as ``--record`` writes it) for replay."""
+def load_recording(path: str | Path, *, progress: bool = False) -> Recording:
+    """Read a rosbag2 directory (as ``--record`` writes it) for replay; ``progress``: a bar on stderr (when it is a
+    terminal) counting the messages read and the recording's time reached."""
+    import sys
+
+    from tqdm import tqdm
+
     p = Path(path)
     if not (p / "metadata.yaml").is_file():
         raise VizError(f"{p}: not a rosbag2 recording (no metadata.yaml); record one with --record DIR")
+    total = sum(count for _type, count in bag_topics(p).values())
+    bar = tqdm(total=total, unit="msg", desc=f"loading {p.name}", file=sys.stderr, mininterval=0.5,
+               disable=not progress or not sys.stderr.isatty())  # fmt: skip
     topics: dict[str, tuple[str, list[int], list[Any]]] = {}
     odom: dict[str, tuple[str, list[int], list[tuple[float, float]]]] = {}
     tf_msgs: list[tuple[int, Any, bool]] = []
@@ -53,6 +62,9 @@ def load_recording(path: str | Path) -> Recording:
     for topic, t_ns, msg in read_bag(p):
         t0 = t_ns if t0 is None else min(t0, t_ns)
         t1 = max(t1, t_ns)
+        bar.update()
+        if bar.n % 2000 == 0:
+            bar.set_postfix_str(f"t={(t1 - t0) / 1e9:.1f} s of the recording", refresh=False)
         if topic in ("/tf", "/tf_static"):
             tf_msgs.append((t_ns, msg, topic == "/tf_static"))
             continue
@@ -71,6 +83,7 @@ def load_recording(path: str | Path) -> Recording:
         _, ts, ms = topics.setdefault(topic, (kind, [], []))
         ts.append(t_ns)
         ms.append(msg)
+    bar.close()
     if t0 is None:
         raise VizError(f"{p}: the recording holds no messages")
     tf = TfBuffer(cache_ns=t1 - t0 + 10**9)
@@ -94,7 +107,7 @@ class BagPlayer:
         self._closed = threading.Event()
         self._seeked = True
         if graph:
-            hub.set_graph({**graph, "rates": {}, "types": {}})
+            hub.set_graph({**with_layout(graph), "rates": {}, "types": {}})
         hub.handler = self.submit
         self._thread = threading.Thread(target=self._loop, name="navlab-replay", daemon=True)
 
@@ -188,5 +201,5 @@ class BagPlayer:
 
 def play_bag(path: str | Path, hub: Hub, *, speed: float = 1.0) -> BagPlayer:
     """Load a recording and start playing it into ``hub``."""
-    rec = load_recording(path)
+    rec = load_recording(path, progress=True)
     return BagPlayer(rec, hub, speed=speed, graph=bag_graph(path)).start()

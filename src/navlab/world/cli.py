@@ -53,14 +53,16 @@ def save_png(world: ClutterWorld, path: str | Path) -> None:
 
 
 def _cmd_clutter(args: argparse.Namespace) -> int:
+    from navlab.cli_common import optional_out, out_file
     from navlab.world.clutter import generate_clutter
 
     world = generate_clutter(args.seed, fill=args.fill, smooth=args.smooth, robot_radius=args.robot_radius,
                              margin=args.margin)
-    out = world.write_world(args.out)
-    if args.png:
-        save_png(world, args.png)
-    summary = {**world.summary(), "world_file": str(out), "png": str(args.png) if args.png else None}
+    out = world.write_world(out_file(args.out, "clutter.world", old_suffixes=(".world", ".sdf")))
+    png = optional_out(args.png, out.parent, "clutter.png")
+    if png:
+        save_png(world, png)
+    summary = {**world.summary(), "world_file": str(out), "png": str(png) if png else None}
     if args.json:
         print(json.dumps(summary))
         return 0
@@ -72,7 +74,7 @@ def _cmd_clutter(args: argparse.Namespace) -> int:
     print(f"reference path {world.reference_path_m:.3f} m for robot radius {world.robot_radius} m "
           f"(T_opt {world.t_opt():.2f} s at 2 m/s; narrowest passage half-width "
           f"{world.metrics['bottleneck_m']:.3f} m)")
-    print(f"wrote {out}" + (f" and {args.png}" if args.png else ""))
+    print(f"wrote {out}" + (f" and {png}" if png else ""))
     return 0
 
 
@@ -111,8 +113,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         "is (8, 0), 10 m away. A corridor wide enough for --robot-radius + --margin is always carved.\n"
         "Prints start, goal and the reference (shortest collision-free) path length.",
         epilog="examples:\n"
-        "  navlab world clutter --seed 3 --fill 0.3 --smooth 2 --out clutter.world --png clutter.png\n"
-        "  navlab sim --world clutter.world --x -2 --y 0 --duration 5",
+        "  navlab world clutter --seed 3 --fill 0.3 --smooth 2 --out clutter --png   # clutter/clutter.world, .png\n"
+        "  navlab sim --world clutter/clutter.world --x -2 --y 0 --duration 5",
     )
     c.add_argument("--seed", type=int, default=0, help="random seed (default 0); same seed, same world")
     c.add_argument("--fill", type=_fraction, default=0.25, help="initial fill probability per cell (default 0.25)")
@@ -121,8 +123,10 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="radius of the robot disc the reference path is planned for (m, default 0.2: mybot)")
     c.add_argument("--margin", type=float, default=0.05,
                    help="extra clearance of the carved corridor beyond the robot radius (m, default 0.05)")
-    c.add_argument("--out", required=True, metavar="FILE.world", help="the .world file to write")
-    c.add_argument("--png", default=None, metavar="FILE.png", help="also draw the world and the reference path")
+    c.add_argument("--out", required=True, metavar="DIR",
+                   help="folder to write clutter.world in (a FILE.world still works this release, deprecated)")
+    c.add_argument("--png", nargs="?", const="", default=None, metavar="FILE.png",
+                   help="also draw the world and the reference path: in FILE.png, or DIR/clutter.png without a value")
     c.add_argument("--json", action="store_true", help="print the summary as one JSON object")
     c.set_defaults(func=_cmd_clutter)
     from navlab.mapping.cli import add_world_office  # the office floor and its recorded logs

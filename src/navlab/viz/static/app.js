@@ -68,7 +68,9 @@ function display(name, dflt) {
   const box = document.createElement("input");
   box.type = "checkbox"; box.checked = dflt; box.dataset.layer = name;
   box.onchange = () => { layers[name] = box.checked; renderer.set({ layers: { [name]: box.checked } }); };
-  label.append(box, " " + name);
+  // long names keep their distinct end ("…local_costmap/costmap", "…local_costmap/footprint"); the whole in a tooltip
+  label.append(box, " " + (name.length > 28 ? "…" + name.slice(-27) : name));
+  label.title = name;
   $("layers").append(label);
 }
 
@@ -138,11 +140,12 @@ function updateStatus(s) {
     if (now - statusMark >= 1000 / STATUS_HZ) {
       statusMark = now;
       if (!seekDragging) $("seek").value = s.t;
-      setText("ttime", `${s.t.toFixed(2)} / ${s.t1.toFixed(2)} s`);
     } else if (!statusTimer) {
       statusTimer = setTimeout(() => { statusTimer = 0; updateStatus(store.state); }, statusMark + 1000 / STATUS_HZ - now);
     }
   }
+  // the same time and precision as the canvas clock (drawClock), on every state, so the two never disagree
+  if (s.replay) setText("ttime", `t = ${s.t.toFixed(1)} / ${s.t1.toFixed(1)} s`);
   setText("pause", s.paused ? "Resume" : "Pause");
   if (!s.replay && document.activeElement !== $("speed") && $("speed").value !== String(s.speed)) $("speed").value = String(s.speed);
   const mb = s.move_base;

@@ -286,6 +286,28 @@ export function drawAxes(ctx, view, T, name, labels) {
   }
 }
 
+// tf frame names: frames within a few pixels of each other (chassis, imu, laser on one robot) share one label
+// ("chassis, imu, laser") instead of printing over each other; labels of nearby groups are stacked downwards
+export function drawFrameLabels(ctx, view, tf) {
+  const groups = [];
+  for (const [name, T] of Object.entries(tf)) {
+    if (!T) continue;
+    const [sx, sy] = view.toScreen(T[0], T[1]);
+    const g = groups.find((q) => Math.hypot(q.sx - sx, q.sy - sy) < 8);
+    if (g) g.names.push(name); else groups.push({ sx, sy, names: [name] });
+  }
+  ctx.fillStyle = "#ccc"; ctx.font = "10px sans-serif";
+  const used = [];
+  for (const g of groups.sort((a, b) => a.sy - b.sy || a.sx - b.sx)) {
+    const text = g.names.sort().join(", ");
+    const w = ctx.measureText(text).width;
+    let y = g.sy - 4;
+    while (used.some((u) => Math.abs(u.y - y) < 11 && g.sx + 4 < u.x + u.w && u.x < g.sx + 4 + w)) y += 11;
+    used.push({ x: g.sx + 4, y, w });
+    ctx.fillText(text, g.sx + 4, y);
+  }
+}
+
 // simulated time, the real-time factor and the pace, in the canvas's bottom-left corner
 export function drawClock(ctx, view, s) {
   const text = `t = ${s.t.toFixed(1)} s   ` + (s.replay ? `replay ${s.speed}x` : `RTF ${s.rtf.toFixed(2)} (${s.speed > 0 ? s.speed + "x" : "max"})`);

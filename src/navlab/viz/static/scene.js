@@ -7,7 +7,7 @@ const MAP_PAL = R.mapPalette(), COST_PAL = R.costmapPalette();
 const ALPHA = (t) => (t.includes("costmap") ? 0.7 : 1.0);
 const gridOrder = (t) => (t.includes("local_costmap") ? 2 : t.includes("costmap") ? 1 : 0);
 const pathColor = (t) => (t.includes("local_plan") ? "#2c2" : t.includes("plan") ? "#36f" : "#dd4");
-const traceColor = (t) => (t.includes("ground_truth") ? "#fff" : "#f90");
+const traceColor = (t) => (t.includes("ground_truth") ? "#1a9e3a" : "#f90"); // truth green (as in the PNGs), visible on white
 // the display each kind of frame belongs to, and whether it is shown before the user says
 export function displayOf(m) {
   switch (m.k) {
@@ -144,7 +144,10 @@ export class Scene {
     }
     for (const [t, f] of Object.entries(st.polygons)) if (this.on(t) && tf[f.frame]) R.drawPolyline(ctx, view, tf[f.frame], f.data, "#0f0", 2, true);
     if (this.on("robot")) R.drawRobot(ctx, view, tf[s.base], "#ff0", 0.2);
-    if (this.on("tf")) for (const [name, T] of Object.entries(tf)) R.drawAxes(ctx, view, T, name, true);
+    if (this.on("tf")) {
+      for (const [name, T] of Object.entries(tf)) R.drawAxes(ctx, view, T, name, false);
+      R.drawFrameLabels(ctx, view, tf);
+    }
     if (this.on("obstacles")) for (const o of s.obstacles || []) R.drawObstacle(ctx, view, o, drag && drag.obstacle === o.name ? "#fff" : "#fa0");
     if (drag && (drag.tool === "goal" || drag.tool === "pose")) {
       R.drawArrow(ctx, view, [drag.x, drag.y, drag.yaw], drag.tool === "goal" ? "#f0f" : "#0f0", 0.5);

@@ -1,0 +1,34 @@
+"""Start-up: every verb's --help and argument errors come before MuJoCo, Numba or Ray are imported."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+_PROBE = r"""
+import contextlib, io, json, sys
+from navlab.cli import build_parser, main
+verbs = sorted(build_parser()._subparsers._group_actions[0].choices)
+cases = [[v, "--help"] for v in verbs] + [[v, "--no-such-option"] for v in verbs]
+cases += [["sim", "--duration", "x"], ["slam", "--log", "no-such.clf", "--out", "out"]]
+codes = {}
+for argv in cases:
+    with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
+        try:
+            code = main(argv)
+        except SystemExit as exc:
+            code = exc.code
+    codes[" ".join(argv)] = code
+heavy = [m for m in ("mujoco", "numba", "ray") if m in sys.modules]
+print(json.dumps({"verbs": verbs, "codes": codes, "heavy": heavy}))
+"""
+
+
+def test_help_and_argument_errors_import_no_mujoco_numba_or_ray(tmp_path):
+    out = subprocess.run([sys.executable, "-c", _PROBE], capture_output=True, text=True, cwd=tmp_path, check=True)
+    got = json.loads(out.stdout)
+    assert len(got["verbs"]) >= 10
+    assert got["heavy"] == [], got["heavy"]
+    for argv, code in got["codes"].items():
+        assert code == (0 if argv.endswith("--help") else 2), (argv, code)
