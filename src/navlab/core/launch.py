@@ -471,7 +471,9 @@ def start(
     if all(xml):
         if "ros" in all_args:
             ros = _truthy(_Context(files[0], {}), all_args.pop("ros"), "ros", "argument ros:=")
-        _start_xml(session, files, all_args, ros=ros, seed=seed)
+        from navlab.core.roslaunch_nodes import start_xml
+
+        start_xml(session, files, all_args, ros=ros, seed=seed)
     else:
         _check_args(files, all_args)
         for file in files:
@@ -491,40 +493,3 @@ def start(
         raise LaunchError(f"{', '.join(map(str, files))}: parameters given for {', '.join(map(repr, unknown))}, but "
                           f"the launch starts no such node (nodes: {', '.join(sorted(started))})")
     return session
-
-
-def _start_xml(session: Session, files: list[Path], args: dict[str, str], *, ros: bool, seed: int) -> None:
-    """ROS 1 XML launch files: read as roslaunch does, then the known nodes started as navlab nodes (in
-    file order) and, with ``ros``, the others as processes."""
-    import logging
-
-    from navlab.core import roslaunch, roslaunch_nodes
-
-    config = roslaunch.load(files, args, seed=seed, allow_commands=ros)
-    plan = roslaunch_nodes.plan(config, ros=ros)
-    log = logging.getLogger("navlab.launch")
-    for note in plan.notes:
-        log.info(note)
-    for warning in plan.warnings:
-        log.warning(warning)
-    session.notes = plan.notes + plan.warnings
-    session.params = config.params
-    for spec in plan.nodes:
-        start_node(session, spec)
-    if plan.processes:
-        from navlab.core.processes import ProcessGroup
-
-        ex = session.executor
-        def required_exit(why: str) -> None:  # roslaunch: a required process that dies ends the launch
-            log.error(why)
-            ex.post(ex.stop)
-
-        group = ProcessGroup(on_required_exit=required_exit)
-        session.processes = group
-        try:
-            for node in plan.processes:
-                group.start(node)
-                log.info(f"process[{node.fqn}]: started ({node.pkg}/{node.type})")
-        except LaunchError:
-            group.stop()
-            raise

@@ -7,7 +7,6 @@ needs besides its parameters (the simulation, for a Gazebo plugin) follow as key
 from __future__ import annotations
 
 import dataclasses
-import enum
 import functools
 import logging
 import sys
@@ -15,12 +14,14 @@ import warnings
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
+from navlab.core.clock import Clock, Time
 from navlab.core.errors import ParameterError
 from navlab.core.executor import Executor
+from navlab.core.parameter import Parameter, SetParametersResult
 from navlab.core.params import ParameterWarning, likely_typo
 from navlab.core.tf import Pose2
 from navlab.core.topics import Publisher, Subscription, Timer, seconds_to_ns
-from navlab.msgs import TFMessage, time_from_ns
+from navlab.msgs import TFMessage
 
 __all__ = [
     "Clock",
@@ -65,56 +66,6 @@ def resolve_name(name: str, namespace: str) -> str:
         return name
     ns = namespace.strip("/")
     return f"/{ns}/{name}" if ns else f"/{name}"
-
-
-@dataclasses.dataclass(frozen=True)
-class Time:
-    """``rclpy.time.Time``: an instant in (simulated) nanoseconds."""
-
-    nanoseconds: int = 0
-    seconds: dataclasses.InitVar[float | None] = None
-
-    def __post_init__(self, seconds: float | None) -> None:
-        if seconds is not None:
-            object.__setattr__(self, "nanoseconds", self.nanoseconds + round(seconds * 1e9))
-
-    def to_msg(self) -> Any:
-        """As ``builtin_interfaces/Time``."""
-        return time_from_ns(self.nanoseconds)
-
-    def seconds_nanoseconds(self) -> tuple[int, int]:
-        """(whole seconds, remaining nanoseconds)."""
-        return divmod(self.nanoseconds, 1_000_000_000)
-
-    @property
-    def sec(self) -> int:
-        """Whole seconds (the message's field)."""
-        return self.nanoseconds // 1_000_000_000
-
-    @property
-    def nanosec(self) -> int:
-        """Nanoseconds past ``sec`` (the message's field)."""
-        return self.nanoseconds % 1_000_000_000
-
-
-class Clock:
-    """Simulated-time clock of an executor."""
-
-    def __init__(self, executor: Executor) -> None:
-        self._executor = executor
-
-    def now_ns(self) -> int:
-        """Current simulated time in nanoseconds."""
-        return self._executor.now_ns
-
-    def now(self) -> Time:
-        """Current simulated time, as rclpy's ``Time`` (``.nanoseconds``, ``.to_msg()``; ``.sec``/``.nanosec``
-        as the message has them)."""
-        return Time(nanoseconds=self._executor.now_ns)
-
-    def seconds(self) -> float:
-        """Current simulated time in seconds."""
-        return self._executor.now_ns / 1e9
 
 
 class _SimTimeAdapter(logging.LoggerAdapter[logging.Logger]):
@@ -488,59 +439,6 @@ class Node:
             if topic is not None and sub in topic.subscriptions:
                 topic.subscriptions.remove(sub)
         self.executor.nodes.pop(self.fully_qualified_name, None)
-
-
-@dataclasses.dataclass(frozen=True)
-class SetParametersResult:
-    """rcl_interfaces/SetParametersResult as rclpy returns it."""
-
-    successful: bool
-    reason: str = ""
-
-
-class ParameterValue:
-    """rclpy's ``get_parameter_value()``: the value under its typed field names."""
-
-    def __init__(self, value: Any) -> None:
-        self.bool_value = value if isinstance(value, bool) else False
-        self.integer_value = value if isinstance(value, int) and not isinstance(value, bool) else 0
-        self.double_value = float(value) if isinstance(value, int | float) and not isinstance(value, bool) else 0.0
-        self.string_value = value if isinstance(value, str) else ""
-        is_list = isinstance(value, list | tuple)
-        self.double_array_value = list(value) if is_list and all(isinstance(v, float) for v in value) else []
-        self.integer_array_value = list(value) if is_list and all(isinstance(v, int) for v in value) else []
-        self.string_array_value = list(value) if is_list and all(isinstance(v, str) for v in value) else []
-        self.bool_array_value = list(value) if is_list and all(isinstance(v, bool) for v in value) else []
-
-
-class Parameter:
-    """``rclpy.parameter.Parameter``: ``name``, ``value`` and ``get_parameter_value()``."""
-
-    class Type(enum.Enum):
-        """rclpy's parameter types (``Parameter.Type.DOUBLE``); navlab takes the type from the value."""
-
-        NOT_SET = 0
-        BOOL = 1
-        INTEGER = 2
-        DOUBLE = 3
-        STRING = 4
-        BYTE_ARRAY = 5
-        BOOL_ARRAY = 6
-        INTEGER_ARRAY = 7
-        DOUBLE_ARRAY = 8
-        STRING_ARRAY = 9
-
-    def __init__(self, name: str, type_: Parameter.Type | None = None, value: Any = None) -> None:
-        self.name = name
-        self.value = value
-        self.type_ = type_
-
-    def get_parameter_value(self) -> ParameterValue:
-        """The value under rclpy's typed field names (``double_value``, ``string_value``, ...)."""
-        return ParameterValue(self.value)
-
-    def __repr__(self) -> str:
-        return f"Parameter({self.name!r}, value={self.value!r})"
 
 
 def _transient_local(qos: Any) -> bool:

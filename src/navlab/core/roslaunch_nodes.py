@@ -21,14 +21,15 @@ navlab/NAME                            the navlab node NAME (``explore``, ``rout
 
 from __future__ import annotations
 
+import logging
 import shlex
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from navlab.core.errors import LaunchError
-from navlab.core.launch import NodeSpec
-from navlab.core.roslaunch import RosConfig, RosNode, ns_join
+from navlab.core.launch import NodeSpec, Session, start_node
+from navlab.core.roslaunch import RosConfig, RosNode, load, ns_join
 
 #: (pkg, type) -> navlab node executable, for nodes whose private parameters pass through unchanged
 DIRECT: dict[tuple[str, str], str] = {
@@ -188,3 +189,36 @@ def _saver_args(node: RosNode) -> dict[str, Any]:
             value: Any = words[i + 1]
             out[flags[word]] = value if word == "-f" else int(value)
     return out
+
+
+def start_xml(session: Session, files: list[Path], args: dict[str, str], *, ros: bool, seed: int) -> None:
+    """ROS 1 XML launch files: read as roslaunch does, then the known nodes started as navlab nodes (in
+    file order) and, with ``ros``, the others as processes."""
+    config = load(files, args, seed=seed, allow_commands=ros)
+    todo = plan(config, ros=ros)
+    log = logging.getLogger("navlab.launch")
+    for note in todo.notes:
+        log.info(note)
+    for warning in todo.warnings:
+        log.warning(warning)
+    session.notes = todo.notes + todo.warnings
+    session.params = config.params
+    for spec in todo.nodes:
+        start_node(session, spec)
+    if todo.processes:
+        from navlab.core.processes import ProcessGroup
+
+        ex = session.executor
+        def required_exit(why: str) -> None:  # roslaunch: a required process that dies ends the launch
+            log.error(why)
+            ex.post(ex.stop)
+
+        group = ProcessGroup(on_required_exit=required_exit)
+        session.processes = group
+        try:
+            for node in todo.processes:
+                group.start(node)
+                log.info(f"process[{node.fqn}]: started ({node.pkg}/{node.type})")
+        except LaunchError:
+            group.stop()
+            raise

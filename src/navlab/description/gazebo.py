@@ -14,8 +14,9 @@ import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field, replace
 from typing import Literal
 
-from navlab.core.limits import check_ceiling
 from navlab.description.errors import DescriptionError
+from navlab.description.gazebo_sensors import IMU_MODEL_PLUGINS, parse_imu, parse_lidar, parse_p3d, sensor_plugin
+from navlab.description.gazebo_values import number, parse_bool, plugin_file, plugin_rate, ros_remaps, scoped
 from navlab.description.materials import gazebo_material
 from navlab.description.model import DiffDriveConfig, ImuConfig, LidarConfig, Link, Origin, P3dConfig, RosControlConfig
 from navlab.description.skid_steer import (
@@ -34,7 +35,6 @@ LASER_PLUGINS = ("libgazebo_ros_laser.so", "libgazebo_ros_gpu_laser.so", "libgaz
 LASER_PLUGIN_NAMES = ("gazebo_ros_laser", "gazebo_ros_ray_sensor", "gazebo_ros_head_rplidar_controller",
                       "gazebo_ros_head_hokuyo_controller")
 IMU_SENSOR_PLUGINS = ("libgazebo_ros_imu_sensor.so",)
-IMU_MODEL_PLUGINS = ("libgazebo_ros_imu.so",)
 #: plugins whose job navlab's simulator does anyway (joint states, ground truth): no warning
 BUILTIN_PLUGINS = ("libgazebo_ros_joint_state_publisher.so",)
 P3D_PLUGINS = ("libgazebo_ros_p3d.so",)
@@ -68,17 +68,10 @@ DD_KEYS_ROS2 = {
     "publish_wheel_tf": "publish_wheel_tf", "command_topic": "command_topic",
     "odometry_topic": "odometry_topic",
 }
-#: tags older laser plugins (or other ones) read that Noetic's gazebo_ros_laser does not: what applies instead
-LASER_NOT_IN_NOETIC = {
-    "gaussianNoise": "the sensor's <ray><noise> (gaussian, stddev)",
-    "hokuyoMinIntensity": "the sensor's intensities as Gazebo computes them",
-    "updateRate": "the sensor's <update_rate>",
-}
 DD_IGNORED = ("alwaysOn", "rosDebugLevel", "publishWheelJointState", "publishOdom", "publish_odom",
               "ros", "num_wheel_pairs", "covariance_x", "covariance_y", "covariance_yaw", "odometryRate")
 FLOAT_FIELDS = ("wheel_separation", "wheel_diameter", "max_torque", "max_accel", "update_rate")
 BOOL_FIELDS = ("publish_tf", "publish_odom", "publish_wheel_tf")
-GAZEBO_DEFAULT_RATE = 1000.0  # Hz: Gazebo's default physics rate; a plugin rate of 0 means every step
 
 
 @dataclass
@@ -93,56 +86,16 @@ class GazeboTags:
     warnings: list[str] = field(default_factory=list)
 
 
-def _bool(text: str, where: str) -> bool:
-    t = text.strip().lower()
-    if t in ("1", "true", "yes"):
-        return True
-    if t in ("0", "false", "no"):
-        return False
-    raise DescriptionError(f"{where}: expected true/false, got {text!r}")
-
-
-def _num(el: ET.Element | None, where: str, default: float) -> float:
-    if el is None or not (el.text or "").strip():
-        return default
-    return floats(el.text, 1, where, f"<{el.tag}>")[0]
-
-
-def _remaps(plugin: ET.Element) -> tuple[str, dict[str, str]]:
-    """ROS 2 ``<ros><namespace>`` and ``<remapping>from:=to</remapping>`` of a plugin."""
-    ros = plugin.find("ros")
-    if ros is None:
-        return "", {}
-    ns = (ros.findtext("namespace") or "").strip()
-    remaps = {}
-    for r in ros.findall("remapping"):
-        src, sep, dst = (r.text or "").partition(":=")
-        if sep:
-            remaps[src.strip()] = dst.strip()
-    return ns, remaps
-
-
-def _scoped(ns: str, topic: str) -> str:
-    """``topic`` in namespace ``ns`` (absolute topics stay as they are)."""
-    if not ns or topic.startswith("/"):
-        return topic
-    return "/" + ns.strip("/") + "/" + topic.lstrip("~/")
-
-
 def _did_you_mean(key: str, choices: list[str]) -> str:
     close = difflib.get_close_matches(key, choices, n=1)
     return f" (did you mean <{close[0]}>?)" if close else ""
-
-
-def _rate(value: float) -> float:
-    return GAZEBO_DEFAULT_RATE if value <= 0 else value
 
 
 def parse_diff_drive(plugin: ET.Element, where: str, warnings: list[str]) -> DiffDriveConfig:
     """The ROS 1 or ROS 2 ``libgazebo_ros_diff_drive.so`` plugin parameters."""
     cfg = DiffDriveConfig()
     values: dict[str, str] = {}
-    ns, remaps = _remaps(plugin)
+    ns, remaps = ros_remaps(plugin)
     known = [*DD_KEYS_ROS1, *DD_KEYS_ROS2, *DD_IGNORED]
     for child in plugin:
         if not isinstance(child.tag, str):
@@ -167,9 +120,9 @@ def parse_diff_drive(plugin: ET.Element, where: str, warnings: list[str]) -> Dif
                 raise DescriptionError(f"{w}: must be positive, got {v}")
             if key in ("max_torque", "max_accel") and v < 0:
                 raise DescriptionError(f"{w}: must be >= 0, got {v}")
-            setattr(cfg, key, _rate(v) if key == "update_rate" else v)
+            setattr(cfg, key, plugin_rate(v) if key == "update_rate" else v)
         elif key in BOOL_FIELDS:
-            setattr(cfg, key, _bool(raw, where + f" ({key})"))
+            setattr(cfg, key, parse_bool(raw, where + f" ({key})"))
         elif key == "odometry_source":
             sources: dict[str, Literal["encoder", "world"]] = {
                 "0": "encoder", "1": "world", "encoder": "encoder", "world": "world"}  # fmt: skip
@@ -185,165 +138,13 @@ def parse_diff_drive(plugin: ET.Element, where: str, warnings: list[str]) -> Dif
         cfg.command_topic = remaps["cmd_vel"]
     if "odom" in remaps:
         cfg.odometry_topic = remaps["odom"]
-    cfg.command_topic = _scoped(cfg.namespace, cfg.command_topic)
-    cfg.odometry_topic = _scoped(cfg.namespace, cfg.odometry_topic)
+    cfg.command_topic = scoped(cfg.namespace, cfg.command_topic)
+    cfg.odometry_topic = scoped(cfg.namespace, cfg.odometry_topic)
     return cfg
 
 
-def _noetic_default(plugin: ET.Element, tag: str, default: str, what: str, where: str, warnings: list[str]) -> str:
-    """``<tag>`` of a ROS 1 plugin, or Noetic's default for it (with a warning naming the tag and the default)."""
-    text = plugin.findtext(tag)
-    if text is None:
-        warnings.append(f"{where}: no <{tag}>: ROS Noetic's {what} then uses {default!r}, and so does navlab")
-        return default
-    return text.strip()
-
-
-def _noise(el: ET.Element | None, where: str) -> tuple[float, float]:
-    """(mean, stddev) of a ``<noise>`` element (gaussian only; others warn-free zero)."""
-    if el is None:
-        return 0.0, 0.0
-    kind = (el.findtext("type") or el.get("type") or "gaussian").strip()
-    if kind == "none":
-        return 0.0, 0.0
-    return _num(el.find("mean"), where, 0.0), _num(el.find("stddev"), where, 0.0)
-
-
-def _sensor_plugin(sensor: ET.Element) -> ET.Element | None:
-    return sensor.find("plugin")
-
-
-def parse_lidar(sensor: ET.Element, link: str, where: str, plugin: ET.Element,
-                warnings: list[str]) -> LidarConfig:
-    """A ray/gpu_ray ``<sensor>`` with a ROS laser plugin."""
-    pose = floats(sensor.findtext("pose") or "0 0 0 0 0 0", 6, where, "<pose>")
-    ray = sensor.find("ray")
-    if ray is None:
-        ray = sensor.find("lidar")  # SDF >= 1.7 spelling
-    if ray is None:
-        raise DescriptionError(f"{where}: a {sensor.get('type')} sensor needs a <ray> element")
-    hor = ray.find("scan/horizontal")
-    if hor is None:
-        raise DescriptionError(f"{where}/<ray>: missing <scan><horizontal>")
-    samples = int(_num(hor.find("samples"), where + "/<horizontal>", 640))
-    if samples < 1:
-        raise DescriptionError(f"{where}/<horizontal>/<samples>: must be >= 1, got {samples}")
-    check_ceiling(DescriptionError, f"{where}/<horizontal>", "<samples>", samples, "lidar_samples")
-    vert = ray.find("scan/vertical/samples")
-    if vert is not None and int(float(vert.text or "1")) > 1:
-        warnings.append(f"{where}: {vert.text} vertical samples; only the horizontal plane is simulated")
-    rng = ray.find("range")
-    rw = where + "/<range>"
-    range_min = _num(rng.find("min") if rng is not None else None, rw, 0.0)
-    range_max = _num(rng.find("max") if rng is not None else None, rw, 10.0)
-    if not 0 <= range_min < range_max:
-        raise DescriptionError(f"{rw}: expected 0 <= min < max, got min {range_min}, max {range_max}")
-    mean, std = _noise(ray.find("noise") if ray.find("noise") is not None else sensor.find("noise"), where)
-    ns, remaps = _remaps(plugin)
-    name = plugin.get("name", "")
-    ros2 = plugin.find("ros") is not None or _plugin_file(plugin) == "libgazebo_ros_ray_sensor.so"
-    if not ros2:  # ROS 1: <topicName>, <frameName>, <robotNamespace>, with Noetic's defaults
-        ns = (plugin.findtext("robotNamespace") or "").strip()
-        topic = _noetic_default(plugin, "topicName", "/world", "gazebo_ros_laser", where, warnings)
-        frame = _noetic_default(plugin, "frameName", "/world", "gazebo_ros_laser", where, warnings)
-        for tag, read in LASER_NOT_IN_NOETIC.items():
-            if plugin.find(tag) is not None:
-                warnings.append(f"{where}: <{tag}> is not read by ROS Noetic's gazebo_ros_laser; {read} applies")
-    else:  # ROS 2: node named after the plugin publishes ~/out unless remapped
-        topic = remaps.get("~/out") or remaps.get("out") or f"{name or 'ray_sensor'}/out"
-        frame = (plugin.findtext("frame_name") or plugin.findtext("frameName") or "").strip()
-        out_type = (plugin.findtext("output_type") or "sensor_msgs/LaserScan").strip()
-        if out_type.replace("/msg/", "/") != "sensor_msgs/LaserScan":
-            warnings.append(f"{where}: output_type {out_type} not supported; publishing sensor_msgs/LaserScan")
-    return LidarConfig(
-        link=link,
-        origin=Origin.from_pose6(pose),
-        update_rate=_rate(_num(sensor.find("update_rate"), where, 0.0)),
-        samples=samples,
-        min_angle=_num(hor.find("min_angle"), where, 0.0),
-        max_angle=_num(hor.find("max_angle"), where, 0.0),
-        range_min=range_min,
-        range_max=range_max,
-        range_resolution=_num(rng.find("resolution") if rng is not None else None, rw, 0.0),
-        noise_mean=mean,
-        noise_stddev=std,
-        topic=_scoped(ns, topic or "scan"),
-        frame_id=frame.lstrip("/") or link,
-        name=sensor.get("name", "laser"),
-    )
-
-
-def _imu_noise(sensor: ET.Element | None, where: str) -> tuple[float, float]:
-    """(gyro stddev, accel stddev) from an SDF ``<imu>`` block (first axis that has noise)."""
-    if sensor is None or sensor.find("imu") is None:
-        return 0.0, 0.0
-    imu = sensor.find("imu")
-    out = []
-    for group in ("angular_velocity", "linear_acceleration"):
-        std = 0.0
-        for axis in ("x", "y", "z"):
-            noise = imu.find(f"{group}/{axis}/noise") if imu is not None else None
-            if noise is not None:
-                std = _noise(noise, where)[1]
-                break
-        out.append(std)
-    legacy = imu.find("noise") if imu is not None else None  # SDF 1.4 <imu><noise><rate>/<accel>
-    if legacy is not None:
-        out[0] = out[0] or _num(legacy.find("rate/stddev"), where, 0.0)
-        out[1] = out[1] or _num(legacy.find("accel/stddev"), where, 0.0)
-    return out[0], out[1]
-
-
-def parse_imu(plugin: ET.Element, link: str, where: str, sensor: ET.Element | None) -> ImuConfig:
-    """An IMU from a sensor plugin (``gazebo_ros_imu_sensor``) or the ROS 1 model plugin ``gazebo_ros_imu``."""
-    gyro, accel = _imu_noise(sensor, where)
-    if not (gyro or accel):  # the ROS 1 model plugin carries an SDF-1.4-style <imu><noise> block itself
-        gyro, accel = _imu_noise(plugin, where)
-    gaussian = _num(plugin.find("gaussianNoise"), where, 0.0)
-    ns, remaps = _remaps(plugin)
-    if plugin.find("ros") is None:  # ROS 1: <topicName>, <frameName>/<bodyName>, <robotNamespace>
-        ns = (plugin.findtext("robotNamespace") or "").strip()
-        topic = (_noetic_default(plugin, "topicName", "/default_imu", "gazebo_ros_imu", where, [])
-                 if _plugin_file(plugin) in IMU_MODEL_PLUGINS else (plugin.findtext("topicName") or "imu").strip())
-        frame = (plugin.findtext("frameName") or plugin.findtext("bodyName") or link).strip()
-    else:
-        topic = remaps.get("~/out") or remaps.get("out") or f"{plugin.get('name') or 'imu'}/out"
-        frame = (plugin.findtext("frame_name") or link).strip()
-    rate = _num(plugin.find("updateRateHZ"), where, 0.0) or _num(plugin.find("updateRate"), where, 0.0)
-    if sensor is not None and not rate:
-        rate = _num(sensor.find("update_rate"), where, 0.0)
-    pose = floats((sensor.findtext("pose") if sensor is not None else None) or "0 0 0 0 0 0", 6, where, "<pose>")
-    return ImuConfig(
-        link=link, origin=Origin.from_pose6(pose),
-        update_rate=_rate(rate), topic=_scoped(ns, topic), frame_id=frame.lstrip("/"),
-        gyro_noise_stddev=gyro or gaussian, accel_noise_stddev=accel or gaussian,
-        name=(sensor.get("name", "imu") if sensor is not None else plugin.get("name", "imu")),
-    )
-
-
-def parse_p3d(plugin: ET.Element, where: str, warnings: list[str]) -> P3dConfig | None:
-    """A ROS 1 ``libgazebo_ros_p3d`` plugin as Noetic reads it: ``bodyName`` and ``topicName`` required (without
-    them the plugin does not load: a warning, and nothing published), ``frameName`` default ``world``,
-    ``updateRate`` default 0 (every physics step), ``robotNamespace`` in front of a relative topic."""
-    missing = [t for t in ("bodyName", "topicName") if not (plugin.findtext(t) or "").strip()]
-    if missing:
-        warnings.append(f"{where}: no <{missing[0]}>: ROS Noetic's gazebo_ros_p3d does not load without it; "
-                        "nothing is published")
-        return None
-    ns = (plugin.findtext("robotNamespace") or "").strip()
-    return P3dConfig(link=str(plugin.findtext("bodyName")).strip(),
-                     topic=_scoped(ns, str(plugin.findtext("topicName")).strip()),
-                     frame_id=(plugin.findtext("frameName") or "world").strip().lstrip("/") or "world",
-                     update_rate=_rate(_num(plugin.find("updateRate"), where, 0.0)),
-                     name=plugin.get("name") or "p3d")
-
-
-def _plugin_file(plugin: ET.Element) -> str:
-    return (plugin.get("filename") or "").rsplit("/", 1)[-1]
-
-
 def _is_laser_plugin(plugin: ET.Element) -> bool:
-    return _plugin_file(plugin) in LASER_PLUGINS or plugin.get("name", "") in LASER_PLUGIN_NAMES
+    return plugin_file(plugin) in LASER_PLUGINS or plugin.get("name", "") in LASER_PLUGIN_NAMES
 
 
 def read_gazebo_tags(root: ET.Element, links: dict[str, Link], joint_names: set[str], source: str) -> GazeboTags:
@@ -361,7 +162,7 @@ def read_gazebo_tags(root: ET.Element, links: dict[str, Link], joint_names: set[
             if not isinstance(child.tag, str):
                 continue
             if ref is not None and child.tag in ("mu1", "mu2"):
-                mu = _num(child, f"{where}/<{child.tag}>", 0.0)
+                mu = number(child, f"{where}/<{child.tag}>", 0.0)
                 if mu < 0:
                     raise DescriptionError(f"{where}/<{child.tag}>: friction {mu}: expected >= 0")
                 setattr(links[ref], child.tag, mu)
@@ -401,7 +202,7 @@ def _read_sensor(sensor: ET.Element, link: str, where: str, out: GazeboTags,
                  imu_sensors: dict[str, ET.Element]) -> None:
     stype = sensor.get("type", "")
     w = f"{where}/<sensor name=\"{sensor.get('name', '')}\" type=\"{stype}\">"
-    plugin = _sensor_plugin(sensor)
+    plugin = sensor_plugin(sensor)
     if stype in ("ray", "gpu_ray", "lidar", "gpu_lidar"):
         if plugin is None:
             out.warnings.append(f"{w}: no ROS plugin, so nothing is published; sensor ignored")
@@ -411,7 +212,7 @@ def _read_sensor(sensor: ET.Element, link: str, where: str, out: GazeboTags,
         else:
             out.lidars.append(parse_lidar(sensor, link, w, plugin, out.warnings))
     elif stype == "imu":
-        if plugin is not None and _plugin_file(plugin) in IMU_SENSOR_PLUGINS:
+        if plugin is not None and plugin_file(plugin) in IMU_SENSOR_PLUGINS:
             out.imus.append(parse_imu(plugin, link, w, sensor))
         elif plugin is not None:
             out.warnings.append(f"{w}: unknown plugin {plugin.get('filename')!r}; sensor ignored")
@@ -423,7 +224,7 @@ def _read_sensor(sensor: ET.Element, link: str, where: str, out: GazeboTags,
 
 
 def _read_model_plugin(plugin: ET.Element, where: str, out: GazeboTags) -> None:
-    fname = _plugin_file(plugin)
+    fname = plugin_file(plugin)
     w = f"{where}/<plugin name=\"{plugin.get('name', '')}\" filename=\"{plugin.get('filename', '')}\">"
     if fname in DIFF_DRIVE_PLUGINS:
         if out.diff_drive is not None:

@@ -13,6 +13,7 @@ from __future__ import annotations
 import xml.etree.ElementTree as ET
 
 from navlab.description.errors import DescriptionError
+from navlab.description.gazebo_values import scoped
 from navlab.description.model import ContactTags, DiffDriveConfig, RosControlConfig
 from navlab.description.urdf import floats
 
@@ -49,11 +50,6 @@ def _unknown(plugin: ET.Element, known: tuple[str, ...], where: str, warnings: l
             warnings.append(f"{where}: unknown parameter <{child.tag}> ignored{hint}")
 
 
-def _scoped(ns: str, topic: str) -> str:
-    ns = ns.strip("/")
-    return topic if not ns or topic.startswith("/") else f"/{ns}/{topic}"
-
-
 def parse_skid_steer(plugin: ET.Element, where: str, warnings: list[str]) -> DiffDriveConfig:
     """``libgazebo_ros_skid_steer_drive.so``'s parameters as a four-wheel :class:`DiffDriveConfig`."""
     _unknown(plugin, SKID_KEYS, where, warnings)
@@ -72,8 +68,8 @@ def parse_skid_steer(plugin: ET.Element, where: str, warnings: list[str]) -> Dif
         wheel_diameter=_number(plugin, "wheelDiameter", 0.15, where),
         max_torque=_number(plugin, "torque", 5.0, where, positive=False),
         update_rate=_number(plugin, "updateRate", 100.0, where, positive=False) or 1000.0,
-        command_topic=_scoped(ns, _text(plugin, "commandTopic", "cmd_vel")),
-        odometry_topic=_scoped(ns, _text(plugin, "odometryTopic", "odom")),
+        command_topic=scoped(ns, _text(plugin, "commandTopic", "cmd_vel")),
+        odometry_topic=scoped(ns, _text(plugin, "odometryTopic", "odom")),
         odometry_frame=_text(plugin, "odometryFrame", "odom"),
         robot_base_frame=_text(plugin, "robotBaseFrame", "base_footprint"),
         odometry_source="world",  # the plugin's odometry is the model's pose ("TODO create some non-perfect odometry")

@@ -65,6 +65,7 @@ from navlab.grid import Grid
 from navlab.navigation.controllers import mapgrid
 from navlab.navigation.controllers.common import (
     GoalLatch,
+    InPlaceFlags,
     LocalFrame,
     OscillationFlags,
     as_plan,
@@ -314,46 +315,6 @@ class RolloutController:
 
 
 # --- base_local_planner/TrajectoryPlannerROS ----------------------------------------------------------
-
-
-class InPlaceFlags:
-    """TrajectoryPlanner's guard against turning on the spot back and forth (``stuck_left``/``stuck_right``).
-
-    Each in-place turn (v <= 0) is recorded with the pose it was chosen at; once the robot turned in place the
-    same way twice, in-place turns the other way are no longer tried. Everything is forgotten when the robot is
-    more than ``reset_dist`` m from the last in-place turn's pose.
-    """
-
-    def __init__(self, reset_dist: float) -> None:
-        self.reset_dist = reset_dist
-        self.prev = (0.0, 0.0)
-        self.reset()
-
-    def reset(self) -> None:
-        """Clear every flag."""
-        self.rotating_left = self.rotating_right = self.stuck_left = self.stuck_right = False
-
-    def allowed(self, w: np.ndarray) -> np.ndarray:
-        """Mask of the in-place turn rates (rad/s) that may be tried (ROS: w < 0 unless ``stuck_left``, w > 0
-        unless ``stuck_right``)."""
-        return ((w < 0) & (not self.stuck_left)) | ((w > 0) & (not self.stuck_right))
-
-    def moved(self, pose: tuple[float, float, float]) -> None:
-        """Forget the flags once the robot is far enough from the last in-place turn."""
-        if math.hypot(pose[0] - self.prev[0], pose[1] - self.prev[1]) > self.reset_dist:
-            self.reset()
-
-    def update(self, pose: tuple[float, float, float], v: float, w: float) -> None:
-        """Record the chosen command (v m/s, w rad/s) at ``pose``."""
-        if not v > 0:
-            if w < 0:
-                self.stuck_right |= self.rotating_right
-                self.rotating_right = True
-            elif w > 0:
-                self.stuck_left |= self.rotating_left
-                self.rotating_left = True
-            self.prev = (pose[0], pose[1])
-        self.moved(pose)
 
 
 class TrajectoryPlannerROS(RolloutController):
