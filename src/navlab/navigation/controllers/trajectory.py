@@ -18,7 +18,8 @@ best one's velocity:
   highest cost under the edges or at the centre cell (``occdist`` takes the highest along the rollout).
   Without a polygon or radius the robot is a point: its centre cell, blocked from INSCRIBED up;
 - *TrajectoryPlanner cost* = pdist_scale * path_dist + gdist_scale * goal_dist + occdist_scale *
-  max_cost, distances at the rollout's end (in cells, or metres with ``meter_scoring``); a rollout that
+  max_cost, distances at the rollout's end (in cells; ``meter_scoring`` multiplies pdist_scale and gdist_scale
+  by the resolution, occdist_scale stays as given, as in ROS 1 noetic); a rollout that
   leaves the map, is blocked, or passes a cell with no path to the plan or goal is rejected (the first failure
   in time decides the code, -1 or -2). With ``heading_scoring`` every rollout has sim_time / sim_granularity
   steps, the distances count at the step at ``heading_scoring_timestep`` only, and 0.3 x the angle from the
@@ -397,7 +398,10 @@ class TrajectoryPlannerROS(RolloutController):
         else:  # numpy's cos/sin, as occupancy_costs
             c, s = np.cos(traj[..., 2]), np.sin(traj[..., 2])
             ox, oy = np.ascontiguousarray(outline[:, 0]), np.ascontiguousarray(outline[:, 1])
-        weights = np.array([res if p.meter_scoring else 1.0, p.pdist_scale, p.gdist_scale, p.occdist_scale])
+        # meter_scoring scales the distance biases by the resolution, not occdist_scale (ROS 1 since the biases'
+        # renaming: TrajectoryPlannerROS::initialize and TrajectoryPlanner::reconfigure)
+        scale = res if p.meter_scoring else 1.0
+        weights = np.array([1.0, scale * p.pdist_scale, scale * p.gdist_scale, p.occdist_scale])
         cost = np.empty(traj.shape[0])
         at = self._heading_step(traj.shape[1])
         _rollout_scores(grid, grid if near is None else near, np.ascontiguousarray(scene.path_dist),
@@ -418,7 +422,9 @@ class TrajectoryPlannerROS(RolloutController):
         horizon = p.sim_period if p.dwa else p.sim_time
         vmax = min(p.max_vel_x, math.hypot(lg[0] - x, lg[1] - y) / p.sim_time)
         vmax = max(min(vmax, v0 + p.acc_lim_x * horizon), p.min_vel_x)
-        vmin = min(max(p.min_vel_x, v0 - p.acc_lim_x * horizon), vmax)
+        # not clamped to vmax: a robot faster than the local goal's cap samples from its reachable lowest speed
+        # down to the cap, as createTrajectories does (its dvx is then negative)
+        vmin = max(p.min_vel_x, v0 - p.acc_lim_x * horizon)
         wmax = min(p.max_vel_theta, w0 + p.acc_lim_theta * horizon)
         wmin = min(max(p.min_vel_theta, w0 - p.acc_lim_theta * horizon), wmax)
         # ROS's order: per speed the straight rollout, then vtheta_samples - 1 turn rates from the lowest up
