@@ -11,9 +11,9 @@ from pathlib import Path
 import pytest
 
 from navlab.cli import main
-from navlab.experiments.truth import true_map
 from navlab.mapping.mapfile import save_map
 from navlab.sim.gazebo import load_world_named
+from navlab.world.truth import true_map
 
 SVG = "{http://www.w3.org/2000/svg}"
 

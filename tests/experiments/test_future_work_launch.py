@@ -15,10 +15,10 @@ from navlab.core import Node
 from navlab.core.launch import start
 from navlab.errors import NavlabError
 from navlab.experiments.navigate_run import sim_launch_args
-from navlab.experiments.truth import true_map
 from navlab.mapping import save_map
 from navlab.navigation.errors import NavigationError
 from navlab.sim.gazebo import load_world_named
+from navlab.world.truth import true_map
 
 
 class _Watch(Node):

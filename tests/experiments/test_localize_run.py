@@ -11,10 +11,10 @@ import pytest
 
 from navlab.cli import main
 from navlab.experiments.localize_run import run_localization
-from navlab.experiments.truth import true_map
 from navlab.localization import LocalizationError
 from navlab.mapping.mapfile import save_map
 from navlab.sim.gazebo import load_world_named
+from navlab.world.truth import true_map
 
 
 def test_tracking_on_a_saved_map_along_a_60_s_route(tmp_path: Path) -> None:

@@ -16,10 +16,10 @@ import pytest
 from navlab.cli import main
 from navlab.errors import NavlabError
 from navlab.experiments.navigate_run import run_navigation
-from navlab.experiments.truth import true_map
 from navlab.mapping.mapfile import save_map
 from navlab.sim.gazebo import load_world_named
 from navlab.sim.spawn import primitive_model
+from navlab.world.truth import true_map
 
 # Goals spread over room.world's free space (map frame = world frame), visited in this order.
 ROOM_GOALS = [(3.5, 3.0, 1.57), (0.5, 2.5, 3.14), (-3.5, 3.0, 3.14), (-3.5, 0.0, -1.57), (-4.0, -3.0, -1.57),

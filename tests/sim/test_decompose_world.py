@@ -1,5 +1,5 @@
 """Issue 13 item 11: a world's concave meshes are decomposed once, in parallel, into a cache keyed by
-their content (fixture: navlab.sim.decompose_bench.furnished_world)."""
+their content (fixture: navlab.bench.decompose.furnished_world)."""
 
 from __future__ import annotations
 
@@ -9,8 +9,8 @@ import shutil
 import numpy as np
 import pytest
 
+from navlab.bench.decompose import furnished_world
 from navlab.sim import decompose
-from navlab.sim.decompose_bench import furnished_world
 from navlab.world import load_world
 
 

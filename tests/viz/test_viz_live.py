@@ -16,7 +16,7 @@ import pytest
 from viz_helpers import canvas_xy, open_page, pixel, to_screen
 
 from navlab.experiments.session import Run, start_run
-from navlab.viz.cli import _true_map
+from navlab.mapping import save_true_map
 from navlab.viz.viewer import Viewer, attach
 
 
@@ -24,7 +24,8 @@ from navlab.viz.viewer import Viewer, attach
 def live() -> Iterator[tuple[Run, Viewer]]:
     """The paper's navigation launch in room_obstacles, watched at 5x real time, its executor in a thread."""
     with tempfile.TemporaryDirectory() as tmp:
-        run = start_run("navigation", world="room_obstacles", map=_true_map("room_obstacles", (0, 0, 0), Path(tmp)))
+        truth = save_true_map("room_obstacles", (0, 0), Path(tmp) / "true_map.yaml")
+        run = start_run("navigation", world="room_obstacles", map=str(truth))
     viewer = attach(run.executor, port=0, speed=5.0)
     thread = threading.Thread(target=lambda: run.run(3600.0, quiet=True), daemon=True)
     thread.start()

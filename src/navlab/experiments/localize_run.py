@@ -22,10 +22,10 @@ from navlab.experiments.metrics import settled_after, trajectory_error
 from navlab.experiments.monitors import PoseMonitor
 from navlab.experiments.plots import ErrorPanel, Marks, Track, plot_run
 from navlab.experiments.session import rounded, start_run
-from navlab.experiments.truth import true_map, unmapped_obstacles
 from navlab.geometry import wrap_angle
 from navlab.grid import GridMap
 from navlab.localization.errors import LocalizationError
+from navlab.world.truth import true_map, unmapped_obstacles
 
 # A 17.5 m loop through room.world / room_obstacles.world, at least 0.5 m from every obstacle.
 DEFAULT_ROUTE: tuple[tuple[float, float], ...] = (

@@ -19,12 +19,12 @@ from navlab.experiments.metrics import free_coverage, score_map, trajectory_erro
 from navlab.experiments.monitors import PoseMonitor
 from navlab.experiments.plots import Marks, Track, plot_run
 from navlab.experiments.session import Run, rounded, start_run
-from navlab.experiments.truth import true_occupancy, world_T_map
 from navlab.geometry import inverse_transform_points2, wrap_angle
 from navlab.grid import GridMap
 from navlab.io.files import check_regular_file
 from navlab.mapping.errors import MappingError
 from navlab.mapping.mapfile import save_map
+from navlab.world.truth import true_occupancy, world_T_map
 
 DRIVERS = ("explore", "teleop", "route")
 WARMUP_S = 5.0  # simulated s of `bench`'s untimed warm-up run

@@ -26,10 +26,10 @@ from navlab.core.record import Recorder
 from navlab.experiments.metrics import distance_to_path
 from navlab.experiments.plots import NavSnapshot
 from navlab.experiments.session import Run, rounded, start_run
-from navlab.experiments.truth import true_map, unmapped_obstacles
 from navlab.geometry import compose2, transform_points2
 from navlab.grid import Grid, GridMap
 from navlab.navigation.errors import NavigationError
+from navlab.world.truth import true_map, unmapped_obstacles
 
 if TYPE_CHECKING:
     from navlab.navigation.move_base import MoveBase

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import json
 
+from navlab.cli.options import add_run_options
 from navlab.errors import NavlabError
 
 
@@ -57,7 +58,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("kind", choices=("robot", "world"), help="what FILE is")
     p.add_argument("file", help="path of the .xacro/.urdf or .world file, or a shipped name "
                    "(robot: mybot; world: room, room_obstacles)")
-    p.add_argument("--json", action="store_true", help="print the summary as one JSON object")
+    add_run_options(p, json=True)
     p.add_argument("--package-path", action="append", default=[], metavar="DIR",
                    help="robot: a directory holding ROS packages for $(find pkg) and package:// "
                    "(repeatable; ROS_PACKAGE_PATH is also searched)")

@@ -130,13 +130,13 @@ def _load() -> float | None:
 
 def run(args: Any) -> dict[str, Any]:
     """Run the benchmark; see the module docstring."""
-    from navlab.viz.cli import _true_map
+    from navlab.mapping import save_true_map
 
     if not Path(CHROMIUM).exists():
         raise VizError(f"navlab bench view needs chromium at {CHROMIUM}")
     seed = int(getattr(args, "seed", 0))
     folder = Path(tempfile.mkdtemp(prefix="navlab-bench-view-"))
-    map_yaml = _true_map("room", (0.0, 0.0, 0.0), folder)
+    map_yaml = str(save_true_map("room", (0.0, 0.0), folder / "true_map.yaml"))
     shot = folder / "obstacle_experiment.png"
     rounds = int(getattr(args, "rounds", ROUNDS) or ROUNDS)
     _drive(map_yaml, seed=seed)  # warm-up: Numba's caches, imports

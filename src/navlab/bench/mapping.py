@@ -53,9 +53,9 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
 
 def office_truth(resolution: float = 0.05) -> Any:
     """The default office floor's true occupancy (a boolean ``Grid``, world frame)."""
-    from navlab.experiments.truth import truth_grid
     from navlab.world import load_world, occupancy
     from navlab.world.office import generate_office
+    from navlab.world.truth import truth_grid
 
     office = generate_office()
     with tempfile.TemporaryDirectory(prefix="navlab-office-") as tmp:
@@ -120,7 +120,7 @@ def run_gmapping(args: argparse.Namespace) -> dict[str, Any]:
     the relations metric of its poses (the filter plus the offline refinement, slam_gmapping's defaults)."""
     import sys
 
-    from navlab.core.bench import run_child
+    from navlab.bench.core import run_child
     from navlab.experiments.metrics import read_relations, relations_error
     from navlab.io.datasets import dataset
 
