@@ -85,12 +85,13 @@ DEMO_GOALS = [(4.3, 1.0, 0.0), (-3.5, -0.5, 3.14), (1.5, -2.5, 0.0)]
 
 def _render(path: Path) -> str:
     """Picture of the paper's robot among the obstacles; skipped (with the reason) without OpenGL."""
-    from navlab.sim.gazebo import load_robot_named, load_world_named
+    from navlab.description import load_robot_named
     from navlab.sim.render import render_image, save_png
     from navlab.sim.simulation import Simulation
+    from navlab.world import load_world
 
     try:
-        sim = Simulation(load_robot_named("mybot"), load_world_named("room_obstacles"), visuals=True)
+        sim = Simulation(load_robot_named("mybot"), load_world("room_obstacles"), visuals=True)
         sim.advance_to(200_000_000)
         return str(save_png(render_image(sim, width=960, height=720), path))
     except Exception as exc:  # no EGL/OSMesa on this machine: the rest of the demo still runs

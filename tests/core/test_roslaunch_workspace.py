@@ -71,8 +71,7 @@ def test_my_slam_maps_the_room() -> None:
 
 def test_my_navigation_reaches_a_goal_with_the_models_costmap_files(tmp_path: Path) -> None:
     from navlab.mapping.mapfile import save_map
-    from navlab.world import load_world
-    from navlab.world.truth import true_map
+    from navlab.world import load_world, true_map
 
     save_map(true_map(load_world(WS / "my_gazebo" / "worlds" / "my_room.world"), (0.0, 0.0)), tmp_path / "map.yaml")
     session = start([WORLD, WS / "my_navigation" / "launch" / "my_navigation.launch"],

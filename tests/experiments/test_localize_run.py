@@ -13,12 +13,11 @@ from navlab.cli import main
 from navlab.experiments.localize_run import run_localization
 from navlab.localization import LocalizationError
 from navlab.mapping.mapfile import save_map
-from navlab.sim.gazebo import load_world_named
-from navlab.world.truth import true_map
+from navlab.world import load_world, true_map
 
 
 def test_tracking_on_a_saved_map_along_a_60_s_route(tmp_path: Path) -> None:
-    grid = true_map(load_world_named("room_obstacles"), (0.0, 0.0))
+    grid = true_map(load_world("room_obstacles"), (0.0, 0.0))
     save_map(grid, tmp_path / "room.yaml")
     res = run_localization("room_obstacles", tmp_path / "room.yaml", duration=60.0, seed=0)
     s = res.summary

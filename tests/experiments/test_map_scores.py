@@ -5,7 +5,7 @@ import pytest
 
 from navlab.experiments.metrics import free_coverage, score_map, trajectory_error
 from navlab.grid import Grid, GridMap
-from navlab.world.truth import truth_grid
+from navlab.world import truth_grid
 
 
 def _truth() -> Grid:

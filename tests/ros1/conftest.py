@@ -45,9 +45,8 @@ def ros_env(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, str]
 @pytest.fixture(scope="session")
 def room_map(tmp_path_factory: pytest.TempPathFactory) -> Path:
     from navlab.mapping.mapfile import save_map
-    from navlab.sim.gazebo import load_world_named
-    from navlab.world.truth import true_map
+    from navlab.world import load_world, true_map
 
     path = tmp_path_factory.mktemp("map") / "room.yaml"
-    save_map(true_map(load_world_named("room"), (0.0, 0.0)), path)
+    save_map(true_map(load_world("room"), (0.0, 0.0)), path)
     return path

@@ -53,9 +53,8 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
 
 def office_truth(resolution: float = 0.05) -> Any:
     """The default office floor's true occupancy (a boolean ``Grid``, world frame)."""
-    from navlab.world import load_world, occupancy
+    from navlab.world import load_world, occupancy, truth_grid
     from navlab.world.office import generate_office
-    from navlab.world.truth import truth_grid
 
     office = generate_office()
     with tempfile.TemporaryDirectory(prefix="navlab-office-") as tmp:

@@ -67,16 +67,16 @@ def _cmd_eval_trajectory(args: argparse.Namespace) -> int:
 
 def _cmd_eval_map(args: argparse.Namespace) -> int:
     """Score a saved map against a world's true occupancy (start pose known, no alignment)."""
+    from navlab.description import load_robot_named
     from navlab.experiments.mapping_run import read_trajectory
     from navlab.experiments.metrics import free_coverage, score_map, trajectory_error
     from navlab.experiments.session import rounded
     from navlab.mapping.mapfile import load_map
-    from navlab.sim.gazebo import load_robot_named, load_world_named
-    from navlab.world.truth import true_occupancy, world_T_map
+    from navlab.world import load_world, true_occupancy, world_T_map
 
     apply_resource_paths(args)
     grid = load_map(args.map)
-    truth = true_occupancy(load_world_named(args.world), grid)
+    truth = true_occupancy(load_world(args.world), grid)
     start = start_pose(args)
     map_in_world = world_T_map(load_robot_named(args.robot), start)  # the odometry source decides
     scores: dict[str, Any] = {"map_frame_in_world": list(map_in_world)}

@@ -161,13 +161,14 @@ def _one_shot(node: Any, t: float, fn: Any) -> None:
 
 
 def _cmd_render(args: argparse.Namespace) -> int:
-    from navlab.sim.gazebo import load_robot_named, load_world_named
+    from navlab.description import load_robot_named
     from navlab.sim.render import render_image, save_png
     from navlab.sim.simulation import Simulation
     from navlab.sim.spawn import check_start_pose, parse_spawn_spec
+    from navlab.world import load_world
 
     apply_resource_paths(args)
-    world = load_world_named(args.world)
+    world = load_world(args.world)
     robot = None if args.no_robot else load_robot_named(args.robot)
     if robot is not None:
         check_start_pose(robot, world, (args.x, args.y, args.yaw))

@@ -24,7 +24,7 @@ from navlab.grid import GridMap
 from navlab.io.files import check_regular_file
 from navlab.mapping.errors import MappingError
 from navlab.mapping.mapfile import save_map
-from navlab.world.truth import true_occupancy, world_T_map
+from navlab.world import true_occupancy, world_T_map
 
 DRIVERS = ("explore", "teleop", "route")
 WARMUP_S = 5.0  # simulated s of `bench`'s untimed warm-up run

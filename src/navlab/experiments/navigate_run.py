@@ -29,7 +29,7 @@ from navlab.experiments.session import Run, rounded, start_run
 from navlab.geometry import compose2, transform_points2
 from navlab.grid import Grid, GridMap
 from navlab.navigation.errors import NavigationError
-from navlab.world.truth import true_map, unmapped_obstacles
+from navlab.world import true_map, unmapped_obstacles
 
 if TYPE_CHECKING:
     from navlab.navigation.move_base import MoveBase
@@ -232,7 +232,7 @@ def run_navigation(
     ``progress``: a function given one line of text per goal sent/ended and every 10 simulated s (None: silent).
     """
     from navlab.mapping.mapfile import load_map, save_map
-    from navlab.sim.gazebo import load_world_named
+    from navlab.world import load_world
 
     def say(text: str) -> None:
         if progress is not None:
@@ -255,7 +255,7 @@ def run_navigation(
     with tempfile.TemporaryDirectory(prefix="navlab-navigate-") as tmp:
         if map_yaml is None:
             served = Path(tmp) / "true_map.yaml"
-            save_map(true_map(load_world_named(world), pose[:2]), served)
+            save_map(true_map(load_world(world), pose[:2]), served)
         else:
             served = Path(map_yaml)
         grid = load_map(served)
@@ -281,7 +281,7 @@ def run_navigation(
     results: list[dict[str, Any]] = []
     shots: list[NavSnapshot] = []
     arrivals: list[NavSnapshot] = []
-    new_obstacles = unmapped_obstacles(load_world_named(world), grid, pose[:2]) if snapshots and not mapless else None
+    new_obstacles = unmapped_obstacles(load_world(world), grid, pose[:2]) if snapshots and not mapless else None
     recorder = Recorder(run.executor, record) if record else None  # the whole run, every goal, in one bag
     run.run(1.0, quiet=True)  # amcl's first update, the costmaps' first maps
     frame = run.odom_frame if mapless else "map"

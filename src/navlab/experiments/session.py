@@ -84,7 +84,7 @@ class Run:
 
 def robot_frames(robot: str) -> tuple[str, str, str]:
     """(base frame, odom frame, scan topic) from a robot's plugin tags (shipped name or file)."""
-    from navlab.sim.gazebo import load_robot_named
+    from navlab.description import load_robot_named
 
     model = load_robot_named(robot)
     dd = model.diff_drive

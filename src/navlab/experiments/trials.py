@@ -44,10 +44,9 @@ def shortest_length(world: str, start: tuple[float, float, float], goals: list[t
     leg has none): SPL's reference."""
     from navlab.mapping.explore import clearance_costmap
     from navlab.navigation.planners.theta_star import ThetaStarPlanner
-    from navlab.sim.gazebo import load_world_named
-    from navlab.world.truth import true_map
+    from navlab.world import load_world, true_map
 
-    costmap = clearance_costmap(true_map(load_world_named(world), start[:2]), robot_radius, comfort=0.01)
+    costmap = clearance_costmap(true_map(load_world(world), start[:2]), robot_radius, comfort=0.01)
     planner = ThetaStarPlanner({"w_traversal_cost": 0.0})  # any-angle: the geometric shortest route
     total, here = 0.0, start
     for goal in goals:

@@ -453,8 +453,7 @@ def _fresh_image_name(ypath: Path, suffix: str) -> str:
 def save_true_map(world: str, start_xy: tuple[float, float], yaml_path: str | os.PathLike[str]) -> Path:
     """Save the true map of ``world`` (a shipped name or a .world file; obstacles 100, free space reachable from
     ``start_xy`` 0, world frame = map frame, 5 cm) as a map_server map at ``yaml_path``; returns the YAML's path."""
-    from navlab.world import load_world
-    from navlab.world.truth import true_map
+    from navlab.world import load_world, true_map
 
     path = Path(yaml_path)
     save_map(true_map(load_world(world), (float(start_xy[0]), float(start_xy[1]))), path)

@@ -1,7 +1,8 @@
 """What a simulated world knows for certain: its occupancy at lidar height, as a grid or as a map.
 
 Runs score maps and trajectories against these (see ``experiments.metrics``); ``navlab localize``
-serves ``true_map`` when no map file is given.
+serves ``true_map`` when no map file is given. (Moved from ``navlab.experiments.truth``, which stays a
+deprecated alias until the next release.)
 """
 
 from __future__ import annotations
