@@ -83,7 +83,7 @@ def main() -> None:
     map_yaml = str(save_true_map("room", (0.0, 0.0), Path(tempfile.mkdtemp(prefix="navlab-viz-profile-")) / "map.yaml"))
     bench._drive(map_yaml, seed=0)  # warm-up: Numba's caches, imports
     run = start_run("navigation", world="room_obstacles", map=map_yaml, seed=0)
-    viewer = attach(run.executor, port=0, speed=args.rate)
+    viewer = attach(run.executor, port=0, rate=args.rate)
     page = HeadlessPage(viewer.url, width=1280, height=800)
     try:
         page.wait_for("window.navlab && navlab.store.state")

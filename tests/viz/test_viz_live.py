@@ -26,7 +26,7 @@ def live() -> Iterator[tuple[Run, Viewer]]:
     with tempfile.TemporaryDirectory() as tmp:
         truth = save_true_map("room_obstacles", (0, 0), Path(tmp) / "true_map.yaml")
         run = start_run("navigation", world="room_obstacles", map=str(truth))
-    viewer = attach(run.executor, port=0, speed=5.0)
+    viewer = attach(run.executor, port=0, rate=5.0)
     thread = threading.Thread(target=lambda: run.run(3600.0, quiet=True), daemon=True)
     thread.start()
     yield run, viewer

@@ -1,9 +1,8 @@
 """Benchmarks: measured performance figures, one module per benchmark group (``navlab bench NAME --json``,
 the verb in :mod:`navlab.cli.bench`, prints them as JSON).
 
-Each benchmark is a function ``run(args) -> dict`` registered in ``BENCHES`` by import path; the
-experiments' own benchmarks (``mapping``, ``nav``, ``clutter``, ``odom``, ``sweep``) are the run functions of
-:mod:`navlab.experiments`. ``navlab bench all --json`` runs them all (but ``soak``) and adds
+Each benchmark is a function ``run(args) -> dict`` registered in ``BENCHES`` by import path.
+``navlab bench all --json`` runs them all (but ``soak``) and adds
 ``summary``: the headline figures (``nav_rtf``, ``sim_rtf``, ``nav_sim_ratio``, ``start_s``,
 ``slam_peak_rss_mb``, ...). ``navlab bench compare OLD.json NEW.json`` prints every figure the two share
 with its ratio new / old.
@@ -15,7 +14,7 @@ from typing import Any
 
 # name -> "module:function"; the function takes the parsed args and returns a JSON-able dict.
 BENCHES: dict[str, str] = {
-    "mapping": "navlab.experiments.mapping_run:bench",
+    "mapping": "navlab.bench.experiments:run_mapping_bench",
     "slam": "navlab.bench.mapping:run",
     "slam-office": "navlab.bench.mapping:run_office",
     "slam-gmapping": "navlab.bench.mapping:run_gmapping",
@@ -28,10 +27,10 @@ BENCHES: dict[str, str] = {
     "decompose": "navlab.bench.decompose:run",
     "controller": "navlab.bench.navigation:run_controller",
     "planner": "navlab.bench.navigation:run_planner",
-    "nav": "navlab.experiments.navigate_run:bench",
-    "clutter": "navlab.experiments.clutter_run:bench",
-    "odom": "navlab.experiments.odom_run:bench",
-    "sweep": "navlab.experiments.sweep:bench",
+    "nav": "navlab.bench.experiments:run_nav",
+    "clutter": "navlab.bench.experiments:run_clutter",
+    "odom": "navlab.bench.experiments:run_odom",
+    "sweep": "navlab.bench.sweep:run",
     "view": "navlab.bench.view:run",
     "ros": "navlab.bench.ros:run",
 }

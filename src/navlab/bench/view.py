@@ -44,7 +44,7 @@ def _drive(
     viewer = None
     try:
         if page is not None:
-            viewer = attach(run.executor, port=0, speed=0.0)
+            viewer = attach(run.executor, port=0, rate=0.0)
             page.goto(viewer.url)
             page.wait_for("window.navlab && navlab.store.state")
         run.run(1.0)

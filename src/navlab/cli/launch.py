@@ -72,7 +72,7 @@ def _cmd_launch(args: argparse.Namespace) -> int:
     rate = args.rate if args.rate is not None else (1.0 if args.duration is None or ros else 0.0)
     follow_clock = ros and follows_clock(launch_args)  # hardware in the loop: the robot's /clock paces the run
     rate = 0.0 if follow_clock else rate
-    session = start(files, seed=args.seed, pace=rate, launch_args=launch_args, ros=ros)
+    session = start(files, seed=args.seed, rate=rate, launch_args=launch_args, ros=ros)
     ex = session.executor
     duration = math.inf if args.duration is None else args.duration
     from navlab.core.introspect import IntrospectionServer

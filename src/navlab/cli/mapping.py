@@ -151,7 +151,7 @@ def _cmd_teleop(args: argparse.Namespace) -> int:
         print("driving the robot of the running navlab launch")
     else:  # the sim launch, here, in real time
         run = start_run("sim", world=args.world or "room", robot=args.robot, pose=start_pose(args), seed=args.seed,
-                        pace=args.rate)  # fmt: skip
+                        rate=args.rate)  # fmt: skip
         ex, gazebo = run.executor, run.gazebo
     if args.joy:
         from navlab import msgs

@@ -76,14 +76,14 @@ def _open_bridge(executor: Any, nodes: dict[str, Any], *, follow_clock: bool = F
     return RosBridge(executor, params=session_params(nodes), follow_clock=follow_clock)
 
 
-def start_viewer(args: argparse.Namespace, executor: Any, *, host: str, port: int, speed: float | None = None) -> Any:
+def start_viewer(args: argparse.Namespace, executor: Any, *, host: str, port: int, rate: float | None = None) -> Any:
     """Attach the viewer, print its URL (and a warning off loopback), open a browser where there is a desktop."""
     from navlab.viz.viewer import attach, host_warning, open_in_browser
 
     warning = host_warning(host)
     if warning:
         print(warning, file=sys.stderr)
-    viewer = attach(executor, host=host, port=port, speed=speed, foxglove_port=getattr(args, "foxglove", None))
+    viewer = attach(executor, host=host, port=port, rate=rate, foxglove_port=getattr(args, "foxglove", None))
     print(f"viewer: {viewer.url}", file=sys.stderr, flush=True)
     if viewer.foxglove is not None:
         print(f"foxglove: ws://{host}:{viewer.foxglove.port} (open it in Foxglove: Open connection)", file=sys.stderr)

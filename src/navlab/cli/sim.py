@@ -100,7 +100,7 @@ def _cmd_sim(args: argparse.Namespace) -> int:
     cmd_vel = _parse_cmd_vel(args.cmd_vel)
     spawns = [parse_spawn_spec(s, default_name=f"spawned_{i}") for i, s in enumerate(args.spawn)]
     run = start_run("sim", world=args.world, robot=args.robot, pose=start_pose(args), seed=args.seed,
-                    pace=args.rate if args.rate is not None else (1.0 if args.ros else 0.0),  # ROS peers: real time
+                    rate=args.rate if args.rate is not None else (1.0 if args.ros else 0.0),  # ROS peers: real time
                     timestep=args.timestep, overrides={"gazebo": parse_sets(args.set)})
     ex, gazebo = run.executor, run.gazebo
     helper = Node(ex, name="sim_cli")

@@ -77,7 +77,7 @@ def _cmd_view(args: argparse.Namespace) -> int:
         if "map" in declared and "map" not in launch_args:
             launch_args["map"] = args.map or str(save_true_map(world, pose[:2], Path(tmp) / "true_map.yaml"))
         run = start_run(args.launch, world=world, robot=robot, pose=pose, seed=args.seed, **launch_args)
-    viewer = start_viewer(args, run.executor, host=args.host, port=args.port, speed=args.rate)
+    viewer = start_viewer(args, run.executor, host=args.host, port=args.port, rate=args.rate)
     try:
         with ros_bridge(args.ros, run.executor, run.session.nodes):
             run.run(args.duration or math.inf, record=args.record, quiet=True, desc="view")
@@ -98,7 +98,7 @@ def _replay(args: argparse.Namespace) -> int:
     if warning:
         print(warning, file=sys.stderr)
     hub = Hub()
-    player = play_bag(args.bag, hub, speed=args.rate or 1.0)
+    player = play_bag(args.bag, hub, rate=args.rate or 1.0)
     server = ViewerServer(hub, host=args.host, port=args.port)
     server.start()
     print(f"viewer: {server.url} (replaying {args.bag})", file=sys.stderr, flush=True)

@@ -427,16 +427,6 @@ def _snapshot(run: Run, mon: NavMonitor, world_T_frame: Pose = (0.0, 0.0, 0.0), 
             "costmap_in_map": world_T_frame if mapless else None}  # fmt: skip
 
 
-def bench(args: Any) -> dict[str, Any]:
-    """``navlab bench nav``: the whole navigation stack (sim + lidar + amcl + costmaps + planner + controller)
-    driving across room_obstacles.world to four goals; real-time factor of the run loop."""
-    goals = [(4.3, 1.0, 0.0), (-3.5, -0.5, 3.14), (1.5, -2.5, 0.0), (0.0, 0.0, 0.0)]
-    run_navigation(goals[:1], world="room_obstacles", goal_timeout=5, seed=getattr(args, "seed", 0))  # warm-up: Numba
-    r = run_navigation(goals, world="room_obstacles", goal_timeout=90, seed=getattr(args, "seed", 0))
-    return {**{k: r.summary[k] for k in ("sim_s", "wall_s", "rtf")}, "goals_succeeded": r.summary["goals_succeeded"],
-            "goals": len(goals), "collisions": r.summary["collisions"]}  # fmt: skip
-
-
 def mean_abs_jerk(cmd: Sequence[tuple[float, float]]) -> float | None:
     """Mean |d²v/dt²| (m/s³) of the commanded linear speed, from (t s, v m/s) samples; None if too few."""
     if len(cmd) < 3:
