@@ -34,7 +34,7 @@ def run_demo(out: str | Path = "navlab-demo", *, seed: int = 0, quiet: bool = Fa
     from navlab.experiments.localize_run import plot_result, run_localization
     from navlab.experiments.mapping_run import run_mapping
     from navlab.experiments.navigate_run import run_navigation, save_goal_pictures
-    from navlab.sim.spawn import primitive_model
+    from navlab.sim import primitive_model
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
@@ -86,8 +86,8 @@ DEMO_GOALS = [(4.3, 1.0, 0.0), (-3.5, -0.5, 3.14), (1.5, -2.5, 0.0)]
 def _render(path: Path) -> str:
     """Picture of the paper's robot among the obstacles; skipped (with the reason) without OpenGL."""
     from navlab.description import load_robot_named
+    from navlab.sim import Simulation
     from navlab.sim.render import render_image, save_png
-    from navlab.sim.simulation import Simulation
     from navlab.world import load_world
 
     try:

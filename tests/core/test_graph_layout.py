@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 
 from navlab.cli import main
-from navlab.mapping.mapfile import save_map
+from navlab.mapping import save_map
 from navlab.world import load_world, true_map
 
 SVG = "{http://www.w3.org/2000/svg}"

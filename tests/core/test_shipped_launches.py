@@ -11,9 +11,8 @@ from scipy import ndimage
 
 from navlab import msgs
 from navlab.cli import main
-from navlab.core import LaunchError, Node
+from navlab.core import LaunchError, Node, load_params
 from navlab.core.launch import resources_dir, start
-from navlab.core.params import load_params
 from navlab.mapping import GridMap, save_map
 from navlab.mapping.gmapping import GMappingParams
 from navlab.mapping.teleop import RouteFollower

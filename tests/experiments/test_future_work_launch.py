@@ -16,7 +16,7 @@ from navlab.core.launch import start
 from navlab.errors import NavlabError
 from navlab.experiments.navigate_run import sim_launch_args
 from navlab.mapping import save_map
-from navlab.navigation.errors import NavigationError
+from navlab.navigation import NavigationError
 from navlab.world import load_world, true_map
 
 

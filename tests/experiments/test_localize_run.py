@@ -12,7 +12,7 @@ import pytest
 from navlab.cli import main
 from navlab.experiments.localize_run import run_localization
 from navlab.localization import LocalizationError
-from navlab.mapping.mapfile import save_map
+from navlab.mapping import save_map
 from navlab.world import load_world, true_map
 
 

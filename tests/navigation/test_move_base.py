@@ -16,8 +16,8 @@ import pytest
 from navlab.cli import main
 from navlab.errors import NavlabError
 from navlab.experiments.navigate_run import run_navigation
-from navlab.mapping.mapfile import save_map
-from navlab.sim.spawn import primitive_model
+from navlab.mapping import save_map
+from navlab.sim import primitive_model
 from navlab.world import load_world, true_map
 
 # Goals spread over room.world's free space (map frame = world frame), visited in this order.

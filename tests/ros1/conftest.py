@@ -44,7 +44,7 @@ def ros_env(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, str]
 
 @pytest.fixture(scope="session")
 def room_map(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    from navlab.mapping.mapfile import save_map
+    from navlab.mapping import save_map
     from navlab.world import load_world, true_map
 
     path = tmp_path_factory.mktemp("map") / "room.yaml"

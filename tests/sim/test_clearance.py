@@ -7,8 +7,7 @@ import math
 import pytest
 
 from navlab.description import load_robot_named
-from navlab.sim.simulation import Simulation
-from navlab.sim.spawn import primitive_model
+from navlab.sim import Simulation, primitive_model
 from navlab.world import load_world
 
 # the Jackal-sized robot of resources/robots/jackal: a 0.508 x 0.320 m chassis box, wheels (r 0.098 m, 0.04 m wide)

@@ -57,8 +57,7 @@ def test_decomposed_only_up_to_the_robots_reach_and_the_robot_still_cannot_drive
     from sim_helpers import make_mybot
 
     from navlab.description.meshes import read_mesh
-    from navlab.sim import Simulation
-    from navlab.sim.spawn import primitive_model
+    from navlab.sim import Simulation, primitive_model
 
     robot = make_mybot(noise=0.0)
     reach = decompose.robot_reach(robot)

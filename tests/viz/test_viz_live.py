@@ -17,7 +17,7 @@ from viz_helpers import canvas_xy, open_page, pixel, to_screen
 
 from navlab.experiments.session import Run, start_run
 from navlab.mapping import save_true_map
-from navlab.viz.viewer import Viewer, attach
+from navlab.viz import Viewer, attach
 
 
 @pytest.fixture(scope="module")

@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 
 from navlab.experiments.session import start_run
+from navlab.viz import attach
 from navlab.viz import frames as fr
 from navlab.viz.hub import ClientStream
-from navlab.viz.viewer import attach
 
 
 def _known_cells(stream: ClientStream, now: float) -> int:

@@ -109,8 +109,7 @@ def _self_cpu() -> float:
 
 def _load_here(world_file: str, cache: str, effort: str, workers: int, reach: str) -> dict[str, Any]:
     """Load the world and build its simulation with the cache at ``cache`` (in a fresh process)."""
-    from navlab.sim import decompose
-    from navlab.sim.simulation import Simulation
+    from navlab.sim import Simulation, decompose
     from navlab.world import load_world
 
     os.environ["NAVLAB_CACHE"] = cache

@@ -24,8 +24,8 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
     A missing log raises ``DatasetNotFoundError`` saying where it was looked for and how to provide it.
     """
     from navlab.experiments.metrics import read_relations, relations_closure, relations_error
+    from navlab.io import dataset
     from navlab.io.carmen import read_carmen
-    from navlab.io.datasets import dataset
     from navlab.mapping.scanmatch import warmup
     from navlab.mapping.slam import run_offline
 
@@ -120,8 +120,8 @@ def run_gmapping(args: argparse.Namespace) -> dict[str, Any]:
     import sys
 
     from navlab.bench.core import run_child
-    from navlab.experiments.metrics import read_relations, relations_error
-    from navlab.io.datasets import dataset
+    from navlab.experiments import read_relations, relations_error
+    from navlab.io import dataset
 
     clf, relations = dataset(CSAIL), read_relations(dataset(RELATIONS))
     with tempfile.TemporaryDirectory(prefix="navlab-bench-") as out:

@@ -24,7 +24,7 @@ import time
 from pathlib import Path
 from typing import Any
 
-from navlab.core.topics import Timer
+from navlab.core import Timer
 from navlab.errors import NavlabError
 from navlab.ros1.live import LiveRun
 

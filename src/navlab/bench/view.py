@@ -23,7 +23,7 @@ import time
 from pathlib import Path
 from typing import Any
 
-from navlab.viz.errors import VizError
+from navlab.viz import VizError
 from navlab.viz.headless import CHROMIUM, HeadlessPage
 
 GOALS = [(4.3, 1.0, 0.0), (-3.5, -0.5, 3.14), (1.5, -2.5, 0.0)]
@@ -38,7 +38,7 @@ def _drive(
     blank page after the drive; ``setup``: JavaScript run in it once it drew the map, e.g.
     ``navlab.settings.maxFps = 20``). Wall time excludes the screenshot."""
     from navlab.experiments.session import start_run
-    from navlab.viz.viewer import attach
+    from navlab.viz import attach
 
     run = start_run("navigation", world="room_obstacles", map=map_yaml, seed=seed)
     viewer = None

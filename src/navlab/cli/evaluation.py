@@ -71,7 +71,7 @@ def _cmd_eval_map(args: argparse.Namespace) -> int:
     from navlab.experiments.mapping_run import read_trajectory
     from navlab.experiments.metrics import free_coverage, score_map, trajectory_error
     from navlab.experiments.session import rounded
-    from navlab.mapping.mapfile import load_map
+    from navlab.mapping import load_map
     from navlab.world import load_world, true_occupancy, world_T_map
 
     apply_resource_paths(args)

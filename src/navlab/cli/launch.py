@@ -36,8 +36,8 @@ def _split_files(first: str, items: list[str]) -> tuple[list[str], list[str]]:
 
 def find_in_package(pkg: str, name: str) -> Path:
     """roslaunch's ``roslaunch PKG FILE``: the file called ``name`` anywhere inside package ``pkg``."""
-    from navlab.core.errors import LaunchError
-    from navlab.description.errors import DescriptionError
+    from navlab.core import LaunchError
+    from navlab.description import DescriptionError
     from navlab.description.packages import find_package
 
     try:

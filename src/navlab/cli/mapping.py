@@ -49,8 +49,7 @@ def _cmd_map_save(args: argparse.Namespace) -> int:
     from navlab.core.launch import start
     from navlab.core.runner import parse_launch_args, run_for
     from navlab.grid import GridMap
-    from navlab.mapping.errors import MappingError
-    from navlab.mapping.mapfile import save_map
+    from navlab.mapping import MappingError, save_map
 
     path = Path(args.out) / "map.yaml"
     if not args.launch:  # the launch running in another shell: /map is latched, so its current map comes first
@@ -77,7 +76,7 @@ def _params_file(path: str | None) -> dict:
     if not path:
         return {}
     from navlab.core.params import read_yaml
-    from navlab.mapping.errors import MappingError
+    from navlab.mapping import MappingError
 
     doc = read_yaml(path) or {}  # a regular UTF-8 file of bounded size and nesting (no FIFO, no alias bomb)
     if not isinstance(doc, dict):
@@ -163,7 +162,7 @@ def _cmd_teleop(args: argparse.Namespace) -> int:
         print("joystick: hold button 0 and move the left stick; Ctrl-C to quit")
     else:
         if not sys.stdin.isatty():
-            from navlab.mapping.errors import MappingError
+            from navlab.mapping import MappingError
 
             raise MappingError("navlab teleop reads keys from a terminal; run it in an interactive shell")
         teleop = TeleopKeyboard(ex, parameters={"speed": args.speed, "turn": args.turn})

@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 
 from navlab.cli.options import add_run_options, out_file, positive_seconds
-from navlab.core.errors import CoreError
+from navlab.core import CoreError
 from navlab.core.graph import Graph
 from navlab.core.launch import Session, start
 from navlab.core.runner import parse_launch_args, run_for
@@ -201,7 +201,7 @@ def _cmd_bag(args: argparse.Namespace) -> int:
 
 
 def _cmd_roscore(args: argparse.Namespace) -> int:
-    from navlab.ros1.master import Master
+    from navlab.ros1 import Master
     from navlab.ros1.net import host_port, master_uri
 
     port = args.port if args.port is not None else host_port(master_uri())[1]

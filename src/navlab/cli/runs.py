@@ -70,7 +70,7 @@ def ros_hook(args: argparse.Namespace, then: Callable[[Any], None] | None = None
 
 
 def _open_bridge(executor: Any, nodes: dict[str, Any], *, follow_clock: bool = False) -> Any:
-    from navlab.ros1.bridge import RosBridge, session_params
+    from navlab.ros1 import RosBridge, session_params
 
     logging.getLogger("navlab.ros1").setLevel(logging.INFO)
     return RosBridge(executor, params=session_params(nodes), follow_clock=follow_clock)

@@ -79,7 +79,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def _parse_cmd_vel(text: str | None) -> tuple[float, float] | None:
-    from navlab.sim.errors import SimError
+    from navlab.sim import SimError
 
     if text is None:
         return None
@@ -94,7 +94,7 @@ def _cmd_sim(args: argparse.Namespace) -> int:
     from navlab import msgs
     from navlab.core import Node
     from navlab.experiments.session import start_run
-    from navlab.sim.spawn import parse_spawn_spec
+    from navlab.sim import parse_spawn_spec
 
     apply_resource_paths(args)
     cmd_vel = _parse_cmd_vel(args.cmd_vel)
@@ -162,8 +162,8 @@ def _one_shot(node: Any, t: float, fn: Any) -> None:
 
 def _cmd_render(args: argparse.Namespace) -> int:
     from navlab.description import load_robot_named
+    from navlab.sim import Simulation
     from navlab.sim.render import render_image, save_png
-    from navlab.sim.simulation import Simulation
     from navlab.sim.spawn import check_start_pose, parse_spawn_spec
     from navlab.world import load_world
 

@@ -58,7 +58,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 def _cmd_view(args: argparse.Namespace) -> int:
     if args.bag:
         if args.ros:
-            from navlab.viz.errors import VizError
+            from navlab.viz import VizError
 
             raise VizError("--ros serves a live launch, not a --bag replay (play the recording with `rosbag play`)")
         return _replay(args)
@@ -89,9 +89,7 @@ def _cmd_view(args: argparse.Namespace) -> int:
 def _replay(args: argparse.Namespace) -> int:
     import time
 
-    from navlab.viz.hub import Hub
-    from navlab.viz.replay import play_bag
-    from navlab.viz.server import ViewerServer
+    from navlab.viz import Hub, ViewerServer, play_bag
     from navlab.viz.viewer import host_warning, open_in_browser
 
     warning = host_warning(args.host)

@@ -24,7 +24,7 @@ from navlab.experiments.plots import ErrorPanel, Marks, Track, plot_run
 from navlab.experiments.session import rounded, start_run
 from navlab.geometry import wrap_angle
 from navlab.grid import GridMap
-from navlab.localization.errors import LocalizationError
+from navlab.localization import LocalizationError
 from navlab.world import true_map, unmapped_obstacles
 
 # A 17.5 m loop through room.world / room_obstacles.world, at least 0.5 m from every obstacle.
@@ -108,8 +108,8 @@ def run_localization(
     that time (s) the robot is teleported to the route waypoint farthest from it and continues the route
     from there. ``record``: also write every topic to a rosbag2 (MCAP) in that folder.
     """
-    from navlab.localization.field import field_from_map
-    from navlab.mapping.mapfile import load_map, save_map
+    from navlab.localization import field_from_map
+    from navlab.mapping import load_map, save_map
     from navlab.mapping.teleop import RouteFollower
     from navlab.world import load_world
 

@@ -22,8 +22,7 @@ from navlab.experiments.session import Run, rounded, start_run
 from navlab.geometry import inverse_transform_points2, wrap_angle
 from navlab.grid import GridMap
 from navlab.io.files import check_regular_file
-from navlab.mapping.errors import MappingError
-from navlab.mapping.mapfile import save_map
+from navlab.mapping import MappingError, save_map
 from navlab.world import true_occupancy, world_T_map
 
 DRIVERS = ("explore", "teleop", "route")

@@ -28,7 +28,7 @@ from navlab.experiments.plots import NavSnapshot
 from navlab.experiments.session import Run, rounded, start_run
 from navlab.geometry import compose2, transform_points2
 from navlab.grid import Grid, GridMap
-from navlab.navigation.errors import NavigationError
+from navlab.navigation import NavigationError
 from navlab.world import true_map, unmapped_obstacles
 
 if TYPE_CHECKING:
@@ -231,7 +231,7 @@ def run_navigation(
     whatever move_base says.
     ``progress``: a function given one line of text per goal sent/ended and every 10 simulated s (None: silent).
     """
-    from navlab.mapping.mapfile import load_map, save_map
+    from navlab.mapping import load_map, save_map
     from navlab.world import load_world
 
     def say(text: str) -> None:

@@ -7,8 +7,8 @@ from pathlib import Path
 from typing import Any
 
 from navlab.core import Executor, Node
+from navlab.description import RobotModel
 from navlab.description.loader import load_robot_named as _load_robot_named
-from navlab.description.model import RobotModel
 from navlab.sim.contacts import CollisionPlugin
 from navlab.sim.errors import SimError
 from navlab.sim.extensions import SimExtensions
@@ -16,8 +16,7 @@ from navlab.sim.imu import ImuSensorPlugin
 from navlab.sim.plugins import DiffDrivePlugin, GroundTruthPlugin, JointStatePlugin, LidarPlugin, RobotStatePublisher
 from navlab.sim.simulation import Simulation
 from navlab.sim.spawn import check_spawn_clear, check_start_pose, load_sdf_model, parse_spawn_spec, primitive_model
-from navlab.world.model import ModelSpec, WorldModel
-from navlab.world.sdf import load_world
+from navlab.world import ModelSpec, WorldModel, load_world
 
 
 def load_robot_named(name_or_path: str, args: list[str] | None = None) -> RobotModel:

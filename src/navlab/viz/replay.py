@@ -17,9 +17,8 @@ from typing import Any
 import numpy as np
 
 from navlab import msgs
-from navlab.core.errors import TfError
+from navlab.core import TfBuffer, TfError
 from navlab.core.graph import with_layout
-from navlab.core.tf import TfBuffer
 from navlab.io.rosbag import bag_graph, bag_topics, read_bag
 from navlab.viz.errors import VizError
 from navlab.viz.hub import Hub
