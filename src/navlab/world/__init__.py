@@ -18,7 +18,7 @@ from navlab.world.occupancy import extents, occupancy, shape_footprints
 from navlab.world.sdf import load_model, load_world
 
 if TYPE_CHECKING:
-    from navlab.world import (
+    from navlab.world.truth import (
         true_map,
         true_occupancy,
         truth_grid,
