@@ -226,7 +226,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="run SLAM offline on a laser log and save the map and trajectory",
         description="Run SLAM on a CARMEN log (FLASER, ODOM, ROBOTLASER1 lines) and write DIR/map.yaml + "
         "DIR/map.pgm (map_server format), DIR/poses.txt (one 'timestamp x y theta' line per scan, robot "
-        "pose in the map frame) and DIR/map.png (map and trajectory).",
+        "pose in the map frame) and DIR/map.png (map and trajectory), and print a summary (not with --quiet).",
     )
     p.add_argument("--log", required=True, metavar="FILE.clf",
                    help="CARMEN log file, or its path inside $NAVLAB_DATA (e.g. mit-csail/mit-csail.clf)")
