@@ -3,6 +3,7 @@
 import pytest
 
 from navlab.core import Executor, Node, ParameterError, load_params
+from navlab.core.params import read_params
 
 ROS1 = """\
 controller_frequency: 5.0
@@ -86,4 +87,4 @@ def test_swapped_letters_of_a_short_name_are_a_typo_not_an_ignored_key():
     from navlab.mapping.gmapping import GMappingParams
 
     with pytest.raises(MappingError, match="did you mean 'lsigma'"):
-        GMappingParams.from_dict({"lsimga": 0.1})
+        read_params(GMappingParams, {"lsimga": 0.1})

@@ -14,10 +14,10 @@ from navlab.cli import main
 from navlab.core import LaunchError, Node
 from navlab.core.launch import resources_dir, start
 from navlab.core.params import load_params
+from navlab.drivers.routes import RouteFollower
 from navlab.experiments.truth import true_map
 from navlab.mapping import GridMap, save_map
 from navlab.mapping.gmapping import GMappingParams
-from navlab.mapping.teleop import RouteFollower
 from navlab.sim.gazebo import load_world_named
 
 

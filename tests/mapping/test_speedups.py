@@ -9,10 +9,8 @@ import math
 
 import numpy as np
 import pytest
-from scipy import sparse
 
 from navlab.geometry import wrap_angle
-from navlab.mapping.explore import _grid_graph
 from navlab.mapping.gmapping_match import _draw_motion, _optimize, _score
 from navlab.mapping.gmapping_tiles import TILE, TilePool, from_dense, raycast_tiles, to_dense
 from navlab.mapping.occupancy import FAST_WALK_CELLS, L_CLAMP, L_FREE, L_OCC, _raycast, integrate_scan
@@ -190,29 +188,6 @@ def test_the_tiled_ray_cast_writes_the_dense_cells_and_copies_only_shared_tiles(
     pool.recount([mine])  # the other particle dropped: its tiles are free again
     assert pool.in_use() == len(written) + np.count_nonzero((mine == theirs) & (mine > 0))
     assert len(TilePool(2).free(40)) >= 40  # the pool grows when short of free tiles
-
-
-def test_the_one_pass_dijkstra_graph_equals_scipys_from_the_edge_list() -> None:
-    rng = np.random.default_rng(2)
-    for _ in range(20):
-        h, w = rng.integers(1, 30, 2)
-        mask = rng.random((h, w)) < 0.7
-        cost = 1.0 + 4.0 * rng.integers(0, 253, (h, w)) / 252.0
-        rows, cols, vals = [], [], []
-        for j, i in zip(*np.nonzero(mask), strict=True):
-            for dj, di, length in ((0, 1, 1.0), (1, 0, 1.0), (1, 1, np.sqrt(2.0)), (1, -1, np.sqrt(2.0))):
-                j2, i2 = j + dj, i + di
-                if 0 <= j2 < h and 0 <= i2 < w and mask[j2, i2]:
-                    a, b = j * w + i, j2 * w + i2
-                    c = length * 0.5 * (cost.flat[a] + cost.flat[b])
-                    rows += [a, b]
-                    cols += [b, a]
-                    vals += [c, c]
-        want = sparse.csr_matrix((vals, (rows, cols)), shape=(h * w, h * w))
-        indptr, indices, data = _grid_graph(mask, cost.ravel())
-        np.testing.assert_array_equal(indptr, want.indptr)
-        np.testing.assert_array_equal(indices, want.indices)
-        np.testing.assert_array_equal(data, want.data)
 
 
 def test_lookup_field_and_correlative_search_near_and_off_the_edges() -> None:

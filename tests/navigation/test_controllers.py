@@ -338,11 +338,11 @@ def test_sample_counts_below_one_warn_and_become_one_as_in_ros(cls, key, caplog)
     (DWAPlannerROS, {"max_vel_x": 0.5, "max_vel_trans": 0.5, "path_distance_bais": 1.0},
      ["path_distance_bais", "did you mean", "path_distance_bias"]),
     (TrajectoryPlannerROS, {"pdist_scal": 1.0}, ["pdist_scal", "did you mean", "pdist_scale"]),
-    (DWAPlannerROS, {"min_vel_x": 0.6}, ["min_vel_x=0.6", "max_vel_x"]),
-    (TrajectoryPlannerROS, {"min_vel_theta": 2.0}, ["min_vel_theta=2.0", "max_vel_theta"]),
-    (TrajectoryPlannerROS, {"sim_time": 0.0}, ["sim_time=0.0", "> 0"]),
-    (TrajectoryPlannerROS, {"escape_vel": 0.1}, ["escape_vel=0.1", "<= 0"]),
-    (DWAPlannerROS, {"xy_goal_tolerance": -0.1}, ["xy_goal_tolerance=-0.1", ">= 0"]),
+    (DWAPlannerROS, {"min_vel_x": 0.6}, ["min_vel_x", "got 0.6", "max_vel_x"]),
+    (TrajectoryPlannerROS, {"min_vel_theta": 2.0}, ["min_vel_theta", "got 2.0", "max_vel_theta"]),
+    (TrajectoryPlannerROS, {"sim_time": 0.0}, ["sim_time", "got 0.0", "> 0"]),
+    (TrajectoryPlannerROS, {"escape_vel": 0.1}, ["escape_vel", "got 0.1", "<= 0"]),
+    (DWAPlannerROS, {"xy_goal_tolerance": -0.1}, ["xy_goal_tolerance", "got -0.1", ">= 0"]),
     (DWAPlannerROS, {"max_rot_vel": 1.0, "max_vel_theta": 2.0}, ["max_rot_vel", "max_vel_theta", "give one"]),
 ])
 def test_bad_parameters_get_a_one_line_error(cls, params, words):
@@ -444,8 +444,8 @@ def test_mppi_parameters():
                           ({"batch_sise": 10}, ["batch_sise", "did you mean", "batch_size"]),
                           ({"CostCritic": {"cost_wieght": 1.0}}, ["cost_wieght", "did you mean", "cost_weight"]),
                           ({"critics": ["CostCritic", "GoalCritc"]}, ["GoalCritc", "did you mean", "GoalCritic"]),
-                          ({"batch_size": 0}, ["batch_size=0", ">= 1"]),
-                          ({"vx_min": 1.0}, ["vx_min=1.0", "vx_max"])):
+                          ({"batch_size": 0}, ["batch_size", "got 0", ">= 1"]),
+                          ({"vx_min": 1.0}, ["vx_min", "got 1.0", "vx_max"])):
         with pytest.raises(NavigationError) as err:
             MPPIController(params, rng=np.random.default_rng(0))
         assert "\n" not in str(err.value)

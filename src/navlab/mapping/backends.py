@@ -24,6 +24,7 @@ from typing import Any
 import numpy as np
 
 from navlab.core.node import dataclass_parameters
+from navlab.core.params import read_params
 from navlab.geometry import between2
 from navlab.grid import GridMap
 from navlab.mapping.errors import MappingError
@@ -52,7 +53,7 @@ class GMappingBackend:
     """``mode: gmapping``: slam_gmapping's RBPF. ``params``: GMapping's names (``particles``, ``delta``, ...)."""
 
     def __init__(self, params: dict[str, Any] | None = None, *, rng: np.random.Generator) -> None:
-        self.params = GMappingParams.from_dict(params)
+        self.params = read_params(GMappingParams, params)
         self.slam = GMapping(self.params, rng=rng)
         gmapping_warmup()  # the kernels' one-time load at start-up, not at the first map update
         self._points: list[ScanPoints] = []  # every scan's points, for the final refinement
@@ -143,8 +144,8 @@ class GraphBackend:
                 raise MappingError(f"graph SLAM parameter '{key}' belongs under 'graph' (graph.{key})")
             else:
                 top[key] = value
-        self.gm = GMappingParams.from_dict(top)  # gating and map parameters
-        self.params = GraphSlamParams.from_dict(own)
+        self.gm = read_params(GMappingParams, top)  # gating and map parameters
+        self.params = read_params(GraphSlamParams, own)
         self.slam = GraphSlam(self.params)
         self._scans: list[tuple[np.ndarray, np.ndarray]] = []  # (ranges, angles) of each processed scan
         self._last: tuple[np.ndarray, int] | None = None  # odom_laser and stamp (ns) of the last processed scan

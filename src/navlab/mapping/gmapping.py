@@ -19,11 +19,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
 from navlab.core.limits import check_ceiling
-from navlab.core.params import dataclass_from_dict
+from navlab.core.params import ParamSpec
 from navlab.geometry import between2, compose2, wrap_angle
 from navlab.grid import GridMap
 from navlab.mapping.errors import MappingError
@@ -82,14 +83,11 @@ class GMappingParams:
     wideStep: float = 0.0873
     wideTurn: float = 0.524
 
-    @classmethod
-    def from_dict(cls, values: dict | None) -> GMappingParams:
-        """Parameters from overrides; unknown names raise ``MappingError`` with a suggestion."""
-        out = dataclass_from_dict(cls, values, what="gmapping", error=MappingError)
-        if out.particles < 1:
-            raise MappingError(f"gmapping parameter 'particles' must be >= 1, got {out.particles}")
-        check_ceiling(MappingError, "gmapping", "particles", out.particles, "particles")
-        return out
+    PARAMS: ClassVar[ParamSpec] = ParamSpec("gmapping", MappingError, at_least={"particles": 1})
+
+    def validate(self) -> None:
+        """The particle count's ceiling."""
+        check_ceiling(MappingError, "gmapping", "particles", self.particles, "particles")
 
 
 class _Particle:

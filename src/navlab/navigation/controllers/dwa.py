@@ -9,6 +9,7 @@ from typing import Any
 
 import numpy as np
 
+from navlab.core.params import read_params
 from navlab.navigation.controllers import mapgrid
 from navlab.navigation.controllers.params import DWAPlannerParams
 from navlab.navigation.controllers.rollout import lookup, occupancy_costs, rollout, velocity_samples
@@ -39,7 +40,7 @@ class DWAPlannerROS(RolloutController):
 
     @staticmethod
     def _parse(params: Any) -> DWAPlannerParams:
-        return DWAPlannerParams.from_dict(params)
+        return read_params(DWAPlannerParams, params)
 
     def _in_place_limits(self, err: float) -> tuple[float, float]:
         return self.params.max_vel_theta, self.params.min_vel_theta

@@ -61,6 +61,7 @@ from typing import Any
 
 import numpy as np
 
+from navlab.core.params import read_params
 from navlab.grid import Grid
 from navlab.navigation.controllers import mapgrid
 from navlab.navigation.controllers.common import (
@@ -340,7 +341,7 @@ class TrajectoryPlannerROS(RolloutController):
 
     @staticmethod
     def _parse(params: Any) -> TrajectoryPlannerParams:
-        return TrajectoryPlannerParams.from_dict(params)
+        return read_params(TrajectoryPlannerParams, params)
 
     def _new_goal(self) -> None:
         self._escaping = False

@@ -15,6 +15,7 @@ import numba
 import numpy as np
 from scipy import ndimage
 
+from navlab.core.params import read_params
 from navlab.grid import COST_FREE, COST_INSCRIBED, COST_LETHAL, COST_UNKNOWN, Grid, GridMap
 from navlab.navigation.costmap.footprint import Footprint, make_footprint
 from navlab.navigation.costmap.params import (
@@ -27,14 +28,6 @@ from navlab.navigation.costmap.params import (
 )
 from navlab.navigation.costmap.raytrace import clear_rays
 from navlab.navigation.errors import NavigationError
-
-
-def _params(cls: type, values: Any, name: str) -> Any:
-    if values is None or isinstance(values, cls):
-        return values if values is not None else cls()
-    if isinstance(values, dict):
-        return layer_params(cls, CostmapParams(namespaces={name: values}), name)
-    raise NavigationError(f"{name}: parameters must be a dict or {cls.__name__}, got {type(values).__name__}")
 
 
 def _same_geometry(a: Grid, b: Grid) -> bool:
@@ -87,7 +80,7 @@ class StaticLayer(Layer):
     """
 
     def __init__(self, params: StaticLayerParams | dict[str, Any] | None = None, *, name: str = "static_layer") -> None:
-        self.params: StaticLayerParams = _params(StaticLayerParams, params, name)
+        self.params: StaticLayerParams = read_params(StaticLayerParams, params, what=name)
         self.name = name
         self.enabled = self.params.enabled
         self.map: GridMap | None = None
@@ -179,7 +172,7 @@ class ObstacleLayer(Layer):
         sources: dict[str, ObservationSource] | None = None,
         footprint: Footprint | None = None,
     ) -> None:
-        self.params: ObstacleLayerParams = _params(ObstacleLayerParams, params, name)
+        self.params: ObstacleLayerParams = read_params(ObstacleLayerParams, params, what=name)
         self.name = name
         self.enabled = self.params.enabled
         self.sources = dict(sources or {})
@@ -318,7 +311,7 @@ class InflationLayer(Layer):
         name: str = "inflation_layer",
         footprint: Footprint | None = None,
     ) -> None:
-        self.params: InflationLayerParams = _params(InflationLayerParams, params, name)
+        self.params: InflationLayerParams = read_params(InflationLayerParams, params, what=name)
         self.name = name
         self.enabled = self.params.enabled
         self.footprint = footprint or make_footprint()
