@@ -13,7 +13,7 @@ import difflib
 import logging
 import math
 import warnings
-from collections.abc import Callable, Iterable, Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any, TypeVar
@@ -216,25 +216,23 @@ class ParamSpec:
     prepare: Callable[[dict[str, Any]], dict[str, Any]] | None = None
 
 
-def did_you_mean(key: str, known: Iterable[str], *, template: str = "; did you mean {!r}?") -> str:
-    """The hint for an unknown name: ``template`` filled with the closest of ``known`` (difflib), or ""."""
-    close = difflib.get_close_matches(str(key), [str(k) for k in known], n=1)
-    return template.format(close[0]) if close else ""
-
-
 def param_error(what: str, key: str, value: Any, expected: str, error: type[Exception] = ParameterError
                 ) -> Exception:
     """The one-line refusal of a parameter ``key`` = ``value`` that is not ``expected``."""
-    return error(f"{what} parameter {key}: expected {expected}, got {value!r}")
+    return error(f"{what + ' ' if what else ''}parameter {key}: expected {expected}, got {value!r}")
 
 
 _EXPECTED = {bool: "true or false", int: "an integer", float: "a number", str: "a string", list: "a list",
              tuple: "a list", dict: "a mapping"}
 
 
-def _typed(kind: type, key: str, val: Any, what: str, error: type[Exception]) -> Any:
-    """``val`` as the type ``kind`` of the field's default, refusing what ROS's typed parameters would (a
-    string for a number, 2.5 for an integer, "yes" for a boolean, NaN or inf)."""
+def typed_value(kind: type, key: str, val: Any, *, what: str = "", error: type[Exception] = ParameterError,
+                finite: bool = True) -> Any:
+    """``val`` as the type ``kind`` of the parameter's default, refusing what ROS's typed parameters would (a
+    string for a number, 2.5 for an integer, "yes" for a boolean, null, NaN; inf too unless ``finite`` is
+    False). The one type rule of settings dataclasses and node parameters."""
+    if isinstance(val, float) and (math.isnan(val) or (finite and kind is float and math.isinf(val))):
+        raise param_error(what, key, val, "a finite number" if finite else "a number", error)
     if kind is bool:
         ok = isinstance(val, bool) or (isinstance(val, int) and val in (0, 1))
     elif kind is int:
@@ -242,19 +240,15 @@ def _typed(kind: type, key: str, val: Any, what: str, error: type[Exception]) ->
             val).is_integer()
     elif kind is float:
         ok = not isinstance(val, bool) and isinstance(val, int | float)
-        if ok and not math.isfinite(val):
-            raise param_error(what, key, val, "a finite number", error)
-    elif kind is str:
-        ok = isinstance(val, str)
     elif kind in (list, tuple):
         ok = isinstance(val, list | tuple)
     elif kind is dict:
         ok = isinstance(val, Mapping)
     else:
-        return val
+        ok = isinstance(val, kind)
     if not ok:
-        raise param_error(what, key, val, _EXPECTED[kind], error)
-    return kind(val)
+        raise param_error(what, key, val, _EXPECTED.get(kind, kind.__name__), error)
+    return kind(val) if kind in _EXPECTED else val
 
 
 def canonical_params(values: Mapping[str, Any], spec: ParamSpec, *, what: str | None = None) -> dict[str, Any]:
@@ -278,7 +272,7 @@ def read_params(cls: type[T], values: Mapping[str, Any] | T | None, *, what: str
     """An instance of the settings dataclass ``cls`` from a ROS parameter dict, as its ``PARAMS`` spec says
     (an instance of ``cls`` is checked and returned as is; None gives the defaults).
 
-    Each value takes its default's type (``_typed``); an unknown key follows ``check_unknown_key`` (a likely
+    Each value takes its default's type (``typed_value``); an unknown key follows ``check_unknown_key`` (a likely
     typo raises with "did you mean", any other key warns and is ignored); then the spec's ranges and
     clamps, then the class's ``validate()``. Every refusal is one line naming the key.
     """
@@ -297,7 +291,7 @@ def read_params(cls: type[T], values: Mapping[str, Any] | T | None, *, what: str
             if key not in names:
                 check_unknown_key(str(key), names, what=what, error=spec.error)
                 continue
-            setattr(out, key, _typed(type(getattr(out, key)), key, val, what, spec.error))
+            setattr(out, key, typed_value(type(getattr(out, key)), key, val, what=what, error=spec.error))
     for f in fields(out):  # type: ignore[arg-type]
         val = getattr(out, f.name)
         if isinstance(val, float) and not math.isfinite(val):

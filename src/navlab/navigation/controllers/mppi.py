@@ -35,7 +35,8 @@ import numpy as np
 from scipy.signal import savgol_coeffs
 
 from navlab.core.limits import check_ceiling
-from navlab.core.params import ParamSpec, did_you_mean, read_params
+from navlab.core.params import ParamSpec, read_params
+from navlab.errors import did_you_mean
 from navlab.grid import COST_INSCRIBED, Grid
 from navlab.navigation.controllers import mppi_critics as critics
 from navlab.navigation.controllers.common import (
