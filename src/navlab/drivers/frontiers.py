@@ -17,8 +17,7 @@ import numpy as np
 from scipy import ndimage
 
 from navlab.grid import COST_INSCRIBED, Grid, GridMap
-from navlab.navigation.costmap.footprint import Footprint
-from navlab.navigation.costmap.layers import InflationLayer, StaticLayer
+from navlab.navigation.costmap import Footprint, InflationLayer, StaticLayer
 from navlab.navigation.planners.common import iheap_pop, iheap_update
 
 OCCUPIED_THRESHOLD = 65  # occupancy (%) from which a cell is an obstacle (map_server's occupied_thresh 0.65)
