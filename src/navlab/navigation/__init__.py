@@ -9,5 +9,5 @@ from navlab.navigation.errors import NavigationError
 from navlab.navigation.goal import GoalOutcome, GoalState, MoveBaseState, RecoveryTrigger
 from navlab.navigation.planners import NavfnPlanner, ThetaStarPlanner, make_planner, path_length
 
-__all__ = ["GoalOutcome", "GoalState", "LayeredCostmap", "MoveBaseState", "NavfnPlanner", "NavigationError", "RecoveryTrigger",
-           "ThetaStarPlanner", "costmap_params", "make_planner", "path_length"]
+__all__ = ["GoalOutcome", "GoalState", "LayeredCostmap", "MoveBaseState", "NavfnPlanner", "NavigationError",
+           "RecoveryTrigger", "ThetaStarPlanner", "costmap_params", "make_planner", "path_length"]
