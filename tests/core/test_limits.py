@@ -8,8 +8,8 @@ from typing import Any
 
 import pytest
 
+from navlab.core import read_params
 from navlab.core.limits import ceilings
-from navlab.core.params import read_params
 from navlab.errors import NavlabError
 from navlab.io.carmen import read_carmen
 from navlab.localization.amcl import AmclParams

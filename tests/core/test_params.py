@@ -4,8 +4,7 @@ import re
 
 import pytest
 
-from navlab.core import Executor, Node, ParameterError, load_params
-from navlab.core.params import read_params
+from navlab.core import Executor, Node, ParameterError, load_params, read_params
 
 ROS1 = """\
 controller_frequency: 5.0

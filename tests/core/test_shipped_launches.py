@@ -11,10 +11,9 @@ from scipy import ndimage
 
 from navlab import msgs
 from navlab.cli import main
-from navlab.core import LaunchError, Node
+from navlab.core import LaunchError, Node, load_params
 from navlab.core.launch import resources_dir, start
-from navlab.core.params import load_params
-from navlab.drivers.routes import RouteFollower
+from navlab.drivers import RouteFollower
 from navlab.experiments.truth import true_map
 from navlab.mapping import GridMap, save_map
 from navlab.mapping.gmapping import GMappingParams

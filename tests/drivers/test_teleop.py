@@ -3,9 +3,7 @@
 import pytest
 
 from navlab.core import Executor
-from navlab.drivers.errors import DriverError
-from navlab.drivers.routes import RouteFollower, load_route
-from navlab.drivers.teleop import JoyMapping, TeleopKeyboard, TeleopState
+from navlab.drivers import DriverError, JoyMapping, RouteFollower, TeleopKeyboard, TeleopState, load_route
 
 
 def test_keyboard_bindings_and_speed_keys():

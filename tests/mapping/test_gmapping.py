@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from navlab.core.params import read_params
+from navlab.core import read_params
 from navlab.mapping import MappingError
 from navlab.mapping.gmapping import GMapping, GMappingParams
 

@@ -9,8 +9,7 @@ import pytest
 from sim_helpers import make_mybot, make_room
 
 from navlab import msgs
-from navlab.core import Executor, Node
-from navlab.core.params import load_params
+from navlab.core import Executor, Node, load_params
 from navlab.resources import root as resources_root
 from navlab.sim import launch_sim
 from navlab.sim.disturbances import parse_disturbances

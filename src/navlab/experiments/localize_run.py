@@ -108,7 +108,7 @@ def run_localization(
     that time (s) the robot is teleported to the route waypoint farthest from it and continues the route
     from there. ``record``: also write every topic to a rosbag2 (MCAP) in that folder.
     """
-    from navlab.drivers.routes import RouteFollower
+    from navlab.drivers import RouteFollower
     from navlab.localization.field import field_from_map
     from navlab.mapping.mapfile import load_map, save_map
     from navlab.sim.gazebo import load_world_named

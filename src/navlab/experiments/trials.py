@@ -42,7 +42,7 @@ def shortest_length(world: str, start: tuple[float, float, float], goals: list[t
                     robot_radius: float = 0.2) -> float | None:  # fmt: skip
     """Length (m) of the shortest collision-free route start -> goals on the world's true map (None if any
     leg has none): SPL's reference."""
-    from navlab.drivers.frontiers import exploration_costmap
+    from navlab.drivers import exploration_costmap
     from navlab.experiments.truth import true_map
     from navlab.navigation.planners.theta_star import ThetaStarPlanner
     from navlab.sim.gazebo import load_world_named

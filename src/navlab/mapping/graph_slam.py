@@ -18,7 +18,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from navlab.core.params import ParamSpec
+from navlab.core import ParamSpec
 from navlab.geometry import between2, compose2, inverse2, rotate_vectors2, transform_points2
 from navlab.mapping.errors import MappingError
 from navlab.mapping.posegraph import PoseGraph

@@ -11,7 +11,7 @@ import math
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
-from navlab.core.params import ParamSpec, read_params
+from navlab.core import ParamSpec, read_params
 from navlab.geometry import wrap_angle
 from navlab.grid import COST_INSCRIBED
 from navlab.navigation.errors import NavigationError

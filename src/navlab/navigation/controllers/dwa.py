@@ -9,7 +9,7 @@ from typing import Any
 
 import numpy as np
 
-from navlab.core.params import read_params
+from navlab.core import read_params
 from navlab.navigation.controllers import mapgrid
 from navlab.navigation.controllers.params import DWAPlannerParams
 from navlab.navigation.controllers.rollout import lookup, occupancy_costs, rollout, velocity_samples

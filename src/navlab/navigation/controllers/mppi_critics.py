@@ -30,7 +30,7 @@ from typing import Any
 
 import numpy as np
 
-from navlab.core.params import ParamSpec
+from navlab.core import ParamSpec
 from navlab.grid import COST_INSCRIBED, COST_LETHAL
 from navlab.navigation.controllers.rollout import footprint_costs
 from navlab.navigation.errors import NavigationError

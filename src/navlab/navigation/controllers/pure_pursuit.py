@@ -13,7 +13,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from navlab.core.params import ParamSpec, read_params
+from navlab.core import ParamSpec, read_params
 from navlab.navigation.errors import NavigationError
 
 

@@ -61,7 +61,7 @@ from typing import Any
 
 import numpy as np
 
-from navlab.core.params import read_params
+from navlab.core import read_params
 from navlab.grid import Grid
 from navlab.navigation.controllers import mapgrid
 from navlab.navigation.controllers.common import (

@@ -15,7 +15,7 @@ import numba
 import numpy as np
 from scipy import ndimage
 
-from navlab.core.params import read_params
+from navlab.core import read_params
 from navlab.grid import COST_FREE, COST_INSCRIBED, COST_LETHAL, COST_UNKNOWN, Grid, GridMap
 from navlab.navigation.costmap.footprint import Footprint, make_footprint
 from navlab.navigation.costmap.params import (

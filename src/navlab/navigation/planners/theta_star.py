@@ -21,7 +21,7 @@ from typing import Any, ClassVar
 import numba
 import numpy as np
 
-from navlab.core.params import ParamSpec, read_params
+from navlab.core import ParamSpec, read_params
 from navlab.grid import COST_INSCRIBED, COST_UNKNOWN, Grid
 from navlab.navigation.errors import NavigationError
 from navlab.navigation.planners.common import (
