@@ -46,7 +46,7 @@ def test_route_file_errors(tmp_path):
 
 
 def test_route_follower_drives_the_simulated_robot_to_its_waypoint():
-    from navlab.sim.gazebo import launch_sim
+    from navlab.sim import launch_sim
 
     ex = Executor(seed=0)
     gz = launch_sim(ex, world="room")

@@ -13,7 +13,7 @@ from navlab.geometry import wrap_angle
 from navlab.localization import ekf
 from navlab.localization.ekf_node import EkfNode
 from navlab.resources import root as resources_root
-from navlab.world.model import WorldModel
+from navlab.world import WorldModel
 
 PARAMS = resources_root() / "params"
 

@@ -23,7 +23,7 @@ import mujoco
 import numpy as np
 
 from navlab.core import Executor, Node
-from navlab.description.model import Geometry, RobotModel
+from navlab.description import Geometry, RobotModel
 from navlab.errors import did_you_mean
 from navlab.sim.errors import SimError
 from navlab.sim.simulation import Simulation
