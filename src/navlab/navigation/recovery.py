@@ -15,6 +15,7 @@ from navlab.core.params import dataclass_from_dict
 from navlab.geometry import wrap_angle
 from navlab.grid import COST_INSCRIBED
 from navlab.navigation.errors import NavigationError
+from navlab.plugins import BuiltFromParams
 
 Pose = tuple[float, float, float]
 
@@ -29,7 +30,7 @@ class ClearCostmapParams:
     affected_maps: str = "both"
 
 
-class ClearCostmapRecovery:
+class ClearCostmapRecovery(BuiltFromParams):
     """``clear_costmap_recovery/ClearCostmapRecovery``: clears the costmaps' obstacle layers outside a square
     of side ``reset_distance`` around the robot; takes one cycle."""
 
@@ -69,7 +70,7 @@ class RotateParams:
     tolerance: float = 0.10
 
 
-class RotateRecovery:
+class RotateRecovery(BuiltFromParams):
     """``rotate_recovery/RotateRecovery``: turn 360° in place (counter-clockwise), stopping early if the
     footprint would hit a lethal cell of the local costmap."""
 
@@ -111,7 +112,7 @@ class BackUpParams:
     time_allowance: float = 10.0
 
 
-class BackUpRecovery:
+class BackUpRecovery(BuiltFromParams):
     """``nav2_behaviors/BackUp``: reverse a short distance, stopping if the footprint behind is lethal."""
 
     def __init__(self, params: dict[str, Any] | None = None) -> None:
