@@ -5,7 +5,7 @@ from __future__ import annotations
 import subprocess
 import sys
 import textwrap
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -18,15 +18,18 @@ def _pip(*args: str) -> None:
                    capture_output=True, text=True, timeout=300)
 
 
-@pytest.fixture
-def install_plugin_package(tmp_path: Path) -> Iterator[Callable[..., None]]:
-    """``install(dist, entry_points, modules={})``: write a package (``pyproject.toml`` declaring
-    ``entry_points`` {group: {name: "module:attr"}}, plus ``modules`` {file name: source}) to a temporary
-    folder and ``pip install`` it into this environment as a user would; uninstalled after the test."""
-    installed: list[str] = []
+class PluginInstaller:
+    """Installs plugin packages into this environment with pip, as a user would; uninstalls them at the end."""
 
-    def install(dist: str, entry_points: dict[str, dict[str, str]], modules: dict[str, str] | None = None) -> None:
-        root = tmp_path / dist
+    def __init__(self, tmp_path: Path) -> None:
+        self.tmp_path = tmp_path
+        self.installed: list[str] = []
+
+    def __call__(self, dist: str, entry_points: dict[str, dict[str, str]], modules: dict[str, str] | None = None
+                 ) -> None:  # fmt: skip
+        """Write a package declaring ``entry_points`` {group: {name: "module:attr"}}, plus ``modules`` {file
+        name: source}, and install it."""
+        root = self.tmp_path / dist
         root.mkdir()
         modules = modules or {}
         groups = "\n".join(f'[project.entry-points."{group}"]\n' + "".join(f'"{k}" = "{v}"\n' for k, v in eps.items())
@@ -47,12 +50,25 @@ def install_plugin_package(tmp_path: Path) -> Iterator[Callable[..., None]]:
             """) + groups)
         for file, source in modules.items():
             (root / file).write_text(source)
+        self.install_dir(dist, root)
+
+    def install_dir(self, dist: str, root: Path) -> None:
+        """``pip install --no-deps --no-build-isolation ROOT`` (the package named ``dist``)."""
         _pip("uninstall", "-y", dist)  # a leftover of an interrupted run
+        self.installed.append(dist)
         _pip("install", "--no-deps", "--no-build-isolation", str(root))
-        installed.append(dist)
         refresh_plugins()
 
-    yield install
-    for dist in installed:
-        _pip("uninstall", "-y", dist)
-    refresh_plugins()
+    def uninstall_all(self) -> None:
+        for dist in self.installed:
+            _pip("uninstall", "-y", dist)
+        refresh_plugins()
+
+
+@pytest.fixture
+def install_plugin_package(tmp_path: Path) -> Iterator[PluginInstaller]:
+    """``install(dist, entry_points, modules={})`` / ``install.install_dir(dist, root)``: a plugin package
+    installed into this environment for the test (pip, no build isolation), uninstalled afterwards."""
+    installer = PluginInstaller(tmp_path)
+    yield installer
+    installer.uninstall_all()

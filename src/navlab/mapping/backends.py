@@ -1,9 +1,9 @@
 """slam_gmapping's ``mode`` plugins: the SLAM algorithms behind the ``SlamBackend`` seam (``navlab.plugins``).
 
-Each backend is built as ``cls(params, *, rng)`` from slam_gmapping's parameter names (a mode's own
-parameters under its name: ``graph.voxel``), and is what both the ``slam_gmapping`` node and
-``navlab slam`` (``run_offline``) drive. Adding a mode is one such class in a new file and one line
-in ``navlab.plugins.REGISTRY["slam_backend"]``.
+Each backend is built as ``cls.from_params(params, context=PluginContext(rng=...))`` from slam_gmapping's
+parameter names (a mode's own parameters under its name: ``graph.voxel``), and is what both the
+``slam_gmapping`` node and ``navlab slam`` (``run_offline``) drive. Adding a mode is one such class and one
+``navlab.slam_backends`` entry point (in navlab's pyproject.toml or a package of one's own: docs/plugins.md).
 
 - ``gmapping``: the Rao-Blackwellized particle filter (:class:`~navlab.mapping.gmapping.GMapping`),
   which applies odometry to every scan and updates the map after ``linearUpdate``/``angularUpdate``/

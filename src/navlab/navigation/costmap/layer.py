@@ -10,11 +10,12 @@ The layers themselves live one per file: ``static_layer``, ``obstacle_layer``, `
 from __future__ import annotations
 
 import dataclasses
+import warnings
 from collections.abc import Mapping
 from typing import Any, Self
 
 from navlab.grid import Grid
-from navlab.navigation.costmap.footprint import Footprint
+from navlab.navigation.costmap.footprint import Footprint, make_footprint
 from navlab.navigation.costmap.params import CostmapParams, layer_params
 from navlab.navigation.errors import NavigationError
 from navlab.plugins import PluginContext
@@ -55,7 +56,20 @@ class Layer:
     def from_params(cls, params: Mapping[str, Any] | None, *, context: PluginContext) -> Self:
         """The layer named ``context.name`` from its parameter namespace ``params`` (ROS names), in the costmap
         ``context.costmap`` (parsed ``CostmapParams``) with the robot's padded ``context.footprint``."""
-        raise NotImplementedError
+        if getattr(cls.from_costmap_params, "__func__", None) is _OLD_HOOK:
+            raise NotImplementedError(f"{cls.__name__} has no from_params(params, *, context)")
+        warnings.warn(f"{cls.__name__}.from_costmap_params is deprecated: implement from_params(params, *, context)",
+                      DeprecationWarning, stacklevel=2)  # a layer written for the old hook: one release
+        footprint = context.footprint if isinstance(context.footprint, Footprint) else make_footprint()
+        return cls.from_costmap_params(context.name, costmap_of(params, context), footprint)
+
+    @classmethod
+    def from_costmap_params(cls, name: str, costmap: CostmapParams, footprint: Footprint) -> Self:
+        """Deprecated (one release): ``from_params`` with the layer's namespace and a ``PluginContext``."""
+        warnings.warn("Layer.from_costmap_params is deprecated: use from_params(params, *, context)",
+                      DeprecationWarning, stacklevel=2)
+        context = PluginContext(name=name, footprint=footprint, costmap=costmap)
+        return cls.from_params(costmap.namespaces.get(name), context=context)
 
     def on_footprint_changed(self, footprint: Footprint) -> None:
         """The robot's (padded) footprint changed."""
@@ -76,3 +90,6 @@ class Layer:
 
     def reset(self) -> None:
         """Forget everything observed."""
+
+
+_OLD_HOOK = vars(Layer)["from_costmap_params"].__func__  # the base's: a layer that overrides neither has no constructor
