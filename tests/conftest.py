@@ -25,8 +25,8 @@ class PluginInstaller:
         self.tmp_path = tmp_path
         self.installed: list[str] = []
 
-    def __call__(self, dist: str, entry_points: dict[str, dict[str, str]], modules: dict[str, str] | None = None
-                 ) -> None:  # fmt: skip
+    def __call__(self, dist: str, entry_points: dict[str, dict[str, str]],
+                 modules: dict[str, str] | None = None) -> None:
         """Write a package declaring ``entry_points`` {group: {name: "module:attr"}}, plus ``modules`` {file
         name: source}, and install it."""
         root = self.tmp_path / dist

@@ -14,7 +14,7 @@ Every class plugin is built the same way: ``cls.from_params(params, *, context)`
 plugin's ROS parameter namespace (a dict; missing keys take ROS defaults) and ``context`` a
 :class:`PluginContext` (what the hosting node gives every plugin: its name, seeded RNG, footprint, ...).
 AMCL's motion models are plain functions and are used as they are. Short aliases (``dwa``) live here.
-:func:`navlab.navigation.check_plugin` checks a plugin against its Protocol.
+:func:`navlab.navigation.plugin_check.check_plugin` checks a plugin against its Protocol (docs/plugins.md).
 
 Every implementation is pure (numpy in, numpy out; no topics, no clock); its node holds parameters.
 Units: metres, radians, seconds; poses ``(x, y, yaw)``; paths ``(N, 2)`` or ``(N, 3)`` arrays in the
