@@ -11,7 +11,7 @@ from dataclasses import replace
 import mujoco
 import numpy as np
 
-from navlab.description.model import Origin, RobotModel, Shape
+from navlab.description import Origin, RobotModel, Shape
 from navlab.sim.builder import (
     DEFAULT_MU,
     DEFAULT_STEP,
@@ -29,7 +29,7 @@ from navlab.sim.builder import (
     set_pose,
 )
 from navlab.sim.errors import SimError
-from navlab.world.model import ModelSpec, WorldModel
+from navlab.world import ModelSpec, WorldModel
 
 
 def add_world_model(spec: mujoco.MjSpec, model: ModelSpec, info: BuildInfo) -> list[str]:
