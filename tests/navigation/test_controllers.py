@@ -162,7 +162,7 @@ def test_at_goal_position_stops_then_turns_in_place_to_goal_yaw(cls):
     assert ctrl.is_goal_reached(pose, (0.0, 0.0))
     assert abs(pose[2] - 1.2) <= ctrl.params.yaw_goal_tolerance
     assert pose[:2] == (0.02, 0.01)
-    assert ctrl.compute_velocity(pose, (0.0, 0.0), grid) == (0.0, 0.0)
+    assert tuple(ctrl.compute_velocity(pose, (0.0, 0.0), grid)) == (0.0, 0.0)
 
 
 def test_latch_xy_goal_tolerance_keeps_turning_after_drifting_out():
@@ -204,7 +204,7 @@ def test_costmap_rotated_origin_gives_the_same_commands():
         b.set_plan(plan_r)
         cmd_a = a.compute_velocity((0.0, 0.0, 0.0), (0.3, 0.0), world)
         cmd_b = b.compute_velocity((0.0, 0.0, yaw), (0.3, 0.0), rot)
-        assert cmd_a == pytest.approx(cmd_b, abs=1e-9)
+        assert tuple(cmd_a) == pytest.approx(tuple(cmd_b), abs=1e-9)
         lp = b.local_plan
         back = np.column_stack([c * lp[:, 0] + s * lp[:, 1], -s * lp[:, 0] + c * lp[:, 1]])
         assert back == pytest.approx(a.local_plan[:, :2], abs=1e-9)
@@ -318,7 +318,7 @@ def test_scoring_weights_change_the_choice():
     for bias in (0.0, 200.0):  # a strong path bias keeps the robot on the (blocked) line longer
         ctrl = DWAPlannerROS({"path_distance_bias": bias, "vth_samples": 30})
         ctrl.set_plan(straight_plan())
-        picks.append(ctrl.compute_velocity((0.0, 0.0, 0.0), (0.4, 0.0), world))
+        picks.append(tuple(ctrl.compute_velocity((0.0, 0.0, 0.0), (0.4, 0.0), world)))
     assert picks[0] != picks[1]
 
 
@@ -459,7 +459,7 @@ def test_a_rollouts_first_failure_in_time_decides_its_code() -> None:
     """``generateTrajectory`` checks poses in time order and returns at the first failure: -1 when the footprint
     is blocked (or off the map), -2 when the cell has no path to the goal. The code matters: only a -2 escape
     rollout keeps TrajectoryPlanner out of escape mode."""
-    from navlab.navigation.controllers.rollout import _rollout_scores
+    from navlab.navigation.controllers.rollout import rollout_scores
 
     res, n = 0.1, 5
     grid = np.zeros((n, n), dtype=np.uint8)
@@ -473,7 +473,7 @@ def test_a_rollouts_first_failure_in_time_decides_its_code() -> None:
         traj = np.array([[[(cells[k][0] + 0.5) * res, (cells[k][1] + 0.5) * res, 0.0] for k in names]])
         out = np.empty(1)
         zeros = np.zeros(traj.shape[:2])
-        _rollout_scores(grid, grid, path_dist, goal_dist, 1.0 / res, traj, zeros, zeros, np.zeros(0), np.zeros(0),
+        rollout_scores(grid, grid, path_dist, goal_dist, 1.0 / res, traj, zeros, zeros, np.zeros(0), np.zeros(0),
                         False, False, np.array([1.0, 0.6, 0.8, 0.01]), float(n * n), np.array([-1]), out)
         return float(out[0])
 

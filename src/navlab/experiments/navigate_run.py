@@ -35,11 +35,6 @@ if TYPE_CHECKING:
     from navlab.navigation.move_base import MoveBase
 
 Pose = tuple[float, float, float]
-CONTROLLERS = {
-    "trajectory": "base_local_planner/TrajectoryPlannerROS",
-    "dwa": "dwa_local_planner/DWAPlannerROS",
-    "mppi": "nav2_mppi_controller::MPPIController",
-}
 
 
 GOAL_TOLERANCE_M = 0.3  # the truth's goal region: twice the shipped robots' xy_goal_tolerance (AMCL's error room)
@@ -246,7 +241,7 @@ def run_navigation(
             raise NavigationError(f"goal {g!r}: expected three finite numbers x y yaw")
     overrides: dict[str, Any] = dict(move_base_params or {})
     if controller:
-        overrides["base_local_planner"] = CONTROLLERS.get(controller, controller)
+        overrides["base_local_planner"] = controller  # a ROS name or a registry alias (dwa, mppi, ...)
     gazebo = {"gazebo": {"disturbances": dict(disturbances)}} if disturbances else {}
     launch_args: dict[str, Any] = sim_launch_args(wheel_controller, ekf)
     if params_dir is not None:

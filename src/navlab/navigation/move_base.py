@@ -12,7 +12,6 @@ spirit: feedback, cancel, result succeeded / aborted with a reason / preempted);
 
 from __future__ import annotations
 
-import inspect
 import math
 from collections.abc import Callable
 from typing import Any
@@ -22,13 +21,12 @@ import numpy as np
 from navlab import msgs
 from navlab.core import Executor, Node, TfError
 from navlab.core.limits import check_ceiling
-from navlab.geometry import inverse_transform_points2, transform_points2, wrap_angle
-from navlab.navigation.costmap.layers import StaticLayer
+from navlab.geometry import transform_points2, wrap_angle
 from navlab.navigation.costmap_ros import Costmap2DROS
 from navlab.navigation.errors import NavigationError
 from navlab.navigation.goal import STATUS, GoalHandle, GoalState, MoveBaseState, RecoveryTrigger, with_headings
 from navlab.navigation.recovery import DEFAULT_RECOVERIES, ClearCostmapRecovery
-from navlab.plugins import load_plugin, plugin_names
+from navlab.plugins import ControlResult, PluginContext, load_plugin, make_plugin, plugin_names, resolve_name
 
 Pose = tuple[float, float, float]
 _MB_DEFAULTS: dict[str, Any] = {
@@ -55,13 +53,6 @@ def short_name(plugin: str) -> str:
     return plugin.replace("::", "/").rsplit("/", 1)[-1]
 
 
-def _construct(cls: Any, params: dict[str, Any], **extra: Any) -> Any:
-    """A plugin instance from its ROS parameter dict, plus the ``extra`` keywords its constructor takes
-    (the node's random generator, the robot's footprint polygon)."""
-    accepted = inspect.signature(cls).parameters
-    return cls(params, **{k: v for k, v in extra.items() if k in accepted})
-
-
 class MoveBase(Node):
     """ROS 1 move_base over navlab's costmaps, planners and controllers (see the module docstring)."""
 
@@ -84,17 +75,18 @@ class MoveBase(Node):
         self.global_costmap = self._costmap("global_costmap", private)
         self.local_costmap = self._costmap("local_costmap", private)
         self.costmaps = {"global": self.global_costmap, "local": self.local_costmap}
-        gp, lp = str(p["base_global_planner"]), str(p["base_local_planner"])
+        gp = resolve_name("global_planner", str(p["base_global_planner"]))
+        lp = resolve_name("controller", str(p["base_local_planner"]))
         self.planner_name, self.controller_name = short_name(gp), short_name(lp)
-        self.planner = _construct(load_plugin("global_planner", gp, param="base_global_planner"),
-                                  self._namespace(self.planner_name))  # fmt: skip
-        footprint = self.local_costmap.layered.footprint
+        self.planner = make_plugin("global_planner", gp, self._namespace(self.planner_name),
+                                   context=PluginContext(name=self.planner_name, rng=self.rng),
+                                   param="base_global_planner")
         # as ROS's planners see them: the costmap's footprint (a round robot's radius, for costmap_2d's 16-gon)
         # and move_base's controller_frequency (they search the parameter upward)
-        self.controller = _construct(load_plugin("controller", lp, param="base_local_planner"),
-                                     self._namespace(self.controller_name), rng=self.rng,
-                                     footprint=footprint.polygon, robot_radius=footprint.radius,
-                                     controller_frequency=p["controller_frequency"])  # fmt: skip
+        context = PluginContext(name=self.controller_name, rng=self.rng, footprint=self.local_costmap.layered.footprint,
+                                controller_frequency=p["controller_frequency"])
+        self.controller = make_plugin("controller", lp, self._namespace(self.controller_name), context=context,
+                                      param="base_local_planner")
         self.recoveries = self._recoveries(raw_recoveries)
         # a parameter file may configure several planners (TrajectoryPlannerROS: and DWAPlannerROS:); ROS ignores
         # the sections of the ones not in use, and so does navlab
@@ -137,14 +129,13 @@ class MoveBase(Node):
         out = []
         for k, spec in enumerate(raw):
             name, kind = str(spec["name"]), str(spec["type"])
-            cls = load_plugin("recovery", kind, param=f"recovery_behaviors[{k}] type")
             params = self._namespace(name)
-            if cls is ClearCostmapRecovery:
+            if load_plugin("recovery", kind, param=f"recovery_behaviors[{k}] type") is ClearCostmapRecovery:
+                # as ROS 1 move_base sets <name>/reset_distance for its resets (unless the file does)
                 default = self.p["conservative_reset_dist"] if name == "conservative_reset" else (
                     4.0 * self.local_costmap.layered.circumscribed_radius)
-                out.append((name, cls(params, default_reset=default)))
-            else:
-                out.append((name, cls(params)))
+                params = {"reset_distance": default, **params}
+            out.append((name, make_plugin("recovery", kind, params, context=PluginContext(name=name, rng=self.rng))))
         return out
 
     # --- goals ---------------------------------------------------------------------------------------
@@ -251,14 +242,7 @@ class MoveBase(Node):
 
     def _on_map_obstacle(self, goal: Pose) -> bool:
         """Whether ``goal`` (global frame) lies on an occupied cell of a static layer's map."""
-        for layer in self.global_costmap.layered.layers:
-            grid = getattr(layer, "map", None)
-            if isinstance(layer, StaticLayer) and grid is not None:
-                mx, my, myaw = layer.map_in_costmap
-                xy = inverse_transform_points2((mx, my, myaw), np.array([goal[:2]]))
-                if int(grid.value_at(xy)[0]) >= layer.params.lethal_cost_threshold:
-                    return True
-        return False
+        return any(layer.on_map_obstacle(goal[:2]) for layer in self.global_costmap.layered.map_layers)
 
     def make_plan(self, start: Pose, goal: Pose) -> np.ndarray | None:
         """A global plan (N, 2+) in the global costmap's frame, or None."""
@@ -287,7 +271,7 @@ class MoveBase(Node):
         self.last_plan_ns = self.executor.now_ns
         if plan is None:
             self.planning_retries += 1
-            self.plan_failure = str(getattr(self.planner, "last_failure", "") or "")
+            self.plan_failure = str(self.planner.last_failure or "")
             if self._on_map_obstacle(goal):  # no recovery clears the map itself: say so now
                 self._finish(GoalState.ABORTED, f"goal ({goal[0]:.2f}, {goal[1]:.2f}) is in an obstacle on the map"
                                         + (f" ({self.plan_failure})" if self.plan_failure else ""))  # fmt: skip
@@ -360,29 +344,24 @@ class MoveBase(Node):
             self._enter_clearing(RecoveryTrigger.OSCILLATION)
             return
         try:
-            cmd = self.controller.compute_velocity(pose, self.velocity, self.local_costmap.costmap)
+            cmd: ControlResult | None = ControlResult.of(
+                self.controller.compute_velocity(pose, self.velocity, self.local_costmap.costmap))
         except NavigationError as exc:
             self.get_logger().debug(f"controller: {exc}")
             cmd = None
-        valid = cmd is not None and all(math.isfinite(c) for c in cmd) and getattr(self.controller, "valid", True)
-        if valid:
-            assert cmd is not None
+        if cmd is not None and cmd.valid and math.isfinite(cmd.v) and math.isfinite(cmd.w):
             self.last_valid_control_ns = now
             if self.recovery_trigger == RecoveryTrigger.CONTROLLING:
                 self.recovery_index = 0
-            self.cmd_pub.publish(msgs.twist(*cmd))
+            self.cmd_pub.publish(msgs.twist(cmd.v, cmd.w))
         else:
             self.cmd_pub.publish(msgs.twist(0.0, 0.0))
             if self._timed_out(self.last_valid_control_ns, p["controller_patience"]):
                 self._enter_clearing(RecoveryTrigger.CONTROLLING)
             elif p["planner_frequency"] <= 0:
                 self.state = MoveBaseState.PLANNING  # ROS replans when the controller fails
-        self._publish_local_plan(now)
-
-    def _publish_local_plan(self, now: int) -> None:
-        traj = getattr(self.controller, "local_plan", None)
-        if traj is not None and len(traj):
-            self._publish_path(self.local_plan_pub, traj, self.local_costmap.global_frame)
+        if cmd is not None and len(cmd.local_plan):
+            self._publish_path(self.local_plan_pub, cmd.local_plan, self.local_costmap.global_frame)
 
     def _publish_path(self, pub: Any, poses: np.ndarray, frame: str) -> None:
         """``nav_msgs/Path`` of (N, 2+) poses, built only when someone listens (hundreds of messages each)."""

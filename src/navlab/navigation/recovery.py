@@ -15,6 +15,7 @@ from navlab.core import ParamSpec, read_params
 from navlab.geometry import wrap_angle
 from navlab.grid import COST_INSCRIBED
 from navlab.navigation.errors import NavigationError
+from navlab.plugins import BuiltFromParams
 
 Pose = tuple[float, float, float]
 
@@ -32,7 +33,7 @@ class ClearCostmapParams:
                                             choices={"affected_maps": ("global", "local", "both")})
 
 
-class ClearCostmapRecovery:
+class ClearCostmapRecovery(BuiltFromParams):
     """``clear_costmap_recovery/ClearCostmapRecovery``: clears the costmaps' obstacle layers outside a square
     of side ``reset_distance`` around the robot; takes one cycle."""
 
@@ -63,7 +64,7 @@ class RotateParams:
     PARAMS: ClassVar[ParamSpec] = ParamSpec("rotate_recovery", NavigationError, above={"max_rotational_vel": 0.0})
 
 
-class RotateRecovery:
+class RotateRecovery(BuiltFromParams):
     """``rotate_recovery/RotateRecovery``: turn 360° in place (counter-clockwise), stopping early if the
     footprint would hit a lethal cell of the local costmap."""
 
@@ -104,7 +105,7 @@ class BackUpParams:
                                             above={"backup_dist": 0.0, "backup_speed": 0.0})
 
 
-class BackUpRecovery:
+class BackUpRecovery(BuiltFromParams):
     """``nav2_behaviors/BackUp``: reverse a short distance, stopping if the footprint behind is lethal."""
 
     def __init__(self, params: dict[str, Any] | None = None) -> None:

@@ -1,4 +1,4 @@
-"""dwa_local_planner/DWAPlannerROS: the dynamic window approach of ROS 1 (see ``trajectory`` for the
+"""dwa_local_planner/DWAPlannerROS: the dynamic window approach of ROS 1 (see ``rollout_controller`` for the
 shared rollout, distance maps and goal handling, and the cost it minimises)."""
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ from navlab.core import read_params
 from navlab.navigation.controllers import mapgrid
 from navlab.navigation.controllers.params import DWAPlannerParams
 from navlab.navigation.controllers.rollout import lookup, occupancy_costs, rollout, velocity_samples
-from navlab.navigation.controllers.trajectory import LocalScene, RolloutController
+from navlab.navigation.controllers.rollout_controller import LocalScene, RolloutController
 
 _EPS = 1e-4
 

@@ -50,6 +50,7 @@ from navlab.navigation.controllers.common import (
     same_goal,
 )
 from navlab.navigation.errors import NavigationError
+from navlab.plugins import ControlResult, PluginContext
 
 WHAT = "MPPIController"
 PATH_SPACING = 0.05  # m: plans are resampled to this (Nav2's path-index offsets assume costmap cells)
@@ -285,9 +286,22 @@ class MPPIController:
         n = int(np.searchsorted(np.cumsum(seg), self.params.prune_distance)) + 2
         return rest[:n]
 
+    @classmethod
+    def from_params(cls, params: Mapping[str, Any] | None, *, context: PluginContext) -> MPPIController:
+        """From the controller's parameter namespace, the host's seeded ``rng`` (required) and the local costmap's
+        footprint polygon (None for a round robot)."""
+        fp = context.footprint
+        return cls(params, rng=context.rng, footprint=None if fp is None else fp.polygon)
+
     def compute_velocity(self, pose: tuple[float, float, float], velocity: tuple[float, float],
-                         costmap: Grid | None) -> tuple[float, float]:
-        """(v m/s, w rad/s) for the robot at ``pose`` (costmap frame) moving at ``velocity`` (v, w)."""
+                         costmap: Grid | None) -> ControlResult:
+        """The command (v m/s, w rad/s) for the robot at ``pose`` (costmap frame) moving at ``velocity`` (v, w),
+        with ``valid`` and the optimal trajectory as ``local_plan``."""
+        v, w = self._command(pose, velocity, costmap)
+        return ControlResult(v, w, self.valid, self.local_plan)
+
+    def _command(self, pose: tuple[float, float, float], velocity: tuple[float, float],
+                 costmap: Grid | None) -> tuple[float, float]:
         if self._plan is None:
             raise NavigationError(f"{WHAT}: compute_velocity called before set_plan")
         if costmap is None:

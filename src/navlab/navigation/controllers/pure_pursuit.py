@@ -15,6 +15,7 @@ import numpy as np
 
 from navlab.core import ParamSpec, read_params
 from navlab.navigation.errors import NavigationError
+from navlab.plugins import BuiltFromParams, ControlResult
 
 
 def follow_path(
@@ -66,9 +67,9 @@ class PurePursuitParams:
                                                       "xy_goal_tolerance": 0.0, "stop_distance": 0.0})
 
 
-class PurePursuit:
-    """``plugins.Controller`` over :func:`follow_path`; ``min_front_range`` (m) is the nearest return ahead,
-    set by the caller from its scans (the follower then stops short of obstacles)."""
+class PurePursuit(BuiltFromParams):
+    """``navlab/PurePursuit`` (a ``plugins.Controller``) over :func:`follow_path`; ``min_front_range`` (m) is the
+    nearest return ahead, set by the caller from its scans (the follower then stops short of obstacles)."""
 
     def __init__(self, params: PurePursuitParams | dict[str, Any] | None = None, **overrides: Any) -> None:
         if overrides:  # keyword parameters over a dict or an instance's values
@@ -83,14 +84,14 @@ class PurePursuit:
 
     def compute_velocity(
         self, pose: tuple[float, float, float], velocity: tuple[float, float] = (0.0, 0.0), costmap: Any = None
-    ) -> tuple[float, float]:
-        """(v, w) toward the plan; zero without a plan or once the goal is reached."""
+    ) -> ControlResult:
+        """The command (v m/s, w rad/s) toward the plan; a stop without a plan or once the goal is reached."""
         if len(self.path) == 0 or self.is_goal_reached(pose, velocity):
-            return 0.0, 0.0
+            return ControlResult(0.0, 0.0)
         p = self.params
         v, w, _ = follow_path(pose, self.path, lookahead=p.lookahead, max_v=p.max_vel_x, max_w=p.max_vel_theta,
                               min_front_range=self.min_front_range, stop_distance=p.stop_distance)  # fmt: skip
-        return v, w
+        return ControlResult(v, w)
 
     def is_goal_reached(self, pose: tuple[float, float, float], velocity: tuple[float, float] = (0.0, 0.0)) -> bool:
         """Within ``xy_goal_tolerance`` of the plan's last point."""

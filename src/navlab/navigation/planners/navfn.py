@@ -34,6 +34,7 @@ from navlab.navigation.planners.common import (
     pose_cell,
     to_world,
 )
+from navlab.plugins import BuiltFromParams
 
 COST_NEUTRAL = 50.0
 COST_FACTOR = 0.8
@@ -306,7 +307,7 @@ def _descend(pot: np.ndarray, u: float, v: float, tu: float, tv: float, step: fl
 # --- the planner ---------------------------------------------------------------------------------
 
 
-class NavfnPlanner:
+class NavfnPlanner(BuiltFromParams):
     """``navfn/NavfnROS`` as a pure planner: :meth:`make_plan` over a costmap ``Grid`` (uint8 costs).
 
     After a call, ``last_failure`` says why there was no path ("" on success), ``stats`` holds the

@@ -33,6 +33,7 @@ from navlab.navigation.planners.common import (
     pose_cell,
     to_world,
 )
+from navlab.plugins import BuiltFromParams
 
 MAX_NON_OBSTACLE = 252.0
 
@@ -156,7 +157,7 @@ def _theta_star(blocked: np.ndarray, trav: np.ndarray, start: int, goal: int, co
     return parent, expanded
 
 
-class ThetaStarPlanner:
+class ThetaStarPlanner(BuiltFromParams):
     """``nav2_theta_star_planner/ThetaStarPlanner`` as a pure planner over a costmap ``Grid`` (uint8 costs).
 
     After a call, ``last_failure`` says why there was no path ("" on success) and ``stats`` holds the
