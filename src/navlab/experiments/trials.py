@@ -96,7 +96,8 @@ def run_trial(sc: Scenario, index: int) -> dict[str, Any]:
         map_yaml: str | Path | None = None
         if clutter is not None:
             world = str(clutter.write_world(Path(tmp) / f"{clutter.name}.world"))
-            start, overrides = clutter.start, {**CLUTTER_PARAMS, **sc.overrides}
+            mybot = {**CLUTTER_PARAMS} if sc.robot == "mybot" else {}  # other robots: their own files (clutter_run)
+            start, overrides = clutter.start, {**mybot, **sc.overrides}
         if sc.map == "map_first":
             mapped = run_mapping(world=sc.resolve(sc.map_world) or sc.map_world or world, robot=sc.robot,
                                  pose=start, out=Path(tmp) / "map", seed=seed, quiet=True)  # fmt: skip
