@@ -13,10 +13,10 @@ from typing import Any, Self
 
 import numba
 import numpy as np
-from scipy import ndimage
 
 from navlab.grid import COST_FREE, COST_INSCRIBED, COST_LETHAL, COST_UNKNOWN, Grid, GridMap
 from navlab.navigation.costmap.footprint import Footprint, make_footprint
+from navlab.navigation.costmap.inflation_kernel import inflate_box
 from navlab.navigation.costmap.params import (
     CostmapParams,
     InflationLayerParams,
@@ -389,28 +389,13 @@ class InflationLayer(Layer):
         j0, j1, i0, i1 = box
         o0, o1 = max(0, j0 - reach), min(seeds.shape[0], j1 + reach)
         p0, p1 = max(0, i0 - reach), min(seeds.shape[1], i1 + reach)
-        near = seeds[o0:o1, p0:p1]
-        if near.any():  # the nearest seed of each cell, its squared distance in cells, the cost of that
-            ft = ndimage.distance_transform_edt(~near, return_distances=False, return_indices=True)
-            _costs_from_features(ft, j0 - o0, i0 - p0, self._table(master.resolution, reach), cost[j0:j1, i0:i1])
+        if seeds[o0:o1, p0:p1].any():  # the squared distance (cells) to each cell's nearest seed, its cost
+            inflate_box(seeds, (o0, o1, p0, p1), (j0, j1, i0, i1), self._table(master.resolution, reach),
+                        cost[j0:j1, i0:i1])
         else:  # no obstacle within reach of the box: nothing to inflate there
             cost[j0:j1, i0:i1] = 0
         self._inflated = (key, seeds, cost)
         return cost
-
-
-@numba.njit(cache=True)
-def _costs_from_features(ft: np.ndarray, r0: int, c0: int, table: np.ndarray,
-                         out: np.ndarray) -> None:  # pragma: no cover - compiled
-    """``out[j, i]`` = ``table`` at the squared distance (cells) from cell (r0 + j, c0 + i) to its nearest seed
-    (``ft``: scipy's feature transform), the table's last entry beyond its end."""
-    last = table.size - 1
-    for j in range(out.shape[0]):
-        for i in range(out.shape[1]):
-            dj = np.int64(ft[0, r0 + j, c0 + i]) - (r0 + j)
-            di = np.int64(ft[1, r0 + j, c0 + i]) - (c0 + i)
-            d2 = dj * dj + di * di
-            out[j, i] = table[d2 if d2 < last else last]
 
 
 @numba.njit(cache=True)

@@ -1,0 +1,78 @@
+"""The inflation layer's distance step, compiled: exact squared cell distances to the nearest lethal cell
+(Felzenszwalb & Huttenlocher's separable distance transform, "Distance Transforms of Sampled Functions",
+2012) turned into costs through the layer's table, for one box of the grid.
+
+The squared distances are integers computed exactly, so the costs equal those of a Euclidean distance
+transform of the same seeds (scipy's ``distance_transform_edt``), bit for bit, without its feature
+arrays. Cells are ``data[j, i]`` (row ``j``, column ``i``), as everywhere in ``navlab.grid``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+
+_FAR = np.int64(1) << 40  # "no seed in this column": beyond any real squared distance of a grid
+
+
+@numba.njit(cache=True)
+def inflate_box(seeds: np.ndarray, region: tuple[int, int, int, int], box: tuple[int, int, int, int],
+                table: np.ndarray, out: np.ndarray) -> None:  # pragma: no cover - compiled
+    """``out`` (the box's shape) = ``table[d2]`` for each cell of ``box`` = (j0, j1, i0, i1), ``d2`` its squared
+    distance in cells to the nearest true cell of ``seeds`` inside ``region`` = (o0, o1, p0, p1) (which holds the
+    box), the table's last entry from its end on (and where the region has no seed)."""
+    o0, o1, p0, p1 = region
+    j0, j1, i0, i1 = box
+    rows, cols = o1 - o0, p1 - p0
+    last = table.size - 1
+    # pass 1: per column, the distance (cells) to the nearest seed in that column, _FAR if none
+    g = np.empty((rows, cols), dtype=np.int64)
+    for c in range(cols):
+        d = _FAR
+        for r in range(rows):
+            if seeds[o0 + r, p0 + c]:
+                d = 0
+            elif d != _FAR:
+                d += 1
+            g[r, c] = d
+        d = _FAR
+        for r in range(rows - 1, -1, -1):
+            if seeds[o0 + r, p0 + c]:
+                d = 0
+            elif d != _FAR:
+                d += 1
+            if d < g[r, c]:
+                g[r, c] = d
+    # pass 2: per row of the box, the lower envelope of the parabolas (i - q)^2 + g[q]^2 over the columns q
+    v = np.empty(cols, dtype=np.int64)
+    z = np.empty(cols + 1, dtype=np.float64)
+    for r in range(j0 - o0, j1 - o0):
+        k = -1
+        for q in range(cols):
+            if g[r, q] == _FAR:
+                continue
+            fq = g[r, q] * g[r, q] + q * q
+            s = 0.0
+            while k >= 0:
+                p = v[k]
+                s = (fq - (g[r, p] * g[r, p] + p * p)) / (2.0 * (q - p))
+                if s <= z[k]:
+                    k -= 1
+                else:
+                    break
+            k += 1
+            v[k] = q
+            z[k] = -math.inf if k == 0 else s
+            z[k + 1] = math.inf
+        m = 0
+        for i in range(i0 - p0, i1 - p0):
+            if k < 0:
+                out[r - (j0 - o0), i - (i0 - p0)] = table[last]
+                continue
+            while z[m + 1] < i:
+                m += 1
+            q = v[m]
+            d2 = (i - q) * (i - q) + g[r, q] * g[r, q]
+            out[r - (j0 - o0), i - (i0 - p0)] = table[d2 if d2 < last else last]
