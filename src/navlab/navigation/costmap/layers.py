@@ -16,7 +16,7 @@ import numpy as np
 
 from navlab.grid import COST_FREE, COST_INSCRIBED, COST_LETHAL, COST_UNKNOWN, Grid, GridMap
 from navlab.navigation.costmap.footprint import Footprint, make_footprint
-from navlab.navigation.costmap.inflation_kernel import inflate_box
+from navlab.navigation.costmap.kernels import combine, inflate_box
 from navlab.navigation.costmap.params import (
     CostmapParams,
     InflationLayerParams,
@@ -93,7 +93,8 @@ class StaticLayer(Layer):
         self.map: GridMap | None = None
         self.costs: np.ndarray | None = None
         self.map_in_costmap = (0.0, 0.0, 0.0)
-        self._lookup: tuple[tuple[Any, ...], np.ndarray, np.ndarray] | None = None
+        # (geometry key, master cells, map cells, whether that is the identity) of the last master
+        self._lookup: tuple[tuple[Any, ...], np.ndarray, np.ndarray, bool] | None = None
 
     @classmethod
     def from_costmap_params(cls, name: str, costmap: CostmapParams, footprint: Footprint) -> Self:
@@ -140,13 +141,17 @@ class StaticLayer(Layer):
         ok = self.map.in_bounds(src)
         dst_flat = np.flatnonzero(ok)
         src_flat = src[ok, 1] * self.map.width + src[ok, 0]
-        self._lookup = (key, dst_flat, src_flat)
+        same = master.data.shape == self.map.data.shape and np.array_equal(dst_flat, src_flat)
+        self._lookup = (key, dst_flat, src_flat, same and len(dst_flat) == master.data.size)
         return dst_flat, src_flat
 
     def update_costs(self, master: Grid) -> None:
         if self.map is None or self.costs is None:
             return
         dst, src = self._cells(master)
+        if not self.params.use_maximum and self._lookup is not None and self._lookup[3]:
+            np.copyto(master.data, self.costs)  # the master is the map, cell for cell
+            return
         out = master.data.reshape(-1)
         vals = self.costs.reshape(-1)[src]
         if self.params.use_maximum:
@@ -283,14 +288,7 @@ class ObstacleLayer(Layer):
         if self.params.footprint_clearing_enabled and self.robot_pose is not None:
             ij = self.footprint.cells(g, self.robot_pose)
             g.data[ij[:, 1], ij[:, 0]] = COST_FREE
-        layer = g.data
-        known = layer != COST_UNKNOWN
-        if self.params.combination_method == 0:
-            master.data[known] = layer[known]
-        else:
-            old = master.data
-            take = known & ((old == COST_UNKNOWN) | (old < layer))
-            old[take] = layer[take]
+        combine(master.data, g.data, self.params.combination_method != 0)
 
     def reset(self) -> None:
         if self.grid is not None:

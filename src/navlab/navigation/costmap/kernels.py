@@ -1,10 +1,12 @@
-"""The inflation layer's distance step, compiled: exact squared cell distances to the nearest lethal cell
-(Felzenszwalb & Huttenlocher's separable distance transform, "Distance Transforms of Sampled Functions",
-2012) turned into costs through the layer's table, for one box of the grid.
+"""Compiled whole-grid steps of the costmap layers (Numba): combining a layer into the master, and the
+inflation layer's distance step.
 
-The squared distances are integers computed exactly, so the costs equal those of a Euclidean distance
-transform of the same seeds (scipy's ``distance_transform_edt``), bit for bit, without its feature
-arrays. Cells are ``data[j, i]`` (row ``j``, column ``i``), as everywhere in ``navlab.grid``.
+``inflate_box``: exact squared cell distances to the nearest lethal cell (Felzenszwalb & Huttenlocher's
+separable distance transform, "Distance Transforms of Sampled Functions", 2012) turned into costs through
+the layer's table, for one box of the grid. The squared distances are integers computed exactly, so the
+costs equal those of a Euclidean distance transform of the same seeds (scipy's ``distance_transform_edt``),
+bit for bit, without its feature arrays. Cells are ``data[j, i]`` (row ``j``, column ``i``), as everywhere
+in ``navlab.grid``; costs are uint8 (255 unknown).
 """
 
 from __future__ import annotations
@@ -13,6 +15,8 @@ import math
 
 import numba
 import numpy as np
+
+from navlab.grid import COST_UNKNOWN
 
 _FAR = np.int64(1) << 40  # "no seed in this column": beyond any real squared distance of a grid
 
@@ -76,3 +80,16 @@ def inflate_box(seeds: np.ndarray, region: tuple[int, int, int, int], box: tuple
             q = v[m]
             d2 = (i - q) * (i - q) + g[r, q] * g[r, q]
             out[r - (j0 - o0), i - (i0 - p0)] = table[d2 if d2 < last else last]
+
+
+@numba.njit(cache=True)
+def combine(master: np.ndarray, layer: np.ndarray, maximum: bool) -> None:  # pragma: no cover - compiled
+    """A layer's known cells into ``master`` (same shape): with ``maximum`` where the layer's cost is higher or
+    the master's unknown (costmap_2d's ``updateWithMax``), else every known cell (``updateWithOverwrite``)."""
+    for j in range(master.shape[0]):
+        for i in range(master.shape[1]):
+            c = layer[j, i]
+            if c == COST_UNKNOWN:
+                continue
+            if not maximum or master[j, i] == COST_UNKNOWN or master[j, i] < c:
+                master[j, i] = c
