@@ -28,6 +28,7 @@ from navlab.navigation.costmap_ros import Costmap2DROS
 from navlab.navigation.errors import NavigationError
 from navlab.navigation.goal import STATUS, GoalHandle, with_headings
 from navlab.navigation.recovery import DEFAULT_RECOVERIES, ClearCostmapRecovery
+from navlab.navigation.scan_points import ScanPoints
 from navlab.plugins import load_plugin, plugin_names
 
 Pose = tuple[float, float, float]
@@ -81,6 +82,7 @@ class MoveBase(Node):
             check_ceiling(NavigationError, "move_base", key, p[key], "rate")
         raw_recoveries = self.declare_parameter("recovery_behaviors", [dict(r) for r in DEFAULT_RECOVERIES])
         private = self.fully_qualified_name
+        self._scan_points = ScanPoints()  # both costmaps read the same scans: their points are worked out once
         self.global_costmap = self._costmap("global_costmap", private)
         self.local_costmap = self._costmap("local_costmap", private)
         self.costmaps = {"global": self.global_costmap, "local": self.local_costmap}
@@ -128,7 +130,8 @@ class MoveBase(Node):
         return self.get_parameters_by_prefix(prefix)
 
     def _costmap(self, name: str, private: str) -> Costmap2DROS:
-        return Costmap2DROS(self, name, self._namespace(name), topic_prefix=f"{private}/{name}")
+        return Costmap2DROS(self, name, self._namespace(name), topic_prefix=f"{private}/{name}",
+                            scan_points=self._scan_points)
 
     def _recoveries(self, raw: Any) -> list[tuple[str, Any]]:
         if not isinstance(raw, list) or not all(isinstance(r, dict) and {"name", "type"} <= set(r) for r in raw):
