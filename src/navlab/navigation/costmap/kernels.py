@@ -93,3 +93,25 @@ def combine(master: np.ndarray, layer: np.ndarray, maximum: bool) -> None:  # pr
                 continue
             if not maximum or master[j, i] == COST_UNKNOWN or master[j, i] < c:
                 master[j, i] = c
+
+
+@numba.njit(cache=True)
+def circle_cells(x: float, y: float, radius: float, origin_x: float, origin_y: float, resolution: float,
+                 width: int, height: int) -> np.ndarray:  # pragma: no cover - compiled
+    """Cells (i, j) (K, 2), row by row, of a ``width`` x ``height`` grid (origin yaw 0) whose centres lie within
+    ``radius`` m of (x, y), plus the cell under (x, y) itself; off-grid cells left out (``Footprint.cells`` of a
+    round robot, in the same float operations)."""
+    i_lo, j_lo = math.floor(((x - radius) - origin_x) / resolution), math.floor(((y - radius) - origin_y) / resolution)
+    i_hi, j_hi = math.floor(((x + radius) - origin_x) / resolution), math.floor(((y + radius) - origin_y) / resolution)
+    ci, cj = math.floor((x - origin_x) / resolution), math.floor((y - origin_y) / resolution)
+    out = np.empty(((j_hi - j_lo + 1) * (i_hi - i_lo + 1), 2), dtype=np.int64)
+    n = 0
+    for j in range(j_lo, j_hi + 1):
+        for i in range(i_lo, i_hi + 1):
+            cx = (i + 0.5) * resolution + origin_x
+            cy = (j + 0.5) * resolution + origin_y
+            inside = math.hypot(cx - x, cy - y) <= radius or (i == ci and j == cj)
+            if inside and 0 <= i < width and 0 <= j < height:
+                out[n, 0], out[n, 1] = i, j
+                n += 1
+    return out[:n].copy()
