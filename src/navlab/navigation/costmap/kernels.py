@@ -115,3 +115,43 @@ def circle_cells(x: float, y: float, radius: float, origin_x: float, origin_y: f
                 out[n, 0], out[n, 1] = i, j
                 n += 1
     return out[:n].copy()
+
+
+@numba.njit(cache=True)
+def mark_returns(data: np.ndarray, pts: np.ndarray, ok: np.ndarray, sensor_x: float, sensor_y: float,
+                 origin_x: float, origin_y: float, resolution: float, min_range: float, max_range: float,
+                 value: np.uint8) -> None:  # pragma: no cover - compiled
+    """``data`` = ``value`` at the cells of the points (N, 2) (m, the grid's frame, origin yaw 0) marked ``ok``
+    whose distance from the sensor lies in [min_range, max_range) (the obstacle layer's marking)."""
+    h, w = data.shape
+    for k in range(pts.shape[0]):
+        px, py = pts[k, 0], pts[k, 1]
+        if not (ok[k] and math.isfinite(px) and math.isfinite(py)):
+            continue
+        d = math.hypot(px - sensor_x, py - sensor_y)
+        if not (d < max_range and d >= min_range):
+            continue
+        i, j = math.floor((px - origin_x) / resolution), math.floor((py - origin_y) / resolution)
+        if 0 <= i < w and 0 <= j < h:
+            data[j, i] = value
+
+
+@numba.njit(cache=True)
+def lethal_changes(data: np.ndarray, lethal: np.uint8, seeds: np.ndarray,
+                   previous: np.ndarray) -> tuple[int, int, int, int, int]:  # pragma: no cover - compiled
+    """``seeds`` = ``data == lethal``; returns (how many seeds, then the bounding rows and columns j0, j1, i0, i1,
+    ends exclusive, of the cells where ``seeds`` differs from ``previous``: all 0 where nothing changed).
+    ``previous`` of another shape: every seed counts as changed."""
+    same_shape = previous.shape == seeds.shape
+    n = 0
+    j0, j1, i0, i1 = data.shape[0], -1, data.shape[1], -1
+    for j in range(data.shape[0]):
+        for i in range(data.shape[1]):
+            s = data[j, i] == lethal
+            seeds[j, i] = s
+            n += s
+            if (previous[j, i] != s) if same_shape else s:
+                j0, j1, i0, i1 = min(j0, j), max(j1, j), min(i0, i), max(i1, i)
+    if j1 < 0:
+        return n, 0, 0, 0, 0
+    return n, j0, j1 + 1, i0, i1 + 1

@@ -16,7 +16,7 @@ import numpy as np
 
 from navlab.grid import COST_FREE, COST_INSCRIBED, COST_LETHAL, COST_UNKNOWN, Grid, GridMap
 from navlab.navigation.costmap.footprint import Footprint, make_footprint
-from navlab.navigation.costmap.kernels import combine, inflate_box
+from navlab.navigation.costmap.kernels import combine, inflate_box, lethal_changes, mark_returns
 from navlab.navigation.costmap.params import (
     CostmapParams,
     InflationLayerParams,
@@ -270,11 +270,8 @@ class ObstacleLayer(Layer):
             clear_rays(g.data, (o[0] - ox) / res, (o[1] - oy) / res, np.ascontiguousarray(cells),
                        src.raytrace_range / res, src.raytrace_min_range / res, np.uint8(COST_FREE))
         if src.marking:
-            d = np.hypot(pts[:, 0] - o[0], pts[:, 1] - o[1])
-            mark = ok & finite & (d < src.obstacle_range) & (d >= src.obstacle_min_range)
-            ij = g.world_to_cell(pts[mark])
-            ij = ij[g.in_bounds(ij)]
-            g.data[ij[:, 1], ij[:, 0]] = COST_LETHAL
+            mark_returns(g.data, pts, ok, float(o[0]), float(o[1]), ox, oy, res, src.obstacle_min_range,
+                         src.obstacle_range, np.uint8(COST_LETHAL))
 
     def update_bounds(self, robot_pose: tuple[float, float, float]) -> None:
         self.robot_pose = (float(robot_pose[0]), float(robot_pose[1]), float(robot_pose[2]))
@@ -359,34 +356,38 @@ class InflationLayer(Layer):
 
     def update_costs(self, master: Grid) -> None:
         data = master.data
-        seeds = data == COST_LETHAL
-        if not seeds.any():
+        reach = math.ceil(self.params.inflation_radius / master.resolution) + 1
+        reach = min(reach, math.ceil(math.hypot(*data.shape)) + 1)  # no cell is further: the table stays grid-sized
+        key = (master.origin, master.resolution, data.shape)
+        cached = self._inflated
+        fresh = cached is None or cached[0] != key
+        seeds = np.empty(data.shape, dtype=np.bool_)
+        previous = np.zeros((0, 0), np.bool_) if fresh or cached is None else cached[1]  # none: every seed is new
+        count, *changed = lethal_changes(data, np.uint8(COST_LETHAL), seeds, previous)
+        if count == 0:
             return
-        cost = self._inflation(master, seeds)
+        cost = self._inflation(master, seeds, reach, key, changed)
         _merge(data, cost, bool(self.params.inflate_unknown))
 
-    def _inflation(self, master: Grid, seeds: np.ndarray) -> np.ndarray:
+    def _inflation(self, master: Grid, seeds: np.ndarray, reach: int, key: Any, changed: list[int]) -> np.ndarray:
         """Inflation costs (uint8, the master's shape; 0 beyond ``inflation_radius``) of the lethal ``seeds``.
 
         A cell's cost depends only on the seeds within ``reach`` cells of it, so after the first update only
-        the cells within ``reach`` of a seed that appeared or vanished are recomputed, from the seeds within
-        ``reach`` of those (exactly what a transform of the whole grid gives them)."""
-        reach = math.ceil(self.params.inflation_radius / master.resolution) + 1
-        reach = min(reach, math.ceil(math.hypot(*seeds.shape)) + 1)  # no cell is further: the table stays grid-sized
-        key = (master.origin, master.resolution, seeds.shape)
+        the cells within ``reach`` of a seed that appeared or vanished (``changed``: their bounding rows and
+        columns) are recomputed, from the seeds within ``reach`` of those (exactly what a transform of the whole
+        grid gives them)."""
         cached = self._inflated
         if cached is None or cached[0] != key:
             cost = np.zeros(seeds.shape, dtype=np.uint8)
-            box = _box(seeds, reach, seeds.shape)
         else:
             cost = cached[2]
-            changed = seeds != cached[1]
-            if not changed.any():
+            if changed[1] == 0:
                 return cost  # the same obstacles as last update: the same inflation (skips the transform)
-            box = _box(changed, reach, seeds.shape)
-        j0, j1, i0, i1 = box
-        o0, o1 = max(0, j0 - reach), min(seeds.shape[0], j1 + reach)
-        p0, p1 = max(0, i0 - reach), min(seeds.shape[1], i1 + reach)
+        h, w = seeds.shape
+        j0, j1 = max(0, changed[0] - reach), min(h, changed[1] + reach)
+        i0, i1 = max(0, changed[2] - reach), min(w, changed[3] + reach)
+        o0, o1 = max(0, j0 - reach), min(h, j1 + reach)
+        p0, p1 = max(0, i0 - reach), min(w, i1 + reach)
         if seeds[o0:o1, p0:p1].any():  # the squared distance (cells) to each cell's nearest seed, its cost
             inflate_box(seeds, (o0, o1, p0, p1), (j0, j1, i0, i1), self._table(master.resolution, reach),
                         cost[j0:j1, i0:i1])
@@ -408,11 +409,3 @@ def _merge(data: np.ndarray, cost: np.ndarray, inflate_unknown: bool) -> None:  
                     data[j, i] = c
             elif c > d:
                 data[j, i] = c
-
-
-def _box(mask: np.ndarray, reach: int, shape: tuple[int, ...]) -> tuple[int, int, int, int]:
-    """Row and column bounds (j0, j1, i0, i1) of the cells within ``reach`` of a true cell of ``mask``."""
-    rows = np.flatnonzero(mask.any(axis=1))
-    cols = np.flatnonzero(mask.any(axis=0))
-    return (max(0, int(rows[0]) - reach), min(shape[0], int(rows[-1]) + reach + 1),
-            max(0, int(cols[0]) - reach), min(shape[1], int(cols[-1]) + reach + 1))
