@@ -120,6 +120,7 @@ class MoveBase(Node):
         self.handle: GoalHandle | None = None
         self.state = "IDLE"  # IDLE, PLANNING, CONTROLLING, CLEARING
         self.global_plan: np.ndarray | None = None
+        self._plan_local: tuple[np.ndarray, tuple[float, float, float], np.ndarray] | None = None  # the last one
         self._ids = 0
         self._reset_goal_state()
 
@@ -235,10 +236,14 @@ class MoveBase(Node):
             t = self.executor.tf.lookup_pose2d(lf, gf)
         except TfError:
             return None
+        last = self._plan_local
+        if last is not None and last[0] is plan and last[1] == t:  # amcl moves map -> odom only now and then
+            return last[2].copy()  # the controller may keep (or change) what it is given
         out = transform_points2(t, plan[:, :2])
         if plan.shape[1] > 2:
             out = np.column_stack([out, wrap_angle(plan[:, 2] + t[2])])
-        return out
+        self._plan_local = (plan, t, out)
+        return out.copy()
 
     # --- planning --------------------------------------------------------------------------------------
 
