@@ -71,7 +71,7 @@ def score_samples(grid: np.ndarray, near: np.ndarray, path_dist: np.ndarray, goa
             steps[r] = max(1, int(sim_time / gran + 0.5))
         else:  # np.maximum(|v| * sim_time / granularity, |w| / angular granularity), rounded, at least 1
             need = max(abs(targets[r, 0]) * sim_time / gran, abs(targets[r, 1]) / ang)
-            steps[r] = max(1, np.int64(math.floor(need + 0.5)))
+            steps[r] = max(1, math.floor(need + 0.5))
     traj = np.empty((n, steps.max(), 3))
     _rollout(pose[0], pose[1], pose[2], velocity[0], velocity[1], targets, steps, sim_time, ax, ath, True, traj)
     c = np.zeros(traj.shape[:2])

@@ -18,7 +18,7 @@ import numpy as np
 
 from navlab.grid import COST_UNKNOWN
 
-_FAR = np.int64(1) << 40  # "no seed in this column": beyond any real squared distance of a grid
+_FAR = 1 << 40  # "no seed in this column": beyond any real squared distance of a grid
 
 
 @numba.njit(cache=True)
