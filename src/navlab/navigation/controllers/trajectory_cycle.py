@@ -15,7 +15,7 @@ import math
 import numba
 import numpy as np
 
-from navlab.navigation.controllers.rollout import _rollout_scores
+from navlab.navigation.controllers.rollout import _rollout, _rollout_scores
 
 
 @numba.njit(cache=True, inline="always")
@@ -75,36 +75,11 @@ def score_samples(grid: np.ndarray, near: np.ndarray, path_dist: np.ndarray, goa
     traj = np.empty((n, steps.max(), 3))
     c = np.empty(traj.shape[:2])
     s = np.empty(traj.shape[:2])
-    _rollout_trig(pose[0], pose[1], pose[2], velocity[0], velocity[1], targets, steps, sim_time, ax, ath, traj, c, s)
+    _rollout(pose[0], pose[1], pose[2], velocity[0], velocity[1], targets, steps, sim_time, ax, ath, True, traj, c, s)
     costs = np.empty(n)
     _rollout_scores(grid, near, path_dist, goal_dist, 1.0 / resolution, traj, c, s, ox, oy, polygon, use_near,
                     weights, impossible, np.full(n, at, dtype=np.int64), costs)
     return targets, traj, costs, ws, dw
-
-
-@numba.njit(cache=True)
-def _rollout_trig(x0: float, y0: float, th0: float, v0: float, w0: float, targets: np.ndarray, steps: np.ndarray,
-                  sim_time: float, ax: float, ath: float, out: np.ndarray, cos: np.ndarray,
-                  sin: np.ndarray) -> None:  # pragma: no cover - compiled
-    """``rollout._rollout`` (accelerating) that also keeps the cosine and sine of each pose's heading, which the
-    integration works out anyway and the footprint costs need."""
-    for r in range(out.shape[0]):
-        x, y, th, v, w = x0, y0, th0, v0, w0
-        tv, tw = targets[r, 0], targets[r, 1]
-        dt = sim_time / steps[r]
-        for k in range(out.shape[1]):
-            if k >= steps[r]:
-                out[r, k, 0], out[r, k, 1], out[r, k, 2] = out[r, k - 1, 0], out[r, k - 1, 1], out[r, k - 1, 2]
-                cos[r, k], sin[r, k] = cos[r, k - 1], sin[r, k - 1]
-                continue
-            out[r, k, 0], out[r, k, 1], out[r, k, 2] = x, y, th
-            v = min(max(tv, v - ax * dt), v + ax * dt)
-            w = min(max(tw, w - ath * dt), w + ath * dt)
-            ch, sh = math.cos(th), math.sin(th)
-            cos[r, k], sin[r, k] = ch, sh
-            x += v * ch * dt
-            y += v * sh * dt
-            th += w * dt
 
 
 @numba.njit(cache=True)
