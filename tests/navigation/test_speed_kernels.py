@@ -97,7 +97,7 @@ def test_kld_bin_count_and_tracking_distance_equal_their_plain_forms() -> None:
     _, first = np.unique(keys, return_index=True)
     is_new = np.zeros(keys.size, np.int64)
     is_new[first] = 1
-    np.testing.assert_array_equal(sampling._bins_so_far(keys), np.cumsum(is_new))
+    np.testing.assert_array_equal(sampling.bins_so_far(keys), np.cumsum(is_new))
     path = np.cumsum(rng.normal(0, 0.1, (80, 2)), axis=0)
     pts = rng.normal(0, 1, (5, 2))
     a, ab = path[:-1], np.diff(path, axis=0)

@@ -55,7 +55,7 @@ def bin_keys(poses: np.ndarray) -> np.ndarray:
 def kld_count(candidates: np.ndarray, kld_err: float, kld_z: float, min_n: int, max_n: int) -> int:
     """How many of ``candidates`` (drawn in random order) KLD-sampling keeps."""
     keys = bin_keys(candidates)
-    k = _bins_so_far(keys)
+    k = bins_so_far(keys)
     counts = np.arange(1, keys.shape[0] + 1)
     over = np.flatnonzero(counts > kld_limit(k, kld_err, kld_z, min_n, max_n))
     n = int(counts[over[0]]) if over.size else keys.shape[0]
@@ -63,7 +63,7 @@ def kld_count(candidates: np.ndarray, kld_err: float, kld_z: float, min_n: int, 
 
 
 @njit(cache=True)
-def _bins_so_far(keys: np.ndarray) -> np.ndarray:  # pragma: no cover - compiled
+def bins_so_far(keys: np.ndarray) -> np.ndarray:  # pragma: no cover - compiled
     """``out[m]``: how many distinct keys ``keys[: m + 1]`` holds (the bins the first m + 1 samples occupy)."""
     seen = set()
     out = np.empty(keys.shape[0], dtype=np.int64)

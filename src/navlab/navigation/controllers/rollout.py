@@ -33,14 +33,14 @@ def rollout(pose: tuple[float, float, float], velocity: tuple[float, float], tar
     n = np.broadcast_to(np.maximum(np.asarray(steps, dtype=np.int64), 1), (len(targets),)).copy()
     out = np.empty((len(targets), int(n.max()) if len(n) else 1, 3))
     none = np.zeros((0, 0))
-    _rollout(float(pose[0]), float(pose[1]), float(pose[2]), float(velocity[0]), float(velocity[1]),
+    integrate_rollouts(float(pose[0]), float(pose[1]), float(pose[2]), float(velocity[0]), float(velocity[1]),
              np.ascontiguousarray(targets, dtype=np.float64), n, float(sim_time), float(acc[0]), float(acc[1]),
              accelerate, out, none, none)
     return out
 
 
 @numba.njit(cache=True)
-def _rollout(x0: float, y0: float, th0: float, v0: float, w0: float, targets: np.ndarray, steps: np.ndarray,
+def integrate_rollouts(x0: float, y0: float, th0: float, v0: float, w0: float, targets: np.ndarray, steps: np.ndarray,
              sim_time: float, ax: float, ath: float, accelerate: bool, out: np.ndarray, cos: np.ndarray,
              sin: np.ndarray) -> None:  # pragma: no cover - compiled
     """:func:`rollout`'s integration into ``out``; ``cos``/``sin`` (the poses' shape, or empty: not kept) get the
