@@ -4,7 +4,7 @@
 the escape), rolls them out and scores them in one call; ``choose`` picks the command from the scores
 (the cheapest forward rollout, else an in-place turn towards the goal). They compute exactly what the
 numpy steps in ``trajectory.TrajectoryPlannerROS._drive`` did (``np.linspace``'s arithmetic, ROS's step
-counts, ``rollout.integrate_rollouts`` and ``rollout._rollout_scores``), without a Python step in between: one
+counts, ``rollout.integrate_rollouts`` and ``rollout.rollout_scores``), without a Python step in between: one
 controller cycle makes two calls instead of some forty numpy calls. Poses are grid-local (m, rad).
 """
 
@@ -15,7 +15,7 @@ import math
 import numba
 import numpy as np
 
-from navlab.navigation.controllers.rollout import _rollout_scores, integrate_rollouts
+from navlab.navigation.controllers.rollout import integrate_rollouts, rollout_scores
 
 
 @numba.njit(cache=True, inline="always")
@@ -78,7 +78,7 @@ def score_samples(grid: np.ndarray, near: np.ndarray, path_dist: np.ndarray, goa
     integrate_rollouts(pose[0], pose[1], pose[2], velocity[0], velocity[1], targets, steps, sim_time, ax, ath, True,
                        traj, c, s)
     costs = np.empty(n)
-    _rollout_scores(grid, near, path_dist, goal_dist, 1.0 / resolution, traj, c, s, ox, oy, polygon, use_near,
+    rollout_scores(grid, near, path_dist, goal_dist, 1.0 / resolution, traj, c, s, ox, oy, polygon, use_near,
                     weights, impossible, np.full(n, at, dtype=np.int64), costs)
     return targets, traj, costs, ws, dw
 
