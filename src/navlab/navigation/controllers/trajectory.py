@@ -88,7 +88,6 @@ class TrajectoryPlannerROS(RolloutController):
     def _score(self, scene: LocalScene, traj: np.ndarray) -> np.ndarray:
         """Costs (S,): pdist * path_dist + gdist * goal_dist + occdist * max_cost (+ 0.3 * heading difference
         with ``heading_scoring``); -1 blocked, -2 no path."""
-        p = self.params
         res = scene.resolution
         traj = np.ascontiguousarray(traj, dtype=np.float64)
         outline = self._outline(res)
@@ -100,10 +99,7 @@ class TrajectoryPlannerROS(RolloutController):
         else:  # numpy's cos/sin, as occupancy_costs
             c, s = np.cos(traj[..., 2]), np.sin(traj[..., 2])
             ox, oy = np.ascontiguousarray(outline[:, 0]), np.ascontiguousarray(outline[:, 1])
-        # meter_scoring scales the distance biases by the resolution, not occdist_scale (ROS 1 since the biases'
-        # renaming: TrajectoryPlannerROS::initialize and TrajectoryPlanner::reconfigure)
-        scale = res if p.meter_scoring else 1.0
-        weights = np.array([1.0, scale * p.pdist_scale, scale * p.gdist_scale, p.occdist_scale])
+        weights = self._weights(res)
         cost = np.empty(traj.shape[0])
         at = self._heading_step(traj.shape[1])
         rollout_scores(grid, grid if near is None else near, np.ascontiguousarray(scene.path_dist),
@@ -166,9 +162,12 @@ class TrajectoryPlannerROS(RolloutController):
         return self._finish(scene, targets, traj, costs, esc if costs[esc] > -2.0 else -1, pose)
 
     def _weights(self, res: float) -> np.ndarray:
-        """The scoring kernel's (scale, pdist_scale, gdist_scale, occdist_scale)."""
+        """The scoring kernel's (1, pdist, gdist, occdist) weights (m or cell units for the distances)."""
         p = self.params
-        return np.array([res if p.meter_scoring else 1.0, p.pdist_scale, p.gdist_scale, p.occdist_scale])
+        # meter_scoring scales the distance biases by the resolution, not occdist_scale (ROS 1 since the biases'
+        # renaming: TrajectoryPlannerROS::initialize and TrajectoryPlanner::reconfigure)
+        scale = res if p.meter_scoring else 1.0
+        return np.array([1.0, scale * p.pdist_scale, scale * p.gdist_scale, p.occdist_scale])
 
     def _end_escape(self, pose: tuple[float, float, float]) -> None:
         """Leave escape mode once ``escape_reset_dist`` m or ``escape_reset_theta`` rad from where it began."""
