@@ -130,6 +130,9 @@ def run_trial(sc: Scenario, index: int) -> dict[str, Any]:
         "goals_succeeded_move_base": sum(g["move_base_outcome"] == "succeeded" for g in goals),
         "time_s": sum(g["time_s"] for g in goals), "path_m": path_m, "shortest_m": shortest, "spl": spl,
         "min_clearance_m": min(g["min_clearance_m"] for g in goals), "collisions": sum(g["collisions"] for g in goals),
+        "near_miss": any(g.get("near_miss", False) for g in goals),
+        "time_under_safety_s": sum(g.get("time_under_safety_s", 0.0) for g in goals),
+        "near_goal_m": min(g.get("near_goal_m", g["final_error_m"]) for g in goals[-1:]),
         "localization_error_mean_m": r.summary.get("localization_error_mean_m"),
         "localization_error_max_m": r.summary.get("localization_error_max_m"),
         "cmd_jerk_mean": r.summary.get("cmd_jerk_mean"), "sim_s": r.summary["sim_s"], "wall_s": r.summary["wall_s"],
@@ -205,6 +208,8 @@ def summarize_trials(results: list[dict[str, Any]]) -> dict[str, Any]:
         "median_time_s": times[1] if times else None, "time_s_quartiles": times,
         "median_path_m": _median(results, "path_m"), "spl_mean": _mean(results, "spl"),
         "min_clearance_m": min((r["min_clearance_m"] for r in results), default=None),
+        "near_misses": sum(bool(r.get("near_miss")) for r in results),  # trials under 5 cm without a contact
+        "time_under_safety_s_mean": _mean(results, "time_under_safety_s"),
         "localization_error_mean_m": _mean(results, "localization_error_mean_m"),
         "cmd_jerk_mean": _mean(results, "cmd_jerk_mean"),
         "tracking_error_mean_m": _mean(results, "tracking_error_m"),
