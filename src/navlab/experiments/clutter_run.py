@@ -33,9 +33,11 @@ def run_clutter_world(
     timeout: float = TIMEOUT_S,
     workdir: str | Path | None = None,
     robot: str = "mybot",
+    failure_picture: str | Path | None = None,
 ) -> dict[str, Any]:
     """One BARN trial in ``world`` (a ``world.clutter.ClutterWorld``) with ``robot`` (and the move_base files the
-    launch picks for it: navlab's params/<robot> where it ships some); returns its figures."""
+    launch picks for it: navlab's params/<robot> where it ships some); returns its figures. ``failure_picture``:
+    a folder where a failed trial leaves ``<world>.png`` (the drive when it ended; ``picture`` names it)."""
     with tempfile.TemporaryDirectory(prefix="navlab-clutter-", dir=workdir) as tmp:
         path = world.write_world(Path(tmp) / f"{world.name}.world")
         gx, gy, gyaw = (float(v) for v in between2(world.start, world.goal))  # the goal in odom (= the start)
@@ -43,12 +45,22 @@ def run_clutter_world(
         params = {**CLUTTER_PARAMS, **(move_base_params or {})}
         r = run_navigation([(gx, gy, gyaw)], world=str(path), pose=(sx, sy, syaw), mapless=True, controller=controller,
                            move_base_params=params, seed=seed, goal_timeout=timeout, goal_tolerance=SUCCESS_M,
-                           robot=robot)  # fmt: skip
+                           robot=robot, snapshots=failure_picture is not None)  # fmt: skip
     g = r.goals[0]
-    return rounded({
+    out = rounded({
         **barn_outcome(world, [g]), "reason": g["reason"], "time_s": g["time_s"], "collisions": g["collisions"],
-        "path_m": g["path_m"], "min_clearance_m": g["min_clearance_m"], "wall_s": r.summary["wall_s"],
+        "path_m": g["path_m"], "min_clearance_m": g["min_clearance_m"], "near_miss": g["near_miss"],
+        "time_under_safety_s": g["time_under_safety_s"], "near_goal_m": g["near_goal_m"],
+        "final_error_m": g["final_error_m"], "wall_s": r.summary["wall_s"],
     })  # fmt: skip
+    if failure_picture is not None and not out["success"] and r.arrivals:
+        from navlab.experiments.plots import plot_navigation
+
+        title = (f"{world.name} (difficulty {world.difficulty:.2f}): {out['failure']} after {g['time_s']} s, "
+                 f"{g['near_goal_m']} m from the goal at the closest\n{g['reason']}"[:220])
+        out["picture"] = str(plot_navigation(r.grid, r.arrivals[0], Path(failure_picture) / f"{world.name}.png",
+                                             title=title, goal=list(world.goal)))  # fmt: skip
+    return out
 
 
 def barn_outcome(world: Any, goals: list[dict[str, Any]]) -> dict[str, Any]:
@@ -118,26 +130,21 @@ def summarize(trials: list[dict[str, Any]]) -> dict[str, Any]:
         "success": sum(t["success"] for t in trials) / n,
         "collision": sum(t["failure"] == "collision" for t in trials) / n,
         "timeout": sum(t["failure"] == "timeout" for t in trials) / n,
+        "stuck": sum(t["failure"] == "stuck" for t in trials) / n,
         "aborted": sum(t["failure"] == "aborted" for t in trials) / n,
+        "missed": sum(t["failure"] in ("missed", "not_reached", "preempted") for t in trials) / n,
         "move_base_success": sum(t["move_base_success"] for t in trials) / n,
         "false_success": sum(t["false_success"] for t in trials),
         "score": sum(t["score"] for t in trials) / n,
         "mean_time_s": sum(t["time_s"] for t in trials if t["success"]) / max(1, sum(t["success"] for t in trials)),
+        "min_clearance_m": min(t["min_clearance_m"] for t in trials),
+        "near_misses": sum(bool(t.get("near_miss")) for t in trials),
+        "time_under_safety_s_mean": sum(t.get("time_under_safety_s", 0.0) for t in trials) / n,
     })  # fmt: skip
 
 
 def bench(args: Any) -> dict[str, Any]:
-    """``navlab bench clutter``: mapless navigation over 50 generated clutter worlds of graded difficulty (``--robot``:
-    mybot with MPPI by default; another shipped robot drives with its own params/<robot> planner unless
-    ``--controller`` names one)."""
-    import time
+    """``navlab bench clutter``: the benchmark's protocol (``experiments.clutter_protocol``)."""
+    from navlab.experiments.clutter_protocol import bench as protocol_bench
 
-    n = int(getattr(args, "worlds", 0) or 50)
-    t0 = time.perf_counter()
-    robot = getattr(args, "robot", None) or "mybot"
-    controller = getattr(args, "controller", None) or ("mppi" if robot == "mybot" else None)  # None: params/<robot>'s
-    out = run_clutter_suite(n, seed=getattr(args, "seed", 0), controller=controller, robot=robot)
-    s = dict(out["summary"])
-    s["wall_s"] = round(time.perf_counter() - t0, 1)
-    s["failed_worlds"] = [t["world"] for t in out["trials"] if not t["success"]]
-    return s
+    return protocol_bench(args)
