@@ -180,6 +180,7 @@ REGISTRY: dict[str, dict[str, str]] = {
         "nav2_navfn_planner/NavfnPlanner": "navlab.navigation.planners.navfn:NavfnPlanner",
         "global_planner/GlobalPlanner": "navlab.navigation.planners.navfn:GlobalPlanner",
         "nav2_theta_star_planner/ThetaStarPlanner": "navlab.navigation.planners.theta_star:ThetaStarPlanner",
+        "nav2_smac_planner/SmacPlannerHybrid": "navlab.navigation.planners.smac_hybrid:SmacPlannerHybrid",
     },
     "recovery": {
         "clear_costmap_recovery/ClearCostmapRecovery": "navlab.navigation.recovery:ClearCostmapRecovery",
@@ -192,6 +193,8 @@ REGISTRY: dict[str, dict[str, str]] = {
         "dwa_local_planner/DWAPlannerROS": "navlab.navigation.controllers.dwa:DWAPlannerROS",
         "nav2_mppi_controller::MPPIController": "navlab.navigation.controllers.mppi:MPPIController",
         "nav2_dwb_controller/DWBLocalPlanner": "navlab.navigation.controllers.dwa:DWBLocalPlanner",
+        "nav2_regulated_pure_pursuit_controller::RegulatedPurePursuitController":
+            "navlab.navigation.controllers.regulated_pure_pursuit:RegulatedPurePursuitController",
     },
 }
 

@@ -44,6 +44,7 @@ CONTROLLERS = {
     "trajectory": "base_local_planner/TrajectoryPlannerROS",
     "dwa": "dwa_local_planner/DWAPlannerROS",
     "mppi": "nav2_mppi_controller::MPPIController",
+    "rpp": "nav2_regulated_pure_pursuit_controller::RegulatedPurePursuitController",
 }
 
 
