@@ -56,8 +56,10 @@ def run_protocol(
     out: str | Path | None = None,
     seed: int = 0,
     progress: bool = False,
+    collision_monitor: bool = False,
 ) -> dict[str, Any]:
-    """Run the ``which`` set's first ``n`` worlds (see the module docstring); ``{"summary", "trials"}``."""
+    """Run the ``which`` set's first ``n`` worlds (see the module docstring); ``{"summary", "trials"}``.
+    ``collision_monitor``: Nav2's velocity smoother and collision monitor between move_base and the wheels."""
     from tqdm import tqdm
 
     from navlab.world.clutter import clutter_suite
@@ -70,14 +72,16 @@ def run_protocol(
     folder = Path(out) if out is not None else None
     if folder is not None:
         folder.mkdir(parents=True, exist_ok=True)
+    launch = {"collision_monitor": "true", "max_speed": str(max_speed or JACKAL_MAX_SPEED)} if collision_monitor else {}
     t0 = time.perf_counter()
     trials = []
     worlds = clutter_suite(50, seed=SETS[which])[:n]
     for world in tqdm(worlds, desc=f"clutter {which}", unit="world", disable=not progress, file=sys.stderr):
         trials.append(run_clutter_world(world, controller=controller, move_base_params=params, seed=seed,
-                                        robot=robot, failure_picture=folder))  # fmt: skip
+                                        robot=robot, failure_picture=folder, launch_args=launch))  # fmt: skip
     s = summarize(trials)
     s.update({"set": which, "robot": robot, "controller": controller or "(robot's files)", "max_speed_mps": max_speed,
+              "collision_monitor": collision_monitor,
               "wall_s": round(time.perf_counter() - t0, 1),
               "failed_worlds": {t["world"]: t["failure"] for t in trials if not t["success"]}})  # fmt: skip
     if folder is not None:

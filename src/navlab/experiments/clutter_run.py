@@ -34,10 +34,12 @@ def run_clutter_world(
     workdir: str | Path | None = None,
     robot: str = "mybot",
     failure_picture: str | Path | None = None,
+    launch_args: dict[str, str] | None = None,
 ) -> dict[str, Any]:
     """One BARN trial in ``world`` (a ``world.clutter.ClutterWorld``) with ``robot`` (and the move_base files the
     launch picks for it: navlab's params/<robot> where it ships some); returns its figures. ``failure_picture``:
-    a folder where a failed trial leaves ``<world>.png`` (the drive when it ended; ``picture`` names it)."""
+    a folder where a failed trial leaves ``<world>.png`` (the drive when it ended; ``picture`` names it);
+    ``launch_args``: more arguments for the mapless launch (``collision_monitor``, ``max_speed``)."""
     with tempfile.TemporaryDirectory(prefix="navlab-clutter-", dir=workdir) as tmp:
         path = world.write_world(Path(tmp) / f"{world.name}.world")
         gx, gy, gyaw = (float(v) for v in between2(world.start, world.goal))  # the goal in odom (= the start)
@@ -45,7 +47,7 @@ def run_clutter_world(
         params = {**CLUTTER_PARAMS, **(move_base_params or {})}
         r = run_navigation([(gx, gy, gyaw)], world=str(path), pose=(sx, sy, syaw), mapless=True, controller=controller,
                            move_base_params=params, seed=seed, goal_timeout=timeout, goal_tolerance=SUCCESS_M,
-                           robot=robot, snapshots=failure_picture is not None)  # fmt: skip
+                           robot=robot, snapshots=failure_picture is not None, launch_args=launch_args)  # fmt: skip
     g = r.goals[0]
     out = rounded({
         **barn_outcome(world, [g]), "reason": g["reason"], "time_s": g["time_s"], "collisions": g["collisions"],
@@ -59,7 +61,7 @@ def run_clutter_world(
         title = (f"{world.name} (difficulty {world.difficulty:.2f}): {out['failure']} after {g['time_s']} s, "
                  f"{g['near_goal_m']} m from the goal at the closest\n{g['reason']}"[:220])
         out["picture"] = str(plot_navigation(r.grid, r.arrivals[0], Path(failure_picture) / f"{world.name}.png",
-                                             title=title, goal=list(world.goal)))  # fmt: skip
+                                             title=title, goal=g["goal"]))  # fmt: skip
     return out
 
 

@@ -241,6 +241,7 @@ def run_navigation(
     goal_tolerance: float = GOAL_TOLERANCE_M,
     progress: Any = None,
     safety_distance: float = SAFETY_DISTANCE_M,
+    launch_args: dict[str, str] | None = None,
 ) -> NavigateResult:
     """Navigate to ``goals`` (x, y, yaw in the map frame) in turn; see ``NavigateResult``.
 
@@ -258,6 +259,7 @@ def run_navigation(
     whatever move_base says.
     ``progress``: a function given one line of text per goal sent/ended and every 10 simulated s (None: silent).
     ``safety_distance``: the clearance (m) under which a goal's ``time_under_safety_s`` counts.
+    ``launch_args``: more arguments for the launch (``{"collision_monitor": "true"}`` on the mapless one).
     """
     from navlab.mapping.mapfile import load_map, save_map
     from navlab.sim.gazebo import load_world_named
@@ -277,7 +279,7 @@ def run_navigation(
     if controller:
         overrides["base_local_planner"] = CONTROLLERS.get(controller, controller)
     gazebo = {"gazebo": {"disturbances": dict(disturbances)}} if disturbances else {}
-    launch_args: dict[str, Any] = sim_launch_args(wheel_controller, ekf)
+    launch_args = {**sim_launch_args(wheel_controller, ekf), **(launch_args or {})}
     if params_dir is not None:
         launch_args["params"] = str(params_dir)
     with tempfile.TemporaryDirectory(prefix="navlab-navigate-") as tmp:
