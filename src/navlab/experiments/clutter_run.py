@@ -21,7 +21,23 @@ from navlab.geometry import between2
 SUCCESS_M = 1.0  # BARN: within 1 m of the goal
 TIMEOUT_S = 100.0  # BARN's time limit
 # At 1 m/s the shipped 4 m local window is too short a view: BARN runs use the ROS tutorial's 6 m x 6 m.
-CLUTTER_PARAMS: dict[str, Any] = {"local_costmap.width": 6.0, "local_costmap.height": 6.0}
+# Dead ends: the rolling global costmap (24 m, unknown space allowed) is what remembers a pocket seen closed, so
+# no recovery clears it (ROS's default resets would forget the pocket and plan back into it); each recovery is
+# followed by a new plan over that memory: clear the local window, back up, spin, back up farther.
+CLUTTER_RECOVERIES: list[dict[str, str]] = [
+    {"name": "clear_local", "type": "clear_costmap_recovery/ClearCostmapRecovery"},
+    {"name": "back_up", "type": "nav2_behaviors/BackUp"},
+    {"name": "spin", "type": "rotate_recovery/RotateRecovery"},
+    {"name": "back_up_far", "type": "nav2_behaviors/BackUp"},
+]
+CLUTTER_PARAMS: dict[str, Any] = {
+    "local_costmap.width": 6.0, "local_costmap.height": 6.0,
+    "recovery_behaviors": CLUTTER_RECOVERIES,
+    "clear_local.affected_maps": "local", "clear_local.reset_distance": 0.0,
+    "back_up.backup_dist": 0.3, "back_up.backup_speed": 0.25,
+    "back_up_far.backup_dist": 0.8, "back_up_far.backup_speed": 0.25,
+    "progress_checker.required_movement_radius": 0.5, "progress_checker.movement_time_allowance": 10.0,
+}
 
 
 def run_clutter_world(
