@@ -87,9 +87,9 @@ class MoveBase(Node):
         self.costmaps = {"global": self.global_costmap, "local": self.local_costmap}
         gp, lp = str(p["base_global_planner"]), str(p["base_local_planner"])
         self.planner_name, self.controller_name = short_name(gp), short_name(lp)
-        self.planner = _construct(load_plugin("global_planner", gp, param="base_global_planner"),
-                                  self._namespace(self.planner_name))  # fmt: skip
         footprint = self.local_costmap.layered.footprint
+        self.planner = _construct(load_plugin("global_planner", gp, param="base_global_planner"),
+                                  self._namespace(self.planner_name), footprint=footprint.polygon)  # fmt: skip
         # as ROS's planners see them: the costmap's footprint (a round robot's radius, for costmap_2d's 16-gon)
         # and move_base's controller_frequency (they search the parameter upward)
         self.controller = _construct(load_plugin("controller", lp, param="base_local_planner"),
