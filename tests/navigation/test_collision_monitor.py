@@ -57,8 +57,9 @@ def test_approach_keeps_the_contact_time_before_collision_away() -> None:
 
 
 def test_configured_polygons_and_bad_ones() -> None:
+    square = [0.3, 0.3, 0.3, -0.3, -0.3, -0.3, -0.3, 0.3]
     params = {"polygons": ["Stop", "Ring"],
-              "Stop": {"type": "polygon", "action_type": "stop", "points": [0.3, 0.3, 0.3, -0.3, -0.3, -0.3, -0.3, 0.3]},
+              "Stop": {"type": "polygon", "action_type": "stop", "points": square},
               "Ring": {"type": "circle", "action_type": "limit", "radius": 1.0, "linear_limit": 0.2, "max_points": 2}}
     mon = CollisionMonitor(parse_polygons(params, None))
     limited = mon.check(1.0, 2.0, cloud(0.8, 0.0, n=3))  # Humble's max_points 2: three points act

@@ -279,9 +279,9 @@ def run_navigation(
     if controller:
         overrides["base_local_planner"] = CONTROLLERS.get(controller, controller)
     gazebo = {"gazebo": {"disturbances": dict(disturbances)}} if disturbances else {}
-    launch_args = {**sim_launch_args(wheel_controller, ekf), **(launch_args or {})}
+    args: dict[str, Any] = {**sim_launch_args(wheel_controller, ekf), **(launch_args or {})}
     if params_dir is not None:
-        launch_args["params"] = str(params_dir)
+        args["params"] = str(params_dir)
     with tempfile.TemporaryDirectory(prefix="navlab-navigate-") as tmp:
         if map_yaml is None:
             served = Path(tmp) / "true_map.yaml"
@@ -291,10 +291,10 @@ def run_navigation(
         grid = load_map(served)
         if mapless:
             run = start_run("navigation_mapless", world=world, robot=robot, pose=pose, seed=seed,
-                            overrides={"move_base": overrides, **gazebo}, on_start=on_start, **launch_args)  # fmt: skip
+                            overrides={"move_base": overrides, **gazebo}, on_start=on_start, **args)  # fmt: skip
         else:
             run = start_run("navigation", world=world, robot=robot, pose=pose, seed=seed, map=str(served),
-                            overrides={"move_base": overrides, **gazebo}, on_start=on_start, **launch_args)  # fmt: skip
+                            overrides={"move_base": overrides, **gazebo}, on_start=on_start, **args)  # fmt: skip
     mb = _move_base(run)
     mon = run.add(NavMonitor, parameters={"base_frame": run.base_frame, "safety_distance": float(safety_distance),
                                           "estimate_frame": "" if mapless else "map"},

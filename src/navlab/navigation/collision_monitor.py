@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+
 from navlab import msgs
 from navlab.core import Executor, Node, TfError
 from navlab.navigation.errors import NavigationError
@@ -133,9 +134,9 @@ def parse_polygons(params: dict[str, Any], footprint: np.ndarray | None) -> list
         known = {k: spec[k] for k in spec if k in keys}
         if "max_points" in spec and "min_points" not in spec:  # Humble's name: the most points that are still ok
             known["min_points"] = int(spec["max_points"]) + 1
-        defaults = Polygon.__dataclass_fields__
+        defaults = Polygon(str(name), action)
         try:
-            out.append(Polygon(str(name), action, pts, **{k: type(defaults[k].default)(v) for k, v in known.items()}))
+            out.append(Polygon(str(name), action, pts, **{k: type(getattr(defaults, k))(v) for k, v in known.items()}))
         except (TypeError, ValueError) as exc:
             raise NavigationError(f"collision_monitor polygon {name}: {exc}") from None
     return out

@@ -162,7 +162,8 @@ class RegulatedPurePursuitController:
 
     def is_goal_reached(self, pose: tuple[float, float, float], velocity: tuple[float, float]) -> bool:
         """Nav2's SimpleGoalChecker: within xy tolerance (latched if ``stateful``) and yaw tolerance."""
-        return self._plan is not None and self._latch.reached(tuple(float(v) for v in pose[:3]), self._goal)
+        return self._plan is not None and self._latch.reached((float(pose[0]), float(pose[1]), float(pose[2])),
+                                                              self._goal)
 
     def compute_velocity(self, pose: tuple[float, float, float], velocity: tuple[float, float],
                          costmap: Grid | None) -> tuple[float, float]:
@@ -278,7 +279,7 @@ class RegulatedPurePursuitController:
             dt = 0.05 / abs(w)
         else:
             return np.array([[pose[0], pose[1], pose[2]]], dtype=np.float64)
-        n = max(1, int(math.ceil(horizon / dt)))
+        n = max(1, math.ceil(horizon / dt))
         t = np.arange(1, n + 1) * min(dt, horizon)
         th = pose[2] + w * t
         if abs(w) > 1e-9:

@@ -166,10 +166,10 @@ class _Search:
         return prims
 
     def cell(self, x: float, y: float) -> tuple[int, int]:
-        return int(math.floor((x - self.ox) / self.res)), int(math.floor((y - self.oy) / self.res))
+        return math.floor((x - self.ox) / self.res), math.floor((y - self.oy) / self.res)
 
     def bin_of(self, yaw: float) -> int:
-        return int(round(yaw / (2 * math.pi / self.bins))) % self.bins
+        return round(yaw / (2 * math.pi / self.bins)) % self.bins
 
     def cell_cost(self, i: int, j: int) -> int:
         return int(self.cost[j, i])
@@ -255,7 +255,7 @@ class SmacPlannerHybrid:
     def _nearest_free_goal(self, s: _Search, goal: tuple[float, float, float]) -> tuple[float, float, float] | None:
         """The free pose (goal's yaw) nearest the goal within ``tolerance`` m, on the search grid."""
         tol = self.params.tolerance
-        n = int(math.ceil(tol / s.res))
+        n = math.ceil(tol / s.res)
         best: tuple[float, tuple[float, float, float]] | None = None
         for dj in range(-n, n + 1):
             for di in range(-n, n + 1):
