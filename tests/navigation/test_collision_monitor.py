@@ -85,3 +85,24 @@ def test_velocity_smoother_limits_acceleration_and_keeps_curvature() -> None:
     with pytest.raises(NavigationError, match="feedback"):
         VelocitySmoother({"feedback": "MAGIC"})
     assert math.isfinite(v)
+
+
+def test_the_monitor_node_stops_a_robot_driven_at_a_wall() -> None:
+    """The mapless launch with collision_monitor:=true: a command of 1 m/s straight at the room's wall, sent
+    where move_base's would go (cmd_vel_nav), is smoothed and then stopped by the polygons before any contact."""
+    from navlab import msgs
+    from navlab.core import Node
+    from navlab.experiments.session import start_run
+
+    run = start_run("navigation_mapless", world="room", pose=(2.0, 0.0, 0.0), collision_monitor="true")
+    mon = run.node("collision_monitor")
+    driver = run.add(Node, name="driver")
+    pub = driver.create_publisher(msgs.Twist, "cmd_vel_nav", 1)
+    hits: list[float] = []
+    driver.create_subscription(msgs.String, "/collisions", lambda _m: hits.append(1.0), 10)
+    driver.create_timer(0.05, lambda: pub.publish(msgs.twist(1.0, 0.0)))
+    run.run(8.0)
+    assert not hits and run.sim.clearance() > 0.0
+    assert mon.actions.get("PolygonStop", 0) + mon.actions.get("FootprintApproach", 0) > 0
+    x, _, _ = run.sim.base_pose2d()
+    assert x > 2.5  # it did drive, and stopped short of the wall
