@@ -45,7 +45,7 @@ WHAT = "RegulatedPurePursuitController"
 SPACING = 0.05  # m: plans are resampled to this
 SEARCH_M = 5.0  # m of path ahead of the last nearest point searched for the robot's nearest point
 _IGNORED = frozenset({"plugin", "transform_tolerance", "use_sim_time", "max_robot_pose_search_dist",
-                      "use_interpolation", "cost_scaling_gain_unused"})
+                      "use_interpolation"})
 
 
 @dataclass
