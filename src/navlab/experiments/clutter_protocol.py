@@ -87,18 +87,3 @@ def run_protocol(
     if folder is not None:
         s["pictures"] = [t["picture"] for t in trials if t.get("picture")]
     return {"summary": s, "trials": trials}
-
-
-def bench(args: Any) -> dict[str, Any]:
-    """``navlab bench clutter`` (see the module docstring): ``--set``, ``--worlds``, ``--robot`` (jackal),
-    ``--controller`` (mppi for the robots whose files tune it; else the robot's own), ``--max-speed`` (2 m/s),
-    ``--out`` (failure pictures)."""
-    robot = getattr(args, "robot", None) or "jackal"
-    controller = getattr(args, "controller", None) or ("mppi" if robot in ("mybot", "jackal") else None)
-    speed = getattr(args, "max_speed", None)
-    out = run_protocol(n=int(getattr(args, "worlds", 0) or 50), which=getattr(args, "set", None) or "test",
-                       robot=robot, controller=controller,
-                       max_speed=(JACKAL_MAX_SPEED if controller else None) if speed is None else (speed or None),
-                       out=getattr(args, "out", None), seed=getattr(args, "seed", 0),
-                       progress=not getattr(args, "quiet", False))  # fmt: skip
-    return out["summary"]

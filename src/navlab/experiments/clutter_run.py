@@ -115,29 +115,6 @@ def clutter_for_trial(world: str, index: int) -> Any:
     return generate_clutter(spec.get("seed", 0) * 1000 + k, fill=fill, smooth=smooth)  # as clutter_suite(n, seed)
 
 
-def run_clutter_suite(
-    n: int = 50,
-    *,
-    seed: int = 0,
-    controller: str | None = "mppi",
-    move_base_params: dict[str, Any] | None = None,
-    progress: bool = False,
-    robot: str = "mybot",
-) -> dict[str, Any]:
-    """The ``clutter_suite(n, seed)`` worlds in turn with ``robot``; the per-world figures and their summary."""
-    import sys
-
-    from tqdm import tqdm
-
-    from navlab.world.clutter import clutter_suite
-
-    trials = []
-    for world in tqdm(clutter_suite(n, seed=seed), desc="clutter", unit="world", disable=not progress, file=sys.stderr):
-        trials.append(run_clutter_world(world, controller=controller, move_base_params=move_base_params, seed=seed,
-                                        robot=robot))
-    return {"summary": summarize(trials), "trials": trials}
-
-
 def summarize(trials: list[dict[str, Any]]) -> dict[str, Any]:
     """BARN's figures over trials: success, collision and timeout rates, mean score."""
     n = len(trials)
@@ -159,10 +136,3 @@ def summarize(trials: list[dict[str, Any]]) -> dict[str, Any]:
         "near_misses": sum(bool(t.get("near_miss")) for t in trials),
         "time_under_safety_s_mean": sum(t.get("time_under_safety_s", 0.0) for t in trials) / n,
     })  # fmt: skip
-
-
-def bench(args: Any) -> dict[str, Any]:
-    """``navlab bench clutter``: the benchmark's protocol (``experiments.clutter_protocol``)."""
-    from navlab.experiments.clutter_protocol import bench as protocol_bench
-
-    return protocol_bench(args)
