@@ -132,7 +132,8 @@ def summarize(trials: list[dict[str, Any]]) -> dict[str, Any]:
         "false_success": sum(t["false_success"] for t in trials),
         "score": sum(t["score"] for t in trials) / n,
         "mean_time_s": sum(t["time_s"] for t in trials if t["success"]) / max(1, sum(t["success"] for t in trials)),
-        "min_clearance_m": min(t["min_clearance_m"] for t in trials),
+        "min_clearance_m": min((t["min_clearance_m"] for t in trials if t["min_clearance_m"] is not None),
+                               default=None),
         "near_misses": sum(bool(t.get("near_miss")) for t in trials),
         "time_under_safety_s_mean": sum(t.get("time_under_safety_s", 0.0) for t in trials) / n,
     })  # fmt: skip

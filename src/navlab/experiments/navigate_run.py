@@ -344,7 +344,8 @@ def run_navigation(
         "false_success": sum(r["false_success"] for r in results),
         "collisions": sum(r["collisions"] for r in results),
         "near_misses": sum(r["near_miss"] for r in results),
-        "min_clearance_m": min((r["min_clearance_m"] for r in results), default=None),
+        "min_clearance_m": min((r["min_clearance_m"] for r in results if r["min_clearance_m"] is not None),
+                               default=None),  # None: a goal that ended before the first sample
         "localization_error_mean_m": float(loc.mean()) if loc.size else None,
         "localization_error_max_m": float(loc.max()) if loc.size else None,
         "cmd_jerk_mean": mean_abs_jerk(mon.cmd),
