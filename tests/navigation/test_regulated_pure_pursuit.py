@@ -94,7 +94,7 @@ def test_collision_ahead_stops_and_marks_the_cycle_invalid() -> None:
     assert (v, w) == (0.0, 0.0) and not c.valid and "collision" in c.last_failure
     c2 = rpp(desired_linear_vel=1.0, use_collision_detection=False)
     c2.set_plan(line(0.0, 3.0))
-    assert c2.compute_velocity((0.0, 0.0, 0.0), (1.0, 0.0), g)[0] > 0 and c2.valid
+    assert c2.compute_velocity((0.0, 0.0, 0.0), (1.0, 0.0), g).v > 0 and c2.valid
 
 
 def test_closed_loop_follows_a_bent_path_to_the_goal() -> None:
@@ -107,7 +107,7 @@ def test_closed_loop_follows_a_bent_path_to_the_goal() -> None:
     for _ in range(400):
         if c.is_goal_reached(pose, vel):
             break
-        vel = c.compute_velocity(pose, vel, g)
+        vel = tuple(c.compute_velocity(pose, vel, g))
         x, y, th = pose
         pose = (x + vel[0] * math.cos(th) * DT, y + vel[0] * math.sin(th) * DT, th + vel[1] * DT)
         d = np.hypot(plan[:, 0] - pose[0], plan[:, 1] - pose[1]).min()

@@ -35,9 +35,9 @@ def speed_overrides(controller: str | None, max_speed: float | None) -> dict[str
     """move_base overrides that set ``controller``'s top forward speed to ``max_speed`` m/s (None: its files')."""
     if max_speed is None or controller is None:
         return {}
-    from navlab.experiments.navigate_run import CONTROLLERS
+    from navlab.plugins import resolve_name
 
-    name = CONTROLLERS.get(controller, controller)
+    name = resolve_name("controller", controller)
     keys = SPEED_KEYS.get(name)
     if keys is None:
         raise ExperimentError(f"bench clutter: --max-speed needs a known local planner ({', '.join(SPEED_KEYS)}), "

@@ -11,9 +11,9 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, ClassVar
 
-from navlab.core.params import dataclass_from_dict
+from navlab.core import ParamSpec, read_params
 from navlab.navigation.errors import NavigationError
 
 Pose = tuple[float, float, float]
@@ -24,6 +24,8 @@ STUCK_PREFIX = "stuck"  # an ABORTED goal's reason starts with this when the rob
 class ProgressCheckerParams:
     """Nav2's ``progress_checker`` namespace (``plugin: nav2_controller::SimpleProgressChecker``)."""
 
+    PARAMS: ClassVar[ParamSpec] = ParamSpec("progress_checker", NavigationError, at_least={
+        "required_movement_radius": 0.0, "movement_time_allowance": 0.0})
     required_movement_radius: float = 0.5  # m
     movement_time_allowance: float = 10.0  # s; 0 switches the checker off
     plugin: str = "nav2_controller::SimpleProgressChecker"
@@ -34,13 +36,7 @@ class SimpleProgressChecker:
     ``required_movement_radius`` of one pose for more than ``movement_time_allowance`` s."""
 
     def __init__(self, params: dict[str, Any] | None = None) -> None:
-        self.params = dataclass_from_dict(ProgressCheckerParams, params, what="progress_checker",
-                                          error=NavigationError)  # fmt: skip
-        p = self.params
-        for key in ("required_movement_radius", "movement_time_allowance"):
-            value = getattr(p, key)
-            if not (math.isfinite(value) and value >= 0):
-                raise NavigationError(f"progress_checker parameter {key}: expected >= 0, got {value}")
+        self.params = read_params(ProgressCheckerParams, params)
         self.baseline: Pose | None = None
         self.baseline_t = 0.0
 

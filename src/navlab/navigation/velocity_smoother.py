@@ -13,11 +13,10 @@ The output goes to ``cmd_vel_smoothed``. :class:`VelocitySmoother` is the algori
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, ClassVar
 
 from navlab import msgs
-from navlab.core import Executor, Node
-from navlab.core.params import dataclass_from_dict
+from navlab.core import Executor, Node, ParamSpec, read_params
 from navlab.navigation.errors import NavigationError
 
 
@@ -25,6 +24,7 @@ from navlab.navigation.errors import NavigationError
 class SmootherParams:
     """nav2_velocity_smoother's parameters ([x, y, theta] lists)."""
 
+    PARAMS: ClassVar[ParamSpec] = ParamSpec("velocity_smoother", NavigationError)
     smoothing_frequency: float = 20.0
     scale_velocities: bool = False
     feedback: str = "OPEN_LOOP"
@@ -59,9 +59,7 @@ class VelocitySmoother:
     """The smoothing rule of ``nav2_velocity_smoother`` for a planar base (x and theta; y is 0)."""
 
     def __init__(self, params: dict[str, Any] | SmootherParams | None = None) -> None:
-        self.params = params if isinstance(params, SmootherParams) else dataclass_from_dict(
-            SmootherParams, params, what="velocity_smoother", error=NavigationError)  # fmt: skip
-        self.params.validate()
+        self.params = read_params(SmootherParams, params)
         self.last = (0.0, 0.0)
 
     def _limits(self, axis: int, current: float, target: float, dt: float) -> float:

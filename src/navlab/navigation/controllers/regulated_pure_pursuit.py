@@ -21,25 +21,25 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
+from navlab.core import ParamSpec, read_params
 from navlab.grid import COST_INSCRIBED, COST_UNKNOWN, Grid
 from navlab.navigation.controllers.common import (
     GoalLatch,
     LocalFrame,
     as_plan,
     bad,
-    check_finite,
     densify,
     footprint_outline,
     goal_of,
-    params_from,
     same_goal,
 )
 from navlab.navigation.controllers.rollout import footprint_costs
 from navlab.navigation.errors import NavigationError
+from navlab.plugins import ControlResult
 
 WHAT = "RegulatedPurePursuitController"
 SPACING = 0.05  # m: plans are resampled to this
@@ -52,6 +52,10 @@ _IGNORED = frozenset({"plugin", "transform_tolerance", "use_sim_time", "max_robo
 class RppParams:
     """nav2_regulated_pure_pursuit_controller's parameters (Nav2 names and defaults)."""
 
+    PARAMS: ClassVar[ParamSpec] = ParamSpec(WHAT, NavigationError, ignored=_IGNORED, above={
+        k: 0.0 for k in ("desired_linear_vel", "lookahead_dist", "min_lookahead_dist", "max_lookahead_dist",
+                         "rotate_to_heading_angular_vel", "max_angular_accel", "controller_frequency",
+                         "max_angular_vel", "inflation_cost_scaling_factor")})
     desired_linear_vel: float = 0.5
     lookahead_dist: float = 0.6
     min_lookahead_dist: float = 0.3
@@ -82,12 +86,6 @@ class RppParams:
 
     def validate(self) -> None:
         """Refuse values Nav2 could not run with (one-line errors naming the key)."""
-        check_finite(WHAT, self)
-        for key in ("desired_linear_vel", "lookahead_dist", "min_lookahead_dist", "max_lookahead_dist",
-                    "rotate_to_heading_angular_vel", "max_angular_accel", "controller_frequency", "max_angular_vel",
-                    "inflation_cost_scaling_factor"):  # fmt: skip
-            if getattr(self, key) <= 0:
-                raise bad(WHAT, key, getattr(self, key), "> 0")
         if self.min_lookahead_dist > self.max_lookahead_dist:
             raise bad(WHAT, "min_lookahead_dist", self.min_lookahead_dist,
                       f"<= max_lookahead_dist ({self.max_lookahead_dist})")
@@ -124,8 +122,7 @@ class RegulatedPurePursuitController:
         values = dict(params) if isinstance(params, Mapping) else params
         if isinstance(values, dict) and controller_frequency is not None:
             values.setdefault("controller_frequency", controller_frequency)
-        self.params = params_from(RppParams, values, what=WHAT, ignored=_IGNORED)
-        self.params.validate()
+        self.params = read_params(RppParams, values)
         self.footprint = None if footprint is None else np.asarray(footprint, dtype=np.float64)
         footprint_outline(self.footprint, SPACING)  # validate now
         self.inscribed_radius = _inscribed(self.footprint, robot_radius)
@@ -166,8 +163,14 @@ class RegulatedPurePursuitController:
                                                               self._goal)
 
     def compute_velocity(self, pose: tuple[float, float, float], velocity: tuple[float, float],
-                         costmap: Grid | None) -> tuple[float, float]:
-        """(v m/s, w rad/s) for the robot at ``pose`` (costmap frame) moving at ``velocity`` (v, w)."""
+                         costmap: Grid | None) -> ControlResult:
+        """The command for the robot at ``pose`` (costmap frame) moving at ``velocity`` (v m/s, w rad/s), with the
+        projected arc as its local plan; not ``valid`` when a collision is ahead."""
+        v, w = self._command(pose, velocity, costmap)
+        return ControlResult(v, w, self.valid, self.local_plan)
+
+    def _command(self, pose: tuple[float, float, float], velocity: tuple[float, float],
+                 costmap: Grid | None) -> tuple[float, float]:
         if self._plan is None:
             raise NavigationError(f"{WHAT}: compute_velocity called before set_plan")
         p = self.params

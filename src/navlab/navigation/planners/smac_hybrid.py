@@ -26,11 +26,12 @@ from __future__ import annotations
 import heapq
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, ClassVar
 
 import numba
 import numpy as np
 
+from navlab.core import ParamSpec, read_params
 from navlab.grid import COST_INSCRIBED, COST_LETHAL, COST_UNKNOWN, Grid
 from navlab.navigation.controllers.common import footprint_outline
 from navlab.navigation.errors import NavigationError
@@ -39,7 +40,6 @@ from navlab.navigation.planners.common import (
     check_costmap,
     iheap_pop,
     iheap_update,
-    params_from,
     pose_cell,
 )
 
@@ -50,6 +50,7 @@ WHAT = "SmacPlannerHybrid"
 class SmacHybridParams:
     """nav2_smac_planner's SmacPlannerHybrid parameters (Nav2 names and defaults)."""
 
+    PARAMS: ClassVar[ParamSpec] = ParamSpec(WHAT, NavigationError)
     downsample_costmap: bool = False
     downsampling_factor: int = 1
     tolerance: float = 0.25
@@ -211,8 +212,7 @@ class SmacPlannerHybrid:
     name = WHAT
 
     def __init__(self, params: SmacHybridParams | dict[str, Any] | None = None, *, footprint: Any = None) -> None:
-        self.params = params_from(SmacHybridParams, params, what=WHAT)
-        self.params.validate()
+        self.params = read_params(SmacHybridParams, params)
         self.footprint = None if footprint is None else np.asarray(footprint, dtype=np.float64)
         self.last_failure = ""
         self.stats: dict[str, int] = {}
