@@ -17,6 +17,8 @@ NODES: dict[str, str] = {
     "move_base": "navlab.navigation.move_base:MoveBase",
     "ekf_node": "navlab.localization.ekf_node:EkfNode",
     "ekf_localization_node": "navlab.localization.ekf_node:EkfNode",
+    "velocity_smoother": "navlab.navigation.velocity_smoother:VelocitySmootherNode",
+    "collision_monitor": "navlab.navigation.collision_monitor:CollisionMonitorNode",
 }
 
 #: launch files' ``$(robot KEY)``: a function of the ``robot`` argument (shipped name, file or

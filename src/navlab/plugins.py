@@ -334,11 +334,13 @@ ALIASES: dict[str, dict[str, str]] = {
         "dwa": "dwa_local_planner/DWAPlannerROS",
         "dwb": "nav2_dwb_controller/DWBLocalPlanner",
         "mppi": "nav2_mppi_controller::MPPIController",
+        "rpp": "nav2_regulated_pure_pursuit_controller::RegulatedPurePursuitController",
     },
     "global_planner": {
         "navfn": "navfn/NavfnROS",
         "global_planner": "global_planner/GlobalPlanner",
         "theta_star": "nav2_theta_star_planner/ThetaStarPlanner",
+        "smac_hybrid": "nav2_smac_planner/SmacPlannerHybrid",
     },
 }
 

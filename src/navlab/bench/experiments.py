@@ -9,7 +9,7 @@ import time
 from pathlib import Path
 from typing import Any
 
-from navlab.experiments.clutter_run import run_clutter_suite
+from navlab.experiments.clutter_protocol import JACKAL_MAX_SPEED, run_protocol
 from navlab.experiments.mapping_run import run_mapping
 from navlab.experiments.navigate_run import run_navigation
 from navlab.experiments.odom_run import ROBOTS, ROUTES, run_drift
@@ -48,18 +48,18 @@ def run_nav(args: Any) -> dict[str, Any]:
 
 
 def run_clutter(args: Any) -> dict[str, Any]:
-    """``navlab bench clutter``: mapless navigation over 50 generated clutter worlds of graded difficulty (``--robot``:
-    mybot with MPPI by default; another shipped robot drives with its own params/<robot> planner unless
-    ``--controller`` names one)."""
-    n = int(getattr(args, "worlds", 0) or 50)
-    t0 = time.perf_counter()
-    robot = getattr(args, "robot", None) or "mybot"
-    controller = getattr(args, "controller", None) or ("mppi" if robot == "mybot" else None)  # None: params/<robot>'s
-    out = run_clutter_suite(n, seed=getattr(args, "seed", 0), controller=controller, robot=robot)
-    s = dict(out["summary"])
-    s["wall_s"] = round(time.perf_counter() - t0, 1)
-    s["failed_worlds"] = [t["world"] for t in out["trials"] if not t["success"]]
-    return s
+    """``navlab bench clutter``: the clutter benchmark's protocol (``experiments.clutter_protocol``): ``--set``
+    (test | tuning), ``--worlds``, ``--robot`` (jackal), ``--controller`` (mppi for the robots whose files tune it,
+    else the robot's own), ``--max-speed`` (2 m/s; 0 keeps the files'), ``--out`` (a picture of each failure)."""
+    robot = getattr(args, "robot", None) or "jackal"
+    controller = getattr(args, "controller", None) or ("mppi" if robot in ("mybot", "jackal") else None)
+    speed = getattr(args, "max_speed", None)
+    out = run_protocol(n=int(getattr(args, "worlds", 0) or 50), which=getattr(args, "set", None) or "test",
+                       robot=robot, controller=controller,
+                       max_speed=(JACKAL_MAX_SPEED if controller else None) if speed is None else (speed or None),
+                       out=getattr(args, "out", None), seed=getattr(args, "seed", 0),
+                       progress=not getattr(args, "quiet", False))  # fmt: skip
+    return out["summary"]
 
 
 def run_odom(args: Any) -> dict[str, Any]:

@@ -89,10 +89,16 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("files", nargs="*", metavar="FILE.json", help="compare: the old and the new results")
     add_run_options(p, seed=0, quiet=True, json=True)
     p.add_argument("--controller", default=None,
-                   help="clutter: local planner to drive with (trajectory, dwa, mppi; default mppi)")
+                   help="clutter: local planner to drive with (trajectory, dwa, mppi, rpp or a ROS plugin name; "
+                   "default mppi for jackal and mybot, else the robot's own files')")
     p.add_argument("--worlds", type=int, default=50, help="clutter: how many generated worlds (default 50)")
     p.add_argument("--robot", default=None,
-                   help="clutter: shipped robot (default mybot; e.g. jackal_skid with its own move_base files)")
+                   help="clutter: shipped robot (default jackal; e.g. jackal_skid with its own move_base files)")
+    p.add_argument("--set", default="test", choices=["test", "tuning"],
+                   help="clutter: the 50 test worlds (report on these) or the separate tuning set (tune on these)")
+    p.add_argument("--max-speed", type=float, default=None, metavar="M_S",
+                   help="clutter: the controller's top speed (default 2.0, the Jackal's; 0 keeps the files')")
+    p.add_argument("--out", default=None, metavar="DIR", help="clutter: a picture of each failure in DIR")
     p.add_argument("--trials", type=int, default=None,
                    help="sweep: trials per combination (default 10; 2 combinations)")
     p.add_argument("--minutes", type=float, default=60.0,

@@ -37,6 +37,7 @@ def _cmd(args: argparse.Namespace) -> int:
         said = f", move_base: {g['move_base_outcome']}" if g["move_base_outcome"] != g["outcome"] else ""
         print(f"    goal {k} {tuple(g['goal'])}: {g['outcome']}{said} in {g['time_s']} s, path {g['path_m']} m, "
               f"{g['final_error_m']} m from the goal, closest {g['min_clearance_m']} m"
+              + (" — NEAR MISS (< 5 cm)" if g.get("near_miss") else "")
               + (f" ({g['reason']})" if g["reason"] else ""))
     print(f"  total {summary['wall_s']} s wall")
     return 0

@@ -146,7 +146,8 @@ def robot_launch_values(name_or_path: str | os.PathLike[str]) -> dict[str, str]:
     has a control YAML), ``controller_params`` (that YAML, else ``diff_drive_controller.yaml`` in ``params``),
     ``own_controller_params`` (that YAML, else empty),
     ``ekf`` (``true`` when a robot_localization YAML sits beside it) and ``ekf_params`` (that YAML, else
-    navlab's ``params/ekf.yaml``)."""
+    navlab's ``params/ekf.yaml``); ``imu_topic`` (its first IMU's topic, else ``imu``) and ``ekf_mapless``
+    (``true`` also when it has an IMU: mapless navigation fuses it, as the real robots do)."""
     from navlab.description.robot_files import robot_files
 
     model = load_robot(name_or_path)
@@ -167,6 +168,8 @@ def robot_launch_values(name_or_path: str | os.PathLike[str]) -> dict[str, str]:
         "controller_params": str(control or params / "diff_drive_controller.yaml"),
         "own_controller_params": str(control or ""),
         "ekf": "true" if ekf is not None else "false",
+        "ekf_mapless": "true" if ekf is not None or model.imus else "false",
+        "imu_topic": model.imus[0].topic if model.imus else "imu",
         "ekf_params": str(ekf or resources.path("params/ekf.yaml")),
     }
     if not own:

@@ -20,9 +20,27 @@ from navlab.geometry import between2
 
 SUCCESS_M = 1.0  # BARN: within 1 m of the goal
 TIMEOUT_S = 100.0  # BARN's time limit
-# At 1 m/s mybot's shipped 4 m local window is too short a view: its BARN runs use the ROS tutorial's 6 m x 6 m
-# (another robot drives with its own files unchanged).
-CLUTTER_PARAMS: dict[str, Any] = {"local_costmap.width": 6.0, "local_costmap.height": 6.0}
+# At 1 m/s the shipped 4 m local window is too short a view: BARN runs use the ROS tutorial's 6 m x 6 m.
+# These settings are for navlab's own robot files (CLUTTER_ROBOTS); any other robot (jackal_skid carries the
+# benchmark's own move_base files, a user's robot its own) drives with its files unchanged.
+# Dead ends: the rolling global costmap (24 m, unknown space allowed) is what remembers a pocket seen closed, so
+# no recovery clears it (ROS's default resets would forget the pocket and plan back into it); each recovery is
+# followed by a new plan over that memory: clear the local window, back up, spin, back up farther.
+CLUTTER_RECOVERIES: list[dict[str, str]] = [
+    {"name": "clear_local", "type": "clear_costmap_recovery/ClearCostmapRecovery"},
+    {"name": "back_up", "type": "nav2_behaviors/BackUp"},
+    {"name": "spin", "type": "rotate_recovery/RotateRecovery"},
+    {"name": "back_up_far", "type": "nav2_behaviors/BackUp"},
+]
+CLUTTER_PARAMS: dict[str, Any] = {
+    "local_costmap.width": 6.0, "local_costmap.height": 6.0,
+    "recovery_behaviors": CLUTTER_RECOVERIES,
+    "clear_local.affected_maps": "local", "clear_local.reset_distance": 0.0,
+    "back_up.backup_dist": 0.3, "back_up.backup_speed": 0.25,
+    "back_up_far.backup_dist": 0.8, "back_up_far.backup_speed": 0.25,
+    "progress_checker.required_movement_radius": 0.5, "progress_checker.movement_time_allowance": 10.0,
+}
+CLUTTER_ROBOTS = ("mybot", "jackal")
 
 
 def run_clutter_world(
@@ -34,22 +52,36 @@ def run_clutter_world(
     timeout: float = TIMEOUT_S,
     workdir: str | Path | None = None,
     robot: str = "mybot",
+    failure_picture: str | Path | None = None,
+    launch_args: dict[str, str] | None = None,
 ) -> dict[str, Any]:
     """One BARN trial in ``world`` (a ``world.clutter.ClutterWorld``) with ``robot`` (and the move_base files the
-    launch picks for it: navlab's params/<robot> where it ships some); returns its figures."""
+    launch picks for it: navlab's params/<robot> where it ships some); returns its figures. ``failure_picture``:
+    a folder where a failed trial leaves ``<world>.png`` (the drive when it ended; ``picture`` names it);
+    ``launch_args``: more arguments for the mapless launch (``collision_monitor``, ``max_speed``)."""
     with tempfile.TemporaryDirectory(prefix="navlab-clutter-", dir=workdir) as tmp:
         path = world.write_world(Path(tmp) / f"{world.name}.world")
         gx, gy, gyaw = (float(v) for v in between2(world.start, world.goal))  # the goal in odom (= the start)
         sx, sy, syaw = (float(v) for v in world.start)
-        params = {**(CLUTTER_PARAMS if robot == "mybot" else {}), **(move_base_params or {})}  # others: their files'
+        params = {**(CLUTTER_PARAMS if robot in CLUTTER_ROBOTS else {}), **(move_base_params or {})}
         r = run_navigation([(gx, gy, gyaw)], world=str(path), pose=(sx, sy, syaw), mapless=True, controller=controller,
                            move_base_params=params, seed=seed, goal_timeout=timeout, goal_tolerance=SUCCESS_M,
-                           robot=robot)  # fmt: skip
+                           robot=robot, snapshots=failure_picture is not None, launch_args=launch_args)  # fmt: skip
     g = r.goals[0]
-    return rounded({
+    out = rounded({
         **barn_outcome(world, [g]), "reason": g["reason"], "time_s": g["time_s"], "collisions": g["collisions"],
-        "path_m": g["path_m"], "min_clearance_m": g["min_clearance_m"], "wall_s": r.summary["wall_s"],
+        "path_m": g["path_m"], "min_clearance_m": g["min_clearance_m"], "near_miss": g["near_miss"],
+        "time_under_safety_s": g["time_under_safety_s"], "near_goal_m": g["near_goal_m"],
+        "final_error_m": g["final_error_m"], "wall_s": r.summary["wall_s"],
     })  # fmt: skip
+    if failure_picture is not None and not out["success"] and r.arrivals:
+        from navlab.experiments.plots import plot_navigation
+
+        title = (f"{world.name} (difficulty {world.difficulty:.2f}): {out['failure']} after {g['time_s']} s, "
+                 f"{g['near_goal_m']} m from the goal at the closest\n{g['reason']}"[:220])
+        out["picture"] = str(plot_navigation(r.grid, r.arrivals[0], Path(failure_picture) / f"{world.name}.png",
+                                             title=title, goal=g["goal"]))  # fmt: skip
+    return out
 
 
 def barn_outcome(world: Any, goals: list[dict[str, Any]]) -> dict[str, Any]:
@@ -86,29 +118,6 @@ def clutter_for_trial(world: str, index: int) -> Any:
     return generate_clutter(spec.get("seed", 0) * 1000 + k, fill=fill, smooth=smooth)  # as clutter_suite(n, seed)
 
 
-def run_clutter_suite(
-    n: int = 50,
-    *,
-    seed: int = 0,
-    controller: str | None = "mppi",
-    move_base_params: dict[str, Any] | None = None,
-    progress: bool = False,
-    robot: str = "mybot",
-) -> dict[str, Any]:
-    """The ``clutter_suite(n, seed)`` worlds in turn with ``robot``; the per-world figures and their summary."""
-    import sys
-
-    from tqdm import tqdm
-
-    from navlab.world.clutter import clutter_suite
-
-    trials = []
-    for world in tqdm(clutter_suite(n, seed=seed), desc="clutter", unit="world", disable=not progress, file=sys.stderr):
-        trials.append(run_clutter_world(world, controller=controller, move_base_params=move_base_params, seed=seed,
-                                        robot=robot))
-    return {"summary": summarize(trials), "trials": trials}
-
-
 def summarize(trials: list[dict[str, Any]]) -> dict[str, Any]:
     """BARN's figures over trials: success, collision and timeout rates, mean score."""
     n = len(trials)
@@ -119,9 +128,15 @@ def summarize(trials: list[dict[str, Any]]) -> dict[str, Any]:
         "success": sum(t["success"] for t in trials) / n,
         "collision": sum(t["failure"] == "collision" for t in trials) / n,
         "timeout": sum(t["failure"] == "timeout" for t in trials) / n,
+        "stuck": sum(t["failure"] == "stuck" for t in trials) / n,
         "aborted": sum(t["failure"] == "aborted" for t in trials) / n,
+        "missed": sum(t["failure"] in ("missed", "not_reached", "preempted") for t in trials) / n,
         "move_base_success": sum(t["move_base_success"] for t in trials) / n,
         "false_success": sum(t["false_success"] for t in trials),
         "score": sum(t["score"] for t in trials) / n,
         "mean_time_s": sum(t["time_s"] for t in trials if t["success"]) / max(1, sum(t["success"] for t in trials)),
+        "min_clearance_m": min((t["min_clearance_m"] for t in trials if t["min_clearance_m"] is not None),
+                               default=None),
+        "near_misses": sum(bool(t.get("near_miss")) for t in trials),
+        "time_under_safety_s_mean": sum(t.get("time_under_safety_s", 0.0) for t in trials) / n,
     })  # fmt: skip

@@ -4,9 +4,13 @@ one after another, each scored from ground truth and the simulator's contacts.
 ``run_navigation`` is the Python API behind ``navlab navigate``. Each goal is judged by the simulator's truth:
 ``outcome`` is ``succeeded`` when the robot truly ended within ``goal_tolerance`` m of the goal, else move_base's
 failure (``aborted`` | ``preempted`` | ``timeout``) or ``not_reached`` when move_base reported success from its
-own (odometry/AMCL) estimate; ``move_base_outcome`` is move_base's verdict beside it and ``false_success`` marks
-the disagreement. Also move_base's reason, time, path length, minimum clearance (m between the robot's
-collision geometry and the world's, from MuJoCo) and collisions (contact episodes).
+own (odometry/AMCL) estimate, ``stuck`` when move_base gave up for lack of progress or the robot truly stayed
+within ``STUCK_RADIUS_M`` for the last ``STUCK_WINDOW_S`` s before the time ran out; ``move_base_outcome`` is
+move_base's verdict beside it and ``false_success`` marks the disagreement. Also move_base's reason, time, path
+length, ``near_goal_m`` (the closest the robot truly came to the goal), minimum clearance (m between the robot's
+collision geometry and the world's, from MuJoCo), ``time_under_safety_s`` (time with the clearance under
+``safety_distance``), ``near_miss`` (clearance under ``NEAR_MISS_M`` without a contact) and collisions
+(contact episodes).
 """
 
 from __future__ import annotations
@@ -28,7 +32,7 @@ from navlab.experiments.plots import NavSnapshot
 from navlab.experiments.session import Run, rounded, start_run
 from navlab.geometry import compose2, transform_points2
 from navlab.grid import Grid, GridMap
-from navlab.navigation import GoalOutcome, NavigationError
+from navlab.navigation import STUCK_PREFIX, GoalOutcome, NavigationError, stuck_window
 from navlab.world import true_map, unmapped_obstacles
 
 if TYPE_CHECKING:
@@ -38,6 +42,10 @@ Pose = tuple[float, float, float]
 
 
 GOAL_TOLERANCE_M = 0.3  # the truth's goal region: twice the shipped robots' xy_goal_tolerance (AMCL's error room)
+SAFETY_DISTANCE_M = 0.10  # clearance (m) under which the drive counts time "under the safety distance"
+NEAR_MISS_M = 0.05  # clearance (m) under which a drive without contact is flagged a near miss
+STUCK_WINDOW_S, STUCK_RADIUS_M = 20.0, 0.5  # a timed-out robot that stayed this close this long was stuck
+SAMPLE_S = 0.1  # NavMonitor's sampling period (s)
 
 
 class NavMonitor(Node):
@@ -48,6 +56,7 @@ class NavMonitor(Node):
     def __init__(self, executor: Executor, *, name: str = "nav_monitor", parameters: dict[str, Any] | None = None,
                  namespace: str = "", sim: Any = None, move_base: Any = None) -> None:  # fmt: skip
         super().__init__(executor, name=name, parameters=parameters, namespace=namespace)
+        self.safety_distance = float(self.declare_parameter("safety_distance", SAFETY_DISTANCE_M))
         self.base_frame = str(self.declare_parameter("base_frame", "base_link"))
         self.sim, self.move_base = sim, move_base
         self.path: list[tuple[float, float, float]] = []
@@ -61,7 +70,7 @@ class NavMonitor(Node):
         self.create_subscription(msgs.Twist, "cmd_vel", self._on_cmd, 10)
         self.create_subscription(msgs.String, "/collisions", lambda _m: self.contacts.append(self.now_s()), 10)
         self.create_subscription(msgs.LaserScan, "scan", self._on_scan, 5)
-        self.create_timer(0.1, self._sample)
+        self.create_timer(SAMPLE_S, self._sample)
 
     def _on_cmd(self, msg: Any) -> None:
         self.cmd.append((self.now_s(), float(msg.linear.x)))
@@ -156,13 +165,23 @@ def _drive_goal(run: Run, mon: NavMonitor, goal: Pose, frame: str, timeout: floa
         mb.cancel_goal()
     t1 = handle.end_s if verdict != GoalOutcome.TIMEOUT and handle.end_s is not None else mon.now_s()
     pts = np.array([p[1:] for p in mon.path[k0:]]).reshape(-1, 2)
-    final_error = math.dist(run.sim.base_pose2d()[:2], compose2(world_T_frame, goal)[:2])
+    goal_world = compose2(world_T_frame, goal)[:2]
+    final_error = math.dist(run.sim.base_pose2d()[:2], goal_world)
     reached = final_error <= tolerance
     false_success = verdict == GoalOutcome.SUCCEEDED and not reached
     outcome = "succeeded" if reached else ("not_reached" if false_success else str(verdict))
     reason = {"succeeded": "", "timeout": f"not reached in {timeout:g} s"}.get(verdict, handle.reason)
     if false_success:
         reason = f"move_base reported success but the robot is {final_error:.2f} m from the goal (> {tolerance:g} m)"
+    if not reached and (verdict == GoalOutcome.ABORTED and handle.reason.startswith(STUCK_PREFIX)):
+        outcome = "stuck"
+    elif not reached and verdict == GoalOutcome.TIMEOUT and stuck_window(mon.path[k0:], STUCK_WINDOW_S, STUCK_RADIUS_M):
+        outcome = "stuck"
+        reason = (f"stuck: the robot stayed within {STUCK_RADIUS_M:g} m for the last {STUCK_WINDOW_S:g} s "
+                  f"(not reached in {timeout:g} s)")
+    clearance = np.asarray(mon.clearance[k0:], dtype=np.float64)
+    collisions = _episodes(mon.contacts, t0, t1)
+    min_clearance = float(clearance.min()) if clearance.size else math.inf
     return {
         "goal": list(goal),
         "outcome": outcome,
@@ -171,9 +190,14 @@ def _drive_goal(run: Run, mon: NavMonitor, goal: Pose, frame: str, timeout: floa
         "reason": reason,
         "time_s": t1 - t0,
         "path_m": float(np.linalg.norm(np.diff(pts, axis=0), axis=1).sum()) if len(pts) > 1 else 0.0,
-        "min_clearance_m": min(mon.clearance[k0:], default=math.inf),
-        "collisions": _episodes(mon.contacts, t0, t1),
+        "min_clearance_m": min_clearance,
+        "time_under_safety_s": float(np.count_nonzero(clearance < mon.safety_distance)) * SAMPLE_S,
+        "safety_distance_m": mon.safety_distance,
+        "near_miss": collisions == 0 and min_clearance < NEAR_MISS_M,
+        "collisions": collisions,
         "final_error_m": final_error,
+        "near_goal_m": min(final_error, float(np.min(np.linalg.norm(pts - goal_world, axis=1))) if len(pts) else
+                           final_error),
         "goal_tolerance_m": tolerance,
         "tracking_error_m": _nanmean(mon.tracking[k0:]),
     }
@@ -208,6 +232,8 @@ def run_navigation(
     on_start: Any = None,
     goal_tolerance: float = GOAL_TOLERANCE_M,
     progress: Any = None,
+    safety_distance: float = SAFETY_DISTANCE_M,
+    launch_args: dict[str, str] | None = None,
 ) -> NavigateResult:
     """Navigate to ``goals`` (x, y, yaw in the map frame) in turn; see ``NavigateResult``.
 
@@ -224,6 +250,8 @@ def run_navigation(
     ``goal_tolerance``: the truth's goal region (m): a goal whose robot truly ends farther away is not reached,
     whatever move_base says.
     ``progress``: a function given one line of text per goal sent/ended and every 10 simulated s (None: silent).
+    ``safety_distance``: the clearance (m) under which a goal's ``time_under_safety_s`` counts.
+    ``launch_args``: more arguments for the launch (``{"collision_monitor": "true"}`` on the mapless one).
     """
     from navlab.mapping import load_map, save_map
     from navlab.world import load_world
@@ -243,9 +271,9 @@ def run_navigation(
     if controller:
         overrides["base_local_planner"] = controller  # a ROS name or a registry alias (dwa, mppi, ...)
     gazebo = {"gazebo": {"disturbances": dict(disturbances)}} if disturbances else {}
-    launch_args: dict[str, Any] = sim_launch_args(wheel_controller, ekf)
+    args: dict[str, Any] = {**sim_launch_args(wheel_controller, ekf), **(launch_args or {})}
     if params_dir is not None:
-        launch_args["params"] = str(params_dir)
+        args["params"] = str(params_dir)
     with tempfile.TemporaryDirectory(prefix="navlab-navigate-") as tmp:
         if map_yaml is None:
             served = Path(tmp) / "true_map.yaml"
@@ -255,12 +283,12 @@ def run_navigation(
         grid = load_map(served)
         if mapless:
             run = start_run("navigation_mapless", world=world, robot=robot, pose=pose, seed=seed,
-                            overrides={"move_base": overrides, **gazebo}, on_start=on_start, **launch_args)  # fmt: skip
+                            overrides={"move_base": overrides, **gazebo}, on_start=on_start, **args)  # fmt: skip
         else:
             run = start_run("navigation", world=world, robot=robot, pose=pose, seed=seed, map=str(served),
-                            overrides={"move_base": overrides, **gazebo}, on_start=on_start, **launch_args)  # fmt: skip
+                            overrides={"move_base": overrides, **gazebo}, on_start=on_start, **args)  # fmt: skip
     mb = _move_base(run)
-    mon = run.add(NavMonitor, parameters={"base_frame": run.base_frame,
+    mon = run.add(NavMonitor, parameters={"base_frame": run.base_frame, "safety_distance": float(safety_distance),
                                           "estimate_frame": "" if mapless else "map"},
                   remappings={"scan": run.scan_topic}, sim=run.sim, move_base=mb)
     dropped: list[tuple[float, float, float, str]] = []  # (x m, y m, t s, name) of what was spawned, world frame
@@ -308,6 +336,9 @@ def run_navigation(
         "goals_succeeded_move_base": sum(r["move_base_outcome"] == "succeeded" for r in results),
         "false_success": sum(r["false_success"] for r in results),
         "collisions": sum(r["collisions"] for r in results),
+        "near_misses": sum(r["near_miss"] for r in results),
+        "min_clearance_m": min((r["min_clearance_m"] for r in results if r["min_clearance_m"] is not None),
+                               default=None),  # None: a goal that ended before the first sample
         "localization_error_mean_m": float(loc.mean()) if loc.size else None,
         "localization_error_max_m": float(loc.max()) if loc.size else None,
         "cmd_jerk_mean": mean_abs_jerk(mon.cmd),
@@ -327,13 +358,12 @@ def save_goal_pictures(result: NavigateResult, folder: str | Path) -> list[str]:
     paths = []
     for k, (goal, mid, end) in enumerate(zip(result.goals, result.snapshots, result.arrivals, strict=True), 1):
         head = f"goal {k} ({', '.join(f'{v:g}' for v in goal['goal'])}): {goal['outcome']} in {goal['time_s']} s"
+        if goal.get("near_miss"):
+            head += f" — NEAR MISS: {100 * goal['min_clearance_m']:.1f} cm from an obstacle"
         for shot, name, when in ((end, f"goal_{k}.png", "end of the drive"), (mid, f"goal_{k}_mid.png", "mid-drive")):
             title = f"{head}\n{when}, t = {shot.get('t', 0.0):.1f} s"
             paths.append(str(plot_navigation(result.grid, shot, out / name, title=title, goal=goal["goal"])))
     return paths
-
-
-NEAR_MISS_M = 0.1  # clearance (m) under which a moment of the drive counts as a near miss in the pictures
 
 
 def _near_misses(mon: NavMonitor) -> np.ndarray:

@@ -67,7 +67,7 @@ class NavSnapshot(TypedDict, total=False):
     costmap_in_map: Pose2 | None  # where the costmap's (and plans') frame sits in the picture's (None: same)
     new_obstacles: np.ndarray | None  # (N, 2) points of obstacles the map does not have (added after mapping)
     dropped: list[tuple[float, float, float, str]]  # models dropped in while driving: (x m, y m, t s, name)
-    near_misses: np.ndarray  # (N, 2) where the true clearance fell under 0.1 m without contact
+    near_misses: np.ndarray  # (N, 2) where the true clearance fell under 5 cm without contact
     collision_xy: np.ndarray  # (N, 2) where contact episodes began
 
 
@@ -221,7 +221,7 @@ def navigation_figure(grid: GridMap, shot: NavSnapshot, *, title: str = "", goal
     near = shot.get("near_misses")
     if near is not None and len(near):
         ax.scatter(near[:, 0], near[:, 1], s=60, marker="o", facecolors="none", edgecolors="gold", linewidths=1.8,
-                   label="near miss (< 0.1 m)")  # fmt: skip
+                   label="near miss (< 5 cm)")  # fmt: skip
     hits = shot.get("collision_xy")
     if hits is not None and len(hits):
         ax.scatter(hits[:, 0], hits[:, 1], s=90, marker="X", c="red", edgecolors="black", label="collision")

@@ -20,7 +20,7 @@ from navlab.errors import NavlabError
 from navlab.experiments.errors import ExperimentError
 
 TRIAL_COLUMNS = ("trial", "seed", "success", "move_base_success", "failure", "time_s", "path_m", "spl",
-                 "final_error_m", "min_clearance_m", "collisions", "localization_error_mean_m", "score",
+                 "final_error_m", "min_clearance_m", "near_miss", "collisions", "localization_error_mean_m", "score",
                  "world")  # fmt: skip
 
 
@@ -235,6 +235,8 @@ def plot_trials(results: list[dict[str, Any]], path: Path, *, title: str = "") -
     a.set_title(f"{title}: time to goal" if title else "time to goal")
     b.plot(trials, [r.get("min_clearance_m") for r in results], "o-", color="tab:blue")
     b.axhline(0.0, color="k", lw=0.8)
+    b.axhline(0.05, color="tab:red", lw=0.8, ls="--", label="near miss (< 5 cm)")
+    b.legend(loc="upper right", fontsize=8)
     b.set_xlabel("trial")
     b.set_ylabel("minimum clearance (m)")
     b.set_title("closest approach to an obstacle")
@@ -312,7 +314,7 @@ def _demo_report(folder: Path) -> Report:
     rep.heading("3. Navigation: move_base on the saved map, obstacles added after mapping")
     goals = nav.get("goals") if isinstance(nav.get("goals"), list) else []
     cols = ["goal", "outcome", "move_base_outcome", "time_s", "path_m", "final_error_m", "min_clearance_m",
-            "collisions", "reason"]
+            "near_miss", "time_under_safety_s", "collisions", "reason"]
     rep.table(cols, [[g.get(c) for c in cols] for g in goals])
     if "goals_succeeded" in nav:
         bag = f"; recording `{Path(nav['record']).name}/`" if nav.get("record") else ""

@@ -84,7 +84,7 @@ def _spawns(sc: Scenario, seed: int) -> list[tuple[float, Any]]:
 
 def run_trial(sc: Scenario, index: int) -> dict[str, Any]:
     """Trial ``index`` of ``sc`` (seed = sc.seed + index); its figures (plus BARN's in a clutter world)."""
-    from navlab.experiments.clutter_run import CLUTTER_PARAMS, SUCCESS_M, barn_outcome, clutter_for_trial
+    from navlab.experiments.clutter_run import CLUTTER_PARAMS, CLUTTER_ROBOTS, SUCCESS_M, barn_outcome, clutter_for_trial
     from navlab.experiments.mapping_run import run_mapping
     from navlab.experiments.navigate_run import run_navigation
 
@@ -96,8 +96,8 @@ def run_trial(sc: Scenario, index: int) -> dict[str, Any]:
         map_yaml: str | Path | None = None
         if clutter is not None:
             world = str(clutter.write_world(Path(tmp) / f"{clutter.name}.world"))
-            mybot = {**CLUTTER_PARAMS} if sc.robot == "mybot" else {}  # other robots: their own files (clutter_run)
-            start, overrides = clutter.start, {**mybot, **sc.overrides}
+            own = CLUTTER_PARAMS if sc.robot in CLUTTER_ROBOTS else {}  # other robots: their own files (clutter_run)
+            start, overrides = clutter.start, {**own, **sc.overrides}
         if sc.map == "map_first":
             mapped = run_mapping(world=sc.resolve(sc.map_world) or sc.map_world or world, robot=sc.robot,
                                  pose=start, out=Path(tmp) / "map", seed=seed, quiet=True)  # fmt: skip
@@ -130,6 +130,9 @@ def run_trial(sc: Scenario, index: int) -> dict[str, Any]:
         "goals_succeeded_move_base": sum(g["move_base_outcome"] == "succeeded" for g in goals),
         "time_s": sum(g["time_s"] for g in goals), "path_m": path_m, "shortest_m": shortest, "spl": spl,
         "min_clearance_m": min(g["min_clearance_m"] for g in goals), "collisions": sum(g["collisions"] for g in goals),
+        "near_miss": any(g.get("near_miss", False) for g in goals),
+        "time_under_safety_s": sum(g.get("time_under_safety_s", 0.0) for g in goals),
+        "near_goal_m": min(g.get("near_goal_m", g["final_error_m"]) for g in goals[-1:]),
         "localization_error_mean_m": r.summary.get("localization_error_mean_m"),
         "localization_error_max_m": r.summary.get("localization_error_max_m"),
         "cmd_jerk_mean": r.summary.get("cmd_jerk_mean"), "sim_s": r.summary["sim_s"], "wall_s": r.summary["wall_s"],
@@ -205,6 +208,8 @@ def summarize_trials(results: list[dict[str, Any]]) -> dict[str, Any]:
         "median_time_s": times[1] if times else None, "time_s_quartiles": times,
         "median_path_m": _median(results, "path_m"), "spl_mean": _mean(results, "spl"),
         "min_clearance_m": min((r["min_clearance_m"] for r in results), default=None),
+        "near_misses": sum(bool(r.get("near_miss")) for r in results),  # trials under 5 cm without a contact
+        "time_under_safety_s_mean": _mean(results, "time_under_safety_s"),
         "localization_error_mean_m": _mean(results, "localization_error_mean_m"),
         "cmd_jerk_mean": _mean(results, "cmd_jerk_mean"),
         "tracking_error_mean_m": _mean(results, "tracking_error_m"),

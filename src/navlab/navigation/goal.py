@@ -37,6 +37,7 @@ class RecoveryTrigger(StrEnum):
     PLANNING = "PLANNING"
     CONTROLLING = "CONTROLLING"
     OSCILLATION = "OSCILLATION"
+    PROGRESS = "PROGRESS"  # Nav2's progress checker: the robot stayed near one pose too long
 
 
 class GoalOutcome(StrEnum):

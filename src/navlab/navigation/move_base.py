@@ -25,6 +25,7 @@ from navlab.geometry import transform_points2, wrap_angle
 from navlab.navigation.costmap_ros import Costmap2DROS
 from navlab.navigation.errors import NavigationError
 from navlab.navigation.goal import STATUS, GoalHandle, GoalState, MoveBaseState, RecoveryTrigger, with_headings
+from navlab.navigation.progress_checker import STUCK_PREFIX, SimpleProgressChecker
 from navlab.navigation.recovery import DEFAULT_RECOVERIES, ClearCostmapRecovery
 from navlab.navigation.scan_points import ScanPoints
 from navlab.plugins import ControlResult, PluginContext, load_plugin, make_plugin, plugin_names, resolve_name
@@ -81,7 +82,8 @@ class MoveBase(Node):
         lp = resolve_name("controller", str(p["base_local_planner"]))
         self.planner_name, self.controller_name = short_name(gp), short_name(lp)
         self.planner = make_plugin("global_planner", gp, self._namespace(self.planner_name),
-                                   context=PluginContext(name=self.planner_name, rng=self.rng),
+                                   context=PluginContext(name=self.planner_name, rng=self.rng,
+                                                         footprint=self.local_costmap.layered.footprint),
                                    param="base_global_planner")
         # as ROS's planners see them: the costmap's footprint (a round robot's radius, for costmap_2d's 16-gon)
         # and move_base's controller_frequency (they search the parameter upward)
@@ -90,6 +92,8 @@ class MoveBase(Node):
         self.controller = make_plugin("controller", lp, self._namespace(self.controller_name), context=context,
                                       param="base_local_planner")
         self.recoveries = self._recoveries(raw_recoveries)
+        # Nav2's progress checker beside ROS 1's oscillation timeout: no progress -> the next recovery, then `stuck`
+        self.progress_checker = SimpleProgressChecker(self._namespace("progress_checker"))
         # a parameter file may configure several planners (TrajectoryPlannerROS: and DWAPlannerROS:); ROS ignores
         # the sections of the ones not in use, and so does navlab
         for kind in ("global_planner", "controller"):
@@ -157,6 +161,8 @@ class MoveBase(Node):
         self.recovery_log: list[str] = []  # the recovery behaviors run for this goal, in order
         self.oscillation_pose: Pose | None = None
         self.last_oscillation_reset_ns = now
+        if hasattr(self, "progress_checker"):
+            self.progress_checker.reset(None, now / 1e9)
 
     def send_goal(self, x: float, y: float, yaw: float, *, frame_id: str = "map",
                   feedback: Callable[[Pose], None] | None = None,
@@ -333,6 +339,14 @@ class MoveBase(Node):
             if self.recovery_trigger == RecoveryTrigger.OSCILLATION:
                 self.recovery_index = 0
 
+    def _progressing(self, pose: Pose, now: int) -> bool:
+        """The progress checker's verdict; progress since the last PROGRESS recovery starts the recoveries over."""
+        baseline = self.progress_checker.baseline
+        ok = self.progress_checker.check(pose, now / 1e9)
+        if self.progress_checker.baseline is not baseline and self.recovery_trigger == RecoveryTrigger.PROGRESS:
+            self.recovery_index = 0
+        return ok
+
     def _controlling(self, pose: Pose, now: int) -> None:
         p = self.p
         if p["planner_frequency"] > 0 and self.last_plan_ns is not None and (
@@ -350,6 +364,9 @@ class MoveBase(Node):
             return
         if p["oscillation_timeout"] > 0 and self._timed_out(self.last_oscillation_reset_ns, p["oscillation_timeout"]):
             self._enter_clearing(RecoveryTrigger.OSCILLATION)
+            return
+        if not self._progressing(pose, now):
+            self._enter_clearing(RecoveryTrigger.PROGRESS)
             return
         try:
             cmd: ControlResult | None = ControlResult.of(
@@ -392,6 +409,10 @@ class MoveBase(Node):
                 RecoveryTrigger.PLANNING: "Failed to find a valid plan. Even after executing recovery behaviors.",
                 RecoveryTrigger.CONTROLLING: "Failed to find a valid control. Even after executing recovery behaviors.",
                 RecoveryTrigger.OSCILLATION: "Robot is oscillating. Even after executing recovery behaviors.",
+                RecoveryTrigger.PROGRESS: f"{STUCK_PREFIX}: the robot moved less than "
+                                          f"{self.progress_checker.params.required_movement_radius:g} m in "
+                                          f"{self.progress_checker.idle_s(self.executor.now_ns / 1e9):.1f} s, "
+                                          "even after executing recovery behaviors.",
             }[trigger]
             if trigger == RecoveryTrigger.PLANNING and self.plan_failure:
                 reason += f" ({self.plan_failure})"
@@ -418,6 +439,9 @@ class MoveBase(Node):
         now = self.executor.now_ns
         self.last_valid_plan_ns = self.last_valid_control_ns = self.last_oscillation_reset_ns = now
         self.oscillation_pose = pose
+        # Nav2 restarts the progress clock with each new control run, from where the robot is now (the
+        # baseline pose stays: a recovery that only wiggles does not count as progress)
+        self.progress_checker.baseline_t = now / 1e9
         self.state = MoveBaseState.PLANNING
 
     # --- services and status ---------------------------------------------------------------------------

@@ -1,0 +1,50 @@
+"""The goal checker and Nav2's progress checker: a goal that settles within tolerance, a robot that cannot make
+progress reported ``stuck`` (not ``timeout``), and the closest approach to the goal reported honestly."""
+
+from __future__ import annotations
+
+import pytest
+
+from navlab.experiments.navigate_run import run_navigation
+from navlab.navigation.errors import NavigationError
+from navlab.navigation.progress_checker import SimpleProgressChecker, stuck_window
+
+
+def test_progress_checker_counts_time_near_one_pose() -> None:
+    pc = SimpleProgressChecker({"required_movement_radius": 0.5, "movement_time_allowance": 10.0})
+    assert pc.check((0.0, 0.0, 0.0), 0.0)
+    assert pc.check((0.4, 0.0, 1.0), 9.0)  # turning and creeping within 0.5 m is not progress ...
+    assert not pc.check((0.3, 0.1, 2.0), 10.5)  # ... and after 10 s it is stuck
+    assert pc.check((0.6, 0.0, 0.0), 11.0)  # moving 0.5 m starts the clock again
+    assert pc.idle_s(15.0) == pytest.approx(4.0)
+    off = SimpleProgressChecker({"movement_time_allowance": 0.0})
+    assert off.check((0.0, 0.0, 0.0), 0.0) and off.check((0.0, 0.0, 0.0), 1e6)
+    with pytest.raises(NavigationError, match="required_movement_radius"):
+        SimpleProgressChecker({"required_movement_radius": -1.0})
+
+
+def test_stuck_window_reads_a_true_path() -> None:
+    still = [(t * 0.1, 1.0 + 0.001 * t, 2.0) for t in range(300)]  # 30 s within a few cm
+    assert stuck_window(still, 20.0, 0.5)
+    moving = [(t * 0.1, 0.05 * t, 0.0) for t in range(300)]
+    assert not stuck_window(moving, 20.0, 0.5)
+    assert not stuck_window(still[:100], 20.0, 0.5)  # 10 s of path cannot show 20 s of standing still
+
+
+def test_a_goal_settles_within_tolerance_and_a_crawling_robot_is_reported_stuck() -> None:
+    """The first goal is reached: the truth's final error is within the tolerance, and the closest approach is
+    no farther than where it ended. Then a controller capped at 2 cm/s cannot make 0.5 m of progress in 2 s:
+    the progress checker runs the recoveries and then ends the goal ``stuck``, with how near it came."""
+    r = run_navigation([(1.0, 0.0, 0.0)], world="room", controller="mppi", goal_timeout=30)
+    g = r.goals[0]
+    assert g["outcome"] == "succeeded" and g["final_error_m"] <= g["goal_tolerance_m"]
+    assert g["near_goal_m"] <= g["final_error_m"] + 1e-9
+    assert not g["near_miss"] and g["time_under_safety_s"] == 0.0 and g["min_clearance_m"] > 0.1
+    crawl = {"MPPIController.vx_max": 0.02, "progress_checker.movement_time_allowance": 2.0,
+             "recovery_behaviors": [{"name": "back_up", "type": "nav2_behaviors/BackUp"}]}
+    r = run_navigation([(2.0, 0.0, 0.0)], world="room", controller="mppi", goal_timeout=30,
+                       move_base_params=crawl)  # fmt: skip
+    g = r.goals[0]
+    assert g["outcome"] == "stuck" and g["move_base_outcome"] == "aborted", g
+    assert g["reason"].startswith("stuck") and g["time_s"] < 15.0
+    assert 1.8 <= g["near_goal_m"] <= 2.0 and g["near_goal_m"] <= g["final_error_m"]
