@@ -2,7 +2,7 @@
 
 ``RosBridge(executor)`` offers a run's topics, tf, clock, parameters and services on ``$ROS_MASTER_URI``
 (starting navlab's own master when none answers); ``Master`` is ``navlab roscore``.
-Exports load lazily: a verb's ``--ros`` option (``navlab.ros1.cli``) imports neither numpy nor rosbags.
+Exports load lazily: declaring a verb's ``--ros`` option (``navlab.cli.ros``) imports neither numpy nor rosbags.
 """
 
 from navlab.lazy import lazy_exports
