@@ -37,3 +37,12 @@ def test_help_and_argument_errors_import_no_mujoco_numba_or_ray(tmp_path):
     assert got["light"], "--help or an unknown option imported numpy"
     for argv, code in got["codes"].items():
         assert code == (0 if argv.endswith("--help") else 2), (argv, code)
+
+
+def test_sim_with_duration_zero_loads_everything_and_steps_nothing(tmp_path):
+    """``navlab sim --duration 0``: the shortest run (the start-up figure of ``navlab bench startup``)."""
+    out = subprocess.run([sys.executable, "-m", "navlab.cli", "sim", "--duration", "0", "--json"], capture_output=True,
+                         text=True, cwd=tmp_path, check=True)  # fmt: skip
+    got = json.loads(out.stdout)
+    assert got["sim_s"] == 0.0 and got["world"] == "room" and got["robot"]
+    assert got["true_pose"] == got["start_pose"]
