@@ -19,7 +19,6 @@ from navlab.core import Node, TfError
 from navlab.geometry import compose2, transform_points2
 from navlab.grid import COST_INSCRIBED, COST_LETHAL, COST_UNKNOWN, Grid, GridMap
 from navlab.navigation.costmap.layered import LayeredCostmap
-from navlab.navigation.costmap.layers import ObstacleLayer, StaticLayer
 
 
 def cost_translation() -> np.ndarray:
@@ -50,9 +49,9 @@ class Costmap2DROS:
         self._table = cost_translation()
         self._pending: dict[str, Any] = {}
         self._sensor_in_base: dict[str, tuple[float, float, float]] = {}
-        statics = [x for x in self.layered.layers if isinstance(x, StaticLayer)]
+        statics = self.layered.map_layers
         if statics:
-            node.create_subscription(msgs.OccupancyGrid, statics[0].params.map_topic, self._on_map, 1)
+            node.create_subscription(msgs.OccupancyGrid, statics[0].map_topic, self._on_map, 1)
         for src_name, src in p.sources.items():
             if src.data_type != "LaserScan":
                 node.get_logger().warning(f"{name}: observation source {src_name} has data_type {src.data_type}; "
@@ -167,12 +166,8 @@ class Costmap2DROS:
         pose = self.layered.robot_pose or self.robot_pose()
         if pose is None:
             return
-        for layer in self.layered.layers:
-            if isinstance(layer, ObstacleLayer) and layer.grid is not None:
-                g = layer.grid
-                xy = g.centers(np.ones(g.data.shape, bool)).reshape(g.height, g.width, 2)
-                outside = (np.abs(xy[..., 0] - pose[0]) > size / 2) | (np.abs(xy[..., 1] - pose[1]) > size / 2)
-                g.data[outside] = layer.default_value
+        for layer in self.layered.scan_layers:
+            layer.clear_outside(pose[:2], size)
         self.layered.update_map(pose)
 
     def cost_at(self, xy: tuple[float, float]) -> int:
