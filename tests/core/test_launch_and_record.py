@@ -133,7 +133,7 @@ def test_cli_error_is_one_line(capsys):
 
 
 def test_cli_usage_errors_are_one_line(capsys):
-    bad = (["launch", "sim", "--duration", "x"], ["launch", "sim", "--duration", "-1"], ["sim", "--duration", "0"])
+    bad = (["launch", "sim", "--duration", "x"], ["launch", "sim", "--duration", "-1"], ["sim", "--duration", "-1"])
     for argv in (*bad, ["no_such_verb"]):
         with pytest.raises(SystemExit) as exc:
             main(argv)

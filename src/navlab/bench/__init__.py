@@ -42,9 +42,11 @@ SUMMARY = {
     "sim_rtf": ("sim", "rtf"),
     "start_s": ("startup", "sim_start_cpu_s"),
     "help_s": ("startup", "help_cpu_s"),
+    "trial_s": ("startup", "trial_cpu_s"),
     "slam_peak_rss_mb": ("slam-gmapping", "peak_rss_mb"),
     "slam_gmapping_cpu_s": ("slam-gmapping", "cpu_s"),
     "slam_gmapping_trans_m": ("slam-gmapping", "relations_trans_m"),
+    "slam_gmapping_filter_trans_m": ("slam-gmapping", "filter_relations_trans_m"),
     "slam_graph_rtf": ("slam", "rtf"),
     "mapping_rtf": ("mapping", "rtf"),
 }

@@ -115,8 +115,9 @@ def run_office(args: argparse.Namespace) -> dict[str, Any]:
 
 
 def run_gmapping(args: argparse.Namespace) -> dict[str, Any]:
-    """``navlab slam --mode gmapping`` on the CSAIL log in a child process: its CPU seconds, peak RSS (MB) and
-    the relations metric of its poses (the filter plus the offline refinement, slam_gmapping's defaults)."""
+    """``navlab slam --mode gmapping`` on the CSAIL log in child processes: CPU seconds, peak RSS (MB) and the
+    relations metric of the poses, with slam_gmapping's defaults (the filter plus the offline refinement) and,
+    as ``filter_*``, with ``--set refine=false`` (the filter alone)."""
     import sys
 
     from navlab.bench.core import run_child
@@ -124,16 +125,19 @@ def run_gmapping(args: argparse.Namespace) -> dict[str, Any]:
     from navlab.io import dataset
 
     clf, relations = dataset(CSAIL), read_relations(dataset(RELATIONS))
-    with tempfile.TemporaryDirectory(prefix="navlab-bench-") as out:
-        cmd = [sys.executable, "-m", "navlab.cli", "slam", "--log", str(clf), "--mode", "gmapping", "--out", out,
-               "--quiet", "--seed", str(getattr(args, "seed", 0))]  # fmt: skip
-        usage = run_child(cmd)
-        poses = np.loadtxt(Path(out) / "poses.txt")
-    rel = relations_error(poses[:, 0], poses[:, 1:4], relations)
-    return {
-        **{k: round(v, 2) for k, v in usage.items()},
-        "relations_trans_m": round(float(rel["trans_abs_mean"]), 4),
-        "relations_rot_deg": round(float(rel["rot_abs_mean_deg"]), 3),
-        "relations_rot_max_deg": round(float(rel["rot_max_deg"]), 2),
-        "relations_over_5deg": rel["rot_over_5deg"],
-    }
+    out: dict[str, Any] = {}
+    for prefix, extra in (("", []), ("filter_", ["--set", "refine=false"])):
+        with tempfile.TemporaryDirectory(prefix="navlab-bench-") as tmp:
+            cmd = [sys.executable, "-m", "navlab.cli", "slam", "--log", str(clf), "--mode", "gmapping", "--out", tmp,
+                   "--quiet", "--seed", str(getattr(args, "seed", 0)), *extra]  # fmt: skip
+            usage = run_child(cmd)
+            poses = np.loadtxt(Path(tmp) / "poses.txt")
+        rel = relations_error(poses[:, 0], poses[:, 1:4], relations)
+        out.update({
+            **{prefix + k: round(v, 2) for k, v in usage.items()},
+            prefix + "relations_trans_m": round(float(rel["trans_abs_mean"]), 4),
+            prefix + "relations_rot_deg": round(float(rel["rot_abs_mean_deg"]), 3),
+            prefix + "relations_rot_max_deg": round(float(rel["rot_max_deg"]), 2),
+            prefix + "relations_over_5deg": rel["rot_over_5deg"],
+        })  # fmt: skip
+    return out

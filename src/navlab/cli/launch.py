@@ -12,8 +12,6 @@ from pathlib import Path
 from typing import Any
 
 from navlab.cli.options import add_resource_path_arguments, add_run_options, apply_resource_paths, positive_seconds
-from navlab.core.launch import start
-from navlab.core.runner import parse_launch_args, run_for
 
 
 def _show_args(file: str) -> int:
@@ -60,6 +58,9 @@ def _cmd_roslaunch(args: argparse.Namespace) -> int:
 
 
 def _cmd_launch(args: argparse.Namespace) -> int:
+    from navlab.core.launch import start  # (not at import: --help loads no numpy)
+    from navlab.core.runner import parse_launch_args, run_for
+
     if args.show_args:
         return _show_args(args.file)
     apply_resource_paths(args)  # --package-path / --model-path for robot:= and world:=
@@ -102,6 +103,9 @@ def _cmd_launch(args: argparse.Namespace) -> int:
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
+    from navlab.core.launch import start
+    from navlab.core.runner import parse_launch_args
+
     """``navlab run FILE.py``: an rclpy-style node file, unchanged, in a launch's simulation."""
     import runpy
     import sys
@@ -134,9 +138,9 @@ def _cmd_run(args: argparse.Namespace) -> int:
 
 
 def _shipped_launches() -> list[str]:
-    from navlab.core.launch import resources_dir
+    from navlab.resources import root  # (navlab.core would load numpy for --help)
 
-    return sorted(f.name.removesuffix(".launch.yaml") for f in (resources_dir() / "launch").glob("*.launch.yaml"))
+    return sorted(f.name.removesuffix(".launch.yaml") for f in (root() / "launch").glob("*.launch.yaml"))
 
 
 def register(sub: argparse._SubParsersAction) -> None:

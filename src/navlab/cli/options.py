@@ -15,15 +15,20 @@ from pathlib import Path
 from typing import Any
 
 
-def positive_seconds(text: str) -> float:
-    """argparse ``type=`` for a duration in simulated seconds: a finite number > 0."""
+def positive_seconds(text: str, *, zero: bool = False) -> float:
+    """argparse ``type=`` for a duration in simulated seconds: a finite number > 0 (>= 0 with ``zero``)."""
     try:
         value = float(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"expected a number of seconds, got {text!r}") from None
-    if not (math.isfinite(value) and value > 0):
-        raise argparse.ArgumentTypeError(f"expected a duration > 0 s, got {text}")
+    if not (math.isfinite(value) and (value > 0 or (zero and value == 0))):
+        raise argparse.ArgumentTypeError(f"expected a duration {'>=' if zero else '>'} 0 s, got {text}")
     return value
+
+
+def seconds_or_zero(text: str) -> float:
+    """argparse ``type=`` for a duration in simulated seconds that may be 0 (set everything up, step nothing)."""
+    return positive_seconds(text, zero=True)
 
 
 def finite_float(text: str) -> float:

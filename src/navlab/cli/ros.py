@@ -15,16 +15,14 @@ import math
 import signal
 from collections.abc import Iterator
 from pathlib import Path
-from typing import Any
-
-import numpy as np
+from typing import TYPE_CHECKING, Any
 
 from navlab.cli.options import add_run_options, out_file, positive_seconds
-from navlab.core import CoreError
-from navlab.core.graph import Graph
-from navlab.core.launch import Session, start
-from navlab.core.runner import parse_launch_args, run_for
 from navlab.io.files import write_text_atomic
+
+if TYPE_CHECKING:  # navlab.core loads numpy and rosbags: imported where a verb runs, so --help stays quick
+    from navlab.core.graph import Graph
+    from navlab.core.launch import Session
 
 
 def _add_source(p: argparse.ArgumentParser) -> None:
@@ -47,6 +45,9 @@ def _watch_seconds(args: argparse.Namespace) -> None:
 
 
 def _start(args: argparse.Namespace) -> Session:
+    from navlab.core.launch import start
+    from navlab.core.runner import parse_launch_args
+
     file, *items = args.launch
     return start(file, seed=args.seed, launch_args=parse_launch_args(items))
 
@@ -72,6 +73,9 @@ def _live_messages(path: Path, topic: str, duration: float) -> Iterator[tuple[in
 
 def _messages(args: argparse.Namespace, topic: str) -> Iterator[tuple[int, Any]] | list[tuple[int, Any]]:
     """(t_ns, msg) on ``topic`` from the bag, a running launch, or a launch started here."""
+    from navlab.core import CoreError
+    from navlab.core.runner import run_for
+
     if args.bag:
         from navlab.io.rosbag import read_bag
 
@@ -94,6 +98,11 @@ def _messages(args: argparse.Namespace, topic: str) -> Iterator[tuple[int, Any]]
 
 
 def _cmd_topic(args: argparse.Namespace) -> int:
+    import numpy as np
+
+    from navlab.core import CoreError
+    from navlab.core.runner import run_for
+
     _watch_seconds(args)
     if args.action == "list":
         if args.bag:
@@ -150,6 +159,9 @@ def _cmd_topic(args: argparse.Namespace) -> int:
 
 
 def _graph_of(args: argparse.Namespace) -> Graph:
+    from navlab.core.graph import Graph
+    from navlab.core.runner import run_for
+
     _watch_seconds(args)
     if args.bag:
         from navlab.io.rosbag import bag_graph, bag_topics

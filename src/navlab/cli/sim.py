@@ -16,7 +16,7 @@ from navlab.cli.options import (
     apply_resource_paths,
     out_file,
     parse_sets,
-    positive_seconds,
+    seconds_or_zero,
     start_pose,
 )
 from navlab.cli.runs import ros_bridge, viewing
@@ -50,7 +50,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         "navlab's watchdog (stop the wheels 0.5 s after the last command; default 0 = off).",
     )
     _add_common(p)
-    p.add_argument("--duration", type=positive_seconds, default=10.0, help="simulated seconds to run (default 10)")
+    p.add_argument("--duration", type=seconds_or_zero, default=10.0,
+                   help="simulated seconds to run (default 10; 0: load the world and robot, step nothing)")
     p.add_argument("--timestep", type=float, default=0.0,
                    help="physics step in s, 0.0005-0.002 (default 0.002, or the world's max_step_size if larger)")
     p.add_argument("--cmd-vel", default=None, metavar="V,W",

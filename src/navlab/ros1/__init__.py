@@ -2,11 +2,18 @@
 
 ``RosBridge(executor)`` offers a run's topics, tf, clock, parameters and services on ``$ROS_MASTER_URI``
 (starting navlab's own master when none answers); ``Master`` is ``navlab roscore``.
+Exports load lazily: declaring a verb's ``--ros`` option (``navlab.cli.ros``) imports neither numpy nor rosbags.
 """
 
-from navlab.ros1.bridge import RosBridge, connect_or_start_master, session_params
-from navlab.ros1.errors import Ros1Error
-from navlab.ros1.master import Master
-from navlab.ros1.types import Ros1Types
+from navlab.lazy import lazy_exports
 
-__all__ = ["Master", "Ros1Error", "Ros1Types", "RosBridge", "connect_or_start_master", "session_params"]
+_EXPORTS = {
+    "Master": "navlab.ros1.master",
+    "Ros1Error": "navlab.ros1.errors",
+    "Ros1Types": "navlab.ros1.types",
+    "RosBridge": "navlab.ros1.bridge",
+    "connect_or_start_master": "navlab.ros1.bridge",
+    "session_params": "navlab.ros1.bridge",
+}
+__all__ = sorted(_EXPORTS)
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

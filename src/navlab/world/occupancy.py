@@ -62,18 +62,36 @@ def _slab_points(verts: np.ndarray, z0: float, z1: float) -> np.ndarray:
     return np.concatenate(pts) if pts else np.zeros((0, 2))
 
 
+def _monotone_chain(pts: np.ndarray) -> list[int]:
+    """Indices of the convex hull's corners of 2-D points sorted by x then y, counter-clockwise from the
+    lowest-x point (Andrew's monotone chain; points on an edge left out). The few corners of a shape's slab
+    need no Qhull (scipy.spatial alone costs 0.25 s to import at every start)."""
+    xy = pts.tolist()
+
+    def half(order: range) -> list[int]:
+        out: list[int] = []
+        for k in order:
+            while len(out) >= 2:
+                (ax, ay), (bx, by), (cx, cy) = xy[out[-2]], xy[out[-1]], xy[k]
+                if (bx - ax) * (cy - ay) - (by - ay) * (cx - ax) > 0:
+                    break
+                out.pop()
+            out.append(k)
+        return out
+
+    lower, upper = half(range(len(xy))), half(range(len(xy) - 1, -1, -1))
+    return lower[:-1] + upper[:-1]
+
+
 def _hull2d(pts: np.ndarray) -> np.ndarray:
     """Convex hull of 2-D points, counter-clockwise; degenerate sets → their extreme segment/point."""
     if len(pts) == 0:
         return pts
-    pts = np.unique(np.round(pts, 12), axis=0)
+    pts = np.unique(np.round(pts, 12), axis=0)  # sorted by x, then y
     if len(pts) >= 3:
-        from scipy.spatial import ConvexHull, QhullError  # scipy.spatial costs 0.25 s to import: only here
-
-        try:
-            return pts[ConvexHull(pts).vertices]
-        except QhullError:
-            pass
+        hull = _monotone_chain(pts)
+        if len(hull) >= 3:
+            return pts[hull]
     if len(pts) == 1:
         return pts
     d = pts - pts.mean(axis=0)
