@@ -84,7 +84,13 @@ def _spawns(sc: Scenario, seed: int) -> list[tuple[float, Any]]:
 
 def run_trial(sc: Scenario, index: int) -> dict[str, Any]:
     """Trial ``index`` of ``sc`` (seed = sc.seed + index); its figures (plus BARN's in a clutter world)."""
-    from navlab.experiments.clutter_run import CLUTTER_PARAMS, CLUTTER_ROBOTS, SUCCESS_M, barn_outcome, clutter_for_trial
+    from navlab.experiments.clutter_run import (
+        CLUTTER_PARAMS,
+        CLUTTER_ROBOTS,
+        SUCCESS_M,
+        barn_outcome,
+        clutter_for_trial,
+    )
     from navlab.experiments.mapping_run import run_mapping
     from navlab.experiments.navigate_run import run_navigation
 
