@@ -17,6 +17,7 @@ NODES: dict[str, str] = {
     "move_base": "navlab.navigation.move_base:MoveBase",
     "ekf_node": "navlab.localization.ekf_node:EkfNode",
     "ekf_localization_node": "navlab.localization.ekf_node:EkfNode",
+    "pointcloud_to_laserscan_node": "navlab.navigation.pointcloud_to_laserscan:PointCloudToLaserScan",
 }
 
 #: launch files' ``$(robot KEY)``: a function of the ``robot`` argument (shipped name, file or

@@ -173,6 +173,10 @@ REGISTRY: dict[str, dict[str, str]] = {
         "nav2_costmap_2d::StaticLayer": "navlab.navigation.costmap.layers:StaticLayer",
         "nav2_costmap_2d::ObstacleLayer": "navlab.navigation.costmap.layers:ObstacleLayer",
         "nav2_costmap_2d::InflationLayer": "navlab.navigation.costmap.layers:InflationLayer",
+        "costmap_2d::VoxelLayer": "navlab.navigation.costmap.voxel_layer:VoxelLayer",
+        "nav2_costmap_2d::VoxelLayer": "navlab.navigation.costmap.voxel_layer:VoxelLayer",
+        "range_sensor_layer::RangeSensorLayer": "navlab.navigation.costmap.range_sensor_layer:RangeSensorLayer",
+        "nav2_costmap_2d::RangeSensorLayer": "navlab.navigation.costmap.range_sensor_layer:RangeSensorLayer",
     },
     "global_planner": {
         "navlab/GridDijkstra": "navlab.mapping.explore:GridDijkstraPlanner",

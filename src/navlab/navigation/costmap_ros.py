@@ -20,6 +20,8 @@ from navlab.geometry import compose2, transform_points2
 from navlab.grid import COST_INSCRIBED, COST_LETHAL, COST_UNKNOWN, Grid, GridMap
 from navlab.navigation.costmap.layered import LayeredCostmap
 from navlab.navigation.costmap.layers import ObstacleLayer, StaticLayer
+from navlab.navigation.costmap.voxel_layer import VoxelLayer
+from navlab.navigation.costmap_sensors import CostmapSensorFeeds
 
 
 def cost_translation() -> np.ndarray:
@@ -53,7 +55,10 @@ class Costmap2DROS:
         statics = [x for x in self.layered.layers if isinstance(x, StaticLayer)]
         if statics:
             node.create_subscription(msgs.OccupancyGrid, statics[0].params.map_topic, self._on_map, 1)
+        self.feeds = CostmapSensorFeeds(node, name, self.global_frame, self.layered.layers)  # voxel, range layers
         for src_name, src in p.sources.items():
+            if src_name in self.feeds.sources:
+                continue
             if src.data_type != "LaserScan":
                 node.get_logger().warning(f"{name}: observation source {src_name} has data_type {src.data_type}; "
                                           "navlab's sensors are LaserScan only, it is ignored")
@@ -136,6 +141,7 @@ class Costmap2DROS:
         for source, msg in list(self._pending.items()):
             self._apply_scan(source, msg)
         self._pending.clear()
+        self.feeds.apply()
         grid = self.layered.update_map(pose)
         self.updated_ns = self.node.executor.now_ns
         self.updates += 1
@@ -168,7 +174,9 @@ class Costmap2DROS:
         if pose is None:
             return
         for layer in self.layered.layers:
-            if isinstance(layer, ObstacleLayer) and layer.grid is not None:
+            if isinstance(layer, VoxelLayer):
+                layer.clear_outside(pose[:2], size)
+            elif isinstance(layer, ObstacleLayer) and layer.grid is not None:
                 g = layer.grid
                 xy = g.centers(np.ones(g.data.shape, bool)).reshape(g.height, g.width, 2)
                 outside = (np.abs(xy[..., 0] - pose[0]) > size / 2) | (np.abs(xy[..., 1] - pose[1]) > size / 2)

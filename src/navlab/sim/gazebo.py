@@ -13,6 +13,7 @@ from navlab.sim.errors import SimError
 from navlab.sim.extensions import SimExtensions
 from navlab.sim.imu import ImuSensorPlugin
 from navlab.sim.plugins import DiffDrivePlugin, GroundTruthPlugin, JointStatePlugin, LidarPlugin, RobotStatePublisher
+from navlab.sim.sensor_plugins import sensor_plugins
 from navlab.sim.simulation import Simulation
 from navlab.sim.spawn import check_spawn_clear, check_start_pose, load_sdf_model, parse_spawn_spec, primitive_model
 from navlab.world.model import ModelSpec, WorldModel
@@ -74,7 +75,7 @@ class GazeboSim(Node):
         check_start_pose(robot, world, pose)  # a start inside an obstacle is refused, not thrown 7 m
         self.robot = robot
         self.sim = Simulation(robot, world, seed=self.rng, timestep=timestep or None, robot_pose=pose,
-                              visuals=visuals)
+                              visuals=visuals or bool(robot.sensors.cameras))  # cameras draw visuals
         self.sim.time_ns = executor.now_ns  # started late: physics time begins at the current time
         for warning in self.sim.info.warnings:
             self.get_logger().warning(warning)
@@ -108,6 +109,7 @@ class GazeboSim(Node):
             "bodyName": p.link, "topicName": p.topic, "frameName": p.frame_id, "updateRate": p.update_rate})
             for p in robot.ground_truths]  # the robot's own p3d plugins
         self.plugins += extensions.plugins(executor, namespace, self.sim)
+        self.plugins += sensor_plugins(executor, namespace, self.sim)  # cameras, 3D lidars, ranges, bumpers
         if robot is not None:  # Gazebo's bumper: what the robot touches, on /collisions
             self.plugins.append(CollisionPlugin(executor, namespace=namespace, sim=self.sim))
         if seed >= 0:

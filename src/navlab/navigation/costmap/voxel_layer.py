@@ -1,0 +1,285 @@
+"""``costmap_2d::VoxelLayer``: an obstacle layer that marks and clears in 3-D (point clouds and laser scans).
+
+Each cell of the layer holds a column of ``z_voxels`` voxels (at most 16) of ``z_resolution`` m from ``origin_z``
+up, packed as costmap_2d's ``voxel_grid`` packs them: bit ``z`` (low half) and bit ``z + 16`` (high half) of a
+uint32 — both set: marked; only the low one: unknown (every voxel at the start); none: free. An observation
+(sensor origin and points in the costmap frame, m) first clears the voxels along each ray (3-D DDA, up to
+``raytrace_range``, cut where the ray leaves the voxel column's height), setting the cell free when its column
+then has at most ``mark_threshold`` marked and at most ``unknown_threshold`` unknown voxels; then marks the
+voxel of each point nearer than ``obstacle_range`` whose height lies in the source's
+[``min_obstacle_height``, ``max_obstacle_height``], the cell lethal when its column has more than
+``mark_threshold`` marked voxels. Rays ending in the same voxel are traced once (to that voxel's centre).
+The costs combine into the master as the obstacle layer's do (``combination_method``; footprint clearing).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any, Self
+
+import numba
+import numpy as np
+
+from navlab.grid import COST_FREE, COST_LETHAL, COST_UNKNOWN, Grid
+from navlab.navigation.costmap.footprint import Footprint, make_footprint
+from navlab.navigation.costmap.layers import Layer
+from navlab.navigation.costmap.params import CostmapParams, ObservationSource, build
+from navlab.navigation.errors import NavigationError
+
+UNKNOWN_COLUMN = np.uint32(0xFFFF)  # every voxel unknown (voxel_grid's reset)
+
+
+@dataclass
+class VoxelLayerParams:
+    """``costmap_2d::VoxelLayer``'s parameters (ROS 1 names and defaults; m)."""
+
+    enabled: bool = True
+    obstacle_range: float = 2.5
+    raytrace_range: float = 3.0
+    max_obstacle_height: float = 2.0
+    track_unknown_space: bool = False
+    footprint_clearing_enabled: bool = True
+    combination_method: int = 1
+    observation_sources: str = ""
+    origin_z: float = 0.0
+    z_resolution: float = 0.2
+    z_voxels: int = 10
+    unknown_threshold: int = 15
+    mark_threshold: int = 0
+    publish_voxel_map: bool = False
+
+    def validate(self, name: str) -> None:
+        """One error line naming the first bad parameter."""
+        if not 1 <= self.z_voxels <= 16:
+            raise NavigationError(f"{name} parameter z_voxels: expected 1..16 (costmap_2d's voxel grid holds 16 "
+                                  f"voxels per column), got {self.z_voxels}")
+        if not (self.z_resolution > 0 and math.isfinite(self.z_resolution)):
+            raise NavigationError(f"{name} parameter z_resolution: expected a number > 0, got {self.z_resolution}")
+        for key in ("obstacle_range", "raytrace_range", "unknown_threshold", "mark_threshold"):
+            if not getattr(self, key) >= 0:
+                raise NavigationError(f"{name} parameter {key}: expected >= 0, got {getattr(self, key)}")
+        if self.combination_method not in (0, 1):
+            raise NavigationError(f"{name} parameter combination_method: expected 0 (overwrite) or 1 (maximum), "
+                                  f"got {self.combination_method}")
+
+
+@numba.njit(cache=True)
+def _popcount(v: int) -> int:
+    n = 0
+    while v:
+        v &= v - 1
+        n += 1
+    return n
+
+
+@numba.njit(cache=True)
+def clear_voxel_rays(columns: np.ndarray, cost: np.ndarray, origin: np.ndarray, ends: np.ndarray, z_voxels: int,
+                     mark_threshold: int, unknown_threshold: int, free: np.uint8) -> None:
+    """Clear the voxels on each segment ``origin`` -> ``ends[k]`` (continuous voxel coordinates: x, y in cells,
+    z in voxels) by a 3-D DDA; each cell touched becomes ``free`` in ``cost`` when its column allows it."""
+    h, w = columns.shape
+    for k in range(ends.shape[0]):
+        x, y, z = origin[0], origin[1], origin[2]
+        dx, dy, dz = ends[k, 0] - x, ends[k, 1] - y, ends[k, 2] - z
+        length = math.sqrt(dx * dx + dy * dy + dz * dz)
+        if length == 0.0:
+            continue
+        i, j, m = math.floor(x), math.floor(y), math.floor(z)
+        steps = abs(math.floor(ends[k, 0]) - i) + abs(math.floor(ends[k, 1]) - j) + abs(math.floor(ends[k, 2]) - m)
+        si = 1 if dx > 0 else -1
+        sj = 1 if dy > 0 else -1
+        sm = 1 if dz > 0 else -1
+        tdx = abs(1.0 / dx) if dx != 0 else np.inf
+        tdy = abs(1.0 / dy) if dy != 0 else np.inf
+        tdz = abs(1.0 / dz) if dz != 0 else np.inf
+        tx = ((i + 1 - x) if dx > 0 else (x - i)) * tdx if dx != 0 else np.inf
+        ty = ((j + 1 - y) if dy > 0 else (y - j)) * tdy if dy != 0 else np.inf
+        tz = ((m + 1 - z) if dz > 0 else (z - m)) * tdz if dz != 0 else np.inf
+        for _ in range(steps + 1):
+            if i < 0 or j < 0 or i >= w or j >= h or m < 0 or m >= z_voxels:
+                break
+            col = columns[j, i] & ~np.uint32((1 << m) | (1 << (m + 16)))
+            columns[j, i] = col
+            marked = col >> 16
+            unknown = (col & 0xFFFF) ^ marked
+            if _popcount(marked) <= mark_threshold and _popcount(unknown) <= unknown_threshold:
+                cost[j, i] = free
+            if tx <= ty and tx <= tz:
+                i += si
+                tx += tdx
+            elif ty <= tz:
+                j += sj
+                ty += tdy
+            else:
+                m += sm
+                tz += tdz
+
+
+class VoxelLayer(Layer):
+    """``costmap_2d::VoxelLayer`` (see the module docstring). ``sources``: its observation sources by name."""
+
+    def __init__(self, params: VoxelLayerParams | dict[str, Any] | None = None, *, name: str = "obstacle_layer",
+                 sources: dict[str, ObservationSource] | None = None, footprint: Footprint | None = None) -> None:
+        if isinstance(params, VoxelLayerParams):
+            self.params = params
+        else:
+            self.params = build(VoxelLayerParams, dict(params or {}), what=name)
+        self.params.validate(name)
+        self.name = name
+        self.enabled = self.params.enabled
+        self.sources: Mapping[str, ObservationSource] = dict(sources or {})
+        self.footprint = footprint or make_footprint()
+        self.grid: Grid | None = None
+        self.columns = np.zeros((0, 0), dtype=np.uint32)
+        self.robot_pose: tuple[float, float, float] | None = None
+
+    @classmethod
+    def from_costmap_params(cls, name: str, costmap: CostmapParams, footprint: Footprint) -> Self:
+        """The layer ``name`` of a parsed costmap (its namespace over the costmap-level values)."""
+        ns = dict(costmap.namespaces.get(name, {}))
+        own = set(VoxelLayerParams.__dataclass_fields__)
+        inherited = {k: getattr(costmap, k) for k in own if hasattr(costmap, k)}
+        params = build(VoxelLayerParams, {**inherited, **{k: v for k, v in ns.items() if not isinstance(v, dict)}},
+                       what=name)
+        names = (params.observation_sources or costmap.observation_sources).split()
+        return cls(params, name=name, sources={n: costmap.sources[n] for n in names if n in costmap.sources},
+                   footprint=footprint)
+
+    @property
+    def default_value(self) -> int:
+        """A never-observed cell: unknown with ``track_unknown_space``, else free."""
+        return COST_UNKNOWN if self.params.track_unknown_space else COST_FREE
+
+    @property
+    def z_top(self) -> float:
+        """Height (m) of the top of the voxel columns."""
+        return self.params.origin_z + self.params.z_voxels * self.params.z_resolution
+
+    def on_footprint_changed(self, footprint: Footprint) -> None:
+        self.footprint = footprint
+
+    def match_size(self, master: Grid) -> None:
+        self.grid = Grid(np.full(master.data.shape, self.default_value, np.uint8), master.resolution, master.origin,
+                         master.frame_id)
+        self.columns = np.full(master.data.shape, UNKNOWN_COLUMN, np.uint32)
+
+    def update_origin(self, master: Grid) -> None:
+        old = self.grid
+        if old is None or old.data.shape != master.data.shape or old.resolution != master.resolution:
+            self.match_size(master)
+            return
+        di, dj = np.rint((np.array(master.origin[:2]) - np.array(old.origin[:2])) / master.resolution).astype(int)
+        h, w = old.data.shape
+        cost = np.full((h, w), self.default_value, np.uint8)
+        cols = np.full((h, w), UNKNOWN_COLUMN, np.uint32)
+        i0, i1, j0, j1 = max(0, -di), min(w, w - di), max(0, -dj), min(h, h - dj)
+        if i0 < i1 and j0 < j1:
+            cost[j0:j1, i0:i1] = old.data[j0 + dj:j1 + dj, i0 + di:i1 + di]
+            cols[j0:j1, i0:i1] = self.columns[j0 + dj:j1 + dj, i0 + di:i1 + di]
+        self.grid = Grid(cost, master.resolution, master.origin, master.frame_id)
+        self.columns = cols
+
+    def add_cloud(self, origin_xyz: Any, points_xyz: np.ndarray, *, source: str | None = None) -> None:
+        """One observation in the costmap frame: the sensor at ``origin_xyz`` and its points (N, 3), m; NaN points
+        are skipped. ``source``: one of :attr:`sources` (its marking, clearing, ranges and heights apply)."""
+        if self.grid is None:
+            raise NavigationError(f"{self.name}: no grid yet; call match_size(master) before add_cloud")
+        src = self._source(source)
+        o = np.asarray(origin_xyz, dtype=np.float64).reshape(3)
+        pts = np.asarray(points_xyz, dtype=np.float64).reshape(-1, 3)
+        pts = pts[np.isfinite(pts).all(axis=1)]
+        g, p = self.grid, self.params
+        scale = np.array([g.resolution, g.resolution, p.z_resolution])
+        base = np.array([g.origin[0], g.origin[1], p.origin_z])
+        if src.clearing and len(pts):
+            rel = pts - o
+            d = np.linalg.norm(rel, axis=1)
+            far = d > src.raytrace_range
+            ends = np.where(far[:, None], o + rel * (src.raytrace_range / np.maximum(d, 1e-12))[:, None], pts)
+            ends = self._clip_height(o, ends)
+            vox = np.unique(np.floor((ends - base) / scale).astype(np.int64), axis=0)
+            clear_voxel_rays(self.columns, g.data, (o - base) / scale, vox + 0.5, p.z_voxels, p.mark_threshold,
+                             p.unknown_threshold, np.uint8(COST_FREE))
+        if src.marking and len(pts):
+            d = np.linalg.norm(pts - o, axis=1)
+            keep = ((d < src.obstacle_range) & (pts[:, 2] >= src.min_obstacle_height)
+                    & (pts[:, 2] <= src.max_obstacle_height))
+            ijk = np.floor((pts[keep] - base) / scale).astype(np.int64)
+            h, w = g.data.shape
+            ok = ((ijk[:, 0] >= 0) & (ijk[:, 0] < w) & (ijk[:, 1] >= 0) & (ijk[:, 1] < h) & (ijk[:, 2] >= 0)
+                  & (ijk[:, 2] < p.z_voxels))
+            ijk = ijk[ok]
+            bits = (np.uint32(1) << ijk[:, 2].astype(np.uint32)) * np.uint32(0x10001)
+            np.bitwise_or.at(self.columns, (ijk[:, 1], ijk[:, 0]), bits)
+            marked = (self.columns[ijk[:, 1], ijk[:, 0]] >> 16).astype("<u2")
+            counts = np.unpackbits(marked.view(np.uint8).reshape(-1, 2), axis=1).sum(axis=1)
+            lethal = counts > p.mark_threshold
+            g.data[ijk[lethal, 1], ijk[lethal, 0]] = COST_LETHAL
+
+    def _clip_height(self, o: np.ndarray, ends: np.ndarray) -> np.ndarray:
+        """Cut each ray where it leaves the voxel columns' height band (ROS clips its raytrace there)."""
+        lo, hi = self.params.origin_z, self.z_top - 1e-6
+        dz = ends[:, 2] - o[2]
+        out = ends.copy()
+        for bound, beyond in ((hi, ends[:, 2] > hi), (lo, ends[:, 2] < lo)):
+            sel = beyond & (dz != 0)
+            s = np.clip((bound - o[2]) / np.where(sel, dz, 1.0), 0.0, 1.0)
+            out[sel] = o + (ends[sel] - o) * s[sel, None]
+        return out
+
+    def _source(self, source: str | None) -> ObservationSource:
+        p = self.params
+        if source is None:
+            return ObservationSource(marking=True, clearing=True, obstacle_range=p.obstacle_range,
+                                     raytrace_range=p.raytrace_range, max_obstacle_height=p.max_obstacle_height)
+        if source not in self.sources:
+            raise NavigationError(f"{self.name}: unknown observation source {source!r} "
+                                  f"(sources: {', '.join(self.sources) or 'none'})")
+        return self.sources[source]
+
+    def update_bounds(self, robot_pose: tuple[float, float, float]) -> None:
+        self.robot_pose = (float(robot_pose[0]), float(robot_pose[1]), float(robot_pose[2]))
+
+    def update_costs(self, master: Grid) -> None:
+        if self.grid is None:
+            return
+        if self.grid.data.shape != master.data.shape or self.grid.origin != master.origin:
+            self.update_origin(master)
+        g = self.grid
+        if self.params.footprint_clearing_enabled and self.robot_pose is not None:
+            ij = self.footprint.cells(g, self.robot_pose)
+            g.data[ij[:, 1], ij[:, 0]] = COST_FREE
+        known = g.data != COST_UNKNOWN
+        if self.params.combination_method == 0:
+            master.data[known] = g.data[known]
+        else:
+            take = known & ((master.data == COST_UNKNOWN) | (master.data < g.data))
+            master.data[take] = g.data[take]
+
+    def reset(self) -> None:
+        if self.grid is not None:
+            self.grid.data[:] = self.default_value
+            self.columns[:] = UNKNOWN_COLUMN
+
+    def clear_outside(self, xy: tuple[float, float], size: float) -> None:
+        """Forget what lies outside the ``size`` x ``size`` m square centred on ``xy`` (clear_costmap_recovery)."""
+        if self.grid is None:
+            return
+        g = self.grid
+        cx = g.origin[0] + (np.arange(g.width) + 0.5) * g.resolution
+        cy = g.origin[1] + (np.arange(g.height) + 0.5) * g.resolution
+        out = (np.abs(cx[None, :] - xy[0]) > size / 2) | (np.abs(cy[:, None] - xy[1]) > size / 2)
+        g.data[out] = self.default_value
+        self.columns[out] = UNKNOWN_COLUMN
+
+    def marked_voxels(self) -> np.ndarray:
+        """Centres (N, 3) in the costmap frame (m) of the marked voxels (what ``publish_voxel_map`` shows)."""
+        if self.grid is None:
+            return np.zeros((0, 3))
+        g, p = self.grid, self.params
+        marked = (self.columns >> 16)[..., None] & (np.uint32(1) << np.arange(p.z_voxels, dtype=np.uint32))
+        j, i, k = np.nonzero(marked)
+        return np.stack([g.origin[0] + (i + 0.5) * g.resolution, g.origin[1] + (j + 0.5) * g.resolution,
+                         p.origin_z + (k + 0.5) * p.z_resolution], axis=1)
