@@ -66,7 +66,7 @@ class VoxelLayerParams:
 
 
 @numba.njit(cache=True)
-def _popcount(v: int) -> int:
+def _popcount(v: np.int64) -> int:
     n = 0
     while v:
         v &= v - 1
@@ -100,7 +100,7 @@ def clear_voxel_rays(columns: np.ndarray, cost: np.ndarray, origin: np.ndarray, 
         for _ in range(steps + 1):
             if i < 0 or j < 0 or i >= w or j >= h or m < 0 or m >= z_voxels:
                 break
-            col = columns[j, i] & ~np.uint32((1 << m) | (1 << (m + 16)))
+            col = np.int64(columns[j, i]) & ~np.int64((1 << m) | (1 << (m + 16)))
             columns[j, i] = col
             marked = col >> 16
             unknown = (col & 0xFFFF) ^ marked

@@ -1,0 +1,99 @@
+"""costmap_2d's VoxelLayer, range_sensor_layer's RangeSensorLayer and pointcloud_to_laserscan."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from navlab.grid import COST_FREE, COST_LETHAL, COST_UNKNOWN, Grid
+from navlab.navigation.costmap.layered import LayeredCostmap
+from navlab.navigation.costmap.params import ObservationSource
+from navlab.navigation.costmap.range_sensor_layer import RangeSensorLayer
+from navlab.navigation.costmap.voxel_layer import VoxelLayer
+from navlab.navigation.errors import NavigationError
+from navlab.navigation.pointcloud_to_laserscan import flatten
+
+
+def _master(size: int = 60, value: int = COST_FREE) -> Grid:
+    return Grid(np.full((size, size), value, np.uint8), 0.1, (-3.0, -3.0, 0.0), "odom")
+
+
+def _cell(g: Grid, x: float, y: float) -> int:
+    i, j = g.world_to_cell(np.array([[x, y]]))[0]
+    return int(g.data[j, i])
+
+
+def _voxel(**src: float) -> VoxelLayer:
+    source = ObservationSource(data_type="PointCloud2", marking=True, clearing=True, **src)
+    layer = VoxelLayer({"z_resolution": 0.1, "z_voxels": 10, "track_unknown_space": True}, name="obstacle_layer",
+                       sources={"cloud": source})
+    layer.match_size(_master())
+    return layer
+
+
+def test_voxel_layer_marks_in_3d_and_keeps_a_low_box_under_a_clearing_ray() -> None:
+    layer = _voxel(min_obstacle_height=0.05, max_obstacle_height=0.5)
+    # a low box top at (1, 0, 0.1), a point above the robot (table top) at (1.5, 0.5, 0.8), floor at (2, -1, 0)
+    layer.add_cloud((0.0, 0.0, 0.3), np.array([[1.0, 0.0, 0.1], [1.5, 0.5, 0.8], [2.0, -1.0, 0.0]]), source="cloud")
+    g = layer.grid
+    assert _cell(g, 1.0, 0.0) == COST_LETHAL
+    assert _cell(g, 1.5, 0.5) == COST_FREE  # above max_obstacle_height: not marked, its ray cleared
+    assert _cell(g, 2.0, -1.0) == COST_FREE and _cell(g, 1.0, -0.5) == COST_FREE  # the floor ray cleared its cells
+    assert _cell(g, -2.0, 2.0) == COST_UNKNOWN  # never seen
+    # a laser plane at 0.3 m passes over the box: it clears its voxels at 0.3 m, the box's column stays marked
+    layer.add_cloud((0.0, 0.0, 0.3), np.array([[2.5, 0.0, 0.3]]), source="cloud")
+    assert _cell(layer.grid, 1.0, 0.0) == COST_LETHAL and _cell(layer.grid, 2.0, 0.0) == COST_FREE
+    # the box goes: a ray to the floor behind it clears its voxel, then the column is free
+    layer.add_cloud((0.0, 0.0, 0.3), np.array([[1.5, 0.0, 0.0]]), source="cloud")
+    assert _cell(layer.grid, 1.0, 0.0) == COST_FREE
+    assert len(layer.marked_voxels()) == 0
+
+
+def test_voxel_layer_from_costmap_params_and_into_the_master() -> None:
+    params = {"global_frame": "odom", "robot_base_frame": "base", "static_map": False, "rolling_window": True,
+              "width": 6.0, "height": 6.0, "resolution": 0.1, "robot_radius": 0.2,
+              "plugins": [{"name": "obstacle_layer", "type": "costmap_2d::VoxelLayer"},
+                          {"name": "inflation_layer", "type": "costmap_2d::InflationLayer"}],
+              "obstacle_layer": {"observation_sources": "cam", "z_voxels": 16, "origin_z": 0.0, "z_resolution": 0.05,
+                                 "cam": {"data_type": "PointCloud2", "topic": "points", "clearing": True}}}
+    layered = LayeredCostmap(params)
+    voxel = layered.layer("obstacle_layer")
+    assert isinstance(voxel, VoxelLayer) and voxel.params.z_voxels == 16 and voxel.z_top == pytest.approx(0.8)
+    voxel.add_cloud((0.0, 0.0, 0.2), np.array([[1.0, 1.0, 0.1]]), source="cam")
+    grid = layered.update_map((0.0, 0.0, 0.0))
+    assert _cell(grid, 1.0, 1.0) == COST_LETHAL and 0 < _cell(grid, 1.25, 1.0) < COST_LETHAL  # inflated around it
+    with pytest.raises(NavigationError, match="z_voxels: expected 1..16"):
+        LayeredCostmap({**params, "obstacle_layer": {**params["obstacle_layer"], "z_voxels": 20}})
+
+
+def test_range_sensor_layer_marks_the_reading_and_clears_short_of_it() -> None:
+    layer = RangeSensorLayer({"topics": ["/sonar_front"], "clear_on_max_reading": True}, name="sonar")
+    assert layer.topics == ["/sonar_front"] and layer.params.phi == 1.2 and layer.params.mark_threshold == 0.8
+    master = _master(value=COST_UNKNOWN)
+    layer.match_size(master)
+    for _ in range(5):  # repeated readings of a wall 1.5 m ahead in a 0.3 rad cone
+        layer.add_range((0.0, 0.0, 0.0), 1.5, field_of_view=0.3, min_range=0.02, max_range=4.0)
+    layer.update_costs(master)
+    assert _cell(master, 1.5, 0.0) == COST_LETHAL
+    assert _cell(master, 0.8, 0.0) == COST_FREE  # short of the reading, on the axis
+    assert _cell(master, 0.8, 0.6) == COST_UNKNOWN  # outside the cone: untouched
+    assert _cell(master, -1.0, 0.0) == COST_UNKNOWN  # behind the sensor
+    # max readings clear (clear_on_max_reading) the cone, the earlier wall fades
+    for _ in range(10):
+        layer.add_range((0.0, 0.0, 0.0), 4.0, field_of_view=0.3, min_range=0.02, max_range=4.0)
+    master.data[:] = COST_UNKNOWN
+    layer.update_costs(master)
+    assert _cell(master, 1.5, 0.0) != COST_LETHAL
+
+
+def test_pointcloud_to_laserscan_keeps_the_nearest_point_per_bin_between_heights() -> None:
+    pts = np.array([[1.0, 0.0, 0.2], [0.5, 0.0, 0.2], [0.3, 0.0, 2.0],  # same bin: nearest in band wins
+                    [0.0, 2.0, 0.1], [np.nan, 0.0, 0.1], [-1.0, 0.0, -0.5]])
+    r = flatten(pts, angle_min=-math.pi, angle_max=math.pi, angle_increment=math.pi / 180, min_height=0.0,
+                max_height=1.0, range_min=0.0, range_max=10.0, fill=math.inf)
+    assert len(r) == 360
+    assert r[180] == pytest.approx(0.5)  # angle 0
+    assert r[270] == pytest.approx(2.0)  # angle pi/2
+    assert np.isinf(r[0]) and np.isinf(r[100])  # the point below min_height and empty bins: inf (use_inf)
