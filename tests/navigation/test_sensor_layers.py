@@ -35,12 +35,12 @@ def _voxel(**src: float) -> VoxelLayer:
 
 def test_voxel_layer_marks_in_3d_and_keeps_a_low_box_under_a_clearing_ray() -> None:
     layer = _voxel(min_obstacle_height=0.05, max_obstacle_height=0.5)
-    # a low box top at (1, 0, 0.1), a point above the robot (table top) at (1.5, 0.5, 0.8), floor at (2, -1, 0)
-    layer.add_cloud((0.0, 0.0, 0.3), np.array([[1.0, 0.0, 0.1], [1.5, 0.5, 0.8], [2.0, -1.0, 0.0]]), source="cloud")
+    # a low box top at (1, 0, 0.1), a point above the robot (table top) at (1.5, 0.5, 0.8), floor at (2.05, -1.05, 0)
+    layer.add_cloud((0.0, 0.0, 0.3), np.array([[1.0, 0.0, 0.1], [1.5, 0.5, 0.8], [2.05, -1.05, 0.0]]), source="cloud")
     g = layer.grid
     assert _cell(g, 1.0, 0.0) == COST_LETHAL
     assert _cell(g, 1.5, 0.5) == COST_FREE  # above max_obstacle_height: not marked, its ray cleared
-    assert _cell(g, 2.0, -1.0) == COST_FREE and _cell(g, 1.0, -0.5) == COST_FREE  # the floor ray cleared its cells
+    assert _cell(g, 2.05, -1.05) == COST_FREE and _cell(g, 1.05, -0.54) == COST_FREE  # the floor ray cleared
     assert _cell(g, -2.0, 2.0) == COST_UNKNOWN  # never seen
     # a laser plane at 0.3 m passes over the box: it clears its voxels at 0.3 m, the box's column stays marked
     layer.add_cloud((0.0, 0.0, 0.3), np.array([[2.5, 0.0, 0.3]]), source="cloud")

@@ -59,4 +59,11 @@ def read_field(msg: Any, name: str) -> np.ndarray:
 
 def read_xyz(msg: Any) -> np.ndarray:
     """Points (N, 3) float32 of a PointCloud2's x, y, z fields (NaNs kept)."""
+    offsets = {f.name: (int(f.offset), int(f.datatype)) for f in msg.fields}
+    step = int(msg.point_step)
+    if (offsets.get("x"), offsets.get("y"), offsets.get("z")) == ((0, FLOAT32), (4, FLOAT32), (8, FLOAT32)) and \
+            step % 4 == 0 and not msg.is_bigendian:  # the usual layout: one strided view, no per-field copies
+        n = int(msg.height) * int(msg.width)
+        flat = np.asarray(msg.data, dtype=np.uint8)[: n * step].view("<f4").reshape(n, step // 4)
+        return flat[:, :3].astype(np.float32)
     return np.stack([read_field(msg, k).astype(np.float32) for k in ("x", "y", "z")], axis=1)

@@ -77,7 +77,7 @@ class PointCloudToLaserScan(Node):
             except TfError as exc:
                 self.get_logger().warning(f"cannot transform the cloud from {frame} to {self.target_frame}: {exc}")
                 return
-            pts = pts @ matrix_from_quat(t[3:]).T + np.array(t[:3])
+            pts = pts @ np.ascontiguousarray(matrix_from_quat(t[3:]).T) + np.array(t[:3])
             frame = self.target_frame
         p = self.p
         fill = math.inf if self.use_inf else p["range_max"] + p["inf_epsilon"]

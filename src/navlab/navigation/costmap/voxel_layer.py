@@ -193,21 +193,27 @@ class VoxelLayer(Layer):
         g, p = self.grid, self.params
         scale = np.array([g.resolution, g.resolution, p.z_resolution])
         base = np.array([g.origin[0], g.origin[1], p.origin_z])
+        h, w = g.data.shape
         if src.clearing and len(pts):
             rel = pts - o
-            d = np.linalg.norm(rel, axis=1)
-            far = d > src.raytrace_range
-            ends = np.where(far[:, None], o + rel * (src.raytrace_range / np.maximum(d, 1e-12))[:, None], pts)
-            ends = self._clip_height(o, ends)
-            vox = np.unique(np.floor((ends - base) / scale).astype(np.int64), axis=0)
+            d = np.sqrt(np.einsum("ij,ij->i", rel, rel))
+            scale_d = np.minimum(1.0, src.raytrace_range / np.maximum(d, 1e-12))
+            ends = self._clip_to_grid(o, o + rel * scale_d[:, None])
+            ijk = np.floor((ends - base) / scale).astype(np.int64)
+            np.clip(ijk, 0, np.array([w - 1, h - 1, p.z_voxels - 1]), out=ijk)
+            # each voxel reached once (rays ending in the same voxel trace the same cells)
+            seen = np.zeros(h * w * p.z_voxels, dtype=bool)
+            seen[(ijk[:, 2] * h + ijk[:, 1]) * w + ijk[:, 0]] = True
+            key = np.flatnonzero(seen)
+            vox = np.stack([key % w, (key // w) % h, key // (w * h)], axis=1)
             clear_voxel_rays(self.columns, g.data, (o - base) / scale, vox + 0.5, p.z_voxels, p.mark_threshold,
                              p.unknown_threshold, np.uint8(COST_FREE))
         if src.marking and len(pts):
-            d = np.linalg.norm(pts - o, axis=1)
-            keep = ((d < src.obstacle_range) & (pts[:, 2] >= src.min_obstacle_height)
+            rel = pts - o
+            d2 = np.einsum("ij,ij->i", rel, rel)
+            keep = ((d2 < src.obstacle_range**2) & (pts[:, 2] >= src.min_obstacle_height)
                     & (pts[:, 2] <= src.max_obstacle_height))
             ijk = np.floor((pts[keep] - base) / scale).astype(np.int64)
-            h, w = g.data.shape
             ok = ((ijk[:, 0] >= 0) & (ijk[:, 0] < w) & (ijk[:, 1] >= 0) & (ijk[:, 1] < h) & (ijk[:, 2] >= 0)
                   & (ijk[:, 2] < p.z_voxels))
             ijk = ijk[ok]
@@ -218,16 +224,22 @@ class VoxelLayer(Layer):
             lethal = counts > p.mark_threshold
             g.data[ijk[lethal, 1], ijk[lethal, 0]] = COST_LETHAL
 
-    def _clip_height(self, o: np.ndarray, ends: np.ndarray) -> np.ndarray:
-        """Cut each ray where it leaves the voxel columns' height band (ROS clips its raytrace there)."""
-        lo, hi = self.params.origin_z, self.z_top - 1e-6
-        dz = ends[:, 2] - o[2]
-        out = ends.copy()
-        for bound, beyond in ((hi, ends[:, 2] > hi), (lo, ends[:, 2] < lo)):
-            sel = beyond & (dz != 0)
-            s = np.clip((bound - o[2]) / np.where(sel, dz, 1.0), 0.0, 1.0)
-            out[sel] = o + (ends[sel] - o) * s[sel, None]
-        return out
+    def _clip_to_grid(self, o: np.ndarray, ends: np.ndarray) -> np.ndarray:
+        """Cut each ray ``o`` -> ``ends`` where it leaves the voxel grid (its cells and the columns' height band;
+        ROS clips its raytrace there too)."""
+        g, p = self.grid, self.params
+        assert g is not None
+        eps = 1e-6
+        lo = np.array([g.origin[0], g.origin[1], p.origin_z]) + eps
+        hi = np.array([g.origin[0] + g.width * g.resolution, g.origin[1] + g.height * g.resolution, self.z_top]) - eps
+        d = ends - o
+        t = np.ones(len(d))
+        for axis in range(3):
+            da = d[:, axis]
+            with np.errstate(divide="ignore", invalid="ignore"):
+                bound = np.where(da > 0, (hi[axis] - o[axis]) / da, np.where(da < 0, (lo[axis] - o[axis]) / da, 1.0))
+            np.minimum(t, bound, out=t)
+        return o + d * np.clip(t, 0.0, 1.0)[:, None]
 
     def _source(self, source: str | None) -> ObservationSource:
         p = self.params
