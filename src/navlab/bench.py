@@ -32,6 +32,7 @@ BENCHES: dict[str, str] = {
     "description": "navlab.description.bench:run",
     "sim": "navlab.sim.bench:run",
     "decompose": "navlab.sim.decompose_bench:run",
+    "sensors": "navlab.sim.sensors_bench:run",
     "controller": "navlab.navigation.bench:run_controller",
     "planner": "navlab.navigation.bench:run_planner",
     "nav": "navlab.experiments.navigate_run:bench",
