@@ -13,7 +13,6 @@ from navlab.sim.errors import SimError
 from navlab.sim.extensions import SimExtensions
 from navlab.sim.imu import ImuSensorPlugin
 from navlab.sim.plugins import DiffDrivePlugin, GroundTruthPlugin, JointStatePlugin, LidarPlugin, RobotStatePublisher
-from navlab.sim.sensor_plugins import sensor_plugins
 from navlab.sim.simulation import Simulation
 from navlab.sim.spawn import check_spawn_clear, check_start_pose, load_sdf_model, parse_spawn_spec, primitive_model
 from navlab.world.model import ModelSpec, WorldModel
@@ -109,7 +108,10 @@ class GazeboSim(Node):
             "bodyName": p.link, "topicName": p.topic, "frameName": p.frame_id, "updateRate": p.update_rate})
             for p in robot.ground_truths]  # the robot's own p3d plugins
         self.plugins += extensions.plugins(executor, namespace, self.sim)
-        self.plugins += sensor_plugins(executor, namespace, self.sim)  # cameras, 3D lidars, ranges, bumpers
+        if robot.sensors.all():  # cameras, 3D lidars, ranges, bumpers (imported only for a robot that has them)
+            from navlab.sim.sensor_plugins import sensor_plugins
+
+            self.plugins += sensor_plugins(executor, namespace, self.sim)
         if robot is not None:  # Gazebo's bumper: what the robot touches, on /collisions
             self.plugins.append(CollisionPlugin(executor, namespace=namespace, sim=self.sim))
         if seed >= 0:
