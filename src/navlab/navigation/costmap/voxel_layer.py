@@ -25,24 +25,16 @@ import numpy as np
 from navlab.grid import COST_FREE, COST_LETHAL, COST_UNKNOWN, Grid
 from navlab.navigation.costmap.footprint import Footprint, make_footprint
 from navlab.navigation.costmap.layers import Layer
-from navlab.navigation.costmap.params import CostmapParams, ObservationSource, build
+from navlab.navigation.costmap.params import CostmapParams, ObservationSource, ObstacleLayerParams, build
 from navlab.navigation.errors import NavigationError
 
 UNKNOWN_COLUMN = np.uint32(0xFFFF)  # every voxel unknown (voxel_grid's reset)
 
 
 @dataclass
-class VoxelLayerParams:
-    """``costmap_2d::VoxelLayer``'s parameters (ROS 1 names and defaults; m)."""
+class VoxelLayerParams(ObstacleLayerParams):
+    """``costmap_2d::VoxelLayer``'s parameters: the obstacle layer's and the voxel grid's (ROS 1 names, defaults; m)."""
 
-    enabled: bool = True
-    obstacle_range: float = 2.5
-    raytrace_range: float = 3.0
-    max_obstacle_height: float = 2.0
-    track_unknown_space: bool = False
-    footprint_clearing_enabled: bool = True
-    combination_method: int = 1
-    observation_sources: str = ""
     origin_z: float = 0.0
     z_resolution: float = 0.2
     z_voxels: int = 10
