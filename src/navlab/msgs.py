@@ -16,8 +16,8 @@ from navlab.errors import NavlabError
 from navlab.geometry import quat_from_yaw, yaw_from_quat
 
 TYPESTORE = get_typestore(Stores.ROS2_HUMBLE)
-# gazebo_msgs (not in the ROS 2 store): the bumper plugin's contact messages, with the fields ROS Noetic and
-# gazebo_ros_pkgs for ROS 2 give them
+# gazebo_msgs and costmap_2d (not in the ROS 2 store): the bumper plugin's contact messages, with the fields ROS
+# Noetic and gazebo_ros_pkgs for ROS 2 give them, and the voxel layer's grid
 TYPESTORE.register({
     **get_types_from_msg("""string info
 string collision1_name
@@ -30,6 +30,10 @@ float64[] depths
 """, "gazebo_msgs/msg/ContactState"),
     **get_types_from_msg("std_msgs/Header header\ngazebo_msgs/ContactState[] states\n",
                          "gazebo_msgs/msg/ContactsState"),
+    # costmap_2d's voxel layer (publish_voxel_map): the packed voxel columns
+    **get_types_from_msg("std_msgs/Header header\nuint32[] data\ngeometry_msgs/Point32 origin\n"
+                         "geometry_msgs/Vector3 resolutions\nuint32 size_x\nuint32 size_y\nuint32 size_z\n",
+                         "costmap_2d/msg/VoxelGrid"),
 })
 _T = TYPESTORE.types
 
@@ -79,6 +83,7 @@ Range = _T["sensor_msgs/msg/Range"]
 Wrench = _T["geometry_msgs/msg/Wrench"]
 ContactState = _T["gazebo_msgs/msg/ContactState"]
 ContactsState = _T["gazebo_msgs/msg/ContactsState"]
+VoxelGrid = _T["costmap_2d/msg/VoxelGrid"]
 
 
 class MessageTypeError(NavlabError, LookupError):

@@ -97,3 +97,14 @@ def test_pointcloud_to_laserscan_keeps_the_nearest_point_per_bin_between_heights
     assert r[180] == pytest.approx(0.5)  # angle 0
     assert r[270] == pytest.approx(2.0)  # angle pi/2
     assert np.isinf(r[0]) and np.isinf(r[100])  # the point below min_height and empty bins: inf (use_inf)
+
+
+def test_voxel_grid_message_packs_the_columns() -> None:
+    layer = _voxel(min_obstacle_height=0.0, max_obstacle_height=2.0)
+    layer.add_cloud((0.0, 0.0, 0.3), np.array([[1.05, 0.05, 0.25]]), source="cloud")
+    msg = layer.voxel_grid_msg(0)
+    assert (msg.size_x, msg.size_y, msg.size_z) == (60, 60, 10) and msg.resolutions.z == pytest.approx(0.1)
+    i, j = layer.grid.world_to_cell(np.array([[1.05, 0.05]]))[0]
+    column = int(msg.data[j * 60 + i])
+    assert column >> 16 == 1 << 2 and column & (1 << 2)  # voxel 2 (0.2 .. 0.3 m) marked: both of its bits set
+    assert column & 0xFFFF == 0xFFFF  # the others unknown (their low bit only), none cleared: no ray crossed them

@@ -55,7 +55,7 @@ class Costmap2DROS:
         statics = [x for x in self.layered.layers if isinstance(x, StaticLayer)]
         if statics:
             node.create_subscription(msgs.OccupancyGrid, statics[0].params.map_topic, self._on_map, 1)
-        self.feeds = CostmapSensorFeeds(node, name, self.global_frame, self.layered.layers)  # voxel, range layers
+        self.feeds = CostmapSensorFeeds(node, name, self.global_frame, self.layered.layers, prefix=prefix)
         for src_name, src in p.sources.items():
             if src_name in self.feeds.sources:
                 continue

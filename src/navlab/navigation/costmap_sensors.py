@@ -32,13 +32,16 @@ def scan_points(msg: Any) -> np.ndarray:
 class CostmapSensorFeeds:
     """Subscriptions and updates for ``layers``' 3-D and range inputs, in ``node``, for a costmap in ``frame``."""
 
-    def __init__(self, node: Node, name: str, frame: str, layers: list[Any]) -> None:
+    def __init__(self, node: Node, name: str, frame: str, layers: list[Any], *, prefix: str | None = None) -> None:
         self.node, self.name, self.frame = node, name, frame
         self.voxel = [x for x in layers if isinstance(x, VoxelLayer)]
         self.range = [x for x in layers if isinstance(x, RangeSensorLayer)]
         self.pending: dict[tuple[int, str], Any] = {}
         self.readings: list[Any] = []
         self.sources: set[str] = set()
+        # publish_voxel_map: <costmap>/<layer>/voxel_grid (costmap_2d/VoxelGrid), after each update's observations
+        self.voxel_pubs = {k: node.create_publisher(msgs.VoxelGrid, f"{prefix or name}/{layer.name}/voxel_grid", 1)
+                           for k, layer in enumerate(self.voxel) if layer.params.publish_voxel_map}
         for k, layer in enumerate(self.voxel):
             for src_name, src in layer.sources.items():
                 kind = msgs.LaserScan if src.data_type == "LaserScan" else msgs.PointCloud2
@@ -79,6 +82,10 @@ class CostmapSensorFeeds:
             moved = pts @ np.ascontiguousarray(rot.T, dtype=np.float32) + origin.astype(np.float32)
             self.voxel[k].add_cloud(origin, moved, source=src_name)
         self.pending.clear()
+        for k, pub in self.voxel_pubs.items():
+            grid = self.voxel[k].voxel_grid_msg(self.node.executor.now_ns)
+            if grid is not None:
+                pub.publish(grid)
         for msg in self.readings:
             place = self._in_costmap(str(msg.header.frame_id).lstrip("/"), msgs.stamp_ns(msg))
             if place is None:

@@ -278,6 +278,19 @@ class VoxelLayer(Layer):
         g.data[out] = self.default_value
         self.columns[out] = UNKNOWN_COLUMN
 
+    def voxel_grid_msg(self, stamp_ns: int) -> Any:
+        """``costmap_2d/VoxelGrid`` of the layer (what ``publish_voxel_map`` publishes), or None before a grid."""
+        from navlab import msgs
+
+        if self.grid is None:
+            return None
+        g, p = self.grid, self.params
+        return msgs.VoxelGrid(
+            header=msgs.header(stamp_ns, g.frame_id), data=self.columns.reshape(-1).astype(np.uint32),
+            origin=msgs.Point32(x=float(g.origin[0]), y=float(g.origin[1]), z=float(p.origin_z)),
+            resolutions=msgs.Vector3(x=g.resolution, y=g.resolution, z=p.z_resolution),
+            size_x=g.width, size_y=g.height, size_z=p.z_voxels)
+
     def marked_voxels(self) -> np.ndarray:
         """Centres (N, 3) in the costmap frame (m) of the marked voxels (what ``publish_voxel_map`` shows)."""
         if self.grid is None:
