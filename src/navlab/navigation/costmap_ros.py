@@ -20,8 +20,7 @@ from navlab.geometry import compose2, transform_points2
 from navlab.grid import COST_INSCRIBED, COST_LETHAL, COST_UNKNOWN, Grid, GridMap
 from navlab.navigation.costmap.layered import LayeredCostmap
 from navlab.navigation.costmap.layers import ObstacleLayer, StaticLayer
-from navlab.navigation.costmap.voxel_layer import VoxelLayer
-from navlab.navigation.costmap_sensors import CostmapSensorFeeds
+from navlab.navigation.costmap_sensors import CloudLayer, CostmapSensorFeeds
 
 
 def cost_translation() -> np.ndarray:
@@ -174,7 +173,7 @@ class Costmap2DROS:
         if pose is None:
             return
         for layer in self.layered.layers:
-            if isinstance(layer, VoxelLayer):
+            if isinstance(layer, CloudLayer):
                 layer.clear_outside(pose[:2], size)
             elif isinstance(layer, ObstacleLayer) and layer.grid is not None:
                 g = layer.grid

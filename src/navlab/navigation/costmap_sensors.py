@@ -9,7 +9,8 @@ frame with the full 3-D tf at the message's stamp (else the latest).
 from __future__ import annotations
 
 import functools
-from typing import Any
+from collections.abc import Mapping
+from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
 
@@ -17,8 +18,34 @@ from navlab import msgs
 from navlab.core import Node, TfError
 from navlab.geometry import matrix_from_quat
 from navlab.io.pointcloud import read_xyz
-from navlab.navigation.costmap.range_sensor_layer import RangeSensorLayer
-from navlab.navigation.costmap.voxel_layer import VoxelLayer
+from navlab.navigation.costmap.params import ObservationSource
+
+
+@runtime_checkable
+class CloudLayer(Protocol):
+    """A layer that takes 3-D observations (a capability; ``costmap_2d::VoxelLayer``): ``sources`` by name, each
+    LaserScan or PointCloud2 with its ``topic``; ``params.publish_voxel_map``; ``voxel_grid_msg``."""
+
+    name: str
+    sources: Mapping[str, ObservationSource]
+    params: Any
+
+    def add_cloud(self, origin_xyz: Any, points_xyz: np.ndarray, *, source: str | None = None) -> None: ...
+
+    def voxel_grid_msg(self, stamp_ns: int) -> Any: ...
+
+    def clear_outside(self, xy: tuple[float, float], size: float) -> None: ...
+
+
+@runtime_checkable
+class RangeLayer(Protocol):
+    """A layer that takes ``sensor_msgs/Range`` readings (a capability; ``range_sensor_layer``) on ``topics``."""
+
+    @property
+    def topics(self) -> list[str]: ...
+
+    def add_range(self, sensor_pose: tuple[float, float, float], reading: float, *, field_of_view: float,
+                  min_range: float, max_range: float) -> None: ...
 
 
 def scan_points(msg: Any) -> np.ndarray:
@@ -34,8 +61,8 @@ class CostmapSensorFeeds:
 
     def __init__(self, node: Node, name: str, frame: str, layers: list[Any], *, prefix: str | None = None) -> None:
         self.node, self.name, self.frame = node, name, frame
-        self.voxel = [x for x in layers if isinstance(x, VoxelLayer)]
-        self.range = [x for x in layers if isinstance(x, RangeSensorLayer)]
+        self.voxel: list[CloudLayer] = [x for x in layers if isinstance(x, CloudLayer)]
+        self.range: list[RangeLayer] = [x for x in layers if isinstance(x, RangeLayer)]
         self.pending: dict[tuple[int, str], Any] = {}
         self.readings: list[Any] = []
         self.sources: set[str] = set()
