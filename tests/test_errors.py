@@ -11,8 +11,8 @@ import pytest
 import navlab
 from navlab import msgs
 from navlab.errors import NavlabError
+from navlab.sim import SimError
 from navlab.sim.diffdrive import EncoderOdometry, wheel_speeds
-from navlab.sim.errors import SimError
 
 
 def _navlab_modules() -> list[str]:

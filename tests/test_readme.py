@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pytest
 
-from navlab.io.datasets import data_dir
+from navlab.io import data_dir
 
 README = Path(__file__).resolve().parents[1] / "README.md"
 

@@ -4,18 +4,17 @@ and no two packages import each other.
 
 Layers, bottom to top::
 
-    0 leaves       errors msgs geometry grid io resources nodes plugins lazy
+    0 leaves       errors msgs geometry grid io resources nodes plugins lazy deprecation
     1 core
     2 description world ros1
     3 sim mapping localization
     4 navigation
     5 experiments viz
-    6 top          cli cli_common demo bench, every package's cli.py and bench.py, navlab/__init__.py
+    6 top          cli bench (packages: the ``navlab`` command's verbs, the benchmarks), demo, navlab/__init__.py
 
 Every import statement counts: module level, inside functions, under ``if TYPE_CHECKING``. Strings
 (the lazy names of ``navlab/__init__.py``, the ``module:Class`` strings of the registries) are not
-imports. A package's ``cli.py`` and ``bench.py`` are top-layer nodes of their own, so they neither lift
-nor tie their package.
+imports. Nothing below imports cli or bench: they are each package's only outside faces.
 
 Usage: ``python tools/check_layers.py [SRC_NAVLAB_DIR]`` (default: ``src/navlab`` of this checkout).
 Prints each violation as ``file:line: a -> b (why)`` and exits 1 if there is any, 0 otherwise.
@@ -30,24 +29,23 @@ from dataclasses import dataclass
 from pathlib import Path
 
 LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
-    ("leaves", ("errors", "msgs", "geometry", "grid", "io", "resources", "nodes", "plugins", "lazy")),
+    ("leaves", ("errors", "msgs", "geometry", "grid", "io", "resources", "nodes", "plugins", "lazy", "deprecation")),
     ("core", ("core",)),
     ("description/world/ros1", ("description", "world", "ros1")),
     ("sim/mapping/localization", ("sim", "mapping", "localization")),
     ("navigation", ("navigation",)),
     ("experiments/viz", ("experiments", "viz")),
-    ("top", ("cli", "cli_common", "demo", "bench", "__main__")),
+    ("top", ("cli", "bench", "demo", "__main__")),
 )
 LAYER_OF: dict[str, int] = {pkg: i for i, (_, pkgs) in enumerate(LAYERS) for pkg in pkgs}
 TOP = len(LAYERS) - 1
-FACE_MODULES = ("cli", "bench")  # a package's face: <pkg>/cli.py and <pkg>/bench.py sit on the top layer
 ROOT = "navlab"
 
 
 @dataclass(frozen=True)
 class Unit:
-    """A node of the layer graph: a package (``mapping``), a top-level module (``msgs``) or a face
-    (``mapping.cli``); ``layer`` is None for a package that is in no layer."""
+    """A node of the layer graph: a package (``mapping``) or a top-level module (``msgs``); ``layer`` is None
+    for a package that is in no layer."""
 
     name: str
     layer: int | None
@@ -70,8 +68,6 @@ def unit_of(parts: tuple[str, ...], src: Path) -> Unit:
     if not parts:
         return Unit(ROOT, TOP)
     head = parts[0]
-    if len(parts) >= 2 and parts[1] in FACE_MODULES and (src / head).is_dir():
-        return Unit(f"{head}.{parts[1]}", TOP)
     return Unit(head, LAYER_OF.get(head))
 
 

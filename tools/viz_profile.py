@@ -71,19 +71,19 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--sim", type=float, default=100.0, help="simulated s to drive (default 100)")
     ap.add_argument("--setup", default="", help="JavaScript run in the page before the drive")
-    ap.add_argument("--speed", type=float, default=0.0, help="the viewer's pace (0: as fast as possible, 1: real time)")
+    ap.add_argument("--rate", type=float, default=0.0, help="the viewer's pace (0: as fast as possible, 1: real time)")
     ap.add_argument("--cdp", action="store_true", help="also the page's CDP Performance metrics (main thread)")
     args = ap.parse_args()
+    from navlab.bench import view as bench
     from navlab.experiments.session import start_run
-    from navlab.viz import bench
-    from navlab.viz.cli import _true_map
+    from navlab.mapping import save_true_map
     from navlab.viz.headless import HeadlessPage
     from navlab.viz.viewer import attach
 
-    map_yaml = _true_map("room", (0.0, 0.0, 0.0), Path(tempfile.mkdtemp(prefix="navlab-viz-profile-")))
+    map_yaml = str(save_true_map("room", (0.0, 0.0), Path(tempfile.mkdtemp(prefix="navlab-viz-profile-")) / "map.yaml"))
     bench._drive(map_yaml, seed=0)  # warm-up: Numba's caches, imports
     run = start_run("navigation", world="room_obstacles", map=map_yaml, seed=0)
-    viewer = attach(run.executor, port=0, speed=args.speed)
+    viewer = attach(run.executor, port=0, rate=args.rate)
     page = HeadlessPage(viewer.url, width=1280, height=800)
     try:
         page.wait_for("window.navlab && navlab.store.state")

@@ -27,7 +27,7 @@ class Counter(Node):
         self.pub.publish(msgs.Float64(data=float(self.n)))
 
 
-ctx = navlab.init(seed=0, pace=0.0)  # rclpy.init(); pace=0: as fast as the CPU allows, 1.0 would be real time
+ctx = navlab.init(seed=0, rate=0.0)  # rclpy.init(); rate=0: as fast as the CPU allows, 1.0 would be real time
 ex = ctx.executor
 Counter()
 printer = Node("printer")

@@ -16,7 +16,7 @@ Top-level names (imported on first use, so ``import navlab`` stays light and loa
 
 - ``navlab.launch(name_or_file, **args)``: start a launch, a shipped name (``sim``, ``mapping``,
   ``localization``, ``talker_listener``) or a ``.launch.yaml`` file, with its arguments as keywords
-  (``map="room.yaml"``); ``seed=`` and ``pace=`` (0 = as fast as possible, 1 = real time) set the run.
+  (``map="room.yaml"``); ``seed=`` and ``rate=`` (0 = as fast as possible, 1 = real time) set the run.
   Returns a ``Session``: ``.run(seconds)``, ``.node(name)``, ``.executor`` (``run_until``, ``tf``, ...).
   This is ``navlab.core.launch.start``.
 - ``navlab.Executor`` and ``navlab.Node``: the rclpy-like runtime for your own nodes

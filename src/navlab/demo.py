@@ -12,14 +12,11 @@
 
 from __future__ import annotations
 
-import argparse
 import json
 import sys
 import time
 from pathlib import Path
 from typing import Any
-
-from navlab.viz.cli import add_view_arguments
 
 
 def _say(text: str, quiet: bool) -> None:
@@ -37,7 +34,7 @@ def run_demo(out: str | Path = "navlab-demo", *, seed: int = 0, quiet: bool = Fa
     from navlab.experiments.localize_run import plot_result, run_localization
     from navlab.experiments.mapping_run import run_mapping
     from navlab.experiments.navigate_run import run_navigation, save_goal_pictures
-    from navlab.sim.spawn import primitive_model
+    from navlab.sim import primitive_model
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
@@ -88,67 +85,14 @@ DEMO_GOALS = [(4.3, 1.0, 0.0), (-3.5, -0.5, 3.14), (1.5, -2.5, 0.0)]
 
 def _render(path: Path) -> str:
     """Picture of the paper's robot among the obstacles; skipped (with the reason) without OpenGL."""
-    from navlab.sim.gazebo import load_robot_named, load_world_named
+    from navlab.description import load_robot_named
+    from navlab.sim import Simulation
     from navlab.sim.render import render_image, save_png
-    from navlab.sim.simulation import Simulation
+    from navlab.world import load_world
 
     try:
-        sim = Simulation(load_robot_named("mybot"), load_world_named("room_obstacles"), visuals=True)
+        sim = Simulation(load_robot_named("mybot"), load_world("room_obstacles"), visuals=True)
         sim.advance_to(200_000_000)
         return str(save_png(render_image(sim, width=960, height=720), path))
     except Exception as exc:  # no EGL/OSMesa on this machine: the rest of the demo still runs
         return f"skipped: {exc}"
-
-
-def _cmd(args: argparse.Namespace) -> int:
-    from navlab.viz.cli import view_hook
-
-    with view_hook(args) as on_start:
-        summary = run_demo(args.out, seed=args.seed, quiet=args.quiet, render=not args.no_render,
-                           record=not args.no_record, on_start=on_start)  # fmt: skip
-    if args.json:
-        print(json.dumps(summary))
-        return 0
-    m, loc = summary["mapping"], summary["localization"]
-    print(f"\nnavlab demo — report in {summary['out']}/report.md and report.html (+ report.json, pictures, recording)")
-    if "render" in summary:
-        print(f"  robot in its world:  {summary['render']}")
-    print(f"  map:                 {m['map']} (+ map.pgm), picture {m['picture']}")
-    print(f"    {m['sim_s']:.0f} simulated s mapped in {m['wall_s']:.1f} s wall ({m['rtf']}x real time)")
-    print(f"    walls: precision {m['precision']:.3f}, recall {m['recall']:.3f}, mean error {m['mean_wall_error_m']} m;"
-          f" free space covered {m['coverage']:.1%}")  # fmt: skip
-    print(f"    SLAM trajectory error {m['position_error_mean_m']} m mean (raw odometry "
-          f"{m['odometry_position_error_mean_m']} m)")
-    print(f"  AMCL on that map with new obstacles: mean error {loc['position_error_mean_m']} m, "
-          f"{loc['yaw_error_mean_deg']}° over {loc['sim_s']:.0f} s; picture {loc['picture']}")
-    n = summary["navigation"]
-    print(f"  move_base on that map: {n['goals_succeeded']} of {len(n['goals'])} goals reached (the simulator's "
-          f"truth; move_base reported {n['goals_succeeded_move_base']}), {n['collisions']} collisions; pictures in "
-          f"{summary['out']}/navigate/")
-    for k, g in enumerate(n["goals"], 1):
-        said = f", move_base: {g['move_base_outcome']}" if g["move_base_outcome"] != g["outcome"] else ""
-        print(f"    goal {k} {tuple(g['goal'])}: {g['outcome']}{said} in {g['time_s']} s, path {g['path_m']} m, "
-              f"{g['final_error_m']} m from the goal, closest {g['min_clearance_m']} m"
-              + (f" ({g['reason']})" if g["reason"] else ""))
-    print(f"  total {summary['wall_s']} s wall")
-    return 0
-
-
-def register(sub: argparse._SubParsersAction) -> None:
-    """Add ``demo``."""
-    p = sub.add_parser(
-        "demo",
-        help="run the paper's pipeline: render, SLAM mapping by exploration, AMCL and move_base on the saved map",
-        description=__doc__,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
-    )
-    p.add_argument("--out", default="navlab-demo", metavar="DIR",
-                   help="the report folder: report.md, report.json, map.png, pictures and the recording "
-                   "(default ./navlab-demo)")
-    p.add_argument("--no-record", action="store_true", help="no rosbag2 recording of the navigation step")
-    p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
-    p.add_argument("--no-render", action="store_true", help="skip the rendered picture (no OpenGL needed)")
-    p.add_argument("--quiet", action="store_true", help="no progress output")
-    p.add_argument("--json", action="store_true", help="print the figures as JSON")
-    add_view_arguments(p)
-    p.set_defaults(func=_cmd)

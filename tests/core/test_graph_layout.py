@@ -11,9 +11,8 @@ from pathlib import Path
 import pytest
 
 from navlab.cli import main
-from navlab.experiments.truth import true_map
-from navlab.mapping.mapfile import save_map
-from navlab.sim.gazebo import load_world_named
+from navlab.mapping import save_map
+from navlab.world import load_world, true_map
 
 SVG = "{http://www.w3.org/2000/svg}"
 
@@ -40,7 +39,7 @@ def _shapes(svg: Path) -> dict[str, tuple[str, tuple[float, float, float, float]
 @pytest.fixture
 def room_map(tmp_path: Path) -> Path:
     path = tmp_path / "room.yaml"
-    save_map(true_map(load_world_named("room"), (0.0, 0.0)), path)
+    save_map(true_map(load_world("room"), (0.0, 0.0)), path)
     return path
 
 

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from navlab.core.errors import LaunchError, ParameterError
+from navlab.core import LaunchError, ParameterError
 from navlab.core.launch import start
 from navlab.core.params import read_yaml
 

@@ -73,7 +73,7 @@ def test_no_running_launch_is_a_clear_error():
 
 
 def test_map_save_takes_the_map_of_a_running_mapping_launch(tmp_path):
-    from navlab.mapping.mapfile import load_map
+    from navlab.mapping import load_map
 
     proc = subprocess.Popen([sys.executable, "-m", "navlab.cli", "launch", "mapping", "--rate", "4"],
                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)  # fmt: skip

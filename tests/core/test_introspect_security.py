@@ -58,7 +58,7 @@ def test_a_socket_served_by_another_process_is_not_trusted(folder: Path) -> None
 
 @pytest.fixture
 def running(folder: Path) -> Iterator[tuple[Any, IntrospectionServer]]:
-    session = start("talker_listener", pace=1.0, rate=50.0)
+    session = start("talker_listener", rate=1.0, launch_args={"rate": 50.0})
     ex = session.executor
     thread = threading.Thread(target=ex.run, args=(60.0,), daemon=True)
     thread.start()

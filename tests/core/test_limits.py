@@ -11,12 +11,12 @@ import pytest
 from navlab.core.limits import ceilings
 from navlab.errors import NavlabError
 from navlab.io.carmen import read_carmen
-from navlab.localization.amcl import AmclParams
+from navlab.localization import AmclParams
 from navlab.mapping.gmapping import GMappingParams
+from navlab.navigation import costmap_params
 from navlab.navigation.controllers.mppi import MppiParams
 from navlab.navigation.controllers.params import DWAPlannerParams, TrajectoryPlannerParams
 from navlab.navigation.costmap.footprint import make_footprint
-from navlab.navigation.costmap.params import costmap_params
 
 
 def _footprint(value: str) -> None:

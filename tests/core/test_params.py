@@ -82,7 +82,7 @@ def test_malformed_yaml_names_file_and_line(tmp_path):
 
 def test_swapped_letters_of_a_short_name_are_a_typo_not_an_ignored_key():
     # difflib rates lsimga / lsigma at 0.83, under the typo cutoff: the swap would have been dropped silently
-    from navlab.mapping.errors import MappingError
+    from navlab.mapping import MappingError
     from navlab.mapping.gmapping import GMappingParams
 
     with pytest.raises(MappingError, match="did you mean 'lsigma'"):

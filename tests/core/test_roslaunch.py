@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from navlab.core.errors import LaunchError
+from navlab.core import LaunchError
 from navlab.core.launch import start
 from navlab.core.roslaunch import load
 

@@ -70,9 +70,8 @@ def test_my_slam_maps_the_room() -> None:
 
 
 def test_my_navigation_reaches_a_goal_with_the_models_costmap_files(tmp_path: Path) -> None:
-    from navlab.experiments.truth import true_map
-    from navlab.mapping.mapfile import save_map
-    from navlab.world import load_world
+    from navlab.mapping import save_map
+    from navlab.world import load_world, true_map
 
     save_map(true_map(load_world(WS / "my_gazebo" / "worlds" / "my_room.world"), (0.0, 0.0)), tmp_path / "map.yaml")
     session = start([WORLD, WS / "my_navigation" / "launch" / "my_navigation.launch"],
@@ -113,7 +112,7 @@ def test_several_launch_files_in_one_call_and_map_saver_writes_the_map(tmp_path:
     assert main(["launch", str(WORLD), str(saver), f"out:={out}", "--duration", "3", "--json", "--quiet"]) == 0
     summary = json.loads(capsys.readouterr().out)
     assert {"/gazebo", "/my_slam_gmapping", "/map_saver"} <= set(summary["nodes"]) and summary["topics"]["/map"] >= 1
-    from navlab.mapping.mapfile import load_map
+    from navlab.mapping import load_map
 
     grid = load_map(out.with_suffix(".yaml"))
     assert grid.resolution == pytest.approx(0.05) and out.with_suffix(".pgm").is_file()

@@ -11,14 +11,12 @@ from scipy import ndimage
 
 from navlab import msgs
 from navlab.cli import main
-from navlab.core import LaunchError, Node
+from navlab.core import LaunchError, Node, load_params
 from navlab.core.launch import resources_dir, start
-from navlab.core.params import load_params
-from navlab.experiments.truth import true_map
 from navlab.mapping import GridMap, save_map
 from navlab.mapping.gmapping import GMappingParams
 from navlab.mapping.teleop import RouteFollower
-from navlab.sim.gazebo import load_world_named
+from navlab.world import load_world, true_map
 
 
 class _Recorder(Node):
@@ -58,7 +56,7 @@ def test_mapping_launch_builds_a_map_while_exploring():
     occupied = grid.data >= 65  # map_server's occupied_thresh
     assert occupied.sum() > 100 and ((grid.data >= 0) & (grid.data < 25)).sum() > 1000
     # the walls it saw are where the world's walls are (within 2 cells)
-    truth = true_map(load_world_named("room"), (0.0, 0.0))
+    truth = true_map(load_world("room"), (0.0, 0.0))
     dist = ndimage.distance_transform_edt(truth.data != 100) * truth.resolution
     rows, cols = np.nonzero(occupied)
     wx = grid.origin[0] + (cols + 0.5) * grid.resolution
@@ -83,7 +81,7 @@ def test_mapping_launch_without_exploration_stands_still():
 @pytest.fixture
 def room_map(tmp_path):
     path = tmp_path / "room.yaml"
-    save_map(true_map(load_world_named("room"), (0.0, 0.0)), path)
+    save_map(true_map(load_world("room"), (0.0, 0.0)), path)
     return path
 
 

@@ -8,8 +8,7 @@ from pathlib import Path
 import pytest
 
 from navlab import resources
-from navlab.description.errors import DescriptionError
-from navlab.description.loader import load_robot
+from navlab.description import DescriptionError, load_robot
 
 # the bypass seen in the issue: reflection through xacro's exposed `python.vars`/`python.type` reaches the
 # globals of a xacro function and from there `os.system`

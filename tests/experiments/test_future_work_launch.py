@@ -15,10 +15,9 @@ from navlab.core import Node
 from navlab.core.launch import start
 from navlab.errors import NavlabError
 from navlab.experiments.navigate_run import sim_launch_args
-from navlab.experiments.truth import true_map
 from navlab.mapping import save_map
-from navlab.navigation.errors import NavigationError
-from navlab.sim.gazebo import load_world_named
+from navlab.navigation import NavigationError
+from navlab.world import load_world, true_map
 
 
 class _Watch(Node):
@@ -71,7 +70,7 @@ def test_without_ekf_the_drive_owns_odom_tf() -> None:
 
 def test_navigation_launch_with_controller_and_ekf(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     map_yaml = tmp_path / "map.yaml"
-    save_map(true_map(load_world_named("room_obstacles"), (0.0, 0.0)), map_yaml)
+    save_map(true_map(load_world("room_obstacles"), (0.0, 0.0)), map_yaml)
     code = main(["launch", "navigation", f"map:={map_yaml}", "ekf:=true", "wheel_controller:=true",
                  "--duration", "1", "--json", "--quiet"])  # fmt: skip
     assert code == 0

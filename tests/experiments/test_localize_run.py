@@ -11,14 +11,13 @@ import pytest
 
 from navlab.cli import main
 from navlab.experiments.localize_run import run_localization
-from navlab.experiments.truth import true_map
 from navlab.localization import LocalizationError
-from navlab.mapping.mapfile import save_map
-from navlab.sim.gazebo import load_world_named
+from navlab.mapping import save_map
+from navlab.world import load_world, true_map
 
 
 def test_tracking_on_a_saved_map_along_a_60_s_route(tmp_path: Path) -> None:
-    grid = true_map(load_world_named("room_obstacles"), (0.0, 0.0))
+    grid = true_map(load_world("room_obstacles"), (0.0, 0.0))
     save_map(grid, tmp_path / "room.yaml")
     res = run_localization("room_obstacles", tmp_path / "room.yaml", duration=60.0, seed=0)
     s = res.summary

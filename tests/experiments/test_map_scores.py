@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 
 from navlab.experiments.metrics import free_coverage, score_map, trajectory_error
-from navlab.experiments.truth import truth_grid
 from navlab.grid import Grid, GridMap
+from navlab.world import truth_grid
 
 
 def _truth() -> Grid:

@@ -11,7 +11,7 @@ import pytest
 
 from navlab.cli import main
 from navlab.experiments.mapping_run import run_mapping
-from navlab.mapping.mapfile import load_map
+from navlab.mapping import load_map
 
 # A loop through the room's open middle, clear of the partitions and the pillar (world frame = odom).
 ROUTE = """\

@@ -10,7 +10,7 @@ import pytest
 from navlab.cli import main
 from navlab.experiments.navigate_run import run_navigation
 from navlab.experiments.plots import navigation_figure
-from navlab.sim.spawn import primitive_model
+from navlab.sim import primitive_model
 
 
 def test_arrival_and_mid_drive_pictures_with_a_legend(tmp_path: Path) -> None:

@@ -31,7 +31,7 @@ def _robot() -> Seed:
 
 
 def _urdf() -> Seed:
-    from navlab.description.loader import load_robot
+    from navlab.description import load_robot
 
     model = load_robot(_resources() / "robots" / "tb3_burger" / "tb3_burger.xacro")
     return Seed({"robot.urdf": model.urdf_xml.encode()}, "robot.urdf")

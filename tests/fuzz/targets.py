@@ -8,7 +8,7 @@ from typing import Any
 
 
 def _robot(path: Path) -> dict[str, Any]:
-    from navlab.description.loader import load_robot
+    from navlab.description import load_robot
     from navlab.description.summary import robot_summary
 
     robot_summary(load_robot(path))
@@ -16,7 +16,7 @@ def _robot(path: Path) -> dict[str, Any]:
 
 
 def _world(path: Path) -> dict[str, Any]:
-    from navlab.world.sdf import load_world
+    from navlab.world import load_world
     from navlab.world.summary import world_summary
 
     world_summary(load_world(path))
@@ -56,7 +56,7 @@ def _move_base(folder: Path) -> dict[str, Any]:
 
 
 def _map(path: Path) -> dict[str, Any]:
-    from navlab.mapping.mapfile import load_map
+    from navlab.mapping import load_map
 
     grid = load_map(path)
     return {"cells": int(grid.data.size)}

@@ -104,7 +104,7 @@ def test_reindex_out_leaves_the_damaged_folder_as_it_was(tmp_path: Path) -> None
 
 
 def test_a_new_recording_never_removes_a_killed_one(tmp_path: Path) -> None:
-    from navlab.io.errors import BagError
+    from navlab.io import BagError
     from navlab.io.rosbag import BagWriter
 
     staging = tmp_path / ".run.partial" / "run"

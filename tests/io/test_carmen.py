@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from navlab.errors import NavlabError
+from navlab.io import IoError
 from navlab.io.carmen import read_carmen, skipped_summary
-from navlab.io.errors import IoError
 
 
 def _flaser(n: int, r: float, pose: tuple[float, float, float], ts: float) -> str:

@@ -10,9 +10,7 @@ from pathlib import Path
 import pytest
 
 from navlab.errors import NavlabError
-from navlab.io import datasets
-from navlab.io.datasets import data_dir, dataset
-from navlab.io.errors import DatasetNotFoundError
+from navlab.io import DatasetNotFoundError, data_dir, dataset, datasets
 
 REPO = Path(__file__).resolve().parents[2]
 

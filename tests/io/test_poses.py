@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from navlab.errors import NavlabError
-from navlab.io.errors import IoError
+from navlab.io import IoError
 from navlab.io.poses import read_poses, read_table, write_poses
 
 

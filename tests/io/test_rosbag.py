@@ -7,7 +7,7 @@ import json
 import pytest
 
 from navlab import msgs
-from navlab.io.errors import BagError, IoError
+from navlab.io import BagError, IoError
 from navlab.io.rosbag import GRAPH_KEY, BagWriter, bag_graph, bag_topics, read_bag
 
 

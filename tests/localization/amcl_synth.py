@@ -7,8 +7,7 @@ import math
 
 import numpy as np
 
-from navlab.localization import Scan
-from navlab.localization.field import MapField
+from navlab.localization import MapField, Scan
 from navlab.localization.synthetic import room_field, simulated_scan
 
 __all__ = ["odometry", "room_field", "route", "scan_at"]

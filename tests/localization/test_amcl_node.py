@@ -12,8 +12,8 @@ from amcl_synth import odometry, room_field, route, scan_at
 from navlab import msgs
 from navlab.core import Executor, Node, ParameterError
 from navlab.grid import GridMap
+from navlab.localization import LocalizationError
 from navlab.localization.amcl_node import Amcl
-from navlab.localization.errors import LocalizationError
 from navlab.localization.models import sample_motion_diff_corrected
 from navlab.localization.synthetic import room_grid
 

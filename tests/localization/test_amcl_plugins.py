@@ -9,8 +9,7 @@ import pytest
 from amcl_synth import room_field
 
 from navlab import plugins
-from navlab.localization.amcl import Amcl, AmclParams, Scan
-from navlab.localization.errors import LocalizationError
+from navlab.localization import Amcl, AmclParams, LocalizationError, Scan
 from navlab.localization.models import BeamModel, LikelihoodFieldModel, sample_motion_diff, sample_motion_diff_corrected
 
 

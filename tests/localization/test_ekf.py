@@ -8,13 +8,12 @@ import numpy as np
 import pytest
 
 from navlab import msgs
-from navlab.core import Executor, Node
-from navlab.core.params import load_params
+from navlab.core import Executor, Node, load_params
 from navlab.geometry import wrap_angle
 from navlab.localization import ekf
 from navlab.localization.ekf_node import EkfNode
 from navlab.resources import root as resources_root
-from navlab.world.model import WorldModel
+from navlab.world import WorldModel
 
 PARAMS = resources_root() / "params"
 

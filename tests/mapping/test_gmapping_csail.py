@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from navlab.experiments.metrics import read_relations
+from navlab.experiments import read_relations
 from navlab.geometry import wrap_angle
 from navlab.io.carmen import read_carmen
 from navlab.mapping.slam import make_slam, run_offline

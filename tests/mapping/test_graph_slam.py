@@ -7,7 +7,7 @@ import json
 import numpy as np
 
 from navlab.cli import main
-from navlab.experiments.metrics import read_relations, relations_error
+from navlab.experiments import read_relations, relations_error
 from navlab.mapping import load_map
 from navlab.mapping.graph_slam import GraphSlam, GraphSlamParams
 

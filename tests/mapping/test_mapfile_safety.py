@@ -9,9 +9,7 @@ import numpy as np
 import pytest
 
 from navlab.grid import GridMap
-from navlab.mapping import mapfile
-from navlab.mapping.errors import MappingError
-from navlab.mapping.mapfile import load_map, save_map
+from navlab.mapping import MappingError, load_map, mapfile, save_map
 
 
 def _grid(width: int, height: int, wall: int) -> GridMap:

@@ -8,8 +8,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from navlab.bench.mapping import office_scores, office_truth
 from navlab.experiments.trajectory import ate
-from navlab.mapping.bench import office_scores, office_truth
 from navlab.mapping.simlog import OdometryNoise, office_log, route_poses
 from navlab.mapping.slam import run_offline
 

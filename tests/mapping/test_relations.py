@@ -10,7 +10,7 @@ import pytest
 
 from navlab.cli import main
 from navlab.experiments.metrics import read_relations, relations_closure, relations_error
-from navlab.io.errors import IoError
+from navlab.io import IoError
 from navlab.io.poses import write_poses
 from navlab.mapping import MappingError
 

@@ -3,7 +3,7 @@
 import pytest
 
 from navlab.core import Executor
-from navlab.mapping.errors import MappingError
+from navlab.mapping import MappingError
 from navlab.mapping.teleop import JoyMapping, RouteFollower, TeleopKeyboard, TeleopState, load_route
 
 
@@ -47,7 +47,7 @@ def test_route_file_errors(tmp_path):
 
 
 def test_route_follower_drives_the_simulated_robot_to_its_waypoint():
-    from navlab.sim.gazebo import launch_sim
+    from navlab.sim import launch_sim
 
     ex = Executor(seed=0)
     gz = launch_sim(ex, world="room")

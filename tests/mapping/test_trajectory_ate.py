@@ -10,8 +10,8 @@ import pytest
 
 from navlab.cli import main
 from navlab.experiments.trajectory import align_se2, apply_se2, associate, ate, read_trajectory
+from navlab.io import IoError
 from navlab.io.carmen import CarmenLog, LaserScan2D, OdomRecord, read_carmen, write_carmen
-from navlab.io.errors import IoError
 from navlab.io.poses import write_poses
 from navlab.mapping import MappingError
 

@@ -13,6 +13,7 @@ import pytest
 from scipy import ndimage
 
 from navlab.grid import COST_INSCRIBED, COST_LETHAL, Grid
+from navlab.navigation import NavigationError
 from navlab.navigation.controllers import DWAPlannerROS, TrajectoryPlannerROS
 from navlab.navigation.controllers import mppi_critics as critics
 from navlab.navigation.controllers import synthetic as syn
@@ -20,7 +21,6 @@ from navlab.navigation.controllers.common import OscillationFlags, crop_plan
 from navlab.navigation.controllers.mapgrid import distance_map
 from navlab.navigation.controllers.mppi import MPPIController
 from navlab.navigation.controllers.trajectory import InPlaceFlags
-from navlab.navigation.errors import NavigationError
 from navlab.plugins import load_plugin
 
 RES = 0.05

@@ -16,10 +16,9 @@ import pytest
 from navlab.cli import main
 from navlab.errors import NavlabError
 from navlab.experiments.navigate_run import run_navigation
-from navlab.experiments.truth import true_map
-from navlab.mapping.mapfile import save_map
-from navlab.sim.gazebo import load_world_named
-from navlab.sim.spawn import primitive_model
+from navlab.mapping import save_map
+from navlab.sim import primitive_model
+from navlab.world import load_world, true_map
 
 # Goals spread over room.world's free space (map frame = world frame), visited in this order.
 ROOM_GOALS = [(3.5, 3.0, 1.57), (0.5, 2.5, 3.14), (-3.5, 3.0, 3.14), (-3.5, 0.0, -1.57), (-4.0, -3.0, -1.57),
@@ -31,7 +30,7 @@ REACHED_M = 0.25  # xy_goal_tolerance 0.15 m plus AMCL's error: the true pose's 
 def room_map(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """The map of the empty room (no obstacles), as the paper's mapping step would have saved it."""
     path = tmp_path_factory.mktemp("map") / "room.yaml"
-    save_map(true_map(load_world_named("room"), (0.0, 0.0)), path)
+    save_map(true_map(load_world("room"), (0.0, 0.0)), path)
     return path
 
 
@@ -90,7 +89,7 @@ def test_goals_outside_the_map_or_in_an_obstacle_are_aborted_with_a_reason() -> 
 
 
 def test_a_walled_off_goal_runs_the_recoveries_then_aborts(tmp_path: Path) -> None:
-    grid = true_map(load_world_named("room"), (0.0, 0.0))
+    grid = true_map(load_world("room"), (0.0, 0.0))
     ring = grid.world_to_cell(np.array([[1.4, -0.6], [2.6, 0.6]]))  # a closed square wall around (2, 0)
     (i0, j0), (i1, j1) = ring
     grid.data[j0:j1 + 1, [i0, i1]] = 100
@@ -124,7 +123,7 @@ def _room_true_map() -> Path:
     import tempfile
 
     path = Path(tempfile.mkdtemp(prefix="navlab-test-")) / "room.yaml"
-    save_map(true_map(load_world_named("room"), (0.0, 0.0)), path)
+    save_map(true_map(load_world("room"), (0.0, 0.0)), path)
     return path
 
 

@@ -44,10 +44,9 @@ def ros_env(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, str]
 
 @pytest.fixture(scope="session")
 def room_map(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    from navlab.experiments.truth import true_map
-    from navlab.mapping.mapfile import save_map
-    from navlab.sim.gazebo import load_world_named
+    from navlab.mapping import save_map
+    from navlab.world import load_world, true_map
 
     path = tmp_path_factory.mktemp("map") / "room.yaml"
-    save_map(true_map(load_world_named("room"), (0.0, 0.0)), path)
+    save_map(true_map(load_world("room"), (0.0, 0.0)), path)
     return path

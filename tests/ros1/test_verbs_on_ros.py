@@ -87,8 +87,8 @@ def test_view_ros_registers_the_live_launch_on_the_master(ros_env: dict[str, str
 def test_the_hook_paces_each_run_and_leaves_runs_without_ros_or_rate_alone() -> None:
     from argparse import Namespace
 
+    from navlab.cli.runs import ros_hook
     from navlab.experiments.session import start_run
-    from navlab.ros1.cli import ros_hook
 
     started: list[Any] = []
     with ros_hook(Namespace(ros=False, rate=None), started.append) as on_start:

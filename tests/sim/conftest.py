@@ -5,8 +5,8 @@ from __future__ import annotations
 import pytest
 from sim_helpers import make_mybot, make_room
 
-from navlab.description.model import RobotModel
-from navlab.world.model import WorldModel
+from navlab.description import RobotModel
+from navlab.world import WorldModel
 
 
 @pytest.fixture

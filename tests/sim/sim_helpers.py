@@ -17,7 +17,7 @@ from navlab.description.model import (
     RobotModel,
     Shape,
 )
-from navlab.world.model import ModelSpec, WorldModel
+from navlab.world import ModelSpec, WorldModel
 
 
 def _cyl_inertial(mass: float, r: float, h: float, axis: str = "z") -> Inertial:

@@ -1,5 +1,5 @@
 """Issue 13 item 11: a world's concave meshes are decomposed once, in parallel, into a cache keyed by
-their content (fixture: navlab.sim.decompose_bench.furnished_world)."""
+their content (fixture: navlab.bench.decompose.furnished_world)."""
 
 from __future__ import annotations
 
@@ -9,8 +9,8 @@ import shutil
 import numpy as np
 import pytest
 
+from navlab.bench.decompose import furnished_world
 from navlab.sim import decompose
-from navlab.sim.decompose_bench import furnished_world
 from navlab.world import load_world
 
 
@@ -57,8 +57,7 @@ def test_decomposed_only_up_to_the_robots_reach_and_the_robot_still_cannot_drive
     from sim_helpers import make_mybot
 
     from navlab.description.meshes import read_mesh
-    from navlab.sim import Simulation
-    from navlab.sim.spawn import primitive_model
+    from navlab.sim import Simulation, primitive_model
 
     robot = make_mybot(noise=0.0)
     reach = decompose.robot_reach(robot)

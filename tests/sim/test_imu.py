@@ -8,10 +8,8 @@ from sim_helpers import make_mybot, make_room
 
 from navlab import msgs
 from navlab.core import Executor, Node
-from navlab.description.model import ImuConfig
-from navlab.sim import launch_sim
-from navlab.sim.errors import SimError
-from navlab.sim.gazebo import load_robot_named
+from navlab.description import ImuConfig, load_robot_named
+from navlab.sim import SimError, launch_sim
 from navlab.sim.imu import AxisNoise, ImuNoise, noise_from_description
 
 SENSOR = """<robot name="mybot"><gazebo reference="chassis"><sensor type="imu" name="imu"><imu>

@@ -12,7 +12,7 @@ from navlab import msgs
 from navlab.core import Executor, Node
 from navlab.geometry import wrap_angle
 from navlab.sim import launch_sim
-from navlab.world.model import WorldModel
+from navlab.world import WorldModel
 
 
 class Probe(Node):

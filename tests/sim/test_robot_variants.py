@@ -10,7 +10,7 @@ from sim_helpers import make_mybot, make_room
 
 from navlab import msgs
 from navlab.core import Executor, Node
-from navlab.description.model import ImuConfig, Joint, Link, Origin
+from navlab.description import ImuConfig, Joint, Link, Origin
 from navlab.sim import Simulation, launch_sim
 from navlab.sim.diffdrive import EncoderOdometry, ramp, wheel_speeds
 

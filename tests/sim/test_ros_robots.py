@@ -79,8 +79,7 @@ def test_cmd_timeout_watchdog_is_a_navlab_parameter() -> None:
 
 
 def test_gazebo_material_colours_the_rendered_chassis() -> None:
-    from navlab.sim import Simulation
-    from navlab.sim.errors import SimError
+    from navlab.sim import SimError, Simulation
     from navlab.sim.render import render_image
 
     robot = load_robot(XACRO)

@@ -8,10 +8,9 @@ from pathlib import Path
 import pytest
 from sim_helpers import make_mybot
 
-from navlab.description.model import Geometry, Link, Shape
-from navlab.sim import Simulation
-from navlab.sim.spawn import primitive_model
-from navlab.world.model import ModelSpec, WorldModel
+from navlab.description import Geometry, Link, Shape
+from navlab.sim import Simulation, primitive_model
+from navlab.world import ModelSpec, WorldModel
 
 # a U seen from above: a bar along y=0..0.5 and two arms x=0..0.5 and x=1..1.5 up to y=1.5
 U_OUTLINE = [(0, 0), (0.5, 0), (1.0, 0), (1.5, 0), (1.5, 1.5), (1.0, 1.5), (1.0, 0.5), (0.5, 0.5), (0.5, 1.5),

@@ -10,7 +10,7 @@ from sim_helpers import box_model, make_mybot, make_room
 
 from navlab.sim import SimError, Simulation
 from navlab.sim.simulation import lidar_angles
-from navlab.world.model import WorldModel
+from navlab.world import WorldModel
 
 WHEEL_R = 0.08
 HALF_SEP = 0.2
@@ -144,8 +144,8 @@ def test_bad_input_is_a_clear_error() -> None:
 def test_numba_lidar_matches_mj_multiray() -> None:
     from dataclasses import replace
 
-    from navlab.description.model import Origin
-    from navlab.sim.spawn import primitive_model
+    from navlab.description import Origin
+    from navlab.sim import primitive_model
 
     robot = make_mybot(noise=0.0)
     tilted = replace(robot.lidars[0], origin=Origin((0.0, 0.0, 0.0), (0.25, 0.1, 0.0)), name="tilted")

@@ -21,7 +21,7 @@ from navlab import msgs
 from navlab.core import Executor, Node
 from navlab.core.node import flatten_params
 from navlab.description import load_robot
-from navlab.sim.gazebo import launch_sim
+from navlab.sim import launch_sim
 
 FIXTURE = Path(__file__).parents[1] / "fixtures" / "skidbot_description"
 XACRO = FIXTURE / "urdf" / "skidbot.urdf.xacro"

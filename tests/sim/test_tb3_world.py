@@ -15,7 +15,7 @@ BURGER = FIX / "turtlebot3_description" / "urdf" / "turtlebot3_burger.urdf.xacro
 
 def test_hexagon_walls_stand_upright():
     world = load_world(WORLD)
-    from navlab.world.occupancy import extents
+    from navlab.world import extents
 
     x0, y0, x1, y1 = extents(world, z_min=0.05, z_max=0.3)
     assert x1 - x0 > 4.0 and y1 - y0 > 3.5  # a 4.2 m wide arena at lidar height, not walls lying flat

@@ -9,12 +9,10 @@ import pytest
 from sim_helpers import make_mybot, make_room
 
 from navlab import msgs
-from navlab.core import Executor, Node
-from navlab.core.params import load_params
+from navlab.core import Executor, Node, load_params
 from navlab.resources import root as resources_root
-from navlab.sim import launch_sim
+from navlab.sim import SimError, launch_sim
 from navlab.sim.disturbances import parse_disturbances
-from navlab.sim.errors import SimError
 from navlab.sim.pid import Pid, PidGains
 from navlab.sim.wheel_control import SpeedLimiter, WheelOdometry
 

@@ -10,8 +10,8 @@ from viz_helpers import next_state
 from websockets.sync.client import connect
 
 from navlab.cli import main
+from navlab.cli.runs import viewing
 from navlab.experiments.session import start_run
-from navlab.viz.cli import viewing
 
 
 def test_sim_and_launch_take_view(capsys: pytest.CaptureFixture[str]) -> None:
@@ -45,9 +45,10 @@ def test_viewing_serves_while_the_block_runs_and_warns_off_loopback(capsys: pyte
 
 
 def test_navlab_view_starts_a_launch_with_ros_style_arguments(capsys: pytest.CaptureFixture[str]) -> None:
-    argv = ["view", "--launch", "sim", "world:=room", "x:=0.5", "--speed", "0", "--duration", "0.2", "--port", "0"]
+    argv = ["view", "--launch", "sim", "world:=room", "x:=0.5", "--rate", "0", "--duration", "0.2", "--port", "0"]
     assert main([*argv, "--no-browser"]) == 0
-    assert "viewer: http://127.0.0.1:" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "viewer: http://127.0.0.1:" in err and "DeprecationWarning" not in err
     assert main(["view", "--launch", "sim", "wrold:=room", "--port", "0", "--no-browser"]) == 2
     assert "did you mean 'world'" in capsys.readouterr().err
 
@@ -63,7 +64,7 @@ def test_navigate_takes_view(capsys: pytest.CaptureFixture[str]) -> None:
 def test_view_hook_moves_the_page_to_each_new_run_on_the_same_port() -> None:
     import socket
 
-    from navlab.viz.cli import view_hook
+    from navlab.cli.runs import view_hook
 
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
@@ -79,3 +80,18 @@ def test_view_hook_moves_the_page_to_each_new_run_on_the_same_port() -> None:
             state = next_state(ws)
         assert 0.2 < state["t"] <= 0.4 + 1e-9  # the second run's clock (the first stopped at 0.1 s)
     assert "/navlab_viewer" not in second.executor.nodes
+
+
+def test_view_speed_is_a_deprecated_alias_of_rate() -> None:
+    """``navlab view --speed`` (the pacing option's old name) still sets the pace, with a warning, this release."""
+    import contextlib
+    import io
+
+    from navlab.cli import build_parser
+
+    err = io.StringIO()
+    with contextlib.redirect_stderr(err):
+        args = build_parser().parse_args(["view", "--speed", "0"])
+    assert args.rate == 0.0
+    assert "--speed is deprecated, use --rate" in err.getvalue()
+    assert build_parser().parse_args(["view"]).rate == 1.0

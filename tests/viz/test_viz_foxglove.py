@@ -14,7 +14,7 @@ from websockets.sync.client import connect
 
 from navlab import msgs
 from navlab.experiments.session import start_run
-from navlab.viz.cli import _true_map
+from navlab.mapping import save_true_map
 from navlab.viz.foxglove_bridge import FoxgloveBridge, message_from_json
 
 SUBPROTOCOL = "foxglove.sdk.v1"  # foxglove-sdk's name for the Foxglove WebSocket protocol
@@ -22,7 +22,8 @@ SUBPROTOCOL = "foxglove.sdk.v1"  # foxglove-sdk's name for the Foxglove WebSocke
 
 def test_foxglove_client_gets_map_and_scan_and_its_goal_reaches_move_base() -> None:
     with tempfile.TemporaryDirectory() as tmp:
-        run = start_run("navigation", world="room_obstacles", map=_true_map("room_obstacles", (0, 0, 0), Path(tmp)))
+        truth = save_true_map("room_obstacles", (0, 0), Path(tmp) / "true_map.yaml")
+        run = start_run("navigation", world="room_obstacles", map=str(truth))
     bridge = FoxgloveBridge(run.executor, port=0)
     thread = threading.Thread(target=lambda: run.run(600.0, quiet=True), daemon=True)
     thread.start()

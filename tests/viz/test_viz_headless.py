@@ -8,10 +8,8 @@ from pathlib import Path
 
 import pytest
 
-from navlab.viz.errors import VizError
+from navlab.viz import Hub, ViewerServer, VizError
 from navlab.viz.headless import CHROMIUM, HeadlessPage
-from navlab.viz.hub import Hub
-from navlab.viz.server import ViewerServer
 
 pytestmark = pytest.mark.skipif(not os.path.exists(CHROMIUM), reason=f"needs chromium at {CHROMIUM}")
 

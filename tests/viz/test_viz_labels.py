@@ -5,8 +5,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from navlab.viz.hub import Hub
-from navlab.viz.server import ViewerServer
+from navlab.viz import Hub, ViewerServer
 
 # every fillText on the page's own canvas (?worker=0: the page draws on its thread), as drawn
 RECORD_TEXT = """

@@ -16,16 +16,17 @@ import pytest
 from viz_helpers import canvas_xy, open_page, pixel, to_screen
 
 from navlab.experiments.session import Run, start_run
-from navlab.viz.cli import _true_map
-from navlab.viz.viewer import Viewer, attach
+from navlab.mapping import save_true_map
+from navlab.viz import Viewer, attach
 
 
 @pytest.fixture(scope="module")
 def live() -> Iterator[tuple[Run, Viewer]]:
     """The paper's navigation launch in room_obstacles, watched at 5x real time, its executor in a thread."""
     with tempfile.TemporaryDirectory() as tmp:
-        run = start_run("navigation", world="room_obstacles", map=_true_map("room_obstacles", (0, 0, 0), Path(tmp)))
-    viewer = attach(run.executor, port=0, speed=5.0)
+        truth = save_true_map("room_obstacles", (0, 0), Path(tmp) / "true_map.yaml")
+        run = start_run("navigation", world="room_obstacles", map=str(truth))
+    viewer = attach(run.executor, port=0, rate=5.0)
     thread = threading.Thread(target=lambda: run.run(3600.0, quiet=True), daemon=True)
     thread.start()
     yield run, viewer

@@ -14,9 +14,8 @@ from navlab import msgs
 from navlab.core import Node
 from navlab.experiments.session import start_run
 from navlab.io.rosbag import read_bag
-from navlab.viz.hub import Hub
+from navlab.viz import Hub, ViewerServer
 from navlab.viz.replay import BagPlayer, load_recording, play_bag
-from navlab.viz.server import ViewerServer
 
 
 @pytest.fixture(scope="module")

@@ -15,7 +15,7 @@ from viz_helpers import open_page, pixel, to_screen
 
 from navlab import msgs
 from navlab.experiments.session import Run, start_run
-from navlab.viz.cli import _true_map
+from navlab.mapping import save_true_map
 from navlab.viz.sensor_frames import image_rgba
 from navlab.viz.viewer import Viewer, attach
 
@@ -39,8 +39,8 @@ def test_image_rgba_shrinks_and_colours() -> None:
 def live() -> Iterator[tuple[Run, Viewer]]:
     with tempfile.TemporaryDirectory() as tmp:
         run = start_run("navigation", world="tables", robot="mybot_depth", pose=(-1.2, 0.0, 0.0),
-                        map=_true_map("tables", (-1.2, 0.0, 0.0), Path(tmp)))
-    viewer = attach(run.executor, port=0, speed=2.0)
+                        map=str(save_true_map("tables", (-1.2, 0.0), Path(tmp) / "true_map.yaml")))
+    viewer = attach(run.executor, port=0, rate=2.0)
     thread = threading.Thread(target=lambda: run.run(3600.0, quiet=True), daemon=True)
     thread.start()
     yield run, viewer

@@ -16,7 +16,7 @@ from viz_helpers import headers, next_state
 from websockets.exceptions import ConnectionClosed, InvalidStatus
 from websockets.sync.client import connect
 
-from navlab.viz.hub import Hub
+from navlab.viz import Hub
 from navlab.viz.server import ViewerServer, safe_static_path, static_dir
 from navlab.viz.viewer import host_warning
 
@@ -123,7 +123,7 @@ def test_survives_malformed_messages_and_mid_frame_disconnects(server: ViewerSer
 
 
 def test_a_port_in_use_is_a_clear_error(server: ViewerServer) -> None:
-    from navlab.viz.errors import VizError
+    from navlab.viz import VizError
 
     with pytest.raises(VizError, match=f"cannot serve the viewer on 127.0.0.1:{server.port}"):
         ViewerServer(Hub(), port=server.port).start()

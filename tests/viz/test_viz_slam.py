@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 
 from navlab.experiments.session import start_run
+from navlab.viz import attach
 from navlab.viz import frames as fr
 from navlab.viz.hub import ClientStream
-from navlab.viz.viewer import attach
 
 
 def _known_cells(stream: ClientStream, now: float) -> int:
@@ -22,7 +22,7 @@ def _known_cells(stream: ClientStream, now: float) -> int:
 
 def test_slam_map_grows_on_the_page() -> None:
     run = start_run("mapping", world="room", explore="true")
-    viewer = attach(run.executor, port=0, speed=0.0)
+    viewer = attach(run.executor, port=0, rate=0.0)
     try:
         run.run(3.0)
         early = _known_cells(ClientStream(viewer.hub), 100.0)

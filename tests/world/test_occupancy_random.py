@@ -6,10 +6,9 @@ import numpy as np
 import pytest
 from scipy.spatial import cKDTree
 
-from navlab.description.model import Geometry, Link, Origin, Shape
+from navlab.description import Geometry, Link, Origin, Shape
 from navlab.geometry import matrix_from_pose6
-from navlab.world import WorldModel, occupancy
-from navlab.world.model import ModelSpec
+from navlab.world import ModelSpec, WorldModel, occupancy
 
 RES, BOUNDS, Z0, Z1 = 0.05, (-2.0, -2.0, 2.0, 2.0), 0.05, 0.5
 

@@ -180,7 +180,7 @@ def echo_launch(file_and_args: list[str], topic: str, out: Printer, duration: fl
     from navlab.core.runner import parse_launch_args
 
     file, *items = file_and_args
-    session = start(file, seed=seed, pace=1.0 if math.isinf(duration) else 0.0, launch_args=parse_launch_args(items))
+    session = start(file, seed=seed, rate=1.0 if math.isinf(duration) else 0.0, launch_args=parse_launch_args(items))
     ex = session.executor
     ex.add_listener(lambda name, msg, _t: out(msg) if name == topic else None)
     run_for(ex, min(duration, 1.0), quiet=True, until=lambda: out.done)

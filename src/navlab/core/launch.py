@@ -438,23 +438,28 @@ def start(
     *,
     executor: Executor | None = None,
     seed: int = 0,
-    pace: float = 0.0,
+    rate: float = 0.0,
     launch_args: dict[str, Any] | None = None,
     overrides: dict[str, dict[str, Any]] | None = None,
     ros: bool = False,
+    pace: float | None = None,
     **args: Any,
 ) -> Session:
     """Start a launch (shipped name or file, or several files as ``roslaunch a.launch b.launch``) with
     arguments; returns the session.
 
     Arguments come as keywords (``start("mapping", world="room")``) or, for names that clash with
-    this function's own (``seed``, ``pace``), in ``launch_args``. ``pace`` is the executor's rate
-    (0 = as fast as possible, 1 = real time). ``overrides`` maps a node name to parameters applied
-    after the launch file's own (``{"amcl": {"laser_max_beams": 60}}``); a name no node has is refused.
+    this function's own (``seed``, ``rate``), in ``launch_args``. ``rate`` is the executor's pace
+    (0 = as fast as possible, 1 = real time; ``pace``, its old name, is deprecated: a launch argument called
+    ``rate`` goes in ``launch_args``). ``overrides`` maps a node name to parameters applied after the launch
+    file's own (``{"amcl": {"laser_max_beams": 60}}``); a name no node has is refused.
     ROS 1 XML files (``.launch``) are read with roslaunch's semantics (:mod:`navlab.core.roslaunch`);
     ``ros`` (or the argument ``ros:=true``) starts the nodes navlab does not implement as processes,
     as roslaunch does, for the ROS bridge. Call :meth:`Session.shutdown` when done.
     """
+    from navlab.deprecation import renamed
+
+    rate = renamed(rate, pace, old="pace", new="rate", where="navlab.launch")
     names = [name_or_path] if isinstance(name_or_path, str | os.PathLike) else list(name_or_path)
     if not names:
         raise LaunchError("no launch file given")
@@ -466,7 +471,7 @@ def start(
     if any(xml) and not all(xml):
         raise LaunchError(f"{', '.join(map(str, files))}: ROS 1 .launch (XML) and YAML launch files cannot be "
                           "started together; start them in one format")
-    session = Session(executor or Executor(seed=seed, rate=pace), args=all_args,
+    session = Session(executor or Executor(seed=seed, rate=rate), args=all_args,
                       overrides={k.lstrip("/"): dict(v) for k, v in (overrides or {}).items()})
     if all(xml):
         if "ros" in all_args:

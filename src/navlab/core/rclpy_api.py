@@ -45,9 +45,14 @@ _DEFAULT: contextvars.ContextVar[Context | None] = contextvars.ContextVar("navla
 
 
 def init(args: Sequence[str] | None = None, *, context: Context | None = None, launch: Any = None,
-         seed: int = 0, pace: float = 0.0, duration: float | None = None, **launch_args: Any) -> Context:
+         seed: int = 0, rate: float = 0.0, duration: float | None = None, pace: float | None = None,
+         **launch_args: Any) -> Context:
     """``rclpy.init()``: make (or take) the default context. ``launch``: a launch to start in it (shipped
-    name or file(s)), with ``launch_args``; ``args`` are ``name:=value`` items as on a command line."""
+    name or file(s)), with ``launch_args``; ``args`` are ``name:=value`` items as on a command line. ``rate``:
+    the pace (0 = as fast as possible, 1 = real time; ``pace``, its old name, is deprecated)."""
+    from navlab.deprecation import renamed
+
+    rate = renamed(rate, pace, old="pace", new="rate", where="navlab.init")
     current = _DEFAULT.get()
     if context is None and launch is None and current is not None and current.prepared:
         current.prepared = False  # `navlab run FILE`: the file's rclpy.init() joins the launch started for it
@@ -58,10 +63,10 @@ def init(args: Sequence[str] | None = None, *, context: Context | None = None, l
             from navlab.core.runner import parse_launch_args
 
             items = parse_launch_args([a for a in args or [] if ":=" in a])
-            session = start(launch, seed=seed, pace=pace, launch_args={**items, **launch_args})
+            session = start(launch, seed=seed, rate=rate, launch_args={**items, **launch_args})
             context = Context(session.executor, session, duration)
         else:
-            context = Context(Executor(seed=seed, rate=pace), None, duration)
+            context = Context(Executor(seed=seed, rate=rate), None, duration)
     _DEFAULT.set(context)
     return context
 

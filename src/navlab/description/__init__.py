@@ -12,7 +12,7 @@ from navlab.lazy import lazy_exports
 
 if TYPE_CHECKING:
     from navlab.description.errors import DescriptionError
-    from navlab.description.loader import load_robot
+    from navlab.description.loader import load_robot, load_robot_named
     from navlab.description.model import (
         DiffDriveConfig,
         Geometry,
@@ -41,6 +41,7 @@ _EXPORTS = {
     "RobotModel": "navlab.description.model",
     "Shape": "navlab.description.model",
     "load_robot": "navlab.description.loader",
+    "load_robot_named": "navlab.description.loader",
 }
 __all__ = [
     "DescriptionError",
@@ -56,5 +57,6 @@ __all__ = [
     "RobotModel",
     "Shape",
     "load_robot",
+    "load_robot_named",
 ]
 __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

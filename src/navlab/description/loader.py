@@ -115,6 +115,12 @@ def load_robot(
     return model
 
 
+def load_robot_named(name_or_path: str, args: list[str] | None = None) -> RobotModel:
+    """A robot from a shipped name (``mybot``), a ``package://`` URI or a .xacro/.urdf path, with xacro
+    arguments as on a command line (``["name:=value", ...]``; items without ``:=`` are ignored)."""
+    return load_robot(name_or_path, args=dict(a.split(":=", 1) for a in args or [] if ":=" in a))
+
+
 def xacro_text(path: str | os.PathLike[str], args: Mapping[str, str] | None = None) -> str:
     """The URDF text ``xacro FILE name:=value`` prints (a launch file's ``<param command="xacro ...">``)."""
     file = robot_path(path)

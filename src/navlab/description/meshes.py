@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from navlab.description.errors import DescriptionError, NotFoundError
-from navlab.io.errors import IoError
+from navlab.io import IoError
 from navlab.io.files import check_regular_file, read_bytes_checked, write_text_atomic
 
 MESH_SUFFIXES = (".stl", ".obj", ".dae")

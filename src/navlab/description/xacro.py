@@ -28,7 +28,7 @@ from xacro import substitution_args
 from navlab.core.safe_eval import MATH_NAMES, ExpressionError, safe_eval
 from navlab.description.errors import DescriptionError
 from navlab.description.packages import PackageIndex
-from navlab.io.errors import IoError
+from navlab.io import IoError
 from navlab.io.files import read_bytes_checked, read_text_checked
 
 MAX_INCLUDE_DEPTH = 32

@@ -124,20 +124,3 @@ def summarize(trials: list[dict[str, Any]]) -> dict[str, Any]:
         "score": sum(t["score"] for t in trials) / n,
         "mean_time_s": sum(t["time_s"] for t in trials if t["success"]) / max(1, sum(t["success"] for t in trials)),
     })  # fmt: skip
-
-
-def bench(args: Any) -> dict[str, Any]:
-    """``navlab bench clutter``: mapless navigation over 50 generated clutter worlds of graded difficulty (``--robot``:
-    mybot with MPPI by default; another shipped robot drives with its own params/<robot> planner unless
-    ``--controller`` names one)."""
-    import time
-
-    n = int(getattr(args, "worlds", 0) or 50)
-    t0 = time.perf_counter()
-    robot = getattr(args, "robot", None) or "mybot"
-    controller = getattr(args, "controller", None) or ("mppi" if robot == "mybot" else None)  # None: params/<robot>'s
-    out = run_clutter_suite(n, seed=getattr(args, "seed", 0), controller=controller, robot=robot)
-    s = dict(out["summary"])
-    s["wall_s"] = round(time.perf_counter() - t0, 1)
-    s["failed_worlds"] = [t["world"] for t in out["trials"] if not t["success"]]
-    return s

@@ -22,10 +22,10 @@ from navlab.experiments.metrics import settled_after, trajectory_error
 from navlab.experiments.monitors import PoseMonitor
 from navlab.experiments.plots import ErrorPanel, Marks, Track, plot_run
 from navlab.experiments.session import rounded, start_run
-from navlab.experiments.truth import true_map, unmapped_obstacles
 from navlab.geometry import wrap_angle
 from navlab.grid import GridMap
-from navlab.localization.errors import LocalizationError
+from navlab.localization import LocalizationError
+from navlab.world import true_map, unmapped_obstacles
 
 # A 17.5 m loop through room.world / room_obstacles.world, at least 0.5 m from every obstacle.
 DEFAULT_ROUTE: tuple[tuple[float, float], ...] = (
@@ -108,10 +108,10 @@ def run_localization(
     that time (s) the robot is teleported to the route waypoint farthest from it and continues the route
     from there. ``record``: also write every topic to a rosbag2 (MCAP) in that folder.
     """
-    from navlab.localization.field import field_from_map
-    from navlab.mapping.mapfile import load_map, save_map
+    from navlab.localization import field_from_map
+    from navlab.mapping import load_map, save_map
     from navlab.mapping.teleop import RouteFollower
-    from navlab.sim.gazebo import load_world_named
+    from navlab.world import load_world
 
     if duration <= 0:
         raise LocalizationError(f"duration must be > 0 s, got {duration}")
@@ -125,7 +125,7 @@ def run_localization(
             from navlab.world import shape_footprints
 
             served = Path(tmp) / "true_map.yaml"
-            world_model = load_world_named(world)
+            world_model = load_world(world)
             if not shape_footprints(world_model):
                 raise LocalizationError(f"world {world}: nothing stands at the lidar's height (an empty world); AMCL "
                                         "needs walls or obstacles to localize against")

@@ -19,15 +19,13 @@ from navlab.experiments.metrics import free_coverage, score_map, trajectory_erro
 from navlab.experiments.monitors import PoseMonitor
 from navlab.experiments.plots import Marks, Track, plot_run
 from navlab.experiments.session import Run, rounded, start_run
-from navlab.experiments.truth import true_occupancy, world_T_map
 from navlab.geometry import inverse_transform_points2, wrap_angle
 from navlab.grid import GridMap
 from navlab.io.files import check_regular_file
-from navlab.mapping.errors import MappingError
-from navlab.mapping.mapfile import save_map
+from navlab.mapping import MappingError, save_map
+from navlab.world import true_occupancy, world_T_map
 
 DRIVERS = ("explore", "teleop", "route")
-WARMUP_S = 5.0  # simulated s of `bench`'s untimed warm-up run
 TRAJECTORY_HEADER = ("# t x y theta true_x true_y true_theta  (s, m, rad; map frame = the odom frame at the start: "
                      "the world for world odometry, the start pose for encoder odometry)")
 
@@ -99,7 +97,7 @@ def run_mapping(
     if sim_params:
         overrides["gazebo"] = dict(sim_params)
     run = start_run("mapping", world=world, robot=robot, pose=pose, seed=seed,
-                    pace=1.0 if driver == "teleop" and rate == 0 else rate, overrides=overrides,
+                    rate=1.0 if driver == "teleop" and rate == 0 else rate, overrides=overrides,
                     explore=str(driver == "explore").lower(), on_start=on_start)  # fmt: skip
     is_done = _add_driver(run, driver, route)
     monitor = run.add(PoseMonitor, parameters={"base_frame": run.base_frame, "odom_frame": run.odom_frame})
@@ -175,22 +173,3 @@ def read_trajectory(path: Path) -> tuple[np.ndarray, np.ndarray]:
     if rows.shape[1] != 7:
         raise MappingError(f"{path}: expected 7 columns (t x y theta true_x true_y true_theta), got {rows.shape[1]}")
     return rows[:, 1:4], rows[:, 4:7]
-
-
-def bench(args: Any) -> dict[str, Any]:
-    """``navlab bench mapping``: the whole mapping stack (sim + lidar + slam_gmapping + exploration)
-    exploring room.world until done; real-time factor of the run loop (sim s / wall s), after an untimed
-    ``WARMUP_S`` warm-up run."""
-    import tempfile
-
-    with tempfile.TemporaryDirectory() as tmp:
-        # a short untimed run first: Numba's kernels load (or compile, on a cold cache) outside the figure
-        run_mapping(world="room", out=Path(tmp) / "warmup", driver="explore", duration=WARMUP_S, quiet=True)
-        r = run_mapping(world="room", out=tmp, driver="explore", duration=300, seed=getattr(args, "seed", 0),
-                        quiet=True)  # fmt: skip
-    keys = ("sim_s", "wall_s", "rtf", "finished", "scans_processed", "coverage", "precision", "recall")
-    out = {k: r.scores[k] for k in keys}
-    # this process's CPU time in the run loop: on a busy machine it shows what one free core would take
-    out["cpu_s"] = round(r.cpu_s, 2)
-    out["rtf_cpu"] = round(r.sim_s / r.cpu_s, 1) if r.cpu_s > 0 else None
-    return out

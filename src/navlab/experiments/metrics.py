@@ -18,11 +18,11 @@ import numpy as np
 from scipy import ndimage
 
 from navlab.experiments.trajectory import ate
-from navlab.experiments.truth import visible_surface
 from navlab.geometry import inverse_transform_points2, transform_points2, wrap_angle
 from navlab.grid import Grid, GridMap
 from navlab.io.poses import read_poses, read_table, write_poses
-from navlab.mapping.errors import MappingError
+from navlab.mapping import MappingError
+from navlab.world import visible_surface
 
 __all__ = [
     "ate", "distance_to_path", "free_coverage", "read_poses", "read_relations", "relations_error", "score_map",

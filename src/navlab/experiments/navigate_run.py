@@ -26,10 +26,10 @@ from navlab.core.record import Recorder
 from navlab.experiments.metrics import distance_to_path
 from navlab.experiments.plots import NavSnapshot
 from navlab.experiments.session import Run, rounded, start_run
-from navlab.experiments.truth import true_map, unmapped_obstacles
 from navlab.geometry import compose2, transform_points2
 from navlab.grid import Grid, GridMap
-from navlab.navigation.errors import NavigationError
+from navlab.navigation import NavigationError
+from navlab.world import true_map, unmapped_obstacles
 
 if TYPE_CHECKING:
     from navlab.navigation.move_base import MoveBase
@@ -231,8 +231,8 @@ def run_navigation(
     whatever move_base says.
     ``progress``: a function given one line of text per goal sent/ended and every 10 simulated s (None: silent).
     """
-    from navlab.mapping.mapfile import load_map, save_map
-    from navlab.sim.gazebo import load_world_named
+    from navlab.mapping import load_map, save_map
+    from navlab.world import load_world
 
     def say(text: str) -> None:
         if progress is not None:
@@ -255,7 +255,7 @@ def run_navigation(
     with tempfile.TemporaryDirectory(prefix="navlab-navigate-") as tmp:
         if map_yaml is None:
             served = Path(tmp) / "true_map.yaml"
-            save_map(true_map(load_world_named(world), pose[:2]), served)
+            save_map(true_map(load_world(world), pose[:2]), served)
         else:
             served = Path(map_yaml)
         grid = load_map(served)
@@ -281,7 +281,7 @@ def run_navigation(
     results: list[dict[str, Any]] = []
     shots: list[NavSnapshot] = []
     arrivals: list[NavSnapshot] = []
-    new_obstacles = unmapped_obstacles(load_world_named(world), grid, pose[:2]) if snapshots and not mapless else None
+    new_obstacles = unmapped_obstacles(load_world(world), grid, pose[:2]) if snapshots and not mapless else None
     recorder = Recorder(run.executor, record) if record else None  # the whole run, every goal, in one bag
     run.run(1.0, quiet=True)  # amcl's first update, the costmaps' first maps
     frame = run.odom_frame if mapless else "map"
@@ -425,16 +425,6 @@ def _snapshot(run: Run, mon: NavMonitor, world_T_frame: Pose = (0.0, 0.0, 0.0), 
             "path": np.array([p[1:] for p in mon.path]), "scan_xy": mon.scan_points(), "robot": run.sim.base_pose2d(),
             "footprint": mb.local_costmap.layered.footprint, "t": mon.now_s(),
             "costmap_in_map": world_T_frame if mapless else None}  # fmt: skip
-
-
-def bench(args: Any) -> dict[str, Any]:
-    """``navlab bench nav``: the whole navigation stack (sim + lidar + amcl + costmaps + planner + controller)
-    driving across room_obstacles.world to four goals; real-time factor of the run loop."""
-    goals = [(4.3, 1.0, 0.0), (-3.5, -0.5, 3.14), (1.5, -2.5, 0.0), (0.0, 0.0, 0.0)]
-    run_navigation(goals[:1], world="room_obstacles", goal_timeout=5, seed=getattr(args, "seed", 0))  # warm-up: Numba
-    r = run_navigation(goals, world="room_obstacles", goal_timeout=90, seed=getattr(args, "seed", 0))
-    return {**{k: r.summary[k] for k in ("sim_s", "wall_s", "rtf")}, "goals_succeeded": r.summary["goals_succeeded"],
-            "goals": len(goals), "collisions": r.summary["collisions"]}  # fmt: skip
 
 
 def mean_abs_jerk(cmd: Sequence[tuple[float, float]]) -> float | None:

@@ -121,19 +121,3 @@ def _route_follower() -> type[Node]:
     from navlab.mapping.teleop import RouteFollower
 
     return RouteFollower
-
-
-def bench(args: Any) -> dict[str, Any]:
-    """``navlab bench odom``: drift per robot, route and EKF setting (see the module)."""
-    import time
-
-    t0 = time.perf_counter()
-    runs = [run_drift(robot, route, ekf=ekf, seed=getattr(args, "seed", 0))
-            for robot in ROBOTS for route in ROUTES for ekf in (False, True)]  # fmt: skip
-    out: dict[str, Any] = {}
-    for r in runs:
-        key = f"{r['robot']}/{r['route']}/{'ekf' if r['ekf'] else 'wheels'}"
-        out[key] = {k: r[k] for k in ("error_per_m", "yaw_error_per_rad", "final_error_m", "max_error_m",
-                                      "distance_m", "turned_rad", "completed")}  # fmt: skip
-    out["wall_s"] = round(time.perf_counter() - t0, 1)
-    return out

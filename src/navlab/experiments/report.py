@@ -181,11 +181,10 @@ def plot_trial_paths(results: list[dict[str, Any]], path: Path, *, title: str = 
     start = results[0].get("start") or [0.0, 0.0, 0.0]
     grid: GridMap | None = None
     if world and all(r.get("world_file") == world for r in results):
-        from navlab.experiments.truth import true_map
-        from navlab.sim.gazebo import load_world_named
+        from navlab.world import load_world, true_map
 
         try:
-            grid = true_map(load_world_named(str(world)), (float(start[0]), float(start[1])))
+            grid = true_map(load_world(str(world)), (float(start[0]), float(start[1])))
         except NavlabError:  # the world file moved since the run: paths without the map
             grid = None
     tracks = []

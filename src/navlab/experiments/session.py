@@ -84,7 +84,7 @@ class Run:
 
 def robot_frames(robot: str) -> tuple[str, str, str]:
     """(base frame, odom frame, scan topic) from a robot's plugin tags (shipped name or file)."""
-    from navlab.sim.gazebo import load_robot_named
+    from navlab.description import load_robot_named
 
     model = load_robot_named(robot)
     dd = model.diff_drive
@@ -101,18 +101,23 @@ def start_run(
     robot: str = "mybot",
     pose: tuple[float, float, float] = (0.0, 0.0, 0.0),
     seed: int = 0,
-    pace: float = 0.0,
+    rate: float = 0.0,
     overrides: dict[str, dict[str, Any]] | None = None,
     on_start: Callable[[Run], None] | None = None,
+    pace: float | None = None,
     **launch_args: Any,
 ) -> Run:
     """Start ``launch`` (a shipped name or a file with the sim's ``world``/``robot``/``x``/``y``/``yaw``
     arguments, plus ``base_frame``/``scan_topic`` when it declares them) and return the ``Run``.
 
     ``overrides`` maps node names to parameters applied after the launch file's (``--set``); ``on_start(run)``
-    is called once the launch started (``--view`` attaches the viewer there).
+    is called once the launch started (``--view`` attaches the viewer there). ``rate``: the pace (0 = as fast as
+    possible, 1 = real time; ``pace``, its old name, is deprecated).
     """
     from navlab.core.launch import declared_args
+    from navlab.deprecation import renamed
+
+    rate = renamed(rate, pace, old="pace", new="rate", where="start_run")
 
     base, odom, scan = robot_frames(robot)
     args: dict[str, Any] = {"world": world, "robot": robot, "x": pose[0], "y": pose[1], "yaw": pose[2]}
@@ -121,7 +126,7 @@ def start_run(
         if key in declared:
             args[key] = value
     args.update(launch_args)
-    session = start(launch, seed=seed, pace=pace, launch_args=args, overrides=overrides)
+    session = start(launch, seed=seed, rate=rate, launch_args=args, overrides=overrides)
     run = Run(session, session.node("gazebo"), base, odom, scan)
     if on_start is not None:
         on_start(run)

@@ -19,10 +19,10 @@ from pathlib import Path
 import numpy as np
 
 from navlab.geometry import wrap_angle
-from navlab.io.errors import IoError
+from navlab.io import IoError
 from navlab.io.files import check_regular_file
 from navlab.io.poses import read_table
-from navlab.mapping.errors import MappingError
+from navlab.mapping import MappingError
 
 CARMEN_SOURCES = ("flaser", "odom", "laser")
 

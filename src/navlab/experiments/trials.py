@@ -42,12 +42,11 @@ def shortest_length(world: str, start: tuple[float, float, float], goals: list[t
                     robot_radius: float = 0.2) -> float | None:  # fmt: skip
     """Length (m) of the shortest collision-free route start -> goals on the world's true map (None if any
     leg has none): SPL's reference."""
-    from navlab.experiments.truth import true_map
     from navlab.mapping.explore import clearance_costmap
-    from navlab.navigation.planners.theta_star import ThetaStarPlanner
-    from navlab.sim.gazebo import load_world_named
+    from navlab.navigation import ThetaStarPlanner
+    from navlab.world import load_world, true_map
 
-    costmap = clearance_costmap(true_map(load_world_named(world), start[:2]), robot_radius, comfort=0.01)
+    costmap = clearance_costmap(true_map(load_world(world), start[:2]), robot_radius, comfort=0.01)
     planner = ThetaStarPlanner({"w_traversal_cost": 0.0})  # any-angle: the geometric shortest route
     total, here = 0.0, start
     for goal in goals:
@@ -65,7 +64,7 @@ def _spawns(sc: Scenario, seed: int) -> list[tuple[float, Any]]:
     from dataclasses import replace
 
     from navlab.geometry import compose2
-    from navlab.sim.spawn import parse_spawn_spec
+    from navlab.sim import parse_spawn_spec
 
     rng = np.random.default_rng([seed, 0x0B57])  # its own stream: the run's seed stays the simulator's
     out: list[tuple[float, Any]] = []

@@ -19,7 +19,7 @@ from navlab.grid import GridMap
 from navlab.localization import amcl as pf
 from navlab.localization.errors import LocalizationError
 from navlab.localization.field import field_from_map
-from navlab.mapping.errors import MappingError
+from navlab.mapping import MappingError
 
 # Nav2's spellings of ROS 1 amcl's parameters (the names and defaults themselves are AmclParams' fields).
 NAV2_ALIASES: dict[str, tuple[str, ...]] = {

@@ -7,7 +7,7 @@ from navlab.lazy import lazy_exports
 if TYPE_CHECKING:
     from navlab.grid import FREE, OCCUPIED, UNKNOWN, GridMap
     from navlab.mapping.errors import MappingError
-    from navlab.mapping.mapfile import load_map, read_map_yaml, save_map
+    from navlab.mapping.mapfile import load_map, read_map_yaml, save_map, save_true_map
 
 _EXPORTS = {
     "FREE": "navlab.grid",
@@ -18,6 +18,7 @@ _EXPORTS = {
     "load_map": "navlab.mapping.mapfile",
     "read_map_yaml": "navlab.mapping.mapfile",
     "save_map": "navlab.mapping.mapfile",
+    "save_true_map": "navlab.mapping.mapfile",
 }
 __all__ = [
     "FREE",
@@ -28,5 +29,6 @@ __all__ = [
     "load_map",
     "read_map_yaml",
     "save_map",
+    "save_true_map",
 ]
 __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

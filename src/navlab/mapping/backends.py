@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-from navlab.core.node import dataclass_parameters
+from navlab.core import dataclass_parameters
 from navlab.geometry import between2
 from navlab.grid import GridMap
 from navlab.mapping.errors import MappingError

@@ -28,10 +28,10 @@ from typing import Any
 
 import numpy as np
 
-from navlab.core.errors import ParameterError
+from navlab.core import ParameterError
 from navlab.core.params import parse_yaml
 from navlab.grid import GridMap
-from navlab.io.errors import IoError
+from navlab.io import IoError
 from navlab.io.files import read_bytes_checked, read_text_checked, write_bytes_atomic, write_text_atomic
 from navlab.mapping.errors import MappingError
 
@@ -448,3 +448,13 @@ def _fresh_image_name(ypath: Path, suffix: str) -> str:
         name = f"{ypath.stem}.{secrets.token_hex(4)}{suffix}"
         if not (ypath.parent / name).exists():
             return name
+
+
+def save_true_map(world: str, start_xy: tuple[float, float], yaml_path: str | os.PathLike[str]) -> Path:
+    """Save the true map of ``world`` (a shipped name or a .world file; obstacles 100, free space reachable from
+    ``start_xy`` 0, world frame = map frame, 5 cm) as a map_server map at ``yaml_path``; returns the YAML's path."""
+    from navlab.world import load_world, true_map
+
+    path = Path(yaml_path)
+    save_map(true_map(load_world(world), (float(start_xy[0]), float(start_xy[1]))), path)
+    return path

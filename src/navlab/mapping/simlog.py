@@ -139,7 +139,7 @@ def record_log(
 ) -> SimLog:
     """Record a sparse log along ``waypoints`` in the world file (see the module docstring). ``seed`` drives
     the lidar noise and the odometry noise (``noise``, default 5 % scale errors and heading drift)."""
-    from navlab.sim.gazebo import load_robot_named
+    from navlab.description import load_robot_named
     from navlab.sim.simulation import Simulation, lidar_angles
     from navlab.world import load_world
 

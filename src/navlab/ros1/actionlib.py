@@ -12,7 +12,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any, Protocol, runtime_checkable
 
 from navlab import msgs
-from navlab.core.topics import Timer
+from navlab.core import Timer
 
 if TYPE_CHECKING:
     from navlab.ros1.bridge import RosBridge

@@ -25,8 +25,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from navlab import msgs
-from navlab.core.executor import Executor
-from navlab.core.topics import Timer
+from navlab.core import Executor, Timer
 from navlab.msgs import TFMessage, type_name
 from navlab.ros1.clock import ClockFollower
 from navlab.ros1.errors import Ros1Error

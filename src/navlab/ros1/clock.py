@@ -9,8 +9,7 @@ from __future__ import annotations
 
 import threading
 
-from navlab.core.executor import Executor
-from navlab.core.topics import Timer
+from navlab.core import Executor, Timer
 from navlab.ros1.net import LOG
 
 MAX_JUMP_NS = 3600 * 1_000_000_000

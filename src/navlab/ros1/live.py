@@ -20,7 +20,7 @@ class LiveRun:
     and offered on the master at ``master``; ready once every node has published (2 simulated seconds)."""
 
     def __init__(self, launch: str, *, master: str | None = None, follow_clock: bool = False, **args: Any) -> None:
-        self.session = start(launch, pace=0.0 if follow_clock else 1.0, **args)
+        self.session = start(launch, rate=0.0 if follow_clock else 1.0, **args)
         self.ex = self.session.executor
         self.bridge = RosBridge(self.ex, master=master, params=session_params(self.session.nodes),
                                 follow_clock=follow_clock)

@@ -15,7 +15,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, TypeVar
 
 from navlab import msgs
-from navlab.core.executor import Executor
+from navlab.core import Executor
 from navlab.ros1.errors import Ros1Error
 from navlab.ros1.wire import Service
 

@@ -27,7 +27,7 @@ from typing import Any
 import mujoco
 import numpy as np
 
-from navlab.description.model import Geometry, Joint, Link, Origin, RobotModel, Shape
+from navlab.description import Geometry, Joint, Link, Origin, RobotModel, Shape
 from navlab.geometry import matrix_from_rpy, quat_from_rpy, wxyz_from_xyzw
 from navlab.sim.errors import SimError
 from navlab.sim.ode_contact import combined_mu, contact_solimp, contact_solref

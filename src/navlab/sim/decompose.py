@@ -39,11 +39,11 @@ from typing import Any
 
 import numpy as np
 
-from navlab.description.model import Origin
-from navlab.io.errors import IoError
+from navlab.description import Origin
+from navlab.io import IoError
 from navlab.io.files import MAX_TEXT_BYTES, atomic_path, read_bytes_checked
 from navlab.sim.errors import SimError
-from navlab.world.model import WorldModel
+from navlab.world import WorldModel
 
 #: CoACD's concavity threshold (smaller: more, tighter parts)
 THRESHOLD = 0.05

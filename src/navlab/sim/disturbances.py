@@ -24,7 +24,7 @@ import mujoco
 import numpy as np
 
 from navlab.core import Executor, Node
-from navlab.description.model import Geometry, RobotModel
+from navlab.description import Geometry, RobotModel
 from navlab.sim.errors import SimError
 from navlab.sim.simulation import Simulation
 

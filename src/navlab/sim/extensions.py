@@ -17,7 +17,7 @@ from __future__ import annotations
 from typing import Any
 
 from navlab.core import Executor, Node
-from navlab.description.model import RobotModel
+from navlab.description import RobotModel
 from navlab.sim.disturbances import SlipPatchPlugin, add_payload, disturbed_robot, parse_disturbances
 from navlab.sim.errors import SimError
 from navlab.sim.ros_control import drive_from_controller, find_controllers

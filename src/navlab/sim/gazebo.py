@@ -7,7 +7,8 @@ from pathlib import Path
 from typing import Any
 
 from navlab.core import Executor, Node
-from navlab.description.model import RobotModel
+from navlab.description import RobotModel
+from navlab.description.loader import load_robot_named as _load_robot_named
 from navlab.sim.contacts import CollisionPlugin
 from navlab.sim.errors import SimError
 from navlab.sim.extensions import SimExtensions
@@ -15,23 +16,26 @@ from navlab.sim.imu import ImuSensorPlugin
 from navlab.sim.plugins import DiffDrivePlugin, GroundTruthPlugin, JointStatePlugin, LidarPlugin, RobotStatePublisher
 from navlab.sim.simulation import Simulation
 from navlab.sim.spawn import check_spawn_clear, check_start_pose, load_sdf_model, parse_spawn_spec, primitive_model
-from navlab.world.model import ModelSpec, WorldModel
+from navlab.world import ModelSpec, WorldModel, load_world
 
 
 def load_robot_named(name_or_path: str, args: list[str] | None = None) -> RobotModel:
-    """A robot from a shipped name (``mybot``), a ``package://`` URI or a .xacro/.urdf path, with xacro
-    arguments ``["name:=value", ...]``."""
-    from navlab.description import load_robot
-
-    xargs = dict(a.split(":=", 1) for a in args or [] if ":=" in a)
-    return load_robot(name_or_path, args=xargs)  # one resolver: navlab.description.loader.robot_path
+    """Deprecated alias (until the next release) of :func:`navlab.description.load_robot_named`."""
+    _moved("load_robot_named", "navlab.description")
+    return _load_robot_named(name_or_path, args)
 
 
 def load_world_named(name_or_path: str) -> WorldModel:
-    """A world from a shipped name (``room``, ``room_obstacles``), a ``package://`` URI or a .world/.sdf path."""
-    from navlab.world import load_world
+    """Deprecated alias (until the next release) of :func:`navlab.world.load_world`."""
+    _moved("load_world_named", "navlab.world.load_world")
+    return load_world(name_or_path)
 
-    return load_world(name_or_path)  # one resolver: navlab.world.sdf.world_path
+
+def _moved(name: str, new: str) -> None:
+    import warnings
+
+    warnings.warn(f"navlab.sim.{name} moved to {new}; the old name works until the next release",
+                  DeprecationWarning, stacklevel=3)
 
 
 class GazeboSim(Node):
@@ -64,8 +68,8 @@ class GazeboSim(Node):
         odometry_noise = self.declare_parameter("odometry_noise", 0.0)
         cmd_timeout = float(self.declare_parameter("cmd_timeout", 0.0))
         publish_odom_tf = bool(self.declare_parameter("publish_odom_tf", True))
-        robot = robot_model if robot_model is not None else load_robot_named(robot_name, robot_args)
-        world = world_model if world_model is not None else load_world_named(world_name)
+        robot = robot_model if robot_model is not None else _load_robot_named(robot_name, robot_args)
+        world = world_model if world_model is not None else load_world(world_name)
         extensions = SimExtensions(self)  # wheel controller and disturbances (navlab.sim.extensions)
         robot = extensions.robot(robot)
         js_rate = extensions.controllers.joint_state_rate or js_rate  # joint_state_controller's publish_rate

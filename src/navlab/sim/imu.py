@@ -21,7 +21,7 @@ import numpy as np
 
 from navlab import msgs
 from navlab.core import Executor, Node
-from navlab.description.model import ImuConfig, RobotModel
+from navlab.description import ImuConfig, RobotModel
 from navlab.geometry import xyzw_from_wxyz
 from navlab.sim.errors import SimError
 from navlab.sim.simulation import Simulation

@@ -17,7 +17,7 @@ import numpy as np
 
 from navlab import msgs
 from navlab.core import Executor, Node
-from navlab.description.model import DiffDriveConfig, ImuConfig, LidarConfig, Origin
+from navlab.description import DiffDriveConfig, ImuConfig, LidarConfig, Origin
 from navlab.geometry import Vec, qmul, qrotate, quat_from_rpy, quat_from_yaw
 from navlab.sim.diffdrive import (
     ODOM_COVARIANCE_DIAG,

@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-from navlab.description.model import DiffDriveConfig, RobotModel
+from navlab.description import DiffDriveConfig, RobotModel
 from navlab.sim.errors import SimError
 
 DIFF_DRIVE_TYPE = "diff_drive_controller/DiffDriveController"

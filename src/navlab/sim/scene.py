@@ -11,7 +11,7 @@ from dataclasses import replace
 import mujoco
 import numpy as np
 
-from navlab.description.model import Origin, RobotModel, Shape
+from navlab.description import Origin, RobotModel, Shape
 from navlab.sim.builder import (
     _VISUAL_PROPS,
     DEFAULT_MU,
@@ -29,7 +29,7 @@ from navlab.sim.builder import (
     add_robot,
 )
 from navlab.sim.errors import SimError
-from navlab.world.model import ModelSpec, WorldModel
+from navlab.world import ModelSpec, WorldModel
 
 
 def add_world_model(spec: mujoco.MjSpec, model: ModelSpec, info: BuildInfo) -> list[str]:

@@ -12,13 +12,13 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from navlab.description.model import DiffDriveConfig, LidarConfig, RobotModel
+from navlab.description import DiffDriveConfig, LidarConfig, RobotModel
 from navlab.geometry import quat_from_rpy, quat_from_yaw, wxyz_from_xyzw, xyzw_from_wxyz, yaw_from_quat
 from navlab.sim.builder import GROUND_CONTACT_BIT, GROUP_ROBOT, GROUP_WORLD, RAY_GEOMGROUP, mj_quat_from_rpy
 from navlab.sim.errors import SimError
 from navlab.sim.raycast import FAST_TYPES, cast_planar, finish_ranges
 from navlab.sim.scene import add_world_model, build_spec, compile_spec, remove_world_model
-from navlab.world.model import ModelSpec, WorldModel
+from navlab.world import ModelSpec, WorldModel
 
 SPAWN_GAP = 0.0005  # m between the robot's lowest point and the floor when it is placed
 

@@ -18,7 +18,7 @@ import numpy as np
 from navlab.core.limits import ceilings
 from navlab.description.model import Geometry, Inertial, Link, RobotModel, Shape, is_geometry_kind
 from navlab.sim.errors import SimError
-from navlab.world.model import ModelSpec, WorldModel
+from navlab.world import ModelSpec, WorldModel
 
 KINDS = ("box", "cylinder", "sphere", "sdf")
 _SIZES = frozenset({"size", "sx", "sy", "sz", "radius", "length", "mass"})
@@ -222,7 +222,7 @@ def check_spawn_clear(robot: RobotModel, robot_pose: tuple[float, float, float],
 def _overlapping(robot: RobotModel, world: WorldModel, pose: tuple[float, float, float], *,
                  margin: float = 0.02, resolution: float = 0.02) -> list[str]:
     """The models of ``world`` that the robot's outline at ``pose`` overlaps ("an obstacle" if unnamed)."""
-    from navlab.world.occupancy import occupancy, shape_footprints
+    from navlab.world import occupancy, shape_footprints
 
     xy, z_lo, z_hi = robot_outline(robot)
     x, y, yaw = pose

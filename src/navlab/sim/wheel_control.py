@@ -32,7 +32,7 @@ import numpy as np
 
 from navlab import msgs
 from navlab.core import Executor, Node
-from navlab.description.model import DiffDriveConfig
+from navlab.description import DiffDriveConfig
 from navlab.sim.errors import SimError
 from navlab.sim.pid import Pid, PidGains
 from navlab.sim.ros_control import wheel_names

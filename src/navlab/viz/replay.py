@@ -17,9 +17,8 @@ from typing import Any
 import numpy as np
 
 from navlab import msgs
-from navlab.core.errors import TfError
+from navlab.core import TfBuffer, TfError
 from navlab.core.graph import with_layout
-from navlab.core.tf import TfBuffer
 from navlab.io.rosbag import bag_graph, bag_topics, read_bag
 from navlab.viz.errors import VizError
 from navlab.viz.hub import Hub
@@ -199,7 +198,11 @@ class BagPlayer:
             return None
 
 
-def play_bag(path: str | Path, hub: Hub, *, speed: float = 1.0) -> BagPlayer:
-    """Load a recording and start playing it into ``hub``."""
+def play_bag(path: str | Path, hub: Hub, *, rate: float = 1.0, speed: float | None = None) -> BagPlayer:
+    """Load a recording and start playing it into ``hub`` at ``rate`` (simulated s per wall-clock s; ``speed``,
+    its old name, is deprecated)."""
+    from navlab.deprecation import renamed
+
+    rate = renamed(rate, speed, old="speed", new="rate", where="play_bag")
     rec = load_recording(path, progress=True)
-    return BagPlayer(rec, hub, speed=speed, graph=bag_graph(path)).start()
+    return BagPlayer(rec, hub, speed=rate, graph=bag_graph(path)).start()

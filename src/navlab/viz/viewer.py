@@ -60,17 +60,22 @@ def attach(
     *,
     host: str = "127.0.0.1",
     port: int = 8765,
-    speed: float | None = None,
+    rate: float | None = None,
     foxglove_port: int | None = None,
     parameters: dict[str, Any] | None = None,
+    speed: float | None = None,
 ) -> Viewer:
     """Start the viewer node on ``executor`` and serve the page on ``host:port`` (0: any free port).
 
-    ``speed``: the pace (simulated s per wall-clock s; 0 = as fast as possible; default: the executor's
-    rate, or real time). ``foxglove_port``: also serve Foxglove's WebSocket protocol there.
+    ``rate``: the pace (simulated s per wall-clock s; 0 = as fast as possible; default: the executor's
+    rate, or real time; ``speed``, its old name, is deprecated). ``foxglove_port``: also serve Foxglove's
+    WebSocket protocol there.
     """
+    from navlab.deprecation import renamed
+
+    rate = renamed(rate, speed, old="speed", new="rate", where="navlab.viz.attach")
     hub = Hub()
-    pace = speed if speed is not None else (executor.rate or 1.0)
+    pace = rate if rate is not None else (executor.rate or 1.0)
     node = ViewerNode(executor, hub=hub, pacer=Pacer(pace), parameters=parameters)
     server = ViewerServer(hub, host=host, port=port)
     try:

@@ -5,7 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from navlab.description.model import Link, Origin
+from navlab.description import Link, Origin
 from navlab.geometry import Pose6  # x y z roll pitch yaw, as in SDF <pose>
 
 

@@ -1,7 +1,8 @@
 """The ``navlab`` command: one verb per step of the paper's pipeline.
 
-Each concern registers its verbs from its own ``cli`` module (a ``register(subparsers)`` function),
-so this file only assembles them and turns ``NavlabError`` into a one-line message.
+Each verb group registers its verbs from its own module in this package (a ``register(subparsers)``
+function); the options they share are declared once in :mod:`navlab.cli.options`. This file only assembles
+them and turns ``NavlabError`` into a one-line message.
 """
 
 from __future__ import annotations
@@ -14,21 +15,24 @@ import re
 import sys
 from typing import NoReturn
 
-from navlab.cli_common import check_named_inputs
+from navlab.cli.options import check_named_inputs
 from navlab.errors import NavlabError
 
-# Modules that define ``register(subparsers: argparse._SubParsersAction) -> None``.
+# Modules that define ``register(subparsers: argparse._SubParsersAction) -> None``, one per verb group.
 COMMAND_MODULES = (  # in the order of the paper's pipeline, then the ROS-style tools
-    "navlab.demo",
-    "navlab.sim.cli",
-    "navlab.description.cli",
-    "navlab.world.cli",
-    "navlab.mapping.cli",
-    "navlab.experiments.cli",
-    "navlab.core.cli",
-    "navlab.viz.cli",
-    "navlab.ros1.cli",
-    "navlab.bench",
+    "navlab.cli.demo",
+    "navlab.cli.sim",
+    "navlab.cli.description",
+    "navlab.cli.world",
+    "navlab.cli.mapping",
+    "navlab.cli.evaluation",
+    "navlab.cli.localization",
+    "navlab.cli.navigation",
+    "navlab.cli.experiments",
+    "navlab.cli.launch",
+    "navlab.cli.ros",
+    "navlab.cli.view",
+    "navlab.cli.bench",
 )
 
 

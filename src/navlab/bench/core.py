@@ -6,8 +6,7 @@ import argparse
 import time
 from typing import Any
 
-from navlab.core.executor import Executor
-from navlab.core.node import Node
+from navlab.core import Executor, Node
 from navlab.msgs import Float64
 
 

@@ -1,4 +1,5 @@
-"""``navlab world clutter``: generate a BARN-style cluttered world (.world SDF, optional PNG and JSON)."""
+"""``navlab world clutter`` (a BARN-style cluttered world: .world SDF, optional PNG and JSON) and ``navlab world
+office`` (the generated office floor and a sparse laser log recorded in it)."""
 
 from __future__ import annotations
 
@@ -6,6 +7,8 @@ import argparse
 import json
 from pathlib import Path
 from typing import TYPE_CHECKING
+
+from navlab.cli.options import add_run_options, optional_out, out_file, print_figures
 
 if TYPE_CHECKING:
     from navlab.world.clutter import ClutterWorld
@@ -53,7 +56,6 @@ def save_png(world: ClutterWorld, path: str | Path) -> None:
 
 
 def _cmd_clutter(args: argparse.Namespace) -> int:
-    from navlab.cli_common import optional_out, out_file
     from navlab.world.clutter import generate_clutter
 
     world = generate_clutter(args.seed, fill=args.fill, smooth=args.smooth, robot_radius=args.robot_radius,
@@ -116,7 +118,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         "  navlab world clutter --seed 3 --fill 0.3 --smooth 2 --out clutter --png   # clutter/clutter.world, .png\n"
         "  navlab sim --world clutter/clutter.world --x -2 --y 0 --duration 5",
     )
-    c.add_argument("--seed", type=int, default=0, help="random seed (default 0); same seed, same world")
+    add_run_options(c, seed=0, json=True)
     c.add_argument("--fill", type=_fraction, default=0.25, help="initial fill probability per cell (default 0.25)")
     c.add_argument("--smooth", type=_count, default=2, help="cellular-automaton rounds (default 2)")
     c.add_argument("--robot-radius", type=float, default=0.2,
@@ -127,9 +129,64 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="folder to write clutter.world in (a FILE.world still works this release, deprecated)")
     c.add_argument("--png", nargs="?", const="", default=None, metavar="FILE.png",
                    help="also draw the world and the reference path: in FILE.png, or DIR/clutter.png without a value")
-    c.add_argument("--json", action="store_true", help="print the summary as one JSON object")
     c.set_defaults(func=_cmd_clutter)
-    from navlab.mapping.cli import add_world_office  # the office floor and its recorded logs
-
     add_world_office(verbs)
 
+
+def _cmd_world_office(args: argparse.Namespace) -> int:
+    from navlab.experiments.session import rounded
+    from navlab.io.carmen import write_carmen
+    from navlab.io.poses import write_poses
+    from navlab.mapping.simlog import OdometryNoise, record_log
+    from navlab.world.office import generate_office
+
+    office = generate_office()
+    world = office.write_world(out_file(args.out, "office.world", old_suffixes=(".world", ".sdf")))
+    log = optional_out(args.log, world.parent, "office.clf")
+    truth = optional_out(args.truth, world.parent, "truth.txt")
+    summary: dict = {"world": str(world), "width_m": office.width, "depth_m": office.depth, "rooms": office.rooms,
+                     "start": list(office.start)}  # fmt: skip
+    if log:
+        rec = record_log(world, office.route(), seed=args.seed, noise=OdometryNoise(scale=args.odom_scale,
+                         heading_drift=args.heading_drift))  # fmt: skip
+        write_carmen(log, rec.log, comment=f"navlab office log, seed {args.seed}: odometry frame = the true "
+                     f"start pose {rec.start} in {world.name}")  # fmt: skip
+        summary.update(log=str(log), scans=len(rec.log.scans), log_s=rec.log.duration)
+        if truth:
+            from navlab.experiments.trajectory import apply_se2
+            from navlab.geometry import inverse2
+
+            # the truth in the log's odometry frame (the start pose), as the SLAM output is
+            write_poses(truth, rec.timestamps, apply_se2(tuple(inverse2(rec.start)), rec.truth))
+            summary["truth"] = str(truth)
+    print_figures(rounded(summary), args.json)
+    return 0
+
+
+def add_world_office(verbs: argparse._SubParsersAction) -> None:
+    """``navlab world office``: the generated office floor, and a sparse log recorded in it."""
+    o = verbs.add_parser(
+        "office",
+        help="an office floor (30 x 20.5 m, 28 alike rooms, corridors closing two loops) and a sparse log in it",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+        description="Writes the generated office floor as a .world file. With --log, drives the robot around "
+        "both loops\n(and into two rooms) in the simulator and records a sparse laser log: a scan every 1 m "
+        "or 0.5 rad,\n181 beams over 180 degrees, wheel odometry with --odom-scale scale errors and heading "
+        "drift.\nThe log's odometry frame is the robot's true start pose; --truth writes the true poses in it.",
+        epilog="examples:\n"
+        "  navlab world office --out office --log --truth --seed 1   # office/office.world, office.clf, truth.txt\n"
+        "  navlab slam --log office/office.clf --out office_map --mode gmapping\n"
+        "  navlab eval trajectory office_map/poses.txt office/truth.txt",
+    )
+    o.add_argument("--out", required=True, metavar="DIR",
+                   help="folder to write office.world in (a FILE.world still works this release, deprecated)")
+    o.add_argument("--log", nargs="?", const="", metavar="FILE.clf",
+                   help="also record a sparse CARMEN log: in FILE.clf, or DIR/office.clf without a value")
+    o.add_argument("--truth", nargs="?", const="", metavar="FILE.txt",
+                   help="with --log: the true poses ('t x y theta', log frame) in FILE.txt, or DIR/truth.txt")
+    add_run_options(o, seed=0, json=True)
+    o.add_argument("--odom-scale", type=float, default=0.05,
+                   help="std. dev. of the odometry's scale errors and per-step noise (default 0.05: 5 %%)")
+    o.add_argument("--heading-drift", type=float, default=0.02,
+                   help="std. dev. of the odometry's heading drift rate, rad/m (default 0.02)")
+    o.set_defaults(func=_cmd_world_office)

@@ -1,62 +1,16 @@
-"""``navlab roscore`` (navlab's own ROS 1 master) and the ``ros:=true`` / ``--ros`` switch of runs."""
+"""What run verbs wrap around a run: ``--view`` (the viewer on each run) and ``--ros`` / ``ros:=true`` (the run
+offered on ROS 1, paced by ``--rate``)."""
 
 from __future__ import annotations
 
 import argparse
 import contextlib
 import logging
-import signal
+import sys
 from collections.abc import Callable, Iterator
 from typing import Any
 
 TRUE = ("true", "1", "yes", "on")
-
-
-def register(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser(
-        "roscore", help="run a ROS 1 master + parameter server (for real ROS tools and navlab's --ros runs)",
-        description="A ROS 1 master and parameter server, as `roscore` starts them, on $ROS_MASTER_URI's port "
-                    "(default 11311). It listens on loopback unless ROS_IP or ROS_HOSTNAME name another address.",
-    )
-    p.add_argument("-p", "--port", type=int, default=None, help="port (default: from $ROS_MASTER_URI, else 11311)")
-    p.set_defaults(func=_cmd_roscore)
-
-
-def _cmd_roscore(args: argparse.Namespace) -> int:
-    from navlab.ros1.master import Master
-    from navlab.ros1.net import host_port, master_uri
-
-    port = args.port if args.port is not None else host_port(master_uri())[1]
-    master = Master(port=port)
-    print(f"navlab roscore: ROS master at {master.uri} (Ctrl-C to stop)", flush=True)
-    signal.signal(signal.SIGTERM, lambda *_: master.close())
-    with contextlib.suppress(KeyboardInterrupt):
-        master.stopped.wait()
-    master.close()
-    return 0
-
-
-def add_ros_argument(p: argparse.ArgumentParser, *, rate: bool = False, pace_option: str = "--rate") -> None:
-    """``--ros``: offer the run on a ROS 1 master (``$ROS_MASTER_URI``, or navlab's own); with ``rate``, also
-    ``--rate`` (for verbs that have no pace option of their own); ``pace_option``: the verb's pace option."""
-    p.add_argument("--ros", action="store_true",
-                   help="join the ROS 1 graph at $ROS_MASTER_URI (or start navlab's own master): real rostopic, "
-                        f"rviz, rosbag and rospy nodes see and drive the run; runs in real time unless {pace_option}")
-    if rate:
-        p.add_argument("--rate", type=pace, default=None,
-                       help="pacing: 0 = as fast as possible (default; real time with --ros), 1 = real time, "
-                            "r = r x real time")
-
-
-def pace(text: str) -> float:
-    """argparse type of ``--rate``: a finite number >= 0 (simulated s per wall-clock s; 0 = as fast as possible)."""
-    try:
-        value = float(text)
-    except ValueError:
-        value = -1.0
-    if not 0 <= value < float("inf"):
-        raise argparse.ArgumentTypeError(f"expected a number >= 0 (0 = as fast as possible), got {text!r}")
-    return value
 
 
 def pop_ros_arg(launch_args: dict[str, str]) -> bool:
@@ -116,7 +70,57 @@ def ros_hook(args: argparse.Namespace, then: Callable[[Any], None] | None = None
 
 
 def _open_bridge(executor: Any, nodes: dict[str, Any], *, follow_clock: bool = False) -> Any:
-    from navlab.ros1.bridge import RosBridge, session_params
+    from navlab.ros1 import RosBridge, session_params
 
     logging.getLogger("navlab.ros1").setLevel(logging.INFO)
     return RosBridge(executor, params=session_params(nodes), follow_clock=follow_clock)
+
+
+def start_viewer(args: argparse.Namespace, executor: Any, *, host: str, port: int, rate: float | None = None) -> Any:
+    """Attach the viewer, print its URL (and a warning off loopback), open a browser where there is a desktop."""
+    from navlab.viz.viewer import attach, host_warning, open_in_browser
+
+    warning = host_warning(host)
+    if warning:
+        print(warning, file=sys.stderr)
+    viewer = attach(executor, host=host, port=port, rate=rate, foxglove_port=getattr(args, "foxglove", None))
+    print(f"viewer: {viewer.url}", file=sys.stderr, flush=True)
+    if viewer.foxglove is not None:
+        print(f"foxglove: ws://{host}:{viewer.foxglove.port} (open it in Foxglove: Open connection)", file=sys.stderr)
+    if not getattr(args, "no_browser", False):
+        open_in_browser(viewer.url)
+    return viewer
+
+
+@contextlib.contextmanager
+def viewing(args: argparse.Namespace, executor: Any) -> Iterator[Any]:
+    """With ``--view``: the viewer on ``executor`` while the block runs (None without ``--view``)."""
+    if not getattr(args, "view", False):
+        yield None
+        return
+    viewer = start_viewer(args, executor, host=args.view_host, port=args.view_port)
+    try:
+        yield viewer
+    finally:
+        viewer.close()
+
+
+@contextlib.contextmanager
+def view_hook(args: argparse.Namespace) -> Iterator[Any]:
+    """With ``--view``: an ``on_start(run)`` for ``start_run`` (and the run functions that take one) that
+    serves the viewer on each run it starts (the previous run's viewer closes); None without ``--view``."""
+    if not getattr(args, "view", False):
+        yield None
+        return
+    viewers: list[Any] = []
+
+    def on_start(run: Any) -> None:
+        while viewers:
+            viewers.pop().close()  # the previous run has finished: its page reconnects to this one
+        viewers.append(start_viewer(args, run.executor, host=args.view_host, port=args.view_port))
+
+    try:
+        yield on_start
+    finally:
+        for viewer in viewers:
+            viewer.close()

@@ -24,7 +24,7 @@ import time
 from pathlib import Path
 from typing import Any
 
-from navlab.core.topics import Timer
+from navlab.core import Timer
 from navlab.errors import NavlabError
 from navlab.ros1.live import LiveRun
 
@@ -141,14 +141,12 @@ def _truth(graph: _Graph) -> tuple[float, float]:
 
 
 def run(args: argparse.Namespace) -> dict[str, Any]:
-    from navlab.experiments.truth import true_map
-    from navlab.mapping.mapfile import save_map
-    from navlab.sim.gazebo import load_world_named
+    from navlab.mapping import save_true_map
 
     with tempfile.TemporaryDirectory(prefix="navlab-bench-ros-") as folder:
         home = Path(folder)
         map_yaml = home / "room.yaml"
-        save_map(true_map(load_world_named("room"), (0.0, 0.0)), map_yaml)
+        save_true_map("room", (0.0, 0.0), map_yaml)
         graph = _Graph(home)
         try:
             live = LiveRun(master=graph.uri, launch="navigation", world="room", map=str(map_yaml), seed=args.seed)

@@ -8,9 +8,10 @@ import math
 import sys
 from typing import Any
 
-from navlab.cli_common import (
+from navlab.cli.options import (
     add_pose_arguments,
     add_resource_path_arguments,
+    add_run_options,
     add_set_argument,
     apply_resource_paths,
     out_file,
@@ -18,8 +19,7 @@ from navlab.cli_common import (
     positive_seconds,
     start_pose,
 )
-from navlab.ros1.cli import add_ros_argument, ros_bridge
-from navlab.viz.cli import add_view_arguments, viewing
+from navlab.cli.runs import ros_bridge, viewing
 
 _SPAWN_HELP = (
     "spawn a model, KIND:key=value,... with KIND box|cylinder|sphere|sdf, e.g. 'box:name=crate,x=2,y=1,size=0.5', "
@@ -51,20 +51,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     _add_common(p)
     p.add_argument("--duration", type=positive_seconds, default=10.0, help="simulated seconds to run (default 10)")
-    p.add_argument("--rate", type=float, default=None,
-                   help="pacing: 0 = as fast as possible (default; real time with --ros), 1 = real time, "
-                        "r = r x real time")
-    p.add_argument("--seed", type=int, default=0, help="random seed of sensor noise (default 0)")
     p.add_argument("--timestep", type=float, default=0.0,
                    help="physics step in s, 0.0005-0.002 (default 0.002, or the world's max_step_size if larger)")
     p.add_argument("--cmd-vel", default=None, metavar="V,W",
                    help="publish this constant cmd_vel (m/s, rad/s) at 10 Hz, e.g. 0.3,0.2")
     add_set_argument(p, "gazebo", "ground_truth_rate=100")
-    p.add_argument("--record", default=None, metavar="DIR", help="record all topics to a rosbag2 in DIR")
-    p.add_argument("--quiet", action="store_true", help="no progress bar")
-    p.add_argument("--json", action="store_true", help="print the summary as one JSON object")
-    add_view_arguments(p)
-    add_ros_argument(p)
+    add_run_options(p, seed=0, rate=None, record=True, quiet=True, json=True, view=True, ros=True)
     p.set_defaults(func=_cmd_sim)
 
     r = sub.add_parser(
@@ -87,7 +79,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def _parse_cmd_vel(text: str | None) -> tuple[float, float] | None:
-    from navlab.sim.errors import SimError
+    from navlab.sim import SimError
 
     if text is None:
         return None
@@ -102,13 +94,13 @@ def _cmd_sim(args: argparse.Namespace) -> int:
     from navlab import msgs
     from navlab.core import Node
     from navlab.experiments.session import start_run
-    from navlab.sim.spawn import parse_spawn_spec
+    from navlab.sim import parse_spawn_spec
 
     apply_resource_paths(args)
     cmd_vel = _parse_cmd_vel(args.cmd_vel)
     spawns = [parse_spawn_spec(s, default_name=f"spawned_{i}") for i, s in enumerate(args.spawn)]
     run = start_run("sim", world=args.world, robot=args.robot, pose=start_pose(args), seed=args.seed,
-                    pace=args.rate if args.rate is not None else (1.0 if args.ros else 0.0),  # ROS peers: real time
+                    rate=args.rate if args.rate is not None else (1.0 if args.ros else 0.0),  # ROS peers: real time
                     timestep=args.timestep, overrides={"gazebo": parse_sets(args.set)})
     ex, gazebo = run.executor, run.gazebo
     helper = Node(ex, name="sim_cli")
@@ -169,13 +161,14 @@ def _one_shot(node: Any, t: float, fn: Any) -> None:
 
 
 def _cmd_render(args: argparse.Namespace) -> int:
-    from navlab.sim.gazebo import load_robot_named, load_world_named
+    from navlab.description import load_robot_named
+    from navlab.sim import Simulation
     from navlab.sim.render import render_image, save_png
-    from navlab.sim.simulation import Simulation
     from navlab.sim.spawn import check_start_pose, parse_spawn_spec
+    from navlab.world import load_world
 
     apply_resource_paths(args)
-    world = load_world_named(args.world)
+    world = load_world(args.world)
     robot = None if args.no_robot else load_robot_named(args.robot)
     if robot is not None:
         check_start_pose(robot, world, (args.x, args.y, args.yaw))

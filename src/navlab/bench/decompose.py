@@ -109,8 +109,7 @@ def _self_cpu() -> float:
 
 def _load_here(world_file: str, cache: str, effort: str, workers: int, reach: str) -> dict[str, Any]:
     """Load the world and build its simulation with the cache at ``cache`` (in a fresh process)."""
-    from navlab.sim import decompose
-    from navlab.sim.simulation import Simulation
+    from navlab.sim import Simulation, decompose
     from navlab.world import load_world
 
     os.environ["NAVLAB_CACHE"] = cache
@@ -142,8 +141,8 @@ def _first_load(world_file: Path, cache: Path, effort: str, workers: int, reach:
 
 def run(args: argparse.Namespace) -> dict[str, Any]:
     """Measure and return {"before", "after", "warm_s", ...} (see the module docstring)."""
+    from navlab.description import load_robot_named
     from navlab.sim import decompose
-    from navlab.sim.gazebo import load_robot_named
 
     seed = int(getattr(args, "seed", 0))
     reach = decompose.robot_reach(load_robot_named(ROBOT)) if not os.environ.get("NAVLAB_DECOMPOSE_REACH") else None

@@ -1,5 +1,9 @@
-"""What every ``navlab`` verb shares, kept light so ``--help`` starts fast: start-pose options, ``--set``,
-durations and printing figures. Imports nothing heavy at module level."""
+"""What every ``navlab`` verb shares, declared once with one help text and kept light so ``--help`` starts fast:
+:func:`add_run_options` (``--seed --json --quiet --record --rate``, ``--view`` and its server options, ``--ros``),
+start-pose options, ``--set``, durations and printing figures. Imports nothing heavy at module level.
+
+Pacing has one name, ``--rate`` (as ``rosbag play --rate``): simulated seconds per wall-clock second, 0 = as
+fast as possible. ``navlab view --speed`` is its deprecated alias for one release."""
 
 from __future__ import annotations
 
@@ -55,6 +59,14 @@ def add_pose_arguments(p: argparse.ArgumentParser, what: str = "robot start") ->
 def start_pose(args: argparse.Namespace) -> tuple[float, float, float]:
     """(x, y, yaw) from :func:`add_pose_arguments`' options."""
     return float(args.x), float(args.y), float(args.yaw)
+
+
+def add_world_robot(p: argparse.ArgumentParser, world: str) -> None:
+    """``--world`` (default ``world``), ``--robot``, the start pose and the resource paths of a run verb."""
+    p.add_argument("--world", default=world, help=f"world file or shipped name (default {world})")
+    p.add_argument("--robot", default="mybot", help="robot .xacro/.urdf or shipped name (default mybot)")
+    add_pose_arguments(p)
+    add_resource_path_arguments(p)
 
 
 def add_resource_path_arguments(p: argparse.ArgumentParser) -> None:
@@ -158,3 +170,88 @@ def check_named_inputs(args: argparse.Namespace) -> None:
         else:
             hint = "" if path.suffix in suffixes else f" (a {kind} is a {' or '.join(suffixes)} file or a shipped name)"
             raise NavlabError(f"{kind} file not found: {path.absolute()}{hint}")
+
+
+DEFAULT_VIEW_PORT = 8765
+RATE_HELP = "pacing, simulated s per wall-clock s: 0 = as fast as possible, 1 = real time, r = r x real time"
+
+
+def pace(text: str) -> float:
+    """argparse type of ``--rate``: a finite number >= 0 (simulated s per wall-clock s; 0 = as fast as possible)."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = -1.0
+    if not 0 <= value < float("inf"):
+        raise argparse.ArgumentTypeError(f"expected a number >= 0 (0 = as fast as possible), got {text!r}")
+    return value
+
+
+class DeprecatedAlias(argparse.Action):
+    """An old option name kept for one release: stores into the new option's ``dest`` and says so on stderr."""
+
+    def __init__(self, option_strings: list[str], dest: str, *, new: str, **kwargs: Any) -> None:
+        self.new = new
+        super().__init__(option_strings, dest, **kwargs)
+
+    def __call__(self, parser: argparse.ArgumentParser, namespace: argparse.Namespace, values: Any,
+                 option_string: str | None = None) -> None:
+        import sys
+
+        print(f"navlab: DeprecationWarning: {option_string} is deprecated, use {self.new} (accepted until the next "
+              "release)", file=sys.stderr)
+        setattr(namespace, self.dest, values)
+
+
+def add_server_arguments(p: argparse.ArgumentParser, *, prefix: str = "") -> None:
+    """``--host``, ``--port`` (with ``prefix``: ``--view-host``, ``--view-port``), ``--no-browser``, ``--foxglove``."""
+    p.add_argument(f"--{prefix}host", default="127.0.0.1",
+                   help="address to listen on (default 127.0.0.1: this machine only; anything else warns)")
+    p.add_argument(f"--{prefix}port", type=int, default=DEFAULT_VIEW_PORT,
+                   help=f"port of the page and its WebSocket (default {DEFAULT_VIEW_PORT}; 0 = any free port)")
+    p.add_argument("--no-browser", action="store_true", help="print the URL only, do not open a browser")
+    p.add_argument("--foxglove", nargs="?", type=int, const=8766, default=None, metavar="PORT",
+                   help="also serve the topics to Foxglove (its WebSocket protocol, ROS 2 schemas) on PORT "
+                   "(default 8766); Foxglove's 3D panel can publish goals and initial poses")
+
+
+def add_view_arguments(p: argparse.ArgumentParser) -> None:
+    """``--view`` and its server options, for verbs that run a simulation."""
+    p.add_argument("--view", action="store_true",
+                   help="watch and command the run in a browser page (navlab view's viewer, paced at real time; "
+                   "the page can pause and change the speed)")
+    add_server_arguments(p, prefix="view-")
+
+
+def add_ros_argument(p: argparse.ArgumentParser) -> None:
+    """``--ros``: offer the run on a ROS 1 master (``$ROS_MASTER_URI``, or navlab's own)."""
+    p.add_argument("--ros", action="store_true",
+                   help="join the ROS 1 graph at $ROS_MASTER_URI (or start navlab's own master): real rostopic, "
+                   "rviz, rosbag and rospy nodes see and drive the run; runs in real time unless --rate")
+
+
+_UNSET: Any = object()
+
+
+def add_run_options(p: argparse.ArgumentParser, *, seed: int | None = _UNSET, json: bool = False,
+                    quiet: bool = False, record: bool = False, rate: float | None = _UNSET,
+                    rate_default: str = "0; real time with --ros", view: bool = False, ros: bool = False) -> None:
+    """The options a run verb shares, each declared here once with one help text: ``--seed`` (given a default),
+    ``--json``, ``--quiet``, ``--record DIR``, ``--rate`` (given a default; None = decided by the verb, which
+    ``rate_default`` describes), ``--view`` with its server options and ``--ros``."""
+    if seed is not _UNSET:
+        p.add_argument("--seed", type=int, default=seed, help=f"random seed (default {seed})")
+    if rate is not _UNSET:
+        shown = rate_default if rate is None else f"{rate:g}"
+        p.add_argument("--rate", type=pace, default=rate, help=f"{RATE_HELP} (default {shown})")
+    if record:
+        p.add_argument("--record", default=None, metavar="DIR",
+                       help="also write every topic to a rosbag2 (MCAP) in DIR")
+    if quiet:
+        p.add_argument("--quiet", action="store_true", help="no progress output on stderr")
+    if json:
+        p.add_argument("--json", action="store_true", help="print the figures as one JSON object")
+    if view:
+        add_view_arguments(p)
+    if ros:
+        add_ros_argument(p)

@@ -1,100 +1,17 @@
-"""``navlab bench NAME --json``: measured performance figures, printed as JSON.
-
-Each benchmark is a function ``run(args) -> dict`` registered in ``BENCHES`` by import path, so a
-concern's benchmark lives beside its code. ``navlab bench all --json`` runs them all (but ``soak``) and adds
-``summary``: the headline figures (``nav_rtf``, ``sim_rtf``, ``nav_sim_ratio``, ``start_s``,
-``slam_peak_rss_mb``, ...). ``navlab bench compare OLD.json NEW.json`` prints every figure the two share
-with its ratio new / old.
-"""
+"""``navlab bench NAME [--json]``: run a benchmark of :mod:`navlab.bench` (or ``all``) and print its figures;
+``navlab bench compare OLD.json NEW.json``: the ratio of every figure two results share."""
 
 from __future__ import annotations
 
 import argparse
 import importlib
 import json
-import statistics
-import sys
 from pathlib import Path
 from typing import Any
 
+from navlab.bench import BENCHES, SUMMARY, compare
+from navlab.cli.options import add_run_options
 from navlab.errors import NavlabError
-
-# name -> "module:function"; the function takes the parsed args and returns a JSON-able dict.
-BENCHES: dict[str, str] = {
-    "mapping": "navlab.experiments.mapping_run:bench",
-    "slam": "navlab.mapping.bench:run",
-    "slam-office": "navlab.mapping.bench:run_office",
-    "slam-gmapping": "navlab.mapping.bench:run_gmapping",
-    "startup": "navlab.bench:run_startup",
-    "core": "navlab.core.bench:run",
-    "soak": "navlab.core.bench:run_soak",
-    "amcl": "navlab.localization.bench:run",
-    "description": "navlab.description.bench:run",
-    "sim": "navlab.sim.bench:run",
-    "decompose": "navlab.sim.decompose_bench:run",
-    "sensors": "navlab.sim.sensors_bench:run",
-    "controller": "navlab.navigation.bench:run_controller",
-    "planner": "navlab.navigation.bench:run_planner",
-    "nav": "navlab.experiments.navigate_run:bench",
-    "clutter": "navlab.experiments.clutter_run:bench",
-    "odom": "navlab.experiments.odom_run:bench",
-    "sweep": "navlab.experiments.sweep:bench",
-    "view": "navlab.viz.bench:run",
-    "ros": "navlab.ros1.bench:run",
-}
-
-
-# summary key -> (bench, key) of ``navlab bench all``
-SUMMARY = {
-    "nav_rtf": ("nav", "rtf"),
-    "sim_rtf": ("sim", "rtf"),
-    "start_s": ("startup", "sim_start_cpu_s"),
-    "help_s": ("startup", "help_cpu_s"),
-    "slam_peak_rss_mb": ("slam-gmapping", "peak_rss_mb"),
-    "slam_gmapping_cpu_s": ("slam-gmapping", "cpu_s"),
-    "slam_gmapping_trans_m": ("slam-gmapping", "relations_trans_m"),
-    "slam_graph_rtf": ("slam", "rtf"),
-    "mapping_rtf": ("mapping", "rtf"),
-}
-
-
-def run_startup(args: argparse.Namespace) -> dict[str, Any]:
-    """Start-up of the ``navlab`` command in child processes, medians of 3 after one untimed run: ``VERB
-    --help`` (sim, slam, navigate) and ``sim --duration 0.01`` (the shortest run: imports, world, robot,
-    MuJoCo model, one step; Numba's cache warm), each in CPU seconds (user + system) and wall seconds."""
-    from navlab.core.bench import run_child
-
-    def median(cmd: list[str]) -> dict[str, float]:
-        run_child(cmd)  # warm: Numba's cache, the OS's file cache
-        runs = [run_child(cmd) for _ in range(3)]
-        return {k: statistics.median(r[k] for r in runs) for k in ("cpu_s", "wall_s")}
-
-    navlab = [sys.executable, "-m", "navlab.cli"]
-    helps = [median([*navlab, verb, "--help"]) for verb in ("sim", "slam", "navigate")]
-    sim = median([*navlab, "sim", "--duration", "0.01", "--quiet"])
-    return {
-        "help_cpu_s": round(max(h["cpu_s"] for h in helps), 3),
-        "help_wall_s": round(max(h["wall_s"] for h in helps), 3),
-        "sim_start_cpu_s": round(sim["cpu_s"], 3),
-        "sim_start_wall_s": round(sim["wall_s"], 3),
-    }
-
-
-def _flat(results: dict[str, Any], prefix: str = "") -> dict[str, float]:
-    """Numeric figures of a bench JSON (nested for ``all``) as ``bench.key`` -> value."""
-    out: dict[str, float] = {}
-    for key, value in results.items():
-        if isinstance(value, dict):
-            out.update(_flat(value, f"{prefix}{key}."))
-        elif isinstance(value, (int, float)) and not isinstance(value, bool):
-            out[prefix + key] = float(value)
-    return out
-
-
-def compare(old: dict[str, Any], new: dict[str, Any]) -> list[tuple[str, float, float, float | None]]:
-    """(figure, old, new, new / old) for every numeric figure both results hold, in the new one's order."""
-    a, b = _flat(old), _flat(new)
-    return [(k, a[k], v, v / a[k] if a[k] else None) for k, v in b.items() if k in a]
 
 
 def _read_json(path: str) -> dict[str, Any]:
@@ -170,9 +87,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("name", choices=[*BENCHES, "all", "compare"],
                    help="which benchmark to run; compare OLD.json NEW.json: the ratio of every shared figure")
     p.add_argument("files", nargs="*", metavar="FILE.json", help="compare: the old and the new results")
-    p.add_argument("--json", action="store_true", help="print one JSON object")
-    p.add_argument("--quiet", action="store_true", help="no 'running ...' lines on stderr")
-    p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    add_run_options(p, seed=0, quiet=True, json=True)
     p.add_argument("--controller", default=None,
                    help="clutter: local planner to drive with (trajectory, dwa, mppi; default mppi)")
     p.add_argument("--worlds", type=int, default=50, help="clutter: how many generated worlds (default 50)")

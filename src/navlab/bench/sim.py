@@ -17,7 +17,7 @@ from typing import Any
 
 from navlab import msgs
 from navlab.core import Executor, Node
-from navlab.sim.gazebo import GazeboSim, launch_sim
+from navlab.sim import GazeboSim, launch_sim
 
 WORLD, ROBOT = "room_obstacles", "mybot"
 SIM_SECONDS = 10.0

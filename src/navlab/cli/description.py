@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import json
 
+from navlab.cli.options import add_run_options
 from navlab.errors import NavlabError
 
 
@@ -21,13 +22,13 @@ def _xacro_args(pairs: list[str]) -> dict[str, str]:
 def _cmd(args: argparse.Namespace) -> int:
     path = args.file  # a path, package:// URI or shipped name: the loaders resolve it (one resolver)
     if args.kind == "robot":
-        from navlab.description.loader import load_robot
+        from navlab.description import load_robot
         from navlab.description.summary import format_robot, robot_summary
 
         summary = robot_summary(load_robot(path, search_paths=args.package_path, args=_xacro_args(args.arg)))
         text = format_robot(summary)
     else:
-        from navlab.world.sdf import load_world
+        from navlab.world import load_world
         from navlab.world.summary import format_world, world_summary
 
         summary = world_summary(load_world(path, model_path=args.model_path))
@@ -57,7 +58,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("kind", choices=("robot", "world"), help="what FILE is")
     p.add_argument("file", help="path of the .xacro/.urdf or .world file, or a shipped name "
                    "(robot: mybot; world: room, room_obstacles)")
-    p.add_argument("--json", action="store_true", help="print the summary as one JSON object")
+    add_run_options(p, json=True)
     p.add_argument("--package-path", action="append", default=[], metavar="DIR",
                    help="robot: a directory holding ROS packages for $(find pkg) and package:// "
                    "(repeatable; ROS_PACKAGE_PATH is also searched)")

@@ -23,7 +23,7 @@ import time
 from pathlib import Path
 from typing import Any
 
-from navlab.viz.errors import VizError
+from navlab.viz import VizError
 from navlab.viz.headless import CHROMIUM, HeadlessPage
 
 GOALS = [(4.3, 1.0, 0.0), (-3.5, -0.5, 3.14), (1.5, -2.5, 0.0)]
@@ -38,13 +38,13 @@ def _drive(
     blank page after the drive; ``setup``: JavaScript run in it once it drew the map, e.g.
     ``navlab.settings.maxFps = 20``). Wall time excludes the screenshot."""
     from navlab.experiments.session import start_run
-    from navlab.viz.viewer import attach
+    from navlab.viz import attach
 
     run = start_run("navigation", world="room_obstacles", map=map_yaml, seed=seed)
     viewer = None
     try:
         if page is not None:
-            viewer = attach(run.executor, port=0, speed=0.0)
+            viewer = attach(run.executor, port=0, rate=0.0)
             page.goto(viewer.url)
             page.wait_for("window.navlab && navlab.store.state")
         run.run(1.0)
@@ -130,13 +130,13 @@ def _load() -> float | None:
 
 def run(args: Any) -> dict[str, Any]:
     """Run the benchmark; see the module docstring."""
-    from navlab.viz.cli import _true_map
+    from navlab.mapping import save_true_map
 
     if not Path(CHROMIUM).exists():
         raise VizError(f"navlab bench view needs chromium at {CHROMIUM}")
     seed = int(getattr(args, "seed", 0))
     folder = Path(tempfile.mkdtemp(prefix="navlab-bench-view-"))
-    map_yaml = _true_map("room", (0.0, 0.0, 0.0), folder)
+    map_yaml = str(save_true_map("room", (0.0, 0.0), folder / "true_map.yaml"))
     shot = folder / "obstacle_experiment.png"
     rounds = int(getattr(args, "rounds", ROUNDS) or ROUNDS)
     _drive(map_yaml, seed=seed)  # warm-up: Numba's caches, imports

@@ -24,8 +24,8 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
     A missing log raises ``DatasetNotFoundError`` saying where it was looked for and how to provide it.
     """
     from navlab.experiments.metrics import read_relations, relations_closure, relations_error
+    from navlab.io import dataset
     from navlab.io.carmen import read_carmen
-    from navlab.io.datasets import dataset
     from navlab.mapping.scanmatch import warmup
     from navlab.mapping.slam import run_offline
 
@@ -53,8 +53,7 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
 
 def office_truth(resolution: float = 0.05) -> Any:
     """The default office floor's true occupancy (a boolean ``Grid``, world frame)."""
-    from navlab.experiments.truth import truth_grid
-    from navlab.world import load_world, occupancy
+    from navlab.world import load_world, occupancy, truth_grid
     from navlab.world.office import generate_office
 
     office = generate_office()
@@ -120,9 +119,9 @@ def run_gmapping(args: argparse.Namespace) -> dict[str, Any]:
     the relations metric of its poses (the filter plus the offline refinement, slam_gmapping's defaults)."""
     import sys
 
-    from navlab.core.bench import run_child
-    from navlab.experiments.metrics import read_relations, relations_error
-    from navlab.io.datasets import dataset
+    from navlab.bench.core import run_child
+    from navlab.experiments import read_relations, relations_error
+    from navlab.io import dataset
 
     clf, relations = dataset(CSAIL), read_relations(dataset(RELATIONS))
     with tempfile.TemporaryDirectory(prefix="navlab-bench-") as out:

@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from navlab.localization.amcl import Amcl, AmclParams
+from navlab.localization import Amcl, AmclParams
 from navlab.localization.synthetic import room_field, simulated_scan
 
 N_PARTICLES = 2000

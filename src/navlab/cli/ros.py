@@ -1,4 +1,5 @@
-"""ROS-style tools: ``navlab launch``, ``navlab topic list|echo|hz``, ``navlab node list``, ``navlab graph``.
+"""ROS-style tools: ``navlab topic list|echo|hz``, ``navlab node list``, ``navlab graph``, ``navlab bag reindex``
+and ``navlab roscore``.
 
 The introspection verbs look at a ``navlab launch`` running in another shell (the default; ``--pid``
 picks one of several), at a launch that they start themselves (``--launch FILE name:=value``, run
@@ -18,14 +19,12 @@ from typing import Any
 
 import numpy as np
 
-from navlab.cli_common import add_resource_path_arguments, apply_resource_paths, out_file, positive_seconds
-from navlab.core.errors import CoreError
+from navlab.cli.options import add_run_options, out_file, positive_seconds
+from navlab.core import CoreError
 from navlab.core.graph import Graph
 from navlab.core.launch import Session, start
 from navlab.core.runner import parse_launch_args, run_for
 from navlab.io.files import write_text_atomic
-from navlab.ros1.cli import add_ros_argument
-from navlab.viz.cli import add_view_arguments
 
 
 def _add_source(p: argparse.ArgumentParser) -> None:
@@ -38,7 +37,7 @@ def _add_source(p: argparse.ArgumentParser) -> None:
     src.add_argument("--pid", type=int, help="which running `navlab launch` to watch when several run")
     p.add_argument("--duration", type=positive_seconds, default=None,
                    help="simulated seconds to watch (default 5; echo: until Ctrl-C or the end of the launch)")
-    p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    add_run_options(p, seed=0)
 
 
 def _watch_seconds(args: argparse.Namespace) -> None:
@@ -92,123 +91,6 @@ def _messages(args: argparse.Namespace, topic: str) -> Iterator[tuple[int, Any]]
     if topic not in session.executor.topics:
         raise CoreError(f"no topic {topic!r} in this launch (topics: {', '.join(sorted(session.executor.topics))})")
     return got
-
-
-def _show_args(file: str) -> int:
-    from navlab.core.launch import declared_args
-
-    rows = declared_args(file)
-    if not rows:
-        print(f"{file}: no arguments")
-    for a in rows:
-        default = f" (default: {a['default']!r})" if "default" in a else " (required)"
-        print(f"  '{a.get('name')}':\n      {a.get('description', '')}{default}")
-    return 0
-
-
-def _split_files(first: str, items: list[str]) -> tuple[list[str], list[str]]:
-    """``FILE [FILE ...] name:=value ...``: the launch files and the arguments (as roslaunch takes them)."""
-    files = [first] + [i for i in items if ":=" not in i]
-    return files, [i for i in items if ":=" in i]
-
-
-def find_in_package(pkg: str, name: str) -> Path:
-    """roslaunch's ``roslaunch PKG FILE``: the file called ``name`` anywhere inside package ``pkg``."""
-    from navlab.core.errors import LaunchError
-    from navlab.description.errors import DescriptionError
-    from navlab.description.packages import find_package
-
-    try:
-        root = find_package(pkg)
-    except DescriptionError as exc:
-        raise LaunchError(str(exc)) from None
-    found = sorted(p for p in root.rglob(name) if p.is_file() and not any(s.startswith(".") for s in p.parts))
-    if not found:
-        raise LaunchError(f"[{name}] is neither a launch file in package [{pkg}] ({root}) nor a launch file name")
-    if len(found) > 1:
-        raise LaunchError(f"[{name}] is ambiguous in package [{pkg}]: {', '.join(map(str, found))}")
-    return found[0]
-
-
-def _cmd_roslaunch(args: argparse.Namespace) -> int:
-    apply_resource_paths(args)
-    if not Path(args.file).is_file() and args.args and ":=" not in args.args[0]:
-        args.file, args.args = str(find_in_package(args.file, args.args[0])), args.args[1:]
-    return _cmd_launch(args)
-
-
-def _cmd_launch(args: argparse.Namespace) -> int:
-    if args.show_args:
-        return _show_args(args.file)
-    apply_resource_paths(args)  # --package-path / --model-path for robot:= and world:=
-    # Like roslaunch, a launch without --duration runs in real time until Ctrl-C.
-    from navlab.ros1.cli import follows_clock, pop_ros_arg, ros_bridge
-
-    files, items = _split_files(args.file, args.args)
-    launch_args = parse_launch_args(items)
-    ros = pop_ros_arg(launch_args) or args.ros  # outside nodes cannot follow 100x: real time unless --rate
-    rate = args.rate if args.rate is not None else (1.0 if args.duration is None or ros else 0.0)
-    follow_clock = ros and follows_clock(launch_args)  # hardware in the loop: the robot's /clock paces the run
-    rate = 0.0 if follow_clock else rate
-    session = start(files, seed=args.seed, pace=rate, launch_args=launch_args, ros=ros)
-    ex = session.executor
-    duration = math.inf if args.duration is None else args.duration
-    from navlab.core.introspect import IntrospectionServer
-
-    # `navlab topic/node/graph` in another shell look into this launch while it runs; SIGTERM ends it
-    # cleanly like Ctrl-C (the recording is closed, the socket removed)
-    signal.signal(signal.SIGTERM, lambda *_: ex.post(ex.stop))
-    from navlab.viz.cli import viewing
-
-    with IntrospectionServer(ex, name=args.file), contextlib.suppress(KeyboardInterrupt), viewing(args, ex), \
-            ros_bridge(ros, ex, session.nodes, follow_clock=follow_clock):
-        try:
-            run_for(ex, duration, record=args.record, quiet=args.quiet, desc=Path(args.file).stem)
-        finally:
-            session.shutdown()
-    topics = {name: t.count for name, t in sorted(ex.topics.items())}
-    summary: dict[str, Any] = {"sim_s": round(ex.now_ns / 1e9, 3), "nodes": sorted(ex.nodes), "topics": topics}
-    if args.record:
-        summary["record"] = str(args.record)
-    if args.json:
-        print(json.dumps(summary))
-    else:
-        print(f"ran {summary['sim_s']:.2f} simulated s; {len(ex.nodes)} nodes")
-        for name, count in topics.items():
-            print(f"  {name}: {count} messages")
-    return 0
-
-
-def _cmd_run(args: argparse.Namespace) -> int:
-    """``navlab run FILE.py``: an rclpy-style node file, unchanged, in a launch's simulation."""
-    import runpy
-    import sys
-
-    from navlab.core import rclpy_api
-    from navlab.core.ros_imports import install
-
-    apply_resource_paths(args)
-    install()
-    files, items = (_split_files(args.launch, args.args) if args.launch else ([], args.args))
-    if files:
-        session = start(files, seed=args.seed, launch_args=parse_launch_args(items))
-        ctx = rclpy_api.Context(session.executor, session, args.duration, prepared=True)
-    else:
-        ctx = rclpy_api.Context(duration=args.duration, prepared=True)
-    rclpy_api.init(context=ctx)
-    argv = sys.argv
-    sys.argv = [args.file]
-    try:
-        runpy.run_path(args.file, run_name="__main__")
-    finally:
-        sys.argv = argv
-        rclpy_api.shutdown(context=ctx)
-    ex = ctx.executor
-    summary = {"sim_s": round(ex.now_ns / 1e9, 3), "nodes": sorted(ex.nodes),
-               "topics": {name: t.count for name, t in sorted(ex.topics.items())}}
-    if args.json:
-        print(json.dumps(summary))
-    return 0
 
 
 def _cmd_topic(args: argparse.Namespace) -> int:
@@ -318,66 +200,22 @@ def _cmd_bag(args: argparse.Namespace) -> int:
     return 0
 
 
-def _shipped_launches() -> list[str]:
-    from navlab.core.launch import resources_dir
+def _cmd_roscore(args: argparse.Namespace) -> int:
+    from navlab.ros1 import Master
+    from navlab.ros1.net import host_port, master_uri
 
-    return sorted(f.name.removesuffix(".launch.yaml") for f in (resources_dir() / "launch").glob("*.launch.yaml"))
+    port = args.port if args.port is not None else host_port(master_uri())[1]
+    master = Master(port=port)
+    print(f"navlab roscore: ROS master at {master.uri} (Ctrl-C to stop)", flush=True)
+    signal.signal(signal.SIGTERM, lambda *_: master.close())
+    with contextlib.suppress(KeyboardInterrupt):
+        master.stopped.wait()
+    master.close()
+    return 0
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    """Add ``launch``, ``topic``, ``node`` and ``graph``."""
-    for verb in ("launch", "roslaunch"):
-        p = sub.add_parser(
-            verb,
-            help="run launch files: navlab YAML (ROS 2 shape) or ROS 1 XML .launch" if verb == "launch"
-            else "roslaunch PKG FILE.launch [name:=value]: a ROS 1 launch file found in a package",
-            description="Run launch files (paths or shipped names; several at once as `roslaunch a.launch b.launch` "
-            "takes them) with name:=value arguments, in simulated time, and print how many messages each topic "
-            "carried. ROS 1 XML .launch files run with roslaunch's semantics; `navlab roslaunch PKG FILE.launch` "
-            "finds FILE inside package PKG (ROS_PACKAGE_PATH and --package-path). Nodes navlab does not implement "
-            "are listed, and started as processes with ros:=true (the ROS bridge). Shipped launches: "
-            f"{', '.join(_shipped_launches())} (e.g. `navlab launch mapping --duration 120`, "
-            "`navlab launch localization map:=map/map.yaml`); `navlab launch NAME --show-args` lists a launch's "
-            "arguments.",
-        )
-        p.add_argument("file", help="launch file or shipped launch name" if verb == "launch"
-                       else "ROS package (then the launch file's name), or a launch file")
-        p.add_argument("args", nargs="*", metavar="FILE|name:=value",
-                       help="more launch files, then launch arguments")
-        p.add_argument("--duration", type=positive_seconds, default=None,
-                       help="simulated seconds to run (default: until Ctrl-C)")
-        p.add_argument("--rate", type=float, default=None,
-                       help="pacing: 0 = as fast as possible, 1 = real time (default: 0 with --duration, else 1)")
-        p.add_argument("--record", metavar="DIR", help="write every topic to a rosbag2 (MCAP) in DIR")
-        p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
-        p.add_argument("--quiet", action="store_true", help="no progress bar")
-        p.add_argument("--json", action="store_true", help="print the summary as JSON")
-        add_view_arguments(p)
-        add_ros_argument(p)
-        add_resource_path_arguments(p)
-        p.add_argument("-s", "--show-args", action="store_true",
-                       help="list the launch's arguments (name, description, default) and exit")
-        p.set_defaults(func=_cmd_launch if verb == "launch" else _cmd_roslaunch)
-
-    p = sub.add_parser(
-        "run",
-        help="run an rclpy-style node file unchanged in a launch's simulation",
-        description="Run a Python file written against rclpy (import rclpy; from rclpy.node import Node; from "
-        "geometry_msgs.msg import Twist; rclpy.init(); rclpy.spin(node)) unchanged, on navlab: `import rclpy` and "
-        "the message packages come from navlab unless a real ROS 2 installation provides them. With --launch, "
-        "the file's rclpy.init() joins that launch (e.g. `navlab run driver.py --launch sim world:=room "
-        "--duration 10`); rclpy.spin() runs --duration simulated seconds.",
-    )
-    p.add_argument("file", help="the Python file")
-    p.add_argument("--launch", metavar="FILE", help="a launch (file or shipped name) to start for the node")
-    p.add_argument("args", nargs="*", metavar="name:=value", help="launch arguments")
-    p.add_argument("--duration", type=positive_seconds, default=None,
-                   help="simulated seconds rclpy.spin() runs (default: until the file calls rclpy.shutdown())")
-    p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
-    p.add_argument("--json", action="store_true", help="print the topics' message counts as JSON")
-    add_resource_path_arguments(p)
-    p.set_defaults(func=_cmd_run)
-
+    """Add ``bag``, ``topic``, ``node``, ``graph`` and ``roscore``."""
     p = sub.add_parser(
         "bag",
         help="recordings: reindex a recording that was killed (ros2 bag reindex)",
@@ -390,7 +228,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("action", choices=["reindex"], help="what to do")
     p.add_argument("dir", metavar="DIR", help="the recording's directory (or the name it was recorded under)")
     p.add_argument("--out", metavar="OUT", help="write the rebuilt recording to this new directory instead")
-    p.add_argument("--json", action="store_true", help="print the result as JSON")
+    add_run_options(p, json=True)
     p.set_defaults(func=_cmd_bag)
 
     p = sub.add_parser(
@@ -409,7 +247,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("-n", "--count", type=int, default=0,
                    help="echo: stop after this many messages (exit 1 if the source ends before)")
     p.add_argument("-v", "--verbose", action="store_true", help="list: show message counts")
-    p.add_argument("--json", action="store_true", help="hz: print JSON")
+    add_run_options(p, json=True)
     p.set_defaults(func=_cmd_topic)
 
     p = sub.add_parser(
@@ -436,3 +274,10 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="output folder: DIR/graph.dot and DIR/graph.svg (default ./graph)")
     p.set_defaults(func=_cmd_graph)
 
+    p = sub.add_parser(
+        "roscore", help="run a ROS 1 master + parameter server (for real ROS tools and navlab's --ros runs)",
+        description="A ROS 1 master and parameter server, as `roscore` starts them, on $ROS_MASTER_URI's port "
+                    "(default 11311). It listens on loopback unless ROS_IP or ROS_HOSTNAME name another address.",
+    )
+    p.add_argument("-p", "--port", type=int, default=None, help="port (default: from $ROS_MASTER_URI, else 11311)")
+    p.set_defaults(func=_cmd_roscore)

@@ -21,11 +21,10 @@ from typing import Any
 import numpy as np
 
 from navlab.grid import Grid, GridMap
+from navlab.navigation import LayeredCostmap, NavfnPlanner, ThetaStarPlanner, path_length
 from navlab.navigation.controllers import DWAPlannerROS, TrajectoryPlannerROS
 from navlab.navigation.controllers import synthetic as syn
 from navlab.navigation.controllers.mppi import MPPIController
-from navlab.navigation.costmap import LayeredCostmap
-from navlab.navigation.planners import NavfnPlanner, ThetaStarPlanner, path_length
 
 # --- controllers ------------------------------------------------------------------------------------
 

@@ -1,0 +1,73 @@
+"""The experiments' benchmarks, each a whole stack run as ``navlab`` runs it: ``navlab bench mapping`` (SLAM
+exploring room), ``nav`` (move_base to four goals), ``clutter`` (mapless navigation over generated clutter
+worlds) and ``odom`` (odometry drift per robot, route and EKF setting)."""
+
+from __future__ import annotations
+
+import tempfile
+import time
+from pathlib import Path
+from typing import Any
+
+from navlab.experiments.clutter_run import run_clutter_suite
+from navlab.experiments.mapping_run import run_mapping
+from navlab.experiments.navigate_run import run_navigation
+from navlab.experiments.odom_run import ROBOTS, ROUTES, run_drift
+
+WARMUP_S = 5.0  # simulated s of `bench mapping`'s untimed warm-up run
+
+
+def run_mapping_bench(args: Any) -> dict[str, Any]:
+    """``navlab bench mapping``: the whole mapping stack (sim + lidar + slam_gmapping + exploration)
+    exploring room.world until done; real-time factor of the run loop (sim s / wall s), after an untimed
+    ``WARMUP_S`` warm-up run."""
+    with tempfile.TemporaryDirectory() as tmp:
+        # a short untimed run first: Numba's kernels load (or compile, on a cold cache) outside the figure
+        run_mapping(world="room", out=Path(tmp) / "warmup", driver="explore", duration=WARMUP_S, quiet=True)
+        r = run_mapping(world="room", out=tmp, driver="explore", duration=300, seed=getattr(args, "seed", 0),
+                        quiet=True)  # fmt: skip
+    keys = ("sim_s", "wall_s", "rtf", "finished", "scans_processed", "coverage", "precision", "recall")
+    out = {k: r.scores[k] for k in keys}
+    # this process's CPU time in the run loop: on a busy machine it shows what one free core would take
+    out["cpu_s"] = round(r.cpu_s, 2)
+    out["rtf_cpu"] = round(r.sim_s / r.cpu_s, 1) if r.cpu_s > 0 else None
+    return out
+
+
+def run_nav(args: Any) -> dict[str, Any]:
+    """``navlab bench nav``: the whole navigation stack (sim + lidar + amcl + costmaps + planner + controller)
+    driving across room_obstacles.world to four goals; real-time factor of the run loop."""
+    goals = [(4.3, 1.0, 0.0), (-3.5, -0.5, 3.14), (1.5, -2.5, 0.0), (0.0, 0.0, 0.0)]
+    run_navigation(goals[:1], world="room_obstacles", goal_timeout=5, seed=getattr(args, "seed", 0))  # warm-up: Numba
+    r = run_navigation(goals, world="room_obstacles", goal_timeout=90, seed=getattr(args, "seed", 0))
+    return {**{k: r.summary[k] for k in ("sim_s", "wall_s", "rtf")}, "goals_succeeded": r.summary["goals_succeeded"],
+            "goals": len(goals), "collisions": r.summary["collisions"]}  # fmt: skip
+
+
+def run_clutter(args: Any) -> dict[str, Any]:
+    """``navlab bench clutter``: mapless navigation over 50 generated clutter worlds of graded difficulty (``--robot``:
+    mybot with MPPI by default; another shipped robot drives with its own params/<robot> planner unless
+    ``--controller`` names one)."""
+    n = int(getattr(args, "worlds", 0) or 50)
+    t0 = time.perf_counter()
+    robot = getattr(args, "robot", None) or "mybot"
+    controller = getattr(args, "controller", None) or ("mppi" if robot == "mybot" else None)  # None: params/<robot>'s
+    out = run_clutter_suite(n, seed=getattr(args, "seed", 0), controller=controller, robot=robot)
+    s = dict(out["summary"])
+    s["wall_s"] = round(time.perf_counter() - t0, 1)
+    s["failed_worlds"] = [t["world"] for t in out["trials"] if not t["success"]]
+    return s
+
+
+def run_odom(args: Any) -> dict[str, Any]:
+    """``navlab bench odom``: drift per robot, route and EKF setting (see the module)."""
+    t0 = time.perf_counter()
+    runs = [run_drift(robot, route, ekf=ekf, seed=getattr(args, "seed", 0))
+            for robot in ROBOTS for route in ROUTES for ekf in (False, True)]  # fmt: skip
+    out: dict[str, Any] = {}
+    for r in runs:
+        key = f"{r['robot']}/{r['route']}/{'ekf' if r['ekf'] else 'wheels'}"
+        out[key] = {k: r[k] for k in ("error_per_m", "yaw_error_per_rad", "final_error_m", "max_error_m",
+                                      "distance_m", "turned_rad", "completed")}  # fmt: skip
+    out["wall_s"] = round(time.perf_counter() - t0, 1)
+    return out
