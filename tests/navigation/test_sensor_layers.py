@@ -108,3 +108,21 @@ def test_voxel_grid_message_packs_the_columns() -> None:
     column = int(msg.data[j * 60 + i])
     assert column >> 16 == 1 << 2 and column & (1 << 2)  # voxel 2 (0.2 .. 0.3 m) marked: both of its bits set
     assert column & 0xFFFF == 0xFFFF  # the others unknown (their low bit only), none cleared: no ray crossed them
+
+
+def test_layers_build_from_params_with_a_context() -> None:
+    from types import SimpleNamespace
+
+    from navlab.navigation.costmap.params import costmap_params
+
+    costmap = costmap_params({"static_map": False, "observation_sources": "cam",
+                              "cam": {"data_type": "PointCloud2", "topic": "points"}})
+    ctx = SimpleNamespace(name="voxels", costmap=costmap, footprint=None)
+    voxel = VoxelLayer.from_params({"z_voxels": 4, "origin_z": -0.1}, context=ctx)
+    assert (voxel.name, voxel.params.z_voxels, voxel.params.origin_z, list(voxel.sources)) == ("voxels", 4, -0.1,
+                                                                                              ["cam"])
+    sonar = RangeSensorLayer.from_params({"topics": ["/sonar_left", "/sonar_right"], "phi": 1.0},
+                                         context=SimpleNamespace(name="sonar", costmap=costmap, footprint=None))
+    assert sonar.topics == ["/sonar_left", "/sonar_right"] and sonar.params.phi == 1.0
+    with pytest.raises(NavigationError, match="clear_threshold"):
+        RangeSensorLayer.from_params({"clear_threshold": 0.9}, context=ctx)

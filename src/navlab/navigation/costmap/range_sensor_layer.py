@@ -13,14 +13,16 @@ cells short of the reading are pushed towards free, those at the reading towards
 
 from __future__ import annotations
 
+import dataclasses
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any, Self
 
 import numpy as np
 
 from navlab.grid import COST_FREE, COST_LETHAL, COST_UNKNOWN, Grid
-from navlab.navigation.costmap.footprint import Footprint
+from navlab.navigation.costmap.footprint import Footprint, make_footprint
 from navlab.navigation.costmap.layers import Layer
 from navlab.navigation.costmap.params import CostmapParams, build
 from navlab.navigation.errors import NavigationError
@@ -87,6 +89,17 @@ class RangeSensorLayer(Layer):
         self.name = name
         self.enabled = self.params.enabled
         self.prob: Grid | None = None
+
+    @classmethod
+    def from_params(cls, params: Mapping[str, Any] | None, *, context: Any) -> Self:
+        """The layer named ``context.name`` (its ``plugins:`` name) from its namespace ``params`` (ROS names), in the
+        costmap ``context.costmap`` (parsed ``CostmapParams``) with the padded ``context.footprint``."""
+        name = context.name or "range_sensor_layer"
+        costmap = context.costmap if isinstance(context.costmap, CostmapParams) else CostmapParams()
+        if params is not None:
+            costmap = dataclasses.replace(costmap, namespaces={**costmap.namespaces, name: dict(params)})
+        footprint = context.footprint if isinstance(context.footprint, Footprint) else make_footprint()
+        return cls.from_costmap_params(name, costmap, footprint)
 
     @classmethod
     def from_costmap_params(cls, name: str, costmap: CostmapParams, footprint: Footprint) -> Self:

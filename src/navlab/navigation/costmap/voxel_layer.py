@@ -14,6 +14,7 @@ The costs combine into the master as the obstacle layer's do (``combination_meth
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -126,6 +127,17 @@ class VoxelLayer(Layer):
         self.grid: Grid | None = None
         self.columns = np.zeros((0, 0), dtype=np.uint32)
         self.robot_pose: tuple[float, float, float] | None = None
+
+    @classmethod
+    def from_params(cls, params: Mapping[str, Any] | None, *, context: Any) -> Self:
+        """The layer named ``context.name`` (its ``plugins:`` name) from its namespace ``params`` (ROS names), in the
+        costmap ``context.costmap`` (parsed ``CostmapParams``) with the padded ``context.footprint``."""
+        name = context.name or "obstacle_layer"
+        costmap = context.costmap if isinstance(context.costmap, CostmapParams) else CostmapParams()
+        if params is not None:
+            costmap = dataclasses.replace(costmap, namespaces={**costmap.namespaces, name: dict(params)})
+        footprint = context.footprint if isinstance(context.footprint, Footprint) else make_footprint()
+        return cls.from_costmap_params(name, costmap, footprint)
 
     @classmethod
     def from_costmap_params(cls, name: str, costmap: CostmapParams, footprint: Footprint) -> Self:
