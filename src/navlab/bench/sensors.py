@@ -112,6 +112,7 @@ def _frames() -> dict[str, float]:
     """Per-frame CPU costs of the sensors and the voxel update, in room_obstacles from the origin."""
     from navlab.description import load_robot
     from navlab.grid import Grid
+    from navlab.io.pointcloud import move_points
     from navlab.navigation.costmap.params import ObservationSource
     from navlab.navigation.costmap.voxel_layer import VoxelLayer
     from navlab.sim.sensors3d import depth_image, depth_points, lidar3d_ranges, sensor_pose
@@ -139,7 +140,7 @@ def _frames() -> dict[str, float]:
     pts = depth_points(depth_image(sim, cam), cam).reshape(-1, 3)
     pos, rot = sensor_pose(sim, cam.link, cam.origin)
     body = np.stack([pts[:, 2], -pts[:, 0], -pts[:, 1]], axis=1)  # optical -> camera body
-    cloud = (body @ np.ascontiguousarray(rot.T) + pos)[np.isfinite(body.sum(axis=1))]
+    cloud = move_points(body[np.isfinite(body.sum(axis=1))], rot, pos)
     layer = VoxelLayer({"z_resolution": 0.05, "z_voxels": 8}, name="voxel", sources={"cam": ObservationSource(
         data_type="PointCloud2", clearing=True, min_obstacle_height=0.04, max_obstacle_height=0.35)})
     layer.match_size(Grid(np.zeros((80, 80), np.uint8), 0.05, (-2.0, -2.0, 0.0), "odom"))

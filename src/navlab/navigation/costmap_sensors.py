@@ -17,7 +17,7 @@ import numpy as np
 from navlab import msgs
 from navlab.core import Node, TfError
 from navlab.geometry import matrix_from_quat
-from navlab.io.pointcloud import read_xyz
+from navlab.io.pointcloud import move_points, read_xyz
 from navlab.navigation.costmap.params import ObservationSource
 
 
@@ -103,11 +103,9 @@ class CostmapSensorFeeds:
             if place is None:
                 continue
             pts = scan_points(msg) if msgs.type_name(msg).endswith("LaserScan") else read_xyz(msg)
-            pts = pts[np.isfinite(pts.sum(axis=1))].astype(np.float32)
             origin, rot = place
-            # (a transposed right operand made numpy's matmul 20x slower on 77k points)
-            moved = pts @ np.ascontiguousarray(rot.T, dtype=np.float32) + origin.astype(np.float32)
-            self.voxel[k].add_cloud(origin, moved, source=src_name)
+            self.voxel[k].add_cloud(origin, move_points(pts[np.isfinite(pts.sum(axis=1))], rot, origin),
+                                    source=src_name)
         self.pending.clear()
         for k, pub in self.voxel_pubs.items():
             grid = self.voxel[k].voxel_grid_msg(self.node.executor.now_ns)

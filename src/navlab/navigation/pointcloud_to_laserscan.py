@@ -20,7 +20,7 @@ import numpy as np
 from navlab import msgs
 from navlab.core import Node, TfError
 from navlab.geometry import matrix_from_quat
-from navlab.io.pointcloud import read_xyz
+from navlab.io.pointcloud import move_points, read_xyz
 from navlab.navigation.errors import NavigationError
 
 DOUBLE_MIN, DOUBLE_MAX = sys.float_info.min, sys.float_info.max
@@ -77,7 +77,7 @@ class PointCloudToLaserScan(Node):
             except TfError as exc:
                 self.get_logger().warning(f"cannot transform the cloud from {frame} to {self.target_frame}: {exc}")
                 return
-            pts = pts @ np.ascontiguousarray(matrix_from_quat(t[3:]).T) + np.array(t[:3])
+            pts = move_points(pts, matrix_from_quat(t[3:]), t[:3]).astype(np.float64)
             frame = self.target_frame
         p = self.p
         fill = math.inf if self.use_inf else p["range_max"] + p["inf_epsilon"]

@@ -14,6 +14,7 @@ import numpy as np
 from navlab.description.model import Origin
 from navlab.description.sensor_model import CameraConfig, Lidar3dConfig, RangeConfig
 from navlab.geometry import matrix_from_quat, qmul, qrotate, quat_from_rpy
+from navlab.io.pointcloud import move_points
 from navlab.sim.raycast3d import ALL, PINHOLE, SPHERICAL, cast_grid, pinhole_dirs, spherical_dirs
 from navlab.sim.simulation import Simulation
 
@@ -39,7 +40,7 @@ def cast(sim: Simulation, pos: np.ndarray, rot: np.ndarray, dirs: np.ndarray, ro
     cast_grid(pos, rot, dirs, rows, cols, mode, params, fast, m.geom_type, m.geom_size, d.geom_xpos, d.geom_xmat,
               tmin, tmax, out)
     if slow is not None:  # meshes: MuJoCo's ray caster, from tmin on
-        world = np.ascontiguousarray(dirs @ rot.T)
+        world = move_points(dirs, rot, (0.0, 0.0, 0.0)).astype(np.float64)
         n = len(world)
         dist = np.empty(n)
         geomid = np.empty(n, dtype=np.int32)

@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-from navlab.io.pointcloud import read_xyz
+from navlab.io.pointcloud import move_points, read_xyz
 from navlab.viz.frames import pack
 
 IMAGE_MAX_W = 160
@@ -61,8 +61,7 @@ def cloud_in_fixed(msg: Any, fixed_T_frame: tuple[float, ...] | None, rng: np.ra
     pts = pts[np.isfinite(pts.sum(axis=1))]
     if len(pts) > CLOUD_MAX:
         pts = pts[rng.choice(len(pts), CLOUD_MAX, replace=False)]
-    rot = np.ascontiguousarray(matrix_from_quat(fixed_T_frame[3:]).T, dtype=np.float32)
-    return pts @ rot + np.asarray(fixed_T_frame[:3], dtype=np.float32)
+    return move_points(pts, matrix_from_quat(fixed_T_frame[3:]), fixed_T_frame[:3])
 
 
 def cloud_frame(topic: str, frame: str, xyz: np.ndarray) -> bytes:
