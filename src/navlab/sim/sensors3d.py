@@ -8,6 +8,8 @@ gaussian noise from the given generator). Frames: the sensor frame is Gazebo's (
 
 from __future__ import annotations
 
+import functools
+
 import mujoco
 import numpy as np
 
@@ -17,8 +19,6 @@ from navlab.geometry import matrix_from_quat, qmul, qrotate, quat_from_rpy
 from navlab.io.pointcloud import move_points
 from navlab.sim.raycast3d import ALL, PINHOLE, SPHERICAL, cast_grid, pinhole_dirs, spherical_dirs
 from navlab.sim.simulation import Simulation
-
-_GRIDS: dict[tuple, tuple[np.ndarray, np.ndarray]] = {}
 
 
 def sensor_pose(sim: Simulation, link: str, origin: Origin) -> tuple[np.ndarray, np.ndarray]:
@@ -56,16 +56,26 @@ def cast(sim: Simulation, pos: np.ndarray, rot: np.ndarray, dirs: np.ndarray, ro
     return out
 
 
+@functools.lru_cache(maxsize=16)
+def _pinhole_dirs(width: int, height: int, focal: float) -> np.ndarray:
+    dirs = pinhole_dirs(width, height, focal)
+    dirs.flags.writeable = False
+    return dirs
+
+
+@functools.lru_cache(maxsize=16)
+def _spherical_dirs(azimuths: tuple[float, ...], elevations: tuple[float, ...]) -> np.ndarray:
+    dirs = spherical_dirs(np.array(azimuths), np.array(elevations))
+    dirs.flags.writeable = False
+    return dirs
+
+
 def _pinhole(cfg: CameraConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(ray directions, their cosine to the optical axis, grid params) of a camera, cached by its geometry."""
+    """(ray directions, their cosine to the optical axis, grid params) of a camera (directions cached by geometry)."""
     cam = cfg.camera
-    key = ("pinhole", cam.width, cam.height, cam.horizontal_fov)
-    if key not in _GRIDS:
-        dirs = pinhole_dirs(cam.width, cam.height, cam.focal_length)
-        _GRIDS[key] = (dirs, dirs[:, 0].copy())
-    dirs, cos = _GRIDS[key]
+    dirs = _pinhole_dirs(cam.width, cam.height, cam.focal_length)
     params = np.array([cam.focal_length, (cam.width - 1) / 2.0, (cam.height - 1) / 2.0])
-    return dirs, cos, params
+    return dirs, dirs[:, 0], params
 
 
 def depth_image(sim: Simulation, cfg: CameraConfig, rng: np.random.Generator | None = None) -> np.ndarray:
@@ -113,11 +123,7 @@ def lidar3d_ranges(sim: Simulation, cfg: Lidar3dConfig, rng: np.random.Generator
     """Ranges (rings x samples, m) of a 3D lidar: the sensor's ray hits from ``range_min`` with noise added
     (``rng``); misses are ``range_max``, as Gazebo's ray sensor reports them."""
     az, el = lidar3d_angles(cfg)
-    key = ("spherical", cfg.samples, cfg.min_angle, cfg.max_angle, cfg.rings, cfg.vertical_min_angle,
-           cfg.vertical_max_angle)
-    if key not in _GRIDS:
-        _GRIDS[key] = (spherical_dirs(az, el), np.zeros(0))
-    dirs = _GRIDS[key][0]
+    dirs = _spherical_dirs(tuple(az.tolist()), tuple(el.tolist()))
     d_az = (az[-1] - az[0]) / (len(az) - 1) if len(az) > 1 else 0.0
     d_el = (el[-1] - el[0]) / (len(el) - 1) if len(el) > 1 else 0.0
     params = np.array([az[0], d_az, el[0], d_el])
