@@ -3,11 +3,14 @@
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 import pytest
 from sim_helpers import make_mybot
 
+from navlab import msgs
+from navlab.core import Executor, Node
 from navlab.description.model import Origin
 from navlab.description.sensor_model import BumperConfig, CameraConfig, CameraModel, Lidar3dConfig, RangeConfig
 from navlab.io.pointcloud import read_field, read_xyz
@@ -144,3 +147,50 @@ def test_sensor_topics_record_to_rosbag2_and_read_back(tmp_path) -> None:
     clouds = [m for topic, _, m in read_bag(bag, topics=["/camera/depth/points"])]
     assert len(clouds) >= 2 and read_xyz(clouds[0]).shape == (320 * 240, 3)  # 15 Hz over 0.2 s
     assert clouds[0].header.frame_id == "camera_depth_optical_frame"
+
+
+SONAR_BUMPER = """<?xml version="1.0"?>
+<robot name="mybot_sonar" xmlns:xacro="http://www.ros.org/wiki/xacro">
+  <xacro:include filename="$(find mybot_description)/mybot.xacro"/>
+  <gazebo reference="chassis">
+    <sensor type="ray" name="sonar_front"><pose>0.2 0 0.05 0 0 0</pose><update_rate>10</update_rate>
+      <ray><scan><horizontal><samples>5</samples><min_angle>-0.13</min_angle><max_angle>0.13</max_angle></horizontal>
+      <vertical><samples>3</samples><min_angle>-0.05</min_angle><max_angle>0.05</max_angle></vertical></scan>
+      <range><min>0.02</min><max>3.0</max></range></ray>
+      <plugin name="sonar" filename="libgazebo_ros_range.so"><topicName>sonar_front</topicName>
+        <frameName>sonar_front_link</frameName><radiation>ultrasound</radiation><fov>0.26</fov></plugin>
+    </sensor>
+    <sensor type="contact" name="bumper"><contact><collision>chassis_collision</collision></contact>
+      <plugin name="bumper" filename="libgazebo_ros_bumper.so"><bumperTopicName>bumper</bumperTopicName></plugin>
+    </sensor>
+  </gazebo>
+</robot>
+"""
+
+
+def test_range_and_bumper_plugins_publish_their_messages(tmp_path) -> None:
+    from navlab.sim.gazebo import launch_sim
+
+    robot = tmp_path / "mybot_sonar.xacro"
+    robot.write_text(SONAR_BUMPER)
+    ex = Executor(seed=0)
+    gz = launch_sim(ex, world="empty", robot=str(robot))
+    gz.spawn(primitive_model("box", "wall", (0.2, 3.0, 1.0), x=1.6))  # its face 1.5 m ahead of the chassis centre
+    got = Probe(ex).got
+    ex.run(0.3)
+    r = got["range"]
+    assert (r.header.frame_id, r.radiation_type, r.field_of_view, r.max_range) == ("sonar_front_link", 0,
+                                                                                 pytest.approx(0.26), 3.0)
+    pos, _ = sensor_pose(gz.sim, "chassis", Origin((0.2, 0.0, 0.05)))
+    assert r.range == pytest.approx(1.5 - pos[0], abs=0.01)  # the nearest ray: on the axis
+    assert got["bumper"].header.frame_id == "world" and got["bumper"].states == []  # touching nothing
+
+
+class Probe(Node):
+    """Keeps the newest sonar reading and bumper state."""
+
+    def __init__(self, ex: Executor) -> None:
+        super().__init__(ex, name="probe")
+        self.got: dict[str, Any] = {}
+        self.create_subscription(msgs.Range, "/sonar_front", lambda m: self.got.__setitem__("range", m), 1)
+        self.create_subscription(msgs.ContactsState, "/bumper", lambda m: self.got.__setitem__("bumper", m), 1)
