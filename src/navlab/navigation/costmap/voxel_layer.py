@@ -110,6 +110,59 @@ def clear_voxel_rays(columns: np.ndarray, cost: np.ndarray, origin: np.ndarray, 
                 tz += tdz
 
 
+@numba.njit(cache=True)
+def ray_end_voxels(origin: np.ndarray, pts: np.ndarray, base: np.ndarray, scale: np.ndarray, dims: np.ndarray,
+                   max_range: float, seen: np.ndarray) -> None:
+    """Flag in ``seen`` (flat, k-major: (k h + j) w + i) the voxel where each ray ``origin`` -> ``pts[n]`` (m) ends:
+    cut to ``max_range`` and to the grid (``base`` its lowest corner, ``scale`` the voxel size, ``dims`` w, h, d)."""
+    w, h, nz = dims[0], dims[1], dims[2]
+    lo = np.empty(3)
+    hi = np.empty(3)
+    for a in range(3):
+        lo[a] = base[a] + 1e-6
+        hi[a] = base[a] + dims[a] * scale[a] - 1e-6
+    for n in range(pts.shape[0]):
+        dx, dy, dz = pts[n, 0] - origin[0], pts[n, 1] - origin[1], pts[n, 2] - origin[2]
+        if not (math.isfinite(dx) and math.isfinite(dy) and math.isfinite(dz)):
+            continue
+        d = math.sqrt(dx * dx + dy * dy + dz * dz)
+        t = 1.0 if d <= max_range else max_range / d
+        for a, da in ((0, dx), (1, dy), (2, dz)):
+            if da > 0:
+                t = min(t, (hi[a] - origin[a]) / da)
+            elif da < 0:
+                t = min(t, (lo[a] - origin[a]) / da)
+        t = max(t, 0.0)
+        i = min(max(math.floor((origin[0] + t * dx - base[0]) / scale[0]), 0), w - 1)
+        j = min(max(math.floor((origin[1] + t * dy - base[1]) / scale[1]), 0), h - 1)
+        k = min(max(math.floor((origin[2] + t * dz - base[2]) / scale[2]), 0), nz - 1)
+        seen[(k * h + j) * w + i] = True
+
+
+@numba.njit(cache=True)
+def mark_voxels(columns: np.ndarray, cost: np.ndarray, origin: np.ndarray, pts: np.ndarray, base: np.ndarray,
+                scale: np.ndarray, z_voxels: int, max_range: float, min_z: float, max_z: float,
+                mark_threshold: int, lethal: np.uint8) -> None:
+    """Mark the voxel of each point (m) nearer than ``max_range`` with its height in [``min_z``, ``max_z``]; its cell
+    turns ``lethal`` when its column holds more than ``mark_threshold`` marked voxels."""
+    h, w = columns.shape
+    r2 = max_range * max_range
+    for n in range(pts.shape[0]):
+        x, y, z = pts[n, 0], pts[n, 1], pts[n, 2]
+        dx, dy, dz = x - origin[0], y - origin[1], z - origin[2]
+        if not (dx * dx + dy * dy + dz * dz < r2 and min_z <= z <= max_z):
+            continue  # NaN fails too
+        i = math.floor((x - base[0]) / scale[0])
+        j = math.floor((y - base[1]) / scale[1])
+        k = math.floor((z - base[2]) / scale[2])
+        if i < 0 or j < 0 or k < 0 or i >= w or j >= h or k >= z_voxels:
+            continue
+        col = np.int64(columns[j, i]) | np.int64((1 << k) | (1 << (k + 16)))
+        columns[j, i] = col
+        if _popcount(col >> 16) > mark_threshold:
+            cost[j, i] = lethal
+
+
 class VoxelLayer(Layer):
     """``costmap_2d::VoxelLayer`` (see the module docstring). ``sources``: its observation sources by name."""
 
@@ -192,58 +245,22 @@ class VoxelLayer(Layer):
             raise NavigationError(f"{self.name}: no grid yet; call match_size(master) before add_cloud")
         src = self._source(source)
         o = np.asarray(origin_xyz, dtype=np.float64).reshape(3)
-        pts = np.asarray(points_xyz, dtype=np.float64).reshape(-1, 3)
-        pts = pts[np.isfinite(pts).all(axis=1)]
+        pts = np.ascontiguousarray(np.asarray(points_xyz, dtype=np.float64).reshape(-1, 3))
         g, p = self.grid, self.params
         scale = np.array([g.resolution, g.resolution, p.z_resolution])
         base = np.array([g.origin[0], g.origin[1], p.origin_z])
         h, w = g.data.shape
         if src.clearing and len(pts):
-            rel = pts - o
-            d = np.sqrt(np.einsum("ij,ij->i", rel, rel))
-            scale_d = np.minimum(1.0, src.raytrace_range / np.maximum(d, 1e-12))
-            ends = self._clip_to_grid(o, o + rel * scale_d[:, None])
-            ijk = np.floor((ends - base) / scale).astype(np.int64)
-            np.clip(ijk, 0, np.array([w - 1, h - 1, p.z_voxels - 1]), out=ijk)
-            # each voxel reached once (rays ending in the same voxel trace the same cells)
+            # each voxel where rays end traced once (rays ending in the same voxel trace the same cells)
             seen = np.zeros(h * w * p.z_voxels, dtype=bool)
-            seen[(ijk[:, 2] * h + ijk[:, 1]) * w + ijk[:, 0]] = True
+            ray_end_voxels(o, pts, base, scale, np.array([w, h, p.z_voxels]), src.raytrace_range, seen)
             key = np.flatnonzero(seen)
             vox = np.stack([key % w, (key // w) % h, key // (w * h)], axis=1)
             clear_voxel_rays(self.columns, g.data, (o - base) / scale, vox + 0.5, p.z_voxels, p.mark_threshold,
                              p.unknown_threshold, np.uint8(COST_FREE))
         if src.marking and len(pts):
-            rel = pts - o
-            d2 = np.einsum("ij,ij->i", rel, rel)
-            keep = ((d2 < src.obstacle_range**2) & (pts[:, 2] >= src.min_obstacle_height)
-                    & (pts[:, 2] <= src.max_obstacle_height))
-            ijk = np.floor((pts[keep] - base) / scale).astype(np.int64)
-            ok = ((ijk[:, 0] >= 0) & (ijk[:, 0] < w) & (ijk[:, 1] >= 0) & (ijk[:, 1] < h) & (ijk[:, 2] >= 0)
-                  & (ijk[:, 2] < p.z_voxels))
-            ijk = ijk[ok]
-            bits = (np.uint32(1) << ijk[:, 2].astype(np.uint32)) * np.uint32(0x10001)
-            np.bitwise_or.at(self.columns, (ijk[:, 1], ijk[:, 0]), bits)
-            marked = (self.columns[ijk[:, 1], ijk[:, 0]] >> 16).astype("<u2")
-            counts = np.unpackbits(marked.view(np.uint8).reshape(-1, 2), axis=1).sum(axis=1)
-            lethal = counts > p.mark_threshold
-            g.data[ijk[lethal, 1], ijk[lethal, 0]] = COST_LETHAL
-
-    def _clip_to_grid(self, o: np.ndarray, ends: np.ndarray) -> np.ndarray:
-        """Cut each ray ``o`` -> ``ends`` where it leaves the voxel grid (its cells and the columns' height band;
-        ROS clips its raytrace there too)."""
-        g, p = self.grid, self.params
-        assert g is not None
-        eps = 1e-6
-        lo = np.array([g.origin[0], g.origin[1], p.origin_z]) + eps
-        hi = np.array([g.origin[0] + g.width * g.resolution, g.origin[1] + g.height * g.resolution, self.z_top]) - eps
-        d = ends - o
-        t = np.ones(len(d))
-        for axis in range(3):
-            da = d[:, axis]
-            with np.errstate(divide="ignore", invalid="ignore"):
-                bound = np.where(da > 0, (hi[axis] - o[axis]) / da, np.where(da < 0, (lo[axis] - o[axis]) / da, 1.0))
-            np.minimum(t, bound, out=t)
-        return o + d * np.clip(t, 0.0, 1.0)[:, None]
+            mark_voxels(self.columns, g.data, o, pts, base, scale, p.z_voxels, src.obstacle_range,
+                        src.min_obstacle_height, src.max_obstacle_height, p.mark_threshold, np.uint8(COST_LETHAL))
 
     def _source(self, source: str | None) -> ObservationSource:
         p = self.params
