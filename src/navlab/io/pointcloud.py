@@ -30,10 +30,14 @@ def pack_cloud(stamp_ns: int, frame_id: str, columns: dict[str, tuple[int, int, 
     ``width`` organised (default one row). ``is_dense`` is false when any x is NaN."""
     n = len(next(iter(columns.values()))[2])
     buf = np.zeros((n, POINT_STEP), dtype=np.uint8)
+    words = buf.view("<f4")  # (n, 8): 4-byte fields at offsets that are multiples of 4 are written as words
     fields = []
     for name, (offset, datatype, values) in columns.items():
         dt = np.dtype(_DTYPES[datatype])
-        buf[:, offset:offset + dt.itemsize] = np.ascontiguousarray(values, dtype=dt).view(np.uint8).reshape(n, -1)
+        if datatype == FLOAT32 and offset % 4 == 0:
+            words[:, offset // 4] = values
+        else:
+            buf[:, offset:offset + dt.itemsize] = np.ascontiguousarray(values, dtype=dt).view(np.uint8).reshape(n, -1)
         fields.append(_field(name, offset, datatype))
     w = n // height if width is None else width
     xs = columns.get("x")
