@@ -194,3 +194,27 @@ class Probe(Node):
         self.got: dict[str, Any] = {}
         self.create_subscription(msgs.Range, "/sonar_front", lambda m: self.got.__setitem__("range", m), 1)
         self.create_subscription(msgs.ContactsState, "/bumper", lambda m: self.got.__setitem__("bumper", m), 1)
+
+
+@pytest.mark.parametrize("pose", [(0.0, 0.0, 0.0), (-1.0, 0.9, -0.5), (2.0, -2.0, 2.5)])
+def test_culled_camera_cast_equals_every_ray_against_every_geom(pose: tuple[float, float, float]) -> None:
+    from navlab.description import load_robot
+    from navlab.sim.raycast3d import ALL, PINHOLE, cast_grid, pinhole_dirs
+    from navlab.world import load_world
+
+    robot = load_robot("mybot_depth")  # pitched 0.35 rad down: the floor's rows and the boxes' blocks are culled
+    cam = robot.sensors.cameras[0]
+    sim = Simulation(robot, load_world("tables"), robot_pose=pose)
+    m, d = sim.model, sim.data
+    fast, _ = sim.ray_geoms()
+    w, h = 64, 48
+    f = w / (2 * math.tan(cam.camera.horizontal_fov / 2))
+    dirs = pinhole_dirs(w, h, f)
+    pos, rot = sensor_pose(sim, cam.link, cam.origin)
+    culled, every = np.empty(w * h), np.empty(w * h)
+    cast_grid(pos, rot, dirs, h, w, PINHOLE, np.array([f, (w - 1) / 2, (h - 1) / 2]), fast, m.geom_type, m.geom_size,
+              d.geom_xpos, d.geom_xmat, 0.05, 20.0, culled)
+    cast_grid(pos, rot, dirs, 1, w * h, ALL, np.zeros(3), fast, m.geom_type, m.geom_size, d.geom_xpos, d.geom_xmat,
+              0.05, 20.0, every)
+    np.testing.assert_array_equal(culled, every)
+    assert np.isfinite(every).mean() > 0.5

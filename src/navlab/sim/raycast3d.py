@@ -33,10 +33,41 @@ def _half_extents(kind: int, size: np.ndarray) -> tuple[float, float, float]:
 
 
 @njit(cache=True)
+def _plane_rows(centre: np.ndarray, xm: np.ndarray, rot: np.ndarray, origin: np.ndarray, params: np.ndarray,
+                rows: int, cols: int, bounds: np.ndarray) -> bool:
+    """The image rows whose rays can reach a plane (the camera's side of it faces them): below the horizon of a
+    floor. Pixel (u, v)'s ray is f x - (u - u0) y - (v - v0) z in the sensor frame (x forward, y left, z up)."""
+    nx, ny, nz = xm[2], xm[5], xm[8]  # the plane's normal in the world
+    side = (origin[0] - centre[0]) * nx + (origin[1] - centre[1]) * ny + (origin[2] - centre[2]) * nz
+    if side == 0.0:
+        return True
+    a = params[0] * (rot[0, 0] * nx + rot[1, 0] * ny + rot[2, 0] * nz)
+    b = rot[0, 1] * nx + rot[1, 1] * ny + rot[2, 1] * nz
+    c = rot[0, 2] * nx + rot[1, 2] * ny + rot[2, 2] * nz
+    half = abs(b) * (cols - 1) / 2.0
+    # rays towards the plane: a - b (u - u0) - c (v - v0) < 0 (camera above; > 0 below) for some u
+    lim = a - half if side > 0 else a + half  # the best u's value of a - b (u - u0)
+    sign = 1.0 if side > 0 else -1.0
+    # need sign * (lim - c (v - v0)) < 0
+    if c == 0.0:
+        return sign * lim < 0
+    v_edge = params[2] + lim / c
+    if sign * c > 0:  # rows below v_edge... solve sign*(lim - c dv) < 0  <=>  sign*c*dv > sign*lim
+        r0 = math.floor(v_edge) - 1
+        bounds[0] = max(r0, 0)
+    else:
+        r1 = math.ceil(v_edge) + 1
+        bounds[1] = min(r1, rows - 1)
+    return bounds[0] <= bounds[1]
+
+
+@njit(cache=True)
 def _block(kind: int, size: np.ndarray, centre: np.ndarray, xm: np.ndarray, rot: np.ndarray, origin: np.ndarray,
            mode: int, params: np.ndarray, rows: int, cols: int, bounds: np.ndarray) -> bool:
     """Fill ``bounds`` (r0, r1, c0, c1, wrap) with the grid block that may see the geom; False if none."""
     bounds[0], bounds[1], bounds[2], bounds[3], bounds[4] = 0, rows - 1, 0, cols - 1, 0
+    if mode == PINHOLE and kind == PLANE:
+        return _plane_rows(centre, xm, rot, origin, params, rows, cols, bounds)
     if mode == ALL or kind == PLANE:
         return True
     ex, ey, ez = _half_extents(kind, size)
