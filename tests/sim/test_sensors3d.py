@@ -218,3 +218,22 @@ def test_culled_camera_cast_equals_every_ray_against_every_geom(pose: tuple[floa
               0.05, 20.0, every)
     np.testing.assert_array_equal(culled, every)
     assert np.isfinite(every).mean() > 0.5
+
+
+def test_culled_lidar_cast_equals_every_ray_against_every_geom() -> None:
+    from navlab.description import load_robot
+    from navlab.sim.raycast3d import ALL, SPHERICAL, cast_grid, spherical_dirs
+    from navlab.world import load_world
+
+    sim = Simulation(load_robot("mybot"), load_world("tables"), robot_pose=(0.5, 1.5, 0.7))
+    m, d = sim.model, sim.data
+    fast, _ = sim.ray_geoms()
+    az, el = np.linspace(-math.pi, math.pi, 361), np.linspace(-0.3, 0.3, 16)
+    dirs = spherical_dirs(az, el)
+    pos, rot = sensor_pose(sim, "laser", Origin((0.0, 0.0, 0.3)))
+    culled, every = np.empty(len(dirs)), np.empty(len(dirs))
+    cast_grid(pos, rot, dirs, 16, 361, SPHERICAL, np.array([az[0], az[1] - az[0], el[0], el[1] - el[0]]), fast,
+              m.geom_type, m.geom_size, d.geom_xpos, d.geom_xmat, 0.3, 30.0, culled)
+    cast_grid(pos, rot, dirs, 1, len(dirs), ALL, np.zeros(4), fast, m.geom_type, m.geom_size, d.geom_xpos,
+              d.geom_xmat, 0.3, 30.0, every)
+    np.testing.assert_array_equal(culled, every)
