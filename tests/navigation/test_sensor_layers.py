@@ -126,3 +126,35 @@ def test_layers_build_from_params_with_a_context() -> None:
     assert sonar.topics == ["/sonar_left", "/sonar_right"] and sonar.params.phi == 1.0
     with pytest.raises(NavigationError, match="clear_threshold"):
         RangeSensorLayer.from_params({"clear_threshold": 0.9}, context=ctx)
+
+
+def test_pointcloud_to_laserscan_node_publishes_a_scan_in_the_target_frame() -> None:
+    from navlab import msgs
+    from navlab.core import Executor, Node
+    from navlab.io.pointcloud import FLOAT32, pack_cloud
+    from navlab.navigation.pointcloud_to_laserscan import PointCloudToLaserScan
+
+    class Probe(Node):
+        def __init__(self, ex: Executor) -> None:
+            super().__init__(ex, name="probe")
+            self.scans: list = []
+            self.pub = self.create_publisher(msgs.PointCloud2, "cloud_in", 1)
+            self.create_subscription(msgs.LaserScan, "scan", self.scans.append, 1)
+
+    ex = Executor(seed=0)
+    # the cloud's frame 'cam' sits 0.5 m ahead of base_link, turned 90 degrees left
+    ex.tf.set_transform("base_link", "cam", 0, (0.5, 0.0, 0.0, 0.0, 0.0, math.sin(math.pi / 4), math.cos(math.pi / 4)),
+                        static=True)
+    PointCloudToLaserScan(ex, parameters={"target_frame": "base_link", "min_height": -0.1, "max_height": 0.1,
+                                          "use_inf": False, "range_max": 10.0})
+    probe = Probe(ex)
+    pts = np.array([[1.0, 0.0, 0.0], [1.0, 0.0, 1.0]], np.float32)  # 1 m ahead of cam: (0.5, 1.0) in base_link
+    probe.pub.publish(pack_cloud(0, "cam", {"x": (0, FLOAT32, pts[:, 0]), "y": (4, FLOAT32, pts[:, 1]),
+                                            "z": (8, FLOAT32, pts[:, 2])}))
+    ex.run(0.01)
+    (scan,) = probe.scans
+    r = np.asarray(scan.ranges)
+    assert scan.header.frame_id == "base_link" and len(r) == 360
+    k = int((math.atan2(1.0, 0.5) + math.pi) / (math.pi / 180))
+    assert r[k] == pytest.approx(math.hypot(0.5, 1.0), abs=1e-5)
+    assert np.sum(r < 10.0) == 1 and r[0] == pytest.approx(11.0)  # empty bins: range_max + inf_epsilon (use_inf false)
