@@ -104,8 +104,7 @@ class CostmapSensorFeeds:
                 continue
             pts = scan_points(msg) if msgs.type_name(msg).endswith("LaserScan") else read_xyz(msg)
             origin, rot = place
-            self.voxel[k].add_cloud(origin, move_points(pts[np.isfinite(pts.sum(axis=1))], rot, origin),
-                                    source=src_name)
+            self.voxel[k].add_cloud(origin, move_points(pts, rot, origin), source=src_name)  # NaNs: skipped there
         self.pending.clear()
         for k, pub in self.voxel_pubs.items():
             grid = self.voxel[k].voxel_grid_msg(self.node.executor.now_ns)

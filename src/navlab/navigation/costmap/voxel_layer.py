@@ -245,7 +245,8 @@ class VoxelLayer(Layer):
             raise NavigationError(f"{self.name}: no grid yet; call match_size(master) before add_cloud")
         src = self._source(source)
         o = np.asarray(origin_xyz, dtype=np.float64).reshape(3)
-        pts = np.ascontiguousarray(np.asarray(points_xyz, dtype=np.float64).reshape(-1, 3))
+        pts = np.asarray(points_xyz).reshape(-1, 3)
+        pts = np.ascontiguousarray(pts if pts.dtype in (np.float32, np.float64) else pts.astype(np.float64))
         g, p = self.grid, self.params
         scale = np.array([g.resolution, g.resolution, p.z_resolution])
         base = np.array([g.origin[0], g.origin[1], p.origin_z])
