@@ -9,8 +9,9 @@ Layers, bottom to top::
     2 description world ros1
     3 sim mapping localization
     4 navigation
-    5 experiments viz
-    6 top          cli bench (packages: the ``navlab`` command's verbs, the benchmarks), demo, navlab/__init__.py
+    5 drivers
+    6 experiments viz
+    7 top          cli bench (packages: the ``navlab`` command's verbs, the benchmarks), demo, navlab/__init__.py
 
 Every import statement counts: module level, inside functions, under ``if TYPE_CHECKING``. Strings
 (the lazy names of ``navlab/__init__.py``, the ``module:Class`` strings of the registries) are not
@@ -34,6 +35,7 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("description/world/ros1", ("description", "world", "ros1")),
     ("sim/mapping/localization", ("sim", "mapping", "localization")),
     ("navigation", ("navigation",)),
+    ("drivers", ("drivers",)),
     ("experiments/viz", ("experiments", "viz")),
     ("top", ("cli", "bench", "demo", "__main__")),
 )

@@ -10,10 +10,10 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+from navlab.drivers import RouteFollower
 from navlab.experiments.localize_run import DEFAULT_ROUTE, plot_result, run_localization
 from navlab.experiments.session import start_run
 from navlab.mapping.mapfile import save_map
-from navlab.mapping.teleop import RouteFollower
 
 OUT = Path("out/examples/04_localize")
 

@@ -5,9 +5,9 @@ Run:  navlab run examples/07_rclpy_node/driver.py --launch sim world:=room --dur
 """
 
 import rclpy
+from geometry_msgs.msg import Twist
 from rclpy.node import Node
 from rclpy.qos import QoSProfile
-from geometry_msgs.msg import Twist
 from sensor_msgs.msg import LaserScan
 
 

@@ -4,6 +4,22 @@ The CLI prints a ``NavlabError`` as one line (``navlab: error: ...``) instead of
 its message must name the file, element or key and say what was expected.
 """
 
+from collections.abc import Iterable
+
 
 class NavlabError(Exception):
     """Base class of every error navlab raises on purpose."""
+
+
+def closest(key: object, known: Iterable[object], n: int = 1) -> list[str]:
+    """The ``n`` names of ``known`` closest to ``key`` (difflib, ratio >= 0.6), best first."""
+    import difflib  # here: every module imports this one, few need it (start-up time)
+
+    return difflib.get_close_matches(str(key), [str(k) for k in known], n=n)
+
+
+def did_you_mean(key: object, known: Iterable[object], *, template: str = "; did you mean {!r}?", n: int = 1) -> str:
+    """The one "did you mean" hint of every error message: ``template`` filled with the closest of ``known``
+    (the ``n`` closest joined with ", "), or "" when nothing is close."""
+    close = closest(key, known, n)
+    return template.format(", ".join(close)) if close else ""

@@ -96,10 +96,9 @@ def get_type(name: str) -> type:
     try:
         return _T[key]
     except KeyError:
-        import difflib
+        from navlab.errors import did_you_mean
 
-        close = difflib.get_close_matches(key, list(_T), n=3)
-        hint = f"; did you mean {', '.join(close)}?" if close else ""
+        hint = did_you_mean(key, _T, template="; did you mean {}?", n=3)
         raise MessageTypeError(f"unknown message type {name!r}{hint}") from None
 
 

@@ -69,7 +69,7 @@ def test_env_with_default_and_boolean_conditions_still_work(tmp_path: Path) -> N
 def test_node_parameter_errors_name_the_launch_and_parameter_file(tmp_path: Path) -> None:
     _write(tmp_path, "talk.yaml", "rate: true\n")
     launch = _write(tmp_path, "p.launch.yaml", "launch:\n- node: {exec: talker, param: [{from: talk.yaml}]}\n")
-    with pytest.raises(ParameterError, match=r"^parameter 'rate': expected float.* \(in .*p\.launch\.yaml: entry 1 "
+    with pytest.raises(ParameterError, match=r"^parameter 'rate': expected a number.* \(in .*p\.launch\.yaml: entry 1 "
                                              r"\(node\) 'talker' \(parameters from talk\.yaml\)\)$"):
         start(str(launch))
 

@@ -8,6 +8,7 @@ from typing import Any
 
 import pytest
 
+from navlab.core import read_params
 from navlab.core.limits import ceilings
 from navlab.errors import NavlabError
 from navlab.io.carmen import read_carmen
@@ -17,6 +18,11 @@ from navlab.navigation import costmap_params
 from navlab.navigation.controllers.mppi import MppiParams
 from navlab.navigation.controllers.params import DWAPlannerParams, TrajectoryPlannerParams
 from navlab.navigation.costmap.footprint import make_footprint
+
+
+def _reader(cls: type) -> Any:
+    """``read_params`` for ``cls``."""
+    return lambda values: read_params(cls, values)
 
 
 def _footprint(value: str) -> None:
@@ -35,14 +41,14 @@ def _amcl(values: dict[str, Any]) -> None:
     (_footprint, "[[1e6, 0], [0, 1], [-1, 0]]", "distance from the centre"),
     (_footprint, str([[k % 7 / 10, k / 1e4] for k in range(2000)]), "number of points"),
     (costmap_params, {"robot_radius": 1e9}, "robot_radius"),
-    (DWAPlannerParams.from_dict, {"vx_samples": 10**6, "vth_samples": 10**6}, "vx_samples x vth_samples x steps"),
-    (DWAPlannerParams.from_dict, {"sim_granularity": 1e-12}, "poses per cycle"),
-    (DWAPlannerParams.from_dict, {"controller_frequency": 1e9}, "controller_frequency"),
-    (TrajectoryPlannerParams.from_dict, {"vx_samples": 10**9}, "vx_samples x vtheta_samples"),
-    (MppiParams.from_dict, {"batch_size": 10**9}, "batch_size x time_steps x iteration_count: 56,000,000,000 poses"),
-    (MppiParams.from_dict, {"time_steps": 10**9}, "batch_size x time_steps"),
+    (_reader(DWAPlannerParams), {"vx_samples": 10**6, "vth_samples": 10**6}, "vx_samples x vth_samples x steps"),
+    (_reader(DWAPlannerParams), {"sim_granularity": 1e-12}, "poses per cycle"),
+    (_reader(DWAPlannerParams), {"controller_frequency": 1e9}, "controller_frequency"),
+    (_reader(TrajectoryPlannerParams), {"vx_samples": 10**9}, "vx_samples x vtheta_samples"),
+    (_reader(MppiParams), {"batch_size": 10**9}, "batch_size x time_steps x iteration_count: 56,000,000,000 poses"),
+    (_reader(MppiParams), {"time_steps": 10**9}, "batch_size x time_steps"),
     (_amcl, {"max_particles": 10**9}, "max_particles"),
-    (GMappingParams.from_dict, {"particles": 10**9}, "particles"),
+    (_reader(GMappingParams), {"particles": 10**9}, "particles"),
 ])
 def test_sizes_beyond_the_ceilings_are_refused_naming_the_key(build: Any, values: dict[str, Any], words: str) -> None:
     with pytest.raises(NavlabError, match="ceiling") as info:
@@ -52,8 +58,8 @@ def test_sizes_beyond_the_ceilings_are_refused_naming_the_key(build: Any, values
 
 def test_the_shipped_defaults_are_far_below_the_ceilings() -> None:
     costmap_params({"width": 100, "height": 100, "resolution": 0.02})  # a 25-million-cell-free office, fine
-    DWAPlannerParams.from_dict({"vx_samples": 20, "vth_samples": 40, "sim_time": 3.0})
-    MppiParams.from_dict({"batch_size": 2000, "time_steps": 100})
+    read_params(DWAPlannerParams, {"vx_samples": 20, "vth_samples": 40, "sim_time": 3.0})
+    read_params(MppiParams, {"batch_size": 2000, "time_steps": 100})
     assert ceilings()["grid_cells"].limit > 1e7
 
 

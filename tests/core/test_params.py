@@ -1,8 +1,10 @@
 """Parameter files (ROS 1 and Nav2 layouts), typed declarations, did-you-mean, malformed YAML."""
 
+import re
+
 import pytest
 
-from navlab.core import Executor, Node, ParameterError, load_params
+from navlab.core import Executor, Node, ParameterError, load_params, read_params
 
 ROS1 = """\
 controller_frequency: 5.0
@@ -86,4 +88,49 @@ def test_swapped_letters_of_a_short_name_are_a_typo_not_an_ignored_key():
     from navlab.mapping.gmapping import GMappingParams
 
     with pytest.raises(MappingError, match="did you mean 'lsigma'"):
-        GMappingParams.from_dict({"lsimga": 0.1})
+        read_params(GMappingParams, {"lsimga": 0.1})
+
+
+def test_one_reader_for_settings_dataclasses(caplog) -> None:  # type: ignore[no-untyped-def]
+    """read_params: aliases, ignored keys, typed values, ranges, choices, ROS's clamp with a warning, the unknown-key
+    policy (a typo raises with "did you mean", another key warns), then validate()."""
+    import dataclasses
+    from typing import ClassVar
+
+    from navlab.core.params import ParameterWarning, ParamSpec
+
+    @dataclasses.dataclass
+    class Demo:
+        max_vel_x: float = 0.5
+        samples: int = 3
+        mode: str = "both"
+        flag: bool = False
+        PARAMS: ClassVar[ParamSpec] = ParamSpec(
+            "demo_planner", aliases={"max_trans_vel": "max_vel_x"}, ignored=frozenset({"use_sim_time"}),
+            above={"max_vel_x": 0.0}, choices={"mode": ("local", "both")}, clamp_at_least={"samples": 1})
+
+        def validate(self) -> None:
+            if self.flag and self.mode == "local":
+                raise ParameterError("demo_planner parameters flag and mode 'local' cannot go together")
+
+    got = read_params(Demo, {"max_trans_vel": 1, "samples": 2.0, "flag": 1, "use_sim_time": True})
+    assert (got.max_vel_x, got.samples, got.flag) == (1.0, 2, True) and isinstance(got.max_vel_x, float)
+    with caplog.at_level("WARNING"):
+        assert read_params(Demo, {"samples": 0}).samples == 1
+    assert "samples is 0; it is set to 1" in caplog.text
+    for values, words in [
+        ({"max_trans_vel": 1.0, "max_vel_x": 2.0}, "two spellings of one parameter"),
+        ({"max_vel_x": "fast"}, "demo_planner parameter max_vel_x: expected a number, got 'fast'"),
+        ({"samples": 2.5}, "samples: expected an integer, got 2.5"),
+        ({"flag": "yes"}, "flag: expected true or false"),
+        ({"max_vel_x": float("nan")}, "max_vel_x: expected a finite number"),
+        ({"max_vel_x": 0.0}, "max_vel_x: expected > 0.0, got 0.0"),
+        ({"mode": "global"}, "mode: expected one of 'local', 'both', got 'global'"),
+        ({"max_vel_xx": 1.0}, "unknown demo_planner parameter 'max_vel_xx'; did you mean 'max_vel_x'?"),
+        ({"flag": True, "mode": "local"}, "cannot go together"),
+        ([1, 2], "expected a dict of ROS parameters, got list"),
+    ]:
+        with pytest.raises(ParameterError, match=re.escape(words)):
+            read_params(Demo, values)
+    with pytest.warns(ParameterWarning, match="unknown demo_planner parameter 'meter_scoring' ignored"):
+        assert read_params(Demo, {"meter_scoring": True}) == Demo()

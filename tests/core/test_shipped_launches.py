@@ -13,9 +13,9 @@ from navlab import msgs
 from navlab.cli import main
 from navlab.core import LaunchError, Node, load_params
 from navlab.core.launch import resources_dir, start
+from navlab.drivers import RouteFollower
 from navlab.mapping import GridMap, save_map
 from navlab.mapping.gmapping import GMappingParams
-from navlab.mapping.teleop import RouteFollower
 from navlab.world import load_world, true_map
 
 

@@ -78,7 +78,7 @@ def _launch(path: Path) -> dict[str, Any]:
 
 
 def _route(path: Path) -> dict[str, Any]:
-    from navlab.mapping.teleop import load_route
+    from navlab.drivers import load_route
 
     load_route(path)
     return {}

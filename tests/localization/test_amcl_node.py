@@ -149,3 +149,27 @@ def test_map_without_free_cells_is_refused_and_unknown_parameters_are_named() ->
         Amcl(Executor(), parameters={"odom_model_type": "dif"})
     with pytest.raises(LocalizationError, match=r"laser_model_type 'beams' \(did you mean 'beam'\?"):
         Amcl(Executor(), parameters={"laser_model_type": "beams"})
+
+
+@pytest.mark.parametrize(("mangle", "words"), [
+    (lambda m: setattr(m.info, "width", m.info.width + 1), ["cells but info says width"]),
+    (lambda m: setattr(m.info, "resolution", 0.0), ["resolution must be a positive number"]),
+    (lambda m: setattr(m.info.origin.position, "x", float("nan")), ["origin must be finite"]),
+])
+def test_malformed_map_is_refused_in_one_line_naming_the_topic(mangle, words, caplog) -> None:  # type: ignore[no-untyped-def]
+    """A malformed /map does not escape the subscriber: amcl logs one line naming the topic and what was wrong,
+    keeps waiting for a map, and takes the next good one."""
+    ex = Executor(seed=0)
+    amcl = Amcl(ex)
+    pub = Node(ex, name="probe").create_publisher(msgs.OccupancyGrid, "map", latched=True)
+    bad = _map_msg()
+    mangle(bad)
+    pub.publish(bad)
+    ex.run(0.1)
+    assert amcl.filter is None
+    assert amcl.last_error.startswith("ignoring map on /map: ") and "\n" not in amcl.last_error
+    for word in words:
+        assert word in amcl.last_error
+    pub.publish(_map_msg())
+    ex.run(0.1)
+    assert amcl.filter is not None

@@ -41,13 +41,18 @@ class _UniformModel:
     def __init__(self, field, params: AmclParams) -> None:
         self.field = field
 
+    @classmethod
+    def from_params(cls, params: AmclParams, *, context: plugins.PluginContext) -> _UniformModel:
+        return cls(context.map_field, params)
+
     def weights(self, particles: np.ndarray, beams, laser_pose) -> np.ndarray:
         type(self).calls += 1
         return np.ones(particles.shape[0])
 
 
-def test_a_new_laser_model_is_one_class_and_one_registry_line(monkeypatch) -> None:
-    monkeypatch.setitem(plugins.REGISTRY["laser_model"], "uniform", f"{__name__}:_UniformModel")
+def test_a_new_laser_model_is_one_class_and_one_entry_point(install_plugin_package) -> None:
+    install_plugin_package("navlab-test-uniform-model",
+                           {"navlab.laser_models": {"uniform": f"{__name__}:_UniformModel"}})
     field = room_field()
     amcl = Amcl(field, AmclParams(laser_model_type="uniform", max_particles=500, min_particles=500),
                 rng=np.random.default_rng(0))  # fmt: skip

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from navlab.core import read_params
 from navlab.mapping import MappingError
 from navlab.mapping.gmapping import GMapping, GMappingParams
 
@@ -41,4 +42,4 @@ def test_gmapping_parameter_names_and_defaults():
     )  # fmt: skip
     assert (p.srr, p.srt, p.str, p.stt, p.resampleThreshold, p.iterations) == (0.1, 0.2, 0.1, 0.2, 0.5, 5)
     with pytest.raises(MappingError, match="did you mean 'linearUpdate'"):
-        GMappingParams.from_dict({"linearupdate": 0.5})
+        read_params(GMappingParams, {"linearupdate": 0.5})

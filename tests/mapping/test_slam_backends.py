@@ -76,9 +76,13 @@ def test_graph_mode_gates_scans_by_slam_gmappings_update_distances() -> None:
 class _DeadReckoning:
     """A toy mode: trusts odometry, maps nothing but the first scan's origin cell."""
 
-    def __init__(self, params: dict[str, Any] | None = None, *, rng: np.random.Generator) -> None:
+    def __init__(self, params: dict[str, Any] | None = None) -> None:
         self.params = dict(params or {})
         self.poses: list[np.ndarray] = []
+
+    @classmethod
+    def from_params(cls, params: dict[str, Any] | None, *, context: plugins.PluginContext) -> _DeadReckoning:
+        return cls(params)
 
     @classmethod
     def parameters(cls) -> dict[str, Any]:
@@ -104,8 +108,9 @@ class _DeadReckoning:
         return {"scans": len(self.poses)}
 
 
-def test_a_new_mode_is_one_class_and_one_registry_line(monkeypatch) -> None:
-    monkeypatch.setitem(plugins.REGISTRY["slam_backend"], "dead_reckoning", f"{__name__}:_DeadReckoning")
+def test_a_new_mode_is_one_class_and_one_entry_point(install_plugin_package) -> None:
+    install_plugin_package("navlab-test-dead-reckoning",
+                           {"navlab.slam_backends": {"dead_reckoning": f"{__name__}:_DeadReckoning"}})
     ex = Executor(seed=0)
     slam = SlamGMapping(ex, parameters={"mode": "dead_reckoning", "delta": 0.2, "map_update_interval": 0.0})
     assert slam.params == {"delta": 0.2}

@@ -9,11 +9,9 @@ import math
 
 import numpy as np
 import pytest
-from scipy import sparse
 
 from navlab.geometry import wrap_angle
-from navlab.mapping.explore import _grid_graph
-from navlab.mapping.gmapping_match import _draw_motion, _optimize, _score
+from navlab.mapping.gmapping_match import draw_motion, match_score, optimize
 from navlab.mapping.gmapping_tiles import TILE, TilePool, from_dense, raycast_tiles, to_dense
 from navlab.mapping.occupancy import FAST_WALK_CELLS, L_CLAMP, L_FREE, L_OCC, _raycast, integrate_scan
 from navlab.mapping.scanmatch import LookupField, correlative_search
@@ -27,7 +25,7 @@ def _tiled(grid: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 def _plain_climb(tiled, args, x0, y0, t0, lstep, astep, iterations):
     """GMapping's ScanMatcher::optimize scoring every candidate in full (the reference)."""
-    cur = _score(*tiled, *args[:5], x0, y0, t0, *args[5:])[0]
+    cur = match_score(*tiled, *args[:5], x0, y0, t0, *args[5:])[0]
     cx, cy, ct = x0, y0, t0
     ld, ad, refinement, best = lstep, astep, 0, -1.0
     while True:
@@ -40,7 +38,7 @@ def _plain_climb(tiled, args, x0, y0, t0, lstep, astep, iterations):
         bx, by, bt = cx, cy, ct
         for nx, ny, nt in ((cx + ld, cy, ct), (cx - ld, cy, ct), (cx, cy + ld, ct), (cx, cy - ld, ct),
                            (cx, cy, ct + ad), (cx, cy, ct - ad)):  # fmt: skip
-            sc = _score(*tiled, *args[:5], nx, ny, nt, *args[5:])[0]
+            sc = match_score(*tiled, *args[:5], nx, ny, nt, *args[5:])[0]
             if sc > cur:
                 cur, bx, by, bt = sc, nx, ny, nt
         cx, cy, ct = bx, by, bt
@@ -73,10 +71,10 @@ def test_the_hill_climb_equals_gmappings_plain_climb() -> None:
         for k in range(12):
             x0, y0, t0 = 2.5 + rng.normal(0, 0.08), 2.0 + rng.normal(0, 0.08), 0.1 + rng.normal(0, 0.05)
             args = (0.0, 0.0, 0, 0, 0.05, r, np.cos(ang), np.sin(ang), 8.0, 1, 0.05, 0.075, skip)
-            got = _optimize(*tiled, *args[:5], x0, y0, t0, *args[5:], 0.05, 0.05, 5)
+            got = optimize(*tiled, *args[:5], x0, y0, t0, *args[5:], 0.05, 0.05, 5)
             want = _plain_climb(tiled, args, x0, y0, t0, 0.05, 0.05, 5)
             assert got[:4] == want, (skip, k)
-            assert got[4] == _score(*tiled, *args[:5], *got[:3], *args[5:])[1]  # the log-likelihood at the result
+            assert got[4] == match_score(*tiled, *args[:5], *got[:3], *args[5:])[1]  # the log-likelihood at the result
 
 
 def _plain_score(grid, ox, oy, res, x, y, t, r, ang, max_urange, kernel, sigma, lsigma, skip):
@@ -118,7 +116,7 @@ def test_the_score_equals_gmappings_plain_score_for_every_kernel_and_near_the_ed
     for x, y, t in ((2.5, 2.0, 0.1), (2.2, 1.7, -0.4), (0.3, 0.2, 0.0), (5.2, 4.2, 2.0)):
         for kernel in (0, 1, 2):
             for skip in (0, 3):
-                got = _score(*tiled, 0.0, 0.0, 0, 0, 0.05, x, y, t, r, cb, sb, 8.0, kernel, 0.05, 0.075, skip)
+                got = match_score(*tiled, 0.0, 0.0, 0, 0, 0.05, x, y, t, r, cb, sb, 8.0, kernel, 0.05, 0.075, skip)
                 want = _plain_score(grid, 0.0, 0.0, 0.05, x, y, t, r, ang, 8.0, kernel, 0.05, 0.075, skip)
                 assert got == want, (x, y, t, kernel, skip)
 
@@ -132,7 +130,7 @@ def test_the_motion_draw_equals_the_vectorised_motion_model() -> None:
     c, s = np.cos(poses[:, 2]), np.sin(poses[:, 2])
     want = np.column_stack([poses[:, 0] + c * noisy[:, 0] - s * noisy[:, 1],
                             poses[:, 1] + s * noisy[:, 0] + c * noisy[:, 1], wrap_angle(poses[:, 2] + noisy[:, 2])])
-    _draw_motion(poses, noise, *step, *sig)
+    draw_motion(poses, noise, *step, *sig)
     np.testing.assert_array_equal(poses, want)
 
 
@@ -190,29 +188,6 @@ def test_the_tiled_ray_cast_writes_the_dense_cells_and_copies_only_shared_tiles(
     pool.recount([mine])  # the other particle dropped: its tiles are free again
     assert pool.in_use() == len(written) + np.count_nonzero((mine == theirs) & (mine > 0))
     assert len(TilePool(2).free(40)) >= 40  # the pool grows when short of free tiles
-
-
-def test_the_one_pass_dijkstra_graph_equals_scipys_from_the_edge_list() -> None:
-    rng = np.random.default_rng(2)
-    for _ in range(20):
-        h, w = rng.integers(1, 30, 2)
-        mask = rng.random((h, w)) < 0.7
-        cost = 1.0 + 4.0 * rng.integers(0, 253, (h, w)) / 252.0
-        rows, cols, vals = [], [], []
-        for j, i in zip(*np.nonzero(mask), strict=True):
-            for dj, di, length in ((0, 1, 1.0), (1, 0, 1.0), (1, 1, np.sqrt(2.0)), (1, -1, np.sqrt(2.0))):
-                j2, i2 = j + dj, i + di
-                if 0 <= j2 < h and 0 <= i2 < w and mask[j2, i2]:
-                    a, b = j * w + i, j2 * w + i2
-                    c = length * 0.5 * (cost.flat[a] + cost.flat[b])
-                    rows += [a, b]
-                    cols += [b, a]
-                    vals += [c, c]
-        want = sparse.csr_matrix((vals, (rows, cols)), shape=(h * w, h * w))
-        indptr, indices, data = _grid_graph(mask, cost.ravel())
-        np.testing.assert_array_equal(indptr, want.indptr)
-        np.testing.assert_array_equal(indices, want.indices)
-        np.testing.assert_array_equal(data, want.data)
 
 
 def test_lookup_field_and_correlative_search_near_and_off_the_edges() -> None:

@@ -178,7 +178,7 @@ def test_plugin_names_and_nav2_spellings() -> None:
 
 @pytest.mark.parametrize(("make", "match"), [
     (lambda: make_planner("navfn/NavfnRos"), "did you mean 'navfn/NavfnROS'"),
-    (lambda: NavfnPlanner({"default_tolerance": -1.0}), "default_tolerance: expected >= 0 m, got -1.0"),
+    (lambda: NavfnPlanner({"default_tolerance": -1.0}), "default_tolerance: expected >= 0.0, got -1.0"),
     (lambda: NavfnPlanner({"allow_unknwn": False}), "did you mean 'allow_unknown'"),
     (lambda: NavfnPlanner({"allow_unknown": "no"}), "allow_unknown: expected true or false, got 'no'"),
     (lambda: ThetaStarPlanner({"how_many_corners": 6}), "how_many_corners: expected 4 or 8, got 6"),

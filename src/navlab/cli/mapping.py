@@ -137,8 +137,8 @@ def _cmd_teleop(args: argparse.Namespace) -> int:
     started here."""
     from navlab.core import CoreError, Executor
     from navlab.core.introspect import RemotePublisher, find_running
+    from navlab.drivers import HELP, TeleopKeyboard, terminal_keys
     from navlab.experiments.session import start_run
-    from navlab.mapping.teleop import HELP, TeleopKeyboard, terminal_keys
 
     gazebo = remote = None
     if args.world is None:
@@ -155,7 +155,7 @@ def _cmd_teleop(args: argparse.Namespace) -> int:
     if args.joy:
         from navlab import msgs
         from navlab.core import Node
-        from navlab.mapping.teleop import JoyMapping, joystick_thread
+        from navlab.drivers import JoyMapping, joystick_thread
 
         pub = Node(ex, name="teleop_twist_joy").create_publisher(msgs.Twist, "cmd_vel", 1)
         joystick_thread(ex, pub, JoyMapping(scale_linear=args.speed, scale_angular=args.turn))

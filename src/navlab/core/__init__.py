@@ -3,7 +3,7 @@
 from navlab.core.errors import CoreError, LaunchError, ParameterError, TfError
 from navlab.core.executor import Executor
 from navlab.core.node import Clock, Node, dataclass_parameters, resolve_name
-from navlab.core.params import load_params, merge_params
+from navlab.core.params import ParamSpec, load_params, merge_params, read_params
 from navlab.core.tf import Pose2, TfBuffer
 from navlab.core.topics import NS_PER_S, Publisher, Subscription, Timer, Topic, seconds_to_ns
 
@@ -14,6 +14,7 @@ __all__ = [
     "Executor",
     "LaunchError",
     "Node",
+    "ParamSpec",
     "ParameterError",
     "Pose2",
     "Publisher",
@@ -25,6 +26,7 @@ __all__ = [
     "dataclass_parameters",
     "load_params",
     "merge_params",
+    "read_params",
     "resolve_name",
     "seconds_to_ns",
 ]

@@ -38,7 +38,7 @@ from navlab.core.errors import LaunchError, ParameterError
 from navlab.core.executor import Executor
 from navlab.core.node import Node, flatten_params
 from navlab.core.params import ParameterWarning, load_params, merge_params, parse_yaml, read_yaml
-from navlab.errors import NavlabError
+from navlab.errors import NavlabError, did_you_mean
 
 _SUBST = re.compile(r"\$\((\S+)(?:\s+([^)]*))?\)")
 
@@ -394,8 +394,6 @@ def _located(exc: NavlabError, where: str) -> NavlabError:
 
 def _check_args(files: list[Path], args: dict[str, Any]) -> None:
     """Refuse arguments no file declares or uses (a typo like ``wrold:=room`` would be ignored)."""
-    import difflib
-
     known: set[str] = set()
     for file in files:
         entries = [e for e in _entries(file) if isinstance(e, dict) and isinstance(e.get("arg"), dict)]
@@ -403,8 +401,7 @@ def _check_args(files: list[Path], args: dict[str, Any]) -> None:
         known |= {m.group(2).strip() for m in _SUBST.finditer(file.read_text()) if m.group(1) == "var" and m.group(2)}
     for name in args:
         if name not in known:
-            close = difflib.get_close_matches(name, sorted(known), n=1)
-            hint = f"did you mean {close[0]!r}? " if close else ""
+            hint = did_you_mean(name, sorted(known), template="did you mean {!r}? ")
             where = ", ".join(map(str, files))
             raise LaunchError(f"{where}: unknown launch argument {name!r} ({hint}arguments: "
                               f"{', '.join(sorted(known))})")

@@ -18,7 +18,7 @@ from navlab.core.clock import Clock, Time
 from navlab.core.errors import ParameterError
 from navlab.core.executor import Executor
 from navlab.core.parameter import Parameter, SetParametersResult
-from navlab.core.params import ParameterWarning, likely_typo
+from navlab.core.params import ParameterWarning, likely_typo, typed_value
 from navlab.core.tf import Pose2
 from navlab.core.topics import Publisher, Subscription, Timer, seconds_to_ns
 from navlab.msgs import TFMessage
@@ -120,25 +120,10 @@ def dataclass_parameters(cls: type, *, prefix: str = "") -> dict[str, Any]:
 
 
 def _coerce(name: str, value: Any, default: Any) -> Any:
-    """Check ``value`` against the type of ``default`` (ints are accepted for floats)."""
+    """Check ``value`` against the type of ``default`` (``params.typed_value``'s rule; inf is a valid double)."""
     if default is None:
         return value
-    if value is None:
-        raise ParameterError(f"parameter {name!r}: expected {type(default).__name__}, got null")
-    kind = type(default)
-    if isinstance(value, float) and value != value:  # NaN: never a usable parameter value
-        raise ParameterError(f"parameter {name!r}: expected a number, got nan")
-    if kind is float and isinstance(value, int) and not isinstance(value, bool):
-        return float(value)
-    if kind is bool and not isinstance(value, bool):
-        raise ParameterError(f"parameter {name!r}: expected true/false, got {value!r}")
-    if kind is int and isinstance(value, bool):
-        raise ParameterError(f"parameter {name!r}: expected an integer, got {value!r}")
-    if kind in (list, tuple) and isinstance(value, list | tuple):
-        return kind(value)
-    if not isinstance(value, kind):
-        raise ParameterError(f"parameter {name!r}: expected {kind.__name__}, got {value!r}")
-    return value
+    return typed_value(type(default), repr(name), value, finite=False)
 
 
 class Node:

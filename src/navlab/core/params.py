@@ -10,9 +10,11 @@ Two layouts are read:
 from __future__ import annotations
 
 import difflib
+import logging
 import math
 import warnings
-from dataclasses import fields, is_dataclass
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any, TypeVar
 
@@ -183,32 +185,137 @@ def load_params(path: str | Path, *, node: str | None = None) -> dict[str, Any]:
     raise ParameterError(f"{path}: no parameters for node {node!r} (nodes in file: {', '.join(nodes)})")
 
 
-def dataclass_from_dict(cls: type[T], values: dict[str, Any] | None, *, what: str, error: type[Exception]) -> T:
-    """An instance of dataclass ``cls`` with ``values`` overriding its defaults, each cast to its default's type.
+@dataclass(frozen=True)
+class ParamSpec:
+    """How a ROS parameter dict becomes a settings dataclass (``read_params``), declared once per class as
+    its ``PARAMS`` class attribute.
 
-    An unknown name follows ``check_unknown_key``: a likely typo raises ``error`` ("unknown WHAT parameter
-    'key'; did you mean 'closest'?"), any other key warns and is ignored.
+    - ``what``: the name in messages (the ROS plugin or node, ``TrajectoryPlannerROS``); ``error``: the
+      package's error class every refusal raises.
+    - ``aliases``: another accepted spelling (an older or Nav2 name) -> field name; both spellings with
+      different values is an error. ``ignored``: keys accepted and dropped (runtime or view-only settings).
+    - ``at_least`` / ``above`` / ``at_most``: field -> bound, refused below (``>=``) / at or below (``>``) /
+      above (``<=``) it; ``choices``: field -> the values allowed.
+    - ``clamp_at_least``: field -> bound; a value below it is set to the bound with a warning, as ROS does
+      (``vy_samples: 0`` in TurtleBot3's DWA files).
+    - ``prepare``: a function from the raw dict to the dict read (one key that sets two fields, nested
+      sections parsed by their own reader).
+
+    After reading, a class's own ``validate()`` (if it has one) checks what spans several fields.
     """
-    if not is_dataclass(cls):
-        raise TypeError(f"dataclass_from_dict needs a dataclass, got {cls!r}")
-    names = [f.name for f in fields(cls)]
-    out = cls()
-    for key, val in (values or {}).items():
-        if key not in names:
-            check_unknown_key(str(key), names, what=what, error=error)
+
+    what: str
+    error: type[Exception] = ParameterError
+    aliases: Mapping[str, str] = field(default_factory=dict)
+    ignored: frozenset[str] = frozenset()
+    at_least: Mapping[str, float] = field(default_factory=dict)
+    above: Mapping[str, float] = field(default_factory=dict)
+    at_most: Mapping[str, float] = field(default_factory=dict)
+    choices: Mapping[str, tuple[Any, ...]] = field(default_factory=dict)
+    clamp_at_least: Mapping[str, float] = field(default_factory=dict)
+    prepare: Callable[[dict[str, Any]], dict[str, Any]] | None = None
+
+
+def param_error(what: str, key: str, value: Any, expected: str, error: type[Exception] = ParameterError
+                ) -> Exception:
+    """The one-line refusal of a parameter ``key`` = ``value`` that is not ``expected``."""
+    return error(f"{what + ' ' if what else ''}parameter {key}: expected {expected}, got {value!r}")
+
+
+_EXPECTED = {bool: "true or false", int: "an integer", float: "a number", str: "a string", list: "a list",
+             tuple: "a list", dict: "a mapping"}
+
+
+def typed_value(kind: type, key: str, val: Any, *, what: str = "", error: type[Exception] = ParameterError,
+                finite: bool = True) -> Any:
+    """``val`` as the type ``kind`` of the parameter's default, refusing what ROS's typed parameters would (a
+    string for a number, 2.5 for an integer, "yes" for a boolean, null, NaN; inf too unless ``finite`` is
+    False). The one type rule of settings dataclasses and node parameters."""
+    if isinstance(val, float) and (math.isnan(val) or (finite and kind is float and math.isinf(val))):
+        raise param_error(what, key, val, "a finite number" if finite else "a number", error)
+    if kind is bool:
+        ok = isinstance(val, bool) or (isinstance(val, int) and val in (0, 1))
+    elif kind is int:
+        ok = not isinstance(val, bool) and isinstance(val, int | float) and math.isfinite(val) and float(
+            val).is_integer()
+    elif kind is float:
+        ok = not isinstance(val, bool) and isinstance(val, int | float)
+    elif kind in (list, tuple):
+        ok = isinstance(val, list | tuple)
+    elif kind is dict:
+        ok = isinstance(val, Mapping)
+    else:
+        ok = isinstance(val, kind)
+    if not ok:
+        raise param_error(what, key, val, _EXPECTED.get(kind, kind.__name__), error)
+    return kind(val) if kind in _EXPECTED else val
+
+
+def canonical_params(values: Mapping[str, Any], spec: ParamSpec, *, what: str | None = None) -> dict[str, Any]:
+    """``values`` with ``spec``'s aliases renamed to field names and its ignored keys dropped; two spellings
+    of one parameter with different values are refused."""
+    what = what or spec.what
+    out: dict[str, Any] = {}
+    spelled: dict[str, str] = {}
+    for key, val in values.items():
+        if key in spec.ignored:
             continue
-        kind = type(getattr(out, key))
-        try:
-            scalar = kind in (int, float, str, bool)
-            if val is None or (isinstance(val, bool) and kind is not bool) or (
-                    scalar and isinstance(val, dict | list)):
-                raise TypeError
-            cast = kind(val)
-        except (TypeError, ValueError):
-            raise error(f"{what} parameter '{key}': expected {kind.__name__}, got {val!r}") from None
-        if isinstance(cast, float) and not math.isfinite(cast):
-            raise error(f"{what} parameter '{key}': expected a finite number, got {val!r}")
-        setattr(out, key, cast)
+        name = spec.aliases.get(key, key)
+        if name in out and out[name] != val:
+            raise spec.error(f"{what} parameters {spelled[name]!r} and {key!r} are two spellings of one parameter "
+                             f"with different values ({out[name]!r} vs {val!r}): give one")
+        out[name], spelled[name] = val, key
+    return out
+
+
+def read_params(cls: type[T], values: Mapping[str, Any] | T | None, *, what: str | None = None) -> T:
+    """An instance of the settings dataclass ``cls`` from a ROS parameter dict, as its ``PARAMS`` spec says
+    (an instance of ``cls`` is checked and returned as is; None gives the defaults).
+
+    Each value takes its default's type (``typed_value``); an unknown key follows ``check_unknown_key`` (a likely
+    typo raises with "did you mean", any other key warns and is ignored); then the spec's ranges and
+    clamps, then the class's ``validate()``. Every refusal is one line naming the key.
+    """
+    spec: ParamSpec = getattr(cls, "PARAMS", None) or ParamSpec(cls.__name__)
+    what = what or spec.what
+    if isinstance(values, cls):
+        out = values
+    else:
+        if values is not None and not isinstance(values, Mapping):
+            raise spec.error(f"{what} parameters: expected a dict of ROS parameters, got {type(values).__name__}")
+        raw = dict(values or {})
+        canon = canonical_params(spec.prepare(raw) if spec.prepare else raw, spec, what=what)
+        out = cls()
+        names = [f.name for f in fields(cls)]  # type: ignore[arg-type]
+        for key, val in canon.items():
+            if key not in names:
+                check_unknown_key(str(key), names, what=what, error=spec.error)
+                continue
+            setattr(out, key, typed_value(type(getattr(out, key)), key, val, what=what, error=spec.error))
+    for f in fields(out):  # type: ignore[arg-type]
+        val = getattr(out, f.name)
+        if isinstance(val, float) and not math.isfinite(val):
+            raise param_error(what, f.name, val, "a finite number", spec.error)
+    for key, low in spec.clamp_at_least.items():
+        if getattr(out, key) < low:
+            logging.getLogger("navlab.params").warning(
+                f"{what}: {key} is {getattr(out, key)}; it is set to {low} (as ROS does)")
+            setattr(out, key, type(getattr(out, key))(low))
+    for key, low in spec.at_least.items():
+        if not getattr(out, key) >= low:
+            raise param_error(what, key, getattr(out, key), f">= {low}", spec.error)
+    for key, low in spec.above.items():
+        if not getattr(out, key) > low:
+            raise param_error(what, key, getattr(out, key), f"> {low}", spec.error)
+    for key, high in spec.at_most.items():
+        if not getattr(out, key) <= high:
+            raise param_error(what, key, getattr(out, key), f"<= {high}", spec.error)
+    for key, allowed in spec.choices.items():
+        if getattr(out, key) not in allowed:
+            raise param_error(what, key, getattr(out, key), f"one of {', '.join(map(repr, allowed))}", spec.error)
+    validate = getattr(out, "validate", None)
+    if callable(validate):
+        validate()
     return out
 
 

@@ -15,7 +15,6 @@ A launch file is data: nothing runs unless a ``<node>`` or a ``command=`` names 
 
 from __future__ import annotations
 
-import difflib
 import os
 import re
 import shlex
@@ -46,6 +45,7 @@ from navlab.core.roslaunch_config import (
     push_ns,
     read_text,
 )
+from navlab.errors import did_you_mean
 
 __all__ = ["FIND_PACKAGE", "RosConfig", "RosNode", "call", "declared_args", "is_xml_launch", "load", "ns_join"]
 
@@ -210,9 +210,8 @@ class _Loader:
             elif el.tag in _IGNORED_TAGS:
                 self.config.notes.append(f"{where}: <{el.tag}> is not used by navlab (skipped)")
             else:
-                close = difflib.get_close_matches(el.tag, ["arg", "param", "rosparam", "include", "group", "remap",
-                                                           "node", "env", "machine", "test"], n=1)
-                hint = f"; did you mean <{close[0]}>?" if close else ""
+                hint = did_you_mean(el.tag, ["arg", "param", "rosparam", "include", "group", "remap", "node", "env",
+                                             "machine", "test"], template="; did you mean <{}>?")
                 raise LaunchError(f"{where}: unknown tag <{el.tag}>{hint}")
 
     def children(self, el: ET.Element, scope: _Scope, where: str) -> Iterator[tuple[ET.Element, str]]:
@@ -442,8 +441,7 @@ def load(files: list[Path], args: Mapping[str, str], *, seed: int = 0, allow_com
         config.declared |= declared_names(root)
     for name in args:
         if name not in config.declared:
-            close = difflib.get_close_matches(name, sorted(config.declared), n=1)
-            hint = f"did you mean {close[0]!r}? " if close else ""
+            hint = did_you_mean(name, sorted(config.declared), template="did you mean {!r}? ")
             raise LaunchError(f"{', '.join(map(str, files))}: unknown launch argument {name!r} ({hint}arguments: "
                               f"{', '.join(sorted(config.declared)) or 'none'})")
     for file in files:

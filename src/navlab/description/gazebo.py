@@ -8,7 +8,6 @@ the rest of the robot loads.
 
 from __future__ import annotations
 
-import difflib
 import math
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field, replace
@@ -30,6 +29,7 @@ from navlab.description.skid_steer import (
     read_contact_tag,
 )
 from navlab.description.urdf import floats
+from navlab.errors import did_you_mean
 
 DIFF_DRIVE_PLUGINS = ("libgazebo_ros_diff_drive.so",)
 LASER_PLUGINS = ("libgazebo_ros_laser.so", "libgazebo_ros_gpu_laser.so", "libgazebo_ros_ray_sensor.so",
@@ -90,8 +90,7 @@ class GazeboTags:
 
 
 def _did_you_mean(key: str, choices: list[str]) -> str:
-    close = difflib.get_close_matches(key, choices, n=1)
-    return f" (did you mean <{close[0]}>?)" if close else ""
+    return did_you_mean(key, choices, template=" (did you mean <{}>?)")
 
 
 def parse_diff_drive(plugin: ET.Element, where: str, warnings: list[str]) -> DiffDriveConfig:

@@ -16,6 +16,7 @@ from navlab.description.errors import DescriptionError
 from navlab.description.gazebo_values import scoped
 from navlab.description.model import ContactTags, DiffDriveConfig, RosControlConfig
 from navlab.description.urdf import floats
+from navlab.errors import did_you_mean
 
 SKID_STEER_PLUGINS = ("libgazebo_ros_skid_steer_drive.so",)
 ROS_CONTROL_PLUGINS = ("libgazebo_ros_control.so",)
@@ -41,12 +42,9 @@ def _number(plugin: ET.Element, key: str, default: float, where: str, *, positiv
 
 
 def _unknown(plugin: ET.Element, known: tuple[str, ...], where: str, warnings: list[str]) -> None:
-    import difflib
-
     for child in plugin:
         if isinstance(child.tag, str) and child.tag not in known:
-            close = difflib.get_close_matches(child.tag, list(known), n=1)
-            hint = f" (did you mean <{close[0]}>?)" if close else ""
+            hint = did_you_mean(child.tag, known, template=" (did you mean <{}>?)")
             warnings.append(f"{where}: unknown parameter <{child.tag}> ignored{hint}")
 
 

@@ -108,9 +108,9 @@ def run_localization(
     that time (s) the robot is teleported to the route waypoint farthest from it and continues the route
     from there. ``record``: also write every topic to a rosbag2 (MCAP) in that folder.
     """
+    from navlab.drivers import RouteFollower
     from navlab.localization import field_from_map
     from navlab.mapping import load_map, save_map
-    from navlab.mapping.teleop import RouteFollower
     from navlab.world import load_world
 
     if duration <= 0:

@@ -44,10 +44,10 @@ class MappingResult:
 
 def _add_driver(run: Run, driver: str, route: str | Path | None) -> Any:
     """Start the driver node; returns a callable telling whether it is done."""
-    from navlab.mapping.teleop import HELP, RouteFollower, TeleopKeyboard, load_route, terminal_keys
+    from navlab.drivers import HELP, RouteFollower, TeleopKeyboard, load_route, terminal_keys
 
     if driver == "explore":
-        from navlab.mapping.explore_node import Explore
+        from navlab.drivers import Explore
 
         explorer = run.node("explore")
         assert isinstance(explorer, Explore)  # the shipped launch's explore

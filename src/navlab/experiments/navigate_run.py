@@ -28,18 +28,13 @@ from navlab.experiments.plots import NavSnapshot
 from navlab.experiments.session import Run, rounded, start_run
 from navlab.geometry import compose2, transform_points2
 from navlab.grid import Grid, GridMap
-from navlab.navigation import NavigationError
+from navlab.navigation import GoalOutcome, NavigationError
 from navlab.world import true_map, unmapped_obstacles
 
 if TYPE_CHECKING:
     from navlab.navigation.move_base import MoveBase
 
 Pose = tuple[float, float, float]
-CONTROLLERS = {
-    "trajectory": "base_local_planner/TrajectoryPlannerROS",
-    "dwa": "dwa_local_planner/DWAPlannerROS",
-    "mppi": "nav2_mppi_controller::MPPIController",
-}
 
 
 GOAL_TOLERANCE_M = 0.3  # the truth's goal region: twice the shipped robots' xy_goal_tolerance (AMCL's error room)
@@ -156,23 +151,22 @@ def _drive_goal(run: Run, mon: NavMonitor, goal: Pose, frame: str, timeout: floa
             next_say += 10.0
             x, y, _ = run.sim.base_pose2d()
             say(f"  t={mon.now_s():.1f} s: {mon.now_s() - t0:.0f} s into this goal, robot at ({x:.2f}, {y:.2f})")
-    # actionlib's terminal states; "timeout": navlab stopped waiting (and cancels the goal)
-    verdict = {"SUCCEEDED": "succeeded", "ABORTED": "aborted", "PREEMPTED": "preempted"}.get(handle.state, "timeout")
+    verdict = GoalOutcome.of(handle.state)
     if not handle.done():
         mb.cancel_goal()
-    t1 = handle.end_s if verdict != "timeout" and handle.end_s is not None else mon.now_s()
+    t1 = handle.end_s if verdict != GoalOutcome.TIMEOUT and handle.end_s is not None else mon.now_s()
     pts = np.array([p[1:] for p in mon.path[k0:]]).reshape(-1, 2)
     final_error = math.dist(run.sim.base_pose2d()[:2], compose2(world_T_frame, goal)[:2])
     reached = final_error <= tolerance
-    false_success = verdict == "succeeded" and not reached
-    outcome = "succeeded" if reached else ("not_reached" if false_success else verdict)
+    false_success = verdict == GoalOutcome.SUCCEEDED and not reached
+    outcome = "succeeded" if reached else ("not_reached" if false_success else str(verdict))
     reason = {"succeeded": "", "timeout": f"not reached in {timeout:g} s"}.get(verdict, handle.reason)
     if false_success:
         reason = f"move_base reported success but the robot is {final_error:.2f} m from the goal (> {tolerance:g} m)"
     return {
         "goal": list(goal),
         "outcome": outcome,
-        "move_base_outcome": verdict,
+        "move_base_outcome": str(verdict),
         "false_success": false_success,
         "reason": reason,
         "time_s": t1 - t0,
@@ -247,7 +241,7 @@ def run_navigation(
             raise NavigationError(f"goal {g!r}: expected three finite numbers x y yaw")
     overrides: dict[str, Any] = dict(move_base_params or {})
     if controller:
-        overrides["base_local_planner"] = CONTROLLERS.get(controller, controller)
+        overrides["base_local_planner"] = controller  # a ROS name or a registry alias (dwa, mppi, ...)
     gazebo = {"gazebo": {"disturbances": dict(disturbances)}} if disturbances else {}
     launch_args: dict[str, Any] = sim_launch_args(wheel_controller, ekf)
     if params_dir is not None:

@@ -118,6 +118,6 @@ def run_drift(robot: str, route: str, *, ekf: bool, seed: int = 0, timeout: floa
 
 
 def _route_follower() -> type[Node]:
-    from navlab.mapping.teleop import RouteFollower
+    from navlab.drivers import RouteFollower
 
     return RouteFollower

@@ -30,12 +30,12 @@ Unknown keys get "did you mean"; bad values one line naming the key.
 
 from __future__ import annotations
 
-import difflib
 import math
 from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any
 
+from navlab.errors import did_you_mean
 from navlab.experiments.errors import ExperimentError
 
 MAP_MODES = ("true", "map_first", "none")
@@ -126,8 +126,7 @@ def clutter_world_spec(world: str, *, where: str = "world") -> dict[str, Any] | 
         key, eq, value = item.partition("=")
         types = CLUTTER_KEYS[kind]
         if not eq or key not in types:
-            close = difflib.get_close_matches(key, list(types), n=1)
-            hint = f"; did you mean '{close[0]}'?" if close else ""
+            hint = did_you_mean(key, types)
             raise ExperimentError(f"{where}: {world!r}: {item!r} is not one of {', '.join(types)}=value{hint}")
         try:
             spec[key] = types[key](value)
@@ -148,8 +147,7 @@ def scenario_from_dict(data: Any, *, where: str = "scenario", path: Path | None 
     names = [f.name for f in fields(Scenario) if f.name != "path"]
     for key in data:
         if key not in names:
-            close = difflib.get_close_matches(str(key), names, n=1)
-            hint = f"; did you mean '{close[0]}'?" if close else ""
+            hint = did_you_mean(key, names)
             raise ExperimentError(f"{where}: unknown key '{key}'{hint} (keys: {', '.join(names)})")
     sc = Scenario(path=path)
     if isinstance(data.get("map"), bool):  # YAML reads `map: true` as a boolean

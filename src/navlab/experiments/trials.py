@@ -42,11 +42,11 @@ def shortest_length(world: str, start: tuple[float, float, float], goals: list[t
                     robot_radius: float = 0.2) -> float | None:  # fmt: skip
     """Length (m) of the shortest collision-free route start -> goals on the world's true map (None if any
     leg has none): SPL's reference."""
-    from navlab.mapping.explore import clearance_costmap
+    from navlab.drivers import exploration_costmap
     from navlab.navigation import ThetaStarPlanner
     from navlab.world import load_world, true_map
 
-    costmap = clearance_costmap(true_map(load_world(world), start[:2]), robot_radius, comfort=0.01)
+    costmap = exploration_costmap(true_map(load_world(world), start[:2]), robot_radius, comfort=0.01)
     planner = ThetaStarPlanner({"w_traversal_cost": 0.0})  # any-angle: the geometric shortest route
     total, here = 0.0, start
     for goal in goals:

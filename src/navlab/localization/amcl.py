@@ -27,7 +27,7 @@ from navlab.localization import sampling
 from navlab.localization.errors import LocalizationError
 from navlab.localization.field import MapField
 from navlab.localization.models import Beams
-from navlab.plugins import PluginError, load_plugin
+from navlab.plugins import PluginContext, PluginError, load_plugin
 
 
 @dataclass
@@ -145,7 +145,8 @@ class Amcl:
         self.field = field
         self.rng = rng
         self.motion_model = self.params.motion_model()
-        self.laser_model = self.params.laser_model()(field, self.params)
+        context = PluginContext(map_field=field, rng=rng)
+        self.laser_model = self.params.laser_model().from_params(self.params, context=context)
         self.particles = np.zeros((0, 3))
         self.weights = np.zeros(0)
         self.w_slow = 0.0

@@ -15,11 +15,10 @@ import numpy as np
 
 from navlab import msgs
 from navlab.core import Executor, Node, TfError, dataclass_parameters
-from navlab.grid import GridMap
+from navlab.grid import GridError, GridMap
 from navlab.localization import amcl as pf
 from navlab.localization.errors import LocalizationError
 from navlab.localization.field import field_from_map
-from navlab.mapping import MappingError
 
 # Nav2's spellings of ROS 1 amcl's parameters (the names and defaults themselves are AmclParams' fields).
 NAV2_ALIASES: dict[str, tuple[str, ...]] = {
@@ -100,10 +99,14 @@ class Amcl(Node):
     def _on_map(self, msg: Any) -> None:
         if self.filter is not None and self.first_map_only:
             return
-        try:
-            field = field_from_map(GridMap.from_msg(msg), max_dist=self.params.laser_likelihood_max_dist,
-                                   name=f"map on {self.resolve_topic_name('map')}")
-        except (LocalizationError, MappingError) as exc:
+        topic = self.resolve_topic_name("map")
+        try:  # a malformed OccupancyGrid (cells vs width x height, resolution, origin, values) is refused
+            grid = GridMap.from_msg(msg)
+            field = field_from_map(grid, max_dist=self.params.laser_likelihood_max_dist, name=f"map on {topic}")
+        except GridError as exc:
+            self._refuse(f"ignoring map on {topic}: {exc}")
+            return
+        except LocalizationError as exc:
             self._refuse(f"ignoring map: {exc}")
             return
         previous = self.filter

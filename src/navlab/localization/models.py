@@ -14,13 +14,15 @@ the robot base frame (one loop over particles × beams).
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING, NamedTuple
+from typing import TYPE_CHECKING, NamedTuple, Self
 
 import numpy as np
 from numba import njit
 
 from navlab.geometry import wrap_angle
-from navlab.localization.raycast import _cast_one
+from navlab.localization.errors import LocalizationError
+from navlab.localization.raycast import cast_one
+from navlab.plugins import PluginContext
 
 if TYPE_CHECKING:
     from navlab.localization.amcl import AmclParams
@@ -191,7 +193,7 @@ def _beam(xs, ys, yaws, lx, ly, lyaw, bearings, ranges, occ, res, range_max,
         p = 1.0
         for m in range(bearings.shape[0]):
             obs = ranges[m]
-            expected = _cast_one(occ, inv_res, res, sx, sy, syaw + bearings[m], range_max)
+            expected = cast_one(occ, inv_res, res, sx, sy, syaw + bearings[m], range_max)
             z = obs - expected
             pz = z_hit * math.exp(-(z * z) / denom)
             if z < 0:
@@ -245,7 +247,21 @@ def beam_weights(
     return out
 
 
-class LikelihoodFieldModel:
+class FieldModel:
+    """What the laser models share: built from amcl's parameters and the map's field (``context.map_field``)."""
+
+    def __init__(self, field: MapField, params: AmclParams) -> None:
+        raise NotImplementedError
+
+    @classmethod
+    def from_params(cls, params: AmclParams, *, context: PluginContext) -> Self:
+        """``params``: ``AmclParams``; ``context.map_field``: the map's ``MapField`` (required)."""
+        if context.map_field is None:
+            raise LocalizationError(f"laser model {cls.__name__}: needs the map's field (context.map_field)")
+        return cls(context.map_field, params)
+
+
+class LikelihoodFieldModel(FieldModel):
     """``laser_model_type: likelihood_field``: each beam endpoint scored by its distance to the nearest
     obstacle (Gaussian of ``laser_sigma_hit``, mixed with ``laser_z_rand``); beams without a hit are skipped."""
 
@@ -271,7 +287,7 @@ class LikelihoodFieldModel:
         )  # fmt: skip
 
 
-class BeamModel:
+class BeamModel(FieldModel):
     """``laser_model_type: beam``: each beam's range compared with the range ray-cast in the map (hit, short,
     max and random components); max-range readings count as readings of ``range_max``."""
 

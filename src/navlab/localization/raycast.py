@@ -13,7 +13,7 @@ from numba import njit
 
 
 @njit(cache=True)
-def _cast_one(occ: np.ndarray, inv_res: float, res: float, x: float, y: float, ang: float,
+def cast_one(occ: np.ndarray, inv_res: float, res: float, x: float, y: float, ang: float,
               max_range: float) -> float:
     h, w = occ.shape
     gx = x * inv_res
@@ -71,7 +71,7 @@ def _cast(occ: np.ndarray, res: float, xs: np.ndarray, ys: np.ndarray, yaws: np.
     inv_res = 1.0 / res
     for k in range(n):
         for m in range(b):
-            out[k, m] = _cast_one(occ, inv_res, res, xs[k], ys[k], yaws[k] + bearings[m], max_range)
+            out[k, m] = cast_one(occ, inv_res, res, xs[k], ys[k], yaws[k] + bearings[m], max_range)
     return out
 
 

@@ -1,9 +1,9 @@
 """slam_gmapping's ``mode`` plugins: the SLAM algorithms behind the ``SlamBackend`` seam (``navlab.plugins``).
 
-Each backend is built as ``cls(params, *, rng)`` from slam_gmapping's parameter names (a mode's own
-parameters under its name: ``graph.voxel``), and is what both the ``slam_gmapping`` node and
-``navlab slam`` (``run_offline``) drive. Adding a mode is one such class in a new file and one line
-in ``navlab.plugins.REGISTRY["slam_backend"]``.
+Each backend is built as ``cls.from_params(params, context=PluginContext(rng=...))`` from slam_gmapping's
+parameter names (a mode's own parameters under its name: ``graph.voxel``), and is what both the
+``slam_gmapping`` node and ``navlab slam`` (``run_offline``) drive. Adding a mode is one such class and one
+``navlab.slam_backends`` entry point (in navlab's pyproject.toml or a package of one's own: docs/plugins.md).
 
 - ``gmapping``: the Rao-Blackwellized particle filter (:class:`~navlab.mapping.gmapping.GMapping`),
   which applies odometry to every scan and updates the map after ``linearUpdate``/``angularUpdate``/
@@ -19,11 +19,12 @@ Pure: numpy in, poses and grids out; no topics, no clock. Ranges in metres, pose
 from __future__ import annotations
 
 import math
-from typing import Any
+from collections.abc import Mapping
+from typing import Any, Self
 
 import numpy as np
 
-from navlab.core import dataclass_parameters
+from navlab.core import dataclass_parameters, read_params
 from navlab.geometry import between2
 from navlab.grid import GridMap
 from navlab.mapping.errors import MappingError
@@ -33,6 +34,7 @@ from navlab.mapping.graph_slam import GraphSlam, GraphSlamParams
 from navlab.mapping.occupancy import build_map
 from navlab.mapping.refine import RefineParams, refine_poses
 from navlab.mapping.scanmatch import ScanPoints, scan_points
+from navlab.plugins import PluginContext
 
 
 def _int_stats(obj: object) -> dict[str, int]:
@@ -48,11 +50,25 @@ def _no_return_as(ranges: np.ndarray, value: float) -> np.ndarray:
     return np.where(np.isfinite(r), r, value)
 
 
-class GMappingBackend:
+class SeededBackend:
+    """What both modes share: built from slam_gmapping's parameters and the node's seeded RNG."""
+
+    def __init__(self, params: dict[str, Any] | None = None, *, rng: np.random.Generator) -> None:
+        raise NotImplementedError
+
+    @classmethod
+    def from_params(cls, params: Mapping[str, Any] | None, *, context: PluginContext) -> Self:
+        """``params``: slam_gmapping's names (a mode's own under its name); ``context.rng`` (required)."""
+        if context.rng is None:
+            raise MappingError(f"SLAM mode {context.name or cls.__name__}: needs a seeded rng in its context")
+        return cls(dict(params or {}), rng=context.rng)
+
+
+class GMappingBackend(SeededBackend):
     """``mode: gmapping``: slam_gmapping's RBPF. ``params``: GMapping's names (``particles``, ``delta``, ...)."""
 
     def __init__(self, params: dict[str, Any] | None = None, *, rng: np.random.Generator) -> None:
-        self.params = GMappingParams.from_dict(params)
+        self.params = read_params(GMappingParams, params)
         self.slam = GMapping(self.params, rng=rng)
         gmapping_warmup()  # the kernels' one-time load at start-up, not at the first map update
         self._points: list[ScanPoints] = []  # every scan's points, for the final refinement
@@ -127,7 +143,7 @@ class GMappingBackend:
         return {**_int_stats(self.slam), **_int_stats(self)}
 
 
-class GraphBackend:
+class GraphBackend(SeededBackend):
     """``mode: graph``: incremental graph SLAM. Its own parameters are ``graph.*`` (``GraphSlamParams``);
     slam_gmapping's ``linearUpdate``/``angularUpdate``/``temporalUpdate`` gate it (:meth:`due`), and
     ``delta``/``maxUrange`` shape its map."""
@@ -143,8 +159,8 @@ class GraphBackend:
                 raise MappingError(f"graph SLAM parameter '{key}' belongs under 'graph' (graph.{key})")
             else:
                 top[key] = value
-        self.gm = GMappingParams.from_dict(top)  # gating and map parameters
-        self.params = GraphSlamParams.from_dict(own)
+        self.gm = read_params(GMappingParams, top)  # gating and map parameters
+        self.params = read_params(GraphSlamParams, own)
         self.slam = GraphSlam(self.params)
         self._scans: list[tuple[np.ndarray, np.ndarray]] = []  # (ranges, angles) of each processed scan
         self._last: tuple[np.ndarray, int] | None = None  # odom_laser and stamp (ns) of the last processed scan

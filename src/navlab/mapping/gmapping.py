@@ -19,15 +19,16 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
+from navlab.core import ParamSpec
 from navlab.core.limits import check_ceiling
-from navlab.core.params import dataclass_from_dict
 from navlab.geometry import between2, compose2, wrap_angle
 from navlab.grid import GridMap
 from navlab.mapping.errors import MappingError
-from navlab.mapping.gmapping_match import _draw_motion, _optimize, _score
+from navlab.mapping.gmapping_match import draw_motion, match_score, optimize
 from navlab.mapping.gmapping_tiles import TILE, TilePool, raycast_tiles, tiles_for, to_dense
 from navlab.mapping.occupancy import L_CLAMP, L_FREE, L_OCC, logodds_to_grid, scan_cells
 
@@ -82,14 +83,11 @@ class GMappingParams:
     wideStep: float = 0.0873
     wideTurn: float = 0.524
 
-    @classmethod
-    def from_dict(cls, values: dict | None) -> GMappingParams:
-        """Parameters from overrides; unknown names raise ``MappingError`` with a suggestion."""
-        out = dataclass_from_dict(cls, values, what="gmapping", error=MappingError)
-        if out.particles < 1:
-            raise MappingError(f"gmapping parameter 'particles' must be >= 1, got {out.particles}")
-        check_ceiling(MappingError, "gmapping", "particles", out.particles, "particles")
-        return out
+    PARAMS: ClassVar[ParamSpec] = ParamSpec("gmapping", MappingError, at_least={"particles": 1})
+
+    def validate(self) -> None:
+        """The particle count's ceiling."""
+        check_ceiling(MappingError, "gmapping", "particles", self.particles, "particles")
 
 
 class _Particle:
@@ -187,7 +185,7 @@ class GMapping:
         dist = math.hypot(step[0], step[1])
         rot = abs(math.atan2(math.sin(step[2]), math.cos(step[2])))
         sig = (p.srr * abs(step[0]) + p.str * rot, p.srr * abs(step[1]) + p.str * rot, p.stt * rot + p.srt * dist)
-        _draw_motion(self.poses, self.rng.normal(0.0, 1.0, self.poses.shape), *step, *sig)
+        draw_motion(self.poses, self.rng.normal(0.0, 1.0, self.poses.shape), *step, *sig)
 
     def add_scan(
         self,
@@ -312,7 +310,7 @@ class GMapping:
             if matched:
                 pose[:] = x, y, wrap_angle(t)
             if not matched or pose[2] != t:  # the weight takes the log-likelihood at another pose
-                _s, lik, _n = _score(
+                _s, lik, _n = match_score(
                     tiles, part.table, ox, oy, oi, oj, res, pose[0], pose[1], pose[2], r, cb, sb, max_urange,
                     p.kernelSize, p.sigma, p.lsigma, p.lskip,
                 )  # fmt: skip
@@ -406,7 +404,7 @@ class GMapping:
         p = self.p
         ox, oy, oi, oj = self._lattice()
         args = (r, cb, sb, max_urange, p.kernelSize, p.sigma, p.lsigma, p.lskip, p.lstep, p.astep, p.iterations)
-        best = _optimize(self.pool.tiles, table, ox, oy, oi, oj, p.delta, pose[0], pose[1], pose[2], *args)
+        best = optimize(self.pool.tiles, table, ox, oy, oi, oj, p.delta, pose[0], pose[1], pose[2], *args)
         if p.wideScore <= 0 or p.wideStep <= 0:
             return best
         scored = r[:: p.lskip + 1]
@@ -417,7 +415,7 @@ class GMapping:
         for n in range(1, int(p.wideTurn / p.wideStep + 1e-9) + 1):
             for turn in (n * p.wideStep, -n * p.wideStep):
                 t0 = pose[2] + turn
-                got = _optimize(self.pool.tiles, table, ox, oy, oi, oj, p.delta, pose[0], pose[1], t0, *args)
+                got = optimize(self.pool.tiles, table, ox, oy, oi, oj, p.delta, pose[0], pose[1], t0, *args)
                 if got[3] > best[3]:
                     best = got
             if best[3] >= enough:

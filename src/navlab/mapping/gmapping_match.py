@@ -208,7 +208,7 @@ def _worst_first(terms: np.ndarray, order: np.ndarray, counts: np.ndarray) -> No
 
 
 @numba.njit(cache=True)
-def _score(
+def match_score(
     tiles: np.ndarray,
     table: np.ndarray,
     ox: float,
@@ -239,7 +239,7 @@ def _score(
 
 
 @numba.njit(cache=True)
-def _optimize(
+def optimize(
     tiles: np.ndarray,
     table: np.ndarray,
     ox: float,
@@ -331,7 +331,7 @@ def _optimize(
 
 
 @numba.njit(cache=True)
-def _draw_motion(
+def draw_motion(
     poses: np.ndarray, noise: np.ndarray, dx: float, dy: float, dt: float, sx: float, sy: float, st: float
 ) -> None:
     """GMapping's MotionModel::drawFromMotion for every particle, in place: pose n (row of ``poses``, (N, 3))
@@ -355,9 +355,9 @@ def warmup() -> None:
     free, used = pool.free(1), np.zeros(1, dtype=np.int64)
     tiles = pool.tiles  # (after free(), which may grow the pool)
     r, c = np.ones(2), np.ones(2)
-    _optimize(tiles, table, 0.0, 0.0, 0, 0, 0.05, 0.1, 0.1, 0.0, r, c, c, 1.0, 1, 0.05, 0.075, 0, 0.05, 0.05, 1)
-    _score(tiles, table, 0.0, 0.0, 0, 0, 0.05, 0.1, 0.1, 0.0, r, c, c, 1.0, 1, 0.05, 0.075, 0)
+    optimize(tiles, table, 0.0, 0.0, 0, 0, 0.05, 0.1, 0.1, 0.0, r, c, c, 1.0, 1, 0.05, 0.075, 0, 0.05, 0.05, 1)
+    match_score(tiles, table, 0.0, 0.0, 0, 0, 0.05, 0.1, 0.1, 0.0, r, c, c, 1.0, 1, 0.05, 0.075, 0)
     raycast_tiles(tiles, table, pool.refs, free, used, 0.0, 0.0, 0, 0, 0.05, 0.1, 0.1, 0.0, r, c, 1.0, 2.0, L_OCC,
                   L_FREE, L_CLAMP)  # fmt: skip
-    _draw_motion(np.zeros((2, 3)), np.zeros((2, 3)), 0.1, 0.0, 0.0, 0.1, 0.1, 0.1)
+    draw_motion(np.zeros((2, 3)), np.zeros((2, 3)), 0.1, 0.0, 0.0, 0.1, 0.1, 0.1)
     scan_cells(np.zeros((2, 3)), r, c, (0.0, 0.0), 0.05, max_urange=1.0, max_range=2.0)

@@ -14,10 +14,11 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
-from navlab.core.params import dataclass_from_dict
+from navlab.core import ParamSpec
 from navlab.geometry import between2, compose2, inverse2, rotate_vectors2, transform_points2
 from navlab.mapping.errors import MappingError
 from navlab.mapping.posegraph import PoseGraph
@@ -82,10 +83,7 @@ class GraphSlamParams:
     refine: bool = False  # finish with dense verified scan-to-scan constraints (mapping.refine); off: measured
     # no gain on the CSAIL log (0.0271 -> 0.0266 m) or the office logs, at +70 % CPU
 
-    @classmethod
-    def from_dict(cls, values: dict[str, float] | None) -> GraphSlamParams:
-        """Parameters from a dict of overrides; unknown names raise ``MappingError`` with suggestions."""
-        return dataclass_from_dict(cls, values, what="graph SLAM", error=MappingError)
+    PARAMS: ClassVar[ParamSpec] = ParamSpec("graph SLAM", MappingError)
 
 
 class GraphSlam:

@@ -18,7 +18,6 @@ atomically.
 from __future__ import annotations
 
 import contextlib
-import difflib
 import math
 import os
 import re
@@ -30,6 +29,7 @@ import numpy as np
 
 from navlab.core import ParameterError
 from navlab.core.params import parse_yaml
+from navlab.errors import closest
 from navlab.grid import GridMap
 from navlab.io import IoError
 from navlab.io.files import read_bytes_checked, read_text_checked, write_bytes_atomic, write_text_atomic
@@ -244,7 +244,7 @@ def read_map_yaml(yaml_path: str | os.PathLike[str]) -> dict[str, Any]:
         raise MappingError(f"{path}: expected a mapping with keys image, resolution, origin, ...")
     for key in doc:
         if key not in _KNOWN_KEYS and key not in _OPTIONAL_KEYS:
-            close = difflib.get_close_matches(str(key), _KNOWN_KEYS, n=1)
+            close = closest(key, _KNOWN_KEYS)
             if close and close[0] not in doc:
                 raise MappingError(f"{path}: unknown key '{key}'; did you mean '{close[0]}'?")
     if "image" not in doc:

@@ -22,7 +22,7 @@ from navlab.io.carmen import CarmenLog
 from navlab.mapping.errors import MappingError
 from navlab.mapping.mapfile import save_map
 from navlab.mapping.occupancy import build_map
-from navlab.plugins import PluginError, SlamBackend, load_plugin
+from navlab.plugins import PluginContext, PluginError, SlamBackend, load_plugin
 
 
 @dataclass
@@ -46,7 +46,8 @@ def make_slam(mode: str, params: dict[str, Any] | None = None, *, seed: int = 0)
         cls = load_plugin("slam_backend", mode, param="SLAM mode")
     except PluginError as exc:
         raise MappingError(str(exc)) from None
-    backend: SlamBackend = cls(flatten_params(params or {}), rng=np.random.default_rng(seed))
+    context = PluginContext(name=mode, rng=np.random.default_rng(seed))
+    backend: SlamBackend = cls.from_params(flatten_params(params or {}), context=context)
     return backend
 
 

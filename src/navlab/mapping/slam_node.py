@@ -20,7 +20,7 @@ from navlab.core import Executor, Node, TfError
 from navlab.geometry import compose2, inverse2
 from navlab.grid import GridMap
 from navlab.mapping.errors import MappingError
-from navlab.plugins import PluginError, SlamBackend, load_plugin
+from navlab.plugins import PluginContext, PluginError, SlamBackend, load_plugin
 
 # slam_gmapping parameters that must be > 0 or >= 0, and (min, max) pairs (issue 14: refused, not run with)
 _POSITIVE = ("transform_publish_period", "throttle_scans", "maxUrange", "sigma", "lstep",
@@ -73,7 +73,7 @@ class SlamGMapping(Node):
         _check_values(self.fully_qualified_name, {"map_update_interval": self.map_update_interval,
                                                   "transform_publish_period": self.transform_publish_period,
                                                   "throttle_scans": self.throttle_scans, **values})
-        self.slam: SlamBackend = backend(values, rng=self.rng)
+        self.slam: SlamBackend = backend.from_params(values, context=PluginContext(name=self.mode, rng=self.rng))
         inner: Any = getattr(self.slam, "slam", None)
         if inner is not None and hasattr(inner, "keep_history"):  # a live node never calls finish(): no per-scan
             inner.keep_history = False  # history (issue 14: it grew the process by ~45 MB per simulated hour)

@@ -6,7 +6,8 @@ Subpackages: ``costmap`` (layers and the layered master grid), ``planners`` (glo
 
 from navlab.navigation.costmap import LayeredCostmap, costmap_params
 from navlab.navigation.errors import NavigationError
+from navlab.navigation.goal import GoalOutcome, GoalState, MoveBaseState, RecoveryTrigger
 from navlab.navigation.planners import NavfnPlanner, ThetaStarPlanner, make_planner, path_length
 
-__all__ = ["LayeredCostmap", "NavfnPlanner", "NavigationError", "ThetaStarPlanner", "costmap_params",
-           "make_planner", "path_length"]
+__all__ = ["GoalOutcome", "GoalState", "LayeredCostmap", "MoveBaseState", "NavfnPlanner", "NavigationError",
+           "RecoveryTrigger", "ThetaStarPlanner", "costmap_params", "make_planner", "path_length"]

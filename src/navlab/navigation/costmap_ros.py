@@ -19,8 +19,7 @@ from navlab.core import Node, TfError
 from navlab.geometry import compose2, transform_points2
 from navlab.grid import COST_INSCRIBED, COST_LETHAL, COST_UNKNOWN, Grid, GridMap
 from navlab.navigation.costmap.layered import LayeredCostmap
-from navlab.navigation.costmap.layers import ObstacleLayer, StaticLayer
-from navlab.navigation.costmap_sensors import CloudLayer, CostmapSensorFeeds
+from navlab.navigation.costmap_sensors import CostmapSensorFeeds
 
 
 def cost_translation() -> np.ndarray:
@@ -51,9 +50,9 @@ class Costmap2DROS:
         self._table = cost_translation()
         self._pending: dict[str, Any] = {}
         self._sensor_in_base: dict[str, tuple[float, float, float]] = {}
-        statics = [x for x in self.layered.layers if isinstance(x, StaticLayer)]
+        statics = self.layered.map_layers
         if statics:
-            node.create_subscription(msgs.OccupancyGrid, statics[0].params.map_topic, self._on_map, 1)
+            node.create_subscription(msgs.OccupancyGrid, statics[0].map_topic, self._on_map, 1)
         self.feeds = CostmapSensorFeeds(node, name, self.global_frame, self.layered.layers, prefix=prefix)
         for src_name, src in p.sources.items():
             if src_name in self.feeds.sources:
@@ -172,14 +171,10 @@ class Costmap2DROS:
         pose = self.layered.robot_pose or self.robot_pose()
         if pose is None:
             return
-        for layer in self.layered.layers:
-            if isinstance(layer, CloudLayer):
-                layer.clear_outside(pose[:2], size)
-            elif isinstance(layer, ObstacleLayer) and layer.grid is not None:
-                g = layer.grid
-                xy = g.centers(np.ones(g.data.shape, bool)).reshape(g.height, g.width, 2)
-                outside = (np.abs(xy[..., 0] - pose[0]) > size / 2) | (np.abs(xy[..., 1] - pose[1]) > size / 2)
-                g.data[outside] = layer.default_value
+        for layer in self.layered.scan_layers:
+            layer.clear_outside(pose[:2], size)
+        for cloud_layer in self.feeds.voxel:
+            cloud_layer.clear_outside(pose[:2], size)
         self.layered.update_map(pose)
 
     def cost_at(self, xy: tuple[float, float]) -> int:

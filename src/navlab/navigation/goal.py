@@ -4,12 +4,60 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from enum import StrEnum
 
 import numpy as np
 
 Pose = tuple[float, float, float]
+
+
+class GoalState(StrEnum):
+    """A goal's state as actionlib names it (str-valued: equal to the old strings, JSON writes the name)."""
+
+    PENDING = "PENDING"
+    ACTIVE = "ACTIVE"
+    SUCCEEDED = "SUCCEEDED"
+    ABORTED = "ABORTED"
+    PREEMPTED = "PREEMPTED"
+
+
+class MoveBaseState(StrEnum):
+    """move_base's state machine (``MoveBaseState`` of move_base.h; str-valued)."""
+
+    IDLE = "IDLE"
+    PLANNING = "PLANNING"
+    CONTROLLING = "CONTROLLING"
+    CLEARING = "CLEARING"
+
+
+class RecoveryTrigger(StrEnum):
+    """What sent move_base into recovery (move_base's ``RecoveryTrigger``; "" before any)."""
+
+    NONE = ""
+    PLANNING = "PLANNING"
+    CONTROLLING = "CONTROLLING"
+    OSCILLATION = "OSCILLATION"
+
+
+class GoalOutcome(StrEnum):
+    """How a navigation trial's goal ended (lower-case, as results files write it); ``TIMEOUT``: navlab stopped
+    waiting (and cancels the goal)."""
+
+    SUCCEEDED = "succeeded"
+    ABORTED = "aborted"
+    PREEMPTED = "preempted"
+    TIMEOUT = "timeout"
+
+    @classmethod
+    def of(cls, state: GoalState) -> GoalOutcome:
+        """The outcome of a goal in ``state`` (a goal not yet finished: ``TIMEOUT``)."""
+        return cls(state.lower()) if state in TERMINAL else cls.TIMEOUT
+
+
+TERMINAL = frozenset({GoalState.SUCCEEDED, GoalState.ABORTED, GoalState.PREEMPTED})
 # action_msgs/GoalStatus codes of the states a goal goes through
-STATUS = {"PENDING": 1, "ACTIVE": 2, "PREEMPTED": 5, "SUCCEEDED": 4, "ABORTED": 6}
+STATUS = {GoalState.PENDING: 1, GoalState.ACTIVE: 2, GoalState.PREEMPTED: 5, GoalState.SUCCEEDED: 4,
+          GoalState.ABORTED: 6}
 
 
 @dataclass
@@ -19,7 +67,7 @@ class GoalHandle:
     goal: Pose
     frame_id: str
     id: int
-    state: str = "PENDING"
+    state: GoalState = GoalState.PENDING
     reason: str = ""
     start_s: float = 0.0
     end_s: float | None = None
@@ -28,7 +76,7 @@ class GoalHandle:
 
     def done(self) -> bool:
         """Whether the goal reached a terminal state."""
-        return self.state in ("SUCCEEDED", "ABORTED", "PREEMPTED")
+        return self.state in TERMINAL
 
 
 def with_headings(xy: np.ndarray, goal_yaw: float) -> np.ndarray:

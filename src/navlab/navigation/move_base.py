@@ -12,7 +12,6 @@ spirit: feedback, cancel, result succeeded / aborted with a reason / preempted);
 
 from __future__ import annotations
 
-import inspect
 import math
 from collections.abc import Callable
 from typing import Any
@@ -22,13 +21,12 @@ import numpy as np
 from navlab import msgs
 from navlab.core import Executor, Node, TfError
 from navlab.core.limits import check_ceiling
-from navlab.geometry import inverse_transform_points2, transform_points2, wrap_angle
-from navlab.navigation.costmap.layers import StaticLayer
+from navlab.geometry import transform_points2, wrap_angle
 from navlab.navigation.costmap_ros import Costmap2DROS
 from navlab.navigation.errors import NavigationError
-from navlab.navigation.goal import STATUS, GoalHandle, with_headings
+from navlab.navigation.goal import STATUS, GoalHandle, GoalState, MoveBaseState, RecoveryTrigger, with_headings
 from navlab.navigation.recovery import DEFAULT_RECOVERIES, ClearCostmapRecovery
-from navlab.plugins import load_plugin, plugin_names
+from navlab.plugins import ControlResult, PluginContext, load_plugin, make_plugin, plugin_names, resolve_name
 
 Pose = tuple[float, float, float]
 _MB_DEFAULTS: dict[str, Any] = {
@@ -55,13 +53,6 @@ def short_name(plugin: str) -> str:
     return plugin.replace("::", "/").rsplit("/", 1)[-1]
 
 
-def _construct(cls: Any, params: dict[str, Any], **extra: Any) -> Any:
-    """A plugin instance from its ROS parameter dict, plus the ``extra`` keywords its constructor takes
-    (the node's random generator, the robot's footprint polygon)."""
-    accepted = inspect.signature(cls).parameters
-    return cls(params, **{k: v for k, v in extra.items() if k in accepted})
-
-
 class MoveBase(Node):
     """ROS 1 move_base over navlab's costmaps, planners and controllers (see the module docstring)."""
 
@@ -84,17 +75,18 @@ class MoveBase(Node):
         self.global_costmap = self._costmap("global_costmap", private)
         self.local_costmap = self._costmap("local_costmap", private)
         self.costmaps = {"global": self.global_costmap, "local": self.local_costmap}
-        gp, lp = str(p["base_global_planner"]), str(p["base_local_planner"])
+        gp = resolve_name("global_planner", str(p["base_global_planner"]))
+        lp = resolve_name("controller", str(p["base_local_planner"]))
         self.planner_name, self.controller_name = short_name(gp), short_name(lp)
-        self.planner = _construct(load_plugin("global_planner", gp, param="base_global_planner"),
-                                  self._namespace(self.planner_name))  # fmt: skip
-        footprint = self.local_costmap.layered.footprint
+        self.planner = make_plugin("global_planner", gp, self._namespace(self.planner_name),
+                                   context=PluginContext(name=self.planner_name, rng=self.rng),
+                                   param="base_global_planner")
         # as ROS's planners see them: the costmap's footprint (a round robot's radius, for costmap_2d's 16-gon)
         # and move_base's controller_frequency (they search the parameter upward)
-        self.controller = _construct(load_plugin("controller", lp, param="base_local_planner"),
-                                     self._namespace(self.controller_name), rng=self.rng,
-                                     footprint=footprint.polygon, robot_radius=footprint.radius,
-                                     controller_frequency=p["controller_frequency"])  # fmt: skip
+        context = PluginContext(name=self.controller_name, rng=self.rng, footprint=self.local_costmap.layered.footprint,
+                                controller_frequency=p["controller_frequency"])
+        self.controller = make_plugin("controller", lp, self._namespace(self.controller_name), context=context,
+                                      param="base_local_planner")
         self.recoveries = self._recoveries(raw_recoveries)
         # a parameter file may configure several planners (TrajectoryPlannerROS: and DWAPlannerROS:); ROS ignores
         # the sections of the ones not in use, and so does navlab
@@ -116,7 +108,7 @@ class MoveBase(Node):
         self.create_timer(0.2, self._publish_status)
         self.velocity = (0.0, 0.0)
         self.handle: GoalHandle | None = None
-        self.state = "IDLE"  # IDLE, PLANNING, CONTROLLING, CLEARING
+        self.state = MoveBaseState.IDLE
         self.global_plan: np.ndarray | None = None
         self._ids = 0
         self._reset_goal_state()
@@ -137,14 +129,13 @@ class MoveBase(Node):
         out = []
         for k, spec in enumerate(raw):
             name, kind = str(spec["name"]), str(spec["type"])
-            cls = load_plugin("recovery", kind, param=f"recovery_behaviors[{k}] type")
             params = self._namespace(name)
-            if cls is ClearCostmapRecovery:
+            if load_plugin("recovery", kind, param=f"recovery_behaviors[{k}] type") is ClearCostmapRecovery:
+                # as ROS 1 move_base sets <name>/reset_distance for its resets (unless the file does)
                 default = self.p["conservative_reset_dist"] if name == "conservative_reset" else (
                     4.0 * self.local_costmap.layered.circumscribed_radius)
-                out.append((name, cls(params, default_reset=default)))
-            else:
-                out.append((name, cls(params)))
+                params = {"reset_distance": default, **params}
+            out.append((name, make_plugin("recovery", kind, params, context=PluginContext(name=name, rng=self.rng))))
         return out
 
     # --- goals ---------------------------------------------------------------------------------------
@@ -152,7 +143,7 @@ class MoveBase(Node):
     def _reset_goal_state(self) -> None:
         now = self.executor.now_ns
         self.recovery_index = 0
-        self.recovery_trigger = ""
+        self.recovery_trigger = RecoveryTrigger.NONE
         self.active_recovery: Any = None
         self.last_valid_plan_ns = now
         self.last_valid_control_ns = now
@@ -168,25 +159,25 @@ class MoveBase(Node):
                   on_done: Callable[[GoalHandle], None] | None = None) -> GoalHandle:  # fmt: skip
         """Start driving to (x, y, yaw) in ``frame_id``; a goal still running is PREEMPTED. Returns its handle."""
         if self.handle is not None and not self.handle.done():
-            self._finish("PREEMPTED", "preempted by a new goal")
+            self._finish(GoalState.PREEMPTED, "preempted by a new goal")
         self._ids += 1
         handle = GoalHandle((float(x), float(y), float(yaw)), frame_id.lstrip("/") or "map", self._ids,
                             start_s=self.executor.now_ns / 1e9, feedback=feedback, on_done=on_done)  # fmt: skip
         self.handle = handle
         if not all(math.isfinite(v) for v in handle.goal):
-            self._finish("ABORTED", f"goal {handle.goal} is not finite")
+            self._finish(GoalState.ABORTED, f"goal {handle.goal} is not finite")
             return handle
-        handle.state = "ACTIVE"
+        handle.state = GoalState.ACTIVE
         self._reset_goal_state()
         self.global_plan = None
-        self.state = "PLANNING"
+        self.state = MoveBaseState.PLANNING
         self.goal_pub.publish(msgs.pose_stamped(self.executor.now_ns, handle.frame_id, *handle.goal))
         return handle
 
     def cancel_goal(self) -> None:
         """Stop the current goal (PREEMPTED) and the robot."""
         if self.handle is not None and not self.handle.done():
-            self._finish("PREEMPTED", "cancelled")
+            self._finish(GoalState.PREEMPTED, "cancelled")
 
     def _on_goal_msg(self, msg: Any) -> None:
         self.send_goal(*msgs.pose2d(msg.pose), frame_id=str(msg.header.frame_id) or "map")
@@ -195,15 +186,15 @@ class MoveBase(Node):
         t = msg.twist.twist
         self.velocity = (float(t.linear.x), float(t.angular.z))
 
-    def _finish(self, state: str, reason: str = "") -> None:
+    def _finish(self, state: GoalState, reason: str = "") -> None:
         h = self.handle
         self.cmd_pub.publish(msgs.twist(0.0, 0.0))
-        self.state = "IDLE"
+        self.state = MoveBaseState.IDLE
         self.active_recovery = None
         if h is None or h.done():
             return
         h.state, h.reason, h.end_s = state, reason, self.executor.now_ns / 1e9
-        log = self.get_logger().info if state == "SUCCEEDED" else self.get_logger().warning
+        log = self.get_logger().info if state == GoalState.SUCCEEDED else self.get_logger().warning
         log(f"goal {h.id} {state.lower()}" + (f": {reason}" if reason else ""))
         self._publish_status()
         if h.on_done is not None:
@@ -251,14 +242,7 @@ class MoveBase(Node):
 
     def _on_map_obstacle(self, goal: Pose) -> bool:
         """Whether ``goal`` (global frame) lies on an occupied cell of a static layer's map."""
-        for layer in self.global_costmap.layered.layers:
-            grid = getattr(layer, "map", None)
-            if isinstance(layer, StaticLayer) and grid is not None:
-                mx, my, myaw = layer.map_in_costmap
-                xy = inverse_transform_points2((mx, my, myaw), np.array([goal[:2]]))
-                if int(grid.value_at(xy)[0]) >= layer.params.lethal_cost_threshold:
-                    return True
-        return False
+        return any(layer.on_map_obstacle(goal[:2]) for layer in self.global_costmap.layered.map_layers)
 
     def make_plan(self, start: Pose, goal: Pose) -> np.ndarray | None:
         """A global plan (N, 2+) in the global costmap's frame, or None."""
@@ -281,21 +265,21 @@ class MoveBase(Node):
             self.global_costmap.update()
         why = self._check_goal(goal)
         if why is not None:
-            self._finish("ABORTED", why)
+            self._finish(GoalState.ABORTED, why)
             return False
         plan = self.make_plan(start, goal)
         self.last_plan_ns = self.executor.now_ns
         if plan is None:
             self.planning_retries += 1
-            self.plan_failure = str(getattr(self.planner, "last_failure", "") or "")
+            self.plan_failure = str(self.planner.last_failure or "")
             if self._on_map_obstacle(goal):  # no recovery clears the map itself: say so now
-                self._finish("ABORTED", f"goal ({goal[0]:.2f}, {goal[1]:.2f}) is in an obstacle on the map"
+                self._finish(GoalState.ABORTED, f"goal ({goal[0]:.2f}, {goal[1]:.2f}) is in an obstacle on the map"
                                         + (f" ({self.plan_failure})" if self.plan_failure else ""))  # fmt: skip
             return False
         self.global_plan = plan
         self.last_valid_plan_ns = self.executor.now_ns
         self.planning_retries = 0
-        if self.recovery_trigger == "PLANNING":
+        if self.recovery_trigger == RecoveryTrigger.PLANNING:
             self.recovery_index = 0
         self._publish_path(self.plan_pub, plan, gf)
         local = self._plan_in_local()
@@ -306,7 +290,7 @@ class MoveBase(Node):
     # --- the cycle -------------------------------------------------------------------------------------
 
     def _cycle(self) -> None:
-        if self.handle is None or self.handle.done() or self.state == "IDLE":
+        if self.handle is None or self.handle.done() or self.state == MoveBaseState.IDLE:
             return
         now = self.executor.now_ns
         pose = self.local_costmap.robot_pose()
@@ -315,17 +299,17 @@ class MoveBase(Node):
         if self.handle.feedback is not None:
             self.handle.feedback(pose)
         self._check_oscillation(pose, now)
-        if self.state == "PLANNING":
+        if self.state == MoveBaseState.PLANNING:
             if self._plan():
-                self.state = "CONTROLLING"
+                self.state = MoveBaseState.CONTROLLING
             elif self.handle.done():
                 return
             elif self._timed_out(self.last_valid_plan_ns, self.p["planner_patience"]) or (
                     0 <= self.p["max_planning_retries"] < self.planning_retries):  # fmt: skip
-                self._enter_clearing("PLANNING")
+                self._enter_clearing(RecoveryTrigger.PLANNING)
             self.cmd_pub.publish(msgs.twist(0.0, 0.0))
             return
-        if self.state == "CLEARING":
+        if self.state == MoveBaseState.CLEARING:
             self._clearing(pose)
             return
         self._controlling(pose, now)
@@ -338,7 +322,7 @@ class MoveBase(Node):
                 "oscillation_distance"]:  # fmt: skip
             self.oscillation_pose = pose
             self.last_oscillation_reset_ns = now
-            if self.recovery_trigger == "OSCILLATION":
+            if self.recovery_trigger == RecoveryTrigger.OSCILLATION:
                 self.recovery_index = 0
 
     def _controlling(self, pose: Pose, now: int) -> None:
@@ -346,7 +330,7 @@ class MoveBase(Node):
         if p["planner_frequency"] > 0 and self.last_plan_ns is not None and (
                 now - self.last_plan_ns) / 1e9 >= 1.0 / p["planner_frequency"]:  # fmt: skip
             if not self._plan() and self._timed_out(self.last_valid_plan_ns, p["planner_patience"]):
-                self._enter_clearing("PLANNING")
+                self._enter_clearing(RecoveryTrigger.PLANNING)
                 return
             if self.handle is None or self.handle.done():
                 return
@@ -354,35 +338,30 @@ class MoveBase(Node):
         if local is not None:
             self.controller.set_plan(local)
         if self.controller.is_goal_reached(pose, self.velocity):
-            self._finish("SUCCEEDED")
+            self._finish(GoalState.SUCCEEDED)
             return
         if p["oscillation_timeout"] > 0 and self._timed_out(self.last_oscillation_reset_ns, p["oscillation_timeout"]):
-            self._enter_clearing("OSCILLATION")
+            self._enter_clearing(RecoveryTrigger.OSCILLATION)
             return
         try:
-            cmd = self.controller.compute_velocity(pose, self.velocity, self.local_costmap.costmap)
+            cmd: ControlResult | None = ControlResult.of(
+                self.controller.compute_velocity(pose, self.velocity, self.local_costmap.costmap))
         except NavigationError as exc:
             self.get_logger().debug(f"controller: {exc}")
             cmd = None
-        valid = cmd is not None and all(math.isfinite(c) for c in cmd) and getattr(self.controller, "valid", True)
-        if valid:
-            assert cmd is not None
+        if cmd is not None and cmd.valid and math.isfinite(cmd.v) and math.isfinite(cmd.w):
             self.last_valid_control_ns = now
-            if self.recovery_trigger == "CONTROLLING":
+            if self.recovery_trigger == RecoveryTrigger.CONTROLLING:
                 self.recovery_index = 0
-            self.cmd_pub.publish(msgs.twist(*cmd))
+            self.cmd_pub.publish(msgs.twist(cmd.v, cmd.w))
         else:
             self.cmd_pub.publish(msgs.twist(0.0, 0.0))
             if self._timed_out(self.last_valid_control_ns, p["controller_patience"]):
-                self._enter_clearing("CONTROLLING")
+                self._enter_clearing(RecoveryTrigger.CONTROLLING)
             elif p["planner_frequency"] <= 0:
-                self.state = "PLANNING"  # ROS replans when the controller fails
-        self._publish_local_plan(now)
-
-    def _publish_local_plan(self, now: int) -> None:
-        traj = getattr(self.controller, "local_plan", None)
-        if traj is not None and len(traj):
-            self._publish_path(self.local_plan_pub, traj, self.local_costmap.global_frame)
+                self.state = MoveBaseState.PLANNING  # ROS replans when the controller fails
+        if cmd is not None and len(cmd.local_plan):
+            self._publish_path(self.local_plan_pub, cmd.local_plan, self.local_costmap.global_frame)
 
     def _publish_path(self, pub: Any, poses: np.ndarray, frame: str) -> None:
         """``nav_msgs/Path`` of (N, 2+) poses, built only when someone listens (hundreds of messages each)."""
@@ -395,20 +374,20 @@ class MoveBase(Node):
 
     # --- recoveries ------------------------------------------------------------------------------------
 
-    def _enter_clearing(self, trigger: str) -> None:
+    def _enter_clearing(self, trigger: RecoveryTrigger) -> None:
         self.recovery_trigger = trigger
         self.cmd_pub.publish(msgs.twist(0.0, 0.0))
         usable = [(n, r) for n, r in self.recoveries
                   if self.p["clearing_rotation_allowed"] or "rotate" not in type(r).__name__.lower()]  # fmt: skip
         if not self.p["recovery_behavior_enabled"] or self.recovery_index >= len(usable):
             reason = {
-                "PLANNING": "Failed to find a valid plan. Even after executing recovery behaviors.",
-                "CONTROLLING": "Failed to find a valid control. Even after executing recovery behaviors.",
-                "OSCILLATION": "Robot is oscillating. Even after executing recovery behaviors.",
+                RecoveryTrigger.PLANNING: "Failed to find a valid plan. Even after executing recovery behaviors.",
+                RecoveryTrigger.CONTROLLING: "Failed to find a valid control. Even after executing recovery behaviors.",
+                RecoveryTrigger.OSCILLATION: "Robot is oscillating. Even after executing recovery behaviors.",
             }[trigger]
-            if trigger == "PLANNING" and self.plan_failure:
+            if trigger == RecoveryTrigger.PLANNING and self.plan_failure:
                 reason += f" ({self.plan_failure})"
-            self._finish("ABORTED", reason)
+            self._finish(GoalState.ABORTED, reason)
             return
         name, behavior = usable[self.recovery_index]
         self.recovery_index += 1
@@ -419,7 +398,7 @@ class MoveBase(Node):
         self.get_logger().info(f"recovery {self.recovery_index}/{len(usable)}: {name} ({trigger.lower()} failed)")
         behavior.start(pose)
         self.active_recovery = behavior
-        self.state = "CLEARING"
+        self.state = MoveBaseState.CLEARING
 
     def _clearing(self, pose: Pose) -> None:
         cmd = self.active_recovery.step(pose, self.costmaps) if self.active_recovery is not None else None
@@ -431,7 +410,7 @@ class MoveBase(Node):
         now = self.executor.now_ns
         self.last_valid_plan_ns = self.last_valid_control_ns = self.last_oscillation_reset_ns = now
         self.oscillation_pose = pose
-        self.state = "PLANNING"
+        self.state = MoveBaseState.PLANNING
 
     # --- services and status ---------------------------------------------------------------------------
 

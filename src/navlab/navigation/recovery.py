@@ -9,12 +9,13 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, ClassVar
 
-from navlab.core.params import dataclass_from_dict
+from navlab.core import ParamSpec, read_params
 from navlab.geometry import wrap_angle
 from navlab.grid import COST_INSCRIBED
 from navlab.navigation.errors import NavigationError
+from navlab.plugins import BuiltFromParams
 
 Pose = tuple[float, float, float]
 
@@ -27,24 +28,17 @@ class ClearCostmapParams:
     layer_names: tuple[str, ...] = ("obstacle_layer",)
     force_updating: bool = False
     affected_maps: str = "both"
+    PARAMS: ClassVar[ParamSpec] = ParamSpec("clear_costmap_recovery", NavigationError,
+                                            at_least={"reset_distance": 0.0},
+                                            choices={"affected_maps": ("global", "local", "both")})
 
 
-class ClearCostmapRecovery:
+class ClearCostmapRecovery(BuiltFromParams):
     """``clear_costmap_recovery/ClearCostmapRecovery``: clears the costmaps' obstacle layers outside a square
     of side ``reset_distance`` around the robot; takes one cycle."""
 
     def __init__(self, params: dict[str, Any] | None = None, *, default_reset: float = 3.0) -> None:
-        values = {"reset_distance": default_reset, **(params or {})}
-        if isinstance(values.get("layer_names"), list):
-            values["layer_names"] = tuple(values["layer_names"])
-        self.params = dataclass_from_dict(ClearCostmapParams, values, what="clear_costmap_recovery",
-                                          error=NavigationError)
-        if not (math.isfinite(self.params.reset_distance) and self.params.reset_distance >= 0):
-            raise NavigationError(f"clear_costmap_recovery parameter reset_distance: expected >= 0 m, "
-                                  f"got {self.params.reset_distance}")
-        if self.params.affected_maps not in ("global", "local", "both"):
-            raise NavigationError("clear_costmap_recovery parameter affected_maps: expected global, local or both, "
-                                  f"got {self.params.affected_maps!r}")
+        self.params = read_params(ClearCostmapParams, {"reset_distance": default_reset, **(params or {})})
 
     def start(self, pose: Pose) -> None:
         """Nothing to remember."""
@@ -67,17 +61,15 @@ class RotateParams:
     min_in_place_rotational_vel: float = 0.4
     acc_lim_th: float = 3.2
     tolerance: float = 0.10
+    PARAMS: ClassVar[ParamSpec] = ParamSpec("rotate_recovery", NavigationError, above={"max_rotational_vel": 0.0})
 
 
-class RotateRecovery:
+class RotateRecovery(BuiltFromParams):
     """``rotate_recovery/RotateRecovery``: turn 360° in place (counter-clockwise), stopping early if the
     footprint would hit a lethal cell of the local costmap."""
 
     def __init__(self, params: dict[str, Any] | None = None) -> None:
-        self.params = dataclass_from_dict(RotateParams, params, what="rotate_recovery", error=NavigationError)
-        if self.params.max_rotational_vel <= 0:
-            raise NavigationError(f"rotate_recovery parameter max_rotational_vel: expected > 0, "
-                                  f"got {self.params.max_rotational_vel}")
+        self.params = read_params(RotateParams, params)
         self._start_yaw = 0.0
         self._turned = 0.0
         self._last = 0.0
@@ -109,16 +101,15 @@ class BackUpParams:
     backup_dist: float = 0.3
     backup_speed: float = 0.1
     time_allowance: float = 10.0
+    PARAMS: ClassVar[ParamSpec] = ParamSpec("back_up", NavigationError,
+                                            above={"backup_dist": 0.0, "backup_speed": 0.0})
 
 
-class BackUpRecovery:
+class BackUpRecovery(BuiltFromParams):
     """``nav2_behaviors/BackUp``: reverse a short distance, stopping if the footprint behind is lethal."""
 
     def __init__(self, params: dict[str, Any] | None = None) -> None:
-        self.params = dataclass_from_dict(BackUpParams, params, what="back_up", error=NavigationError)
-        if self.params.backup_dist <= 0 or self.params.backup_speed <= 0:
-            raise NavigationError("back_up parameters backup_dist and backup_speed: expected > 0, got "
-                                  f"{self.params.backup_dist} and {self.params.backup_speed}")
+        self.params = read_params(BackUpParams, params)
         self._start: Pose = (0.0, 0.0, 0.0)
         self._steps = 0
 

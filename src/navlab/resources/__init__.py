@@ -78,10 +78,9 @@ def route(name: str) -> Path:
 
 def _unknown(kind: str, name: str, shipped: list[str]) -> ResourceError:
     """One line: ``world 'rooom': no such file here and no shipped world of that name; did you mean 'room'?``"""
-    import difflib
+    from navlab.errors import did_you_mean
 
-    close = difflib.get_close_matches(name, shipped, n=1)
-    hint = f"; did you mean {close[0]!r}?" if close else ""
+    hint = did_you_mean(name, shipped)
     return ResourceError(f"{kind} {name!r}: no such file here and no shipped {kind} of that name{hint} "
                          f"(shipped: {', '.join(shipped)})")
 

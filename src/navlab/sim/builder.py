@@ -109,7 +109,7 @@ def mj_quat_from_rpy(rpy: tuple[float, float, float]) -> np.ndarray:
 
 
 
-def _set_pose(element: Any, origin: Origin) -> None:
+def set_pose(element: Any, origin: Origin) -> None:
     """Set ``pos``/``quat`` of a MuJoCo spec element (``MjsBody``, ``MjsGeom``, ``MjsSite``...; untyped)."""
     element.pos = np.asarray(origin.xyz, dtype=float)
     element.quat = mj_quat_from_rpy(origin.rpy)
@@ -120,7 +120,7 @@ def _set_pose(element: Any, origin: Origin) -> None:
 # --- geometry -------------------------------------------------------------------------------------
 
 
-class _Geoms:
+class Geoms:
     """Adds shapes to bodies, registering mesh assets once per (file, scale)."""
 
     def __init__(self, spec: mujoco.MjSpec, info: BuildInfo) -> None:
@@ -166,21 +166,21 @@ class _Geoms:
             raise SimError(f"{where}: {g.kind} geometry needs more size values than {size}") from None
         if g.kind != "mesh" and min(s for s in size if s is not None) <= 0:
             raise SimError(f"{where}: {g.kind} size {size} must be positive")
-        _set_pose(geom, shape.origin)
+        set_pose(geom, shape.origin)
         for key, value in props.items():
             setattr(geom, key, value)
         return geom
 
 
-def _contact_props(kind: str, group: int) -> dict[str, object]:
+def contact_props(kind: str, group: int) -> dict[str, object]:
     contype, conaffinity = _CONTACT_BITS[kind]
     return {"contype": contype, "conaffinity": conaffinity, "group": group}
 
 
-_VISUAL_PROPS: dict[str, object] = {"contype": 0, "conaffinity": 0, "group": GROUP_VISUAL, "mass": 0.0}
+VISUAL_PROPS: dict[str, object] = {"contype": 0, "conaffinity": 0, "group": GROUP_VISUAL, "mass": 0.0}
 
 
-def _set_inertial(body: mujoco.MjsBody, link: Link, moving: bool, info: BuildInfo, where: str) -> None:
+def set_inertial(body: mujoco.MjsBody, link: Link, moving: bool, info: BuildInfo, where: str) -> None:
     inertial = link.inertial
     if inertial is None:
         if moving:
@@ -252,10 +252,10 @@ def add_robot(
 ) -> None:
     """Add ``robot`` with its root at ``pose`` = (x, y, z, yaw) in the world frame (m, rad)."""
     children = _check_tree(robot)
-    geoms = _Geoms(spec, info)
+    geoms = Geoms(spec, info)
     info.robot_name = robot.name
     info.root_body = robot.root_link
-    contact = {**_contact_props("robot", GROUP_ROBOT), "priority": 1}
+    contact = {**contact_props("robot", GROUP_ROBOT), "priority": 1}
     total_mass = sum(lk.inertial.mass for lk in robot.links.values() if lk.inertial is not None)
     wheels = sum(map(len, robot.diff_drive.wheel_joints())) if robot.diff_drive is not None else 1
     if wheels > 2:  # skid steer: wheels slide sideways; isotropic Coulomb friction (see navlab.sim.ode_contact)
@@ -264,7 +264,7 @@ def add_robot(
     def fill(body: mujoco.MjsBody, link: Link, axis: np.ndarray | None, rigid_to_root: bool) -> None:
         where = f"robot {robot.name!r} link {link.name!r}"
         info.link_bodies[link.name] = body.name
-        _set_inertial(body, link, axis is not None, info, where)
+        set_inertial(body, link, axis is not None, info, where)
         mu, condim = _link_friction(link, rigid_to_root)
         # ODE contact tags map onto a skid-steer robot's wheels; two-wheel robots keep the contact their
         # straight-line and turning tests were measured with (TurtleBot3's kp/kd would slow it by 10 %)
@@ -287,7 +287,7 @@ def add_robot(
         shown = (link.visuals or link.collisions) if info.visuals else []
         for i, shape in enumerate(shown):
             try:
-                g = geoms.add(body, shape, f"{where} visual {i}", **_VISUAL_PROPS)
+                g = geoms.add(body, shape, f"{where} visual {i}", **VISUAL_PROPS)
             except SimError as exc:
                 info.warnings.append(f"{exc}; visual skipped")
                 continue
@@ -295,7 +295,7 @@ def add_robot(
         for joint in children.get(link.name, []):
             child = robot.links[joint.child]
             cbody = body.add_body(name=child.name)
-            _set_pose(cbody, joint.origin)
+            set_pose(cbody, joint.origin)
             _add_joint(cbody, joint, f"robot {robot.name!r} joint {joint.name!r}", info)
             fixed = joint.type == "fixed"
             jaxis = None if fixed else np.asarray(joint.axis, dtype=float) / np.linalg.norm(joint.axis)
@@ -303,7 +303,7 @@ def add_robot(
 
     x, y, z, yaw = pose
     root = spec.worldbody.add_body(name=robot.root_link)
-    _set_pose(root, Origin(xyz=(x, y, z), rpy=(0.0, 0.0, yaw)))
+    set_pose(root, Origin(xyz=(x, y, z), rpy=(0.0, 0.0, yaw)))
     root.add_freejoint(name=f"{robot.name}::root")
     fill(root, robot.links[robot.root_link], None, rigid_to_root=True)
 
@@ -360,7 +360,7 @@ def _add_site(spec: mujoco.MjSpec, info: BuildInfo, link: str, origin: Origin, n
         raise SimError(f"robot {robot.name!r}: sensor {name!r} is attached to unknown link {link!r}")
     body = spec.body(info.link_bodies[link])
     site = body.add_site(name=name)
-    _set_pose(site, origin)
+    set_pose(site, origin)
     return name
 
 

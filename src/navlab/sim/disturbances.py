@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import copy
 import dataclasses
-import difflib
 import math
 from dataclasses import dataclass, field
 from typing import Any
@@ -25,6 +24,7 @@ import numpy as np
 
 from navlab.core import Executor, Node
 from navlab.description import Geometry, RobotModel
+from navlab.errors import did_you_mean
 from navlab.sim.errors import SimError
 from navlab.sim.simulation import Simulation
 
@@ -82,8 +82,7 @@ def parse_disturbances(params: dict[str, Any], *, where: str = "disturbances") -
     """A validated :class:`Disturbances` from parameters (unknown keys: "did you mean")."""
     for key in params:
         if key not in KEYS:
-            close = difflib.get_close_matches(str(key), KEYS, n=1)
-            hint = f"; did you mean '{close[0]}'?" if close else ""
+            hint = did_you_mean(key, KEYS)
             raise SimError(f"{where}: unknown key '{key}'{hint} (keys: {', '.join(KEYS)})")
     out = Disturbances()
     if "wheel_radius_error" in params:
@@ -110,8 +109,7 @@ def parse_disturbances(params: dict[str, Any], *, where: str = "disturbances") -
             raise SimError(f"{w}: expected a mapping, got {raw!r}")
         for key in raw:
             if key not in PATCH_KEYS:
-                close = difflib.get_close_matches(str(key), PATCH_KEYS, n=1)
-                hint = f"; did you mean '{close[0]}'?" if close else ""
+                hint = did_you_mean(key, PATCH_KEYS)
                 raise SimError(f"{w}: unknown key '{key}'{hint} (keys: {', '.join(PATCH_KEYS)})")
         for key in ("x", "y", "mu"):
             if key not in raw:

@@ -13,6 +13,7 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
+from navlab.errors import did_you_mean
 from navlab.sim.errors import SimError
 
 
@@ -41,10 +42,7 @@ class PidGains:
         known = ("p", "i", "d", "i_clamp", "i_clamp_min", "i_clamp_max", "antiwindup")
         for key in params:
             if key not in known:
-                import difflib
-
-                close = difflib.get_close_matches(str(key), known, n=1)
-                hint = f"; did you mean '{close[0]}'?" if close else ""
+                hint = did_you_mean(key, known)
                 raise SimError(f"{where}: unknown pid parameter '{key}'{hint} (known: {', '.join(known)})")
         values: dict[str, Any] = {}
         for key in ("p", "i", "d"):

@@ -13,7 +13,6 @@ import numpy as np
 
 from navlab.description import Origin, RobotModel, Shape
 from navlab.sim.builder import (
-    _VISUAL_PROPS,
     DEFAULT_MU,
     DEFAULT_STEP,
     GROUP_RAY_MESH,
@@ -21,12 +20,13 @@ from navlab.sim.builder import (
     GROUP_WORLD_HULL,
     MAX_STEP,
     MIN_STEP,
+    VISUAL_PROPS,
     BuildInfo,
-    _contact_props,
-    _Geoms,
-    _set_inertial,
-    _set_pose,
+    Geoms,
     add_robot,
+    contact_props,
+    set_inertial,
+    set_pose,
 )
 from navlab.sim.errors import SimError
 from navlab.world import ModelSpec, WorldModel
@@ -40,11 +40,11 @@ def add_world_model(spec: mujoco.MjSpec, model: ModelSpec, info: BuildInfo) -> l
     """
     if model.name in info.world_parts or model.name == info.robot_name:
         raise SimError(f"a model named {model.name!r} already exists in the world")
-    geoms = _Geoms(spec, info)
+    geoms = Geoms(spec, info)
     x, y, z, roll, pitch, yaw = model.pose
     model_pose = Origin(xyz=(x, y, z), rpy=(roll, pitch, yaw))
     kind = "static" if model.static else "dynamic"
-    props = _contact_props(kind, GROUP_WORLD)
+    props = contact_props(kind, GROUP_WORLD)
     bodies: list[str] = []
     geom_names: list[str] = []
     for link in model.links:
@@ -57,10 +57,10 @@ def add_world_model(spec: mujoco.MjSpec, model: ModelSpec, info: BuildInfo) -> l
             body = spec.worldbody
         else:
             body = spec.worldbody.add_body(name=scoped)
-            _set_pose(body, link_pose)
+            set_pose(body, link_pose)
             body.add_freejoint(name=f"{scoped}::free")
             if link.inertial is not None:
-                _set_inertial(body, link, True, info, where)
+                set_inertial(body, link, True, info, where)
             bodies.append(scoped)
 
         def place(shape: Shape, _offset: Origin | None = offset) -> Shape:
@@ -93,7 +93,7 @@ def add_world_model(spec: mujoco.MjSpec, model: ModelSpec, info: BuildInfo) -> l
             continue
         for i, shape in enumerate(link.visuals or link.collisions):
             try:
-                g = geoms.add(body, place(shape), f"{where} visual {i}", **_VISUAL_PROPS, name=f"{scoped}::visual{i}")
+                g = geoms.add(body, place(shape), f"{where} visual {i}", **VISUAL_PROPS, name=f"{scoped}::visual{i}")
             except SimError as exc:
                 info.warnings.append(f"{exc}; visual skipped")
                 continue
@@ -122,7 +122,7 @@ def _add_convex_parts(spec: mujoco.MjSpec, body: mujoco.MjsBody, shape: Shape, w
         part = f"{name}::part{k}"
         spec.add_mesh(name=part, uservert=verts.ravel().tolist(), userface=faces.ravel().tolist())
         geom = body.add_geom(type=mujoco.mjtGeom.mjGEOM_MESH, meshname=part)
-        _set_pose(geom, shape.origin)
+        set_pose(geom, shape.origin)
         for key, value in {**props, **extra, "name": part}.items():
             setattr(geom, key, value)
         names.append(part)
@@ -155,10 +155,10 @@ def _add_scenery(spec: mujoco.MjSpec, world: WorldModel) -> None:
                              dir=np.array([0.3, 0.2, -1.0]), diffuse=np.array([0.6, 0.6, 0.6]))
     if world.ground_plane:
         spec.worldbody.add_geom(name="ground_plane", type=mujoco.mjtGeom.mjGEOM_PLANE,
-                                size=np.array([0.0, 0.0, 1.0]), **_contact_props("ground", GROUP_WORLD),
+                                size=np.array([0.0, 0.0, 1.0]), **contact_props("ground", GROUP_WORLD),
                                 rgba=np.array([0.5, 0.5, 0.5, 1.0]))  # mj_ray skips transparent geoms
         spec.worldbody.add_geom(name="ground_plane_visual", type=mujoco.mjtGeom.mjGEOM_PLANE,
-                                size=np.array([50.0, 50.0, 1.0]), material="grid", **_VISUAL_PROPS)
+                                size=np.array([50.0, 50.0, 1.0]), material="grid", **VISUAL_PROPS)
 
 
 def build_spec(

@@ -17,6 +17,7 @@ import numpy as np
 
 from navlab.core.limits import ceilings
 from navlab.description.model import Geometry, Inertial, Link, RobotModel, Shape, is_geometry_kind
+from navlab.errors import did_you_mean
 from navlab.sim.errors import SimError
 from navlab.world import ModelSpec, WorldModel
 
@@ -91,10 +92,7 @@ def parse_spawn_spec(text: str, *, default_name: str = "") -> tuple[ModelSpec, f
         if not sep:
             raise SimError(f"spawn spec {text!r}: {item!r} is not key=value")
         if key not in _KEYS:
-            import difflib
-
-            close = difflib.get_close_matches(key, sorted(_KEYS), n=1)
-            hint = f" (did you mean {close[0]!r}?)" if close else ""
+            hint = did_you_mean(key, sorted(_KEYS), template=" (did you mean {!r}?)")
             raise SimError(f"spawn spec {text!r}: unknown key {key!r}{hint}")
         opts[key] = value
 

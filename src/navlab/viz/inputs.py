@@ -14,7 +14,7 @@ import math
 import re
 from typing import Any
 
-from navlab.mapping.teleop import MOVE_BINDINGS, SPEED_BINDINGS
+from navlab.drivers import MOVE_BINDINGS, SPEED_BINDINGS
 
 OPS = ("goal", "initialpose", "cancel", "key", "spawn", "move", "delete", "pause", "resume", "speed", "seek",
        "play")  # fmt: skip

@@ -26,7 +26,7 @@ import numpy as np
 from navlab import msgs
 from navlab.core import Executor, Node, TfError
 from navlab.core.graph import Graph, with_layout
-from navlab.mapping.teleop import MOVE_BINDINGS, SPEED_BINDINGS, TeleopState
+from navlab.drivers import MOVE_BINDINGS, SPEED_BINDINGS, TeleopState
 from navlab.viz.hub import Hub
 from navlab.viz.inputs import check_input
 from navlab.viz.sensor_frames import cloud_in_fixed

@@ -10,58 +10,20 @@ m/s, rad/s.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any, TypeVar
+from typing import Any
 
 import numpy as np
 
-from navlab.core.params import dataclass_from_dict
+from navlab.core.params import param_error
 from navlab.geometry import wrap_angle
 from navlab.grid import Grid
 from navlab.navigation.errors import NavigationError
 
-T = TypeVar("T")
-
-
-def params_from(cls: type[T], values: Mapping[str, Any] | T | None, *, what: str,
-                aliases: Mapping[str, str] | None = None, ignored: frozenset[str] = frozenset()) -> T:
-    """An instance of the parameter dataclass ``cls`` from a ROS parameter dict (or ``cls`` as is).
-
-    ``aliases`` maps another accepted spelling (an older ROS name) to the field name; giving both
-    spellings with different values is an error. Keys in ``ignored`` are accepted and dropped.
-    Unknown keys raise ``NavigationError`` with "did you mean".
-    """
-    if isinstance(values, cls):
-        return values
-    if values is not None and not isinstance(values, Mapping):
-        raise NavigationError(f"{what} parameters: expected a dict of ROS parameters, got {type(values).__name__}")
-    canon: dict[str, Any] = {}
-    spelled: dict[str, str] = {}
-    for key, val in (values or {}).items():
-        if key in ignored:
-            continue
-        name = (aliases or {}).get(key, key)
-        if name in canon and canon[name] != val:
-            raise NavigationError(f"{what} parameters {spelled[name]!r} and {key!r} are two spellings of one "
-                                  f"parameter with different values ({canon[name]!r} vs {val!r}): give one")
-        canon[name], spelled[name] = val, key
-    try:
-        return dataclass_from_dict(cls, canon, what=what, error=NavigationError)
-    except (TypeError, ValueError) as exc:
-        raise NavigationError(f"{what} parameters: a value has the wrong type ({exc})") from None
-
 
 def bad(what: str, key: str, value: Any, expected: str) -> NavigationError:
     """The one-line error for a parameter ``key`` = ``value`` that is not ``expected``."""
-    return NavigationError(f"{what} parameter {key}={value!r}: expected {expected}")
-
-
-def check_finite(what: str, obj: Any) -> None:
-    """Refuse a NaN or infinite float field of the dataclass ``obj``."""
-    for key, val in vars(obj).items():
-        if isinstance(val, float) and not math.isfinite(val):
-            raise bad(what, key, val, "a finite number")
+    return param_error(what, key, value, expected, NavigationError)  # type: ignore[return-value]
 
 
 def as_plan(path: Any) -> np.ndarray:

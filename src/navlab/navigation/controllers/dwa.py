@@ -1,4 +1,4 @@
-"""dwa_local_planner/DWAPlannerROS: the dynamic window approach of ROS 1 (see ``trajectory`` for the
+"""dwa_local_planner/DWAPlannerROS: the dynamic window approach of ROS 1 (see ``rollout_controller`` for the
 shared rollout, distance maps and goal handling, and the cost it minimises)."""
 
 from __future__ import annotations
@@ -9,10 +9,11 @@ from typing import Any
 
 import numpy as np
 
+from navlab.core import read_params
 from navlab.navigation.controllers import mapgrid
 from navlab.navigation.controllers.params import DWAPlannerParams
 from navlab.navigation.controllers.rollout import lookup, occupancy_costs, rollout, velocity_samples
-from navlab.navigation.controllers.trajectory import LocalScene, RolloutController
+from navlab.navigation.controllers.rollout_controller import LocalScene, RolloutController
 
 _EPS = 1e-4
 
@@ -39,7 +40,7 @@ class DWAPlannerROS(RolloutController):
 
     @staticmethod
     def _parse(params: Any) -> DWAPlannerParams:
-        return DWAPlannerParams.from_dict(params)
+        return read_params(DWAPlannerParams, params)
 
     def _in_place_limits(self, err: float) -> tuple[float, float]:
         return self.params.max_vel_theta, self.params.min_vel_theta

@@ -25,17 +25,18 @@ are read here too. Units: m, rad, s.
 
 from __future__ import annotations
 
-import difflib
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field, fields
-from typing import Any
+from typing import Any, ClassVar
 
 import numba
 import numpy as np
 from scipy.signal import savgol_coeffs
 
+from navlab.core import ParamSpec, read_params
 from navlab.core.limits import check_ceiling
+from navlab.errors import did_you_mean
 from navlab.grid import COST_INSCRIBED, Grid
 from navlab.navigation.controllers import mppi_critics as critics
 from navlab.navigation.controllers.common import (
@@ -43,14 +44,13 @@ from navlab.navigation.controllers.common import (
     LocalFrame,
     as_plan,
     bad,
-    check_finite,
     densify,
     footprint_outline,
     goal_of,
-    params_from,
     same_goal,
 )
 from navlab.navigation.errors import NavigationError
+from navlab.plugins import ControlResult, PluginContext
 
 WHAT = "MPPIController"
 PATH_SPACING = 0.05  # m: plans are resampled to this (Nav2's path-index offsets assume costmap cells)
@@ -93,31 +93,7 @@ class MppiParams:
         "PathAngleCritic", "PreferForwardCritic"])
     critic_params: dict[str, Any] = field(default_factory=dict)
 
-    @classmethod
-    def from_dict(cls, values: Mapping[str, Any] | MppiParams | None) -> MppiParams:
-        """From a Nav2 controller namespace dict (critic sections nested or dotted), validated."""
-        if isinstance(values, MppiParams):
-            values.validate()
-            return values
-        flat: dict[str, Any] = {}
-        sections: dict[str, dict[str, Any]] = {}
-        names = [f.name for f in fields(cls) if f.name != "critic_params"]
-        for key, val in (values or {}).items():
-            head, dot, tail = str(key).partition(".")
-            if head in critics.CRITICS:
-                sections.setdefault(head, {}).update({tail: val} if dot else dict(val or {}))
-            elif dot or (isinstance(val, Mapping) and head not in _IGNORED):
-                close = difflib.get_close_matches(head, [*names, *critics.CRITICS], n=1)
-                hint = f"; did you mean '{close[0]}'?" if close else ""
-                raise NavigationError(f"unknown {WHAT} parameter '{key}'{hint}")
-            else:
-                flat[key] = val
-        out = params_from(cls, flat, what=WHAT, ignored=_IGNORED)
-        out.critics = [str(c).rsplit("::", 1)[-1] for c in out.critics]
-        out.critic_params = {name: params_from(critics.CRITICS[name], sec, what=f"{WHAT} {name}")
-                             for name, sec in sections.items()}
-        out.validate()
-        return out
+    PARAMS: ClassVar[ParamSpec]
 
     def critic(self, name: str) -> Any:
         """The parameters of critic ``name`` (its defaults if the file set none)."""
@@ -125,7 +101,6 @@ class MppiParams:
 
     def validate(self) -> None:
         """Raise ``NavigationError`` naming the first bad parameter."""
-        check_finite(WHAT, self)
         for key in ("batch_size", "iteration_count", "retry_attempt_limit"):
             if getattr(self, key) < 1:
                 raise bad(WHAT, key, getattr(self, key), ">= 1")
@@ -153,9 +128,31 @@ class MppiParams:
             raise bad(WHAT, "motion_model", self.motion_model, "'DiffDrive' (navlab's controllers drive (v, w))")
         for name in self.critics:
             if name not in critics.CRITICS:
-                close = difflib.get_close_matches(name, list(critics.CRITICS), n=1)
-                hint = f"did you mean '{close[0]}'? " if close else ""
+                hint = did_you_mean(name, critics.CRITICS, template="did you mean {!r}? ")
                 raise bad(WHAT, "critics", name, f"a known critic ({hint}known: {', '.join(critics.CRITICS)})")
+
+
+def _critic_sections(values: dict[str, Any]) -> dict[str, Any]:
+    """Nav2's critic sections (``CostCritic: {...}`` or dotted ``CostCritic.cost_weight``) read by their own
+    specs into ``critic_params``; critic names without their ``mppi::critics::`` prefix."""
+    flat: dict[str, Any] = {}
+    sections: dict[str, dict[str, Any]] = {}
+    names = [f.name for f in fields(MppiParams) if f.name != "critic_params"]
+    for key, val in values.items():
+        head, dot, tail = str(key).partition(".")
+        if head in critics.CRITICS:
+            sections.setdefault(head, {}).update({tail: val} if dot else dict(val or {}))
+        elif dot or (isinstance(val, Mapping) and head not in _IGNORED):
+            raise NavigationError(f"unknown {WHAT} parameter '{key}'{did_you_mean(head, [*names, *critics.CRITICS])}")
+        else:
+            flat[key] = val
+    if isinstance(flat.get("critics"), list | tuple):
+        flat["critics"] = [str(c).rsplit("::", 1)[-1] for c in flat["critics"]]
+    flat["critic_params"] = {name: read_params(critics.CRITICS[name], sec) for name, sec in sections.items()}
+    return flat
+
+
+MppiParams.PARAMS = ParamSpec(WHAT, NavigationError, ignored=_IGNORED, prepare=_critic_sections)
 
 
 @numba.njit(cache=True)
@@ -231,7 +228,7 @@ class MPPIController:
                  footprint: Any = None) -> None:
         if not isinstance(rng, np.random.Generator):
             raise NavigationError(f"{WHAT} needs rng=numpy.random.Generator (seeded), got {type(rng).__name__}")
-        self.params = MppiParams.from_dict(params)
+        self.params = read_params(MppiParams, params)
         self.rng = rng
         self.footprint = None if footprint is None else np.asarray(footprint, dtype=np.float64)
         footprint_outline(self.footprint, PATH_SPACING)  # validate now
@@ -289,9 +286,22 @@ class MPPIController:
         n = int(np.searchsorted(np.cumsum(seg), self.params.prune_distance)) + 2
         return rest[:n]
 
+    @classmethod
+    def from_params(cls, params: Mapping[str, Any] | None, *, context: PluginContext) -> MPPIController:
+        """From the controller's parameter namespace, the host's seeded ``rng`` (required) and the local costmap's
+        footprint polygon (None for a round robot)."""
+        fp = context.footprint
+        return cls(params, rng=context.rng, footprint=None if fp is None else fp.polygon)
+
     def compute_velocity(self, pose: tuple[float, float, float], velocity: tuple[float, float],
-                         costmap: Grid | None) -> tuple[float, float]:
-        """(v m/s, w rad/s) for the robot at ``pose`` (costmap frame) moving at ``velocity`` (v, w)."""
+                         costmap: Grid | None) -> ControlResult:
+        """The command (v m/s, w rad/s) for the robot at ``pose`` (costmap frame) moving at ``velocity`` (v, w),
+        with ``valid`` and the optimal trajectory as ``local_plan``."""
+        v, w = self._command(pose, velocity, costmap)
+        return ControlResult(v, w, self.valid, self.local_plan)
+
+    def _command(self, pose: tuple[float, float, float], velocity: tuple[float, float],
+                 costmap: Grid | None) -> tuple[float, float]:
         if self._plan is None:
             raise NavigationError(f"{WHAT}: compute_velocity called before set_plan")
         if costmap is None:

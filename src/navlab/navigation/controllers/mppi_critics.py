@@ -30,8 +30,10 @@ from typing import Any
 
 import numpy as np
 
+from navlab.core import ParamSpec
 from navlab.grid import COST_INSCRIBED, COST_LETHAL
 from navlab.navigation.controllers.rollout import footprint_costs
+from navlab.navigation.errors import NavigationError
 
 
 @dataclass
@@ -121,6 +123,8 @@ class TwirlingCritic:
 CRITICS: dict[str, type] = {c.__name__: c for c in (
     ConstraintCritic, CostCritic, GoalCritic, GoalAngleCritic, PathAlignCritic, PathFollowCritic,
     PathAngleCritic, PreferForwardCritic, TwirlingCritic)}
+for _name, _cls in CRITICS.items():  # each critic's section is read as "MPPIController <critic>"
+    _cls.PARAMS = ParamSpec(f"MPPIController {_name}", NavigationError)  # type: ignore[attr-defined]
 
 
 @dataclass

@@ -16,14 +16,13 @@ footprint is not scaled with speed).
 
 from __future__ import annotations
 
-import logging
 import math
-from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, ClassVar
 
+from navlab.core import ParamSpec
 from navlab.core.limits import check_ceiling
-from navlab.navigation.controllers.common import bad, check_finite, params_from
+from navlab.navigation.controllers.common import bad
 from navlab.navigation.errors import NavigationError
 
 TP = "TrajectoryPlannerROS"
@@ -80,31 +79,10 @@ class TrajectoryPlannerParams(_Periodic):
     yaw_goal_tolerance: float = 0.05
     latch_xy_goal_tolerance: bool = False
     prune_plan: bool = True
-
-    @classmethod
-    def from_dict(cls, values: Mapping[str, Any] | TrajectoryPlannerParams | None) -> TrajectoryPlannerParams:
-        """From a TrajectoryPlannerROS parameter dict (unknown keys: "did you mean"), validated."""
-        if isinstance(values, Mapping) and "max_rotational_vel" in values:  # the oldest spelling
-            values = dict(values)
-            vmax = values.pop("max_rotational_vel")
-            values.setdefault("max_vel_theta", vmax)
-            values.setdefault("min_vel_theta", -float(vmax))
-        out = params_from(cls, values, what=TP, ignored=_VIEW_ONLY, aliases={
-            "backup_vel": "escape_vel", "acc_lim_th": "acc_lim_theta", "path_distance_bias": "pdist_scale",
-            "goal_distance_bias": "gdist_scale", "vth_samples": "vtheta_samples"})
-        _clamp_samples(TP, out, "vx_samples", "vtheta_samples")
-        out.validate()
-        return out
+    PARAMS: ClassVar[ParamSpec]
 
     def validate(self) -> None:
         """Raise ``NavigationError`` naming the first bad parameter."""
-        check_finite(TP, self)
-        _positive(TP, self, "acc_lim_x", "acc_lim_theta", "sim_time", "sim_granularity", "controller_frequency",
-                  "max_vel_x", "max_vel_theta")
-        _at_least(TP, self, 0.0, "acc_lim_y", "min_in_place_vel_theta", "pdist_scale", "gdist_scale", "occdist_scale",
-                  "heading_lookahead", "oscillation_reset_dist", "xy_goal_tolerance", "yaw_goal_tolerance",
-                  "escape_reset_dist", "escape_reset_theta", "min_vel_x")
-        _at_least(TP, self, 1, "vx_samples", "vtheta_samples")
         ang = self.angular_sim_granularity if self.angular_sim_granularity > 0 else self.sim_granularity
         steps = max(max(abs(self.max_vel_x), abs(self.escape_vel)) * self.sim_time / self.sim_granularity,
                     max(abs(self.max_vel_theta), abs(self.min_vel_theta)) / ang) + 1
@@ -158,29 +136,10 @@ class DWAPlannerParams(_Periodic):
     prune_plan: bool = True
     use_dwa: bool = True
     cheat_factor: float = 1.0
-
-    @classmethod
-    def from_dict(cls, values: Mapping[str, Any] | DWAPlannerParams | None) -> DWAPlannerParams:
-        """From a DWAPlannerROS parameter dict (unknown keys: "did you mean"), validated."""
-        out = params_from(cls, values, what=DWA, ignored=_VIEW_ONLY, aliases={
-            "max_trans_vel": "max_vel_trans", "min_trans_vel": "min_vel_trans", "max_rot_vel": "max_vel_theta",
-            "min_rot_vel": "min_vel_theta", "acc_lim_th": "acc_lim_theta", "rot_stopped_vel": "theta_stopped_vel",
-            "pdist_scale": "path_distance_bias", "gdist_scale": "goal_distance_bias",
-            "vtheta_samples": "vth_samples", "dwa": "use_dwa"})
-        _clamp_samples(DWA, out, "vx_samples", "vy_samples", "vth_samples")
-        out.validate()
-        return out
+    PARAMS: ClassVar[ParamSpec]
 
     def validate(self) -> None:
         """Raise ``NavigationError`` naming the first bad parameter."""
-        check_finite(DWA, self)
-        _positive(DWA, self, "acc_lim_x", "acc_lim_theta", "sim_time", "sim_granularity", "angular_sim_granularity",
-                  "controller_frequency", "max_vel_trans", "max_vel_x")
-        _at_least(DWA, self, 0.0, "min_vel_trans", "min_vel_theta", "max_vel_theta", "path_distance_bias",
-                  "goal_distance_bias", "occdist_scale", "twirling_scale", "forward_point_distance",
-                  "oscillation_reset_dist", "xy_goal_tolerance", "yaw_goal_tolerance", "trans_stopped_vel",
-                  "theta_stopped_vel", "stop_time_buffer")
-        _at_least(DWA, self, 1, "vx_samples", "vy_samples", "vth_samples")
         steps = self.sim_time * max(max(abs(self.max_vel_x), abs(self.min_vel_x), self.max_vel_trans)
                                     / self.sim_granularity, self.max_vel_theta / self.angular_sim_granularity) + 1
         _sized(DWA, self, steps, "vx_samples", "vth_samples")
@@ -197,29 +156,42 @@ def _sized(what: str, obj: Any, steps: float, *sample_keys: str) -> None:
                   samples * steps, "rollout_poses")
 
 
-def _clamp_samples(what: str, obj: Any, *keys: str) -> None:
-    """A sample count <= 0 becomes 1 with a warning, as both ROS 1 planners do (``vy_samples: 0`` is in
-    TurtleBot3's DWA files: a differential robot samples no y speed)."""
-    for key in keys:
-        if getattr(obj, key) <= 0:
-            logging.getLogger("navlab.navigation").warning(
-                f"{what}: {key} is {getattr(obj, key)}; at least one value is sampled, so {key} is set to 1 "
-                "(as ROS does)")
-            setattr(obj, key, 1)
-
-
-def _positive(what: str, obj: Any, *keys: str) -> None:
-    for key in keys:
-        if not getattr(obj, key) > 0:
-            raise bad(what, key, getattr(obj, key), "> 0")
-
-
-def _at_least(what: str, obj: Any, low: float, *keys: str) -> None:
-    for key in keys:
-        if not getattr(obj, key) >= low:
-            raise bad(what, key, getattr(obj, key), f">= {low}")
-
-
 def _ordered(what: str, obj: Any, low: str, high: str) -> None:
     if getattr(obj, low) > getattr(obj, high):
         raise bad(what, low, getattr(obj, low), f"<= {high} ({getattr(obj, high)})")
+
+
+def _oldest_spelling(values: dict[str, Any]) -> dict[str, Any]:
+    """TrajectoryPlannerROS's oldest ``max_rotational_vel`` sets both ends of the rotation range."""
+    if "max_rotational_vel" in values:
+        values = dict(values)
+        vmax = values.pop("max_rotational_vel")
+        values.setdefault("max_vel_theta", vmax)
+        values.setdefault("min_vel_theta", -vmax if isinstance(vmax, int | float) and not isinstance(vmax, bool)
+                          else vmax)
+    return values
+
+
+# a sample count <= 0 becomes 1 with a warning, as both ROS 1 planners do
+TrajectoryPlannerParams.PARAMS = ParamSpec(
+    TP, NavigationError, ignored=_VIEW_ONLY, prepare=_oldest_spelling,
+    clamp_at_least={"vx_samples": 1, "vtheta_samples": 1},
+    above=dict.fromkeys(("acc_lim_x", "acc_lim_theta", "sim_time", "sim_granularity", "controller_frequency",
+                         "max_vel_x", "max_vel_theta"), 0.0),
+    at_least=dict.fromkeys(("acc_lim_y", "min_in_place_vel_theta", "pdist_scale", "gdist_scale", "occdist_scale",
+                            "heading_lookahead", "oscillation_reset_dist", "xy_goal_tolerance", "yaw_goal_tolerance",
+                            "escape_reset_dist", "escape_reset_theta", "min_vel_x"), 0.0),
+    aliases={"backup_vel": "escape_vel", "acc_lim_th": "acc_lim_theta", "path_distance_bias": "pdist_scale",
+             "goal_distance_bias": "gdist_scale", "vth_samples": "vtheta_samples"})
+DWAPlannerParams.PARAMS = ParamSpec(
+    DWA, NavigationError, ignored=_VIEW_ONLY, clamp_at_least={"vx_samples": 1, "vy_samples": 1, "vth_samples": 1},
+    above=dict.fromkeys(("acc_lim_x", "acc_lim_theta", "sim_time", "sim_granularity", "angular_sim_granularity",
+                         "controller_frequency", "max_vel_trans", "max_vel_x"), 0.0),
+    at_least=dict.fromkeys(("min_vel_trans", "min_vel_theta", "max_vel_theta", "path_distance_bias",
+                            "goal_distance_bias", "occdist_scale", "twirling_scale", "forward_point_distance",
+                            "oscillation_reset_dist", "xy_goal_tolerance", "yaw_goal_tolerance", "trans_stopped_vel",
+                            "theta_stopped_vel", "stop_time_buffer"), 0.0),
+    aliases={"max_trans_vel": "max_vel_trans", "min_trans_vel": "min_vel_trans", "max_rot_vel": "max_vel_theta",
+             "min_rot_vel": "min_vel_theta", "acc_lim_th": "acc_lim_theta", "rot_stopped_vel": "theta_stopped_vel",
+             "pdist_scale": "path_distance_bias", "gdist_scale": "goal_distance_bias",
+             "vtheta_samples": "vth_samples", "dwa": "use_dwa"})

@@ -2,7 +2,7 @@
 
 ``rollout`` integrates (v, w) samples as base_local_planner does; ``footprint_costs``/``occupancy_costs``
 read a costmap under a robot's outline (costmap_2d's 16-gon for a round robot) at many poses; the
-``_rollout_scores`` kernel scores whole rollouts (path/goal distance, occupancy) in one pass. Poses are in
+``rollout_scores`` kernel scores whole rollouts (path/goal distance, occupancy) in one pass. Poses are in
 grid-local metres (the costmap's origin at 0, its axes), costs the costmap's uint8 values.
 """
 
@@ -184,7 +184,7 @@ def _footprint_pass(grid: np.ndarray, near: np.ndarray, inv: float, x: np.ndarra
 
 
 @numba.njit(cache=True)
-def _rollout_scores(grid: np.ndarray, near: np.ndarray, path_dist: np.ndarray, goal_dist: np.ndarray, inv: float,
+def rollout_scores(grid: np.ndarray, near: np.ndarray, path_dist: np.ndarray, goal_dist: np.ndarray, inv: float,
                     traj: np.ndarray, c: np.ndarray, s: np.ndarray, ox: np.ndarray, oy: np.ndarray, polygon: bool,
                     use_near: bool, weights: np.ndarray, impossible: float, at: np.ndarray,
                     out: np.ndarray) -> None:  # pragma: no cover - compiled

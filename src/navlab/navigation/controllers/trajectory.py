@@ -1,318 +1,20 @@
-"""base_local_planner's TrajectoryPlanner (with its ``dwa`` flag) and dwa_local_planner's DWAPlanner.
-
-Both sample velocity pairs (v, w) in a dynamic window around the current velocity, roll every sample
-out over ``sim_time`` (all at once, numpy), score the rollouts on the local costmap and command the
-best one's velocity:
-
-- *window*: ``v ± acc_lim_x * T``, ``w ± acc_lim_theta * T`` clipped to the velocity limits, with
-  ``T = sim_period`` (1 / controller_frequency) for DWA and ``T = sim_time`` for plain trajectory rollout;
-- *plan*: as ``transformGlobalPlan`` hands it on, the (pruned) plan from its first pose within half the
-  local costmap's larger side of the robot up to the first pose beyond that again; the *local goal* is
-  its last pose (it caps TrajectoryPlanner's speed at ``distance / sim_time``, DWA pushes it
-  ``forward_point_distance`` away from the robot for its front goal);
-- *distances*: base_local_planner's MapGrid, 4-connected cell steps from the plan's cells and from the
-  local goal's cell (the plan's last cell in the local costmap), blocked by LETHAL/INSCRIBED/unknown
-  cells (TrajectoryPlanner: except, on the path map, the cells under the robot now);
-- *footprint*: costmap_2d's robot footprint, a polygon (``robot_radius`` alone: ``makeFootprintFromRadius``'s
-  16-gon). A pose is blocked when the polygon's edges cross a LETHAL or unknown cell, its cost is the
-  highest cost under the edges or at the centre cell (``occdist`` takes the highest along the rollout).
-  Without a polygon or radius the robot is a point: its centre cell, blocked from INSCRIBED up;
-- *TrajectoryPlanner cost* = pdist_scale * path_dist + gdist_scale * goal_dist + occdist_scale *
-  max_cost, distances at the rollout's end (in cells, or metres with ``meter_scoring``); a rollout that
-  leaves the map, is blocked, or passes a cell with no path to the plan or goal is rejected (the first failure
-  in time decides the code, -1 or -2). With ``heading_scoring`` every rollout has sim_time / sim_granularity
-  steps, the distances count at the step at ``heading_scoring_timestep`` only, and 0.3 x the angle from the
-  heading there to the last plan point in clear sight (``headingDiff``) is added. In-place
-  turns (at least ``min_in_place_vel_theta``) win when their cost is no higher than the best forward
-  rollout's (an in-place turn ends where the robot is: it wins when no forward rollout gets closer),
-  the one whose look-ahead point (``heading_lookahead``) is closest to the goal; with nothing valid it
-  backs off at ``escape_vel``;
-- *DWA cost* = path_distance_bias * path_dist + goal_distance_bias * goal_dist + occdist_scale *
-  max_cost + the same biases at a point ``forward_point_distance`` ahead of the end pose (to the plan,
-  and to the local goal pushed that far beyond itself) + ``twirling_scale`` * |w|; biases scaled by the
-  resolution (ROS does); a rollout any of whose poses sits on a cell with no path to the plan or goal is
-  rejected. As in ROS, a critic whose scale is 0 is skipped, rejections included.
-
-Each sample is rolled out in ROS's number of steps (from its speed and turn rate over
-``sim_granularity`` / ``angular_sim_granularity``) and scored at its last step, one step short of
-``sim_time``.
-
-Near the goal both stop within the acceleration limits, then turn in place to the goal yaw
-(``xy_goal_tolerance``, ``yaw_goal_tolerance``, ``latch_xy_goal_tolerance``). Oscillation flags
-forbid turning back the other way (DWA: or reversing) until the robot moved ``oscillation_reset_dist``
-(TrajectoryPlanner's ``stuck_left``/``stuck_right`` on its in-place turns, DWA's
-``OscillationCostFunction``).
-
-The planners read move_base's ``controller_frequency`` (ROS searches the parameter upward) unless their
-own section sets it: ``sim_period`` is one controller cycle.
-
-Deliberate differences from ROS: holonomic (y-velocity) samples are not generated, since the
-controllers command a differential base; the 16-gon of a round robot is not padded vertex by vertex
-(``robot_radius`` is taken as given, padding included); footprint edges are sampled every half cell
-rather than Bresenham-rasterised.
+"""base_local_planner/TrajectoryPlannerROS: trajectory rollout (or DWA with its ``dwa`` flag) as ROS 1's
+base_local_planner does it (see ``rollout_controller`` for the shared cycle and the cost it minimises).
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
-from navlab.grid import Grid
-from navlab.navigation.controllers import mapgrid
-from navlab.navigation.controllers.common import (
-    GoalLatch,
-    InPlaceFlags,
-    LocalFrame,
-    OscillationFlags,
-    as_plan,
-    circle_footprint,
-    crop_plan,
-    footprint_outline,
-    goal_of,
-    prune_plan,
-    rotate_to_goal,
-    same_goal,
-    stop_with_acc_limits,
-    stopped,
-)
+from navlab.core import read_params
+from navlab.navigation.controllers.common import InPlaceFlags
 from navlab.navigation.controllers.params import TrajectoryPlannerParams
-from navlab.navigation.controllers.rollout import (
-    _rollout_scores,
-    footprint_cells,
-    heading_diffs,
-    lookup,
-    outline_reach_max,
-    rollout,
-)
-from navlab.navigation.errors import NavigationError
-
-# --- the shared cycle ------------------------------------------------------------------------------
-
-
-@dataclass
-class LocalScene:
-    """One cycle's inputs in grid-local coordinates: pose, cost array, the plan as ROS's planners get it
-    (``plan`` (N, 2), cropped around the robot), its cells and the distance maps."""
-
-    frame: LocalFrame
-    pose: tuple[float, float, float]
-    cost: np.ndarray
-    resolution: float
-    plan: np.ndarray
-    path_cells: np.ndarray
-    path_dist: np.ndarray
-    goal_dist: np.ndarray
-
-    @property
-    def impossible(self) -> float:
-        """MapGrid's obstacle value (cells in the grid): distances at or above it are hopeless."""
-        return float(self.cost.size)
-
-    def local_goal(self) -> np.ndarray:
-        """Grid-local point (2,): the cropped plan's last pose (``transformed_plan.back()``)."""
-        return self.plan[-1].copy()
-
-
-class RolloutController:
-    """What TrajectoryPlannerROS and DWAPlannerROS share: plan, goal handling, outputs.
-
-    After each :meth:`compute_velocity`: ``local_plan`` (N, 3) chosen rollout (costmap frame; empty when
-    stopping, turning at the goal or failing), ``samples`` (S, 2) the (v, w) tried, ``costs`` (S,) their
-    costs (< 0: rejected), ``valid`` False when no valid command was found (ROS's ``computeVelocityCommands``
-    returning false: move_base's cue for recovery).
-    """
-
-    what = ""
-    params: Any
-    _stopped_vel = (0.01, 0.01)
-    _accelerate = True
-
-    def __init__(self, params: Mapping[str, Any] | Any | None = None, *, footprint: Any = None,
-                 robot_radius: float | None = None, controller_frequency: float | None = None,
-                 rng: np.random.Generator | None = None) -> None:
-        if controller_frequency is not None and (params is None or isinstance(params, Mapping)):
-            params = {"controller_frequency": controller_frequency, **(params or {})}  # its own value wins
-        self.params = self._parse(params)
-        self.footprint = None if footprint is None else np.asarray(footprint, dtype=np.float64)
-        if footprint_outline(self.footprint, 0.05) is None:  # validate now; no polygon: the round robot's 16-gon
-            self.footprint = None if robot_radius is None else circle_footprint(float(robot_radius))
-        p = self.params
-        self._latch = GoalLatch(p.xy_goal_tolerance, p.yaw_goal_tolerance, p.latch_xy_goal_tolerance)
-        self._osc = OscillationFlags(p.oscillation_reset_dist, getattr(p, "oscillation_reset_angle", -1.0))
-        self._plan: np.ndarray | None = None
-        self._rotating_to_goal = False
-        self._outlines: dict[tuple[float, bytes | None], np.ndarray | None] = {}
-        self._near: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
-        self._clear_outputs()
-
-    @staticmethod
-    def _parse(params: Any) -> Any:
-        raise NotImplementedError
-
-    def _clear_outputs(self) -> None:
-        self.local_plan = np.zeros((0, 3))
-        self.samples = np.zeros((0, 2))
-        self.costs = np.zeros(0)
-        self._traj = np.zeros((0, 0, 3))
-        self._frame = LocalFrame(0.0, 0.0, 0.0)
-        self.valid = True
-
-    @property
-    def trajectories(self) -> np.ndarray:
-        """Every rollout (S, n, 3) of the last cycle, in the costmap frame."""
-        if self._traj.size == 0:
-            return self._traj.copy()
-        return self._frame.poses_out(self._traj.reshape(-1, 3)).reshape(self._traj.shape)
-
-    def set_plan(self, path: np.ndarray) -> None:
-        """The global plan (N, 2) or (N, 3) in the costmap's frame; an (N, 3) plan's last yaw is the goal yaw.
-
-        A plan to a new goal (beyond the goal tolerances from the last one) clears the goal latch and the
-        oscillation flags; the same plan sent again every cycle keeps them."""
-        plan = as_plan(path)
-        p = self.params
-        if self._plan is None or not same_goal(goal_of(self._plan), goal_of(plan), p.xy_goal_tolerance,
-                                               p.yaw_goal_tolerance):
-            self._latch.reset()
-            self._osc.reset()
-            self._rotating_to_goal = False
-            self._new_goal()
-        self._plan = plan
-
-    def _new_goal(self) -> None:
-        """Forget per-goal state (subclasses add theirs)."""
-
-    def is_goal_reached(self, pose: tuple[float, float, float], velocity: tuple[float, float]) -> bool:
-        """Within xy (possibly latched) and yaw tolerance of the plan's last pose."""
-        if self._plan is None:
-            return False
-        return self._latch.reached(tuple(map(float, pose)), goal_of(self._plan))  # type: ignore[arg-type]
-
-    def compute_velocity(self, pose: tuple[float, float, float], velocity: tuple[float, float],
-                         costmap: Grid | None) -> tuple[float, float]:
-        """(v m/s, w rad/s) for the robot at ``pose`` (costmap frame) moving at ``velocity`` (v, w)."""
-        if self._plan is None:
-            raise NavigationError(f"{self.what}: compute_velocity called before set_plan")
-        if costmap is None:
-            raise NavigationError(f"{self.what}: needs a local costmap (got None)")
-        pose = (float(pose[0]), float(pose[1]), float(pose[2]))
-        velocity = (float(velocity[0]), float(velocity[1]))
-        self._clear_outputs()
-        if self.params.prune_plan:
-            self._plan = prune_plan(self._plan, pose[0], pose[1])
-        goal = goal_of(self._plan)
-        scene = self._scene(pose, costmap)
-        if self._latch.xy_reached(pose, goal):
-            return self._stop_rotate(pose, velocity, goal, scene)
-        if scene is None:
-            self.valid = False
-            return 0.0, 0.0
-        return self._drive(scene, pose, velocity, goal)
-
-    # --- pieces -----------------------------------------------------------------------------------
-
-    def _scene(self, pose: tuple[float, float, float], costmap: Grid) -> LocalScene | None:
-        assert self._plan is not None
-        frame = LocalFrame.of(costmap)
-        self._frame = frame
-        cost = np.ascontiguousarray(costmap.data, dtype=np.uint8)
-        res = costmap.resolution
-        pose_l = frame.pose_in(pose)
-        reach = 0.5 * res * max(cost.shape)
-        plan = crop_plan(frame.points_in(self._plan[:, :2]), pose_l[0], pose_l[1], reach)
-        if len(plan) == 0:
-            return None  # ROS: an empty transformed plan (no pose of the plan near the robot)
-        cells = mapgrid.plan_cells(cost, plan, res)
-        if len(cells) == 0:
-            return None  # ROS: "None of the points of the global plan were in the local costmap"
-        free = self._free_cells(cost, pose_l, res)
-        return LocalScene(frame, pose_l, cost, res, plan, cells, mapgrid.distance_map(cost, cells, free),
-                          mapgrid.distance_map(cost, cells[-1:]))
-
-    def _free_cells(self, cost: np.ndarray, pose_l: tuple[float, float, float], res: float) -> np.ndarray | None:
-        """Cells never obstacles for the path map's wave (None: none)."""
-        return None
-
-    def _outline(self, res: float) -> np.ndarray | None:
-        """The footprint's edge points at ``res`` (cached: the same footprint and resolution every cycle)."""
-        key = (res, None if self.footprint is None else self.footprint.tobytes())
-        if key not in self._outlines:
-            self._outlines[key] = footprint_outline(self.footprint, res)
-        return self._outlines[key]
-
-    def _near_max(self, scene: LocalScene) -> np.ndarray | None:
-        """``outline_reach_max`` of the scene's costs (None for a point robot), kept while the costs stay the
-        same (the local costmap updates less often than the controller runs)."""
-        outline = self._outline(scene.resolution)
-        if outline is None:
-            return None
-        cached = self._near
-        if (cached is not None and cached[0] is outline and cached[1].shape == scene.cost.shape
-                and np.array_equal(cached[1], scene.cost)):
-            return cached[2]
-        near = outline_reach_max(scene.cost, scene.resolution, outline)
-        self._near = (outline, scene.cost.copy(), near)
-        return near
-
-    def _stop_rotate(self, pose: tuple[float, float, float], velocity: tuple[float, float],
-                     goal: tuple[float, float, float | None], scene: LocalScene | None) -> tuple[float, float]:
-        """At the goal position: stop within the acceleration limits, then turn in place to the goal yaw."""
-        p = self.params
-        err = self._latch.yaw_error(pose, goal)
-        if abs(err) <= p.yaw_goal_tolerance:
-            self._rotating_to_goal = False
-            return 0.0, 0.0
-        if not self._rotating_to_goal and not stopped(velocity, *self._stopped_vel):
-            cmd = stop_with_acc_limits(velocity, p.acc_lim_x, p.acc_lim_theta, p.sim_period)
-        else:
-            self._rotating_to_goal = True
-            max_w, min_w = self._in_place_limits(err)
-            cmd = (0.0, rotate_to_goal(err, velocity[1], max_w=max_w, min_in_place_w=min_w,
-                                       acc_theta=p.acc_lim_theta, sim_period=p.sim_period))
-        if scene is not None and not self._command_valid(scene, velocity, cmd):
-            self.valid = False
-            return 0.0, 0.0
-        return cmd
-
-    def _in_place_limits(self, err: float) -> tuple[float, float]:
-        raise NotImplementedError
-
-    def _command_valid(self, scene: LocalScene, velocity: tuple[float, float], cmd: tuple[float, float]) -> bool:
-        """Whether rolling ``cmd`` out for sim_time scores as a legal trajectory (ROS's ``checkTrajectory``)."""
-        p = self.params
-        targets = np.array([cmd])
-        traj = rollout(scene.pose, velocity, targets, self._steps(targets), p.sim_time,
-                       (p.acc_lim_x, p.acc_lim_theta), accelerate=self._accelerate)
-        return bool(self._check(scene, targets, traj)[0] >= 0)
-
-    def _check(self, scene: LocalScene, targets: np.ndarray, traj: np.ndarray) -> np.ndarray:
-        """Costs (S,) of rollouts checked outside the sampling loop (< 0: illegal)."""
-        raise NotImplementedError
-
-    def _steps(self, targets: np.ndarray) -> np.ndarray:
-        """Rollout steps (S,) of each sample, as the ROS planner counts them."""
-        raise NotImplementedError
-
-    def _finish(self, scene: LocalScene, targets: np.ndarray, traj: np.ndarray, costs: np.ndarray, best: int,
-                pose: tuple[float, float, float]) -> tuple[float, float]:
-        """Store the cycle's outputs; command sample ``best`` (or stop and flag failure if it is -1)."""
-        self.samples, self.costs, self._traj = targets, costs, traj
-        if best < 0:
-            self.valid = False
-            return 0.0, 0.0
-        path = traj[best]
-        moved = np.nonzero(np.any(path[1:] != path[:-1], axis=1))[0]
-        self.local_plan = scene.frame.poses_out(path[: (int(moved[-1]) + 2) if len(moved) else 1])
-        return float(targets[best, 0]), float(targets[best, 1])
-
-    def _drive(self, scene: LocalScene, pose: tuple[float, float, float], velocity: tuple[float, float],
-               goal: tuple[float, float, float | None]) -> tuple[float, float]:
-        raise NotImplementedError
-
+from navlab.navigation.controllers.rollout import footprint_cells, heading_diffs, lookup, rollout, rollout_scores
+from navlab.navigation.controllers.rollout_controller import LocalScene, RolloutController
 
 # --- base_local_planner/TrajectoryPlannerROS ----------------------------------------------------------
 
@@ -340,7 +42,7 @@ class TrajectoryPlannerROS(RolloutController):
 
     @staticmethod
     def _parse(params: Any) -> TrajectoryPlannerParams:
-        return TrajectoryPlannerParams.from_dict(params)
+        return read_params(TrajectoryPlannerParams, params)
 
     def _new_goal(self) -> None:
         self._escaping = False
@@ -400,7 +102,7 @@ class TrajectoryPlannerROS(RolloutController):
         weights = np.array([res if p.meter_scoring else 1.0, p.pdist_scale, p.gdist_scale, p.occdist_scale])
         cost = np.empty(traj.shape[0])
         at = self._heading_step(traj.shape[1])
-        _rollout_scores(grid, grid if near is None else near, np.ascontiguousarray(scene.path_dist),
+        rollout_scores(grid, grid if near is None else near, np.ascontiguousarray(scene.path_dist),
                         np.ascontiguousarray(scene.goal_dist), 1.0 / res, traj, c, s, ox, oy, outline is not None,
                         near is not None, weights, scene.impossible, np.full(len(traj), at, dtype=np.int64), cost)
         if at >= 0:  # ROS: + 0.3 * headingDiff at the scored step (not scaled by meter_scoring)

@@ -15,10 +15,10 @@ import numpy as np
 
 from navlab.grid import COST_FREE, COST_UNKNOWN, Grid, GridMap
 from navlab.navigation.costmap.footprint import Footprint, make_footprint
-from navlab.navigation.costmap.layers import Layer, ObstacleLayer, StaticLayer
+from navlab.navigation.costmap.layer import Layer
 from navlab.navigation.costmap.params import CostmapParams, costmap_params
 from navlab.navigation.errors import NavigationError
-from navlab.plugins import load_plugin
+from navlab.plugins import MapLayer, PluginContext, ScanLayer, make_plugin
 
 
 class LayeredCostmap:
@@ -40,12 +40,14 @@ class LayeredCostmap:
         self.master = Grid(np.full((h, w), default, np.uint8), p.resolution, (p.origin_x, p.origin_y, 0.0), frame)
         self.layers: list[Layer] = []
         for k, spec in enumerate(p.plugins):
-            cls = load_plugin("costmap_layer", spec.type, param=f"plugins[{k}] ({spec.name}) type")
-            if not hasattr(cls, "from_costmap_params"):
-                raise NavigationError(f"costmap layer {spec.name}: {spec.type} cannot be built from costmap parameters")
-            layer = cls.from_costmap_params(spec.name, p, self.footprint)
+            context = PluginContext(name=spec.name, footprint=self.footprint, costmap=p)
+            layer = make_plugin("costmap_layer", spec.type, p.namespaces.get(spec.name), context=context,
+                                param=f"plugins[{k}] ({spec.name}) type")
             layer.match_size(self.master)
             self.layers.append(layer)
+        # the layers that take a map, and those that take scans (capabilities, by what they implement)
+        self.map_layers: list[MapLayer] = [x for x in self.layers if isinstance(x, MapLayer)]
+        self.scan_layers: list[ScanLayer] = [x for x in self.layers if isinstance(x, ScanLayer)]
         self.robot_pose: tuple[float, float, float] | None = None
 
     def _cells(self, metres: float) -> int:
@@ -106,7 +108,7 @@ class LayeredCostmap:
     def set_map(self, grid: GridMap, *, map_in_costmap: tuple[float, float, float] = (0.0, 0.0, 0.0)) -> None:
         """A new ``/map`` for the static layers. Not rolling: the master takes the map's size, resolution and
         origin (as costmap_2d does). ``map_in_costmap``: pose of the map frame in the costmap frame."""
-        statics = [x for x in self.layers if isinstance(x, StaticLayer)]
+        statics = self.map_layers
         if not statics:
             raise NavigationError("costmap has no static layer to take a map (set static_map: true or add "
                                   "costmap_2d::StaticLayer to plugins)")
@@ -131,10 +133,10 @@ class LayeredCostmap:
     ) -> None:
         """Give one scan (sensor origin and endpoints (N, 2), m, costmap frame) to the obstacle layers
         (or to the one named ``layer``); see ``ObstacleLayer.add_scan``."""
-        targets = [self.layer(layer)] if layer else [x for x in self.layers if isinstance(x, ObstacleLayer)]
+        targets = [self.layer(layer)] if layer else self.scan_layers
         for target in targets:
-            if not isinstance(target, ObstacleLayer):
-                raise NavigationError(f"costmap layer {target.name!r} is not an obstacle layer")
+            if not isinstance(target, ScanLayer):
+                raise NavigationError(f"costmap layer {layer!r} is not an obstacle layer")
             if source is not None and source not in target.sources and layer is None:
                 continue
             target.add_scan(origin_xy, endpoints_xy, valid, source=source)

@@ -12,11 +12,11 @@ parameters unless its namespace sets it. Distances in metres, frequencies in Hz.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, fields
-from typing import TYPE_CHECKING, Any, TypeVar
+from dataclasses import dataclass, field, fields, replace
+from typing import TYPE_CHECKING, Any, ClassVar, TypeVar
 
 from navlab.core.limits import check_ceiling
-from navlab.core.params import check_unknown_key, dataclass_from_dict
+from navlab.core.params import ParamSpec, canonical_params, check_unknown_key, read_params
 from navlab.navigation.errors import NavigationError
 
 if TYPE_CHECKING:
@@ -68,6 +68,7 @@ class ObservationSource:
     inf_is_valid: bool = False
     expected_update_rate: float = 0.0
     observation_persistence: float = 0.0
+    PARAMS: ClassVar[ParamSpec]
 
 
 @dataclass
@@ -83,6 +84,7 @@ class StaticLayerParams:
     lethal_cost_threshold: int = 100
     unknown_cost_value: int = -1
     trinary_costmap: bool = True
+    PARAMS: ClassVar[ParamSpec]
 
 
 @dataclass
@@ -99,6 +101,7 @@ class ObstacleLayerParams:
     footprint_clearing_enabled: bool = True
     combination_method: int = 1
     observation_sources: str = ""
+    PARAMS: ClassVar[ParamSpec]
 
 
 @dataclass
@@ -109,6 +112,7 @@ class InflationLayerParams:
     inflation_radius: float = 0.55
     cost_scaling_factor: float = 10.0
     inflate_unknown: bool = False
+    PARAMS: ClassVar[ParamSpec]
 
 
 @dataclass
@@ -154,6 +158,7 @@ class CostmapParams:
     plugins: list[PluginSpec] = field(default_factory=list)
     sources: dict[str, ObservationSource] = field(default_factory=dict)
     namespaces: dict[str, dict[str, Any]] = field(default_factory=dict)
+    PARAMS: ClassVar[ParamSpec]
 
     def validate(self) -> None:
         """Raise ``NavigationError`` naming the first bad parameter, its value and what was expected."""
@@ -184,28 +189,6 @@ def _non_negative(what: str, name: str, value: float) -> None:
     _finite(what, name, value)
     if value < 0:
         raise NavigationError(f"{what} parameter {name}: expected >= 0, got {value}")
-
-
-def build(cls: type[T], values: dict[str, Any] | None, *, what: str) -> T:
-    """An instance of dataclass ``cls`` from ``values``: unknown keys say "did you mean"; a value of the wrong
-    type (a string for a number, 2.5 for an integer, "yes" for a boolean) names its key and what was expected."""
-    names = {f.name: f for f in fields(cls)}
-    defaults = cls()
-    for key, val in (values or {}).items():
-        if key not in names:
-            continue  # dataclass_from_dict reports it with "did you mean"
-        kind = type(getattr(defaults, key))
-        ok = (
-            (kind is bool and (isinstance(val, bool) or val in (0, 1)))
-            or (kind is int and not isinstance(val, bool) and isinstance(val, int | float) and float(val).is_integer())
-            or (kind is float and not isinstance(val, bool) and isinstance(val, int | float))
-            or (kind is str and isinstance(val, str))
-            or kind not in (bool, int, float, str)
-        )
-        if not ok:
-            expected = {bool: "true or false", int: "an integer", float: "a number", str: "a string"}[kind]
-            raise NavigationError(f"{what} parameter {key}: expected {expected}, got {val!r}")
-    return dataclass_from_dict(cls, values, what=what, error=NavigationError)
 
 
 def _split_dotted(values: dict[str, Any]) -> dict[str, Any]:
@@ -284,8 +267,7 @@ def costmap_params(values: dict[str, Any] | None = None) -> CostmapParams:
         flat["footprint"] = str([list(map(float, p)) for p in flat["footprint"]])
     if isinstance(flat.get("observation_sources"), list | tuple):
         flat["observation_sources"] = " ".join(map(str, flat["observation_sources"]))
-    params = build(CostmapParams, flat, what="costmap")
-    params.validate()
+    params = read_params(CostmapParams, flat)
     if "plugins" in values:
         params.plugins = _parse_plugins(values["plugins"], namespaces)
     else:
@@ -302,7 +284,8 @@ def costmap_params(values: dict[str, Any] | None = None) -> CostmapParams:
         if not isinstance(raw, dict):
             raise NavigationError(f"costmap parameter observation_sources names {src!r} but there is no "
                                   f"'{src}: {{topic: ..., data_type: LaserScan, ...}}'")
-        params.sources[src] = observation_source(raw, params, name=src, layer=_with_aliases(ns, src))
+        params.sources[src] = observation_source(raw, params, name=src,
+                                                 layer=canonical_params(ns, LAYER_SPEC, what=src))
     known = {p.name for p in params.plugins} | set(params.sources)
     for key, ns in namespaces.items():
         if key not in known:  # another plugin's section (ROS ignores it) or a misspelt layer: check_unknown_key
@@ -313,19 +296,25 @@ def costmap_params(values: dict[str, Any] | None = None) -> CostmapParams:
     return params
 
 
-def _with_aliases(values: dict[str, Any], what: str) -> dict[str, Any]:
-    out: dict[str, Any] = {}
-    for key, val in values.items():
-        if key in IGNORED or isinstance(val, dict):
-            continue
-        name = ALIASES.get(key, key)
-        if name == "observation_sources" and isinstance(val, list | tuple):
-            val = " ".join(map(str, val))
-        if name in out:
-            other = next(k for k in values if ALIASES.get(k, k) == name and k != key)
-            raise NavigationError(f"{what} parameters {other} and {key} both set (the same parameter); keep one")
-        out[name] = val
+def _layer_keys(values: dict[str, Any]) -> dict[str, Any]:
+    """A layer's or source's own keys: its nested sections (a source inside its layer) dropped, a YAML list of
+    ``observation_sources`` joined into ROS's space-separated string."""
+    out = {key: val for key, val in values.items() if not isinstance(val, dict)}
+    if isinstance(out.get("observation_sources"), list | tuple):
+        out["observation_sources"] = " ".join(map(str, out["observation_sources"]))
     return out
+
+
+_RANGES = dict.fromkeys(("obstacle_range", "raytrace_range", "obstacle_min_range", "raytrace_min_range"), 0.0)
+LAYER_SPEC = ParamSpec("layer", NavigationError, aliases=ALIASES, ignored=IGNORED, prepare=_layer_keys)
+StaticLayerParams.PARAMS = replace(LAYER_SPEC, what="static_layer", at_least={"lethal_cost_threshold": 1},
+                                   at_most={"lethal_cost_threshold": 100})
+ObstacleLayerParams.PARAMS = replace(LAYER_SPEC, what="obstacle_layer", at_least=_RANGES,
+                                     choices={"combination_method": (0, 1)})  # overwrite, maximum
+InflationLayerParams.PARAMS = replace(LAYER_SPEC, what="inflation_layer",
+                                      at_least={"inflation_radius": 0.0, "cost_scaling_factor": 0.0})
+ObservationSource.PARAMS = replace(LAYER_SPEC, what="observation source", at_least=_RANGES)
+CostmapParams.PARAMS = ParamSpec("costmap", NavigationError)
 
 
 def observation_source(values: dict[str, Any], costmap: CostmapParams, *, name: str,
@@ -334,10 +323,9 @@ def observation_source(values: dict[str, Any], costmap: CostmapParams, *, name: 
     ``raytrace_range`` and ``max_obstacle_height``."""
     inherited = {key: (layer or {}).get(key, getattr(costmap, key))
                  for key in ("obstacle_range", "raytrace_range", "max_obstacle_height")}
-    src = build(ObservationSource, {**inherited, **_with_aliases(values, f"observation source {name}")},
-                what=f"observation source {name}")
-    for key in ("obstacle_range", "raytrace_range", "obstacle_min_range", "raytrace_min_range"):
-        _non_negative(f"observation source {name}", key, getattr(src, key))
+    what = f"observation source {name}"
+    own = canonical_params(values, LAYER_SPEC, what=what)
+    src = read_params(ObservationSource, {**inherited, **own}, what=what)
     if src.min_obstacle_height > src.max_obstacle_height:
         raise NavigationError(f"observation source {name} parameters min_obstacle_height {src.min_obstacle_height} > "
                               f"max_obstacle_height {src.max_obstacle_height}: expected min <= max")
@@ -351,23 +339,5 @@ def layer_params(cls: type[T], costmap: CostmapParams, name: str) -> T:
     """A layer's parameters: the costmap-level value of each of its fields, overridden by its namespace ``name``."""
     own = {f.name for f in fields(cls)}
     inherited = {f.name: getattr(costmap, f.name) for f in fields(CostmapParams) if f.name in own}
-    ns = _with_aliases(costmap.namespaces.get(name, {}), name)
-    params = build(cls, {**inherited, **ns}, what=name)
-    _validate_layer(params, name)
-    return params
-
-
-def _validate_layer(params: Any, name: str) -> None:
-    """Range checks shared by the layer parameter classes."""
-    if isinstance(params, InflationLayerParams):
-        _non_negative(name, "inflation_radius", params.inflation_radius)
-        _non_negative(name, "cost_scaling_factor", params.cost_scaling_factor)
-    elif isinstance(params, ObstacleLayerParams):
-        for key in ("obstacle_range", "raytrace_range", "obstacle_min_range", "raytrace_min_range"):
-            _non_negative(name, key, getattr(params, key))
-        if params.combination_method not in (0, 1):
-            raise NavigationError(f"{name} parameter combination_method: expected 0 (overwrite) or 1 (maximum), "
-                                  f"got {params.combination_method}")
-    elif isinstance(params, StaticLayerParams) and not 0 < params.lethal_cost_threshold <= 100:
-        raise NavigationError(f"{name} parameter lethal_cost_threshold: expected 1..100, "
-                              f"got {params.lethal_cost_threshold}")
+    ns = canonical_params(costmap.namespaces.get(name, {}), getattr(cls, "PARAMS", LAYER_SPEC), what=name)
+    return read_params(cls, {**inherited, **ns}, what=name)

@@ -13,19 +13,18 @@ cells short of the reading are pushed towards free, those at the reading towards
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any, Self
+from typing import Any, ClassVar, Self
 
 import numpy as np
 
+from navlab.core.params import ParamSpec, read_params
 from navlab.grid import COST_FREE, COST_LETHAL, COST_UNKNOWN, Grid
-from navlab.navigation.costmap.footprint import Footprint, make_footprint
-from navlab.navigation.costmap.layers import Layer
-from navlab.navigation.costmap.params import CostmapParams, build
+from navlab.navigation.costmap.layer import Layer
 from navlab.navigation.errors import NavigationError
+from navlab.plugins import PluginContext
 
 
 @dataclass
@@ -42,17 +41,26 @@ class RangeSensorLayerParams:
     inflate_cone: float = 1.0
     input_sensor_type: str = "ALL"  # ALL | VARIABLE | FIXED
     ns: str = ""
+    PARAMS: ClassVar[ParamSpec]
 
-    def validate(self, name: str) -> None:
-        """One error line naming the first bad parameter."""
-        if not 0 <= self.clear_threshold < self.mark_threshold <= 1:
-            raise NavigationError(f"{name} parameters clear_threshold {self.clear_threshold} and mark_threshold "
-                                  f"{self.mark_threshold}: expected 0 <= clear < mark <= 1")
-        if not self.inflate_cone > 0:
-            raise NavigationError(f"{name} parameter inflate_cone: expected > 0, got {self.inflate_cone}")
-        if self.input_sensor_type.upper() not in ("ALL", "VARIABLE", "FIXED"):
-            raise NavigationError(f"{name} parameter input_sensor_type: expected ALL, VARIABLE or FIXED, "
-                                  f"got {self.input_sensor_type!r}")
+    def validate(self) -> None:
+        """What spans two parameters (one error line)."""
+        if not self.clear_threshold < self.mark_threshold:
+            raise NavigationError(f"range_sensor_layer parameters clear_threshold {self.clear_threshold} and "
+                                  f"mark_threshold {self.mark_threshold}: expected clear < mark")
+
+
+def _topics_joined(values: dict[str, Any]) -> dict[str, Any]:
+    """A YAML list of ``topics`` as ROS's space-separated string."""
+    if isinstance(values.get("topics"), list | tuple):
+        values = {**values, "topics": " ".join(map(str, values["topics"]))}
+    return values
+
+
+RangeSensorLayerParams.PARAMS = ParamSpec(
+    "range_sensor_layer", NavigationError, prepare=_topics_joined, ignored=frozenset({"enabled_topics"}),
+    at_least={"clear_threshold": 0.0, "no_readings_timeout": 0.0}, at_most={"mark_threshold": 1.0},
+    above={"inflate_cone": 0.0}, choices={"input_sensor_type": ("ALL", "VARIABLE", "FIXED")})
 
 
 def sensor_model(r: float, d: np.ndarray, theta: np.ndarray, half_angle: float, phi_v: float,
@@ -78,33 +86,15 @@ class RangeSensorLayer(Layer):
 
     def __init__(self, params: RangeSensorLayerParams | dict[str, Any] | None = None, *,
                  name: str = "range_sensor_layer") -> None:
-        if isinstance(params, RangeSensorLayerParams):
-            self.params = params
-        else:
-            values = dict(params or {})
-            if isinstance(values.get("topics"), list | tuple):
-                values["topics"] = " ".join(map(str, values["topics"]))
-            self.params = build(RangeSensorLayerParams, values, what=name)
-        self.params.validate(name)
+        self.params: RangeSensorLayerParams = read_params(RangeSensorLayerParams, params, what=name)
         self.name = name
         self.enabled = self.params.enabled
         self.prob: Grid | None = None
 
     @classmethod
-    def from_params(cls, params: Mapping[str, Any] | None, *, context: Any) -> Self:
-        """The layer named ``context.name`` (its ``plugins:`` name) from its namespace ``params`` (ROS names), in the
-        costmap ``context.costmap`` (parsed ``CostmapParams``) with the padded ``context.footprint``."""
-        name = context.name or "range_sensor_layer"
-        costmap = context.costmap if isinstance(context.costmap, CostmapParams) else CostmapParams()
-        if params is not None:
-            costmap = dataclasses.replace(costmap, namespaces={**costmap.namespaces, name: dict(params)})
-        footprint = context.footprint if isinstance(context.footprint, Footprint) else make_footprint()
-        return cls.from_costmap_params(name, costmap, footprint)
-
-    @classmethod
-    def from_costmap_params(cls, name: str, costmap: CostmapParams, footprint: Footprint) -> Self:
-        """The layer ``name`` of a parsed costmap (its namespace)."""
-        return cls(dict(costmap.namespaces.get(name, {})), name=name)
+    def from_params(cls, params: Mapping[str, Any] | None, *, context: PluginContext) -> Self:
+        """The layer named ``context.name`` (its ``plugins:`` name) from its namespace ``params`` (ROS names)."""
+        return cls(dict(params or {}), name=context.name or "range_sensor_layer")
 
     @property
     def topics(self) -> list[str]:

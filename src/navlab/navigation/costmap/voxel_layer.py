@@ -23,11 +23,13 @@ from typing import Any, Self
 import numba
 import numpy as np
 
+from navlab.core.params import read_params
 from navlab.grid import COST_FREE, COST_LETHAL, COST_UNKNOWN, Grid
 from navlab.navigation.costmap.footprint import Footprint, make_footprint
-from navlab.navigation.costmap.layers import Layer
-from navlab.navigation.costmap.params import CostmapParams, ObservationSource, ObstacleLayerParams, build
+from navlab.navigation.costmap.layer import Layer, costmap_of
+from navlab.navigation.costmap.params import IGNORED, ObservationSource, ObstacleLayerParams, layer_params
 from navlab.navigation.errors import NavigationError
+from navlab.plugins import PluginContext
 
 UNKNOWN_COLUMN = np.uint32(0xFFFF)  # every voxel unknown (voxel_grid's reset)
 
@@ -43,19 +45,18 @@ class VoxelLayerParams(ObstacleLayerParams):
     mark_threshold: int = 0
     publish_voxel_map: bool = False
 
-    def validate(self, name: str) -> None:
-        """One error line naming the first bad parameter."""
-        if not 1 <= self.z_voxels <= 16:
-            raise NavigationError(f"{name} parameter z_voxels: expected 1..16 (costmap_2d's voxel grid holds 16 "
-                                  f"voxels per column), got {self.z_voxels}")
-        if not (self.z_resolution > 0 and math.isfinite(self.z_resolution)):
-            raise NavigationError(f"{name} parameter z_resolution: expected a number > 0, got {self.z_resolution}")
-        for key in ("obstacle_range", "raytrace_range", "unknown_threshold", "mark_threshold"):
-            if not getattr(self, key) >= 0:
-                raise NavigationError(f"{name} parameter {key}: expected >= 0, got {getattr(self, key)}")
-        if self.combination_method not in (0, 1):
-            raise NavigationError(f"{name} parameter combination_method: expected 0 (overwrite) or 1 (maximum), "
-                                  f"got {self.combination_method}")
+    def validate(self) -> None:
+        """The obstacle layer's checks (ranges, combination_method) come from the spec; nothing spans fields."""
+
+
+VOXEL_KEYS = frozenset({"origin_z", "z_resolution", "z_voxels", "unknown_threshold", "mark_threshold",
+                        "publish_voxel_map"})
+# the obstacle layer's spec, with the voxel keys read (the costmap level ignores them) and their ranges
+VoxelLayerParams.PARAMS = dataclasses.replace(
+    ObstacleLayerParams.PARAMS, what="voxel_layer", ignored=IGNORED - VOXEL_KEYS,
+    above={**ObstacleLayerParams.PARAMS.above, "z_resolution": 0.0},
+    at_least={**ObstacleLayerParams.PARAMS.at_least, "z_voxels": 1, "unknown_threshold": 0, "mark_threshold": 0},
+    at_most={**ObstacleLayerParams.PARAMS.at_most, "z_voxels": 16})  # costmap_2d's voxel grid: 16 per column
 
 
 @numba.njit(cache=True)
@@ -168,11 +169,7 @@ class VoxelLayer(Layer):
 
     def __init__(self, params: VoxelLayerParams | dict[str, Any] | None = None, *, name: str = "obstacle_layer",
                  sources: dict[str, ObservationSource] | None = None, footprint: Footprint | None = None) -> None:
-        if isinstance(params, VoxelLayerParams):
-            self.params = params
-        else:
-            self.params = build(VoxelLayerParams, dict(params or {}), what=name)
-        self.params.validate(name)
+        self.params: VoxelLayerParams = read_params(VoxelLayerParams, params, what=name)
         self.name = name
         self.enabled = self.params.enabled
         self.sources: Mapping[str, ObservationSource] = dict(sources or {})
@@ -182,26 +179,15 @@ class VoxelLayer(Layer):
         self.robot_pose: tuple[float, float, float] | None = None
 
     @classmethod
-    def from_params(cls, params: Mapping[str, Any] | None, *, context: Any) -> Self:
+    def from_params(cls, params: Mapping[str, Any] | None, *, context: PluginContext) -> Self:
         """The layer named ``context.name`` (its ``plugins:`` name) from its namespace ``params`` (ROS names), in the
-        costmap ``context.costmap`` (parsed ``CostmapParams``) with the padded ``context.footprint``."""
+        costmap ``context.costmap`` (its observation sources) with the padded ``context.footprint``."""
         name = context.name or "obstacle_layer"
-        costmap = context.costmap if isinstance(context.costmap, CostmapParams) else CostmapParams()
-        if params is not None:
-            costmap = dataclasses.replace(costmap, namespaces={**costmap.namespaces, name: dict(params)})
-        footprint = context.footprint if isinstance(context.footprint, Footprint) else make_footprint()
-        return cls.from_costmap_params(name, costmap, footprint)
-
-    @classmethod
-    def from_costmap_params(cls, name: str, costmap: CostmapParams, footprint: Footprint) -> Self:
-        """The layer ``name`` of a parsed costmap (its namespace over the costmap-level values)."""
-        ns = dict(costmap.namespaces.get(name, {}))
-        own = set(VoxelLayerParams.__dataclass_fields__)
-        inherited = {k: getattr(costmap, k) for k in own if hasattr(costmap, k)}
-        params = build(VoxelLayerParams, {**inherited, **{k: v for k, v in ns.items() if not isinstance(v, dict)}},
-                       what=name)
-        names = (params.observation_sources or costmap.observation_sources).split()
-        return cls(params, name=name, sources={n: costmap.sources[n] for n in names if n in costmap.sources},
+        costmap = costmap_of(params, context)
+        settings = layer_params(VoxelLayerParams, costmap, name)
+        names = (settings.observation_sources or costmap.observation_sources).split()
+        footprint = context.footprint if isinstance(context.footprint, Footprint) else None
+        return cls(settings, name=name, sources={n: costmap.sources[n] for n in names if n in costmap.sources},
                    footprint=footprint)
 
     @property

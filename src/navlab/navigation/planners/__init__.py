@@ -12,13 +12,13 @@ from typing import Any
 from navlab.navigation.planners.common import path_length
 from navlab.navigation.planners.navfn import GlobalPlanner, GlobalPlannerParams, NavfnParams, NavfnPlanner
 from navlab.navigation.planners.theta_star import ThetaStarParams, ThetaStarPlanner
-from navlab.plugins import load_plugin
+from navlab.plugins import make_plugin
 
 
 def make_planner(name: str, params: dict[str, Any] | None = None) -> Any:
     """The global planner registered as ``name`` (``base_global_planner``), built from its parameter dict;
     an unknown name says "did you mean"."""
-    return load_plugin("global_planner", name, param="base_global_planner")(params)
+    return make_plugin("global_planner", name, params, param="base_global_planner")
 
 
 __all__ = ["GlobalPlanner", "GlobalPlannerParams", "NavfnParams", "NavfnPlanner", "ThetaStarParams",

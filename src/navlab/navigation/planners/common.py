@@ -13,7 +13,6 @@ import numba
 import numpy as np
 
 from navlab.grid import COST_LETHAL, Grid
-from navlab.navigation.costmap.params import build
 from navlab.navigation.errors import NavigationError
 
 
@@ -53,25 +52,6 @@ def check_start(data: np.ndarray, i: int, j: int, start: Any, who: str) -> None:
     if data[j, i] == COST_LETHAL:
         raise NavigationError(f"{who}: start ({float(start[0]):.3f}, {float(start[1]):.3f}) is in an obstacle "
                               f"(cost {COST_LETHAL} at cell ({i}, {j})); is the robot localized?")
-
-
-def params_from(cls: type, values: Any, *, what: str, aliases: dict[str, str] | None = None) -> Any:
-    """A planner's parameter dataclass from a dict (ROS names, "did you mean" on unknown keys) or as given."""
-    if values is None:
-        return cls()
-    if isinstance(values, cls):
-        return values
-    if not isinstance(values, dict):
-        raise NavigationError(f"{what}: parameters must be a dict or {cls.__name__}, got {type(values).__name__}")
-    renamed: dict[str, Any] = {}
-    names: dict[str, str] = aliases or {}
-    key: str  # parameter names (``build`` reports an unknown or non-string key)
-    for key, val in values.items():
-        name = names.get(key, key)
-        if name in renamed:
-            raise NavigationError(f"{what} parameters {key} and {name} both set; keep one")
-        renamed[name] = val
-    return build(cls, renamed, what=what)
 
 
 def path_length(path: np.ndarray | None) -> float:

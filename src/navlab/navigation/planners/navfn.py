@@ -16,12 +16,13 @@ ignored (the last potential stays available as ``planner.potential``).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
-from typing import Any
+from dataclasses import dataclass, replace
+from typing import Any, ClassVar
 
 import numba
 import numpy as np
 
+from navlab.core import ParamSpec, read_params
 from navlab.grid import COST_INSCRIBED, COST_UNKNOWN, Grid
 from navlab.navigation.errors import NavigationError
 from navlab.navigation.planners.common import (
@@ -30,10 +31,10 @@ from navlab.navigation.planners.common import (
     dedupe,
     iheap_pop,
     iheap_update,
-    params_from,
     pose_cell,
     to_world,
 )
+from navlab.plugins import BuiltFromParams
 
 COST_NEUTRAL = 50.0
 COST_FACTOR = 0.8
@@ -53,15 +54,10 @@ class NavfnParams:
     cost_factor: float = COST_FACTOR
     neutral_cost: float = COST_NEUTRAL
     lethal_cost: int = COST_INSCRIBED  # costs >= this are obstacles (navfn: COST_OBS_ROS = 253)
+    PARAMS: ClassVar[ParamSpec]
 
     def validate(self, what: str = "navfn") -> None:
         """Refuse a bad value naming the key."""
-        if not (math.isfinite(self.default_tolerance) and self.default_tolerance >= 0):
-            raise NavigationError(f"{what} parameter default_tolerance: expected >= 0 m, got {self.default_tolerance}")
-        if not (math.isfinite(self.neutral_cost) and self.neutral_cost > 0):
-            raise NavigationError(f"{what} parameter neutral_cost: expected > 0, got {self.neutral_cost}")
-        if not (math.isfinite(self.cost_factor) and self.cost_factor >= 0):
-            raise NavigationError(f"{what} parameter cost_factor: expected >= 0, got {self.cost_factor}")
         if not 1 <= self.lethal_cost <= COST_UNKNOWN:
             raise NavigationError(f"{what} parameter lethal_cost: expected 1..255, got {self.lethal_cost}")
 
@@ -88,6 +84,23 @@ class GlobalPlannerParams(NavfnParams):
         if self.use_grid_path:
             raise NavigationError(f"{what} parameter use_grid_path: only false (gradient-descent paths) is "
                                   "supported, got true")
+
+
+def _use_astar(values: dict[str, Any]) -> dict[str, Any]:
+    """Nav2 navfn's ``use_astar`` is ``use_dijkstra`` negated."""
+    if "use_astar" in values:
+        values = dict(values)
+        if "use_dijkstra" in values:
+            raise NavigationError("navfn parameters use_astar and use_dijkstra both set; keep one")
+        astar = values.pop("use_astar")
+        values["use_dijkstra"] = (not astar) if isinstance(astar, bool) else astar
+    return values
+
+
+NavfnParams.PARAMS = ParamSpec("navfn", NavigationError, aliases={"tolerance": "default_tolerance"},
+                               prepare=_use_astar, above={"neutral_cost": 0.0},
+                               at_least={"default_tolerance": 0.0, "cost_factor": 0.0})
+GlobalPlannerParams.PARAMS = replace(NavfnParams.PARAMS, what="global_planner")
 
 
 # --- kernels (Numba) -----------------------------------------------------------------------------
@@ -294,7 +307,7 @@ def _descend(pot: np.ndarray, u: float, v: float, tu: float, tv: float, step: fl
 # --- the planner ---------------------------------------------------------------------------------
 
 
-class NavfnPlanner:
+class NavfnPlanner(BuiltFromParams):
     """``navfn/NavfnROS`` as a pure planner: :meth:`make_plan` over a costmap ``Grid`` (uint8 costs).
 
     After a call, ``last_failure`` says why there was no path ("" on success), ``stats`` holds the
@@ -305,14 +318,7 @@ class NavfnPlanner:
     name = "navfn"
 
     def __init__(self, params: NavfnParams | dict[str, Any] | None = None) -> None:
-        values = dict(params) if isinstance(params, dict) else params
-        if isinstance(values, dict) and "use_astar" in values:  # Nav2 navfn's spelling of the A* option
-            if "use_dijkstra" in values:
-                raise NavigationError(f"{self.name} parameters use_astar and use_dijkstra both set; keep one")
-            values["use_dijkstra"] = not bool(values.pop("use_astar"))
-        self.params = params_from(self.params_class, values, what=self.name,
-                                  aliases={"tolerance": "default_tolerance"})
-        self.params.validate()
+        self.params = read_params(self.params_class, params)
         self.last_failure = ""
         self.stats: dict[str, int] = {}
         self.potential: np.ndarray | None = None

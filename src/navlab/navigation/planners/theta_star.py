@@ -16,11 +16,12 @@ from __future__ import annotations
 import itertools
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, ClassVar
 
 import numba
 import numpy as np
 
+from navlab.core import ParamSpec, read_params
 from navlab.grid import COST_INSCRIBED, COST_UNKNOWN, Grid
 from navlab.navigation.errors import NavigationError
 from navlab.navigation.planners.common import (
@@ -29,10 +30,10 @@ from navlab.navigation.planners.common import (
     dedupe,
     iheap_pop,
     iheap_update,
-    params_from,
     pose_cell,
     to_world,
 )
+from navlab.plugins import BuiltFromParams
 
 MAX_NON_OBSTACLE = 252.0
 
@@ -48,18 +49,14 @@ class ThetaStarParams:
     allow_unknown: bool = True
     use_final_approach_orientation: bool = False
     terminal_checking_interval: int = 5000
+    PARAMS: ClassVar[ParamSpec] = ParamSpec("theta_star", NavigationError, above={"w_euc_cost": 0.0},
+                                            at_least={"w_traversal_cost": 0.0, "w_heuristic_cost": 0.0})
 
     def validate(self) -> None:
         """Refuse a bad value naming the key."""
         if self.how_many_corners not in (4, 8):
             raise NavigationError("theta_star parameter how_many_corners: expected 4 or 8, "
                                   f"got {self.how_many_corners}")
-        for key in ("w_euc_cost", "w_traversal_cost", "w_heuristic_cost"):
-            v = getattr(self, key)
-            if not (math.isfinite(v) and v >= 0):
-                raise NavigationError(f"theta_star parameter {key}: expected >= 0, got {v}")
-        if self.w_euc_cost <= 0:
-            raise NavigationError(f"theta_star parameter w_euc_cost: expected > 0, got {self.w_euc_cost}")
 
 
 @numba.njit(cache=True)
@@ -160,7 +157,7 @@ def _theta_star(blocked: np.ndarray, trav: np.ndarray, start: int, goal: int, co
     return parent, expanded
 
 
-class ThetaStarPlanner:
+class ThetaStarPlanner(BuiltFromParams):
     """``nav2_theta_star_planner/ThetaStarPlanner`` as a pure planner over a costmap ``Grid`` (uint8 costs).
 
     After a call, ``last_failure`` says why there was no path ("" on success) and ``stats`` holds the
@@ -170,8 +167,7 @@ class ThetaStarPlanner:
     name = "theta_star"
 
     def __init__(self, params: ThetaStarParams | dict[str, Any] | None = None) -> None:
-        self.params: ThetaStarParams = params_from(ThetaStarParams, params, what=self.name)
-        self.params.validate()
+        self.params: ThetaStarParams = read_params(ThetaStarParams, params)
         self.last_failure = ""
         self.stats: dict[str, int] = {}
 

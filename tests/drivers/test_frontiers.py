@@ -1,12 +1,21 @@
-"""Exploration algorithms on synthetic grids: frontiers, planning around walls, the path follower."""
+"""Exploration algorithms on synthetic grids: frontiers, the costs from navigation's layers, planning around
+walls, the bounded search against a full one (scipy's Dijkstra), the path follower."""
 
 import math
 
 import numpy as np
+from scipy import sparse
+from scipy.sparse.csgraph import dijkstra
 
-from navlab.grid import GridMap
-from navlab.mapping.explore import find_frontiers, plan_to_frontier, traversable
-from navlab.mapping.follow import follow_path
+from navlab.drivers.frontiers import (
+    exploration_costmap,
+    find_frontiers,
+    plan_to_frontier,
+    prepare_frontier_search,
+    traversable,
+)
+from navlab.grid import COST_INSCRIBED, COST_LETHAL, COST_UNKNOWN, GridMap
+from navlab.navigation.controllers.pure_pursuit import follow_path
 
 
 def _half_known_room() -> GridMap:
@@ -35,8 +44,9 @@ def test_plan_goes_around_the_wall_and_keeps_clearance():
     assert path[-1][0] > 1.9  # reaches the frontier column
     assert path[:, 1].min() < 1.0  # had to pass below the interior wall's lower end
     # every path cell keeps the robot radius from occupied cells
-    mask = traversable(grid, 0.25)
-    cells = grid.world_to_cell(path)
+    known = grid.crop_to_known()
+    mask = traversable(exploration_costmap(known, 0.25))
+    cells = known.world_to_cell(path)
     assert mask[cells[:, 1], cells[:, 0]].all()
 
 
@@ -59,14 +69,13 @@ def test_follower_turns_then_drives_and_stops_for_obstacles():
 
 def _full_search_goal(grid: GridMap, robot_xy: tuple[float, float]) -> tuple[float, float] | None:
     """The frontier goal by a Dijkstra over the whole map (the reference for the bounded search)."""
-    from navlab.mapping.explore import GridDijkstraPlanner, clearance_costmap
-
-    grid = grid.crop_to_known()
-    found = GridDijkstraPlanner().distances(clearance_costmap(grid, 0.3), robot_xy)
+    search = prepare_frontier_search(grid)
+    found = search.distances(robot_xy)
     assert found is not None
     dist = found[0]
+    grid = search.grid
     best, best_cost = None, math.inf
-    for f in find_frontiers(grid, min_cells=5):
+    for f in search.frontiers:
         d = dist[f.cells[:, 1], f.cells[:, 0]]
         if not np.isfinite(d).any():
             continue
@@ -95,34 +104,45 @@ def test_bounded_search_picks_the_goal_of_a_full_search():
         assert np.allclose(path[-1], goal)
 
 
-def test_clearance_is_scipys_euclidean_distance_transform():
-    from scipy import ndimage
-
-    from navlab.mapping.explore import clearance
-
-    rng = np.random.default_rng(5)
-    for _ in range(300):
-        h, w = (int(v) for v in rng.integers(1, 50, 2))
-        data = np.where(rng.random((h, w)) < rng.random() ** 3, 100, 0).astype(np.int8)
-        data[rng.integers(h), rng.integers(w)] = 100
+def test_full_search_is_scipys_dijkstra_over_the_step_costs():
+    rng = np.random.default_rng(2)
+    for _ in range(20):
+        h, w = (int(v) for v in rng.integers(3, 30, 2))
+        data = np.where(rng.random((h, w)) < 0.1, 100, 0).astype(np.int8)
+        data[h // 2, w // 2] = 0
         grid = GridMap(data, 0.05, (0.0, 0.0, 0.0))
-        assert np.array_equal(clearance(grid), ndimage.distance_transform_edt(data < 65) * 0.05)
-    assert np.isinf(clearance(GridMap(np.zeros((4, 5), dtype=np.int8), 0.05, (0.0, 0.0, 0.0)))).all()
+        search = prepare_frontier_search(grid, robot_radius=0.05)
+        start_xy = tuple(grid.cell_to_world(np.array([[w // 2, h // 2]]))[0])
+        start = search.start_cell(start_xy)
+        assert start is not None
+        found = search.distances(start_xy)
+        assert found is not None
+        mask = search.mask.copy()
+        mask[start[1], start[0]] = True
+        rows, cols, vals = [], [], []
+        for j, i in zip(*np.nonzero(mask), strict=True):
+            for dj, di, length in ((0, 1, 1.0), (1, 0, 1.0), (1, 1, np.sqrt(2.0)), (1, -1, np.sqrt(2.0))):
+                j2, i2 = j + dj, i + di
+                if 0 <= j2 < h and 0 <= i2 < w and mask[j2, i2]:
+                    a, b = j * w + i, j2 * w + i2
+                    c = length * 0.5 * (search.cell_cost[a] + search.cell_cost[b])
+                    rows += [a, b]
+                    cols += [b, a]
+                    vals += [c, c]
+        graph = sparse.csr_matrix((vals, (rows, cols)), shape=(h * w, h * w))
+        want = dijkstra(graph, indices=start[1] * w + start[0]).reshape(h, w)
+        np.testing.assert_allclose(found[0], want, rtol=1e-12)
 
 
-def test_clearance_costmap_follows_its_formula():
-    from navlab.grid import COST_INSCRIBED, COST_LETHAL, COST_UNKNOWN
-    from navlab.mapping.explore import clearance, clearance_costmap
-
-    rng = np.random.default_rng(7)
-    for _ in range(200):
-        h, w = (int(v) for v in rng.integers(1, 40, 2))
-        data = rng.choice(np.array([-1, 0, 30, 64, 65, 100], dtype=np.int8), size=(h, w))
-        grid = GridMap(data, 0.05, (0.0, 0.0, 0.0))
-        radius, comfort = float(rng.uniform(0.05, 0.5)), float(rng.uniform(0.05, 0.8))
-        dist = clearance(grid)
-        expect = np.rint(252.0 * np.clip((radius + comfort - dist) / comfort, 0.0, 1.0) ** 2).astype(np.uint8)
-        expect[dist <= radius] = COST_INSCRIBED
-        expect[data < 0] = COST_UNKNOWN
-        expect[data >= 65] = COST_LETHAL
-        assert np.array_equal(clearance_costmap(grid, radius, comfort=comfort).data, expect)
+def test_exploration_costs_are_navigations_static_and_inflation_layers():
+    data = np.zeros((40, 40), dtype=np.int8)
+    data[:, 30:] = -1  # unknown beyond x = 1.5 m
+    data[20, 10] = 100  # one obstacle at (0.525, 1.025)
+    data[5, 5] = 64  # under the occupied threshold: free
+    costs = exploration_costmap(GridMap(data, 0.05, (0.0, 0.0, 0.0)), 0.2, comfort=0.4).data
+    assert costs[20, 10] == COST_LETHAL
+    assert costs[20, 14] == COST_INSCRIBED  # 0.20 m away: within the radius
+    assert (costs[:, 30:] == COST_UNKNOWN).all()
+    profile = costs[20, 15:20].astype(int)  # 0.25 .. 0.45 m: falling with the distance
+    assert (np.diff(profile) < 0).all() and 0 < profile[-1] < profile[0] < COST_INSCRIBED
+    assert costs[20, 23] == 0 and costs[5, 5] == 0  # beyond radius + comfort (0.65 m); 64 % is free

@@ -3,8 +3,7 @@
 import pytest
 
 from navlab.core import Executor
-from navlab.mapping import MappingError
-from navlab.mapping.teleop import JoyMapping, RouteFollower, TeleopKeyboard, TeleopState, load_route
+from navlab.drivers import DriverError, JoyMapping, RouteFollower, TeleopKeyboard, TeleopState, load_route
 
 
 def test_keyboard_bindings_and_speed_keys():
@@ -39,10 +38,10 @@ def test_joystick_mapping_needs_the_deadman_button():
 def test_route_file_errors(tmp_path):
     f = tmp_path / "r.yaml"
     f.write_text("segments:\n  - {linear: 0.2}\n")
-    with pytest.raises(MappingError, match=r"segments\[0\]"):
+    with pytest.raises(DriverError, match=r"segments\[0\]"):
         load_route(f)
     f.write_text("speed: 1\n")
-    with pytest.raises(MappingError, match="segments"):
+    with pytest.raises(DriverError, match="segments"):
         load_route(f)
 
 

@@ -1,0 +1,10 @@
+"""The drivers' error."""
+
+from navlab.mapping.errors import MappingError
+
+
+class DriverError(MappingError):
+    """A driver (exploration, teleop, route) refused its input: one line naming the file, key or device.
+
+    A ``MappingError`` for one release, so ``except MappingError`` around the drivers' old home still catches it.
+    """

@@ -1,0 +1,165 @@
+"""costmap_2d::ObstacleLayer: marking and ray clearing from laser scans (see ``layer`` for the interface).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any, Self
+
+import numpy as np
+
+from navlab.core import read_params
+from navlab.grid import COST_FREE, COST_LETHAL, COST_UNKNOWN, Grid
+from navlab.navigation.costmap.footprint import Footprint, make_footprint
+from navlab.navigation.costmap.layer import Layer, costmap_of, same_geometry
+from navlab.navigation.costmap.params import ObservationSource, ObstacleLayerParams, layer_params
+from navlab.navigation.costmap.raytrace import clear_rays
+from navlab.navigation.errors import NavigationError
+from navlab.plugins import PluginContext
+
+
+class ObstacleLayer(Layer):
+    """``costmap_2d::ObstacleLayer``: marks scan endpoints nearer than ``obstacle_range`` as lethal and clears
+    the cells along each ray up to ``raytrace_range`` (Bresenham, Numba); clears the cells under the robot's
+    footprint (``footprint_clearing_enabled``); combines into the master by maximum (``combination_method``
+    1, unknown cells of the layer skipped) or overwrite (0). Call :meth:`match_size` (the layered costmap
+    does) before :meth:`add_scan`.
+    """
+
+    def __init__(
+        self,
+        params: ObstacleLayerParams | dict[str, Any] | None = None,
+        *,
+        name: str = "obstacle_layer",
+        sources: dict[str, ObservationSource] | None = None,
+        footprint: Footprint | None = None,
+    ) -> None:
+        self.params: ObstacleLayerParams = read_params(ObstacleLayerParams, params, what=name)
+        self.name = name
+        self.enabled = self.params.enabled
+        self.sources = dict(sources or {})
+        self.footprint = footprint or make_footprint()
+        self.grid: Grid | None = None
+        self.robot_pose: tuple[float, float, float] | None = None
+
+    @classmethod
+    def from_params(cls, params: Mapping[str, Any] | None, *, context: PluginContext) -> Self:
+        name = context.name or "obstacle_layer"
+        costmap = costmap_of(params, context)
+        settings = layer_params(ObstacleLayerParams, costmap, name)
+        names = (settings.observation_sources or costmap.observation_sources).split()
+        footprint = context.footprint if isinstance(context.footprint, Footprint) else None
+        return cls(settings, name=name, sources={n: costmap.sources[n] for n in names if n in costmap.sources},
+                   footprint=footprint)
+
+    @property
+    def default_value(self) -> int:
+        """What a never-observed cell holds: unknown with ``track_unknown_space``, else free."""
+        return COST_UNKNOWN if self.params.track_unknown_space else COST_FREE
+
+    def on_footprint_changed(self, footprint: Footprint) -> None:
+        self.footprint = footprint
+
+    def match_size(self, master: Grid) -> None:
+        data = np.full(master.data.shape, self.default_value, dtype=np.uint8)
+        self.grid = Grid(data, master.resolution, master.origin, master.frame_id)
+
+    def update_origin(self, master: Grid) -> None:
+        old = self.grid
+        if old is None or old.data.shape != master.data.shape or old.resolution != master.resolution:
+            self.match_size(master)
+            return
+        shift = np.rint((np.array(master.origin[:2]) - np.array(old.origin[:2])) / master.resolution).astype(int)
+        di, dj = int(shift[0]), int(shift[1])
+        h, w = old.data.shape
+        new = np.full((h, w), self.default_value, dtype=np.uint8)
+        # new cell (i, j) is old cell (i + di, j + dj)
+        i0, i1 = max(0, -di), min(w, w - di)
+        j0, j1 = max(0, -dj), min(h, h - dj)
+        if i0 < i1 and j0 < j1:
+            new[j0:j1, i0:i1] = old.data[j0 + dj : j1 + dj, i0 + di : i1 + di]
+        self.grid = Grid(new, master.resolution, master.origin, master.frame_id)
+
+    def _source_settings(self, source: str | None) -> ObservationSource:
+        p = self.params
+        if source is None:
+            return ObservationSource(marking=True, clearing=True, obstacle_range=p.obstacle_range,
+                                     raytrace_range=p.raytrace_range, obstacle_min_range=p.obstacle_min_range,
+                                     raytrace_min_range=p.raytrace_min_range)
+        if source not in self.sources:
+            known = ", ".join(self.sources) or "none"
+            raise NavigationError(f"{self.name}: unknown observation source {source!r} (sources: {known})")
+        return self.sources[source]
+
+    def add_scan(
+        self,
+        origin_xy: tuple[float, float] | np.ndarray,
+        endpoints_xy: np.ndarray,
+        valid: np.ndarray | None = None,
+        *,
+        source: str | None = None,
+    ) -> None:
+        """Apply one scan in the costmap frame: the sensor at ``origin_xy`` (m) and ray endpoints (N, 2) (m).
+
+        ``valid`` (N,) marks real returns; the others (max-range rays, inf projected to a distance) only clear.
+        Without ``source`` the layer's own ranges apply and the scan both marks and clears; with a source name
+        its ``marking``, ``clearing`` and ranges apply. Clearing runs first, then marking.
+        """
+        if self.grid is None:
+            raise NavigationError(f"{self.name}: no grid yet; call match_size(master) before add_scan")
+        pts = np.asarray(endpoints_xy, dtype=np.float64).reshape(-1, 2)
+        ok = np.ones(len(pts), bool) if valid is None else np.asarray(valid, bool).reshape(-1)
+        if len(ok) != len(pts):
+            raise NavigationError(f"{self.name}.add_scan: valid has {len(ok)} entries for {len(pts)} endpoints")
+        o = np.asarray(origin_xy, dtype=np.float64).reshape(-1)[:2]
+        if not np.isfinite(o).all():
+            raise NavigationError(f"{self.name}.add_scan: sensor origin must be finite, got {o.tolist()}")
+        src = self._source_settings(source)
+        g = self.grid
+        res, (ox, oy, _) = g.resolution, g.origin
+        finite = np.isfinite(pts).all(axis=1)
+        if src.clearing:
+            cells = (pts[finite] - (ox, oy)) / res
+            clear_rays(g.data, (o[0] - ox) / res, (o[1] - oy) / res, np.ascontiguousarray(cells),
+                       src.raytrace_range / res, src.raytrace_min_range / res, np.uint8(COST_FREE))
+        if src.marking:
+            d = np.hypot(pts[:, 0] - o[0], pts[:, 1] - o[1])
+            mark = ok & finite & (d < src.obstacle_range) & (d >= src.obstacle_min_range)
+            ij = g.world_to_cell(pts[mark])
+            ij = ij[g.in_bounds(ij)]
+            g.data[ij[:, 1], ij[:, 0]] = COST_LETHAL
+
+    def clear_outside(self, xy: tuple[float, float], size: float) -> None:
+        """Forget what lies outside the ``size`` x ``size`` m square centred on ``xy`` (m, costmap frame):
+        clear_costmap_recovery's reset."""
+        g = self.grid
+        if g is None:
+            return
+        centres = g.centers(np.ones(g.data.shape, bool)).reshape(g.height, g.width, 2)
+        outside = (np.abs(centres[..., 0] - xy[0]) > size / 2) | (np.abs(centres[..., 1] - xy[1]) > size / 2)
+        g.data[outside] = self.default_value
+
+    def update_bounds(self, robot_pose: tuple[float, float, float]) -> None:
+        self.robot_pose = (float(robot_pose[0]), float(robot_pose[1]), float(robot_pose[2]))
+
+    def update_costs(self, master: Grid) -> None:
+        if self.grid is None:
+            return
+        if not same_geometry(self.grid, master):
+            self.update_origin(master)
+        g = self.grid
+        if self.params.footprint_clearing_enabled and self.robot_pose is not None:
+            ij = self.footprint.cells(g, self.robot_pose)
+            g.data[ij[:, 1], ij[:, 0]] = COST_FREE
+        layer = g.data
+        known = layer != COST_UNKNOWN
+        if self.params.combination_method == 0:
+            master.data[known] = layer[known]
+        else:
+            old = master.data
+            take = known & ((old == COST_UNKNOWN) | (old < layer))
+            old[take] = layer[take]
+
+    def reset(self) -> None:
+        if self.grid is not None:
+            self.grid.data[:] = self.default_value
