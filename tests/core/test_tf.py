@@ -87,3 +87,13 @@ def test_pose_at_a_stamp_falls_back_on_the_latest_only_outside_the_history():
     assert buf.lookup_pose2d_or_latest("map", "laser", 1_200_000_000) == latest  # within tolerance: the newest
     with pytest.raises(TfError, match="base_link"):
         buf.lookup_pose2d_or_latest("map", "base_link", 0)
+
+
+def test_a_remembered_lookup_is_forgotten_when_a_transform_arrives():
+    buf = _buf()
+    assert buf.lookup_pose2d("map", "chassis")[:2] == pytest.approx((3.5, 2.0))
+    assert buf.lookup_pose2d("map", "chassis", 500_000_000)[:2] == pytest.approx((2.5, 2.0))
+    buf.set_transform("odom", "chassis", 2_000_000_000, (5.0, 2.0, 0.0, 0.0, 0.0, 0.0, 1.0))
+    buf.set_transform("map", "odom", 0, (1.5, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0), static=True)  # amcl's correction
+    assert buf.lookup_pose2d("map", "chassis")[:2] == pytest.approx((6.5, 2.0))
+    assert buf.lookup_pose2d("map", "chassis", 500_000_000)[:2] == pytest.approx((3.5, 2.0))

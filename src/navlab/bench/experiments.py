@@ -36,12 +36,15 @@ def run_mapping_bench(args: Any) -> dict[str, Any]:
 
 def run_nav(args: Any) -> dict[str, Any]:
     """``navlab bench nav``: the whole navigation stack (sim + lidar + amcl + costmaps + planner + controller)
-    driving across room_obstacles.world to four goals; real-time factor of the run loop."""
+    driving across room_obstacles.world to four goals; real-time factor of the run loop by wall time (``rtf``) and
+    by this process's CPU time (``rtf_cpu``: what one free core gives, as ``bench sim``'s ``rtf``)."""
     goals = [(4.3, 1.0, 0.0), (-3.5, -0.5, 3.14), (1.5, -2.5, 0.0), (0.0, 0.0, 0.0)]
     run_navigation(goals[:1], world="room_obstacles", goal_timeout=5, seed=getattr(args, "seed", 0))  # warm-up: Numba
     r = run_navigation(goals, world="room_obstacles", goal_timeout=90, seed=getattr(args, "seed", 0))
-    return {**{k: r.summary[k] for k in ("sim_s", "wall_s", "rtf")}, "goals_succeeded": r.summary["goals_succeeded"],
-            "goals": len(goals), "collisions": r.summary["collisions"]}  # fmt: skip
+    s = r.summary
+    return {**{k: s[k] for k in ("sim_s", "wall_s", "rtf", "cpu_s")},
+            "rtf_cpu": round(s["sim_s"] / s["cpu_s"], 1) if s["cpu_s"] > 0 else None,
+            "goals_succeeded": s["goals_succeeded"], "goals": len(goals), "collisions": s["collisions"]}  # fmt: skip
 
 
 def run_clutter(args: Any) -> dict[str, Any]:

@@ -52,6 +52,11 @@ class TfBuffer:
         self._version = 0  # bumped whenever the tree's shape changes (an edge added or re-parented)
         # (target, source) -> (version, target's edges up to the common ancestor, source's edges up to it)
         self._chains: dict[tuple[str, str], tuple[int, list[tuple[str, _Edge]], list[tuple[str, _Edge]]]] = {}
+        # lookups answered since the last transform came in (target, source, t_ns, tolerance) -> result: many nodes
+        # ask the same question at one instant (the costmaps, move_base, amcl, monitors)
+        self._data = 0  # bumped by every set_transform
+        self._lookups: dict[tuple[str, str, int | None, int], Tf] = {}
+        self._lookups_at = 0
 
     def frames(self) -> list[str]:
         """Every frame seen, as parent or child."""
@@ -68,6 +73,7 @@ class TfBuffer:
         """Add ``parent_T_child`` valid at ``t_ns`` (static transforms are valid at every time)."""
         if not parent or not child:
             raise TfError(f"transform needs both frame names, got parent={parent!r} child={child!r}")
+        self._data += 1
         e = self._edges.get(child)
         if e is None or e.parent != parent or e.static != static:
             e = self._edges[child] = _Edge(parent, static)
@@ -163,6 +169,18 @@ class TfBuffer:
 
     def lookup(self, target: str, source: str, t_ns: int | None = None) -> Tf:
         """``target_T_source`` at ``t_ns`` (None: the latest time every edge on the path has)."""
+        if self._lookups_at != self._data:
+            self._lookups.clear()
+            self._lookups_at = self._data
+        key = (target, source, t_ns, self.tolerance_ns)
+        hit = self._lookups.get(key)
+        if hit is not None:
+            return hit
+        out = self._lookup(target, source, t_ns)
+        self._lookups[key] = out
+        return out
+
+    def _lookup(self, target: str, source: str, t_ns: int | None) -> Tf:
         edges_t, edges_s = self._chain(target.lstrip("/"), source.lstrip("/"))
         if t_ns is None:  # the newest time every dynamic edge between the two frames has (None if all static)
             for _, e in (*edges_s, *edges_t):

@@ -14,6 +14,7 @@ from __future__ import annotations
 import math
 import os
 
+import numba
 import numpy as np
 from scipy import ndimage
 
@@ -240,10 +241,22 @@ def distance_to_path(points: np.ndarray, path: np.ndarray) -> np.ndarray:
         return np.full(len(pts), np.nan)
     if len(poly) == 1:
         return np.hypot(pts[:, 0] - poly[0, 0], pts[:, 1] - poly[0, 1])
-    a, b = poly[:-1], poly[1:]
-    ab = b - a
-    length2 = np.maximum((ab**2).sum(axis=1), 1e-18)
-    rel = pts[:, None, :] - a[None, :, :]  # (N, M-1, 2)
-    t = np.clip((rel * ab[None]).sum(axis=2) / length2[None], 0.0, 1.0)
-    nearest = a[None] + t[..., None] * ab[None]
-    return np.sqrt(((pts[:, None, :] - nearest) ** 2).sum(axis=2)).min(axis=1)
+    return _distance_to_polyline(np.ascontiguousarray(pts), np.ascontiguousarray(poly))
+
+
+@numba.njit(cache=True)
+def _distance_to_polyline(pts: np.ndarray, poly: np.ndarray) -> np.ndarray:  # pragma: no cover - compiled
+    """Each point's distance (m) to the nearest of the segments ``poly[k]``-``poly[k + 1]`` (M >= 2)."""
+    out = np.empty(pts.shape[0])
+    for n in range(pts.shape[0]):
+        px, py = pts[n, 0], pts[n, 1]
+        best = math.inf
+        for k in range(poly.shape[0] - 1):
+            ax, ay = poly[k, 0], poly[k, 1]
+            abx, aby = poly[k + 1, 0] - ax, poly[k + 1, 1] - ay
+            length2 = max(abx * abx + aby * aby, 1e-18)
+            t = min(max(((px - ax) * abx + (py - ay) * aby) / length2, 0.0), 1.0)
+            dx, dy = px - (ax + t * abx), py - (ay + t * aby)
+            best = min(best, math.sqrt(dx * dx + dy * dy))
+        out[n] = best
+    return out

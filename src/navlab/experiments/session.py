@@ -76,10 +76,11 @@ class Run:
         return until is not None and until()
 
     def figures(self) -> dict[str, float]:
-        """``{"sim_s", "wall_s", "rtf"}`` of everything run so far."""
+        """``{"sim_s", "wall_s", "rtf", "cpu_s"}`` of everything run so far (``cpu_s``: this process's CPU time)."""
         sim_s, wall_s = self.timing["sim_s"], self.timing["wall_s"]
         return {"sim_s": round(sim_s, 2), "wall_s": round(wall_s, 2),
-                "rtf": round(sim_s / wall_s, 1) if wall_s > 0 else math.inf}  # fmt: skip
+                "rtf": round(sim_s / wall_s, 1) if wall_s > 0 else math.inf,
+                "cpu_s": round(self.timing["cpu_s"], 2)}  # fmt: skip
 
 
 def robot_frames(robot: str) -> tuple[str, str, str]:

@@ -20,6 +20,7 @@ from dataclasses import dataclass, fields
 from typing import Any
 
 import numpy as np
+from numba import njit
 
 from navlab.core.limits import check_ceiling
 from navlab.geometry import wrap_angle
@@ -134,6 +135,17 @@ class Scan:
     angle_increment: float
     range_min: float
     range_max: float
+
+
+@njit(cache=True)
+def any_in_range(ranges: np.ndarray, range_min: float, range_max: float) -> bool:  # pragma: no cover - compiled
+    """Whether one of ``ranges`` (m) lies in [range_min, range_max) (NaN does not)."""
+    found = False
+    for k in range(ranges.size):
+        if range_min <= ranges[k] < range_max:
+            found = True
+            break
+    return found
 
 
 class Amcl:

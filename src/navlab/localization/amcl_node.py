@@ -176,10 +176,8 @@ class Amcl(Node):
 
     def _count_invalid(self, msg: Any, t_ns: int) -> None:
         """Count a scan without one reading in [range_min, range_max) and say so, at most every 10 s."""
-        r = np.asarray(msg.ranges, dtype=np.float64)
-        with np.errstate(invalid="ignore"):
-            if np.any((r >= float(msg.range_min)) & (r < float(msg.range_max))):
-                return
+        if pf.any_in_range(np.asarray(msg.ranges), float(msg.range_min), float(msg.range_max)):
+            return
         self.scans_invalid += 1
         if self._invalid_logged_ns is None or t_ns - self._invalid_logged_ns >= 10_000_000_000:
             self._invalid_logged_ns = t_ns

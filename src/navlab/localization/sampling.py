@@ -55,14 +55,22 @@ def bin_keys(poses: np.ndarray) -> np.ndarray:
 def kld_count(candidates: np.ndarray, kld_err: float, kld_z: float, min_n: int, max_n: int) -> int:
     """How many of ``candidates`` (drawn in random order) KLD-sampling keeps."""
     keys = bin_keys(candidates)
-    _, first = np.unique(keys, return_index=True)
-    is_new = np.zeros(keys.shape[0], dtype=np.int64)
-    is_new[first] = 1
-    k = np.cumsum(is_new)
+    k = bins_so_far(keys)
     counts = np.arange(1, keys.shape[0] + 1)
     over = np.flatnonzero(counts > kld_limit(k, kld_err, kld_z, min_n, max_n))
     n = int(counts[over[0]]) if over.size else keys.shape[0]
     return max(min(n, max_n), min_n)
+
+
+@njit(cache=True)
+def bins_so_far(keys: np.ndarray) -> np.ndarray:  # pragma: no cover - compiled
+    """``out[m]``: how many distinct keys ``keys[: m + 1]`` holds (the bins the first m + 1 samples occupy)."""
+    seen = set()
+    out = np.empty(keys.shape[0], dtype=np.int64)
+    for m in range(keys.shape[0]):
+        seen.add(keys[m])
+        out[m] = len(seen)
+    return out
 
 
 @dataclass(frozen=True)

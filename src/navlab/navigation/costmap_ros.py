@@ -20,6 +20,7 @@ from navlab.geometry import compose2, transform_points2
 from navlab.grid import COST_INSCRIBED, COST_LETHAL, COST_UNKNOWN, Grid, GridMap
 from navlab.navigation.costmap.layered import LayeredCostmap
 from navlab.navigation.costmap_sensors import CostmapSensorFeeds
+from navlab.navigation.scan_points import ScanPoints
 
 
 def cost_translation() -> np.ndarray:
@@ -35,11 +36,14 @@ class Costmap2DROS:
 
     ``params``: the costmap's ROS parameters (``costmap_common_params.yaml`` merged with its own file);
     ``topic_prefix``: where ``costmap`` and ``footprint`` are published (default ``name``; move_base uses
-    ``/move_base/global_costmap``).
+    ``/move_base/global_costmap``); ``scan_points``: a ``ScanPoints`` shared with other costmaps of the node (each
+    scan's laser-frame points are then worked out once).
     """
 
-    def __init__(self, node: Node, name: str, params: dict[str, Any], *, topic_prefix: str | None = None) -> None:
+    def __init__(self, node: Node, name: str, params: dict[str, Any], *, topic_prefix: str | None = None,
+                 scan_points: ScanPoints | None = None) -> None:
         self.node, self.name = node, name
+        self.scan_points = scan_points or ScanPoints()  # move_base shares one between its two costmaps
         prefix = topic_prefix if topic_prefix is not None else name
         self.layered = LayeredCostmap(params)
         p = self.layered.params
@@ -112,15 +116,10 @@ class Costmap2DROS:
             return
         sensor = compose2(base, self._sensor_in_base[frame])
         src = self.layered.params.sources[source]
-        r = np.asarray(msg.ranges, dtype=np.float64)
-        a = float(msg.angle_min) + float(msg.angle_increment) * np.arange(len(r))
-        valid = np.isfinite(r) & (r >= float(msg.range_min)) & (r < float(msg.range_max))
         # rays without a return clear out to raytrace_range (inf_is_valid), others end at their return
         clear_to = src.raytrace_range if src.inf_is_valid else float(msg.range_max)
-        dist = np.where(valid, r, np.where(np.isnan(r), np.nan, clear_to))
-        keep = np.isfinite(dist)
-        pts = np.stack([dist[keep] * np.cos(a[keep]), dist[keep] * np.sin(a[keep])], axis=1)
-        self.layered.add_scan(sensor[:2], transform_points2(sensor, pts), valid[keep], source=source)
+        pts, valid = self.scan_points.points(msg, clear_to)
+        self.layered.add_scan(sensor[:2], transform_points2(sensor, pts), valid, source=source)
 
     def _on_scan(self, source: str, msg: Any) -> None:
         """Keep the newest scan of each observation source for the next update."""

@@ -26,6 +26,7 @@ from navlab.navigation.costmap_ros import Costmap2DROS
 from navlab.navigation.errors import NavigationError
 from navlab.navigation.goal import STATUS, GoalHandle, GoalState, MoveBaseState, RecoveryTrigger, with_headings
 from navlab.navigation.recovery import DEFAULT_RECOVERIES, ClearCostmapRecovery
+from navlab.navigation.scan_points import ScanPoints
 from navlab.plugins import ControlResult, PluginContext, load_plugin, make_plugin, plugin_names, resolve_name
 
 Pose = tuple[float, float, float]
@@ -72,6 +73,7 @@ class MoveBase(Node):
             check_ceiling(NavigationError, "move_base", key, p[key], "rate")
         raw_recoveries = self.declare_parameter("recovery_behaviors", [dict(r) for r in DEFAULT_RECOVERIES])
         private = self.fully_qualified_name
+        self._scan_points = ScanPoints()  # both costmaps read the same scans: their points are worked out once
         self.global_costmap = self._costmap("global_costmap", private)
         self.local_costmap = self._costmap("local_costmap", private)
         self.costmaps = {"global": self.global_costmap, "local": self.local_costmap}
@@ -110,6 +112,7 @@ class MoveBase(Node):
         self.handle: GoalHandle | None = None
         self.state = MoveBaseState.IDLE
         self.global_plan: np.ndarray | None = None
+        self._plan_local: tuple[np.ndarray, tuple[float, float, float], np.ndarray] | None = None  # the last one
         self._ids = 0
         self._reset_goal_state()
 
@@ -120,7 +123,8 @@ class MoveBase(Node):
         return self.get_parameters_by_prefix(prefix)
 
     def _costmap(self, name: str, private: str) -> Costmap2DROS:
-        return Costmap2DROS(self, name, self._namespace(name), topic_prefix=f"{private}/{name}")
+        return Costmap2DROS(self, name, self._namespace(name), topic_prefix=f"{private}/{name}",
+                            scan_points=self._scan_points)
 
     def _recoveries(self, raw: Any) -> list[tuple[str, Any]]:
         if not isinstance(raw, list) or not all(isinstance(r, dict) and {"name", "type"} <= set(r) for r in raw):
@@ -223,10 +227,14 @@ class MoveBase(Node):
             t = self.executor.tf.lookup_pose2d(lf, gf)
         except TfError:
             return None
+        last = self._plan_local
+        if last is not None and last[0] is plan and last[1] == t:  # amcl moves map -> odom only now and then
+            return last[2].copy()  # the controller may keep (or change) what it is given
         out = transform_points2(t, plan[:, :2])
         if plan.shape[1] > 2:
             out = np.column_stack([out, wrap_angle(plan[:, 2] + t[2])])
-        return out
+        self._plan_local = (plan, t, out)
+        return out.copy()
 
     # --- planning --------------------------------------------------------------------------------------
 

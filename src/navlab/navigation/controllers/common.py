@@ -13,6 +13,7 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
+import numba
 import numpy as np
 
 from navlab.core.params import param_error
@@ -122,8 +123,32 @@ def prune_plan(plan: np.ndarray, x: float, y: float) -> np.ndarray:
     """Drop the poses before the first one within 1 m of (x, y) (base_local_planner's ``prunePlan``).
 
     A plan with no pose within 1 m is kept whole (ROS would empty it)."""
-    near = np.nonzero(np.hypot(plan[:, 0] - x, plan[:, 1] - y) < 1.0)[0]
-    return plan[near[0]:] if len(near) else plan
+    first = _first_near(plan, x, y, 1.0)
+    return plan[first:] if first >= 0 else plan
+
+
+@numba.njit(cache=True)
+def _first_near(plan: np.ndarray, x: float, y: float, distance: float) -> int:  # pragma: no cover - compiled
+    """Index of the first pose of ``plan`` closer than ``distance`` m to (x, y) (``math.hypot``), -1 if none."""
+    for k in range(plan.shape[0]):
+        if math.hypot(plan[k, 0] - x, plan[k, 1] - y) < distance:
+            return k
+    return -1
+
+
+@numba.njit(cache=True)
+def _crop_span(plan: np.ndarray, x: float, y: float, radius: float) -> tuple[int, int]:  # pragma: no cover
+    """(first, end) of ``crop_plan``'s stretch; (0, 0) when no pose lies within ``radius`` m."""
+    r2 = radius * radius
+    first = -1
+    for k in range(plan.shape[0]):
+        dx, dy = plan[k, 0] - x, plan[k, 1] - y
+        if dx * dx + dy * dy <= r2:
+            if first < 0:
+                first = k
+        elif first >= 0:
+            return first, k + 1
+    return (first, plan.shape[0]) if first >= 0 else (0, 0)
 
 
 def crop_plan(plan: np.ndarray, x: float, y: float, radius: float) -> np.ndarray:
@@ -131,12 +156,8 @@ def crop_plan(plan: np.ndarray, x: float, y: float, radius: float) -> np.ndarray
     the first pose within ``radius`` m (half the local costmap's larger side) up to the first pose beyond it
     again, that one included (ROS's loop keeps it). Empty when no pose is that close (ROS: an empty
     transformed plan, no command)."""
-    inside = (plan[:, 0] - x) ** 2 + (plan[:, 1] - y) ** 2 <= radius * radius
-    if not inside.any():
-        return plan[:0]
-    first = int(np.argmax(inside))
-    beyond = np.nonzero(~inside[first:])[0]
-    return plan[first:first + (int(beyond[0]) + 1 if len(beyond) else len(plan) - first)]
+    first, end = _crop_span(plan, x, y, radius)
+    return plan[first:end]
 
 
 def circle_footprint(radius: float) -> np.ndarray:

@@ -32,16 +32,20 @@ def rollout(pose: tuple[float, float, float], velocity: tuple[float, float], tar
     """
     n = np.broadcast_to(np.maximum(np.asarray(steps, dtype=np.int64), 1), (len(targets),)).copy()
     out = np.empty((len(targets), int(n.max()) if len(n) else 1, 3))
-    _rollout(float(pose[0]), float(pose[1]), float(pose[2]), float(velocity[0]), float(velocity[1]),
+    none = np.zeros((0, 0))
+    integrate_rollouts(float(pose[0]), float(pose[1]), float(pose[2]), float(velocity[0]), float(velocity[1]),
              np.ascontiguousarray(targets, dtype=np.float64), n, float(sim_time), float(acc[0]), float(acc[1]),
-             accelerate, out)
+             accelerate, out, none, none)
     return out
 
 
 @numba.njit(cache=True)
-def _rollout(x0: float, y0: float, th0: float, v0: float, w0: float, targets: np.ndarray, steps: np.ndarray,
-             sim_time: float, ax: float, ath: float, accelerate: bool,
-             out: np.ndarray) -> None:  # pragma: no cover - compiled
+def integrate_rollouts(x0: float, y0: float, th0: float, v0: float, w0: float, targets: np.ndarray, steps: np.ndarray,
+             sim_time: float, ax: float, ath: float, accelerate: bool, out: np.ndarray, cos: np.ndarray,
+             sin: np.ndarray) -> None:  # pragma: no cover - compiled
+    """:func:`rollout`'s integration into ``out``; ``cos``/``sin`` (the poses' shape, or empty: not kept) get the
+    cosine and sine of each pose's heading, which the integration works out anyway."""
+    keep = cos.size > 0
     for s in range(out.shape[0]):
         x, y, th, v, w = x0, y0, th0, v0, w0
         tv, tw = targets[s, 0], targets[s, 1]
@@ -49,6 +53,8 @@ def _rollout(x0: float, y0: float, th0: float, v0: float, w0: float, targets: np
         for k in range(out.shape[1]):
             if k >= steps[s]:
                 out[s, k, 0], out[s, k, 1], out[s, k, 2] = out[s, k - 1, 0], out[s, k - 1, 1], out[s, k - 1, 2]
+                if keep:
+                    cos[s, k], sin[s, k] = cos[s, k - 1], sin[s, k - 1]
                 continue
             out[s, k, 0], out[s, k, 1], out[s, k, 2] = x, y, th
             if accelerate:
@@ -56,8 +62,11 @@ def _rollout(x0: float, y0: float, th0: float, v0: float, w0: float, targets: np
                 w = min(max(tw, w - ath * dt), w + ath * dt)
             else:
                 v, w = tv, tw
-            x += v * math.cos(th) * dt
-            y += v * math.sin(th) * dt
+            ch, sh = math.cos(th), math.sin(th)
+            if keep:
+                cos[s, k], sin[s, k] = ch, sh
+            x += v * ch * dt
+            y += v * sh * dt
             th += w * dt
 
 

@@ -139,6 +139,7 @@ class RolloutController:
         self._rotating_to_goal = False
         self._outlines: dict[tuple[float, bytes | None], np.ndarray | None] = {}
         self._near: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
+        self._goal_map: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None  # (costs, goal cell, distances)
         self._clear_outputs()
 
     @staticmethod
@@ -237,7 +238,19 @@ class RolloutController:
             return None  # ROS: "None of the points of the global plan were in the local costmap"
         free = self._free_cells(cost, pose_l, res)
         return LocalScene(frame, pose_l, cost, res, plan, cells, mapgrid.distance_map(cost, cells, free),
-                          mapgrid.distance_map(cost, cells[-1:]))
+                          self._goal_dist(cost, cells[-1:]))
+
+    def _goal_dist(self, cost: np.ndarray, goal: np.ndarray) -> np.ndarray:
+        """The local goal cell's distance map, kept while the costs and that cell stay the same (the robot moves
+        a few cells per costmap update; the goal cell moves less often)."""
+        cached = self._goal_map
+        if (cached is not None and np.array_equal(cached[1], goal) and cached[0].shape == cost.shape
+                and np.array_equal(cached[0], cost)):
+            return cached[2]
+        dist = mapgrid.distance_map(cost, goal)
+        self._goal_map = (cost.copy(), goal.copy(), dist)
+        return dist
+
 
     def _free_cells(self, cost: np.ndarray, pose_l: tuple[float, float, float], res: float) -> np.ndarray | None:
         """Cells never obstacles for the path map's wave (None: none)."""

@@ -11,9 +11,10 @@ from typing import Any
 import numpy as np
 
 from navlab.core import read_params
+from navlab.navigation.controllers import trajectory_cycle as cycle
 from navlab.navigation.controllers.common import InPlaceFlags
 from navlab.navigation.controllers.params import TrajectoryPlannerParams
-from navlab.navigation.controllers.rollout import footprint_cells, heading_diffs, lookup, rollout, rollout_scores
+from navlab.navigation.controllers.rollout import footprint_cells, heading_diffs, rollout_scores
 from navlab.navigation.controllers.rollout_controller import LocalScene, RolloutController
 
 # --- base_local_planner/TrajectoryPlannerROS ----------------------------------------------------------
@@ -123,42 +124,30 @@ class TrajectoryPlannerROS(RolloutController):
         vmin = min(max(p.min_vel_x, v0 - p.acc_lim_x * horizon), vmax)
         wmax = min(p.max_vel_theta, w0 + p.acc_lim_theta * horizon)
         wmin = min(max(p.min_vel_theta, w0 - p.acc_lim_theta * horizon), wmax)
-        # ROS's order: per speed the straight rollout, then vtheta_samples - 1 turn rates from the lowest up
-        vxs = np.linspace(vmin, vmax, p.vx_samples) if p.vx_samples > 1 else np.array([vmin])
-        ws = np.linspace(wmin, wmax, p.vtheta_samples) if p.vtheta_samples > 1 else np.array([wmin])
-        dw = (wmax - wmin) / (p.vtheta_samples - 1) if p.vtheta_samples > 1 else 0.0
-        spin = np.where(ws > 0, np.maximum(ws, p.min_in_place_vel_theta), np.minimum(ws, -p.min_in_place_vel_theta))
-        # rows: forward (each speed: w 0, then ws[:-1]), in place (0, spin), escape (escape_vel, 0); one array
-        nw, nf, ni = len(ws), len(vxs) * len(ws), len(ws)
-        targets = np.zeros((nf + ni + 1, 2))
-        targets[:nf, 0] = np.repeat(vxs, nw)
-        targets[:nf].reshape(len(vxs), nw, 2)[:, 1:, 1] = ws[:-1]  # a view: targets[:nf] is contiguous
-        targets[nf:nf + ni, 1] = spin
-        targets[-1, 0] = p.escape_vel
-        traj = rollout(scene.pose, velocity, targets, self._steps(targets), p.sim_time, (p.acc_lim_x, p.acc_lim_theta),
-                       accelerate=True)
-        costs = self._score(scene, traj)
-        best = -1
-        if not self._escaping:
-            ok = costs[:nf] >= 0
-            if ok.any():
-                best = int(np.argmin(np.where(ok, costs[:nf], np.inf)))
-        # turn in place towards where the look-ahead point is nearest the goal
-        ahead = traj[nf:nf + ni, -1]
-        hx = ahead[:, 0] + p.heading_lookahead * np.cos(ahead[:, 2])
-        hy = ahead[:, 1] + p.heading_lookahead * np.sin(ahead[:, 2])
-        head_dist, head_in = lookup(scene.goal_dist, scene.resolution, hx, hy)
-        allowed = self._spin.allowed(ws)
-        best_heading = math.inf
-        # Python floats and bools of the same values: the loop reads them without numpy scalar lookups
-        cost_l, ws_l, dist_l = costs.tolist(), ws.tolist(), head_dist.tolist()
-        in_l, allowed_l = head_in.tolist(), allowed.tolist()
-        for k in range(ni):
-            c = cost_l[nf + k]
-            if c < 0 or not (best < 0 or c <= cost_l[best]) or abs(ws_l[k]) <= dw or not in_l[k] or not allowed_l[k]:
-                continue
-            if dist_l[k] < best_heading:
-                best, best_heading = nf + k, dist_l[k]
+        # samples, rollouts and costs in one compiled call (trajectory_cycle), then the choice in another
+        res = scene.resolution
+        outline = self._outline(res)
+        near = self._near_max(scene)
+        ang = p.angular_sim_granularity if p.angular_sim_granularity > 0 else p.sim_granularity
+        limits = np.array([vmin, vmax, wmin, wmax, p.min_in_place_vel_theta, p.escape_vel, p.acc_lim_x,
+                           p.acc_lim_theta])
+        steps = max(1, int(p.sim_time / p.sim_granularity + 0.5)) if p.heading_scoring else 0
+        at = self._heading_step(steps) if p.heading_scoring else -1
+        empty = np.zeros(0)
+        targets, traj, costs, ws, dw = cycle.score_samples(
+            scene.cost, scene.cost if near is None else near, scene.path_dist, scene.goal_dist, res, scene.pose,
+            velocity, limits, (p.vx_samples, p.vtheta_samples), np.array([p.sim_time, p.sim_granularity, ang,
+                                                                          float(p.heading_scoring)]),
+            empty if outline is None else np.ascontiguousarray(outline[:, 0]),
+            empty if outline is None else np.ascontiguousarray(outline[:, 1]),
+            outline is not None, near is not None, self._weights(res), scene.impossible, at)
+        if at >= 0:  # ROS: + 0.3 * headingDiff at the scored step (not scaled by meter_scoring)
+            ok = costs >= 0
+            costs[ok] += 0.3 * heading_diffs(scene.cost, res, np.ascontiguousarray(scene.plan[:, :2]),
+                                             np.ascontiguousarray(traj[ok, at]))
+        nf = len(targets) - len(ws) - 1
+        best = cycle.choose(costs, traj, ws, dw, nf, self._escaping, scene.goal_dist, res, p.heading_lookahead,
+                            self._spin.stuck_left, self._spin.stuck_right)
         if best >= 0:
             self._spin.update(pose, float(targets[best, 0]), float(targets[best, 1]))
             self._end_escape(pose)
@@ -170,6 +159,11 @@ class TrajectoryPlannerROS(RolloutController):
             self._escaping, self._escape_pose = True, pose
         self._end_escape(pose)
         return self._finish(scene, targets, traj, costs, esc if costs[esc] > -2.0 else -1, pose)
+
+    def _weights(self, res: float) -> np.ndarray:
+        """The scoring kernel's (scale, pdist_scale, gdist_scale, occdist_scale)."""
+        p = self.params
+        return np.array([res if p.meter_scoring else 1.0, p.pdist_scale, p.gdist_scale, p.occdist_scale])
 
     def _end_escape(self, pose: tuple[float, float, float]) -> None:
         """Leave escape mode once ``escape_reset_dist`` m or ``escape_reset_theta`` rad from where it began."""

@@ -17,6 +17,7 @@ import numpy as np
 
 from navlab.core.limits import check_ceiling
 from navlab.grid import Grid
+from navlab.navigation.costmap.kernels import circle_cells
 from navlab.navigation.errors import NavigationError
 
 
@@ -61,6 +62,9 @@ class Footprint:
             raise NavigationError(f"footprint cells need a costmap with origin yaw 0, got {grid.origin[2]}")
         x, y, _ = pose
         reach = self.circumscribed_radius
+        if self.polygon is None:  # a round robot: one compiled pass
+            return circle_cells(float(x), float(y), reach, grid.origin[0], grid.origin[1], grid.resolution,
+                                grid.width, grid.height)
         lo = grid.world_to_cell(np.array([[x - reach, y - reach]]))[0]
         hi = grid.world_to_cell(np.array([[x + reach, y + reach]]))[0]
         ii, jj = np.meshgrid(np.arange(lo[0], hi[0] + 1), np.arange(lo[1], hi[1] + 1))

@@ -9,11 +9,11 @@ from typing import Any, Self
 
 import numba
 import numpy as np
-from scipy import ndimage
 
 from navlab.core import read_params
 from navlab.grid import COST_FREE, COST_INSCRIBED, COST_LETHAL, COST_UNKNOWN, Grid
 from navlab.navigation.costmap.footprint import Footprint, make_footprint
+from navlab.navigation.costmap.kernels import inflate_box, lethal_changes
 from navlab.navigation.costmap.layer import Layer, costmap_of
 from navlab.navigation.costmap.params import InflationLayerParams, layer_params
 from navlab.plugins import PluginContext
@@ -83,56 +83,45 @@ class InflationLayer(Layer):
 
     def update_costs(self, master: Grid) -> None:
         data = master.data
-        seeds = data == COST_LETHAL
-        if not seeds.any():
+        reach = math.ceil(self.params.inflation_radius / master.resolution) + 1
+        reach = min(reach, math.ceil(math.hypot(*data.shape)) + 1)  # no cell is further: the table stays grid-sized
+        key = (master.origin, master.resolution, data.shape)
+        cached = self._inflated
+        fresh = cached is None or cached[0] != key
+        seeds = np.empty(data.shape, dtype=np.bool_)
+        previous = np.zeros((0, 0), np.bool_) if fresh or cached is None else cached[1]  # none: every seed is new
+        count, *changed = lethal_changes(data, np.uint8(COST_LETHAL), seeds, previous)
+        if count == 0:
             return
-        cost = self._inflation(master, seeds)
+        cost = self._inflation(master, seeds, reach, key, changed)
         _merge(data, cost, bool(self.params.inflate_unknown))
 
-    def _inflation(self, master: Grid, seeds: np.ndarray) -> np.ndarray:
+    def _inflation(self, master: Grid, seeds: np.ndarray, reach: int, key: Any, changed: list[int]) -> np.ndarray:
         """Inflation costs (uint8, the master's shape; 0 beyond ``inflation_radius``) of the lethal ``seeds``.
 
         A cell's cost depends only on the seeds within ``reach`` cells of it, so after the first update only
-        the cells within ``reach`` of a seed that appeared or vanished are recomputed, from the seeds within
-        ``reach`` of those (exactly what a transform of the whole grid gives them)."""
-        reach = math.ceil(self.params.inflation_radius / master.resolution) + 1
-        reach = min(reach, math.ceil(math.hypot(*seeds.shape)) + 1)  # no cell is further: the table stays grid-sized
-        key = (master.origin, master.resolution, seeds.shape)
+        the cells within ``reach`` of a seed that appeared or vanished (``changed``: their bounding rows and
+        columns) are recomputed, from the seeds within ``reach`` of those (exactly what a transform of the whole
+        grid gives them)."""
         cached = self._inflated
         if cached is None or cached[0] != key:
             cost = np.zeros(seeds.shape, dtype=np.uint8)
-            box = _box(seeds, reach, seeds.shape)
         else:
             cost = cached[2]
-            changed = seeds != cached[1]
-            if not changed.any():
+            if changed[1] == 0:
                 return cost  # the same obstacles as last update: the same inflation (skips the transform)
-            box = _box(changed, reach, seeds.shape)
-        j0, j1, i0, i1 = box
-        o0, o1 = max(0, j0 - reach), min(seeds.shape[0], j1 + reach)
-        p0, p1 = max(0, i0 - reach), min(seeds.shape[1], i1 + reach)
-        near = seeds[o0:o1, p0:p1]
-        if near.any():  # the nearest seed of each cell, its squared distance in cells, the cost of that
-            ft = ndimage.distance_transform_edt(~near, return_distances=False, return_indices=True)
-            _costs_from_features(ft, j0 - o0, i0 - p0, self._table(master.resolution, reach), cost[j0:j1, i0:i1])
+        h, w = seeds.shape
+        j0, j1 = max(0, changed[0] - reach), min(h, changed[1] + reach)
+        i0, i1 = max(0, changed[2] - reach), min(w, changed[3] + reach)
+        o0, o1 = max(0, j0 - reach), min(h, j1 + reach)
+        p0, p1 = max(0, i0 - reach), min(w, i1 + reach)
+        if seeds[o0:o1, p0:p1].any():  # the squared distance (cells) to each cell's nearest seed, its cost
+            inflate_box(seeds, (o0, o1, p0, p1), (j0, j1, i0, i1), self._table(master.resolution, reach),
+                        cost[j0:j1, i0:i1])
         else:  # no obstacle within reach of the box: nothing to inflate there
             cost[j0:j1, i0:i1] = 0
         self._inflated = (key, seeds, cost)
         return cost
-
-
-@numba.njit(cache=True)
-def _costs_from_features(ft: np.ndarray, r0: int, c0: int, table: np.ndarray,
-                         out: np.ndarray) -> None:  # pragma: no cover - compiled
-    """``out[j, i]`` = ``table`` at the squared distance (cells) from cell (r0 + j, c0 + i) to its nearest seed
-    (``ft``: scipy's feature transform), the table's last entry beyond its end."""
-    last = table.size - 1
-    for j in range(out.shape[0]):
-        for i in range(out.shape[1]):
-            dj = np.int64(ft[0, r0 + j, c0 + i]) - (r0 + j)
-            di = np.int64(ft[1, r0 + j, c0 + i]) - (c0 + i)
-            d2 = dj * dj + di * di
-            out[j, i] = table[d2 if d2 < last else last]
 
 
 @numba.njit(cache=True)
@@ -147,11 +136,3 @@ def _merge(data: np.ndarray, cost: np.ndarray, inflate_unknown: bool) -> None:  
                     data[j, i] = c
             elif c > d:
                 data[j, i] = c
-
-
-def _box(mask: np.ndarray, reach: int, shape: tuple[int, ...]) -> tuple[int, int, int, int]:
-    """Row and column bounds (j0, j1, i0, i1) of the cells within ``reach`` of a true cell of ``mask``."""
-    rows = np.flatnonzero(mask.any(axis=1))
-    cols = np.flatnonzero(mask.any(axis=0))
-    return (max(0, int(rows[0]) - reach), min(shape[0], int(rows[-1]) + reach + 1),
-            max(0, int(cols[0]) - reach), min(shape[1], int(cols[-1]) + reach + 1))

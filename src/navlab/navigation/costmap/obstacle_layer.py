@@ -11,6 +11,7 @@ import numpy as np
 from navlab.core import read_params
 from navlab.grid import COST_FREE, COST_LETHAL, COST_UNKNOWN, Grid
 from navlab.navigation.costmap.footprint import Footprint, make_footprint
+from navlab.navigation.costmap.kernels import combine, mark_returns
 from navlab.navigation.costmap.layer import Layer, costmap_of, same_geometry
 from navlab.navigation.costmap.params import ObservationSource, ObstacleLayerParams, layer_params
 from navlab.navigation.costmap.raytrace import clear_rays
@@ -123,11 +124,8 @@ class ObstacleLayer(Layer):
             clear_rays(g.data, (o[0] - ox) / res, (o[1] - oy) / res, np.ascontiguousarray(cells),
                        src.raytrace_range / res, src.raytrace_min_range / res, np.uint8(COST_FREE))
         if src.marking:
-            d = np.hypot(pts[:, 0] - o[0], pts[:, 1] - o[1])
-            mark = ok & finite & (d < src.obstacle_range) & (d >= src.obstacle_min_range)
-            ij = g.world_to_cell(pts[mark])
-            ij = ij[g.in_bounds(ij)]
-            g.data[ij[:, 1], ij[:, 0]] = COST_LETHAL
+            mark_returns(g.data, pts, ok, float(o[0]), float(o[1]), ox, oy, res, src.obstacle_min_range,
+                         src.obstacle_range, np.uint8(COST_LETHAL))
 
     def clear_outside(self, xy: tuple[float, float], size: float) -> None:
         """Forget what lies outside the ``size`` x ``size`` m square centred on ``xy`` (m, costmap frame):
@@ -151,14 +149,7 @@ class ObstacleLayer(Layer):
         if self.params.footprint_clearing_enabled and self.robot_pose is not None:
             ij = self.footprint.cells(g, self.robot_pose)
             g.data[ij[:, 1], ij[:, 0]] = COST_FREE
-        layer = g.data
-        known = layer != COST_UNKNOWN
-        if self.params.combination_method == 0:
-            master.data[known] = layer[known]
-        else:
-            old = master.data
-            take = known & ((old == COST_UNKNOWN) | (old < layer))
-            old[take] = layer[take]
+        combine(master.data, g.data, self.params.combination_method != 0)
 
     def reset(self) -> None:
         if self.grid is not None:

@@ -33,7 +33,8 @@ class StaticLayer(Layer):
         self.map: GridMap | None = None
         self.costs: np.ndarray | None = None
         self.map_in_costmap = (0.0, 0.0, 0.0)
-        self._lookup: tuple[tuple[Any, ...], np.ndarray, np.ndarray] | None = None
+        # (geometry key, master cells, map cells, whether that is the identity) of the last master
+        self._lookup: tuple[tuple[Any, ...], np.ndarray, np.ndarray, bool] | None = None
 
     @classmethod
     def from_params(cls, params: Mapping[str, Any] | None, *, context: PluginContext) -> Self:
@@ -93,13 +94,17 @@ class StaticLayer(Layer):
         ok = self.map.in_bounds(src)
         dst_flat = np.flatnonzero(ok)
         src_flat = src[ok, 1] * self.map.width + src[ok, 0]
-        self._lookup = (key, dst_flat, src_flat)
+        same = master.data.shape == self.map.data.shape and np.array_equal(dst_flat, src_flat)
+        self._lookup = (key, dst_flat, src_flat, same and len(dst_flat) == master.data.size)
         return dst_flat, src_flat
 
     def update_costs(self, master: Grid) -> None:
         if self.map is None or self.costs is None:
             return
         dst, src = self._cells(master)
+        if not self.params.use_maximum and self._lookup is not None and self._lookup[3]:
+            np.copyto(master.data, self.costs)  # the master is the map, cell for cell
+            return
         out = master.data.reshape(-1)
         vals = self.costs.reshape(-1)[src]
         if self.params.use_maximum:
