@@ -10,12 +10,31 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from rosbags.typesys import Stores, get_typestore
+from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
 from navlab.errors import NavlabError
 from navlab.geometry import quat_from_yaw, yaw_from_quat
 
 TYPESTORE = get_typestore(Stores.ROS2_HUMBLE)
+# gazebo_msgs and costmap_2d (not in the ROS 2 store): the bumper plugin's contact messages, with the fields ROS
+# Noetic and gazebo_ros_pkgs for ROS 2 give them, and the voxel layer's grid
+TYPESTORE.register({
+    **get_types_from_msg("""string info
+string collision1_name
+string collision2_name
+geometry_msgs/Wrench[] wrenches
+geometry_msgs/Wrench total_wrench
+geometry_msgs/Vector3[] contact_positions
+geometry_msgs/Vector3[] contact_normals
+float64[] depths
+""", "gazebo_msgs/msg/ContactState"),
+    **get_types_from_msg("std_msgs/Header header\ngazebo_msgs/ContactState[] states\n",
+                         "gazebo_msgs/msg/ContactsState"),
+    # costmap_2d's voxel layer (publish_voxel_map): the packed voxel columns
+    **get_types_from_msg("std_msgs/Header header\nuint32[] data\ngeometry_msgs/Point32 origin\n"
+                         "geometry_msgs/Vector3 resolutions\nuint32 size_x\nuint32 size_y\nuint32 size_z\n",
+                         "costmap_2d/msg/VoxelGrid"),
+})
 _T = TYPESTORE.types
 
 Time = _T["builtin_interfaces/msg/Time"]
@@ -55,6 +74,16 @@ GoalStatusArray = _T["action_msgs/msg/GoalStatusArray"]
 GoalInfo = _T["action_msgs/msg/GoalInfo"]
 UUID = _T["unique_identifier_msgs/msg/UUID"]
 Bool = _T["std_msgs/msg/Bool"]
+Image = _T["sensor_msgs/msg/Image"]
+CameraInfo = _T["sensor_msgs/msg/CameraInfo"]
+RegionOfInterest = _T["sensor_msgs/msg/RegionOfInterest"]
+PointCloud2 = _T["sensor_msgs/msg/PointCloud2"]
+PointField = _T["sensor_msgs/msg/PointField"]
+Range = _T["sensor_msgs/msg/Range"]
+Wrench = _T["geometry_msgs/msg/Wrench"]
+ContactState = _T["gazebo_msgs/msg/ContactState"]
+ContactsState = _T["gazebo_msgs/msg/ContactsState"]
+VoxelGrid = _T["costmap_2d/msg/VoxelGrid"]
 
 
 class MessageTypeError(NavlabError, LookupError):

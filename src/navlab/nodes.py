@@ -19,6 +19,7 @@ NODES: dict[str, str] = {
     "ekf_localization_node": "navlab.localization.ekf_node:EkfNode",
     "velocity_smoother": "navlab.navigation.velocity_smoother:VelocitySmootherNode",
     "collision_monitor": "navlab.navigation.collision_monitor:CollisionMonitorNode",
+    "pointcloud_to_laserscan_node": "navlab.navigation.pointcloud_to_laserscan:PointCloudToLaserScan",
 }
 
 #: launch files' ``$(robot KEY)``: a function of the ``robot`` argument (shipped name, file or

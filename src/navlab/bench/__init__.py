@@ -25,6 +25,7 @@ BENCHES: dict[str, str] = {
     "description": "navlab.bench.description:run",
     "sim": "navlab.bench.sim:run",
     "decompose": "navlab.bench.decompose:run",
+    "sensors": "navlab.bench.sensors:run",
     "controller": "navlab.bench.navigation:run_controller",
     "planner": "navlab.bench.navigation:run_planner",
     "nav": "navlab.bench.experiments:run_nav",

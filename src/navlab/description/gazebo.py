@@ -15,9 +15,11 @@ from typing import Literal
 
 from navlab.description.errors import DescriptionError
 from navlab.description.gazebo_sensors import IMU_MODEL_PLUGINS, parse_imu, parse_lidar, parse_p3d, sensor_plugin
+from navlab.description.gazebo_sensors3d import read_sensor3d
 from navlab.description.gazebo_values import number, parse_bool, plugin_file, plugin_rate, ros_remaps, scoped
 from navlab.description.materials import gazebo_material
 from navlab.description.model import DiffDriveConfig, ImuConfig, LidarConfig, Link, Origin, P3dConfig, RosControlConfig
+from navlab.description.sensor_model import SensorSuite
 from navlab.description.skid_steer import (
     CONTACT_TAGS,
     ROS_CONTROL_PLUGINS,
@@ -83,6 +85,7 @@ class GazeboTags:
     lidars: list[LidarConfig] = field(default_factory=list)
     imus: list[ImuConfig] = field(default_factory=list)
     ground_truths: list[P3dConfig] = field(default_factory=list)
+    sensors: SensorSuite = field(default_factory=SensorSuite)  # cameras, 3D lidars, ranges, bumpers
     warnings: list[str] = field(default_factory=list)
 
 
@@ -202,6 +205,8 @@ def _read_sensor(sensor: ET.Element, link: str, where: str, out: GazeboTags,
     stype = sensor.get("type", "")
     w = f"{where}/<sensor name=\"{sensor.get('name', '')}\" type=\"{stype}\">"
     plugin = sensor_plugin(sensor)
+    if plugin is not None and read_sensor3d(sensor, plugin, link, w, out.sensors, out.warnings):
+        return
     if stype in ("ray", "gpu_ray", "lidar", "gpu_lidar"):
         if plugin is None:
             out.warnings.append(f"{w}: no ROS plugin, so nothing is published; sensor ignored")
@@ -218,8 +223,8 @@ def _read_sensor(sensor: ET.Element, link: str, where: str, out: GazeboTags,
         else:
             imu_sensors[link] = sensor
     else:
-        out.warnings.append(f"{w}: sensor type {stype!r} is not simulated (navlab has ray/gpu_ray and imu); "
-                            "ignored")
+        out.warnings.append(f"{w}: sensor type {stype!r} is not simulated (navlab has ray/gpu_ray, imu, "
+                            "camera, depth and contact sensors with their gazebo_ros plugins); ignored")
 
 
 def _read_model_plugin(plugin: ET.Element, where: str, out: GazeboTags) -> None:

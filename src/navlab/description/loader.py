@@ -107,6 +107,7 @@ def load_robot(
     model.lidars = tags.lidars
     model.imus = tags.imus
     model.ground_truths = tags.ground_truths
+    model.sensors = tags.sensors
     model.warnings += tags.warnings
     if model.diff_drive is None and model.ros_control is None:
         model.warnings.append(f"{source}: no libgazebo_ros_diff_drive.so plugin; cmd_vel will not move "

@@ -9,11 +9,14 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Literal, TypeGuard, get_args
+from typing import TYPE_CHECKING, Literal, TypeGuard, get_args
 
 import numpy as np
 
 from navlab.geometry import Pose6, compose6, matrix_from_pose6, pose6_from_matrix
+
+if TYPE_CHECKING:
+    from navlab.description.sensor_model import SensorSuite
 
 Vec3 = tuple[float, float, float]
 
@@ -251,6 +254,12 @@ class P3dConfig:
     name: str = "p3d"
 
 
+def _sensor_suite() -> SensorSuite:
+    from navlab.description.sensor_model import SensorSuite  # it imports Origin from here
+
+    return SensorSuite()
+
+
 @dataclass
 class RobotModel:
     """A whole robot: links by name, joints in file order, the root link, and its plugins."""
@@ -264,6 +273,7 @@ class RobotModel:
     lidars: list[LidarConfig] = field(default_factory=list)
     imus: list[ImuConfig] = field(default_factory=list)
     ground_truths: list[P3dConfig] = field(default_factory=list)  # p3d plugins
+    sensors: SensorSuite = field(default_factory=lambda: _sensor_suite())  # cameras, 3D lidars, ranges, bumpers
     warnings: list[str] = field(default_factory=list)
     source: Path | None = None
     urdf_xml: str = ""  # the expanded URDF (after xacro), for robot_description

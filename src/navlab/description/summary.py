@@ -49,6 +49,7 @@ def robot_summary(robot: RobotModel) -> dict[str, Any]:
         "ros_control": asdict(robot.ros_control) if robot.ros_control else None,
         "lidars": [{**asdict(lidar), "origin": asdict(lidar.origin)} for lidar in robot.lidars],
         "imus": [{**asdict(imu), "origin": asdict(imu.origin)} for imu in robot.imus],
+        "sensors": [{"sensor": type(c).__name__, **asdict(c)} for c in robot.sensors.all()],
         "warnings": list(robot.warnings),
     }
 
@@ -88,6 +89,28 @@ def format_robot(s: dict[str, Any]) -> str:
     for imu in s["imus"]:
         lines.append(f"  imu {imu['name']} on {imu['link']}: {imu['update_rate']} Hz -> {imu['topic']} "
                      f"[{imu['frame_id']}]")
+    for c in s.get("sensors", []):
+        lines.append(f"  {sensor_line(c)}")
     lines += [f"  warning: {w}" for w in s["warnings"]]
     lines.append("  OK" if not s["warnings"] else f"  OK with {len(s['warnings'])} warning(s)")
     return "\n".join(lines)
+
+
+def sensor_line(c: dict[str, Any]) -> str:
+    """One line for a camera, depth camera, 3D lidar, range sensor or bumper of :func:`robot_summary`."""
+    sensor, at = c["sensor"], f"{c['name']} on {c['link']}"
+    if sensor == "CameraConfig":
+        cam = c["camera"]
+        what = (f"{cam['width']} x {cam['height']}, hfov {cam['horizontal_fov']:.4g} rad, clip {cam['near']}-"
+                f"{cam['far']} m, {c['update_rate']} Hz")
+        if c["kind"] == "depth":
+            return f"depth camera {at}: {what} -> {c['depth_image_topic']}, {c['point_cloud_topic']} [{c['frame_id']}]"
+        return f"camera {at}: {what} -> {c['image_topic']} [{c['frame_id']}]"
+    if sensor == "Lidar3dConfig":
+        return (f"3D lidar {at}: {c['rings']} rings {c['vertical_min_angle']:.4g}..{c['vertical_max_angle']:.4g} rad x "
+                f"{c['samples']} samples, {c['range_min']}-{c['range_max']} m, {c['update_rate']} Hz -> {c['topic']} "
+                f"[{c['frame_id']}]")
+    if sensor == "RangeConfig":
+        return (f"range ({c['radiation']}) {at}: fov {c['fov']} rad, {c['range_min']}-{c['range_max']} m, "
+                f"{c['update_rate']} Hz -> {c['topic']} [{c['frame_id']}]")
+    return f"bumper {at}: collision {c['collision']}, {c['update_rate']} Hz -> {c['topic']} [{c['frame_id']}]"

@@ -19,6 +19,7 @@ from navlab.core import Node, TfError
 from navlab.geometry import compose2, transform_points2
 from navlab.grid import COST_INSCRIBED, COST_LETHAL, COST_UNKNOWN, Grid, GridMap
 from navlab.navigation.costmap.layered import LayeredCostmap
+from navlab.navigation.costmap_sensors import CostmapSensorFeeds
 from navlab.navigation.scan_points import ScanPoints
 
 
@@ -56,7 +57,10 @@ class Costmap2DROS:
         statics = self.layered.map_layers
         if statics:
             node.create_subscription(msgs.OccupancyGrid, statics[0].map_topic, self._on_map, 1)
+        self.feeds = CostmapSensorFeeds(node, name, self.global_frame, self.layered.layers, prefix=prefix)
         for src_name, src in p.sources.items():
+            if src_name in self.feeds.sources:
+                continue
             if src.data_type != "LaserScan":
                 node.get_logger().warning(f"{name}: observation source {src_name} has data_type {src.data_type}; "
                                           "navlab's sensors are LaserScan only, it is ignored")
@@ -134,6 +138,7 @@ class Costmap2DROS:
         for source, msg in list(self._pending.items()):
             self._apply_scan(source, msg)
         self._pending.clear()
+        self.feeds.apply()
         grid = self.layered.update_map(pose)
         self.updated_ns = self.node.executor.now_ns
         self.updates += 1
@@ -167,6 +172,8 @@ class Costmap2DROS:
             return
         for layer in self.layered.scan_layers:
             layer.clear_outside(pose[:2], size)
+        for cloud_layer in self.feeds.voxel:
+            cloud_layer.clear_outside(pose[:2], size)
         self.layered.update_map(pose)
 
     def cost_at(self, xy: tuple[float, float]) -> int:

@@ -78,7 +78,7 @@ class GazeboSim(Node):
         check_start_pose(robot, world, pose)  # a start inside an obstacle is refused, not thrown 7 m
         self.robot = robot
         self.sim = Simulation(robot, world, seed=self.rng, timestep=timestep or None, robot_pose=pose,
-                              visuals=visuals)
+                              visuals=visuals or bool(robot.sensors.cameras))  # cameras draw visuals
         self.sim.time_ns = executor.now_ns  # started late: physics time begins at the current time
         for warning in self.sim.info.warnings:
             self.get_logger().warning(warning)
@@ -112,6 +112,10 @@ class GazeboSim(Node):
             "bodyName": p.link, "topicName": p.topic, "frameName": p.frame_id, "updateRate": p.update_rate})
             for p in robot.ground_truths]  # the robot's own p3d plugins
         self.plugins += extensions.plugins(executor, namespace, self.sim)
+        if robot.sensors.all():  # cameras, 3D lidars, ranges, bumpers (imported only for a robot that has them)
+            from navlab.sim.sensor_plugins import sensor_plugins
+
+            self.plugins += sensor_plugins(executor, namespace, self.sim)
         if robot is not None:  # Gazebo's bumper: what the robot touches, on /collisions
             self.plugins.append(CollisionPlugin(executor, namespace=namespace, sim=self.sim))
         if seed >= 0:

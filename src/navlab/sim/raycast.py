@@ -231,3 +231,7 @@ def finish_ranges(
         else:
             r = np.inf
         out[i] = r
+
+
+#: the exact ray-shape test (a compiled function), for the 3-D casters in :mod:`navlab.sim.raycast3d`
+ray_hit = _hit

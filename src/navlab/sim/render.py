@@ -74,7 +74,7 @@ def render_image(
     model, data = sim.model, sim.data
     model.vis.global_.offwidth = max(model.vis.global_.offwidth, width)
     model.vis.global_.offheight = max(model.vis.global_.offheight, height)
-    ctx = _gl_context(width, height)
+    ctx = gl_context(width, height)
     try:
         ctx.make_current()
         mjr = mujoco.MjrContext(model, mujoco.mjtFontScale.mjFONTSCALE_100)
@@ -94,7 +94,7 @@ def render_image(
     return np.flipud(rgb).copy()
 
 
-def _gl_context(width: int, height: int) -> _GLContext:
+def gl_context(width: int, height: int) -> _GLContext:
     """An offscreen OpenGL context: MUJOCO_GL's choice if it is egl/osmesa, else EGL, then OSMesa."""
     wanted = os.environ.get("MUJOCO_GL", "").lower()
     order = [wanted] if wanted in ("egl", "osmesa") else ["egl", "osmesa"]

@@ -391,6 +391,18 @@ class Simulation:
             np.minimum(dist, self._multiray(cfg, rot, pnt, angles, self._ray_slow_groups), out=dist)
         return dist
 
+    def link_body(self, link: str) -> int:
+        """The MuJoCo body id that carries a robot link (fixed links are fused into a moving ancestor)."""
+        if link not in self._body:
+            raise SimError(f"no link named {link!r} on the robot")
+        return int(self._body[link][0])
+
+    def ray_geoms(self) -> tuple[np.ndarray, np.ndarray | None]:
+        """(ids of the world's primitive geoms the fast casters test, geom groups of the rest for
+        ``mj_multiRay`` or None): what every ray sensor sees (the robot's own geoms are not seen)."""
+        self._sync()
+        return self._ray_fast, self._ray_slow_groups
+
     def _multiray(
         self, cfg: LidarConfig, rot: np.ndarray, pnt: np.ndarray, angles: np.ndarray, groups: np.ndarray
     ) -> np.ndarray:

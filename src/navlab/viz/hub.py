@@ -18,10 +18,11 @@ from typing import Any
 import numpy as np
 
 from navlab.viz import frames as fr
+from navlab.viz import sensor_frames
 
 # kind of stream -> most frames per wall-clock second sent to one page
 RATES_HZ = {"state": 30.0, "scan": 15.0, "map": 2.0, "costmap": 4.0, "path": 10.0, "poses": 5.0,
-            "polygon": 10.0, "trace": 2.0, "graph": 0.5}  # fmt: skip
+            "polygon": 10.0, "trace": 2.0, "graph": 0.5, "image": 5.0, "cloud": 5.0}  # fmt: skip
 TRACE_STEP_M = 0.02  # a trace gets a point when the robot moved this far
 TRACE_MAX = 20_000  # points kept per trace
 
@@ -205,6 +206,10 @@ class ClientStream:
             return fr.path_frame(topic, frame, msg)
         if slot.kind == "poses_arr":
             return fr.poses_frame(topic, frame, msg)
+        if slot.kind == "image":
+            return sensor_frames.image_frame(topic, msg)
+        if slot.kind == "cloud_arr":
+            return sensor_frames.cloud_frame(topic, slot.frame, msg)
         if slot.kind == "goal":
             p = msg.pose
             yaw = 2.0 * float(np.arctan2(p.orientation.z, p.orientation.w))
@@ -219,4 +224,6 @@ def _rate_kind(topic: str, kind: str) -> str:
         return "poses"
     if kind == "path_arr":
         return "path"
+    if kind == "cloud_arr":
+        return "cloud"
     return kind

@@ -29,11 +29,12 @@ from navlab.core.graph import Graph, with_layout
 from navlab.drivers import MOVE_BINDINGS, SPEED_BINDINGS, TeleopState
 from navlab.viz.hub import Hub
 from navlab.viz.inputs import check_input
+from navlab.viz.sensor_frames import cloud_in_fixed
 
 # rviz's 2D Pose Estimate: x/y variance 0.25 m², yaw variance (pi/12)² rad²
 INITIALPOSE_COV = (0.25, 0.25, 0.0, 0.0, 0.0, 0.06853891945200942)
 KINDS = {msgs.OccupancyGrid: "grid", msgs.LaserScan: "scan", msgs.Path: "path", msgs.PoseArray: "poses",
-         msgs.PolygonStamped: "polygon"}  # fmt: skip
+         msgs.PolygonStamped: "polygon", msgs.Image: "image", msgs.PointCloud2: "cloud"}  # fmt: skip
 ODOM_PERIOD_NS = 50_000_000  # simulated ns between odometry samples kept for the traces (20 Hz at most)
 GRAPH_WALL_PERIOD = 1.0  # wall-clock s between refreshes of the node graph (at most)
 PEEK_PERIOD = 0.2  # wall-clock s between copies of the plans and the particle cloud
@@ -229,6 +230,17 @@ class ViewerNode(Node):
             self.hub.put(topic, kind, arr[:, :3].copy() if kind == "poses_arr" else arr[:, :2].copy(), frame)
 
     def _on_msg(self, topic: str, kind: str, msg: Any) -> None:
+        if kind == "cloud":  # moved into the fixed frame here, where tf is (a few thousand points)
+            fixed, frame, tf = self._fixed(), str(msg.header.frame_id).lstrip("/"), self.executor.tf
+            try:
+                t = tf.lookup(fixed, frame, msgs.stamp_ns(msg)) if tf.can_transform(fixed, frame, msgs.stamp_ns(msg)) \
+                    else tf.lookup(fixed, frame)
+            except TfError:
+                return
+            xyz = cloud_in_fixed(msg, t, self.rng)
+            if xyz is not None:
+                self.hub.put(topic, "cloud_arr", xyz, fixed)
+            return
         self.hub.put(topic, kind, msg)
 
     def _on_odom(self, topic: str, msg: Any) -> None:

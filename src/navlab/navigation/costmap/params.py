@@ -200,12 +200,21 @@ def _split_dotted(values: dict[str, Any]) -> dict[str, Any]:
             sub = out.setdefault(head, {})
             if not isinstance(sub, dict):
                 raise NavigationError(f"costmap parameter {head}: both a value and a namespace ({key})")
-            sub.update(_split_dotted({tail: val}))
+            _merge(sub, _split_dotted({tail: val}))
         elif isinstance(val, dict) and isinstance(out.get(key), dict):
-            out[key].update(val)
+            _merge(out[key], val)
         else:
             out[key] = val
     return out
+
+
+def _merge(into: dict[str, Any], values: dict[str, Any]) -> None:
+    """Deep update: ``a.b.c`` and ``a.b.d`` both land in ``a: {b: {c, d}}`` (a shallow update kept the last)."""
+    for key, val in values.items():
+        if isinstance(val, dict) and isinstance(into.get(key), dict):
+            _merge(into[key], val)
+        else:
+            into[key] = val
 
 
 def _parse_plugins(raw: Any, namespaces: dict[str, Any]) -> list[PluginSpec]:
@@ -330,5 +339,5 @@ def layer_params(cls: type[T], costmap: CostmapParams, name: str) -> T:
     """A layer's parameters: the costmap-level value of each of its fields, overridden by its namespace ``name``."""
     own = {f.name for f in fields(cls)}
     inherited = {f.name: getattr(costmap, f.name) for f in fields(CostmapParams) if f.name in own}
-    ns = canonical_params(costmap.namespaces.get(name, {}), LAYER_SPEC, what=name)
+    ns = canonical_params(costmap.namespaces.get(name, {}), getattr(cls, "PARAMS", LAYER_SPEC), what=name)
     return read_params(cls, {**inherited, **ns}, what=name)

@@ -91,6 +91,7 @@ function onMessage(m) {
     case "poses": store.poses[m.topic] = m; break;
     case "polygon": store.polygons[m.topic] = m; break;
     case "trace": store.traces[m.topic] = m; break;
+    case "cloud": case "image": break; // drawn by the scene (a display toggle each)
     case "graph": store.graph = m; if (!$("graph").hidden) drawGraph($("graphbody"), m); break;
     case "ack": stats.acks.push(m); if (m.error) { stats.errors.push(m.error); flash(m.error); } break;
     case "error": stats.errors.push(m.error); flash(m.error); break;

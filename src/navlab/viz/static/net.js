@@ -4,7 +4,7 @@
 const UTF8 = new TextDecoder();
 
 // One frame at byte `off` (a multiple of 4) of `buf`, `len` bytes long: its header, and its payload as a view
-// (no copy): `cells` (uint8) for grids, `data` (float32) for the others. A JSON message is a frame of header only.
+// (no copy): `cells` (uint8) for grids and images (RGBA), `data` (float32) for the others. A JSON message is a frame of header only.
 export function decodeFrame(buf, off = 0, len = buf.byteLength - off) {
   const dv = new DataView(buf, off, len);
   const n = dv.getUint32(0, true);
@@ -12,7 +12,7 @@ export function decodeFrame(buf, off = 0, len = buf.byteLength - off) {
   const start = off + 4 + n + ((4 - ((4 + n) % 4)) % 4), end = off + len;
   const k = header.k;
   const at = Math.min(start, buf.byteLength), size = Math.max(0, end - start);
-  if (k === "grid" || k === "tiles") header.cells = new Uint8Array(buf, at, size);
+  if (k === "grid" || k === "tiles" || k === "image") header.cells = new Uint8Array(buf, at, size);
   else if (k !== "state" && k !== "graph") header.data = new Float32Array(buf, at, size / 4);
   return header;
 }

@@ -335,3 +335,55 @@ export function compose(a, b) {
   const c = Math.cos(a[2]), s = Math.sin(a[2]);
   return [a[0] + c * b[0] - s * b[1], a[1] + s * b[0] + c * b[1], a[2] + b[2]];
 }
+
+// A point cloud seen from above (points in frame T = [x, y, yaw]), coloured by height: blue low, red high.
+export function drawCloud(ctx, view, T, f) {
+  if (!T) return;
+  const d = view.d, k = view.scale * d, size = Math.max(2, Math.round(2 * d));
+  const c = Math.cos(T[2]), s = Math.sin(T[2]), data = f.data;
+  const ox = ctx.canvas.width / 2 + (T[0] - view.cx) * k, oy = ctx.canvas.height / 2 - (T[1] - view.cy) * k;
+  ctx.save();
+  ctx.setTransform(1, 0, 0, 1, 0, 0);
+  const bins = [[], [], [], []]; // z < 0.05, < 0.3, < 1, above (m): one fill per colour
+  for (let i = 0; i + 2 < data.length; i += 3) {
+    const z = data[i + 2];
+    bins[z < 0.05 ? 0 : z < 0.3 ? 1 : z < 1.0 ? 2 : 3].push(i);
+  }
+  const colours = ["#36c", "#2c8", "#fc3", "#f43"];
+  for (let b = 0; b < 4; b++) {
+    ctx.fillStyle = colours[b];
+    ctx.beginPath();
+    for (const i of bins[b]) {
+      const x = data[i], y = data[i + 1];
+      ctx.rect(Math.round(ox + (c * x - s * y) * k), Math.round(oy - (s * x + c * y) * k), size, size);
+    }
+    ctx.fill();
+  }
+  ctx.restore();
+}
+
+// An image frame (RGBA cells, w x h) as a small canvas to draw
+export function imageCanvas(m) {
+  const canvas = makeCanvas(m.w, m.h);
+  const img = new ImageData(new Uint8ClampedArray(m.cells), m.w, m.h); // a copy: the frame's buffer is reused
+  canvas.getContext("2d").putImageData(img, 0, 0);
+  canvas.topic = m.topic;
+  return canvas;
+}
+
+// The camera images in the top-right corner, one under the other, with their topics
+export function drawImages(ctx, view, images) {
+  const d = view.d;
+  let y = 8 * d;
+  ctx.save();
+  ctx.setTransform(1, 0, 0, 1, 0, 0);
+  ctx.font = `${11 * d}px sans-serif`;
+  for (const [topic, canvas] of images) {
+    const w = canvas.width * d, h = canvas.height * d, x = ctx.canvas.width - w - 8 * d;
+    ctx.drawImage(canvas, x, y, w, h);
+    ctx.strokeStyle = "#fff"; ctx.strokeRect(x, y, w, h);
+    ctx.fillStyle = "#fff"; ctx.fillText(topic, x, y + h + 12 * d);
+    y += h + 20 * d;
+  }
+  ctx.restore();
+}

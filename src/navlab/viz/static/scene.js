@@ -11,7 +11,7 @@ const traceColor = (t) => (t.includes("ground_truth") ? "#1a9e3a" : "#f90"); // 
 // the display each kind of frame belongs to, and whether it is shown before the user says
 export function displayOf(m) {
   switch (m.k) {
-    case "grid": case "tiles": case "scan": case "path": case "poses": return [m.topic, true];
+    case "grid": case "tiles": case "scan": case "path": case "poses": case "cloud": case "image": return [m.topic, true];
     case "polygon": return [m.topic, m.topic.includes("local")];
     case "trace": return ["trace " + m.topic, true];
     default: return null;
@@ -25,7 +25,7 @@ export class Scene {
     this.canvas = canvas;
     this.ctx = canvas.getContext("2d", { alpha: false });
     this.onFrame = onFrame;
-    this.store = { state: null, grids: {}, scans: {}, paths: {}, poses: {}, polygons: {}, traces: {} };
+    this.store = { state: null, grids: {}, scans: {}, paths: {}, poses: {}, polygons: {}, traces: {}, clouds: {}, images: {} };
     this.layers = {};
     for (const [name, on] of FIXED_DISPLAYS) this.layers[name] = on;
     this.drag = null;
@@ -58,6 +58,8 @@ export class Scene {
       case "poses": s.poses[m.topic] = m; break;
       case "polygon": s.polygons[m.topic] = m; break;
       case "trace": s.traces[m.topic] = m; break;
+      case "cloud": s.clouds[m.topic] = m; break;
+      case "image": s.images[m.topic] = R.imageCanvas(m); break;
       default: return;
     }
     const d = displayOf(m);
@@ -136,6 +138,7 @@ export class Scene {
     for (const t of moving) (this.moving[t] ||= new R.MovingGrid()).draw(ctx, view, st.grids[t], tf, ALPHA(t));
     for (const [t, f] of Object.entries(st.traces)) if (this.on("trace " + t)) (this.traces[t] ||= new R.Trace()).draw(ctx, view, tf[f.frame], f, traceColor(t));
     for (const [t, f] of Object.entries(st.paths)) if (this.on(t)) R.drawPolyline(ctx, view, tf[f.frame], f.data, pathColor(t), 2.5);
+    for (const [t, f] of Object.entries(st.clouds)) if (this.on(t)) R.drawCloud(ctx, view, tf[f.frame], f);
     for (const [t, f] of Object.entries(st.scans)) if (this.on(t)) R.drawScan(ctx, view, f.pose && f.fixed === s.fixed ? f.pose : tf[f.frame], f, "#f33");
     for (const [t, f] of Object.entries(st.poses)) {
       if (!this.on(t)) continue;
@@ -156,6 +159,7 @@ export class Scene {
       const o = (s.obstacles || []).find((q) => q.name === drag.obstacle);
       if (o) R.drawObstacle(ctx, view, { ...o, x: drag.x, y: drag.y }, "#fff");
     }
+    R.drawImages(ctx, view, Object.entries(st.images).filter(([t]) => this.on(t)));
     R.drawClock(ctx, view, s);
   }
 

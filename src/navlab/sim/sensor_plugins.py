@@ -1,0 +1,298 @@
+"""gazebo_ros sensor plugins as navlab nodes: camera, depth camera (openni_kinect), Velodyne 3D lidar, range, bumper.
+
+Each node publishes what its ROS Noetic plugin publishes, with the plugin's topics and frame, every
+``1/update_rate`` simulated seconds — and, as Gazebo's sensors do, only while anyone subscribes (or a recorder
+or viewer listens): an unread camera costs nothing. Sensor frames that are not links of the robot get a static
+tf from their link (a camera's optical frame turned z forward, x right, y down).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import mujoco
+import numpy as np
+
+from navlab import msgs
+from navlab.core import Executor, Node
+from navlab.description.model import Origin
+from navlab.description.sensor_model import BumperConfig, CameraConfig, Lidar3dConfig, RangeConfig, SensorConfig
+from navlab.geometry import qmul, quat_from_rpy
+from navlab.io.pointcloud import FLOAT32, UINT16, pack_cloud
+from navlab.sim.sensors3d import depth_image, depth_points, lidar3d_angles, lidar3d_ranges, range_reading, sensor_pose
+from navlab.sim.simulation import Simulation
+
+ENCODINGS = {"R8G8B8": ("rgb8", 3), "B8G8R8": ("bgr8", 3), "L8": ("mono8", 1)}
+OPTICAL = quat_from_rpy(-math.pi / 2, 0.0, -math.pi / 2)  # camera body frame -> optical frame
+
+
+class SensorNode(Node):
+    """What the sensor plugins share: the config, a timer at the sensor's rate, its frame's static tf."""
+
+    def __init__(self, executor: Executor, *, name: str, namespace: str, sim: Simulation, config: SensorConfig,
+                 optical: bool = False) -> None:
+        super().__init__(executor, name=name, namespace=namespace)
+        assert sim.robot is not None
+        self.sim, self.cfg = sim, config
+        self.frame_id = getattr(config, "frame_id", "") or config.link
+        if self.frame_id not in sim.robot.links and hasattr(config, "origin"):
+            o = config.origin
+            q = quat_from_rpy(*o.rpy)
+            self.send_static_transform([msgs.TransformStamped(
+                header=msgs.header(executor.now_ns, config.link), child_frame_id=self.frame_id,
+                transform=msgs.Transform(translation=msgs.Vector3(x=o.xyz[0], y=o.xyz[1], z=o.xyz[2]),
+                                         rotation=msgs.quaternion_msg(qmul(q, OPTICAL) if optical else q)))])
+        self.create_timer(max(1.0 / config.update_rate, sim.timestep), self.update)
+
+    def read(self, *pubs: Any) -> bool:
+        """Whether any of ``pubs`` has a subscriber, or a recorder/viewer listens."""
+        return self.executor.has_listeners or any(p.get_subscription_count() for p in pubs)
+
+    def update(self) -> None:
+        """One sensor update."""
+        raise NotImplementedError
+
+
+def camera_info(cfg: CameraConfig, stamp_ns: int, frame_id: str) -> Any:
+    """``sensor_msgs/CameraInfo`` as gazebo_ros_camera_utils fills it (plumb_bob, K from the field of view)."""
+    cam = cfg.camera
+    f, cx, cy = cam.focal_length, cam.cx, cam.cy
+    return msgs.CameraInfo(
+        header=msgs.header(stamp_ns, frame_id), height=cam.height, width=cam.width, distortion_model="plumb_bob",
+        d=np.array(cfg.distortion, dtype=np.float64), k=np.array([f, 0, cx, 0, f, cy, 0, 0, 1], dtype=np.float64),
+        r=np.eye(3).ravel(), p=np.array([f, 0, cx, -f * cfg.hack_baseline, 0, f, cy, 0, 0, 0, 1, 0], dtype=np.float64),
+        binning_x=0, binning_y=0,
+        roi=msgs.RegionOfInterest(x_offset=0, y_offset=0, height=0, width=0, do_rectify=False),
+    )
+
+
+class CameraPlugin(SensorNode):
+    """``libgazebo_ros_camera.so`` (and the colour image of a depth camera): ``sensor_msgs/Image`` on
+    ``image_topic`` and ``CameraInfo`` on ``camera_info_topic``, rendered offscreen (see
+    :mod:`navlab.sim.camera_render`), with the ``<camera><noise>`` (std dev on the 0..1 scale) per pixel."""
+
+    def __init__(self, executor: Executor, *, name: str = "", parameters: dict[str, Any] | None = None,
+                 namespace: str = "", sim: Simulation, config: CameraConfig) -> None:
+        super().__init__(executor, name=name or f"{config.name}_plugin", namespace=namespace, sim=sim,
+                         config=config, optical=True)
+        self.cam = config
+        self.renderer: Any = None
+        self.image_pub = self.create_publisher(msgs.Image, config.image_topic, 2)
+        self.info_pub = self.create_publisher(msgs.CameraInfo, config.camera_info_topic, 2)
+        self.last_image: np.ndarray | None = None
+
+    def image(self) -> np.ndarray:
+        """Render the camera's RGB image now (height x width x 3 uint8), noise added."""
+        if self.renderer is None:
+            from navlab.sim.camera_render import CameraRenderer
+
+            self.renderer = CameraRenderer(self.sim, self.cam)
+        rgb = self.renderer.render()
+        cam = self.cam.camera
+        if cam.noise_stddev > 0 or cam.noise_mean:
+            noisy = rgb + 255.0 * (cam.noise_mean + cam.noise_stddev * self.rng.standard_normal(rgb.shape))
+            rgb = np.clip(np.rint(noisy), 0, 255).astype(np.uint8)
+        self.last_image = rgb
+        return rgb
+
+    def update(self) -> None:
+        if not self.read(self.image_pub, self.info_pub):
+            return
+        now = self.executor.now_ns
+        self.image_pub.publish(self.image_msg(self.image(), now))
+        self.info_pub.publish(camera_info(self.cam, now, self.frame_id))
+
+    def image_msg(self, rgb: np.ndarray, stamp_ns: int) -> Any:
+        """``sensor_msgs/Image`` in the camera's ``<format>`` (rgb8, bgr8 or mono8)."""
+        encoding, channels = ENCODINGS[self.cam.camera.format]
+        if channels == 1:
+            data = np.rint(rgb @ np.array([0.299, 0.587, 0.114])).astype(np.uint8)
+        else:
+            data = rgb[..., ::-1] if encoding == "bgr8" else rgb
+        h, w = rgb.shape[:2]
+        return msgs.Image(header=msgs.header(stamp_ns, self.frame_id), height=h, width=w, encoding=encoding,
+                          is_bigendian=0, step=w * channels, data=np.ascontiguousarray(data).reshape(-1))
+
+    def destroy_node(self) -> None:
+        """Free the GL context with the node."""
+        if self.renderer is not None:
+            self.renderer.close()
+            self.renderer = None
+        super().destroy_node()
+
+
+class DepthCameraPlugin(CameraPlugin):
+    """``libgazebo_ros_openni_kinect.so``: the depth image (32FC1, m along the optical axis, NaN outside the point
+    cloud cutoffs) on ``depth_image_topic``, the organised cloud (x y z rgb, optical frame) on
+    ``point_cloud_topic``, ``CameraInfo`` on both info topics, the colour image (rendered) only when read.
+    Depth comes from ray casting (:func:`navlab.sim.sensors3d.depth_image`), not from the renderer."""
+
+    def __init__(self, executor: Executor, *, name: str = "", parameters: dict[str, Any] | None = None,
+                 namespace: str = "", sim: Simulation, config: CameraConfig) -> None:
+        super().__init__(executor, name=name, parameters=parameters, namespace=namespace, sim=sim, config=config)
+        self.depth_pub = self.create_publisher(msgs.Image, config.depth_image_topic, 1)
+        self.cloud_pub = self.create_publisher(msgs.PointCloud2, config.point_cloud_topic, 1)
+        self.depth_info_pub = self.create_publisher(msgs.CameraInfo, config.depth_info_topic, 1)
+
+    def update(self) -> None:
+        now = self.executor.now_ns
+        colour = self.read(self.image_pub)
+        if colour:
+            self.image_pub.publish(self.image_msg(self.image(), now))
+        if self.read(self.depth_pub, self.cloud_pub):
+            depth = depth_image(self.sim, self.cam, self.rng)
+            if self.read(self.depth_pub):
+                h, w = depth.shape
+                self.depth_pub.publish(msgs.Image(
+                    header=msgs.header(now, self.frame_id), height=h, width=w, encoding="32FC1", is_bigendian=0,
+                    step=4 * w, data=depth.reshape(-1).view(np.uint8)))
+            if self.read(self.cloud_pub):
+                self.cloud_pub.publish(self.cloud(depth, now))
+        if self.read(self.info_pub):
+            self.info_pub.publish(camera_info(self.cam, now, self.frame_id))
+        if self.read(self.depth_info_pub):
+            self.depth_info_pub.publish(camera_info(self.cam, now, self.frame_id))
+
+    def cloud(self, depth: np.ndarray, stamp_ns: int) -> Any:
+        """The organised PointCloud2 of a depth image (rgb from the last colour image when sizes match, else 0)."""
+        h, w = depth.shape
+        pts = depth_points(depth, self.cam).reshape(-1, 3)
+        rgb = np.zeros((h * w, 4), dtype=np.uint8)
+        if self.last_image is not None and self.last_image.shape[:2] == (h, w):
+            rgb[:, :3] = self.last_image.reshape(-1, 3)[:, ::-1]  # PCL packs b, g, r
+        return pack_cloud(stamp_ns, self.frame_id, {
+            "x": (0, FLOAT32, pts[:, 0]), "y": (4, FLOAT32, pts[:, 1]), "z": (8, FLOAT32, pts[:, 2]),
+            "rgb": (16, FLOAT32, rgb.view(np.float32).reshape(-1))}, height=h, width=w)
+
+
+class VelodynePlugin(SensorNode):
+    """``GazeboRosVelodyneLaser``: ``sensor_msgs/PointCloud2`` (x y z intensity ring, 32-byte points) of the points
+    with ``max(min_range, range_min) < r < min(max_range, range_max - range_min - 0.01)``, ring 0 the lowest."""
+
+    def __init__(self, executor: Executor, *, name: str = "", parameters: dict[str, Any] | None = None,
+                 namespace: str = "", sim: Simulation, config: Lidar3dConfig) -> None:
+        super().__init__(executor, name=name or f"{config.name}_plugin", namespace=namespace, sim=sim, config=config)
+        self.lidar = config
+        self.pub = self.create_publisher(msgs.PointCloud2, config.topic, 1)
+        az, el = lidar3d_angles(config)
+        self.unit = np.stack([np.cos(el)[:, None] * np.cos(az)[None, :], np.cos(el)[:, None] * np.sin(az)[None, :],
+                              np.broadcast_to(np.sin(el)[:, None], (len(el), len(az)))], axis=-1)
+        self.ring = np.broadcast_to(np.arange(len(el), dtype=np.uint16)[:, None], (len(el), len(az)))
+
+    def update(self) -> None:
+        if self.read(self.pub):
+            self.pub.publish(self.cloud(lidar3d_ranges(self.sim, self.lidar, self.rng), self.executor.now_ns))
+
+    def cloud(self, ranges: np.ndarray, stamp_ns: int) -> Any:
+        """The plugin's cloud from ranges (rings x samples); organised (NaN: dropped) if ``organize_cloud``."""
+        c = self.lidar
+        lo = max(c.min_range, c.range_min)
+        hi = min(c.max_range, c.range_max - c.range_min - 0.01)
+        r = np.minimum(ranges, c.range_max - c.range_min)
+        keep = (lo < r) & (r < hi)
+        xyz = (r[..., None] * self.unit).astype(np.float32)
+        if c.organize_cloud:
+            xyz[~keep] = np.nan
+            pts, rings = xyz.reshape(-1, 3), self.ring.reshape(-1)
+            height, width = c.rings, c.samples
+        else:
+            pts, rings = xyz[keep], self.ring[keep]
+            height, width = 1, len(pts)
+        return pack_cloud(stamp_ns, self.frame_id, {
+            "x": (0, FLOAT32, pts[:, 0]), "y": (4, FLOAT32, pts[:, 1]), "z": (8, FLOAT32, pts[:, 2]),
+            "intensity": (16, FLOAT32, np.zeros(len(pts), np.float32)), "ring": (20, UINT16, rings)},
+            height=height, width=width)
+
+
+class RangePlugin(SensorNode):
+    """``gazebo_ros_range``: ``sensor_msgs/Range`` (ULTRASOUND 0 / INFRARED 1, ``field_of_view`` the plugin's
+    ``<fov>``, min/max the ray sensor's range) with the nearest return of the sensor's rays."""
+
+    def __init__(self, executor: Executor, *, name: str = "", parameters: dict[str, Any] | None = None,
+                 namespace: str = "", sim: Simulation, config: RangeConfig) -> None:
+        super().__init__(executor, name=name or f"{config.name}_plugin", namespace=namespace, sim=sim, config=config)
+        self.range = config
+        self.pub = self.create_publisher(msgs.Range, config.topic, 1)
+
+    def update(self) -> None:
+        if not self.read(self.pub):
+            return
+        c = self.range
+        self.pub.publish(msgs.Range(
+            header=msgs.header(self.executor.now_ns, self.frame_id), radiation_type=0 if c.radiation == "ultrasound"
+            else 1, field_of_view=float(c.fov), min_range=float(c.range_min), max_range=float(c.range_max),
+            range=float(range_reading(self.sim, c, self.rng))))
+
+
+class BumperPlugin(SensorNode):
+    """``gazebo_ros_bumper``: ``gazebo_msgs/ContactsState`` of the bumper link's contacts with anything but the
+    floor (MuJoCo contacts of the link's body: position and normal in ``frameName``'s frame — ``world`` or a
+    link — depth in m, contact force as the wrench), published every update even when empty (Noetic does)."""
+
+    def __init__(self, executor: Executor, *, name: str = "", parameters: dict[str, Any] | None = None,
+                 namespace: str = "", sim: Simulation, config: BumperConfig) -> None:
+        super().__init__(executor, name=name or f"{config.name}_plugin", namespace=namespace, sim=sim, config=config)
+        self.bumper = config
+        self.pub = self.create_publisher(msgs.ContactsState, config.topic, 1)
+
+    def update(self) -> None:
+        if self.read(self.pub):
+            self.pub.publish(msgs.ContactsState(header=msgs.header(self.executor.now_ns, self.frame_id),
+                                                states=self.states()))
+
+    def states(self) -> list[Any]:
+        """One ContactState per contact of the bumper's body with a world geom."""
+        sim = self.sim
+        m, d = sim.model, sim.data
+        body = sim.link_body(self.bumper.link)
+        if self.frame_id == "world" or self.frame_id not in (sim.robot.links if sim.robot else {}):
+            pos0, rot = np.zeros(3), np.eye(3)
+        else:
+            pos0, rot = sensor_pose(sim, self.frame_id, Origin())
+        force = np.zeros(6)
+        out = []
+        for i in range(d.ncon):
+            con = d.contact[i]
+            g1, g2 = int(con.geom1), int(con.geom2)
+            mine = m.geom_bodyid[g1] == body, m.geom_bodyid[g2] == body
+            if not any(mine) or all(mine):
+                continue
+            other = g2 if mine[0] else g1
+            if m.geom_type[other] == mujoco.mjtGeom.mjGEOM_PLANE:
+                continue  # the floor
+            mujoco.mj_contactForce(m, d, i, force)
+            frame = con.frame.reshape(3, 3)
+            f_world = frame.T @ force[:3] * (1 if mine[0] else -1)
+            normal = frame[0] * (1 if mine[0] else -1)
+            wrench = msgs.Wrench(force=_vec(rot.T @ f_world), torque=_vec(np.zeros(3)))
+            out.append(msgs.ContactState(
+                info=f"Debug:  i:({i}/{d.ncon})", collision1_name=self.bumper.collision,
+                collision2_name=_geom_name(m, other), wrenches=[wrench], total_wrench=wrench,
+                contact_positions=[_vec(rot.T @ (con.pos - pos0))], contact_normals=[_vec(rot.T @ normal)],
+                depths=np.array([max(0.0, -float(con.dist))])))
+        return out
+
+
+def _vec(v: np.ndarray) -> Any:
+    return msgs.Vector3(x=float(v[0]), y=float(v[1]), z=float(v[2]))
+
+
+def _geom_name(m: mujoco.MjModel, g: int) -> str:
+    name = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_GEOM, g)
+    body = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, int(m.geom_bodyid[g])) or "world"
+    return name or f"{body}::geom{g}"
+
+
+def sensor_plugins(executor: Executor, namespace: str, sim: Simulation) -> list[Node]:
+    """One node per extra sensor of ``sim``'s robot (cameras, depth cameras, 3D lidars, ranges, bumpers)."""
+    assert sim.robot is not None
+    suite = sim.robot.sensors
+    nodes: list[Node] = []
+    for cam in suite.cameras:
+        cls = DepthCameraPlugin if cam.kind == "depth" else CameraPlugin
+        nodes.append(cls(executor, namespace=namespace, sim=sim, config=cam))
+    nodes += [VelodynePlugin(executor, namespace=namespace, sim=sim, config=c) for c in suite.lidars3d]
+    nodes += [RangePlugin(executor, namespace=namespace, sim=sim, config=c) for c in suite.ranges]
+    nodes += [BumperPlugin(executor, namespace=namespace, sim=sim, config=c) for c in suite.bumpers]
+    return nodes
