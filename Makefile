@@ -41,6 +41,7 @@ demo: $(STAMP)
 
 test: $(STAMP) $(CHROMIUM) $(DOT) $(ROS_TOOLS)
 	$(BIN)/ruff check src tests
+	$(BIN)/ruff format --check src tests
 	$(BIN)/python tools/check_layers.py
 	$(BIN)/mypy
 	$(BIN)/python -m pytest
@@ -51,6 +52,7 @@ fuzz: $(STAMP)
 
 lint: $(STAMP)
 	$(BIN)/ruff check src tests
+	$(BIN)/ruff format --check src tests
 
 bench: $(STAMP)
 	$(BIN)/navlab bench all --json

@@ -28,17 +28,23 @@ def test_a_mistyped_verb_gets_did_you_mean(capsys: pytest.CaptureFixture[str]) -
     assert "unknown action 'eco'; did you mean 'echo'?" in _one_line(capsys)
 
 
-@pytest.mark.parametrize(("argv", "message"), [
-    (["navigate", "--world", "rooom", "--goal", "1", "0", "0"],
-     "navlab: error: world 'rooom': no such file here and no shipped world of that name; did you mean 'room'?"),
-    (["localize", "--world", "missing.world"], "navlab: error: world file not found: "),
-    (["map", "--robot", "mybt"], "navlab: error: robot 'mybt': no such file here and no shipped robot"),
-])
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (
+            ["navigate", "--world", "rooom", "--goal", "1", "0", "0"],
+            "navlab: error: world 'rooom': no such file here and no shipped world of that name; did you mean 'room'?",
+        ),
+        (["localize", "--world", "missing.world"], "navlab: error: world file not found: "),
+        (["map", "--robot", "mybt"], "navlab: error: robot 'mybt': no such file here and no shipped robot"),
+    ],
+)
 def test_a_missing_world_or_robot_is_one_line_before_heavy_imports(argv: list[str], message: str, tmp_path) -> None:
-    code = ("import sys, time; t = time.perf_counter(); from navlab.cli import main; rc = main(sys.argv[1:]); "
-            "print(rc, time.perf_counter() - t, *[m for m in ('mujoco', 'numba', 'ray') if m in sys.modules])")
-    proc = subprocess.run([sys.executable, "-c", code, *argv], capture_output=True, text=True, cwd=tmp_path,
-                          timeout=60)  # fmt: skip
+    code = (
+        "import sys, time; t = time.perf_counter(); from navlab.cli import main; rc = main(sys.argv[1:]); "
+        "print(rc, time.perf_counter() - t, *[m for m in ('mujoco', 'numba', 'ray') if m in sys.modules])"
+    )
+    proc = subprocess.run([sys.executable, "-c", code, *argv], capture_output=True, text=True, cwd=tmp_path, timeout=60)
     rc, seconds, *heavy = proc.stdout.split()
     assert rc == "2" and proc.stderr.startswith(message) and proc.stderr.count("\n") == 1, proc.stderr
     assert heavy == [] and float(seconds) < 5.0

@@ -23,5 +23,5 @@ def test_demo_maps_localizes_and_navigates(tmp_path: Path, capsys: pytest.Captur
     assert json.loads((report / "report.json").read_text())["navigation"]["goals"] == nav["goals"]
     assert "| [4.3, 1, 0] | succeeded |" in (report / "report.md").read_text()
     page = (report / "report.html").read_text()  # one self-contained page: the map and every goal inlined
-    assert page.count("data:image/png;base64,") >= 4 and "src=\"http" not in page
+    assert page.count("data:image/png;base64,") >= 4 and 'src="http' not in page
     assert (report / "map.png").is_file() and (report / "recording" / "metadata.yaml").is_file()

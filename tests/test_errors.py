@@ -24,8 +24,13 @@ def test_every_public_exception_class_derives_from_navlab_error():
     for name in _navlab_modules():
         module = importlib.import_module(name)
         for attr, obj in vars(module).items():
-            if (inspect.isclass(obj) and issubclass(obj, BaseException) and obj.__module__ == name
-                    and not attr.startswith("_") and not issubclass(obj, NavlabError)):
+            if (
+                inspect.isclass(obj)
+                and issubclass(obj, BaseException)
+                and obj.__module__ == name
+                and not attr.startswith("_")
+                and not issubclass(obj, NavlabError)
+            ):
                 offenders.append(f"{name}.{attr}({', '.join(b.__name__ for b in obj.__bases__)})")
     assert offenders == []
 

@@ -36,6 +36,7 @@ def _run(src: Path) -> subprocess.CompletedProcess[str]:
 def tree(tmp_path: Path) -> Path:
     """A copy of src/navlab's Python files to plant imports in."""
     dst = tmp_path / "navlab"
+
     def ignore(folder: str, names: list[str]) -> list[str]:
         return [n for n in names if n == "__pycache__" or not (n.endswith(".py") or (Path(folder) / n).is_dir())]
 
@@ -88,10 +89,16 @@ def test_two_packages_importing_each_other_fail(tree):
     assert check.violations(tree) == []
     b = _plant(tree / "resources" / "__init__.py", "from navlab.geometry import wrap_angle")
     found = check.violations(tree)
-    assert any(v.endswith(f"geometry.py:{a}: geometry -> resources "
-                          "(circle: geometry and resources import each other)") for v in found)
-    assert any(v.endswith(f"resources/__init__.py:{b}: resources -> geometry "
-                          "(circle: resources and geometry import each other)") for v in found)
+    assert any(
+        v.endswith(f"geometry.py:{a}: geometry -> resources (circle: geometry and resources import each other)")
+        for v in found
+    )
+    assert any(
+        v.endswith(
+            f"resources/__init__.py:{b}: resources -> geometry (circle: resources and geometry import each other)"
+        )
+        for v in found
+    )
     assert len(found) == 2
     assert _run(tree).returncode == 1
 
@@ -122,8 +129,9 @@ def test_cli_and_bench_sit_on_top_and_strings_are_not_imports(tree):
 def test_a_package_cli_module_is_no_exception(tree):
     # a cli.py inside a package belongs to its package: importing upward from it is reported
     line = _plant(tree / "mapping" / "cli.py", "from navlab.experiments import metrics")
-    assert any(f"mapping/cli.py:{line}: mapping.cli -> experiments.metrics (upward" in v
-               for v in check.violations(tree))
+    assert any(
+        f"mapping/cli.py:{line}: mapping.cli -> experiments.metrics (upward" in v for v in check.violations(tree)
+    )
 
 
 def test_package_in_no_layer_fails(tree):

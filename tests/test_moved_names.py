@@ -31,13 +31,16 @@ def test_loaders_moved_from_sim_to_description_and_world() -> None:
     assert [m.name for m in world.models] == [m.name for m in load_world("room").models]
 
 
-@pytest.mark.parametrize(("old", "name", "new"), [
-    ("navlab.mapping.explore", "plan_to_frontier", "navlab.drivers.frontiers"),
-    ("navlab.mapping.explore_node", "Explore", "navlab.drivers.explore"),
-    ("navlab.mapping.follow", "PurePursuit", "navlab.navigation.controllers.pure_pursuit"),
-    ("navlab.mapping.teleop", "TeleopKeyboard", "navlab.drivers.teleop"),
-    ("navlab.mapping.teleop", "load_route", "navlab.drivers.routes"),
-])
+@pytest.mark.parametrize(
+    ("old", "name", "new"),
+    [
+        ("navlab.mapping.explore", "plan_to_frontier", "navlab.drivers.frontiers"),
+        ("navlab.mapping.explore_node", "Explore", "navlab.drivers.explore"),
+        ("navlab.mapping.follow", "PurePursuit", "navlab.navigation.controllers.pure_pursuit"),
+        ("navlab.mapping.teleop", "TeleopKeyboard", "navlab.drivers.teleop"),
+        ("navlab.mapping.teleop", "load_route", "navlab.drivers.routes"),
+    ],
+)
 def test_drivers_moved_out_of_mapping(old: str, name: str, new: str) -> None:
     with pytest.warns(DeprecationWarning, match=f"{old}.{name} moved to {new}.{name}"):
         got = getattr(importlib.import_module(old), name)

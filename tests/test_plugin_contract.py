@@ -71,10 +71,14 @@ class WallBlindLayer:
 
 
 def test_the_checker_names_what_a_broken_plugin_lacks(install_plugin_package) -> None:
-    install_plugin_package("navlab-test-broken-plugins", {
-        "navlab.controllers": {"broken/TupleController": "broken_plugins:TupleController"},
-        "navlab.costmap_layers": {"broken::WallBlindLayer": "broken_plugins:WallBlindLayer"},
-    }, {"broken_plugins.py": BROKEN})
+    install_plugin_package(
+        "navlab-test-broken-plugins",
+        {
+            "navlab.controllers": {"broken/TupleController": "broken_plugins:TupleController"},
+            "navlab.costmap_layers": {"broken::WallBlindLayer": "broken_plugins:WallBlindLayer"},
+        },
+        {"broken_plugins.py": BROKEN},
+    )
     assert "broken/TupleController" in plugin_names("controller")
     with pytest.raises(PluginError, match=r"does not implement Controller: missing is_goal_reached"):
         check_plugin("controller", "broken/TupleController")
@@ -91,13 +95,13 @@ def _package_from_docs(root: Path) -> None:
         (root / name).write_text(text)
 
 
-def test_a_third_party_package_adds_a_controller_navlab_drives_with_by_name(install_plugin_package,
-                                                                            tmp_path: Path) -> None:
+def test_a_third_party_package_adds_a_controller_navlab_drives_with_by_name(
+    install_plugin_package, tmp_path: Path
+) -> None:
     _package_from_docs(tmp_path / "my-nav-plugins")
     install_plugin_package.install_dir("my-nav-plugins", tmp_path / "my-nav-plugins")
     check_plugin("controller", "my_nav_plugins/CarrotController")
-    r = run_navigation([(2.0, 0.5, 0.0)], world="room", controller="my_nav_plugins/CarrotController",
-                       goal_timeout=40)
+    r = run_navigation([(2.0, 0.5, 0.0)], world="room", controller="my_nav_plugins/CarrotController", goal_timeout=40)
     assert "carrot_controller" in sys.modules  # it was the package's controller that drove
     (goal,) = r.goals
     assert goal["outcome"] == "succeeded" and goal["collisions"] == 0, goal

@@ -73,15 +73,19 @@ def _run(cmd: str, cwd: Path) -> subprocess.CompletedProcess[str]:
     env["PATH"] = f"{bin_dir}{os.pathsep}{env.get('PATH', '')}"
     words = [str(README.parent / w) if w.startswith(CHECKOUT_FILES) else w for w in cmd.split()]
     line = " ".join(words) + "".join(f" {shlex.quote(w)}" for w in _extra(cmd)) + " --quiet" * ("--quiet" in _help(cmd))
-    return subprocess.run(["bash", "-c", line], cwd=cwd, env=env, capture_output=True, text=True, timeout=600,
-                          stdin=subprocess.DEVNULL)  # fmt: skip
+    return subprocess.run(
+        ["bash", "-c", line], cwd=cwd, env=env, capture_output=True, text=True, timeout=600, stdin=subprocess.DEVNULL
+    )
 
 
 def _help(cmd: str) -> str:
     """The verb's --help text (to know whether it takes --quiet)."""
     words = shlex.split(cmd)
-    return subprocess.run([sys.executable, "-m", "navlab.cli", words[1], "--help"], capture_output=True,
-                          text=True).stdout if words[1] not in ("eval",) else ""  # fmt: skip
+    return (
+        subprocess.run([sys.executable, "-m", "navlab.cli", words[1], "--help"], capture_output=True, text=True).stdout
+        if words[1] not in ("eval",)
+        else ""
+    )
 
 
 def test_readme_lists_the_commands_the_test_runs() -> None:
@@ -123,8 +127,15 @@ def test_readme_teleop_drives_from_a_terminal(tmp_path: Path) -> None:
 
     master, slave = pty.openpty()
     env = {**os.environ, "TMPDIR": str(tmp_path)}  # no other launch's socket: the standalone sim
-    proc = subprocess.Popen([sys.executable, "-m", "navlab.cli", "teleop", "--world", "room"], stdin=slave,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, cwd=tmp_path, env=env, text=True)
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "navlab.cli", "teleop", "--world", "room"],
+        stdin=slave,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        cwd=tmp_path,
+        env=env,
+        text=True,
+    )
     os.close(slave)
     time.sleep(3.0)
     os.write(master, b"i")

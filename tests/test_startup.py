@@ -41,8 +41,13 @@ def test_help_and_argument_errors_import_no_mujoco_numba_or_ray(tmp_path):
 
 def test_sim_with_duration_zero_loads_everything_and_steps_nothing(tmp_path):
     """``navlab sim --duration 0``: the shortest run (the start-up figure of ``navlab bench startup``)."""
-    out = subprocess.run([sys.executable, "-m", "navlab.cli", "sim", "--duration", "0", "--json"], capture_output=True,
-                         text=True, cwd=tmp_path, check=True)  # fmt: skip
+    out = subprocess.run(
+        [sys.executable, "-m", "navlab.cli", "sim", "--duration", "0", "--json"],
+        capture_output=True,
+        text=True,
+        cwd=tmp_path,
+        check=True,
+    )
     got = json.loads(out.stdout)
     assert got["sim_s"] == 0.0 and got["world"] == "room" and got["robot"]
     assert got["true_pose"] == got["start_pose"]

@@ -43,8 +43,21 @@ if TYPE_CHECKING:
     from navlab.core.rclpy_api import create_node, init, ok, shutdown, spin, spin_once
     from navlab.core.ros_imports import install as install_ros_imports
 
-__all__ = ["Executor", "Node", "Parameter", "__version__", "create_node", "init", "install_ros_imports", "launch",
-           "msgs", "ok", "shutdown", "spin", "spin_once"]
+__all__ = [
+    "Executor",
+    "Node",
+    "Parameter",
+    "__version__",
+    "create_node",
+    "init",
+    "install_ros_imports",
+    "launch",
+    "msgs",
+    "ok",
+    "shutdown",
+    "spin",
+    "spin_once",
+]
 
 # name -> (module, attribute or None for the module itself)
 _LAZY: dict[str, tuple[str, str | None]] = {

@@ -28,8 +28,15 @@ def _progress(text: str) -> None:
     print(f"      {text}", file=sys.stderr, flush=True)
 
 
-def run_demo(out: str | Path = "navlab-demo", *, seed: int = 0, quiet: bool = False, render: bool = True,
-             record: bool = True, on_start: Any = None) -> dict[str, Any]:  # fmt: skip
+def run_demo(
+    out: str | Path = "navlab-demo",
+    *,
+    seed: int = 0,
+    quiet: bool = False,
+    render: bool = True,
+    record: bool = True,
+    on_start: Any = None,
+) -> dict[str, Any]:
     """Run the four steps, writing the report folder ``out``; returns the figures (also in report.json)."""
     from navlab.experiments.localize_run import plot_result, run_localization
     from navlab.experiments.mapping_run import run_mapping
@@ -44,18 +51,29 @@ def run_demo(out: str | Path = "navlab-demo", *, seed: int = 0, quiet: bool = Fa
         _say("[1/4] rendering the robot in room_obstacles.world ...", quiet)
         summary["render"] = _render(out / "world.png")
     _say("[2/4] mapping room.world with slam_gmapping while the robot explores ...", quiet)
-    mapping = run_mapping(world="room", out=out / "map", driver="explore", duration=300, seed=seed, quiet=quiet,
-                          on_start=on_start)  # fmt: skip
+    mapping = run_mapping(
+        world="room", out=out / "map", driver="explore", duration=300, seed=seed, quiet=quiet, on_start=on_start
+    )
     summary["mapping"] = {"map": str(mapping.map_yaml), "picture": str(out / "map" / "map.png"), **mapping.scores}
     _say("[3/4] AMCL on the saved map, in the room with new obstacles (room_obstacles.world) ...", quiet)
-    loc = run_localization("room_obstacles", mapping.map_yaml, duration=60.0, seed=seed, progress=not quiet,
-                           on_start=on_start)  # fmt: skip
+    loc = run_localization(
+        "room_obstacles", mapping.map_yaml, duration=60.0, seed=seed, progress=not quiet, on_start=on_start
+    )
     summary["localization"] = {**loc.summary, "picture": str(plot_result(loc, out / "localize.png"))}
     _say("[4/4] move_base on the saved map, to goals among the new obstacles and one more cylinder ...", quiet)
     late = primitive_model("cylinder", "late_cylinder", (0.15, 0.6), x=-1.0, y=-0.45)
-    nav = run_navigation(DEMO_GOALS, world="room_obstacles", map_yaml=mapping.map_yaml, spawn=[(20.0, late)],
-                         seed=seed, goal_timeout=90, snapshots=True, progress=None if quiet else _progress,
-                         record=out / "recording" if record else None, on_start=on_start)  # fmt: skip
+    nav = run_navigation(
+        DEMO_GOALS,
+        world="room_obstacles",
+        map_yaml=mapping.map_yaml,
+        spawn=[(20.0, late)],
+        seed=seed,
+        goal_timeout=90,
+        snapshots=True,
+        progress=None if quiet else _progress,
+        record=out / "recording" if record else None,
+        on_start=on_start,
+    )
     pictures = save_goal_pictures(nav, out / "navigate")
     for k, goal in enumerate(nav.goals):
         goal["picture"], goal["picture_mid"] = pictures[2 * k], pictures[2 * k + 1]

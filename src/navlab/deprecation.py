@@ -11,6 +11,9 @@ def renamed(value: Any, old_value: Any, *, old: str, new: str, where: str) -> An
     given instead: ``old_value`` is None when the old name was not used. Warns once per call that uses it."""
     if old_value is None:
         return value
-    warnings.warn(f"{where}({old}=...) is deprecated, use {new}= (the old name works until the next release)",
-                  DeprecationWarning, stacklevel=3)
+    warnings.warn(
+        f"{where}({old}=...) is deprecated, use {new}= (the old name works until the next release)",
+        DeprecationWarning,
+        stacklevel=3,
+    )
     return old_value

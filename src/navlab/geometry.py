@@ -104,11 +104,13 @@ def qrotate(q: Vec, v: Vec) -> tuple[float, float, float]:
 def matrix_from_quat(q: Vec) -> np.ndarray:
     """3×3 rotation matrix of a unit quaternion (x, y, z, w)."""
     x, y, z, w = (float(v) for v in q)
-    return np.array([
-        [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-    ])  # fmt: skip
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+        ]
+    )
 
 
 def wxyz_from_xyzw(q: Vec) -> np.ndarray:
@@ -126,13 +128,21 @@ def xyzw_from_wxyz(q: Vec) -> Quat:
 
 def matrix_from_rpy(roll: float, pitch: float, yaw: float) -> np.ndarray:
     """3×3 rotation R = Rz(yaw) Ry(pitch) Rx(roll) (URDF/SDF convention)."""
-    cr, sr, cp, sp, cy, sy = (math.cos(roll), math.sin(roll), math.cos(pitch), math.sin(pitch),
-                              math.cos(yaw), math.sin(yaw))  # fmt: skip
-    return np.array([
-        [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
-        [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
-        [-sp, cp * sr, cp * cr],
-    ])  # fmt: skip
+    cr, sr, cp, sp, cy, sy = (
+        math.cos(roll),
+        math.sin(roll),
+        math.cos(pitch),
+        math.sin(pitch),
+        math.cos(yaw),
+        math.sin(yaw),
+    )
+    return np.array(
+        [
+            [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+            [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+            [-sp, cp * sr, cp * cr],
+        ]
+    )
 
 
 def rpy_from_matrix(r: np.ndarray) -> tuple[float, float, float]:
@@ -212,8 +222,15 @@ def interpolate3(a: Tf, b: Tf, s: float) -> Tf:
         sa, sb = math.sin((1 - s) * th) / math.sin(th), math.sin(s * th) / math.sin(th)
         q = [sa * x + sb * y for x, y in zip(qa, qb, strict=True)]
     n = math.sqrt(sum(x * x for x in q))
-    return (a[0] + s * (b[0] - a[0]), a[1] + s * (b[1] - a[1]), a[2] + s * (b[2] - a[2]),
-            q[0] / n, q[1] / n, q[2] / n, q[3] / n)  # fmt: skip
+    return (
+        a[0] + s * (b[0] - a[0]),
+        a[1] + s * (b[1] - a[1]),
+        a[2] + s * (b[2] - a[2]),
+        q[0] / n,
+        q[1] / n,
+        q[2] / n,
+        q[3] / n,
+    )
 
 
 # --- SE(2) poses (x, y, yaw) --------------------------------------------------------------------

@@ -40,8 +40,11 @@ def moved_exports(old: str, exports: dict[str, str]) -> Callable[[str], Any]:
         module = exports.get(name)
         if module is None:
             raise AttributeError(f"module {old!r} has no attribute {name!r}")
-        warnings.warn(f"{old}.{name} moved to {module}.{name}; the old name goes in the next release",
-                      DeprecationWarning, stacklevel=2)
+        warnings.warn(
+            f"{old}.{name} moved to {module}.{name}; the old name goes in the next release",
+            DeprecationWarning,
+            stacklevel=2,
+        )
         return getattr(importlib.import_module(module), name)
 
     return __getattr__

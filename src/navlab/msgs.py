@@ -18,8 +18,10 @@ from navlab.geometry import quat_from_yaw, yaw_from_quat
 TYPESTORE = get_typestore(Stores.ROS2_HUMBLE)
 # gazebo_msgs and costmap_2d (not in the ROS 2 store): the bumper plugin's contact messages, with the fields ROS
 # Noetic and gazebo_ros_pkgs for ROS 2 give them, and the voxel layer's grid
-TYPESTORE.register({
-    **get_types_from_msg("""string info
+TYPESTORE.register(
+    {
+        **get_types_from_msg(
+            """string info
 string collision1_name
 string collision2_name
 geometry_msgs/Wrench[] wrenches
@@ -27,14 +29,20 @@ geometry_msgs/Wrench total_wrench
 geometry_msgs/Vector3[] contact_positions
 geometry_msgs/Vector3[] contact_normals
 float64[] depths
-""", "gazebo_msgs/msg/ContactState"),
-    **get_types_from_msg("std_msgs/Header header\ngazebo_msgs/ContactState[] states\n",
-                         "gazebo_msgs/msg/ContactsState"),
-    # costmap_2d's voxel layer (publish_voxel_map): the packed voxel columns
-    **get_types_from_msg("std_msgs/Header header\nuint32[] data\ngeometry_msgs/Point32 origin\n"
-                         "geometry_msgs/Vector3 resolutions\nuint32 size_x\nuint32 size_y\nuint32 size_z\n",
-                         "costmap_2d/msg/VoxelGrid"),
-})
+""",
+            "gazebo_msgs/msg/ContactState",
+        ),
+        **get_types_from_msg(
+            "std_msgs/Header header\ngazebo_msgs/ContactState[] states\n", "gazebo_msgs/msg/ContactsState"
+        ),
+        # costmap_2d's voxel layer (publish_voxel_map): the packed voxel columns
+        **get_types_from_msg(
+            "std_msgs/Header header\nuint32[] data\ngeometry_msgs/Point32 origin\n"
+            "geometry_msgs/Vector3 resolutions\nuint32 size_x\nuint32 size_y\nuint32 size_z\n",
+            "costmap_2d/msg/VoxelGrid",
+        ),
+    }
+)
 _T = TYPESTORE.types
 
 Time = _T["builtin_interfaces/msg/Time"]
@@ -167,16 +175,12 @@ def pose_stamped(stamp_ns: int, frame_id: str, x: float, y: float, yaw: float) -
     return PoseStamped(header=header(stamp_ns, frame_id), pose=pose_from_2d(x, y, yaw))
 
 
-def transform_stamped(
-    stamp_ns: int, parent: str, child: str, x: float, y: float, yaw: float, z: float = 0.0
-) -> Any:
+def transform_stamped(stamp_ns: int, parent: str, child: str, x: float, y: float, yaw: float, z: float = 0.0) -> Any:
     """``geometry_msgs/TransformStamped`` ``parent_T_child`` in the plane (plus height ``z``)."""
     return TransformStamped(
         header=header(stamp_ns, parent),
         child_frame_id=child,
-        transform=Transform(
-            translation=Vector3(x=float(x), y=float(y), z=float(z)), rotation=quaternion_from_yaw(yaw)
-        ),
+        transform=Transform(translation=Vector3(x=float(x), y=float(y), z=float(z)), rotation=quaternion_from_yaw(yaw)),
     )
 
 

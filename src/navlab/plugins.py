@@ -108,7 +108,8 @@ class ControlResult:
     def __eq__(self, other: object) -> bool:
         if isinstance(other, ControlResult):
             return (self.v, self.w, self.valid) == (other.v, other.w, other.valid) and np.array_equal(
-                self.local_plan, other.local_plan)
+                self.local_plan, other.local_plan
+            )
         if isinstance(other, tuple | list):
             return (self.v, self.w) == tuple(other)
         return NotImplemented
@@ -120,8 +121,11 @@ class ControlResult:
         """``out`` as a ControlResult: itself, or a controller's old ``(v, w)`` tuple (deprecated, one release)."""
         if isinstance(out, ControlResult):
             return out
-        warnings.warn("a controller returning (v, w) is deprecated: return navlab.plugins.ControlResult",
-                      DeprecationWarning, stacklevel=3)
+        warnings.warn(
+            "a controller returning (v, w) is deprecated: return navlab.plugins.ControlResult",
+            DeprecationWarning,
+            stacklevel=3,
+        )
         v, w = out
         return cls(float(v), float(w))
 
@@ -162,8 +166,16 @@ class SlamBackend(Plugin, Protocol):
         """Every parameter name the mode reads, with its ROS default."""
         ...
 
-    def add_scan(self, ranges: np.ndarray, angle_min: float, angle_increment: float, odom_laser: np.ndarray, *,
-                 range_max: float | None = None, stamp_ns: int | None = None) -> np.ndarray | None:
+    def add_scan(
+        self,
+        ranges: np.ndarray,
+        angle_min: float,
+        angle_increment: float,
+        odom_laser: np.ndarray,
+        *,
+        range_max: float | None = None,
+        stamp_ns: int | None = None,
+    ) -> np.ndarray | None:
         """Process one scan (ranges m; inf/NaN = no return) taken with the laser at ``odom_laser`` (x, y, yaw
         in the odom frame) at ``stamp_ns`` (ns; None for a log's scans); returns the laser's pose in the map
         frame, or None when the scan only moved the estimate and did not update the map. ``range_max``:
@@ -197,8 +209,14 @@ class MotionModel(Protocol):
     place by the odometry step from ``odom_old`` to ``odom_new`` (robot poses in the odom frame), with noise
     ``alphas`` = odom_alpha1..4 drawn from ``rng``."""
 
-    def __call__(self, particles: np.ndarray, odom_old: Pose, odom_new: Pose,
-                 alphas: tuple[float, float, float, float], rng: np.random.Generator) -> None: ...
+    def __call__(
+        self,
+        particles: np.ndarray,
+        odom_old: Pose,
+        odom_new: Pose,
+        alphas: tuple[float, float, float, float],
+        rng: np.random.Generator,
+    ) -> None: ...
 
 
 @runtime_checkable
@@ -264,8 +282,9 @@ class ScanLayer(Protocol):
 
     sources: Mapping[str, Any]
 
-    def add_scan(self, origin_xy: Any, endpoints_xy: np.ndarray, valid: np.ndarray | None = None, *,
-                 source: str | None = None) -> None:
+    def add_scan(
+        self, origin_xy: Any, endpoints_xy: np.ndarray, valid: np.ndarray | None = None, *, source: str | None = None
+    ) -> None:
         """One scan in the costmap frame: the sensor at ``origin_xy`` (m), ray endpoints (N, 2) (m), ``valid``
         (N,) real returns (the others only clear); ``source`` one of ``sources`` (None: the layer's own)."""
         ...
@@ -356,8 +375,10 @@ def _entry_points(group: str) -> dict[str, metadata.EntryPoint]:
     """The installed entry points of ``group`` by name (read once; :func:`refresh_plugins` re-reads)."""
     found = {ep.name: ep for ep in metadata.entry_points(group=group)}
     if not found:
-        raise PluginError(f"no {group} entry points are installed: navlab's own install is out of date "
-                          "(run `make install` or `pip install -e .` in the checkout)")
+        raise PluginError(
+            f"no {group} entry points are installed: navlab's own install is out of date "
+            "(run `make install` or `pip install -e .` in the checkout)"
+        )
     return found
 
 
@@ -394,20 +415,30 @@ def load_plugin(kind: str, name: str, *, param: str | None = None) -> Any:
         raise PluginError(f"{kind} {name!r}: cannot load {ep.value} ({exc})") from None
 
 
-def make_plugin(kind: str, name: str, params: Mapping[str, Any] | None = None, *,
-                context: PluginContext | None = None, param: str | None = None) -> Any:
+def make_plugin(
+    kind: str,
+    name: str,
+    params: Mapping[str, Any] | None = None,
+    *,
+    context: PluginContext | None = None,
+    param: str | None = None,
+) -> Any:
     """An instance of the plugin registered as ``name``: ``cls.from_params(params, context=context)``."""
     cls = load_plugin(kind, name, param=param)
     build = getattr(cls, "from_params", None)
     if build is None:
-        raise PluginError(f"{kind} {name!r}: {cls.__module__}.{cls.__qualname__} has no from_params(params, *, "
-                          "context) classmethod")
+        raise PluginError(
+            f"{kind} {name!r}: {cls.__module__}.{cls.__qualname__} has no from_params(params, *, context) classmethod"
+        )
     return build(params, context=context or PluginContext())
 
 
 def __getattr__(name: str) -> Any:
     if name == "REGISTRY":  # the dict of navlab <= 0.x; one release of read-only compatibility
-        warnings.warn("navlab.plugins.REGISTRY is deprecated: plugins are entry points (plugin_names, "
-                      "load_plugin)", DeprecationWarning, stacklevel=2)
+        warnings.warn(
+            "navlab.plugins.REGISTRY is deprecated: plugins are entry points (plugin_names, load_plugin)",
+            DeprecationWarning,
+            stacklevel=2,
+        )
         return {kind: {n: ep.value for n, ep in _entry_points(group).items()} for kind, (group, _) in KINDS.items()}
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -44,8 +44,18 @@ def test_fewer_messages_than_count_before_the_end_is_exit_1(capsys: pytest.Captu
 
 
 def test_piped_into_head_is_not_an_error() -> None:
-    cmd = [sys.executable, "-m", "navlab.cli", "topic", "echo", "/chatter", "--launch", "talker_listener",
-           "--duration", "5000"]
+    cmd = [
+        sys.executable,
+        "-m",
+        "navlab.cli",
+        "topic",
+        "echo",
+        "/chatter",
+        "--launch",
+        "talker_listener",
+        "--duration",
+        "5000",
+    ]
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     assert proc.stdout is not None and proc.stderr is not None
     first = proc.stdout.readline()

@@ -44,8 +44,10 @@ def room_map(tmp_path: Path) -> Path:
 
 
 def test_navigation_graph_has_every_vertex_and_no_overlaps(room_map: Path, tmp_path: Path) -> None:
-    assert main(["graph", "--launch", "navigation", f"map:={room_map}", "--duration", "1",
-                 "--out", str(tmp_path / "g")]) == 0  # fmt: skip
+    assert (
+        main(["graph", "--launch", "navigation", f"map:={room_map}", "--duration", "1", "--out", str(tmp_path / "g")])
+        == 0
+    )
     dot = (tmp_path / "g" / "graph.dot").read_text()
     shapes = _shapes(tmp_path / "g" / "graph.svg")
     nodes = re.findall(r'"n:([^"]+)" \[label', dot)

@@ -11,8 +11,10 @@ from navlab.core import LaunchError, ParameterError
 from navlab.core.launch import start
 from navlab.core.params import read_yaml
 
-BOMB = "\n".join(["a0: &a0 [lol, lol, lol, lol, lol, lol, lol, lol, lol, lol]"]
-                 + [f"a{k}: &a{k} [" + ", ".join([f"*a{k - 1}"] * 10) + "]" for k in range(1, 10)])
+BOMB = "\n".join(
+    ["a0: &a0 [lol, lol, lol, lol, lol, lol, lol, lol, lol, lol]"]
+    + [f"a{k}: &a{k} [" + ", ".join([f"*a{k - 1}"] * 10) + "]" for k in range(1, 10)]
+)
 
 
 def _write(tmp_path: Path, name: str, data: str | bytes) -> Path:
@@ -40,17 +42,20 @@ def test_deep_nesting_binary_and_pipes_are_errors_not_tracebacks(tmp_path: Path)
         read_yaml(_write(tmp_path, "nul.yaml", "a: 1\x00\n"))
 
 
-@pytest.mark.parametrize(("entries", "message"), [
-    ("- let: {value: x}", r"entry 1 \(let\): missing 'name'"),
-    ("- let: {name: x}", r"entry 1 \(let\): a let needs a 'value'"),
-    ("- include: {arg: []}", r"entry 1 \(include\): missing 'file'"),
-    ("- node: {exec: talker, remap: [{to: x}]}", r"remap\[0\] needs 'from' and 'to'"),
-    ("- node: {exec: talker, if: maybe}", r"'if' is 'maybe'; expected true or false"),
-    ("- node: {exec: talker, name: '$(env NAVLAB_TEST_SURELY_UNSET)'}", r"NAVLAB_TEST_SURELY_UNSET.*not set"),
-    ("- node: {exec: 'os:getcwd'}", r"os:getcwd is not a navlab Node class"),
-    ("- node: {exec: talker, param: [{name: rate, value: 0}]}", r"rate.*expected Hz > 0.*'talker'"),
-    ("- node: {exec: talker, param: [{name: rate, value: .nan}]}", r"'rate': expected a number, got nan.*'talker'"),
-])
+@pytest.mark.parametrize(
+    ("entries", "message"),
+    [
+        ("- let: {value: x}", r"entry 1 \(let\): missing 'name'"),
+        ("- let: {name: x}", r"entry 1 \(let\): a let needs a 'value'"),
+        ("- include: {arg: []}", r"entry 1 \(include\): missing 'file'"),
+        ("- node: {exec: talker, remap: [{to: x}]}", r"remap\[0\] needs 'from' and 'to'"),
+        ("- node: {exec: talker, if: maybe}", r"'if' is 'maybe'; expected true or false"),
+        ("- node: {exec: talker, name: '$(env NAVLAB_TEST_SURELY_UNSET)'}", r"NAVLAB_TEST_SURELY_UNSET.*not set"),
+        ("- node: {exec: 'os:getcwd'}", r"os:getcwd is not a navlab Node class"),
+        ("- node: {exec: talker, param: [{name: rate, value: 0}]}", r"rate.*expected Hz > 0.*'talker'"),
+        ("- node: {exec: talker, param: [{name: rate, value: .nan}]}", r"'rate': expected a number, got nan.*'talker'"),
+    ],
+)
 def test_malformed_launch_entries_name_the_file_and_entry(tmp_path: Path, entries: str, message: str) -> None:
     launch = _write(tmp_path, "bad.launch.yaml", "launch:\n" + entries + "\n")
     with pytest.raises((LaunchError, ParameterError), match=message) as err:  # the problem, and where it is
@@ -59,9 +64,14 @@ def test_malformed_launch_entries_name_the_file_and_entry(tmp_path: Path, entrie
 
 
 def test_env_with_default_and_boolean_conditions_still_work(tmp_path: Path) -> None:
-    launch = _write(tmp_path, "ok.launch.yaml", (
-        "launch:\n- node: {exec: talker, name: \"$(env NAVLAB_TEST_SURELY_UNSET talky)\", if: 'True'}\n"
-        "- node: {exec: listener, unless: '1'}\n"))
+    launch = _write(
+        tmp_path,
+        "ok.launch.yaml",
+        (
+            "launch:\n- node: {exec: talker, name: \"$(env NAVLAB_TEST_SURELY_UNSET talky)\", if: 'True'}\n"
+            "- node: {exec: listener, unless: '1'}\n"
+        ),
+    )
     session = start(str(launch))
     assert list(session.nodes) == ["/talky"]
 
@@ -69,8 +79,11 @@ def test_env_with_default_and_boolean_conditions_still_work(tmp_path: Path) -> N
 def test_node_parameter_errors_name_the_launch_and_parameter_file(tmp_path: Path) -> None:
     _write(tmp_path, "talk.yaml", "rate: true\n")
     launch = _write(tmp_path, "p.launch.yaml", "launch:\n- node: {exec: talker, param: [{from: talk.yaml}]}\n")
-    with pytest.raises(ParameterError, match=r"^parameter 'rate': expected a number.* \(in .*p\.launch\.yaml: entry 1 "
-                                             r"\(node\) 'talker' \(parameters from talk\.yaml\)\)$"):
+    with pytest.raises(
+        ParameterError,
+        match=r"^parameter 'rate': expected a number.* \(in .*p\.launch\.yaml: entry 1 "
+        r"\(node\) 'talker' \(parameters from talk\.yaml\)\)$",
+    ):
         start(str(launch))
 
 

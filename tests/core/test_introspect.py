@@ -18,8 +18,10 @@ from navlab.core.introspect import find_running, socket_dir
 def running_launch():
     proc = subprocess.Popen(
         [sys.executable, "-m", "navlab.cli", "launch", "talker_listener", "rate:=20"],
-        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-    )  # fmt: skip
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     sock = socket_dir() / f"{proc.pid}.sock"
     deadline = time.monotonic() + 30
     while not sock.exists() and time.monotonic() < deadline and proc.poll() is None:
@@ -45,8 +47,10 @@ def test_tools_see_a_launch_running_in_another_process(running_launch, capsys):
     # a topic nobody publishes: echo waits for it, as rostopic does, here bounded by the launch's clock
     assert main(["topic", "echo", "/nope", "--pid", pid, "--duration", "1.5"]) == 1
     err = capsys.readouterr().err.splitlines()
-    assert err == ["WARNING: topic [/nope] does not appear to be published yet",
-                   "navlab: no message on /nope: 1.5 simulated s passed"]
+    assert err == [
+        "WARNING: topic [/nope] does not appear to be published yet",
+        "navlab: no message on /nope: 1.5 simulated s passed",
+    ]
 
 
 def test_echo_runs_until_the_launch_ends(running_launch, capsys):
@@ -75,8 +79,11 @@ def test_no_running_launch_is_a_clear_error():
 def test_map_save_takes_the_map_of_a_running_mapping_launch(tmp_path):
     from navlab.mapping import load_map
 
-    proc = subprocess.Popen([sys.executable, "-m", "navlab.cli", "launch", "mapping", "--rate", "4"],
-                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)  # fmt: skip
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "navlab.cli", "launch", "mapping", "--rate", "4"],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
     try:
         sock = socket_dir() / f"{proc.pid}.sock"
         deadline = time.monotonic() + 30
@@ -95,8 +102,11 @@ def test_remote_cmd_vel_drives_the_robot_of_a_running_launch():
     from navlab import msgs
     from navlab.core.introspect import RemotePublisher, subscribe
 
-    proc = subprocess.Popen([sys.executable, "-m", "navlab.cli", "launch", "sim", "--rate", "2"],
-                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)  # fmt: skip
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "navlab.cli", "launch", "sim", "--rate", "2"],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
     try:
         sock = socket_dir() / f"{proc.pid}.sock"
         deadline = time.monotonic() + 30

@@ -97,15 +97,19 @@ def test_bad_clients_get_error_replies_and_the_launch_goes_on(running: tuple[Any
     assert "error" in _send(server.path, [b"\xff\xfe not json"])[0]
     twist = TYPESTORE.types["geometry_msgs/msg/Twist"]
     vec = TYPESTORE.types["geometry_msgs/msg/Vector3"]
-    cdr = base64.b64encode(bytes(TYPESTORE.serialize_cdr(twist(vec(1.0, 0.0, 0.0), vec(0.0, 0.0, 0.0)),
-                                                         "geometry_msgs/msg/Twist"))).decode()
-    replies = _send(server.path, [
-        b'{"cmd": "publish"}',
-        json.dumps({"topic": "/chatter", "type": "geometry_msgs/msg/Twist", "cdr": cdr}).encode(),  # wrong type
-        b"not json at all",
-        json.dumps({"topic": "/x", "type": "no_pkg/msg/Nope", "cdr": cdr}).encode(),
-        json.dumps({"topic": "/x", "type": "std_msgs/msg/String", "cdr": "!!!"}).encode(),
-    ])
+    cdr = base64.b64encode(
+        bytes(TYPESTORE.serialize_cdr(twist(vec(1.0, 0.0, 0.0), vec(0.0, 0.0, 0.0)), "geometry_msgs/msg/Twist"))
+    ).decode()
+    replies = _send(
+        server.path,
+        [
+            b'{"cmd": "publish"}',
+            json.dumps({"topic": "/chatter", "type": "geometry_msgs/msg/Twist", "cdr": cdr}).encode(),  # wrong type
+            b"not json at all",
+            json.dumps({"topic": "/x", "type": "no_pkg/msg/Nope", "cdr": cdr}).encode(),
+            json.dumps({"topic": "/x", "type": "std_msgs/msg/String", "cdr": "!!!"}).encode(),
+        ],
+    )
     errors = [r["error"] for r in replies]
     assert any("'/chatter' has type std_msgs/msg/String, but geometry_msgs/msg/Twist" in e for e in errors)
     assert any("malformed request line" in e for e in errors)
@@ -119,8 +123,9 @@ def test_bad_clients_get_error_replies_and_the_launch_goes_on(running: tuple[Any
     assert "/chatter" in introspect.request(server.path, "graph")["types"]
 
 
-def test_over_long_lines_and_too_many_clients_are_refused(running: tuple[Any, IntrospectionServer],
-                                                          monkeypatch: pytest.MonkeyPatch) -> None:
+def test_over_long_lines_and_too_many_clients_are_refused(
+    running: tuple[Any, IntrospectionServer], monkeypatch: pytest.MonkeyPatch
+) -> None:
     _ex, server = running
     monkeypatch.setattr(introspect, "MAX_LINE", 1000)
     assert "longer than 1000 bytes" in _send(server.path, [b'{"cmd": "' + b"x" * 2000 + b'"}'])[0]["error"]

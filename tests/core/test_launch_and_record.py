@@ -71,17 +71,27 @@ def test_recording_round_trip(tmp_path):
     def tick() -> None:
         t = ex.now_ns
         m = msgs.Odometry(
-            header=msgs.header(t, "odom"), child_frame_id="chassis",
+            header=msgs.header(t, "odom"),
+            child_frame_id="chassis",
             pose=msgs.PoseWithCovariance(pose=msgs.pose_from_2d(t / 1e9, 0.5, 0.1), covariance=msgs.covariance((1, 2))),
             twist=msgs.TwistWithCovariance(twist=msgs.twist(0.3, 0.1), covariance=msgs.covariance()),
         )
         pub.publish(m)
         sent.append((t, m))
-        scan_pub.publish(msgs.LaserScan(
-            header=msgs.header(t, "laser"), angle_min=-1.0, angle_max=1.0, angle_increment=0.5, time_increment=0.0,
-            scan_time=0.1, range_min=0.2, range_max=25.0,
-            ranges=node.rng.random(5).astype("float32"), intensities=np.zeros(0, "float32"),
-        ))
+        scan_pub.publish(
+            msgs.LaserScan(
+                header=msgs.header(t, "laser"),
+                angle_min=-1.0,
+                angle_max=1.0,
+                angle_increment=0.5,
+                time_increment=0.0,
+                scan_time=0.1,
+                range_min=0.2,
+                range_max=25.0,
+                ranges=node.rng.random(5).astype("float32"),
+                intensities=np.zeros(0, "float32"),
+            )
+        )
 
     node.create_timer(0.1, tick)
     bag = tmp_path / "run"

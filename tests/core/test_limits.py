@@ -33,23 +33,29 @@ def _amcl(values: dict[str, Any]) -> None:
     AmclParams(**values).validate()
 
 
-@pytest.mark.parametrize(("build", "values", "words"), [
-    (costmap_params, {"width": 1e6, "height": 1e6, "resolution": 0.05},
-     "width x height / resolution²: 400,000,000,000,000 cells"),
-    (costmap_params, {"resolution": 1e-7}, "cells, more than"),
-    (costmap_params, {"update_frequency": 1e9}, "update_frequency: 1,000,000,000 Hz"),
-    (_footprint, "[[1e6, 0], [0, 1], [-1, 0]]", "distance from the centre"),
-    (_footprint, str([[k % 7 / 10, k / 1e4] for k in range(2000)]), "number of points"),
-    (costmap_params, {"robot_radius": 1e9}, "robot_radius"),
-    (_reader(DWAPlannerParams), {"vx_samples": 10**6, "vth_samples": 10**6}, "vx_samples x vth_samples x steps"),
-    (_reader(DWAPlannerParams), {"sim_granularity": 1e-12}, "poses per cycle"),
-    (_reader(DWAPlannerParams), {"controller_frequency": 1e9}, "controller_frequency"),
-    (_reader(TrajectoryPlannerParams), {"vx_samples": 10**9}, "vx_samples x vtheta_samples"),
-    (_reader(MppiParams), {"batch_size": 10**9}, "batch_size x time_steps x iteration_count: 56,000,000,000 poses"),
-    (_reader(MppiParams), {"time_steps": 10**9}, "batch_size x time_steps"),
-    (_amcl, {"max_particles": 10**9}, "max_particles"),
-    (_reader(GMappingParams), {"particles": 10**9}, "particles"),
-])
+@pytest.mark.parametrize(
+    ("build", "values", "words"),
+    [
+        (
+            costmap_params,
+            {"width": 1e6, "height": 1e6, "resolution": 0.05},
+            "width x height / resolution²: 400,000,000,000,000 cells",
+        ),
+        (costmap_params, {"resolution": 1e-7}, "cells, more than"),
+        (costmap_params, {"update_frequency": 1e9}, "update_frequency: 1,000,000,000 Hz"),
+        (_footprint, "[[1e6, 0], [0, 1], [-1, 0]]", "distance from the centre"),
+        (_footprint, str([[k % 7 / 10, k / 1e4] for k in range(2000)]), "number of points"),
+        (costmap_params, {"robot_radius": 1e9}, "robot_radius"),
+        (_reader(DWAPlannerParams), {"vx_samples": 10**6, "vth_samples": 10**6}, "vx_samples x vth_samples x steps"),
+        (_reader(DWAPlannerParams), {"sim_granularity": 1e-12}, "poses per cycle"),
+        (_reader(DWAPlannerParams), {"controller_frequency": 1e9}, "controller_frequency"),
+        (_reader(TrajectoryPlannerParams), {"vx_samples": 10**9}, "vx_samples x vtheta_samples"),
+        (_reader(MppiParams), {"batch_size": 10**9}, "batch_size x time_steps x iteration_count: 56,000,000,000 poses"),
+        (_reader(MppiParams), {"time_steps": 10**9}, "batch_size x time_steps"),
+        (_amcl, {"max_particles": 10**9}, "max_particles"),
+        (_reader(GMappingParams), {"particles": 10**9}, "particles"),
+    ],
+)
 def test_sizes_beyond_the_ceilings_are_refused_naming_the_key(build: Any, values: dict[str, Any], words: str) -> None:
     with pytest.raises(NavlabError, match="ceiling") as info:
         build(values)
@@ -67,7 +73,7 @@ def _log(path: Path, wild: tuple[float, float] | None) -> Path:
     lines = []
     for k in range(30):
         x = 0.05 * k
-        ox, oy = (wild if wild is not None and k == 15 else (x, 0.0))
+        ox, oy = wild if wild is not None and k == 15 else (x, 0.0)
         ranges = " ".join("2.0" for _ in range(181))
         lines.append(f"FLASER 181 {ranges} {ox} {oy} 0.0 {ox} {oy} 0.0 {k * 0.2:.3f} host {k * 0.2:.3f}")
     path.write_text("\n".join(lines) + "\n")

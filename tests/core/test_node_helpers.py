@@ -20,8 +20,14 @@ def _node_classes() -> list[type]:
     from navlab.sim.imu import ImuSensorPlugin
 
     classes = [getattr(importlib.import_module(m), c) for m, c in (t.split(":") for t in NODES.values())]
-    classes += [sim_plugins.DiffDrivePlugin, sim_plugins.LidarPlugin, ImuSensorPlugin, sim_plugins.JointStatePlugin,
-                sim_plugins.RobotStatePublisher, sim_plugins.GroundTruthPlugin]  # fmt: skip
+    classes += [
+        sim_plugins.DiffDrivePlugin,
+        sim_plugins.LidarPlugin,
+        ImuSensorPlugin,
+        sim_plugins.JointStatePlugin,
+        sim_plugins.RobotStatePublisher,
+        sim_plugins.GroundTruthPlugin,
+    ]
     return classes  # the base Node has rclpy's constructor (issue 23; tests/core/test_rclpy_api.py)
 
 
@@ -68,14 +74,18 @@ class _FilterParams:
 
 def test_parameters_declared_from_a_dataclass_with_aliases() -> None:
     assert dataclass_parameters(_FilterParams, prefix="pf") == {
-        "pf.min_particles": 100, "pf.kld_err": 0.01, "pf.laser_model_type": "likelihood_field"}  # fmt: skip
+        "pf.min_particles": 100,
+        "pf.kld_err": 0.01,
+        "pf.laser_model_type": "likelihood_field",
+    }
     ex = Executor()
     node = Node(ex, name="amcl", parameters={"pf_err": 0.05, "min_particles": 7})
     values = node.declare_parameters(dataclass_parameters(_FilterParams), aliases={"kld_err": ("pf_err",)})
     assert _FilterParams(**values) == _FilterParams(min_particles=7, kld_err=0.05)
     with pytest.raises(ParameterError, match="min_particles"):
         Node(ex, name="bad", parameters={"min_particles": "many"}).declare_parameters(
-            dataclass_parameters(_FilterParams))
+            dataclass_parameters(_FilterParams)
+        )
     with pytest.raises(ParameterError, match="not a dataclass"):
         dataclass_parameters(dict)
 
@@ -104,7 +114,8 @@ def test_executor_and_node_modules_do_not_import_each_other() -> None:
     def imports(module: str) -> set[str]:
         tree = ast.parse(inspect.getsource(importlib.import_module(module)))
         return {n.module for n in ast.walk(tree) if isinstance(n, ast.ImportFrom) and n.module} | {
-            a.name for n in ast.walk(tree) if isinstance(n, ast.Import) for a in n.names}
+            a.name for n in ast.walk(tree) if isinstance(n, ast.Import) for a in n.names
+        }
 
     assert "navlab.core.node" not in imports("navlab.core.executor")
     assert "navlab.core.node" not in imports("navlab.core.topics")

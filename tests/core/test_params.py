@@ -106,8 +106,13 @@ def test_one_reader_for_settings_dataclasses(caplog) -> None:  # type: ignore[no
         mode: str = "both"
         flag: bool = False
         PARAMS: ClassVar[ParamSpec] = ParamSpec(
-            "demo_planner", aliases={"max_trans_vel": "max_vel_x"}, ignored=frozenset({"use_sim_time"}),
-            above={"max_vel_x": 0.0}, choices={"mode": ("local", "both")}, clamp_at_least={"samples": 1})
+            "demo_planner",
+            aliases={"max_trans_vel": "max_vel_x"},
+            ignored=frozenset({"use_sim_time"}),
+            above={"max_vel_x": 0.0},
+            choices={"mode": ("local", "both")},
+            clamp_at_least={"samples": 1},
+        )
 
         def validate(self) -> None:
             if self.flag and self.mode == "local":

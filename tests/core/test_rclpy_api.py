@@ -26,9 +26,26 @@ DRIVER = Path(__file__).parents[2] / "examples" / "07_rclpy_node" / "driver.py" 
 def test_an_rclpy_node_file_runs_unchanged(tmp_path: Path) -> None:
     file = tmp_path / "driver.py"
     file.write_text(DRIVER.read_text())
-    done = subprocess.run([sys.executable, "-m", "navlab.cli", "run", str(file), "--launch", "sim", "world:=room",
-                           "--duration", "2", "--json"], capture_output=True, text=True, timeout=300, check=False,
-                          cwd=tmp_path)
+    done = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "navlab.cli",
+            "run",
+            str(file),
+            "--launch",
+            "sim",
+            "world:=room",
+            "--duration",
+            "2",
+            "--json",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        check=False,
+        cwd=tmp_path,
+    )
     assert done.returncode == 0, done.stderr[-2000:]
     out = json.loads(done.stdout.strip().splitlines()[-1])
     assert out["sim_s"] == 2.0 and out["topics"]["/cmd_vel"] == 20  # 10 Hz for 2 simulated seconds

@@ -32,13 +32,18 @@ def test_roslaunch_semantics(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) ->
     monkeypatch.setenv("NAVLAB_T_ENV", "from-env")
     monkeypatch.delenv("NAVLAB_T_UNSET", raising=False)
     _write(tmp_path / "cfg.yaml", "gain: 2\nnested: {a: 1, b: [1, 2]}\nname: $(arg robot)\n")
-    _write(tmp_path / "inc.launch", """<launch>
+    _write(
+        tmp_path / "inc.launch",
+        """<launch>
   <arg name="speed"/>
   <arg name="fixed" value="F"/>
   <param name="speed" value="$(arg speed)"/>
   <node pkg="p" type="t" name="inner"><param name="here" value="$(dirname)"/></node>
-</launch>""")
-    top = _write(tmp_path / "top.launch", """<launch>
+</launch>""",
+    )
+    top = _write(
+        tmp_path / "top.launch",
+        """<launch>
   <arg name="robot" default="r1"/>
   <arg name="use_group" default="true"/>
   <arg name="count" default="3"/>
@@ -67,7 +72,8 @@ def test_roslaunch_semantics(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) ->
     <include file="$(dirname)/inc.launch" ns="sub"><arg name="speed" value="0.3"/></include>
   </group>
   <group unless="$(arg use_group)"><node pkg="p" type="t" name="never"/></group>
-</launch>""")
+</launch>""",
+    )
     config = load([top], {"robot": "r2"})
     p = config.params
     assert p["/global/int"] == 7 and p["/float"] == 1.5 and p["/text"] == "7" and p["/flag"] is True
@@ -89,22 +95,26 @@ def test_roslaunch_semantics(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) ->
     assert config.params_under("/robots/driver") == {"private": 1, "rel": 2, "tuned": {"k": 0.5}}
 
 
-@pytest.mark.parametrize(("body", "args", "message"), [
-    ('<arg name="speed" default="1"/>', {"sped": "2"}, "unknown launch argument 'sped' (did you mean 'speed'?"),
-    ('<arg name="speed"/><param name="s" value="$(arg speed)"/>', {}, "arg 'speed' is not set; pass speed:=VALUE"),
-    ('<arg name="speed" value="1"/>', {"speed": "2"}, "cannot override arg 'speed'"),
-    ('<param name="s" value="$(arg nope)"/>', {}, "arg 'nope' is not defined"),
-    ('<param name="s" value="$(env NAVLAB_T_UNSET)"/>', {}, "environment variable 'NAVLAB_T_UNSET' is not set"),
-    ('<param name="s" value="$(find no_such_pkg)"/>', {}, "ROS package 'no_such_pkg' not found"),
-    ('<param name="s" command="ls /"/>', {}, "runs a program; navlab runs programs named by a launch file only"),
-    ('<group if="maybe"/>', {}, "'maybe' is not a boolean"),
-    ('<nodes pkg="a" type="b" name="c"/>', {}, "unknown tag <nodes>; did you mean <node>?"),
-    ('<node pkg="a" type="b" name="c"/><node pkg="a" type="b" name="c"/>', {}, "already in this launch"),
-    ('<param name="s" value="x $(eval 1 + 1)"/>', {}, "must be the whole attribute"),
-    ('<include file="$(dirname)/inc.launch"><arg name="bogus" value="1"/></include>', {}, "unused args [bogus]"),
-])
-def test_bad_launch_files_get_one_clear_error(tmp_path: Path, body: str, args: dict[str, str], message: str,
-                                              monkeypatch: pytest.MonkeyPatch) -> None:
+@pytest.mark.parametrize(
+    ("body", "args", "message"),
+    [
+        ('<arg name="speed" default="1"/>', {"sped": "2"}, "unknown launch argument 'sped' (did you mean 'speed'?"),
+        ('<arg name="speed"/><param name="s" value="$(arg speed)"/>', {}, "arg 'speed' is not set; pass speed:=VALUE"),
+        ('<arg name="speed" value="1"/>', {"speed": "2"}, "cannot override arg 'speed'"),
+        ('<param name="s" value="$(arg nope)"/>', {}, "arg 'nope' is not defined"),
+        ('<param name="s" value="$(env NAVLAB_T_UNSET)"/>', {}, "environment variable 'NAVLAB_T_UNSET' is not set"),
+        ('<param name="s" value="$(find no_such_pkg)"/>', {}, "ROS package 'no_such_pkg' not found"),
+        ('<param name="s" command="ls /"/>', {}, "runs a program; navlab runs programs named by a launch file only"),
+        ('<group if="maybe"/>', {}, "'maybe' is not a boolean"),
+        ('<nodes pkg="a" type="b" name="c"/>', {}, "unknown tag <nodes>; did you mean <node>?"),
+        ('<node pkg="a" type="b" name="c"/><node pkg="a" type="b" name="c"/>', {}, "already in this launch"),
+        ('<param name="s" value="x $(eval 1 + 1)"/>', {}, "must be the whole attribute"),
+        ('<include file="$(dirname)/inc.launch"><arg name="bogus" value="1"/></include>', {}, "unused args [bogus]"),
+    ],
+)
+def test_bad_launch_files_get_one_clear_error(
+    tmp_path: Path, body: str, args: dict[str, str], message: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
     monkeypatch.delenv("NAVLAB_T_UNSET", raising=False)
     _write(tmp_path / "inc.launch", "<launch/>")
     file = _write(tmp_path / "bad.launch", f"<launch>{body}</launch>")
@@ -114,14 +124,17 @@ def test_bad_launch_files_get_one_clear_error(tmp_path: Path, body: str, args: d
 
 
 def test_eval_runs_in_the_sandbox(tmp_path: Path) -> None:
-    file = _write(tmp_path / "e.launch", """<launch>
+    file = _write(
+        tmp_path / "e.launch",
+        """<launch>
   <arg name="radius" default="0.5"/>
   <param name="twice" value="$(eval 2 * float(radius))"/>
   <param name="picked" value="$(eval arg('radius') == '0.5')"/>
   <group if="$(eval float(radius) &gt; 0.4 and optenv('NAVLAB_T_UNSET', 'x') == 'x')">
     <param name="big" value="$(eval find('my_slam').endswith('my_slam'))"/>
   </group>
-</launch>""")
+</launch>""",
+    )
     config = load([file], {})
     assert config.params["/twice"] == 1.0 and config.params["/picked"] is True and config.params["/big"] is True
     bad = _write(tmp_path / "b.launch", '<launch><param name="x" value="$(eval __import__(\'os\'))"/></launch>')
@@ -137,8 +150,9 @@ def _recorded(path: Path, timeout: float = 20.0) -> dict:
     return json.loads(path.read_text())
 
 
-def test_unknown_node_starts_as_a_process_with_the_ros_environment(tmp_path: Path,
-                                                                  monkeypatch: pytest.MonkeyPatch) -> None:
+def test_unknown_node_starts_as_a_process_with_the_ros_environment(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     monkeypatch.setenv("ROS_HOME", str(tmp_path / "ros_home"))
     monkeypatch.setenv("ROS_MASTER_URI", "http://localhost:11999")
     out = tmp_path / "record.json"
@@ -161,8 +175,9 @@ def test_unknown_node_starts_as_a_process_with_the_ros_environment(tmp_path: Pat
 def test_a_required_process_that_exits_stops_the_launch(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setenv("ROS_HOME", str(tmp_path / "ros_home"))
     out = tmp_path / "record.json"
-    session = start(WS / "my_tools" / "launch" / "record.launch", launch_args={"out": str(out), "exit_code": "0",
-                                                                             "ros": "true"})
+    session = start(
+        WS / "my_tools" / "launch" / "record.launch", launch_args={"out": str(out), "exit_code": "0", "ros": "true"}
+    )
     try:
         _recorded(out)
         deadline = time.monotonic() + 20
@@ -183,12 +198,16 @@ def test_without_the_bridge_an_unknown_node_is_named_not_run(tmp_path: Path) -> 
     assert "my_tools/recorder" in note and "ros:=true" in note
 
 
-def test_an_unknown_harmless_key_warns_naming_the_parameter_file(tmp_path: Path,
-                                                                 caplog: pytest.LogCaptureFixture) -> None:
+def test_an_unknown_harmless_key_warns_naming_the_parameter_file(
+    tmp_path: Path, caplog: pytest.LogCaptureFixture
+) -> None:
     _write(tmp_path / "amcl_params.yaml", "min_particles: 200\nuse_map_topic: true\nfancy_new_option: 3\n")
-    file = _write(tmp_path / "amcl.launch", """<launch>
+    file = _write(
+        tmp_path / "amcl.launch",
+        """<launch>
   <node pkg="amcl" type="amcl" name="amcl"><rosparam file="$(dirname)/amcl_params.yaml" command="load"/></node>
-</launch>""")
+</launch>""",
+    )
     with caplog.at_level("WARNING", logger="navlab.launch"):
         session = start(file)
     assert session.node("amcl").get_parameter("min_particles") == 200

@@ -25,12 +25,28 @@ def _workspace(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setenv("ROS_PACKAGE_PATH", str(WS))
 
 
-def test_roslaunch_my_gazebo_my_world_simulates(capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch,
-                                               tmp_path: Path) -> None:
+def test_roslaunch_my_gazebo_my_world_simulates(
+    capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch, tmp_path: Path
+) -> None:
     monkeypatch.delenv("ROS_PACKAGE_PATH")  # found through --package-path, as a user passes it
     monkeypatch.chdir(tmp_path)
-    assert main(["roslaunch", "my_gazebo", "my_world.launch", "--package-path", str(WS), "--duration", "1",
-                 "--json", "--quiet", "x_pos:=0.5"]) == 0
+    assert (
+        main(
+            [
+                "roslaunch",
+                "my_gazebo",
+                "my_world.launch",
+                "--package-path",
+                str(WS),
+                "--duration",
+                "1",
+                "--json",
+                "--quiet",
+                "x_pos:=0.5",
+            ]
+        )
+        == 0
+    )
     out = json.loads(capsys.readouterr().out)
     assert "/gazebo" in out["nodes"] and out["topics"]["/scan"] >= 4 and out["topics"]["/tf"] >= 25
 
@@ -74,9 +90,15 @@ def test_my_navigation_reaches_a_goal_with_the_models_costmap_files(tmp_path: Pa
     from navlab.world import load_world, true_map
 
     save_map(true_map(load_world(WS / "my_gazebo" / "worlds" / "my_room.world"), (0.0, 0.0)), tmp_path / "map.yaml")
-    session = start([WORLD, WS / "my_navigation" / "launch" / "my_navigation.launch"],
-                    launch_args={"map_file": str(tmp_path / "map.yaml"), "model": "large",
-                                 "initial_pose_x": "-1.0", "initial_pose_y": "-0.5"})
+    session = start(
+        [WORLD, WS / "my_navigation" / "launch" / "my_navigation.launch"],
+        launch_args={
+            "map_file": str(tmp_path / "map.yaml"),
+            "model": "large",
+            "initial_pose_x": "-1.0",
+            "initial_pose_y": "-0.5",
+        },
+    )
     move_base = session.node("move_base")
     for costmap in (move_base.global_costmap, move_base.local_costmap):  # costmap_common_params_large into both
         assert costmap.layered.footprint.polygon.max() == pytest.approx(0.2 + 0.01)  # + footprint_padding
@@ -85,9 +107,15 @@ def test_my_navigation_reaches_a_goal_with_the_models_costmap_files(tmp_path: Pa
     node = Node(session.executor, name="rviz_goal")
     pub = node.create_publisher(msgs.PoseStamped, "/move_base_simple/goal", 1)
     session.run(0.5)
-    pub.publish(msgs.PoseStamped(header=msgs.Header(stamp=msgs.time_from_ns(session.executor.now_ns), frame_id="map"),
-                                 pose=msgs.Pose(position=msgs.Point(x=goal[0], y=goal[1], z=0.0),
-                                                orientation=msgs.Quaternion(x=0.0, y=0.0, z=0.0, w=1.0))))
+    pub.publish(
+        msgs.PoseStamped(
+            header=msgs.Header(stamp=msgs.time_from_ns(session.executor.now_ns), frame_id="map"),
+            pose=msgs.Pose(
+                position=msgs.Point(x=goal[0], y=goal[1], z=0.0),
+                orientation=msgs.Quaternion(x=0.0, y=0.0, z=0.0, w=1.0),
+            ),
+        )
+    )
     gazebo = session.node("gazebo")
 
     def arrived() -> bool:
@@ -97,8 +125,9 @@ def test_my_navigation_reaches_a_goal_with_the_models_costmap_files(tmp_path: Pa
     assert session.executor.run_until(arrived, timeout=30.0)
 
 
-def test_several_launch_files_in_one_call_and_map_saver_writes_the_map(tmp_path: Path,
-                                                                      capsys: pytest.CaptureFixture[str]) -> None:
+def test_several_launch_files_in_one_call_and_map_saver_writes_the_map(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     """`navlab launch A.launch B.launch name:=value` (roslaunch a.launch b.launch): the world, gmapping and
     map_saver in one process; map_saver -f writes the first map it receives, as map_server's map_saver does."""
     saver = tmp_path / "save.launch"

@@ -111,8 +111,10 @@ def test_localization_launch_needs_a_map():
 def test_cli_launch_and_graph_of_shipped_launches(room_map, tmp_path, capsys):
     assert main(["launch", "mapping", "--duration", "2", "--quiet", "--json"]) == 0
     assert '"/map"' in capsys.readouterr().out
-    assert main(["graph", "--launch", "localization", f"map:={room_map}", "--duration", "1", "--out",
-                 str(tmp_path / "g")]) == 0  # fmt: skip
+    assert (
+        main(["graph", "--launch", "localization", f"map:={room_map}", "--duration", "1", "--out", str(tmp_path / "g")])
+        == 0
+    )
     dot = (tmp_path / "g" / "graph.dot").read_text()
     assert '"n:/map_server" -> "t:/map"' in dot and '"t:/map" -> "n:/amcl"' in dot
     assert '"n:/amcl" -> "t:/amcl_pose"' in dot

@@ -61,8 +61,10 @@ def test_executor_feeds_tf_from_topics():
     ex = Executor()
     node = Node(ex, name="pub")
     node.send_static_transform(msgs.transform_stamped(0, "chassis", "laser", 0.0, 0.0, 0.0, 0.06))
-    node.create_timer(0.1, lambda: node.send_transform(msgs.transform_stamped(ex.now_ns, "odom", "chassis",
-                                                                                ex.now_ns / 1e9, 0.0, 0.0)))
+    node.create_timer(
+        0.1,
+        lambda: node.send_transform(msgs.transform_stamped(ex.now_ns, "odom", "chassis", ex.now_ns / 1e9, 0.0, 0.0)),
+    )
     ex.run(1.0)
     assert ex.tf.lookup_pose2d("odom", "laser", 550_000_000)[0] == pytest.approx(0.55)
 

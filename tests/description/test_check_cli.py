@@ -31,15 +31,25 @@ def test_check_robot_json(capsys):
 def test_check_robot_text_lists_links_joints_plugins(capsys):
     assert main(["check", "robot", str(FIX / "turtlebot3_description/urdf/turtlebot3_burger.urdf.xacro")]) == 0
     out = capsys.readouterr().out
-    for word in ("turtlebot3_burger", "base_footprint", "wheel_left_joint", "continuous", "diff drive",
-                 "lds_lfcd_sensor", "imu_plugin", "OK"):
+    for word in (
+        "turtlebot3_burger",
+        "base_footprint",
+        "wheel_left_joint",
+        "continuous",
+        "diff drive",
+        "lds_lfcd_sensor",
+        "imu_plugin",
+        "OK",
+    ):
         assert word in out
 
 
 def test_check_robot_xacro_arg_and_strict(tmp_path, capsys):
     f = tmp_path / "r.xacro"
-    f.write_text('<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro"><xacro:arg name="m" default="1"/>'
-                 '<link name="a"><inertial><mass value="$(arg m)"/></inertial></link></robot>')
+    f.write_text(
+        '<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro"><xacro:arg name="m" default="1"/>'
+        '<link name="a"><inertial><mass value="$(arg m)"/></inertial></link></robot>'
+    )
     s = _json(capsys, ["check", "robot", str(f), "--arg", "m:=3", "--json"])
     assert s["links"]["a"]["mass"] == 3
     assert main(["check", "robot", str(f), "--strict"]) == 1  # no diff drive: a warning
@@ -73,6 +83,12 @@ def test_check_world_error(tmp_path, capsys):
 
 
 def test_check_robot_by_package_uri(capsys):
-    argv = ["check", "robot", "package://turtlebot3_description/urdf/turtlebot3_burger.urdf.xacro",
-            "--package-path", str(FIX), "--json"]
+    argv = [
+        "check",
+        "robot",
+        "package://turtlebot3_description/urdf/turtlebot3_burger.urdf.xacro",
+        "--package-path",
+        str(FIX),
+        "--json",
+    ]
     assert _json(capsys, argv)["name"] == "turtlebot3_burger"

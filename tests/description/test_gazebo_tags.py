@@ -80,7 +80,8 @@ def test_ros2_namespace_prefixes_relative_topics(tmp_path):
 
 def test_noetic_ignores_torque_and_legacy_mode_and_says_which_tag_it_reads(tmp_path):
     tag = ROS1.replace("<wheelTorque>4</wheelTorque>", "<torque>15</torque>").replace(
-        "<legacyMode>false</legacyMode>", "<legacyMode>true</legacyMode>")
+        "<legacyMode>false</legacyMode>", "<legacyMode>true</legacyMode>"
+    )
     robot = _robot(tmp_path, tag)
     assert robot.diff_drive.max_torque == 5.0  # Noetic's wheelTorque default, not the ignored <torque>
     assert robot.diff_drive.legacy_mode is False  # Noetic has no legacy mode
@@ -95,21 +96,41 @@ RAY = """<ray><scan><horizontal><samples>{n}</samples><resolution>1</resolution>
   <noise><type>gaussian</type><mean>0.0</mean><stddev>0.03</stddev></noise></ray>"""
 
 
-@pytest.mark.parametrize("stype,plugin,topic", [
-    ("ray", '<plugin name="gazebo_ros_laser_controller" filename="libgazebo_ros_laser.so">'
-     "<topicName>/front/scan</topicName><frameName>scan_link</frameName></plugin>", "/front/scan"),
-    ("gpu_ray", '<plugin name="gpu" filename="libgazebo_ros_gpu_laser.so">'
-     "<robotNamespace>bot</robotNamespace><topicName>scan</topicName><frameName>scan_link</frameName></plugin>",
-     "/bot/scan"),
-    ("ray", '<plugin name="scanner" filename="libgazebo_ros_ray_sensor.so"><ros><namespace>/demo</namespace>'
-     "<remapping>~/out:=scan</remapping></ros><output_type>sensor_msgs/LaserScan</output_type>"
-     "<frame_name>scan_link</frame_name></plugin>", "/demo/scan"),
-    ("ray", '<plugin name="scanner" filename="libgazebo_ros_ray_sensor.so">'
-     "<output_type>sensor_msgs/LaserScan</output_type></plugin>", "scanner/out"),
-])
+@pytest.mark.parametrize(
+    "stype,plugin,topic",
+    [
+        (
+            "ray",
+            '<plugin name="gazebo_ros_laser_controller" filename="libgazebo_ros_laser.so">'
+            "<topicName>/front/scan</topicName><frameName>scan_link</frameName></plugin>",
+            "/front/scan",
+        ),
+        (
+            "gpu_ray",
+            '<plugin name="gpu" filename="libgazebo_ros_gpu_laser.so">'
+            "<robotNamespace>bot</robotNamespace><topicName>scan</topicName><frameName>scan_link</frameName></plugin>",
+            "/bot/scan",
+        ),
+        (
+            "ray",
+            '<plugin name="scanner" filename="libgazebo_ros_ray_sensor.so"><ros><namespace>/demo</namespace>'
+            "<remapping>~/out:=scan</remapping></ros><output_type>sensor_msgs/LaserScan</output_type>"
+            "<frame_name>scan_link</frame_name></plugin>",
+            "/demo/scan",
+        ),
+        (
+            "ray",
+            '<plugin name="scanner" filename="libgazebo_ros_ray_sensor.so">'
+            "<output_type>sensor_msgs/LaserScan</output_type></plugin>",
+            "scanner/out",
+        ),
+    ],
+)
 def test_laser_plugins(tmp_path, stype, plugin, topic):
-    tag = (f'<gazebo reference="scan_link"><sensor type="{stype}" name="front_laser">'
-           f'<pose>0.1 0 0.2 0 0 0</pose><update_rate>15</update_rate>{RAY.format(n=541)}{plugin}</sensor></gazebo>')
+    tag = (
+        f'<gazebo reference="scan_link"><sensor type="{stype}" name="front_laser">'
+        f"<pose>0.1 0 0.2 0 0 0</pose><update_rate>15</update_rate>{RAY.format(n=541)}{plugin}</sensor></gazebo>"
+    )
     robot = _robot(tmp_path, ROS1, tag)
     (lidar,) = robot.lidars
     assert lidar.link == "scan_link" and lidar.name == "front_laser" and lidar.topic == topic
@@ -120,16 +141,22 @@ def test_laser_plugins(tmp_path, stype, plugin, topic):
 
 
 def test_imu_sensor_plugins_ros1_and_ros2(tmp_path):
-    noise = ("<imu><angular_velocity><x><noise type='gaussian'><mean>0</mean><stddev>0.002</stddev></noise></x>"
-             "</angular_velocity><linear_acceleration><x><noise type='gaussian'><mean>0</mean>"
-             "<stddev>0.017</stddev></noise></x></linear_acceleration></imu>")
-    ros2 = (f'<gazebo reference="imu_link"><sensor type="imu" name="imu_sensor"><update_rate>200</update_rate>'
-            f'{noise}<plugin name="imu_plugin" filename="libgazebo_ros_imu_sensor.so"><ros>'
-            f"<remapping>~/out:=imu</remapping></ros></plugin></sensor></gazebo>")
-    ros1 = ('<gazebo reference="imu_link"><sensor type="imu" name="imu_sensor"><update_rate>200</update_rate>'
-            '<plugin name="imu_plugin" filename="libgazebo_ros_imu_sensor.so"><topicName>imu</topicName>'
-            "<bodyName>imu_link</bodyName><updateRateHZ>100.0</updateRateHZ><gaussianNoise>0.01</gaussianNoise>"
-            "<frameName>imu_link</frameName></plugin></sensor></gazebo>")
+    noise = (
+        "<imu><angular_velocity><x><noise type='gaussian'><mean>0</mean><stddev>0.002</stddev></noise></x>"
+        "</angular_velocity><linear_acceleration><x><noise type='gaussian'><mean>0</mean>"
+        "<stddev>0.017</stddev></noise></x></linear_acceleration></imu>"
+    )
+    ros2 = (
+        f'<gazebo reference="imu_link"><sensor type="imu" name="imu_sensor"><update_rate>200</update_rate>'
+        f'{noise}<plugin name="imu_plugin" filename="libgazebo_ros_imu_sensor.so"><ros>'
+        f"<remapping>~/out:=imu</remapping></ros></plugin></sensor></gazebo>"
+    )
+    ros1 = (
+        '<gazebo reference="imu_link"><sensor type="imu" name="imu_sensor"><update_rate>200</update_rate>'
+        '<plugin name="imu_plugin" filename="libgazebo_ros_imu_sensor.so"><topicName>imu</topicName>'
+        "<bodyName>imu_link</bodyName><updateRateHZ>100.0</updateRateHZ><gaussianNoise>0.01</gaussianNoise>"
+        "<frameName>imu_link</frameName></plugin></sensor></gazebo>"
+    )
     (a,) = _robot(tmp_path, ROS1, ros2, name="a.urdf").imus
     assert (a.link, a.topic, a.update_rate) == ("imu_link", "imu", 200)
     assert (a.gyro_noise_stddev, a.accel_noise_stddev) == (0.002, 0.017)
@@ -139,10 +166,13 @@ def test_imu_sensor_plugins_ros1_and_ros2(tmp_path):
 
 
 def test_unknown_plugin_and_sensor_warn_and_the_rest_loads(tmp_path):
-    tags = ('<gazebo><plugin name="arm_ctrl" filename="libgazebo_ros_vacuum_gripper.so"/></gazebo>'
-            '<gazebo reference="scan_link"><sensor type="camera" name="front_cam"/></gazebo>'
-            '<gazebo reference="scan_link"><sensor type="ray" name="sonar">' + RAY.format(n=5)
-            + '<plugin name="x" filename="libmy_sonar.so"/></sensor></gazebo>')
+    tags = (
+        '<gazebo><plugin name="arm_ctrl" filename="libgazebo_ros_vacuum_gripper.so"/></gazebo>'
+        '<gazebo reference="scan_link"><sensor type="camera" name="front_cam"/></gazebo>'
+        '<gazebo reference="scan_link"><sensor type="ray" name="sonar">'
+        + RAY.format(n=5)
+        + '<plugin name="x" filename="libmy_sonar.so"/></sensor></gazebo>'
+    )
     robot = _robot(tmp_path, ROS1, tags)
     text = "\n".join(robot.warnings)
     assert "libgazebo_ros_vacuum_gripper.so" in text and "arm_ctrl" in text
@@ -153,9 +183,11 @@ def test_unknown_plugin_and_sensor_warn_and_the_rest_loads(tmp_path):
 
 
 def test_link_friction_and_bad_reference(tmp_path):
-    tags = ('<gazebo reference="wl"><mu1>0.8</mu1><mu2>0.6</mu2><kp>1e6</kp></gazebo>'
-            '<gazebo reference="no_such_link"><mu1>1</mu1></gazebo>'
-            '<gazebo reference="wr"><mu3>1</mu3></gazebo>')
+    tags = (
+        '<gazebo reference="wl"><mu1>0.8</mu1><mu2>0.6</mu2><kp>1e6</kp></gazebo>'
+        '<gazebo reference="no_such_link"><mu1>1</mu1></gazebo>'
+        '<gazebo reference="wr"><mu3>1</mu3></gazebo>'
+    )
     robot = _robot(tmp_path, ROS1, tags)
     assert (robot.links["wl"].mu1, robot.links["wl"].mu2) == (0.8, 0.6)
     assert robot.links["wr"].mu1 is None
@@ -181,22 +213,35 @@ def test_diff_drive_bad_value_names_element(tmp_path):
 def test_noetic_laser_defaults_and_ignored_tags(tmp_path):
     """ROS Noetic's gazebo_ros_laser: no <topicName> publishes on /world, no <frameName> stamps frame /world;
     <gaussianNoise>/<hokuyoMinIntensity>/<updateRate> are not read (the sensor's <noise>/<update_rate> are)."""
-    plugin = ('<plugin name="laser" filename="libgazebo_ros_laser.so"><gaussianNoise>0.5</gaussianNoise>'
-              "<hokuyoMinIntensity>101</hokuyoMinIntensity><updateRate>40</updateRate></plugin>")
-    tag = (f'<gazebo reference="scan_link"><sensor type="ray" name="front_laser"><update_rate>15</update_rate>'
-           f"{RAY.format(n=181)}{plugin}</sensor></gazebo>")
+    plugin = (
+        '<plugin name="laser" filename="libgazebo_ros_laser.so"><gaussianNoise>0.5</gaussianNoise>'
+        "<hokuyoMinIntensity>101</hokuyoMinIntensity><updateRate>40</updateRate></plugin>"
+    )
+    tag = (
+        f'<gazebo reference="scan_link"><sensor type="ray" name="front_laser"><update_rate>15</update_rate>'
+        f"{RAY.format(n=181)}{plugin}</sensor></gazebo>"
+    )
     robot = _robot(tmp_path, ROS1, tag)
     (lidar,) = robot.lidars
     assert (lidar.topic, lidar.frame_id, lidar.update_rate, lidar.noise_stddev) == ("/world", "world", 15, 0.03)
     said = " | ".join(robot.warnings)
-    for words in ("no <topicName>", "'/world'", "no <frameName>", "<gaussianNoise> is not read",
-                  "<ray><noise>", "<hokuyoMinIntensity> is not read", "<updateRate> is not read",
-                  "<update_rate>"):
+    for words in (
+        "no <topicName>",
+        "'/world'",
+        "no <frameName>",
+        "<gaussianNoise> is not read",
+        "<ray><noise>",
+        "<hokuyoMinIntensity> is not read",
+        "<updateRate> is not read",
+        "<update_rate>",
+    ):
         assert words in said
 
 
 def test_noetic_imu_model_plugin_default_topic(tmp_path):
-    tag = ('<gazebo><plugin name="imu" filename="libgazebo_ros_imu.so"><bodyName>imu_link</bodyName>'
-           "<updateRate>50</updateRate></plugin></gazebo>")
+    tag = (
+        '<gazebo><plugin name="imu" filename="libgazebo_ros_imu.so"><bodyName>imu_link</bodyName>'
+        "<updateRate>50</updateRate></plugin></gazebo>"
+    )
     (imu,) = _robot(tmp_path, ROS1, tag).imus
     assert imu.topic == "/default_imu" and imu.frame_id == "imu_link"  # Noetic's gazebo_ros_imu defaults

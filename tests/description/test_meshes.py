@@ -28,8 +28,10 @@ def test_binary_stl_extents_in_millimetres():
 
 def test_ascii_stl_and_obj(tmp_path):
     stl = tmp_path / "t.stl"
-    stl.write_text("solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 2 0\n"
-                   "endloop\nendfacet\nendsolid t\n")
+    stl.write_text(
+        "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 2 0\n"
+        "endloop\nendfacet\nendsolid t\n"
+    )
     verts, faces = read_mesh(stl)
     assert verts[faces[0]].tolist() == [[0, 0, 0], [1, 0, 0], [0, 2, 0]]
     obj = tmp_path / "q.obj"
@@ -62,9 +64,11 @@ def test_dae_converted_once_to_cached_obj():
 
 def test_urdf_dae_mesh_scale_includes_collada_unit(tmp_path):
     urdf = tmp_path / "r.urdf"
-    urdf.write_text(f'<robot name="r"><link name="a"><inertial><mass value="1"/></inertial>'
-                    f'<collision><geometry><mesh filename="file://{DAE}" scale="2 2 2"/></geometry></collision>'
-                    f"</link></robot>")
+    urdf.write_text(
+        f'<robot name="r"><link name="a"><inertial><mass value="1"/></inertial>'
+        f'<collision><geometry><mesh filename="file://{DAE}" scale="2 2 2"/></geometry></collision>'
+        f"</link></robot>"
+    )
     geom = load_robot(urdf).links["a"].collisions[0].geometry
     assert geom.mesh_source == DAE and geom.mesh_path.suffix == ".obj"
     assert geom.mesh_scale == pytest.approx((0.0508, 0.0508, 0.0508))
@@ -74,8 +78,10 @@ def test_malformed_dae_names_file(tmp_path):
     bad = tmp_path / "bad.dae"
     bad.write_text("<COLLADA><asset>")
     urdf = tmp_path / "r.urdf"
-    urdf.write_text('<robot name="r"><link name="a"><inertial><mass value="1"/></inertial>'
-                    '<visual><geometry><mesh filename="bad.dae"/></geometry></visual></link></robot>')
+    urdf.write_text(
+        '<robot name="r"><link name="a"><inertial><mass value="1"/></inertial>'
+        '<visual><geometry><mesh filename="bad.dae"/></geometry></visual></link></robot>'
+    )
     with pytest.raises(DescriptionError, match=r'<link name="a">.*bad\.dae: malformed COLLADA'):
         load_robot(urdf)
 

@@ -127,8 +127,10 @@ def test_ros_package_path_is_searched(tmp_path, monkeypatch):
     gz.write_text(gz.read_text().replace("<wheelSeparation>0.4<", "<wheelSeparation>0.7<"))
     top = tmp_path / "elsewhere" / "robot.xacro"
     top.parent.mkdir()
-    top.write_text('<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">'
-                   '<xacro:include filename="$(find mybot_description)/mybot.xacro"/></robot>')
+    top.write_text(
+        '<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">'
+        '<xacro:include filename="$(find mybot_description)/mybot.xacro"/></robot>'
+    )
     monkeypatch.setenv("ROS_PACKAGE_PATH", str(tmp_path / "ws"))
     assert load_robot(top).diff_drive.wheel_separation == 0.7
     monkeypatch.delenv("ROS_PACKAGE_PATH")

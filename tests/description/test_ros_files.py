@@ -30,8 +30,9 @@ def _env(tmp_path, monkeypatch):
 
 
 def _world(path: Path, includes: str) -> Path:
-    path.write_text(f'<sdf version="1.6"><world name="w"><include><uri>model://ground_plane</uri></include>'
-                    f"{includes}</world></sdf>")
+    path.write_text(
+        f'<sdf version="1.6"><world name="w"><include><uri>model://ground_plane</uri></include>{includes}</world></sdf>'
+    )
     return path
 
 
@@ -41,7 +42,8 @@ def _model(root: Path, name: str, size: float) -> None:
     (d / "model.config").write_text(f"<model><name>{name}</name><sdf version='1.6'>model.sdf</sdf></model>")
     (d / "model.sdf").write_text(
         f'<sdf version="1.6"><model name="{name}"><static>true</static><link name="l"><collision name="c">'
-        f"<geometry><box><size>{size} {size} 1</size></box></geometry></collision></link></model></sdf>")
+        f"<geometry><box><size>{size} {size} 1</size></box></geometry></collision></link></model></sdf>"
+    )
 
 
 def test_y_up_inch_dae_wall_stands_as_in_gazebo_and_check_warns(tmp_path, capsys):
@@ -50,9 +52,9 @@ def test_y_up_inch_dae_wall_stands_as_in_gazebo_and_check_warns(tmp_path, capsys
     (models / "wall" / "model.config").write_text("<model><name>wall</name><sdf>model.sdf</sdf></model>")
     (models / "wall" / "model.sdf").write_text(
         '<sdf version="1.6"><model name="wall"><static>true</static><link name="l"><collision name="c">'
-        "<geometry><mesh><uri>model://wall/meshes/wall.dae</uri></mesh></geometry></collision></link></model></sdf>")
-    world = load_world(_world(tmp_path / "w.world", "<include><uri>model://wall</uri></include>"),
-                       model_path=[models])
+        "<geometry><mesh><uri>model://wall/meshes/wall.dae</uri></mesh></geometry></collision></link></model></sdf>"
+    )
+    world = load_world(_world(tmp_path / "w.world", "<include><uri>model://wall</uri></include>"), model_path=[models])
     geom = world.models[0].links[0].collisions[0].geometry
     from navlab.description.meshes import read_mesh
 
@@ -90,8 +92,10 @@ def test_missing_visual_mesh_warns_and_skips_but_missing_collision_mesh_is_an_er
     assert main(["check", "robot", URI, "--arg", "visual_mesh:=gone.dae"]) == 0
     assert "visual skipped" in capsys.readouterr().out
     urdf = tmp_path / "r.urdf"
-    urdf.write_text('<robot name="r"><link name="a"><inertial><mass value="1"/></inertial><collision><geometry>'
-                    '<mesh filename="gone.stl"/></geometry></collision></link></robot>')
+    urdf.write_text(
+        '<robot name="r"><link name="a"><inertial><mass value="1"/></inertial><collision><geometry>'
+        '<mesh filename="gone.stl"/></geometry></collision></link></robot>'
+    )
     with pytest.raises(NotFoundError, match=r"<collision>\[0\]/<geometry>/<mesh>: mesh file .*gone\.stl not found"):
         load_robot(urdf)
 
@@ -100,8 +104,13 @@ def test_model_uri_searches_every_folder_and_three_slashes(tmp_path):
     first, second = tmp_path / "a", tmp_path / "b"
     _model(first, "crate", 0.5)
     _model(second, "barrel", 0.7)
-    world = load_world(_world(tmp_path / "w.world", "<include><uri>model://crate</uri></include>"
-                              "<include><uri>model:///barrel</uri></include>"), model_path=[first, second])
+    world = load_world(
+        _world(
+            tmp_path / "w.world",
+            "<include><uri>model://crate</uri></include><include><uri>model:///barrel</uri></include>",
+        ),
+        model_path=[first, second],
+    )
     assert {m.name for m in world.models} == {"crate", "barrel"}
     index = PackageIndex(use_env=False)
     (second / "barrel" / "meshes").mkdir()
@@ -118,16 +127,24 @@ def test_gazebo_model_path_export_and_missing_model_names_folders(tmp_path, monk
     world = load_world(_world(tmp_path / "w.world", "<include><uri>model://pillar</uri></include>"))
     assert [m.name for m in world.models] == ["pillar"]  # found through package.xml's export
     with pytest.raises(WorldError) as err:
-        load_world(_world(tmp_path / "x.world", "<include><uri>model://no_such_model</uri></include>"),
-                   model_path=[tmp_path / "a", tmp_path / "b"])
+        load_world(
+            _world(tmp_path / "x.world", "<include><uri>model://no_such_model</uri></include>"),
+            model_path=[tmp_path / "a", tmp_path / "b"],
+        )
     msg = str(err.value)
     assert "'no_such_model'" in msg and str(tmp_path / "a") in msg and str(tmp_path / "b") in msg
     assert str(PKG / "models") in msg
 
 
-@pytest.mark.parametrize("uri", ["package://tutorial_bot_description/../../../etc/passwd",
-                                 "package://tutorial_bot_description/urdf/../../..",
-                                 "model://../../etc/passwd", "model://pillar/../../../package.xml"])
+@pytest.mark.parametrize(
+    "uri",
+    [
+        "package://tutorial_bot_description/../../../etc/passwd",
+        "package://tutorial_bot_description/urdf/../../..",
+        "model://../../etc/passwd",
+        "model://pillar/../../../package.xml",
+    ],
+)
 def test_uris_cannot_leave_their_package_or_model(tmp_path, uri):
     index = PackageIndex()
     with pytest.raises(DescriptionError, match=r"leaves its root|model name"):

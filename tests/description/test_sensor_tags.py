@@ -56,7 +56,8 @@ def test_camera_topics_under_namespace_and_camera_name(tmp_path) -> None:
 def test_openni_kinect_defaults(tmp_path) -> None:
     sensor = CAMERA.replace('type="camera"', 'type="depth"').format(
         plugin='<plugin name="k" filename="libgazebo_ros_openni_kinect.so"><cameraName>kinect</cameraName>'
-               '<frameName>k_optical</frameName></plugin>')
+        "<frameName>k_optical</frameName></plugin>"
+    )
     (cam,) = _load(tmp_path, sensor).sensors.cameras
     assert cam.kind == "depth"
     assert cam.image_topic == "/kinect/ir/image_raw" and cam.camera_info_topic == "/kinect/ir/camera_info"
@@ -72,23 +73,51 @@ RAY = """<sensor type="ray" name="{name}"><update_rate>10</update_rate><ray><sca
 
 
 def test_velodyne_defaults(tmp_path) -> None:
-    sensor = RAY.format(name="vlp", h=440, hmin=-math.pi, hmax=math.pi, v=16, vmin=-0.2618, vmax=0.2618, rmax=100,
-                        plugin='<plugin name="v" filename="libgazebo_ros_velodyne_laser.so"/>')
+    sensor = RAY.format(
+        name="vlp",
+        h=440,
+        hmin=-math.pi,
+        hmax=math.pi,
+        v=16,
+        vmin=-0.2618,
+        vmax=0.2618,
+        rmax=100,
+        plugin='<plugin name="v" filename="libgazebo_ros_velodyne_laser.so"/>',
+    )
     robot = _load(tmp_path, sensor)
     (lid,) = robot.sensors.lidars3d
     assert (lid.samples, lid.rings, lid.vertical_min_angle, lid.vertical_max_angle) == (440, 16, -0.2618, 0.2618)
-    assert (lid.topic, lid.frame_id, lid.min_range, lid.max_range, lid.noise_stddev) == ("/world", "world", 0.0,
-                                                                                         math.inf, 0.0)
+    assert (lid.topic, lid.frame_id, lid.min_range, lid.max_range, lid.noise_stddev) == (
+        "/world",
+        "world",
+        0.0,
+        math.inf,
+        0.0,
+    )
     assert lid.organize_cloud is False
     assert any("<topicName>" in w for w in robot.warnings)
 
 
 def test_range_defaults(tmp_path) -> None:
-    sensor = RAY.format(name="sonar", h=5, hmin=-0.1, hmax=0.1, v=5, vmin=-0.1, vmax=0.1, rmax=4,
-                        plugin='<plugin name="r" filename="libgazebo_ros_range.so"/>')
+    sensor = RAY.format(
+        name="sonar",
+        h=5,
+        hmin=-0.1,
+        hmax=0.1,
+        v=5,
+        vmin=-0.1,
+        vmax=0.1,
+        rmax=4,
+        plugin='<plugin name="r" filename="libgazebo_ros_range.so"/>',
+    )
     (rng,) = _load(tmp_path, sensor).sensors.ranges
-    assert (rng.topic, rng.frame_id, rng.radiation, rng.fov, rng.noise_stddev) == ("/range", "world", "ultrasound",
-                                                                                   0.05, 0.0)
+    assert (rng.topic, rng.frame_id, rng.radiation, rng.fov, rng.noise_stddev) == (
+        "/range",
+        "world",
+        "ultrasound",
+        0.05,
+        0.0,
+    )
     assert (rng.samples, rng.vertical_samples, rng.range_min, rng.range_max) == (5, 5, 0.3, 4.0)
 
 
@@ -99,23 +128,65 @@ def test_bumper_defaults(tmp_path) -> None:
     assert (b.topic, b.frame_id, b.collision) == ("bumper_states", "world", "base_collision")
 
 
-@pytest.mark.parametrize(("sensor", "message"), [
-    (CAMERA.replace("<width>64</width>", "<width>-3</width>").format(
-        plugin='<plugin name="c" filename="libgazebo_ros_camera.so"/>'), "<image>: width and height"),
-    (CAMERA.replace("<near>0.02</near>", "<near>40</near>").format(
-        plugin='<plugin name="c" filename="libgazebo_ros_camera.so"/>'), "<clip>: expected 0 < near < far"),
-    (CAMERA.replace("<horizontal_fov>1.2</horizontal_fov>", "<horizontal_fov>4</horizontal_fov>").format(
-        plugin='<plugin name="c" filename="libgazebo_ros_camera.so"/>'), "<horizontal_fov>: expected 0 < fov < pi"),
-    (CAMERA.format(plugin='<plugin name="c" filename="libgazebo_ros_velodyne_laser.so"/>'),
-     "needs a sensor of type ray or gpu_ray, got 'camera'"),
-    (RAY.format(name="s", h=1, hmin=0, hmax=0, v=1, vmin=0, vmax=0, rmax=4,
-                plugin='<plugin name="r" filename="libgazebo_ros_range.so"><radiation>laser</radiation></plugin>'),
-     "<radiation>: expected ultrasound or infrared"),
-    (RAY.format(name="s", h=8, hmin=0, hmax=1, v=4, vmin=0.5, vmax=-0.5, rmax=4,
-                plugin='<plugin name="v" filename="libgazebo_ros_velodyne_laser.so"/>'), "max_angle -0.5 < min_angle"),
-    ('<sensor type="contact" name="b"><plugin name="b" filename="libgazebo_ros_bumper.so"/></sensor>',
-     "needs <contact><collision>"),
-])
+@pytest.mark.parametrize(
+    ("sensor", "message"),
+    [
+        (
+            CAMERA.replace("<width>64</width>", "<width>-3</width>").format(
+                plugin='<plugin name="c" filename="libgazebo_ros_camera.so"/>'
+            ),
+            "<image>: width and height",
+        ),
+        (
+            CAMERA.replace("<near>0.02</near>", "<near>40</near>").format(
+                plugin='<plugin name="c" filename="libgazebo_ros_camera.so"/>'
+            ),
+            "<clip>: expected 0 < near < far",
+        ),
+        (
+            CAMERA.replace("<horizontal_fov>1.2</horizontal_fov>", "<horizontal_fov>4</horizontal_fov>").format(
+                plugin='<plugin name="c" filename="libgazebo_ros_camera.so"/>'
+            ),
+            "<horizontal_fov>: expected 0 < fov < pi",
+        ),
+        (
+            CAMERA.format(plugin='<plugin name="c" filename="libgazebo_ros_velodyne_laser.so"/>'),
+            "needs a sensor of type ray or gpu_ray, got 'camera'",
+        ),
+        (
+            RAY.format(
+                name="s",
+                h=1,
+                hmin=0,
+                hmax=0,
+                v=1,
+                vmin=0,
+                vmax=0,
+                rmax=4,
+                plugin='<plugin name="r" filename="libgazebo_ros_range.so"><radiation>laser</radiation></plugin>',
+            ),
+            "<radiation>: expected ultrasound or infrared",
+        ),
+        (
+            RAY.format(
+                name="s",
+                h=8,
+                hmin=0,
+                hmax=1,
+                v=4,
+                vmin=0.5,
+                vmax=-0.5,
+                rmax=4,
+                plugin='<plugin name="v" filename="libgazebo_ros_velodyne_laser.so"/>',
+            ),
+            "max_angle -0.5 < min_angle",
+        ),
+        (
+            '<sensor type="contact" name="b"><plugin name="b" filename="libgazebo_ros_bumper.so"/></sensor>',
+            "needs <contact><collision>",
+        ),
+    ],
+)
 def test_bad_sensor_tags_one_line(tmp_path, sensor: str, message: str) -> None:
     with pytest.raises(DescriptionError) as err:
         _load(tmp_path, sensor)

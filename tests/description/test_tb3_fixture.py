@@ -27,8 +27,15 @@ def burger():
 
 def test_structure(burger):
     assert burger.name == "turtlebot3_burger" and burger.root_link == "base_footprint"
-    assert set(burger.links) == {"base_footprint", "base_link", "wheel_left_link", "wheel_right_link",
-                                 "caster_back_link", "imu_link", "base_scan"}
+    assert set(burger.links) == {
+        "base_footprint",
+        "base_link",
+        "wheel_left_link",
+        "wheel_right_link",
+        "caster_back_link",
+        "imu_link",
+        "base_scan",
+    }
     types = {j.name: j.type for j in burger.joints}
     assert types["wheel_left_joint"] == types["wheel_right_joint"] == "continuous"
     assert types["base_joint"] == types["scan_joint"] == types["imu_joint"] == "fixed"
@@ -73,13 +80,14 @@ def test_copied_package_loads_through_search_path(tmp_path):
     ws = tmp_path / "catkin_ws" / "src"
     shutil.copytree(PKG, ws / "turtlebot3" / "turtlebot3_description")
     top = tmp_path / "burger.urdf.xacro"
-    top.write_text('<robot name="b" xmlns:xacro="http://ros.org/wiki/xacro"><xacro:include '
-                   'filename="$(find turtlebot3_description)/urdf/turtlebot3_burger.urdf.xacro"/></robot>')
+    top.write_text(
+        '<robot name="b" xmlns:xacro="http://ros.org/wiki/xacro"><xacro:include '
+        'filename="$(find turtlebot3_description)/urdf/turtlebot3_burger.urdf.xacro"/></robot>'
+    )
     robot = load_robot(top, search_paths=[ws])
     assert robot.links["base_link"].visuals[0].geometry.mesh_path.is_relative_to(ws)
 
 
 def test_load_by_package_uri():
-    robot = load_robot("package://turtlebot3_description/urdf/turtlebot3_burger.urdf.xacro",
-                       search_paths=[PKG.parent])
+    robot = load_robot("package://turtlebot3_description/urdf/turtlebot3_burger.urdf.xacro", search_paths=[PKG.parent])
     assert robot.name == "turtlebot3_burger" and robot.source == TOP

@@ -50,8 +50,14 @@ def test_route_follower_drives_the_simulated_robot_to_its_waypoint():
 
     ex = Executor(seed=0)
     gz = launch_sim(ex, world="room")
-    route = RouteFollower(ex, parameters={"segments": [{"linear": 0.0, "angular": 0.5, "duration": 1.0}],
-                                          "waypoints": [[1.0, 0.5]], "base_frame": "chassis"})  # fmt: skip
+    route = RouteFollower(
+        ex,
+        parameters={
+            "segments": [{"linear": 0.0, "angular": 0.5, "duration": 1.0}],
+            "waypoints": [[1.0, 0.5]],
+            "base_frame": "chassis",
+        },
+    )
     assert ex.run_until(lambda: route.done, timeout=30.0)
     x, y, _ = gz.sim.base_pose2d()
     assert abs(x - 1.0) < 0.12 and abs(y - 0.5) < 0.12

@@ -27,8 +27,9 @@ def _trials(folder: Path) -> dict[str, list[dict[str, object]]]:
     return out
 
 
-def test_ray_runs_a_sweep_with_the_same_results_as_local_workers(tmp_path: Path,
-                                                                  monkeypatch: pytest.MonkeyPatch) -> None:  # fmt: skip
+def test_ray_runs_a_sweep_with_the_same_results_as_local_workers(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     monkeypatch.delenv("RAY_ADDRESS", raising=False)  # a local Ray instance, started and stopped here
     params = {"local_costmap.update_frequency": [1.0, 5.0]}
     local = run_sweep(scenario_from_dict(TINY), params, tmp_path / "local", workers=2)

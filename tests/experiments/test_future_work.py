@@ -29,21 +29,30 @@ def test_shipped_comparison_scenarios() -> None:
     assert c.navigation_options()["disturbances"]["wheel_radius_error"] == [0.03, 0.0]
 
 
-@pytest.mark.parametrize("extra, message", [
-    ({"ekf": True}, "ekf needs wheel_controller: diff_drive_controller"),
-    ({"disturbances": {"slip_pathces": []}}, "did you mean 'slip_patches'"),
-    ({"disturbances": {"wheel_radius_error": [0.1]}}, "expected \\[left, right\\]"),
-    ({"wheel_controller": 3}, "wheel_controller: expected"),
-])  # fmt: skip
+@pytest.mark.parametrize(
+    "extra, message",
+    [
+        ({"ekf": True}, "ekf needs wheel_controller: diff_drive_controller"),
+        ({"disturbances": {"slip_pathces": []}}, "did you mean 'slip_patches'"),
+        ({"disturbances": {"wheel_radius_error": [0.1]}}, "expected \\[left, right\\]"),
+        ({"wheel_controller": 3}, "wheel_controller: expected"),
+    ],
+)
 def test_bad_future_work_keys(extra: dict, message: str) -> None:
     with pytest.raises(ExperimentError, match=message):
         scenario_from_dict({"goals": [[1.0, 0.0, 0.0]], **extra})
 
 
 def test_controller_and_ekf_drive_a_goal_and_report_tracking_error() -> None:
-    r = run_navigation([(1.5, 0.0, 0.0)], world="room", wheel_controller="diff_drive_controller", ekf="default",
-                       disturbances={"slip_patches": [{"x": 0.0, "y": 0.0, "radius": 0.5, "mu": 0.05}]},
-                       goal_timeout=30.0, seed=0)  # fmt: skip
+    r = run_navigation(
+        [(1.5, 0.0, 0.0)],
+        world="room",
+        wheel_controller="diff_drive_controller",
+        ekf="default",
+        disturbances={"slip_patches": [{"x": 0.0, "y": 0.0, "radius": 0.5, "mu": 0.05}]},
+        goal_timeout=30.0,
+        seed=0,
+    )
     (goal,) = r.goals
     assert goal["outcome"] == "succeeded" and goal["collisions"] == 0
     assert 0.0 <= goal["tracking_error_m"] < 0.15 and goal["final_error_m"] < 0.25

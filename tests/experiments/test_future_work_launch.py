@@ -71,8 +71,19 @@ def test_without_ekf_the_drive_owns_odom_tf() -> None:
 def test_navigation_launch_with_controller_and_ekf(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     map_yaml = tmp_path / "map.yaml"
     save_map(true_map(load_world("room_obstacles"), (0.0, 0.0)), map_yaml)
-    code = main(["launch", "navigation", f"map:={map_yaml}", "ekf:=true", "wheel_controller:=true",
-                 "--duration", "1", "--json", "--quiet"])  # fmt: skip
+    code = main(
+        [
+            "launch",
+            "navigation",
+            f"map:={map_yaml}",
+            "ekf:=true",
+            "wheel_controller:=true",
+            "--duration",
+            "1",
+            "--json",
+            "--quiet",
+        ]
+    )
     assert code == 0
     out = json.loads(capsys.readouterr().out)
     assert {"/ekf_se", "/mobile_base_controller", "/amcl", "/move_base"} <= set(out["nodes"])
@@ -90,7 +101,11 @@ def test_scenario_keys_map_to_the_launch_args(tmp_path: Path) -> None:
     mine = tmp_path / "ctrl.yaml"
     mine.write_text("mobile_base_controller: {wheel_radius: 0.08}\n")
     args = sim_launch_args(str(mine), str(mine))
-    assert args == {"wheel_controller": "true", "controller_params": str(mine.resolve()), "ekf": "true",
-                    "ekf_params": str(mine.resolve())}  # fmt: skip
+    assert args == {
+        "wheel_controller": "true",
+        "controller_params": str(mine.resolve()),
+        "ekf": "true",
+        "ekf_params": str(mine.resolve()),
+    }
     with pytest.raises(NavigationError, match="expected gazebo_ros_diff_drive or diff_drive_controller"):
         sim_launch_args("pid_please", None)

@@ -30,8 +30,13 @@ def test_tracking_on_a_saved_map_along_a_60_s_route(tmp_path: Path) -> None:
 
 
 def test_global_localization_converges_within_20_s_of_motion() -> None:
-    res = run_localization("room_obstacles", global_localization=True, duration=22.0, seed=0,
-                           amcl_params={"odom_model_type": "diff-corrected"})
+    res = run_localization(
+        "room_obstacles",
+        global_localization=True,
+        duration=22.0,
+        seed=0,
+        amcl_params={"odom_model_type": "diff-corrected"},
+    )
     s = res.summary
     assert np.nanmax(res.error[:40]) > 0.5  # it really started lost
     assert s["converged_s"] is not None and s["converged_s"] <= 20.0
@@ -53,8 +58,22 @@ def test_kidnapped_robot_recovers_within_30_s_with_recovery_alphas() -> None:
 
 
 def test_localize_cli_prints_json_and_saves_a_picture(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    assert main(["localize", "--duration", "4", "--json", "--quiet", "--out", str(tmp_path / "loc"),
-                 "--set", "laser_max_beams=60"]) == 0
+    assert (
+        main(
+            [
+                "localize",
+                "--duration",
+                "4",
+                "--json",
+                "--quiet",
+                "--out",
+                str(tmp_path / "loc"),
+                "--set",
+                "laser_max_beams=60",
+            ]
+        )
+        == 0
+    )
     out = json.loads(capsys.readouterr().out)
     assert out["mode"] == "tracking" and out["position_error_mean_m"] < 0.05 and out["updates"] >= 3
     assert (tmp_path / "loc" / "localize.png").stat().st_size > 10_000 and out["png"].endswith("loc/localize.png")

@@ -49,9 +49,15 @@ def test_route_mapping_puts_walls_where_the_world_has_them(route_file, tmp_path,
 
 def test_slam_beats_raw_odometry_when_encoders_are_off(route_file, tmp_path):
     r = run_mapping(
-        world="room", driver="route", route=route_file, out=tmp_path / "m", duration=150, quiet=True,
-        sim_params={"odometry_noise": 0.03}, seed=0,
-    )  # fmt: skip
+        world="room",
+        driver="route",
+        route=route_file,
+        out=tmp_path / "m",
+        duration=150,
+        quiet=True,
+        sim_params={"odometry_noise": 0.03},
+        seed=0,
+    )
     s = r.scores
     assert s["odometry_position_error_mean_m"] > 0.15, s  # the noisy encoders really drift
     assert s["position_error_mean_m"] < 0.5 * s["odometry_position_error_mean_m"], s

@@ -15,8 +15,7 @@ from navlab.sim import primitive_model
 
 def test_arrival_and_mid_drive_pictures_with_a_legend(tmp_path: Path) -> None:
     late = primitive_model("cylinder", "late_cylinder", (0.15, 0.6), x=1.0, y=1.0)
-    r = run_navigation([(1.5, 0.0, 0.0)], world="room_obstacles", spawn=[(2.0, late)], goal_timeout=20,
-                       snapshots=True)  # fmt: skip
+    r = run_navigation([(1.5, 0.0, 0.0)], world="room_obstacles", spawn=[(2.0, late)], goal_timeout=20, snapshots=True)
     assert r.goals[0]["outcome"] == "succeeded" and len(r.arrivals) == len(r.snapshots) == 1
     end, mid = r.arrivals[0], r.snapshots[0]
     assert end["t"] > mid["t"] and end["dropped"][0][3] == "late_cylinder"
@@ -25,10 +24,29 @@ def test_arrival_and_mid_drive_pictures_with_a_legend(tmp_path: Path) -> None:
     assert {"robot (truth)", "goal", "dropped in while driving", "driven path (truth)", "map: wall"} <= set(labels)
 
 
-def test_cli_writes_both_pictures_and_exits_1_when_a_goal_is_missed(tmp_path: Path,
-                                                                    capsys: pytest.CaptureFixture[str]) -> None:
-    code = main(["navigate", "--world", "room_obstacles", "--goal", "1.5", "0", "0", "--goal", "4.3", "1.0", "0",
-                 "--timeout", "6", "--out", str(tmp_path / "nav"), "--quiet"])  # fmt: skip
+def test_cli_writes_both_pictures_and_exits_1_when_a_goal_is_missed(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    code = main(
+        [
+            "navigate",
+            "--world",
+            "room_obstacles",
+            "--goal",
+            "1.5",
+            "0",
+            "0",
+            "--goal",
+            "4.3",
+            "1.0",
+            "0",
+            "--timeout",
+            "6",
+            "--out",
+            str(tmp_path / "nav"),
+            "--quiet",
+        ]
+    )
     err = capsys.readouterr().err
     assert code == 1 and "navlab: 1 of 2 goals not reached (timeout)" in err
     names = sorted(p.name for p in (tmp_path / "nav").iterdir())

@@ -26,7 +26,8 @@ def _self_contained(page: str) -> list[bytes]:
 
 
 def test_a_run_and_a_sweep_are_reported_as_markdown_pngs_and_one_html_page(
-        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:  # fmt: skip
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     run_experiment(scenario_from_dict(TINY), tmp_path / "run")
     assert main(["report", str(tmp_path / "run")]) == 0
     assert "run report" in capsys.readouterr().out
@@ -52,7 +53,8 @@ def test_a_run_and_a_sweep_are_reported_as_markdown_pngs_and_one_html_page(
 
 
 def test_a_demo_folder_is_reported_and_a_wrong_folder_is_refused(
-        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:  # fmt: skip
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     import matplotlib
 
     matplotlib.use("Agg")
@@ -62,12 +64,26 @@ def test_a_demo_folder_is_reported_and_a_wrong_folder_is_refused(
     (demo / "navigate").mkdir(parents=True)
     for png in ("map.png", "navigate/goal_1.png"):
         plt.imsave(demo / png, [[0.0, 1.0], [1.0, 0.0]])
-    goal = {"goal": [4.3, 1.0, 0.0], "outcome": "succeeded", "time_s": 20.1, "path_m": 5.0, "min_clearance_m": 0.3,
-            "collisions": 0, "reason": ""}  # fmt: skip
-    (demo / "report.json").write_text(json.dumps({
-        "out": str(demo), "mapping": {"precision": 0.97, "recall": 0.93, "picture": "x"},
-        "localization": {"position_error_mean_m": 0.03}, "navigation": {"goals": [goal], "collisions": 0},
-        "wall_s": 80.0}))  # fmt: skip
+    goal = {
+        "goal": [4.3, 1.0, 0.0],
+        "outcome": "succeeded",
+        "time_s": 20.1,
+        "path_m": 5.0,
+        "min_clearance_m": 0.3,
+        "collisions": 0,
+        "reason": "",
+    }
+    (demo / "report.json").write_text(
+        json.dumps(
+            {
+                "out": str(demo),
+                "mapping": {"precision": 0.97, "recall": 0.93, "picture": "x"},
+                "localization": {"position_error_mean_m": 0.03},
+                "navigation": {"goals": [goal], "collisions": 0},
+                "wall_s": 80.0,
+            }
+        )
+    )
     assert main(["report", str(demo)]) == 0
     md = (demo / "report.md").read_text()
     assert "| precision | 0.97 |" in md and "| (4.3, 1.0, 0.0) |" not in md and "succeeded" in md

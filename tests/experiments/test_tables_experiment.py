@@ -16,8 +16,9 @@ def _first_goal(name: str) -> dict:
     return r.goals[0]
 
 
-@pytest.mark.parametrize(("scenario", "reached", "collides"), [("tables_lidar", False, True),
-                                                               ("tables_depth", True, False)])
+@pytest.mark.parametrize(
+    ("scenario", "reached", "collides"), [("tables_lidar", False, True), ("tables_depth", True, False)]
+)
 def test_depth_camera_avoids_what_the_lidar_misses(scenario: str, reached: bool, collides: bool) -> None:
     goal = _first_goal(scenario)
     assert (goal["outcome"] == "succeeded") is reached, goal

@@ -13,9 +13,23 @@ from navlab.experiments.scenario import load_scenario, scenario_from_dict
 from navlab.experiments.trials import read_results, run_experiment, wilson_interval
 
 SMALL = {"name": "small", "world": "room", "goals": [[1.5, 0.5, 0.0]], "trials": 3, "seed": 5, "time_limit": 40}
-METRICS = {"trial", "seed", "success", "failure", "reason", "time_s", "path_m", "shortest_m", "spl",
-           "min_clearance_m", "collisions", "localization_error_mean_m", "localization_error_max_m",
-           "cmd_jerk_mean", "per_goal"}
+METRICS = {
+    "trial",
+    "seed",
+    "success",
+    "failure",
+    "reason",
+    "time_s",
+    "path_m",
+    "shortest_m",
+    "spl",
+    "min_clearance_m",
+    "collisions",
+    "localization_error_mean_m",
+    "localization_error_max_m",
+    "cmd_jerk_mean",
+    "per_goal",
+}
 
 
 def _lines(path: Path) -> list[str]:
@@ -82,7 +96,11 @@ def test_a_two_by_two_sweep_writes_its_table_and_plots(tmp_path: Path) -> None:
     params = parse_params(["local_costmap.update_frequency=1,5", "controller=trajectory,mppi"])
     rows = run_sweep(scenario_from_dict({**SMALL, "trials": 1}), params, tmp_path)
     assert [(r["local_costmap.update_frequency"], r["controller"]) for r in rows] == [
-        (1, "trajectory"), (1, "mppi"), (5, "trajectory"), (5, "mppi")]
+        (1, "trajectory"),
+        (1, "mppi"),
+        (5, "trajectory"),
+        (5, "mppi"),
+    ]
     assert all(r["success_rate"] == 1.0 and r["collisions"] == 0 for r in rows), rows
     table = (tmp_path / "sweep.md").read_text().splitlines()
     assert len(table) == 2 + 4 and "local_costmap.update_frequency" in table[0]

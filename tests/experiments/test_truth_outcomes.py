@@ -14,8 +14,14 @@ from navlab.experiments.trials import read_results, run_experiment
 
 # no map, no amcl: move_base trusts the wheel odometry, and wheels 30 % larger than described make it drift:
 # the robot truly ends ~0.4 m from the goal when odometry says it is within move_base's 0.15 m
-DRIFT = {"name": "drift", "world": "room", "map": "none", "goals": [[2.0, 0.0, 0.0]], "time_limit": 40,
-         "disturbances": {"wheel_radius_error": [0.3, 0.3]}}
+DRIFT = {
+    "name": "drift",
+    "world": "room",
+    "map": "none",
+    "goals": [[2.0, 0.0, 0.0]],
+    "time_limit": 40,
+    "disturbances": {"wheel_radius_error": [0.3, 0.3]},
+}
 
 
 def test_odometry_drift_is_move_base_success_but_truth_failure(tmp_path: Path) -> None:
@@ -43,8 +49,9 @@ def test_a_goal_cancelled_at_13_s_reads_preempted_at_13_s() -> None:
 
         timer.append(node.create_timer(14.0, cancel))
 
-    r = run_navigation([(-3.5, -0.5, 3.14)], world="room_obstacles", pose=(4.3, 1.0, 0.0), goal_timeout=110,
-                       on_start=cancel_later)
+    r = run_navigation(
+        [(-3.5, -0.5, 3.14)], world="room_obstacles", pose=(4.3, 1.0, 0.0), goal_timeout=110, on_start=cancel_later
+    )
     (goal,) = r.goals
     assert goal["outcome"] == "preempted" and goal["move_base_outcome"] == "preempted", goal
     assert goal["reason"] == "cancelled" and goal["time_s"] == pytest.approx(13.0, abs=0.01)

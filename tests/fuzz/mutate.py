@@ -43,30 +43,125 @@ class Case:
 POS, NONNEG = "pos", "nonneg"
 RULES: dict[str, dict[str, str]] = {
     "amcl": {
-        **dict.fromkeys(("min_particles", "max_particles", "kld_err", "kld_z", "resample_interval",
-                         "laser_max_beams", "laser_sigma_hit", "laser_lambda_short", "laser_likelihood_max_dist"),
-                        POS),
-        **dict.fromkeys(("update_min_d", "update_min_a", "recovery_alpha_slow", "recovery_alpha_fast",
-                         "initial_cov_xx", "initial_cov_yy", "initial_cov_aa", "laser_z_hit", "laser_z_short",
-                         "laser_z_max", "laser_z_rand", "odom_alpha1", "odom_alpha2", "odom_alpha3", "odom_alpha4",
-                         "odom_alpha5", "transform_tolerance"), NONNEG),
+        **dict.fromkeys(
+            (
+                "min_particles",
+                "max_particles",
+                "kld_err",
+                "kld_z",
+                "resample_interval",
+                "laser_max_beams",
+                "laser_sigma_hit",
+                "laser_lambda_short",
+                "laser_likelihood_max_dist",
+            ),
+            POS,
+        ),
+        **dict.fromkeys(
+            (
+                "update_min_d",
+                "update_min_a",
+                "recovery_alpha_slow",
+                "recovery_alpha_fast",
+                "initial_cov_xx",
+                "initial_cov_yy",
+                "initial_cov_aa",
+                "laser_z_hit",
+                "laser_z_short",
+                "laser_z_max",
+                "laser_z_rand",
+                "odom_alpha1",
+                "odom_alpha2",
+                "odom_alpha3",
+                "odom_alpha4",
+                "odom_alpha5",
+                "transform_tolerance",
+            ),
+            NONNEG,
+        ),
     },
     "gmapping": {
-        **dict.fromkeys(("transform_publish_period", "throttle_scans", "maxUrange", "sigma",
-                         "lstep", "astep", "lsigma", "ogain", "particles", "delta", "llsamplerange",
-                         "llsamplestep", "lasamplerange", "lasamplestep", "occ_thresh", "resampleThreshold"), POS),
-        **dict.fromkeys(("map_update_interval", "maxRange", "kernelSize", "iterations", "lskip", "minimumScore",
-                         "srr", "srt", "str", "stt", "linearUpdate", "angularUpdate"), NONNEG),
+        **dict.fromkeys(
+            (
+                "transform_publish_period",
+                "throttle_scans",
+                "maxUrange",
+                "sigma",
+                "lstep",
+                "astep",
+                "lsigma",
+                "ogain",
+                "particles",
+                "delta",
+                "llsamplerange",
+                "llsamplestep",
+                "lasamplerange",
+                "lasamplestep",
+                "occ_thresh",
+                "resampleThreshold",
+            ),
+            POS,
+        ),
+        **dict.fromkeys(
+            (
+                "map_update_interval",
+                "maxRange",
+                "kernelSize",
+                "iterations",
+                "lskip",
+                "minimumScore",
+                "srr",
+                "srt",
+                "str",
+                "stt",
+                "linearUpdate",
+                "angularUpdate",
+            ),
+            NONNEG,
+        ),
     },
     "move_base": {
-        **dict.fromkeys(("max_vel_x", "max_vel_theta", "acc_lim_x", "acc_lim_theta", "robot_radius",
-                         "width", "height", "resolution",
-                         "controller_frequency", "vx_max", "wz_max", "vx_std", "prune_distance"), POS),
-        **dict.fromkeys(("xy_goal_tolerance", "yaw_goal_tolerance", "inflation_radius", "cost_scaling_factor",
-                         "update_frequency", "publish_frequency", "transform_tolerance", "planner_frequency",
-                         "planner_patience", "controller_patience", "oscillation_timeout", "oscillation_distance",
-                         "conservative_reset_dist", "occdist_scale", "min_in_place_vel_theta",
-                         "obstacle_range", "raytrace_range", "acc_lim_y"), NONNEG),  # ROS: 0 range = mark nothing
+        **dict.fromkeys(
+            (
+                "max_vel_x",
+                "max_vel_theta",
+                "acc_lim_x",
+                "acc_lim_theta",
+                "robot_radius",
+                "width",
+                "height",
+                "resolution",
+                "controller_frequency",
+                "vx_max",
+                "wz_max",
+                "vx_std",
+                "prune_distance",
+            ),
+            POS,
+        ),
+        **dict.fromkeys(
+            (
+                "xy_goal_tolerance",
+                "yaw_goal_tolerance",
+                "inflation_radius",
+                "cost_scaling_factor",
+                "update_frequency",
+                "publish_frequency",
+                "transform_tolerance",
+                "planner_frequency",
+                "planner_patience",
+                "controller_patience",
+                "oscillation_timeout",
+                "oscillation_distance",
+                "conservative_reset_dist",
+                "occdist_scale",
+                "min_in_place_vel_theta",
+                "obstacle_range",
+                "raytrace_range",
+                "acc_lim_y",
+            ),
+            NONNEG,
+        ),  # ROS: 0 range = mark nothing
     },
     "map": {"resolution": POS},
     "route": {"duration": POS},
@@ -74,10 +169,34 @@ RULES: dict[str, dict[str, str]] = {
     "launch": {"rate": POS},
     # XML: element text by tag, attributes as element@attribute
     "urdf": {
-        **dict.fromkeys(("mass@value", "box@size", "cylinder@radius", "cylinder@length", "sphere@radius",
-                         "samples", "wheelSeparation", "wheelDiameter"), POS),
-        **dict.fromkeys(("inertia@ixx", "inertia@iyy", "inertia@izz", "mu1", "mu2", "kp", "kd", "wheelTorque",
-                         "limit@effort", "limit@velocity"), NONNEG),  # Gazebo: update rates <= 0 mean "every step"
+        **dict.fromkeys(
+            (
+                "mass@value",
+                "box@size",
+                "cylinder@radius",
+                "cylinder@length",
+                "sphere@radius",
+                "samples",
+                "wheelSeparation",
+                "wheelDiameter",
+            ),
+            POS,
+        ),
+        **dict.fromkeys(
+            (
+                "inertia@ixx",
+                "inertia@iyy",
+                "inertia@izz",
+                "mu1",
+                "mu2",
+                "kp",
+                "kd",
+                "wheelTorque",
+                "limit@effort",
+                "limit@velocity",
+            ),
+            NONNEG,
+        ),  # Gazebo: update rates <= 0 mean "every step"
     },
     "world": {
         **dict.fromkeys(("size", "radius", "length", "mass", "max_step_size"), POS),
@@ -88,14 +207,61 @@ RULES["robot"] = RULES["urdf"]
 
 # XML numbers the loaders read (a NaN in a light's colour that nothing reads is not an accepted invalid value)
 READ_XML: dict[str, frozenset[str]] = {
-    "urdf": frozenset({"origin@xyz", "origin@rpy", "mass@value", "inertia@ixx", "inertia@iyy", "inertia@izz",
-                       "inertia@ixy", "inertia@ixz", "inertia@iyz", "box@size", "cylinder@radius", "cylinder@length",
-                       "sphere@radius", "mesh@scale", "limit@lower", "limit@upper", "limit@effort", "limit@velocity",
-                       "axis@xyz", "mu1", "mu2", "updateRate", "update_rate", "samples", "min_angle", "max_angle",
-                       "min", "max", "wheelSeparation", "wheelDiameter", "wheelTorque", "wheelAcceleration",
-                       "pose"}),
-    "world": frozenset({"pose", "size", "radius", "length", "mass", "mu", "mu2", "ixx", "iyy", "izz", "ixy", "ixz",
-                        "iyz", "max_step_size"}),
+    "urdf": frozenset(
+        {
+            "origin@xyz",
+            "origin@rpy",
+            "mass@value",
+            "inertia@ixx",
+            "inertia@iyy",
+            "inertia@izz",
+            "inertia@ixy",
+            "inertia@ixz",
+            "inertia@iyz",
+            "box@size",
+            "cylinder@radius",
+            "cylinder@length",
+            "sphere@radius",
+            "mesh@scale",
+            "limit@lower",
+            "limit@upper",
+            "limit@effort",
+            "limit@velocity",
+            "axis@xyz",
+            "mu1",
+            "mu2",
+            "updateRate",
+            "update_rate",
+            "samples",
+            "min_angle",
+            "max_angle",
+            "min",
+            "max",
+            "wheelSeparation",
+            "wheelDiameter",
+            "wheelTorque",
+            "wheelAcceleration",
+            "pose",
+        }
+    ),
+    "world": frozenset(
+        {
+            "pose",
+            "size",
+            "radius",
+            "length",
+            "mass",
+            "mu",
+            "mu2",
+            "ixx",
+            "iyy",
+            "izz",
+            "ixy",
+            "ixz",
+            "iyz",
+            "max_step_size",
+        }
+    ),
 }
 READ_XML["robot"] = READ_XML["urdf"]
 
@@ -124,7 +290,8 @@ def _text(fmt: str, seed: Seed, rng: np.random.Generator) -> Case:
     data = seed.files[name]
     binary_file = name.endswith(".pgm")
     kind = ["binary", "nul", "truncate", "empty", "dup_line", "drop_line", "crlf", "bom", "long_token"][
-        int(rng.integers(9))]
+        int(rng.integers(9))
+    ]
     pos = int(rng.integers(len(data) + 1))
     invalid = False
     if kind == "binary":
@@ -141,7 +308,7 @@ def _text(fmt: str, seed: Seed, rng: np.random.Generator) -> Case:
     elif kind in ("dup_line", "drop_line"):
         lines = data.split(b"\n")
         k = int(rng.integers(len(lines)))
-        lines[k:k + 1] = [lines[k], lines[k]] if kind == "dup_line" else []
+        lines[k : k + 1] = [lines[k], lines[k]] if kind == "dup_line" else []
         data = b"\n".join(lines)
     elif kind == "crlf":
         data = data.replace(b"\n", b"\r\n")
@@ -247,7 +414,7 @@ def _typo(key: str, rng: np.random.Generator) -> str:
     if len(key) < 3:
         return key + "_x"
     i = int(rng.integers(1, len(key) - 1))
-    return key[:i] + key[i + 1] + key[i] + key[i + 2:] if key[i] != key[i + 1] else key + "s"
+    return key[:i] + key[i + 1] + key[i] + key[i + 2 :] if key[i] != key[i + 1] else key + "s"
 
 
 def _yaml_structure(fmt: str, seed: Seed, rng: np.random.Generator) -> Case:
@@ -255,7 +422,8 @@ def _yaml_structure(fmt: str, seed: Seed, rng: np.random.Generator) -> Case:
     text = seed.files[name]
     doc = yaml.safe_load(text)
     kind = ["unknown_key", "delete_key", "pair", "alias_bomb", "deep_nest", "top_list", "top_scalar"][
-        int(rng.integers(7))]
+        int(rng.integers(7))
+    ]
     if kind == "alias_bomb":
         lines = ["fuzz_a0: &a0 [lol, lol, lol, lol, lol, lol, lol, lol, lol, lol]"]
         for k in range(1, 10):
@@ -302,14 +470,20 @@ def _yaml_structure(fmt: str, seed: Seed, rng: np.random.Generator) -> Case:
     if kind == "unknown_key" and isinstance(key, str):
         misspelt = _typo(key, rng)
         d[misspelt] = d[key]
-        top = fmt in STRICT_KEYS and not (fmt == "move_base" and path and path[0] in (
-            "laser_scan_sensor", "DWAPlannerROS", "MPPIController"))
+        top = fmt in STRICT_KEYS and not (
+            fmt == "move_base" and path and path[0] in ("laser_scan_sensor", "DWAPlannerROS", "MPPIController")
+        )
         # a typo of a key that the format leaves open (plugin sub-namespaces) is not wrong by construction; nor,
         # in ROS parameter files, is a key too far from every known one to be its misspelling: ROS ignores it,
         # navlab warns (the unknown-key policy, navlab.core.params.check_unknown_key)
         typo = difflib.SequenceMatcher(None, misspelt, key).ratio() >= TYPO_CUTOFF
-        return Case(fmt, f"yaml:unknown_key@{key}", (top and fmt != "scenario" and typo) or (
-            fmt == "scenario" and not path), {**seed.files, name: _dump(doc)}, seed.main)
+        return Case(
+            fmt,
+            f"yaml:unknown_key@{key}",
+            (top and fmt != "scenario" and typo) or (fmt == "scenario" and not path),
+            {**seed.files, name: _dump(doc)},
+            seed.main,
+        )
     del d[key]
     return Case(fmt, f"yaml:delete_key@{key}", False, {**seed.files, name: _dump(doc)}, seed.main)
 
@@ -320,10 +494,30 @@ def _yaml_structure(fmt: str, seed: Seed, rng: np.random.Generator) -> Case:
 def _launch(fmt: str, seed: Seed, rng: np.random.Generator) -> Case:
     doc = yaml.safe_load(seed.files[seed.main])
     entries = doc["launch"]
-    kind = ["let_no_name", "let_no_value", "include_no_file", "include_arg_no_value", "remap_no_to",
-            "remap_no_from", "if_maybe", "if_number", "unless_list", "env_unset", "include_self", "rate_zero",
-            "rate_negative", "rate_nan", "rate_text", "exec_function", "exec_missing", "entry_list", "param_no_from",
-            "undefined_var", "arg_no_name", "include_missing"][int(rng.integers(22))]
+    kind = [
+        "let_no_name",
+        "let_no_value",
+        "include_no_file",
+        "include_arg_no_value",
+        "remap_no_to",
+        "remap_no_from",
+        "if_maybe",
+        "if_number",
+        "unless_list",
+        "env_unset",
+        "include_self",
+        "rate_zero",
+        "rate_negative",
+        "rate_nan",
+        "rate_text",
+        "exec_function",
+        "exec_missing",
+        "entry_list",
+        "param_no_from",
+        "undefined_var",
+        "arg_no_name",
+        "include_missing",
+    ][int(rng.integers(22))]
     invalid = True
     by_kind = {next(iter(e)): e[next(iter(e))] for e in entries if isinstance(e, dict)}
     node = next(e["node"] for e in entries if "node" in e)
@@ -397,10 +591,19 @@ def _xml_value(fmt: str, seed: Seed, rng: np.random.Generator) -> Case:
     kind = ["nan", "inf", "negative", "zero", "word", "huge"][int(rng.integers(6))]
     rule = RULES[fmt].get(key)
     old = float(tokens[t]) if re.fullmatch(rb"[-+]?[0-9.]+(e[-+]?[0-9]+)?", tokens[t], re.I) else 1.0
-    new = {"nan": b"nan", "inf": b"inf", "negative": repr(-abs(old) - 1.0).encode(), "zero": b"0",
-           "word": b"abc", "huge": b"1e308"}[kind]
-    invalid = key in READ_XML[fmt] and (kind in ("nan", "inf", "word") or (
-        kind == "negative" and rule in (POS, NONNEG)) or (kind == "zero" and rule == POS))
+    new = {
+        "nan": b"nan",
+        "inf": b"inf",
+        "negative": repr(-abs(old) - 1.0).encode(),
+        "zero": b"0",
+        "word": b"abc",
+        "huge": b"1e308",
+    }[kind]
+    invalid = key in READ_XML[fmt] and (
+        kind in ("nan", "inf", "word")
+        or (kind == "negative" and rule in (POS, NONNEG))
+        or (kind == "zero" and rule == POS)
+    )
     tokens[t] = new
     body = data[:start] + b" ".join(tokens) + data[end:]
     return Case(fmt, f"xml:{kind}@{key}", invalid, {**seed.files, name: body}, seed.main)
@@ -414,7 +617,7 @@ def _xml_structure(fmt: str, seed: Seed, rng: np.random.Generator) -> Case:
     invalid = True
     if kind == "deep":
         depth = int(rng.integers(200, 20000))
-        body = data[: root_end + 1] + b"<fuzz>" * depth + b"</fuzz>" * depth + data[root_end + 1:]
+        body = data[: root_end + 1] + b"<fuzz>" * depth + b"</fuzz>" * depth + data[root_end + 1 :]
         invalid = False
     elif kind in ("entity_bomb", "external_entity"):
         if kind == "entity_bomb":
@@ -430,20 +633,25 @@ def _xml_structure(fmt: str, seed: Seed, rng: np.random.Generator) -> Case:
         body = data[:decl_end] + b"\n" + dtd + data[decl_end:first]
         rest = data[first:]
         close = rest.find(b">")
-        body += rest[: close + 1] + b"<!--" + b"-->" + use + rest[close + 1:]
+        body += rest[: close + 1] + b"<!--" + b"-->" + use + rest[close + 1 :]
     elif kind == "minmax":
         m = re.search(rb"<min>\s*([-0-9.e]+)\s*</min>(\s*)<max>\s*([-0-9.e]+)\s*</max>", data)
         if m is None:
             return _xml_value(fmt, seed, rng)
         hi = float(m.group(3))
-        body = data[: m.start()] + f"<min>{hi + 1.0}</min>".encode() + m.group(2) + m.group(0)[
-            m.group(0).find(b"<max>"):] + data[m.end():]
+        body = (
+            data[: m.start()]
+            + f"<min>{hi + 1.0}</min>".encode()
+            + m.group(2)
+            + m.group(0)[m.group(0).find(b"<max>") :]
+            + data[m.end() :]
+        )
     elif kind == "drop_element":
         tags = [m for m in re.finditer(rb"<([A-Za-z_][\w]*)[^>/]*>[^<]*</\1>", data)]
         if not tags:
             return _text(fmt, seed, rng)
         m = tags[int(rng.integers(len(tags)))]
-        body = data[: m.start()] + data[m.end():]
+        body = data[: m.start()] + data[m.end() :]
         invalid = False
     else:
         body = data.replace(b"</robot>", b"").replace(b"</sdf>", b"")
@@ -454,24 +662,39 @@ def _xacro(fmt: str, seed: Seed, rng: np.random.Generator) -> Case:
     main = seed.main
     data = seed.files[main]
     close = data.rfind(b"</robot>")
-    kind = ["code_import", "code_open", "code_subclass", "code_vars", "code_format", "load_yaml_outside",
-            "include_outside", "self_include", "macro_recursion", "find_escape"][int(rng.integers(10))]
+    kind = [
+        "code_import",
+        "code_open",
+        "code_subclass",
+        "code_vars",
+        "code_format",
+        "load_yaml_outside",
+        "include_outside",
+        "self_include",
+        "macro_recursion",
+        "find_escape",
+    ][int(rng.integers(10))]
     marker = "navlab_fuzz_escape_marker"
     snippets = {  # each evaluated where it stands (an unused xacro:property would never be evaluated)
         "code_import": f"<fuzz v=\"${{__import__('os').system('touch {marker}')}}\"/>",
         "code_open": f"<fuzz v=\"${{open('{marker}', 'w').write('x')}}\"/>",
-        "code_subclass": ("<fuzz v=\"${[c for c in python.type(python.type).mro(python.type)[-1]."
-                          "__subclasses__() if c.__name__ == 'Popen'][0](['touch', '" + marker + "'])}\"/>"),
-        "code_vars": ("<fuzz v=\"${python.vars(python.type(python.vars(python.type(xacro.fatal))['__globals__']))"
-                      "['__get__'](python.vars(python.type(xacro.fatal))['__globals__'], xacro.fatal)['os']"
-                      f".system('touch {marker}')}}\"/>"),
+        "code_subclass": (
+            '<fuzz v="${[c for c in python.type(python.type).mro(python.type)[-1].'
+            "__subclasses__() if c.__name__ == 'Popen'][0](['touch', '" + marker + "'])}\"/>"
+        ),
+        "code_vars": (
+            "<fuzz v=\"${python.vars(python.type(python.vars(python.type(xacro.fatal))['__globals__']))"
+            "['__get__'](python.vars(python.type(xacro.fatal))['__globals__'], xacro.fatal)['os']"
+            f".system('touch {marker}')}}\"/>"
+        ),
         "code_format": "<fuzz v=\"${'{0.__class__.__base__.__subclasses__}'.format(1)}\"/>",
         "load_yaml_outside": "<fuzz v=\"${xacro.load_yaml('/etc/passwd')}\"/>",
-        "include_outside": "<xacro:include filename=\"/etc/hostname\"/>",
-        "self_include": f"<xacro:include filename=\"{main.rsplit('/', 1)[-1]}\"/>",
-        "macro_recursion": ("<xacro:macro name=\"fzr\" params=\"n\"><xacro:fzr n=\"${n+1}\"/></xacro:macro>"
-                            "<xacro:fzr n=\"0\"/>"),
-        "find_escape": "<xacro:include filename=\"$(find navlab_tb3_burger_description)/../../../../etc/hostname\"/>",
+        "include_outside": '<xacro:include filename="/etc/hostname"/>',
+        "self_include": f'<xacro:include filename="{main.rsplit("/", 1)[-1]}"/>',
+        "macro_recursion": (
+            '<xacro:macro name="fzr" params="n"><xacro:fzr n="${n+1}"/></xacro:macro><xacro:fzr n="0"/>'
+        ),
+        "find_escape": '<xacro:include filename="$(find navlab_tb3_burger_description)/../../../../etc/hostname"/>',
     }
     body = data[:close] + snippets[kind].encode() + b"\n" + data[close:]
     return Case(fmt, f"xacro:{kind}", True, {**seed.files, main: body}, main, {"marker": marker})
@@ -484,8 +707,17 @@ def _carmen(fmt: str, seed: Seed, rng: np.random.Generator) -> Case:
     lines = seed.files[seed.main].decode().split("\n")
     flaser = [i for i, ln in enumerate(lines) if ln.startswith("FLASER")]
     rl1 = [i for i, ln in enumerate(lines) if ln.startswith("ROBOTLASER1")]
-    kind = ["count_minus", "count_plus", "rl1_count", "backwards", "huge_line", "nan_range", "word_field",
-            "negative_count", "no_newline_giant"][int(rng.integers(9))]
+    kind = [
+        "count_minus",
+        "count_plus",
+        "rl1_count",
+        "backwards",
+        "huge_line",
+        "nan_range",
+        "word_field",
+        "negative_count",
+        "no_newline_giant",
+    ][int(rng.integers(9))]
     i = flaser[int(rng.integers(len(flaser)))]
     tok = lines[i].split()
     if kind in ("count_minus", "count_plus"):
@@ -508,11 +740,11 @@ def _carmen(fmt: str, seed: Seed, rng: np.random.Generator) -> Case:
         tok[1] = "-5"
     else:
         lines.append("FLASER 3 " + "1.0 " * 4_000_000)
-        return Case(fmt, f"carmen:{kind}", True, {seed.main: "\n".join(lines).encode()}, seed.main,
-                    {"skipped_at_least": 1})
+        return Case(
+            fmt, f"carmen:{kind}", True, {seed.main: "\n".join(lines).encode()}, seed.main, {"skipped_at_least": 1}
+        )
     lines[i] = " ".join(tok)
-    return Case(fmt, f"carmen:{kind}", True, {seed.main: "\n".join(lines).encode()}, seed.main,
-                {"skipped_at_least": 1})
+    return Case(fmt, f"carmen:{kind}", True, {seed.main: "\n".join(lines).encode()}, seed.main, {"skipped_at_least": 1})
 
 
 # --- map image mutations --------------------------------------------------------------------------------------
@@ -521,11 +753,24 @@ def _carmen(fmt: str, seed: Seed, rng: np.random.Generator) -> Case:
 def _pgm(fmt: str, seed: Seed, rng: np.random.Generator) -> Case:
     pgm = seed.files["map.pgm"]
     files = dict(seed.files)
-    kind = ["p4", "bomb", "maxval_zero", "maxval_big", "truncated", "fifo", "dev_zero", "directory", "missing",
-            "ascii_junk", "width_mismatch", "png_junk", "extra_data"][int(rng.integers(13))]
+    kind = [
+        "p4",
+        "bomb",
+        "maxval_zero",
+        "maxval_big",
+        "truncated",
+        "fifo",
+        "dev_zero",
+        "directory",
+        "missing",
+        "ascii_junk",
+        "width_mismatch",
+        "png_junk",
+        "extra_data",
+    ][int(rng.integers(13))]
     invalid = kind != "extra_data"
     head, _, _ = pgm.partition(b"255\n")
-    body = pgm[len(head) + 4:]
+    body = pgm[len(head) + 4 :]
     if kind == "p4":
         files["map.pgm"] = b"P4" + pgm[2:]
     elif kind == "bomb":

@@ -30,8 +30,11 @@ from .mutate import (
 )
 from .seeds import Seed
 
-PLANNERS = {"trajectory": "base_local_planner/TrajectoryPlannerROS", "dwa": "dwa_local_planner/DWAPlannerROS",
-            "mppi": "nav2_mppi_controller::MPPIController"}
+PLANNERS = {
+    "trajectory": "base_local_planner/TrajectoryPlannerROS",
+    "dwa": "dwa_local_planner/DWAPlannerROS",
+    "mppi": "nav2_mppi_controller::MPPIController",
+}
 SECTION = {"trajectory": "TrajectoryPlannerROS", "dwa": "DWAPlannerROS", "mppi": "MPPIController"}
 # (file, section or None, key, value, invalid): sizes that exhaust memory or time, and malformed shapes
 _SIZES: list[tuple[str, str | None, str, object, bool]] = [
@@ -42,8 +45,13 @@ _SIZES: list[tuple[str, str | None, str, object, bool]] = [
     ("costmap_common_params.yaml", None, "footprint", [[1e6, 1e6], [1e6, -1e6], [-1e6, 0.0]], True),
     ("costmap_common_params.yaml", None, "footprint", [[0.1, 0.1]], True),
     ("costmap_common_params.yaml", None, "footprint", "[[0.2, 0.2], [0.2, -0.2]", True),
-    ("costmap_common_params.yaml", None, "footprint", [[float(0.3 * np.cos(a)), float(0.3 * np.sin(a))]
-                                                      for a in np.linspace(0, 6.28, 5000)], True),
+    (
+        "costmap_common_params.yaml",
+        None,
+        "footprint",
+        [[float(0.3 * np.cos(a)), float(0.3 * np.sin(a))] for a in np.linspace(0, 6.28, 5000)],
+        True,
+    ),
     ("costmap_common_params.yaml", None, "robot_radius", 1e9, True),
     ("costmap_common_params.yaml", None, "inflation_radius", 1e6, False),  # large, but bounded by the grid
     ("costmap_common_params.yaml", None, "raytrace_range", 1e12, False),
@@ -52,8 +60,13 @@ _SIZES: list[tuple[str, str | None, str, object, bool]] = [
 ]
 _PLANNER_SIZES: dict[str, list[tuple[str, object]]] = {
     "trajectory": [("vx_samples", 10**9), ("vtheta_samples", 10**9), ("sim_granularity", 1e-12), ("sim_time", 1e9)],
-    "dwa": [("vx_samples", 10**9), ("vth_samples", 10**9), ("sim_granularity", 1e-12),
-            ("angular_sim_granularity", 1e-12), ("sim_time", 1e9)],
+    "dwa": [
+        ("vx_samples", 10**9),
+        ("vth_samples", 10**9),
+        ("sim_granularity", 1e-12),
+        ("angular_sim_granularity", 1e-12),
+        ("sim_time", 1e9),
+    ],
     "mppi": [("batch_size", 10**9), ("time_steps", 10**9), ("iteration_count", 10**9)],
 }
 
@@ -68,8 +81,9 @@ def _nav_size(fmt: str, seed: Seed, rng: np.random.Generator) -> Case:
     planner = list(PLANNERS)[int(rng.integers(len(PLANNERS)))]
     files = dict(seed.files)
     _select(files, planner)
-    options = _SIZES + [("base_local_planner_params.yaml", SECTION[planner], k, v, True)
-                        for k, v in _PLANNER_SIZES[planner]]
+    options = _SIZES + [
+        ("base_local_planner_params.yaml", SECTION[planner], k, v, True) for k, v in _PLANNER_SIZES[planner]
+    ]
     name, section, key, value, invalid = options[int(rng.integers(len(options)))]
     path = f"params/{name}"
     doc = yaml.safe_load(files[path])
@@ -90,10 +104,19 @@ def _nav_planner(fmt: str, seed: Seed, rng: np.random.Generator) -> Case:
     key = keys[int(rng.integers(len(keys)))]
     kind = ["nan", "inf", "negative", "zero", "string", "huge"][int(rng.integers(6))]
     rule = RULES["move_base"].get(key)
-    section[key] = {"nan": float("nan"), "inf": float("inf"), "negative": -abs(section[key]) - 1.0, "zero": 0,
-                    "string": "fast", "huge": 1e308}[kind]
-    invalid = kind in ("nan", "inf", "string") or (kind == "negative" and rule in (POS, NONNEG)) or (
-        kind == "zero" and rule == POS)
+    section[key] = {
+        "nan": float("nan"),
+        "inf": float("inf"),
+        "negative": -abs(section[key]) - 1.0,
+        "zero": 0,
+        "string": "fast",
+        "huge": 1e308,
+    }[kind]
+    invalid = (
+        kind in ("nan", "inf", "string")
+        or (kind == "negative" and rule in (POS, NONNEG))
+        or (kind == "zero" and rule == POS)
+    )
     files[path] = _dump(doc)
     return Case(fmt, f"nav:{planner}:{kind}@{key}", invalid, files, seed.main)
 
@@ -106,7 +129,8 @@ _SIM = ["sim", "--duration", "0.2", "--quiet", "--json"]
 
 def _goal(fmt: str, seed: Seed, rng: np.random.Generator) -> Case:
     kind = ["start", "spawn_size", "spawn_place", "spawn_time", "spawn_on_robot", "goal", "goal_far"][
-        int(rng.integers(7))]
+        int(rng.integers(7))
+    ]
     bad = _BAD_NUMBERS[int(rng.integers(len(_BAD_NUMBERS)))]
     invalid = True
     names = []
@@ -134,8 +158,9 @@ def _goal(fmt: str, seed: Seed, rng: np.random.Generator) -> Case:
     else:
         argv, names = ["navigate", "--goal", "900000", "-900000.0", "0", "--timeout", "1", "--json"], ["goal"]
         invalid = False  # a goal off the map is move_base's to abort, not the command line's to refuse
-    return Case(fmt, f"goal:{kind}:{bad}", invalid, {"run.json": json.dumps(argv).encode()}, seed.main,
-                {"names": names})
+    return Case(
+        fmt, f"goal:{kind}:{bad}", invalid, {"run.json": json.dumps(argv).encode()}, seed.main, {"names": names}
+    )
 
 
 # --- rosbag2 recordings -------------------------------------------------------------------------------------
@@ -144,8 +169,21 @@ def _goal(fmt: str, seed: Seed, rng: np.random.Generator) -> Case:
 def _bag(fmt: str, seed: Seed, rng: np.random.Generator) -> Case:
     files = dict(seed.files)
     mcap, meta = "rec/rec.mcap", "rec/metadata.yaml"
-    kind = ["flip", "truncate", "zeros", "fifo", "dev_zero", "outside", "meta_value", "meta_delete", "no_meta",
-            "graph_garbage", "compression", "chunk_size", "splice"][int(rng.integers(13))]
+    kind = [
+        "flip",
+        "truncate",
+        "zeros",
+        "fifo",
+        "dev_zero",
+        "outside",
+        "meta_value",
+        "meta_delete",
+        "no_meta",
+        "graph_garbage",
+        "compression",
+        "chunk_size",
+        "splice",
+    ][int(rng.integers(13))]
     data = bytearray(files[mcap])
     invalid = kind in ("fifo", "dev_zero", "outside", "graph_garbage", "compression")
     if kind == "flip":
@@ -176,13 +214,17 @@ def _bag(fmt: str, seed: Seed, rng: np.random.Generator) -> Case:
         del files[meta]
     elif kind == "graph_garbage":
         doc = yaml.safe_load(files[meta])
-        doc["rosbag2_bagfile_information"]["custom_data"] = {"navlab.graph": ['{"nodes": 5}', "[1, 2", "null"][
-            int(rng.integers(3))]}
+        doc["rosbag2_bagfile_information"]["custom_data"] = {
+            "navlab.graph": ['{"nodes": 5}', "[1, 2", "null"][int(rng.integers(3))]
+        }
         invalid = doc["rosbag2_bagfile_information"]["custom_data"]["navlab.graph"] != "null"
         files[meta] = _dump(doc)
     elif kind == "compression":
-        files[mcap] = bytes(data).replace(b"\x04\x00\x00\x00zstd", b"\x04\x00\x00\x00zzzz") \
-            if b"zstd" in data else bytes(data).replace(b"\x00\x00\x00\x00\x00\x00\x00\x00", b"\xff" * 8, 3)
+        files[mcap] = (
+            bytes(data).replace(b"\x04\x00\x00\x00zstd", b"\x04\x00\x00\x00zzzz")
+            if b"zstd" in data
+            else bytes(data).replace(b"\x00\x00\x00\x00\x00\x00\x00\x00", b"\xff" * 8, 3)
+        )
         invalid = b"zstd" in data
     elif kind == "chunk_size":
         k = data.find(b"\x06", 8)  # the first chunk record: claim an enormous uncompressed size
@@ -192,8 +234,14 @@ def _bag(fmt: str, seed: Seed, rng: np.random.Generator) -> Case:
     else:
         k = int(rng.integers(8, len(data)))
         files[mcap] = bytes(data[:k] + data[k:][::-1])
-    return Case(fmt, f"bag:{kind}", invalid, files, seed.main,
-                {"keep": {"rec/notes.txt": "my notes", "rec/other/data.txt": "other data"}})
+    return Case(
+        fmt,
+        f"bag:{kind}",
+        invalid,
+        files,
+        seed.main,
+        {"keep": {"rec/notes.txt": "my notes", "rec/other/data.txt": "other data"}},
+    )
 
 
 # --- BARN-size worlds ----------------------------------------------------------------------------------------
@@ -207,26 +255,34 @@ def _world_nesting(fmt: str, seed: Seed, rng: np.random.Generator) -> Case:
     invalid = True
     if kind == "nested_models":
         depth = int(rng.integers(50, 3000))
-        body = (b"<model name='m'><static>true</static>" * depth
-                + b"<link name='l'/>" + b"</model>" * depth)
+        body = b"<model name='m'><static>true</static>" * depth + b"<link name='l'/>" + b"</model>" * depth
     elif kind in ("include_cycle", "include_self"):
         other = "b" if kind == "include_cycle" else "a"
         files["models/a/model.config"] = b"<?xml version='1.0'?><model><name>a</name><sdf>model.sdf</sdf></model>"
-        files["models/a/model.sdf"] = (f"<?xml version='1.0'?><sdf version='1.6'><model name='a'><include><uri>"
-                                       f"model://{other}</uri></include><link name='l'/></model></sdf>").encode()
+        files["models/a/model.sdf"] = (
+            f"<?xml version='1.0'?><sdf version='1.6'><model name='a'><include><uri>"
+            f"model://{other}</uri></include><link name='l'/></model></sdf>"
+        ).encode()
         files["models/b/model.config"] = b"<?xml version='1.0'?><model><name>b</name><sdf>model.sdf</sdf></model>"
-        files["models/b/model.sdf"] = (b"<?xml version='1.0'?><sdf version='1.6'><model name='b'><include><uri>"
-                                       b"model://a</uri></include><link name='l'/></model></sdf>")
+        files["models/b/model.sdf"] = (
+            b"<?xml version='1.0'?><sdf version='1.6'><model name='b'><include><uri>"
+            b"model://a</uri></include><link name='l'/></model></sdf>"
+        )
         body = b"<include><uri>model://a</uri></include>"
     elif kind == "many_models":
         n = int(rng.integers(2000, 20000))
-        body = b"".join(b"<model name='c%d'><static>true</static><pose>%d 0 0 0 0 0</pose><link name='l'><collision "
-                        b"name='c'><geometry><sphere><radius>0.1</radius></sphere></geometry></collision></link>"
-                        b"</model>" % (k, k % 50) for k in range(n))
+        body = b"".join(
+            b"<model name='c%d'><static>true</static><pose>%d 0 0 0 0 0</pose><link name='l'><collision "
+            b"name='c'><geometry><sphere><radius>0.1</radius></sphere></geometry></collision></link>"
+            b"</model>" % (k, k % 50)
+            for k in range(n)
+        )
         invalid = False
     else:
-        body = (b"<model name='big'><static>true</static><link name='l'><collision name='c'><geometry><box><size>"
-                b"1e300 1e300 1</size></box></geometry></collision></link></model>")
+        body = (
+            b"<model name='big'><static>true</static><link name='l'><collision name='c'><geometry><box><size>"
+            b"1e300 1e300 1</size></box></geometry></collision></link></model>"
+        )
     files[seed.main] = data[:close] + body + data[close:]
     return Case(fmt, f"world:{kind}", invalid, files, seed.main, {"model_path": "models"})
 
@@ -254,16 +310,17 @@ def _slam_pose(fmt: str, seed: Seed, rng: np.random.Generator) -> Case:
             lines[j] = " ".join(t)
         return Case(fmt, f"slam:{kind}", False, {seed.main: "\n".join(lines).encode()}, seed.main)
     lines[i] = " ".join(tok)
-    return Case(fmt, f"slam:{kind}", True, {seed.main: "\n".join(lines).encode()}, seed.main,
-                {"skipped_at_least": 1})
+    return Case(fmt, f"slam:{kind}", True, {seed.main: "\n".join(lines).encode()}, seed.main, {"skipped_at_least": 1})
 
 
 def _as(base: str, mutator: Callable[[str, Seed, np.random.Generator], Case]) -> Callable[..., Case]:
     """``mutator`` with the rules of format ``base`` (a BARN world is a world, a SLAM log a CARMEN log)."""
+
     def run(fmt: str, seed: Seed, rng: np.random.Generator) -> Case:
         case = mutator(base, seed, rng)
         case.fmt = fmt
         return case
+
     return run
 
 
@@ -273,7 +330,12 @@ def mutators_nav(fmt: str) -> list[Callable[[str, Seed, np.random.Generator], Ca
         "navparams": [_nav_size, _nav_size, _nav_planner, _text],
         "goal": [_goal],
         "bag": [_bag],
-        "barn": [_world_nesting, _world_nesting, _as("world", _xml_value), _as("world", _xml_structure),
-                 _as("world", _text)],
+        "barn": [
+            _world_nesting,
+            _world_nesting,
+            _as("world", _xml_value),
+            _as("world", _xml_structure),
+            _as("world", _text),
+        ],
         "slam": [_slam_pose, _slam_pose, _as("carmen", _carmen), _as("carmen", _text)],
     }.get(fmt, [])

@@ -71,8 +71,11 @@ def _worker() -> None:
             tb = traceback.extract_tb(exc.__traceback__)
             where = f"{Path(tb[-1].filename).name}:{tb[-1].lineno}" if tb else "?"
             reply = {"status": "traceback", "message": f"{type(exc).__name__} at {where}: {str(exc)[:300]}"}
-        lost = [rel for rel, text in (req.get("keep") or {}).items()
-                if not (folder / rel).is_file() or (folder / rel).read_text() != text]
+        lost = [
+            rel
+            for rel, text in (req.get("keep") or {}).items()
+            if not (folder / rel).is_file() or (folder / rel).read_text() != text
+        ]
         if lost:
             reply = {"status": "lost", "message": f"the user's files are gone or changed: {', '.join(lost)}"}
         marker = req.get("marker")
@@ -92,7 +95,7 @@ def _write_case(case: Case, folder: Path) -> None:
         if data == FIFO:
             os.mkfifo(p)
         elif data.startswith(LINK_PREFIX):
-            p.symlink_to(data[len(LINK_PREFIX):].decode())
+            p.symlink_to(data[len(LINK_PREFIX) :].decode())
         else:
             p.write_bytes(data)
 
@@ -109,8 +112,14 @@ class Worker:
             env = {**os.environ, "PYTHONPATH": src + os.pathsep + str(REPO)}
             env.pop("NAVLAB_FUZZ_SURELY_UNSET", None)
             self.proc = subprocess.Popen(
-                [sys.executable, "-m", "tests.fuzz.runner", "--worker"], cwd=REPO, env=env, text=True,
-                stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL)
+                [sys.executable, "-m", "tests.fuzz.runner", "--worker"],
+                cwd=REPO,
+                env=env,
+                text=True,
+                stdin=subprocess.PIPE,
+                stdout=subprocess.PIPE,
+                stderr=subprocess.DEVNULL,
+            )
         return self.proc
 
     def kill(self) -> None:
@@ -154,8 +163,9 @@ def classify(case: Case, reply: dict[str, Any], folder: Path) -> Result:
     info = reply.get("info") or {}
     skipped_min = case.expect.get("skipped_at_least")
     if skipped_min is not None:
-        return Result(case, "accepted" if info.get("skipped", 0) >= skipped_min else "accepted-invalid",
-                      json.dumps(info))
+        return Result(
+            case, "accepted" if info.get("skipped", 0) >= skipped_min else "accepted-invalid", json.dumps(info)
+        )
     return Result(case, "accepted-invalid" if case.invalid else "accepted", "")
 
 
@@ -176,8 +186,13 @@ def run_cases(todo: list[Case], *, timeout: float = 10.0, progress: bool = False
             folder = root / f"case{k:05d}"
             folder.mkdir()
             _write_case(case, folder)
-            req = {"fmt": case.fmt, "dir": str(folder), "main": case.main, "marker": case.expect.get("marker"),
-                   "keep": case.expect.get("keep")}
+            req = {
+                "fmt": case.fmt,
+                "dir": str(folder),
+                "main": case.main,
+                "marker": case.expect.get("marker"),
+                "keep": case.expect.get("keep"),
+            }
             results.append(classify(case, worker.run(req, timeout), folder))
             shutil.rmtree(folder, ignore_errors=True)
             if progress and (k + 1) % 100 == 0:
@@ -221,13 +236,22 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--json", action="store_true")
     args = p.parse_args(argv)
     t0 = time.monotonic()
-    results = run_cases(cases(args.cases, args.seed, tuple(args.format or FORMATS)), timeout=args.timeout,
-                        progress=not args.json)
+    results = run_cases(
+        cases(args.cases, args.seed, tuple(args.format or FORMATS)), timeout=args.timeout, progress=not args.json
+    )
     counts = table(results)
     bad = [r for r in results if r.outcome in BAD or r.outcome == "vague"]
     if args.json:
-        print(json.dumps({"cases": len(results), "seconds": round(time.monotonic() - t0, 1), "table": counts,
-                          "bad": [[r.case.fmt, r.case.mutation, r.outcome, r.detail] for r in bad]}))
+        print(
+            json.dumps(
+                {
+                    "cases": len(results),
+                    "seconds": round(time.monotonic() - t0, 1),
+                    "table": counts,
+                    "bad": [[r.case.fmt, r.case.mutation, r.outcome, r.detail] for r in bad],
+                }
+            )
+        )
     else:
         print(format_table(counts))
         shown: Counter[str] = Counter()

@@ -5,8 +5,24 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
-FORMATS = ("robot", "urdf", "world", "amcl", "gmapping", "move_base", "map", "carmen", "launch", "route",
-           "scenario", "navparams", "goal", "bag", "barn", "slam")
+FORMATS = (
+    "robot",
+    "urdf",
+    "world",
+    "amcl",
+    "gmapping",
+    "move_base",
+    "map",
+    "carmen",
+    "launch",
+    "route",
+    "scenario",
+    "navparams",
+    "goal",
+    "bag",
+    "barn",
+    "slam",
+)
 
 
 @dataclass
@@ -51,9 +67,16 @@ def _param(name: str) -> Seed:
 def _move_base() -> Seed:
     folder = _resources() / "params" / "mybot"
     files = {f"params/{p.name}": p.read_bytes() for p in sorted(folder.glob("*.yaml"))}
-    mutable = [f"params/{n}" for n in ("costmap_common_params.yaml", "local_costmap_params.yaml",
-                                       "global_costmap_params.yaml", "base_local_planner_params.yaml",
-                                       "move_base_params.yaml")]
+    mutable = [
+        f"params/{n}"
+        for n in (
+            "costmap_common_params.yaml",
+            "local_costmap_params.yaml",
+            "global_costmap_params.yaml",
+            "base_local_planner_params.yaml",
+            "move_base_params.yaml",
+        )
+    ]
     return Seed(files, "params", mutable)
 
 
@@ -67,8 +90,10 @@ def _map() -> Seed:
     for k in range(40, 60):
         pixels[k] = 205
     pgm = f"P5\n# CREATOR: navlab fuzz\n{width} {height}\n255\n".encode() + bytes(pixels)
-    yaml_text = ("image: map.pgm\nresolution: 0.050000\norigin: [-0.600000, -0.400000, 0.000000]\nnegate: 0\n"
-                 "occupied_thresh: 0.65\nfree_thresh: 0.196\nmode: trinary\n")
+    yaml_text = (
+        "image: map.pgm\nresolution: 0.050000\norigin: [-0.600000, -0.400000, 0.000000]\nnegate: 0\n"
+        "occupied_thresh: 0.65\nfree_thresh: 0.196\nmode: trinary\n"
+    )
     return Seed({"map.yaml": yaml_text.encode(), "map.pgm": pgm}, "map.yaml", ["map.yaml", "map.pgm"])
 
 
@@ -79,11 +104,14 @@ def _carmen() -> Seed:
         x, th = 0.1 * k, 0.01 * k
         ranges = " ".join(f"{1.5 + 0.01 * ((k + j) % 7):.3f}" for j in range(181))
         lines.append(f"ODOM {x:.3f} 0.000 {th:.3f} 0.2 0.0 0.0 {t:.6f} host {t:.6f}")
-        lines.append(f"FLASER 181 {ranges} {x:.3f} 0.000 {th:.3f} {x:.3f} 0.000 {th:.3f} {t + 0.01:.6f} host "
-                     f"{t + 0.01:.6f}")
+        lines.append(
+            f"FLASER 181 {ranges} {x:.3f} 0.000 {th:.3f} {x:.3f} 0.000 {th:.3f} {t + 0.01:.6f} host {t + 0.01:.6f}"
+        )
         rl = " ".join(f"{2.0 + 0.01 * j % 3:.3f}" for j in range(90))
-        lines.append(f"ROBOTLASER1 0 -1.5708 3.14159 0.0349 81.9 0.01 0 90 {rl} 0 {x + 0.1:.3f} 0.000 {th:.3f} "
-                     f"{x:.3f} 0.000 {th:.3f} 0.2 0.0 0.0 0.0 0.0 {t + 0.02:.6f} host {t + 0.02:.6f}")
+        lines.append(
+            f"ROBOTLASER1 0 -1.5708 3.14159 0.0349 81.9 0.01 0 90 {rl} 0 {x + 0.1:.3f} 0.000 {th:.3f} "
+            f"{x:.3f} 0.000 {th:.3f} 0.2 0.0 0.0 0.0 0.0 {t + 0.02:.6f} host {t + 0.02:.6f}"
+        )
         t += 0.5
     return Seed({"log.clf": ("\n".join(lines) + "\n").encode()}, "log.clf")
 
@@ -123,20 +151,29 @@ launch:
 
 
 def _launch() -> Seed:
-    return Seed({"main.launch.yaml": _LAUNCH_MAIN.encode(), "talkers.launch.yaml": _LAUNCH_INCLUDED.encode(),
-                 "talker.yaml": b"rate: 2.0\n"},
-                "main.launch.yaml", ["main.launch.yaml", "talkers.launch.yaml", "talker.yaml"])
+    return Seed(
+        {
+            "main.launch.yaml": _LAUNCH_MAIN.encode(),
+            "talkers.launch.yaml": _LAUNCH_INCLUDED.encode(),
+            "talker.yaml": b"rate: 2.0\n",
+        },
+        "main.launch.yaml",
+        ["main.launch.yaml", "talkers.launch.yaml", "talker.yaml"],
+    )
 
 
 def _route() -> Seed:
-    text = ("segments:\n  - {linear: 0.0, angular: 0.8, duration: 8.0}\n  - {linear: 0.2, angular: 0.0, "
-            "duration: 2.5}\nwaypoints:\n  - [1.2, -1.0]\n  - [-1.5, -0.9]\n  - [0.0, 0.0]\n")
+    text = (
+        "segments:\n  - {linear: 0.0, angular: 0.8, duration: 8.0}\n  - {linear: 0.2, angular: 0.0, "
+        "duration: 2.5}\nwaypoints:\n  - [1.2, -1.0]\n  - [-1.5, -0.9]\n  - [0.0, 0.0]\n"
+    )
     return Seed({"route.yaml": text.encode()}, "route.yaml")
 
 
 def _scenario() -> Seed:
-    return Seed({"scenario.yaml": (_resources() / "scenarios" / "obstacles_after_mapping.yaml").read_bytes()},
-                "scenario.yaml")
+    return Seed(
+        {"scenario.yaml": (_resources() / "scenarios" / "obstacles_after_mapping.yaml").read_bytes()}, "scenario.yaml"
+    )
 
 
 def _goal() -> Seed:
@@ -157,8 +194,9 @@ def _bag() -> Seed:
             for k in range(300):
                 bag.write("/chatter", string_t(f"hello {k}"), k * 10_000_000)
                 bag.write("/clock", clock_t(time_t(sec=k // 100, nanosec=k % 100 * 10_000_000)), k * 10_000_000)
-            bag.set_custom_data(GRAPH_KEY, '{"nodes": ["/talker"], "topics": {"/chatter": {"pub": ["/talker"], '
-                                           '"sub": []}}}')
+            bag.set_custom_data(
+                GRAPH_KEY, '{"nodes": ["/talker"], "topics": {"/chatter": {"pub": ["/talker"], "sub": []}}}'
+            )
         files = {f"rec/{p.name}": p.read_bytes() for p in (Path(tmp) / "rec").iterdir()}
     files.update({"rec/notes.txt": b"my notes", "rec/other/data.txt": b"other data"})
     return Seed(files, "rec", ["rec/rec.mcap", "rec/metadata.yaml"])
@@ -182,8 +220,20 @@ def _barn() -> Seed:
 def build_seeds() -> dict[str, Seed]:
     """One valid seed per format in :data:`FORMATS`."""
     return {
-        "robot": _robot(), "urdf": _urdf(), "world": _world(), "amcl": _param("amcl"),
-        "gmapping": _param("gmapping"), "move_base": _move_base(), "map": _map(), "carmen": _carmen(),
-        "launch": _launch(), "route": _route(), "scenario": _scenario(), "navparams": _move_base(),
-        "goal": _goal(), "bag": _bag(), "barn": _barn(), "slam": _carmen(),
+        "robot": _robot(),
+        "urdf": _urdf(),
+        "world": _world(),
+        "amcl": _param("amcl"),
+        "gmapping": _param("gmapping"),
+        "move_base": _move_base(),
+        "map": _map(),
+        "carmen": _carmen(),
+        "launch": _launch(),
+        "route": _route(),
+        "scenario": _scenario(),
+        "navparams": _move_base(),
+        "goal": _goal(),
+        "bag": _bag(),
+        "barn": _barn(),
+        "slam": _carmen(),
     }

@@ -33,25 +33,32 @@ def _through_launch(folder: Path, node_yaml: str, extra: str = "") -> None:
 
 
 def _amcl(path: Path) -> dict[str, Any]:
-    _through_launch(path.parent, f"{{pkg: navlab, exec: amcl, name: amcl, param: [{{from: {path.name}}}]}}",
-                    "- node: {pkg: navlab, exec: map_server, name: map_server, param: [{name: yaml_filename, "
-                    "value: map/map.yaml}]}\n")
+    _through_launch(
+        path.parent,
+        f"{{pkg: navlab, exec: amcl, name: amcl, param: [{{from: {path.name}}}]}}",
+        "- node: {pkg: navlab, exec: map_server, name: map_server, param: [{name: yaml_filename, "
+        "value: map/map.yaml}]}\n",
+    )
     return {}
 
 
 def _gmapping(path: Path) -> dict[str, Any]:
-    _through_launch(path.parent, "{pkg: navlab, exec: slam_gmapping, name: slam_gmapping, "
-                    f"param: [{{from: {path.name}}}]}}")
+    _through_launch(
+        path.parent, f"{{pkg: navlab, exec: slam_gmapping, name: slam_gmapping, param: [{{from: {path.name}}}]}}"
+    )
     return {}
 
 
 def _move_base(folder: Path) -> dict[str, Any]:
     p = folder.name
-    _through_launch(folder.parent, "{pkg: navlab, exec: move_base, name: move_base, param: ["
-                    f"{{from: {p}/costmap_common_params.yaml, ns: global_costmap}}, "
-                    f"{{from: {p}/costmap_common_params.yaml, ns: local_costmap}}, "
-                    f"{{from: {p}/global_costmap_params.yaml}}, {{from: {p}/local_costmap_params.yaml}}, "
-                    f"{{from: {p}/base_local_planner_params.yaml}}, {{from: {p}/move_base_params.yaml}}]}}")
+    _through_launch(
+        folder.parent,
+        "{pkg: navlab, exec: move_base, name: move_base, param: ["
+        f"{{from: {p}/costmap_common_params.yaml, ns: global_costmap}}, "
+        f"{{from: {p}/costmap_common_params.yaml, ns: local_costmap}}, "
+        f"{{from: {p}/global_costmap_params.yaml}}, {{from: {p}/local_costmap_params.yaml}}, "
+        f"{{from: {p}/base_local_planner_params.yaml}}, {{from: {p}/move_base_params.yaml}}]}}",
+    )
     return {}
 
 
@@ -129,9 +136,12 @@ def _bag(folder: Path) -> dict[str, Any]:
     from navlab.errors import NavlabError
 
     errors: list[NavlabError] = []
-    for argv in (["topic", "echo", "/chatter", "--bag", folder.name, "--count", "3"],
-                 ["node", "list", "--bag", folder.name], ["graph", "--bag", folder.name, "--out", "graph"],
-                 ["bag", "reindex", folder.name]):
+    for argv in (
+        ["topic", "echo", "/chatter", "--bag", folder.name, "--count", "3"],
+        ["node", "list", "--bag", folder.name],
+        ["graph", "--bag", folder.name, "--out", "graph"],
+        ["bag", "reindex", folder.name],
+    ):
         try:
             _cli(argv)
         except NavlabError as exc:
@@ -152,7 +162,20 @@ def _slam(path: Path) -> dict[str, Any]:
 
 
 TARGETS: dict[str, Callable[[Path], dict[str, Any]]] = {
-    "robot": _robot, "urdf": _robot, "world": _world, "amcl": _amcl, "gmapping": _gmapping,
-    "move_base": _move_base, "map": _map, "carmen": _carmen, "launch": _launch, "route": _route,
-    "scenario": _scenario, "navparams": _move_base, "goal": _goal, "bag": _bag, "barn": _barn, "slam": _slam,
+    "robot": _robot,
+    "urdf": _robot,
+    "world": _world,
+    "amcl": _amcl,
+    "gmapping": _gmapping,
+    "move_base": _move_base,
+    "map": _map,
+    "carmen": _carmen,
+    "launch": _launch,
+    "route": _route,
+    "scenario": _scenario,
+    "navparams": _move_base,
+    "goal": _goal,
+    "bag": _bag,
+    "barn": _barn,
+    "slam": _slam,
 }

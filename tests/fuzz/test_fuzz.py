@@ -14,7 +14,10 @@ def test_fast_fuzz_subset_has_only_clean_errors_and_valid_acceptances() -> None:
     todo = cases(320, seed=0)
     assert {c.fmt for c in todo} == set(FORMATS) and len(todo) >= 300
     results = run_cases(todo, timeout=30.0)  # generous: a real hang never answers; a loaded CI machine is slow
-    bad = [f"{r.outcome}: {r.case.fmt} {r.case.mutation}: {r.detail[:160]}" for r in results
-           if r.outcome in (*BAD, "vague")]
+    bad = [
+        f"{r.outcome}: {r.case.fmt} {r.case.mutation}: {r.detail[:160]}"
+        for r in results
+        if r.outcome in (*BAD, "vague")
+    ]
     assert not bad, format_table(table(results)) + "\n" + "\n".join(bad[:20])
     assert sum(r.outcome == "clean" for r in results) > 150  # the mutations do break the inputs

@@ -51,11 +51,22 @@ def _graph_garbage(bag: Path) -> None:
 
 
 @pytest.mark.parametrize("damage", [_flip_bytes, _fifo, _bad_metadata, _outside, _graph_garbage])
-@pytest.mark.parametrize("argv", [["topic", "echo", "/chatter", "--bag"], ["node", "list", "--bag"],
-                                  ["topic", "list", "--bag"], ["graph", "--out", "g", "--bag"]])
-def test_damaged_recordings_end_in_one_line(bag: Path, damage: Callable[[Path], None], argv: list[str],
-                                            capsys: pytest.CaptureFixture[str],
-                                            monkeypatch: pytest.MonkeyPatch) -> None:
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["topic", "echo", "/chatter", "--bag"],
+        ["node", "list", "--bag"],
+        ["topic", "list", "--bag"],
+        ["graph", "--out", "g", "--bag"],
+    ],
+)
+def test_damaged_recordings_end_in_one_line(
+    bag: Path,
+    damage: Callable[[Path], None],
+    argv: list[str],
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
     damage(bag)
     monkeypatch.chdir(bag.parent)
     code = main([*argv, str(bag)])

@@ -70,7 +70,11 @@ def test_dataset_fixture_fails_rather_than_skips(tmp_path):
     env = {**os.environ, "NAVLAB_DATA": str(tmp_path / "empty")}
     result = subprocess.run(
         [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "-rf", str(tmp_path)],
-        capture_output=True, text=True, env=env, cwd=tmp_path, check=False,
+        capture_output=True,
+        text=True,
+        env=env,
+        cwd=tmp_path,
+        check=False,
     )
     assert result.returncode == 1, result.stdout
     assert "1 failed" in result.stdout and "skipped" not in result.stdout

@@ -40,9 +40,12 @@ def route(n_steps: int, dt: float = 0.1) -> list[tuple[float, float, float]]:
     return poses
 
 
-def odometry(truth: list[tuple[float, float, float]], rng: np.random.Generator,
-             start: tuple[float, float, float] = (0.0, 0.0, 0.0),
-             teleport_at: int | None = None) -> list[tuple[float, float, float]]:
+def odometry(
+    truth: list[tuple[float, float, float]],
+    rng: np.random.Generator,
+    start: tuple[float, float, float] = (0.0, 0.0, 0.0),
+    teleport_at: int | None = None,
+) -> list[tuple[float, float, float]]:
     """Odometry poses (odom frame starting at ``start``) with a 3 % scale error and noisy heading.
 
     ``teleport_at``: index where the truth jumps (kidnapping); odometry repeats the previous step there.
@@ -58,6 +61,7 @@ def odometry(truth: list[tuple[float, float, float]], rng: np.random.Generator,
         fx *= 1.03
         dth = dth * 1.02 + rng.normal(0, 0.002)
         ox, oy, oth = out[-1]
-        out.append((ox + math.cos(oth) * fx - math.sin(oth) * fy, oy + math.sin(oth) * fx + math.cos(oth) * fy,
-                    oth + dth))
+        out.append(
+            (ox + math.cos(oth) * fx - math.sin(oth) * fy, oy + math.sin(oth) * fx + math.cos(oth) * fy, oth + dth)
+        )
     return out

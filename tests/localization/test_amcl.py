@@ -11,8 +11,9 @@ from amcl_synth import odometry, room_field, route, scan_at
 from navlab.localization import Amcl, AmclParams, LocalizationError, Scan, build_field
 
 
-def _run(params: AmclParams, truth: list, odo: list, *, seed: int = 1, init: tuple | None = None,
-         scan_seed: int = 0) -> tuple[Amcl, np.ndarray]:
+def _run(
+    params: AmclParams, truth: list, odo: list, *, seed: int = 1, init: tuple | None = None, scan_seed: int = 0
+) -> tuple[Amcl, np.ndarray]:
     """Run the filter along the route; return it and per-step (position error m, |yaw error| rad)."""
     field = room_field()
     rng = np.random.default_rng(scan_seed)
@@ -32,8 +33,14 @@ def _run(params: AmclParams, truth: list, odo: list, *, seed: int = 1, init: tup
 def test_tracking_follows_the_route_within_centimetres() -> None:
     truth = route(500)  # 50 s, about 12 m driven, odometry 3 % long and drifting in heading
     odo = odometry(truth, np.random.default_rng(5), start=(2.0, -1.0, 0.5))
-    params = AmclParams(odom_model_type="diff-corrected", odom_alpha1=0.05, odom_alpha2=0.05,
-                        odom_alpha3=0.05, odom_alpha4=0.05, laser_max_beams=60)
+    params = AmclParams(
+        odom_model_type="diff-corrected",
+        odom_alpha1=0.05,
+        odom_alpha2=0.05,
+        odom_alpha3=0.05,
+        odom_alpha4=0.05,
+        laser_max_beams=60,
+    )
     amcl, errs = _run(params, truth, odo, init=truth[0])
     assert errs[:, 0].mean() < 0.05
     assert errs[:, 0].max() < 0.15
@@ -72,12 +79,12 @@ def test_global_localization_converges_from_a_uniform_spread() -> None:
 def test_kidnapped_robot_recovers_with_recovery_alphas() -> None:
     full = route(1000)
     k0, jump = 150, 170
-    truth = full[:k0] + full[k0 + jump:k0 + jump + 450]
+    truth = full[:k0] + full[k0 + jump : k0 + jump + 450]
     assert math.dist(truth[k0 - 1][:2], truth[k0][:2]) > 3.0
     odo = odometry(truth, np.random.default_rng(9), teleport_at=k0)
     params = AmclParams(recovery_alpha_slow=0.01, recovery_alpha_fast=0.1)
     _, errs = _run(params, truth, odo, init=truth[0])
-    assert errs[k0 - 10:k0, 0].max() < 0.15  # tracking before
+    assert errs[k0 - 10 : k0, 0].max() < 0.15  # tracking before
     assert errs[k0 + 5, 0] > 2.0  # lost right after the teleport
     assert errs[-50:, 0].max() < 0.15  # found again and tracking
     # without recovery it stays lost
@@ -93,8 +100,7 @@ def test_same_seed_gives_identical_particle_clouds() -> None:
     c, _ = _run(AmclParams(max_particles=1000), truth, odo, seed=43)
     assert np.array_equal(a.particles, b.particles)
     assert np.array_equal(a.weights, b.weights)
-    assert not np.array_equal(a.particles.shape, c.particles.shape) or not np.array_equal(a.particles,
-                                                                                           c.particles)
+    assert not np.array_equal(a.particles.shape, c.particles.shape) or not np.array_equal(a.particles, c.particles)
 
 
 def test_updates_only_after_enough_motion_or_on_request() -> None:
@@ -128,11 +134,13 @@ def test_all_inf_scan_is_no_update() -> None:
     amcl = Amcl(field, AmclParams(), rng=np.random.default_rng(0))
     amcl.set_initial_pose(3.0, 3.0, 0.0)
     before = amcl.particles.copy()
-    blank = Scan(ranges=np.full(360, np.inf), angle_min=-math.pi, angle_increment=2 * math.pi / 360,
-                 range_min=0.1, range_max=8.0)
+    blank = Scan(
+        ranges=np.full(360, np.inf), angle_min=-math.pi, angle_increment=2 * math.pi / 360, range_min=0.1, range_max=8.0
+    )
     assert not amcl.update((0.0, 0.0, 0.0), blank)
-    nan = Scan(ranges=np.full(360, np.nan), angle_min=-math.pi, angle_increment=2 * math.pi / 360,
-               range_min=0.1, range_max=8.0)
+    nan = Scan(
+        ranges=np.full(360, np.nan), angle_min=-math.pi, angle_increment=2 * math.pi / 360, range_min=0.1, range_max=8.0
+    )
     assert not amcl.update((1.0, 0.0, 0.0), nan)
     assert np.array_equal(before, amcl.particles)
     assert amcl.n_updates == 0

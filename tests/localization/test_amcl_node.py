@@ -38,11 +38,20 @@ class FakeRobot(Node):
         self.send_transform(msgs.transform_stamped(t, "odom", "base_link", *self.odo[self.k]))
         s = scan_at(self.field, self.truth[self.k], self.scan_rng)
         ranges = np.full(s.ranges.shape, np.inf) if self.blank else s.ranges
-        self.scan_pub.publish(msgs.LaserScan(
-            header=msgs.header(t, "laser"), angle_min=s.angle_min,
-            angle_max=s.angle_min + s.angle_increment * (len(ranges) - 1), angle_increment=s.angle_increment,
-            time_increment=0.0, scan_time=0.1, range_min=s.range_min, range_max=s.range_max,
-            ranges=ranges.astype(np.float32), intensities=np.zeros(0, np.float32)))
+        self.scan_pub.publish(
+            msgs.LaserScan(
+                header=msgs.header(t, "laser"),
+                angle_min=s.angle_min,
+                angle_max=s.angle_min + s.angle_increment * (len(ranges) - 1),
+                angle_increment=s.angle_increment,
+                time_increment=0.0,
+                scan_time=0.1,
+                range_min=s.range_min,
+                range_max=s.range_max,
+                ranges=ranges.astype(np.float32),
+                intensities=np.zeros(0, np.float32),
+            )
+        )
         self.k += 1
 
 
@@ -59,8 +68,9 @@ def _setup(params: dict[str, Any], n: int = 300, seed: int = 0) -> tuple[Executo
     robot = FakeRobot(ex, truth=truth, odo=odo)
     probe = Node(ex, name="probe")
     probe.create_subscription(msgs.PoseWithCovarianceStamped, "amcl_pose", got["pose"].append)
-    probe.create_subscription(msgs.TFMessage, "/tf", lambda m: got["tf"].extend(
-        t for t in m.transforms if t.child_frame_id == "odom"))
+    probe.create_subscription(
+        msgs.TFMessage, "/tf", lambda m: got["tf"].extend(t for t in m.transforms if t.child_frame_id == "odom")
+    )
     probe.create_publisher(msgs.OccupancyGrid, "map", latched=True).publish(_map_msg())
     got["initialpose"] = probe.create_publisher(msgs.PoseWithCovarianceStamped, "initialpose")
     return ex, amcl, robot, got
@@ -75,8 +85,9 @@ def _error(robot: FakeRobot, ex: Executor) -> float:
 
 def test_node_tracks_from_initial_pose_parameters_and_publishes_ros_outputs() -> None:
     truth0 = route(1)[0]
-    ex, amcl, robot, got = _setup({"initial_pose_x": truth0[0], "initial_pose_y": truth0[1],
-                                   "initial_pose_a": truth0[2], "max_particles": 2000})
+    ex, amcl, robot, got = _setup(
+        {"initial_pose_x": truth0[0], "initial_pose_y": truth0[1], "initial_pose_a": truth0[2], "max_particles": 2000}
+    )
     ex.run(25.0)
     assert _error(robot, ex) < 0.10
     assert got["pose"], "amcl_pose was never published"
@@ -111,14 +122,18 @@ def test_global_localization_service_and_nomotion_update() -> None:
 
 def test_bad_initial_pose_is_refused_and_all_inf_scans_do_not_update() -> None:
     truth0 = route(1)[0]
-    ex, amcl, robot, got = _setup({"initial_pose_x": truth0[0], "initial_pose_y": truth0[1],
-                                   "initial_pose_a": truth0[2]})
+    ex, amcl, robot, got = _setup(
+        {"initial_pose_x": truth0[0], "initial_pose_y": truth0[1], "initial_pose_a": truth0[2]}
+    )
     ex.run(2.0)
     before = amcl.filter.estimate
     for x in (float("nan"), 40.0):
-        got["initialpose"].publish(msgs.PoseWithCovarianceStamped(
-            header=msgs.header(ex.now_ns, "map"),
-            pose=msgs.PoseWithCovariance(pose=msgs.pose_from_2d(x, 1.0, 0.0), covariance=msgs.covariance())))
+        got["initialpose"].publish(
+            msgs.PoseWithCovarianceStamped(
+                header=msgs.header(ex.now_ns, "map"),
+                pose=msgs.PoseWithCovariance(pose=msgs.pose_from_2d(x, 1.0, 0.0), covariance=msgs.covariance()),
+            )
+        )
         assert "ignoring initialpose" in amcl.last_error
     assert amcl.filter.estimate == before
     n0 = amcl.filter.n_updates
@@ -136,7 +151,8 @@ def test_map_without_free_cells_is_refused_and_unknown_parameters_are_named() ->
     amcl = Amcl(ex)
     probe = Node(ex, name="probe")
     probe.create_publisher(msgs.OccupancyGrid, "map", latched=True).publish(
-        _map_msg(np.full((50, 50), 100, dtype=np.int8)))
+        _map_msg(np.full((50, 50), 100, dtype=np.int8))
+    )
     ex.run(0.1)
     assert amcl.filter is None
     assert "no free cells" in amcl.last_error
@@ -151,11 +167,14 @@ def test_map_without_free_cells_is_refused_and_unknown_parameters_are_named() ->
         Amcl(Executor(), parameters={"laser_model_type": "beams"})
 
 
-@pytest.mark.parametrize(("mangle", "words"), [
-    (lambda m: setattr(m.info, "width", m.info.width + 1), ["cells but info says width"]),
-    (lambda m: setattr(m.info, "resolution", 0.0), ["resolution must be a positive number"]),
-    (lambda m: setattr(m.info.origin.position, "x", float("nan")), ["origin must be finite"]),
-])
+@pytest.mark.parametrize(
+    ("mangle", "words"),
+    [
+        (lambda m: setattr(m.info, "width", m.info.width + 1), ["cells but info says width"]),
+        (lambda m: setattr(m.info, "resolution", 0.0), ["resolution must be a positive number"]),
+        (lambda m: setattr(m.info.origin.position, "x", float("nan")), ["origin must be finite"]),
+    ],
+)
 def test_malformed_map_is_refused_in_one_line_naming_the_topic(mangle, words, caplog) -> None:  # type: ignore[no-untyped-def]
     """A malformed /map does not escape the subscriber: amcl logs one line naming the topic and what was wrong,
     keeps waiting for a map, and takes the next good one."""

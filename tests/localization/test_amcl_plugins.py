@@ -51,11 +51,15 @@ class _UniformModel:
 
 
 def test_a_new_laser_model_is_one_class_and_one_entry_point(install_plugin_package) -> None:
-    install_plugin_package("navlab-test-uniform-model",
-                           {"navlab.laser_models": {"uniform": f"{__name__}:_UniformModel"}})
+    install_plugin_package(
+        "navlab-test-uniform-model", {"navlab.laser_models": {"uniform": f"{__name__}:_UniformModel"}}
+    )
     field = room_field()
-    amcl = Amcl(field, AmclParams(laser_model_type="uniform", max_particles=500, min_particles=500),
-                rng=np.random.default_rng(0))  # fmt: skip
+    amcl = Amcl(
+        field,
+        AmclParams(laser_model_type="uniform", max_particles=500, min_particles=500),
+        rng=np.random.default_rng(0),
+    )
     amcl.set_initial_pose(2.0, 2.0, 0.0)
     scan = Scan(np.full(60, 2.0), -math.pi, 2 * math.pi / 60, 0.1, 10.0)
     assert amcl.update((0.0, 0.0, 0.0), scan) and amcl.update((0.5, 0.0, 0.0), scan)

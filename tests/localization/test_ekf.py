@@ -76,25 +76,34 @@ def test_differential_and_relative_inputs() -> None:
 
 def test_imu_measurement_rotates_into_the_base_and_removes_gravity() -> None:
     upside = np.diag([1.0, -1.0, -1.0])  # an IMU mounted upside down (roll pi)
-    z, r = ekf.imu_measurement(upside, orientation_rpy=(math.pi, 0.0, 0.3), orientation_cov=np.eye(3) * 0.01,
-                               angular_velocity=(0.0, 0.0, -0.5), angular_velocity_cov=np.eye(3) * 1e-4,
-                               linear_acceleration=(0.2, 0.0, -9.80665), linear_acceleration_cov=np.eye(3) * 0.01,
-                               remove_gravity=True)  # fmt: skip
+    z, r = ekf.imu_measurement(
+        upside,
+        orientation_rpy=(math.pi, 0.0, 0.3),
+        orientation_cov=np.eye(3) * 0.01,
+        angular_velocity=(0.0, 0.0, -0.5),
+        angular_velocity_cov=np.eye(3) * 1e-4,
+        linear_acceleration=(0.2, 0.0, -9.80665),
+        linear_acceleration_cov=np.eye(3) * 0.01,
+        remove_gravity=True,
+    )
     assert z[[3, 4, 5]] == pytest.approx([0.0, 0.0, 0.3], abs=1e-9)
     assert z[11] == pytest.approx(0.5) and r[11, 11] == pytest.approx(1e-4)
     assert z[[12, 13, 14]] == pytest.approx([0.2, 0.0, 0.0], abs=1e-9)
 
 
-@pytest.mark.parametrize("params, message", [
-    ({"odom0": "odom", "odom0_config": [True] * 12}, "odom0_config: expected 15 booleans .* got 12 values"),
-    ({"imu0": "imu", "imu0_config": "all"}, "imu0_config'?: expected"),
-    ({"process_noise_covariance": [0.1] * 20}, "process_noise_covariance: expected 225"),
-    ({"initial_estimate_covariance": [-1.0] + [1.0] * 14}, "diagonal entries must be >= 0, negative for x"),
-    ({"odom0": "odom", "odom0_twist_rejection_threshold": -2.0}, "expected a distance > 0"),
-    ({"frequency": 0.0}, "frequency"),
-    ({"world_frame": "earth"}, "world_frame 'earth'"),
-    ({"odom0": "odom", "odom0_confg": [True] * 15}, "did you mean 'odom0_config'"),
-])  # fmt: skip
+@pytest.mark.parametrize(
+    "params, message",
+    [
+        ({"odom0": "odom", "odom0_config": [True] * 12}, "odom0_config: expected 15 booleans .* got 12 values"),
+        ({"imu0": "imu", "imu0_config": "all"}, "imu0_config'?: expected"),
+        ({"process_noise_covariance": [0.1] * 20}, "process_noise_covariance: expected 225"),
+        ({"initial_estimate_covariance": [-1.0] + [1.0] * 14}, "diagonal entries must be >= 0, negative for x"),
+        ({"odom0": "odom", "odom0_twist_rejection_threshold": -2.0}, "expected a distance > 0"),
+        ({"frequency": 0.0}, "frequency"),
+        ({"world_frame": "earth"}, "world_frame 'earth'"),
+        ({"odom0": "odom", "odom0_confg": [True] * 15}, "did you mean 'odom0_config'"),
+    ],
+)
 def test_bad_parameters_get_clear_errors(params: dict, message: str) -> None:
     with pytest.raises(Exception, match=message):
         EkfNode(Executor(seed=0), parameters=params)
@@ -106,10 +115,17 @@ def test_imu_without_a_frame_is_reported_and_ignored() -> None:
     pub = Node(ex, name="probe").create_publisher(msgs.Imu, "imu")
     for frame in ("", "imu_link"):
         node.last_error = None
-        pub.publish(msgs.Imu(header=msgs.header(ex.now_ns, frame), orientation=msgs.quaternion_from_yaw(0.0),
-                             orientation_covariance=np.zeros(9), angular_velocity=msgs.Vector3(x=0.0, y=0.0, z=0.3),
-                             angular_velocity_covariance=np.eye(3).ravel() * 1e-4, linear_acceleration=msgs.Vector3(
-                                 x=0.0, y=0.0, z=0.0), linear_acceleration_covariance=np.zeros(9)))  # fmt: skip
+        pub.publish(
+            msgs.Imu(
+                header=msgs.header(ex.now_ns, frame),
+                orientation=msgs.quaternion_from_yaw(0.0),
+                orientation_covariance=np.zeros(9),
+                angular_velocity=msgs.Vector3(x=0.0, y=0.0, z=0.3),
+                angular_velocity_covariance=np.eye(3).ravel() * 1e-4,
+                linear_acceleration=msgs.Vector3(x=0.0, y=0.0, z=0.0),
+                linear_acceleration_covariance=np.zeros(9),
+            )
+        )
         ex.run(0.1)
         assert node.last_error is not None
         assert ("no frame_id" in node.last_error) if not frame else ("'imu_link'" in node.last_error)
@@ -124,8 +140,14 @@ def test_slip_patch_heading_drift_smaller_with_imu_fusion_than_wheel_odometry() 
     ctrl = load_params(PARAMS / "mybot" / "diff_drive_controller.yaml")
     ctrl["mobile_base_controller"]["enable_odom_tf"] = False
     ex = Executor(seed=0)
-    launch_sim(ex, world=WorldModel("empty"), robot="mybot", seed=1, **ctrl,
-               disturbances={"slip_patches": [{"x": 0.0, "y": 0.0, "radius": 1.0, "mu": 0.03}]})  # fmt: skip
+    launch_sim(
+        ex,
+        world=WorldModel("empty"),
+        robot="mybot",
+        seed=1,
+        **ctrl,
+        disturbances={"slip_patches": [{"x": 0.0, "y": 0.0, "radius": 1.0, "mu": 0.03}]},
+    )
     node = EkfNode(ex, parameters=load_params(PARAMS / "ekf.yaml"))
     probe = Node(ex, name="probe")
     got: dict = {"odom": [], "odometry/filtered": [], "/ground_truth/odom": []}

@@ -25,10 +25,20 @@ def _scans(ex: Executor, ranges: np.ndarray, seconds: float) -> None:
     pub = Node(ex, name="fake_laser").create_publisher(msgs.LaserScan, "scan", 5)
 
     def send() -> None:
-        pub.publish(msgs.LaserScan(header=msgs.header(ex.now_ns, "laser"), angle_min=-1.0, angle_max=1.0,
-                                   angle_increment=2.0 / (len(ranges) - 1), time_increment=0.0, scan_time=0.0,
-                                   range_min=0.1, range_max=10.0, ranges=ranges.astype(np.float32),
-                                   intensities=np.zeros(0, np.float32)))
+        pub.publish(
+            msgs.LaserScan(
+                header=msgs.header(ex.now_ns, "laser"),
+                angle_min=-1.0,
+                angle_max=1.0,
+                angle_increment=2.0 / (len(ranges) - 1),
+                time_increment=0.0,
+                scan_time=0.0,
+                range_min=0.1,
+                range_max=10.0,
+                ranges=ranges.astype(np.float32),
+                intensities=np.zeros(0, np.float32),
+            )
+        )
 
     Node(ex, name="laser_timer").create_timer(0.1, send)
     ex.run(seconds)

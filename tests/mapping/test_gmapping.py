@@ -38,8 +38,14 @@ def test_rbpf_beats_drifting_odometry_and_is_seeded(synth_world, odometry_noise)
 def test_gmapping_parameter_names_and_defaults():
     p = GMappingParams()
     assert (p.particles, p.linearUpdate, p.angularUpdate, p.delta, p.sigma, p.lsigma, p.ogain) == (
-        30, 1.0, 0.5, 0.05, 0.05, 0.075, 3.0,
-    )  # fmt: skip
+        30,
+        1.0,
+        0.5,
+        0.05,
+        0.05,
+        0.075,
+        3.0,
+    )
     assert (p.srr, p.srt, p.str, p.stt, p.resampleThreshold, p.iterations) == (0.1, 0.2, 0.1, 0.2, 0.5, 5)
     with pytest.raises(MappingError, match="did you mean 'linearUpdate'"):
         read_params(GMappingParams, {"linearupdate": 0.5})

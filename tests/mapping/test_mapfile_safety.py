@@ -18,8 +18,9 @@ def _grid(width: int, height: int, wall: int) -> GridMap:
     return GridMap(data, 0.05, (-1.0, -2.0, 0.0), "map")
 
 
-def test_a_save_killed_before_the_yaml_is_replaced_leaves_the_old_pair(tmp_path: Path,
-                                                                       monkeypatch: pytest.MonkeyPatch) -> None:
+def test_a_save_killed_before_the_yaml_is_replaced_leaves_the_old_pair(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     old, new = _grid(30, 20, 3), _grid(30, 20, 17)  # same size: only the pixels tell them apart
     yaml_path = tmp_path / "map.yaml"
     save_map(old, yaml_path, crop_margin_cells=None)
@@ -43,8 +44,11 @@ def test_an_image_that_does_not_match_the_recorded_size_is_refused(tmp_path: Pat
     save_map(_grid(30, 20, 3), tmp_path / "a.yaml", crop_margin_cells=None)
     save_map(_grid(40, 20, 3), tmp_path / "b.yaml", crop_margin_cells=None)
     (tmp_path / "b.pgm").replace(tmp_path / "a.pgm")  # a copied image from another map
-    with pytest.raises(MappingError, match=r"a\.yaml: image a\.pgm is 40 x 20 pixels but the YAML records "
-                                           r"image_size \[30, 20\]"):
+    with pytest.raises(
+        MappingError,
+        match=r"a\.yaml: image a\.pgm is 40 x 20 pixels but the YAML records "
+        r"image_size \[30, 20\]",
+    ):
         load_map(tmp_path / "a.yaml")
     # a ROS map_saver YAML has no image_size: loaded as ROS loads it
     text = (tmp_path / "a.yaml").read_text().replace("image_size: [30, 20]\n", "")
@@ -52,13 +56,16 @@ def test_an_image_that_does_not_match_the_recorded_size_is_refused(tmp_path: Pat
     assert load_map(tmp_path / "a.yaml").data.shape == (20, 40)
 
 
-@pytest.mark.parametrize(("kind", "message"), [
-    ("p4", r"a PBM bitmap \(P4\)"),
-    ("bomb", r"60000 x 60000 pixels; a map image may have at most"),
-    ("fifo", r"is a named pipe"),
-    ("device", r"is a device"),
-    ("directory", r"is a directory"),
-])
+@pytest.mark.parametrize(
+    ("kind", "message"),
+    [
+        ("p4", r"a PBM bitmap \(P4\)"),
+        ("bomb", r"60000 x 60000 pixels; a map image may have at most"),
+        ("fifo", r"is a named pipe"),
+        ("device", r"is a device"),
+        ("directory", r"is a directory"),
+    ],
+)
 def test_hostile_images_are_refused_quickly(tmp_path: Path, kind: str, message: str) -> None:
     save_map(_grid(30, 20, 3), tmp_path / "m.yaml", crop_margin_cells=None)
     pgm = tmp_path / "m.pgm"

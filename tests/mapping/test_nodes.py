@@ -48,12 +48,18 @@ class _FakeRobot(Node):
         ranges = np.where(ranges > 29.0, np.inf, ranges).astype(np.float32)
         self.scan_pub.publish(
             msgs.LaserScan(
-                header=msgs.header(t, "laser"), angle_min=self.world.angle_min,
+                header=msgs.header(t, "laser"),
+                angle_min=self.world.angle_min,
                 angle_max=self.world.angle_min + self.world.angle_increment * (self.world.n - 1),
-                angle_increment=self.world.angle_increment, time_increment=0.0, scan_time=0.1,
-                range_min=0.1, range_max=30.0, ranges=ranges, intensities=np.zeros(0, np.float32),
+                angle_increment=self.world.angle_increment,
+                time_increment=0.0,
+                scan_time=0.1,
+                range_min=0.1,
+                range_max=30.0,
+                ranges=ranges,
+                intensities=np.zeros(0, np.float32),
             )
-        )  # fmt: skip
+        )
         self.k += 1
 
 
@@ -88,8 +94,14 @@ def test_slam_node_maps_the_room_and_corrects_odometry(synth_world, odometry_noi
     gt = synth_world.route()[:200]
     odo = odometry_noise(gt, rng)
     ex = Executor(seed=1)
-    params = {"scan_topic": "/mybot/laser/scan", "map_update_interval": 2.0, "linearUpdate": 0.3,
-              "angularUpdate": 0.2, "mode": mode, "particles": 15}  # fmt: skip
+    params = {
+        "scan_topic": "/mybot/laser/scan",
+        "map_update_interval": 2.0,
+        "linearUpdate": 0.3,
+        "angularUpdate": 0.2,
+        "mode": mode,
+        "particles": 15,
+    }
     if mode == "graph":
         params.update({"linearUpdate": 0.1, "angularUpdate": 0.1})
     slam = SlamGMapping(ex, parameters=params)

@@ -51,8 +51,9 @@ def test_graph_mode_survives_larger_steps_in_corridors(truth, tmp_path):
     from navlab.world.office import generate_office
 
     office = generate_office()
-    sim_log = record_log(office.write_world(tmp_path / "office.world"), office.route(), seed=1, linear_step=1.6,
-                         angular_step=0.9)  # fmt: skip
+    sim_log = record_log(
+        office.write_world(tmp_path / "office.world"), office.route(), seed=1, linear_step=1.6, angular_step=0.9
+    )
     got = office_scores(sim_log, run_offline(sim_log.log, mode="graph"), truth)
     assert got["ate_rmse_m"] <= 0.10 and got["ate_max_m"] <= 0.30 and got["precision"] >= 0.95, got
 

@@ -109,8 +109,9 @@ class _DeadReckoning:
 
 
 def test_a_new_mode_is_one_class_and_one_entry_point(install_plugin_package) -> None:
-    install_plugin_package("navlab-test-dead-reckoning",
-                           {"navlab.slam_backends": {"dead_reckoning": f"{__name__}:_DeadReckoning"}})
+    install_plugin_package(
+        "navlab-test-dead-reckoning", {"navlab.slam_backends": {"dead_reckoning": f"{__name__}:_DeadReckoning"}}
+    )
     ex = Executor(seed=0)
     slam = SlamGMapping(ex, parameters={"mode": "dead_reckoning", "delta": 0.2, "map_update_interval": 0.0})
     assert slam.params == {"delta": 0.2}
@@ -123,10 +124,20 @@ def test_a_new_mode_is_one_class_and_one_entry_point(install_plugin_package) -> 
     for k in range(3):
         t = k * 100_000_000
         robot.send_transform(msgs.transform_stamped(t, "odom", "base_link", 0.2 * k, 0.0, 0.0))
-        scans.publish(msgs.LaserScan(
-            header=msgs.header(t, "laser"), angle_min=a0, angle_max=a0 + inc * (len(r) - 1), angle_increment=inc,
-            time_increment=0.0, scan_time=0.1, range_min=0.1, range_max=10.0, ranges=r.astype(np.float32),
-            intensities=np.zeros(0, np.float32)))  # fmt: skip
+        scans.publish(
+            msgs.LaserScan(
+                header=msgs.header(t, "laser"),
+                angle_min=a0,
+                angle_max=a0 + inc * (len(r) - 1),
+                angle_increment=inc,
+                time_increment=0.0,
+                scan_time=0.1,
+                range_min=0.1,
+                range_max=10.0,
+                ranges=r.astype(np.float32),
+                intensities=np.zeros(0, np.float32),
+            )
+        )
         ex.run(0.1)
     assert slam.scans_processed == 3 and maps and maps[-1].info.resolution == pytest.approx(0.2)
     np.testing.assert_allclose(slam.slam.trajectory()[-1], compose2((0.4, 0.0, 0.0), (0.1, 0.0, 0.0)))

@@ -36,8 +36,14 @@ def _plain_climb(tiled, args, x0, y0, t0, lstep, astep, iterations):
             break
         best = cur
         bx, by, bt = cx, cy, ct
-        for nx, ny, nt in ((cx + ld, cy, ct), (cx - ld, cy, ct), (cx, cy + ld, ct), (cx, cy - ld, ct),
-                           (cx, cy, ct + ad), (cx, cy, ct - ad)):  # fmt: skip
+        for nx, ny, nt in (
+            (cx + ld, cy, ct),
+            (cx - ld, cy, ct),
+            (cx, cy + ld, ct),
+            (cx, cy - ld, ct),
+            (cx, cy, ct + ad),
+            (cx, cy, ct - ad),
+        ):
             sc = match_score(*tiled, *args[:5], nx, ny, nt, *args[5:])[0]
             if sc > cur:
                 cur, bx, by, bt = sc, nx, ny, nt
@@ -58,8 +64,7 @@ def _room_map(rng: np.random.Generator, res: float = 0.05) -> tuple[np.ndarray, 
         return np.minimum(np.abs(tx), np.abs(ty)) + rng.normal(0, 0.01, ang.size)
 
     for x, y, t in ((2.0, 2.0, 0.0), (3.0, 1.5, 0.4), (1.5, 2.5, -0.3)):
-        integrate_scan(grid, (0.0, 0.0), res, np.array([x, y, t]), ranges(x, y, t), ang, max_urange=8.0,
-                       max_range=10.0)  # fmt: skip
+        integrate_scan(grid, (0.0, 0.0), res, np.array([x, y, t]), ranges(x, y, t), ang, max_urange=8.0, max_range=10.0)
     return grid, ranges(2.5, 2.0, 0.1), ang
 
 
@@ -128,8 +133,13 @@ def test_the_motion_draw_equals_the_vectorised_motion_model() -> None:
     step, sig = (0.03, -0.01, 0.02), (0.004, 0.003, 0.006)
     noisy = np.asarray(step)[None, :] + noise * np.asarray(sig)[None, :]
     c, s = np.cos(poses[:, 2]), np.sin(poses[:, 2])
-    want = np.column_stack([poses[:, 0] + c * noisy[:, 0] - s * noisy[:, 1],
-                            poses[:, 1] + s * noisy[:, 0] + c * noisy[:, 1], wrap_angle(poses[:, 2] + noisy[:, 2])])
+    want = np.column_stack(
+        [
+            poses[:, 0] + c * noisy[:, 0] - s * noisy[:, 1],
+            poses[:, 1] + s * noisy[:, 0] + c * noisy[:, 1],
+            wrap_angle(poses[:, 2] + noisy[:, 2]),
+        ]
+    )
     draw_motion(poses, noise, *step, *sig)
     np.testing.assert_array_equal(poses, want)
 
@@ -148,7 +158,7 @@ def test_the_unchecked_ray_walk_equals_the_checked_one() -> None:
             part = np.zeros((h, w), dtype=dtype)
             _raycast(part, 0.0, 0.0, oi, oj, *args)
             _raycast(part, 0.0, 0.0, oi, oj, *args)
-            np.testing.assert_array_equal(part, whole[oj:oj + h, oi:oi + w])
+            np.testing.assert_array_equal(part, whole[oj : oj + h, oi : oi + w])
     # lines longer than the fixed-point walk takes (FAST_WALK_CELLS) walk by the error term
     r_long = np.array([FAST_WALK_CELLS * 0.05 + 3.0, 150.0, 40.0])
     ang_long = np.array([0.0, 0.002, -0.004])
@@ -160,8 +170,9 @@ def test_the_unchecked_ray_walk_equals_the_checked_one() -> None:
     np.testing.assert_array_equal(part, whole[:, 10:])
     assert np.count_nonzero(whole) > FAST_WALK_CELLS
     with pytest.raises(ValueError, match="C-contiguous"):
-        integrate_scan(np.zeros((20, 20))[:, ::2], (0.0, 0.0), 0.05, np.zeros(3), r, ang, max_urange=8.0,
-                       max_range=10.0)  # fmt: skip
+        integrate_scan(
+            np.zeros((20, 20))[:, ::2], (0.0, 0.0), 0.05, np.zeros(3), r, ang, max_urange=8.0, max_range=10.0
+        )
 
 
 def test_the_tiled_ray_cast_writes_the_dense_cells_and_copies_only_shared_tiles() -> None:
@@ -201,8 +212,9 @@ def test_lookup_field_and_correlative_search_near_and_off_the_edges() -> None:
         cj = np.floor((pts[:, 1] - f.origin[1]) / f.resolution).astype(int)
         assert np.all(f.grid[cj, ci] == np.float32(1.0))
         for window in (0.0, 0.3, 5.0):  # 5 m: shifts leave the field (the checked path)
-            pose, score = correlative_search(f, pts, np.array([0.02, -0.03, 0.0]), lin_window=window,
-                                             ang_window=0.02, ang_step=0.01)  # fmt: skip
+            pose, score = correlative_search(
+                f, pts, np.array([0.02, -0.03, 0.0]), lin_window=window, ang_window=0.02, ang_step=0.01
+            )
             want = np.zeros(3) if window > 0 else np.array([0.02, -0.03, 0.0])
             np.testing.assert_allclose(pose, want, atol=0.051)
             assert 0.0 < score <= 1.0

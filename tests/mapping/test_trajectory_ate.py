@@ -35,8 +35,11 @@ def test_rigidly_moved_trajectory_has_zero_ate_and_a_bent_one_does_not():
     bent[10, 1] += 2.0
     out = ate(bent, p)
     assert out["max_m"] > 1.5 and out["share_over_far"] == pytest.approx(1 / 80)
-    assert out["rmse_m"] == pytest.approx(math.sqrt(np.mean(np.hypot(*(apply_se2(
-        (out["align_x"], out["align_y"], out["align_yaw"]), bent) - p)[:, :2].T) ** 2)))  # fmt: skip
+    assert out["rmse_m"] == pytest.approx(
+        math.sqrt(
+            np.mean(np.hypot(*(apply_se2((out["align_x"], out["align_y"], out["align_yaw"]), bent) - p)[:, :2].T) ** 2)
+        )
+    )
     with pytest.raises(MappingError, match="79 estimated poses but 80"):
         ate(p[1:], p)
 

@@ -44,8 +44,9 @@ def test_stop_slowdown_and_free_space() -> None:
 
 
 def test_approach_keeps_the_contact_time_before_collision_away() -> None:
-    mon = CollisionMonitor([Polygon("FootprintApproach", "approach", FOOTPRINT, min_points=4,
-                                    time_before_collision=1.2)])  # fmt: skip
+    mon = CollisionMonitor(
+        [Polygon("FootprintApproach", "approach", FOOTPRINT, min_points=4, time_before_collision=1.2)]
+    )
     far = mon.check(0.5, 0.0, cloud(1.5, 0.0))  # 1.25 m of gap at 0.5 m/s: 2.5 s away
     assert far.v == 0.5
     close = mon.check(1.0, 0.0, cloud(1.0, 0.0))  # 0.75 m at 1 m/s: 0.75 s away -> slowed
@@ -58,9 +59,11 @@ def test_approach_keeps_the_contact_time_before_collision_away() -> None:
 
 def test_configured_polygons_and_bad_ones() -> None:
     square = [0.3, 0.3, 0.3, -0.3, -0.3, -0.3, -0.3, 0.3]
-    params = {"polygons": ["Stop", "Ring"],
-              "Stop": {"type": "polygon", "action_type": "stop", "points": square},
-              "Ring": {"type": "circle", "action_type": "limit", "radius": 1.0, "linear_limit": 0.2, "max_points": 2}}
+    params = {
+        "polygons": ["Stop", "Ring"],
+        "Stop": {"type": "polygon", "action_type": "stop", "points": square},
+        "Ring": {"type": "circle", "action_type": "limit", "radius": 1.0, "linear_limit": 0.2, "max_points": 2},
+    }
     mon = CollisionMonitor(parse_polygons(params, None))
     limited = mon.check(1.0, 2.0, cloud(0.8, 0.0, n=3))  # Humble's max_points 2: three points act
     assert (limited.v, limited.action) == (0.2, "limit") and limited.w == pytest.approx(0.5)

@@ -63,8 +63,13 @@ def drive(ctrl, world: Grid, mask: np.ndarray, start, plan: np.ndarray, steps: i
         i, j = world.world_to_cell(np.array([pose[:2]]))[0]
         least = min(least, clearance[j, i])
         speeds.append(vel[0])
-    return {"reached": ctrl.is_goal_reached(pose, vel), "time": k * DT, "clearance": least,
-            "speed": float(np.mean(speeds)), "pose": pose}
+    return {
+        "reached": ctrl.is_goal_reached(pose, vel),
+        "time": k * DT,
+        "clearance": least,
+        "speed": float(np.mean(speeds)),
+        "pose": pose,
+    }
 
 
 @pytest.fixture(scope="module")
@@ -115,8 +120,11 @@ def test_chosen_rollout_keeps_off_lethal_and_inscribed_cells(cls):
     assert ctrl.valid and len(ctrl.local_plan)
     assert (world.value_at(ctrl.local_plan[:, :2], outside=255) < COST_INSCRIBED).all()
     # every sample whose rollout touches such a cell is rejected (cost < 0)
-    hits = (world.value_at(ctrl.trajectories[..., :2].reshape(-1, 2), outside=255) >= COST_INSCRIBED).reshape(
-        ctrl.trajectories.shape[:2]).any(axis=1)
+    hits = (
+        (world.value_at(ctrl.trajectories[..., :2].reshape(-1, 2), outside=255) >= COST_INSCRIBED)
+        .reshape(ctrl.trajectories.shape[:2])
+        .any(axis=1)
+    )
     assert hits.any()
     assert (ctrl.costs[hits] < 0).all()
 
@@ -304,8 +312,18 @@ def test_both_ros1_spellings_are_read():
     assert TrajectoryPlannerROS({"backup_vel": -0.2}).params.escape_vel == -0.2
     tp = TrajectoryPlannerROS({"max_rotational_vel": 0.8}).params
     assert (tp.max_vel_theta, tp.min_vel_theta) == (0.8, -0.8)
-    dwa = DWAPlannerROS({"pdist_scale": 20.0, "gdist_scale": 10.0, "max_trans_vel": 0.4, "min_trans_vel": 0.05,
-                         "max_rot_vel": 1.5, "min_rot_vel": 0.3, "acc_lim_th": 2.0, "rot_stopped_vel": 0.05}).params
+    dwa = DWAPlannerROS(
+        {
+            "pdist_scale": 20.0,
+            "gdist_scale": 10.0,
+            "max_trans_vel": 0.4,
+            "min_trans_vel": 0.05,
+            "max_rot_vel": 1.5,
+            "min_rot_vel": 0.3,
+            "acc_lim_th": 2.0,
+            "rot_stopped_vel": 0.05,
+        }
+    ).params
     assert (dwa.path_distance_bias, dwa.goal_distance_bias) == (20.0, 10.0)
     assert (dwa.max_vel_trans, dwa.min_vel_trans, dwa.max_vel_theta, dwa.min_vel_theta) == (0.4, 0.05, 1.5, 0.3)
     assert (dwa.acc_lim_theta, dwa.theta_stopped_vel) == (2.0, 0.05)
@@ -322,9 +340,16 @@ def test_scoring_weights_change_the_choice():
     assert picks[0] != picks[1]
 
 
-@pytest.mark.parametrize("cls, key", [(DWAPlannerROS, "vx_samples"), (DWAPlannerROS, "vy_samples"),
-                                      (DWAPlannerROS, "vth_samples"), (TrajectoryPlannerROS, "vx_samples"),
-                                      (TrajectoryPlannerROS, "vtheta_samples")])
+@pytest.mark.parametrize(
+    "cls, key",
+    [
+        (DWAPlannerROS, "vx_samples"),
+        (DWAPlannerROS, "vy_samples"),
+        (DWAPlannerROS, "vth_samples"),
+        (TrajectoryPlannerROS, "vx_samples"),
+        (TrajectoryPlannerROS, "vtheta_samples"),
+    ],
+)
 def test_sample_counts_below_one_warn_and_become_one_as_in_ros(cls, key, caplog):
     """dwa_local_planner and base_local_planner warn and sample one value (TurtleBot3's files set vy_samples: 0)."""
     with caplog.at_level("WARNING", logger="navlab.navigation"):
@@ -334,17 +359,23 @@ def test_sample_counts_below_one_warn_and_become_one_as_in_ros(cls, key, caplog)
     assert f"{key} is 0" in msg and "set to 1" in msg
 
 
-@pytest.mark.parametrize("cls, params, words", [
-    (DWAPlannerROS, {"max_vel_x": 0.5, "max_vel_trans": 0.5, "path_distance_bais": 1.0},
-     ["path_distance_bais", "did you mean", "path_distance_bias"]),
-    (TrajectoryPlannerROS, {"pdist_scal": 1.0}, ["pdist_scal", "did you mean", "pdist_scale"]),
-    (DWAPlannerROS, {"min_vel_x": 0.6}, ["min_vel_x", "got 0.6", "max_vel_x"]),
-    (TrajectoryPlannerROS, {"min_vel_theta": 2.0}, ["min_vel_theta", "got 2.0", "max_vel_theta"]),
-    (TrajectoryPlannerROS, {"sim_time": 0.0}, ["sim_time", "got 0.0", "> 0"]),
-    (TrajectoryPlannerROS, {"escape_vel": 0.1}, ["escape_vel", "got 0.1", "<= 0"]),
-    (DWAPlannerROS, {"xy_goal_tolerance": -0.1}, ["xy_goal_tolerance", "got -0.1", ">= 0"]),
-    (DWAPlannerROS, {"max_rot_vel": 1.0, "max_vel_theta": 2.0}, ["max_rot_vel", "max_vel_theta", "give one"]),
-])
+@pytest.mark.parametrize(
+    "cls, params, words",
+    [
+        (
+            DWAPlannerROS,
+            {"max_vel_x": 0.5, "max_vel_trans": 0.5, "path_distance_bais": 1.0},
+            ["path_distance_bais", "did you mean", "path_distance_bias"],
+        ),
+        (TrajectoryPlannerROS, {"pdist_scal": 1.0}, ["pdist_scal", "did you mean", "pdist_scale"]),
+        (DWAPlannerROS, {"min_vel_x": 0.6}, ["min_vel_x", "got 0.6", "max_vel_x"]),
+        (TrajectoryPlannerROS, {"min_vel_theta": 2.0}, ["min_vel_theta", "got 2.0", "max_vel_theta"]),
+        (TrajectoryPlannerROS, {"sim_time": 0.0}, ["sim_time", "got 0.0", "> 0"]),
+        (TrajectoryPlannerROS, {"escape_vel": 0.1}, ["escape_vel", "got 0.1", "<= 0"]),
+        (DWAPlannerROS, {"xy_goal_tolerance": -0.1}, ["xy_goal_tolerance", "got -0.1", ">= 0"]),
+        (DWAPlannerROS, {"max_rot_vel": 1.0, "max_vel_theta": 2.0}, ["max_rot_vel", "max_vel_theta", "give one"]),
+    ],
+)
 def test_bad_parameters_get_a_one_line_error(cls, params, words):
     with pytest.raises(NavigationError) as err:
         cls(params)
@@ -355,9 +386,11 @@ def test_bad_parameters_get_a_one_line_error(cls, params, words):
 
 
 def test_registered_under_ros_names():
-    for name, cls in (("base_local_planner/TrajectoryPlannerROS", TrajectoryPlannerROS),
-                      ("dwa_local_planner/DWAPlannerROS", DWAPlannerROS),
-                      ("nav2_mppi_controller::MPPIController", MPPIController)):
+    for name, cls in (
+        ("base_local_planner/TrajectoryPlannerROS", TrajectoryPlannerROS),
+        ("dwa_local_planner/DWAPlannerROS", DWAPlannerROS),
+        ("nav2_mppi_controller::MPPIController", MPPIController),
+    ):
         assert load_plugin("controller", name) is cls
     assert issubclass(load_plugin("controller", "nav2_dwb_controller/DWBLocalPlanner"), DWAPlannerROS)
 
@@ -385,8 +418,14 @@ def test_mppi_same_seed_same_commands():
 def test_mppi_steers_around_an_obstacle_on_the_path():
     world = with_disc(free_map(8.0, (-1.0, -4.0, 0.0)), (1.5, 0.0), 0.2)
     blocked = world.data >= COST_LETHAL
-    out = drive(MPPIController(rng=np.random.default_rng(0)), world, blocked, (0.0, 0.0, 0.0),
-                straight_plan(0.0, 3.5), steps=400)
+    out = drive(
+        MPPIController(rng=np.random.default_rng(0)),
+        world,
+        blocked,
+        (0.0, 0.0, 0.0),
+        straight_plan(0.0, 3.5),
+        steps=400,
+    )
     assert out["reached"], out
     assert out["clearance"] >= 0.2 - RES
 
@@ -425,9 +464,23 @@ def test_mppi_cost_critic_scores_collisions_far_above_clearance():
     cost = np.zeros((3, t_n), dtype=np.uint8)
     cost[1, 5] = 100  # passes through inflation
     cost[2, 5] = COST_LETHAL  # collides
-    batch = critics.Batch(xs, np.zeros_like(xs), np.zeros_like(xs), np.full_like(xs, 0.3), np.zeros_like(xs), cost,
-                          xs, (0.0, 0.0, 0.0), np.zeros((0, 2)), (5.0, 0.0, None), 5.0, 0.05, (-0.35, 0.5),
-                          np.zeros((4, 4), dtype=np.uint8), RES)
+    batch = critics.Batch(
+        xs,
+        np.zeros_like(xs),
+        np.zeros_like(xs),
+        np.full_like(xs, 0.3),
+        np.zeros_like(xs),
+        cost,
+        xs,
+        (0.0, 0.0, 0.0),
+        np.zeros((0, 2)),
+        (5.0, 0.0, None),
+        5.0,
+        0.05,
+        (-0.35, 0.5),
+        np.zeros((4, 4), dtype=np.uint8),
+        RES,
+    )
     out = critics.cost(critics.CostCritic(trajectory_point_step=1), batch)
     assert out[0] == 0.0 < out[1] < 1.0 < 100.0 < out[2]
     near = critics.goal(critics.GoalCritic(), batch)
@@ -435,17 +488,26 @@ def test_mppi_cost_critic_scores_collisions_far_above_clearance():
 
 
 def test_mppi_parameters():
-    p = MPPIController({"vx_max": 0.6, "CostCritic": {"cost_weight": 2.0}, "GoalCritic.threshold_to_consider": 1.0,
-                        "plugin": "nav2_mppi_controller::MPPIController"}, rng=np.random.default_rng(0)).params
+    p = MPPIController(
+        {
+            "vx_max": 0.6,
+            "CostCritic": {"cost_weight": 2.0},
+            "GoalCritic.threshold_to_consider": 1.0,
+            "plugin": "nav2_mppi_controller::MPPIController",
+        },
+        rng=np.random.default_rng(0),
+    ).params
     assert p.vx_max == 0.6 and p.critic("CostCritic").cost_weight == 2.0
     assert p.critic("GoalCritic").threshold_to_consider == 1.0
     assert p.critic("PathFollowCritic").offset_from_furthest == 6  # Nav2's default
-    for params, words in (({"CostCritc": {"cost_weight": 1.0}}, ["CostCritc", "did you mean", "CostCritic"]),
-                          ({"batch_sise": 10}, ["batch_sise", "did you mean", "batch_size"]),
-                          ({"CostCritic": {"cost_wieght": 1.0}}, ["cost_wieght", "did you mean", "cost_weight"]),
-                          ({"critics": ["CostCritic", "GoalCritc"]}, ["GoalCritc", "did you mean", "GoalCritic"]),
-                          ({"batch_size": 0}, ["batch_size", "got 0", ">= 1"]),
-                          ({"vx_min": 1.0}, ["vx_min", "got 1.0", "vx_max"])):
+    for params, words in (
+        ({"CostCritc": {"cost_weight": 1.0}}, ["CostCritc", "did you mean", "CostCritic"]),
+        ({"batch_sise": 10}, ["batch_sise", "did you mean", "batch_size"]),
+        ({"CostCritic": {"cost_wieght": 1.0}}, ["cost_wieght", "did you mean", "cost_weight"]),
+        ({"critics": ["CostCritic", "GoalCritc"]}, ["GoalCritc", "did you mean", "GoalCritic"]),
+        ({"batch_size": 0}, ["batch_size", "got 0", ">= 1"]),
+        ({"vx_min": 1.0}, ["vx_min", "got 1.0", "vx_max"]),
+    ):
         with pytest.raises(NavigationError) as err:
             MPPIController(params, rng=np.random.default_rng(0))
         assert "\n" not in str(err.value)
@@ -473,8 +535,24 @@ def test_a_rollouts_first_failure_in_time_decides_its_code() -> None:
         traj = np.array([[[(cells[k][0] + 0.5) * res, (cells[k][1] + 0.5) * res, 0.0] for k in names]])
         out = np.empty(1)
         zeros = np.zeros(traj.shape[:2])
-        rollout_scores(grid, grid, path_dist, goal_dist, 1.0 / res, traj, zeros, zeros, np.zeros(0), np.zeros(0),
-                        False, False, np.array([1.0, 0.6, 0.8, 0.01]), float(n * n), np.array([-1]), out)
+        rollout_scores(
+            grid,
+            grid,
+            path_dist,
+            goal_dist,
+            1.0 / res,
+            traj,
+            zeros,
+            zeros,
+            np.zeros(0),
+            np.zeros(0),
+            False,
+            False,
+            np.array([1.0, 0.6, 0.8, 0.01]),
+            float(n * n),
+            np.array([-1]),
+            out,
+        )
         return float(out[0])
 
     assert score("no_path", "free", "lethal") == -2.0  # no path first (the old kernel said -1: blocked anywhere)

@@ -19,8 +19,13 @@ COMMON = {
     "robot_radius": 0.2,
     "inflation_radius": 0.55,
     "observation_sources": "laser_scan_sensor",
-    "laser_scan_sensor": {"sensor_frame": "chassis", "data_type": "LaserScan", "topic": "/mybot/laser/scan",
-                          "marking": True, "clearing": True},
+    "laser_scan_sensor": {
+        "sensor_frame": "chassis",
+        "data_type": "LaserScan",
+        "topic": "/mybot/laser/scan",
+        "marking": True,
+        "clearing": True,
+    },
 }
 
 
@@ -50,8 +55,17 @@ def test_pre_hydro_params_give_static_obstacle_inflation_and_the_map_sizes_the_g
 
 
 def test_static_map_false_and_rolling_window_for_a_local_costmap() -> None:
-    cm = LayeredCostmap({**COMMON, "global_frame": "odom", "static_map": False, "rolling_window": True,
-                         "width": 3.0, "height": 3.0, "resolution": 0.05})
+    cm = LayeredCostmap(
+        {
+            **COMMON,
+            "global_frame": "odom",
+            "static_map": False,
+            "rolling_window": True,
+            "width": 3.0,
+            "height": 3.0,
+            "resolution": 0.05,
+        }
+    )
     assert [x.name for x in cm.layers] == ["obstacle_layer", "inflation_layer"]
     assert cm.costmap.data.shape == (60, 60) and cm.costmap.frame_id == "odom"
     with pytest.raises(NavigationError, match="no static layer"):
@@ -59,8 +73,17 @@ def test_static_map_false_and_rolling_window_for_a_local_costmap() -> None:
 
 
 def test_rolling_window_keeps_world_fixed_cells() -> None:
-    cm = LayeredCostmap({"global_frame": "odom", "static_map": False, "rolling_window": True, "width": 4.0,
-                         "height": 4.0, "robot_radius": 0.1, "inflation_radius": 0.0})
+    cm = LayeredCostmap(
+        {
+            "global_frame": "odom",
+            "static_map": False,
+            "rolling_window": True,
+            "width": 4.0,
+            "height": 4.0,
+            "robot_radius": 0.1,
+            "inflation_radius": 0.0,
+        }
+    )
     cm.update_map((0.0, 0.0, 0.0))
     assert cm.costmap.origin[:2] == pytest.approx((-2.0, -2.0))
     cm.add_scan((0.0, 0.0), np.array([[1.0, 0.5], [-1.5, -1.5]]))
@@ -92,24 +115,33 @@ def test_obstacle_on_the_static_map_clears_when_it_moves_but_walls_stay() -> Non
 
 
 def test_plugins_list_ros1_and_nav2_styles() -> None:
-    ros1 = LayeredCostmap({
-        "robot_radius": 0.2,
-        "plugins": [{"name": "static", "type": "costmap_2d::StaticLayer"},
-                    {"name": "inflation", "type": "costmap_2d::InflationLayer"}],
-        "inflation": {"inflation_radius": 0.3, "cost_scaling_factor": 4.0},
-    })
+    ros1 = LayeredCostmap(
+        {
+            "robot_radius": 0.2,
+            "plugins": [
+                {"name": "static", "type": "costmap_2d::StaticLayer"},
+                {"name": "inflation", "type": "costmap_2d::InflationLayer"},
+            ],
+            "inflation": {"inflation_radius": 0.3, "cost_scaling_factor": 4.0},
+        }
+    )
     assert [x.name for x in ros1.layers] == ["static", "inflation"]
     infl = ros1.layer("inflation")
     assert isinstance(infl, InflationLayer) and infl.params.inflation_radius == 0.3
-    nav2 = LayeredCostmap({
-        "robot_radius": 0.2,
-        "plugins": ["obstacle_layer", "inflation_layer"],
-        "obstacle_layer": {"plugin": "nav2_costmap_2d::ObstacleLayer", "observation_sources": "scan",
-                           "scan": {"topic": "/scan", "obstacle_max_range": 2.0, "clearing": True}},
-        "inflation_layer.plugin": "nav2_costmap_2d::InflationLayer",
-        "inflation_layer.inflation_radius": 0.4,
-        "inflation_layer.inflate_around_unknown": True,
-    })
+    nav2 = LayeredCostmap(
+        {
+            "robot_radius": 0.2,
+            "plugins": ["obstacle_layer", "inflation_layer"],
+            "obstacle_layer": {
+                "plugin": "nav2_costmap_2d::ObstacleLayer",
+                "observation_sources": "scan",
+                "scan": {"topic": "/scan", "obstacle_max_range": 2.0, "clearing": True},
+            },
+            "inflation_layer.plugin": "nav2_costmap_2d::InflationLayer",
+            "inflation_layer.inflation_radius": 0.4,
+            "inflation_layer.inflate_around_unknown": True,
+        }
+    )
     assert [type(x) for x in nav2.layers] == [ObstacleLayer, InflationLayer]
     assert nav2.params.sources["scan"].obstacle_range == 2.0
     infl = nav2.layer("inflation_layer")
@@ -117,14 +149,37 @@ def test_plugins_list_ros1_and_nav2_styles() -> None:
 
 
 def test_the_ros_wiki_tutorial_files_load() -> None:
-    common = {"obstacle_range": 2.5, "raytrace_range": 3.0, "footprint": "[[0.2, 0.15], [0.2, -0.15], [-0.2, -0.15], "
-              "[-0.2, 0.15]]", "inflation_radius": 0.55, "map_type": "voxel", "z_voxels": 2, "origin_z": 0.0,
-              "observation_sources": "laser_scan_sensor",
-              "laser_scan_sensor": {"sensor_frame": "laser", "data_type": "LaserScan", "topic": "scan",
-                                    "marking": True, "clearing": True}}
-    local = LayeredCostmap({**common, "global_frame": "odom", "robot_base_frame": "base_link", "update_frequency": 5.0,
-                            "publish_frequency": 2.0, "static_map": False, "rolling_window": True, "width": 6.0,
-                            "height": 6.0, "resolution": 0.05})
+    common = {
+        "obstacle_range": 2.5,
+        "raytrace_range": 3.0,
+        "footprint": "[[0.2, 0.15], [0.2, -0.15], [-0.2, -0.15], [-0.2, 0.15]]",
+        "inflation_radius": 0.55,
+        "map_type": "voxel",
+        "z_voxels": 2,
+        "origin_z": 0.0,
+        "observation_sources": "laser_scan_sensor",
+        "laser_scan_sensor": {
+            "sensor_frame": "laser",
+            "data_type": "LaserScan",
+            "topic": "scan",
+            "marking": True,
+            "clearing": True,
+        },
+    }
+    local = LayeredCostmap(
+        {
+            **common,
+            "global_frame": "odom",
+            "robot_base_frame": "base_link",
+            "update_frequency": 5.0,
+            "publish_frequency": 2.0,
+            "static_map": False,
+            "rolling_window": True,
+            "width": 6.0,
+            "height": 6.0,
+            "resolution": 0.05,
+        }
+    )
     assert local.costmap.data.shape == (120, 120)
     assert local.inscribed_radius == pytest.approx(0.16)  # padded by footprint_padding 0.01
     assert local.circumscribed_radius == pytest.approx(math.hypot(0.21, 0.16))
@@ -143,18 +198,27 @@ def test_track_unknown_space_fills_unknown() -> None:
     assert _at(cm2, 2.5, -0.7) == 0
 
 
-@pytest.mark.parametrize(("params", "match"), [
-    ({"inflation_radius": -0.5}, "inflation_radius: expected >= 0, got -0.5"),
-    ({"inflation_layer": {"inflation_radius": -1.0}}, "inflation_layer parameter inflation_radius: expected >= 0"),
-    ({"inflation_raduis": 0.5}, "did you mean 'inflation_radius'"),
-    ({"inflation_layer": {"cost_scaling_factr": 3.0}}, "did you mean 'cost_scaling_factor'"),
-    ({"resolution": 0.0}, "resolution: expected > 0"),
-    ({"robot_radius": "big"}, "robot_radius: expected a number, got 'big'"),
-    ({"plugins": [{"name": "inf", "type": "costmap_2d::InflationLayr"}]}, "did you mean 'costmap_2d::InflationLayer'"),
-    ({"observation_sources": "laser"}, "names 'laser' but there is no"),
-    ({"obstacle_layer": {"combination_method": 5}}, "combination_method: expected one of 0, 1"),
-    ({"obstacle_layr": {"enabled": True}}, "unknown costmap parameter 'obstacle_layr'; did you mean 'obstacle_layer'"),
-])
+@pytest.mark.parametrize(
+    ("params", "match"),
+    [
+        ({"inflation_radius": -0.5}, "inflation_radius: expected >= 0, got -0.5"),
+        ({"inflation_layer": {"inflation_radius": -1.0}}, "inflation_layer parameter inflation_radius: expected >= 0"),
+        ({"inflation_raduis": 0.5}, "did you mean 'inflation_radius'"),
+        ({"inflation_layer": {"cost_scaling_factr": 3.0}}, "did you mean 'cost_scaling_factor'"),
+        ({"resolution": 0.0}, "resolution: expected > 0"),
+        ({"robot_radius": "big"}, "robot_radius: expected a number, got 'big'"),
+        (
+            {"plugins": [{"name": "inf", "type": "costmap_2d::InflationLayr"}]},
+            "did you mean 'costmap_2d::InflationLayer'",
+        ),
+        ({"observation_sources": "laser"}, "names 'laser' but there is no"),
+        ({"obstacle_layer": {"combination_method": 5}}, "combination_method: expected one of 0, 1"),
+        (
+            {"obstacle_layr": {"enabled": True}},
+            "unknown costmap parameter 'obstacle_layr'; did you mean 'obstacle_layer'",
+        ),
+    ],
+)
 def test_bad_parameters_get_one_line_errors(params: dict, match: str) -> None:
     with pytest.raises((NavigationError, PluginError), match=match) as info:
         LayeredCostmap(params)
@@ -170,7 +234,10 @@ def test_keys_ros_ignores_warn_and_are_dropped() -> None:
     with pytest.warns(ParameterWarning) as caught:
         cm = LayeredCostmap({**COMMON, **extra})
     assert {w.message.key for w in caught if isinstance(w.message, ParameterWarning)} == {
-        "meter_scoring", "voxel_layer", "old_key_of_2014"}
+        "meter_scoring",
+        "voxel_layer",
+        "old_key_of_2014",
+    }
     plain = LayeredCostmap(COMMON)
     assert [layer.params for layer in cm.layers] == [layer.params for layer in plain.layers]
 

@@ -148,8 +148,10 @@ def test_footprint_is_cleared_under_the_robot_and_max_combines_into_the_master()
 
 def test_inflation_costs_follow_the_costmap_2d_formula() -> None:
     inscribed, radius, factor = 0.2, 0.6, 3.0
-    layer = InflationLayer({"inflation_radius": radius, "cost_scaling_factor": factor},
-                           footprint=make_footprint(robot_radius=inscribed, footprint_padding=0.0))
+    layer = InflationLayer(
+        {"inflation_radius": radius, "cost_scaling_factor": factor},
+        footprint=make_footprint(robot_radius=inscribed, footprint_padding=0.0),
+    )
     master = _master(81, 81, (0.0, 0.0))
     master.data[40, 40] = COST_LETHAL
     layer.update_costs(master)
@@ -175,8 +177,10 @@ def test_inflation_leaves_unknown_cells_unless_inscribed() -> None:
     master.data[0, 0] = COST_LETHAL
     layer.update_costs(master)
     assert master.data[0, :4].tolist() == [COST_LETHAL, COST_INSCRIBED, COST_INSCRIBED, COST_UNKNOWN]
-    layer = InflationLayer({"inflation_radius": 0.5, "inflate_unknown": True},
-                           footprint=make_footprint(robot_radius=0.1, footprint_padding=0))
+    layer = InflationLayer(
+        {"inflation_radius": 0.5, "inflate_unknown": True},
+        footprint=make_footprint(robot_radius=0.1, footprint_padding=0),
+    )
     master = _master(30, 1, (0.0, 0.0), fill=COST_UNKNOWN)
     master.data[0, 0] = COST_LETHAL
     layer.update_costs(master)
@@ -217,11 +221,14 @@ def test_footprint_string_form_and_circle() -> None:
     assert circle.inscribed_radius == pytest.approx(0.21) and circle.circumscribed_radius == pytest.approx(0.21)
 
 
-@pytest.mark.parametrize(("value", "match"), [
-    ("[[0.2, 0.2], [0.2, -0.2]]", "at least 3 points"),
-    ("[[0.2, 0.2], [0.2, -0.2], [oops]]", "list of \\[x, y\\] points"),
-    ([[1.0, 1.0], [2.0, 1.0], [2.0, 2.0]], "centre \\(0, 0\\) must lie inside"),
-])
+@pytest.mark.parametrize(
+    ("value", "match"),
+    [
+        ("[[0.2, 0.2], [0.2, -0.2]]", "at least 3 points"),
+        ("[[0.2, 0.2], [0.2, -0.2], [oops]]", "list of \\[x, y\\] points"),
+        ([[1.0, 1.0], [2.0, 1.0], [2.0, 2.0]], "centre \\(0, 0\\) must lie inside"),
+    ],
+)
 def test_bad_footprints_are_refused(value: object, match: str) -> None:
     with pytest.raises(NavigationError, match=match):
         make_footprint(footprint=value)

@@ -14,7 +14,8 @@ ROBOT = Path(__file__).parents[1] / "fixtures" / "ros_ws" / "my_description" / "
 
 
 def test_a_turtlebot3_sized_robot_without_parameters_navigates_with_the_generic_set(
-        caplog: pytest.LogCaptureFixture) -> None:
+    caplog: pytest.LogCaptureFixture,
+) -> None:
     seen: dict[str, object] = {}
 
     def on_start(run: object) -> None:

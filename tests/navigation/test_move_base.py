@@ -21,8 +21,18 @@ from navlab.sim import primitive_model
 from navlab.world import load_world, true_map
 
 # Goals spread over room.world's free space (map frame = world frame), visited in this order.
-ROOM_GOALS = [(3.5, 3.0, 1.57), (0.5, 2.5, 3.14), (-3.5, 3.0, 3.14), (-3.5, 0.0, -1.57), (-4.0, -3.0, -1.57),
-              (-1.0, -2.5, 0.0), (2.0, -3.2, 0.0), (4.2, -1.0, 1.57), (3.0, 0.5, 3.14), (0.0, 0.0, 0.0)]
+ROOM_GOALS = [
+    (3.5, 3.0, 1.57),
+    (0.5, 2.5, 3.14),
+    (-3.5, 3.0, 3.14),
+    (-3.5, 0.0, -1.57),
+    (-4.0, -3.0, -1.57),
+    (-1.0, -2.5, 0.0),
+    (2.0, -3.2, 0.0),
+    (4.2, -1.0, 1.57),
+    (3.0, 0.5, 3.14),
+    (0.0, 0.0, 0.0),
+]
 REACHED_M = 0.25  # xy_goal_tolerance 0.15 m plus AMCL's error: the true pose's distance to the goal
 
 
@@ -47,8 +57,9 @@ def test_ten_goals_over_the_room_are_all_reached_without_collision() -> None:
 
 def test_obstacles_added_after_mapping_are_seen_and_driven_around(room_map: Path) -> None:
     """The paper's experiment: the map has no obstacles, the world has them (room_obstacles)."""
-    r = run_navigation([(4.3, 1.0, 0.0), (-3.5, -0.5, 3.14)], world="room_obstacles", map_yaml=room_map,
-                       goal_timeout=60)
+    r = run_navigation(
+        [(4.3, 1.0, 0.0), (-3.5, -0.5, 3.14)], world="room_obstacles", map_yaml=room_map, goal_timeout=60
+    )
     assert all(_ok(g) for g in r.goals), r.goals
     # the straight line to the first goal crosses the cylinder at (3.6, 0.8): the drive had to detour
     assert r.goals[0]["path_m"] > math.hypot(4.3, 1.0) + 0.2
@@ -70,11 +81,21 @@ def test_a_slow_local_costmap_lets_the_robot_hit_what_appears_in_front_of_it() -
 
     # at 7 s the robot drives forward (a 0.2 Hz local costmap is first filled at 5 s, next at 10 s); at 4 s it
     # was still backing off its empty costmap and saw the cylinder in that first update
-    slow = run_navigation([(4.0, 0.0, 0.0)], world="room", spawn=[(7.0, ahead)], goal_timeout=60,
-                          move_base_params={"local_costmap.update_frequency": 0.2, "planner_frequency": 0.0})
+    slow = run_navigation(
+        [(4.0, 0.0, 0.0)],
+        world="room",
+        spawn=[(7.0, ahead)],
+        goal_timeout=60,
+        move_base_params={"local_costmap.update_frequency": 0.2, "planner_frequency": 0.0},
+    )
     assert slow.goals[0]["collisions"] >= 1, slow.goals
-    fast = run_navigation([(4.0, 0.0, 0.0)], world="room", spawn=[(7.0, ahead)], goal_timeout=60,
-                          move_base_params={"local_costmap.update_frequency": 5.0, "planner_frequency": 0.0})
+    fast = run_navigation(
+        [(4.0, 0.0, 0.0)],
+        world="room",
+        spawn=[(7.0, ahead)],
+        goal_timeout=60,
+        move_base_params={"local_costmap.update_frequency": 5.0, "planner_frequency": 0.0},
+    )
     assert fast.goals[0]["collisions"] == 0, fast.goals
 
 
@@ -92,8 +113,8 @@ def test_a_walled_off_goal_runs_the_recoveries_then_aborts(tmp_path: Path) -> No
     grid = true_map(load_world("room"), (0.0, 0.0))
     ring = grid.world_to_cell(np.array([[1.4, -0.6], [2.6, 0.6]]))  # a closed square wall around (2, 0)
     (i0, j0), (i1, j1) = ring
-    grid.data[j0:j1 + 1, [i0, i1]] = 100
-    grid.data[[j0, j1], i0:i1 + 1] = 100
+    grid.data[j0 : j1 + 1, [i0, i1]] = 100
+    grid.data[[j0, j1], i0 : i1 + 1] = 100
     save_map(grid, tmp_path / "walled.yaml")
     r = run_navigation([(2.0, 0.0, 0.0)], world="room", map_yaml=tmp_path / "walled.yaml", goal_timeout=120)
     g = r.goals[0]
@@ -105,16 +126,27 @@ def test_a_boxed_in_robot_tries_every_recovery_then_aborts() -> None:
     from navlab.experiments.session import start_run
 
     run = start_run("navigation", world="room", map=str(_room_true_map()))
-    for k, (x, y, size) in enumerate([(0.6, 0.0, (0.1, 1.4, 0.5)), (-0.6, 0.0, (0.1, 1.4, 0.5)),
-                                      (0.0, 0.6, (1.4, 0.1, 0.5)), (0.0, -0.6, (1.4, 0.1, 0.5))]):  # fmt: skip
+    for k, (x, y, size) in enumerate(
+        [
+            (0.6, 0.0, (0.1, 1.4, 0.5)),
+            (-0.6, 0.0, (0.1, 1.4, 0.5)),
+            (0.0, 0.6, (1.4, 0.1, 0.5)),
+            (0.0, -0.6, (1.4, 0.1, 0.5)),
+        ]
+    ):
         run.gazebo.spawn(primitive_model("box", f"box{k}", size, x=x, y=y))
     run.run(1.0)
     mb = run.node("move_base")
     handle = mb.send_goal(3.0, 0.0, 0.0)  # type: ignore[attr-defined]
     run.run(120.0, until=handle.done)
     assert handle.state == "ABORTED" and "Even after executing recovery behaviors" in handle.reason
-    assert mb.recovery_log == ["conservative_reset", "rotate_recovery", "aggressive_reset",  # type: ignore[attr-defined]
-                               "rotate_recovery", "back_up"]
+    assert mb.recovery_log == [
+        "conservative_reset",
+        "rotate_recovery",
+        "aggressive_reset",  # type: ignore[attr-defined]
+        "rotate_recovery",
+        "back_up",
+    ]
     bumper = next(p for p in run.gazebo.plugins if type(p).__name__ == "CollisionPlugin")  # type: ignore[attr-defined]
     assert bumper.collisions == 0
 
@@ -139,8 +171,10 @@ def test_navigate_cli_prints_json_and_pictures(tmp_path: Path, capsys: pytest.Ca
 def test_bad_parameters_get_one_line_errors(capsys: pytest.CaptureFixture[str]) -> None:
     with pytest.raises(NavlabError, match="did you mean 'navfn/NavfnROS'"):
         run_navigation([(1.0, 0.0, 0.0)], world="room", move_base_params={"base_global_planner": "navfn/NavFnROS"})
-    assert main(["navigate", "--world", "room", "--goal", "1", "0", "0",
-                 "--set", "local_costmap.inflation_radius=-0.5"]) == 2
+    assert (
+        main(["navigate", "--world", "room", "--goal", "1", "0", "0", "--set", "local_costmap.inflation_radius=-0.5"])
+        == 2
+    )
     err = capsys.readouterr().err.strip()
     assert "inflation_radius" in err and len(err.splitlines()) == 1
 
@@ -160,8 +194,14 @@ def test_a_robot_with_a_polygon_footprint_navigates_with_its_own_parameter_files
     """The Jackal-sized robot: box footprint, another base frame (base_link) and scan topic (front/scan)."""
     from navlab import resources
 
-    r = run_navigation([(3.0, 0.5, 0.0), (-3.0, -0.5, 3.14)], world="room", robot="jackal",
-                       params_dir=resources.root() / "params" / "jackal", controller="mppi", goal_timeout=60)
+    r = run_navigation(
+        [(3.0, 0.5, 0.0), (-3.0, -0.5, 3.14)],
+        world="room",
+        robot="jackal",
+        params_dir=resources.root() / "params" / "jackal",
+        controller="mppi",
+        goal_timeout=60,
+    )
     assert all(_ok(g) for g in r.goals), r.goals
 
 
@@ -173,20 +213,31 @@ def test_move_base_publishes_costmaps_plans_and_status_as_ros_does() -> None:
     run = start_run("navigation", world="room_obstacles", map=str(_room_true_map()))
     got: dict[str, list] = {}
     listener = run.add(Node, name="listener")
-    for topic, kind in [("/move_base/global_costmap/costmap", msgs.OccupancyGrid),
-                        ("/move_base/local_costmap/costmap", msgs.OccupancyGrid),
-                        ("/move_base/local_costmap/footprint", msgs.PolygonStamped),
-                        ("/move_base/NavfnROS/plan", msgs.Path),
-                        ("/move_base/TrajectoryPlannerROS/local_plan", msgs.Path),
-                        ("/move_base/status", msgs.GoalStatusArray), ("/cmd_vel", msgs.Twist)]:  # fmt: skip
+    for topic, kind in [
+        ("/move_base/global_costmap/costmap", msgs.OccupancyGrid),
+        ("/move_base/local_costmap/costmap", msgs.OccupancyGrid),
+        ("/move_base/local_costmap/footprint", msgs.PolygonStamped),
+        ("/move_base/NavfnROS/plan", msgs.Path),
+        ("/move_base/TrajectoryPlannerROS/local_plan", msgs.Path),
+        ("/move_base/status", msgs.GoalStatusArray),
+        ("/cmd_vel", msgs.Twist),
+    ]:
         listener.create_subscription(kind, topic, lambda m, t=topic: got.setdefault(t, []).append(m))
     run.run(1.0)
     goal = msgs.pose_stamped(run.executor.now_ns, "map", 4.3, 1.0, 0.0)
     listener.create_publisher(msgs.PoseStamped, "/move_base_simple/goal").publish(goal)  # rviz's 2D Nav Goal
     run.run(4.0)
-    assert all(got.get(t) for t in ["/move_base/global_costmap/costmap", "/move_base/local_costmap/costmap",
-                                    "/move_base/local_costmap/footprint", "/move_base/NavfnROS/plan",
-                                    "/move_base/TrajectoryPlannerROS/local_plan", "/cmd_vel"]), sorted(got)
+    assert all(
+        got.get(t)
+        for t in [
+            "/move_base/global_costmap/costmap",
+            "/move_base/local_costmap/costmap",
+            "/move_base/local_costmap/footprint",
+            "/move_base/NavfnROS/plan",
+            "/move_base/TrajectoryPlannerROS/local_plan",
+            "/cmd_vel",
+        ]
+    ), sorted(got)
     local = got["/move_base/local_costmap/costmap"][-1]
     assert local.header.frame_id == "odom" and local.info.width == 80  # a 4 m rolling window at 5 cm
     assert set(np.unique(local.data)) <= set(range(-1, 101))  # costmap_2d's translation to 0..100, -1
@@ -196,7 +247,8 @@ def test_move_base_publishes_costmaps_plans_and_status_as_ros_does() -> None:
 
 
 def test_a_key_ros_ignores_warns_naming_the_file_and_a_typo_still_fails(
-        tmp_path: Path, caplog: pytest.LogCaptureFixture) -> None:
+    tmp_path: Path, caplog: pytest.LogCaptureFixture
+) -> None:
     """ROS reads what it knows and ignores the rest of a namespace: ``meter_scoring`` (TrajectoryPlannerROS's)
     in costmap_common_params.yaml loads with a warning naming key and file; a misspelt known key is refused."""
     import shutil

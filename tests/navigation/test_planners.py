@@ -176,15 +176,18 @@ def test_plugin_names_and_nav2_spellings() -> None:
     assert isinstance(make_planner("nav2_theta_star_planner/ThetaStarPlanner"), ThetaStarPlanner)
 
 
-@pytest.mark.parametrize(("make", "match"), [
-    (lambda: make_planner("navfn/NavfnRos"), "did you mean 'navfn/NavfnROS'"),
-    (lambda: NavfnPlanner({"default_tolerance": -1.0}), "default_tolerance: expected >= 0.0, got -1.0"),
-    (lambda: NavfnPlanner({"allow_unknwn": False}), "did you mean 'allow_unknown'"),
-    (lambda: NavfnPlanner({"allow_unknown": "no"}), "allow_unknown: expected true or false, got 'no'"),
-    (lambda: ThetaStarPlanner({"how_many_corners": 6}), "how_many_corners: expected 4 or 8, got 6"),
-    (lambda: ThetaStarPlanner({"w_traversal_cost": -2.0}), "w_traversal_cost: expected >= 0"),
-    (lambda: GlobalPlanner({"use_grid_path": True}), "use_grid_path: only false"),
-])
+@pytest.mark.parametrize(
+    ("make", "match"),
+    [
+        (lambda: make_planner("navfn/NavfnRos"), "did you mean 'navfn/NavfnROS'"),
+        (lambda: NavfnPlanner({"default_tolerance": -1.0}), "default_tolerance: expected >= 0.0, got -1.0"),
+        (lambda: NavfnPlanner({"allow_unknwn": False}), "did you mean 'allow_unknown'"),
+        (lambda: NavfnPlanner({"allow_unknown": "no"}), "allow_unknown: expected true or false, got 'no'"),
+        (lambda: ThetaStarPlanner({"how_many_corners": 6}), "how_many_corners: expected 4 or 8, got 6"),
+        (lambda: ThetaStarPlanner({"w_traversal_cost": -2.0}), "w_traversal_cost: expected >= 0"),
+        (lambda: GlobalPlanner({"use_grid_path": True}), "use_grid_path: only false"),
+    ],
+)
 def test_bad_parameters_get_one_line_errors(make, match: str) -> None:  # type: ignore[no-untyped-def]
     with pytest.raises((NavigationError, PluginError), match=match) as info:
         make()

@@ -40,10 +40,12 @@ def test_a_goal_settles_within_tolerance_and_a_crawling_robot_is_reported_stuck(
     assert g["outcome"] == "succeeded" and g["final_error_m"] <= g["goal_tolerance_m"]
     assert g["near_goal_m"] <= g["final_error_m"] + 1e-9
     assert not g["near_miss"] and g["time_under_safety_s"] == 0.0 and g["min_clearance_m"] > 0.1
-    crawl = {"MPPIController.vx_max": 0.02, "progress_checker.movement_time_allowance": 2.0,
-             "recovery_behaviors": [{"name": "back_up", "type": "nav2_behaviors/BackUp"}]}
-    r = run_navigation([(2.0, 0.0, 0.0)], world="room", controller="mppi", goal_timeout=30,
-                       move_base_params=crawl)  # fmt: skip
+    crawl = {
+        "MPPIController.vx_max": 0.02,
+        "progress_checker.movement_time_allowance": 2.0,
+        "recovery_behaviors": [{"name": "back_up", "type": "nav2_behaviors/BackUp"}],
+    }
+    r = run_navigation([(2.0, 0.0, 0.0)], world="room", controller="mppi", goal_timeout=30, move_base_params=crawl)
     g = r.goals[0]
     assert g["outcome"] == "stuck" and g["move_base_outcome"] == "aborted", g
     assert g["reason"].startswith("stuck") and g["time_s"] < 15.0

@@ -27,8 +27,11 @@ def _cell(g: Grid, x: float, y: float) -> int:
 
 def _voxel(**src: float) -> VoxelLayer:
     source = ObservationSource(data_type="PointCloud2", marking=True, clearing=True, **src)
-    layer = VoxelLayer({"z_resolution": 0.1, "z_voxels": 10, "track_unknown_space": True}, name="obstacle_layer",
-                       sources={"cloud": source})
+    layer = VoxelLayer(
+        {"z_resolution": 0.1, "z_voxels": 10, "track_unknown_space": True},
+        name="obstacle_layer",
+        sources={"cloud": source},
+    )
     layer.match_size(_master())
     return layer
 
@@ -52,12 +55,27 @@ def test_voxel_layer_marks_in_3d_and_keeps_a_low_box_under_a_clearing_ray() -> N
 
 
 def test_voxel_layer_from_costmap_params_and_into_the_master() -> None:
-    params = {"global_frame": "odom", "robot_base_frame": "base", "static_map": False, "rolling_window": True,
-              "width": 6.0, "height": 6.0, "resolution": 0.1, "robot_radius": 0.2,
-              "plugins": [{"name": "obstacle_layer", "type": "costmap_2d::VoxelLayer"},
-                          {"name": "inflation_layer", "type": "costmap_2d::InflationLayer"}],
-              "obstacle_layer": {"observation_sources": "cam", "z_voxels": 16, "origin_z": 0.0, "z_resolution": 0.05,
-                                 "cam": {"data_type": "PointCloud2", "topic": "points", "clearing": True}}}
+    params = {
+        "global_frame": "odom",
+        "robot_base_frame": "base",
+        "static_map": False,
+        "rolling_window": True,
+        "width": 6.0,
+        "height": 6.0,
+        "resolution": 0.1,
+        "robot_radius": 0.2,
+        "plugins": [
+            {"name": "obstacle_layer", "type": "costmap_2d::VoxelLayer"},
+            {"name": "inflation_layer", "type": "costmap_2d::InflationLayer"},
+        ],
+        "obstacle_layer": {
+            "observation_sources": "cam",
+            "z_voxels": 16,
+            "origin_z": 0.0,
+            "z_resolution": 0.05,
+            "cam": {"data_type": "PointCloud2", "topic": "points", "clearing": True},
+        },
+    }
     layered = LayeredCostmap(params)
     voxel = layered.layer("obstacle_layer")
     assert isinstance(voxel, VoxelLayer) and voxel.params.z_voxels == 16 and voxel.z_top == pytest.approx(0.8)
@@ -89,10 +107,27 @@ def test_range_sensor_layer_marks_the_reading_and_clears_short_of_it() -> None:
 
 
 def test_pointcloud_to_laserscan_keeps_the_nearest_point_per_bin_between_heights() -> None:
-    pts = np.array([[1.0, 0.0, 0.2], [0.5, 0.0, 0.2], [0.3, 0.0, 2.0],  # same bin: nearest in band wins
-                    [0.0, 2.0, 0.1], [np.nan, 0.0, 0.1], [-1.0, 0.0, -0.5]])
-    r = flatten(pts, angle_min=-math.pi, angle_max=math.pi, angle_increment=math.pi / 180, min_height=0.0,
-                max_height=1.0, range_min=0.0, range_max=10.0, fill=math.inf)
+    pts = np.array(
+        [
+            [1.0, 0.0, 0.2],
+            [0.5, 0.0, 0.2],
+            [0.3, 0.0, 2.0],  # same bin: nearest in band wins
+            [0.0, 2.0, 0.1],
+            [np.nan, 0.0, 0.1],
+            [-1.0, 0.0, -0.5],
+        ]
+    )
+    r = flatten(
+        pts,
+        angle_min=-math.pi,
+        angle_max=math.pi,
+        angle_increment=math.pi / 180,
+        min_height=0.0,
+        max_height=1.0,
+        range_min=0.0,
+        range_max=10.0,
+        fill=math.inf,
+    )
     assert len(r) == 360
     assert r[180] == pytest.approx(0.5)  # angle 0
     assert r[270] == pytest.approx(2.0)  # angle pi/2
@@ -115,14 +150,21 @@ def test_layers_build_from_params_with_a_context() -> None:
 
     from navlab.navigation.costmap.params import costmap_params
 
-    costmap = costmap_params({"static_map": False, "observation_sources": "cam",
-                              "cam": {"data_type": "PointCloud2", "topic": "points"}})
+    costmap = costmap_params(
+        {"static_map": False, "observation_sources": "cam", "cam": {"data_type": "PointCloud2", "topic": "points"}}
+    )
     ctx = SimpleNamespace(name="voxels", costmap=costmap, footprint=None)
     voxel = VoxelLayer.from_params({"z_voxels": 4, "origin_z": -0.1}, context=ctx)
-    assert (voxel.name, voxel.params.z_voxels, voxel.params.origin_z, list(voxel.sources)) == ("voxels", 4, -0.1,
-                                                                                              ["cam"])
-    sonar = RangeSensorLayer.from_params({"topics": ["/sonar_left", "/sonar_right"], "phi": 1.0},
-                                         context=SimpleNamespace(name="sonar", costmap=costmap, footprint=None))
+    assert (voxel.name, voxel.params.z_voxels, voxel.params.origin_z, list(voxel.sources)) == (
+        "voxels",
+        4,
+        -0.1,
+        ["cam"],
+    )
+    sonar = RangeSensorLayer.from_params(
+        {"topics": ["/sonar_left", "/sonar_right"], "phi": 1.0},
+        context=SimpleNamespace(name="sonar", costmap=costmap, footprint=None),
+    )
     assert sonar.topics == ["/sonar_left", "/sonar_right"] and sonar.params.phi == 1.0
     with pytest.raises(NavigationError, match="clear_threshold"):
         RangeSensorLayer.from_params({"clear_threshold": 0.9}, context=ctx)
@@ -143,14 +185,24 @@ def test_pointcloud_to_laserscan_node_publishes_a_scan_in_the_target_frame() -> 
 
     ex = Executor(seed=0)
     # the cloud's frame 'cam' sits 0.5 m ahead of base_link, turned 90 degrees left
-    ex.tf.set_transform("base_link", "cam", 0, (0.5, 0.0, 0.0, 0.0, 0.0, math.sin(math.pi / 4), math.cos(math.pi / 4)),
-                        static=True)
-    PointCloudToLaserScan(ex, parameters={"target_frame": "base_link", "min_height": -0.1, "max_height": 0.1,
-                                          "use_inf": False, "range_max": 10.0})
+    ex.tf.set_transform(
+        "base_link", "cam", 0, (0.5, 0.0, 0.0, 0.0, 0.0, math.sin(math.pi / 4), math.cos(math.pi / 4)), static=True
+    )
+    PointCloudToLaserScan(
+        ex,
+        parameters={
+            "target_frame": "base_link",
+            "min_height": -0.1,
+            "max_height": 0.1,
+            "use_inf": False,
+            "range_max": 10.0,
+        },
+    )
     probe = Probe(ex)
     pts = np.array([[1.0, 0.0, 0.0], [1.0, 0.0, 1.0]], np.float32)  # 1 m ahead of cam: (0.5, 1.0) in base_link
-    probe.pub.publish(pack_cloud(0, "cam", {"x": (0, FLOAT32, pts[:, 0]), "y": (4, FLOAT32, pts[:, 1]),
-                                            "z": (8, FLOAT32, pts[:, 2])}))
+    probe.pub.publish(
+        pack_cloud(0, "cam", {"x": (0, FLOAT32, pts[:, 0]), "y": (4, FLOAT32, pts[:, 1]), "z": (8, FLOAT32, pts[:, 2])})
+    )
     ex.run(0.01)
     (scan,) = probe.scans
     r = np.asarray(scan.ranges)

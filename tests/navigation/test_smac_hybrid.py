@@ -24,15 +24,16 @@ def wall_with_gap(gap: float = 0.5) -> Grid:
     n = round(6.0 / RES)
     data = np.zeros((n, n), np.uint8)
     y = -3.0 + (np.arange(n) + 0.5) * RES
-    data[np.abs(y) > gap / 2, n // 2 - 5: n // 2 + 5] = COST_LETHAL
+    data[np.abs(y) > gap / 2, n // 2 - 5 : n // 2 + 5] = COST_LETHAL
     return Grid(data, RES, (-3.0, -3.0, 0.0), "odom")
 
 
 def footprint_free(grid: Grid, path: np.ndarray, footprint: list[list[float]]) -> bool:
     """Every pose of ``path`` keeps the footprint's filled polygon off lethal cells."""
     poly = np.asarray(footprint)
-    xs, ys = np.meshgrid(np.linspace(poly[:, 0].min(), poly[:, 0].max(), 13),
-                         np.linspace(poly[:, 1].min(), poly[:, 1].max(), 7))  # fmt: skip
+    xs, ys = np.meshgrid(
+        np.linspace(poly[:, 0].min(), poly[:, 0].max(), 13), np.linspace(poly[:, 1].min(), poly[:, 1].max(), 7)
+    )
     body = np.column_stack([xs.ravel(), ys.ravel()])
     for x, y, th in path:
         c, s = math.cos(th), math.sin(th)
@@ -72,8 +73,13 @@ def test_through_a_gap_narrower_than_the_robots_outer_circle() -> None:
     the straight line from start to goal would scrape the wall."""
     grid = wall_with_gap(0.5)
     start, goal = (-1.5, 1.0, 0.0), (1.5, -1.0, 0.0)
-    line = np.column_stack([np.linspace(start[0], goal[0], 60), np.linspace(start[1], goal[1], 60),
-                            np.full(60, math.atan2(goal[1] - start[1], goal[0] - start[0]))])  # fmt: skip
+    line = np.column_stack(
+        [
+            np.linspace(start[0], goal[0], 60),
+            np.linspace(start[1], goal[1], 60),
+            np.full(60, math.atan2(goal[1] - start[1], goal[0] - start[0])),
+        ]
+    )
     assert not footprint_free(grid, line, LONG)
     outer = ndimage.binary_dilation(grid.data == COST_LETHAL, iterations=round(0.335 / RES))
     round_robot = Grid(np.where(outer, COST_LETHAL, 0).astype(np.uint8), RES, grid.origin, grid.frame_id)

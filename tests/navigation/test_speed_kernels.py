@@ -62,8 +62,12 @@ def test_incremental_and_rolling_inflation_equals_a_fresh_layer() -> None:
 def test_round_footprint_cells_are_the_centres_within_the_radius() -> None:
     rng = np.random.default_rng(1)
     for _ in range(200):
-        grid = Grid(np.zeros((int(rng.integers(3, 40)), int(rng.integers(3, 40))), np.uint8), RES,
-                    (float(rng.uniform(-1, 1)), float(rng.uniform(-1, 1)), 0.0), "map")  # fmt: skip
+        grid = Grid(
+            np.zeros((int(rng.integers(3, 40)), int(rng.integers(3, 40))), np.uint8),
+            RES,
+            (float(rng.uniform(-1, 1)), float(rng.uniform(-1, 1)), 0.0),
+            "map",
+        )
         radius = float(rng.uniform(0.01, 0.4))
         x = grid.origin[0] + float(rng.uniform(-0.3, grid.width * RES + 0.3))
         y = grid.origin[1] + float(rng.uniform(-0.3, grid.height * RES + 0.3))
@@ -72,7 +76,8 @@ def test_round_footprint_cells_are_the_centres_within_the_radius() -> None:
         centres = grid.cell_to_world(np.stack([ii.ravel(), jj.ravel()], axis=1))
         inside = np.hypot(centres[:, 0] - x, centres[:, 1] - y) <= radius
         inside |= (ii.ravel() == math.floor((x - grid.origin[0]) / RES)) & (
-            jj.ravel() == math.floor((y - grid.origin[1]) / RES))  # fmt: skip
+            jj.ravel() == math.floor((y - grid.origin[1]) / RES)
+        )
         expected = np.stack([ii.ravel(), jj.ravel()], axis=1)[inside]
         assert sorted(map(tuple, cells.tolist())) == sorted(map(tuple, expected.tolist()))
 

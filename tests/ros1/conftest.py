@@ -23,12 +23,18 @@ def ros_env(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, str]
     for tool in TOOLS:
         require(tool)
     port = free_port()
-    env = {**os.environ, "ROS_MASTER_URI": f"http://127.0.0.1:{port}/", "ROS_IP": "127.0.0.1",
-           "ROS_HOME": str(tmp_path_factory.mktemp("ros_home")), "PYTHONPATH": ""}
+    env = {
+        **os.environ,
+        "ROS_MASTER_URI": f"http://127.0.0.1:{port}/",
+        "ROS_IP": "127.0.0.1",
+        "ROS_HOME": str(tmp_path_factory.mktemp("ros_home")),
+        "PYTHONPATH": "",
+    }
     env.pop("VIRTUAL_ENV", None)
     env["PATH"] = "/usr/bin:/bin"
-    master = subprocess.Popen([require("rosmaster"), "--core", "-p", str(port)], env=env,
-                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    master = subprocess.Popen(
+        [require("rosmaster"), "--core", "-p", str(port)], env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL
+    )
     deadline = time.monotonic() + 10
     while time.monotonic() < deadline:
         with socket.socket() as s:

@@ -16,9 +16,16 @@ import pytest
 from navlab.ros1.live import LiveRun
 
 SYSTEM_PYTHON = "/usr/bin/python3"
-TOOLS = {"Xvfb": "xvfb", "rviz": "rviz", "rosmaster": "python3-rosmaster", "rostopic": "python3-rostopic",
-         "rosbag": "python3-rosbag", "rosservice": "python3-rosservice", "rosparam": "python3-rosparam",
-         "rosnode": "python3-rosnode"}
+TOOLS = {
+    "Xvfb": "xvfb",
+    "rviz": "rviz",
+    "rosmaster": "python3-rosmaster",
+    "rostopic": "python3-rostopic",
+    "rosbag": "python3-rosbag",
+    "rosservice": "python3-rosservice",
+    "rosparam": "python3-rosparam",
+    "rosnode": "python3-rosnode",
+}
 
 
 def require(tool: str) -> str:
@@ -51,7 +58,9 @@ def rospy(env: dict[str, str], code: str, timeout: float = 60.0) -> str:
 def send_move_base_goal(env: dict[str, str], x: float, y: float, timeout: float = 60.0) -> int:
     """A rospy ``SimpleActionClient('move_base', MoveBaseAction)`` sends (x, y) in map; the final goal state
     (actionlib_msgs/GoalStatus: 3 is SUCCEEDED)."""
-    out = rospy(env, f"""
+    out = rospy(
+        env,
+        f"""
 import rospy, actionlib
 from move_base_msgs.msg import MoveBaseAction, MoveBaseGoal
 rospy.init_node('goal_sender', anonymous=True)
@@ -65,7 +74,9 @@ goal.target_pose.pose.orientation.w = 1.0
 client.send_goal(goal)
 client.wait_for_result(rospy.Duration({timeout}))
 print(client.get_state())
-""", timeout=timeout + 30)
+""",
+        timeout=timeout + 30,
+    )
     return int(out.strip())
 
 
@@ -90,9 +101,21 @@ class Screen:
     def __init__(self, folder: Path, width: int = 800, height: int = 600) -> None:
         self.folder = folder
         self.display = f":{free_port() % 500 + 100}"
-        self.proc = subprocess.Popen([require("Xvfb"), self.display, "-screen", "0", f"{width}x{height}x24",
-                                      "-fbdir", str(folder), "-nolisten", "tcp"],
-                                     stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        self.proc = subprocess.Popen(
+            [
+                require("Xvfb"),
+                self.display,
+                "-screen",
+                "0",
+                f"{width}x{height}x24",
+                "-fbdir",
+                str(folder),
+                "-nolisten",
+                "tcp",
+            ],
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+        )
         deadline = time.monotonic() + 10
         while not (folder / "Xvfb_screen0").exists() and time.monotonic() < deadline:
             time.sleep(0.1)

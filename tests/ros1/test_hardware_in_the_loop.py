@@ -21,9 +21,21 @@ from navlab.ros1.live import LiveRun
 @pytest.fixture(scope="module")
 def robot(ros_env: dict[str, str]) -> Iterator[subprocess.Popen[bytes]]:
     """The "real robot": a navlab simulation alone, on the wire (real time)."""
-    proc = subprocess.Popen([str(Path(sys.executable).parent / "navlab"), "launch", "sim", "ros:=true", "world:=room",
-                             "--duration", "300", "--quiet"], env=ros_env, stdout=subprocess.DEVNULL,
-                            stderr=subprocess.DEVNULL)
+    proc = subprocess.Popen(
+        [
+            str(Path(sys.executable).parent / "navlab"),
+            "launch",
+            "sim",
+            "ros:=true",
+            "world:=room",
+            "--duration",
+            "300",
+            "--quiet",
+        ],
+        env=ros_env,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
     ros(ros_env, "rostopic", "echo", "-n", "1", "/odom/header/stamp", timeout=60)  # it is up
     try:
         yield proc
@@ -46,9 +58,24 @@ def recording(ros_env: dict[str, str], tmp_path_factory: pytest.TempPathFactory)
     """What the robot sends while the first test drives it: a ROS 1 bag with /clock, for `rosbag play`
     (call the fixture's value to wait for the bag to be closed)."""
     bag = tmp_path_factory.mktemp("bag") / "robot.bag"
-    rec = subprocess.Popen([require("rosbag"), "record", "-O", str(bag), "--duration=10", "/clock", "/tf",
-                            "/tf_static", "/odom", "/mybot/laser/scan", "/ground_truth/odom"], env=ros_env,
-                           stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    rec = subprocess.Popen(
+        [
+            require("rosbag"),
+            "record",
+            "-O",
+            str(bag),
+            "--duration=10",
+            "/clock",
+            "/tf",
+            "/tf_static",
+            "/odom",
+            "/mybot/laser/scan",
+            "/ground_truth/odom",
+        ],
+        env=ros_env,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
     time.sleep(2.0)  # subscribed before the goal is sent
 
     def finished() -> Path:
@@ -59,39 +86,63 @@ def recording(ros_env: dict[str, str], tmp_path_factory: pytest.TempPathFactory)
     rec.wait(30)
 
 
-def test_move_base_drives_the_robot_of_another_process_to_the_goal(hil: LiveRun, ros_env: dict[str, str],
-                                                                  recording: Callable[[], Path]) -> None:
+def test_move_base_drives_the_robot_of_another_process_to_the_goal(
+    hil: LiveRun, ros_env: dict[str, str], recording: Callable[[], Path]
+) -> None:
     assert "/gazebo" not in hil.ex.nodes  # no simulator in this run
     assert send_move_base_goal(ros_env, 1.5, 0.0, timeout=90) == 3  # SUCCEEDED
-    truth = yaml.safe_load(ros(ros_env, "rostopic", "echo", "-n", "1", "/ground_truth/odom/pose/pose/position")
-                           .split("---")[0])
+    truth = yaml.safe_load(
+        ros(ros_env, "rostopic", "echo", "-n", "1", "/ground_truth/odom/pose/pose/position").split("---")[0]
+    )
     assert math.hypot(truth["x"] - 1.5, truth["y"]) < 0.3  # where the robot really is, in its own process
 
 
-def test_amcl_localizes_on_a_rosbag_play_of_the_robot(recording: Callable[[], Path], room_map: Path,
-                                                      ros_env: dict[str, str], tmp_path: Path) -> None:
+def test_amcl_localizes_on_a_rosbag_play_of_the_robot(
+    recording: Callable[[], Path], room_map: Path, ros_env: dict[str, str], tmp_path: Path
+) -> None:
     """The recording of the drive above (its map -> odom left out), played by `rosbag play` on a fresh master to
     map_server + amcl (``localization sim:=false``): amcl ends where the recorded ground truth ends."""
     from rosbags.highlevel import AnyReader
 
     filtered = tmp_path / "robot_only.bag"  # the robot's topics, without the navigation run's map -> odom
-    ros(ros_env, "rosbag", "filter", str(recording()), str(filtered),
-        "topic != '/tf' or m.transforms[0].child_frame_id != 'odom'", timeout=60)
+    ros(
+        ros_env,
+        "rosbag",
+        "filter",
+        str(recording()),
+        str(filtered),
+        "topic != '/tf' or m.transforms[0].child_frame_id != 'odom'",
+        timeout=60,
+    )
     with AnyReader([filtered]) as reader:
-        truth = [reader.deserialize(raw, c.msgtype) for c, _, raw in reader.messages(
-            [c for c in reader.connections if c.topic == "/ground_truth/odom"])]
+        truth = [
+            reader.deserialize(raw, c.msgtype)
+            for c, _, raw in reader.messages([c for c in reader.connections if c.topic == "/ground_truth/odom"])
+        ]
     end = truth[-1].pose.pose.position
     port = free_port()
     env = {**ros_env, "ROS_MASTER_URI": f"http://127.0.0.1:{port}/"}
-    master = subprocess.Popen([require("rosmaster"), "--core", "-p", str(port)], env=env,
-                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    master = subprocess.Popen(
+        [require("rosmaster"), "--core", "-p", str(port)], env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL
+    )
     try:
         time.sleep(1.5)
         start = truth[0].pose.pose.position
-        play = subprocess.Popen([require("rosbag"), "play", "--delay=3", str(filtered)], env=env,
-                                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-        run = LiveRun("localization", master=env["ROS_MASTER_URI"], follow_clock=True, map=str(room_map),
-                      sim="false", x=str(start.x), y=str(start.y))
+        play = subprocess.Popen(
+            [require("rosbag"), "play", "--delay=3", str(filtered)],
+            env=env,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+        )
+        run = LiveRun(
+            "localization",
+            master=env["ROS_MASTER_URI"],
+            follow_clock=True,
+            map=str(room_map),
+            sim="false",
+            x=str(start.x),
+            y=str(start.y),
+        )
         try:
             play.wait(60)
             time.sleep(1.0)  # the bag's clock has stopped, and with it the run: its tf can be read from here

@@ -28,10 +28,21 @@ def nav(ros_env: dict[str, str], room_map: Path) -> Iterator[LiveRun]:
 
 
 def test_rostopic_lists_the_runs_topics_with_ros1_types_and_hz_holds_the_scan_rate(
-        nav: LiveRun, ros_env: dict[str, str]) -> None:
+    nav: LiveRun, ros_env: dict[str, str]
+) -> None:
     listed = ros(ros_env, "rostopic", "list").split()
-    for topic in ("/mybot/laser/scan", "/odom", "/tf", "/tf_static", "/map", "/clock", "/cmd_vel",
-                  "/move_base/goal", "/move_base/status", "/amcl_pose"):
+    for topic in (
+        "/mybot/laser/scan",
+        "/odom",
+        "/tf",
+        "/tf_static",
+        "/map",
+        "/clock",
+        "/cmd_vel",
+        "/move_base/goal",
+        "/move_base/status",
+        "/amcl_pose",
+    ):
         assert topic in listed
     assert ros(ros_env, "rostopic", "type", "/odom").strip() == "nav_msgs/Odometry"
     assert ros(ros_env, "rostopic", "type", "/tf").strip() == "tf2_msgs/TFMessage"
@@ -54,13 +65,16 @@ def test_parameters_and_robot_description_are_on_the_parameter_server(nav: LiveR
 
 
 def test_tf2_looks_up_map_to_chassis_as_navlab_does(nav: LiveRun, ros_env: dict[str, str]) -> None:
-    out = rospy(ros_env, """
+    out = rospy(
+        ros_env,
+        """
 import rospy, tf2_ros
 rospy.init_node('tf_probe')
 buf = tf2_ros.Buffer(); tf2_ros.TransformListener(buf)
 t = buf.lookup_transform('map', 'chassis', rospy.Time(0), rospy.Duration(10)).transform.translation
 print(t.x, t.y)
-""")
+""",
+    )
     x, y = map(float, out.split())
     nx, ny, _ = nav.call(lambda: nav.ex.tf.lookup_pose2d("map", "chassis", None))
     assert abs(x - nx) < 0.05 and abs(y - ny) < 0.05
@@ -69,7 +83,9 @@ print(t.x, t.y)
 def test_services_clear_costmaps_static_map_and_make_plan(nav: LiveRun, ros_env: dict[str, str]) -> None:
     ros(ros_env, "rosservice", "call", "/move_base/clear_costmaps")
     assert ros(ros_env, "rosservice", "type", "/static_map").strip() == "nav_msgs/GetMap"
-    out = rospy(ros_env, """
+    out = rospy(
+        ros_env,
+        """
 import rospy
 from nav_msgs.srv import GetMap, GetPlan
 from geometry_msgs.msg import PoseStamped
@@ -79,20 +95,24 @@ m = rospy.ServiceProxy('/static_map', GetMap)().map
 goal = PoseStamped(); goal.header.frame_id = 'map'; goal.pose.position.x = 2.0; goal.pose.orientation.w = 1.0
 plan = rospy.ServiceProxy('/move_base/make_plan', GetPlan)(start=PoseStamped(), goal=goal, tolerance=0.0).plan
 print(m.info.width, len(plan.poses), plan.poses[-1].pose.position.x)
-""")
+""",
+    )
     width, n, last_x = out.split()
     assert int(width) > 0 and int(n) > 5 and abs(float(last_x) - 2.0) < 0.1
 
 
 def test_a_use_sim_time_node_follows_the_clock(nav: LiveRun, ros_env: dict[str, str]) -> None:
-    out = rospy(ros_env, """
+    out = rospy(
+        ros_env,
+        """
 import rospy
 rospy.set_param('/use_sim_time', True)
 rospy.init_node('clock_probe')
 rospy.sleep(0.5)  # sleeps on /clock: returns only if the clock runs
 print(rospy.get_time())
 rospy.delete_param('/use_sim_time')
-""")
+""",
+    )
     now = nav.ex.now_ns / 1e9
     assert 0.5 < float(out) <= now + 0.1 and now - float(out) < 5.0
 
@@ -111,12 +131,13 @@ def _near(mask: np.ndarray, pts: np.ndarray, radius: int) -> np.ndarray:
     h, w = mask.shape
     out = np.zeros(len(pts), dtype=bool)
     for k, (c, r) in enumerate(pts.astype(int)):
-        out[k] = mask[max(r - radius, 0):min(r + radius + 1, h), max(c - radius, 0):min(c + radius + 1, w)].any()
+        out[k] = mask[max(r - radius, 0) : min(r + radius + 1, h), max(c - radius, 0) : min(c + radius + 1, w)].any()
     return out
 
 
 def test_real_rviz_shows_the_map_scan_robot_and_plan_where_navlab_has_them(
-        nav: LiveRun, ros_env: dict[str, str], tmp_path: Path) -> None:
+    nav: LiveRun, ros_env: dict[str, str], tmp_path: Path
+) -> None:
     """Runs last in this module (it freezes the run): rviz with a saved config, compared by pixels with where
     navlab has the map's walls, the last scan, the robot and the global plan (projected with the view's scale)."""
     scans: list[object] = []
@@ -124,10 +145,18 @@ def test_real_rviz_shows_the_map_scan_robot_and_plan_where_navlab_has_them(
     nav.call(lambda: nav.session.node("move_base").send_goal(-2.5, 1.0, 0.0))
     ros(ros_env, "rosparam", "set", "/use_sim_time", "true")  # rviz keeps the run's time (from /clock)
     screen = Screen(tmp_path)
-    env = {**ros_env, "DISPLAY": screen.display, "LIBGL_ALWAYS_SOFTWARE": "1",
-           "ROS_PACKAGE_PATH": str(resources_dir() / "robots")}  # package://mybot_description meshes
-    viewer = subprocess.Popen([require("rviz"), "-d", str(Path(__file__).parent / "data" / "navlab.rviz")], env=env,
-                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    env = {
+        **ros_env,
+        "DISPLAY": screen.display,
+        "LIBGL_ALWAYS_SOFTWARE": "1",
+        "ROS_PACKAGE_PATH": str(resources_dir() / "robots"),
+    }  # package://mybot_description meshes
+    viewer = subprocess.Popen(
+        [require("rviz"), "-d", str(Path(__file__).parent / "data" / "navlab.rviz")],
+        env=env,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
     try:
         red = lambda img: (img[..., 0] > 200) & (img[..., 1] < 60) & (img[..., 2] < 60)  # noqa: E731
         green = lambda img: (img[..., 1] > 200) & (img[..., 0] < 60) & (img[..., 2] < 60)  # noqa: E731

@@ -37,8 +37,21 @@ def test_rostopic_pub_cmd_vel_drives_the_robot_the_commanded_distance(sim: LiveR
     got: list[tuple[int, float]] = []
     sim.call(lambda: sim.ex.add_listener(lambda t, m, ns: got.append((ns, m.linear.x)) if t == "/cmd_vel" else None))
     x0, y0 = _truth(sim)
-    ros(ros_env, "timeout", "-s", "INT", "4", "rostopic", "pub", "-r", "20", "/cmd_vel", "geometry_msgs/Twist",
-        "{linear: {x: 0.2}}", ok=(124,))
+    ros(
+        ros_env,
+        "timeout",
+        "-s",
+        "INT",
+        "4",
+        "rostopic",
+        "pub",
+        "-r",
+        "20",
+        "/cmd_vel",
+        "geometry_msgs/Twist",
+        "{linear: {x: 0.2}}",
+        ok=(124,),
+    )
     ros(ros_env, "rostopic", "pub", "-1", "/cmd_vel", "geometry_msgs/Twist", "{}")
     stop = [ns for ns, v in got if v == 0.0]
     moving = [ns for ns, v in got if v > 0]
@@ -48,11 +61,11 @@ def test_rostopic_pub_cmd_vel_drives_the_robot_the_commanded_distance(sim: LiveR
     assert abs(math.hypot(x1 - x0, y1 - y0) - commanded) < 0.15 * commanded
 
 
-def test_rosbag_records_the_run_with_its_counts_and_types(sim: LiveRun, ros_env: dict[str, str],
-                                                          tmp_path: Path) -> None:
+def test_rosbag_records_the_run_with_its_counts_and_types(
+    sim: LiveRun, ros_env: dict[str, str], tmp_path: Path
+) -> None:
     bag = tmp_path / "run.bag"
-    ros(ros_env, "rosbag", "record", "-O", str(bag), "--duration=4", "/odom", "/mybot/laser/scan", "/tf",
-        timeout=60)
+    ros(ros_env, "rosbag", "record", "-O", str(bag), "--duration=4", "/odom", "/mybot/laser/scan", "/tf", timeout=60)
     info = yaml.safe_load(ros(ros_env, "rosbag", "info", "--yaml", str(bag)))
     topics = {t["topic"]: t for t in info["topics"]}
     assert topics["/mybot/laser/scan"]["type"] == "sensor_msgs/LaserScan"
@@ -61,8 +74,9 @@ def test_rosbag_records_the_run_with_its_counts_and_types(sim: LiveRun, ros_env:
     assert 100 < topics["/mybot/laser/scan"]["messages"] < 200  # 40 Hz for ~4 s of real time
 
 
-def test_a_peer_sending_garbage_is_dropped_and_the_run_goes_on(sim: LiveRun, ros_env: dict[str, str],
-                                                              caplog: pytest.LogCaptureFixture) -> None:
+def test_a_peer_sending_garbage_is_dropped_and_the_run_goes_on(
+    sim: LiveRun, ros_env: dict[str, str], caplog: pytest.LogCaptureFixture
+) -> None:
     port = sim.bridge.tcpros.port
     with socket.create_connection(("127.0.0.1", port)) as s:
         s.sendall(struct.pack("<I", 12) + b"\xff" * 12)
@@ -74,13 +88,16 @@ def test_a_peer_sending_garbage_is_dropped_and_the_run_goes_on(sim: LiveRun, ros
 def test_navlab_roscore_serves_real_rospy_nodes_and_rosparam(ros_env: dict[str, str], tmp_path: Path) -> None:
     port = free_port()
     env = {**ros_env, "ROS_MASTER_URI": f"http://127.0.0.1:{port}/"}
-    core = subprocess.Popen([str(Path(sys.executable).parent / "navlab"), "roscore", "-p", str(port)],
-                            stdout=subprocess.PIPE, text=True)
+    core = subprocess.Popen(
+        [str(Path(sys.executable).parent / "navlab"), "roscore", "-p", str(port)], stdout=subprocess.PIPE, text=True
+    )
     try:
         assert "ROS master at" in (core.stdout.readline() if core.stdout else "")
         ros(env, "rosparam", "set", "/demo/gain", "2.5")
         assert float(ros(env, "rosparam", "get", "/demo/gain")) == 2.5
-        out = rospy(env, """
+        out = rospy(
+            env,
+            """
 import rospy
 from std_msgs.msg import String
 rospy.init_node('talker_listener')
@@ -92,7 +109,8 @@ t = rospy.Time.now() + rospy.Duration(5)
 while not got and rospy.Time.now() < t:
     rospy.sleep(0.05)
 print(got[0], rospy.search_param('gain') or '')
-""")
+""",
+        )
         assert out.split()[0] == "hello"
         assert "/chatter" in ros(env, "rostopic", "list")
     finally:
@@ -103,8 +121,13 @@ print(got[0], rospy.search_param('gain') or '')
 def test_navlab_sim_ros_starts_its_own_master_when_none_answers(ros_env: dict[str, str]) -> None:
     env = {**ros_env, "ROS_MASTER_URI": f"http://127.0.0.1:{free_port()}/"}  # nothing listens there
     env.pop("ROS_IP")  # and nothing says where to listen: loopback
-    proc = subprocess.Popen([str(Path(sys.executable).parent / "navlab"), "sim", "--ros", "--duration", "60",
-                             "--quiet"], env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    proc = subprocess.Popen(
+        [str(Path(sys.executable).parent / "navlab"), "sim", "--ros", "--duration", "60", "--quiet"],
+        env=env,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     try:
         deadline = time.monotonic() + 30
         listed = ""
@@ -127,8 +150,11 @@ def test_a_subscriber_that_never_reads_does_not_slow_the_run(sim: LiveRun) -> No
     with socket.socket() as s:
         s.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)  # before connecting: a small receive window
         s.connect(("127.0.0.1", sim.bridge.tcpros.port))
-        s.sendall(encode_header({"callerid": "/stuck", "topic": "/mybot/laser/scan", "md5sum": "*",
-                                 "type": "sensor_msgs/LaserScan"}))
+        s.sendall(
+            encode_header(
+                {"callerid": "/stuck", "topic": "/mybot/laser/scan", "md5sum": "*", "type": "sensor_msgs/LaserScan"}
+            )
+        )
         assert recv_header(s)["type"] == "sensor_msgs/LaserScan"
         sim0, wall0 = sim.ex.now_ns, time.monotonic()
         time.sleep(5.0)  # 200 scans of ~6 kB: far more than the small window and the queue (100) hold

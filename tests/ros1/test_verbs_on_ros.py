@@ -29,13 +29,19 @@ print(json.dumps({"value": msg, "pubs": {t: n for t, n in pubs}, "subs": {t: n f
 """
 
 
-def _while_running(ros_env: dict[str, str], argv: list[str], topic: str, msg_type: str, field: str,
-                   *, until_done: bool) -> tuple[dict[str, Any], str]:
+def _while_running(
+    ros_env: dict[str, str], argv: list[str], topic: str, msg_type: str, field: str, *, until_done: bool
+) -> tuple[dict[str, Any], str]:
     """Run ``navlab ARGV`` on the master of ``ros_env`` while a rospy node waits for ``topic``'s first message;
     the node's findings and navlab's stdout (after it ends by itself with ``until_done``, else once stopped)."""
     pkg, cls = msg_type.split("/")
-    listener = subprocess.Popen([SYSTEM_PYTHON, "-c", _LISTENER, topic, pkg, cls, field], env=ros_env,
-                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    listener = subprocess.Popen(
+        [SYSTEM_PYTHON, "-c", _LISTENER, topic, pkg, cls, field],
+        env=ros_env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     env = {**os.environ, "ROS_MASTER_URI": ros_env["ROS_MASTER_URI"], "ROS_IP": "127.0.0.1"}
     run = subprocess.Popen([NAVLAB, *argv], env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
@@ -53,9 +59,14 @@ def _while_running(ros_env: dict[str, str], argv: list[str], topic: str, msg_typ
 
 
 def test_navigate_ros_is_on_the_graph_in_real_time_and_reaches_its_goal(ros_env: dict[str, str]) -> None:
-    seen, out = _while_running(ros_env, ["navigate", "--ros", "--world", "room", "--goal", "1.0", "0.0", "0.0",
-                                         "--timeout", "20", "--json"],
-                               "/odom", "nav_msgs/Odometry", "child_frame_id", until_done=True)
+    seen, out = _while_running(
+        ros_env,
+        ["navigate", "--ros", "--world", "room", "--goal", "1.0", "0.0", "0.0", "--timeout", "20", "--json"],
+        "/odom",
+        "nav_msgs/Odometry",
+        "child_frame_id",
+        until_done=True,
+    )
     assert seen["value"] == "chassis"
     assert seen["pubs"]["/mybot/laser/scan"]  # the lidar plugin publishes it
     assert "/move_base" in seen["subs"]["/move_base/goal"]  # actionlib's server, for SimpleActionClient
@@ -66,9 +77,27 @@ def test_navigate_ros_is_on_the_graph_in_real_time_and_reaches_its_goal(ros_env:
 
 
 def test_map_ros_serves_the_growing_map_to_rospy(ros_env: dict[str, str], tmp_path: Path) -> None:
-    seen, _ = _while_running(ros_env, ["map", "--ros", "--world", "room", "--duration", "8", "--rate", "2",
-                                       "--out", str(tmp_path / "map"), "--json", "--quiet"],
-                             "/map", "nav_msgs/OccupancyGrid", "info.resolution", until_done=True)
+    seen, _ = _while_running(
+        ros_env,
+        [
+            "map",
+            "--ros",
+            "--world",
+            "room",
+            "--duration",
+            "8",
+            "--rate",
+            "2",
+            "--out",
+            str(tmp_path / "map"),
+            "--json",
+            "--quiet",
+        ],
+        "/map",
+        "nav_msgs/OccupancyGrid",
+        "info.resolution",
+        until_done=True,
+    )
     assert abs(seen["value"] - 0.05) < 1e-9
     assert "/slam_gmapping" in seen["pubs"]["/map"]
     assert seen["pubs"]["/mybot/laser/scan"]  # the lidar plugin publishes it
@@ -76,9 +105,14 @@ def test_map_ros_serves_the_growing_map_to_rospy(ros_env: dict[str, str], tmp_pa
 
 
 def test_view_ros_registers_the_live_launch_on_the_master(ros_env: dict[str, str]) -> None:
-    seen, _ = _while_running(ros_env, ["view", "--ros", "--no-browser", "--port", "0", "--duration", "60"],
-                             "/amcl_pose", "geometry_msgs/PoseWithCovarianceStamped", "header.frame_id",
-                             until_done=False)
+    seen, _ = _while_running(
+        ros_env,
+        ["view", "--ros", "--no-browser", "--port", "0", "--duration", "60"],
+        "/amcl_pose",
+        "geometry_msgs/PoseWithCovarianceStamped",
+        "header.frame_id",
+        until_done=False,
+    )
     assert seen["value"] == "map"
     assert "/amcl" in seen["pubs"]["/amcl_pose"]
     assert "/move_base" in seen["subs"]["/move_base_simple/goal"]

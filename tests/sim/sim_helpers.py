@@ -28,8 +28,9 @@ def _cyl_inertial(mass: float, r: float, h: float, axis: str = "z") -> Inertial:
     return Inertial(mass=mass, ixx=side, iyy=side, izz=along)
 
 
-def make_mybot(*, torque: float = 15.0, caster_mu: float | None = 0.0, odometry_source: str = "encoder",
-               noise: float = 0.01) -> RobotModel:
+def make_mybot(
+    *, torque: float = 15.0, caster_mu: float | None = 0.0, odometry_source: str = "encoder", noise: float = 0.01
+) -> RobotModel:
     """The paper's robot: cylinder base r 0.2 m, wheels r 0.08 m 0.4 m apart, two caster spheres, a lidar."""
     wheel_rpy = (math.pi / 2, 0.0, 0.0)
     links = {
@@ -67,13 +68,23 @@ def make_mybot(*, torque: float = 15.0, caster_mu: float | None = 0.0, odometry_
         joints=joints,
         root_link="chassis",
         diff_drive=DiffDriveConfig(
-            update_rate=30.0, wheel_separation=0.4, wheel_diameter=0.16, max_torque=torque,
-            robot_base_frame="chassis", odometry_source=odometry_source,  # type: ignore[arg-type]
+            update_rate=30.0,
+            wheel_separation=0.4,
+            wheel_diameter=0.16,
+            max_torque=torque,
+            robot_base_frame="chassis",
+            odometry_source=odometry_source,  # type: ignore[arg-type]
         ),
         lidars=[
             LidarConfig(
-                link="laser", update_rate=40.0, samples=720, range_min=0.2, range_max=25.0,
-                noise_stddev=noise, topic="/mybot/laser/scan", frame_id="laser",
+                link="laser",
+                update_rate=40.0,
+                samples=720,
+                range_min=0.2,
+                range_max=25.0,
+                noise_stddev=noise,
+                topic="/mybot/laser/scan",
+                frame_id="laser",
             )
         ],
     )

@@ -15,15 +15,19 @@ from navlab.world import load_world
 FRONT, SIDE = 0.254, 0.37559 / 2 + 0.02
 
 
-@pytest.mark.parametrize(("yaw", "box_xy", "expected"), [
-    (0.0, (FRONT + 0.3 + 0.2, 0.0), 0.3),  # 0.3 m ahead of the chassis' front face
-    (0.0, (0.0, SIDE + 0.25 + 0.2), 0.25),  # 0.25 m beside a wheel (the chassis is 0.048 m further in)
-    (math.pi / 2, (SIDE + 0.25 + 0.2, 0.0), 0.25),  # turned: the same wheel now faces +x
-    # turned 45 degrees: the chassis corner reaches x = 0.254 cos45 + 0.16 sin45
-    (math.pi / 4, (1.0, 0.0), 0.8 - (0.254 + 0.16) * math.sqrt(0.5)),
-])
+@pytest.mark.parametrize(
+    ("yaw", "box_xy", "expected"),
+    [
+        (0.0, (FRONT + 0.3 + 0.2, 0.0), 0.3),  # 0.3 m ahead of the chassis' front face
+        (0.0, (0.0, SIDE + 0.25 + 0.2), 0.25),  # 0.25 m beside a wheel (the chassis is 0.048 m further in)
+        (math.pi / 2, (SIDE + 0.25 + 0.2, 0.0), 0.25),  # turned: the same wheel now faces +x
+        # turned 45 degrees: the chassis corner reaches x = 0.254 cos45 + 0.16 sin45
+        (math.pi / 4, (1.0, 0.0), 0.8 - (0.254 + 0.16) * math.sqrt(0.5)),
+    ],
+)
 def test_a_rectangular_robot_beside_a_box_reports_the_geometric_distance(
-        yaw: float, box_xy: tuple[float, float], expected: float) -> None:
+    yaw: float, box_xy: tuple[float, float], expected: float
+) -> None:
     sim = Simulation(load_robot_named("jackal"), load_world("room"), robot_pose=(0.0, 0.0, yaw))
     sim.spawn(primitive_model("box", "box", (0.4, 0.4, 0.5), x=box_xy[0], y=box_xy[1]))
     assert sim.clearance() == pytest.approx(expected, abs=0.01)

@@ -13,8 +13,21 @@ from navlab.sim import SimError, parse_spawn_spec
 
 
 def test_sim_verb_drives_and_summarises(capsys: pytest.CaptureFixture[str]) -> None:
-    code = main(["sim", "--duration", "2", "--cmd-vel", "0.5,0", "--quiet", "--json",
-                 "--spawn", "box:name=crate,x=3,y=2,size=0.4", "--spawn", "cylinder:name=drum,x=-3,t=1"])
+    code = main(
+        [
+            "sim",
+            "--duration",
+            "2",
+            "--cmd-vel",
+            "0.5,0",
+            "--quiet",
+            "--json",
+            "--spawn",
+            "box:name=crate,x=3,y=2,size=0.4",
+            "--spawn",
+            "cylinder:name=drum,x=-3,t=1",
+        ]
+    )
     assert code == 0
     out = json.loads(capsys.readouterr().out)
     assert out["sim_s"] == pytest.approx(2.0)

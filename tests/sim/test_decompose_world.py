@@ -102,9 +102,11 @@ def test_a_script_without_a_main_guard_loads_a_world_with_concave_meshes(tmp_pat
         "from navlab.sim import decompose\n"
         "from navlab.world import load_world\n"
         f"world = load_world({str(world_file)!r})\n"
-        "print('decomposed', decompose.decompose_world(world, workers=2, progress=False), flush=True)\n")
+        "print('decomposed', decompose.decompose_world(world, workers=2, progress=False), flush=True)\n"
+    )
     env = {**os.environ, "NAVLAB_CACHE": str(tmp_path / "cache")}
-    done = subprocess.run([sys.executable, str(script)], env=env, capture_output=True, text=True, timeout=600,
-                          check=False)
+    done = subprocess.run(
+        [sys.executable, str(script)], env=env, capture_output=True, text=True, timeout=600, check=False
+    )
     assert done.returncode == 0, done.stderr[-2000:]
     assert done.stdout.splitlines() == ["decomposed 2"]  # the script ran once: no worker re-ran it

@@ -18,8 +18,10 @@ AXIS = "<{a}><noise type='gaussian'><mean>{m}</mean><stddev>{s}</stddev><bias_me
 
 
 def _xml(gyro: tuple[float, float, float], accel: tuple[float, float, float]) -> str:
-    return SENSOR.format(gyro="".join(AXIS.format(a=a, m=gyro[0], s=gyro[1], b=gyro[2]) for a in "xyz"),
-                         accel="".join(AXIS.format(a=a, m=accel[0], s=accel[1], b=accel[2]) for a in "xyz"))
+    return SENSOR.format(
+        gyro="".join(AXIS.format(a=a, m=gyro[0], s=gyro[1], b=gyro[2]) for a in "xyz"),
+        accel="".join(AXIS.format(a=a, m=accel[0], s=accel[1], b=accel[2]) for a in "xyz"),
+    )
 
 
 def test_noise_statistics_match_the_parameters_over_10000_samples() -> None:

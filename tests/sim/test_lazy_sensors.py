@@ -16,8 +16,9 @@ from navlab.core.launch import start
     ("name", "msgtype", "per_half_s", "frame"),
     [("/imu", msgs.Imu, 50, "chassis"), ("/ground_truth/odom", msgs.Odometry, 25, "world")],  # 100 Hz, 50 Hz
 )
-def test_sensor_publishes_for_subscribers_and_listeners_only(name: str, msgtype: Any, per_half_s: int,
-                                                             frame: str) -> None:  # fmt: skip
+def test_sensor_publishes_for_subscribers_and_listeners_only(
+    name: str, msgtype: Any, per_half_s: int, frame: str
+) -> None:
     s = start("sim")
     ex = s.executor
     topic = ex.topic(name, msgtype)

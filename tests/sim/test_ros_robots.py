@@ -22,8 +22,9 @@ PKG = Path(__file__).parents[1] / "fixtures" / "tutorial_bot_description"
 XACRO = PKG / "urdf" / "tutorial_bot.urdf.xacro"
 
 
-def _drive(robot: object, twists: list[tuple[float, float, float]], duration: float,
-           **params: object) -> tuple[Executor, object]:
+def _drive(
+    robot: object, twists: list[tuple[float, float, float]], duration: float, **params: object
+) -> tuple[Executor, object]:
     """Run the robot in the test room; publish each (t, v, w) once at time t."""
     ex = Executor(seed=0)
     gazebo = launch_sim(ex, world=make_room(), robot=robot, **params)  # type: ignore[arg-type]
@@ -85,8 +86,9 @@ def test_gazebo_material_colours_the_rendered_chassis() -> None:
     robot = load_robot(XACRO)
     sim = Simulation(robot, make_room(), visuals=True)
     try:
-        image = render_image(sim, width=160, height=120, elevation=-89.0, distance=1.2,
-                             lookat=(0.0, 0.0, 0.0)).astype(int)
+        image = render_image(sim, width=160, height=120, elevation=-89.0, distance=1.2, lookat=(0.0, 0.0, 0.0)).astype(
+            int
+        )
     except SimError as exc:
         pytest.skip(f"no offscreen OpenGL here: {exc}")
     r, g, b = image[..., 0], image[..., 1], image[..., 2]
@@ -121,8 +123,11 @@ def test_a_torque_tag_drives_as_noetic_drives_it_with_wheel_torque_5(tmp_path: P
 
     src = Path(__file__).parents[1] / "fixtures" / "ros_ws" / "my_description"
     x_after: dict[str, float] = {}
-    for label, tag in (("torque", "<torque>0.001</torque>"), ("default", "<wheelTorque>5</wheelTorque>"),
-                       ("weak", "<wheelTorque>0.001</wheelTorque>")):
+    for label, tag in (
+        ("torque", "<torque>0.001</torque>"),
+        ("default", "<wheelTorque>5</wheelTorque>"),
+        ("weak", "<wheelTorque>0.001</wheelTorque>"),
+    ):
         pkg = tmp_path / label / "my_description"
         shutil.copytree(src, pkg)
         gz = pkg / "urdf" / "my_robot.gazebo.xacro"
@@ -141,14 +146,20 @@ def test_p3d_plugins_publish_where_noetic_publishes(tmp_path: Path) -> None:
     pkg = tmp_path / "my_description"
     shutil.copytree(Path(__file__).parents[1] / "fixtures" / "ros_ws" / "my_description", pkg)
     gz = pkg / "urdf" / "my_robot.gazebo.xacro"
-    gz.write_text(gz.read_text().replace("</robot>", """
+    gz.write_text(
+        gz.read_text().replace(
+            "</robot>",
+            """
   <gazebo><plugin name="truth" filename="libgazebo_ros_p3d.so"><bodyName>base_link</bodyName>
     <topicName>truth/odom</topicName><robotNamespace>my_robot</robotNamespace><updateRate>20</updateRate></plugin></gazebo>
   <gazebo><plugin name="broken" filename="libgazebo_ros_p3d.so"><bodyName>base_link</bodyName></plugin></gazebo>
-</robot>"""))
+</robot>""",
+        )
+    )
     robot = load_robot(pkg / "urdf" / "my_robot.urdf.xacro")
     assert [(p.link, p.topic, p.frame_id, p.update_rate) for p in robot.ground_truths] == [
-        ("base_link", "/my_robot/truth/odom", "world", 20.0)]
+        ("base_link", "/my_robot/truth/odom", "world", 20.0)
+    ]
     assert any("no <topicName>" in w and "does not load" in w for w in robot.warnings)
     ex, _ = _drive(robot, [(0.05, 0.2, 0.0)], 0.05)
     got: list[object] = []
@@ -158,9 +169,14 @@ def test_p3d_plugins_publish_where_noetic_publishes(tmp_path: Path) -> None:
     assert got[-1].pose.pose.position.x > 0.05  # type: ignore[attr-defined]
 
 
-@pytest.mark.parametrize(("tag", "odom", "tf"), [("<publishTf>false</publishTf>", False, False),
-                                                 ("<publishOdomTF>false</publishOdomTF>", True, False),
-                                                 ("", True, True)])
+@pytest.mark.parametrize(
+    ("tag", "odom", "tf"),
+    [
+        ("<publishTf>false</publishTf>", False, False),
+        ("<publishOdomTF>false</publishOdomTF>", True, False),
+        ("", True, True),
+    ],
+)
 def test_publish_tf_and_publish_odom_tf_as_noetic(tmp_path: Path, tag: str, odom: bool, tf: bool) -> None:
     """Noetic: <publishTf>false publishes no odometry at all; <publishOdomTF>false keeps the topic, drops the tf."""
     import shutil

@@ -26,8 +26,7 @@ def test_package_robot_through_sim_render_launch_map_and_navigate(tmp_path, caps
     assert out["robot"] == "tutorial_bot" and out["messages"]["/tutorial_bot/laser/scan"] >= 9
     assert main(["launch", "sim", f"robot:={ROBOT}", "--duration", "0.3", "--quiet", "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["topics"]["/tutorial_bot/laser/scan"] >= 5
-    assert main(["map", "--robot", ROBOT, "--duration", "2", "--out", str(tmp_path / "map"), "--quiet",
-                 "--json"]) == 0
+    assert main(["map", "--robot", ROBOT, "--duration", "2", "--out", str(tmp_path / "map"), "--quiet", "--json"]) == 0
     assert (tmp_path / "map" / "map.yaml").is_file()
     capsys.readouterr()
     code = main(["navigate", "--robot", ROBOT, "--goal", "0.5", "0", "0", "--timeout", "3", "--json"])
@@ -40,12 +39,15 @@ def test_package_robot_through_sim_render_launch_map_and_navigate(tmp_path, caps
     assert code == 0 and (tmp_path / "r.png").stat().st_size > 100
 
 
-@pytest.mark.parametrize("argv", [
-    ["sim", "--x", "4.95", "--duration", "0.2", "--quiet"],
-    ["render", "--x", "4.95", "--out", "never.png"],
-    ["launch", "sim", "x:=4.95", "--duration", "0.2", "--quiet"],
-    ["map", "--x", "4.95", "--duration", "1", "--quiet"],
-])
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["sim", "--x", "4.95", "--duration", "0.2", "--quiet"],
+        ["render", "--x", "4.95", "--out", "never.png"],
+        ["launch", "sim", "x:=4.95", "--duration", "0.2", "--quiet"],
+        ["map", "--x", "4.95", "--duration", "1", "--quiet"],
+    ],
+)
 def test_start_pose_inside_a_wall_is_refused_with_a_message(argv, tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
     assert main(argv) == 2
@@ -58,13 +60,33 @@ def test_package_and_model_path_options(tmp_path, monkeypatch, capsys):
     monkeypatch.setenv("ROS_PACKAGE_PATH", "")
     monkeypatch.setenv("GAZEBO_MODEL_PATH", "")
     world = tmp_path / "w.world"
-    world.write_text('<sdf version="1.6"><world name="w"><include><uri>model://ground_plane</uri></include>'
-                     "<include><uri>model:///pillar</uri><pose>2 0 0 0 0 0</pose></include></world></sdf>")
+    world.write_text(
+        '<sdf version="1.6"><world name="w"><include><uri>model://ground_plane</uri></include>'
+        "<include><uri>model:///pillar</uri><pose>2 0 0 0 0 0</pose></include></world></sdf>"
+    )
     models = FIX / "tutorial_bot_description" / "models"
     assert main(["sim", "--robot", ROBOT, "--world", str(world), "--duration", "0.2", "--quiet", "--json"]) == 2
     assert "tutorial_bot_description" in capsys.readouterr().err  # the package is named in the error
-    assert main(["sim", "--robot", ROBOT, "--world", str(world), "--package-path", str(FIX), "--model-path",
-                 str(models), "--duration", "0.2", "--quiet", "--json"]) == 0
+    assert (
+        main(
+            [
+                "sim",
+                "--robot",
+                ROBOT,
+                "--world",
+                str(world),
+                "--package-path",
+                str(FIX),
+                "--model-path",
+                str(models),
+                "--duration",
+                "0.2",
+                "--quiet",
+                "--json",
+            ]
+        )
+        == 0
+    )
     assert "pillar" in json.loads(capsys.readouterr().out)["models"]
 
 
@@ -79,10 +101,23 @@ def test_map_with_package_and_model_path_options(tmp_path, monkeypatch, capsys):
     (models / "crate" / "model.config").write_text((pillar / "model.config").read_text().replace("pillar", "crate"))
     (models / "crate" / "model.sdf").write_text((pillar / "model.sdf").read_text().replace("pillar", "crate"))
     world = tmp_path / "w.world"
-    world.write_text('<sdf version="1.6"><world name="w"><include><uri>model://ground_plane</uri></include>'
-                     "<include><uri>model:///crate</uri><pose>1.5 0 0 0 0 0</pose></include></world></sdf>")
-    argv = ["map", "--robot", ROBOT, "--world", str(world), "--duration", "2", "--out", str(tmp_path / "m"),
-            "--quiet", "--json"]
+    world.write_text(
+        '<sdf version="1.6"><world name="w"><include><uri>model://ground_plane</uri></include>'
+        "<include><uri>model:///crate</uri><pose>1.5 0 0 0 0 0</pose></include></world></sdf>"
+    )
+    argv = [
+        "map",
+        "--robot",
+        ROBOT,
+        "--world",
+        str(world),
+        "--duration",
+        "2",
+        "--out",
+        str(tmp_path / "m"),
+        "--quiet",
+        "--json",
+    ]
     assert main(argv) == 2
     assert "tutorial_bot_description" in capsys.readouterr().err  # not found without the options
     assert main([*argv, "--package-path", str(FIX), "--model-path", str(models)]) == 0
@@ -90,9 +125,17 @@ def test_map_with_package_and_model_path_options(tmp_path, monkeypatch, capsys):
     assert out["scans_processed"] > 0 and not out["map_empty"]  # the laser saw the crate
 
 
-@pytest.mark.parametrize("verb", [["navigate", "--goal", "1", "0", "0"], ["localize"], ["launch", "mapping"],
-                                  ["view"], ["experiment", "run", "empty_room"], ["eval", "map", "m.yaml",
-                                  "--world", "room"]])  # fmt: skip
+@pytest.mark.parametrize(
+    "verb",
+    [
+        ["navigate", "--goal", "1", "0", "0"],
+        ["localize"],
+        ["launch", "mapping"],
+        ["view"],
+        ["experiment", "run", "empty_room"],
+        ["eval", "map", "m.yaml", "--world", "room"],
+    ],
+)
 def test_every_robot_verb_takes_the_path_options(verb):
     from navlab.cli import build_parser
 

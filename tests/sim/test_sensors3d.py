@@ -29,9 +29,13 @@ def _sim(*models, visuals: bool = False) -> Simulation:
 def test_depth_pixel_is_the_range_to_a_known_box_within_noise() -> None:
     box = primitive_model("box", "box", (0.4, 2.0, 1.0), x=2.0)  # front face at x = 1.8
     sim = _sim(box)
-    cfg = CameraConfig(link="chassis", kind="depth", origin=CAM_ORIGIN, point_cloud_cutoff=0.1,
-                       camera=CameraModel(width=32, height=24, horizontal_fov=0.8, near=0.05, far=10.0,
-                                          noise_stddev=0.01))
+    cfg = CameraConfig(
+        link="chassis",
+        kind="depth",
+        origin=CAM_ORIGIN,
+        point_cloud_cutoff=0.1,
+        camera=CameraModel(width=32, height=24, horizontal_fov=0.8, near=0.05, far=10.0, noise_stddev=0.01),
+    )
     depth = depth_image(sim, cfg, np.random.default_rng(1))
     pos, _ = sensor_pose(sim, "chassis", CAM_ORIGIN)
     expected = 1.8 - pos[0]  # a level camera: depth along the optical axis = the distance to the face's plane
@@ -50,9 +54,20 @@ def test_3d_lidar_rings_at_the_configured_angles() -> None:
 
     wall = primitive_model("box", "wall", (0.2, 20.0, 4.0), x=3.0)
     sim = _sim(wall)
-    cfg = Lidar3dConfig(link="chassis", origin=Origin((0.0, 0.0, 0.3)), samples=90, min_angle=-0.6, max_angle=0.6,
-                        rings=8, vertical_min_angle=-0.2, vertical_max_angle=0.25, range_min=0.3, range_max=20.0,
-                        topic="points", frame_id="velodyne")
+    cfg = Lidar3dConfig(
+        link="chassis",
+        origin=Origin((0.0, 0.0, 0.3)),
+        samples=90,
+        min_angle=-0.6,
+        max_angle=0.6,
+        rings=8,
+        vertical_min_angle=-0.2,
+        vertical_max_angle=0.25,
+        range_min=0.3,
+        range_max=20.0,
+        topic="points",
+        frame_id="velodyne",
+    )
     sim.robot.sensors.lidars3d.append(cfg)
     plugin = VelodynePlugin(Executor(), sim=sim, config=cfg)
     msg = plugin.cloud(lidar3d_ranges(sim, cfg), 0)
@@ -75,9 +90,19 @@ def test_sonar_cone_returns_the_nearest_surface_in_its_cone() -> None:
     inside = primitive_model("box", "post", (0.1, 0.1, 1.0), x=1.5, y=1.5 * math.tan(0.12))  # 0.12 rad off axis
     outside = primitive_model("box", "far_post", (0.1, 0.1, 1.0), x=1.0, y=1.0 * math.tan(0.4))  # outside
     # vertical spread small enough that the floor stays beyond max range (a wider cone near the floor sees it)
-    cfg = RangeConfig(link="chassis", origin=Origin((0.0, 0.0, 0.2)), samples=9, min_angle=-0.15, max_angle=0.15,
-                      vertical_samples=3, vertical_min_angle=-0.05, vertical_max_angle=0.05, range_min=0.02,
-                      range_max=4.0, fov=0.3)
+    cfg = RangeConfig(
+        link="chassis",
+        origin=Origin((0.0, 0.0, 0.2)),
+        samples=9,
+        min_angle=-0.15,
+        max_angle=0.15,
+        vertical_samples=3,
+        vertical_min_angle=-0.05,
+        vertical_max_angle=0.05,
+        range_min=0.02,
+        range_max=4.0,
+        fov=0.3,
+    )
     pos, _ = sensor_pose(_sim(), "chassis", cfg.origin)
     assert range_reading(_sim(wall, outside), cfg) == pytest.approx((2.9 - pos[0]), abs=1e-6)  # the wall, on axis
     near = range_reading(_sim(wall, inside, outside), cfg)
@@ -92,8 +117,9 @@ def test_a_coloured_box_appears_where_the_camera_model_puts_it() -> None:
 
     red = primitive_model("box", "red", (0.3, 0.3, 0.3), x=2.0, y=0.5, z=0.3, rgba=(1.0, 0.0, 0.0, 1.0))
     sim = _sim(red, visuals=True)
-    cfg = CameraConfig(link="chassis", origin=CAM_ORIGIN, camera=CameraModel(width=64, height=48,
-                                                                             horizontal_fov=1.2, far=20.0))
+    cfg = CameraConfig(
+        link="chassis", origin=CAM_ORIGIN, camera=CameraModel(width=64, height=48, horizontal_fov=1.2, far=20.0)
+    )
     try:
         renderer = CameraRenderer(sim, cfg)
     except Exception as exc:  # no EGL/OSMesa on this machine
@@ -141,9 +167,11 @@ def test_sensor_topics_record_to_rosbag2_and_read_back(tmp_path) -> None:
     ex.run(0.2)
     bag = rec.close()
     types = {topic: kind for topic, (kind, _) in bag_topics(bag).items()}
-    assert types == {"/camera/depth/points": "sensor_msgs/msg/PointCloud2",
-                     "/camera/depth/image_raw": "sensor_msgs/msg/Image",
-                     "/camera/depth/camera_info": "sensor_msgs/msg/CameraInfo"}
+    assert types == {
+        "/camera/depth/points": "sensor_msgs/msg/PointCloud2",
+        "/camera/depth/image_raw": "sensor_msgs/msg/Image",
+        "/camera/depth/camera_info": "sensor_msgs/msg/CameraInfo",
+    }
     clouds = [m for topic, _, m in read_bag(bag, topics=["/camera/depth/points"])]
     assert len(clouds) >= 2 and read_xyz(clouds[0]).shape == (320 * 240, 3)  # 15 Hz over 0.2 s
     assert clouds[0].header.frame_id == "camera_depth_optical_frame"
@@ -179,8 +207,12 @@ def test_range_and_bumper_plugins_publish_their_messages(tmp_path) -> None:
     got = Probe(ex).got
     ex.run(0.3)
     r = got["range"]
-    assert (r.header.frame_id, r.radiation_type, r.field_of_view, r.max_range) == ("sonar_front_link", 0,
-                                                                                 pytest.approx(0.26), 3.0)
+    assert (r.header.frame_id, r.radiation_type, r.field_of_view, r.max_range) == (
+        "sonar_front_link",
+        0,
+        pytest.approx(0.26),
+        3.0,
+    )
     pos, _ = sensor_pose(gz.sim, "chassis", Origin((0.2, 0.0, 0.05)))
     assert r.range == pytest.approx(1.5 - pos[0], abs=0.01)  # the nearest ray: on the axis
     assert got["bumper"].header.frame_id == "world" and got["bumper"].states == []  # touching nothing
@@ -212,10 +244,40 @@ def test_culled_camera_cast_equals_every_ray_against_every_geom(pose: tuple[floa
     dirs = pinhole_dirs(w, h, f)
     pos, rot = sensor_pose(sim, cam.link, cam.origin)
     culled, every = np.empty(w * h), np.empty(w * h)
-    cast_grid(pos, rot, dirs, h, w, PINHOLE, np.array([f, (w - 1) / 2, (h - 1) / 2]), fast, m.geom_type, m.geom_size,
-              d.geom_xpos, d.geom_xmat, 0.05, 20.0, culled)
-    cast_grid(pos, rot, dirs, 1, w * h, ALL, np.zeros(3), fast, m.geom_type, m.geom_size, d.geom_xpos, d.geom_xmat,
-              0.05, 20.0, every)
+    cast_grid(
+        pos,
+        rot,
+        dirs,
+        h,
+        w,
+        PINHOLE,
+        np.array([f, (w - 1) / 2, (h - 1) / 2]),
+        fast,
+        m.geom_type,
+        m.geom_size,
+        d.geom_xpos,
+        d.geom_xmat,
+        0.05,
+        20.0,
+        culled,
+    )
+    cast_grid(
+        pos,
+        rot,
+        dirs,
+        1,
+        w * h,
+        ALL,
+        np.zeros(3),
+        fast,
+        m.geom_type,
+        m.geom_size,
+        d.geom_xpos,
+        d.geom_xmat,
+        0.05,
+        20.0,
+        every,
+    )
     np.testing.assert_array_equal(culled, every)
     assert np.isfinite(every).mean() > 0.5
 
@@ -232,8 +294,38 @@ def test_culled_lidar_cast_equals_every_ray_against_every_geom() -> None:
     dirs = spherical_dirs(az, el)
     pos, rot = sensor_pose(sim, "laser", Origin((0.0, 0.0, 0.3)))
     culled, every = np.empty(len(dirs)), np.empty(len(dirs))
-    cast_grid(pos, rot, dirs, 16, 361, SPHERICAL, np.array([az[0], az[1] - az[0], el[0], el[1] - el[0]]), fast,
-              m.geom_type, m.geom_size, d.geom_xpos, d.geom_xmat, 0.3, 30.0, culled)
-    cast_grid(pos, rot, dirs, 1, len(dirs), ALL, np.zeros(4), fast, m.geom_type, m.geom_size, d.geom_xpos,
-              d.geom_xmat, 0.3, 30.0, every)
+    cast_grid(
+        pos,
+        rot,
+        dirs,
+        16,
+        361,
+        SPHERICAL,
+        np.array([az[0], az[1] - az[0], el[0], el[1] - el[0]]),
+        fast,
+        m.geom_type,
+        m.geom_size,
+        d.geom_xpos,
+        d.geom_xmat,
+        0.3,
+        30.0,
+        culled,
+    )
+    cast_grid(
+        pos,
+        rot,
+        dirs,
+        1,
+        len(dirs),
+        ALL,
+        np.zeros(4),
+        fast,
+        m.geom_type,
+        m.geom_size,
+        d.geom_xpos,
+        d.geom_xmat,
+        0.3,
+        30.0,
+        every,
+    )
     np.testing.assert_array_equal(culled, every)

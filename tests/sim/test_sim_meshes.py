@@ -13,8 +13,7 @@ from navlab.sim import Simulation, primitive_model
 from navlab.world import ModelSpec, WorldModel
 
 # a U seen from above: a bar along y=0..0.5 and two arms x=0..0.5 and x=1..1.5 up to y=1.5
-U_OUTLINE = [(0, 0), (0.5, 0), (1.0, 0), (1.5, 0), (1.5, 1.5), (1.0, 1.5), (1.0, 0.5), (0.5, 0.5), (0.5, 1.5),
-             (0, 1.5)]
+U_OUTLINE = [(0, 0), (0.5, 0), (1.0, 0), (1.5, 0), (1.5, 1.5), (1.0, 1.5), (1.0, 0.5), (0.5, 0.5), (0.5, 1.5), (0, 1.5)]
 U_TOP = [(0, 1, 7), (0, 7, 8), (0, 8, 9), (1, 2, 6), (1, 6, 7), (3, 4, 5), (3, 5, 6), (3, 6, 2)]
 
 

@@ -189,9 +189,22 @@ def test_planar_caster_sees_the_floor_up_to_the_cutoff_and_not_beyond() -> None:
         c, s = math.cos(tilt), math.sin(tilt)
         rot = np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])  # columns: sensor axes in the world
         out = np.empty(n)
-        cast_planar(np.array([0.0, 0.0, h]), rot, np.cos(a), np.sin(a), -math.pi, 2 * math.pi / n,
-                    np.array([0], dtype=np.int32), np.array([PLANE]), np.zeros((1, 3)), np.zeros((1, 3)),
-                    np.eye(3).reshape(1, 9), 0.05, cutoff, out)
+        cast_planar(
+            np.array([0.0, 0.0, h]),
+            rot,
+            np.cos(a),
+            np.sin(a),
+            -math.pi,
+            2 * math.pi / n,
+            np.array([0], dtype=np.int32),
+            np.array([PLANE]),
+            np.zeros((1, 3)),
+            np.zeros((1, 3)),
+            np.eye(3).reshape(1, 9),
+            0.05,
+            cutoff,
+            out,
+        )
         dz = -s * np.cos(a)  # world z of each beam direction
         with np.errstate(divide="ignore"):
             expect = np.where(dz < 0, h / -dz, np.inf)

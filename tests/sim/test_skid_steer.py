@@ -38,8 +38,16 @@ def _yaw(sim: object) -> float:
     return math.atan2(2 * (q[3] * q[2] + q[0] * q[1]), 1 - 2 * (q[1] ** 2 + q[2] ** 2))
 
 
-def drive(v: float, w: float, *, drive_kind: str = "ros_control", multiplier: float = 1.0, mu: float = 0.3,
-          settle: float = 1.0, duration: float = 2.0) -> dict[str, float]:  # fmt: skip
+def drive(
+    v: float,
+    w: float,
+    *,
+    drive_kind: str = "ros_control",
+    multiplier: float = 1.0,
+    mu: float = 0.3,
+    settle: float = 1.0,
+    duration: float = 2.0,
+) -> dict[str, float]:
     """Command (v, w) on skidbot; the true speed and yaw rate over ``duration`` s after ``settle`` s, and the
     odometry's."""
     ex = Executor(seed=0)
@@ -62,9 +70,16 @@ def drive(v: float, w: float, *, drive_kind: str = "ros_control", multiplier: fl
         turned += (_yaw(gz.sim) - last + math.pi) % (2 * math.pi) - math.pi
     p1 = gz.sim.link_pose("base_link").position
     o = odom[-1]
-    return {"w": turned / duration, "v": float(np.linalg.norm(p1[:2] - p0[:2])) / duration,
-            "odom_w": o.twist.twist.angular.z, "odom_v": o.twist.twist.linear.x, "z": float(p1[2]),
-            "odom_x": o.pose.pose.position.x, "true_x": float(p1[0]), "y0": y0}  # fmt: skip
+    return {
+        "w": turned / duration,
+        "v": float(np.linalg.norm(p1[:2] - p0[:2])) / duration,
+        "odom_w": o.twist.twist.angular.z,
+        "odom_v": o.twist.twist.linear.x,
+        "z": float(p1[2]),
+        "odom_x": o.pose.pose.position.x,
+        "true_x": float(p1[0]),
+        "y0": y0,
+    }
 
 
 def test_shipped_jackal_skid_has_the_public_shape() -> None:
@@ -124,8 +139,12 @@ def test_robot_files_turn_on_the_controller_and_the_ekf_by_default() -> None:
     senders: set[str] = set()
     filtered: list = []
     watch = Node(s.executor, name="watch")
-    watch.create_subscription(msgs.TFMessage, "/tf", lambda m: senders.update(
-        t.header.frame_id + ">" + t.child_frame_id for t in m.transforms), 100)
+    watch.create_subscription(
+        msgs.TFMessage,
+        "/tf",
+        lambda m: senders.update(t.header.frame_id + ">" + t.child_frame_id for t in m.transforms),
+        100,
+    )
     watch.create_subscription(msgs.Odometry, "/odometry/filtered", filtered.append, 100)
     cmd = watch.create_publisher(msgs.Twist, "/cmd_vel", 1)
     watch.create_timer(0.1, lambda: cmd.publish(msgs.twist(0.3, 0.5)))
@@ -148,11 +167,16 @@ def test_ekf_keeps_drift_within_two_percent_on_a_clutter_course() -> None:
 def test_controllers_are_found_by_type() -> None:
     from navlab.sim.ros_control import find_controllers
 
-    found = find_controllers({
-        "base.type": "diff_drive_controller/DiffDriveController", "base.left_wheel": ["a", "b"],
-        "arm.type": "position_controllers/JointTrajectoryController", "arm.joints": ["j1"],
-        "joints.type": "joint_state_controller/JointStateController", "joints.publish_rate": 20,
-    })  # fmt: skip
+    found = find_controllers(
+        {
+            "base.type": "diff_drive_controller/DiffDriveController",
+            "base.left_wheel": ["a", "b"],
+            "arm.type": "position_controllers/JointTrajectoryController",
+            "arm.joints": ["j1"],
+            "joints.type": "joint_state_controller/JointStateController",
+            "joints.publish_rate": 20,
+        }
+    )
     assert (found.diff_drive, found.joint_state_rate) == ("base", 20.0)
     assert set(found.names) == {"base", "arm", "joints"}  # their keys are the YAML's, not unknown parameters
     assert found.ignored == ("arm (position_controllers/JointTrajectoryController)",)

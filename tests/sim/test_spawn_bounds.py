@@ -11,22 +11,25 @@ from navlab.cli import main
 from navlab.sim import SimError, parse_spawn_spec
 
 
-@pytest.mark.parametrize(("spec", "words"), [
-    ("sphere:x=1,radius=inf", "radius=inf: expected a finite number within ±10000 m"),
-    ("box:x=1,size=nan", "size=nan"),
-    ("cylinder:x=1e308,radius=0.2", "x=1e308: expected a finite number within ±1e+06 m"),
-    ("box:x=1,t=-5", "t=-5: expected a time >= 0 s"),
-])
+@pytest.mark.parametrize(
+    ("spec", "words"),
+    [
+        ("sphere:x=1,radius=inf", "radius=inf: expected a finite number within ±10000 m"),
+        ("box:x=1,size=nan", "size=nan"),
+        ("cylinder:x=1e308,radius=0.2", "x=1e308: expected a finite number within ±1e+06 m"),
+        ("box:x=1,t=-5", "t=-5: expected a time >= 0 s"),
+    ],
+)
 def test_spawn_specs_out_of_bounds_are_refused(spec: str, words: str) -> None:
     with pytest.raises(SimError, match="spawn spec") as info:
         parse_spawn_spec(spec)
     assert words in str(info.value)
 
 
-@pytest.mark.parametrize("argv", [["--x", "1e308"], ["--yaw=-1e7"],
-                                  ["--spawn", "cylinder:x=0,y=0,radius=0.3,t=0.1"]])
-def test_sim_refuses_overflowing_starts_and_spawns_onto_the_robot(argv: list[str],
-                                                                  capsys: pytest.CaptureFixture[str]) -> None:
+@pytest.mark.parametrize("argv", [["--x", "1e308"], ["--yaw=-1e7"], ["--spawn", "cylinder:x=0,y=0,radius=0.3,t=0.1"]])
+def test_sim_refuses_overflowing_starts_and_spawns_onto_the_robot(
+    argv: list[str], capsys: pytest.CaptureFixture[str]
+) -> None:
     with contextlib.nullcontext() if argv[0] == "--spawn" else pytest.raises(SystemExit):
         code = main(["sim", "--duration", "0.3", "--quiet", *argv])
         assert code == 2

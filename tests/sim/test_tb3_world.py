@@ -24,10 +24,19 @@ def test_hexagon_walls_stand_upright():
 
 def test_turtlebot3_fixture_drives_and_maps_its_world(tmp_path):
     route = tmp_path / "route.yaml"
-    route.write_text("segments:\n  - {linear: 0.0, angular: 0.8, duration: 8.5}\n"
-                     "  - {linear: 0.15, angular: 0.0, duration: 2.0}\n")
-    r = run_mapping(world=str(WORLD), robot=str(BURGER), pose=(0.0, -0.55, 0.0), driver="route", route=route,
-                    out=tmp_path / "m", duration=15, quiet=True)
+    route.write_text(
+        "segments:\n  - {linear: 0.0, angular: 0.8, duration: 8.5}\n  - {linear: 0.15, angular: 0.0, duration: 2.0}\n"
+    )
+    r = run_mapping(
+        world=str(WORLD),
+        robot=str(BURGER),
+        pose=(0.0, -0.55, 0.0),
+        driver="route",
+        route=route,
+        out=tmp_path / "m",
+        duration=15,
+        quiet=True,
+    )
     s = r.scores
     assert r.finished and s["scans_processed"] >= 10, s
     assert s["map_frame_in_world"] == [0.0, 0.0, 0.0]  # TurtleBot3: <odometrySource>world

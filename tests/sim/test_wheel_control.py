@@ -49,21 +49,25 @@ def test_pid_proportional_only_leaves_an_offset() -> None:
     assert w[-1] == pytest.approx(10.0 / (1 + 0.02), rel=1e-3)  # p / (p + viscous)
 
 
-@pytest.mark.parametrize("params, message", [
-    ({"p": -1.0}, "p: expected a finite number >= 0"),
-    ({"p": 1.0, "i": -0.5}, "i: expected a finite number >= 0"),
-    ({"p": 1.0, "i_clamp": -1.0}, "i_clamp: expected a number >= 0"),
-    ({"p": 1.0, "kp": 2.0}, "did you mean 'p'"),
-    ({"d": "fast"}, "d: expected a finite number"),
-])  # fmt: skip
+@pytest.mark.parametrize(
+    "params, message",
+    [
+        ({"p": -1.0}, "p: expected a finite number >= 0"),
+        ({"p": 1.0, "i": -0.5}, "i: expected a finite number >= 0"),
+        ({"p": 1.0, "i_clamp": -1.0}, "i_clamp: expected a number >= 0"),
+        ({"p": 1.0, "kp": 2.0}, "did you mean 'p'"),
+        ({"d": "fast"}, "d: expected a finite number"),
+    ],
+)
 def test_pid_bad_gains_are_refused(params: dict, message: str) -> None:
     with pytest.raises(SimError, match=message):
         PidGains.from_params(params, where="pid_gains.left_wheel_hinge")
 
 
 def test_speed_limiter_acceleration_velocity_and_jerk() -> None:
-    lim = SpeedLimiter({"has_velocity_limits": True, "max_velocity": 0.5, "has_acceleration_limits": True,
-                        "max_acceleration": 1.0})  # fmt: skip
+    lim = SpeedLimiter(
+        {"has_velocity_limits": True, "max_velocity": 0.5, "has_acceleration_limits": True, "max_acceleration": 1.0}
+    )
     v = v0 = v1 = 0.0
     out = []
     for _ in range(100):
@@ -96,8 +100,9 @@ def _controller_params(**extra: object) -> dict:
     return params
 
 
-def _drive(params: dict, v: float, w: float, seconds: float, *, robot: object = None,
-           stop_at: float = math.inf) -> tuple[Executor, object, dict]:  # fmt: skip
+def _drive(
+    params: dict, v: float, w: float, seconds: float, *, robot: object = None, stop_at: float = math.inf
+) -> tuple[Executor, object, dict]:
     ex = Executor(seed=0)
     gazebo = launch_sim(ex, world=make_room(), robot=robot or make_mybot(), **params)  # type: ignore[arg-type]
     probe = Node(ex, name="probe")
@@ -111,8 +116,16 @@ def _drive(params: dict, v: float, w: float, seconds: float, *, robot: object = 
 
 
 def test_controller_ramps_to_the_command_within_its_limits_and_publishes_odometry() -> None:
-    params = _controller_params(linear={"x": {"has_acceleration_limits": True, "max_acceleration": 0.5,
-                                              "has_velocity_limits": True, "max_velocity": 0.4}})  # fmt: skip
+    params = _controller_params(
+        linear={
+            "x": {
+                "has_acceleration_limits": True,
+                "max_acceleration": 0.5,
+                "has_velocity_limits": True,
+                "max_velocity": 0.4,
+            }
+        }
+    )
     ex, gazebo, got = _drive(params, 0.6, 0.0, 2.0)
     controller = gazebo.plugins[0]
     assert type(controller).__name__ == "DiffDriveController"
@@ -138,18 +151,34 @@ def test_controller_stops_after_cmd_vel_timeout() -> None:
     assert gazebo.sim.base_pose2d()[0] < 0.4 * 1.5 + 0.15  # stopped about 0.5 s after the last command
 
 
-@pytest.mark.parametrize("params, message", [
-    ({"mobile_base_controller": {"type": "diff_drive_controller/DiffDriveController"},
-      "gazebo_ros_control": {"pid_gains": {"left_wheel_hinge": {"p": -1.0}}}},
-     "pid_gains.left_wheel_hinge: pid gain p"),
-    ({"mobile_base_controller": {"type": "diff_drive_controller/DiffDriveController",
-                                 "pose_covariance_diagonal": [0.1, 0.1]}}, "expected 6 numbers"),
-    ({"mobile_base_controller": {"type": "effort_controllers/JointGroupEffortController"}}, "navlab simulates"),
-    ({"mobile_base_controller": {"type": "diff_drive_controller/DiffDriveController", "publish_rat": 5.0}},
-     "did you mean 'publish_rate'"),
-    ({"disturbances": {"payload": 3.0}}, "did you mean 'payload_mass'"),
-    ({"disturbances": {"slip_patches": [{"x": 0, "y": 0, "mu": 0.1}]}}, "either radius"),
-])  # fmt: skip
+@pytest.mark.parametrize(
+    "params, message",
+    [
+        (
+            {
+                "mobile_base_controller": {"type": "diff_drive_controller/DiffDriveController"},
+                "gazebo_ros_control": {"pid_gains": {"left_wheel_hinge": {"p": -1.0}}},
+            },
+            "pid_gains.left_wheel_hinge: pid gain p",
+        ),
+        (
+            {
+                "mobile_base_controller": {
+                    "type": "diff_drive_controller/DiffDriveController",
+                    "pose_covariance_diagonal": [0.1, 0.1],
+                }
+            },
+            "expected 6 numbers",
+        ),
+        ({"mobile_base_controller": {"type": "effort_controllers/JointGroupEffortController"}}, "navlab simulates"),
+        (
+            {"mobile_base_controller": {"type": "diff_drive_controller/DiffDriveController", "publish_rat": 5.0}},
+            "did you mean 'publish_rate'",
+        ),
+        ({"disturbances": {"payload": 3.0}}, "did you mean 'payload_mass'"),
+        ({"disturbances": {"slip_patches": [{"x": 0, "y": 0, "mu": 0.1}]}}, "either radius"),
+    ],
+)
 def test_bad_controller_and_disturbance_parameters(params: dict, message: str) -> None:
     with pytest.raises(Exception, match=message):
         launch_sim(Executor(seed=0), world=make_room(), robot=make_mybot(), **params)

@@ -40,8 +40,14 @@ def test_foxglove_client_gets_map_and_scan_and_its_goal_reaches_move_base() -> N
             assert scan_ch["encoding"] == "cdr" and scan_ch["schemaEncoding"] == "ros2msg"
             assert scan_ch["schemaName"] == "sensor_msgs/msg/LaserScan" and "float32[] ranges" in str(scan_ch["schema"])
             subs = {1: "/map", 2: "/mybot/laser/scan"}
-            ws.send(json.dumps({"op": "subscribe", "subscriptions": [
-                {"id": k, "channelId": channels[t]["id"]} for k, t in subs.items()]}))  # fmt: skip
+            ws.send(
+                json.dumps(
+                    {
+                        "op": "subscribe",
+                        "subscriptions": [{"id": k, "channelId": channels[t]["id"]} for k, t in subs.items()],
+                    }
+                )
+            )
             got: dict[str, object] = {}
             sim_times: list[int] = []
             while len(got) < 2 or not sim_times:
@@ -55,8 +61,21 @@ def test_foxglove_client_gets_map_and_scan_and_its_goal_reaches_move_base() -> N
             assert 0 < sim_times[-1] <= run.executor.now_ns
             assert got["/map"].info.width > 100 and len(got["/mybot/laser/scan"].ranges) > 100  # type: ignore[attr-defined]
             # publish a goal as Foxglove's 3D panel does: advertise a client channel, then binary messages
-            ws.send(json.dumps({"op": "advertise", "channels": [{"id": 7, "topic": "/move_base_simple/goal",
-                                "encoding": "cdr", "schemaName": "geometry_msgs/msg/PoseStamped"}]}))  # fmt: skip
+            ws.send(
+                json.dumps(
+                    {
+                        "op": "advertise",
+                        "channels": [
+                            {
+                                "id": 7,
+                                "topic": "/move_base_simple/goal",
+                                "encoding": "cdr",
+                                "schemaName": "geometry_msgs/msg/PoseStamped",
+                            }
+                        ],
+                    }
+                )
+            )
             time.sleep(0.3)
             goal = msgs.pose_stamped(0, "map", -1.5, 0.0, 3.14)
             ws.send(b"\x01" + struct.pack("<I", 7) + bytes(msgs.TYPESTORE.serialize_cdr(goal, msgs.type_name(goal))))
@@ -73,9 +92,15 @@ def test_foxglove_client_gets_map_and_scan_and_its_goal_reaches_move_base() -> N
 
 
 def test_json_encoded_client_messages_become_ros_messages() -> None:
-    pose = message_from_json("geometry_msgs/msg/PoseWithCovarianceStamped", {
-        "header": {"frame_id": "map", "stamp": {"sec": 3, "nanosec": 5}},
-        "pose": {"pose": {"position": {"x": 1.0, "y": 2.0}, "orientation": {"z": 1.0, "w": 0.0}},
-                 "covariance": [0.25] + [0.0] * 35}})  # fmt: skip
+    pose = message_from_json(
+        "geometry_msgs/msg/PoseWithCovarianceStamped",
+        {
+            "header": {"frame_id": "map", "stamp": {"sec": 3, "nanosec": 5}},
+            "pose": {
+                "pose": {"position": {"x": 1.0, "y": 2.0}, "orientation": {"z": 1.0, "w": 0.0}},
+                "covariance": [0.25] + [0.0] * 35,
+            },
+        },
+    )
     assert msgs.pose2d(pose.pose.pose) == (1.0, 2.0, 3.141592653589793) and pose.header.frame_id == "map"
     assert msgs.stamp_ns(pose) == 3_000_000_005 and pose.pose.covariance[0] == 0.25

@@ -82,9 +82,18 @@ def test_a_page_gets_the_newest_placed_scan_while_a_newer_one_waits_for_its_pose
     hub = Hub()
 
     def scan(t_ns: int, r: float) -> object:
-        return msgs.LaserScan(header=msgs.header(t_ns, "laser"), angle_min=0.0, angle_max=0.0, angle_increment=0.01,
-                              time_increment=0.0, scan_time=0.0, range_min=0.1, range_max=10.0,
-                              ranges=np.array([r], dtype=np.float32), intensities=np.zeros(0, np.float32))  # fmt: skip
+        return msgs.LaserScan(
+            header=msgs.header(t_ns, "laser"),
+            angle_min=0.0,
+            angle_max=0.0,
+            angle_increment=0.01,
+            time_increment=0.0,
+            scan_time=0.0,
+            range_min=0.1,
+            range_max=10.0,
+            ranges=np.array([r], dtype=np.float32),
+            intensities=np.zeros(0, np.float32),
+        )
 
     hub.put("/scan", "scan", scan(1_000_000, 1.0))
     hub.place_scans("map", lambda frame, t_ns: [t_ns / 1e9, 0.0, 0.0])
@@ -111,11 +120,17 @@ def test_pose_array_yaw_from_quaternions() -> None:
 def test_inputs_are_checked_and_bad_ones_named() -> None:
     assert check_input({"op": "goal", "x": 1, "y": 2.5, "yaw": 0.1, "frame": "map"})[1]["x"] == 1.0
     assert check_input({"op": "spawn", "kind": "cylinder", "x": 0, "y": 0})[1]["dims"] == [0.2, 0.5]
-    for bad, word in [([1, 2], "JSON object"), ({"op": "rm -rf"}, "unknown op"), ({"op": "goal", "x": "1", "y": 0,
-                      "yaw": 0}, "'x'"), ({"op": "goal", "x": float("nan"), "y": 0, "yaw": 0}, "finite"),
-                      ({"op": "spawn", "kind": "house", "x": 0, "y": 0}, "kind"), ({"op": "key", "key": "ii"}, "key"),
-                      ({"op": "delete", "name": "../x"}, "name"), ({"op": "goal", "x": 0, "y": 0, "yaw": 0,
-                      "frame": "<script>"}, "frame"), ({"op": "speed", "value": -1}, "value")]:  # fmt: skip
+    for bad, word in [
+        ([1, 2], "JSON object"),
+        ({"op": "rm -rf"}, "unknown op"),
+        ({"op": "goal", "x": "1", "y": 0, "yaw": 0}, "'x'"),
+        ({"op": "goal", "x": float("nan"), "y": 0, "yaw": 0}, "finite"),
+        ({"op": "spawn", "kind": "house", "x": 0, "y": 0}, "kind"),
+        ({"op": "key", "key": "ii"}, "key"),
+        ({"op": "delete", "name": "../x"}, "name"),
+        ({"op": "goal", "x": 0, "y": 0, "yaw": 0, "frame": "<script>"}, "frame"),
+        ({"op": "speed", "value": -1}, "value"),
+    ]:
         with pytest.raises(ValueError, match=word):
             check_input(bad)
 

@@ -22,11 +22,30 @@ TRUTH = "/husky_with_a_long_namespace/ground_truth/odom"
 
 def test_tf_labels_at_one_place_are_joined_and_long_display_names_keep_their_ends(chromium: Any) -> None:
     hub = Hub()
-    tf = {"map": [0.0, 0.0, 0.0], "odom": [0.0, 0.0, 0.0],  # one place: one label
-          "base_link": [1.0, 0.5, 0.3], "imu_link": [1.0, 0.5, 0.3], "laser": [1.02, 0.5, 0.3],  # ~1 px apart
-          "caster": [1.0, 0.35, 0.3]}  # 9 px below base_link: its own label, stacked clear of the other  # fmt: skip
-    hub.set_state({"t": 1.0, "t0": 0.0, "t1": 1.0, "rtf": 1.0, "paused": True, "speed": 1.0, "fixed": "map",
-                   "base": "base_link", "tf": tf, "move_base": None, "obstacles": [], "replay": False})  # fmt: skip
+    tf = {
+        "map": [0.0, 0.0, 0.0],
+        "odom": [0.0, 0.0, 0.0],  # one place: one label
+        "base_link": [1.0, 0.5, 0.3],
+        "imu_link": [1.0, 0.5, 0.3],
+        "laser": [1.02, 0.5, 0.3],  # ~1 px apart
+        "caster": [1.0, 0.35, 0.3],
+    }  # 9 px below base_link: its own label, stacked clear of the other
+    hub.set_state(
+        {
+            "t": 1.0,
+            "t0": 0.0,
+            "t1": 1.0,
+            "rtf": 1.0,
+            "paused": True,
+            "speed": 1.0,
+            "fixed": "map",
+            "base": "base_link",
+            "tf": tf,
+            "move_base": None,
+            "obstacles": [],
+            "replay": False,
+        }
+    )
     for topic in (ODOM, TRUTH):
         hub.set_trace(topic, "map", [[0.0, 0.0], [1.0, 0.5]])
     with ViewerServer(hub, port=0) as server:

@@ -183,8 +183,7 @@ def test_nav_goal_drag_sends_the_robot_there(live: tuple[Run, Viewer], page: Any
     assert "SUCCEEDED" in page.inner_text("#outcome")
 
 
-def test_added_obstacle_appears_in_scan_and_local_costmap(live: tuple[Run, Viewer], page: Any,
-                                                          artifacts: Path) -> None:  # fmt: skip
+def test_added_obstacle_appears_in_scan_and_local_costmap(live: tuple[Run, Viewer], page: Any, artifacts: Path) -> None:
     run, viewer = live
     page.click("#pause")  # place it with the world held still
     assert _wait(lambda: page.evaluate("navlab.store.state.paused"))
@@ -262,8 +261,11 @@ def test_pose_estimate_drag_publishes_initialpose_to_amcl(live: tuple[Run, Viewe
 
     def reset_there() -> bool:
         est = amcl.filter.estimate if amcl.filter is not None else None
-        return est is not None and math.dist(est[:2], target) < 0.25 and abs(math.remainder(est[2] - math.pi / 2,
-                                                                                           math.tau)) < 0.4  # fmt: skip
+        return (
+            est is not None
+            and math.dist(est[:2], target) < 0.25
+            and abs(math.remainder(est[2] - math.pi / 2, math.tau)) < 0.4
+        )
 
     assert _wait(reset_there, 5)
     spread = np.asarray(amcl.filter.particles)[:, :2].std(axis=0)

@@ -50,8 +50,9 @@ def _odom_at(bag: Path, t_s: float) -> tuple[float, float, float]:
     return best
 
 
-def test_seek_shows_the_robot_where_it_was(served: tuple[BagPlayer, ViewerServer], chromium: Any, bag: Path,
-                                           artifacts: Path) -> None:  # fmt: skip
+def test_seek_shows_the_robot_where_it_was(
+    served: tuple[BagPlayer, ViewerServer], chromium: Any, bag: Path, artifacts: Path
+) -> None:
     _player, server = served
     page = open_page(chromium, server.url)
     page.wait_for_selector("#timeline:not([hidden])")

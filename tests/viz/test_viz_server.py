@@ -54,10 +54,20 @@ def test_serves_the_page_and_refuses_paths_outside_its_folder(server: ViewerServ
     assert _get(server, "/app.js")[0] == 200
     assert _get(server, "/missing.js")[0] == 404
     secret = "/etc/passwd"
-    for path in ["/../../../../etc/passwd", "/%2e%2e/%2e%2e/%2e%2e/etc/passwd", "/..%2f..%2f..%2fetc%2fpasswd",
-                 "/%2E%2E%5C%2E%2E%5Cetc%5Cpasswd", "/..\\..\\etc\\passwd", "//etc/passwd", "/%2fetc%2fpasswd",
-                 "/static/../../pyproject.toml", "/./app.js", "/app.js%00.png", "http://127.0.0.1/../../etc/passwd",
-                 secret]:  # fmt: skip
+    for path in [
+        "/../../../../etc/passwd",
+        "/%2e%2e/%2e%2e/%2e%2e/etc/passwd",
+        "/..%2f..%2f..%2fetc%2fpasswd",
+        "/%2E%2E%5C%2E%2E%5Cetc%5Cpasswd",
+        "/..\\..\\etc\\passwd",
+        "//etc/passwd",
+        "/%2fetc%2fpasswd",
+        "/static/../../pyproject.toml",
+        "/./app.js",
+        "/app.js%00.png",
+        "http://127.0.0.1/../../etc/passwd",
+        secret,
+    ]:
         status, body = _get(server, path)
         assert status in (400, 403, 404), path
         assert b"root:" not in body and b"[project]" not in body, path
@@ -81,8 +91,13 @@ def test_binds_loopback_by_default_and_warns_otherwise(server: ViewerServer) -> 
 
 
 def test_websocket_from_another_origin_or_host_is_refused(server: ViewerServer) -> None:
-    for origin in ["http://evil.example", f"http://evil.example:{server.port}", f"http://127.0.0.1:{server.port + 1}",
-                   "null", f"file://127.0.0.1:{server.port}"]:  # fmt: skip
+    for origin in [
+        "http://evil.example",
+        f"http://evil.example:{server.port}",
+        f"http://127.0.0.1:{server.port + 1}",
+        "null",
+        f"file://127.0.0.1:{server.port}",
+    ]:
         with pytest.raises(InvalidStatus) as info:
             _ws(server, origin)
         assert info.value.response.status_code == 403, origin
@@ -103,8 +118,12 @@ def test_survives_malformed_messages_and_mid_frame_disconnects(server: ViewerSer
     # a raw client: handshake, then half a frame announcing 4000 bytes, then gone
     sock = socket.create_connection(("127.0.0.1", server.port), timeout=5)
     key = base64.b64encode(os.urandom(16)).decode()
-    sock.sendall((f"GET /ws HTTP/1.1\r\nHost: 127.0.0.1:{server.port}\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
-                  f"Sec-WebSocket-Key: {key}\r\nSec-WebSocket-Version: 13\r\n\r\n").encode())  # fmt: skip
+    sock.sendall(
+        (
+            f"GET /ws HTTP/1.1\r\nHost: 127.0.0.1:{server.port}\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
+            f"Sec-WebSocket-Key: {key}\r\nSec-WebSocket-Version: 13\r\n\r\n"
+        ).encode()
+    )
     assert b"101" in sock.recv(4096).split(b"\r\n")[0]
     sock.sendall(bytes([0x81, 0x80 | 126]) + struct.pack(">H", 4000) + os.urandom(4) + b'{"op": "go')
     sock.close()

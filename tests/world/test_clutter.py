@@ -40,8 +40,10 @@ def test_same_seed_same_world_other_seed_other_world() -> None:
 
 
 def test_cylinder_count_grows_with_fill() -> None:
-    counts = [np.mean([len(generate_clutter(s, fill=f, smooth=2).cylinders) for s in range(3)])
-              for f in (0.1, 0.2, 0.3, 0.4, 0.5)]
+    counts = [
+        np.mean([len(generate_clutter(s, fill=f, smooth=2).cylinders) for s in range(3)])
+        for f in (0.1, 0.2, 0.3, 0.4, 0.5)
+    ]
     assert all(b > a for a, b in itertools.pairwise(counts)), counts
     assert len(generate_clutter(0, fill=0.0, smooth=0).cylinders) == 0
 
@@ -116,8 +118,7 @@ def test_reference_path_is_collision_free_and_at_least_the_straight_line(seed: i
     assert w.reference_path_m == pytest.approx(length)
     assert math.isfinite(length) and length >= 10.0 - 1e-9
     assert w.t_opt() == pytest.approx(length / 2.0)
-    dense = np.vstack([a + t * (b - a) for a, b in itertools.pairwise(p)
-                       for t in np.linspace(0.0, 1.0, 400)])
+    dense = np.vstack([a + t * (b - a) for a, b in itertools.pairwise(p) for t in np.linspace(0.0, 1.0, 400)])
     d = np.linalg.norm(dense[:, None, :] - w.cylinders[None, :, :], axis=2).min(axis=1)
     assert d.min() >= w.robot_radius + CYLINDER_RADIUS - 1e-6  # the disc never touches a cylinder
     beside_walls = dense[:, 0] <= FIELD  # the side walls run up to the field's far edge
@@ -170,8 +171,22 @@ def test_barn_score() -> None:
 
 def test_cli_writes_world_png_and_json(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     out, png = tmp_path / "c" / "clutter.world", tmp_path / "c" / "clutter.png"
-    code = main(["world", "clutter", "--seed", "3", "--fill", "0.3", "--smooth", "2", "--out", str(out.parent),
-                 "--png", "--json"])
+    code = main(
+        [
+            "world",
+            "clutter",
+            "--seed",
+            "3",
+            "--fill",
+            "0.3",
+            "--smooth",
+            "2",
+            "--out",
+            str(out.parent),
+            "--png",
+            "--json",
+        ]
+    )
     assert code == 0
     summary = json.loads(capsys.readouterr().out)
     w = generate_clutter(3, fill=0.3, smooth=2)

@@ -14,8 +14,11 @@ RES, BOUNDS, Z0, Z1 = 0.05, (-2.0, -2.0, 2.0, 2.0), 0.05, 0.5
 
 
 def _random_shape(rng: np.random.Generator, kind: str) -> tuple[Geometry, tuple[float, ...]]:
-    size = {"box": tuple(rng.uniform(0.1, 0.8, 3)), "cylinder": (rng.uniform(0.05, 0.4), rng.uniform(0.1, 0.8)),
-            "sphere": (rng.uniform(0.05, 0.4),)}[kind]
+    size = {
+        "box": tuple(rng.uniform(0.1, 0.8, 3)),
+        "cylinder": (rng.uniform(0.05, 0.4), rng.uniform(0.1, 0.8)),
+        "sphere": (rng.uniform(0.05, 0.4),),
+    }[kind]
     rpy = tuple(rng.uniform(-np.pi, np.pi, 3)) if rng.random() < 0.5 else (0.0, 0.0, rng.uniform(-np.pi, np.pi))
     pose = (*rng.uniform(-1.0, 1.0, 2), rng.uniform(0.1, 0.45), *rpy)  # centre inside the band
     return Geometry(kind, size=size), pose
@@ -35,8 +38,9 @@ def _inside(geom: Geometry, p: np.ndarray) -> np.ndarray:
 def test_occupancy_matches_point_sampling(seed):
     rng = np.random.default_rng(seed)
     geom, pose = _random_shape(rng, ("box", "cylinder", "sphere")[seed % 3])
-    model = ModelSpec(name="s", pose=pose, static=True,
-                      links=[Link(name="l", collisions=[Shape(geometry=geom, origin=Origin())])])
+    model = ModelSpec(
+        name="s", pose=pose, static=True, links=[Link(name="l", collisions=[Shape(geometry=geom, origin=Origin())])]
+    )
     grid = occupancy(WorldModel(name="w", models=[model]), RES, BOUNDS, z_min=Z0, z_max=Z1)
     # sample the band densely, keep points inside the shape
     step, reach = 0.01, float(np.linalg.norm(geom.size))  # reach bounds the shape's extent from its centre

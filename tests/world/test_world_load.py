@@ -75,8 +75,10 @@ def test_gazebo_model_path_env(monkeypatch):
 
 def _write(tmp_path, body: str, version: str = "1.6", name: str = "w.world") -> Path:
     f = tmp_path / name
-    f.write_text(f'<?xml version="1.0"?><sdf version="{version}"><world name="w">'
-                 f"<include><uri>model://ground_plane</uri></include>{body}</world></sdf>")
+    f.write_text(
+        f'<?xml version="1.0"?><sdf version="{version}"><world name="w">'
+        f"<include><uri>model://ground_plane</uri></include>{body}</world></sdf>"
+    )
     return f
 
 
@@ -120,18 +122,30 @@ def test_no_ground_plane_warns(tmp_path):
     assert not world.ground_plane and any("ground plane" in w for w in world.warnings)
 
 
-@pytest.mark.parametrize("body,pattern", [
-    ("<include><uri>model://no_such_model</uri></include>", r"w\.world.*model://no_such_model.*not found"),
-    ('<model name="m"><link name="l"><collision name="c"><geometry><box><size>1 1</size></box></geometry>'
-     "</collision></link></model>", r'<model name="m">/<link name="l">/<collision name="c">/<geometry>/<box>/<size>'),
-    ('<model name="m"><link name="l"><collision name="c"><geometry><cylinder><radius>-1</radius>'
-     "<length>1</length></cylinder></geometry></collision></link></model>", r"sizes must be positive"),
-    ('<model name="m"><link name="l"><collision name="c"><geometry><mesh><uri>meshes/gone.stl</uri></mesh>'
-     "</geometry></collision></link></model>", r'<model name="m">.*gone\.stl not found'),
-    ('<model name="m"><pose>0 0 x 0 0 0</pose></model>', r'<model name="m">/<pose>'),
-    ('<model name="m"><link name="a"/></model><model name="m"><link name="a"/></model>', r"duplicate model"),
-    ('<physics type="ode"><max_step_size>-1</max_step_size></physics>', r"<physics>/<max_step_size>"),
-])
+@pytest.mark.parametrize(
+    "body,pattern",
+    [
+        ("<include><uri>model://no_such_model</uri></include>", r"w\.world.*model://no_such_model.*not found"),
+        (
+            '<model name="m"><link name="l"><collision name="c"><geometry><box><size>1 1</size></box></geometry>'
+            "</collision></link></model>",
+            r'<model name="m">/<link name="l">/<collision name="c">/<geometry>/<box>/<size>',
+        ),
+        (
+            '<model name="m"><link name="l"><collision name="c"><geometry><cylinder><radius>-1</radius>'
+            "<length>1</length></cylinder></geometry></collision></link></model>",
+            r"sizes must be positive",
+        ),
+        (
+            '<model name="m"><link name="l"><collision name="c"><geometry><mesh><uri>meshes/gone.stl</uri></mesh>'
+            "</geometry></collision></link></model>",
+            r'<model name="m">.*gone\.stl not found',
+        ),
+        ('<model name="m"><pose>0 0 x 0 0 0</pose></model>', r'<model name="m">/<pose>'),
+        ('<model name="m"><link name="a"/></model><model name="m"><link name="a"/></model>', r"duplicate model"),
+        ('<physics type="ode"><max_step_size>-1</max_step_size></physics>', r"<physics>/<max_step_size>"),
+    ],
+)
 def test_bad_worlds_name_file_and_element(tmp_path, body, pattern):
     with pytest.raises(WorldError, match=pattern):
         load_world(_write(tmp_path, body))

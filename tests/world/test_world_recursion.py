@@ -14,8 +14,9 @@ HEAD = "<?xml version='1.0'?><sdf version='1.6'>"
 def _model(folder: Path, name: str, includes: str) -> None:
     (folder / name).mkdir(parents=True)
     (folder / name / "model.config").write_text(f"<model><name>{name}</name><sdf>model.sdf</sdf></model>")
-    (folder / name / "model.sdf").write_text(f"{HEAD}<model name='{name}'><include><uri>model://{includes}</uri>"
-                                             "</include><link name='l'/></model></sdf>")
+    (folder / name / "model.sdf").write_text(
+        f"{HEAD}<model name='{name}'><include><uri>model://{includes}</uri></include><link name='l'/></model></sdf>"
+    )
 
 
 @pytest.mark.parametrize(("a_includes", "chain"), [("a", "model.sdf -> model.sdf"), ("b", "-> model.sdf")])
@@ -32,12 +33,18 @@ def test_include_loops_are_refused_naming_the_chain(tmp_path: Path, a_includes: 
 def test_models_nested_without_end_are_refused(tmp_path: Path) -> None:
     depth = 2000
     world = tmp_path / "deep.world"
-    world.write_text(f"{HEAD}<world name='w'>" + "<model name='m'>" * depth + "<link name='l'/>"
-                     + "</model>" * depth + "</world></sdf>")
+    world.write_text(
+        f"{HEAD}<world name='w'>"
+        + "<model name='m'>" * depth
+        + "<link name='l'/>"
+        + "</model>" * depth
+        + "</world></sdf>"
+    )
     with pytest.raises(WorldError, match="nest deeper than 32 levels"):
         load_world(world)
     shallow = tmp_path / "shallow.world"
-    shallow.write_text(f"{HEAD}<world name='w'>" + "<model name='m'>" * 5 + "<link name='l'/>" + "</model>" * 5
-                       + "</world></sdf>")
+    shallow.write_text(
+        f"{HEAD}<world name='w'>" + "<model name='m'>" * 5 + "<link name='l'/>" + "</model>" * 5 + "</world></sdf>"
+    )
     (model,) = load_world(shallow).models
     assert model.links[0].name == "m::m::m::m::l"

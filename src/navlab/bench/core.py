@@ -80,9 +80,14 @@ def run_soak(args: argparse.Namespace) -> dict[str, Any]:
             gc.collect()
             samples[str(minute)] = round(_rss_mb(), 1)
     first, last = samples["1"], samples[str(int(minutes))]
-    return {"sim_min": int(minutes), "rss_mb_after_1_min": first, "rss_mb_end": last,
-            "growth_mb": round(last - first, 1), "rss_mb_by_minute": samples,
-            "wall_s": round(time.perf_counter() - t0, 1)}
+    return {
+        "sim_min": int(minutes),
+        "rss_mb_after_1_min": first,
+        "rss_mb_end": last,
+        "growth_mb": round(last - first, 1),
+        "rss_mb_by_minute": samples,
+        "wall_s": round(time.perf_counter() - t0, 1),
+    }
 
 
 def run_child(cmd: list[str]) -> dict[str, float]:

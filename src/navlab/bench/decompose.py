@@ -1,8 +1,8 @@
-"""``navlab bench decompose``: the first load of a furnished world (many concave meshes) before and
-after issue 13, on a generated world, each with a cold cache.
+"""``navlab bench decompose``: the first load of a furnished world (many concave meshes) with CoACD's
+defaults and with navlab's bounded, parallel decomposition, on a generated world, each with a cold cache.
 
 - ``before``: CoACD at its default effort, one mesh after another in this process (navlab before
-  issue 13);
+  bounded effort);
 - ``after_whole``: bounded effort (``decompose.EFFORTS["bounded"]``) in parallel worker processes,
   whole meshes;
 - ``after``: the same, decomposed only up to the reach of mybot (``decompose.robot_reach``): parts
@@ -52,8 +52,12 @@ def _piece(kind: str, rng: np.random.Generator) -> list[Box]:
         return [([0, 0, 0], [a, d, h]), ([0, d, 0], [d, b, h])]
     if kind == "sofa":  # U seen from above
         w, d, h = rng.uniform(1.5, 2.4), rng.uniform(0.8, 1.0), rng.uniform(0.7, 0.9)
-        return [([0, 0, 0], [w, 0.2, h]), ([0, 0.2, 0], [0.2, d, h * 0.7]), ([w - 0.2, 0.2, 0], [w, d, h * 0.7]),
-                ([0.2, 0.2, 0], [w - 0.2, d, 0.4])]
+        return [
+            ([0, 0, 0], [w, 0.2, h]),
+            ([0, 0.2, 0], [0.2, d, h * 0.7]),
+            ([w - 0.2, 0.2, 0], [w, d, h * 0.7]),
+            ([0.2, 0.2, 0], [w - 0.2, d, 0.4]),
+        ]
     if kind == "shelf":  # open shelf: sides, back and boards
         w, d, h = rng.uniform(0.8, 1.4), rng.uniform(0.3, 0.45), rng.uniform(0.8, 1.8)
         boxes: list[Box] = [([0, 0, 0], [t, d, h]), ([w - t, 0, 0], [w, d, h]), ([0, d - t, 0], [w, d, h])]
@@ -88,12 +92,15 @@ def furnished_world(folder: Path, n: int = MESHES, seed: int = 0, kinds: tuple[s
             f'<sdf version="1.6"><model name="{name}"><static>true</static><link name="link">'
             f'<collision name="c"><geometry><mesh><uri>model://{name}/meshes/{name}.stl</uri></mesh></geometry>'
             f'</collision><visual name="v"><geometry><mesh><uri>model://{name}/meshes/{name}.stl</uri></mesh>'
-            "</geometry></visual></link></model></sdf>")
+            "</geometry></visual></link></model></sdf>"
+        )
         x, y = 3.0 * (i % 4), 3.0 * (i // 4)
         includes.append(f"<include><uri>model://{name}</uri><pose>{x} {y} 0 0 0 0</pose></include>")
     world = folder / "furnished.world"
-    world.write_text('<sdf version="1.6"><world name="furnished"><include><uri>model://ground_plane</uri>'
-                     f"</include>{''.join(includes)}</world></sdf>")
+    world.write_text(
+        '<sdf version="1.6"><world name="furnished"><include><uri>model://ground_plane</uri>'
+        f"</include>{''.join(includes)}</world></sdf>"
+    )
     return world
 
 
@@ -124,10 +131,16 @@ def _load_here(world_file: str, cache: str, effort: str, workers: int, reach: st
     meshes = decompose.concave_meshes(world, decompose.default_reach())
     parts = [len(decompose.convex_parts(p, s, cut=c)) for p, s, c in meshes]
     mb = 1024.0 if os.uname().sysname != "Darwin" else 1024.0 * 1024.0  # ru_maxrss: KiB on Linux, bytes on macOS
-    return {"wall_s": round(wall, 1), "cpu_s": round(cpu, 1), "meshes": len(meshes),
-            "parts_per_mesh": round(float(np.mean(parts)), 1), "geoms": int(sim.model.ngeom), "workers": workers,
-            "peak_rss_mb": round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / mb),
-            "peak_worker_rss_mb": round(resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / mb)}
+    return {
+        "wall_s": round(wall, 1),
+        "cpu_s": round(cpu, 1),
+        "meshes": len(meshes),
+        "parts_per_mesh": round(float(np.mean(parts)), 1),
+        "geoms": int(sim.model.ngeom),
+        "workers": workers,
+        "peak_rss_mb": round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / mb),
+        "peak_worker_rss_mb": round(resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / mb),
+    }
 
 
 def _first_load(world_file: Path, cache: Path, effort: str, workers: int, reach: str = "off") -> dict[str, Any]:
@@ -157,9 +170,16 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
         warm_s = time.perf_counter() - t0
         whole = _first_load(world, folder / "cache_whole", "bounded", workers, "off")
         before = _first_load(world, folder / "cache_before", "full", 1, "off")
-    return {"before": before, "after_whole": whole, "after": after, "reach_m": reach_s, "robot": ROBOT,
-            "warm_s": round(warm_s, 2), "warm_wall_s": warm["wall_s"],
-            "speedup_wall": round(before["wall_s"] / max(after["wall_s"], 1e-9), 1),
-            "speedup_cpu": round(before["cpu_s"] / max(after["cpu_s"], 1e-9), 1),
-            "reach_speedup_cpu": round(whole["cpu_s"] / max(after["cpu_s"], 1e-9), 2),
-            "note": "cold caches, each load in a fresh process; wall time on a shared machine depends on its load"}
+    return {
+        "before": before,
+        "after_whole": whole,
+        "after": after,
+        "reach_m": reach_s,
+        "robot": ROBOT,
+        "warm_s": round(warm_s, 2),
+        "warm_wall_s": warm["wall_s"],
+        "speedup_wall": round(before["wall_s"] / max(after["wall_s"], 1e-9), 1),
+        "speedup_cpu": round(before["cpu_s"] / max(after["cpu_s"], 1e-9), 1),
+        "reach_speedup_cpu": round(whole["cpu_s"] / max(after["cpu_s"], 1e-9), 2),
+        "note": "cold caches, each load in a fresh process; wall time on a shared machine depends on its load",
+    }

@@ -24,8 +24,9 @@ def run_mapping_bench(args: Any) -> dict[str, Any]:
     with tempfile.TemporaryDirectory() as tmp:
         # a short untimed run first: Numba's kernels load (or compile, on a cold cache) outside the figure
         run_mapping(world="room", out=Path(tmp) / "warmup", driver="explore", duration=WARMUP_S, quiet=True)
-        r = run_mapping(world="room", out=tmp, driver="explore", duration=300, seed=getattr(args, "seed", 0),
-                        quiet=True)  # fmt: skip
+        r = run_mapping(
+            world="room", out=tmp, driver="explore", duration=300, seed=getattr(args, "seed", 0), quiet=True
+        )
     keys = ("sim_s", "wall_s", "rtf", "finished", "scans_processed", "coverage", "precision", "recall")
     out = {k: r.scores[k] for k in keys}
     # this process's CPU time in the run loop: on a busy machine it shows what one free core would take
@@ -42,9 +43,13 @@ def run_nav(args: Any) -> dict[str, Any]:
     run_navigation(goals[:1], world="room_obstacles", goal_timeout=5, seed=getattr(args, "seed", 0))  # warm-up: Numba
     r = run_navigation(goals, world="room_obstacles", goal_timeout=90, seed=getattr(args, "seed", 0))
     s = r.summary
-    return {**{k: s[k] for k in ("sim_s", "wall_s", "rtf", "cpu_s")},
-            "rtf_cpu": round(s["sim_s"] / s["cpu_s"], 1) if s["cpu_s"] > 0 else None,
-            "goals_succeeded": s["goals_succeeded"], "goals": len(goals), "collisions": s["collisions"]}  # fmt: skip
+    return {
+        **{k: s[k] for k in ("sim_s", "wall_s", "rtf", "cpu_s")},
+        "rtf_cpu": round(s["sim_s"] / s["cpu_s"], 1) if s["cpu_s"] > 0 else None,
+        "goals_succeeded": s["goals_succeeded"],
+        "goals": len(goals),
+        "collisions": s["collisions"],
+    }
 
 
 def run_clutter(args: Any) -> dict[str, Any]:
@@ -54,23 +59,42 @@ def run_clutter(args: Any) -> dict[str, Any]:
     robot = getattr(args, "robot", None) or "jackal"
     controller = getattr(args, "controller", None) or ("mppi" if robot in ("mybot", "jackal") else None)
     speed = getattr(args, "max_speed", None)
-    out = run_protocol(n=int(getattr(args, "worlds", 0) or 50), which=getattr(args, "set", None) or "test",
-                       robot=robot, controller=controller,
-                       max_speed=(JACKAL_MAX_SPEED if controller else None) if speed is None else (speed or None),
-                       out=getattr(args, "out", None), seed=getattr(args, "seed", 0),
-                       progress=not getattr(args, "quiet", False))  # fmt: skip
+    out = run_protocol(
+        n=int(getattr(args, "worlds", 0) or 50),
+        which=getattr(args, "set", None) or "test",
+        robot=robot,
+        controller=controller,
+        max_speed=(JACKAL_MAX_SPEED if controller else None) if speed is None else (speed or None),
+        out=getattr(args, "out", None),
+        seed=getattr(args, "seed", 0),
+        progress=not getattr(args, "quiet", False),
+    )
     return out["summary"]
 
 
 def run_odom(args: Any) -> dict[str, Any]:
     """``navlab bench odom``: drift per robot, route and EKF setting (see the module)."""
     t0 = time.perf_counter()
-    runs = [run_drift(robot, route, ekf=ekf, seed=getattr(args, "seed", 0))
-            for robot in ROBOTS for route in ROUTES for ekf in (False, True)]  # fmt: skip
+    runs = [
+        run_drift(robot, route, ekf=ekf, seed=getattr(args, "seed", 0))
+        for robot in ROBOTS
+        for route in ROUTES
+        for ekf in (False, True)
+    ]
     out: dict[str, Any] = {}
     for r in runs:
         key = f"{r['robot']}/{r['route']}/{'ekf' if r['ekf'] else 'wheels'}"
-        out[key] = {k: r[k] for k in ("error_per_m", "yaw_error_per_rad", "final_error_m", "max_error_m",
-                                      "distance_m", "turned_rad", "completed")}  # fmt: skip
+        out[key] = {
+            k: r[k]
+            for k in (
+                "error_per_m",
+                "yaw_error_per_rad",
+                "final_error_m",
+                "max_error_m",
+                "distance_m",
+                "turned_rad",
+                "completed",
+            )
+        }
     out["wall_s"] = round(time.perf_counter() - t0, 1)
     return out

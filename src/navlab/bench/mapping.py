@@ -76,8 +76,13 @@ def office_scores(sim_log: Any, result: Any, truth: Any) -> dict[str, float]:
     a = ate(result.poses, truth_in_map)
     world_T_map = compose2(sim_log.start, (a["align_x"], a["align_y"], a["align_yaw"]))
     m = score_map(result.grid, truth, world_T_map=(float(world_T_map[0]), float(world_T_map[1]), float(world_T_map[2])))
-    return {"ate_rmse_m": a["rmse_m"], "ate_max_m": a["max_m"], "ate_share_over_0.5m": a["share_over_far"],
-            "precision": float(m["precision"]), "recall": float(m["recall"])}  # fmt: skip
+    return {
+        "ate_rmse_m": a["rmse_m"],
+        "ate_max_m": a["max_m"],
+        "ate_share_over_0.5m": a["share_over_far"],
+        "precision": float(m["precision"]),
+        "recall": float(m["recall"]),
+    }
 
 
 def run_office(args: argparse.Namespace) -> dict[str, Any]:
@@ -128,16 +133,32 @@ def run_gmapping(args: argparse.Namespace) -> dict[str, Any]:
     out: dict[str, Any] = {}
     for prefix, extra in (("", []), ("filter_", ["--set", "refine=false"])):
         with tempfile.TemporaryDirectory(prefix="navlab-bench-") as tmp:
-            cmd = [sys.executable, "-m", "navlab.cli", "slam", "--log", str(clf), "--mode", "gmapping", "--out", tmp,
-                   "--quiet", "--seed", str(getattr(args, "seed", 0)), *extra]  # fmt: skip
+            cmd = [
+                sys.executable,
+                "-m",
+                "navlab.cli",
+                "slam",
+                "--log",
+                str(clf),
+                "--mode",
+                "gmapping",
+                "--out",
+                tmp,
+                "--quiet",
+                "--seed",
+                str(getattr(args, "seed", 0)),
+                *extra,
+            ]
             usage = run_child(cmd)
             poses = np.loadtxt(Path(tmp) / "poses.txt")
         rel = relations_error(poses[:, 0], poses[:, 1:4], relations)
-        out.update({
-            **{prefix + k: round(v, 2) for k, v in usage.items()},
-            prefix + "relations_trans_m": round(float(rel["trans_abs_mean"]), 4),
-            prefix + "relations_rot_deg": round(float(rel["rot_abs_mean_deg"]), 3),
-            prefix + "relations_rot_max_deg": round(float(rel["rot_max_deg"]), 2),
-            prefix + "relations_over_5deg": rel["rot_over_5deg"],
-        })  # fmt: skip
+        out.update(
+            {
+                **{prefix + k: round(v, 2) for k, v in usage.items()},
+                prefix + "relations_trans_m": round(float(rel["trans_abs_mean"]), 4),
+                prefix + "relations_rot_deg": round(float(rel["rot_abs_mean_deg"]), 3),
+                prefix + "relations_rot_max_deg": round(float(rel["rot_max_deg"]), 2),
+                prefix + "relations_over_5deg": rel["rot_over_5deg"],
+            }
+        )
     return out

@@ -29,8 +29,9 @@ from navlab.navigation.controllers.mppi import MPPIController
 # --- controllers ------------------------------------------------------------------------------------
 
 
-def _time_cycles(ctrl: Any, plan: np.ndarray, scenes: list[tuple[tuple[float, float, float], Grid]],
-                 repeat: int) -> np.ndarray:
+def _time_cycles(
+    ctrl: Any, plan: np.ndarray, scenes: list[tuple[tuple[float, float, float], Grid]], repeat: int
+) -> np.ndarray:
     """Milliseconds of each ``compute_velocity`` over ``scenes`` (pose, local costmap), after a warm-up."""
     ctrl.set_plan(plan)
     for pose, local in scenes[:3]:

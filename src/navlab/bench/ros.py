@@ -53,11 +53,20 @@ class _Graph:
 
     def __init__(self, home: Path) -> None:
         port = _free_port()
-        self.env = {"PATH": "/usr/bin:/bin", "ROS_MASTER_URI": f"http://127.0.0.1:{port}/", "ROS_IP": "127.0.0.1",
-                    "ROS_HOME": str(home), "HOME": str(home)}
+        self.env = {
+            "PATH": "/usr/bin:/bin",
+            "ROS_MASTER_URI": f"http://127.0.0.1:{port}/",
+            "ROS_IP": "127.0.0.1",
+            "ROS_HOME": str(home),
+            "HOME": str(home),
+        }
         self.uri = self.env["ROS_MASTER_URI"]
-        self.proc = subprocess.Popen([_tool("rosmaster"), "--core", "-p", str(port)], env=self.env,
-                                     stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        self.proc = subprocess.Popen(
+            [_tool("rosmaster"), "--core", "-p", str(port)],
+            env=self.env,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+        )
         time.sleep(1.5)
 
     def close(self) -> None:
@@ -66,9 +75,16 @@ class _Graph:
 
 
 def _hz(graph: _Graph, topics: list[str]) -> dict[str, float | None]:
-    procs = {t: subprocess.Popen(["timeout", "-s", "INT", str(HZ_WINDOW_S), _tool("rostopic"), "hz", t],
-                                 env=graph.env, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
-             for t in topics}
+    procs = {
+        t: subprocess.Popen(
+            ["timeout", "-s", "INT", str(HZ_WINDOW_S), _tool("rostopic"), "hz", t],
+            env=graph.env,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.DEVNULL,
+            text=True,
+        )
+        for t in topics
+    }
     out: dict[str, float | None] = {}
     for topic, proc in procs.items():
         text, _ = proc.communicate(timeout=HZ_WINDOW_S + 20)
@@ -116,9 +132,12 @@ pub.publish(Twist()); time.sleep(0.3)
     timer.cancel()
     wall = [m[0] - s for m, s in zip(moving, sent, strict=False)]
     simulated = [(m[1] - i) / 1e9 for m, i in zip(moving, injected, strict=False)]
-    return {"samples": len(wall), "wall_median_s": round(statistics.median(wall), 4) if wall else None,
-            "wall_max_s": round(max(wall), 4) if wall else None,
-            "sim_median_s": round(statistics.median(simulated), 4) if simulated else None}
+    return {
+        "samples": len(wall),
+        "wall_median_s": round(statistics.median(wall), 4) if wall else None,
+        "wall_max_s": round(max(wall), 4) if wall else None,
+        "sim_median_s": round(statistics.median(simulated), 4) if simulated else None,
+    }
 
 
 def _drive(live: LiveRun, goal: tuple[float, float, float], timeout_s: float = 60.0) -> dict[str, Any]:
@@ -133,8 +152,13 @@ def _drive(live: LiveRun, goal: tuple[float, float, float], timeout_s: float = 6
 
 
 def _truth(graph: _Graph) -> tuple[float, float]:
-    out = subprocess.run([_tool("rostopic"), "echo", "-n", "1", "/ground_truth/odom/pose/pose/position"],
-                         env=graph.env, capture_output=True, text=True, timeout=30).stdout
+    out = subprocess.run(
+        [_tool("rostopic"), "echo", "-n", "1", "/ground_truth/odom/pose/pose/position"],
+        env=graph.env,
+        capture_output=True,
+        text=True,
+        timeout=30,
+    ).stdout
     x = re.search(r"x: (\S+)", out)
     y = re.search(r"y: (\S+)", out)
     return (float(x.group(1)), float(y.group(1))) if x and y else (math.nan, math.nan)
@@ -160,10 +184,21 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
                 single_rows = [_drive(single, g) for g in GOALS]
             finally:
                 single.close()
-            robot = subprocess.Popen([str(Path(sys.executable).parent / "navlab"), "launch", "sim", "ros:=true",
-                                      "world:=room", "--duration", "600", "--quiet"],
-                                     env={**graph.env, "PATH": f"{Path(sys.executable).parent}:/usr/bin:/bin"},
-                                     stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+            robot = subprocess.Popen(
+                [
+                    str(Path(sys.executable).parent / "navlab"),
+                    "launch",
+                    "sim",
+                    "ros:=true",
+                    "world:=room",
+                    "--duration",
+                    "600",
+                    "--quiet",
+                ],
+                env={**graph.env, "PATH": f"{Path(sys.executable).parent}:/usr/bin:/bin"},
+                stdout=subprocess.DEVNULL,
+                stderr=subprocess.DEVNULL,
+            )
             try:
                 _truth(graph)  # waits for the robot
                 hil = LiveRun(master=graph.uri, launch="navigation", map=str(map_yaml), sim="false", follow_clock=True)

@@ -80,15 +80,25 @@ def _nav_rtf(robot: str, seed: int, topic: str | None = None, params: str | None
     cpu0 = time.process_time()
     r = run_navigation(GOALS, goal_timeout=90, **kw)
     cpu = time.process_time() - cpu0
-    return {"rtf": round(r.summary["sim_s"] / cpu, 1), "rtf_wall": r.summary["rtf"],
-            "goals_succeeded": r.summary["goals_succeeded"], "collisions": r.summary["collisions"]}
+    return {
+        "rtf": round(r.summary["sim_s"] / cpu, 1),
+        "rtf_wall": r.summary["rtf"],
+        "goals_succeeded": r.summary["goals_succeeded"],
+        "collisions": r.summary["collisions"],
+    }
 
 
 class _Reader(Node):
     """Subscribes ``topic`` (an Image if ``image``, else a PointCloud2) so that the sensor computes every frame."""
 
-    def __init__(self, executor: Any, *, name: str = "bench_reader", parameters: dict[str, Any] | None = None,
-                 namespace: str = "") -> None:
+    def __init__(
+        self,
+        executor: Any,
+        *,
+        name: str = "bench_reader",
+        parameters: dict[str, Any] | None = None,
+        namespace: str = "",
+    ) -> None:
         super().__init__(executor, name=name, parameters=parameters, namespace=namespace)
         kind = msgs.Image if self.declare_parameter("image", False) else msgs.PointCloud2
         self.frames = 0
@@ -141,8 +151,15 @@ def _frames() -> dict[str, float]:
     pos, rot = sensor_pose(sim, cam.link, cam.origin)
     body = np.stack([pts[:, 2], -pts[:, 0], -pts[:, 1]], axis=1)  # optical -> camera body
     cloud = move_points(body[np.isfinite(body.sum(axis=1))], rot, pos)
-    layer = VoxelLayer({"z_resolution": 0.05, "z_voxels": 8}, name="voxel", sources={"cam": ObservationSource(
-        data_type="PointCloud2", clearing=True, min_obstacle_height=0.04, max_obstacle_height=0.35)})
+    layer = VoxelLayer(
+        {"z_resolution": 0.05, "z_voxels": 8},
+        name="voxel",
+        sources={
+            "cam": ObservationSource(
+                data_type="PointCloud2", clearing=True, min_obstacle_height=0.04, max_obstacle_height=0.35
+            )
+        },
+    )
     layer.match_size(Grid(np.zeros((80, 80), np.uint8), 0.05, (-2.0, -2.0, 0.0), "odom"))
     out["voxel_update_ms"] = _per_frame(lambda: layer.add_cloud(pos, cloud, source="cam"))
     return out

@@ -39,8 +39,14 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
     navlab = [sys.executable, "-m", "navlab.cli"]
     helps = [median([*navlab, verb, "--help"]) for verb in ("sim", "slam", "navigate")]
     sim = median([*navlab, "sim", "--duration", "0", "--quiet"])
-    trials = [json.loads(subprocess.run([sys.executable, "-c", _TRIAL], capture_output=True, text=True,
-                                        check=True).stdout.splitlines()[-1]) for _ in range(3)]  # fmt: skip
+    trials = [
+        json.loads(
+            subprocess.run(
+                [sys.executable, "-c", _TRIAL], capture_output=True, text=True, check=True
+            ).stdout.splitlines()[-1]
+        )
+        for _ in range(3)
+    ]
     return {
         "help_cpu_s": round(max(h["cpu_s"] for h in helps), 3),
         "help_wall_s": round(max(h["wall_s"] for h in helps), 3),

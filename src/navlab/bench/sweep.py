@@ -40,20 +40,45 @@ def run(args: Any) -> dict[str, Any]:
     ``ray_startup_s`` (``import ray`` + ``ray.init``) and ``ray_shutdown_s`` (which a sweep overlaps with
     writing its tables and plots); ``ray_overhead_s``: the Ray sweep's wall time over 2 local workers'."""
     per = int(getattr(args, "trials", None) or BENCH_TRIALS)
-    scenario = {"name": "bench_sweep", "world": "room", "goals": [[3.5, 3.0, 1.57], [-3.5, 0.0, -1.57]],
-                "trials": per, "seed": int(getattr(args, "seed", 0) or 0), "time_limit": 60}  # fmt: skip
-    out: dict[str, Any] = {"trials": 2 * per, "trials_per_combination": per, "cpus": os.cpu_count(),
-                           "load_1min": round(os.getloadavg()[0], 2)}  # fmt: skip
+    scenario = {
+        "name": "bench_sweep",
+        "world": "room",
+        "goals": [[3.5, 3.0, 1.57], [-3.5, 0.0, -1.57]],
+        "trials": per,
+        "seed": int(getattr(args, "seed", 0) or 0),
+        "time_limit": 60,
+    }
+    out: dict[str, Any] = {
+        "trials": 2 * per,
+        "trials_per_combination": per,
+        "cpus": os.cpu_count(),
+        "load_1min": round(os.getloadavg()[0], 2),
+    }
     env = {k: v for k, v in os.environ.items() if k != "RAY_ADDRESS"}  # a local instance: this machine's figure
     with tempfile.TemporaryDirectory(prefix="navlab-bench-sweep-") as tmp:
         path = Path(tmp) / "bench_sweep.yaml"
         path.write_text(yaml.safe_dump(scenario))
-        configs = [("workers_1", ["--workers", "1"]), ("workers_2", ["--workers", "2"]),
-                   ("ray_2", ["--workers", "2", "--backend", "ray"])]  # fmt: skip
+        configs = [
+            ("workers_1", ["--workers", "1"]),
+            ("workers_2", ["--workers", "2"]),
+            ("ray_2", ["--workers", "2", "--backend", "ray"]),
+        ]
         for k, (key, extra) in enumerate(configs + configs[::-1]):  # A B C C B A: drifting load hits all alike
-            cmd = [sys.executable, "-m", "navlab.cli", "experiment", "sweep", str(path), "--param",
-                   "controller=trajectory,dwa", "--out", str(Path(tmp) / f"{key}{k}"), "--quiet", "--json",
-                   *extra]  # fmt: skip
+            cmd = [
+                sys.executable,
+                "-m",
+                "navlab.cli",
+                "experiment",
+                "sweep",
+                str(path),
+                "--param",
+                "controller=trajectory,dwa",
+                "--out",
+                str(Path(tmp) / f"{key}{k}"),
+                "--quiet",
+                "--json",
+                *extra,
+            ]
             cpu0, t0 = _machine_cpu_s(), time.perf_counter()
             done = subprocess.run(cmd, env=env, capture_output=True, text=True, check=False)
             wall, cpu1 = time.perf_counter() - t0, _machine_cpu_s()
@@ -63,8 +88,9 @@ def run(args: Any) -> dict[str, Any]:
             if runs[-1] == min(runs):  # the less disturbed run is the figure
                 out[f"{key}_s"] = runs[-1]
                 out[f"{key}_cpu_s"] = round(cpu1 - cpu0, 1) if cpu0 is not None and cpu1 is not None else None
-        costs = subprocess.run([sys.executable, "-c", RAY_COSTS], env=env, capture_output=True, text=True,
-                               check=False, cwd=tmp)  # fmt: skip
+        costs = subprocess.run(
+            [sys.executable, "-c", RAY_COSTS], env=env, capture_output=True, text=True, check=False, cwd=tmp
+        )
         if costs.returncode != 0:
             raise ExperimentError(f"bench sweep: timing Ray's start-up failed: {costs.stderr.strip()[-500:]}")
     ray = json.loads(costs.stdout.strip().splitlines()[-1])

@@ -71,8 +71,11 @@ def main(argv: list[str] | None = None) -> int:
     args, extra = parser.parse_known_args(argv)
     if extra:  # `navlab launch mapping --duration 60 world:=room`: launch arguments may follow options, as in ROS
         target = next((a for a in ("args", "launch") if isinstance(getattr(args, a, None), list)), None)
-        if (target is None or any(e.startswith("-") for e in extra)
-                or (target == "launch" and not all(":=" in e for e in extra))):
+        if (
+            target is None
+            or any(e.startswith("-") for e in extra)
+            or (target == "launch" and not all(":=" in e for e in extra))
+        ):
             parser.error(f"unrecognized arguments: {' '.join(extra)}")
         getattr(args, target).extend(extra)
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING, format="%(levelname)s %(message)s")

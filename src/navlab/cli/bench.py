@@ -84,23 +84,46 @@ def register(sub: argparse._SubParsersAction) -> None:
         "as key suffixes). Run on an idle machine for stable numbers; the figures measured so far are in the "
         "docs (docs/mapping.md, docs/navigation.md, docs/viewer.md).",
     )
-    p.add_argument("name", choices=[*BENCHES, "all", "compare"],
-                   help="which benchmark to run; compare OLD.json NEW.json: the ratio of every shared figure")
+    p.add_argument(
+        "name",
+        choices=[*BENCHES, "all", "compare"],
+        help="which benchmark to run; compare OLD.json NEW.json: the ratio of every shared figure",
+    )
     p.add_argument("files", nargs="*", metavar="FILE.json", help="compare: the old and the new results")
     add_run_options(p, seed=0, quiet=True, json=True)
-    p.add_argument("--controller", default=None,
-                   help="clutter: local planner to drive with (trajectory, dwa, mppi, rpp or a ROS plugin name; "
-                   "default mppi for jackal and mybot, else the robot's own files')")
+    p.add_argument(
+        "--controller",
+        default=None,
+        help="clutter: local planner to drive with (trajectory, dwa, mppi, rpp or a ROS plugin name; "
+        "default mppi for jackal and mybot, else the robot's own files')",
+    )
     p.add_argument("--worlds", type=int, default=50, help="clutter: how many generated worlds (default 50)")
-    p.add_argument("--robot", default=None,
-                   help="clutter: shipped robot (default jackal; e.g. jackal_skid with its own move_base files)")
-    p.add_argument("--set", default="test", choices=["test", "tuning"],
-                   help="clutter: the 50 test worlds (report on these) or the separate tuning set (tune on these)")
-    p.add_argument("--max-speed", type=float, default=None, metavar="M_S",
-                   help="clutter: the controller's top speed (default 2.0, the Jackal's; 0 keeps the files')")
+    p.add_argument(
+        "--robot",
+        default=None,
+        help="clutter: shipped robot (default jackal; e.g. jackal_skid with its own move_base files)",
+    )
+    p.add_argument(
+        "--set",
+        default="test",
+        choices=["test", "tuning"],
+        help="clutter: the 50 test worlds (report on these) or the separate tuning set (tune on these)",
+    )
+    p.add_argument(
+        "--max-speed",
+        type=float,
+        default=None,
+        metavar="M_S",
+        help="clutter: the controller's top speed (default 2.0, the Jackal's; 0 keeps the files')",
+    )
     p.add_argument("--out", default=None, metavar="DIR", help="clutter: a picture of each failure in DIR")
-    p.add_argument("--trials", type=int, default=None,
-                   help="sweep: trials per combination (default 10; 2 combinations)")
-    p.add_argument("--minutes", type=float, default=60.0,
-                   help="soak: simulated minutes of the mapping launch (default 60); RSS after 1 and at the end")
+    p.add_argument(
+        "--trials", type=int, default=None, help="sweep: trials per combination (default 10; 2 combinations)"
+    )
+    p.add_argument(
+        "--minutes",
+        type=float,
+        default=60.0,
+        help="soak: simulated minutes of the mapping launch (default 60); RSS after 1 and at the end",
+    )
     p.set_defaults(func=_cmd)

@@ -56,16 +56,29 @@ def register(sub: argparse._SubParsersAction) -> None:
         "  navlab check world my.world --model-path ~/.gazebo/models",
     )
     p.add_argument("kind", choices=("robot", "world"), help="what FILE is")
-    p.add_argument("file", help="path of the .xacro/.urdf or .world file, or a shipped name "
-                   "(robot: mybot; world: room, room_obstacles)")
+    p.add_argument(
+        "file",
+        help="path of the .xacro/.urdf or .world file, or a shipped name (robot: mybot; world: room, room_obstacles)",
+    )
     add_run_options(p, json=True)
-    p.add_argument("--package-path", action="append", default=[], metavar="DIR",
-                   help="robot: a directory holding ROS packages for $(find pkg) and package:// "
-                   "(repeatable; ROS_PACKAGE_PATH is also searched)")
-    p.add_argument("--arg", action="append", default=[], metavar="NAME:=VALUE",
-                   help="robot: a xacro argument (repeatable)")
-    p.add_argument("--model-path", action="append", default=[], metavar="DIR",
-                   help="world: a directory holding Gazebo models for model:// includes (repeatable; "
-                   "GAZEBO_MODEL_PATH is also searched)")
+    p.add_argument(
+        "--package-path",
+        action="append",
+        default=[],
+        metavar="DIR",
+        help="robot: a directory holding ROS packages for $(find pkg) and package:// "
+        "(repeatable; ROS_PACKAGE_PATH is also searched)",
+    )
+    p.add_argument(
+        "--arg", action="append", default=[], metavar="NAME:=VALUE", help="robot: a xacro argument (repeatable)"
+    )
+    p.add_argument(
+        "--model-path",
+        action="append",
+        default=[],
+        metavar="DIR",
+        help="world: a directory holding Gazebo models for model:// includes (repeatable; "
+        "GAZEBO_MODEL_PATH is also searched)",
+    )
     p.add_argument("--strict", action="store_true", help="exit with status 1 if there are warnings")
     p.set_defaults(func=_cmd)

@@ -17,8 +17,11 @@ from navlab.cli.options import (
 )
 
 # relations_error's keys -> the CLI's JSON keys with unit suffixes (the old keys are printed too, deprecated)
-DEPRECATED_RELATION_KEYS = {"trans_abs_mean": "trans_abs_mean_m", "trans_abs_std": "trans_abs_std_m",
-                            "trans_sq_mean": "trans_sq_mean_m2"}
+DEPRECATED_RELATION_KEYS = {
+    "trans_abs_mean": "trans_abs_mean_m",
+    "trans_abs_std": "trans_abs_std_m",
+    "trans_sq_mean": "trans_sq_mean_m2",
+}
 
 
 def _cmd_eval_relations(args: argparse.Namespace) -> int:
@@ -43,8 +46,10 @@ def _cmd_eval_relations(args: argparse.Namespace) -> int:
         print(f"rotation:    {out['rot_abs_mean_deg']:.3f} ± {out['rot_abs_std_deg']:.3f} deg")
         if closure["n_triangles"]:
             n, median, floor = closure["n_triangles"], closure["closure_median_m"], closure["noise_floor_m"]
-            print(f"the relations' own {n} triangles close to {median:.4f} m median: with independent errors, "
-                  f"poses without error would score about {floor:.4f} m")  # fmt: skip
+            print(
+                f"the relations' own {n} triangles close to {median:.4f} m median: with independent errors, "
+                f"poses without error would score about {floor:.4f} m"
+            )
     return 0
 
 
@@ -52,16 +57,19 @@ def _cmd_eval_trajectory(args: argparse.Namespace) -> int:
     from navlab.experiments.trajectory import read_trajectory, trajectory_ate
 
     est = read_trajectory(args.estimate, carmen=args.carmen)
-    truth = read_trajectory(args.truth or args.estimate, carmen=args.carmen_truth,
-                            columns="estimate" if args.truth else "truth")  # fmt: skip
+    truth = read_trajectory(
+        args.truth or args.estimate, carmen=args.carmen_truth, columns="estimate" if args.truth else "truth"
+    )
     out = trajectory_ate(est, truth, tolerance=args.tolerance, align=not args.no_align, far=args.far)
     if args.json:
         print_figures(out, True)
     else:
         print(f"poses compared: {out['poses']} ({out['n_estimated']} estimated, {out['n_truth']} true)")
         print(f"ATE RMSE {out['rmse_m']:.4f} m, mean {out['mean_m']:.4f} m, max {out['max_m']:.4f} m")
-        print(f"poses off by > {args.far} m: {100 * out['share_over_far']:.1f} %; mean yaw error "
-              f"{out['yaw_mean_deg']:.3f} deg")  # fmt: skip
+        print(
+            f"poses off by > {args.far} m: {100 * out['share_over_far']:.1f} %; mean yaw error "
+            f"{out['yaw_mean_deg']:.3f} deg"
+        )
     return 0
 
 
@@ -108,13 +116,22 @@ def register(sub: argparse._SubParsersAction) -> None:
         "JSON keys carry their units (trans_abs_mean_m, rot_abs_mean_deg, ...); trans_abs_mean, trans_abs_std "
         "and trans_sq_mean are deprecated aliases kept for one release.",
     )
-    r.add_argument("poses", help="poses file: 'timestamp x y theta' per line, a TUM file, or a CARMEN log "
-                   "(its own odometry: see --carmen)")
-    r.add_argument("--carmen", choices=("flaser", "odom", "laser"), default="flaser",
-                   help="poses of a CARMEN log: flaser = the robot's odometry pose of each scan (default), "
-                   "odom = ODOM lines, laser = the laser's pose of each scan")
-    r.add_argument("relations", help="relations file: 't1 t2 x y z roll pitch yaw' per line, or its path inside "
-                   "$NAVLAB_DATA (e.g. mit-csail/mit-csail.relations)")
+    r.add_argument(
+        "poses",
+        help="poses file: 'timestamp x y theta' per line, a TUM file, or a CARMEN log (its own odometry: see --carmen)",
+    )
+    r.add_argument(
+        "--carmen",
+        choices=("flaser", "odom", "laser"),
+        default="flaser",
+        help="poses of a CARMEN log: flaser = the robot's odometry pose of each scan (default), "
+        "odom = ODOM lines, laser = the laser's pose of each scan",
+    )
+    r.add_argument(
+        "relations",
+        help="relations file: 't1 t2 x y z roll pitch yaw' per line, or its path inside "
+        "$NAVLAB_DATA (e.g. mit-csail/mit-csail.relations)",
+    )
     r.add_argument("--tolerance", type=float, default=1e-3, help="timestamp match tolerance in s (default 0.001)")
     add_run_options(r, json=True)
     r.set_defaults(func=_cmd_eval_relations)
@@ -129,12 +146,24 @@ def register(sub: argparse._SubParsersAction) -> None:
         "('t x y theta true_x true_y true_theta': without TRUTH its true columns are the truth).",
     )
     t.add_argument("estimate", metavar="EST", help="estimated trajectory file")
-    t.add_argument("truth", metavar="TRUTH", nargs="?", help="reference trajectory file (default: EST's true "
-                   "columns, for navlab map's trajectory.txt)")
-    t.add_argument("--carmen", choices=("flaser", "odom", "laser"), default="flaser",
-                   help="poses of EST when it is a CARMEN log (default flaser: the robot pose of each scan)")
-    t.add_argument("--carmen-truth", choices=("flaser", "odom", "laser"), default="flaser",
-                   help="poses of TRUTH when it is a CARMEN log (default flaser)")
+    t.add_argument(
+        "truth",
+        metavar="TRUTH",
+        nargs="?",
+        help="reference trajectory file (default: EST's true columns, for navlab map's trajectory.txt)",
+    )
+    t.add_argument(
+        "--carmen",
+        choices=("flaser", "odom", "laser"),
+        default="flaser",
+        help="poses of EST when it is a CARMEN log (default flaser: the robot pose of each scan)",
+    )
+    t.add_argument(
+        "--carmen-truth",
+        choices=("flaser", "odom", "laser"),
+        default="flaser",
+        help="poses of TRUTH when it is a CARMEN log (default flaser)",
+    )
     t.add_argument("--tolerance", type=float, default=0.02, help="timestamp match tolerance in s (default 0.02)")
     t.add_argument("--far", type=float, default=0.5, help="error (m) counted as far off (default 0.5)")
     t.add_argument("--no-align", action="store_true", help="compare the poses as given (no rigid alignment)")
@@ -152,13 +181,18 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     m.add_argument("map", help="map_server YAML file")
     m.add_argument("--world", required=True, help="world file or shipped name (room, room_obstacles)")
-    m.add_argument("--robot", default="mybot",
-                   help="the robot that mapped: .xacro/.urdf or shipped name (default mybot); its diff-drive "
-                   "odometry source decides the map frame")  # fmt: skip
+    m.add_argument(
+        "--robot",
+        default="mybot",
+        help="the robot that mapped: .xacro/.urdf or shipped name (default mybot); its diff-drive "
+        "odometry source decides the map frame",
+    )
     add_pose_arguments(m, "robot start")
     add_resource_path_arguments(m)
-    m.add_argument("--trajectory", metavar="FILE",
-                   help="SLAM vs true trajectory to score too (default: trajectory.txt beside the map, "
-                   "as navlab map writes it)")  # fmt: skip
+    m.add_argument(
+        "--trajectory",
+        metavar="FILE",
+        help="SLAM vs true trajectory to score too (default: trajectory.txt beside the map, as navlab map writes it)",
+    )
     add_run_options(m, json=True)
     m.set_defaults(func=_cmd_eval_map)

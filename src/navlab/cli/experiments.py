@@ -26,8 +26,16 @@ def _cmd_experiment(args: argparse.Namespace) -> int:
     if args.action == "sweep":
         from navlab.experiments.sweep import parse_params, run_sweep
 
-        rows = run_sweep(sc, parse_params(args.param), out, trials=args.trials, seed=args.seed, workers=args.workers,
-                         backend=args.backend, progress=not args.quiet and sys.stderr.isatty())  # fmt: skip
+        rows = run_sweep(
+            sc,
+            parse_params(args.param),
+            out,
+            trials=args.trials,
+            seed=args.seed,
+            workers=args.workers,
+            backend=args.backend,
+            progress=not args.quiet and sys.stderr.isatty(),
+        )
         if not args.json:
             print(f"{len(rows)} combinations of {sc.name}: {out}/sweep.md (+ sweep.csv, a PNG per parameter)")
             print((Path(out) / "sweep.md").read_text())
@@ -36,8 +44,15 @@ def _cmd_experiment(args: argparse.Namespace) -> int:
         return 0
     if args.param:
         raise ExperimentError("--param is for `navlab experiment sweep`")
-    summary = run_experiment(sc, out, trials=args.trials, seed=args.seed, workers=args.workers, backend=args.backend,
-                             progress=not args.quiet and sys.stderr.isatty())  # fmt: skip
+    summary = run_experiment(
+        sc,
+        out,
+        trials=args.trials,
+        seed=args.seed,
+        workers=args.workers,
+        backend=args.backend,
+        progress=not args.quiet and sys.stderr.isatty(),
+    )
     if not args.json:
         print(f"{summary['trials']} trials of {sc.name}: results in {out}/results.jsonl, summary in {out}/summary.json")
     print_figures(summary, args.json)
@@ -49,8 +64,10 @@ def _cmd_report(args: argparse.Namespace) -> int:
 
     out = render_report(args.dir)
     if not args.json:
-        print(f"{out['kind']} report: {out['html']} (one self-contained page) and {out['markdown']}, "
-              f"{len(out['figures'])} figures")
+        print(
+            f"{out['kind']} report: {out['html']} (one self-contained page) and {out['markdown']}, "
+            f"{len(out['figures'])} figures"
+        )
     else:
         print_figures(out, True)
     return 0
@@ -77,20 +94,37 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--param name=v1,v2 [--param ...]: the same for every combination, with DIR/sweep.md, sweep.csv and a plot "
         "per parameter. --backend ray runs the trials as Ray tasks (a cluster at $RAY_ADDRESS or a local instance).",
     )
-    p.add_argument("action", choices=["run", "sweep"],
-                   help="run: the scenario's trials; sweep: the trials for every combination of --param values")
+    p.add_argument(
+        "action",
+        choices=["run", "sweep"],
+        help="run: the scenario's trials; sweep: the trials for every combination of --param values",
+    )
     p.add_argument("file", help="scenario YAML, or a shipped scenario's name")
     p.add_argument("--trials", type=int, default=None, help="how many trials (default: the scenario's)")
-    p.add_argument("--seed", type=int, default=None,
-                   help="seed of trial 0; trial k uses seed + k (default: the scenario's)")
-    p.add_argument("--workers", type=int, default=None,
-                   help="parallel processes (local: default 1), or the CPUs of a local Ray instance (default all)")
-    p.add_argument("--backend", choices=["local", "ray"], default="local",
-                   help="local: worker processes on this machine (default); ray: Ray tasks on the cluster at "
-                   "$RAY_ADDRESS, or on a local Ray instance when it is not set (same results for the same seeds)")
-    p.add_argument("--param", action="append", default=[], metavar="NAME=V1,V2,...",
-                   help="sweep: a move_base parameter (or controller) and its values, e.g. "
-                   "local_costmap.update_frequency=0.5,1,2,5 (repeatable: the grid of all combinations)")
+    p.add_argument(
+        "--seed", type=int, default=None, help="seed of trial 0; trial k uses seed + k (default: the scenario's)"
+    )
+    p.add_argument(
+        "--workers",
+        type=int,
+        default=None,
+        help="parallel processes (local: default 1), or the CPUs of a local Ray instance (default all)",
+    )
+    p.add_argument(
+        "--backend",
+        choices=["local", "ray"],
+        default="local",
+        help="local: worker processes on this machine (default); ray: Ray tasks on the cluster at "
+        "$RAY_ADDRESS, or on a local Ray instance when it is not set (same results for the same seeds)",
+    )
+    p.add_argument(
+        "--param",
+        action="append",
+        default=[],
+        metavar="NAME=V1,V2,...",
+        help="sweep: a move_base parameter (or controller) and its values, e.g. "
+        "local_costmap.update_frequency=0.5,1,2,5 (repeatable: the grid of all combinations)",
+    )
     p.add_argument("--out", metavar="DIR", default=None, help="results folder (default runs/<scenario name>)")
     add_run_options(p, quiet=True, json=True)
     add_resource_path_arguments(p)

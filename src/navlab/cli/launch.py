@@ -83,8 +83,12 @@ def _cmd_launch(args: argparse.Namespace) -> int:
     signal.signal(signal.SIGTERM, lambda *_: ex.post(ex.stop))
     from navlab.cli.runs import viewing
 
-    with IntrospectionServer(ex, name=args.file), contextlib.suppress(KeyboardInterrupt), viewing(args, ex), \
-            ros_bridge(ros, ex, session.nodes, follow_clock=follow_clock):
+    with (
+        IntrospectionServer(ex, name=args.file),
+        contextlib.suppress(KeyboardInterrupt),
+        viewing(args, ex),
+        ros_bridge(ros, ex, session.nodes, follow_clock=follow_clock),
+    ):
         try:
             run_for(ex, duration, record=args.record, quiet=args.quiet, desc=Path(args.file).stem)
         finally:
@@ -115,7 +119,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
 
     apply_resource_paths(args)
     install()
-    files, items = (_split_files(args.launch, args.args) if args.launch else ([], args.args))
+    files, items = _split_files(args.launch, args.args) if args.launch else ([], args.args)
     if files:
         session = start(files, seed=args.seed, launch_args=parse_launch_args(items))
         ctx = rclpy_api.Context(session.executor, session, args.duration, prepared=True)
@@ -130,8 +134,11 @@ def _cmd_run(args: argparse.Namespace) -> int:
         sys.argv = argv
         rclpy_api.shutdown(context=ctx)
     ex = ctx.executor
-    summary = {"sim_s": round(ex.now_ns / 1e9, 3), "nodes": sorted(ex.nodes),
-               "topics": {name: t.count for name, t in sorted(ex.topics.items())}}
+    summary = {
+        "sim_s": round(ex.now_ns / 1e9, 3),
+        "nodes": sorted(ex.nodes),
+        "topics": {name: t.count for name, t in sorted(ex.topics.items())},
+    }
     if args.json:
         print(json.dumps(summary))
     return 0
@@ -148,7 +155,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     for verb in ("launch", "roslaunch"):
         p = sub.add_parser(
             verb,
-            help="run launch files: navlab YAML (ROS 2 shape) or ROS 1 XML .launch" if verb == "launch"
+            help="run launch files: navlab YAML (ROS 2 shape) or ROS 1 XML .launch"
+            if verb == "launch"
             else "roslaunch PKG FILE.launch [name:=value]: a ROS 1 launch file found in a package",
             description="Run launch files (paths or shipped names; several at once as `roslaunch a.launch b.launch` "
             "takes them) with name:=value arguments, in simulated time, and print how many messages each topic "
@@ -159,17 +167,34 @@ def register(sub: argparse._SubParsersAction) -> None:
             "`navlab launch localization map:=map/map.yaml`); `navlab launch NAME --show-args` lists a launch's "
             "arguments.",
         )
-        p.add_argument("file", help="launch file or shipped launch name" if verb == "launch"
-                       else "ROS package (then the launch file's name), or a launch file")
-        p.add_argument("args", nargs="*", metavar="FILE|name:=value",
-                       help="more launch files, then launch arguments")
-        p.add_argument("--duration", type=positive_seconds, default=None,
-                       help="simulated seconds to run (default: until Ctrl-C)")
-        add_run_options(p, seed=0, rate=None, rate_default="0 with --duration, else 1", record=True, quiet=True,
-                        json=True, view=True, ros=True)
+        p.add_argument(
+            "file",
+            help="launch file or shipped launch name"
+            if verb == "launch"
+            else "ROS package (then the launch file's name), or a launch file",
+        )
+        p.add_argument("args", nargs="*", metavar="FILE|name:=value", help="more launch files, then launch arguments")
+        p.add_argument(
+            "--duration", type=positive_seconds, default=None, help="simulated seconds to run (default: until Ctrl-C)"
+        )
+        add_run_options(
+            p,
+            seed=0,
+            rate=None,
+            rate_default="0 with --duration, else 1",
+            record=True,
+            quiet=True,
+            json=True,
+            view=True,
+            ros=True,
+        )
         add_resource_path_arguments(p)
-        p.add_argument("-s", "--show-args", action="store_true",
-                       help="list the launch's arguments (name, description, default) and exit")
+        p.add_argument(
+            "-s",
+            "--show-args",
+            action="store_true",
+            help="list the launch's arguments (name, description, default) and exit",
+        )
         p.set_defaults(func=_cmd_launch if verb == "launch" else _cmd_roslaunch)
 
     p = sub.add_parser(
@@ -184,8 +209,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("file", help="the Python file")
     p.add_argument("--launch", metavar="FILE", help="a launch (file or shipped name) to start for the node")
     p.add_argument("args", nargs="*", metavar="name:=value", help="launch arguments")
-    p.add_argument("--duration", type=positive_seconds, default=None,
-                   help="simulated seconds rclpy.spin() runs (default: until the file calls rclpy.shutdown())")
+    p.add_argument(
+        "--duration",
+        type=positive_seconds,
+        default=None,
+        help="simulated seconds rclpy.spin() runs (default: until the file calls rclpy.shutdown())",
+    )
     add_run_options(p, seed=0, json=True)
     add_resource_path_arguments(p)
     p.set_defaults(func=_cmd_run)

@@ -33,10 +33,21 @@ def _cmd_map(args: argparse.Namespace) -> int:
     driver = "teleop" if args.teleop else "route" if args.route else "explore"
     with view_hook(args) as view, ros_hook(args, view) as on_start:
         result = run_mapping(
-            world=args.world, robot=args.robot, pose=start_pose(args), out=args.out, driver=driver, route=args.route,
-            duration=args.duration, mode=args.mode, seed=args.seed, rate=args.rate or 0.0, record=args.record,
-            quiet=args.quiet, slam_params=parse_sets(args.set), on_start=on_start,
-        )  # fmt: skip
+            world=args.world,
+            robot=args.robot,
+            pose=start_pose(args),
+            out=args.out,
+            driver=driver,
+            route=args.route,
+            duration=args.duration,
+            mode=args.mode,
+            seed=args.seed,
+            rate=args.rate or 0.0,
+            record=args.record,
+            quiet=args.quiet,
+            slam_params=parse_sets(args.set),
+            on_start=on_start,
+        )
     if not args.json:
         print(f"saved {result.map_yaml} (+ map.pgm, map.png) after {result.sim_s:.1f} simulated s")
     print_figures(result.scores, args.json)
@@ -114,18 +125,25 @@ def _cmd_slam(args: argparse.Namespace) -> int:
     wall = time.perf_counter() - t0
     paths = write_outputs(result, args.out)
     paths["figure"] = Path(args.out) / "map.png"
-    plot_run(result.grid, [Track(result.poses, "SLAM trajectory", "r-", width=0.7)], paths["figure"],
-             title=f"{log.path.name if log.path else ''} ({args.mode})", crop=False)  # fmt: skip
+    plot_run(
+        result.grid,
+        [Track(result.poses, "SLAM trajectory", "r-", width=0.7)],
+        paths["figure"],
+        title=f"{log.path.name if log.path else ''} ({args.mode})",
+        crop=False,
+    )
     log_s = float(result.timestamps[-1] - result.timestamps[0])
-    summary = rounded({
-        "scans": len(result.timestamps),
-        "skipped_lines": len(log.skipped),
-        "log_s": log_s,
-        "wall_s": wall,
-        "rtf": log_s / wall if wall > 0 else None,
-        **result.stats,
-        **{k: str(v) for k, v in paths.items()},
-    })  # fmt: skip
+    summary = rounded(
+        {
+            "scans": len(result.timestamps),
+            "skipped_lines": len(log.skipped),
+            "log_s": log_s,
+            "wall_s": wall,
+            "rtf": log_s / wall if wall > 0 else None,
+            **result.stats,
+            **{k: str(v) for k, v in paths.items()},
+        }
+    )
     if args.json or not args.quiet:
         print_figures(summary, args.json)
     return 0
@@ -149,8 +167,9 @@ def _cmd_teleop(args: argparse.Namespace) -> int:
         ex.add_listener(lambda topic, msg, _t: remote.publish(topic, msg) if topic == "/cmd_vel" else None)
         print("driving the robot of the running navlab launch")
     else:  # the sim launch, here, in real time
-        run = start_run("sim", world=args.world or "room", robot=args.robot, pose=start_pose(args), seed=args.seed,
-                        rate=args.rate)  # fmt: skip
+        run = start_run(
+            "sim", world=args.world or "room", robot=args.robot, pose=start_pose(args), seed=args.seed, rate=args.rate
+        )
         ex, gazebo = run.executor, run.gazebo
     if args.joy:
         from navlab import msgs
@@ -187,8 +206,10 @@ def _show_teleop(teleop: Any, gazebo: Any) -> None:
     if gazebo is not None:
         x, y, yaw = gazebo.sim.base_pose2d()
         where = f"  robot at ({x:.2f}, {y:.2f}, {yaw:.2f} rad)"
-    sys.stderr.write(f"\rt={teleop.executor.now_ns / 1e9:7.1f} s  sending linear.x {tw.linear.x:+.2f} m/s  angular.z "
-                     f"{tw.angular.z:+.2f} rad/s  (currently: speed {st.speed:.2f} turn {st.turn:.2f}){where}  ")
+    sys.stderr.write(
+        f"\rt={teleop.executor.now_ns / 1e9:7.1f} s  sending linear.x {tw.linear.x:+.2f} m/s  angular.z "
+        f"{tw.angular.z:+.2f} rad/s  (currently: speed {st.speed:.2f} turn {st.turn:.2f}){where}  "
+    )
     sys.stderr.flush()
 
 
@@ -207,16 +228,22 @@ def register(sub: argparse._SubParsersAction) -> None:
     drive = p.add_mutually_exclusive_group()
     drive.add_argument("--explore", action="store_true", help="frontier exploration (the default)")
     drive.add_argument("--teleop", action="store_true", help="drive with the keyboard, in real time")
-    drive.add_argument("--route", metavar="FILE",
-                       help="a route YAML (segments and/or waypoints) or a shipped route's name (room)")
+    drive.add_argument(
+        "--route", metavar="FILE", help="a route YAML (segments and/or waypoints) or a shipped route's name (room)"
+    )
     p.add_argument("--out", default="map", metavar="DIR", help="output folder (default ./map)")
-    p.add_argument("--mode", default="gmapping",
-                   help="SLAM mode: gmapping, the paper's RBPF (default), or graph (pose graph)")  # fmt: skip
+    p.add_argument(
+        "--mode", default="gmapping", help="SLAM mode: gmapping, the paper's RBPF (default), or graph (pose graph)"
+    )
     add_set_argument(p, "slam_gmapping", "particles=50")
     p.add_argument("--duration", type=positive_seconds, default=600.0, help="at most this many simulated s (600)")
-    p.add_argument("--launch", nargs="+", metavar=("FILE", "name:=value"),
-                   help="save: start this launch here and save its /map after --duration (default: save the "
-                   "/map of the `navlab launch` running in another shell)")  # fmt: skip
+    p.add_argument(
+        "--launch",
+        nargs="+",
+        metavar=("FILE", "name:=value"),
+        help="save: start this launch here and save its /map after --duration (default: save the "
+        "/map of the `navlab launch` running in another shell)",
+    )
     p.add_argument("--pid", type=int, help="save: which running navlab launch, when several run")
     add_run_options(p, seed=0, rate=None, record=True, quiet=True, json=True, view=True, ros=True)
     p.set_defaults(func=_cmd_map)
@@ -228,8 +255,12 @@ def register(sub: argparse._SubParsersAction) -> None:
         "DIR/map.pgm (map_server format), DIR/poses.txt (one 'timestamp x y theta' line per scan, robot "
         "pose in the map frame) and DIR/map.png (map and trajectory), and print a summary (not with --quiet).",
     )
-    p.add_argument("--log", required=True, metavar="FILE.clf",
-                   help="CARMEN log file, or its path inside $NAVLAB_DATA (e.g. mit-csail/mit-csail.clf)")
+    p.add_argument(
+        "--log",
+        required=True,
+        metavar="FILE.clf",
+        help="CARMEN log file, or its path inside $NAVLAB_DATA (e.g. mit-csail/mit-csail.clf)",
+    )
     p.add_argument("--out", required=True, metavar="DIR", help="output directory (created if missing)")
     p.add_argument(
         "--mode",
@@ -237,8 +268,9 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="slam_gmapping's mode, a SLAM plugin: gmapping: the paper's Rao-Blackwellized particle filter "
         "(default, as in navlab map); graph: scan-to-map matching + loop closure + pose-graph optimisation",
     )
-    p.add_argument("--params", metavar="YAML", help="SLAM parameters: slam_gmapping's names (graph mode's own "
-                   "under 'graph:')")
+    p.add_argument(
+        "--params", metavar="YAML", help="SLAM parameters: slam_gmapping's names (graph mode's own under 'graph:')"
+    )
     add_set_argument(p, "slam_gmapping", "particles=50")
     p.add_argument("--resolution", type=float, default=0.05, help="map resolution in m/cell (default 0.05)")
     p.add_argument("--max-scans", type=int, default=None, help="only the first N scans")
@@ -253,14 +285,18 @@ def register(sub: argparse._SubParsersAction) -> None:
         "teleop_twist_keyboard does next to a ROS launch (e.g. `navlab launch mapping explore:=false`). "
         "With --world, or when no launch runs, it starts the simulator here in real time.",
     )
-    p.add_argument("--world", default=None,
-                   help="start this world here (file or shipped name) instead of driving a running launch")
+    p.add_argument(
+        "--world", default=None, help="start this world here (file or shipped name) instead of driving a running launch"
+    )
     p.add_argument("--pid", type=int, help="which running navlab launch to drive, when several run")
     p.add_argument("--robot", default="mybot", help="robot file or shipped name (default mybot)")
     add_pose_arguments(p)
     p.add_argument("--speed", type=float, default=0.5, help="linear speed, m/s (default 0.5)")
     p.add_argument("--turn", type=float, default=1.0, help="angular speed, rad/s (default 1.0)")
-    p.add_argument("--joy", action="store_true",
-                   help="drive with the first joystick (pygame; teleop_twist_joy's axes and deadman button 0)")
+    p.add_argument(
+        "--joy",
+        action="store_true",
+        help="drive with the first joystick (pygame; teleop_twist_joy's axes and deadman button 0)",
+    )
     add_run_options(p, seed=0, rate=1.0)
     p.set_defaults(func=_cmd_teleop)

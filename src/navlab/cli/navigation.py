@@ -31,12 +31,23 @@ def _cmd_navigate(args: argparse.Namespace) -> int:
         spawns.append((t, model))
     with view_hook(args) as view, ros_hook(args, view) as on_start:
         result = run_navigation(
-            [tuple(g) for g in args.goal], world=args.world, map_yaml=args.map, robot=args.robot,
-            pose=start_pose(args), controller=args.controller, params_dir=args.params,
-            move_base_params=parse_sets(args.set), spawn=spawns, goal_timeout=args.timeout, seed=args.seed,
-            record=args.record, snapshots=bool(args.out), mapless=args.mapless, on_start=on_start,
+            [tuple(g) for g in args.goal],
+            world=args.world,
+            map_yaml=args.map,
+            robot=args.robot,
+            pose=start_pose(args),
+            controller=args.controller,
+            params_dir=args.params,
+            move_base_params=parse_sets(args.set),
+            spawn=spawns,
+            goal_timeout=args.timeout,
+            seed=args.seed,
+            record=args.record,
+            snapshots=bool(args.out),
+            mapless=args.mapless,
+            on_start=on_start,
             progress=None if args.quiet else lambda text: print(text, file=sys.stderr, flush=True),
-        )  # fmt: skip
+        )
     figures: dict[str, Any] = {"goals": result.goals, **result.summary}
     if args.out:
         figures["pictures"] = save_goal_pictures(result, args.out)
@@ -46,15 +57,20 @@ def _cmd_navigate(args: argparse.Namespace) -> int:
         for k, g in enumerate(result.goals, 1):
             mb = g.get("move_base_outcome", g["outcome"])
             said = f" (move_base: {mb})" if mb != g["outcome"] else ""
-            print(f"goal {k} ({', '.join(f'{v:g}' for v in g['goal'])}): {g['outcome']}{said} in {g['time_s']} s, "
-                  f"path "
-                  f"{g['path_m']} m, closest {g['min_clearance_m']} m, {g['collisions']} collisions"
-                  + (f" ({g['reason']})" if g["reason"] else ""))  # fmt: skip
+            print(
+                f"goal {k} ({', '.join(f'{v:g}' for v in g['goal'])}): {g['outcome']}{said} in {g['time_s']} s, "
+                f"path "
+                f"{g['path_m']} m, closest {g['min_clearance_m']} m, {g['collisions']} collisions"
+                + (f" ({g['reason']})" if g["reason"] else "")
+            )
         print_figures({k: v for k, v in figures.items() if k != "goals"}, False)
     failed = [g for g in result.goals if g["outcome"] != "succeeded"]
     if failed:  # as a script would want it: 0 only when every goal succeeded
-        print(f"navlab: {len(failed)} of {len(result.goals)} goals not reached "
-              f"({', '.join(sorted({g['outcome'] for g in failed}))})", file=sys.stderr)
+        print(
+            f"navlab: {len(failed)} of {len(result.goals)} goals not reached "
+            f"({', '.join(sorted({g['outcome'] for g in failed}))})",
+            file=sys.stderr,
+        )
         return 1
     return 0
 
@@ -74,24 +90,54 @@ def register(sub: argparse._SubParsersAction) -> None:
         "when every goal succeeded (1 otherwise).",
     )
     add_world_robot(p, "room_obstacles")
-    p.add_argument("--map", metavar="MAP.yaml", default=None,
-                   help="map_server map to navigate on; default: the world's true occupancy at 5 cm")
-    p.add_argument("--mapless", action="store_true",
-                   help="no map and no amcl: move_base's global costmap rolls in odom, built from the laser; "
-                   "goals are then in odom (the start pose)")  # fmt: skip
-    p.add_argument("--goal", nargs=3, type=coordinate, action="append", required=True, metavar=("X", "Y", "YAW"),
-                   help="a goal in the map frame (odom with --mapless) (m, m, rad); repeat for a sequence")  # fmt: skip
-    p.add_argument("--controller", default=None,
-                   help="local planner: trajectory (TrajectoryPlannerROS), dwa (DWAPlannerROS), mppi, or a ROS "
-                   "plugin name (default: move_base_params.yaml's base_local_planner)")  # fmt: skip
-    p.add_argument("--params", metavar="DIR", default=None,
-                   help="folder of move_base's ROS 1 parameter files (default: the shipped params/mybot)")
+    p.add_argument(
+        "--map",
+        metavar="MAP.yaml",
+        default=None,
+        help="map_server map to navigate on; default: the world's true occupancy at 5 cm",
+    )
+    p.add_argument(
+        "--mapless",
+        action="store_true",
+        help="no map and no amcl: move_base's global costmap rolls in odom, built from the laser; "
+        "goals are then in odom (the start pose)",
+    )
+    p.add_argument(
+        "--goal",
+        nargs=3,
+        type=coordinate,
+        action="append",
+        required=True,
+        metavar=("X", "Y", "YAW"),
+        help="a goal in the map frame (odom with --mapless) (m, m, rad); repeat for a sequence",
+    )
+    p.add_argument(
+        "--controller",
+        default=None,
+        help="local planner: trajectory (TrajectoryPlannerROS), dwa (DWAPlannerROS), mppi, or a ROS "
+        "plugin name (default: move_base_params.yaml's base_local_planner)",
+    )
+    p.add_argument(
+        "--params",
+        metavar="DIR",
+        default=None,
+        help="folder of move_base's ROS 1 parameter files (default: the shipped params/mybot)",
+    )
     add_set_argument(p, "move_base", "local_costmap.update_frequency=1.0")
-    p.add_argument("--spawn", action="append", default=[], metavar="SPEC",
-                   help="add an obstacle while running, e.g. 'cylinder:x=1,y=0.5,radius=0.15,length=0.5,t=5' "
-                   "(see navlab sim --help; repeatable)")  # fmt: skip
+    p.add_argument(
+        "--spawn",
+        action="append",
+        default=[],
+        metavar="SPEC",
+        help="add an obstacle while running, e.g. 'cylinder:x=1,y=0.5,radius=0.15,length=0.5,t=5' "
+        "(see navlab sim --help; repeatable)",
+    )
     p.add_argument("--timeout", type=positive_seconds, default=90.0, help="simulated s allowed per goal (90)")
-    p.add_argument("--out", metavar="DIR", default=None,
-                   help="save two pictures per goal into DIR: goal_N.png when it ended, goal_N_mid.png mid-drive")
+    p.add_argument(
+        "--out",
+        metavar="DIR",
+        default=None,
+        help="save two pictures per goal into DIR: goal_N.png when it ended, goal_N_mid.png mid-drive",
+    )
     add_run_options(p, seed=0, rate=None, record=True, quiet=True, json=True, view=True, ros=True)
     p.set_defaults(func=_cmd_navigate)

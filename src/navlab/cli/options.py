@@ -77,12 +77,21 @@ def add_world_robot(p: argparse.ArgumentParser, world: str) -> None:
 def add_resource_path_arguments(p: argparse.ArgumentParser) -> None:
     """``--package-path DIR`` and ``--model-path DIR`` (repeatable): where ``package://``/``$(find pkg)``
     and ``model://`` are looked up, before ``ROS_PACKAGE_PATH`` and ``GAZEBO_MODEL_PATH``."""
-    p.add_argument("--package-path", action="append", default=[], metavar="DIR",
-                   help="a folder holding ROS packages for package:// and $(find pkg) (repeatable; searched "
-                   "before ROS_PACKAGE_PATH)")
-    p.add_argument("--model-path", action="append", default=[], metavar="DIR",
-                   help="a folder holding Gazebo models for model:// (repeatable; searched before "
-                   "GAZEBO_MODEL_PATH)")
+    p.add_argument(
+        "--package-path",
+        action="append",
+        default=[],
+        metavar="DIR",
+        help="a folder holding ROS packages for package:// and $(find pkg) (repeatable; searched "
+        "before ROS_PACKAGE_PATH)",
+    )
+    p.add_argument(
+        "--model-path",
+        action="append",
+        default=[],
+        metavar="DIR",
+        help="a folder holding Gazebo models for model:// (repeatable; searched before GAZEBO_MODEL_PATH)",
+    )
 
 
 def apply_resource_paths(args: argparse.Namespace) -> None:
@@ -99,8 +108,13 @@ def apply_resource_paths(args: argparse.Namespace) -> None:
 
 def add_set_argument(p: argparse.ArgumentParser, node: str, example: str) -> None:
     """``--set NAME=VALUE`` (repeatable): one parameter of ``node``, parsed as YAML."""
-    p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
-                   help=f"override one {node} parameter, e.g. --set {example} (repeatable)")  # fmt: skip
+    p.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help=f"override one {node} parameter, e.g. --set {example} (repeatable)",
+    )
 
 
 def parse_sets(items: Sequence[str]) -> dict[str, Any]:
@@ -138,8 +152,11 @@ def out_file(out: str, name: str, *, old_suffixes: tuple[str, ...]) -> Path:
 
     path = Path(out)
     if path.suffix.lower() in old_suffixes:
-        print(f"navlab: DeprecationWarning: --out {out}: --out names a folder now (it gets {name}); a file name is "
-              "accepted until the next release", file=sys.stderr)  # fmt: skip
+        print(
+            f"navlab: DeprecationWarning: --out {out}: --out names a folder now (it gets {name}); a file name is "
+            "accepted until the next release",
+            file=sys.stderr,
+        )
         path.parent.mkdir(parents=True, exist_ok=True)
         return path
     path.mkdir(parents=True, exist_ok=True)
@@ -199,48 +216,85 @@ class DeprecatedAlias(argparse.Action):
         self.new = new
         super().__init__(option_strings, dest, **kwargs)
 
-    def __call__(self, parser: argparse.ArgumentParser, namespace: argparse.Namespace, values: Any,
-                 option_string: str | None = None) -> None:
+    def __call__(
+        self,
+        parser: argparse.ArgumentParser,
+        namespace: argparse.Namespace,
+        values: Any,
+        option_string: str | None = None,
+    ) -> None:
         import sys
 
-        print(f"navlab: DeprecationWarning: {option_string} is deprecated, use {self.new} (accepted until the next "
-              "release)", file=sys.stderr)
+        print(
+            f"navlab: DeprecationWarning: {option_string} is deprecated, use {self.new} (accepted until the next "
+            "release)",
+            file=sys.stderr,
+        )
         setattr(namespace, self.dest, values)
 
 
 def add_server_arguments(p: argparse.ArgumentParser, *, prefix: str = "") -> None:
     """``--host``, ``--port`` (with ``prefix``: ``--view-host``, ``--view-port``), ``--no-browser``, ``--foxglove``."""
-    p.add_argument(f"--{prefix}host", default="127.0.0.1",
-                   help="address to listen on (default 127.0.0.1: this machine only; anything else warns)")
-    p.add_argument(f"--{prefix}port", type=int, default=DEFAULT_VIEW_PORT,
-                   help=f"port of the page and its WebSocket (default {DEFAULT_VIEW_PORT}; 0 = any free port)")
+    p.add_argument(
+        f"--{prefix}host",
+        default="127.0.0.1",
+        help="address to listen on (default 127.0.0.1: this machine only; anything else warns)",
+    )
+    p.add_argument(
+        f"--{prefix}port",
+        type=int,
+        default=DEFAULT_VIEW_PORT,
+        help=f"port of the page and its WebSocket (default {DEFAULT_VIEW_PORT}; 0 = any free port)",
+    )
     p.add_argument("--no-browser", action="store_true", help="print the URL only, do not open a browser")
-    p.add_argument("--foxglove", nargs="?", type=int, const=8766, default=None, metavar="PORT",
-                   help="also serve the topics to Foxglove (its WebSocket protocol, ROS 2 schemas) on PORT "
-                   "(default 8766); Foxglove's 3D panel can publish goals and initial poses")
+    p.add_argument(
+        "--foxglove",
+        nargs="?",
+        type=int,
+        const=8766,
+        default=None,
+        metavar="PORT",
+        help="also serve the topics to Foxglove (its WebSocket protocol, ROS 2 schemas) on PORT "
+        "(default 8766); Foxglove's 3D panel can publish goals and initial poses",
+    )
 
 
 def add_view_arguments(p: argparse.ArgumentParser) -> None:
     """``--view`` and its server options, for verbs that run a simulation."""
-    p.add_argument("--view", action="store_true",
-                   help="watch and command the run in a browser page (navlab view's viewer, paced at real time; "
-                   "the page can pause and change the speed)")
+    p.add_argument(
+        "--view",
+        action="store_true",
+        help="watch and command the run in a browser page (navlab view's viewer, paced at real time; "
+        "the page can pause and change the speed)",
+    )
     add_server_arguments(p, prefix="view-")
 
 
 def add_ros_argument(p: argparse.ArgumentParser) -> None:
     """``--ros``: offer the run on a ROS 1 master (``$ROS_MASTER_URI``, or navlab's own)."""
-    p.add_argument("--ros", action="store_true",
-                   help="join the ROS 1 graph at $ROS_MASTER_URI (or start navlab's own master): real rostopic, "
-                   "rviz, rosbag and rospy nodes see and drive the run; runs in real time unless --rate")
+    p.add_argument(
+        "--ros",
+        action="store_true",
+        help="join the ROS 1 graph at $ROS_MASTER_URI (or start navlab's own master): real rostopic, "
+        "rviz, rosbag and rospy nodes see and drive the run; runs in real time unless --rate",
+    )
 
 
 _UNSET: Any = object()
 
 
-def add_run_options(p: argparse.ArgumentParser, *, seed: int | None = _UNSET, json: bool = False,
-                    quiet: bool = False, record: bool = False, rate: float | None = _UNSET,
-                    rate_default: str = "0; real time with --ros", view: bool = False, ros: bool = False) -> None:
+def add_run_options(
+    p: argparse.ArgumentParser,
+    *,
+    seed: int | None = _UNSET,
+    json: bool = False,
+    quiet: bool = False,
+    record: bool = False,
+    rate: float | None = _UNSET,
+    rate_default: str = "0; real time with --ros",
+    view: bool = False,
+    ros: bool = False,
+) -> None:
     """The options a run verb shares, each declared here once with one help text: ``--seed`` (given a default),
     ``--json``, ``--quiet``, ``--record DIR``, ``--rate`` (given a default; None = decided by the verb, which
     ``rate_default`` describes), ``--view`` with its server options and ``--ros``."""
@@ -250,8 +304,9 @@ def add_run_options(p: argparse.ArgumentParser, *, seed: int | None = _UNSET, js
         shown = rate_default if rate is None else f"{rate:g}"
         p.add_argument("--rate", type=pace, default=rate, help=f"{RATE_HELP} (default {shown})")
     if record:
-        p.add_argument("--record", default=None, metavar="DIR",
-                       help="also write every topic to a rosbag2 (MCAP) in DIR")
+        p.add_argument(
+            "--record", default=None, metavar="DIR", help="also write every topic to a rosbag2 (MCAP) in DIR"
+        )
     if quiet:
         p.add_argument("--quiet", action="store_true", help="no progress output on stderr")
     if json:

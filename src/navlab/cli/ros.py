@@ -28,13 +28,19 @@ if TYPE_CHECKING:  # navlab.core loads numpy and rosbags: imported where a verb 
 def _add_source(p: argparse.ArgumentParser) -> None:
     src = p.add_mutually_exclusive_group()
     src.add_argument(
-        "--launch", nargs="+", metavar=("FILE", "name:=value"),
+        "--launch",
+        nargs="+",
+        metavar=("FILE", "name:=value"),
         help="start this launch (file or shipped name, then its arguments) here and watch it",
     )
     src.add_argument("--bag", metavar="DIR", help="read a rosbag2 recording instead")
     src.add_argument("--pid", type=int, help="which running `navlab launch` to watch when several run")
-    p.add_argument("--duration", type=positive_seconds, default=None,
-                   help="simulated seconds to watch (default 5; echo: until Ctrl-C or the end of the launch)")
+    p.add_argument(
+        "--duration",
+        type=positive_seconds,
+        default=None,
+        help="simulated seconds to watch (default 5; echo: until Ctrl-C or the end of the launch)",
+    )
     add_run_options(p, seed=0)
 
 
@@ -256,8 +262,13 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("action", choices=["list", "echo", "hz"], help="what to do")
     p.add_argument("topic", nargs="?", help="topic name (echo, hz)")
     _add_source(p)
-    p.add_argument("-n", "--count", type=int, default=0,
-                   help="echo: stop after this many messages (exit 1 if the source ends before)")
+    p.add_argument(
+        "-n",
+        "--count",
+        type=int,
+        default=0,
+        help="echo: stop after this many messages (exit 1 if the source ends before)",
+    )
     p.add_argument("-v", "--verbose", action="store_true", help="list: show message counts")
     add_run_options(p, json=True)
     p.set_defaults(func=_cmd_topic)
@@ -282,14 +293,16 @@ def register(sub: argparse._SubParsersAction) -> None:
         "subscriber, laid out left to right by Graphviz's dot (Debian package graphviz).",
     )
     _add_source(p)
-    p.add_argument("--out", default="graph", metavar="DIR",
-                   help="output folder: DIR/graph.dot and DIR/graph.svg (default ./graph)")
+    p.add_argument(
+        "--out", default="graph", metavar="DIR", help="output folder: DIR/graph.dot and DIR/graph.svg (default ./graph)"
+    )
     p.set_defaults(func=_cmd_graph)
 
     p = sub.add_parser(
-        "roscore", help="run a ROS 1 master + parameter server (for real ROS tools and navlab's --ros runs)",
+        "roscore",
+        help="run a ROS 1 master + parameter server (for real ROS tools and navlab's --ros runs)",
         description="A ROS 1 master and parameter server, as `roscore` starts them, on $ROS_MASTER_URI's port "
-                    "(default 11311). It listens on loopback unless ROS_IP or ROS_HOSTNAME name another address.",
+        "(default 11311). It listens on loopback unless ROS_IP or ROS_HOSTNAME name another address.",
     )
     p.add_argument("-p", "--port", type=int, default=None, help="port (default: from $ROS_MASTER_URI, else 11311)")
     p.set_defaults(func=_cmd_roscore)

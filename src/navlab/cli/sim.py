@@ -29,10 +29,14 @@ _SPAWN_HELP = (
 
 
 def _add_common(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--world", default="room", help="shipped world (room, room_obstacles) or a .world file "
-                   "(default: room)")
-    p.add_argument("--robot", default="mybot", help="shipped robot (mybot), a .xacro/.urdf file or a "
-                   "package://pkg/urdf/robot.xacro URI (default: mybot)")
+    p.add_argument(
+        "--world", default="room", help="shipped world (room, room_obstacles) or a .world file (default: room)"
+    )
+    p.add_argument(
+        "--robot",
+        default="mybot",
+        help="shipped robot (mybot), a .xacro/.urdf file or a package://pkg/urdf/robot.xacro URI (default: mybot)",
+    )
     add_pose_arguments(p)
     add_resource_path_arguments(p)
     p.add_argument("--spawn", action="append", default=[], metavar="SPEC", help=_SPAWN_HELP)
@@ -50,12 +54,24 @@ def register(sub: argparse._SubParsersAction) -> None:
         "navlab's watchdog (stop the wheels 0.5 s after the last command; default 0 = off).",
     )
     _add_common(p)
-    p.add_argument("--duration", type=seconds_or_zero, default=10.0,
-                   help="simulated seconds to run (default 10; 0: load the world and robot, step nothing)")
-    p.add_argument("--timestep", type=float, default=0.0,
-                   help="physics step in s, 0.0005-0.002 (default 0.002, or the world's max_step_size if larger)")
-    p.add_argument("--cmd-vel", default=None, metavar="V,W",
-                   help="publish this constant cmd_vel (m/s, rad/s) at 10 Hz, e.g. 0.3,0.2")
+    p.add_argument(
+        "--duration",
+        type=seconds_or_zero,
+        default=10.0,
+        help="simulated seconds to run (default 10; 0: load the world and robot, step nothing)",
+    )
+    p.add_argument(
+        "--timestep",
+        type=float,
+        default=0.0,
+        help="physics step in s, 0.0005-0.002 (default 0.002, or the world's max_step_size if larger)",
+    )
+    p.add_argument(
+        "--cmd-vel",
+        default=None,
+        metavar="V,W",
+        help="publish this constant cmd_vel (m/s, rad/s) at 10 Hz, e.g. 0.3,0.2",
+    )
     add_set_argument(p, "gazebo", "ground_truth_rate=100")
     add_run_options(p, seed=0, rate=None, record=True, quiet=True, json=True, view=True, ros=True)
     p.set_defaults(func=_cmd_sim)
@@ -67,9 +83,13 @@ def register(sub: argparse._SubParsersAction) -> None:
         "the paper's Figs. 4 and 5. Spawned models (--spawn) are drawn too.",
     )
     _add_common(r)
-    r.add_argument("--out", default=".", metavar="DIR",
-                   help="folder for DIR/world.png (default: the current folder; a FILE.png is deprecated but still "
-                   "works this release)")
+    r.add_argument(
+        "--out",
+        default=".",
+        metavar="DIR",
+        help="folder for DIR/world.png (default: the current folder; a FILE.png is deprecated but still "
+        "works this release)",
+    )
     r.add_argument("--width", type=int, default=960, help="image width in pixels (default 960)")
     r.add_argument("--height", type=int, default=720, help="image height in pixels (default 720)")
     r.add_argument("--azimuth", type=float, default=135.0, help="camera azimuth in degrees (default 135)")
@@ -100,9 +120,16 @@ def _cmd_sim(args: argparse.Namespace) -> int:
     apply_resource_paths(args)
     cmd_vel = _parse_cmd_vel(args.cmd_vel)
     spawns = [parse_spawn_spec(s, default_name=f"spawned_{i}") for i, s in enumerate(args.spawn)]
-    run = start_run("sim", world=args.world, robot=args.robot, pose=start_pose(args), seed=args.seed,
-                    rate=args.rate if args.rate is not None else (1.0 if args.ros else 0.0),  # ROS peers: real time
-                    timestep=args.timestep, overrides={"gazebo": parse_sets(args.set)})
+    run = start_run(
+        "sim",
+        world=args.world,
+        robot=args.robot,
+        pose=start_pose(args),
+        seed=args.seed,
+        rate=args.rate if args.rate is not None else (1.0 if args.ros else 0.0),  # ROS peers: real time
+        timestep=args.timestep,
+        overrides={"gazebo": parse_sets(args.set)},
+    )
     ex, gazebo = run.executor, run.gazebo
     helper = Node(ex, name="sim_cli")
     for model, t in spawns:
@@ -177,8 +204,14 @@ def _cmd_render(args: argparse.Namespace) -> int:
     for i, spec in enumerate(args.spawn):
         sim.spawn(parse_spawn_spec(spec, default_name=f"spawned_{i}")[0])
     sim.advance_to(200_000_000)  # let the robot and dynamic models settle for 0.2 s
-    image = render_image(sim, width=args.width, height=args.height, azimuth=args.azimuth,
-                         elevation=args.elevation, distance=args.distance)
+    image = render_image(
+        sim,
+        width=args.width,
+        height=args.height,
+        azimuth=args.azimuth,
+        elevation=args.elevation,
+        distance=args.distance,
+    )
     path = save_png(image, out_file(args.out, "world.png", old_suffixes=(".png",)))
     print(f"wrote {path} ({args.width}x{args.height})", file=sys.stderr)
     return 0

@@ -45,8 +45,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     add_pose_arguments(p)
     p.add_argument("--map", default=None, help="map YAML for launches that take one (default: the world's true map)")
     p.add_argument("--bag", default=None, metavar="DIR", help="replay this rosbag2 recording instead of a launch")
-    p.add_argument("--duration", type=positive_seconds, default=None,
-                   help="stop after this many simulated s (default: until Ctrl-C)")
+    p.add_argument(
+        "--duration",
+        type=positive_seconds,
+        default=None,
+        help="stop after this many simulated s (default: until Ctrl-C)",
+    )
     add_run_options(p, seed=0, record=True, rate=1.0)
     p.add_argument("--speed", dest="rate", type=pace, action=DeprecatedAlias, new="--rate", help=argparse.SUPPRESS)
     add_server_arguments(p)

@@ -29,14 +29,23 @@ def save_png(world: ClutterWorld, path: str | Path) -> None:
 
     fig, ax = plt.subplots(figsize=(10, 5.2))
     try:
-        ax.add_collection(PatchCollection([Rectangle((w.x - w.sx / 2, w.y - w.sy / 2), w.sx, w.sy)
-                                           for w in world.walls], facecolor="0.55", edgecolor="none"))
-        ax.add_collection(PatchCollection([Circle((x, y), CYLINDER_RADIUS) for x, y in world.cylinders],
-                                          facecolor="0.2", edgecolor="none"))
+        ax.add_collection(
+            PatchCollection(
+                [Rectangle((w.x - w.sx / 2, w.y - w.sy / 2), w.sx, w.sy) for w in world.walls],
+                facecolor="0.55",
+                edgecolor="none",
+            )
+        )
+        ax.add_collection(
+            PatchCollection(
+                [Circle((x, y), CYLINDER_RADIUS) for x, y in world.cylinders], facecolor="0.2", edgecolor="none"
+            )
+        )
         ax.add_patch(Rectangle((0.0, -FIELD / 2), FIELD, FIELD, fill=False, linestyle=":", edgecolor="0.6"))
         ref = world.reference_path
-        ax.plot(ref[:, 0], ref[:, 1], "-", color="tab:blue", lw=1.5,
-                label=f"reference path {world.reference_path_m:.2f} m")
+        ax.plot(
+            ref[:, 0], ref[:, 1], "-", color="tab:blue", lw=1.5, label=f"reference path {world.reference_path_m:.2f} m"
+        )
         (sx, sy, _), (gx, gy, _) = world.start, world.goal
         ax.add_patch(Circle((sx, sy), world.robot_radius, facecolor="none", edgecolor="tab:green", lw=1.5))
         ax.plot([sx], [sy], "o", color="tab:green", label="start")
@@ -46,8 +55,9 @@ def save_png(world: ClutterWorld, path: str | Path) -> None:
         ax.set_ylim(-FIELD / 2 - 0.6, FIELD / 2 + 0.6)
         ax.set_xlabel("x (m)")
         ax.set_ylabel("y (m)")
-        ax.set_title(f"{world.name}: {len(world.cylinders)} cylinders ({world.carved} carved), "
-                     f"difficulty {world.difficulty:.3f}")
+        ax.set_title(
+            f"{world.name}: {len(world.cylinders)} cylinders ({world.carved} carved), difficulty {world.difficulty:.3f}"
+        )
         ax.legend(loc="upper right", fontsize=8)
         fig.tight_layout()
         save_figure_atomic(fig, path, dpi=120)
@@ -58,8 +68,9 @@ def save_png(world: ClutterWorld, path: str | Path) -> None:
 def _cmd_clutter(args: argparse.Namespace) -> int:
     from navlab.world.clutter import generate_clutter
 
-    world = generate_clutter(args.seed, fill=args.fill, smooth=args.smooth, robot_radius=args.robot_radius,
-                             margin=args.margin)
+    world = generate_clutter(
+        args.seed, fill=args.fill, smooth=args.smooth, robot_radius=args.robot_radius, margin=args.margin
+    )
     out = world.write_world(out_file(args.out, "clutter.world", old_suffixes=(".world", ".sdf")))
     png = optional_out(args.png, out.parent, "clutter.png")
     if png:
@@ -69,13 +80,17 @@ def _cmd_clutter(args: argparse.Namespace) -> int:
         print(json.dumps(summary))
         return 0
     (sx, sy, syaw), (gx, gy, gyaw) = world.start, world.goal
-    print(f"{world.name}: {len(world.cylinders)} cylinders ({world.carved} carved for the corridor), "
-          f"difficulty {world.difficulty:.3f}")
+    print(
+        f"{world.name}: {len(world.cylinders)} cylinders ({world.carved} carved for the corridor), "
+        f"difficulty {world.difficulty:.3f}"
+    )
     print(f"start  x {sx:.3f} y {sy:.3f} yaw {syaw:.3f}")
     print(f"goal   x {gx:.3f} y {gy:.3f} yaw {gyaw:.3f}")
-    print(f"reference path {world.reference_path_m:.3f} m for robot radius {world.robot_radius} m "
-          f"(T_opt {world.t_opt():.2f} s at 2 m/s; narrowest passage half-width "
-          f"{world.metrics['bottleneck_m']:.3f} m)")
+    print(
+        f"reference path {world.reference_path_m:.3f} m for robot radius {world.robot_radius} m "
+        f"(T_opt {world.t_opt():.2f} s at 2 m/s; narrowest passage half-width "
+        f"{world.metrics['bottleneck_m']:.3f} m)"
+    )
     print(f"wrote {out}" + (f" and {png}" if png else ""))
     return 0
 
@@ -102,8 +117,11 @@ def _count(text: str) -> int:
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the ``world`` verb (``navlab world clutter``)."""
-    p = sub.add_parser("world", help="generate worlds (BARN-style clutter)",
-                       description="Generate Gazebo .world files navlab and Gazebo classic both load.")
+    p = sub.add_parser(
+        "world",
+        help="generate worlds (BARN-style clutter)",
+        description="Generate Gazebo .world files navlab and Gazebo classic both load.",
+    )
     verbs = p.add_subparsers(dest="world_command", metavar="WHAT", required=True)
     c = verbs.add_parser(
         "clutter",
@@ -121,14 +139,32 @@ def register(sub: argparse._SubParsersAction) -> None:
     add_run_options(c, seed=0, json=True)
     c.add_argument("--fill", type=_fraction, default=0.25, help="initial fill probability per cell (default 0.25)")
     c.add_argument("--smooth", type=_count, default=2, help="cellular-automaton rounds (default 2)")
-    c.add_argument("--robot-radius", type=float, default=0.2,
-                   help="radius of the robot disc the reference path is planned for (m, default 0.2: mybot)")
-    c.add_argument("--margin", type=float, default=0.05,
-                   help="extra clearance of the carved corridor beyond the robot radius (m, default 0.05)")
-    c.add_argument("--out", required=True, metavar="DIR",
-                   help="folder to write clutter.world in (a FILE.world still works this release, deprecated)")
-    c.add_argument("--png", nargs="?", const="", default=None, metavar="FILE.png",
-                   help="also draw the world and the reference path: in FILE.png, or DIR/clutter.png without a value")
+    c.add_argument(
+        "--robot-radius",
+        type=float,
+        default=0.2,
+        help="radius of the robot disc the reference path is planned for (m, default 0.2: mybot)",
+    )
+    c.add_argument(
+        "--margin",
+        type=float,
+        default=0.05,
+        help="extra clearance of the carved corridor beyond the robot radius (m, default 0.05)",
+    )
+    c.add_argument(
+        "--out",
+        required=True,
+        metavar="DIR",
+        help="folder to write clutter.world in (a FILE.world still works this release, deprecated)",
+    )
+    c.add_argument(
+        "--png",
+        nargs="?",
+        const="",
+        default=None,
+        metavar="FILE.png",
+        help="also draw the world and the reference path: in FILE.png, or DIR/clutter.png without a value",
+    )
     c.set_defaults(func=_cmd_clutter)
     add_world_office(verbs)
 
@@ -144,13 +180,26 @@ def _cmd_world_office(args: argparse.Namespace) -> int:
     world = office.write_world(out_file(args.out, "office.world", old_suffixes=(".world", ".sdf")))
     log = optional_out(args.log, world.parent, "office.clf")
     truth = optional_out(args.truth, world.parent, "truth.txt")
-    summary: dict = {"world": str(world), "width_m": office.width, "depth_m": office.depth, "rooms": office.rooms,
-                     "start": list(office.start)}  # fmt: skip
+    summary: dict = {
+        "world": str(world),
+        "width_m": office.width,
+        "depth_m": office.depth,
+        "rooms": office.rooms,
+        "start": list(office.start),
+    }
     if log:
-        rec = record_log(world, office.route(), seed=args.seed, noise=OdometryNoise(scale=args.odom_scale,
-                         heading_drift=args.heading_drift))  # fmt: skip
-        write_carmen(log, rec.log, comment=f"navlab office log, seed {args.seed}: odometry frame = the true "
-                     f"start pose {rec.start} in {world.name}")  # fmt: skip
+        rec = record_log(
+            world,
+            office.route(),
+            seed=args.seed,
+            noise=OdometryNoise(scale=args.odom_scale, heading_drift=args.heading_drift),
+        )
+        write_carmen(
+            log,
+            rec.log,
+            comment=f"navlab office log, seed {args.seed}: odometry frame = the true "
+            f"start pose {rec.start} in {world.name}",
+        )
         summary.update(log=str(log), scans=len(rec.log.scans), log_s=rec.log.duration)
         if truth:
             from navlab.experiments.trajectory import apply_se2
@@ -178,15 +227,37 @@ def add_world_office(verbs: argparse._SubParsersAction) -> None:
         "  navlab slam --log office/office.clf --out office_map --mode gmapping\n"
         "  navlab eval trajectory office_map/poses.txt office/truth.txt",
     )
-    o.add_argument("--out", required=True, metavar="DIR",
-                   help="folder to write office.world in (a FILE.world still works this release, deprecated)")
-    o.add_argument("--log", nargs="?", const="", metavar="FILE.clf",
-                   help="also record a sparse CARMEN log: in FILE.clf, or DIR/office.clf without a value")
-    o.add_argument("--truth", nargs="?", const="", metavar="FILE.txt",
-                   help="with --log: the true poses ('t x y theta', log frame) in FILE.txt, or DIR/truth.txt")
+    o.add_argument(
+        "--out",
+        required=True,
+        metavar="DIR",
+        help="folder to write office.world in (a FILE.world still works this release, deprecated)",
+    )
+    o.add_argument(
+        "--log",
+        nargs="?",
+        const="",
+        metavar="FILE.clf",
+        help="also record a sparse CARMEN log: in FILE.clf, or DIR/office.clf without a value",
+    )
+    o.add_argument(
+        "--truth",
+        nargs="?",
+        const="",
+        metavar="FILE.txt",
+        help="with --log: the true poses ('t x y theta', log frame) in FILE.txt, or DIR/truth.txt",
+    )
     add_run_options(o, seed=0, json=True)
-    o.add_argument("--odom-scale", type=float, default=0.05,
-                   help="std. dev. of the odometry's scale errors and per-step noise (default 0.05: 5 %%)")
-    o.add_argument("--heading-drift", type=float, default=0.02,
-                   help="std. dev. of the odometry's heading drift rate, rad/m (default 0.02)")
+    o.add_argument(
+        "--odom-scale",
+        type=float,
+        default=0.05,
+        help="std. dev. of the odometry's scale errors and per-step noise (default 0.05: 5 %%)",
+    )
+    o.add_argument(
+        "--heading-drift",
+        type=float,
+        default=0.02,
+        help="std. dev. of the odometry's heading drift rate, rad/m (default 0.02)",
+    )
     o.set_defaults(func=_cmd_world_office)

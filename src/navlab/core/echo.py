@@ -172,8 +172,9 @@ def _echo_until(path: Path, topic: str, out: Printer, duration: float, start: fl
     return 0
 
 
-def echo_launch(file_and_args: list[str], topic: str, out: Printer, duration: float, seed: int,
-                run_for: Callable[..., Any]) -> int:  # fmt: skip
+def echo_launch(
+    file_and_args: list[str], topic: str, out: Printer, duration: float, seed: int, run_for: Callable[..., Any]
+) -> int:
     """Start a launch here and echo ``topic`` as it is published: in real time until Ctrl-C (as roslaunch +
     rostopic echo), or as fast as possible for ``duration`` simulated s; ends early after ``--count``."""
     from navlab.core.launch import start
@@ -189,6 +190,7 @@ def echo_launch(file_and_args: list[str], topic: str, out: Printer, duration: fl
     if not out.done and duration > 1.0:
         run_for(ex, duration - 1.0, quiet=True, until=lambda: out.done)
     if not out.printed and topic not in ex.topics:
-        raise CoreError(f"no topic {topic!r} in this launch after {duration:g} simulated s "
-                        f"(topics: {', '.join(sorted(ex.topics))})")  # fmt: skip
+        raise CoreError(
+            f"no topic {topic!r} in this launch after {duration:g} simulated s (topics: {', '.join(sorted(ex.topics))})"
+        )
     return _short_of(out, topic, f"{duration:g} simulated s passed") if not out.done else 0

@@ -107,9 +107,7 @@ class Executor:
             if name in ("/tf", "/tf_static"):
                 self._attach_tf(t)
         elif type_name(t.msgtype) != type_name(msgtype):  # the same type, or navlab's rclpy-style class of it
-            raise CoreError(
-                f"topic {name!r} has type {type_name(t.msgtype)}, but {type_name(msgtype)} was asked for"
-            )
+            raise CoreError(f"topic {name!r} has type {type_name(t.msgtype)}, but {type_name(msgtype)} was asked for")
         return t
 
     def _attach_tf(self, topic: Topic) -> None:

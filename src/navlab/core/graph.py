@@ -23,6 +23,7 @@ class Graph:
     @classmethod
     def from_executor(cls, ex: Executor) -> Graph:
         """The live graph of an executor."""
+
         def subscribers(name: str, t: Any) -> list[str]:
             subs = {s.node for s in t.subscriptions if s.node not in HIDDEN_NODES}
             return sorted(subs | ex.tf_listeners if name in ("/tf", "/tf_static") else subs)
@@ -52,8 +53,12 @@ class Graph:
         def q(text: str) -> str:
             return '"' + text.replace("\\", "\\\\").replace('"', '\\"') + '"'
 
-        lines = ["digraph navlab {", "  rankdir=LR;", '  node [fontname="Helvetica", fontsize=10];',
-                 '  edge [color="#555555"];']  # fmt: skip
+        lines = [
+            "digraph navlab {",
+            "  rankdir=LR;",
+            '  node [fontname="Helvetica", fontsize=10];',
+            '  edge [color="#555555"];',
+        ]
         for n in self.nodes:
             lines.append(f"  {q('n:' + n)} [label={q(n)}, shape=ellipse];")
         for t, (pubs, subs) in self.topics.items():
@@ -72,8 +77,10 @@ class Graph:
 
     def without_topics(self, hidden: tuple[str, ...]) -> Graph:
         """The same graph without the ``hidden`` topics (and topics nobody publishes or subscribes)."""
-        return Graph(nodes=list(self.nodes), topics={t: ps for t, ps in self.topics.items()
-                                                     if t not in hidden and (ps[0] or ps[1])})  # fmt: skip
+        return Graph(
+            nodes=list(self.nodes),
+            topics={t: ps for t, ps in self.topics.items() if t not in hidden and (ps[0] or ps[1])},
+        )
 
     def layout(self) -> dict[str, Any]:
         """Graphviz ``dot``'s layered layout, for drawing in the viewer: ``width``/``height`` and each vertex's
@@ -93,9 +100,14 @@ class Graph:
                 out["height"] = height
             elif f[0] == "node":
                 kind, name = f[1][0], f[1][2:]
-                out["vertices"][f[1]] = {"name": name, "kind": "topic" if kind == "t" else "node",
-                                         "x": float(f[2]) * 72, "y": height - float(f[3]) * 72,
-                                         "w": float(f[4]) * 72, "h": float(f[5]) * 72}  # fmt: skip
+                out["vertices"][f[1]] = {
+                    "name": name,
+                    "kind": "topic" if kind == "t" else "node",
+                    "x": float(f[2]) * 72,
+                    "y": height - float(f[3]) * 72,
+                    "w": float(f[4]) * 72,
+                    "h": float(f[5]) * 72,
+                }
             elif f[0] == "edge":
                 n = int(f[3])
                 pts = [[float(f[4 + 2 * i]) * 72, height - float(f[5 + 2 * i]) * 72] for i in range(n)]
@@ -109,10 +121,18 @@ class Graph:
 
         dot = shutil.which("dot")
         if dot is None:
-            raise CoreError("Graphviz's `dot` is not installed, so the graph cannot be laid out "
-                            "(Debian: sudo apt-get install graphviz)")  # fmt: skip
-        proc = subprocess.run([dot, f"-T{fmt}"], input=self.to_dot(rate_line=rate_line), capture_output=True,
-                              text=True, timeout=60, check=False)  # fmt: skip
+            raise CoreError(
+                "Graphviz's `dot` is not installed, so the graph cannot be laid out "
+                "(Debian: sudo apt-get install graphviz)"
+            )
+        proc = subprocess.run(
+            [dot, f"-T{fmt}"],
+            input=self.to_dot(rate_line=rate_line),
+            capture_output=True,
+            text=True,
+            timeout=60,
+            check=False,
+        )
         if proc.returncode != 0:
             raise CoreError(f"dot failed to lay out the graph: {proc.stderr.strip()}")
         return proc.stdout

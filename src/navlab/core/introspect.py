@@ -71,11 +71,15 @@ def checked_socket_dir(*, create: bool) -> Path | None:
     if not stat.S_ISDIR(st.st_mode):
         raise CoreError(f"{folder}: not a directory; navlab keeps its launch sockets there (remove it)")
     if st.st_uid != os.getuid():
-        raise CoreError(f"{folder}: belongs to user id {st.st_uid}, not to you ({os.getuid()}); refusing to use "
-                        "another user's socket folder (remove it, or set TMPDIR to a private folder)")
+        raise CoreError(
+            f"{folder}: belongs to user id {st.st_uid}, not to you ({os.getuid()}); refusing to use "
+            "another user's socket folder (remove it, or set TMPDIR to a private folder)"
+        )
     if st.st_mode & 0o077:
-        raise CoreError(f"{folder}: mode {stat.S_IMODE(st.st_mode):04o}, expected 0700; refusing a socket folder "
-                        f"others can enter (chmod 700 {folder})")
+        raise CoreError(
+            f"{folder}: mode {stat.S_IMODE(st.st_mode):04o}, expected 0700; refusing a socket folder "
+            f"others can enter (chmod 700 {folder})"
+        )
     return folder
 
 
@@ -260,8 +264,10 @@ class IntrospectionServer:
         try:
             pub = self._publisher(topic, type(msg))
             if pub.topic.msgtype is not type(msg):
-                return (f"topic {topic!r} carries {type_name(pub.topic.msgtype)}, not {type_name(msg)}; "
-                        "message not published")
+                return (
+                    f"topic {topic!r} carries {type_name(pub.topic.msgtype)}, not {type_name(msg)}; "
+                    "message not published"
+                )
             pub.publish(msg)
         except CoreError as exc:
             return str(exc)
@@ -283,8 +289,11 @@ class IntrospectionServer:
 
         def listen(name: str, msg: Any, t_ns: int) -> None:
             if name == topic:
-                line = {"t": t_ns, "type": type_name(msg), "cdr": base64.b64encode(
-                    bytes(TYPESTORE.serialize_cdr(msg, type_name(msg)))).decode()}
+                line = {
+                    "t": t_ns,
+                    "type": type_name(msg),
+                    "cdr": base64.b64encode(bytes(TYPESTORE.serialize_cdr(msg, type_name(msg)))).decode(),
+                }
                 with contextlib.suppress(queue.Full):  # a slow reader drops messages, never stalls the sim
                     q.put_nowait(json.dumps(line).encode() + b"\n")
 
@@ -335,8 +344,10 @@ def find_running(pid: int | None = None) -> Path:
                 return path
         raise CoreError(f"no running navlab launch with pid {pid} (running: {pids})")
     if not live:
-        raise CoreError("no running navlab launch found; start one (navlab launch FILE) in another shell, "
-                        "or look at one here with --launch FILE or at a recording with --bag DIR")  # fmt: skip
+        raise CoreError(
+            "no running navlab launch found; start one (navlab launch FILE) in another shell, "
+            "or look at one here with --launch FILE or at a recording with --bag DIR"
+        )
     if len(live) > 1:
         raise CoreError(f"several navlab launches are running (pids {pids}); choose one with --pid")
     return live[0]
@@ -352,8 +363,10 @@ def _connect(path: Path, request: dict[str, Any]) -> tuple[socket.socket, Any]:
         raise CoreError(f"cannot reach the launch at {path} ({exc.strerror})") from None
     if peer_uid != os.getuid() or (path.stem.isdigit() and peer_pid != int(path.stem)):
         sock.close()
-        raise CoreError(f"{path} is served by process {peer_pid} of user id {peer_uid}, not by the launch "
-                        f"{path.stem} of yours; not trusted")
+        raise CoreError(
+            f"{path} is served by process {peer_pid} of user id {peer_uid}, not by the launch "
+            f"{path.stem} of yours; not trusted"
+        )
     f = sock.makefile("rwb")
     f.write(json.dumps(request).encode() + b"\n")
     f.flush()

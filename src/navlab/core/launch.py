@@ -194,8 +194,10 @@ class _Context:
             if kind == "env":
                 name, sep, default = arg.partition(" ")
                 if name not in os.environ and not sep:  # ROS 2: an unset variable without a default is an error
-                    raise LaunchError(f"{self.file}: {where}: environment variable {name!r} is not set and "
-                                      f"$(env {name}) gives no default (write $(env {name} DEFAULT))")
+                    raise LaunchError(
+                        f"{self.file}: {where}: environment variable {name!r} is not set and "
+                        f"$(env {name}) gives no default (write $(env {name} DEFAULT))"
+                    )
                 return os.environ.get(name, default.strip("'\""))
             if kind == "find-pkg-share":
                 if arg == "navlab":
@@ -232,7 +234,7 @@ def _expand(text: str, resolve: Callable[[str, str], str], where: str) -> str:
             k += 1
         if k >= len(text):
             raise LaunchError(f"{where}: unterminated substitution in {text!r}")
-        kind, _, arg = _expand(text[j + 2:k], resolve, where).strip().partition(" ")
+        kind, _, arg = _expand(text[j + 2 : k], resolve, where).strip().partition(" ")
         out.append(resolve(kind, arg.strip()))
         i = k + 1
     out.append(text[i:])
@@ -283,8 +285,9 @@ def _node_params(ctx: _Context, spec: dict[str, Any], where: str) -> tuple[dict[
     for item in _items(ctx, spec, "param", where, ()):
         if isinstance(item, dict) and not _condition(ctx, item, where):  # a param entry's if/unless
             continue
-        item = ctx.subst({k: v for k, v in item.items() if k not in ("if", "unless")} if isinstance(item, dict)
-                         else item, where)
+        item = ctx.subst(
+            {k: v for k, v in item.items() if k not in ("if", "unless")} if isinstance(item, dict) else item, where
+        )
         if not isinstance(item, dict):
             raise LaunchError(f"{ctx.file}: {where}: a param entry must be a mapping, got {item!r}")
         if "from" in item:
@@ -352,21 +355,35 @@ def _run_entries(ctx: _Context, session: Session, depth: int) -> None:
                 path = ctx.file.parent / path
             if not path.is_file():
                 raise LaunchError(f"{ctx.file}: {where}: included file {path} does not exist")
-            sub_args = {str(a["name"]): str(ctx.subst(a["value"], where))
-                        for a in _items(ctx, spec, "arg", where, ("name", "value"))}
+            sub_args = {
+                str(a["name"]): str(ctx.subst(a["value"], where))
+                for a in _items(ctx, spec, "arg", where, ("name", "value"))
+            }
             _run_entries(_Context(path, sub_args), session, depth + 1)
         elif kind == "node":
             exec_name = spec.get("exec")
             if not exec_name or not isinstance(exec_name, str):
                 raise LaunchError(f"{ctx.file}: {where}: a node needs 'exec' (a node name or module:Class)")
-            remaps = {str(ctx.subst(r["from"], where)): _text(ctx, r, "to", where)
-                      for r in _items(ctx, spec, "remap", where, ("from", "to"))}
+            remaps = {
+                str(ctx.subst(r["from"], where)): _text(ctx, r, "to", where)
+                for r in _items(ctx, spec, "remap", where, ("from", "to"))
+            }
             params, files = _node_params(ctx, spec, where)
             node_name = _text(ctx, spec, "name", where) if "name" in spec else ""
             namespace = _text(ctx, spec, "namespace", where) if spec.get("namespace") else ""
             source = f" (parameters from {', '.join(files)})" if files else ""
-            start_node(session, NodeSpec(exec_name, node_name, namespace, params, remaps,
-                                         f"{ctx.file}: {where} {node_name or exec_name!r}{source}", files))
+            start_node(
+                session,
+                NodeSpec(
+                    exec_name,
+                    node_name,
+                    namespace,
+                    params,
+                    remaps,
+                    f"{ctx.file}: {where} {node_name or exec_name!r}{source}",
+                    files,
+                ),
+            )
         else:
             raise LaunchError(f"{ctx.file}: {where}: unknown entry {kind!r} (expected arg, let, include or node)")
 
@@ -403,8 +420,9 @@ def _check_args(files: list[Path], args: dict[str, Any]) -> None:
         if name not in known:
             hint = did_you_mean(name, sorted(known), template="did you mean {!r}? ")
             where = ", ".join(map(str, files))
-            raise LaunchError(f"{where}: unknown launch argument {name!r} ({hint}arguments: "
-                              f"{', '.join(sorted(known))})")
+            raise LaunchError(
+                f"{where}: unknown launch argument {name!r} ({hint}arguments: {', '.join(sorted(known))})"
+            )
 
 
 def _from_cwd(value: Any) -> Any:
@@ -466,10 +484,15 @@ def start(
 
     xml = [is_xml_launch(f) for f in files]
     if any(xml) and not all(xml):
-        raise LaunchError(f"{', '.join(map(str, files))}: ROS 1 .launch (XML) and YAML launch files cannot be "
-                          "started together; start them in one format")
-    session = Session(executor or Executor(seed=seed, rate=rate), args=all_args,
-                      overrides={k.lstrip("/"): dict(v) for k, v in (overrides or {}).items()})
+        raise LaunchError(
+            f"{', '.join(map(str, files))}: ROS 1 .launch (XML) and YAML launch files cannot be "
+            "started together; start them in one format"
+        )
+    session = Session(
+        executor or Executor(seed=seed, rate=rate),
+        args=all_args,
+        overrides={k.lstrip("/"): dict(v) for k, v in (overrides or {}).items()},
+    )
     if all(xml):
         if "ros" in all_args:
             ros = _truthy(_Context(files[0], {}), all_args.pop("ros"), "ros", "argument ros:=")
@@ -492,6 +515,8 @@ def start(
     unknown = sorted(set(session.overrides) - started)
     if unknown:
         session.shutdown()
-        raise LaunchError(f"{', '.join(map(str, files))}: parameters given for {', '.join(map(repr, unknown))}, but "
-                          f"the launch starts no such node (nodes: {', '.join(sorted(started))})")
+        raise LaunchError(
+            f"{', '.join(map(str, files))}: parameters given for {', '.join(map(repr, unknown))}, but "
+            f"the launch starts no such node (nodes: {', '.join(sorted(started))})"
+        )
     return session

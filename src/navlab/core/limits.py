@@ -1,4 +1,4 @@
-"""Ceilings on the parameters that size work or memory (issue 21): one table, one check, one error line.
+"""Ceilings on the parameters that size work or memory: one table, one check, one error line.
 
 A parameter file may ask for anything its format can spell; a costmap of 10^14 cells, a rollout of
 10^12 poses or a timer at 10^9 Hz would exhaust the machine's memory or never end. Each ceiling below is
@@ -52,8 +52,11 @@ def ceilings() -> dict[str, Ceiling]:
     return {
         "rate": Ceiling(1000.0, "Hz", "a timer faster than 1 kHz of simulated time only burns CPU"),
         "grid_cells": Ceiling(_memory(16), "cells", f"the layers of a grid must fit in {memory}"),
-        "rollout_poses": Ceiling(_memory(256, 5e7), "poses per cycle",
-                                 f"every pose of one control cycle is held in {memory} and scored in time"),
+        "rollout_poses": Ceiling(
+            _memory(256, 5e7),
+            "poses per cycle",
+            f"every pose of one control cycle is held in {memory} and scored in time",
+        ),
         "footprint_m": Ceiling(100.0, "m", "a footprint reaching further than 100 m is not a robot"),
         "polygon_points": Ceiling(1000.0, "points", "a footprint is a polygon of a few points"),
         "particles": Ceiling(1e6, "particles", "each particle is updated on every scan"),

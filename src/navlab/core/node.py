@@ -50,9 +50,12 @@ def _renamed_keywords(**renames: str) -> Callable[[Callable[..., Any]], Callable
                     raise TypeError(f"{method.__name__}() got both {old!r} and {renames[old]!r}")
                 kwargs[renames[old]] = kwargs.pop(old)
             if used:
-                warnings.warn(f"{method.__name__}({'=..., '.join(used)}=...) is deprecated and goes in the next "
-                              f"release: write {'=..., '.join(renames[o] for o in used)}=... (rclpy's names)",
-                              DeprecationWarning, stacklevel=2)
+                warnings.warn(
+                    f"{method.__name__}({'=..., '.join(used)}=...) is deprecated and goes in the next "
+                    f"release: write {'=..., '.join(renames[o] for o in used)}=... (rclpy's names)",
+                    DeprecationWarning,
+                    stacklevel=2,
+                )
             return method(*args, **kwargs)
 
         return call
@@ -156,9 +159,12 @@ class Node:
         if isinstance(node_name, Executor) or (executor is not None and node_name is None):
             executor = node_name if isinstance(node_name, Executor) else executor
             if not sys._getframe(1).f_globals.get("__name__", "").startswith("navlab."):  # navlab's own: no warning
-                warnings.warn("Node(executor, name=...) is deprecated and goes in the next release: write "
-                              "Node('name', parameter_overrides=...) after navlab.init(), as rclpy does",
-                              DeprecationWarning, stacklevel=2)
+                warnings.warn(
+                    "Node(executor, name=...) is deprecated and goes in the next release: write "
+                    "Node('name', parameter_overrides=...) after navlab.init(), as rclpy does",
+                    DeprecationWarning,
+                    stacklevel=2,
+                )
             self._rclpy_style = False
         else:
             from navlab.core.rclpy_api import context_executor
@@ -207,8 +213,16 @@ class Node:
     # --- communication ---------------------------------------------------------------------------
 
     @_renamed_keywords(msgtype="msg_type", qos="qos_profile")
-    def create_publisher(self, msg_type: type, topic: str, qos_profile: Any = 10, *, latched: bool = False,
-                         callback_group: Any = None, event_callbacks: Any = None) -> Publisher:
+    def create_publisher(
+        self,
+        msg_type: type,
+        topic: str,
+        qos_profile: Any = 10,
+        *,
+        latched: bool = False,
+        callback_group: Any = None,
+        event_callbacks: Any = None,
+    ) -> Publisher:
         """Publisher of ``msg_type`` on ``topic`` (``latched``, or a ``qos_profile`` whose durability is
         transient_local: ROS's latching). ``callback_group``/``event_callbacks`` are accepted as rclpy's;
         one executor thread runs every callback."""
@@ -221,8 +235,15 @@ class Node:
 
     @_renamed_keywords(msgtype="msg_type", qos="qos_profile")
     def create_subscription(
-        self, msg_type: type, topic: str, callback: Callable[[Any], None], qos_profile: Any = 10, *,
-        callback_group: Any = None, event_callbacks: Any = None, raw: bool = False,
+        self,
+        msg_type: type,
+        topic: str,
+        callback: Callable[[Any], None],
+        qos_profile: Any = 10,
+        *,
+        callback_group: Any = None,
+        event_callbacks: Any = None,
+        raw: bool = False,
     ) -> Subscription:
         """Call ``callback(msg)`` for each message on ``topic`` (rclpy's signature)."""
         sub = Subscription(self.resolve_topic_name(topic), msg_type, callback, self.fully_qualified_name)
@@ -231,8 +252,16 @@ class Node:
         return sub
 
     @_renamed_keywords(period="timer_period_sec")
-    def create_timer(self, timer_period_sec: float, callback: Callable[[], None], callback_group: Any = None,
-                     clock: Any = None, *, priority: int = 0, idle: Callable[[], bool] | None = None) -> Timer:
+    def create_timer(
+        self,
+        timer_period_sec: float,
+        callback: Callable[[], None],
+        callback_group: Any = None,
+        clock: Any = None,
+        *,
+        priority: int = 0,
+        idle: Callable[[], bool] | None = None,
+    ) -> Timer:
         """Call ``callback()`` every ``timer_period_sec`` simulated seconds (rclpy's signature; lower
         ``priority`` runs first on ties).
 
@@ -241,8 +270,10 @@ class Node:
         """
         period = timer_period_sec
         if isinstance(period, bool) or not isinstance(period, int | float) or not 0 < period < 1e9:
-            raise ParameterError(f"node {self.fully_qualified_name}: timer period {period!r} s: expected a "
-                                 "finite number > 0 (is a rate parameter 0, negative or not a number?)")
+            raise ParameterError(
+                f"node {self.fully_qualified_name}: timer period {period!r} s: expected a "
+                "finite number > 0 (is a rate parameter 0, negative or not a number?)"
+            )
         timer = Timer(self.executor, seconds_to_ns(period), callback, priority, self.executor.now_ns, idle)
         self.timers.append(timer)
         return timer
@@ -321,8 +352,15 @@ class Node:
     # --- parameters ------------------------------------------------------------------------------
 
     @_renamed_keywords(default="value")
-    def declare_parameter(self, name: str, value: Any = None, descriptor: Any = None, ignore_override: bool = False,
-                          *, aliases: Sequence[str] = ()) -> Any:
+    def declare_parameter(
+        self,
+        name: str,
+        value: Any = None,
+        descriptor: Any = None,
+        ignore_override: bool = False,
+        *,
+        aliases: Sequence[str] = (),
+    ) -> Any:
         """Declare a parameter (rclpy's signature) and return it: the override given at construction, or
         ``value`` (the default); a :class:`Parameter` for an rclpy-style node, the plain value otherwise.
 
@@ -410,8 +448,14 @@ class Node:
             if close:
                 lines.append(f"{key!r} (did you mean {close[0]!r}?)")
             else:
-                warnings.warn(ParameterWarning(f"node {self.fully_qualified_name}: unknown parameter {key!r} "
-                                               "ignored (ROS ignores what it does not read)", key), stacklevel=2)
+                warnings.warn(
+                    ParameterWarning(
+                        f"node {self.fully_qualified_name}: unknown parameter {key!r} "
+                        "ignored (ROS ignores what it does not read)",
+                        key,
+                    ),
+                    stacklevel=2,
+                )
         if lines:
             raise ParameterError(f"node {self.fully_qualified_name}: unknown parameter " + ", ".join(lines))
 

@@ -55,8 +55,10 @@ def check_unknown_key(key: str, known: list[str], *, what: str, error: type[Exce
     close = likely_typo(key, known)
     if close:
         raise error(f"unknown {what} parameter '{key}'; did you mean '{close[0]}'?")
-    warnings.warn(ParameterWarning(f"unknown {what} parameter '{key}' ignored (ROS ignores what it does not "
-                                   "read)", key), stacklevel=3)
+    warnings.warn(
+        ParameterWarning(f"unknown {what} parameter '{key}' ignored (ROS ignores what it does not read)", key),
+        stacklevel=3,
+    )
 
 
 MAX_YAML_BYTES = 16 << 20  # a parameter, launch, route or scenario file is never this large
@@ -97,8 +99,11 @@ class _BoundedLoader(yaml.SafeLoader):
 
             if size(node) > MAX_YAML_NODES:
                 raise yaml.composer.ComposerError(
-                    None, None, f"aliases (*name) expand to more than {MAX_YAML_NODES} values (an alias bomb?)",
-                    node.start_mark)
+                    None,
+                    None,
+                    f"aliases (*name) expand to more than {MAX_YAML_NODES} values (an alias bomb?)",
+                    node.start_mark,
+                )
         return node
 
 
@@ -112,8 +117,9 @@ def parse_yaml(text: str, source: str | Path) -> Any:
     except yaml.reader.ReaderError as exc:  # a control character such as NUL, before parsing starts
         line = text[: exc.position].count("\n") + 1
         col = exc.position - (text.rfind("\n", 0, exc.position) + 1) + 1
-        raise ParameterError(f"{source}:{line}:{col}: malformed YAML: character #x{exc.character:04x} is not "
-                             "allowed in YAML") from None
+        raise ParameterError(
+            f"{source}:{line}:{col}: malformed YAML: character #x{exc.character:04x} is not allowed in YAML"
+        ) from None
     try:
         return loader.get_single_data()
     except yaml.MarkedYAMLError as exc:
@@ -144,9 +150,7 @@ def read_yaml(path: str | Path) -> Any:
 
 def is_nav2_layout(data: Any) -> bool:
     """Whether a parsed file uses Nav2's ``node: ros__parameters:`` layout."""
-    return isinstance(data, dict) and any(
-        isinstance(v, dict) and "ros__parameters" in v for v in data.values()
-    )
+    return isinstance(data, dict) and any(isinstance(v, dict) and "ros__parameters" in v for v in data.values())
 
 
 def _unwrap_nav2(data: dict[str, Any]) -> dict[str, Any]:
@@ -216,18 +220,25 @@ class ParamSpec:
     prepare: Callable[[dict[str, Any]], dict[str, Any]] | None = None
 
 
-def param_error(what: str, key: str, value: Any, expected: str, error: type[Exception] = ParameterError
-                ) -> Exception:
+def param_error(what: str, key: str, value: Any, expected: str, error: type[Exception] = ParameterError) -> Exception:
     """The one-line refusal of a parameter ``key`` = ``value`` that is not ``expected``."""
     return error(f"{what + ' ' if what else ''}parameter {key}: expected {expected}, got {value!r}")
 
 
-_EXPECTED = {bool: "true or false", int: "an integer", float: "a number", str: "a string", list: "a list",
-             tuple: "a list", dict: "a mapping"}
+_EXPECTED = {
+    bool: "true or false",
+    int: "an integer",
+    float: "a number",
+    str: "a string",
+    list: "a list",
+    tuple: "a list",
+    dict: "a mapping",
+}
 
 
-def typed_value(kind: type, key: str, val: Any, *, what: str = "", error: type[Exception] = ParameterError,
-                finite: bool = True) -> Any:
+def typed_value(
+    kind: type, key: str, val: Any, *, what: str = "", error: type[Exception] = ParameterError, finite: bool = True
+) -> Any:
     """``val`` as the type ``kind`` of the parameter's default, refusing what ROS's typed parameters would (a
     string for a number, 2.5 for an integer, "yes" for a boolean, null, NaN; inf too unless ``finite`` is
     False). The one type rule of settings dataclasses and node parameters."""
@@ -236,8 +247,12 @@ def typed_value(kind: type, key: str, val: Any, *, what: str = "", error: type[E
     if kind is bool:
         ok = isinstance(val, bool) or (isinstance(val, int) and val in (0, 1))
     elif kind is int:
-        ok = not isinstance(val, bool) and isinstance(val, int | float) and math.isfinite(val) and float(
-            val).is_integer()
+        ok = (
+            not isinstance(val, bool)
+            and isinstance(val, int | float)
+            and math.isfinite(val)
+            and float(val).is_integer()
+        )
     elif kind is float:
         ok = not isinstance(val, bool) and isinstance(val, int | float)
     elif kind in (list, tuple):
@@ -262,8 +277,10 @@ def canonical_params(values: Mapping[str, Any], spec: ParamSpec, *, what: str | 
             continue
         name = spec.aliases.get(key, key)
         if name in out and out[name] != val:
-            raise spec.error(f"{what} parameters {spelled[name]!r} and {key!r} are two spellings of one parameter "
-                             f"with different values ({out[name]!r} vs {val!r}): give one")
+            raise spec.error(
+                f"{what} parameters {spelled[name]!r} and {key!r} are two spellings of one parameter "
+                f"with different values ({out[name]!r} vs {val!r}): give one"
+            )
         out[name], spelled[name] = val, key
     return out
 
@@ -299,7 +316,8 @@ def read_params(cls: type[T], values: Mapping[str, Any] | T | None, *, what: str
     for key, low in spec.clamp_at_least.items():
         if getattr(out, key) < low:
             logging.getLogger("navlab.params").warning(
-                f"{what}: {key} is {getattr(out, key)}; it is set to {low} (as ROS does)")
+                f"{what}: {key} is {getattr(out, key)}; it is set to {low} (as ROS does)"
+            )
             setattr(out, key, type(getattr(out, key))(low))
     for key, low in spec.at_least.items():
         if not getattr(out, key) >= low:

@@ -40,8 +40,9 @@ def find_executable(pkg: str, typ: str, where: str) -> Path:
     if on_path:
         return Path(on_path)
     where_pkg = f"in package {pkg} ({root})" if root else f"(package {pkg!r} not found)"
-    raise LaunchError(f"{where}: cannot launch node of type [{pkg}/{typ}]: no executable {typ!r} {where_pkg} "
-                      "nor on PATH")
+    raise LaunchError(
+        f"{where}: cannot launch node of type [{pkg}/{typ}]: no executable {typ!r} {where_pkg} nor on PATH"
+    )
 
 
 def ros_home() -> Path:
@@ -94,8 +95,7 @@ class ProcessGroup:
         run = _Running(node, argv, env, self._spawn(node, argv, env, log_file))
         with self._lock:
             self.running.append(run)
-        threading.Thread(target=self._watch, args=(run, log_file), daemon=True,
-                         name=f"navlab-proc-{node.name}").start()
+        threading.Thread(target=self._watch, args=(run, log_file), daemon=True, name=f"navlab-proc-{node.name}").start()
 
     def _spawn(self, node: RosNode, argv: list[str], env: dict[str, str], log_file: Path) -> subprocess.Popen[bytes]:
         cwd = Path(node.cwd) if node.cwd and node.cwd != "node" else ros_home()

@@ -44,9 +44,17 @@ class Context:
 _DEFAULT: contextvars.ContextVar[Context | None] = contextvars.ContextVar("navlab_default_context", default=None)
 
 
-def init(args: Sequence[str] | None = None, *, context: Context | None = None, launch: Any = None,
-         seed: int = 0, rate: float = 0.0, duration: float | None = None, pace: float | None = None,
-         **launch_args: Any) -> Context:
+def init(
+    args: Sequence[str] | None = None,
+    *,
+    context: Context | None = None,
+    launch: Any = None,
+    seed: int = 0,
+    rate: float = 0.0,
+    duration: float | None = None,
+    pace: float | None = None,
+    **launch_args: Any,
+) -> Context:
     """``rclpy.init()``: make (or take) the default context. ``launch``: a launch to start in it (shipped
     name or file(s)), with ``launch_args``; ``args`` are ``name:=value`` items as on a command line. ``rate``:
     the pace (0 = as fast as possible, 1 = real time; ``pace``, its old name, is deprecated)."""

@@ -28,10 +28,24 @@ import numpy as np
 
 from navlab.msgs import TYPESTORE
 
-_NUMERIC = {"float64": np.float64, "float32": np.float32, "double": np.float64, "float": np.float32,
-            "int8": np.int8, "uint8": np.uint8, "int16": np.int16, "uint16": np.uint16, "int32": np.int32,
-            "uint32": np.uint32, "int64": np.int64, "uint64": np.uint64, "byte": np.uint8, "octet": np.uint8,
-            "char": np.uint8, "bool": np.bool_}
+_NUMERIC = {
+    "float64": np.float64,
+    "float32": np.float32,
+    "double": np.float64,
+    "float": np.float32,
+    "int8": np.int8,
+    "uint8": np.uint8,
+    "int16": np.int16,
+    "uint16": np.uint16,
+    "int32": np.int32,
+    "uint32": np.uint32,
+    "int64": np.int64,
+    "uint64": np.uint64,
+    "byte": np.uint8,
+    "octet": np.uint8,
+    "char": np.uint8,
+    "bool": np.bool_,
+}
 
 
 def _default(node: tuple[Any, Any]) -> Any:
@@ -162,11 +176,17 @@ def _rclpy_modules() -> dict[str, dict[str, Any]]:
         "rclpy.node": {"Node": Node},
         "rclpy.parameter": {"Parameter": Parameter},
         "rclpy.time": {"Time": Time},
-        "rclpy.executors": {"SingleThreadedExecutor": SingleThreadedExecutor,
-                            "MultiThreadedExecutor": MultiThreadedExecutor},
-        "rclpy.qos": {"QoSProfile": QoSProfile, "DurabilityPolicy": DurabilityPolicy,
-                      "ReliabilityPolicy": ReliabilityPolicy, "HistoryPolicy": HistoryPolicy,
-                      "qos_profile_sensor_data": QoSProfile(depth=5, reliability=ReliabilityPolicy.BEST_EFFORT)},
+        "rclpy.executors": {
+            "SingleThreadedExecutor": SingleThreadedExecutor,
+            "MultiThreadedExecutor": MultiThreadedExecutor,
+        },
+        "rclpy.qos": {
+            "QoSProfile": QoSProfile,
+            "DurabilityPolicy": DurabilityPolicy,
+            "ReliabilityPolicy": ReliabilityPolicy,
+            "HistoryPolicy": HistoryPolicy,
+            "qos_profile_sensor_data": QoSProfile(depth=5, reliability=ReliabilityPolicy.BEST_EFFORT),
+        },
     }
 
 

@@ -68,8 +68,15 @@ class _Scope:
 
     def child(self, **changes: Any) -> _Scope:
         """A nested scope (group, node, include): the same args; remaps and env copied."""
-        return _Scope(self.file, self.args, changes.get("ns", self.ns), list(self.remaps),
-                      dict(changes.get("env", self.env)), changes.get("node", self.node), self.unset)
+        return _Scope(
+            self.file,
+            self.args,
+            changes.get("ns", self.ns),
+            list(self.remaps),
+            dict(changes.get("env", self.env)),
+            changes.get("node", self.node),
+            self.unset,
+        )
 
 
 class _Loader:
@@ -110,7 +117,8 @@ class _Loader:
             return os.environ[name]
 
         return {
-            "arg": arg, "env": env,
+            "arg": arg,
+            "env": env,
             "optenv": lambda name, default="": os.environ.get(name) or default,
             "find": lambda pkg: self.find(pkg, where),
             "anon": self.anon_name,
@@ -123,7 +131,7 @@ class _Loader:
             return text
         stripped = text.strip()
         if stripped.startswith("$(eval ") and stripped.endswith(")"):
-            return self.eval(stripped[len("$(eval "):-1], scope, where)
+            return self.eval(stripped[len("$(eval ") : -1], scope, where)
         if "$(eval " in text:
             raise LaunchError(f"{where}: $(eval ...) must be the whole attribute value, got {text!r}")
         funcs = self.functions(scope, where)
@@ -134,8 +142,10 @@ class _Loader:
                 return os.environ.get(words[0], " ".join(words[1:]))
             need = {"arg": 1, "env": 1, "find": 1, "anon": 1, "dirname": 0}
             if kind not in need:
-                raise LaunchError(f"{where}: unknown substitution $({kind}) (roslaunch has arg, env, optenv, "
-                                  "find, anon, dirname, eval)")
+                raise LaunchError(
+                    f"{where}: unknown substitution $({kind}) (roslaunch has arg, env, optenv, "
+                    "find, anon, dirname, eval)"
+                )
             if len(words) != need[kind]:
                 raise LaunchError(f"{where}: $({kind}) takes {need[kind]} argument(s), got {m.group(0)!r}")
             return str(funcs[kind](*words))
@@ -158,8 +168,9 @@ class _Loader:
 
     # --- attributes -----------------------------------------------------------------------------
 
-    def attr(self, el: ET.Element, key: str, scope: _Scope, where: str, *, required: bool = False,
-             default: str | None = None) -> str | None:
+    def attr(
+        self, el: ET.Element, key: str, scope: _Scope, where: str, *, required: bool = False, default: str | None = None
+    ) -> str | None:
         raw = el.get(key)
         if raw is None:
             if required:
@@ -210,8 +221,11 @@ class _Loader:
             elif el.tag in _IGNORED_TAGS:
                 self.config.notes.append(f"{where}: <{el.tag}> is not used by navlab (skipped)")
             else:
-                hint = did_you_mean(el.tag, ["arg", "param", "rosparam", "include", "group", "remap", "node", "env",
-                                             "machine", "test"], template="; did you mean <{}>?")
+                hint = did_you_mean(
+                    el.tag,
+                    ["arg", "param", "rosparam", "include", "group", "remap", "node", "env", "machine", "test"],
+                    template="; did you mean <{}>?",
+                )
                 raise LaunchError(f"{where}: unknown tag <{el.tag}>{hint}")
 
     def children(self, el: ET.Element, scope: _Scope, where: str) -> Iterator[tuple[ET.Element, str]]:
@@ -222,8 +236,9 @@ class _Loader:
                 if self.active(child, scope, cwhere):
                     yield child, cwhere
 
-    def common(self, el: ET.Element, scope: _Scope, where: str, remaps: list[tuple[str, str]],
-               env: dict[str, str]) -> bool:
+    def common(
+        self, el: ET.Element, scope: _Scope, where: str, remaps: list[tuple[str, str]], env: dict[str, str]
+    ) -> bool:
         """``<param>``, ``<rosparam>``, ``<remap>`` and ``<env>``, which launch, group and node share (remaps
         and env go to the lists given); False for any other tag."""
         if el.tag == "param":
@@ -234,7 +249,8 @@ class _Loader:
             remaps.append(self.remap(el, scope, where))
         elif el.tag == "env":
             env[str(self.attr(el, "name", scope, where, required=True))] = str(
-                self.attr(el, "value", scope, where, required=True))
+                self.attr(el, "value", scope, where, required=True)
+            )
         else:
             return False
         return True
@@ -247,8 +263,10 @@ class _Loader:
             raise LaunchError(f"{where}: arg {name!r} has already been declared")
         if "value" in el.attrib:
             if name in given:
-                raise LaunchError(f"{where}: cannot override arg {name!r}, which has a fixed value= "
-                                  "(roslaunch: only a default= can be overridden)")
+                raise LaunchError(
+                    f"{where}: cannot override arg {name!r}, which has a fixed value= "
+                    "(roslaunch: only a default= can be overridden)"
+                )
             scope.args[name] = str(self.attr(el, "value", scope, where))
         elif name in given:
             scope.args[name] = given[name]
@@ -274,8 +292,10 @@ class _Loader:
         kind = self.attr(el, "type", scope, where, default="auto") or "auto"
         sources = [k for k in ("value", "textfile", "binfile", "command") if k in el.attrib]
         if len(sources) != 1:
-            raise LaunchError(f"{where}: <param> needs exactly one of value, textfile, binfile, command "
-                              f"(got {', '.join(sources) or 'none'})")
+            raise LaunchError(
+                f"{where}: <param> needs exactly one of value, textfile, binfile, command "
+                f"(got {', '.join(sources) or 'none'})"
+            )
         origin = str(scope.file)
         if "value" in el.attrib:
             value: Any = convert_value(str(self.attr(el, "value", scope, where)), kind, where)
@@ -312,8 +332,10 @@ class _Loader:
             self.config.sources[name] = (path, xargs)
             return text
         if not self.config.allow_commands:
-            raise LaunchError(f"{where}: command {cmd!r} runs a program; navlab runs programs named by a launch "
-                              "file only with the ROS bridge on (ros:=true); xacro commands run inside navlab")
+            raise LaunchError(
+                f"{where}: command {cmd!r} runs a program; navlab runs programs named by a launch "
+                "file only with the ROS bridge on (ros:=true); xacro commands run inside navlab"
+            )
         import subprocess
 
         try:
@@ -383,8 +405,10 @@ class _Loader:
         declared = declared_names(root)
         unused = sorted(set(passed) - declared)
         if unused and not pass_all:
-            raise LaunchError(f"{outer.file}: unused args [{', '.join(unused)}] for include of [{path}] "
-                              f"(it declares: {', '.join(sorted(declared)) or 'none'})")
+            raise LaunchError(
+                f"{outer.file}: unused args [{', '.join(unused)}] for include of [{path}] "
+                f"(it declares: {', '.join(sorted(declared)) or 'none'})"
+            )
         scope = _Scope(path, {}, outer.ns, list(outer.remaps), dict(outer.env))
         self.block(root, scope, {k: v for k, v in passed.items() if k in declared}, depth)
 
@@ -396,15 +420,22 @@ class _Loader:
             raise LaunchError(f"{where}: node name {name!r} must be a base name (use ns= for namespaces)")
         ns_attr = self.attr(el, "ns", scope, where)
         ns = push_ns(scope.ns, ns_attr) if ns_attr else scope.ns
-        node = RosNode(pkg, typ, name, ns, args=self.attr(el, "args", scope, where, default="") or "",
-                       remaps=list(scope.remaps), env=dict(scope.env),
-                       respawn=self.flag(el, "respawn", scope, where),
-                       respawn_delay=number(self.attr(el, "respawn_delay", scope, where, default="0"), where),
-                       required=self.flag(el, "required", scope, where),
-                       output=self.attr(el, "output", scope, where, default="log") or "log",
-                       cwd=self.attr(el, "cwd", scope, where, default="") or "",
-                       launch_prefix=self.attr(el, "launch-prefix", scope, where, default="") or "",
-                       where=where)
+        node = RosNode(
+            pkg,
+            typ,
+            name,
+            ns,
+            args=self.attr(el, "args", scope, where, default="") or "",
+            remaps=list(scope.remaps),
+            env=dict(scope.env),
+            respawn=self.flag(el, "respawn", scope, where),
+            respawn_delay=number(self.attr(el, "respawn_delay", scope, where, default="0"), where),
+            required=self.flag(el, "required", scope, where),
+            output=self.attr(el, "output", scope, where, default="log") or "log",
+            cwd=self.attr(el, "cwd", scope, where, default="") or "",
+            launch_prefix=self.attr(el, "launch-prefix", scope, where, default="") or "",
+            where=where,
+        )
         if self.flag(el, "clear_params", scope, where):
             self.config.delete_param(node.fqn)
         inner = scope.child(ns=ns, node=node.fqn)
@@ -412,8 +443,9 @@ class _Loader:
             if not self.common(child, inner, cwhere, node.remaps, node.env):
                 raise LaunchError(f"{cwhere}: <node> takes <param>, <rosparam>, <remap> and <env> children")
         if any(n.fqn == node.fqn for n in self.config.nodes):
-            raise LaunchError(f"{where}: a node named {node.fqn!r} is already in this launch "
-                              "(roslaunch refuses duplicate node names)")
+            raise LaunchError(
+                f"{where}: a node named {node.fqn!r} is already in this launch (roslaunch refuses duplicate node names)"
+            )
         self.config.nodes.append(node)
 
 
@@ -442,8 +474,10 @@ def load(files: list[Path], args: Mapping[str, str], *, seed: int = 0, allow_com
     for name in args:
         if name not in config.declared:
             hint = did_you_mean(name, sorted(config.declared), template="did you mean {!r}? ")
-            raise LaunchError(f"{', '.join(map(str, files))}: unknown launch argument {name!r} ({hint}arguments: "
-                              f"{', '.join(sorted(config.declared)) or 'none'})")
+            raise LaunchError(
+                f"{', '.join(map(str, files))}: unknown launch argument {name!r} ({hint}arguments: "
+                f"{', '.join(sorted(config.declared)) or 'none'})"
+            )
     for file in files:
         root = parse_launch(file)
         scope = _Scope(file, {})

@@ -25,7 +25,8 @@ XACRO_TEXT = "navlab.description.loader:xacro_text"
 MAX_LAUNCH_BYTES = 4 << 20
 #: what ``$(eval ...)`` may call besides a launch format's own functions (both launch formats)
 EVAL_BUILTINS: dict[str, Callable[..., Any]] = {
-    f.__name__: f for f in (int, float, str, bool, abs, min, max, round, len)}
+    f.__name__: f for f in (int, float, str, bool, abs, min, max, round, len)
+}
 
 
 def call(target: str, *args: Any) -> Any:
@@ -111,7 +112,7 @@ class RosConfig:
         out: dict[str, Any] = {}
         for key, value in self.params.items():
             if key.startswith(prefix):
-                *parents, leaf = key[len(prefix):].split("/")
+                *parents, leaf = key[len(prefix) :].split("/")
                 here = out
                 for part in parents:
                     here = here.setdefault(part, {})

@@ -76,8 +76,15 @@ def _spawn_robot(config: RosConfig, node: RosNode) -> dict[str, Any]:
     while i < len(words):
         flag = words[i]
         value = words[i + 1] if i + 1 < len(words) else None
-        if flag in _SPAWN_FLOATS or flag in ("-param", "-file", "-model", "-robot_namespace",
-                                             "-gazebo_namespace", "-reference_frame", "-database"):
+        if flag in _SPAWN_FLOATS or flag in (
+            "-param",
+            "-file",
+            "-model",
+            "-robot_namespace",
+            "-gazebo_namespace",
+            "-reference_frame",
+            "-database",
+        ):
             if value is None:
                 raise LaunchError(f"{node.where}: spawn_model {flag} needs a value")
             if flag in _SPAWN_FLOATS:
@@ -88,21 +95,27 @@ def _spawn_robot(config: RosConfig, node: RosNode) -> dict[str, Any]:
             elif flag == "-param":
                 name = ns_join(node.namespace, value)
                 if name not in config.sources:
-                    raise LaunchError(f"{node.where}: spawn_model -param {value}: parameter {name!r} was not set "
-                                      "from a file (expected <param name=... command=\"xacro FILE\"> or textfile=)")
+                    raise LaunchError(
+                        f"{node.where}: spawn_model -param {value}: parameter {name!r} was not set "
+                        'from a file (expected <param name=... command="xacro FILE"> or textfile=)'
+                    )
                 path, xargs = config.sources[name]
                 out["robot"] = str(path)
                 out["robot_args"] = [f"{k}:={v}" for k, v in xargs.items()]
             elif flag == "-file":
                 out["robot"] = value
             elif flag == "-database":
-                raise LaunchError(f"{node.where}: spawn_model -database {value}: navlab spawns robots from -file or "
-                                  "-param (a URDF/xacro)")
+                raise LaunchError(
+                    f"{node.where}: spawn_model -database {value}: navlab spawns robots from -file or "
+                    "-param (a URDF/xacro)"
+                )
             i += 2
             continue
         if flag == "-sdf":
-            raise LaunchError(f"{node.where}: spawn_model -sdf: navlab spawns a robot from a URDF (-urdf); put "
-                              "static SDF models in the .world file")
+            raise LaunchError(
+                f"{node.where}: spawn_model -sdf: navlab spawns a robot from a URDF (-urdf); put "
+                "static SDF models in the .world file"
+            )
         if flag == "-J":  # -J JOINT POSITION
             i += 3
             continue
@@ -137,8 +150,10 @@ def plan(config: RosConfig, *, ros: bool) -> Plan:
                 raise LaunchError(f"{node.where}: a second Gazebo server; navlab runs one world per launch")
             world, paused = _gazebo_world(node)
             if paused:
-                out.warnings.append(f"{node.where}: paused:=true: navlab's simulation starts running (time still "
-                                 "advances only as the launch runs)")
+                out.warnings.append(
+                    f"{node.where}: paused:=true: navlab's simulation starts running (time still "
+                    "advances only as the launch runs)"
+                )
             gazebo = NodeSpec("gazebo", node.name, node.namespace, {"world": world}, _remaps(node), origin)
             out.nodes.append(gazebo)
         elif key == ("gazebo_ros", "spawn_model"):
@@ -151,8 +166,9 @@ def plan(config: RosConfig, *, ros: bool) -> Plan:
                 params = {**params, "yaml_filename": words[0]}
             out.nodes.append(NodeSpec("map_server", node.name, node.namespace, params, _remaps(node), origin, files))
         elif key == ("map_server", "map_saver"):
-            out.nodes.append(NodeSpec("map_saver", node.name, node.namespace,
-                                      {**params, **_saver_args(node)}, _remaps(node), origin))
+            out.nodes.append(
+                NodeSpec("map_saver", node.name, node.namespace, {**params, **_saver_args(node)}, _remaps(node), origin)
+            )
         elif node.pkg == "navlab":
             out.nodes.append(NodeSpec(node.type, node.name, node.namespace, params, _remaps(node), origin, files))
         elif key in COVERED:
@@ -162,20 +178,27 @@ def plan(config: RosConfig, *, ros: bool) -> Plan:
         elif ros:
             out.processes.append(node)
         else:
-            out.warnings.append(f"{node.where}: node {node.fqn!r} ({node.pkg}/{node.type}) is not one navlab runs; "
-                             "with the ROS bridge on (ros:=true) it is started as a process")
+            out.warnings.append(
+                f"{node.where}: node {node.fqn!r} ({node.pkg}/{node.type}) is not one navlab runs; "
+                "with the ROS bridge on (ros:=true) it is started as a process"
+            )
     if spawns:
         if gazebo is None:
-            raise LaunchError(f"{spawns[0].where}: spawn_model needs a Gazebo server in the launch (include "
-                              "gazebo_ros empty_world.launch)")
+            raise LaunchError(
+                f"{spawns[0].where}: spawn_model needs a Gazebo server in the launch (include "
+                "gazebo_ros empty_world.launch)"
+            )
         if len(spawns) > 1:
-            raise LaunchError(f"{spawns[1].where}: navlab simulates one robot per world (already spawned by "
-                              f"{spawns[0].where})")
+            raise LaunchError(
+                f"{spawns[1].where}: navlab simulates one robot per world (already spawned by {spawns[0].where})"
+            )
         robot = _spawn_robot(config, spawns[0])
         gazebo.params.update({k: v for k, v in robot.items() if k in ("robot", "robot_args", "x", "y", "yaw")})
     elif gazebo is not None:
-        raise LaunchError(f"{gazebo.origin}: the world has no robot; navlab's gazebo needs one (spawn it with "
-                          "gazebo_ros spawn_model -urdf -param robot_description)")
+        raise LaunchError(
+            f"{gazebo.origin}: the world has no robot; navlab's gazebo needs one (spawn it with "
+            "gazebo_ros spawn_model -urdf -param robot_description)"
+        )
     return out
 
 
@@ -209,6 +232,7 @@ def start_xml(session: Session, files: list[Path], args: dict[str, str], *, ros:
         from navlab.core.processes import ProcessGroup
 
         ex = session.executor
+
         def required_exit(why: str) -> None:  # roslaunch: a required process that dies ends the launch
             log.error(why)
             ex.post(ex.stop)

@@ -32,9 +32,13 @@ def run_for(
 
     recorder = Recorder(ex, record, topics=record_topics) if record else None
     bar = tqdm(
-        total=None if math.isinf(duration) else round(duration, 3), unit="sim s", desc=desc, file=sys.stderr,
+        total=None if math.isinf(duration) else round(duration, 3),
+        unit="sim s",
+        desc=desc,
+        file=sys.stderr,
         disable=quiet or not sys.stderr.isatty(),
-        bar_format="{desc}: {n:.1f} sim s [{rate_fmt}]" if math.isinf(duration)
+        bar_format="{desc}: {n:.1f} sim s [{rate_fmt}]"
+        if math.isinf(duration)
         else "{l_bar}{bar}| {n:.1f}/{total:.1f} sim s [{rate_fmt}]",
     )
     try:

@@ -37,7 +37,6 @@ MAX_FACTORIAL = 1_000  # argument of math.factorial / comb / perm
 MATH_NAMES: Mapping[str, Any] = {k: v for k, v in vars(math).items() if not k.startswith("_")}
 
 
-
 class ExpressionError(CoreError):
     """An expression in a data file cannot be evaluated (unknown name, division by zero, wrong types)."""
 
@@ -47,33 +46,91 @@ class UnsafeExpressionError(ExpressionError):
 
 
 _BINOPS: dict[type, Callable[[Any, Any], Any]] = {
-    ast.Add: operator.add, ast.Sub: operator.sub, ast.Mult: operator.mul, ast.Div: operator.truediv,
-    ast.FloorDiv: operator.floordiv, ast.Mod: operator.mod, ast.Pow: operator.pow, ast.LShift: operator.lshift,
-    ast.RShift: operator.rshift, ast.BitAnd: operator.and_, ast.BitOr: operator.or_, ast.BitXor: operator.xor,
+    ast.Add: operator.add,
+    ast.Sub: operator.sub,
+    ast.Mult: operator.mul,
+    ast.Div: operator.truediv,
+    ast.FloorDiv: operator.floordiv,
+    ast.Mod: operator.mod,
+    ast.Pow: operator.pow,
+    ast.LShift: operator.lshift,
+    ast.RShift: operator.rshift,
+    ast.BitAnd: operator.and_,
+    ast.BitOr: operator.or_,
+    ast.BitXor: operator.xor,
 }
 _UNARY: dict[type, Callable[[Any], Any]] = {
-    ast.UAdd: operator.pos, ast.USub: operator.neg, ast.Not: operator.not_, ast.Invert: operator.invert,
+    ast.UAdd: operator.pos,
+    ast.USub: operator.neg,
+    ast.Not: operator.not_,
+    ast.Invert: operator.invert,
 }
 _COMPARE: dict[type, Callable[[Any, Any], Any]] = {
-    ast.Eq: operator.eq, ast.NotEq: operator.ne, ast.Lt: operator.lt, ast.LtE: operator.le, ast.Gt: operator.gt,
-    ast.GtE: operator.ge, ast.Is: operator.is_, ast.IsNot: operator.is_not,
-    ast.In: lambda a, b: a in b, ast.NotIn: lambda a, b: a not in b,
+    ast.Eq: operator.eq,
+    ast.NotEq: operator.ne,
+    ast.Lt: operator.lt,
+    ast.LtE: operator.le,
+    ast.Gt: operator.gt,
+    ast.GtE: operator.ge,
+    ast.Is: operator.is_,
+    ast.IsNot: operator.is_not,
+    ast.In: lambda a, b: a in b,
+    ast.NotIn: lambda a, b: a not in b,
 }
 #: pure methods an expression may call on values of these types (``format`` is not one: it reaches attributes)
 _METHODS: dict[type, frozenset[str]] = {
-    str: frozenset({"lower", "upper", "strip", "lstrip", "rstrip", "split", "rsplit", "splitlines", "startswith",
-                    "endswith", "find", "rfind", "index", "rindex", "count", "isdigit", "isalpha", "isalnum",
-                    "isspace", "islower", "isupper", "isnumeric", "title", "capitalize", "swapcase", "casefold",
-                    "replace", "join", "partition", "rpartition", "removeprefix", "removesuffix"}),
+    str: frozenset(
+        {
+            "lower",
+            "upper",
+            "strip",
+            "lstrip",
+            "rstrip",
+            "split",
+            "rsplit",
+            "splitlines",
+            "startswith",
+            "endswith",
+            "find",
+            "rfind",
+            "index",
+            "rindex",
+            "count",
+            "isdigit",
+            "isalpha",
+            "isalnum",
+            "isspace",
+            "islower",
+            "isupper",
+            "isnumeric",
+            "title",
+            "capitalize",
+            "swapcase",
+            "casefold",
+            "replace",
+            "join",
+            "partition",
+            "rpartition",
+            "removeprefix",
+            "removesuffix",
+        }
+    ),
     list: frozenset({"index", "count"}),
     tuple: frozenset({"index", "count"}),
     dict: frozenset({"get", "keys", "values", "items"}),
 }
 #: node types refused, with the words the error uses
 _REFUSED: dict[type, str] = {
-    ast.Lambda: "a lambda", ast.NamedExpr: "an assignment expression (:=)", ast.ListComp: "a comprehension",
-    ast.SetComp: "a comprehension", ast.DictComp: "a comprehension", ast.GeneratorExp: "a generator expression",
-    ast.Await: "await", ast.Yield: "yield", ast.YieldFrom: "yield", ast.MatMult: "the @ operator",
+    ast.Lambda: "a lambda",
+    ast.NamedExpr: "an assignment expression (:=)",
+    ast.ListComp: "a comprehension",
+    ast.SetComp: "a comprehension",
+    ast.DictComp: "a comprehension",
+    ast.GeneratorExp: "a generator expression",
+    ast.Await: "await",
+    ast.Yield: "yield",
+    ast.YieldFrom: "yield",
+    ast.MatMult: "the @ operator",
 }
 _PERCENT_FIELD = re.compile(r"%(?:\([^)]*\))?[-#0 +]*(\*|\d*)(?:\.(\*|\d*))?")
 _SPEC_NUMBER = re.compile(r"\d+")
@@ -108,18 +165,28 @@ class _Evaluator:
         self.allowed = {id(f) for f in functions.values()}
         self._keep = list(functions.values())  # the ids above stay valid while this evaluator lives
         self.wrapped: dict[int, Callable[..., Any]] = {}  # allowed builtins that size work -> bounded versions
-        for fn, guard in ((range, self._guard_range), (math.factorial, self._guard_factorial),
-                          (math.comb, self._guard_factorial), (math.perm, self._guard_factorial),
-                          (round, self._guard_round), (sum, self._guard_sum), (math.prod, self._guard_prod)):
+        for fn, guard in (
+            (range, self._guard_range),
+            (math.factorial, self._guard_factorial),
+            (math.comb, self._guard_factorial),
+            (math.perm, self._guard_factorial),
+            (round, self._guard_round),
+            (sum, self._guard_sum),
+            (math.prod, self._guard_prod),
+        ):
             if id(fn) in self.allowed:
                 self.wrapped[id(fn)] = self._bounded(fn, guard)
         self.allowed |= {id(f) for f in self.wrapped.values()}
 
-    def _bounded(self, fn: Callable[..., Any], guard: Callable[[tuple[Any, ...], dict[str, Any]], None],
-                 ) -> Callable[..., Any]:
+    def _bounded(
+        self,
+        fn: Callable[..., Any],
+        guard: Callable[[tuple[Any, ...], dict[str, Any]], None],
+    ) -> Callable[..., Any]:
         def bounded(*args: Any, **kwargs: Any) -> Any:
             guard(args, kwargs)
             return fn(*args, **kwargs)
+
         return bounded
 
     def value(self, value: Any) -> Any:
@@ -128,8 +195,9 @@ class _Evaluator:
 
     # --- errors -------------------------------------------------------------------------------------------
     def unsafe(self, what: str) -> UnsafeExpressionError:
-        return UnsafeExpressionError(f"expression '{_short(self.expr)}': {what} is not allowed "
-                                     "(an expression in a data file is not code)")
+        return UnsafeExpressionError(
+            f"expression '{_short(self.expr)}': {what} is not allowed (an expression in a data file is not code)"
+        )
 
     def error(self, what: str) -> ExpressionError:
         return ExpressionError(f"expression '{_short(self.expr)}': {what}")
@@ -170,12 +238,22 @@ class _Evaluator:
             if ints and a.bit_length() + b.bit_length() > MAX_INT_BITS:
                 raise self.unsafe(f"a product of more than {MAX_INT_BITS} bits")
             seq, n = (a, b) if isinstance(b, int) else (b, a)
-            if isinstance(n, int) and isinstance(seq, (str, bytes, list, tuple)) and n > 0 \
-                    and self.items(seq) * n > MAX_ITEMS:
-                raise self.unsafe(f"repeating a {type(seq).__name__} of {self.items(seq):,} items {n:,} times "
-                                  f"(more than {MAX_ITEMS:,})")
-        if op is ast.Add and isinstance(a, (str, bytes, list, tuple)) and isinstance(b, (str, bytes, list, tuple)) \
-                and self.items(a) + self.items(b) > MAX_ITEMS:
+            if (
+                isinstance(n, int)
+                and isinstance(seq, (str, bytes, list, tuple))
+                and n > 0
+                and self.items(seq) * n > MAX_ITEMS
+            ):
+                raise self.unsafe(
+                    f"repeating a {type(seq).__name__} of {self.items(seq):,} items {n:,} times "
+                    f"(more than {MAX_ITEMS:,})"
+                )
+        if (
+            op is ast.Add
+            and isinstance(a, (str, bytes, list, tuple))
+            and isinstance(b, (str, bytes, list, tuple))
+            and self.items(a) + self.items(b) > MAX_ITEMS
+        ):
             raise self.unsafe(f"a value of more than {MAX_ITEMS:,} characters/items")
         if op is ast.Mod and isinstance(a, str):
             for width, precision in _PERCENT_FIELD.findall(a):
@@ -201,8 +279,11 @@ class _Evaluator:
             raise self.unsafe("sum() of anything but numbers")
 
     def _guard_prod(self, args: tuple[Any, ...], kwargs: dict[str, Any]) -> None:
-        if args and isinstance(args[0], (list, tuple)) and \
-                sum(abs(int(v)).bit_length() for v in args[0] if isinstance(v, int)) > MAX_INT_BITS:
+        if (
+            args
+            and isinstance(args[0], (list, tuple))
+            and sum(abs(int(v)).bit_length() for v in args[0] if isinstance(v, int)) > MAX_INT_BITS
+        ):
             raise self.unsafe(f"a product of more than {MAX_INT_BITS} bits")
 
     # --- evaluation -----------------------------------------------------------------------------------------
@@ -248,18 +329,22 @@ class _Evaluator:
     def bind(self, value: Any, attr: str) -> _BoundMethod:
         fn = getattr(value, attr)
         if attr == "replace":
+
             def replace(old: str, new: str, count: int = -1) -> str:
                 n = value.count(old) if count < 0 else min(count, value.count(old))
                 if len(value) + n * (len(new) - len(old)) > MAX_ITEMS:
                     raise self.unsafe(f"a value of more than {MAX_ITEMS:,} characters")
                 return value.replace(old, new, count)
+
             return _BoundMethod(replace, "str.replace")
         if attr == "join":
+
             def join(items: Iterable[Any]) -> str:
                 parts = list(items)
                 if sum(len(p) if isinstance(p, str) else 0 for p in parts) + len(value) * len(parts) > MAX_ITEMS:
                     raise self.unsafe(f"a value of more than {MAX_ITEMS:,} characters")
                 return fn(parts)
+
             return _BoundMethod(join, "str.join")
         return _BoundMethod(fn, f"{type(value).__name__}.{attr}")
 

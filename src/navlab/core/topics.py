@@ -85,9 +85,14 @@ class Timer:
     """
 
     def __init__(
-        self, queue: TimerQueue, period_ns: int, callback: Callable[[], None], priority: int, start_ns: int,
+        self,
+        queue: TimerQueue,
+        period_ns: int,
+        callback: Callable[[], None],
+        priority: int,
+        start_ns: int,
         idle: Callable[[], bool] | None = None,
-    ) -> None:  # fmt: skip
+    ) -> None:
         if period_ns <= 0:
             raise CoreError(f"timer period must be > 0 s, got {period_ns / 1e9}")
         self._queue = queue

@@ -32,46 +32,106 @@ from navlab.description.urdf import floats
 from navlab.errors import did_you_mean
 
 DIFF_DRIVE_PLUGINS = ("libgazebo_ros_diff_drive.so",)
-LASER_PLUGINS = ("libgazebo_ros_laser.so", "libgazebo_ros_gpu_laser.so", "libgazebo_ros_ray_sensor.so",
-                 "libgazebo_ros_head_rplidar_controller.so")
-LASER_PLUGIN_NAMES = ("gazebo_ros_laser", "gazebo_ros_ray_sensor", "gazebo_ros_head_rplidar_controller",
-                      "gazebo_ros_head_hokuyo_controller")
+LASER_PLUGINS = (
+    "libgazebo_ros_laser.so",
+    "libgazebo_ros_gpu_laser.so",
+    "libgazebo_ros_ray_sensor.so",
+    "libgazebo_ros_head_rplidar_controller.so",
+)
+LASER_PLUGIN_NAMES = (
+    "gazebo_ros_laser",
+    "gazebo_ros_ray_sensor",
+    "gazebo_ros_head_rplidar_controller",
+    "gazebo_ros_head_hokuyo_controller",
+)
 IMU_SENSOR_PLUGINS = ("libgazebo_ros_imu_sensor.so",)
 #: plugins whose job navlab's simulator does anyway (joint states, ground truth): no warning
 BUILTIN_PLUGINS = ("libgazebo_ros_joint_state_publisher.so",)
 P3D_PLUGINS = ("libgazebo_ros_p3d.so",)
 #: <gazebo reference="link"> tags understood or harmless to ignore (rendering, ODE contact tuning)
-LINK_TAGS = ("mu1", "mu2", "material", "kp", "kd", "minDepth", "maxVel", "fdir1", "selfCollide",
-             "self_collide", "turnGravityOff", "gravity", "maxContacts", "dampingFactor", "sensor",
-             "implicitSpringDamper", "provideFeedback", "stopCfm", "stopErp", "visual", "collision",
-             "laserRetro", "static", "velocity_decay", "enable_wind", "kinematic")
+LINK_TAGS = (
+    "mu1",
+    "mu2",
+    "material",
+    "kp",
+    "kd",
+    "minDepth",
+    "maxVel",
+    "fdir1",
+    "selfCollide",
+    "self_collide",
+    "turnGravityOff",
+    "gravity",
+    "maxContacts",
+    "dampingFactor",
+    "sensor",
+    "implicitSpringDamper",
+    "provideFeedback",
+    "stopCfm",
+    "stopErp",
+    "visual",
+    "collision",
+    "laserRetro",
+    "static",
+    "velocity_decay",
+    "enable_wind",
+    "kinematic",
+)
 
 DD_KEYS_ROS1 = {
-    "leftJoint": "left_joint", "rightJoint": "right_joint", "wheelSeparation": "wheel_separation",
-    "wheelDiameter": "wheel_diameter", "wheelTorque": "max_torque",
-    "wheelAcceleration": "max_accel", "updateRate": "update_rate", "commandTopic": "command_topic",
-    "odometryTopic": "odometry_topic", "odometryFrame": "odometry_frame",
-    "robotBaseFrame": "robot_base_frame", "odometrySource": "odometry_source", "publishTf": "publish_odom",
-    "publishOdomTF": "publish_tf", "publishWheelTF": "publish_wheel_tf", "robotNamespace": "namespace",
+    "leftJoint": "left_joint",
+    "rightJoint": "right_joint",
+    "wheelSeparation": "wheel_separation",
+    "wheelDiameter": "wheel_diameter",
+    "wheelTorque": "max_torque",
+    "wheelAcceleration": "max_accel",
+    "updateRate": "update_rate",
+    "commandTopic": "command_topic",
+    "odometryTopic": "odometry_topic",
+    "odometryFrame": "odometry_frame",
+    "robotBaseFrame": "robot_base_frame",
+    "odometrySource": "odometry_source",
+    "publishTf": "publish_odom",
+    "publishOdomTF": "publish_tf",
+    "publishWheelTF": "publish_wheel_tf",
+    "robotNamespace": "namespace",
 }
 #: tags older ROS 1 releases read that Noetic's gazebo_ros_diff_drive does not: the warning names what it reads
 DD_NOT_IN_NOETIC = {
     "torque": "<torque> is not read by ROS Noetic's gazebo_ros_diff_drive (ignored since Hydro); it reads "
-              "<wheelTorque> (default 5 N m), which applies",
+    "<wheelTorque> (default 5 N m), which applies",
     "legacyMode": "<legacyMode> was removed from gazebo_ros_diff_drive in Melodic (gazebo_ros_pkgs PR #707); "
-                  "Noetic drives the <leftJoint> joint as the left wheel and <rightJoint> as the right one",
+    "Noetic drives the <leftJoint> joint as the left wheel and <rightJoint> as the right one",
 }
 DD_KEYS_ROS2 = {
-    "left_joint": "left_joint", "right_joint": "right_joint", "wheel_separation": "wheel_separation",
-    "wheel_diameter": "wheel_diameter", "max_wheel_torque": "max_torque",
-    "max_wheel_acceleration": "max_accel", "update_rate": "update_rate",
-    "odometry_frame": "odometry_frame", "robot_base_frame": "robot_base_frame",
-    "odometry_source": "odometry_source", "publish_odom_tf": "publish_tf",
-    "publish_wheel_tf": "publish_wheel_tf", "command_topic": "command_topic",
+    "left_joint": "left_joint",
+    "right_joint": "right_joint",
+    "wheel_separation": "wheel_separation",
+    "wheel_diameter": "wheel_diameter",
+    "max_wheel_torque": "max_torque",
+    "max_wheel_acceleration": "max_accel",
+    "update_rate": "update_rate",
+    "odometry_frame": "odometry_frame",
+    "robot_base_frame": "robot_base_frame",
+    "odometry_source": "odometry_source",
+    "publish_odom_tf": "publish_tf",
+    "publish_wheel_tf": "publish_wheel_tf",
+    "command_topic": "command_topic",
     "odometry_topic": "odometry_topic",
 }
-DD_IGNORED = ("alwaysOn", "rosDebugLevel", "publishWheelJointState", "publishOdom", "publish_odom",
-              "ros", "num_wheel_pairs", "covariance_x", "covariance_y", "covariance_yaw", "odometryRate")
+DD_IGNORED = (
+    "alwaysOn",
+    "rosDebugLevel",
+    "publishWheelJointState",
+    "publishOdom",
+    "publish_odom",
+    "ros",
+    "num_wheel_pairs",
+    "covariance_x",
+    "covariance_y",
+    "covariance_yaw",
+    "odometryRate",
+)
 FLOAT_FIELDS = ("wheel_separation", "wheel_diameter", "max_torque", "max_accel", "update_rate")
 BOOL_FIELDS = ("publish_tf", "publish_odom", "publish_wheel_tf")
 
@@ -110,8 +170,9 @@ def parse_diff_drive(plugin: ET.Element, where: str, warnings: list[str]) -> Dif
         elif key is not None:
             values[key] = (child.text or "").strip()
         elif child.tag not in DD_IGNORED:
-            warnings.append(f"{where}: unknown diff-drive parameter <{child.tag}> ignored"
-                            f"{_did_you_mean(child.tag, known)}")
+            warnings.append(
+                f"{where}: unknown diff-drive parameter <{child.tag}> ignored{_did_you_mean(child.tag, known)}"
+            )
     if "odometry_source" not in values:
         cfg.odometry_source = "world"  # both plugins default to the true pose
     for key, raw in values.items():
@@ -127,7 +188,11 @@ def parse_diff_drive(plugin: ET.Element, where: str, warnings: list[str]) -> Dif
             setattr(cfg, key, parse_bool(raw, where + f" ({key})"))
         elif key == "odometry_source":
             sources: dict[str, Literal["encoder", "world"]] = {
-                "0": "encoder", "1": "world", "encoder": "encoder", "world": "world"}  # fmt: skip
+                "0": "encoder",
+                "1": "world",
+                "encoder": "encoder",
+                "world": "world",
+            }
             src = sources.get(raw.lower())
             if src is None:
                 raise DescriptionError(f"{where}: odometry source {raw!r}: expected encoder/world (0/1)")
@@ -177,13 +242,16 @@ def read_gazebo_tags(root: ET.Element, links: dict[str, Link], joint_names: set[
             elif child.tag == "plugin":
                 _read_model_plugin(child, where, out)
             elif ref is not None and child.tag not in LINK_TAGS:
-                out.warnings.append(f"{where}: unknown tag <{child.tag}> ignored"
-                                    f"{_did_you_mean(child.tag, list(LINK_TAGS))}")
+                out.warnings.append(
+                    f"{where}: unknown tag <{child.tag}> ignored{_did_you_mean(child.tag, list(LINK_TAGS))}"
+                )
     covered = {imu.link for imu in out.imus}
     for link, sensor in imu_sensors.items():
         if link not in covered:
-            out.warnings.append(f'{source}: <gazebo reference="{link}">: imu sensor '
-                                f"{sensor.get('name')!r} has no ROS plugin; nothing is published")
+            out.warnings.append(
+                f'{source}: <gazebo reference="{link}">: imu sensor '
+                f"{sensor.get('name')!r} has no ROS plugin; nothing is published"
+            )
     return out
 
 
@@ -194,16 +262,19 @@ def _apply_material(link: Link, el: ET.Element, where: str, warnings: list[str])
     rgba = gazebo_material(name)
     if rgba is None:
         if name:
-            warnings.append(f"{where}: material {name!r} is not one of Gazebo's named materials navlab knows "
-                            "(Gazebo/Orange, Gazebo/Grey, ...); the URDF colour is kept")
+            warnings.append(
+                f"{where}: material {name!r} is not one of Gazebo's named materials navlab knows "
+                "(Gazebo/Orange, Gazebo/Grey, ...); the URDF colour is kept"
+            )
         return
     link.visuals = [replace(v, rgba=rgba) for v in link.visuals]
 
 
-def _read_sensor(sensor: ET.Element, link: str, where: str, out: GazeboTags,
-                 imu_sensors: dict[str, ET.Element]) -> None:
+def _read_sensor(
+    sensor: ET.Element, link: str, where: str, out: GazeboTags, imu_sensors: dict[str, ET.Element]
+) -> None:
     stype = sensor.get("type", "")
-    w = f"{where}/<sensor name=\"{sensor.get('name', '')}\" type=\"{stype}\">"
+    w = f'{where}/<sensor name="{sensor.get("name", "")}" type="{stype}">'
     plugin = sensor_plugin(sensor)
     if plugin is not None and read_sensor3d(sensor, plugin, link, w, out.sensors, out.warnings):
         return
@@ -211,8 +282,9 @@ def _read_sensor(sensor: ET.Element, link: str, where: str, out: GazeboTags,
         if plugin is None:
             out.warnings.append(f"{w}: no ROS plugin, so nothing is published; sensor ignored")
         elif not _is_laser_plugin(plugin):
-            out.warnings.append(f"{w}: unknown plugin {plugin.get('filename')!r} "
-                                f"(name {plugin.get('name')!r}); sensor ignored")
+            out.warnings.append(
+                f"{w}: unknown plugin {plugin.get('filename')!r} (name {plugin.get('name')!r}); sensor ignored"
+            )
         else:
             out.lidars.append(parse_lidar(sensor, link, w, plugin, out.warnings))
     elif stype == "imu":
@@ -223,13 +295,15 @@ def _read_sensor(sensor: ET.Element, link: str, where: str, out: GazeboTags,
         else:
             imu_sensors[link] = sensor
     else:
-        out.warnings.append(f"{w}: sensor type {stype!r} is not simulated (navlab has ray/gpu_ray, imu, "
-                            "camera, depth and contact sensors with their gazebo_ros plugins); ignored")
+        out.warnings.append(
+            f"{w}: sensor type {stype!r} is not simulated (navlab has ray/gpu_ray, imu, "
+            "camera, depth and contact sensors with their gazebo_ros plugins); ignored"
+        )
 
 
 def _read_model_plugin(plugin: ET.Element, where: str, out: GazeboTags) -> None:
     fname = plugin_file(plugin)
-    w = f"{where}/<plugin name=\"{plugin.get('name', '')}\" filename=\"{plugin.get('filename', '')}\">"
+    w = f'{where}/<plugin name="{plugin.get("name", "")}" filename="{plugin.get("filename", "")}">'
     if fname in DIFF_DRIVE_PLUGINS:
         if out.diff_drive is not None:
             out.warnings.append(f"{w}: a second diff-drive plugin; the first one is used")
@@ -252,8 +326,10 @@ def _read_model_plugin(plugin: ET.Element, where: str, out: GazeboTags) -> None:
         if p3d is not None:
             out.ground_truths.append(p3d)
     elif fname not in BUILTIN_PLUGINS:
-        out.warnings.append(f"{w}: unknown plugin, ignored (navlab simulates libgazebo_ros_diff_drive, "
-                            "skid_steer_drive, gazebo_ros_control, laser/ray-sensor and imu plugins)")
+        out.warnings.append(
+            f"{w}: unknown plugin, ignored (navlab simulates libgazebo_ros_diff_drive, "
+            "skid_steer_drive, gazebo_ros_control, laser/ray-sensor and imu plugins)"
+        )
 
 
 def _side(joint: str, chain: dict[str, tuple[str, Origin]]) -> float:
@@ -277,12 +353,19 @@ def swapped_joints_note(dd: DiffDriveConfig, chain: dict[str, tuple[str, Origin]
     wheel whatever side it is on, so such a robot turns the opposite way to cmd_vel, in Gazebo and here."""
     if dd.legacy_mode or _side(dd.left_joint, chain) >= _side(dd.right_joint, chain):
         return None
-    return (f"<leftJoint> {dd.left_joint!r} is the wheel on the right: ROS Noetic's plugin drives it as the left "
-            "wheel, so the robot turns the opposite way to cmd_vel's angular.z, as it does in Gazebo")
+    return (
+        f"<leftJoint> {dd.left_joint!r} is the wheel on the right: ROS Noetic's plugin drives it as the left "
+        "wheel, so the robot turns the opposite way to cmd_vel's angular.z, as it does in Gazebo"
+    )
 
 
-def check_plugin_joints(tags: GazeboTags, joints: dict[str, str], links: dict[str, Link], source: str,
-                        chain: dict[str, tuple[str, Origin]] | None = None) -> None:
+def check_plugin_joints(
+    tags: GazeboTags,
+    joints: dict[str, str],
+    links: dict[str, Link],
+    source: str,
+    chain: dict[str, tuple[str, Origin]] | None = None,
+) -> None:
     """The diff-drive joints must be continuous/revolute joints; sensors must sit on existing links.
 
     With ``chain`` (see :func:`swapped_joints_note`) a note on a robot whose left and right joints are
@@ -292,11 +375,15 @@ def check_plugin_joints(tags: GazeboTags, joints: dict[str, str], links: dict[st
         lefts, rights = dd.wheel_joints()
         for role, name in [*(("left", n) for n in lefts), *(("right", n) for n in rights)]:
             if name not in joints:
-                raise DescriptionError(f"{source}: diff-drive plugin: {role} joint {name!r} is not a joint of "
-                                       f"the robot (joints: {', '.join(joints)})")
+                raise DescriptionError(
+                    f"{source}: diff-drive plugin: {role} joint {name!r} is not a joint of "
+                    f"the robot (joints: {', '.join(joints)})"
+                )
             if joints[name] not in ("continuous", "revolute"):
-                raise DescriptionError(f"{source}: diff-drive plugin: {role} joint {name!r} is {joints[name]}, "
-                                       "expected continuous or revolute")
+                raise DescriptionError(
+                    f"{source}: diff-drive plugin: {role} joint {name!r} is {joints[name]}, "
+                    "expected continuous or revolute"
+                )
         if chain is not None:
             note = swapped_joints_note(dd, chain)
             if note:
@@ -306,8 +393,10 @@ def check_plugin_joints(tags: GazeboTags, joints: dict[str, str], links: dict[st
             raise DescriptionError(f"{source}: imu plugin {imu.name!r}: body {imu.link!r} is not a link")
     for p3d in list(tags.ground_truths):
         if p3d.link not in links:  # Noetic: "bodyName: X does not exist", the plugin does not load
-            tags.warnings.append(f"{source}: p3d plugin {p3d.name!r}: bodyName {p3d.link!r} is not a link of the "
-                                 "robot; as in ROS Noetic the plugin does not load")
+            tags.warnings.append(
+                f"{source}: p3d plugin {p3d.name!r}: bodyName {p3d.link!r} is not a link of the "
+                "robot; as in ROS Noetic the plugin does not load"
+            )
             tags.ground_truths.remove(p3d)
     for lidar in tags.lidars:
         if not math.isfinite(lidar.max_angle - lidar.min_angle) or lidar.max_angle < lidar.min_angle:

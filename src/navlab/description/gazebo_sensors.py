@@ -43,8 +43,7 @@ def sensor_plugin(sensor: ET.Element) -> ET.Element | None:
     return sensor.find("plugin")
 
 
-def parse_lidar(sensor: ET.Element, link: str, where: str, plugin: ET.Element,
-                warnings: list[str]) -> LidarConfig:
+def parse_lidar(sensor: ET.Element, link: str, where: str, plugin: ET.Element, warnings: list[str]) -> LidarConfig:
     """A ray/gpu_ray ``<sensor>`` with a ROS laser plugin."""
     pose = floats(sensor.findtext("pose") or "0 0 0 0 0 0", 6, where, "<pose>")
     ray = sensor.find("ray")
@@ -133,8 +132,11 @@ def parse_imu(plugin: ET.Element, link: str, where: str, sensor: ET.Element | No
     ns, remaps = ros_remaps(plugin)
     if plugin.find("ros") is None:  # ROS 1: <topicName>, <frameName>/<bodyName>, <robotNamespace>
         ns = (plugin.findtext("robotNamespace") or "").strip()
-        topic = (noetic_default(plugin, "topicName", "/default_imu", "gazebo_ros_imu", where, [])
-                 if plugin_file(plugin) in IMU_MODEL_PLUGINS else (plugin.findtext("topicName") or "imu").strip())
+        topic = (
+            noetic_default(plugin, "topicName", "/default_imu", "gazebo_ros_imu", where, [])
+            if plugin_file(plugin) in IMU_MODEL_PLUGINS
+            else (plugin.findtext("topicName") or "imu").strip()
+        )
         frame = (plugin.findtext("frameName") or plugin.findtext("bodyName") or link).strip()
     else:
         topic = remaps.get("~/out") or remaps.get("out") or f"{plugin.get('name') or 'imu'}/out"
@@ -144,9 +146,13 @@ def parse_imu(plugin: ET.Element, link: str, where: str, sensor: ET.Element | No
         rate = number(sensor.find("update_rate"), where, 0.0)
     pose = floats((sensor.findtext("pose") if sensor is not None else None) or "0 0 0 0 0 0", 6, where, "<pose>")
     return ImuConfig(
-        link=link, origin=Origin.from_pose6(pose),
-        update_rate=plugin_rate(rate), topic=scoped(ns, topic), frame_id=frame.lstrip("/"),
-        gyro_noise_stddev=gyro or gaussian, accel_noise_stddev=accel or gaussian,
+        link=link,
+        origin=Origin.from_pose6(pose),
+        update_rate=plugin_rate(rate),
+        topic=scoped(ns, topic),
+        frame_id=frame.lstrip("/"),
+        gyro_noise_stddev=gyro or gaussian,
+        accel_noise_stddev=accel or gaussian,
         name=(sensor.get("name", "imu") if sensor is not None else plugin.get("name", "imu")),
     )
 
@@ -157,12 +163,15 @@ def parse_p3d(plugin: ET.Element, where: str, warnings: list[str]) -> P3dConfig 
     ``updateRate`` default 0 (every physics step), ``robotNamespace`` in front of a relative topic."""
     missing = [t for t in ("bodyName", "topicName") if not (plugin.findtext(t) or "").strip()]
     if missing:
-        warnings.append(f"{where}: no <{missing[0]}>: ROS Noetic's gazebo_ros_p3d does not load without it; "
-                        "nothing is published")
+        warnings.append(
+            f"{where}: no <{missing[0]}>: ROS Noetic's gazebo_ros_p3d does not load without it; nothing is published"
+        )
         return None
     ns = (plugin.findtext("robotNamespace") or "").strip()
-    return P3dConfig(link=str(plugin.findtext("bodyName")).strip(),
-                     topic=scoped(ns, str(plugin.findtext("topicName")).strip()),
-                     frame_id=(plugin.findtext("frameName") or "world").strip().lstrip("/") or "world",
-                     update_rate=plugin_rate(number(plugin.find("updateRate"), where, 0.0)),
-                     name=plugin.get("name") or "p3d")
+    return P3dConfig(
+        link=str(plugin.findtext("bodyName")).strip(),
+        topic=scoped(ns, str(plugin.findtext("topicName")).strip()),
+        frame_id=(plugin.findtext("frameName") or "world").strip().lstrip("/") or "world",
+        update_rate=plugin_rate(number(plugin.find("updateRate"), where, 0.0)),
+        name=plugin.get("name") or "p3d",
+    )

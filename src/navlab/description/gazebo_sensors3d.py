@@ -35,16 +35,18 @@ IMAGE_FORMATS = ("R8G8B8", "B8G8R8", "L8")
 MAX_PIXELS = 4096 * 4096
 
 
-def read_sensor3d(sensor: ET.Element, plugin: ET.Element, link: str, where: str, out: SensorSuite,
-                  warnings: list[str]) -> bool:
+def read_sensor3d(
+    sensor: ET.Element, plugin: ET.Element, link: str, where: str, out: SensorSuite, warnings: list[str]
+) -> bool:
     """Add the sensor to ``out`` if its plugin is one of :data:`SENSOR_PLUGINS`; False otherwise."""
     fname = plugin_file(plugin)
     stype = sensor.get("type", "")
     if fname in CAMERA_PLUGINS or fname in DEPTH_PLUGINS:
         wanted = ("camera",) if fname in CAMERA_PLUGINS else ("depth", "depth_camera", "camera", "rgbd_camera")
         _expect_type(stype, wanted, fname, where)
-        out.cameras.append(parse_camera(sensor, plugin, link, where, warnings,
-                                        kind="camera" if fname in CAMERA_PLUGINS else "depth"))
+        out.cameras.append(
+            parse_camera(sensor, plugin, link, where, warnings, kind="camera" if fname in CAMERA_PLUGINS else "depth")
+        )
     elif fname in VELODYNE_PLUGINS:
         _expect_type(stype, ("ray", "gpu_ray"), fname, where)
         out.lidars3d.append(parse_velodyne(sensor, plugin, link, where, warnings))
@@ -92,8 +94,10 @@ def parse_camera_model(cam: ET.Element | None, where: str) -> CameraModel:
     if width < 1 or height < 1 or width != int(width) or height != int(height):
         raise DescriptionError(f"{w}/<image>: width and height must be whole numbers >= 1, got {width} x {height}")
     if width * height > MAX_PIXELS:
-        raise DescriptionError(f"{w}/<image>: {width:.0f} x {height:.0f} pixels, more than navlab's ceiling of "
-                               f"{MAX_PIXELS:,} (4096 x 4096)")
+        raise DescriptionError(
+            f"{w}/<image>: {width:.0f} x {height:.0f} pixels, more than navlab's ceiling of "
+            f"{MAX_PIXELS:,} (4096 x 4096)"
+        )
     fmt = (cam.findtext("image/format") or "R8G8B8").strip()
     if fmt not in IMAGE_FORMATS:
         raise DescriptionError(f"{w}/<image>/<format>: {fmt!r} not supported; expected one of {IMAGE_FORMATS}")
@@ -104,24 +108,42 @@ def parse_camera_model(cam: ET.Element | None, where: str) -> CameraModel:
     mean, std = sensor_noise(cam.find("noise"), w + "/<noise>")
     if std < 0:
         raise DescriptionError(f"{w}/<noise>/<stddev>: must be >= 0, got {std}")
-    return CameraModel(width=int(width), height=int(height), horizontal_fov=hfov, near=near, far=far, format=fmt,
-                       noise_mean=mean, noise_stddev=std)
+    return CameraModel(
+        width=int(width),
+        height=int(height),
+        horizontal_fov=hfov,
+        near=near,
+        far=far,
+        format=fmt,
+        noise_mean=mean,
+        noise_stddev=std,
+    )
 
 
-def parse_camera(sensor: ET.Element, plugin: ET.Element, link: str, where: str, warnings: list[str], *,
-                 kind: str) -> CameraConfig:
+def parse_camera(
+    sensor: ET.Element, plugin: ET.Element, link: str, where: str, warnings: list[str], *, kind: str
+) -> CameraConfig:
     """``gazebo_ros_camera`` / ``gazebo_ros_openni_kinect``: GazeboRosCameraUtils' tags with Noetic's defaults."""
     cam = parse_camera_model(sensor.find("camera"), where)
     ns = (plugin.findtext("robotNamespace") or "").strip()
     name = (plugin.findtext("cameraName") or "").strip()
     frame = (plugin.findtext("frameName") or "").strip()
     if not frame:
-        warnings.append(f"{where}: no <frameName>: ROS Noetic's camera plugin then stamps images with an empty "
-                        f"frame; navlab uses the link {link!r}")
+        warnings.append(
+            f"{where}: no <frameName>: ROS Noetic's camera plugin then stamps images with an empty "
+            f"frame; navlab uses the link {link!r}"
+        )
     depth = kind == "depth"
-    cfg = CameraConfig(link=link, kind=kind, origin=_pose(sensor, where), update_rate=_rate(sensor, plugin, where),
-                       camera=cam, camera_name=name, frame_id=frame.lstrip("/") or link,
-                       name=sensor.get("name", "camera"))
+    cfg = CameraConfig(
+        link=link,
+        kind=kind,
+        origin=_pose(sensor, where),
+        update_rate=_rate(sensor, plugin, where),
+        camera=cam,
+        camera_name=name,
+        frame_id=frame.lstrip("/") or link,
+        name=sensor.get("name", "camera"),
+    )
     prefix = scoped(ns, name) if name else ns.strip("/")
 
     def topic(tag: str, default: str) -> str:
@@ -136,15 +158,20 @@ def parse_camera(sensor: ET.Element, plugin: ET.Element, link: str, where: str, 
     cfg.point_cloud_cutoff = number(plugin.find("pointCloudCutoff"), where + "/<pointCloudCutoff>", 0.4)
     cfg.point_cloud_cutoff_max = number(plugin.find("pointCloudCutoffMax"), where + "/<pointCloudCutoffMax>", 5.0)
     if depth and not 0 <= cfg.point_cloud_cutoff < cfg.point_cloud_cutoff_max:
-        raise DescriptionError(f"{where}: expected 0 <= <pointCloudCutoff> < <pointCloudCutoffMax>, got "
-                               f"{cfg.point_cloud_cutoff} and {cfg.point_cloud_cutoff_max}")
+        raise DescriptionError(
+            f"{where}: expected 0 <= <pointCloudCutoff> < <pointCloudCutoffMax>, got "
+            f"{cfg.point_cloud_cutoff} and {cfg.point_cloud_cutoff_max}"
+        )
     cfg.hack_baseline = number(plugin.find("hackBaseline"), where + "/<hackBaseline>", 0.0)
-    k1, k2, k3, t1, t2 = (number(plugin.find(f"distortion{k}"), f"{where}/<distortion{k}>", 0.0)
-                          for k in ("K1", "K2", "K3", "T1", "T2"))
+    k1, k2, k3, t1, t2 = (
+        number(plugin.find(f"distortion{k}"), f"{where}/<distortion{k}>", 0.0) for k in ("K1", "K2", "K3", "T1", "T2")
+    )
     cfg.distortion = (k1, k2, t1, t2, k3)
     if any(cfg.distortion):
-        warnings.append(f"{where}: lens distortion (<distortionK1>..) is reported in CameraInfo.D but not applied "
-                        "to the simulated image")
+        warnings.append(
+            f"{where}: lens distortion (<distortionK1>..) is reported in CameraInfo.D but not applied "
+            "to the simulated image"
+        )
     return cfg
 
 
@@ -169,11 +196,14 @@ def _ray_grid(sensor: ET.Element, where: str) -> tuple[ET.Element, dict[str, flo
         if axis == "vertical" and not -math.pi / 2 <= lo <= hi <= math.pi / 2:
             raise DescriptionError(f"{w}: vertical angles must lie in [-pi/2, pi/2], got {lo} .. {hi}")
         out[f"{axis}_samples"], out[f"{axis}_min"], out[f"{axis}_max"] = int(samples), lo, hi
-    check_ceiling(DescriptionError, f"{where}/<ray>/<scan>/<horizontal>", "<samples>", out["horizontal_samples"],
-                  "lidar_samples")
+    check_ceiling(
+        DescriptionError, f"{where}/<ray>/<scan>/<horizontal>", "<samples>", out["horizontal_samples"], "lidar_samples"
+    )
     if out["horizontal_samples"] * out["vertical_samples"] > MAX_PIXELS:
-        raise DescriptionError(f"{where}/<ray>/<scan>: {out['horizontal_samples'] * out['vertical_samples']:,.0f} "
-                               f"rays, more than navlab's ceiling of {MAX_PIXELS:,}")
+        raise DescriptionError(
+            f"{where}/<ray>/<scan>: {out['horizontal_samples'] * out['vertical_samples']:,.0f} "
+            f"rays, more than navlab's ceiling of {MAX_PIXELS:,}"
+        )
     rng = ray.find("range")
     rw = f"{where}/<ray>/<range>"
     out["min"] = number(rng.find("min") if rng is not None else None, rw + "/<min>", 0.0)
@@ -184,8 +214,7 @@ def _ray_grid(sensor: ET.Element, where: str) -> tuple[ET.Element, dict[str, flo
     return ray, out
 
 
-def parse_velodyne(sensor: ET.Element, plugin: ET.Element, link: str, where: str,
-                   warnings: list[str]) -> Lidar3dConfig:
+def parse_velodyne(sensor: ET.Element, plugin: ET.Element, link: str, where: str, warnings: list[str]) -> Lidar3dConfig:
     """``GazeboRosVelodyneLaser`` (velodyne_gazebo_plugins): ``<topicName>`` (default ``/world``), ``<frameName>``
     (``/world``), ``<min_range>`` (0), ``<max_range>`` (inf), ``<gaussianNoise>`` (0), ``<robotNamespace>``,
     ``<organize_cloud>`` (false)."""
@@ -198,13 +227,22 @@ def parse_velodyne(sensor: ET.Element, plugin: ET.Element, link: str, where: str
         raise DescriptionError(f"{where}/<gaussianNoise>: must be >= 0, got {noise}")
     organize = plugin.findtext("organize_cloud")
     return Lidar3dConfig(
-        link=link, origin=_pose(sensor, where), update_rate=_rate(sensor, plugin, where),
-        samples=int(g["horizontal_samples"]), min_angle=g["horizontal_min"], max_angle=g["horizontal_max"],
-        rings=int(g["vertical_samples"]), vertical_min_angle=g["vertical_min"], vertical_max_angle=g["vertical_max"],
-        range_min=g["min"], range_max=g["max"],
+        link=link,
+        origin=_pose(sensor, where),
+        update_rate=_rate(sensor, plugin, where),
+        samples=int(g["horizontal_samples"]),
+        min_angle=g["horizontal_min"],
+        max_angle=g["horizontal_max"],
+        rings=int(g["vertical_samples"]),
+        vertical_min_angle=g["vertical_min"],
+        vertical_max_angle=g["vertical_max"],
+        range_min=g["min"],
+        range_max=g["max"],
         min_range=number(plugin.find("min_range"), where + "/<min_range>", 0.0),
         max_range=number(plugin.find("max_range"), where + "/<max_range>", math.inf),
-        noise_stddev=math.hypot(noise, g["noise"]), topic=scoped(ns, topic), frame_id=frame.lstrip("/") or link,
+        noise_stddev=math.hypot(noise, g["noise"]),
+        topic=scoped(ns, topic),
+        frame_id=frame.lstrip("/") or link,
         organize_cloud=parse_bool(organize, where + "/<organize_cloud>") if organize else False,
         name=sensor.get("name", "velodyne"),
     )
@@ -225,17 +263,27 @@ def parse_range(sensor: ET.Element, plugin: ET.Element, link: str, where: str, w
     if not 0 < fov < math.pi or noise < 0:
         raise DescriptionError(f"{where}: expected 0 < <fov> < pi and <gaussianNoise> >= 0, got {fov} and {noise}")
     return RangeConfig(
-        link=link, origin=_pose(sensor, where), update_rate=_rate(sensor, plugin, where),
-        samples=int(g["horizontal_samples"]), min_angle=g["horizontal_min"], max_angle=g["horizontal_max"],
-        vertical_samples=int(g["vertical_samples"]), vertical_min_angle=g["vertical_min"],
-        vertical_max_angle=g["vertical_max"], range_min=g["min"], range_max=g["max"], radiation=radiation, fov=fov,
-        noise_stddev=math.hypot(noise, g["noise"]), topic=scoped(ns.strip("/"), topic),
-        frame_id=frame.lstrip("/") or link, name=sensor.get("name", "range"),
+        link=link,
+        origin=_pose(sensor, where),
+        update_rate=_rate(sensor, plugin, where),
+        samples=int(g["horizontal_samples"]),
+        min_angle=g["horizontal_min"],
+        max_angle=g["horizontal_max"],
+        vertical_samples=int(g["vertical_samples"]),
+        vertical_min_angle=g["vertical_min"],
+        vertical_max_angle=g["vertical_max"],
+        range_min=g["min"],
+        range_max=g["max"],
+        radiation=radiation,
+        fov=fov,
+        noise_stddev=math.hypot(noise, g["noise"]),
+        topic=scoped(ns.strip("/"), topic),
+        frame_id=frame.lstrip("/") or link,
+        name=sensor.get("name", "range"),
     )
 
 
-def parse_bumper(sensor: ET.Element, plugin: ET.Element, link: str, where: str,
-                 warnings: list[str]) -> BumperConfig:
+def parse_bumper(sensor: ET.Element, plugin: ET.Element, link: str, where: str, warnings: list[str]) -> BumperConfig:
     """``gazebo_ros_bumper`` on a contact sensor: ``<bumperTopicName>`` (``bumper_states``), ``<frameName>``
     (``world``), ``<robotNamespace>``; the sensor's ``<contact><collision>`` names the collision it watches."""
     collision = (sensor.findtext("contact/collision") or "").strip()
@@ -244,6 +292,11 @@ def parse_bumper(sensor: ET.Element, plugin: ET.Element, link: str, where: str,
     ns = (plugin.findtext("robotNamespace") or "").strip()
     topic = (plugin.findtext("bumperTopicName") or "bumper_states").strip()
     frame = (plugin.findtext("frameName") or "world").strip()
-    return BumperConfig(link=link, collision=collision, update_rate=_rate(sensor, plugin, where),
-                        topic=scoped(ns, topic), frame_id=frame.lstrip("/") or "world",
-                        name=sensor.get("name", "bumper"))
+    return BumperConfig(
+        link=link,
+        collision=collision,
+        update_rate=_rate(sensor, plugin, where),
+        topic=scoped(ns, topic),
+        frame_id=frame.lstrip("/") or "world",
+        name=sensor.get("name", "bumper"),
+    )

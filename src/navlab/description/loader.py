@@ -95,8 +95,9 @@ def load_robot(
         return sim_path, unit, named
 
     name, links, joints, root_link = parse_urdf(root, source, resolve_mesh, warnings=warnings)
-    model = RobotModel(name=name, links=links, joints=joints, root_link=root_link, source=path,
-                       urdf_xml=urdf_xml, warnings=warnings)
+    model = RobotModel(
+        name=name, links=links, joints=joints, root_link=root_link, source=path, urdf_xml=urdf_xml, warnings=warnings
+    )
     _moving_mass_check(model, source)
     tags = read_gazebo_tags(root, links, {j.name for j in joints}, source)
     parent_joint = {j.child: j.name for j in joints}
@@ -110,8 +111,7 @@ def load_robot(
     model.sensors = tags.sensors
     model.warnings += tags.warnings
     if model.diff_drive is None and model.ros_control is None:
-        model.warnings.append(f"{source}: no libgazebo_ros_diff_drive.so plugin; cmd_vel will not move "
-                              "the robot")
+        model.warnings.append(f"{source}: no libgazebo_ros_diff_drive.so plugin; cmd_vel will not move the robot")
     return model
 
 
@@ -178,5 +178,6 @@ def robot_launch_values(name_or_path: str | os.PathLike[str]) -> dict[str, str]:
             f"robot {model.name!r} has no navigation parameters of its own and params:= was not given: move_base "
             f"uses navlab's generic ROS-default set ({values['params']}) with the footprint {values['footprint']} (m) "
             "around "
-            "its collision geometry; pass params:=DIR for the robot's tuned files")
+            "its collision geometry; pass params:=DIR for the robot's tuned files"
+        )
     return values

@@ -43,6 +43,8 @@ def cache_dir() -> Path:
 
 # ---------------------------------------------------------------------------------------- reading
 MAX_MESH_BYTES = 256 << 20  # the largest mesh file navlab reads
+
+
 def read_stl(path: Path) -> tuple[np.ndarray, np.ndarray]:
     """Vertices (n, 3) and triangle indices (m, 3) of a binary or ASCII STL file."""
     try:
@@ -52,8 +54,9 @@ def read_stl(path: Path) -> tuple[np.ndarray, np.ndarray]:
     if len(data) >= 84:
         (count,) = struct.unpack_from("<I", data, 80)
         if 84 + 50 * count == len(data):
-            rec = np.frombuffer(data, dtype=np.dtype([("n", "<f4", 3), ("v", "<f4", (3, 3)), ("a", "<u2")]),
-                                count=count, offset=84)
+            rec = np.frombuffer(
+                data, dtype=np.dtype([("n", "<f4", 3), ("v", "<f4", (3, 3)), ("a", "<u2")]), count=count, offset=84
+            )
             verts = rec["v"].reshape(-1, 3).astype(float)
             return verts, np.arange(len(verts)).reshape(-1, 3)
     text = data.decode("ascii", errors="replace")
@@ -222,8 +225,10 @@ def up_axis_warning(path: Path, where: str) -> str | None:
     up = collada_up_axis(path)
     if up is None or up.upper() == "Z_UP":
         return None
-    return (f"{where}: mesh {path} declares <up_axis>{up}</up_axis>; Gazebo classic ignores it (and so "
-            "does navlab): the vertices are used as Z-up. Re-export the mesh if it looks rotated")
+    return (
+        f"{where}: mesh {path} declares <up_axis>{up}</up_axis>; Gazebo classic ignores it (and so "
+        "does navlab): the vertices are used as Z-up. Re-export the mesh if it looks rotated"
+    )
 
 
 def read_dae(path: Path) -> tuple[np.ndarray, np.ndarray, float]:
@@ -244,8 +249,9 @@ def read_dae(path: Path) -> tuple[np.ndarray, np.ndarray, float]:
                 raise DescriptionError(f"{path}: <unit meter={u.get('meter')!r}>: expected a number") from None
     geoms = {g.get("id"): g for lib in _children(root, "library_geometries") for g in _children(lib, "geometry")}
     lib_nodes = {n.get("id"): n for lib in _children(root, "library_nodes") for n in _children(lib, "node")}
-    scenes = {s.get("id"): s for lib in _children(root, "library_visual_scenes")
-              for s in _children(lib, "visual_scene")}
+    scenes = {
+        s.get("id"): s for lib in _children(root, "library_visual_scenes") for s in _children(lib, "visual_scene")
+    }
     instances: list[tuple[str | None, np.ndarray]] = []  # (geometry id, node_T_geometry)
 
     def visit(node: ET.Element, parent: np.ndarray, depth: int) -> None:

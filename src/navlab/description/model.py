@@ -191,8 +191,9 @@ class DiffDriveConfig:
     extra_right_joints: tuple[str, ...] = ()
     # what drives the wheels: the gazebo_ros_diff_drive or gazebo_ros_skid_steer_drive plugin, or ros_control's
     # diff_drive_controller (gazebo_ros_control)
-    drive: Literal["gazebo_ros_diff_drive", "gazebo_ros_skid_steer_drive", "gazebo_ros_control"] = \
+    drive: Literal["gazebo_ros_diff_drive", "gazebo_ros_skid_steer_drive", "gazebo_ros_control"] = (
         "gazebo_ros_diff_drive"
+    )
     # odometry covariance diagonal (x, y, yaw) when the plugin names one (skid steer's covariance_x/y/yaw)
     odom_covariance: tuple[float, float, float] | None = None
 

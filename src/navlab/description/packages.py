@@ -160,8 +160,9 @@ class PackageIndex:
                 out.append(p)
         return out
 
-    def find_model(self, uri: str, model_paths: Iterable[str | os.PathLike[str]] = (), *,
-                   need_file: bool = False) -> Path:
+    def find_model(
+        self, uri: str, model_paths: Iterable[str | os.PathLike[str]] = (), *, need_file: bool = False
+    ) -> Path:
         """The path a ``model://name[/rel]`` (or ``model:///name/rel``) URI names: the first folder of
         the model search path holding ``name`` (and ``rel``, when ``need_file``); else a ROS package
         called ``name`` (gazebo_ros serves packages as models). NotFoundError names the model and
@@ -184,8 +185,10 @@ class PackageIndex:
         if first is not None:
             return first
         where = ", ".join(str(p) for p in searched) or "no folders"
-        raise NotFoundError(f"model {name!r} ({uri}) not found; searched {where}; add the folder holding "
-                            f"{name}/ to GAZEBO_MODEL_PATH or pass --model-path")
+        raise NotFoundError(
+            f"model {name!r} ({uri}) not found; searched {where}; add the folder holding "
+            f"{name}/ to GAZEBO_MODEL_PATH or pass --model-path"
+        )
 
     def resolve_uri(self, uri: str, *, base_dir: Path, model_paths: Iterable[str | os.PathLike[str]] = ()) -> Path:
         """Absolute path of ``package://``, ``file://``, ``model://``, absolute or relative ``uri``.

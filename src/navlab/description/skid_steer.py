@@ -20,11 +20,26 @@ from navlab.errors import did_you_mean
 
 SKID_STEER_PLUGINS = ("libgazebo_ros_skid_steer_drive.so",)
 ROS_CONTROL_PLUGINS = ("libgazebo_ros_control.so",)
-SKID_KEYS = ("robotNamespace", "broadcastTF", "leftFrontJoint", "rightFrontJoint", "leftRearJoint",
-             "rightRearJoint", "wheelSeparation", "wheelDiameter", "torque", "commandTopic", "odometryTopic",
-             "odometryFrame", "robotBaseFrame", "updateRate", "covariance_x", "covariance_y", "covariance_yaw")
-ROS_CONTROL_KEYS = ("robotNamespace", "controlPeriod", "robotParam", "robotSimType", "legacyModeNS",
-                    "eStopTopic")
+SKID_KEYS = (
+    "robotNamespace",
+    "broadcastTF",
+    "leftFrontJoint",
+    "rightFrontJoint",
+    "leftRearJoint",
+    "rightRearJoint",
+    "wheelSeparation",
+    "wheelDiameter",
+    "torque",
+    "commandTopic",
+    "odometryTopic",
+    "odometryFrame",
+    "robotBaseFrame",
+    "updateRate",
+    "covariance_x",
+    "covariance_y",
+    "covariance_yaw",
+)
+ROS_CONTROL_KEYS = ("robotNamespace", "controlPeriod", "robotParam", "robotSimType", "legacyModeNS", "eStopTopic")
 #: contact tags of ``<gazebo reference="link">`` -> ContactTags field
 CONTACT_TAGS = {"kp": "kp", "kd": "kd", "minDepth": "min_depth", "maxVel": "max_vel", "fdir1": "fdir1"}
 
@@ -55,8 +70,10 @@ def parse_skid_steer(plugin: ET.Element, where: str, warnings: list[str]) -> Dif
     if text not in ("true", "false", "1", "0"):
         raise DescriptionError(f"{where}/<broadcastTF>: expected true/false, got {text!r}")
     ns = _text(plugin, "robotNamespace", "")
-    cov = tuple(_number(plugin, f"covariance_{k}", d, where, positive=False)
-                for k, d in (("x", 0.0001), ("y", 0.0001), ("yaw", 0.01)))  # fmt: skip
+    cov = tuple(
+        _number(plugin, f"covariance_{k}", d, where, positive=False)
+        for k, d in (("x", 0.0001), ("y", 0.0001), ("yaw", 0.01))
+    )
     return DiffDriveConfig(
         left_joint=_text(plugin, "leftFrontJoint", "left_front_joint"),
         right_joint=_text(plugin, "rightFrontJoint", "right_front_joint"),
@@ -84,8 +101,10 @@ def parse_ros_control(plugin: ET.Element, where: str, warnings: list[str]) -> Ro
     sim_type = _text(plugin, "robotSimType", "gazebo_ros_control/DefaultRobotHWSim")
     if sim_type != "gazebo_ros_control/DefaultRobotHWSim":
         warnings.append(f"{where}: robotSimType {sim_type!r}: navlab simulates DefaultRobotHWSim")
-    return RosControlConfig(namespace=_text(plugin, "robotNamespace", "/"),
-                            control_period=_number(plugin, "controlPeriod", 0.0, where, positive=False))
+    return RosControlConfig(
+        namespace=_text(plugin, "robotNamespace", "/"),
+        control_period=_number(plugin, "controlPeriod", 0.0, where, positive=False),
+    )
 
 
 def read_contact_tag(contact: ContactTags | None, el: ET.Element, where: str) -> ContactTags:

@@ -41,10 +41,18 @@ def robot_summary(robot: RobotModel) -> dict[str, Any]:
         "root_link": robot.root_link,
         "total_mass": sum(link.inertial.mass for link in robot.links.values() if link.inertial),
         "links": links,
-        "joints": [{"name": j.name, "type": j.type, "parent": j.parent, "child": j.child,
-                    "xyz": [round(v, 9) for v in j.origin.xyz], "rpy": [round(v, 9) for v in j.origin.rpy],
-                    "axis": [round(v, 9) for v in j.axis]}
-                   for j in robot.joints],
+        "joints": [
+            {
+                "name": j.name,
+                "type": j.type,
+                "parent": j.parent,
+                "child": j.child,
+                "xyz": [round(v, 9) for v in j.origin.xyz],
+                "rpy": [round(v, 9) for v in j.origin.rpy],
+                "axis": [round(v, 9) for v in j.axis],
+            }
+            for j in robot.joints
+        ],
         "diff_drive": asdict(robot.diff_drive) if robot.diff_drive else None,
         "ros_control": asdict(robot.ros_control) if robot.ros_control else None,
         "lidars": [{**asdict(lidar), "origin": asdict(lidar.origin)} for lidar in robot.lidars],
@@ -56,9 +64,11 @@ def robot_summary(robot: RobotModel) -> dict[str, Any]:
 
 def format_robot(s: dict[str, Any]) -> str:
     """Human-readable text of :func:`robot_summary`."""
-    lines = [f"robot {s['name']}  ({s['source']})",
-             f"  root link {s['root_link']}, total mass {s['total_mass']:.3f} kg",
-             f"  links ({len(s['links'])}):"]
+    lines = [
+        f"robot {s['name']}  ({s['source']})",
+        f"  root link {s['root_link']}, total mass {s['total_mass']:.3f} kg",
+        f"  links ({len(s['links'])}):",
+    ]
     for name, link in s["links"].items():
         mass = "no inertial" if link["mass"] is None else f"{link['mass']:g} kg"
         shapes = ", ".join(f"{c['kind']} {c.get('size', c.get('scale'))}" for c in link["collisions"]) or "-"
@@ -66,29 +76,36 @@ def format_robot(s: dict[str, Any]) -> str:
         lines.append(f"    {name:<22} {mass:<12} collision: {shapes}{fr}")
     lines.append(f"  joints ({len(s['joints'])}):")
     for j in s["joints"]:
-        lines.append(f"    {j['name']:<22} {j['type']:<10} {j['parent']} -> {j['child']}  xyz {j['xyz']} "
-                     f"axis {j['axis']}")
+        lines.append(
+            f"    {j['name']:<22} {j['type']:<10} {j['parent']} -> {j['child']}  xyz {j['xyz']} axis {j['axis']}"
+        )
     dd = s["diff_drive"]
     if dd:
         left = "+".join([dd["left_joint"], *dd["extra_left_joints"]])
         right = "+".join([dd["right_joint"], *dd["extra_right_joints"]])
-        lines.append(f"  diff drive ({dd['drive']}): joints {left}/{right}, separation "
-                     f"{dd['wheel_separation']} m, diameter {dd['wheel_diameter']} m, torque {dd['max_torque']} N m, "
-                     f"{dd['update_rate']} Hz, {dd['command_topic']} -> {dd['odometry_topic']} "
-                     f"({dd['odometry_frame']} -> {dd['robot_base_frame']}, source {dd['odometry_source']})")
+        lines.append(
+            f"  diff drive ({dd['drive']}): joints {left}/{right}, separation "
+            f"{dd['wheel_separation']} m, diameter {dd['wheel_diameter']} m, torque {dd['max_torque']} N m, "
+            f"{dd['update_rate']} Hz, {dd['command_topic']} -> {dd['odometry_topic']} "
+            f"({dd['odometry_frame']} -> {dd['robot_base_frame']}, source {dd['odometry_source']})"
+        )
     elif s.get("ros_control"):
-        lines.append(f"  diff drive: from the ros_control YAML (gazebo_ros_control, namespace "
-                     f"{s['ros_control']['namespace']})")
+        lines.append(
+            f"  diff drive: from the ros_control YAML (gazebo_ros_control, namespace {s['ros_control']['namespace']})"
+        )
     else:
         lines.append("  diff drive: none")
     for lidar in s["lidars"]:
-        lines.append(f"  lidar {lidar['name']} on {lidar['link']}: {lidar['samples']} samples "
-                     f"{lidar['min_angle']:.4g}..{lidar['max_angle']:.4g} rad, {lidar['range_min']}-"
-                     f"{lidar['range_max']} m, noise {lidar['noise_stddev']} m, {lidar['update_rate']} Hz -> "
-                     f"{lidar['topic']} [{lidar['frame_id']}]")
+        lines.append(
+            f"  lidar {lidar['name']} on {lidar['link']}: {lidar['samples']} samples "
+            f"{lidar['min_angle']:.4g}..{lidar['max_angle']:.4g} rad, {lidar['range_min']}-"
+            f"{lidar['range_max']} m, noise {lidar['noise_stddev']} m, {lidar['update_rate']} Hz -> "
+            f"{lidar['topic']} [{lidar['frame_id']}]"
+        )
     for imu in s["imus"]:
-        lines.append(f"  imu {imu['name']} on {imu['link']}: {imu['update_rate']} Hz -> {imu['topic']} "
-                     f"[{imu['frame_id']}]")
+        lines.append(
+            f"  imu {imu['name']} on {imu['link']}: {imu['update_rate']} Hz -> {imu['topic']} [{imu['frame_id']}]"
+        )
     for c in s.get("sensors", []):
         lines.append(f"  {sensor_line(c)}")
     lines += [f"  warning: {w}" for w in s["warnings"]]
@@ -101,16 +118,22 @@ def sensor_line(c: dict[str, Any]) -> str:
     sensor, at = c["sensor"], f"{c['name']} on {c['link']}"
     if sensor == "CameraConfig":
         cam = c["camera"]
-        what = (f"{cam['width']} x {cam['height']}, hfov {cam['horizontal_fov']:.4g} rad, clip {cam['near']}-"
-                f"{cam['far']} m, {c['update_rate']} Hz")
+        what = (
+            f"{cam['width']} x {cam['height']}, hfov {cam['horizontal_fov']:.4g} rad, clip {cam['near']}-"
+            f"{cam['far']} m, {c['update_rate']} Hz"
+        )
         if c["kind"] == "depth":
             return f"depth camera {at}: {what} -> {c['depth_image_topic']}, {c['point_cloud_topic']} [{c['frame_id']}]"
         return f"camera {at}: {what} -> {c['image_topic']} [{c['frame_id']}]"
     if sensor == "Lidar3dConfig":
-        return (f"3D lidar {at}: {c['rings']} rings {c['vertical_min_angle']:.4g}..{c['vertical_max_angle']:.4g} rad x "
-                f"{c['samples']} samples, {c['range_min']}-{c['range_max']} m, {c['update_rate']} Hz -> {c['topic']} "
-                f"[{c['frame_id']}]")
+        return (
+            f"3D lidar {at}: {c['rings']} rings {c['vertical_min_angle']:.4g}..{c['vertical_max_angle']:.4g} rad x "
+            f"{c['samples']} samples, {c['range_min']}-{c['range_max']} m, {c['update_rate']} Hz -> {c['topic']} "
+            f"[{c['frame_id']}]"
+        )
     if sensor == "RangeConfig":
-        return (f"range ({c['radiation']}) {at}: fov {c['fov']} rad, {c['range_min']}-{c['range_max']} m, "
-                f"{c['update_rate']} Hz -> {c['topic']} [{c['frame_id']}]")
+        return (
+            f"range ({c['radiation']}) {at}: fov {c['fov']} rad, {c['range_min']}-{c['range_max']} m, "
+            f"{c['update_rate']} Hz -> {c['topic']} [{c['frame_id']}]"
+        )
     return f"bumper {at}: collision {c['collision']}, {c['update_rate']} Hz -> {c['topic']} [{c['frame_id']}]"

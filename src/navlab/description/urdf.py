@@ -70,8 +70,9 @@ def parse_geometry(el: ET.Element | None, where: str, resolve_mesh: MeshResolver
         raise DescriptionError(f"{where}: missing (expected <box>, <cylinder>, <sphere> or <mesh>)")
     shapes = [c for c in el if isinstance(c.tag, str)]
     if len(shapes) != 1:
-        raise DescriptionError(f"{where}: expected exactly one of <box>, <cylinder>, <sphere>, <mesh>; "
-                               f"found {[c.tag for c in shapes]}")
+        raise DescriptionError(
+            f"{where}: expected exactly one of <box>, <cylinder>, <sphere>, <mesh>; found {[c.tag for c in shapes]}"
+        )
     s = shapes[0]
     w = f"{where}/<{s.tag}>"
     if s.tag == "box":
@@ -86,8 +87,9 @@ def parse_geometry(el: ET.Element | None, where: str, resolve_mesh: MeshResolver
             raise DescriptionError(f"{w}: missing attribute 'filename'")
         sc = floats(s.get("scale", "1 1 1"), 3, w, "attribute scale")
         path, unit, named = resolve_mesh(filename, w)
-        return Geometry("mesh", mesh_path=path, mesh_scale=(sc[0] * unit, sc[1] * unit, sc[2] * unit),
-                        mesh_source=named)
+        return Geometry(
+            "mesh", mesh_path=path, mesh_scale=(sc[0] * unit, sc[1] * unit, sc[2] * unit), mesh_source=named
+        )
     else:
         raise DescriptionError(f"{w}: unknown geometry (expected box, cylinder, sphere or mesh)")
     if any(v <= 0 for v in size):
@@ -97,8 +99,9 @@ def parse_geometry(el: ET.Element | None, where: str, resolve_mesh: MeshResolver
     return Geometry(kind, size=size)
 
 
-def _rgba(visual: ET.Element, materials: dict[str, tuple[float, float, float, float]],
-          where: str) -> tuple[float, float, float, float] | None:
+def _rgba(
+    visual: ET.Element, materials: dict[str, tuple[float, float, float, float]], where: str
+) -> tuple[float, float, float, float] | None:
     mat = visual.find("material")
     if mat is None:
         return None
@@ -129,8 +132,14 @@ def parse_inertial(el: ET.Element, where: str) -> Inertial:
     return Inertial(mass=mass, origin=parse_origin(el.find("origin"), where), **vals)
 
 
-def _shapes(link_el: ET.Element, tag: str, where: str, resolve_mesh: MeshResolver,
-            materials: dict[str, tuple[float, float, float, float]], warnings: list[str] | None) -> list[Shape]:
+def _shapes(
+    link_el: ET.Element,
+    tag: str,
+    where: str,
+    resolve_mesh: MeshResolver,
+    materials: dict[str, tuple[float, float, float, float]],
+    warnings: list[str] | None,
+) -> list[Shape]:
     """The link's ``<collision>`` or ``<visual>`` elements. A visual whose mesh file is missing is
     skipped with a warning when ``warnings`` is given (Gazebo loads the robot without it)."""
     out = []
@@ -143,17 +152,24 @@ def _shapes(link_el: ET.Element, tag: str, where: str, resolve_mesh: MeshResolve
                 raise
             warnings.append(f"{exc}; visual skipped (Gazebo shows the link without it)")
             continue
-        out.append(Shape(
-            geometry=geometry,
-            origin=parse_origin(el.find("origin"), w),
-            rgba=_rgba(el, materials, w) if tag == "visual" else None,
-            name=el.get("name", ""),
-        ))
+        out.append(
+            Shape(
+                geometry=geometry,
+                origin=parse_origin(el.find("origin"), w),
+                rgba=_rgba(el, materials, w) if tag == "visual" else None,
+                name=el.get("name", ""),
+            )
+        )
     return out
 
 
-def parse_link(el: ET.Element, where: str, resolve_mesh: MeshResolver,
-               materials: dict[str, tuple[float, float, float, float]], warnings: list[str] | None = None) -> Link:
+def parse_link(
+    el: ET.Element,
+    where: str,
+    resolve_mesh: MeshResolver,
+    materials: dict[str, tuple[float, float, float, float]],
+    warnings: list[str] | None = None,
+) -> Link:
     """One ``<link>`` (``warnings``: where skipped visuals are reported; None: a missing visual mesh is an error)."""
     inertial_el = el.find("inertial")
     return Link(
@@ -168,8 +184,9 @@ def parse_joint(el: ET.Element, where: str) -> Joint:
     """One ``<joint>``; revolute and prismatic joints need a ``<limit>``, as in urdfdom."""
     jtype = el.get("type", "")
     if not is_joint_type(jtype):
-        raise DescriptionError(f"{where}: type {jtype!r} is not a URDF joint type (expected one of "
-                               f"{', '.join(JOINT_TYPES)})")
+        raise DescriptionError(
+            f"{where}: type {jtype!r} is not a URDF joint type (expected one of {', '.join(JOINT_TYPES)})"
+        )
     links = {}
     for tag in ("parent", "child"):
         sub = el.find(tag)
@@ -205,14 +222,24 @@ def parse_joint(el: ET.Element, where: str) -> Joint:
         damping = _attr_float(dyn, "damping", where + "/<dynamics>", 0.0)
         friction = _attr_float(dyn, "friction", where + "/<dynamics>", 0.0)
     return Joint(
-        name=el.get("name", ""), type=jtype, parent=links["parent"], child=links["child"],
-        origin=parse_origin(el.find("origin"), where), axis=axis, lower=lower, upper=upper,
-        effort=effort, velocity=velocity, damping=damping, friction=friction,
+        name=el.get("name", ""),
+        type=jtype,
+        parent=links["parent"],
+        child=links["child"],
+        origin=parse_origin(el.find("origin"), where),
+        axis=axis,
+        lower=lower,
+        upper=upper,
+        effort=effort,
+        velocity=velocity,
+        damping=damping,
+        friction=friction,
     )
 
 
-def parse_urdf(root: ET.Element, source: str, resolve_mesh: MeshResolver, *,
-               warnings: list[str] | None = None) -> tuple[str, dict[str, Link], list[Joint], str]:
+def parse_urdf(
+    root: ET.Element, source: str, resolve_mesh: MeshResolver, *, warnings: list[str] | None = None
+) -> tuple[str, dict[str, Link], list[Joint], str]:
     """Parse a ``<robot>`` element; return (robot name, links, joints, root link).
 
     ``warnings``: a list that collects what loads with a warning (a visual whose mesh is missing is
@@ -240,7 +267,7 @@ def parse_urdf(root: ET.Element, source: str, resolve_mesh: MeshResolver, *,
             raise DescriptionError(f"{where}: duplicate link name")
         links[lname] = parse_link(el, where, resolve_mesh, materials, warnings)
     if not links:
-        raise DescriptionError(f"{source}: <robot name=\"{name}\"> has no <link>")
+        raise DescriptionError(f'{source}: <robot name="{name}"> has no <link>')
     joints: list[Joint] = []
     seen: set[str] = set()
     parent_of: dict[str, str] = {}
@@ -257,14 +284,17 @@ def parse_urdf(root: ET.Element, source: str, resolve_mesh: MeshResolver, *,
             if lname not in links:
                 raise DescriptionError(f"{where}/<{role}>: link {lname!r} is not defined")
         if joint.child in parent_of:
-            raise DescriptionError(f"{where}: link {joint.child!r} already has parent joint to "
-                                   f"{parent_of[joint.child]!r} (a URDF is a tree)")
+            raise DescriptionError(
+                f"{where}: link {joint.child!r} already has parent joint to "
+                f"{parent_of[joint.child]!r} (a URDF is a tree)"
+            )
         parent_of[joint.child] = joint.parent
         joints.append(joint)
     roots = [n for n in links if n not in parent_of]
     if len(roots) != 1:
-        raise DescriptionError(f"{source}: the links must form one tree with one root; roots found: "
-                               f"{roots or 'none (a joint cycle)'}")
+        raise DescriptionError(
+            f"{source}: the links must form one tree with one root; roots found: {roots or 'none (a joint cycle)'}"
+        )
     for lname in links:  # detect cycles
         seen_chain = {lname}
         cur = lname

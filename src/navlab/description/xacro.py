@@ -117,8 +117,10 @@ def _find_through(index: PackageIndex, top: Path) -> Iterator[None]:
         name = original_abs(filename_spec)
         real = Path(os.path.realpath(name))
         if not _inside(real, roots):
-            raise xacro.XacroException(f"{filename_spec} is outside the robot's package(s) "
-                                       f"({', '.join(map(str, roots))}); descriptions may only read their own files")
+            raise xacro.XacroException(
+                f"{filename_spec} is outside the robot's package(s) "
+                f"({', '.join(map(str, roots))}); descriptions may only read their own files"
+            )
         stack = [Path(os.path.realpath(f)) for f in (xacro.filestack or []) if f]
         if real in stack:
             raise xacro.XacroException(f"{filename_spec} includes itself (include loop)")
@@ -133,17 +135,28 @@ def _find_through(index: PackageIndex, top: Path) -> Iterator[None]:
             except IoError as exc:
                 raise xacro.XacroException(str(exc)) from None
         if isinstance(inp, str) and ("<!DOCTYPE" in inp or "<!ENTITY" in inp):
-            raise xacro.XacroException(f"{filename or 'description'}: DOCTYPE/ENTITY declarations are not allowed "
-                                       "in a robot description")
+            raise xacro.XacroException(
+                f"{filename or 'description'}: DOCTYPE/ENTITY declarations are not allowed in a robot description"
+            )
         return original_parse(inp, filename)
 
     def eval_extension(s: str, context: dict[str, Any]) -> str:  # roslaunch's $(eval ...), by the safe interpreter
         context.setdefault("arg", {})
         functions: dict[str, Any] = {
-            "arg": lambda name: substitution_args.convert_value(substitution_args._eval_arg(name, args=context["arg"]),
-                                                                "auto"),
-            "find": find, "env": substitution_args._eval_env, "optenv": substitution_args._eval_optenv,
-            **MATH_NAMES, "list": list, "dict": dict, "map": map, "str": str, "float": float, "int": int}
+            "arg": lambda name: substitution_args.convert_value(
+                substitution_args._eval_arg(name, args=context["arg"]), "auto"
+            ),
+            "find": find,
+            "env": substitution_args._eval_env,
+            "optenv": substitution_args._eval_optenv,
+            **MATH_NAMES,
+            "list": list,
+            "dict": dict,
+            "map": map,
+            "str": str,
+            "float": float,
+            "int": int,
+        }
         return str(safe_eval(s, _EvalNames(context["arg"], functions), functions=functions))
 
     saved = {name: getattr(xacro, name) for name in ("safe_eval", "abs_filename_spec", "parse", "_global_symbols")}
@@ -212,9 +225,7 @@ def expand(path: Path, index: PackageIndex, args: Mapping[str, str] | None = Non
             "(pass it in args / name:=value)"
         ) from None
     except Exception as exc:  # xacro raises NameError, KeyError, ... from evaluated expressions
-        raise DescriptionError(
-            f"{_current_file(path)}: xacro error: {type(exc).__name__}: {exc}"
-        ) from None
+        raise DescriptionError(f"{_current_file(path)}: xacro error: {type(exc).__name__}: {exc}") from None
     finally:
         xacro.filestack = None
         xacro.all_includes = []  # xacro's module-level include log would grow with every load

@@ -103,8 +103,14 @@ class Explore(Node):
         if self._search is None or self._search[0] is not self.grid:  # a new map since the last plan
             search = prepare_frontier_search(self.grid, robot_radius=self.robot_radius, min_frontier_cells=min_cells)
             self._search = (self.grid, search)
-        path = plan_to_frontier(self.grid, pose[:2], robot_radius=self.robot_radius, min_frontier_cells=min_cells,
-                                blacklist=self.blacklist, prepared=self._search[1])  # fmt: skip
+        path = plan_to_frontier(
+            self.grid,
+            pose[:2],
+            robot_radius=self.robot_radius,
+            min_frontier_cells=min_cells,
+            blacklist=self.blacklist,
+            prepared=self._search[1],
+        )
         if path is None:
             self._no_frontier += 1
             self.path = None

@@ -71,8 +71,9 @@ def find_frontiers(
     return sorted(out, key=lambda f: -f.size)
 
 
-def exploration_costmap(grid: GridMap, robot_radius: float, *, comfort: float = COMFORT,
-                        cost_scaling_factor: float | None = None) -> Grid:
+def exploration_costmap(
+    grid: GridMap, robot_radius: float, *, comfort: float = COMFORT, cost_scaling_factor: float | None = None
+) -> Grid:
     """costmap_2d costs (uint8) of an occupancy map, from navigation's layers: a ``StaticLayer`` (trinary at
     ``OCCUPIED_THRESHOLD``, unknown cells 255) and an ``InflationLayer`` for a round robot of ``robot_radius``
     (253 within it of an obstacle, then falling off over ``comfort`` m at ``cost_scaling_factor``, by default
@@ -82,8 +83,10 @@ def exploration_costmap(grid: GridMap, robot_radius: float, *, comfort: float = 
     static.set_map(grid)
     static.update_costs(master)
     scaling = 3.0 / comfort if cost_scaling_factor is None else cost_scaling_factor
-    inflation = InflationLayer({"inflation_radius": robot_radius + comfort, "cost_scaling_factor": scaling},
-                               footprint=Footprint(float(robot_radius), None))
+    inflation = InflationLayer(
+        {"inflation_radius": robot_radius + comfort, "cost_scaling_factor": scaling},
+        footprint=Footprint(float(robot_radius), None),
+    )
     inflation.update_costs(master)
     return master
 
@@ -93,8 +96,9 @@ def traversable(costmap: Grid) -> np.ndarray:
     return costmap.data < COST_INSCRIBED
 
 
-def nearest_traversable(mask: np.ndarray, cell: tuple[int, int], max_cells: int = START_SEARCH_CELLS
-                        ) -> tuple[int, int] | None:
+def nearest_traversable(
+    mask: np.ndarray, cell: tuple[int, int], max_cells: int = START_SEARCH_CELLS
+) -> tuple[int, int] | None:
     """The traversable cell closest to ``cell`` within ``max_cells`` (the robot may sit in inflation)."""
     i, j = cell
     h, w = mask.shape
@@ -188,8 +192,9 @@ class FrontierSearch:
         ci, cj = self.costmap.world_to_cell(np.array([robot_xy]))[0]
         return nearest_traversable(self.mask, (int(ci), int(cj)))
 
-    def distances(self, robot_xy: tuple[float, float], bonus: np.ndarray | None = None, max_bonus: float = np.inf
-                  ) -> tuple[np.ndarray, np.ndarray] | None:
+    def distances(
+        self, robot_xy: tuple[float, float], bonus: np.ndarray | None = None, max_bonus: float = np.inf
+    ) -> tuple[np.ndarray, np.ndarray] | None:
         """(step-cost distance in cells (H, W), flat predecessors) from the robot: every reachable cell, or
         with ``bonus`` the bounded search of :func:`plan_to_frontier`; None if no cell near the robot is free."""
         start = self.start_cell(robot_xy)
@@ -199,8 +204,9 @@ class FrontierSearch:
         mask[start[1], start[0]] = True
         g = self.grid
         goals = np.full(g.width * g.height, np.nan) if bonus is None else bonus
-        flat, pred = _frontier_dijkstra(mask, self.cell_cost, start[1] * g.width + start[0], goals,
-                                        float(g.resolution), float(max_bonus))
+        flat, pred = _frontier_dijkstra(
+            mask, self.cell_cost, start[1] * g.width + start[0], goals, float(g.resolution), float(max_bonus)
+        )
         return flat.reshape(g.height, g.width), pred
 
 
@@ -210,8 +216,13 @@ def prepare_frontier_search(grid: GridMap, *, robot_radius: float = 0.3, min_fro
     costmap = exploration_costmap(grid, robot_radius)
     cost = np.where(costmap.data < COST_INSCRIBED, costmap.data, 0).astype(np.float64)
     cell_cost = (1.0 + WEIGHT * cost / 252.0).ravel()
-    return FrontierSearch(grid, costmap, traversable(costmap), cell_cost,
-                          find_frontiers(grid, min_cells=min_frontier_cells, occupied_threshold=OCCUPIED_THRESHOLD))
+    return FrontierSearch(
+        grid,
+        costmap,
+        traversable(costmap),
+        cell_cost,
+        find_frontiers(grid, min_cells=min_frontier_cells, occupied_threshold=OCCUPIED_THRESHOLD),
+    )
 
 
 def plan_to_frontier(

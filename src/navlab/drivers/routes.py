@@ -45,8 +45,11 @@ def load_route(path: str | Path) -> tuple[list[tuple[float, float, float]], np.n
         segments.append((lin, ang, dur))
     raw = data.get("waypoints") or []
     if not isinstance(raw, list) or not all(
-            isinstance(w, list) and len(w) == 2 and all(isinstance(v, int | float) and not isinstance(v, bool)
-                                                       and math.isfinite(v) for v in w) for w in raw):
+        isinstance(w, list)
+        and len(w) == 2
+        and all(isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v) for v in w)
+        for w in raw
+    ):
         raise DriverError(f"{path}: waypoints: expected a list of [x, y] pairs of finite numbers, got {raw!r}")
     return segments, np.array(raw, dtype=float).reshape(-1, 2)
 

@@ -36,8 +36,9 @@ def _indexed(fn: Callable[[T], R], job: tuple[int, T]) -> tuple[int, R]:
     return job[0], fn(job[1])
 
 
-def run_tasks(fn: Callable[[T], R], items: Sequence[T], *, backend: str = "local",
-              workers: int | None = None) -> Iterator[tuple[int, R]]:  # fmt: skip
+def run_tasks(
+    fn: Callable[[T], R], items: Sequence[T], *, backend: str = "local", workers: int | None = None
+) -> Iterator[tuple[int, R]]:
     """Yield ``(i, fn(items[i]))`` for every item as it finishes; ``workers``: processes (local, default 1) or
     CPUs of a local Ray instance (default: all)."""
     if backend not in BACKENDS:
@@ -109,15 +110,25 @@ def init_ray(ray: Any, workers: int | None) -> None:
         if address:
             ray.init(address=address, log_to_driver=False, logging_level=logging.WARNING)
         else:
-            ray.init(num_cpus=workers or os.cpu_count() or 1, include_dashboard=False, log_to_driver=False,
-                     logging_level=logging.WARNING)
+            ray.init(
+                num_cpus=workers or os.cpu_count() or 1,
+                include_dashboard=False,
+                log_to_driver=False,
+                logging_level=logging.WARNING,
+            )
     except Exception as exc:  # Ray raises ConnectionError, RuntimeError, ValueError, ... by cause
         where = f"the cluster at RAY_ADDRESS={address!r}" if address else "a local Ray instance"
-        hint = ("; a cluster with token authentication (which `ray start` turns on when ~/.ray/auth_token exists) "
-                "needs RAY_AUTH_MODE=token here too" if address and not os.environ.get("RAY_AUTH_MODE") else "")
-        raise ExperimentError(f"--backend ray: could not start or reach {where}: "
-                              f"{type(exc).__name__}: {str(exc).strip().splitlines()[0] if str(exc).strip() else ''}"
-                              f"{hint}") from exc  # fmt: skip
+        hint = (
+            "; a cluster with token authentication (which `ray start` turns on when ~/.ray/auth_token exists) "
+            "needs RAY_AUTH_MODE=token here too"
+            if address and not os.environ.get("RAY_AUTH_MODE")
+            else ""
+        )
+        raise ExperimentError(
+            f"--backend ray: could not start or reach {where}: "
+            f"{type(exc).__name__}: {str(exc).strip().splitlines()[0] if str(exc).strip() else ''}"
+            f"{hint}"
+        ) from exc
 
 
 def check_reachable(address: str, timeout: float = 5.0) -> None:
@@ -135,5 +146,7 @@ def check_reachable(address: str, timeout: float = 5.0) -> None:
         with socket.create_connection((host.strip("[]"), int(port)), timeout=timeout):
             pass
     except OSError as exc:
-        raise ExperimentError(f"--backend ray: the Ray cluster at RAY_ADDRESS={address!r} is unreachable ({exc}); "
-                              "start it with `ray start --head` or unset RAY_ADDRESS for a local instance") from None
+        raise ExperimentError(
+            f"--backend ray: the Ray cluster at RAY_ADDRESS={address!r} is unreachable ({exc}); "
+            "start it with `ray start --head` or unset RAY_ADDRESS for a local instance"
+        ) from None

@@ -27,7 +27,8 @@ SPEED_KEYS: dict[str, tuple[str, ...]] = {
     "base_local_planner/TrajectoryPlannerROS": ("TrajectoryPlannerROS.max_vel_x",),
     "dwa_local_planner/DWAPlannerROS": ("DWAPlannerROS.max_vel_x", "DWAPlannerROS.max_vel_trans"),
     "nav2_regulated_pure_pursuit_controller::RegulatedPurePursuitController": (
-        "RegulatedPurePursuitController.desired_linear_vel",),
+        "RegulatedPurePursuitController.desired_linear_vel",
+    ),
 }
 
 
@@ -40,8 +41,9 @@ def speed_overrides(controller: str | None, max_speed: float | None) -> dict[str
     name = resolve_name("controller", controller)
     keys = SPEED_KEYS.get(name)
     if keys is None:
-        raise ExperimentError(f"bench clutter: --max-speed needs a known local planner ({', '.join(SPEED_KEYS)}), "
-                              f"got {controller!r}")  # fmt: skip
+        raise ExperimentError(
+            f"bench clutter: --max-speed needs a known local planner ({', '.join(SPEED_KEYS)}), got {controller!r}"
+        )
     return dict.fromkeys(keys, float(max_speed))
 
 
@@ -77,13 +79,29 @@ def run_protocol(
     trials = []
     worlds = clutter_suite(50, seed=SETS[which])[:n]
     for world in tqdm(worlds, desc=f"clutter {which}", unit="world", disable=not progress, file=sys.stderr):
-        trials.append(run_clutter_world(world, controller=controller, move_base_params=params, seed=seed,
-                                        robot=robot, failure_picture=folder, launch_args=launch))  # fmt: skip
+        trials.append(
+            run_clutter_world(
+                world,
+                controller=controller,
+                move_base_params=params,
+                seed=seed,
+                robot=robot,
+                failure_picture=folder,
+                launch_args=launch,
+            )
+        )
     s = summarize(trials)
-    s.update({"set": which, "robot": robot, "controller": controller or "(robot's files)", "max_speed_mps": max_speed,
-              "collision_monitor": collision_monitor,
-              "wall_s": round(time.perf_counter() - t0, 1),
-              "failed_worlds": {t["world"]: t["failure"] for t in trials if not t["success"]}})  # fmt: skip
+    s.update(
+        {
+            "set": which,
+            "robot": robot,
+            "controller": controller or "(robot's files)",
+            "max_speed_mps": max_speed,
+            "collision_monitor": collision_monitor,
+            "wall_s": round(time.perf_counter() - t0, 1),
+            "failed_worlds": {t["world"]: t["failure"] for t in trials if not t["success"]},
+        }
+    )
     if folder is not None:
         s["pictures"] = [t["picture"] for t in trials if t.get("picture")]
     return {"summary": s, "trials": trials}

@@ -33,12 +33,17 @@ CLUTTER_RECOVERIES: list[dict[str, str]] = [
     {"name": "back_up_far", "type": "nav2_behaviors/BackUp"},
 ]
 CLUTTER_PARAMS: dict[str, Any] = {
-    "local_costmap.width": 6.0, "local_costmap.height": 6.0,
+    "local_costmap.width": 6.0,
+    "local_costmap.height": 6.0,
     "recovery_behaviors": CLUTTER_RECOVERIES,
-    "clear_local.affected_maps": "local", "clear_local.reset_distance": 0.0,
-    "back_up.backup_dist": 0.3, "back_up.backup_speed": 0.25,
-    "back_up_far.backup_dist": 0.8, "back_up_far.backup_speed": 0.25,
-    "progress_checker.required_movement_radius": 0.5, "progress_checker.movement_time_allowance": 10.0,
+    "clear_local.affected_maps": "local",
+    "clear_local.reset_distance": 0.0,
+    "back_up.backup_dist": 0.3,
+    "back_up.backup_speed": 0.25,
+    "back_up_far.backup_dist": 0.8,
+    "back_up_far.backup_speed": 0.25,
+    "progress_checker.required_movement_radius": 0.5,
+    "progress_checker.movement_time_allowance": 10.0,
 }
 CLUTTER_ROBOTS = ("mybot", "jackal")
 
@@ -64,23 +69,48 @@ def run_clutter_world(
         gx, gy, gyaw = (float(v) for v in between2(world.start, world.goal))  # the goal in odom (= the start)
         sx, sy, syaw = (float(v) for v in world.start)
         params = {**(CLUTTER_PARAMS if robot in CLUTTER_ROBOTS else {}), **(move_base_params or {})}
-        r = run_navigation([(gx, gy, gyaw)], world=str(path), pose=(sx, sy, syaw), mapless=True, controller=controller,
-                           move_base_params=params, seed=seed, goal_timeout=timeout, goal_tolerance=SUCCESS_M,
-                           robot=robot, snapshots=failure_picture is not None, launch_args=launch_args)  # fmt: skip
+        r = run_navigation(
+            [(gx, gy, gyaw)],
+            world=str(path),
+            pose=(sx, sy, syaw),
+            mapless=True,
+            controller=controller,
+            move_base_params=params,
+            seed=seed,
+            goal_timeout=timeout,
+            goal_tolerance=SUCCESS_M,
+            robot=robot,
+            snapshots=failure_picture is not None,
+            launch_args=launch_args,
+        )
     g = r.goals[0]
-    out = rounded({
-        **barn_outcome(world, [g]), "reason": g["reason"], "time_s": g["time_s"], "collisions": g["collisions"],
-        "path_m": g["path_m"], "min_clearance_m": g["min_clearance_m"], "near_miss": g["near_miss"],
-        "time_under_safety_s": g["time_under_safety_s"], "near_goal_m": g["near_goal_m"],
-        "final_error_m": g["final_error_m"], "wall_s": r.summary["wall_s"],
-    })  # fmt: skip
+    out = rounded(
+        {
+            **barn_outcome(world, [g]),
+            "reason": g["reason"],
+            "time_s": g["time_s"],
+            "collisions": g["collisions"],
+            "path_m": g["path_m"],
+            "min_clearance_m": g["min_clearance_m"],
+            "near_miss": g["near_miss"],
+            "time_under_safety_s": g["time_under_safety_s"],
+            "near_goal_m": g["near_goal_m"],
+            "final_error_m": g["final_error_m"],
+            "wall_s": r.summary["wall_s"],
+        }
+    )
     if failure_picture is not None and not out["success"] and r.arrivals:
         from navlab.experiments.plots import plot_navigation
 
-        title = (f"{world.name} (difficulty {world.difficulty:.2f}): {out['failure']} after {g['time_s']} s, "
-                 f"{g['near_goal_m']} m from the goal at the closest\n{g['reason']}"[:220])
-        out["picture"] = str(plot_navigation(r.grid, r.arrivals[0], Path(failure_picture) / f"{world.name}.png",
-                                             title=title, goal=g["goal"]))  # fmt: skip
+        title = (
+            f"{world.name} (difficulty {world.difficulty:.2f}): {out['failure']} after {g['time_s']} s, "
+            f"{g['near_goal_m']} m from the goal at the closest\n{g['reason']}"[:220]
+        )
+        out["picture"] = str(
+            plot_navigation(
+                r.grid, r.arrivals[0], Path(failure_picture) / f"{world.name}.png", title=title, goal=g["goal"]
+            )
+        )
     return out
 
 
@@ -95,11 +125,16 @@ def barn_outcome(world: Any, goals: list[dict[str, Any]]) -> dict[str, Any]:
     success = collisions == 0 and g["final_error_m"] is not None and g["final_error_m"] <= SUCCESS_M
     missed = "missed" if g["outcome"] == "succeeded" else g["outcome"]  # move_base's tolerance is not BARN's
     failure = "" if success else ("collision" if collisions else missed)
-    return {"world": world.name, "difficulty": world.difficulty, "success": success, "failure": failure,
-            "move_base_success": collisions == 0 and all(x["move_base_outcome"] == "succeeded" for x in goals),
-            "false_success": sum(x["move_base_outcome"] == "succeeded" and x["final_error_m"] > SUCCESS_M
-                                 for x in goals),
-            "t_opt_s": world.t_opt(), "score": barn_score(success, time_s, world.t_opt())}  # fmt: skip
+    return {
+        "world": world.name,
+        "difficulty": world.difficulty,
+        "success": success,
+        "failure": failure,
+        "move_base_success": collisions == 0 and all(x["move_base_outcome"] == "succeeded" for x in goals),
+        "false_success": sum(x["move_base_outcome"] == "succeeded" and x["final_error_m"] > SUCCESS_M for x in goals),
+        "t_opt_s": world.t_opt(),
+        "score": barn_score(success, time_s, world.t_opt()),
+    }
 
 
 def clutter_for_trial(world: str, index: int) -> Any:
@@ -123,20 +158,23 @@ def summarize(trials: list[dict[str, Any]]) -> dict[str, Any]:
     n = len(trials)
     if n == 0:
         return {"worlds": 0}
-    return rounded({
-        "worlds": n,
-        "success": sum(t["success"] for t in trials) / n,
-        "collision": sum(t["failure"] == "collision" for t in trials) / n,
-        "timeout": sum(t["failure"] == "timeout" for t in trials) / n,
-        "stuck": sum(t["failure"] == "stuck" for t in trials) / n,
-        "aborted": sum(t["failure"] == "aborted" for t in trials) / n,
-        "missed": sum(t["failure"] in ("missed", "not_reached", "preempted") for t in trials) / n,
-        "move_base_success": sum(t["move_base_success"] for t in trials) / n,
-        "false_success": sum(t["false_success"] for t in trials),
-        "score": sum(t["score"] for t in trials) / n,
-        "mean_time_s": sum(t["time_s"] for t in trials if t["success"]) / max(1, sum(t["success"] for t in trials)),
-        "min_clearance_m": min((t["min_clearance_m"] for t in trials if t["min_clearance_m"] is not None),
-                               default=None),
-        "near_misses": sum(bool(t.get("near_miss")) for t in trials),
-        "time_under_safety_s_mean": sum(t.get("time_under_safety_s", 0.0) for t in trials) / n,
-    })  # fmt: skip
+    return rounded(
+        {
+            "worlds": n,
+            "success": sum(t["success"] for t in trials) / n,
+            "collision": sum(t["failure"] == "collision" for t in trials) / n,
+            "timeout": sum(t["failure"] == "timeout" for t in trials) / n,
+            "stuck": sum(t["failure"] == "stuck" for t in trials) / n,
+            "aborted": sum(t["failure"] == "aborted" for t in trials) / n,
+            "missed": sum(t["failure"] in ("missed", "not_reached", "preempted") for t in trials) / n,
+            "move_base_success": sum(t["move_base_success"] for t in trials) / n,
+            "false_success": sum(t["false_success"] for t in trials),
+            "score": sum(t["score"] for t in trials) / n,
+            "mean_time_s": sum(t["time_s"] for t in trials if t["success"]) / max(1, sum(t["success"] for t in trials)),
+            "min_clearance_m": min(
+                (t["min_clearance_m"] for t in trials if t["min_clearance_m"] is not None), default=None
+            ),
+            "near_misses": sum(bool(t.get("near_miss")) for t in trials),
+            "time_under_safety_s_mean": sum(t.get("time_under_safety_s", 0.0) for t in trials) / n,
+        }
+    )

@@ -29,9 +29,16 @@ from navlab.world import true_map, unmapped_obstacles
 
 # A 17.5 m loop through room.world / room_obstacles.world, at least 0.5 m from every obstacle.
 DEFAULT_ROUTE: tuple[tuple[float, float], ...] = (
-    (3.0, 0.0), (3.0, -0.6), (-0.6, -0.6), (-0.6, -0.1), (-2.6, -0.1), (-2.6, 0.5), (-0.6, 0.5),
-    (0.3, 1.4), (0.3, 0.2),
-)  # fmt: skip
+    (3.0, 0.0),
+    (3.0, -0.6),
+    (-0.6, -0.6),
+    (-0.6, -0.1),
+    (-2.6, -0.1),
+    (-2.6, 0.5),
+    (-0.6, 0.5),
+    (0.3, 1.4),
+    (0.3, 0.2),
+)
 CONVERGED_M = 0.10  # position error (m) that counts as localized
 
 
@@ -61,9 +68,17 @@ class Kidnapper(Node):
     """At ``at`` s, teleports the robot to the route waypoint farthest from it (through the simulator's
     API) and sends the route follower on from there."""
 
-    def __init__(self, executor: Any, *, name: str = "kidnapper", parameters: dict[str, Any] | None = None,
-                 namespace: str = "", sim: Any = None, follower: Any = None,
-                 route: Sequence[tuple[float, float]] = DEFAULT_ROUTE) -> None:  # fmt: skip
+    def __init__(
+        self,
+        executor: Any,
+        *,
+        name: str = "kidnapper",
+        parameters: dict[str, Any] | None = None,
+        namespace: str = "",
+        sim: Any = None,
+        follower: Any = None,
+        route: Sequence[tuple[float, float]] = DEFAULT_ROUTE,
+    ) -> None:
         super().__init__(executor, name=name, parameters=parameters, namespace=namespace)
         self.at = float(self.declare_parameter("at", 20.0))
         self.sim, self.follower, self.route = sim, follower, list(route)
@@ -127,49 +142,74 @@ def run_localization(
             served = Path(tmp) / "true_map.yaml"
             world_model = load_world(world)
             if not shape_footprints(world_model):
-                raise LocalizationError(f"world {world}: nothing stands at the lidar's height (an empty world); AMCL "
-                                        "needs walls or obstacles to localize against")
+                raise LocalizationError(
+                    f"world {world}: nothing stands at the lidar's height (an empty world); AMCL "
+                    "needs walls or obstacles to localize against"
+                )
             grid = true_map(world_model, (pose[0], pose[1]))
             save_map(grid, served)
         name = str(map_yaml or f"true map of {world}")
         if not np.any(grid.data >= 65):
-            raise LocalizationError(f"map {name} has no occupied cell; AMCL needs walls or obstacles to localize "
-                                    "against")
+            raise LocalizationError(
+                f"map {name} has no occupied cell; AMCL needs walls or obstacles to localize against"
+            )
         fld = field_from_map(grid, name=name)  # refuse a bad map before running
         init = initial if initial is not None else pose
         if not fld.contains(init[0], init[1]):
             x0, y0, x1, y1 = grid.bounds()
-            raise LocalizationError(f"initial pose ({init[0]}, {init[1]}) lies outside the map {name} "
-                                    f"(x {x0:.2f}..{x1:.2f}, y {y0:.2f}..{y1:.2f})")  # fmt: skip
+            raise LocalizationError(
+                f"initial pose ({init[0]}, {init[1]}) lies outside the map {name} "
+                f"(x {x0:.2f}..{x1:.2f}, y {y0:.2f}..{y1:.2f})"
+            )
         amcl = {"initial_pose_x": init[0], "initial_pose_y": init[1], "initial_pose_a": init[2], **(amcl_params or {})}
-        run = start_run("localization", world=world, robot=robot, pose=pose, seed=seed, map=str(served),
-                        overrides={"amcl": amcl}, on_start=on_start)  # fmt: skip
+        run = start_run(
+            "localization",
+            world=world,
+            robot=robot,
+            pose=pose,
+            seed=seed,
+            map=str(served),
+            overrides={"amcl": amcl},
+            on_start=on_start,
+        )
         if global_localization:
             run.executor.call_service("/global_localization")
-        follower = run.add(RouteFollower, parameters={"waypoints": [list(w) for w in route], "loop": True,
-                                                      "pose_topic": "/ground_truth/odom"})  # fmt: skip
-        monitor = run.add(PoseMonitor, parameters={"base_frame": run.base_frame, "odom_frame": run.odom_frame,
-                                                   "rate": 10.0})  # fmt: skip
+        follower = run.add(
+            RouteFollower,
+            parameters={"waypoints": [list(w) for w in route], "loop": True, "pose_topic": "/ground_truth/odom"},
+        )
+        monitor = run.add(
+            PoseMonitor, parameters={"base_frame": run.base_frame, "odom_frame": run.odom_frame, "rate": 10.0}
+        )
         kidnapper = None
         if kidnap_at is not None:
             kidnapper = run.add(Kidnapper, parameters={"at": kidnap_at}, sim=run.sim, follower=follower, route=route)
         run.run(duration, record=record, quiet=not progress, chunk=1.0, desc="localize")
     s = monitor.samples()
-    res = LocalizeResult(t=s["t"], truth=s["truth"], estimate=s["estimate"], grid=grid,
-                         unmapped=None if map_yaml is None else unmapped_obstacles(run.sim.world, grid, pose[:2]))
+    res = LocalizeResult(
+        t=s["t"],
+        truth=s["truth"],
+        estimate=s["estimate"],
+        grid=grid,
+        unmapped=None if map_yaml is None else unmapped_obstacles(run.sim.world, grid, pose[:2]),
+    )
     from navlab.localization.amcl_node import Amcl
 
     node = run.node("amcl")
     assert isinstance(node, Amcl)  # the shipped launch's amcl
-    res.summary = rounded({
-        "world": world, "map": str(map_yaml) if map_yaml else "true",
-        "mode": "global" if global_localization else "tracking",
-        **_errors(res, kidnapper.event if kidnapper else {}, global_localization),
-        "updates": node.filter.n_updates if node.filter else 0,
-        "scans": node.scans_received, "scans_invalid": node.scans_invalid,
-        "particles_final": node.filter.n_particles if node.filter else 0,
-        **run.figures(),
-    })  # fmt: skip
+    res.summary = rounded(
+        {
+            "world": world,
+            "map": str(map_yaml) if map_yaml else "true",
+            "mode": "global" if global_localization else "tracking",
+            **_errors(res, kidnapper.event if kidnapper else {}, global_localization),
+            "updates": node.filter.n_updates if node.filter else 0,
+            "scans": node.scans_received,
+            "scans_invalid": node.scans_invalid,
+            "particles_final": node.filter.n_particles if node.filter else 0,
+            **run.figures(),
+        }
+    )
     return res
 
 
@@ -208,17 +248,24 @@ def plot_result(res: LocalizeResult, path: str | Path) -> Path:
         truth, est = np.insert(truth, k, np.nan, axis=0), np.insert(est, k, np.nan, axis=0)
         events["kidnapped"] = res.summary["kidnap_s"]
     mean = res.summary.get("position_error_mean_m")
-    marks = [] if res.unmapped is None or not len(res.unmapped) else [Marks(res.unmapped, "obstacle not in the map",
-                                                                            "tab:purple")]  # fmt: skip
+    marks = (
+        []
+        if res.unmapped is None or not len(res.unmapped)
+        else [Marks(res.unmapped, "obstacle not in the map", "tab:purple")]
+    )
     return plot_run(
         res.grid,
         [Track(truth, "ground truth", "-", "tab:green", 2.0), Track(est, "AMCL estimate", "--", "tab:red")],
         path,
         title=f"AMCL ({res.summary.get('mode', '')}) in {res.summary.get('world', '')} on map "
-              f"{Path(str(res.summary.get('map', ''))).name}",
-        error=ErrorPanel(res.t, res.error, title="position error: AMCL vs truth" + (
-                         f" (mean {100 * mean:.1f} cm)" if mean is not None else ""),
-                         threshold=CONVERGED_M, events=events),
+        f"{Path(str(res.summary.get('map', ''))).name}",
+        error=ErrorPanel(
+            res.t,
+            res.error,
+            title="position error: AMCL vs truth" + (f" (mean {100 * mean:.1f} cm)" if mean is not None else ""),
+            threshold=CONVERGED_M,
+            events=events,
+        ),
         marks=marks,
         dpi=110,
-    )  # fmt: skip
+    )

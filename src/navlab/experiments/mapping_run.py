@@ -26,8 +26,10 @@ from navlab.mapping import MappingError, save_map
 from navlab.world import true_occupancy, world_T_map
 
 DRIVERS = ("explore", "teleop", "route")
-TRAJECTORY_HEADER = ("# t x y theta true_x true_y true_theta  (s, m, rad; map frame = the odom frame at the start: "
-                     "the world for world odometry, the start pose for encoder odometry)")
+TRAJECTORY_HEADER = (
+    "# t x y theta true_x true_y true_theta  (s, m, rad; map frame = the odom frame at the start: "
+    "the world for world odometry, the start pose for encoder odometry)"
+)
 
 
 @dataclass
@@ -56,10 +58,15 @@ def _add_driver(run: Run, driver: str, route: str | Path | None) -> Any:
         if route is None:
             raise MappingError("driver 'route' needs a route file (--route FILE)")
         segments, waypoints = load_route(route)
-        follower = run.add(RouteFollower, parameters={
-            "segments": [{"linear": v, "angular": w, "duration": d} for v, w, d in segments],
-            "waypoints": waypoints.tolist(), "base_frame": run.base_frame, "odom_frame": run.odom_frame,
-        })  # fmt: skip
+        follower = run.add(
+            RouteFollower,
+            parameters={
+                "segments": [{"linear": v, "angular": w, "duration": d} for v, w, d in segments],
+                "waypoints": waypoints.tolist(),
+                "base_frame": run.base_frame,
+                "odom_frame": run.odom_frame,
+            },
+        )
         return lambda: follower.done
     teleop = run.add(TeleopKeyboard)
     print("teleop_twist_keyboard:\n" + HELP)
@@ -96,9 +103,17 @@ def run_mapping(
     overrides = {"slam_gmapping": {"mode": mode, **(slam_params or {})}}
     if sim_params:
         overrides["gazebo"] = dict(sim_params)
-    run = start_run("mapping", world=world, robot=robot, pose=pose, seed=seed,
-                    rate=1.0 if driver == "teleop" and rate == 0 else rate, overrides=overrides,
-                    explore=str(driver == "explore").lower(), on_start=on_start)  # fmt: skip
+    run = start_run(
+        "mapping",
+        world=world,
+        robot=robot,
+        pose=pose,
+        seed=seed,
+        rate=1.0 if driver == "teleop" and rate == 0 else rate,
+        overrides=overrides,
+        explore=str(driver == "explore").lower(),
+        on_start=on_start,
+    )
     is_done = _add_driver(run, driver, route)
     monitor = run.add(PoseMonitor, parameters={"base_frame": run.base_frame, "odom_frame": run.odom_frame})
     run.run(duration, until=is_done, record=record, quiet=quiet, desc=f"mapping {world}")
@@ -130,24 +145,36 @@ def run_mapping(
     if len(s["t"]):
         # the estimate is in the map frame; bring the truth into it
         tru = s["truth"]
-        tru_map = np.column_stack([inverse_transform_points2(map_in_world, tru[:, :2]),
-                                   wrap_angle(tru[:, 2] - map_in_world[2])])
+        tru_map = np.column_stack(
+            [inverse_transform_points2(map_in_world, tru[:, :2]), wrap_angle(tru[:, 2] - map_in_world[2])]
+        )
         est = s["estimate"]
         scores.update(trajectory_error(est, tru_map))
         odom_err = trajectory_error(s["odometry"], tru_map)  # raw odometry is in the odom frame = the map frame
         scores["odometry_position_error_mean_m"] = odom_err["position_error_mean_m"]
         scores["odometry_yaw_error_mean_deg"] = odom_err["yaw_error_mean_deg"]
         write_trajectory(out_dir / "trajectory.txt", s["t"], est, tru_map)
-        title = (f"{mode} map of {Path(str(world)).stem} after {float(s['t'][-1]):.0f} simulated s "
-                 f"(SLAM error {scores['position_error_mean_m']:.3f} m mean)")
-        marks = [Marks(tru_map[:1, :2], "start", "black", "o", 40.0),
-                 Marks(tru_map[-1:, :2], "end", "black", "s", 40.0)]
-        plot_run(grid, [Track(tru_map, "ground truth", "g-", width=1.5), Track(est, "SLAM estimate", "b--")],
-                 out_dir / "map.png", title=title, marks=marks)  # fmt: skip
+        title = (
+            f"{mode} map of {Path(str(world)).stem} after {float(s['t'][-1]):.0f} simulated s "
+            f"(SLAM error {scores['position_error_mean_m']:.3f} m mean)"
+        )
+        marks = [
+            Marks(tru_map[:1, :2], "start", "black", "o", 40.0),
+            Marks(tru_map[-1:, :2], "end", "black", "s", 40.0),
+        ]
+        plot_run(
+            grid,
+            [Track(tru_map, "ground truth", "g-", width=1.5), Track(est, "SLAM estimate", "b--")],
+            out_dir / "map.png",
+            title=title,
+            marks=marks,
+        )
     if scores["map_empty"]:
         scores["finished"] = False  # nothing was mapped, whatever the driver says
-        scores["warning"] = (f"the map is empty: no obstacle was seen ({slam.scans_invalid} of {slam.scans_received} "
-                             "scans had no reading within the lidar's range)")
+        scores["warning"] = (
+            f"the map is empty: no obstacle was seen ({slam.scans_invalid} of {slam.scans_received} "
+            "scans had no reading within the lidar's range)"
+        )
         logging.getLogger("navlab.mapping").warning(scores["warning"])
     result.scores = rounded(scores)
     return result

@@ -26,8 +26,16 @@ from navlab.mapping import MappingError
 from navlab.world import visible_surface
 
 __all__ = [
-    "ate", "distance_to_path", "free_coverage", "read_poses", "read_relations", "relations_error", "score_map",
-    "settled_after", "trajectory_error", "write_poses",
+    "ate",
+    "distance_to_path",
+    "free_coverage",
+    "read_poses",
+    "read_relations",
+    "relations_error",
+    "score_map",
+    "settled_after",
+    "trajectory_error",
+    "write_poses",
 ]  # pose files live in navlab.io.poses
 
 
@@ -119,12 +127,20 @@ def relations_closure(relations: np.ndarray, *, time_tolerance: float = 1e-3) ->
             closure.append(np.hypot(end[0] - rel[ac, 2], end[1] - rel[ac, 3]))
     err = np.asarray(closure)
     if not len(err):
-        return {"n_triangles": 0, "closure_median_m": float("nan"), "closure_mean_m": float("nan"),
-                "noise_floor_m": float("nan")}  # fmt: skip
+        return {
+            "n_triangles": 0,
+            "closure_median_m": float("nan"),
+            "closure_mean_m": float("nan"),
+            "noise_floor_m": float("nan"),
+        }
     # the closure is the sum of three relations' errors: per axis sigma * sqrt(3), so its mean 2D norm is
     # sqrt(3) times one relation's
-    return {"n_triangles": len(err), "closure_median_m": float(np.median(err)), "closure_mean_m": float(err.mean()),
-            "noise_floor_m": float(err.mean() / np.sqrt(3.0))}  # fmt: skip
+    return {
+        "n_triangles": len(err),
+        "closure_median_m": float(np.median(err)),
+        "closure_mean_m": float(err.mean()),
+        "noise_floor_m": float(err.mean() / np.sqrt(3.0)),
+    }
 
 
 # --- maps and trajectories against a simulated world's truth ------------------------------------
@@ -209,8 +225,12 @@ def trajectory_error(est: np.ndarray, truth: np.ndarray) -> dict[str, float]:
     ok = np.isfinite(est).all(axis=1) & np.isfinite(truth).all(axis=1)
     est, truth = est[ok], truth[ok]
     if len(est) == 0:
-        return {"poses": 0, "position_error_mean_m": math.nan, "position_error_max_m": math.nan,
-                "yaw_error_mean_deg": math.nan}  # fmt: skip
+        return {
+            "poses": 0,
+            "position_error_mean_m": math.nan,
+            "position_error_max_m": math.nan,
+            "yaw_error_mean_deg": math.nan,
+        }
     dpos = np.hypot(est[:, 0] - truth[:, 0], est[:, 1] - truth[:, 1])
     dyaw = np.abs(wrap_angle(est[:, 2] - truth[:, 2]))
     return {
@@ -234,7 +254,7 @@ def settled_after(t: np.ndarray, err: np.ndarray, t0: float, threshold: float) -
 
 def distance_to_path(points: np.ndarray, path: np.ndarray) -> np.ndarray:
     """Distance (m) from each point (N, 2) to the polyline ``path`` (M, >=2; x y in the same frame): the
-    path tracking error of a driven path against the global plan (issue 15)."""
+    path tracking error of a driven path against the global plan."""
     pts = np.asarray(points, dtype=np.float64).reshape(-1, 2)
     poly = np.asarray(path, dtype=np.float64)[:, :2]
     if len(poly) == 0:

@@ -18,8 +18,14 @@ class PoseMonitor(Node):
     ``estimate_frame`` → ``base_frame``) and odometry (tf ``odom_frame`` → ``base_frame``); (x, y, yaw) in
     m and rad, NaN where not available yet. ``samples()`` returns them as arrays."""
 
-    def __init__(self, executor: Executor, *, name: str = "pose_monitor", parameters: dict[str, Any] | None = None,
-                 namespace: str = "") -> None:  # fmt: skip
+    def __init__(
+        self,
+        executor: Executor,
+        *,
+        name: str = "pose_monitor",
+        parameters: dict[str, Any] | None = None,
+        namespace: str = "",
+    ) -> None:
         super().__init__(executor, name=name, parameters=parameters, namespace=namespace)
         self.base_frame = self.declare_parameter("base_frame", "base_link")
         self.estimate_frame = self.declare_parameter("estimate_frame", "map")
@@ -43,8 +49,12 @@ class PoseMonitor(Node):
     def _sample(self) -> None:
         if self._truth is None:
             return
-        row = (self.executor.now_ns / 1e9, *msgs.pose2d(self._truth.pose.pose), *self._lookup(self.estimate_frame),
-               *self._lookup(self.odom_frame))  # fmt: skip
+        row = (
+            self.executor.now_ns / 1e9,
+            *msgs.pose2d(self._truth.pose.pose),
+            *self._lookup(self.estimate_frame),
+            *self._lookup(self.odom_frame),
+        )
         self._rows.append(row)
 
     def samples(self) -> dict[str, np.ndarray]:

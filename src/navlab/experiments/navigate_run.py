@@ -53,8 +53,16 @@ class NavMonitor(Node):
     the world's, ``Simulation.clearance``) at 10 Hz, contact episodes on ``/collisions``; and the last scan's
     points in the world for the pictures."""
 
-    def __init__(self, executor: Executor, *, name: str = "nav_monitor", parameters: dict[str, Any] | None = None,
-                 namespace: str = "", sim: Any = None, move_base: Any = None) -> None:  # fmt: skip
+    def __init__(
+        self,
+        executor: Executor,
+        *,
+        name: str = "nav_monitor",
+        parameters: dict[str, Any] | None = None,
+        namespace: str = "",
+        sim: Any = None,
+        move_base: Any = None,
+    ) -> None:
         super().__init__(executor, name=name, parameters=parameters, namespace=namespace)
         self.safety_distance = float(self.declare_parameter("safety_distance", SAFETY_DISTANCE_M))
         self.base_frame = str(self.declare_parameter("base_frame", "base_link"))
@@ -94,8 +102,9 @@ class NavMonitor(Node):
         self.clearance.append(self.sim.clearance())
         plan = getattr(self.move_base, "global_plan", None)  # in the map frame: the world's with a true map
         ok = self.estimate_frame == "map" and plan is not None and len(plan) > 0
-        self.tracking.append(float(distance_to_path(np.array([[x, y]]), plan)[0]) if ok and plan is not None
-                             else math.nan)  # fmt: skip
+        self.tracking.append(
+            float(distance_to_path(np.array([[x, y]]), plan)[0]) if ok and plan is not None else math.nan
+        )
 
     def scan_points(self) -> np.ndarray | None:
         """The last scan's returns (N, 2) in the world frame (from the true pose), or None."""
@@ -140,9 +149,19 @@ def _episodes(times: Sequence[float], t0: float, t1: float, gap: float = 0.25) -
     return sum(1 for k, t in enumerate(ts) if k == 0 or t - ts[k - 1] > gap)
 
 
-def _drive_goal(run: Run, mon: NavMonitor, goal: Pose, frame: str, timeout: float,
-                shots: list[NavSnapshot] | None = None, world_T_frame: Pose = (0.0, 0.0, 0.0),
-                tolerance: float = GOAL_TOLERANCE_M, *, shot: Any = None, say: Any = None) -> dict[str, Any]:
+def _drive_goal(
+    run: Run,
+    mon: NavMonitor,
+    goal: Pose,
+    frame: str,
+    timeout: float,
+    shots: list[NavSnapshot] | None = None,
+    world_T_frame: Pose = (0.0, 0.0, 0.0),
+    tolerance: float = GOAL_TOLERANCE_M,
+    *,
+    shot: Any = None,
+    say: Any = None,
+) -> dict[str, Any]:
     """Send one goal (in ``frame``, which sits at ``world_T_frame``) and run until it ends or ``timeout`` s
     pass; ``shots`` collects ``shot()`` a second; ``say(text)`` gets a progress line every 10 simulated s.
     Judged by the truth (within ``tolerance`` m at the end) beside move_base's verdict (see the module
@@ -177,8 +196,10 @@ def _drive_goal(run: Run, mon: NavMonitor, goal: Pose, frame: str, timeout: floa
         outcome = "stuck"
     elif not reached and verdict == GoalOutcome.TIMEOUT and stuck_window(mon.path[k0:], STUCK_WINDOW_S, STUCK_RADIUS_M):
         outcome = "stuck"
-        reason = (f"stuck: the robot stayed within {STUCK_RADIUS_M:g} m for the last {STUCK_WINDOW_S:g} s "
-                  f"(not reached in {timeout:g} s)")
+        reason = (
+            f"stuck: the robot stayed within {STUCK_RADIUS_M:g} m for the last {STUCK_WINDOW_S:g} s "
+            f"(not reached in {timeout:g} s)"
+        )
     clearance = np.asarray(mon.clearance[k0:], dtype=np.float64)
     collisions = _episodes(mon.contacts, t0, t1)
     min_clearance = float(clearance.min()) if clearance.size else math.inf
@@ -196,8 +217,9 @@ def _drive_goal(run: Run, mon: NavMonitor, goal: Pose, frame: str, timeout: floa
         "near_miss": collisions == 0 and min_clearance < NEAR_MISS_M,
         "collisions": collisions,
         "final_error_m": final_error,
-        "near_goal_m": min(final_error, float(np.min(np.linalg.norm(pts - goal_world, axis=1))) if len(pts) else
-                           final_error),
+        "near_goal_m": min(
+            final_error, float(np.min(np.linalg.norm(pts - goal_world, axis=1))) if len(pts) else final_error
+        ),
         "goal_tolerance_m": tolerance,
         "tracking_error_m": _nanmean(mon.tracking[k0:]),
     }
@@ -282,15 +304,40 @@ def run_navigation(
             served = Path(map_yaml)
         grid = load_map(served)
         if mapless:
-            run = start_run("navigation_mapless", world=world, robot=robot, pose=pose, seed=seed,
-                            overrides={"move_base": overrides, **gazebo}, on_start=on_start, **args)  # fmt: skip
+            run = start_run(
+                "navigation_mapless",
+                world=world,
+                robot=robot,
+                pose=pose,
+                seed=seed,
+                overrides={"move_base": overrides, **gazebo},
+                on_start=on_start,
+                **args,
+            )
         else:
-            run = start_run("navigation", world=world, robot=robot, pose=pose, seed=seed, map=str(served),
-                            overrides={"move_base": overrides, **gazebo}, on_start=on_start, **args)  # fmt: skip
+            run = start_run(
+                "navigation",
+                world=world,
+                robot=robot,
+                pose=pose,
+                seed=seed,
+                map=str(served),
+                overrides={"move_base": overrides, **gazebo},
+                on_start=on_start,
+                **args,
+            )
     mb = _move_base(run)
-    mon = run.add(NavMonitor, parameters={"base_frame": run.base_frame, "safety_distance": float(safety_distance),
-                                          "estimate_frame": "" if mapless else "map"},
-                  remappings={"scan": run.scan_topic}, sim=run.sim, move_base=mb)
+    mon = run.add(
+        NavMonitor,
+        parameters={
+            "base_frame": run.base_frame,
+            "safety_distance": float(safety_distance),
+            "estimate_frame": "" if mapless else "map",
+        },
+        remappings={"scan": run.scan_topic},
+        sim=run.sim,
+        move_base=mb,
+    )
     dropped: list[tuple[float, float, float, str]] = []  # (x m, y m, t s, name) of what was spawned, world frame
 
     def drop(model: Any) -> None:
@@ -316,11 +363,27 @@ def run_navigation(
         gx, gy, gyaw = (float(v) for v in goal)
         say(f"goal {k}/{len(goals)} ({gx:g}, {gy:g}, {gyaw:g}) sent at t={mon.now_s():.1f} s")
         shot = (lambda: _snapshot(run, mon, world_T_frame, mapless)) if snapshots else None
-        results.append(rounded(_drive_goal(run, mon, (gx, gy, gyaw), frame, goal_timeout, during, world_T_frame,
-                                           goal_tolerance, shot=shot, say=say)))  # fmt: skip
+        results.append(
+            rounded(
+                _drive_goal(
+                    run,
+                    mon,
+                    (gx, gy, gyaw),
+                    frame,
+                    goal_timeout,
+                    during,
+                    world_T_frame,
+                    goal_tolerance,
+                    shot=shot,
+                    say=say,
+                )
+            )
+        )
         r = results[-1]
-        say(f"goal {k}/{len(goals)}: {r['outcome']} after {r['time_s']} s (t={mon.now_s():.1f} s)"
-            + (f": {r['reason']}" if r["reason"] else ""))
+        say(
+            f"goal {k}/{len(goals)}: {r['outcome']} after {r['time_s']} s (t={mon.now_s():.1f} s)"
+            + (f": {r['reason']}" if r["reason"] else "")
+        )
         if shot is not None:  # the paper's pictures show the robot on its way (the middle of the drive); + arrival
             end: NavSnapshot = shot()
             end["new_obstacles"], end["dropped"] = new_obstacles, list(dropped)
@@ -331,20 +394,23 @@ def run_navigation(
             arrivals.append(end)
     bag = recorder.close() if recorder else None
     loc = np.array(mon.localization_error)
-    summary = rounded({
-        "goals_succeeded": sum(r["outcome"] == "succeeded" for r in results),  # the truth's
-        "goals_succeeded_move_base": sum(r["move_base_outcome"] == "succeeded" for r in results),
-        "false_success": sum(r["false_success"] for r in results),
-        "collisions": sum(r["collisions"] for r in results),
-        "near_misses": sum(r["near_miss"] for r in results),
-        "min_clearance_m": min((r["min_clearance_m"] for r in results if r["min_clearance_m"] is not None),
-                               default=None),  # None: a goal that ended before the first sample
-        "localization_error_mean_m": float(loc.mean()) if loc.size else None,
-        "localization_error_max_m": float(loc.max()) if loc.size else None,
-        "cmd_jerk_mean": mean_abs_jerk(mon.cmd),
-        **run.figures(),
-        **({"record": str(bag)} if bag else {}),
-    })  # fmt: skip
+    summary = rounded(
+        {
+            "goals_succeeded": sum(r["outcome"] == "succeeded" for r in results),  # the truth's
+            "goals_succeeded_move_base": sum(r["move_base_outcome"] == "succeeded" for r in results),
+            "false_success": sum(r["false_success"] for r in results),
+            "collisions": sum(r["collisions"] for r in results),
+            "near_misses": sum(r["near_miss"] for r in results),
+            "min_clearance_m": min(
+                (r["min_clearance_m"] for r in results if r["min_clearance_m"] is not None), default=None
+            ),  # None: a goal that ended before the first sample
+            "localization_error_mean_m": float(loc.mean()) if loc.size else None,
+            "localization_error_max_m": float(loc.max()) if loc.size else None,
+            "cmd_jerk_mean": mean_abs_jerk(mon.cmd),
+            **run.figures(),
+            **({"record": str(bag)} if bag else {}),
+        }
+    )
     return NavigateResult(results, summary, grid, shots, arrivals, np.array(mon.path, dtype=np.float64).reshape(-1, 3))
 
 
@@ -399,7 +465,7 @@ WHEEL_CONTROLLERS = ("gazebo_ros_diff_drive", "diff_drive_controller")
 
 
 def sim_launch_args(wheel_controller: str, ekf: str | Path | None) -> dict[str, str]:
-    """The shipped launches' arguments for a wheel controller and an EKF (issue 15): ``wheel_controller:=true``
+    """The shipped launches' arguments for a wheel controller and an EKF: ``wheel_controller:=true``
     (+ ``controller_params:=FILE`` for a ros_control YAML), ``ekf:=true`` (+ ``ekf_params:=FILE`` unless
     ``default``/``true``: the shipped params/ekf.yaml)."""
     args: dict[str, str] = {}
@@ -408,8 +474,9 @@ def sim_launch_args(wheel_controller: str, ekf: str | Path | None) -> dict[str, 
         if wheel_controller != "diff_drive_controller":
             if not Path(wheel_controller).is_file():
                 known = " or ".join(WHEEL_CONTROLLERS)
-                raise NavigationError(f"wheel_controller {wheel_controller!r}: expected {known} or a ros_control "
-                                      "YAML file")  # fmt: skip
+                raise NavigationError(
+                    f"wheel_controller {wheel_controller!r}: expected {known} or a ros_control YAML file"
+                )
             args["controller_params"] = str(Path(wheel_controller).resolve())
     if ekf:
         args["ekf"] = "true"
@@ -444,11 +511,18 @@ def _snapshot(run: Run, mon: NavMonitor, world_T_frame: Pose = (0.0, 0.0, 0.0), 
             odom_to_map = run.executor.tf.lookup_pose2d("map", mb.local_costmap.global_frame)
         except TfError:  # no tf: no local plan drawn
             local = None
-    return {"costmap": gc, "plan": None if plan is None else plan.copy(),
-            "local_plan": None if local is None else np.asarray(local).copy(), "odom_to_map": odom_to_map,
-            "path": np.array([p[1:] for p in mon.path]), "scan_xy": mon.scan_points(), "robot": run.sim.base_pose2d(),
-            "footprint": mb.local_costmap.layered.footprint, "t": mon.now_s(),
-            "costmap_in_map": world_T_frame if mapless else None}  # fmt: skip
+    return {
+        "costmap": gc,
+        "plan": None if plan is None else plan.copy(),
+        "local_plan": None if local is None else np.asarray(local).copy(),
+        "odom_to_map": odom_to_map,
+        "path": np.array([p[1:] for p in mon.path]),
+        "scan_xy": mon.scan_points(),
+        "robot": run.sim.base_pose2d(),
+        "footprint": mb.local_costmap.layered.footprint,
+        "t": mon.now_s(),
+        "costmap_in_map": world_T_frame if mapless else None,
+    }
 
 
 def mean_abs_jerk(cmd: Sequence[tuple[float, float]]) -> float | None:

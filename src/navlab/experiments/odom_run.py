@@ -34,8 +34,14 @@ SPEED = 0.5  # m/s: the benchmark's max_vel_x
 class DriftMonitor(Node):
     """Samples the true pose (``/ground_truth/odom``) and the odometry (``topic``) every ``1/rate`` s."""
 
-    def __init__(self, executor: Executor, *, name: str = "drift_monitor", parameters: dict[str, Any] | None = None,
-                 namespace: str = "") -> None:  # fmt: skip
+    def __init__(
+        self,
+        executor: Executor,
+        *,
+        name: str = "drift_monitor",
+        parameters: dict[str, Any] | None = None,
+        namespace: str = "",
+    ) -> None:
         super().__init__(executor, name=name, parameters=parameters, namespace=namespace)
         topic = self.declare_parameter("topic", "/odom")
         rate = self.declare_parameter("rate", 10.0)
@@ -68,10 +74,15 @@ def drift_figures(truth: np.ndarray, odom: np.ndarray) -> dict[str, float | None
     distance = float(np.hypot(*np.diff(truth[:, :2], axis=0).T).sum())
     turned = float(np.abs(wrap_angle(np.diff(truth[:, 2]))).sum())
     yaw_err = abs(float(wrap_angle(odom[-1, 2] - rel[-1, 2])))
-    return {"distance_m": distance, "turned_rad": turned, "final_error_m": float(err[-1]),
-            "max_error_m": float(err.max()), "final_yaw_error_rad": yaw_err,
-            "error_per_m": float(err[-1]) / max(distance, 1e-9),
-            "yaw_error_per_rad": yaw_err / turned if turned > 0.1 else None}
+    return {
+        "distance_m": distance,
+        "turned_rad": turned,
+        "final_error_m": float(err[-1]),
+        "max_error_m": float(err.max()),
+        "final_yaw_error_rad": yaw_err,
+        "error_per_m": float(err[-1]) / max(distance, 1e-9),
+        "yaw_error_per_rad": yaw_err / turned if turned > 0.1 else None,
+    }
 
 
 def route_of(name: str) -> tuple[str, tuple[float, float, float], list[list[float]], Any]:
@@ -83,8 +94,12 @@ def route_of(name: str) -> tuple[str, tuple[float, float, float], list[list[floa
     if name == "clutter":
         from navlab.world.clutter import generate_clutter
 
-        world = generate_clutter(int(CLUTTER["seed"]), fill=CLUTTER["fill"], smooth=int(CLUTTER["smooth"]),
-                                 robot_radius=CLUTTER["robot_radius"])
+        world = generate_clutter(
+            int(CLUTTER["seed"]),
+            fill=CLUTTER["fill"],
+            smooth=int(CLUTTER["smooth"]),
+            robot_radius=CLUTTER["robot_radius"],
+        )
         path = world.reference_path[1:]
         return "", world.start, [list(map(float, p)) for p in path], world
     raise ValueError(f"unknown route {name!r} (routes: {', '.join(ROUTES)})")
@@ -100,8 +115,15 @@ def run_drift(robot: str, route: str, *, ekf: bool, seed: int = 0, timeout: floa
         if clutter is not None:
             world = str(clutter.write_world(Path(tmp) / f"{clutter.name}.world"))
         run = start_run("sim", world=world, robot=robot, pose=pose, seed=seed, ekf="true" if ekf else "false")
-        follower = run.add(_route_follower(), parameters={"waypoints": waypoints, "pose_topic": "/ground_truth/odom",
-                                                          "max_vel_x": SPEED, "waypoint_tolerance": 0.15})
+        follower = run.add(
+            _route_follower(),
+            parameters={
+                "waypoints": waypoints,
+                "pose_topic": "/ground_truth/odom",
+                "max_vel_x": SPEED,
+                "waypoint_tolerance": 0.15,
+            },
+        )
         monitor = run.add(DriftMonitor, parameters={"topic": "/odometry/filtered" if ekf else "/odom"})
         length = float(sum(math.dist(a, b) for a, b in zip([pose[:2], *waypoints[:-1]], waypoints, strict=True)))
         limit = timeout if timeout is not None else 3.0 * length / SPEED + 10.0
@@ -113,8 +135,9 @@ def run_drift(robot: str, route: str, *, ekf: bool, seed: int = 0, timeout: floa
     if len(data) < 2:
         raise RuntimeError(f"odom drift run {robot}/{route}: no odometry on {'/odometry/filtered' if ekf else '/odom'}")
     figures = drift_figures(data[:, :3], data[:, 3:])
-    return rounded({"robot": robot, "route": route, "ekf": ekf, "completed": bool(follower.done), "time_s": t,
-                    **figures})  # fmt: skip
+    return rounded(
+        {"robot": robot, "route": route, "ekf": ekf, "completed": bool(follower.done), "time_s": t, **figures}
+    )
 
 
 def _route_follower() -> type[Node]:

@@ -118,8 +118,9 @@ def plot_run(
     else:
         fig, (ax, ax2) = plt.subplots(1, 2, figsize=(12, 5), gridspec_kw={"width_ratios": [1.3, 1]})
     x0, y0, x1, y1 = grid.bounds()
-    ax.imshow(map_image(grid), cmap="gray", vmin=0, vmax=1, origin="lower", extent=(x0, x1, y0, y1),
-              interpolation="nearest")  # fmt: skip
+    ax.imshow(
+        map_image(grid), cmap="gray", vmin=0, vmax=1, origin="lower", extent=(x0, x1, y0, y1), interpolation="nearest"
+    )
     for m in marks:
         ax.scatter(m.xy[:, 0], m.xy[:, 1], s=m.size, marker=m.marker, c=m.color, label=m.label, zorder=3)
     for tr in tracks:
@@ -144,8 +145,9 @@ def plot_run(
     if ax2 is not None and error is not None:
         ax2.plot(error.t, np.asarray(error.values) * 100, color="tab:red")
         if error.threshold is not None:
-            ax2.axhline(error.threshold * 100, color="gray", ls=":", lw=1,
-                        label=f"converged below {error.threshold * 100:g} cm")
+            ax2.axhline(
+                error.threshold * 100, color="gray", ls=":", lw=1, label=f"converged below {error.threshold * 100:g} cm"
+            )
         for label, t in error.events.items():
             ax2.axvline(t, color="black", ls="--", lw=1, label=label)
         if error.events or error.threshold is not None:
@@ -179,8 +181,9 @@ def navigation_figure(grid: GridMap, shot: NavSnapshot, *, title: str = "", goal
 
     fig, ax = plt.subplots(figsize=(9, 7))
     x0, y0, x1, y1 = grid.bounds()
-    ax.imshow(map_image(grid), cmap="gray", vmin=0, vmax=1, origin="lower", extent=(x0, x1, y0, y1),
-              interpolation="nearest")  # fmt: skip
+    ax.imshow(
+        map_image(grid), cmap="gray", vmin=0, vmax=1, origin="lower", extent=(x0, x1, y0, y1), interpolation="nearest"
+    )
     handles: list[Any] = [Patch(facecolor="black", label="map: wall"), Patch(facecolor="0.8", label="map: unknown")]
     cm, in_map = shot.get("costmap"), shot.get("costmap_in_map")
     if cm is not None and (in_map is None or abs(in_map[2]) < 1e-6):  # a rotated odom costmap is not drawn
@@ -198,10 +201,18 @@ def navigation_figure(grid: GridMap, shot: NavSnapshot, *, title: str = "", goal
     if new is not None and len(new):
         ax.scatter(new[:, 0], new[:, 1], s=2, marker="s", c="tab:purple", label="obstacle not in the map")
     for k, (dx_, dy_, t, name) in enumerate(shot.get("dropped") or []):
-        ax.scatter([dx_], [dy_], s=260, facecolors="none", edgecolors="magenta", linewidths=2,
-                   label="dropped in while driving" if k == 0 else None)  # fmt: skip
-        ax.annotate(f"{name}\n(t={t:.0f} s)", (dx_, dy_), xytext=(8, 8), textcoords="offset points", fontsize=7,
-                    color="magenta")  # fmt: skip
+        ax.scatter(
+            [dx_],
+            [dy_],
+            s=260,
+            facecolors="none",
+            edgecolors="magenta",
+            linewidths=2,
+            label="dropped in while driving" if k == 0 else None,
+        )
+        ax.annotate(
+            f"{name}\n(t={t:.0f} s)", (dx_, dy_), xytext=(8, 8), textcoords="offset points", fontsize=7, color="magenta"
+        )
     trail = np.asarray(shot.get("path"))
     if trail.ndim == 2 and len(trail):
         ax.plot(trail[:, 0], trail[:, 1], "-", color="0.35", lw=1.0, label="driven path (truth)")
@@ -220,8 +231,16 @@ def navigation_figure(grid: GridMap, shot: NavSnapshot, *, title: str = "", goal
         ax.scatter(scan_xy[:, 0], scan_xy[:, 1], s=1.5, c="tab:red", label="laser (last scan)")
     near = shot.get("near_misses")
     if near is not None and len(near):
-        ax.scatter(near[:, 0], near[:, 1], s=60, marker="o", facecolors="none", edgecolors="gold", linewidths=1.8,
-                   label="near miss (< 5 cm)")  # fmt: skip
+        ax.scatter(
+            near[:, 0],
+            near[:, 1],
+            s=60,
+            marker="o",
+            facecolors="none",
+            edgecolors="gold",
+            linewidths=1.8,
+            label="near miss (< 5 cm)",
+        )
     hits = shot.get("collision_xy")
     if hits is not None and len(hits):
         ax.scatter(hits[:, 0], hits[:, 1], s=90, marker="X", c="red", edgecolors="black", label="collision")
@@ -253,15 +272,22 @@ def navigation_figure(grid: GridMap, shot: NavSnapshot, *, title: str = "", goal
     ax.set_xlabel(f"x [m] ({'world' if in_map is not None else 'map'} frame)")
     ax.set_ylabel("y [m]")
     lines, _labels = ax.get_legend_handles_labels()
-    ax.legend(handles=handles + lines, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=7, title="legend",
-              title_fontsize=8)  # fmt: skip
+    ax.legend(
+        handles=handles + lines,
+        loc="upper left",
+        bbox_to_anchor=(1.01, 1.0),
+        fontsize=7,
+        title="legend",
+        title_fontsize=8,
+    )
     if title:
         ax.set_title(title, fontsize=10)
     return fig
 
 
-def plot_navigation(grid: GridMap, shot: NavSnapshot, path: str | Path, *, title: str = "",
-                    goal: Sequence[float] | None = None) -> Path:  # fmt: skip
+def plot_navigation(
+    grid: GridMap, shot: NavSnapshot, path: str | Path, *, title: str = "", goal: Sequence[float] | None = None
+) -> Path:
     """Save :func:`navigation_figure` as a PNG at ``path`` (atomically); returns the path."""
     import matplotlib.pyplot as plt
 
@@ -278,5 +304,9 @@ def plot_navigation(grid: GridMap, shot: NavSnapshot, path: str | Path, *, title
 
 def _arrow(ax: Any, x: float, y: float, yaw: float, color: str, length: float = 0.45) -> None:
     """A heading arrow of ``length`` m from (x, y) along ``yaw`` (rad)."""
-    ax.annotate("", xy=(x + length * np.cos(yaw), y + length * np.sin(yaw)), xytext=(x, y),
-                arrowprops={"arrowstyle": "-|>", "color": color, "lw": 1.8})  # fmt: skip
+    ax.annotate(
+        "",
+        xy=(x + length * np.cos(yaw), y + length * np.sin(yaw)),
+        xytext=(x, y),
+        arrowprops={"arrowstyle": "-|>", "color": color, "lw": 1.8},
+    )

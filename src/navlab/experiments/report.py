@@ -19,9 +19,23 @@ from typing import Any
 from navlab.errors import NavlabError
 from navlab.experiments.errors import ExperimentError
 
-TRIAL_COLUMNS = ("trial", "seed", "success", "move_base_success", "failure", "time_s", "path_m", "spl",
-                 "final_error_m", "min_clearance_m", "near_miss", "collisions", "localization_error_mean_m", "score",
-                 "world")  # fmt: skip
+TRIAL_COLUMNS = (
+    "trial",
+    "seed",
+    "success",
+    "move_base_success",
+    "failure",
+    "time_s",
+    "path_m",
+    "spl",
+    "final_error_m",
+    "min_clearance_m",
+    "near_miss",
+    "collisions",
+    "localization_error_mean_m",
+    "score",
+    "world",
+)
 
 
 @dataclass
@@ -93,14 +107,19 @@ def to_html(rep: Report, folder: Path) -> str:
             body.append(f"<table><thead><tr>{head}</tr></thead><tbody>{rows}</tbody></table>")
         else:
             data = base64.b64encode((folder / block[1]).read_bytes()).decode("ascii")
-            body.append(f'<figure><img alt="{e(block[2])}" src="data:image/png;base64,{data}">'
-                        f"<figcaption>{e(block[2])}</figcaption></figure>")  # fmt: skip
-    style = ("body{font-family:sans-serif;max-width:1200px;margin:2em auto;padding:0 1em;color:#222}"
-             "table{border-collapse:collapse;margin:1em 0;font-size:90%}td,th{border:1px solid #bbb;padding:3px 8px;"
-             "text-align:right}th{background:#eee}img{max-width:100%}figcaption{color:#555;font-size:90%}")  # fmt: skip
-    return ("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
-            f"<title>{e(rep.title)}</title><style>{style}</style></head>\n<body>\n" + "\n".join(body)
-            + "\n</body></html>\n")  # fmt: skip
+            body.append(
+                f'<figure><img alt="{e(block[2])}" src="data:image/png;base64,{data}">'
+                f"<figcaption>{e(block[2])}</figcaption></figure>"
+            )
+    style = (
+        "body{font-family:sans-serif;max-width:1200px;margin:2em auto;padding:0 1em;color:#222}"
+        "table{border-collapse:collapse;margin:1em 0;font-size:90%}td,th{border:1px solid #bbb;padding:3px 8px;"
+        "text-align:right}th{background:#eee}img{max-width:100%}figcaption{color:#555;font-size:90%}"
+    )
+    return (
+        '<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8">'
+        f"<title>{e(rep.title)}</title><style>{style}</style></head>\n<body>\n" + "\n".join(body) + "\n</body></html>\n"
+    )
 
 
 def folder_kind(folder: Path) -> str:
@@ -111,8 +130,10 @@ def folder_kind(folder: Path) -> str:
         return "run"
     if (folder / "report.json").is_file():
         return "demo"
-    raise ExperimentError(f"{folder}: not a results folder (expected results.jsonl from `navlab experiment run`, "
-                          "sweep.csv from `navlab experiment sweep` or report.json from `navlab demo`)")  # fmt: skip
+    raise ExperimentError(
+        f"{folder}: not a results folder (expected results.jsonl from `navlab experiment run`, "
+        "sweep.csv from `navlab experiment sweep` or report.json from `navlab demo`)"
+    )
 
 
 def render_report(folder: str | Path) -> dict[str, Any]:
@@ -127,8 +148,12 @@ def render_report(folder: str | Path) -> dict[str, Any]:
     write_text_atomic(folder / "report.md", to_markdown(rep))
     write_text_atomic(folder / "report.html", to_html(rep, folder))
     figures = [b[1] for b in rep.blocks if b[0] == "img"]
-    return {"kind": kind, "markdown": str(folder / "report.md"), "html": str(folder / "report.html"),
-            "figures": [str(folder / f) for f in figures]}  # fmt: skip
+    return {
+        "kind": kind,
+        "markdown": str(folder / "report.md"),
+        "html": str(folder / "report.html"),
+        "figures": [str(folder / f) for f in figures],
+    }
 
 
 # ----------------------------------------------------------------------------------------------- runs
@@ -147,12 +172,19 @@ def _run_report(folder: Path) -> Report:
     rep = Report(f"Experiment {name}: {len(results)} trials")
     ok = sum(bool(r["success"]) for r in results)
     lo, hi = summary["success_ci95"]
-    said = "" if summary.get("move_base_success_rate") is None else (
-        f" move_base reported {summary['move_base_success_rate']:.0%}, with {summary['false_success']} false "
-        "successes (goals it called reached that the robot truly missed).")
-    rep.text(f"{ok} of {len(results)} trials succeeded by the simulator's truth ({ok / len(results):.0%}, 95 % Wilson "
-             f"interval {lo:.0%}–{hi:.0%}); {summary['trials_with_collision']} trials with a collision "
-             f"({summary['collisions']} contact episodes in all).{said}")  # fmt: skip
+    said = (
+        ""
+        if summary.get("move_base_success_rate") is None
+        else (
+            f" move_base reported {summary['move_base_success_rate']:.0%}, with {summary['false_success']} false "
+            "successes (goals it called reached that the robot truly missed)."
+        )
+    )
+    rep.text(
+        f"{ok} of {len(results)} trials succeeded by the simulator's truth ({ok / len(results):.0%}, 95 % Wilson "
+        f"interval {lo:.0%}–{hi:.0%}); {summary['trials_with_collision']} trials with a collision "
+        f"({summary['collisions']} contact episodes in all).{said}"
+    )
     rep.heading("Summary")
     rep.table(["figure", "value"], _summary_rows(summary))
     rep.heading("Trials")
@@ -201,10 +233,13 @@ def plot_trial_paths(results: list[dict[str, Any]], path: Path, *, title: str = 
         lo, hi = pts.min(0) - 1.0, pts.max(0) + 1.0
         shape = (int((hi[1] - lo[1]) / 0.05) + 1, int((hi[0] - lo[0]) / 0.05) + 1)
         grid = GridMap(np.full(shape, -1, dtype=np.int8), 0.05, (float(lo[0]), float(lo[1]), 0.0))
-    marks = [Marks(np.array([start[:2]]), "start", "black", "o", 60.0), Marks(goals[:, :2], "goals", "tab:purple",
-                                                                              "*", 180.0)]  # fmt: skip
-    return plot_run(grid, tracks, path, title=f"{title}: {len(results)} trials' true paths", marks=marks, crop=False,
-                    dpi=100)
+    marks = [
+        Marks(np.array([start[:2]]), "start", "black", "o", 60.0),
+        Marks(goals[:, :2], "goals", "tab:purple", "*", 180.0),
+    ]
+    return plot_run(
+        grid, tracks, path, title=f"{title}: {len(results)} trials' true paths", marks=marks, crop=False, dpi=100
+    )
 
 
 def _scenario_name(folder: Path) -> str:
@@ -296,13 +331,16 @@ def _demo_report(folder: Path) -> Report:
     """The demo's report: the paper's three steps with their figures and pictures (``navlab demo`` writes it
     with this too, so a re-render gives the same page)."""
     data = json.loads((folder / "report.json").read_text())
-    m, loc, nav = (data.get(k) if isinstance(data.get(k), dict) else {} for k in ("mapping", "localization",
-                                                                                 "navigation"))  # fmt: skip
+    m, loc, nav = (
+        data.get(k) if isinstance(data.get(k), dict) else {} for k in ("mapping", "localization", "navigation")
+    )
     rep = Report("navlab demo: the paper's pipeline in simulation")
     if "wall_s" in data:
         world = ", `world.png` (Figs. 4–5)" if (folder / "world.png").is_file() else ""
-        rep.text(f"Total {data['wall_s']} s wall. Pictures: `map.png` (Fig. 7), `localize.png`, "
-                 f"`navigate/goal_N_mid.png` and `goal_N.png` (Figs. 9–12){world}.")
+        rep.text(
+            f"Total {data['wall_s']} s wall. Pictures: `map.png` (Fig. 7), `localize.png`, "
+            f"`navigate/goal_N_mid.png` and `goal_N.png` (Figs. 9–12){world}."
+        )
     rep.heading("1. Mapping: slam_gmapping while the robot explores room.world")
     rep.table(["figure", "value"], [[k, v] for k, v in m.items() if k not in ("map", "picture")])
     if (folder / "map.png").is_file():
@@ -313,15 +351,28 @@ def _demo_report(folder: Path) -> Report:
         rep.image("localize.png", "AMCL's estimate against the ground truth")
     rep.heading("3. Navigation: move_base on the saved map, obstacles added after mapping")
     goals = nav.get("goals") if isinstance(nav.get("goals"), list) else []
-    cols = ["goal", "outcome", "move_base_outcome", "time_s", "path_m", "final_error_m", "min_clearance_m",
-            "near_miss", "time_under_safety_s", "collisions", "reason"]
+    cols = [
+        "goal",
+        "outcome",
+        "move_base_outcome",
+        "time_s",
+        "path_m",
+        "final_error_m",
+        "min_clearance_m",
+        "near_miss",
+        "time_under_safety_s",
+        "collisions",
+        "reason",
+    ]
     rep.table(cols, [[g.get(c) for c in cols] for g in goals])
     if "goals_succeeded" in nav:
         bag = f"; recording `{Path(nav['record']).name}/`" if nav.get("record") else ""
-        rep.text(f"{nav['goals_succeeded']} of {len(goals)} goals reached (the simulator's truth; move_base reported "
-                 f"{nav.get('goals_succeeded_move_base', '-')}), {nav.get('collisions')} collisions "
-                 "(contact episodes); "
-                 f"{nav.get('sim_s')} simulated s at {nav.get('rtf')}x real time{bag}.")  # fmt: skip
+        rep.text(
+            f"{nav['goals_succeeded']} of {len(goals)} goals reached (the simulator's truth; move_base reported "
+            f"{nav.get('goals_succeeded_move_base', '-')}), {nav.get('collisions')} collisions "
+            "(contact episodes); "
+            f"{nav.get('sim_s')} simulated s at {nav.get('rtf')}x real time{bag}."
+        )
     for k, g in enumerate(goals, 1):
         for png, when in ((f"navigate/goal_{k}_mid.png", "mid-drive"), (f"navigate/goal_{k}.png", "end of the drive")):
             if (folder / png).is_file():

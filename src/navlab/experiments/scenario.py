@@ -39,8 +39,10 @@ from navlab.errors import did_you_mean
 from navlab.experiments.errors import ExperimentError
 
 MAP_MODES = ("true", "map_first", "none")
-CLUTTER_KEYS: dict[str, dict[str, type]] = {"clutter": {"seed": int, "fill": float, "smooth": int},
-                                             "clutter_suite": {"n": int, "seed": int}}
+CLUTTER_KEYS: dict[str, dict[str, type]] = {
+    "clutter": {"seed": int, "fill": float, "smooth": int},
+    "clutter_suite": {"n": int, "seed": int},
+}
 
 
 @dataclass
@@ -75,9 +77,12 @@ class Scenario:
         return str(candidate) if candidate.exists() else value
 
     def navigation_options(self) -> dict[str, Any]:
-        """``run_navigation``'s wheel controller, EKF and disturbances keywords (issue 15)."""
-        return {"wheel_controller": self.resolve(self.wheel_controller) or self.wheel_controller,
-                "ekf": self.resolve(self.ekf), "disturbances": dict(self.disturbances)}  # fmt: skip
+        """``run_navigation``'s wheel controller, EKF and disturbances keywords."""
+        return {
+            "wheel_controller": self.resolve(self.wheel_controller) or self.wheel_controller,
+            "ekf": self.resolve(self.ekf),
+            "disturbances": dict(self.disturbances),
+        }
 
 
 def _pose(value: Any, where: str) -> tuple[float, float, float]:
@@ -100,10 +105,14 @@ def _time(t: Any, where: str) -> float:
 
 def _obstacle(ob: Any, where: str) -> dict[str, Any]:
     """``{t, spec[, frame]}`` with ``t`` seconds or ``[lo, hi]`` and ``frame`` world (default) or robot."""
-    if not isinstance(ob, dict) or not {"t", "spec"} <= set(ob) <= {"t", "spec", "frame"} or \
-            not isinstance(ob["spec"], str):  # fmt: skip
-        raise ExperimentError(f"{where}: expected {{t: seconds, spec: 'cylinder:x=..,y=..'[, frame: world|robot]}}, "
-                              f"got {ob!r}")  # fmt: skip
+    if (
+        not isinstance(ob, dict)
+        or not {"t", "spec"} <= set(ob) <= {"t", "spec", "frame"}
+        or not isinstance(ob["spec"], str)
+    ):
+        raise ExperimentError(
+            f"{where}: expected {{t: seconds, spec: 'cylinder:x=..,y=..'[, frame: world|robot]}}, got {ob!r}"
+        )
     t = ob["t"]
     if isinstance(t, list):
         if len(t) != 2 or _time(t[0], f"{where}.t") > _time(t[1], f"{where}.t"):
@@ -134,8 +143,11 @@ def clutter_world_spec(world: str, *, where: str = "world") -> dict[str, Any] | 
             raise ExperimentError(f"{where}: {world!r}: {key}={value!r} is not {types[key].__name__}") from None
     if kind == "clutter" and not {"fill", "smooth"} <= set(spec):
         raise ExperimentError(f"{where}: {world!r}: clutter needs fill=0..1 and smooth=rounds (seed=S optional)")
-    if not 0.0 <= spec.get("fill", 0.0) <= 1.0 or min(spec.get("smooth", 0), spec.get("seed", 0)) < 0 or \
-            spec.get("n", 1) < 1:  # fmt: skip
+    if (
+        not 0.0 <= spec.get("fill", 0.0) <= 1.0
+        or min(spec.get("smooth", 0), spec.get("seed", 0)) < 0
+        or spec.get("n", 1) < 1
+    ):
         raise ExperimentError(f"{where}: {world!r}: expected fill in [0, 1], smooth and seed >= 0, n >= 1")
     return spec
 
@@ -168,8 +180,10 @@ def scenario_from_dict(data: Any, *, where: str = "scenario", path: Path | None 
     clutter = clutter_world_spec(sc.world, where=f"{where}: world")
     if clutter is not None:
         if "start" in data or data.get("map", "none") != "none":
-            raise ExperimentError(f"{where}: a clutter world sets its own start and is mapless: leave out 'start' "
-                                  "and 'map' (or write map: none)")  # fmt: skip
+            raise ExperimentError(
+                f"{where}: a clutter world sets its own start and is mapless: leave out 'start' "
+                "and 'map' (or write map: none)"
+            )
         sc.map = "none"
         goals = goals if goals is not None else [[10.0, 0.0, 0.0]]  # the world's goal, in odom (= the start)
     if not isinstance(goals, list) or not goals:
@@ -200,14 +214,16 @@ def scenario_from_dict(data: Any, *, where: str = "scenario", path: Path | None 
 
 
 def _future_work_keys(sc: Scenario, data: dict[str, Any], where: str) -> None:
-    """wheel_controller, ekf and disturbances (issue 15), checked here so a bad value fails before any trial."""
+    """wheel_controller, ekf and disturbances, checked here so a bad value fails before any trial."""
     from navlab.errors import NavlabError
     from navlab.sim.disturbances import parse_disturbances
 
     if "wheel_controller" in data:
         if not isinstance(data["wheel_controller"], str) or not data["wheel_controller"]:
-            raise ExperimentError(f"{where}: wheel_controller: expected gazebo_ros_diff_drive, diff_drive_controller "
-                                  f"or a ros_control YAML file, got {data['wheel_controller']!r}")  # fmt: skip
+            raise ExperimentError(
+                f"{where}: wheel_controller: expected gazebo_ros_diff_drive, diff_drive_controller "
+                f"or a ros_control YAML file, got {data['wheel_controller']!r}"
+            )
         sc.wheel_controller = data["wheel_controller"]
     ekf = data.get("ekf")
     sc.ekf = ("default" if ekf else None) if isinstance(ekf, bool) or ekf is None else str(ekf)

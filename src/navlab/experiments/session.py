@@ -78,9 +78,12 @@ class Run:
     def figures(self) -> dict[str, float]:
         """``{"sim_s", "wall_s", "rtf", "cpu_s"}`` of everything run so far (``cpu_s``: this process's CPU time)."""
         sim_s, wall_s = self.timing["sim_s"], self.timing["wall_s"]
-        return {"sim_s": round(sim_s, 2), "wall_s": round(wall_s, 2),
-                "rtf": round(sim_s / wall_s, 1) if wall_s > 0 else math.inf,
-                "cpu_s": round(self.timing["cpu_s"], 2)}  # fmt: skip
+        return {
+            "sim_s": round(sim_s, 2),
+            "wall_s": round(wall_s, 2),
+            "rtf": round(sim_s / wall_s, 1) if wall_s > 0 else math.inf,
+            "cpu_s": round(self.timing["cpu_s"], 2),
+        }
 
 
 def robot_frames(robot: str) -> tuple[str, str, str]:

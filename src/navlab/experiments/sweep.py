@@ -23,8 +23,18 @@ from navlab.experiments.scenario import Scenario
 from navlab.experiments.trials import run_experiments
 
 # "trials_with_collision" counts trials (as success and failures do); "collisions" counts contact episodes
-COLUMNS = ("success_rate", "success_ci95", "move_base_success_rate", "false_success", "trials_with_collision",
-           "collisions", "median_time_s", "spl_mean", "min_clearance_m", "score_mean")
+COLUMNS = (
+    "success_rate",
+    "success_ci95",
+    "move_base_success_rate",
+    "false_success",
+    "trials_with_collision",
+    "collisions",
+    "median_time_s",
+    "spl_mean",
+    "min_clearance_m",
+    "score_mean",
+)
 
 
 def parse_params(items: list[str]) -> dict[str, list[Any]]:
@@ -33,8 +43,9 @@ def parse_params(items: list[str]) -> dict[str, list[Any]]:
     for item in items:
         name, sep, values = item.partition("=")
         if not sep or not name.strip() or not values.strip():
-            raise ExperimentError(f"--param {item!r}: expected name=value1,value2,... "
-                                  "(e.g. local_costmap.update_frequency=0.5,1,2,5)")  # fmt: skip
+            raise ExperimentError(
+                f"--param {item!r}: expected name=value1,value2,... (e.g. local_costmap.update_frequency=0.5,1,2,5)"
+            )
         out[name.strip()] = [yaml.safe_load(v) for v in values.split(",")]
     if not out:
         raise ExperimentError("a sweep needs at least one --param name=value1,value2,...")
@@ -46,9 +57,17 @@ def combinations(params: dict[str, list[Any]]) -> list[dict[str, Any]]:
     return [dict(zip(params, values, strict=True)) for values in itertools.product(*params.values())]
 
 
-def run_sweep(sc: Scenario, params: dict[str, list[Any]], out: str | Path, *, trials: int | None = None,
-              seed: int | None = None, workers: int | None = 1, backend: str = "local",
-              progress: bool = False) -> list[dict[str, Any]]:  # fmt: skip
+def run_sweep(
+    sc: Scenario,
+    params: dict[str, list[Any]],
+    out: str | Path,
+    *,
+    trials: int | None = None,
+    seed: int | None = None,
+    workers: int | None = 1,
+    backend: str = "local",
+    progress: bool = False,
+) -> list[dict[str, Any]]:
     """Run the scenario for every combination (all their trials share the ``workers``, or Ray with
     ``backend="ray"``); write the table and the plots; return the rows."""
     folder = Path(out)
@@ -84,8 +103,11 @@ def write_table(rows: list[dict[str, Any]], names: list[str], folder: Path) -> N
         return "/".join(str(x) for x in v) if isinstance(v, list) else str(v)
 
     csv = [",".join(header), *(",".join(cell(r[h]) for h in header) for r in rows)]
-    md = ["| " + " | ".join(header) + " |", "|" + " --- |" * len(header),
-          *("| " + " | ".join(cell(r[h]) for h in header) + " |" for r in rows)]  # fmt: skip
+    md = [
+        "| " + " | ".join(header) + " |",
+        "|" + " --- |" * len(header),
+        *("| " + " | ".join(cell(r[h]) for h in header) + " |" for r in rows),
+    ]
     write_text_atomic(folder / "sweep.csv", "\n".join(csv) + "\n")
     write_text_atomic(folder / "sweep.md", "\n".join(md) + "\n")
 
@@ -107,15 +129,25 @@ def plot_sweep(rows: list[dict[str, Any]], names: list[str], folder: Path) -> li
         style = {"marker": "o", "linestyle": "-" if numeric else "none"}
         score = any(r.get("score_mean") is not None for r in rows)  # BARN's score in clutter worlds
         fig, axes = plt.subplots(1, 4 if score else 3, figsize=(17 if score else 13, 3.6))
-        for others, group in itertools.groupby(sorted(rows, key=lambda r: str([r[n] for n in names if n != name])),
-                                               key=lambda r: [r[n] for n in names if n != name]):  # fmt: skip
+        for others, group in itertools.groupby(
+            sorted(rows, key=lambda r: str([r[n] for n in names if n != name])),
+            key=lambda r: [r[n] for n in names if n != name],
+        ):
             g = sorted(group, key=lambda r: values.index(r[name]))
             xs = [values.index(r[name]) for r in g]
             label = ", ".join(f"{n}={v}" for n, v in zip([n for n in names if n != name], others, strict=True)) or None
             ci = [r["success_ci95"] or [0, 1] for r in g]
-            axes[0].errorbar(xs, [r["success_rate"] for r in g], yerr=[[r["success_rate"] - c[0] for r, c in zip(g, ci,
-                             strict=True)], [c[1] - r["success_rate"] for r, c in zip(g, ci, strict=True)]],
-                             capsize=3, label=label, **style)  # fmt: skip
+            axes[0].errorbar(
+                xs,
+                [r["success_rate"] for r in g],
+                yerr=[
+                    [r["success_rate"] - c[0] for r, c in zip(g, ci, strict=True)],
+                    [c[1] - r["success_rate"] for r, c in zip(g, ci, strict=True)],
+                ],
+                capsize=3,
+                label=label,
+                **style,
+            )
             axes[1].plot(xs, [r.get("trials_with_collision", r["collisions"]) for r in g], label=label, **style)
             axes[2].plot(xs, [r["median_time_s"] for r in g], label=label, **style)
             if score:

@@ -89,9 +89,7 @@ def ate(est: np.ndarray, truth: np.ndarray, *, align: bool = True, far: float = 
     }
 
 
-def associate(
-    t_est: np.ndarray, t_truth: np.ndarray, *, tolerance: float = 0.02
-) -> tuple[np.ndarray, np.ndarray]:
+def associate(t_est: np.ndarray, t_truth: np.ndarray, *, tolerance: float = 0.02) -> tuple[np.ndarray, np.ndarray]:
     """Index pairs (i into ``t_est``, j into ``t_truth``) of the nearest true timestamp to each estimated
     one within ``tolerance`` s, each true pose used at most once (the closest claim wins)."""
     te = np.asarray(t_est, dtype=np.float64)

@@ -38,8 +38,9 @@ def wilson_interval(successes: int, n: int, z: float = 1.96) -> tuple[float, flo
     return max(0.0, centre - half), min(1.0, centre + half)
 
 
-def shortest_length(world: str, start: tuple[float, float, float], goals: list[tuple[float, float, float]],
-                    robot_radius: float = 0.2) -> float | None:  # fmt: skip
+def shortest_length(
+    world: str, start: tuple[float, float, float], goals: list[tuple[float, float, float]], robot_radius: float = 0.2
+) -> float | None:
     """Length (m) of the shortest collision-free route start -> goals on the world's true map (None if any
     leg has none): SPL's reference."""
     from navlab.drivers import exploration_costmap
@@ -72,6 +73,7 @@ def _spawns(sc: Scenario, seed: int) -> list[tuple[float, Any]]:
         model = parse_spawn_spec(ob["spec"], default_name=f"obstacle_{k}")[0]
         t = float(rng.uniform(*ob["t"])) if isinstance(ob["t"], list) else float(ob["t"])
         if ob.get("frame", "world") == "robot":
+
             def place(sim: Any, m: Any = model) -> Any:
                 x, y, yaw = compose2(sim.base_pose2d(), (m.pose[0], m.pose[1], m.pose[5]))
                 return replace(m, pose=(x, y, m.pose[2], m.pose[3], m.pose[4], yaw))
@@ -105,16 +107,33 @@ def run_trial(sc: Scenario, index: int) -> dict[str, Any]:
             own = CLUTTER_PARAMS if sc.robot in CLUTTER_ROBOTS else {}  # other robots: their own files (clutter_run)
             start, overrides = clutter.start, {**own, **sc.overrides}
         if sc.map == "map_first":
-            mapped = run_mapping(world=sc.resolve(sc.map_world) or sc.map_world or world, robot=sc.robot,
-                                 pose=start, out=Path(tmp) / "map", seed=seed, quiet=True)  # fmt: skip
+            mapped = run_mapping(
+                world=sc.resolve(sc.map_world) or sc.map_world or world,
+                robot=sc.robot,
+                pose=start,
+                out=Path(tmp) / "map",
+                seed=seed,
+                quiet=True,
+            )
             map_yaml = mapped.map_yaml
         elif sc.map not in ("true", "none"):
             map_yaml = sc.resolve(sc.map)
-        r = run_navigation(sc.goals, world=world, map_yaml=map_yaml, robot=sc.robot, pose=start,
-                           controller=sc.controller, params_dir=sc.resolve(sc.params), move_base_params=overrides,
-                           spawn=_spawns(sc, seed), goal_timeout=sc.time_limit, seed=seed, mapless=sc.map == "none",
-                           goal_tolerance=SUCCESS_M if clutter is not None else sc.goal_tolerance_m,
-                           **sc.navigation_options())  # fmt: skip
+        r = run_navigation(
+            sc.goals,
+            world=world,
+            map_yaml=map_yaml,
+            robot=sc.robot,
+            pose=start,
+            controller=sc.controller,
+            params_dir=sc.resolve(sc.params),
+            move_base_params=overrides,
+            spawn=_spawns(sc, seed),
+            goal_timeout=sc.time_limit,
+            seed=seed,
+            mapless=sc.map == "none",
+            goal_tolerance=SUCCESS_M if clutter is not None else sc.goal_tolerance_m,
+            **sc.navigation_options(),
+        )
     goals = r.goals
     failed = next((g for g in goals if g["outcome"] != "succeeded" or g["collisions"]), None)
     success = failed is None
@@ -128,25 +147,41 @@ def run_trial(sc: Scenario, index: int) -> dict[str, Any]:
         success, failure = barn.pop("success"), barn.pop("failure")
         shortest = clutter.reference_path_m if len(goals) == 1 else None
     spl = (float(success) * shortest / max(path_m, shortest)) if shortest else None
-    return rounded({
-        "trial": index, "seed": seed, "success": success, "failure": failure,
-        "reason": "" if failed is None else failed["reason"],
-        "move_base_success": move_base_success, "false_success": sum(g["false_success"] for g in goals),
-        "goals_succeeded": sum(g["outcome"] == "succeeded" for g in goals), "goals": len(goals),
-        "goals_succeeded_move_base": sum(g["move_base_outcome"] == "succeeded" for g in goals),
-        "time_s": sum(g["time_s"] for g in goals), "path_m": path_m, "shortest_m": shortest, "spl": spl,
-        "min_clearance_m": min(g["min_clearance_m"] for g in goals), "collisions": sum(g["collisions"] for g in goals),
-        "near_miss": any(g.get("near_miss", False) for g in goals),
-        "time_under_safety_s": sum(g.get("time_under_safety_s", 0.0) for g in goals),
-        "near_goal_m": min(g.get("near_goal_m", g["final_error_m"]) for g in goals[-1:]),
-        "localization_error_mean_m": r.summary.get("localization_error_mean_m"),
-        "localization_error_max_m": r.summary.get("localization_error_max_m"),
-        "cmd_jerk_mean": r.summary.get("cmd_jerk_mean"), "sim_s": r.summary["sim_s"], "wall_s": r.summary["wall_s"],
-        "tracking_error_m": _mean(goals, "tracking_error_m"), "final_error_m": _mean(goals, "final_error_m"),
-        **barn, "per_goal": goals,
-        "world_file": str(world) if clutter is None else None, "start": list(start),
-        "path_xy": _thin(r.path[:, 1:]),  # for the report's trajectory picture
-    })  # fmt: skip
+    return rounded(
+        {
+            "trial": index,
+            "seed": seed,
+            "success": success,
+            "failure": failure,
+            "reason": "" if failed is None else failed["reason"],
+            "move_base_success": move_base_success,
+            "false_success": sum(g["false_success"] for g in goals),
+            "goals_succeeded": sum(g["outcome"] == "succeeded" for g in goals),
+            "goals": len(goals),
+            "goals_succeeded_move_base": sum(g["move_base_outcome"] == "succeeded" for g in goals),
+            "time_s": sum(g["time_s"] for g in goals),
+            "path_m": path_m,
+            "shortest_m": shortest,
+            "spl": spl,
+            "min_clearance_m": min(g["min_clearance_m"] for g in goals),
+            "collisions": sum(g["collisions"] for g in goals),
+            "near_miss": any(g.get("near_miss", False) for g in goals),
+            "time_under_safety_s": sum(g.get("time_under_safety_s", 0.0) for g in goals),
+            "near_goal_m": min(g.get("near_goal_m", g["final_error_m"]) for g in goals[-1:]),
+            "localization_error_mean_m": r.summary.get("localization_error_mean_m"),
+            "localization_error_max_m": r.summary.get("localization_error_max_m"),
+            "cmd_jerk_mean": r.summary.get("cmd_jerk_mean"),
+            "sim_s": r.summary["sim_s"],
+            "wall_s": r.summary["wall_s"],
+            "tracking_error_m": _mean(goals, "tracking_error_m"),
+            "final_error_m": _mean(goals, "final_error_m"),
+            **barn,
+            "per_goal": goals,
+            "world_file": str(world) if clutter is None else None,
+            "start": list(start),
+            "path_xy": _thin(r.path[:, 1:]),  # for the report's trajectory picture
+        }
+    )
 
 
 def _thin(xy: np.ndarray, step: float = 0.05) -> list[list[float]]:
@@ -203,25 +238,31 @@ def summarize_trials(results: list[dict[str, Any]]) -> dict[str, Any]:
     for r in results:
         if not r["success"]:
             failures[r["failure"]] = failures.get(r["failure"], 0) + 1
-    return rounded({
-        "trials": n, "success_rate": ok / n if n else None, "success_ci95": [lo, hi],
-        # move_base's own verdict beside the truth's (trials recorded before issue 30 have neither key)
-        "move_base_success_rate": _rate(results, "move_base_success"),
-        "false_success": sum(int(r.get("false_success") or 0) for r in results),
-        "collisions": sum(r["collisions"] for r in results),  # contact episodes (events), over all trials
-        "trials_with_collision": sum(bool(r["collisions"]) for r in results),  # trials, as "failures" counts
-        "failures": failures,
-        "median_time_s": times[1] if times else None, "time_s_quartiles": times,
-        "median_path_m": _median(results, "path_m"), "spl_mean": _mean(results, "spl"),
-        "min_clearance_m": min((r["min_clearance_m"] for r in results), default=None),
-        "near_misses": sum(bool(r.get("near_miss")) for r in results),  # trials under 5 cm without a contact
-        "time_under_safety_s_mean": _mean(results, "time_under_safety_s"),
-        "localization_error_mean_m": _mean(results, "localization_error_mean_m"),
-        "cmd_jerk_mean": _mean(results, "cmd_jerk_mean"),
-        "tracking_error_mean_m": _mean(results, "tracking_error_m"),
-        "final_error_mean_m": _mean(results, "final_error_m"),
-        **({"score_mean": _mean(results, "score")} if any("score" in r for r in results) else {}),  # BARN
-    })  # fmt: skip
+    return rounded(
+        {
+            "trials": n,
+            "success_rate": ok / n if n else None,
+            "success_ci95": [lo, hi],
+            # move_base's own verdict beside the truth's (trials recorded by older navlab releases have neither key)
+            "move_base_success_rate": _rate(results, "move_base_success"),
+            "false_success": sum(int(r.get("false_success") or 0) for r in results),
+            "collisions": sum(r["collisions"] for r in results),  # contact episodes (events), over all trials
+            "trials_with_collision": sum(bool(r["collisions"]) for r in results),  # trials, as "failures" counts
+            "failures": failures,
+            "median_time_s": times[1] if times else None,
+            "time_s_quartiles": times,
+            "median_path_m": _median(results, "path_m"),
+            "spl_mean": _mean(results, "spl"),
+            "min_clearance_m": min((r["min_clearance_m"] for r in results), default=None),
+            "near_misses": sum(bool(r.get("near_miss")) for r in results),  # trials under 5 cm without a contact
+            "time_under_safety_s_mean": _mean(results, "time_under_safety_s"),
+            "localization_error_mean_m": _mean(results, "localization_error_mean_m"),
+            "cmd_jerk_mean": _mean(results, "cmd_jerk_mean"),
+            "tracking_error_mean_m": _mean(results, "tracking_error_m"),
+            "final_error_mean_m": _mean(results, "final_error_m"),
+            **({"score_mean": _mean(results, "score")} if any("score" in r for r in results) else {}),  # BARN
+        }
+    )
 
 
 def _rate(results: list[dict[str, Any]], key: str) -> float | None:
@@ -244,9 +285,16 @@ def _trial_in_worker(args: tuple[Scenario, int]) -> dict[str, Any]:
     return run_trial(*args)
 
 
-def run_experiment(sc: Scenario, out: str | Path, *, trials: int | None = None, seed: int | None = None,
-                   workers: int | None = 1, backend: str = "local",
-                   progress: bool = False) -> dict[str, Any]:  # fmt: skip
+def run_experiment(
+    sc: Scenario,
+    out: str | Path,
+    *,
+    trials: int | None = None,
+    seed: int | None = None,
+    workers: int | None = 1,
+    backend: str = "local",
+    progress: bool = False,
+) -> dict[str, Any]:
     """Run the scenario's trials not yet in ``out``/results.jsonl (in ``workers`` processes, or on Ray with
     ``backend="ray"``), append each as it finishes, and return (and write ``summary.json``) the summary over
     all of them."""
@@ -257,8 +305,14 @@ def run_experiment(sc: Scenario, out: str | Path, *, trials: int | None = None, 
     return run_experiments([(sc, Path(out))], workers=workers, backend=backend, progress=progress, desc=sc.name)[0]
 
 
-def run_experiments(jobs: list[tuple[Scenario, Path]], *, workers: int | None = 1, backend: str = "local",
-                    progress: bool = False, desc: str = "trials") -> list[dict[str, Any]]:  # fmt: skip
+def run_experiments(
+    jobs: list[tuple[Scenario, Path]],
+    *,
+    workers: int | None = 1,
+    backend: str = "local",
+    progress: bool = False,
+    desc: str = "trials",
+) -> list[dict[str, Any]]:
     """Several experiments (scenario, results folder) at once: every unfinished trial of every one goes to the
     same workers (see ``backends.run_tasks``); the driver appends each trial's line to its folder's
     results.jsonl as it finishes, then writes each ``summary.json``. Returns the summaries in order."""
@@ -274,16 +328,18 @@ def run_experiments(jobs: list[tuple[Scenario, Path]], *, workers: int | None = 
         if sc.trials < 1:
             raise ExperimentError(f"trials: expected an integer >= 1, got {sc.trials}")
         folder.mkdir(parents=True, exist_ok=True)
-        finished = {int(r["trial"]): r for r in read_results(folder / "results.jsonl")
-                    if r.get("seed") == sc.seed + int(r["trial"])}  # fmt: skip
+        finished = {
+            int(r["trial"]): r
+            for r in read_results(folder / "results.jsonl")
+            if r.get("seed") == sc.seed + int(r["trial"])
+        }
         done.append(finished)
         for k in range(sc.trials):
             if k not in finished:
                 tasks.append((sc, k))
                 owner.append(j)
     total = sum(sc.trials for sc, _ in jobs)
-    bar = tqdm(total=total, initial=total - len(tasks), desc=desc, unit="trial", file=sys.stderr,
-               disable=not progress)  # fmt: skip
+    bar = tqdm(total=total, initial=total - len(tasks), desc=desc, unit="trial", file=sys.stderr, disable=not progress)
     try:
         for i, rec in run_tasks(_trial_in_worker, tasks, backend=backend, workers=workers):
             j = owner[i]

@@ -11,5 +11,8 @@ from navlab.world.truth import (  # noqa: F401 - re-exported for the old import 
     world_T_map,
 )
 
-warnings.warn("navlab.experiments.truth moved to navlab.world (navlab.world.truth); the old path works until the "
-              "next release", DeprecationWarning, stacklevel=2)
+warnings.warn(
+    "navlab.experiments.truth moved to navlab.world (navlab.world.truth); the old path works until the next release",
+    DeprecationWarning,
+    stacklevel=2,
+)

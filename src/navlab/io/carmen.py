@@ -112,8 +112,10 @@ def _count(tok: list[str], index: int, what: str) -> int:
 def _fields(tok: list[str], expected: int, what: str) -> None:
     """A line must have exactly the fields its counts announce (with or without host and logger time)."""
     if len(tok) not in (expected, expected - 2):
-        raise _Bad(f"{what}: {len(tok)} fields, but its counts make {expected} (a count that disagrees with "
-                   "its readings would shift every field after them)")
+        raise _Bad(
+            f"{what}: {len(tok)} fields, but its counts make {expected} (a count that disagrees with "
+            "its readings would shift every field after them)"
+        )
 
 
 def _laser(ranges: list[float], max_range: float, what: str) -> np.ndarray:
@@ -155,8 +157,16 @@ def _parse_robotlaser1(tok: list[str]) -> LaserScan2D:
     lx, ly, lt, rx, ry, rt = _floats(tok, base, 6, "ROBOTLASER1 poses")
     ts = _floats(tok, base + 11, 1, "ROBOTLASER1 timestamp")[0]
     _poses((lx, ly, lt), (rx, ry, rt), what="ROBOTLASER1")
-    return LaserScan2D(ts, _laser(ranges, max_range, "ROBOTLASER1"), start, res, max_range, (lx, ly, lt), (rx, ry, rt),
-                       kind="ROBOTLASER1")
+    return LaserScan2D(
+        ts,
+        _laser(ranges, max_range, "ROBOTLASER1"),
+        start,
+        res,
+        max_range,
+        (lx, ly, lt),
+        (rx, ry, rt),
+        kind="ROBOTLASER1",
+    )
 
 
 def _parse_odom(tok: list[str]) -> OdomRecord:
@@ -193,12 +203,19 @@ def read_carmen(path: str | os.PathLike[str], *, max_skipped_report: int = 5) ->
             try:
                 if kind in ("FLASER", "ROBOTLASER1", "ODOM"):
                     rec: LaserScan2D | OdomRecord
-                    rec = (_parse_flaser(tok) if kind == "FLASER" else _parse_robotlaser1(tok) if kind != "ODOM"
-                           else _parse_odom(tok))
+                    rec = (
+                        _parse_flaser(tok)
+                        if kind == "FLASER"
+                        else _parse_robotlaser1(tok)
+                        if kind != "ODOM"
+                        else _parse_odom(tok)
+                    )
                     stream = "odom" if kind == "ODOM" else "scan"
                     if rec.timestamp < last[stream]:
-                        raise _Bad(f"timestamp {rec.timestamp} is before the previous {stream} "
-                                   f"({last[stream]}); timestamps must not go backwards")
+                        raise _Bad(
+                            f"timestamp {rec.timestamp} is before the previous {stream} "
+                            f"({last[stream]}); timestamps must not go backwards"
+                        )
                     last[stream] = rec.timestamp
                     if isinstance(rec, OdomRecord):
                         log.odometry.append(rec)
@@ -210,8 +227,9 @@ def read_carmen(path: str | os.PathLike[str], *, max_skipped_report: int = 5) ->
                     log.ignored_types[kind] = log.ignored_types.get(kind, 0) + 1
             except (_Bad, ValueError) as exc:
                 log.skipped.append(f"{p.name}:{lineno}: skipped {kind} line ({exc})")
-    log.scans = _without_outliers(log, log.scans, [[s.odom_pose for s in log.scans], [s.laser_pose for s in log.scans]],
-                                  lines["scan"])
+    log.scans = _without_outliers(
+        log, log.scans, [[s.odom_pose for s in log.scans], [s.laser_pose for s in log.scans]], lines["scan"]
+    )
     log.odometry = _without_outliers(log, log.odometry, [[o.pose for o in log.odometry]], lines["odom"])
     if not log.scans:
         extra = f"; {len(log.skipped)} malformed lines, first: {log.skipped[0]}" if log.skipped else ""
@@ -219,8 +237,9 @@ def read_carmen(path: str | os.PathLike[str], *, max_skipped_report: int = 5) ->
     return log
 
 
-def _without_outliers(log: CarmenLog, records: list[Any], poses: list[list[tuple[float, float, float]]],
-                      linenos: list[int]) -> list[Any]:
+def _without_outliers(
+    log: CarmenLog, records: list[Any], poses: list[list[tuple[float, float, float]]], linenos: list[int]
+) -> list[Any]:
     """``records`` without those with a pose (one list per pose kind) further from the median of its
     ``OUTLIER_WINDOW`` neighbours each side than ``OUTLIER_SLACK`` + ``OUTLIER_SPEED`` x their time span
     allows (one wild pose would otherwise grow a SLAM map without bound); each rejected record is counted."""
@@ -265,16 +284,25 @@ def write_carmen(path: str | os.PathLike[str], log: CarmenLog, *, comment: str =
         fov = s.angle_increment * (n - 1)
         lx, ly, lt = s.laser_pose
         rx, ry, rt = s.odom_pose
-        rows.append((s.timestamp, (
-            f"ROBOTLASER1 0 {s.angle_min:.9f} {fov:.9f} {s.angle_increment:.9f} {s.max_range:g} 0.01 0 {n} "
-            + " ".join(f"{v:.3f}" for v in r)
-            + f" 0 {lx:.6f} {ly:.6f} {lt:.6f} {rx:.6f} {ry:.6f} {rt:.6f} 0 0 0 0 0 "
-            f"{s.timestamp:.6f} navlab {s.timestamp:.6f}"
-        )))  # fmt: skip
+        rows.append(
+            (
+                s.timestamp,
+                (
+                    f"ROBOTLASER1 0 {s.angle_min:.9f} {fov:.9f} {s.angle_increment:.9f} {s.max_range:g} 0.01 0 {n} "
+                    + " ".join(f"{v:.3f}" for v in r)
+                    + f" 0 {lx:.6f} {ly:.6f} {lt:.6f} {rx:.6f} {ry:.6f} {rt:.6f} 0 0 0 0 0 "
+                    f"{s.timestamp:.6f} navlab {s.timestamp:.6f}"
+                ),
+            )
+        )
     for o in log.odometry:
         x, y, t = o.pose
-        rows.append((o.timestamp, f"ODOM {x:.6f} {y:.6f} {t:.6f} {o.tv:.6f} {o.rv:.6f} 0 {o.timestamp:.6f} navlab "
-                                  f"{o.timestamp:.6f}"))  # fmt: skip
+        rows.append(
+            (
+                o.timestamp,
+                f"ODOM {x:.6f} {y:.6f} {t:.6f} {o.tv:.6f} {o.rv:.6f} 0 {o.timestamp:.6f} navlab {o.timestamp:.6f}",
+            )
+        )
     rows.sort(key=lambda row: row[0])
     head = "".join(f"# {line}\n" for line in comment.splitlines())
     out = Path(path)

@@ -47,8 +47,11 @@ def dataset(relpath: str | os.PathLike[str]) -> Path:
         raise DatasetNotFoundError(f"dataset {rel}: expected a path relative to the datasets folder ({ENV_VAR})")
     path = data_dir() / rel
     if not path.exists():
-        where = (f"{ENV_VAR}={os.environ[ENV_VAR]}" if os.environ.get(ENV_VAR, "").strip()
-                 else f"{ENV_VAR} is unset, so the default {default_data_dir()}")
+        where = (
+            f"{ENV_VAR}={os.environ[ENV_VAR]}"
+            if os.environ.get(ENV_VAR, "").strip()
+            else f"{ENV_VAR} is unset, so the default {default_data_dir()}"
+        )
         raise DatasetNotFoundError(
             f"dataset {rel} not found at {path} ({where}); set {ENV_VAR} to the folder that holds "
             f"{rel.parts[0]}/, or put the data at ../shared/datasets relative to the repository root"

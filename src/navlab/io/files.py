@@ -77,8 +77,13 @@ def machine_memory_bytes() -> int:
 
 
 def _kind(mode: int) -> str:
-    for test, name in ((stat.S_ISDIR, "a directory"), (stat.S_ISFIFO, "a named pipe"), (stat.S_ISCHR, "a device"),
-                       (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket")):
+    for test, name in (
+        (stat.S_ISDIR, "a directory"),
+        (stat.S_ISFIFO, "a named pipe"),
+        (stat.S_ISCHR, "a device"),
+        (stat.S_ISBLK, "a block device"),
+        (stat.S_ISSOCK, "a socket"),
+    ):
         if test(mode):
             return name
     return "not a regular file"
@@ -128,8 +133,10 @@ def decode_text(data: bytes, path: str | os.PathLike[str], *, what: str) -> str:
         return data.decode("utf-8").removeprefix("\ufeff")
     except UnicodeDecodeError as exc:
         line = data[: exc.start].count(b"\n") + 1
-        raise IoError(f"{path}:{line}: byte 0x{data[exc.start]:02x} is not UTF-8 text; expected a {what} "
-                      "in UTF-8 (is it a binary file?)") from None
+        raise IoError(
+            f"{path}:{line}: byte 0x{data[exc.start]:02x} is not UTF-8 text; expected a {what} "
+            "in UTF-8 (is it a binary file?)"
+        ) from None
 
 
 def read_text_checked(path: str | os.PathLike[str], *, what: str, max_bytes: int = MAX_TEXT_BYTES) -> str:

@@ -15,8 +15,16 @@ from navlab import msgs
 from navlab.io.errors import IoError
 
 INT8, UINT8, INT16, UINT16, INT32, UINT32, FLOAT32, FLOAT64 = range(1, 9)  # sensor_msgs/PointField datatypes
-_DTYPES = {INT8: "i1", UINT8: "u1", INT16: "<i2", UINT16: "<u2", INT32: "<i4", UINT32: "<u4", FLOAT32: "<f4",
-           FLOAT64: "<f8"}  # fmt: skip
+_DTYPES = {
+    INT8: "i1",
+    UINT8: "u1",
+    INT16: "<i2",
+    UINT16: "<u2",
+    INT32: "<i4",
+    UINT32: "<u4",
+    FLOAT32: "<f4",
+    FLOAT64: "<f8",
+}
 POINT_STEP = 32
 
 
@@ -24,8 +32,14 @@ def _field(name: str, offset: int, datatype: int) -> Any:
     return msgs.PointField(name=name, offset=offset, datatype=datatype, count=1)
 
 
-def pack_cloud(stamp_ns: int, frame_id: str, columns: dict[str, tuple[int, int, np.ndarray]], *, height: int = 1,
-               width: int | None = None) -> Any:
+def pack_cloud(
+    stamp_ns: int,
+    frame_id: str,
+    columns: dict[str, tuple[int, int, np.ndarray]],
+    *,
+    height: int = 1,
+    width: int | None = None,
+) -> Any:
     """A PointCloud2 of 32-byte points from ``columns``: name -> (offset, datatype, values (N,)); ``height`` x
     ``width`` organised (default one row). ``is_dense`` is false when any x is NaN."""
     n = len(next(iter(columns.values()))[2])
@@ -37,14 +51,22 @@ def pack_cloud(stamp_ns: int, frame_id: str, columns: dict[str, tuple[int, int, 
         if datatype == FLOAT32 and offset % 4 == 0:
             words[:, offset // 4] = values
         else:
-            buf[:, offset:offset + dt.itemsize] = np.ascontiguousarray(values, dtype=dt).view(np.uint8).reshape(n, -1)
+            buf[:, offset : offset + dt.itemsize] = np.ascontiguousarray(values, dtype=dt).view(np.uint8).reshape(n, -1)
         fields.append(_field(name, offset, datatype))
     w = n // height if width is None else width
     xs = columns.get("x")
     dense = xs is None or not np.isnan(np.asarray(xs[2], dtype=np.float32)).any()
-    return msgs.PointCloud2(header=msgs.header(stamp_ns, frame_id), height=height, width=w, fields=fields,
-                            is_bigendian=False, point_step=POINT_STEP, row_step=POINT_STEP * w,
-                            data=buf.reshape(-1), is_dense=bool(dense))
+    return msgs.PointCloud2(
+        header=msgs.header(stamp_ns, frame_id),
+        height=height,
+        width=w,
+        fields=fields,
+        is_bigendian=False,
+        point_step=POINT_STEP,
+        row_step=POINT_STEP * w,
+        data=buf.reshape(-1),
+        is_dense=bool(dense),
+    )
 
 
 def read_field(msg: Any, name: str) -> np.ndarray:
@@ -56,7 +78,7 @@ def read_field(msg: Any, name: str) -> np.ndarray:
             dt = np.dtype(_DTYPES.get(int(f.datatype), "u1"))
             n = int(msg.height) * int(msg.width)
             raw = np.asarray(msg.data, dtype=np.uint8)[: n * int(msg.point_step)].reshape(n, int(msg.point_step))
-            return raw[:, int(f.offset):int(f.offset) + dt.itemsize].copy().view(dt).reshape(n)
+            return raw[:, int(f.offset) : int(f.offset) + dt.itemsize].copy().view(dt).reshape(n)
     names = ", ".join(f.name for f in msg.fields) or "none"
     raise IoError(f"PointCloud2 has no field {name!r} (fields: {names})")
 
@@ -65,8 +87,11 @@ def read_xyz(msg: Any) -> np.ndarray:
     """Points (N, 3) float32 of a PointCloud2's x, y, z fields (NaNs kept)."""
     offsets = {f.name: (int(f.offset), int(f.datatype)) for f in msg.fields}
     step = int(msg.point_step)
-    if (offsets.get("x"), offsets.get("y"), offsets.get("z")) == ((0, FLOAT32), (4, FLOAT32), (8, FLOAT32)) and \
-            step % 4 == 0 and not msg.is_bigendian:  # the usual layout: one strided view, no per-field copies
+    if (
+        (offsets.get("x"), offsets.get("y"), offsets.get("z")) == ((0, FLOAT32), (4, FLOAT32), (8, FLOAT32))
+        and step % 4 == 0
+        and not msg.is_bigendian
+    ):  # the usual layout: one strided view, no per-field copies
         n = int(msg.height) * int(msg.width)
         flat = np.asarray(msg.data, dtype=np.uint8)[: n * step].view("<f4").reshape(n, step // 4)
         return flat[:, :3].astype(np.float32)

@@ -46,8 +46,10 @@ class BagWriter:
         self._staging = self.path.parent / f".{self.path.name}.partial"
         self._tmp = self._staging / self.path.name
         if self._staging.exists() or self._staging.is_symlink():  # a killed recording: never removed for a new one
-            raise BagError(f"{self.path}: {self._staging} holds a recording that was killed; recover it with "
-                           f"`navlab bag reindex {self.path}` (or move it away) before recording under this name")
+            raise BagError(
+                f"{self.path}: {self._staging} holds a recording that was killed; recover it with "
+                f"`navlab bag reindex {self.path}` (or move it away) before recording under this name"
+            )
         try:
             self._staging.mkdir(parents=True)
             self._writer = Writer(self._tmp, version=8, storage_plugin=StoragePlugin.MCAP)
@@ -79,8 +81,10 @@ class BagWriter:
                 os.rename(self._tmp, self.path)  # refuses to replace anything but an empty folder
                 self._staging.rmdir()
             except OSError as exc:
-                raise BagError(f"{self.path}: cannot move the finished recording from {self._tmp} into place "
-                               f"({exc.strerror or exc}); it is kept there") from None
+                raise BagError(
+                    f"{self.path}: cannot move the finished recording from {self._tmp} into place "
+                    f"({exc.strerror or exc}); it is kept there"
+                ) from None
         return self.path
 
     def __enter__(self) -> BagWriter:
@@ -186,8 +190,11 @@ def bag_graph(path: str | Path) -> dict[str, Any] | None:
     except Exception as exc:  # the reader's boundary
         raise damaged(path, f"metadata.yaml: {_what(exc)}") from None
     if graph is not None and not _graph_shaped(graph):
-        raise damaged(path, f"metadata.yaml: {GRAPH_KEY} is not a graph "
-                      "({nodes: [names], topics: {name: {pub: [names], sub: [names]}}})")
+        raise damaged(
+            path,
+            f"metadata.yaml: {GRAPH_KEY} is not a graph "
+            "({nodes: [names], topics: {name: {pub: [names], sub: [names]}}})",
+        )
     return graph
 
 
@@ -196,8 +203,11 @@ def _graph_shaped(graph: Any) -> bool:
         return isinstance(v, list) and all(isinstance(x, str) for x in v)
 
     topics = graph.get("topics", {}) if isinstance(graph, dict) else None
-    return isinstance(topics, dict) and names(graph.get("nodes", [])) and all(
-        isinstance(v, dict) and names(v.get("pub")) and names(v.get("sub")) for v in topics.values())
+    return (
+        isinstance(topics, dict)
+        and names(graph.get("nodes", []))
+        and all(isinstance(v, dict) and names(v.get("pub")) and names(v.get("sub")) for v in topics.values())
+    )
 
 
 # --- recovering a recording that was killed (ros2 bag reindex) -------------------------------------------
@@ -315,8 +325,10 @@ def reindex_bag(path: str | Path, out: str | Path | None = None) -> dict[str, An
     try:
         writer = Writer(rebuilt, version=8, storage_plugin=StoragePlugin.MCAP)
         writer.open()
-        conns = {cid: writer.add_connection(topic, msgtype, typestore=TYPESTORE)
-                 for cid, (topic, msgtype) in sorted(channels.items())}
+        conns = {
+            cid: writer.add_connection(topic, msgtype, typestore=TYPESTORE)
+            for cid, (topic, msgtype) in sorted(channels.items())
+        }
         for cid, t_ns, data in sorted(messages, key=lambda m: m[1]):
             writer.write(conns[cid], t_ns, data)
         writer.close()

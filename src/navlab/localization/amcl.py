@@ -93,22 +93,38 @@ class AmclParams:
                 raise LocalizationError(f"amcl parameter {name}: expected > 0, got {getattr(self, name)}")
         if not 0 < self.kld_z < 1:
             raise LocalizationError(f"amcl parameter kld_z: expected 0 < kld_z < 1, got {self.kld_z}")
-        for name in ("update_min_d", "update_min_a", "laser_z_hit", "laser_z_short", "laser_z_max", "laser_z_rand",
-                     "odom_alpha1", "odom_alpha2", "odom_alpha3", "odom_alpha4", "initial_cov_xx", "initial_cov_yy",
-                     "initial_cov_aa"):
+        for name in (
+            "update_min_d",
+            "update_min_a",
+            "laser_z_hit",
+            "laser_z_short",
+            "laser_z_max",
+            "laser_z_rand",
+            "odom_alpha1",
+            "odom_alpha2",
+            "odom_alpha3",
+            "odom_alpha4",
+            "initial_cov_xx",
+            "initial_cov_yy",
+            "initial_cov_aa",
+        ):
             if getattr(self, name) < 0:
                 raise LocalizationError(f"amcl parameter {name}: expected >= 0, got {getattr(self, name)}")
         if 0 < self.laser_max_range <= self.laser_min_range:
-            raise LocalizationError(f"amcl parameters laser_min_range={self.laser_min_range}, laser_max_range="
-                                    f"{self.laser_max_range}: expected laser_min_range < laser_max_range")
+            raise LocalizationError(
+                f"amcl parameters laser_min_range={self.laser_min_range}, laser_max_range="
+                f"{self.laser_max_range}: expected laser_min_range < laser_max_range"
+            )
         self.motion_model()
         self.laser_model()
         for name in ("recovery_alpha_slow", "recovery_alpha_fast"):
             if not 0.0 <= getattr(self, name) <= 1.0:
                 raise LocalizationError(f"amcl parameter {name}: expected 0..1, got {getattr(self, name)}")
         if self.recovery_alpha_slow > 0 and self.recovery_alpha_fast <= self.recovery_alpha_slow:
-            raise LocalizationError("amcl parameters recovery_alpha_fast must exceed recovery_alpha_slow "
-                                    f"(got fast={self.recovery_alpha_fast}, slow={self.recovery_alpha_slow})")
+            raise LocalizationError(
+                "amcl parameters recovery_alpha_fast must exceed recovery_alpha_slow "
+                f"(got fast={self.recovery_alpha_fast}, slow={self.recovery_alpha_slow})"
+            )
 
     def motion_model(self) -> Any:
         """The ``odom_model_type`` plugin (a ``MotionModel`` function); an unknown name says "did you mean"."""
@@ -185,8 +201,10 @@ class Amcl:
         h, w = self.field.shape
         res = self.field.resolution
         if not self.field.contains(x, y):
-            raise LocalizationError(f"initial pose ({x:.3f}, {y:.3f}) lies outside the map "
-                                    f"({w}×{h} cells of {res} m from origin {self.field.origin[:2]})")
+            raise LocalizationError(
+                f"initial pose ({x:.3f}, {y:.3f}) lies outside the map "
+                f"({w}×{h} cells of {res} m from origin {self.field.origin[:2]})"
+            )
         if cov is None:
             cov = np.diag([p.initial_cov_xx, p.initial_cov_yy, p.initial_cov_aa])
         cov = np.asarray(cov, dtype=np.float64)

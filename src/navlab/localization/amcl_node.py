@@ -54,8 +54,9 @@ class Amcl(Node):
         self.transform_tolerance = self.declare_parameter("transform_tolerance", 0.1)
         for pname, value in (("odom_alpha5", self.odom_alpha5), ("transform_tolerance", self.transform_tolerance)):
             if not 0 <= value < float("inf"):
-                raise LocalizationError(f"node {self.fully_qualified_name}: parameter {pname}: expected a finite "
-                                        f"number >= 0, got {value!r}")
+                raise LocalizationError(
+                    f"node {self.fully_qualified_name}: parameter {pname}: expected a finite number >= 0, got {value!r}"
+                )
         self.initial_pose = (
             self.declare_parameter("initial_pose_x", 0.0),
             self.declare_parameter("initial_pose_y", 0.0),
@@ -70,8 +71,9 @@ class Amcl(Node):
         self.declare_parameter("use_map_topic", False)
         for pname, default in (("gui_publish_rate", -1.0), ("save_pose_rate", 0.5)):  # read, not used
             if not abs(self.declare_parameter(pname, default)) < float("inf"):
-                raise LocalizationError(f"node {self.fully_qualified_name}: parameter {pname}: expected a finite "
-                                        "number (<= 0: off)")
+                raise LocalizationError(
+                    f"node {self.fully_qualified_name}: parameter {pname}: expected a finite number (<= 0: off)"
+                )
         self.check_parameters()
 
         self.filter: pf.Amcl | None = None
@@ -183,7 +185,8 @@ class Amcl(Node):
             self._invalid_logged_ns = t_ns
             self.get_logger().warning(
                 f"scan has no valid reading (all beyond range or not finite): {self.scans_invalid} of "
-                f"{self.scans_received} scans so far; the laser cannot correct the pose, only odometry moves it")
+                f"{self.scans_received} scans so far; the laser cannot correct the pose, only odometry moves it"
+            )
 
     def _on_scan(self, msg: Any) -> None:
         self.scans_received += 1

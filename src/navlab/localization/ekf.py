@@ -48,8 +48,9 @@ def matrix_from(value: Any, key: str) -> np.ndarray:
     a = np.asarray(value, dtype=np.float64).ravel() if isinstance(value, list | tuple | np.ndarray) else None
     if a is None or a.size not in (N, N * N) or not np.isfinite(a).all():
         got = f"{len(value)} values" if isinstance(value, list | tuple) else repr(value)
-        raise LocalizationError(f"{key}: expected 225 finite numbers (a 15x15 matrix, row-major) or 15 (its "
-                                f"diagonal), got {got}")  # fmt: skip
+        raise LocalizationError(
+            f"{key}: expected 225 finite numbers (a 15x15 matrix, row-major) or 15 (its diagonal), got {got}"
+        )
     m = np.diag(a) if a.size == N else a.reshape(N, N)
     if (np.diag(m) < 0).any():
         bad = [STATE[i] for i in np.flatnonzero(np.diag(m) < 0)]
@@ -134,8 +135,9 @@ def _predict(state: np.ndarray, cov: np.ndarray, q: np.ndarray, dt: float) -> tu
 
 
 @njit(cache=True)
-def _correct(state: np.ndarray, cov: np.ndarray, z: np.ndarray, r: np.ndarray, idx: np.ndarray,
-             threshold: float) -> tuple[bool, np.ndarray, np.ndarray]:  # fmt: skip
+def _correct(
+    state: np.ndarray, cov: np.ndarray, z: np.ndarray, r: np.ndarray, idx: np.ndarray, threshold: float
+) -> tuple[bool, np.ndarray, np.ndarray]:
     """Kalman update on the entries ``idx``: (accepted, state, covariance); Joseph form."""
     m = idx.size
     innov = np.empty(m)
@@ -173,9 +175,14 @@ def _correct(state: np.ndarray, cov: np.ndarray, z: np.ndarray, r: np.ndarray, i
 class Ekf:
     """The filter: ``state`` (15,), ``covariance`` (15, 15); ``predict(dt)`` and ``correct(z, R, mask)``."""
 
-    def __init__(self, *, process_noise: np.ndarray | Sequence[float] = DEFAULT_PROCESS_NOISE,
-                 initial_covariance: np.ndarray | Sequence[float] = DEFAULT_INITIAL_COVARIANCE,
-                 two_d_mode: bool = False, initial_state: Sequence[float] | None = None) -> None:  # fmt: skip
+    def __init__(
+        self,
+        *,
+        process_noise: np.ndarray | Sequence[float] = DEFAULT_PROCESS_NOISE,
+        initial_covariance: np.ndarray | Sequence[float] = DEFAULT_INITIAL_COVARIANCE,
+        two_d_mode: bool = False,
+        initial_state: Sequence[float] | None = None,
+    ) -> None:
         self.process_noise = matrix_from(list(np.asarray(process_noise).ravel()), "process_noise_covariance")
         self.covariance = matrix_from(list(np.asarray(initial_covariance).ravel()), "initial_estimate_covariance")
         self.state = np.zeros(N)
@@ -233,8 +240,9 @@ class Ekf:
 # --- measurements ------------------------------------------------------------------------------------
 
 
-def measurement(values: dict[int, float], cov: np.ndarray | None = None,
-                first: int = 0) -> tuple[np.ndarray, np.ndarray]:
+def measurement(
+    values: dict[int, float], cov: np.ndarray | None = None, first: int = 0
+) -> tuple[np.ndarray, np.ndarray]:
     """(z, R) with ``values`` at state indices and the block ``cov`` (k×k) placed from index ``first``."""
     z = np.full(N, np.nan)
     for i, v in values.items():
@@ -242,7 +250,7 @@ def measurement(values: dict[int, float], cov: np.ndarray | None = None,
     r = np.zeros((N, N))
     if cov is not None:
         k = cov.shape[0]
-        r[first:first + k, first:first + k] = cov
+        r[first : first + k, first : first + k] = cov
     return z, r
 
 
@@ -256,11 +264,19 @@ def twist_measurement(twist6: Sequence[float] | np.ndarray, cov6: np.ndarray) ->
     return measurement({6 + i: float(v) for i, v in enumerate(twist6)}, np.asarray(cov6).reshape(6, 6), 6)
 
 
-def imu_measurement(base_R_imu: np.ndarray, *, orientation_rpy: Sequence[float] | None, orientation_cov: np.ndarray,
-                    angular_velocity: Sequence[float], angular_velocity_cov: np.ndarray,
-                    linear_acceleration: Sequence[float], linear_acceleration_cov: np.ndarray,
-                    remove_gravity: bool = False, gravity: float = 9.80665,
-                    parts: tuple[bool, bool, bool] = (True, True, True)) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+def imu_measurement(
+    base_R_imu: np.ndarray,
+    *,
+    orientation_rpy: Sequence[float] | None,
+    orientation_cov: np.ndarray,
+    angular_velocity: Sequence[float],
+    angular_velocity_cov: np.ndarray,
+    linear_acceleration: Sequence[float],
+    linear_acceleration_cov: np.ndarray,
+    remove_gravity: bool = False,
+    gravity: float = 9.80665,
+    parts: tuple[bool, bool, bool] = (True, True, True),
+) -> tuple[np.ndarray, np.ndarray]:
     """An IMU reading (in the IMU frame) as a base-frame measurement: orientation (the IMU frame's in the
     world, turned into the base's), angular velocity and linear acceleration rotated into the base frame;
     with ``remove_gravity`` the gravity the accelerometer reads is subtracted (using the orientation).
@@ -295,8 +311,9 @@ class PoseInput:
         self._first: np.ndarray | None = None
         self._prev: tuple[np.ndarray, np.ndarray, float] | None = None
 
-    def convert(self, pose6: Sequence[float], cov6: np.ndarray, t: float,
-                mask: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:  # fmt: skip
+    def convert(
+        self, pose6: Sequence[float], cov6: np.ndarray, t: float, mask: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
         """(z, R, mask) of a pose at time ``t`` (s), or None (the first pose of a differential input)."""
         m = matrix_from_pose6([float(v) for v in pose6])
         cov = np.asarray(cov6, dtype=np.float64).reshape(6, 6)

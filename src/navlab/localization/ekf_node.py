@@ -32,8 +32,9 @@ INF = float(np.finfo(np.float64).max)  # robot_localization's "no rejection" (nu
 class EkfNode(Node):
     """robot_localization's ``ekf_localization_node`` / ``ekf_node``."""
 
-    def __init__(self, executor: Executor, *, name: str = "ekf_se", parameters: dict[str, Any] | None = None,
-                 namespace: str = "") -> None:  # fmt: skip
+    def __init__(
+        self, executor: Executor, *, name: str = "ekf_se", parameters: dict[str, Any] | None = None, namespace: str = ""
+    ) -> None:
         super().__init__(executor, name=name, parameters=parameters, namespace=namespace)
         self.listen_tf()  # a tf2 TransformListener, as in ROS: the graph shows it reading /tf
         d = self.declare_parameter
@@ -54,17 +55,23 @@ class EkfNode(Node):
         self.base_frame = str(d("base_link_frame", "base_link"))
         self.world_frame = str(d("world_frame", self.odom_frame))
         if self.world_frame not in (self.map_frame, self.odom_frame):
-            raise LocalizationError(f"{self.fully_qualified_name}: world_frame {self.world_frame!r}: expected "
-                                    f"map_frame {self.map_frame!r} or odom_frame {self.odom_frame!r}")  # fmt: skip
+            raise LocalizationError(
+                f"{self.fully_qualified_name}: world_frame {self.world_frame!r}: expected "
+                f"map_frame {self.map_frame!r} or odom_frame {self.odom_frame!r}"
+            )
         self.gravity = float(d("gravitational_acceleration", 9.80665))
         try:
             self.filter = ekf.Ekf(
-                process_noise=ekf.matrix_from(d("process_noise_covariance", list(ekf.DEFAULT_PROCESS_NOISE)),
-                                              "process_noise_covariance"),
-                initial_covariance=ekf.matrix_from(d("initial_estimate_covariance",
-                                                     list(ekf.DEFAULT_INITIAL_COVARIANCE)),
-                                                   "initial_estimate_covariance"),
-                two_d_mode=self.two_d_mode, initial_state=d("initial_state", [0.0] * ekf.N))  # fmt: skip
+                process_noise=ekf.matrix_from(
+                    d("process_noise_covariance", list(ekf.DEFAULT_PROCESS_NOISE)), "process_noise_covariance"
+                ),
+                initial_covariance=ekf.matrix_from(
+                    d("initial_estimate_covariance", list(ekf.DEFAULT_INITIAL_COVARIANCE)),
+                    "initial_estimate_covariance",
+                ),
+                two_d_mode=self.two_d_mode,
+                initial_state=d("initial_state", [0.0] * ekf.N),
+            )
         except LocalizationError as exc:
             raise LocalizationError(f"{self.fully_qualified_name}: {exc}") from None
         self.inputs: list[dict[str, Any]] = []
@@ -84,8 +91,12 @@ class EkfNode(Node):
         self._imu_rot: dict[str, np.ndarray] = {}
         self.pub = self.create_publisher(msgs.Odometry, "odometry/filtered", 10)
         for spec in self.inputs:
-            msgtype = {"odom": msgs.Odometry, "imu": msgs.Imu, "pose": msgs.PoseWithCovarianceStamped,
-                       "twist": _twist_type()}[spec["kind"]]  # fmt: skip
+            msgtype = {
+                "odom": msgs.Odometry,
+                "imu": msgs.Imu,
+                "pose": msgs.PoseWithCovarianceStamped,
+                "twist": _twist_type(),
+            }[spec["kind"]]
             self.create_subscription(msgtype, spec["topic"], self._queue_for(spec), spec["queue"])
         self.create_timer(1.0 / self.frequency, self.update)
 
@@ -93,13 +104,24 @@ class EkfNode(Node):
         name = f"{kind}{n}"
         d = self.declare_parameter
         mask = ekf.mask_from(d(f"{name}_config", [False] * ekf.N), f"{self.fully_qualified_name}: {name}_config")
-        spec: dict[str, Any] = {"kind": kind, "name": name, "topic": topic, "mask": mask,
-                                "queue": int(d(f"{name}_queue_size", 10)), "nodelay": d(f"{name}_nodelay", False)}
+        spec: dict[str, Any] = {
+            "kind": kind,
+            "name": name,
+            "topic": topic,
+            "mask": mask,
+            "queue": int(d(f"{name}_queue_size", 10)),
+            "nodelay": d(f"{name}_nodelay", False),
+        }
         if kind in ("odom", "imu", "pose"):
-            spec["pose"] = ekf.PoseInput(differential=bool(d(f"{name}_differential", False)),
-                                         relative=bool(d(f"{name}_relative", False)))  # fmt: skip
-        keys = {"odom": ("pose", "twist"), "imu": ("pose", "twist", "linear_acceleration"), "pose": ("pose",),
-                "twist": ("twist",)}[kind]  # fmt: skip
+            spec["pose"] = ekf.PoseInput(
+                differential=bool(d(f"{name}_differential", False)), relative=bool(d(f"{name}_relative", False))
+            )
+        keys = {
+            "odom": ("pose", "twist"),
+            "imu": ("pose", "twist", "linear_acceleration"),
+            "pose": ("pose",),
+            "twist": ("twist",),
+        }[kind]
         for key in keys:  # poseN/twistN: <input>_rejection_threshold
             pname = f"{name}_{key}_rejection_threshold" if kind in ("odom", "imu") else f"{name}_rejection_threshold"
             value = float(d(pname, INF))
@@ -134,8 +156,10 @@ class EkfNode(Node):
         if kind in ("odom", "pose"):
             frame = str(msg.header.frame_id).lstrip("/")
             if frame and frame != self.world_frame:
-                self._error(f"{spec['name']}: pose in frame {frame!r}, expected world_frame {self.world_frame!r}; "
-                            "its pose part is ignored")  # fmt: skip
+                self._error(
+                    f"{spec['name']}: pose in frame {frame!r}, expected world_frame {self.world_frame!r}; "
+                    "its pose part is ignored"
+                )
             else:
                 self._fuse_pose(spec, msg.pose, t, mask)
         if kind in ("odom", "twist"):
@@ -174,8 +198,10 @@ class EkfNode(Node):
             try:
                 tf = self.executor.tf.lookup(self.base_frame, frame)
             except TfError as exc:
-                self._error(f"{name}: no transform from the IMU frame {frame!r} to base_link_frame "
-                            f"{self.base_frame!r} ({exc}); the IMU is ignored until there is one")  # fmt: skip
+                self._error(
+                    f"{name}: no transform from the IMU frame {frame!r} to base_link_frame "
+                    f"{self.base_frame!r} ({exc}); the IMU is ignored until there is one"
+                )
                 return None
             rot = matrix_from_quat(tf[3:7])
         self._imu_rot[frame] = rot
@@ -190,11 +216,17 @@ class EkfNode(Node):
         rpy = rpy_from_quat((q.x, q.y, q.z, q.w)) if have_orientation else None
         w, a = msg.angular_velocity, msg.linear_acceleration
         z, r = ekf.imu_measurement(
-            rot, orientation_rpy=rpy, orientation_cov=np.asarray(msg.orientation_covariance),
-            angular_velocity=(w.x, w.y, w.z), angular_velocity_cov=np.asarray(msg.angular_velocity_covariance),
+            rot,
+            orientation_rpy=rpy,
+            orientation_cov=np.asarray(msg.orientation_covariance),
+            angular_velocity=(w.x, w.y, w.z),
+            angular_velocity_cov=np.asarray(msg.angular_velocity_covariance),
             linear_acceleration=(a.x, a.y, a.z),
             linear_acceleration_cov=np.asarray(msg.linear_acceleration_covariance),
-            remove_gravity=spec["remove_gravity"], gravity=self.gravity, parts=spec["imu_parts"])  # fmt: skip
+            remove_gravity=spec["remove_gravity"],
+            gravity=self.gravity,
+            parts=spec["imu_parts"],
+        )
         mask = spec["mask"]
         groups = ((3, 6, "pose"), (9, 12, "twist"), (12, 15, "linear_acceleration"))
         for lo, hi, key in groups:
@@ -235,17 +267,26 @@ class EkfNode(Node):
     def _publish(self, t_ns: int) -> None:
         s, p = self.filter.state, self.filter.covariance
         q = quat_from_rpy(s[3], s[4], s[5])
-        self.pub.publish(msgs.Odometry(
-            header=msgs.header(t_ns, self.world_frame), child_frame_id=self.base_frame,
-            pose=msgs.PoseWithCovariance(
-                pose=msgs.Pose(position=msgs.Point(x=float(s[0]), y=float(s[1]), z=float(s[2])),
-                               orientation=msgs.quaternion_msg(q)),
-                covariance=p[:6, :6].ravel().copy()),
-            twist=msgs.TwistWithCovariance(
-                twist=msgs.Twist(linear=msgs.Vector3(x=float(s[6]), y=float(s[7]), z=float(s[8])),
-                                 angular=msgs.Vector3(x=float(s[9]), y=float(s[10]), z=float(s[11]))),
-                covariance=p[6:12, 6:12].ravel().copy()),
-        ))  # fmt: skip
+        self.pub.publish(
+            msgs.Odometry(
+                header=msgs.header(t_ns, self.world_frame),
+                child_frame_id=self.base_frame,
+                pose=msgs.PoseWithCovariance(
+                    pose=msgs.Pose(
+                        position=msgs.Point(x=float(s[0]), y=float(s[1]), z=float(s[2])),
+                        orientation=msgs.quaternion_msg(q),
+                    ),
+                    covariance=p[:6, :6].ravel().copy(),
+                ),
+                twist=msgs.TwistWithCovariance(
+                    twist=msgs.Twist(
+                        linear=msgs.Vector3(x=float(s[6]), y=float(s[7]), z=float(s[8])),
+                        angular=msgs.Vector3(x=float(s[9]), y=float(s[10]), z=float(s[11])),
+                    ),
+                    covariance=p[6:12, 6:12].ravel().copy(),
+                ),
+            )
+        )
         if not self.publish_tf:
             return
         stamp = t_ns + round(self.transform_time_offset * 1e9)

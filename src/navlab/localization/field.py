@@ -103,8 +103,9 @@ def build_field(
     """
     arr = np.asarray(data)
     if arr.ndim != 2 or arr.size == 0:
-        raise LocalizationError(f"{name}: occupancy data must be a non-empty 2-D (height, width) array, "
-                                f"got shape {arr.shape}")
+        raise LocalizationError(
+            f"{name}: occupancy data must be a non-empty 2-D (height, width) array, got shape {arr.shape}"
+        )
     if not (math.isfinite(resolution) and resolution > 0):
         raise LocalizationError(f"{name}: resolution must be a positive number of metres, got {resolution!r}")
     if len(origin) != 3 or not all(math.isfinite(float(v)) for v in origin):
@@ -116,8 +117,9 @@ def build_field(
     free = (arr >= 0) & (arr <= FREE_MAX)
     free_index = np.flatnonzero(free)
     if free_index.size == 0:
-        raise LocalizationError(f"{name}: the map has no free cells (values 0..{FREE_MAX}); "
-                                "AMCL needs free space to place particles")
+        raise LocalizationError(
+            f"{name}: the map has no free cells (values 0..{FREE_MAX}); AMCL needs free space to place particles"
+        )
     if occupied.any():
         dist = distance_transform_edt(~occupied) * resolution
         inside = distance_transform_edt(occupied) * resolution if (~occupied).any() else np.zeros(arr.shape)
@@ -144,8 +146,7 @@ def field_from_map(grid: Any, *, max_dist: float = 2.0, name: str = "map") -> Ma
     """``MapField`` from anything with ``data``, ``resolution`` and ``origin`` (e.g. ``GridMap``)."""
     for attr in ("data", "resolution", "origin"):
         if not hasattr(grid, attr):
-            raise LocalizationError(f"{name}: expected a grid map with .data, .resolution and .origin; "
-                                    f"missing .{attr}")
+            raise LocalizationError(f"{name}: expected a grid map with .data, .resolution and .origin; missing .{attr}")
     o = [float(v) for v in grid.origin]
     if len(o) == 2:
         o.append(0.0)

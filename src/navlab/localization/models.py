@@ -180,8 +180,26 @@ def likelihood_field_weights(
 
 
 @njit(cache=True, fastmath=True)
-def _beam(xs, ys, yaws, lx, ly, lyaw, bearings, ranges, occ, res, range_max,
-          z_hit, z_short, z_max, z_rand, sigma_hit, lambda_short, out):
+def _beam(
+    xs,
+    ys,
+    yaws,
+    lx,
+    ly,
+    lyaw,
+    bearings,
+    ranges,
+    occ,
+    res,
+    range_max,
+    z_hit,
+    z_short,
+    z_max,
+    z_rand,
+    sigma_hit,
+    lambda_short,
+    out,
+):
     inv_res = 1.0 / res
     denom = 2.0 * sigma_hit * sigma_hit
     for k in range(xs.shape[0]):
@@ -282,9 +300,17 @@ class LikelihoodFieldModel(FieldModel):
         ey = np.ascontiguousarray(ly + rr * np.sin(a))
         f = self.field
         return likelihood_field_weights(
-            f.to_grid(particles), ex, ey, self._signed, f.resolution, f.max_dist, self._lut,
-            self.z_hit, self.z_rand, beams.range_max,
-        )  # fmt: skip
+            f.to_grid(particles),
+            ex,
+            ey,
+            self._signed,
+            f.resolution,
+            f.max_dist,
+            self._lut,
+            self.z_hit,
+            self.z_rand,
+            beams.range_max,
+        )
 
 
 class BeamModel(FieldModel):
@@ -304,6 +330,14 @@ class BeamModel(FieldModel):
         obs = np.where(np.isfinite(r[keep]), np.minimum(r[keep], rmax), rmax)
         f = self.field
         return beam_weights(
-            f.to_grid(particles), laser_pose, beams.bearings[keep], obs, f.occupied, f.resolution, rmax,
-            self.z, self.sigma_hit, self.lambda_short,
-        )  # fmt: skip
+            f.to_grid(particles),
+            laser_pose,
+            beams.bearings[keep],
+            obs,
+            f.occupied,
+            f.resolution,
+            rmax,
+            self.z,
+            self.sigma_hit,
+            self.lambda_short,
+        )

@@ -13,8 +13,7 @@ from numba import njit
 
 
 @njit(cache=True)
-def cast_one(occ: np.ndarray, inv_res: float, res: float, x: float, y: float, ang: float,
-              max_range: float) -> float:
+def cast_one(occ: np.ndarray, inv_res: float, res: float, x: float, y: float, ang: float, max_range: float) -> float:
     h, w = occ.shape
     gx = x * inv_res
     gy = y * inv_res
@@ -53,9 +52,7 @@ def cast_one(occ: np.ndarray, inv_res: float, res: float, x: float, y: float, an
             return max_range
         if i < 0 or j < 0 or i >= w or j >= h:
             # Left the map: nothing more to hit (unless it re-enters, which a ray from inside cannot).
-            if (i < 0 and step_i < 0) or (i >= w and step_i > 0) or (j < 0 and step_j < 0) or (
-                j >= h and step_j > 0
-            ):
+            if (i < 0 and step_i < 0) or (i >= w and step_i > 0) or (j < 0 and step_j < 0) or (j >= h and step_j > 0):
                 return max_range
             continue
         if occ[j, i]:
@@ -63,8 +60,15 @@ def cast_one(occ: np.ndarray, inv_res: float, res: float, x: float, y: float, an
 
 
 @njit(cache=True)
-def _cast(occ: np.ndarray, res: float, xs: np.ndarray, ys: np.ndarray, yaws: np.ndarray,
-          bearings: np.ndarray, max_range: float) -> np.ndarray:
+def _cast(
+    occ: np.ndarray,
+    res: float,
+    xs: np.ndarray,
+    ys: np.ndarray,
+    yaws: np.ndarray,
+    bearings: np.ndarray,
+    max_range: float,
+) -> np.ndarray:
     n = xs.shape[0]
     b = bearings.shape[0]
     out = np.empty((n, b))

@@ -158,8 +158,9 @@ def cluster(poses: np.ndarray, weights: np.ndarray) -> Clusters:
     bin_label = _label_bins(ukeys)
     n_comp = int(bin_label.max()) + 1
     labels = bin_label[inv]
-    acc = _cluster_sums(labels, n_comp, np.ascontiguousarray(poses, dtype=np.float64),
-                        np.ascontiguousarray(weights, dtype=np.float64))
+    acc = _cluster_sums(
+        labels, n_comp, np.ascontiguousarray(poses, dtype=np.float64), np.ascontiguousarray(weights, dtype=np.float64)
+    )
     wsum = acc[:, 0]
     safe = np.where(wsum > 0, wsum, 1.0)
     mx, my, cth, sth = (acc[:, i] / safe for i in (1, 2, 3, 4))

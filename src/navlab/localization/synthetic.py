@@ -27,8 +27,10 @@ def room_grid(resolution: float = 0.05) -> np.ndarray:
 
     def box(x0: float, y0: float, x1: float, y1: float) -> None:
         # (x, y) in the room frame, i.e. 0.2 m from the grid corner
-        g[round((y0 + 0.2) / resolution):round((y1 + 0.2) / resolution),
-          round((x0 + 0.2) / resolution):round((x1 + 0.2) / resolution)] = 100
+        g[
+            round((y0 + 0.2) / resolution) : round((y1 + 0.2) / resolution),
+            round((x0 + 0.2) / resolution) : round((x1 + 0.2) / resolution),
+        ] = 100
 
     box(1.8, 1.8, 2.6, 2.4)
     box(5.3, 3.8, 5.8, 5.4)

@@ -108,8 +108,9 @@ class GMappingBackend(SeededBackend):
         self.slam.keep_scans = self.keep_scans
         if self.params.refine and self.keep_scans:
             r = ranges if range_max is None else _no_return_as(ranges, range_max)
-            self._points.append(scan_points(r, angle_min, angle_increment, range_max=min(self.params.maxUrange, 30.0),
-                                            voxel=0.04))  # fmt: skip
+            self._points.append(
+                scan_points(r, angle_min, angle_increment, range_max=min(self.params.maxUrange, 30.0), voxel=0.04)
+            )
         first = not self.slam.particles
         before = self.slam.updates
         stamp = None if stamp_ns is None else stamp_ns * 1e-9
@@ -218,9 +219,13 @@ class GraphBackend(SeededBackend):
             return None
         max_range = self._max_range or self.gm.maxUrange
         return build_map(
-            self.slam.poses, self._scans, resolution=self.gm.delta, max_urange=min(self.gm.maxUrange, max_range),
-            max_range=max_range, frame_id=frame_id,
-        )  # fmt: skip
+            self.slam.poses,
+            self._scans,
+            resolution=self.gm.delta,
+            max_urange=min(self.gm.maxUrange, max_range),
+            max_range=max_range,
+            frame_id=frame_id,
+        )
 
     def finish(self) -> np.ndarray:
         """The optimised laser poses (N, 3) of every scan added."""

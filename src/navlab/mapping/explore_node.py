@@ -2,6 +2,9 @@
 
 from navlab.lazy import moved_exports
 
-__getattr__ = moved_exports(__name__, {
-    "Explore": "navlab.drivers.explore",
-})
+__getattr__ = moved_exports(
+    __name__,
+    {
+        "Explore": "navlab.drivers.explore",
+    },
+)

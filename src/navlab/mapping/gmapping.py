@@ -159,9 +159,14 @@ class GMapping:
         """Grow every particle's table by whole tiles (cells stay put) to hold the scan integrated from
         ``poses``, and note how many tiles that scan can touch."""
         lo, hi = scan_cells(
-            poses, r, ang, (float(self._anchor[0]), float(self._anchor[1])), self.p.delta,
-            max_urange=max_urange, max_range=max_range,
-        )  # fmt: skip
+            poses,
+            r,
+            ang,
+            (float(self._anchor[0]), float(self._anchor[1])),
+            self.p.delta,
+            max_urange=max_urange,
+            max_range=max_range,
+        )
         self._seen = (np.minimum(self._seen[0], lo), np.maximum(self._seen[1], hi))
         th, tw = self.particles[0].table.shape
         t_lo, t_hi = (lo - self._offset) // TILE, (hi - self._offset) // TILE  # (column, row) of tiles
@@ -249,8 +254,13 @@ class GMapping:
 
     def _check_size(self, rows: int, cols: int) -> None:
         """Every particle holds a map: refuse maps that together would not fit the machine's memory."""
-        check_ceiling(MappingError, "gmapping", "particles x map cells (the map spans the scans' reach at delta)",
-                      float(self.p.particles) * rows * cols, "slam_particle_cells")
+        check_ceiling(
+            MappingError,
+            "gmapping",
+            "particles x map cells (the map spans the scans' reach at delta)",
+            float(self.p.particles) * rows * cols,
+            "slam_particle_cells",
+        )
 
     def _init(self, odom: np.ndarray, r: np.ndarray, ang: np.ndarray, max_urange: float, max_range: float) -> None:
         p = self.p
@@ -258,9 +268,14 @@ class GMapping:
         lo = np.minimum(np.maximum([p.xmin, p.ymin], odom[:2] - reach), odom[:2] - 1.0)
         self._anchor = np.floor(lo / p.delta) * p.delta
         cells_lo, cells_hi = scan_cells(
-            odom, r, ang, (float(self._anchor[0]), float(self._anchor[1])), p.delta,
-            max_urange=max_urange, max_range=max_range,
-        )  # fmt: skip
+            odom,
+            r,
+            ang,
+            (float(self._anchor[0]), float(self._anchor[1])),
+            p.delta,
+            max_urange=max_urange,
+            max_range=max_range,
+        )
         self._offset = cells_lo - MAP_MARGIN_CELLS
         self._seen = (cells_lo, cells_hi)
         w, h = (cells_hi - cells_lo + 1 + 2 * MAP_MARGIN_CELLS).tolist()
@@ -282,10 +297,27 @@ class GMapping:
         ox, oy, oi, oj = self._lattice()
         free = self.pool.free(self._scan_tiles)
         raycast_tiles(
-            self.pool.tiles, table, self.pool.refs, free, np.zeros(1, dtype=np.int64), ox, oy, oi, oj,
-            self.p.delta, float(pose[0]), float(pose[1]), float(pose[2]), r, ang, max_urange, max_range,
-            L_OCC, L_FREE, L_CLAMP,
-        )  # fmt: skip
+            self.pool.tiles,
+            table,
+            self.pool.refs,
+            free,
+            np.zeros(1, dtype=np.int64),
+            ox,
+            oy,
+            oi,
+            oj,
+            self.p.delta,
+            float(pose[0]),
+            float(pose[1]),
+            float(pose[2]),
+            r,
+            ang,
+            max_urange,
+            max_range,
+            L_OCC,
+            L_FREE,
+            L_CLAMP,
+        )
 
     def _lattice(self) -> tuple[float, float, int, int]:
         """(anchor x, anchor y, offset column, offset row) as the numba kernels take them."""
@@ -311,9 +343,25 @@ class GMapping:
                 pose[:] = x, y, wrap_angle(t)
             if not matched or pose[2] != t:  # the weight takes the log-likelihood at another pose
                 _s, lik, _n = match_score(
-                    tiles, part.table, ox, oy, oi, oj, res, pose[0], pose[1], pose[2], r, cb, sb, max_urange,
-                    p.kernelSize, p.sigma, p.lsigma, p.lskip,
-                )  # fmt: skip
+                    tiles,
+                    part.table,
+                    ox,
+                    oy,
+                    oi,
+                    oj,
+                    res,
+                    pose[0],
+                    pose[1],
+                    pose[2],
+                    r,
+                    cb,
+                    sb,
+                    max_urange,
+                    p.kernelSize,
+                    p.sigma,
+                    p.lsigma,
+                    p.lskip,
+                )
             part.weight += lik
         # normalise (GMapping: gain 1 / (ogain * N)) and resample on N_eff
         lw = np.array([q.weight for q in self.particles])
@@ -425,9 +473,10 @@ class GMapping:
     def map(self, *, frame_id: str = "map") -> GridMap:
         """The best particle's occupancy grid: the cells any scan reached plus ``MAP_MARGIN_CELLS``."""
         g = to_dense(self.pool.tiles, self.best().table)
-        (c0, r0), (c1, r1) = (self._seen[0] - MAP_MARGIN_CELLS - self._offset).tolist(), (
-            self._seen[1] + MAP_MARGIN_CELLS + 1 - self._offset
-        ).tolist()
+        (c0, r0), (c1, r1) = (
+            (self._seen[0] - MAP_MARGIN_CELLS - self._offset).tolist(),
+            (self._seen[1] + MAP_MARGIN_CELLS + 1 - self._offset).tolist(),
+        )
         c0, r0 = max(c0, 0), max(r0, 0)
         origin = self.origin + np.array([c0, r0]) * self.p.delta
         return logodds_to_grid(

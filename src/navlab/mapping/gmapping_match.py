@@ -129,12 +129,19 @@ def _score_above(
         ei, ej, fi, fj = iw[0, k], iw[1, k], iw[2, k], iw[3, k]
         best = 1e9  # the nearest match's squared distance: a minimum, so the cells' order does not matter
         found = False
-        inside = (min(ei, fi) >= kernel and min(ej, fj) >= kernel and max(ei, fi) < w - kernel
-                  and max(ej, fj) < h - kernel)  # fmt: skip
+        inside = (
+            min(ei, fi) >= kernel and min(ej, fj) >= kernel and max(ei, fi) < w - kernel and max(ej, fj) < h - kernel
+        )
         # GMapping's default kernel with both 3 x 3 windows inside one tile each (nearly always): unrolled,
         # each cell's x and y term once, flat unsigned indices (no wrap-around checks) and no branches
-        if (inside and kernel == 1 and 1 <= (ei & MASK) < MASK and 1 <= (ej & MASK) < MASK and 1 <= (fi & MASK) < MASK
-                and 1 <= (fj & MASK) < MASK):  # fmt: skip
+        if (
+            inside
+            and kernel == 1
+            and 1 <= (ei & MASK) < MASK
+            and 1 <= (ej & MASK) < MASK
+            and 1 <= (fi & MASK) < MASK
+            and 1 <= (fj & MASK) < MASK
+        ):
             ce = table[ej >> SHIFT, ei >> SHIFT] * TILE * TILE + (ej & MASK) * TILE + (ei & MASK)
             cf = table[fj >> SHIFT, fi >> SHIFT] * TILE * TILE + (fj & MASK) * TILE + (fi & MASK)
             x0, x1, x2 = fw[2, k], fw[3, k], fw[4, k]
@@ -234,8 +241,9 @@ def match_score(
     rv, cv, sv = _valid_beams(ranges, cb, sb, max_urange, skip)
     nb = rv.shape[0]
     fw, iw = np.empty((10, nb)), np.empty((4, nb), dtype=np.int64)
-    return _score_above(tiles, table, ox, oy, oi, oj, res, px, py, pt, rv, cv, sv, kernel, sigma, lsigma, -1.0, fw, iw,
-                        np.arange(nb))  # fmt: skip
+    return _score_above(
+        tiles, table, ox, oy, oi, oj, res, px, py, pt, rv, cv, sv, kernel, sigma, lsigma, -1.0, fw, iw, np.arange(nb)
+    )
 
 
 @numba.njit(cache=True)
@@ -276,8 +284,9 @@ def optimize(
     terms = np.empty(nb)  # the score terms of the best pose found in this step of the climb
     seen = np.empty((SEEN_POSES, 5))  # x, y, theta, score (-1: no better than the pose it was tried from), lik
     cx, cy, ct = x0, y0, t0
-    cur, cur_lik, _n = _score_above(tiles, table, ox, oy, oi, oj, res, cx, cy, ct, rv, cv, sv, kernel, sigma, lsigma,
-                                    -1.0, fw, iw, order)  # fmt: skip
+    cur, cur_lik, _n = _score_above(
+        tiles, table, ox, oy, oi, oj, res, cx, cy, ct, rv, cv, sv, kernel, sigma, lsigma, -1.0, fw, iw, order
+    )
     _worst_first(fw[8], order, counts)
     seen[0, 0], seen[0, 1], seen[0, 2], seen[0, 3], seen[0, 4] = cx, cy, ct, cur, cur_lik
     n_seen = 1
@@ -313,8 +322,9 @@ def optimize(
             if q < n_seen:
                 sc, lik = seen[q, 3], seen[q, 4]
             else:
-                sc, lik, _n = _score_above(tiles, table, ox, oy, oi, oj, res, nx, ny, nt, rv, cv, sv, kernel, sigma,
-                                           lsigma, cur, fw, iw, order)  # fmt: skip
+                sc, lik, _n = _score_above(
+                    tiles, table, ox, oy, oi, oj, res, nx, ny, nt, rv, cv, sv, kernel, sigma, lsigma, cur, fw, iw, order
+                )
                 if n_seen < SEEN_POSES:
                     seen[n_seen, 0], seen[n_seen, 1], seen[n_seen, 2] = nx, ny, nt
                     seen[n_seen, 3], seen[n_seen, 4] = sc, lik
@@ -357,7 +367,8 @@ def warmup() -> None:
     r, c = np.ones(2), np.ones(2)
     optimize(tiles, table, 0.0, 0.0, 0, 0, 0.05, 0.1, 0.1, 0.0, r, c, c, 1.0, 1, 0.05, 0.075, 0, 0.05, 0.05, 1)
     match_score(tiles, table, 0.0, 0.0, 0, 0, 0.05, 0.1, 0.1, 0.0, r, c, c, 1.0, 1, 0.05, 0.075, 0)
-    raycast_tiles(tiles, table, pool.refs, free, used, 0.0, 0.0, 0, 0, 0.05, 0.1, 0.1, 0.0, r, c, 1.0, 2.0, L_OCC,
-                  L_FREE, L_CLAMP)  # fmt: skip
+    raycast_tiles(
+        tiles, table, pool.refs, free, used, 0.0, 0.0, 0, 0, 0.05, 0.1, 0.1, 0.0, r, c, 1.0, 2.0, L_OCC, L_FREE, L_CLAMP
+    )
     draw_motion(np.zeros((2, 3)), np.zeros((2, 3)), 0.1, 0.0, 0.0, 0.1, 0.1, 0.1)
     scan_cells(np.zeros((2, 3)), r, c, (0.0, 0.0), 0.05, max_urange=1.0, max_range=2.0)

@@ -94,8 +94,9 @@ def cell(tiles: np.ndarray, table: np.ndarray, j: int, i: int) -> float:
 
 
 @numba.njit(cache=True, inline="always")
-def _own(tiles: np.ndarray, table: np.ndarray, refs: np.ndarray, free: np.ndarray, used: np.ndarray, tj: int,
-         ti: int) -> int:  # fmt: skip
+def _own(
+    tiles: np.ndarray, table: np.ndarray, refs: np.ndarray, free: np.ndarray, used: np.ndarray, tj: int, ti: int
+) -> int:
     """The id of tile (``tj``, ``ti``) of this particle's map after making it private: a shared tile (or
     tile 0) is first copied into the next of the ``free`` tiles (``used[0]`` of them taken so far)."""
     t = table[tj, ti]

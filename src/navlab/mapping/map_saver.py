@@ -20,8 +20,14 @@ from navlab.mapping.mapfile import save_map
 class MapSaver(Node):
     """Write the first ``map`` message as map_saver does."""
 
-    def __init__(self, executor: Executor, *, name: str = "map_saver", parameters: dict[str, Any] | None = None,
-                 namespace: str = "") -> None:
+    def __init__(
+        self,
+        executor: Executor,
+        *,
+        name: str = "map_saver",
+        parameters: dict[str, Any] | None = None,
+        namespace: str = "",
+    ) -> None:
         super().__init__(executor, name=name, parameters=parameters, namespace=namespace)
         self.map_file = str(self.declare_parameter("map_file", "map"))
         self.occ = int(self.declare_parameter("threshold_occupied", 65))
@@ -34,7 +40,13 @@ class MapSaver(Node):
         if self.saved is not None:
             return
         yaml_path = Path(self.map_file).expanduser().with_suffix(".yaml")
-        save_map(GridMap.from_msg(msg), yaml_path, image_name=yaml_path.with_suffix(".pgm").name,
-                 threshold_occupied=self.occ, threshold_free=self.free, crop_margin_cells=None)
+        save_map(
+            GridMap.from_msg(msg),
+            yaml_path,
+            image_name=yaml_path.with_suffix(".pgm").name,
+            threshold_occupied=self.occ,
+            threshold_free=self.free,
+            crop_margin_cells=None,
+        )
         self.saved = yaml_path
         self.get_logger().info(f"Done: wrote {yaml_path} and {yaml_path.with_suffix('.pgm').name}")

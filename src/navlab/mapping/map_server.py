@@ -19,9 +19,13 @@ class MapServer(Node):
     """Serve one map file on the latched ``map`` topic."""
 
     def __init__(
-        self, executor: Executor, *, name: str = "map_server", parameters: dict[str, Any] | None = None,
+        self,
+        executor: Executor,
+        *,
+        name: str = "map_server",
+        parameters: dict[str, Any] | None = None,
         namespace: str = "",
-    ) -> None:  # fmt: skip
+    ) -> None:
         super().__init__(executor, name=name, parameters=parameters, namespace=namespace)
         self.yaml_filename = self.declare_parameter("yaml_filename", "", aliases=("map", "map_file"))
         self.frame_id = self.declare_parameter("frame_id", "map")

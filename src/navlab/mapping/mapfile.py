@@ -78,8 +78,9 @@ def _read_pnm(path: Path, buf: bytes) -> np.ndarray:
     if width <= 0 or height <= 0:
         raise MappingError(f"{path}: image size {width}x{height}, expected positive width and height")
     if width * height > MAX_IMAGE_PIXELS:
-        raise MappingError(f"{path}: image of {width} x {height} pixels; a map image may have at most "
-                           f"{MAX_IMAGE_PIXELS}")
+        raise MappingError(
+            f"{path}: image of {width} x {height} pixels; a map image may have at most {MAX_IMAGE_PIXELS}"
+        )
     if not 0 < maxval < 65536:
         raise MappingError(f"{path}: PNM maxval {maxval}, expected 1..65535")
     count = width * height * channels
@@ -118,8 +119,9 @@ def read_image(path: str | os.PathLike[str]) -> tuple[np.ndarray, bool]:
     if buf[:2] in (b"P2", b"P3", b"P5", b"P6"):
         return _read_pnm(p, buf), False
     if buf[:2] in (b"P1", b"P4"):
-        raise MappingError(f"{p}: a PBM bitmap ({buf[:2].decode()}); expected a greyscale PGM (P2/P5), a PPM "
-                           "(P3/P6) or a PNG")
+        raise MappingError(
+            f"{p}: a PBM bitmap ({buf[:2].decode()}); expected a greyscale PGM (P2/P5), a PPM (P3/P6) or a PNG"
+        )
     try:
         import io
 
@@ -127,8 +129,10 @@ def read_image(path: str | os.PathLike[str]) -> tuple[np.ndarray, bool]:
 
         with Image.open(io.BytesIO(buf)) as img:
             if img.width * img.height > MAX_IMAGE_PIXELS:
-                raise MappingError(f"{p}: image of {img.width} x {img.height} pixels; a map image may have at "
-                                   f"most {MAX_IMAGE_PIXELS} (a decompression bomb?)")
+                raise MappingError(
+                    f"{p}: image of {img.width} x {img.height} pixels; a map image may have at "
+                    f"most {MAX_IMAGE_PIXELS} (a decompression bomb?)"
+                )
             has_alpha = img.mode in ("LA", "RGBA", "PA") or "transparency" in img.info
             grey_modes = ("L", "1", "I", "I;16", "F")
             if has_alpha:
@@ -267,8 +271,11 @@ def read_map_yaml(yaml_path: str | os.PathLike[str]) -> dict[str, Any]:
     ):
         raise _key_error(path, "origin", "[x, y, yaw] (three finite numbers)", origin)
     size = doc.get("image_size")
-    if size is not None and not (isinstance(size, list) and len(size) == 2 and all(
-            isinstance(v, int) and not isinstance(v, bool) and v > 0 for v in size)):
+    if size is not None and not (
+        isinstance(size, list)
+        and len(size) == 2
+        and all(isinstance(v, int) and not isinstance(v, bool) and v > 0 for v in size)
+    ):
         raise _key_error(path, "image_size", "[width, height] in pixels (written by navlab's map saver)", size)
     negate = doc.get("negate", 0)
     if isinstance(negate, bool):
@@ -305,7 +312,8 @@ def load_map(yaml_path: str | os.PathLike[str], *, frame_id: str = "map") -> Gri
         w, h = meta["image_size"]
         raise MappingError(
             f"{yaml_path}: image {meta['image'].name} is {pixels.shape[1]} x {pixels.shape[0]} pixels but the YAML "
-            f"records image_size [{w}, {h}]: the pair is not from one save (an interrupted save, or a copied image?)")
+            f"records image_size [{w}, {h}]: the pair is not from one save (an interrupted save, or a copied image?)"
+        )
     values = _pixels_to_values(
         pixels,
         has_alpha,
@@ -420,8 +428,12 @@ def save_map(
         f"image_size: [{grid.width}, {grid.height}]\n"
     )
     write_text_atomic(ypath, text)  # the switch from the old pair to the new one
-    if (previous is not None and previous != ipath.resolve() and previous.parent == ypath.parent.resolve()
-            and re.fullmatch(rf"{re.escape(ypath.stem)}(\.[0-9a-f]{{8}})?\.(pgm|png)", previous.name)):
+    if (
+        previous is not None
+        and previous != ipath.resolve()
+        and previous.parent == ypath.parent.resolve()
+        and re.fullmatch(rf"{re.escape(ypath.stem)}(\.[0-9a-f]{{8}})?\.(pgm|png)", previous.name)
+    ):
         with contextlib.suppress(OSError):
             previous.unlink()  # the old pair's image, no longer named by any YAML this save wrote
     return ipath

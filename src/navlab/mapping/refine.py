@@ -56,14 +56,13 @@ class RefineParams:
     rematch_theta: float = 0.0
 
 
-def _match(
-    a: ScanPoints, b: ScanPoints, rel: np.ndarray, p: RefineParams
-) -> tuple[np.ndarray, bool]:
+def _match(a: ScanPoints, b: ScanPoints, rel: np.ndarray, p: RefineParams) -> tuple[np.ndarray, bool]:
     """Pose of scan ``b`` in scan ``a``'s frame, refined by ICP from ``rel``, and whether it is verified."""
     if len(a.xy) < 20 or len(b.xy) < 20:
         return rel, False
-    res = icp_point_to_line(a.xy, a.normals, b.xy, rel, max_dist=p.icp_max_dist, min_dist=p.icp_min_dist,
-                            iterations=p.icp_iterations)  # fmt: skip
+    res = icp_point_to_line(
+        a.xy, a.normals, b.xy, rel, max_dist=p.icp_max_dist, min_dist=p.icp_min_dist, iterations=p.icp_iterations
+    )
     corr = res.pose - rel
     ok = (
         res.inlier_fraction >= p.min_inliers

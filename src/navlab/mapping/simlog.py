@@ -102,12 +102,16 @@ def noisy_odometry(truth: np.ndarray, noise: OdometryNoise, rng: np.random.Gener
     for k in range(1, len(g)):
         z = between2(g[k - 1], g[k])
         d = math.hypot(z[0], z[1])
-        zz = np.array([
-            z[0] * s_lin + rng.normal(0.0, noise.scale * d),
-            z[1] * s_lin + rng.normal(0.0, noise.scale * d * 0.5),
-            z[2] * s_rot + rng.normal(0.0, noise.scale * abs(z[2])) + drift * d
-            + rng.normal(0.0, noise.heading_walk * math.sqrt(d)),
-        ])  # fmt: skip
+        zz = np.array(
+            [
+                z[0] * s_lin + rng.normal(0.0, noise.scale * d),
+                z[1] * s_lin + rng.normal(0.0, noise.scale * d * 0.5),
+                z[2] * s_rot
+                + rng.normal(0.0, noise.scale * abs(z[2]))
+                + drift * d
+                + rng.normal(0.0, noise.heading_walk * math.sqrt(d)),
+            ]
+        )
         odo.append(compose2(odo[-1], zz))
     return np.array(odo)
 
@@ -166,10 +170,18 @@ def record_log(
         ranges = np.where(ranges >= cfg.range_max, np.inf, ranges).astype(np.float32)
         od_t = (float(od[0]), float(od[1]), float(od[2]))
         laser = compose2(od, offset)
-        log.scans.append(LaserScan2D(
-            float(t0 + t), ranges, float(angles[keep[0]]), inc, float(cfg.range_max),
-            (float(laser[0]), float(laser[1]), float(laser[2])), od_t, kind="ROBOTLASER1",
-        ))  # fmt: skip
+        log.scans.append(
+            LaserScan2D(
+                float(t0 + t),
+                ranges,
+                float(angles[keep[0]]),
+                inc,
+                float(cfg.range_max),
+                (float(laser[0]), float(laser[1]), float(laser[2])),
+                od_t,
+                kind="ROBOTLASER1",
+            )
+        )
         log.odometry.append(OdomRecord(float(t0 + t), od_t, 0.0, 0.0))
     start = (float(truth[0, 0]), float(truth[0, 1]), float(truth[0, 2]))
     return SimLog(log, truth, t0 + times, start, Path(world_file))

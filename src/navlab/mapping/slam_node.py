@@ -22,12 +22,42 @@ from navlab.grid import GridMap
 from navlab.mapping.errors import MappingError
 from navlab.plugins import PluginContext, PluginError, SlamBackend, load_plugin
 
-# slam_gmapping parameters that must be > 0 or >= 0, and (min, max) pairs (issue 14: refused, not run with)
-_POSITIVE = ("transform_publish_period", "throttle_scans", "maxUrange", "sigma", "lstep",
-             "astep", "lsigma", "ogain", "particles", "delta", "llsamplerange", "llsamplestep", "lasamplerange",
-             "lasamplestep", "occ_thresh", "resampleThreshold")
-_NON_NEGATIVE = ("map_update_interval", "maxRange", "kernelSize", "iterations", "lskip", "minimumScore", "srr",
-                 "srt", "str", "stt", "linearUpdate", "angularUpdate", "wideScore", "wideStep", "wideTurn")
+# slam_gmapping parameters that must be > 0 or >= 0, and (min, max) pairs (refused, not run with)
+_POSITIVE = (
+    "transform_publish_period",
+    "throttle_scans",
+    "maxUrange",
+    "sigma",
+    "lstep",
+    "astep",
+    "lsigma",
+    "ogain",
+    "particles",
+    "delta",
+    "llsamplerange",
+    "llsamplestep",
+    "lasamplerange",
+    "lasamplestep",
+    "occ_thresh",
+    "resampleThreshold",
+)
+_NON_NEGATIVE = (
+    "map_update_interval",
+    "maxRange",
+    "kernelSize",
+    "iterations",
+    "lskip",
+    "minimumScore",
+    "srr",
+    "srt",
+    "str",
+    "stt",
+    "linearUpdate",
+    "angularUpdate",
+    "wideScore",
+    "wideStep",
+    "wideTurn",
+)
 
 
 INVALID_LOG_PERIOD_NS = 10_000_000_000  # at most one "scans without readings" warning per 10 simulated s
@@ -52,9 +82,13 @@ class SlamGMapping(Node):
     """slam_gmapping: the ``mode``'s SLAM backend (a ``SlamBackend`` plugin) driven by scans and tf odometry."""
 
     def __init__(
-        self, executor: Executor, *, name: str = "slam_gmapping", parameters: dict[str, Any] | None = None,
+        self,
+        executor: Executor,
+        *,
+        name: str = "slam_gmapping",
+        parameters: dict[str, Any] | None = None,
         namespace: str = "",
-    ) -> None:  # fmt: skip
+    ) -> None:
         super().__init__(executor, name=name, parameters=parameters, namespace=namespace)
         self.listen_tf()  # a tf2 TransformListener, as in ROS: the graph shows it reading /tf
         self.base_frame = self.declare_parameter("base_frame", "base_link")
@@ -70,13 +104,19 @@ class SlamGMapping(Node):
         except PluginError as exc:
             raise MappingError(f"node {self.fully_qualified_name}: {exc}") from None
         values = self.declare_parameters(backend.parameters())
-        _check_values(self.fully_qualified_name, {"map_update_interval": self.map_update_interval,
-                                                  "transform_publish_period": self.transform_publish_period,
-                                                  "throttle_scans": self.throttle_scans, **values})
+        _check_values(
+            self.fully_qualified_name,
+            {
+                "map_update_interval": self.map_update_interval,
+                "transform_publish_period": self.transform_publish_period,
+                "throttle_scans": self.throttle_scans,
+                **values,
+            },
+        )
         self.slam: SlamBackend = backend.from_params(values, context=PluginContext(name=self.mode, rng=self.rng))
         inner: Any = getattr(self.slam, "slam", None)
         if inner is not None and hasattr(inner, "keep_history"):  # a live node never calls finish(): no per-scan
-            inner.keep_history = False  # history (issue 14: it grew the process by ~45 MB per simulated hour)
+            inner.keep_history = False  # history (it grew the process by ~45 MB per simulated hour)
         self.params = self.slam.params
         self.check_parameters()
 
@@ -127,7 +167,8 @@ class SlamGMapping(Node):
             self.get_logger().warning(
                 f"scan on {self.resolve_topic_name(self.scan_topic)} has no valid reading (all beyond range or "
                 f"not finite): {self.scans_invalid} of {self.scans_received} scans so far; the map stays empty "
-                "where the lidar sees nothing")
+                "where the lidar sees nothing"
+            )
 
     def _on_scan(self, msg: Any) -> None:
         self.scans_received += 1
@@ -144,9 +185,13 @@ class SlamGMapping(Node):
         # slam_gmapping: readings below range_min count as no return, like non-finite ones (+inf stays inf)
         r = np.where(returned, ranges, np.inf)
         pose = self.slam.add_scan(
-            r, float(msg.angle_min), float(msg.angle_increment), odom_laser, range_max=float(msg.range_max),
+            r,
+            float(msg.angle_min),
+            float(msg.angle_increment),
+            odom_laser,
+            range_max=float(msg.range_max),
             stamp_ns=t_ns,
-        )  # fmt: skip
+        )
         if pose is None:
             return
         self._stamps.append(t_ns)

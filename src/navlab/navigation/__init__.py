@@ -10,6 +10,19 @@ from navlab.navigation.goal import GoalOutcome, GoalState, MoveBaseState, Recove
 from navlab.navigation.planners import NavfnPlanner, ThetaStarPlanner, make_planner, path_length
 from navlab.navigation.progress_checker import STUCK_PREFIX, SimpleProgressChecker, stuck_window
 
-__all__ = ["STUCK_PREFIX", "GoalOutcome", "GoalState", "LayeredCostmap", "MoveBaseState", "NavfnPlanner",
-           "NavigationError", "RecoveryTrigger", "SimpleProgressChecker", "ThetaStarPlanner", "costmap_params",
-           "make_planner", "path_length", "stuck_window"]
+__all__ = [
+    "STUCK_PREFIX",
+    "GoalOutcome",
+    "GoalState",
+    "LayeredCostmap",
+    "MoveBaseState",
+    "NavfnPlanner",
+    "NavigationError",
+    "RecoveryTrigger",
+    "SimpleProgressChecker",
+    "ThetaStarPlanner",
+    "costmap_params",
+    "make_planner",
+    "path_length",
+    "stuck_window",
+]

@@ -108,26 +108,39 @@ def parse_polygons(params: dict[str, Any], footprint: np.ndarray | None) -> list
         fp = np.asarray(footprint, dtype=np.float64)
         return [
             Polygon("PolygonStop", "stop", grow(fp, float(params.get("stop_margin", 0.05))), min_points=4),
-            Polygon("PolygonSlow", "slowdown", grow(fp, float(params.get("slowdown_margin", 0.3))), min_points=4,
-                    slowdown_ratio=float(params.get("slowdown_ratio", 0.3))),
-            Polygon("FootprintApproach", "approach", fp, min_points=4,
-                    time_before_collision=float(params.get("time_before_collision", 1.2))),
+            Polygon(
+                "PolygonSlow",
+                "slowdown",
+                grow(fp, float(params.get("slowdown_margin", 0.3))),
+                min_points=4,
+                slowdown_ratio=float(params.get("slowdown_ratio", 0.3)),
+            ),
+            Polygon(
+                "FootprintApproach",
+                "approach",
+                fp,
+                min_points=4,
+                time_before_collision=float(params.get("time_before_collision", 1.2)),
+            ),
         ]
     out = []
     for name in names:
         spec = dict(params.get(str(name)) or {})
         action = str(spec.pop("action_type", ""))
         if action not in ACTIONS:
-            raise NavigationError(f"collision_monitor polygon {name}: action_type expected one of "
-                                  f"{', '.join(ACTIONS)}, got {action!r}")  # fmt: skip
+            raise NavigationError(
+                f"collision_monitor polygon {name}: action_type expected one of {', '.join(ACTIONS)}, got {action!r}"
+            )
         kind = str(spec.pop("type", "polygon"))
         pts = None
         if kind == "polygon":
             raw = np.asarray(spec.pop("points", spec.pop("footprint", footprint)), dtype=np.float64)
             pts = raw.reshape(-1, 2) if raw.size % 2 == 0 and raw.size >= 6 else None
             if pts is None:
-                raise NavigationError(f"collision_monitor polygon {name}: points expected [x1, y1, x2, y2, x3, y3, "
-                                      f"...] (>= 3 points), got {raw.tolist()!r}")  # fmt: skip
+                raise NavigationError(
+                    f"collision_monitor polygon {name}: points expected [x1, y1, x2, y2, x3, y3, "
+                    f"...] (>= 3 points), got {raw.tolist()!r}"
+                )
         elif kind != "circle":
             raise NavigationError(f"collision_monitor polygon {name}: type expected polygon or circle, got {kind!r}")
         keys = {f for f in Polygon.__dataclass_fields__ if f not in ("name", "action_type", "points")}
@@ -161,8 +174,12 @@ class CollisionMonitor:
                 elif poly.action_type == "slowdown":
                     cand = Verdict(v * poly.slowdown_ratio, w * poly.slowdown_ratio, poly.name, "slowdown")
                 elif poly.action_type == "limit":
-                    cand = Verdict(math.copysign(min(abs(v), poly.linear_limit), v),
-                                   math.copysign(min(abs(w), poly.angular_limit), w), poly.name, "limit")  # fmt: skip
+                    cand = Verdict(
+                        math.copysign(min(abs(v), poly.linear_limit), v),
+                        math.copysign(min(abs(w), poly.angular_limit), w),
+                        poly.name,
+                        "limit",
+                    )
                 else:
                     continue
             else:
@@ -202,15 +219,25 @@ class CollisionMonitorNode(Node):
     ``polygons`` and their namespaces, ``source_timeout`` (s: an older scan counts as no data and stops the
     robot, Nav2's behaviour)."""
 
-    def __init__(self, executor: Executor, *, name: str = "collision_monitor", parameters: dict[str, Any] | None = None,
-                 namespace: str = "") -> None:  # fmt: skip
+    def __init__(
+        self,
+        executor: Executor,
+        *,
+        name: str = "collision_monitor",
+        parameters: dict[str, Any] | None = None,
+        namespace: str = "",
+    ) -> None:
         super().__init__(executor, name=name, parameters=parameters, namespace=namespace)
         self.base_frame = str(self.declare_parameter("base_frame_id", "base_link"))
         self.source_timeout = float(self.declare_parameter("source_timeout", 2.0))
         footprint = as_list(self.declare_parameter("footprint", []))
         raw: dict[str, Any] = {"polygons": self.declare_parameter("polygons", [])}
-        for key, default in (("stop_margin", 0.05), ("slowdown_margin", 0.3), ("slowdown_ratio", 0.3),
-                             ("time_before_collision", 1.2)):  # fmt: skip
+        for key, default in (
+            ("stop_margin", 0.05),
+            ("slowdown_margin", 0.3),
+            ("slowdown_ratio", 0.3),
+            ("time_before_collision", 1.2),
+        ):
             raw[key] = self.declare_parameter(key, default)
         for poly in raw["polygons"] or []:
             self.accept_parameters(str(poly))

@@ -40,8 +40,15 @@ class Costmap2DROS:
     scan's laser-frame points are then worked out once).
     """
 
-    def __init__(self, node: Node, name: str, params: dict[str, Any], *, topic_prefix: str | None = None,
-                 scan_points: ScanPoints | None = None) -> None:
+    def __init__(
+        self,
+        node: Node,
+        name: str,
+        params: dict[str, Any],
+        *,
+        topic_prefix: str | None = None,
+        scan_points: ScanPoints | None = None,
+    ) -> None:
         self.node, self.name = node, name
         self.scan_points = scan_points or ScanPoints()  # move_base shares one between its two costmaps
         prefix = topic_prefix if topic_prefix is not None else name
@@ -62,8 +69,10 @@ class Costmap2DROS:
             if src_name in self.feeds.sources:
                 continue
             if src.data_type != "LaserScan":
-                node.get_logger().warning(f"{name}: observation source {src_name} has data_type {src.data_type}; "
-                                          "navlab's sensors are LaserScan only, it is ignored")
+                node.get_logger().warning(
+                    f"{name}: observation source {src_name} has data_type {src.data_type}; "
+                    "navlab's sensors are LaserScan only, it is ignored"
+                )
                 continue
             topic = src.topic or src_name
             node.create_subscription(msgs.LaserScan, topic, functools.partial(self._on_scan, src_name), 5)
@@ -153,10 +162,12 @@ class Costmap2DROS:
         pose = self.layered.robot_pose or self.robot_pose()
         if pose is not None:
             poly = self.layered.footprint_at(pose)
-            self.footprint_pub.publish(msgs.PolygonStamped(
-                header=msgs.header(now, self.global_frame),
-                polygon=msgs.Polygon(points=[msgs.Point32(x=float(x), y=float(y), z=0.0) for x, y in poly]),
-            ))  # fmt: skip
+            self.footprint_pub.publish(
+                msgs.PolygonStamped(
+                    header=msgs.header(now, self.global_frame),
+                    polygon=msgs.Polygon(points=[msgs.Point32(x=float(x), y=float(y), z=0.0) for x, y in poly]),
+                )
+            )
 
     def clear(self) -> None:
         """Forget every observation (the ``clear_costmaps`` service)."""

@@ -44,8 +44,15 @@ class RangeLayer(Protocol):
     @property
     def topics(self) -> list[str]: ...
 
-    def add_range(self, sensor_pose: tuple[float, float, float], reading: float, *, field_of_view: float,
-                  min_range: float, max_range: float) -> None: ...
+    def add_range(
+        self,
+        sensor_pose: tuple[float, float, float],
+        reading: float,
+        *,
+        field_of_view: float,
+        min_range: float,
+        max_range: float,
+    ) -> None: ...
 
 
 def scan_points(msg: Any) -> np.ndarray:
@@ -67,13 +74,15 @@ class CostmapSensorFeeds:
         self.readings: list[Any] = []
         self.sources: set[str] = set()
         # publish_voxel_map: <costmap>/<layer>/voxel_grid (costmap_2d/VoxelGrid), after each update's observations
-        self.voxel_pubs = {k: node.create_publisher(msgs.VoxelGrid, f"{prefix or name}/{layer.name}/voxel_grid", 1)
-                           for k, layer in enumerate(self.voxel) if layer.params.publish_voxel_map}
+        self.voxel_pubs = {
+            k: node.create_publisher(msgs.VoxelGrid, f"{prefix or name}/{layer.name}/voxel_grid", 1)
+            for k, layer in enumerate(self.voxel)
+            if layer.params.publish_voxel_map
+        }
         for k, layer in enumerate(self.voxel):
             for src_name, src in layer.sources.items():
                 kind = msgs.LaserScan if src.data_type == "LaserScan" else msgs.PointCloud2
-                node.create_subscription(kind, src.topic or src_name,
-                                         functools.partial(self._keep, (k, src_name)), 5)
+                node.create_subscription(kind, src.topic or src_name, functools.partial(self._keep, (k, src_name)), 5)
                 self.sources.add(src_name)
         topics = sorted({t for layer in self.range for t in layer.topics})
         for topic in topics:
@@ -117,7 +126,11 @@ class CostmapSensorFeeds:
             origin, rot = place
             yaw = float(np.arctan2(rot[1, 0], rot[0, 0]))
             for layer in self.range:
-                layer.add_range((float(origin[0]), float(origin[1]), yaw), float(msg.range),
-                                field_of_view=float(msg.field_of_view), min_range=float(msg.min_range),
-                                max_range=float(msg.max_range))
+                layer.add_range(
+                    (float(origin[0]), float(origin[1]), yaw),
+                    float(msg.range),
+                    field_of_view=float(msg.field_of_view),
+                    min_range=float(msg.min_range),
+                    max_range=float(msg.max_range),
+                )
         self.readings.clear()

@@ -57,8 +57,13 @@ class GoalOutcome(StrEnum):
 
 TERMINAL = frozenset({GoalState.SUCCEEDED, GoalState.ABORTED, GoalState.PREEMPTED})
 # action_msgs/GoalStatus codes of the states a goal goes through
-STATUS = {GoalState.PENDING: 1, GoalState.ACTIVE: 2, GoalState.PREEMPTED: 5, GoalState.SUCCEEDED: 4,
-          GoalState.ABORTED: 6}
+STATUS = {
+    GoalState.PENDING: 1,
+    GoalState.ACTIVE: 2,
+    GoalState.PREEMPTED: 5,
+    GoalState.SUCCEEDED: 4,
+    GoalState.ABORTED: 6,
+}
 
 
 @dataclass

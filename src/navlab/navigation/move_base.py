@@ -58,8 +58,14 @@ def short_name(plugin: str) -> str:
 class MoveBase(Node):
     """ROS 1 move_base over navlab's costmaps, planners and controllers (see the module docstring)."""
 
-    def __init__(self, executor: Executor, *, name: str = "move_base", parameters: dict[str, Any] | None = None,
-                 namespace: str = "") -> None:  # fmt: skip
+    def __init__(
+        self,
+        executor: Executor,
+        *,
+        name: str = "move_base",
+        parameters: dict[str, Any] | None = None,
+        namespace: str = "",
+    ) -> None:
         super().__init__(executor, name=name, parameters=parameters, namespace=namespace)
         self.listen_tf()  # a tf2 TransformListener, as in ROS: the graph shows it reading /tf
         p = {k: self.declare_parameter(k, v) for k, v in _MB_DEFAULTS.items()}
@@ -81,16 +87,24 @@ class MoveBase(Node):
         gp = resolve_name("global_planner", str(p["base_global_planner"]))
         lp = resolve_name("controller", str(p["base_local_planner"]))
         self.planner_name, self.controller_name = short_name(gp), short_name(lp)
-        self.planner = make_plugin("global_planner", gp, self._namespace(self.planner_name),
-                                   context=PluginContext(name=self.planner_name, rng=self.rng,
-                                                         footprint=self.local_costmap.layered.footprint),
-                                   param="base_global_planner")
+        self.planner = make_plugin(
+            "global_planner",
+            gp,
+            self._namespace(self.planner_name),
+            context=PluginContext(name=self.planner_name, rng=self.rng, footprint=self.local_costmap.layered.footprint),
+            param="base_global_planner",
+        )
         # as ROS's planners see them: the costmap's footprint (a round robot's radius, for costmap_2d's 16-gon)
         # and move_base's controller_frequency (they search the parameter upward)
-        context = PluginContext(name=self.controller_name, rng=self.rng, footprint=self.local_costmap.layered.footprint,
-                                controller_frequency=p["controller_frequency"])
-        self.controller = make_plugin("controller", lp, self._namespace(self.controller_name), context=context,
-                                      param="base_local_planner")
+        context = PluginContext(
+            name=self.controller_name,
+            rng=self.rng,
+            footprint=self.local_costmap.layered.footprint,
+            controller_frequency=p["controller_frequency"],
+        )
+        self.controller = make_plugin(
+            "controller", lp, self._namespace(self.controller_name), context=context, param="base_local_planner"
+        )
         self.recoveries = self._recoveries(raw_recoveries)
         # Nav2's progress checker beside ROS 1's oscillation timeout: no progress -> the next recovery, then `stuck`
         self.progress_checker = SimpleProgressChecker(self._namespace("progress_checker"))
@@ -127,21 +141,26 @@ class MoveBase(Node):
         return self.get_parameters_by_prefix(prefix)
 
     def _costmap(self, name: str, private: str) -> Costmap2DROS:
-        return Costmap2DROS(self, name, self._namespace(name), topic_prefix=f"{private}/{name}",
-                            scan_points=self._scan_points)
+        return Costmap2DROS(
+            self, name, self._namespace(name), topic_prefix=f"{private}/{name}", scan_points=self._scan_points
+        )
 
     def _recoveries(self, raw: Any) -> list[tuple[str, Any]]:
         if not isinstance(raw, list) or not all(isinstance(r, dict) and {"name", "type"} <= set(r) for r in raw):
-            raise NavigationError("move_base parameter recovery_behaviors: expected a list of {name, type}, "
-                                  f"got {raw!r}")
+            raise NavigationError(
+                f"move_base parameter recovery_behaviors: expected a list of {{name, type}}, got {raw!r}"
+            )
         out = []
         for k, spec in enumerate(raw):
             name, kind = str(spec["name"]), str(spec["type"])
             params = self._namespace(name)
             if load_plugin("recovery", kind, param=f"recovery_behaviors[{k}] type") is ClearCostmapRecovery:
                 # as ROS 1 move_base sets <name>/reset_distance for its resets (unless the file does)
-                default = self.p["conservative_reset_dist"] if name == "conservative_reset" else (
-                    4.0 * self.local_costmap.layered.circumscribed_radius)
+                default = (
+                    self.p["conservative_reset_dist"]
+                    if name == "conservative_reset"
+                    else (4.0 * self.local_costmap.layered.circumscribed_radius)
+                )
                 params = {"reset_distance": default, **params}
             out.append((name, make_plugin("recovery", kind, params, context=PluginContext(name=name, rng=self.rng))))
         return out
@@ -164,15 +183,28 @@ class MoveBase(Node):
         if hasattr(self, "progress_checker"):
             self.progress_checker.reset(None, now / 1e9)
 
-    def send_goal(self, x: float, y: float, yaw: float, *, frame_id: str = "map",
-                  feedback: Callable[[Pose], None] | None = None,
-                  on_done: Callable[[GoalHandle], None] | None = None) -> GoalHandle:  # fmt: skip
+    def send_goal(
+        self,
+        x: float,
+        y: float,
+        yaw: float,
+        *,
+        frame_id: str = "map",
+        feedback: Callable[[Pose], None] | None = None,
+        on_done: Callable[[GoalHandle], None] | None = None,
+    ) -> GoalHandle:
         """Start driving to (x, y, yaw) in ``frame_id``; a goal still running is PREEMPTED. Returns its handle."""
         if self.handle is not None and not self.handle.done():
             self._finish(GoalState.PREEMPTED, "preempted by a new goal")
         self._ids += 1
-        handle = GoalHandle((float(x), float(y), float(yaw)), frame_id.lstrip("/") or "map", self._ids,
-                            start_s=self.executor.now_ns / 1e9, feedback=feedback, on_done=on_done)  # fmt: skip
+        handle = GoalHandle(
+            (float(x), float(y), float(yaw)),
+            frame_id.lstrip("/") or "map",
+            self._ids,
+            start_s=self.executor.now_ns / 1e9,
+            feedback=feedback,
+            on_done=on_done,
+        )
         self.handle = handle
         if not all(math.isfinite(v) for v in handle.goal):
             self._finish(GoalState.ABORTED, f"goal {handle.goal} is not finite")
@@ -250,8 +282,9 @@ class MoveBase(Node):
         ij = g.world_to_cell(np.array([goal[:2]]))
         if not g.in_bounds(ij)[0]:
             x0, y0, x1, y1 = g.bounds()
-            return (f"goal ({goal[0]:.2f}, {goal[1]:.2f}) is outside the map "
-                    f"(x {x0:.2f}..{x1:.2f}, y {y0:.2f}..{y1:.2f})")  # fmt: skip
+            return (
+                f"goal ({goal[0]:.2f}, {goal[1]:.2f}) is outside the map (x {x0:.2f}..{x1:.2f}, y {y0:.2f}..{y1:.2f})"
+            )
         return None
 
     def _on_map_obstacle(self, goal: Pose) -> bool:
@@ -287,8 +320,11 @@ class MoveBase(Node):
             self.planning_retries += 1
             self.plan_failure = str(self.planner.last_failure or "")
             if self._on_map_obstacle(goal):  # no recovery clears the map itself: say so now
-                self._finish(GoalState.ABORTED, f"goal ({goal[0]:.2f}, {goal[1]:.2f}) is in an obstacle on the map"
-                                        + (f" ({self.plan_failure})" if self.plan_failure else ""))  # fmt: skip
+                self._finish(
+                    GoalState.ABORTED,
+                    f"goal ({goal[0]:.2f}, {goal[1]:.2f}) is in an obstacle on the map"
+                    + (f" ({self.plan_failure})" if self.plan_failure else ""),
+                )
             return False
         self.global_plan = plan
         self.last_valid_plan_ns = self.executor.now_ns
@@ -319,7 +355,8 @@ class MoveBase(Node):
             elif self.handle.done():
                 return
             elif self._timed_out(self.last_valid_plan_ns, self.p["planner_patience"]) or (
-                    0 <= self.p["max_planning_retries"] < self.planning_retries):  # fmt: skip
+                0 <= self.p["max_planning_retries"] < self.planning_retries
+            ):
                 self._enter_clearing(RecoveryTrigger.PLANNING)
             self.cmd_pub.publish(msgs.twist(0.0, 0.0))
             return
@@ -332,8 +369,10 @@ class MoveBase(Node):
         return (self.executor.now_ns - since_ns) / 1e9 > patience_s
 
     def _check_oscillation(self, pose: Pose, now: int) -> None:
-        if self.oscillation_pose is None or math.dist(pose[:2], self.oscillation_pose[:2]) >= self.p[
-                "oscillation_distance"]:  # fmt: skip
+        if (
+            self.oscillation_pose is None
+            or math.dist(pose[:2], self.oscillation_pose[:2]) >= self.p["oscillation_distance"]
+        ):
             self.oscillation_pose = pose
             self.last_oscillation_reset_ns = now
             if self.recovery_trigger == RecoveryTrigger.OSCILLATION:
@@ -349,8 +388,11 @@ class MoveBase(Node):
 
     def _controlling(self, pose: Pose, now: int) -> None:
         p = self.p
-        if p["planner_frequency"] > 0 and self.last_plan_ns is not None and (
-                now - self.last_plan_ns) / 1e9 >= 1.0 / p["planner_frequency"]:  # fmt: skip
+        if (
+            p["planner_frequency"] > 0
+            and self.last_plan_ns is not None
+            and (now - self.last_plan_ns) / 1e9 >= 1.0 / p["planner_frequency"]
+        ):
             if not self._plan() and self._timed_out(self.last_valid_plan_ns, p["planner_patience"]):
                 self._enter_clearing(RecoveryTrigger.PLANNING)
                 return
@@ -370,7 +412,8 @@ class MoveBase(Node):
             return
         try:
             cmd: ControlResult | None = ControlResult.of(
-                self.controller.compute_velocity(pose, self.velocity, self.local_costmap.costmap))
+                self.controller.compute_velocity(pose, self.velocity, self.local_costmap.costmap)
+            )
         except NavigationError as exc:
             self.get_logger().debug(f"controller: {exc}")
             cmd = None
@@ -393,26 +436,35 @@ class MoveBase(Node):
         if not (pub.get_subscription_count() or self.executor.has_listeners):
             return
         now = self.executor.now_ns
-        pub.publish(msgs.Path(header=msgs.header(now, frame), poses=[
-            msgs.pose_stamped(now, frame, float(q[0]), float(q[1]), float(q[2]) if len(q) > 2 else 0.0) for q in poses
-        ]))  # fmt: skip
+        pub.publish(
+            msgs.Path(
+                header=msgs.header(now, frame),
+                poses=[
+                    msgs.pose_stamped(now, frame, float(q[0]), float(q[1]), float(q[2]) if len(q) > 2 else 0.0)
+                    for q in poses
+                ],
+            )
+        )
 
     # --- recoveries ------------------------------------------------------------------------------------
 
     def _enter_clearing(self, trigger: RecoveryTrigger) -> None:
         self.recovery_trigger = trigger
         self.cmd_pub.publish(msgs.twist(0.0, 0.0))
-        usable = [(n, r) for n, r in self.recoveries
-                  if self.p["clearing_rotation_allowed"] or "rotate" not in type(r).__name__.lower()]  # fmt: skip
+        usable = [
+            (n, r)
+            for n, r in self.recoveries
+            if self.p["clearing_rotation_allowed"] or "rotate" not in type(r).__name__.lower()
+        ]
         if not self.p["recovery_behavior_enabled"] or self.recovery_index >= len(usable):
             reason = {
                 RecoveryTrigger.PLANNING: "Failed to find a valid plan. Even after executing recovery behaviors.",
                 RecoveryTrigger.CONTROLLING: "Failed to find a valid control. Even after executing recovery behaviors.",
                 RecoveryTrigger.OSCILLATION: "Robot is oscillating. Even after executing recovery behaviors.",
                 RecoveryTrigger.PROGRESS: f"{STUCK_PREFIX}: the robot moved less than "
-                                          f"{self.progress_checker.params.required_movement_radius:g} m in "
-                                          f"{self.progress_checker.idle_s(self.executor.now_ns / 1e9):.1f} s, "
-                                          "even after executing recovery behaviors.",
+                f"{self.progress_checker.params.required_movement_radius:g} m in "
+                f"{self.progress_checker.idle_s(self.executor.now_ns / 1e9):.1f} s, "
+                "even after executing recovery behaviors.",
             }[trigger]
             if trigger == RecoveryTrigger.PLANNING and self.plan_failure:
                 reason += f" ({self.plan_failure})"
@@ -454,6 +506,7 @@ class MoveBase(Node):
     def _srv_make_plan(self, request: Any) -> dict[str, Any]:
         """``make_plan``: request ``{"start": (x, y, yaw) | None, "goal": (x, y, yaw)}`` in the global frame
         (or PoseStamped messages); response ``{"plan": (N, 2+) array | None}``."""
+
         def pose(v: Any) -> Pose | None:
             if v is None:
                 return None
@@ -472,8 +525,12 @@ class MoveBase(Node):
         if h is not None:
             uuid = np.zeros(16, dtype=np.uint8)
             uuid[:8] = np.frombuffer(int(h.id).to_bytes(8, "little"), dtype=np.uint8)
-            statuses.append(msgs.GoalStatus(
-                goal_info=msgs.GoalInfo(goal_id=msgs.UUID(uuid=uuid), stamp=msgs.time_from_ns(round(h.start_s * 1e9))),
-                status=STATUS[h.state],
-            ))  # fmt: skip
+            statuses.append(
+                msgs.GoalStatus(
+                    goal_info=msgs.GoalInfo(
+                        goal_id=msgs.UUID(uuid=uuid), stamp=msgs.time_from_ns(round(h.start_s * 1e9))
+                    ),
+                    status=STATUS[h.state],
+                )
+            )
         self.status_pub.publish(msgs.GoalStatusArray(status_list=statuses))

@@ -56,8 +56,9 @@ def _build(target: Any, kind: str, name: str, params: Any, context: PluginContex
     protocol = KINDS[kind][1]
     if not isinstance(instance, protocol):
         missing = [m for m in _members(protocol) if not hasattr(instance, m)]
-        raise PluginError(f"{kind} {name!r} ({_where(target)}) does not implement {protocol.__name__}: "
-                          f"missing {', '.join(missing)}")
+        raise PluginError(
+            f"{kind} {name!r} ({_where(target)}) does not implement {protocol.__name__}: missing {', '.join(missing)}"
+        )
     return instance
 
 
@@ -94,8 +95,12 @@ def _room_scan(n: int = 90) -> tuple[np.ndarray, float, float]:
 
 
 def _controller(target: Any, name: str) -> Any:
-    context = PluginContext(name=short_name(name), rng=np.random.default_rng(0),
-                            footprint=make_footprint(robot_radius=0.2), controller_frequency=20.0)
+    context = PluginContext(
+        name=short_name(name),
+        rng=np.random.default_rng(0),
+        footprint=make_footprint(robot_radius=0.2),
+        controller_frequency=20.0,
+    )
     ctrl = _build(target, "controller", name, {}, context)
     ctrl.set_plan(np.column_stack([np.linspace(0.0, 1.2, 25), np.zeros(25), np.zeros(25)]))
     out = ctrl.compute_velocity((0.0, 0.0, 0.0), (0.0, 0.0), _free_grid())
@@ -108,31 +113,45 @@ def _controller(target: Any, name: str) -> Any:
 
 
 def _planner(target: Any, name: str) -> Any:
-    planner = _build(target, "global_planner", name, {}, PluginContext(name=short_name(name),
-                                                                       rng=np.random.default_rng(0)))
+    planner = _build(
+        target, "global_planner", name, {}, PluginContext(name=short_name(name), rng=np.random.default_rng(0))
+    )
     start, goal = (-1.0, -1.0, 0.0), (1.0, 1.0, 0.0)
     path = planner.make_plan(_free_grid("map"), start, goal)
     _expect(path is not None, f"no path across a free grid ({planner.last_failure!r})")
     path = np.asarray(path, dtype=np.float64)
     _expect(path.ndim == 2 and path.shape[1] >= 2 and len(path) >= 2, f"path has shape {path.shape}")
-    _expect(math.dist(path[0, :2], start[:2]) <= 2 * RES and math.dist(path[-1, :2], goal[:2]) <= 2 * RES,
-            f"path runs from {path[0, :2]} to {path[-1, :2]}, not from {start[:2]} to {goal[:2]}")
+    _expect(
+        math.dist(path[0, :2], start[:2]) <= 2 * RES and math.dist(path[-1, :2], goal[:2]) <= 2 * RES,
+        f"path runs from {path[0, :2]} to {path[-1, :2]}, not from {start[:2]} to {goal[:2]}",
+    )
     _expect(planner.last_failure == "", f"last_failure is {planner.last_failure!r} after a success")
     return planner
 
 
 def _layer(target: Any, name: str) -> Any:
-    costmap = costmap_params({"global_frame": "map", "plugins": [{"name": "checked", "type": name}],
-                              "robot_radius": 0.2, "width": 3.0, "height": 3.0, "resolution": RES,
-                              "origin_x": ORIGIN[0], "origin_y": ORIGIN[1]})
+    costmap = costmap_params(
+        {
+            "global_frame": "map",
+            "plugins": [{"name": "checked", "type": name}],
+            "robot_radius": 0.2,
+            "width": 3.0,
+            "height": 3.0,
+            "resolution": RES,
+            "origin_x": ORIGIN[0],
+            "origin_y": ORIGIN[1],
+        }
+    )
     context = PluginContext(name="checked", footprint=make_footprint(robot_radius=0.2), costmap=costmap)
     layer = _build(target, "costmap_layer", name, {}, context)
     master = _free_grid("map")
     layer.match_size(master)
     if isinstance(layer, MapLayer):
         layer.set_map(_room())
-        _expect(layer.on_map_obstacle((-1.49, 0.0)) and not layer.on_map_obstacle((0.0, 0.0)),
-                "on_map_obstacle does not see the map's wall (or sees one in the free middle)")
+        _expect(
+            layer.on_map_obstacle((-1.49, 0.0)) and not layer.on_map_obstacle((0.0, 0.0)),
+            "on_map_obstacle does not see the map's wall (or sees one in the free middle)",
+        )
     if isinstance(layer, ScanLayer):
         ranges, a0, inc = _room_scan()
         a = a0 + inc * np.arange(len(ranges))
@@ -148,15 +167,28 @@ def _layer(target: Any, name: str) -> Any:
 
 def _recovery(target: Any, name: str) -> Any:
     node = Node(Executor(seed=0), name="check_plugin")
-    cm = Costmap2DROS(node, "local_costmap", {"global_frame": "odom", "rolling_window": True, "static_map": False,
-                                              "width": 3.0, "height": 3.0, "resolution": RES, "robot_radius": 0.2})
+    cm = Costmap2DROS(
+        node,
+        "local_costmap",
+        {
+            "global_frame": "odom",
+            "rolling_window": True,
+            "static_map": False,
+            "width": 3.0,
+            "height": 3.0,
+            "resolution": RES,
+            "robot_radius": 0.2,
+        },
+    )
     pose = (0.0, 0.0, 0.0)
     cm.layered.update_map(pose)
     behavior = _build(target, "recovery", name, {}, PluginContext(name=short_name(name), rng=node.rng))
     behavior.start(pose)
     cmd = behavior.step(pose, {"global": cm, "local": cm})
-    _expect(cmd is None or (len(cmd) == 2 and all(math.isfinite(c) for c in cmd)),
-            f"step returned {cmd!r}, expected None or a finite (v, w)")
+    _expect(
+        cmd is None or (len(cmd) == 2 and all(math.isfinite(c) for c in cmd)),
+        f"step returned {cmd!r}, expected None or a finite (v, w)",
+    )
     return behavior
 
 
@@ -179,8 +211,10 @@ def _laser_model(target: Any, name: str) -> Any:
     beams = Beams(a0 + inc * np.arange(len(ranges)), ranges, np.ones(len(ranges), bool), 0.1, 10.0)
     particles = np.array([[0.0, 0.0, 0.0], [0.5, 0.3, 1.0], [-0.6, 0.2, -2.0]])
     w = np.asarray(model.weights(particles, beams, (0.0, 0.0, 0.0)), dtype=np.float64)
-    _expect(w.shape == (3,) and bool(np.isfinite(w).all()) and bool((w > 0).all()),
-            f"weights {w} are not 3 finite positive scores")
+    _expect(
+        w.shape == (3,) and bool(np.isfinite(w).all()) and bool((w > 0).all()),
+        f"weights {w} are not 3 finite positive scores",
+    )
     _expect(w[0] > w[2], "the true pose does not score above a wrong one")
     return model
 

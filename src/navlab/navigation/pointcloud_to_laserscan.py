@@ -26,8 +26,18 @@ from navlab.navigation.errors import NavigationError
 DOUBLE_MIN, DOUBLE_MAX = sys.float_info.min, sys.float_info.max
 
 
-def flatten(points: np.ndarray, *, angle_min: float, angle_max: float, angle_increment: float, min_height: float,
-            max_height: float, range_min: float, range_max: float, fill: float) -> np.ndarray:
+def flatten(
+    points: np.ndarray,
+    *,
+    angle_min: float,
+    angle_max: float,
+    angle_increment: float,
+    min_height: float,
+    max_height: float,
+    range_min: float,
+    range_max: float,
+    fill: float,
+) -> np.ndarray:
     """Ranges (float32) of the scan bins from ``points`` (N, 3) in the scan's frame: the nearest planar range
     of the points in each bin, ``fill`` where none is."""
     n = math.ceil((angle_max - angle_min) / angle_increment)
@@ -47,19 +57,37 @@ def flatten(points: np.ndarray, *, angle_min: float, angle_max: float, angle_inc
 class PointCloudToLaserScan(Node):
     """The ``pointcloud_to_laserscan_node`` (see the module docstring)."""
 
-    def __init__(self, executor: Any, *, name: str = "pointcloud_to_laserscan",
-                 parameters: dict[str, Any] | None = None, namespace: str = "") -> None:
+    def __init__(
+        self,
+        executor: Any,
+        *,
+        name: str = "pointcloud_to_laserscan",
+        parameters: dict[str, Any] | None = None,
+        namespace: str = "",
+    ) -> None:
         super().__init__(executor, name=name, parameters=parameters, namespace=namespace)
         self.target_frame = str(self.declare_parameter("target_frame", "")).lstrip("/")
         self.tolerance = float(self.declare_parameter("transform_tolerance", 0.01))
-        p = {k: float(self.declare_parameter(k, v)) for k, v in (
-            ("min_height", DOUBLE_MIN), ("max_height", DOUBLE_MAX), ("angle_min", -math.pi), ("angle_max", math.pi),
-            ("angle_increment", math.pi / 180.0), ("scan_time", 1.0 / 30.0), ("range_min", 0.0),
-            ("range_max", DOUBLE_MAX), ("inf_epsilon", 1.0))}
+        p = {
+            k: float(self.declare_parameter(k, v))
+            for k, v in (
+                ("min_height", DOUBLE_MIN),
+                ("max_height", DOUBLE_MAX),
+                ("angle_min", -math.pi),
+                ("angle_max", math.pi),
+                ("angle_increment", math.pi / 180.0),
+                ("scan_time", 1.0 / 30.0),
+                ("range_min", 0.0),
+                ("range_max", DOUBLE_MAX),
+                ("inf_epsilon", 1.0),
+            )
+        }
         self.use_inf = bool(self.declare_parameter("use_inf", True))
         if not p["angle_increment"] > 0 or not p["angle_min"] < p["angle_max"]:
-            raise NavigationError(f"{name}: expected angle_min < angle_max and angle_increment > 0, got "
-                                  f"{p['angle_min']}, {p['angle_max']}, {p['angle_increment']}")
+            raise NavigationError(
+                f"{name}: expected angle_min < angle_max and angle_increment > 0, got "
+                f"{p['angle_min']}, {p['angle_max']}, {p['angle_increment']}"
+            )
         if p["min_height"] > p["max_height"] or p["range_min"] > p["range_max"]:
             raise NavigationError(f"{name}: expected min_height <= max_height and range_min <= range_max")
         self.p = p
@@ -81,11 +109,28 @@ class PointCloudToLaserScan(Node):
             frame = self.target_frame
         p = self.p
         fill = math.inf if self.use_inf else p["range_max"] + p["inf_epsilon"]
-        ranges = flatten(pts, angle_min=p["angle_min"], angle_max=p["angle_max"],
-                         angle_increment=p["angle_increment"], min_height=p["min_height"],
-                         max_height=p["max_height"], range_min=p["range_min"], range_max=p["range_max"], fill=fill)
-        self.pub.publish(msgs.LaserScan(
-            header=msgs.header(stamp, frame), angle_min=p["angle_min"], angle_max=p["angle_max"],
-            angle_increment=p["angle_increment"], time_increment=0.0, scan_time=p["scan_time"],
-            range_min=p["range_min"], range_max=p["range_max"], ranges=ranges,
-            intensities=np.zeros(0, np.float32)))
+        ranges = flatten(
+            pts,
+            angle_min=p["angle_min"],
+            angle_max=p["angle_max"],
+            angle_increment=p["angle_increment"],
+            min_height=p["min_height"],
+            max_height=p["max_height"],
+            range_min=p["range_min"],
+            range_max=p["range_max"],
+            fill=fill,
+        )
+        self.pub.publish(
+            msgs.LaserScan(
+                header=msgs.header(stamp, frame),
+                angle_min=p["angle_min"],
+                angle_max=p["angle_max"],
+                angle_increment=p["angle_increment"],
+                time_increment=0.0,
+                scan_time=p["scan_time"],
+                range_min=p["range_min"],
+                range_max=p["range_max"],
+                ranges=ranges,
+                intensities=np.zeros(0, np.float32),
+            )
+        )

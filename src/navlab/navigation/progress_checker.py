@@ -24,8 +24,9 @@ STUCK_PREFIX = "stuck"  # an ABORTED goal's reason starts with this when the rob
 class ProgressCheckerParams:
     """Nav2's ``progress_checker`` namespace (``plugin: nav2_controller::SimpleProgressChecker``)."""
 
-    PARAMS: ClassVar[ParamSpec] = ParamSpec("progress_checker", NavigationError, at_least={
-        "required_movement_radius": 0.0, "movement_time_allowance": 0.0})
+    PARAMS: ClassVar[ParamSpec] = ParamSpec(
+        "progress_checker", NavigationError, at_least={"required_movement_radius": 0.0, "movement_time_allowance": 0.0}
+    )
     required_movement_radius: float = 0.5  # m
     movement_time_allowance: float = 10.0  # s; 0 switches the checker off
     plugin: str = "nav2_controller::SimpleProgressChecker"

@@ -28,9 +28,12 @@ class ClearCostmapParams:
     layer_names: tuple[str, ...] = ("obstacle_layer",)
     force_updating: bool = False
     affected_maps: str = "both"
-    PARAMS: ClassVar[ParamSpec] = ParamSpec("clear_costmap_recovery", NavigationError,
-                                            at_least={"reset_distance": 0.0},
-                                            choices={"affected_maps": ("global", "local", "both")})
+    PARAMS: ClassVar[ParamSpec] = ParamSpec(
+        "clear_costmap_recovery",
+        NavigationError,
+        at_least={"reset_distance": 0.0},
+        choices={"affected_maps": ("global", "local", "both")},
+    )
 
 
 class ClearCostmapRecovery(BuiltFromParams):
@@ -101,8 +104,7 @@ class BackUpParams:
     backup_dist: float = 0.3
     backup_speed: float = 0.1
     time_allowance: float = 10.0
-    PARAMS: ClassVar[ParamSpec] = ParamSpec("back_up", NavigationError,
-                                            above={"backup_dist": 0.0, "backup_speed": 0.0})
+    PARAMS: ClassVar[ParamSpec] = ParamSpec("back_up", NavigationError, above={"backup_dist": 0.0, "backup_speed": 0.0})
 
 
 class BackUpRecovery(BuiltFromParams):

@@ -40,19 +40,25 @@ class SmootherParams:
     def validate(self) -> None:
         """One-line errors for values the smoother cannot use."""
         if self.smoothing_frequency <= 0:
-            raise NavigationError(f"velocity_smoother parameter smoothing_frequency: expected > 0 Hz, got "
-                                  f"{self.smoothing_frequency}")  # fmt: skip
+            raise NavigationError(
+                f"velocity_smoother parameter smoothing_frequency: expected > 0 Hz, got {self.smoothing_frequency}"
+            )
         if self.feedback not in ("OPEN_LOOP", "CLOSED_LOOP"):
-            raise NavigationError(f"velocity_smoother parameter feedback: expected OPEN_LOOP or CLOSED_LOOP, got "
-                                  f"{self.feedback!r}")  # fmt: skip
+            raise NavigationError(
+                f"velocity_smoother parameter feedback: expected OPEN_LOOP or CLOSED_LOOP, got {self.feedback!r}"
+            )
         for key in ("max_velocity", "min_velocity", "max_accel", "max_decel", "deadband_velocity"):
             if len(getattr(self, key)) != 3:
-                raise NavigationError(f"velocity_smoother parameter {key}: expected [x, y, theta], got "
-                                      f"{getattr(self, key)!r}")  # fmt: skip
+                raise NavigationError(
+                    f"velocity_smoother parameter {key}: expected [x, y, theta], got {getattr(self, key)!r}"
+                )
         if any(a <= 0 for a in (self.max_accel[0], self.max_accel[2])) or any(
-                d >= 0 for d in (self.max_decel[0], self.max_decel[2])):  # fmt: skip
-            raise NavigationError("velocity_smoother parameters max_accel (> 0) and max_decel (< 0) expected for x "
-                                  f"and theta, got {self.max_accel} and {self.max_decel}")
+            d >= 0 for d in (self.max_decel[0], self.max_decel[2])
+        ):
+            raise NavigationError(
+                "velocity_smoother parameters max_accel (> 0) and max_decel (< 0) expected for x "
+                f"and theta, got {self.max_accel} and {self.max_decel}"
+            )
 
 
 class VelocitySmoother:
@@ -69,13 +75,16 @@ class VelocitySmoother:
         rate = p.max_accel[axis] if speeding_up else -p.max_decel[axis]
         return max(-rate * dt, min(rate * dt, target - current))
 
-    def step(self, target: tuple[float, float], dt: float, current: tuple[float, float] | None = None
-             ) -> tuple[float, float]:  # fmt: skip
+    def step(
+        self, target: tuple[float, float], dt: float, current: tuple[float, float] | None = None
+    ) -> tuple[float, float]:
         """The next (v, w) toward ``target`` after ``dt`` s, from ``current`` (CLOSED_LOOP) or the last output."""
         p = self.params
         now = self.last if current is None else current
-        goal = [min(max(target[0], p.min_velocity[0]), p.max_velocity[0]),
-                min(max(target[1], p.min_velocity[2]), p.max_velocity[2])]  # fmt: skip
+        goal = [
+            min(max(target[0], p.min_velocity[0]), p.max_velocity[0]),
+            min(max(target[1], p.min_velocity[2]), p.max_velocity[2]),
+        ]
         dv = self._limits(0, now[0], goal[0], dt)
         dw = self._limits(2, now[1], goal[1], dt)
         if p.scale_velocities:  # slow both axes by the most limited one's ratio (keeps the curvature)
@@ -101,8 +110,14 @@ def as_list(value: Any) -> Any:
 class VelocitySmootherNode(Node):
     """``nav2_velocity_smoother``'s node: ``cmd_vel`` in, ``cmd_vel_smoothed`` out at ``smoothing_frequency``."""
 
-    def __init__(self, executor: Executor, *, name: str = "velocity_smoother", parameters: dict[str, Any] | None = None,
-                 namespace: str = "") -> None:  # fmt: skip
+    def __init__(
+        self,
+        executor: Executor,
+        *,
+        name: str = "velocity_smoother",
+        parameters: dict[str, Any] | None = None,
+        namespace: str = "",
+    ) -> None:
         super().__init__(executor, name=name, parameters=parameters, namespace=namespace)
         values = {k: as_list(self.declare_parameter(k, v)) for k, v in vars(SmootherParams()).items()}
         self.smoother = VelocitySmoother(values)

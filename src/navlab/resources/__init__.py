@@ -63,8 +63,11 @@ def robot(name: str) -> Path:
     """A shipped robot's top xacro by name (``"mybot"``)."""
     full = path(f"robots/{name}/{name}.xacro", must_exist=False)
     if not full.is_file():
-        raise _unknown("robot", name, sorted(p.parent.name for p in (root() / "robots").glob("*/*.xacro")
-                                             if p.stem == p.parent.name))  # fmt: skip
+        raise _unknown(
+            "robot",
+            name,
+            sorted(p.parent.name for p in (root() / "robots").glob("*/*.xacro") if p.stem == p.parent.name),
+        )
     return full
 
 
@@ -81,8 +84,9 @@ def _unknown(kind: str, name: str, shipped: list[str]) -> ResourceError:
     from navlab.errors import did_you_mean
 
     hint = did_you_mean(name, shipped)
-    return ResourceError(f"{kind} {name!r}: no such file here and no shipped {kind} of that name{hint} "
-                         f"(shipped: {', '.join(shipped)})")
+    return ResourceError(
+        f"{kind} {name!r}: no such file here and no shipped {kind} of that name{hint} (shipped: {', '.join(shipped)})"
+    )
 
 
 def model_path() -> Path:

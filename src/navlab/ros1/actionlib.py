@@ -29,8 +29,9 @@ class GoalServer(Protocol):
 
     fully_qualified_name: str
 
-    def send_goal(self, x: float, y: float, yaw: float, *, frame_id: str = "map", feedback: Any = None,
-                  on_done: Any = None) -> Any: ...
+    def send_goal(
+        self, x: float, y: float, yaw: float, *, frame_id: str = "map", feedback: Any = None, on_done: Any = None
+    ) -> Any: ...
 
     def cancel_goal(self) -> None: ...
 
@@ -54,10 +55,18 @@ class MoveBaseActionServer:
         self.status_pub = bridge.offer(f"{ns}/status", "actionlib_msgs/msg/GoalStatusArray", ns)
         self.feedback_pub = bridge.offer(f"{ns}/feedback", "move_base_msgs/msg/MoveBaseActionFeedback", ns)
         self.result_pub = bridge.offer(f"{ns}/result", "move_base_msgs/msg/MoveBaseActionResult", ns)
-        bridge.subscribe(f"{ns}/goal", "move_base_msgs/msg/MoveBaseActionGoal", ns,
-                         self._receiver("move_base_msgs/msg/MoveBaseActionGoal", self._on_goal))
-        bridge.subscribe(f"{ns}/cancel", "actionlib_msgs/msg/GoalID", ns,
-                         self._receiver("actionlib_msgs/msg/GoalID", self._on_cancel))
+        bridge.subscribe(
+            f"{ns}/goal",
+            "move_base_msgs/msg/MoveBaseActionGoal",
+            ns,
+            self._receiver("move_base_msgs/msg/MoveBaseActionGoal", self._on_goal),
+        )
+        bridge.subscribe(
+            f"{ns}/cancel",
+            "actionlib_msgs/msg/GoalID",
+            ns,
+            self._receiver("actionlib_msgs/msg/GoalID", self._on_cancel),
+        )
         self.timer = Timer(bridge.ex, STATUS_PERIOD_NS, self._publish_status, 0, bridge.ex.now_ns)
 
     def _receiver(self, ros1: str, handler: Any) -> Any:
@@ -72,8 +81,9 @@ class MoveBaseActionServer:
     def _on_goal(self, action_goal: Any) -> None:
         goal_id = action_goal.goal_id
         if not goal_id.id:  # actionlib's servers name anonymous goals
-            goal_id = self.store["actionlib_msgs/msg/GoalID"](stamp=msgs.time_from_ns(self.bridge.ex.now_ns),
-                                                                id=f"{self.node.fully_qualified_name}-{len(self.goals)}")
+            goal_id = self.store["actionlib_msgs/msg/GoalID"](
+                stamp=msgs.time_from_ns(self.bridge.ex.now_ns), id=f"{self.node.fully_qualified_name}-{len(self.goals)}"
+            )
         target = action_goal.goal.target_pose
         x, y, yaw = msgs.pose2d(target.pose)
         key = goal_id.id
@@ -84,8 +94,9 @@ class MoveBaseActionServer:
         def done(handle: Any) -> None:
             self._result(key)
 
-        handle = self.node.send_goal(x, y, yaw, frame_id=target.header.frame_id or "map", feedback=feedback,
-                                     on_done=done)
+        handle = self.node.send_goal(
+            x, y, yaw, frame_id=target.header.frame_id or "map", feedback=feedback, on_done=done
+        )
         self.goals[key] = (goal_id, handle)
         if handle.done():
             self._result(key)
@@ -96,15 +107,19 @@ class MoveBaseActionServer:
         cancels every goal given before it."""
         stamp_ns = msgs.ns_from_time(goal_id.stamp)
         for key, (gid, handle) in self.goals.items():
-            hit = (not goal_id.id and stamp_ns == 0) or key == goal_id.id or \
-                (stamp_ns and msgs.ns_from_time(gid.stamp) <= stamp_ns)
+            hit = (
+                (not goal_id.id and stamp_ns == 0)
+                or key == goal_id.id
+                or (stamp_ns and msgs.ns_from_time(gid.stamp) <= stamp_ns)
+            )
             if hit and not handle.done():  # only the newest goal can still run: a new goal preempts the last
                 self.node.cancel_goal()
 
     def _status(self, key: str) -> Any:
         gid, handle = self.goals[key]
-        return self.store["actionlib_msgs/msg/GoalStatus"](goal_id=gid, status=CODE.get(handle.state, ABORTED),
-                                                             text=handle.reason)
+        return self.store["actionlib_msgs/msg/GoalStatus"](
+            goal_id=gid, status=CODE.get(handle.state, ABORTED), text=handle.reason
+        )
 
     def _header(self) -> Any:
         return self.store["std_msgs/msg/Header"](seq=0, stamp=msgs.time_from_ns(self.bridge.ex.now_ns), frame_id="")
@@ -113,24 +128,28 @@ class MoveBaseActionServer:
         if not self.status_pub.connections:
             return
         latest = list(self.goals)[-20:]  # recent goals, as actionlib keeps finished ones for a while
-        msg = self.store["actionlib_msgs/msg/GoalStatusArray"](header=self._header(),
-                                                               status_list=[self._status(k) for k in latest])
+        msg = self.store["actionlib_msgs/msg/GoalStatusArray"](
+            header=self._header(), status_list=[self._status(k) for k in latest]
+        )
         self.status_pub.send(self.types.serialize(msg, "actionlib_msgs/msg/GoalStatusArray"))
 
     def _feedback(self, key: str, pose: Any) -> None:
         if not self.feedback_pub.connections or key not in self.goals:
             return
         _gid, handle = self.goals[key]
-        position = self.types.to_ros1(msgs.pose_stamped(self.bridge.ex.now_ns, handle.frame_id, *pose),
-                                      "geometry_msgs/msg/PoseStamped")
+        position = self.types.to_ros1(
+            msgs.pose_stamped(self.bridge.ex.now_ns, handle.frame_id, *pose), "geometry_msgs/msg/PoseStamped"
+        )
         msg = self.store["move_base_msgs/msg/MoveBaseActionFeedback"](
-            header=self._header(), status=self._status(key),
-            feedback=self.store["move_base_msgs/msg/MoveBaseFeedback"](base_position=position))
+            header=self._header(),
+            status=self._status(key),
+            feedback=self.store["move_base_msgs/msg/MoveBaseFeedback"](base_position=position),
+        )
         self.feedback_pub.send(self.types.serialize(msg, "move_base_msgs/msg/MoveBaseActionFeedback"))
 
     def _result(self, key: str) -> None:
         msg = self.store["move_base_msgs/msg/MoveBaseActionResult"](
-            header=self._header(), status=self._status(key),
-            result=self.store["move_base_msgs/msg/MoveBaseResult"]())
+            header=self._header(), status=self._status(key), result=self.store["move_base_msgs/msg/MoveBaseResult"]()
+        )
         self.result_pub.send(self.types.serialize(msg, "move_base_msgs/msg/MoveBaseActionResult"))
         self._publish_status()

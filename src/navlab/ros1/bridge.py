@@ -49,8 +49,9 @@ def connect_or_start_master(uri: str | None = None) -> tuple[str, Master | None]
         pass
     host, port = host_port(uri)
     if host not in ("localhost", "127.0.0.1", binding().advertise):
-        raise Ros1Error(f"no ROS master answers at {uri} (ROS_MASTER_URI), and navlab can only start its own "
-                        "on this machine")
+        raise Ros1Error(
+            f"no ROS master answers at {uri} (ROS_MASTER_URI), and navlab can only start its own on this machine"
+        )
     master = Master(port=port)
     LOG.warning("no ROS master answered at %s: started navlab's own (navlab roscore)", uri)
     return master.uri, master
@@ -69,8 +70,15 @@ class WireSubscription:
 class RosBridge:
     """Offer the run of ``executor`` on the ROS 1 master at ``master``; ``close()`` unregisters everything."""
 
-    def __init__(self, executor: Executor, *, master: str | None = None, params: dict[str, Any] | None = None,
-                 name: str | None = None, follow_clock: bool = False) -> None:
+    def __init__(
+        self,
+        executor: Executor,
+        *,
+        master: str | None = None,
+        params: dict[str, Any] | None = None,
+        name: str | None = None,
+        follow_clock: bool = False,
+    ) -> None:
         self.ex = executor
         self.name = name or f"{BRIDGE_NAME}_{os.getpid()}"
         name = self.name
@@ -97,12 +105,17 @@ class RosBridge:
         if follow_clock:  # the graph owns the time: no /clock of our own
             follower = self.follower = ClockFollower(executor)
             clock_type = "rosgraph_msgs/msg/Clock"
-            self.subscribe("/clock", clock_type, name, lambda raw: follower.tick(
-                msgs.ns_from_time(self.types.deserialize(raw, clock_type).clock)))
+            self.subscribe(
+                "/clock",
+                clock_type,
+                name,
+                lambda raw: follower.tick(msgs.ns_from_time(self.types.deserialize(raw, clock_type).clock)),
+            )
         else:
             clock = self.offer("/clock", "rosgraph_msgs/msg/Clock", name)
-            self._clock = Timer(executor, CLOCK_PERIOD_NS, self._tick_clock, -100, executor.now_ns,
-                                idle=lambda: not clock.connections)
+            self._clock = Timer(
+                executor, CLOCK_PERIOD_NS, self._tick_clock, -100, executor.now_ns, idle=lambda: not clock.connections
+            )
         self._log_handler = _RosoutHandler(self)
         logging.getLogger("navlab").addHandler(self._log_handler)
         executor.add_listener(self._on_publish)
@@ -136,8 +149,9 @@ class RosBridge:
             if safe is not None:
                 self._jobs.put(functools.partial(self._master, "setParam", self.name, key, safe))
 
-    def offer(self, topic: str, ros1_type: str, caller_id: str, latched: Callable[[], list[bytes]] | None = None
-               ) -> Publication:
+    def offer(
+        self, topic: str, ros1_type: str, caller_id: str, latched: Callable[[], list[bytes]] | None = None
+    ) -> Publication:
         pub = Publication(topic, self.types.wire_type(ros1_type), caller_id, latched or (lambda: []))
         self.tcpros.publications[topic] = pub
         self._jobs.put(lambda: self._master("registerPublisher", caller_id, topic, pub.wtype.wire, self.uri))
@@ -186,8 +200,7 @@ class RosBridge:
         sub = self.subs[topic] = WireSubscription(self.types.wire_type(ros1), caller, deliver)
 
         def register() -> None:
-            self._update_publishers(topic, self._master("registerSubscriber", caller, topic, sub.wtype.wire,
-                                                        self.uri))
+            self._update_publishers(topic, self._master("registerSubscriber", caller, topic, sub.wtype.wire, self.uri))
 
         self._jobs.put(register)
 
@@ -198,8 +211,9 @@ class RosBridge:
         conns = sub.connections
         for api in apis:
             if api != self.uri and (api not in conns or conns[api].closed):
-                conns[api] = Incoming(api, topic, sub.wtype, sub.caller_id, sub.deliver,
-                                      lambda c: _discard(conns, c.api))
+                conns[api] = Incoming(
+                    api, topic, sub.wtype, sub.caller_id, sub.deliver, lambda c: _discard(conns, c.api)
+                )
         for api in list(conns):
             if api not in apis:
                 conns.pop(api).close()
@@ -231,7 +245,8 @@ class RosBridge:
     def _tick_clock(self) -> None:
         clock_type = self.types.store.types["rosgraph_msgs/msg/Clock"]
         self.tcpros.publications["/clock"].send(
-            self.types.serialize(clock_type(clock=msgs.time_from_ns(self.ex.now_ns)), "rosgraph_msgs/msg/Clock"))
+            self.types.serialize(clock_type(clock=msgs.time_from_ns(self.ex.now_ns)), "rosgraph_msgs/msg/Clock")
+        )
 
     # --- the slave API ---------------------------------------------------------------------------------
 
@@ -264,14 +279,20 @@ class RosBridge:
             return [1, "shutdown", 0]
 
         return {
-            "getBusStats": lambda caller_id: [1, "stats", [[[t, 0, [[0, p.count, 0, True]]]
-                                                           for t, p in self.tcpros.publications.items()], [], []]],
+            "getBusStats": lambda caller_id: [
+                1,
+                "stats",
+                [[[t, 0, [[0, p.count, 0, True]]] for t, p in self.tcpros.publications.items()], [], []],
+            ],
             "getBusInfo": bus_info,
             "getMasterUri": lambda caller_id: [1, "master", self.master_uri],
             "shutdown": shutdown,
             "getPid": lambda caller_id: [1, "pid", os.getpid()],
-            "getSubscriptions": lambda caller_id: [1, "subscriptions", [[t, s.wtype.wire]
-                                                                         for t, s in self.subs.items()]],
+            "getSubscriptions": lambda caller_id: [
+                1,
+                "subscriptions",
+                [[t, s.wtype.wire] for t, s in self.subs.items()],
+            ],
             "getPublications": lambda caller_id: [1, "publications", pubs()],
             "paramUpdate": lambda caller_id, key, value: [1, "ok", 0],
             "publisherUpdate": publisher_update,
@@ -346,8 +367,13 @@ def _xmlrpc_value(value: Any) -> Any:
 class _RosoutHandler(logging.Handler):
     """navlab's log lines as ``rosgraph_msgs/Log`` on ``/rosout`` (level, node name, text)."""
 
-    LEVELS: ClassVar[dict[int, int]] = {logging.DEBUG: 1, logging.INFO: 2, logging.WARNING: 4, logging.ERROR: 8,
-                                        logging.CRITICAL: 16}
+    LEVELS: ClassVar[dict[int, int]] = {
+        logging.DEBUG: 1,
+        logging.INFO: 2,
+        logging.WARNING: 4,
+        logging.ERROR: 8,
+        logging.CRITICAL: 16,
+    }
 
     def __init__(self, bridge: RosBridge) -> None:
         super().__init__(logging.INFO)
@@ -363,9 +389,14 @@ class _RosoutHandler(logging.Handler):
         node = getattr(record, "node", None) or "/" + record.name.removeprefix("navlab").strip(".").replace(".", "/")
         msg = store.types["rosgraph_msgs/msg/Log"](
             header=store.types["std_msgs/msg/Header"](seq=0, stamp=time_from_ns(self.bridge.ex.now_ns), frame_id=""),
-            level=self.LEVELS.get(record.levelno, 2), name=node, msg=record.getMessage(), file=record.pathname,
-            function=record.funcName, line=record.lineno,
-            topics=[t for t, p in self.bridge.tcpros.publications.items() if p.caller_id == node])
+            level=self.LEVELS.get(record.levelno, 2),
+            name=node,
+            msg=record.getMessage(),
+            file=record.pathname,
+            function=record.funcName,
+            line=record.lineno,
+            topics=[t for t, p in self.bridge.tcpros.publications.items() if p.caller_id == node],
+        )
         pub.send(self.bridge.types.serialize(msg, "rosgraph_msgs/msg/Log"))
 
 

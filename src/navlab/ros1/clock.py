@@ -40,8 +40,11 @@ class ClockFollower:
             if self.latest_ns >= 0 and t_ns - self.latest_ns > MAX_JUMP_NS:
                 if not self._warned:
                     self._warned = True
-                    LOG.error("ros1: /clock jumped %.0f s ahead: ignored (follow a simulator's /clock or play a "
-                              "bag that recorded /clock, without --clock)", (t_ns - self.latest_ns) / 1e9)
+                    LOG.error(
+                        "ros1: /clock jumped %.0f s ahead: ignored (follow a simulator's /clock or play a "
+                        "bag that recorded /clock, without --clock)",
+                        (t_ns - self.latest_ns) / 1e9,
+                    )
                 return
             if t_ns > self.latest_ns:
                 self.latest_ns = t_ns

@@ -22,8 +22,9 @@ class LiveRun:
     def __init__(self, launch: str, *, master: str | None = None, follow_clock: bool = False, **args: Any) -> None:
         self.session = start(launch, rate=0.0 if follow_clock else 1.0, **args)
         self.ex = self.session.executor
-        self.bridge = RosBridge(self.ex, master=master, params=session_params(self.session.nodes),
-                                follow_clock=follow_clock)
+        self.bridge = RosBridge(
+            self.ex, master=master, params=session_params(self.session.nodes), follow_clock=follow_clock
+        )
         self.thread = threading.Thread(target=self.ex.spin, name="navlab-live", daemon=True)
         self.thread.start()
         while self.ex.now_ns < 2_000_000_000 and self.thread.is_alive():  # tf publishers appear on first use

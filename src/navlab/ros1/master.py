@@ -107,12 +107,32 @@ class Master:
         self.param_subscribers: dict[str, dict[str, str]] = {}  # key -> caller_id -> caller_api
         self._notify = ThreadPoolExecutor(max_workers=4, thread_name_prefix="ros1-master-notify")
         functions: dict[str, Callable[..., Reply]] = {
-            name: getattr(self, name) for name in (
-                "registerService", "unregisterService", "registerSubscriber", "unregisterSubscriber",
-                "registerPublisher", "unregisterPublisher", "lookupNode", "getPublishedTopics", "getTopicTypes",
-                "getSystemState", "getUri", "lookupService", "getPid", "shutdown",
-                "deleteParam", "setParam", "getParam", "searchParam", "subscribeParam", "unsubscribeParam",
-                "hasParam", "getParamNames")}
+            name: getattr(self, name)
+            for name in (
+                "registerService",
+                "unregisterService",
+                "registerSubscriber",
+                "unregisterSubscriber",
+                "registerPublisher",
+                "unregisterPublisher",
+                "lookupNode",
+                "getPublishedTopics",
+                "getTopicTypes",
+                "getSystemState",
+                "getUri",
+                "lookupService",
+                "getPid",
+                "shutdown",
+                "deleteParam",
+                "setParam",
+                "getParam",
+                "searchParam",
+                "subscribeParam",
+                "unsubscribeParam",
+                "hasParam",
+                "getParamNames",
+            )
+        }
         self.server = XmlRpcServer(functions, host or bind.bind, bind.advertise, port)
         self.uri = self.server.uri
         self.stopped = threading.Event()
@@ -204,8 +224,11 @@ class Master:
 
     def getPublishedTopics(self, caller_id: str, subgraph: str) -> Reply:
         with self._lock:
-            rows = [[t, self.topic_types.get(t, "*")] for t, p in self.publishers.items()
-                    if p and t.startswith(subgraph or "")]
+            rows = [
+                [t, self.topic_types.get(t, "*")]
+                for t, p in self.publishers.items()
+                if p and t.startswith(subgraph or "")
+            ]
         return [1, "published topics", rows]
 
     def getTopicTypes(self, caller_id: str) -> Reply:
@@ -239,8 +262,13 @@ class Master:
             for watched, subs in self.param_subscribers.items():
                 if key.startswith(watched.rstrip("/")) or watched.startswith(key):
                     for api in subs.values():
-                        self._send(api, "paramUpdate", MASTER_ID, watched + "/" if not watched.endswith("/")
-                                   else watched, self._get_or_empty(watched))
+                        self._send(
+                            api,
+                            "paramUpdate",
+                            MASTER_ID,
+                            watched + "/" if not watched.endswith("/") else watched,
+                            self._get_or_empty(watched),
+                        )
         return [1, f"parameter {key} set", 0]
 
     def _get_or_empty(self, key: str) -> Any:

@@ -51,8 +51,9 @@ def offer_services(bridge: RosBridge) -> None:
         adapter = _ADAPTERS[stype_name]
         srv = Service(wire_name, stype, caller, _handler(bridge, name, stype.request, stype.response, adapter))
         bridge.tcpros.services[wire_name] = srv
-        bridge._jobs.put(functools.partial(bridge._master,
-                                           "registerService", srv.caller_id, srv.name, bridge.tcpros.uri, bridge.uri))
+        bridge._jobs.put(
+            functools.partial(bridge._master, "registerService", srv.caller_id, srv.name, bridge.tcpros.uri, bridge.uri)
+        )
 
 
 def call_in_executor(executor: Executor, fn: Callable[[], T], timeout: float = 30.0) -> T:
@@ -83,8 +84,11 @@ def _handler(bridge: RosBridge, name: str, req_type: str, res_type: str, adapter
     def handle(raw: bytes) -> bytes:
         request = bridge.types.deserialize(raw, req_type)
         response = bridge.types.store.types[res_type]
-        result = call_in_executor(bridge.ex, lambda: adapter(bridge, lambda r: bridge.ex.call_service(name, r),
-                                                              request, response), CALL_TIMEOUT)
+        result = call_in_executor(
+            bridge.ex,
+            lambda: adapter(bridge, lambda r: bridge.ex.call_service(name, r), request, response),
+            CALL_TIMEOUT,
+        )
         return bridge.types.serialize(result, res_type)
 
     return handle
@@ -106,8 +110,13 @@ def _get_plan(bridge: RosBridge, call: Callable[[Any], Any], request: Any, respo
     plan = call({"start": None if empty_start else start, "goal": goal}).get("plan")
     stamp = bridge.ex.now_ns
     frame = goal.header.frame_id or "map"
-    poses = [] if plan is None else [msgs.pose_stamped(stamp, frame, float(r[0]), float(r[1]),
-                                                       float(r[2]) if len(r) > 2 else 0.0) for r in plan]
+    poses = (
+        []
+        if plan is None
+        else [
+            msgs.pose_stamped(stamp, frame, float(r[0]), float(r[1]), float(r[2]) if len(r) > 2 else 0.0) for r in plan
+        ]
+    )
     path = msgs.Path(header=msgs.header(stamp, frame), poses=poses)
     return response(plan=bridge.types.to_ros1(path, "nav_msgs/msg/Path"))
 
@@ -119,8 +128,16 @@ def _spawn(bridge: RosBridge, call: Callable[[Any], Any], request: Any, response
     with tempfile.TemporaryDirectory(prefix="navlab-spawn-") as folder:  # navlab spawns SDF models from files
         path = Path(folder) / "model.sdf"
         path.write_text(request.model_xml)
-        result = call({"file": str(path), "name": request.model_name, "x": pose.position.x, "y": pose.position.y,
-                       "z": pose.position.z, "yaw": yaw_from_quaternion(pose.orientation)})
+        result = call(
+            {
+                "file": str(path),
+                "name": request.model_name,
+                "x": pose.position.x,
+                "y": pose.position.y,
+                "z": pose.position.z,
+                "yaw": yaw_from_quaternion(pose.orientation),
+            }
+        )
     return response(success=bool(result.get("success", True)), status_message=str(result.get("status_message", "")))
 
 
@@ -130,6 +147,9 @@ def _delete(bridge: RosBridge, call: Callable[[Any], Any], request: Any, respons
 
 
 _ADAPTERS: dict[str, Adapter] = {
-    "std_srvs/srv/Empty": _empty, "nav_msgs/srv/GetMap": _get_map, "nav_msgs/srv/GetPlan": _get_plan,
-    "gazebo_msgs/srv/SpawnModel": _spawn, "gazebo_msgs/srv/DeleteModel": _delete,
+    "std_srvs/srv/Empty": _empty,
+    "nav_msgs/srv/GetMap": _get_map,
+    "nav_msgs/srv/GetPlan": _get_plan,
+    "gazebo_msgs/srv/SpawnModel": _spawn,
+    "gazebo_msgs/srv/DeleteModel": _delete,
 }

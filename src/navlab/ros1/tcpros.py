@@ -33,7 +33,7 @@ def decode_header(body: bytes) -> dict[str, str]:
         i += 4
         if i + n > len(body):
             raise Ros1Error("connection header field runs past its end")
-        key, sep, value = body[i:i + n].decode("utf-8", "replace").partition("=")
+        key, sep, value = body[i : i + n].decode("utf-8", "replace").partition("=")
         if not sep:
             raise Ros1Error(f"connection header field without '=': {key[:40]!r}")
         out[key] = value

@@ -27,23 +27,30 @@ EXTRA_MSGS: dict[str, str] = {
     "move_base_msgs/msg/MoveBaseGoal": "geometry_msgs/PoseStamped target_pose",
     "move_base_msgs/msg/MoveBaseResult": "",
     "move_base_msgs/msg/MoveBaseFeedback": "geometry_msgs/PoseStamped base_position",
-    "move_base_msgs/msg/MoveBaseActionGoal":
-        "Header header\nactionlib_msgs/GoalID goal_id\nmove_base_msgs/MoveBaseGoal goal",
-    "move_base_msgs/msg/MoveBaseActionResult":
-        "Header header\nactionlib_msgs/GoalStatus status\nmove_base_msgs/MoveBaseResult result",
-    "move_base_msgs/msg/MoveBaseActionFeedback":
-        "Header header\nactionlib_msgs/GoalStatus status\nmove_base_msgs/MoveBaseFeedback feedback",
+    "move_base_msgs/msg/MoveBaseActionGoal": (
+        "Header header\nactionlib_msgs/GoalID goal_id\nmove_base_msgs/MoveBaseGoal goal"
+    ),
+    "move_base_msgs/msg/MoveBaseActionResult": (
+        "Header header\nactionlib_msgs/GoalStatus status\nmove_base_msgs/MoveBaseResult result"
+    ),
+    "move_base_msgs/msg/MoveBaseActionFeedback": (
+        "Header header\nactionlib_msgs/GoalStatus status\nmove_base_msgs/MoveBaseFeedback feedback"
+    ),
 }
 # services: name -> (request text, response text)
 EXTRA_SRVS: dict[str, tuple[str, str]] = {
     "std_srvs/srv/Empty": ("", ""),
     "nav_msgs/srv/GetMap": ("", "nav_msgs/OccupancyGrid map"),
-    "nav_msgs/srv/GetPlan": ("geometry_msgs/PoseStamped start\ngeometry_msgs/PoseStamped goal\nfloat32 tolerance",
-                             "nav_msgs/Path plan"),
+    "nav_msgs/srv/GetPlan": (
+        "geometry_msgs/PoseStamped start\ngeometry_msgs/PoseStamped goal\nfloat32 tolerance",
+        "nav_msgs/Path plan",
+    ),
     "gazebo_msgs/srv/DeleteModel": ("string model_name", "bool success\nstring status_message"),
     "gazebo_msgs/srv/SpawnModel": (
         "string model_name\nstring model_xml\nstring robot_namespace\ngeometry_msgs/Pose initial_pose\n"
-        "string reference_frame", "bool success\nstring status_message"),
+        "string reference_frame",
+        "bool success\nstring status_message",
+    ),
 }
 
 
@@ -199,9 +206,21 @@ class Ros1Types:
 
 _ROS1_TIME = {"builtin_interfaces/msg/Time": "time", "builtin_interfaces/msg/Duration": "duration"}
 _MISSING = object()
-_NUMPY = {"bool": np.uint8, "byte": np.uint8, "char": np.uint8, "int8": np.int8, "uint8": np.uint8,
-          "int16": np.int16, "uint16": np.uint16, "int32": np.int32, "uint32": np.uint32, "int64": np.int64,
-          "uint64": np.uint64, "float32": np.float32, "float64": np.float64}
+_NUMPY = {
+    "bool": np.uint8,
+    "byte": np.uint8,
+    "char": np.uint8,
+    "int8": np.int8,
+    "uint8": np.uint8,
+    "int16": np.int16,
+    "uint16": np.uint16,
+    "int32": np.int32,
+    "uint32": np.uint32,
+    "int64": np.int64,
+    "uint64": np.uint64,
+    "float32": np.float32,
+    "float64": np.float64,
+}
 
 
 def _same(v: Any) -> Any:
@@ -212,8 +231,15 @@ def _default(store: Any, desc: Any) -> Callable[[], Any]:
     """The zero value of a field missing on the other side (ROS 1's Header.seq, ...)."""
     if desc[0] == Nodetype.BASE:
         kind = desc[1][0]
-        return (lambda: "") if kind == "string" else (lambda: False) if kind == "bool" else \
-            (lambda: 0.0) if kind.startswith("float") else (lambda: 0)
+        return (
+            (lambda: "")
+            if kind == "string"
+            else (lambda: False)
+            if kind == "bool"
+            else (lambda: 0.0)
+            if kind.startswith("float")
+            else (lambda: 0)
+        )
     if desc[0] == Nodetype.NAME:
         sub = str(desc[1])
         return lambda: store.types[sub](**{n: _default(store, d)() for n, d in store.fielddefs[sub][1]})

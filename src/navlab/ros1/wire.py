@@ -151,13 +151,25 @@ class TcpRosServer:
             return
         md5 = header.get("md5sum", "*")
         if md5 not in ("*", pub.wtype.md5sum):
-            self._refuse(sock, f"{topic}: md5sum mismatch: theirs {md5} ({header.get('type')}), "
-                               f"ours {pub.wtype.md5sum} ({pub.wtype.wire})")
+            self._refuse(
+                sock,
+                f"{topic}: md5sum mismatch: theirs {md5} ({header.get('type')}), "
+                f"ours {pub.wtype.md5sum} ({pub.wtype.wire})",
+            )
             return
         latched = pub.latched()
-        sock.sendall(encode_header({
-            "callerid": pub.caller_id, "md5sum": pub.wtype.md5sum, "type": pub.wtype.wire, "topic": topic,
-            "message_definition": pub.wtype.definition, "latching": "1" if latched else "0"}))
+        sock.sendall(
+            encode_header(
+                {
+                    "callerid": pub.caller_id,
+                    "md5sum": pub.wtype.md5sum,
+                    "type": pub.wtype.wire,
+                    "topic": topic,
+                    "message_definition": pub.wtype.definition,
+                    "latching": "1" if latched else "0",
+                }
+            )
+        )
         if header.get("tcp_nodelay") == "1":
             sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
         # a small kernel buffer: a subscriber that stops reading backs up into its bounded queue, not into megabytes
@@ -177,9 +189,13 @@ class TcpRosServer:
         if md5 not in ("*", srv.stype.md5sum):
             self._refuse(sock, f"{srv.name}: md5sum mismatch: theirs {md5}, ours {srv.stype.md5sum}")
             return
-        reply = {"callerid": srv.caller_id, "md5sum": srv.stype.md5sum, "type": srv.stype.name.replace("/srv/", "/"),
-                 "request_type": srv.stype.request.replace("/msg/", "/"),
-                 "response_type": srv.stype.response.replace("/msg/", "/")}
+        reply = {
+            "callerid": srv.caller_id,
+            "md5sum": srv.stype.md5sum,
+            "type": srv.stype.name.replace("/srv/", "/"),
+            "request_type": srv.stype.request.replace("/msg/", "/"),
+            "response_type": srv.stype.response.replace("/msg/", "/"),
+        }
         sock.sendall(encode_header(reply))
         if header.get("probe") == "1":
             sock.close()
@@ -205,8 +221,15 @@ class TcpRosServer:
 class Incoming:
     """navlab's subscription to one outside publisher: a reader thread handing each message to ``deliver``."""
 
-    def __init__(self, publisher_api: str, topic: str, wtype: WireType, caller_id: str,
-                 deliver: Callable[[bytes], None], on_close: Callable[[Incoming], None]) -> None:
+    def __init__(
+        self,
+        publisher_api: str,
+        topic: str,
+        wtype: WireType,
+        caller_id: str,
+        deliver: Callable[[bytes], None],
+        on_close: Callable[[Incoming], None],
+    ) -> None:
         self.api, self.topic, self.wtype, self.caller_id = publisher_api, topic, wtype, caller_id
         self._deliver, self._on_close = deliver, on_close
         self.sock: socket.socket | None = None
@@ -221,9 +244,18 @@ class Incoming:
                 raise Ros1Error(f"publisher {self.api} offers no TCPROS for {self.topic}")
             self.sock = socket.create_connection((proto[1], int(proto[2])), timeout=10.0)
             self.sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-            self.sock.sendall(encode_header({
-                "callerid": self.caller_id, "topic": self.topic, "md5sum": self.wtype.md5sum,
-                "type": self.wtype.wire, "message_definition": self.wtype.definition, "tcp_nodelay": "1"}))
+            self.sock.sendall(
+                encode_header(
+                    {
+                        "callerid": self.caller_id,
+                        "topic": self.topic,
+                        "md5sum": self.wtype.md5sum,
+                        "type": self.wtype.wire,
+                        "message_definition": self.wtype.definition,
+                        "tcp_nodelay": "1",
+                    }
+                )
+            )
             header = recv_header(self.sock)
             if "error" in header:
                 raise Ros1Error(header["error"])
@@ -249,8 +281,9 @@ class Incoming:
             self._on_close(self)
 
 
-def service_call(uri: str, service: str, stype: ServiceType, caller_id: str, request: bytes,
-                 timeout: float = 10.0) -> bytes:
+def service_call(
+    uri: str, service: str, stype: ServiceType, caller_id: str, request: bytes, timeout: float = 10.0
+) -> bytes:
     """Call an outside ROS 1 service at ``uri`` (``rosrpc://host:port``); the response bytes."""
     sock = socket.create_connection(host_port(uri), timeout=timeout)
     try:

@@ -107,14 +107,10 @@ def mj_quat_from_rpy(rpy: tuple[float, float, float]) -> np.ndarray:
     return wxyz_from_xyzw(quat_from_rpy(*(float(a) for a in rpy)))
 
 
-
-
 def set_pose(element: Any, origin: Origin) -> None:
     """Set ``pos``/``quat`` of a MuJoCo spec element (``MjsBody``, ``MjsGeom``, ``MjsSite``...; untyped)."""
     element.pos = np.asarray(origin.xyz, dtype=float)
     element.quat = mj_quat_from_rpy(origin.rpy)
-
-
 
 
 # --- geometry -------------------------------------------------------------------------------------
@@ -205,9 +201,7 @@ def set_inertial(body: mujoco.MjsBody, link: Link, moving: bool, info: BuildInfo
     body.mass = float(inertial.mass)
     body.ipos = np.asarray(inertial.origin.xyz, dtype=float)
     body.iquat = np.array([1.0, 0.0, 0.0, 0.0])
-    body.fullinertia = np.array(
-        [tensor[0, 0], tensor[1, 1], tensor[2, 2], tensor[0, 1], tensor[0, 2], tensor[1, 2]]
-    )
+    body.fullinertia = np.array([tensor[0, 0], tensor[1, 1], tensor[2, 2], tensor[0, 1], tensor[0, 2], tensor[1, 2]])
     body.explicitinertial = True
 
 
@@ -270,19 +264,27 @@ def add_robot(
         # straight-line and turning tests were measured with (TurtleBot3's kp/kd would slow it by 10 %)
         skid = wheels > 2 and axis is not None and not rigid_to_root
         tags = link.contact if skid else None
-        contact["solref"] = np.array(contact_solref(tags, total_mass / wheels, timestep=MAX_STEP,
-                                                    default=ROBOT_SOLREF, skid=skid))
+        contact["solref"] = np.array(
+            contact_solref(tags, total_mass / wheels, timestep=MAX_STEP, default=ROBOT_SOLREF, skid=skid)
+        )
         contact["solimp"] = np.array(contact_solimp(tags, default=ROBOT_SOLIMP, skid=skid))
         for i, shape in enumerate(link.collisions):
-            g = geoms.add(body, shape, f"{where} collision {i}", friction=np.array([mu, 0.005, 0.0001]),
-                          condim=condim, **contact)
+            g = geoms.add(
+                body, shape, f"{where} collision {i}", friction=np.array([mu, 0.005, 0.0001]), condim=condim, **contact
+            )
             if shape.geometry.kind == "cylinder" and axis is not None:
                 cyl_axis = matrix_from_rpy(*shape.origin.rpy)[:, 2]
                 if abs(float(cyl_axis @ axis)) > 0.99:  # a wheel: see WHEEL_FLOOR_SPHERES
                     g.contype, g.conaffinity = _CONTACT_BITS["wheel"]
                     floor = Shape(Geometry("sphere", (float(shape.geometry.size[0]),)), origin=shape.origin)
-                    f = geoms.add(body, floor, f"{where} collision {i}", friction=np.array([mu, 0.005, 0.0001]),
-                                  condim=condim, **contact)
+                    f = geoms.add(
+                        body,
+                        floor,
+                        f"{where} collision {i}",
+                        friction=np.array([mu, 0.005, 0.0001]),
+                        condim=condim,
+                        **contact,
+                    )
                     f.contype, f.conaffinity = _CONTACT_BITS["wheel_floor"]
         shown = (link.visuals or link.collisions) if info.visuals else []
         for i, shape in enumerate(shown):
@@ -373,8 +375,13 @@ def _wheel_inertia(robot: RobotModel, joint: Joint) -> float:
     own = 0.0
     inertial = robot.links[joint.child].inertial
     if inertial is not None:
-        tensor = np.array([[inertial.ixx, inertial.ixy, inertial.ixz], [inertial.ixy, inertial.iyy, inertial.iyz],
-                           [inertial.ixz, inertial.iyz, inertial.izz]])
+        tensor = np.array(
+            [
+                [inertial.ixx, inertial.ixy, inertial.ixz],
+                [inertial.ixy, inertial.iyy, inertial.iyz],
+                [inertial.ixz, inertial.iyz, inertial.izz],
+            ]
+        )
         rot = matrix_from_rpy(*inertial.origin.rpy)
         axis = np.asarray(joint.axis, dtype=float) / np.linalg.norm(joint.axis)
         com = np.asarray(inertial.origin.xyz, dtype=float)

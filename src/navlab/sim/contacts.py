@@ -15,8 +15,15 @@ from navlab.core import Executor, Node
 class CollisionPlugin(Node):
     """Reports the robot's contacts with world models on ``/collisions`` (see the module docstring)."""
 
-    def __init__(self, executor: Executor, *, name: str = "collisions", parameters: dict[str, Any] | None = None,
-                 namespace: str = "", sim: Any = None) -> None:  # fmt: skip
+    def __init__(
+        self,
+        executor: Executor,
+        *,
+        name: str = "collisions",
+        parameters: dict[str, Any] | None = None,
+        namespace: str = "",
+        sim: Any = None,
+    ) -> None:
         super().__init__(executor, name=name, parameters=parameters, namespace=namespace)
         rate = float(self.declare_parameter("rate", 20.0))
         self.sim = sim

@@ -47,11 +47,16 @@ from navlab.world import WorldModel
 
 #: CoACD's concavity threshold (smaller: more, tighter parts)
 THRESHOLD = 0.05
-#: CoACD options per effort level: "full" is CoACD's defaults (navlab before issue 13), "bounded" the default
+#: CoACD options per effort level: "full" is CoACD's defaults (navlab before bounded effort), "bounded" the default
 EFFORTS: dict[str, dict[str, Any]] = {
     "full": {},
-    "bounded": {"preprocess_resolution": 30, "resolution": 500, "mcts_nodes": 6, "mcts_iterations": 20,
-                "mcts_max_depth": 2},
+    "bounded": {
+        "preprocess_resolution": 30,
+        "resolution": 500,
+        "mcts_nodes": 6,
+        "mcts_iterations": 20,
+        "mcts_max_depth": 2,
+    },
 }
 DEFAULT_EFFORT = "bounded"  # unless $NAVLAB_DECOMPOSE_EFFORT names another of EFFORTS
 _VERSION = "1"  # bump when the way parts are computed changes (invalidates the cache)
@@ -128,8 +133,15 @@ def local_cut(origin: Origin | None, reach: float | None) -> float | None:
     return round(float(reach) - float(m[2, 3]), 3)
 
 
-def cache_file(path: Path, scale: tuple[float, float, float] = (1.0, 1.0, 1.0), *, threshold: float = THRESHOLD,
-               seed: int = 0, effort: str | None = None, cut: float | None = None) -> Path:
+def cache_file(
+    path: Path,
+    scale: tuple[float, float, float] = (1.0, 1.0, 1.0),
+    *,
+    threshold: float = THRESHOLD,
+    seed: int = 0,
+    effort: str | None = None,
+    cut: float | None = None,
+) -> Path:
     """Where the parts of this mesh (by content), scale, options and clipping height ``cut`` (m in
     the mesh's frame, None: whole) are cached (``effort`` None: :func:`default_effort`)."""
     effort = effort or default_effort()
@@ -163,8 +175,9 @@ def _coacd(path: Path, verts: np.ndarray, faces: np.ndarray, threshold: float, s
     return [(np.asarray(v, dtype=float), np.asarray(f, dtype=np.int32)) for v, f in result]
 
 
-def _compute(path: Path, scale: tuple[float, float, float], threshold: float, seed: int, effort: str,
-             cut: float | None = None) -> Parts:
+def _compute(
+    path: Path, scale: tuple[float, float, float], threshold: float, seed: int, effort: str, cut: float | None = None
+) -> Parts:
     from navlab.description.meshes import read_mesh
 
     verts, faces = read_mesh(Path(path))
@@ -188,8 +201,13 @@ def _store(cached: Path, parts: Parts) -> None:
 
 
 def convex_parts(
-    path: Path, scale: tuple[float, float, float] = (1.0, 1.0, 1.0), *, threshold: float = THRESHOLD,
-    seed: int = 0, effort: str | None = None, cut: float | None = None,
+    path: Path,
+    scale: tuple[float, float, float] = (1.0, 1.0, 1.0),
+    *,
+    threshold: float = THRESHOLD,
+    seed: int = 0,
+    effort: str | None = None,
+    cut: float | None = None,
 ) -> Parts:
     """Convex parts (vertices (n, 3) in m, triangles (m, 3)) of the mesh file scaled by ``scale``;
     with ``cut`` (m, mesh frame) only the part below it is decomposed (see the module docstring).
@@ -205,8 +223,9 @@ def convex_parts(
     return parts
 
 
-def _worker(path: str, scale: tuple[float, float, float], threshold: float, seed: int, effort: str,
-            cut: float | None = None) -> int:
+def _worker(
+    path: str, scale: tuple[float, float, float], threshold: float, seed: int, effort: str, cut: float | None = None
+) -> int:
     """Decompose one mesh into the cache (in a worker process); returns the number of parts."""
     return len(convex_parts(Path(path), scale, threshold=threshold, seed=seed, effort=effort, cut=cut))
 
@@ -332,8 +351,9 @@ def _main_not_reimported() -> Iterator[None]:
     script without an ``if __name__ == "__main__":`` guard would then start workers of its own and crash.
     The workers need only navlab's own modules."""
     main = sys.modules.get("__main__")
-    saved: dict[str, Any] = {k: main.__dict__[k] for k in ("__file__", "__spec__")
-                             if main is not None and k in main.__dict__}
+    saved: dict[str, Any] = {
+        k: main.__dict__[k] for k in ("__file__", "__spec__") if main is not None and k in main.__dict__
+    }
     try:
         if main is not None:
             main.__dict__.pop("__file__", None)
@@ -346,22 +366,36 @@ def _main_not_reimported() -> Iterator[None]:
                 main.__dict__.pop("__spec__", None)
 
 
-def decompose_meshes(meshes: Sequence[MeshKey] | Iterable[MeshKey], *, workers: int | None = None,
-                     progress: bool | None = None, threshold: float = THRESHOLD, seed: int = 0,
-                     effort: str | None = None) -> int:
+def decompose_meshes(
+    meshes: Sequence[MeshKey] | Iterable[MeshKey],
+    *,
+    workers: int | None = None,
+    progress: bool | None = None,
+    threshold: float = THRESHOLD,
+    seed: int = 0,
+    effort: str | None = None,
+) -> int:
     """Fill the cache for every (mesh, scale) not in it yet, ``workers`` processes at a time (default:
     :func:`default_workers`), with a progress bar and time estimate (``progress`` None: on a terminal).
     Returns how many meshes were decomposed."""
     effort = effort or default_effort()
-    todo = [(p, s, c) for p, s, c in meshes
-            if not cache_file(p, s, threshold=threshold, seed=seed, effort=effort, cut=c).is_file()]
+    todo = [
+        (p, s, c)
+        for p, s, c in meshes
+        if not cache_file(p, s, threshold=threshold, seed=seed, effort=effort, cut=c).is_file()
+    ]
     if not todo:
         return 0
     from tqdm import tqdm
 
     n_workers = min(workers or default_workers(), len(todo))
-    bar = tqdm(total=len(todo), desc=f"decomposing {len(todo)} concave meshes (once; cached)", unit="mesh",
-               disable=None if progress is None else not progress, leave=False)
+    bar = tqdm(
+        total=len(todo),
+        desc=f"decomposing {len(todo)} concave meshes (once; cached)",
+        unit="mesh",
+        disable=None if progress is None else not progress,
+        leave=False,
+    )
     try:
         if n_workers <= 1:
             for path, scale, cut in todo:
@@ -383,8 +417,9 @@ def decompose_meshes(meshes: Sequence[MeshKey] | Iterable[MeshKey], *, workers: 
     return len(todo)
 
 
-def decompose_world(world: WorldModel, *, reach: float | None = None, workers: int | None = None,
-                    progress: bool | None = None) -> int:
+def decompose_world(
+    world: WorldModel, *, reach: float | None = None, workers: int | None = None, progress: bool | None = None
+) -> int:
     """Decompose the world's uncached concave collision meshes (up to ``reach``, see
     :func:`concave_meshes`) before its scene is built (see :func:`decompose_meshes`); returns how
     many were decomposed."""

@@ -26,12 +26,14 @@ ODOM_COVARIANCE_DIAG = (1e-5, 1e-5, 1e12, 1e12, 1e12, 1e-3)
 
 def _check_geometry(separation: float, diameter: float) -> None:
     if not (math.isfinite(separation) and separation > 0 and math.isfinite(diameter) and diameter > 0):
-        raise SimError(f"diff drive: wheel separation {separation} m and wheel diameter {diameter} m: "
-                       "expected finite numbers > 0")
+        raise SimError(
+            f"diff drive: wheel separation {separation} m and wheel diameter {diameter} m: expected finite numbers > 0"
+        )
 
 
-def wheel_speeds(v: float, w: float, separation: float, diameter: float, *,
-                 legacy_mode: bool = False) -> tuple[float, float]:
+def wheel_speeds(
+    v: float, w: float, separation: float, diameter: float, *, legacy_mode: bool = False
+) -> tuple[float, float]:
     """(left joint, right joint) angular velocities (rad/s) for body speed ``v`` (m/s) and yaw rate ``w``
     (rad/s). ``legacy_mode`` (ROS 1's ``<legacyMode>``): the two joints' turning terms are swapped."""
     _check_geometry(separation, diameter)
@@ -58,9 +60,14 @@ def ramp(current: float, target: float, max_accel: float, dt: float) -> float:
     return current + max(-step, min(step, target - current))
 
 
-def noetic_wheel_commands(targets: tuple[float, float], measured: tuple[float, float],
-                          instructed: tuple[float, float], max_accel: float, dt: float,
-                          near: float) -> tuple[tuple[float, float], tuple[float, float]]:
+def noetic_wheel_commands(
+    targets: tuple[float, float],
+    measured: tuple[float, float],
+    instructed: tuple[float, float],
+    max_accel: float,
+    dt: float,
+    near: float,
+) -> tuple[tuple[float, float], tuple[float, float]]:
     """The wheel velocity commands ROS Noetic's gazebo_ros_diff_drive sets with ``wheelAcceleration``.
 
     All speeds in the same unit (navlab: rad/s of the joints). With no limit (``max_accel`` 0), or when
@@ -71,8 +78,10 @@ def noetic_wheel_commands(targets: tuple[float, float], measured: tuple[float, f
     if max_accel <= 0 or abs(targets[0] - measured[0]) < near or abs(targets[1] - measured[1]) < near:
         return targets, instructed
     step = max_accel * dt
-    ramped = (instructed[0] + max(-step, min(step, targets[0] - measured[0])),
-              instructed[1] + max(-step, min(step, targets[1] - measured[1])))
+    ramped = (
+        instructed[0] + max(-step, min(step, targets[0] - measured[0])),
+        instructed[1] + max(-step, min(step, targets[1] - measured[1])),
+    )
     return ramped, ramped
 
 

@@ -101,8 +101,10 @@ def parse_disturbances(params: dict[str, Any], *, where: str = "disturbances") -
         out.slip_rate = _num(params["slip_rate"], f"{where}.slip_rate", low=0.0, strict=True)
     patches = params.get("slip_patches") or []
     if not isinstance(patches, list):
-        raise SimError(f"{where}.slip_patches: expected a list of {{x, y, size_x, size_y, mu}} or "
-                       f"{{x, y, radius, mu}}, got {patches!r}")  # fmt: skip
+        raise SimError(
+            f"{where}.slip_patches: expected a list of {{x, y, size_x, size_y, mu}} or "
+            f"{{x, y, radius, mu}}, got {patches!r}"
+        )
     for k, raw in enumerate(patches):
         w = f"{where}.slip_patches[{k}]"
         if not isinstance(raw, dict):
@@ -181,9 +183,17 @@ class SlipPatchPlugin(Node):
     ``wheel_friction`` holds the current (left, right) sliding friction, for tests and monitors.
     """
 
-    def __init__(self, executor: Executor, *, name: str = "slip_patches", parameters: dict[str, Any] | None = None,
-                 namespace: str = "", sim: Simulation, patches: list[SlipPatch],
-                 rate: float = 100.0) -> None:  # fmt: skip
+    def __init__(
+        self,
+        executor: Executor,
+        *,
+        name: str = "slip_patches",
+        parameters: dict[str, Any] | None = None,
+        namespace: str = "",
+        sim: Simulation,
+        patches: list[SlipPatch],
+        rate: float = 100.0,
+    ) -> None:
         super().__init__(executor, name=name, parameters=parameters, namespace=namespace)
         assert sim.robot is not None
         self.sim, self.patches = sim, list(patches)
@@ -202,8 +212,9 @@ class SlipPatchPlugin(Node):
         self._geoms, self._base_mu = [], []
         for link in self.links:
             b = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, self.sim.info.link_bodies[link])
-            g = np.flatnonzero((m.geom_bodyid == b) & (m.geom_type == mujoco.mjtGeom.mjGEOM_SPHERE)
-                               & (m.geom_contype != 0))  # fmt: skip
+            g = np.flatnonzero(
+                (m.geom_bodyid == b) & (m.geom_type == mujoco.mjtGeom.mjGEOM_SPHERE) & (m.geom_contype != 0)
+            )
             if g.size == 0:
                 raise SimError(f"slip patches: wheel link {link!r} has no floor contact geom")
             self._geoms.append(g)

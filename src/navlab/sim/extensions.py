@@ -42,8 +42,9 @@ class SimExtensions:
 
     def __init__(self, node: Node) -> None:
         tops = {k.split(".")[0] for k in node.list_parameters() if "." in k}
-        self.controllers = find_controllers({f"{t}.{k}": v for t in tops for k, v in
-                                             node.get_parameters_by_prefix(t).items()})
+        self.controllers = find_controllers(
+            {f"{t}.{k}": v for t in tops for k, v in node.get_parameters_by_prefix(t).items()}
+        )
         self.controller_name = self.controllers.diff_drive or ""
         self.controller = node.get_parameters_by_prefix(self.controller_name) if self.controller_name else {}
         ros_control = node.get_parameters_by_prefix("gazebo_ros_control")
@@ -56,11 +57,14 @@ class SimExtensions:
         gains = _nest(ros_control)
         unknown = sorted(set(gains) - {"pid_gains"})
         if unknown:
-            raise SimError(f"{where}: unknown gazebo_ros_control parameter(s) {unknown} "
-                           "(known: control_period, pid_gains.<joint>.{p,i,d,i_clamp})")  # fmt: skip
+            raise SimError(
+                f"{where}: unknown gazebo_ros_control parameter(s) {unknown} "
+                "(known: control_period, pid_gains.<joint>.{p,i,d,i_clamp})"
+            )
         self.pid_gains: dict[str, Any] = gains.get("pid_gains", {})
-        self.disturbances = parse_disturbances(_nest(node.get_parameters_by_prefix("disturbances")),
-                                               where=f"{where}: disturbances")  # fmt: skip
+        self.disturbances = parse_disturbances(
+            _nest(node.get_parameters_by_prefix("disturbances")), where=f"{where}: disturbances"
+        )
 
     def robot(self, robot: RobotModel) -> RobotModel:
         """The robot as simulated: a ``gazebo_ros_control`` robot's drive from its diff-drive controller; wheel
@@ -77,12 +81,20 @@ class SimExtensions:
 
         assert sim.robot is not None and sim.robot.diff_drive is not None
         ros_control = sim.robot.ros_control
-        period = self.control_period if ros_control is None or not ros_control.control_period \
-            else ros_control.control_period
-        return DiffDriveController(executor, name=self.controller_name, parameters=self.controller,
-                                   namespace=namespace, sim=sim, config=sim.robot.diff_drive,
-                                   pid_gains=self.pid_gains, control_period=period,
-                                   velocity_interface=ros_control is not None)  # fmt: skip
+        period = (
+            self.control_period if ros_control is None or not ros_control.control_period else ros_control.control_period
+        )
+        return DiffDriveController(
+            executor,
+            name=self.controller_name,
+            parameters=self.controller,
+            namespace=namespace,
+            sim=sim,
+            config=sim.robot.diff_drive,
+            pid_gains=self.pid_gains,
+            control_period=period,
+            velocity_interface=ros_control is not None,
+        )
 
     def plugins(self, executor: Executor, namespace: str, sim: Simulation) -> list[Node]:
         """Apply the payload; the slip-patch node when there are patches."""

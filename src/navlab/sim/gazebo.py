@@ -34,8 +34,9 @@ def load_world_named(name_or_path: str) -> WorldModel:
 def _moved(name: str, new: str) -> None:
     import warnings
 
-    warnings.warn(f"navlab.sim.{name} moved to {new}; the old name works until the next release",
-                  DeprecationWarning, stacklevel=3)
+    warnings.warn(
+        f"navlab.sim.{name} moved to {new}; the old name works until the next release", DeprecationWarning, stacklevel=3
+    )
 
 
 class GazeboSim(Node):
@@ -51,15 +52,21 @@ class GazeboSim(Node):
     false: neither the diff-drive plugin nor the wheel controller sends tf odom → base, an EKF owns it).
     ``robot_model``/``world_model`` replace the files."""
 
-    def __init__(self, executor: Executor, *, name: str = "gazebo", parameters: dict[str, Any] | None = None,
-                 namespace: str = "", robot_model: RobotModel | None = None,
-                 world_model: WorldModel | None = None) -> None:
+    def __init__(
+        self,
+        executor: Executor,
+        *,
+        name: str = "gazebo",
+        parameters: dict[str, Any] | None = None,
+        namespace: str = "",
+        robot_model: RobotModel | None = None,
+        world_model: WorldModel | None = None,
+    ) -> None:
         super().__init__(executor, name=name, parameters=parameters, namespace=namespace)
         world_name = self.declare_parameter("world", "room")
         robot_name = self.declare_parameter("robot", "mybot")
         robot_args = [str(a) for a in self.declare_parameter("robot_args", [])]
-        pose = (self.declare_parameter("x", 0.0), self.declare_parameter("y", 0.0),
-                self.declare_parameter("yaw", 0.0))
+        pose = (self.declare_parameter("x", 0.0), self.declare_parameter("y", 0.0), self.declare_parameter("yaw", 0.0))
         timestep = self.declare_parameter("timestep", 0.0)
         js_rate = self.declare_parameter("joint_state_rate", 30.0)
         gt_rate = self.declare_parameter("ground_truth_rate", 50.0)
@@ -77,8 +84,14 @@ class GazeboSim(Node):
             self.get_logger().warning(warning)
         check_start_pose(robot, world, pose)  # a start inside an obstacle is refused, not thrown 7 m
         self.robot = robot
-        self.sim = Simulation(robot, world, seed=self.rng, timestep=timestep or None, robot_pose=pose,
-                              visuals=visuals or bool(robot.sensors.cameras))  # cameras draw visuals
+        self.sim = Simulation(
+            robot,
+            world,
+            seed=self.rng,
+            timestep=timestep or None,
+            robot_pose=pose,
+            visuals=visuals or bool(robot.sensors.cameras),
+        )  # cameras draw visuals
         self.sim.time_ns = executor.now_ns  # started late: physics time begins at the current time
         for warning in self.sim.info.warnings:
             self.get_logger().warning(warning)
@@ -94,23 +107,42 @@ class GazeboSim(Node):
                 if extensions.controller:
                     extensions.controller["enable_odom_tf"] = False
             drive = extensions.drive_plugin(executor, namespace, self.sim)
-            self.plugins.append(drive or DiffDrivePlugin(executor, namespace=namespace, sim=self.sim,
-                                                         config=robot.diff_drive))
-        self.plugins += [LidarPlugin(executor, namespace=namespace, sim=self.sim, index=i)
-                         for i in range(len(robot.lidars))]
-        self.plugins += [ImuSensorPlugin(executor, namespace=namespace, sim=self.sim, index=i)
-                         for i in range(len(robot.imus))]
-        self.plugins.append(JointStatePlugin(executor, parameters={"publish_frequency": js_rate}, namespace=namespace,
-                                             sim=self.sim))
+            self.plugins.append(
+                drive or DiffDrivePlugin(executor, namespace=namespace, sim=self.sim, config=robot.diff_drive)
+            )
+        self.plugins += [
+            LidarPlugin(executor, namespace=namespace, sim=self.sim, index=i) for i in range(len(robot.lidars))
+        ]
+        self.plugins += [
+            ImuSensorPlugin(executor, namespace=namespace, sim=self.sim, index=i) for i in range(len(robot.imus))
+        ]
+        self.plugins.append(
+            JointStatePlugin(executor, parameters={"publish_frequency": js_rate}, namespace=namespace, sim=self.sim)
+        )
         self.plugins.append(RobotStatePublisher(executor, namespace=namespace, sim=self.sim))
         p3d_topics = {p.topic for p in robot.ground_truths}
         if gt_rate > 0 and "/ground_truth/odom" not in p3d_topics:  # navlab's own, for evaluation
             base = robot.diff_drive.robot_base_frame if robot.diff_drive else robot.root_link
-            self.plugins.append(GroundTruthPlugin(executor, parameters={"bodyName": base, "updateRate": gt_rate},
-                                                 namespace=namespace, sim=self.sim))
-        self.plugins += [GroundTruthPlugin(executor, name=p.name, namespace=namespace, sim=self.sim, parameters={
-            "bodyName": p.link, "topicName": p.topic, "frameName": p.frame_id, "updateRate": p.update_rate})
-            for p in robot.ground_truths]  # the robot's own p3d plugins
+            self.plugins.append(
+                GroundTruthPlugin(
+                    executor, parameters={"bodyName": base, "updateRate": gt_rate}, namespace=namespace, sim=self.sim
+                )
+            )
+        self.plugins += [
+            GroundTruthPlugin(
+                executor,
+                name=p.name,
+                namespace=namespace,
+                sim=self.sim,
+                parameters={
+                    "bodyName": p.link,
+                    "topicName": p.topic,
+                    "frameName": p.frame_id,
+                    "updateRate": p.update_rate,
+                },
+            )
+            for p in robot.ground_truths
+        ]  # the robot's own p3d plugins
         self.plugins += extensions.plugins(executor, namespace, self.sim)
         if robot.sensors.all():  # cameras, 3D lidars, ranges, bumpers (imported only for a robot that has them)
             from navlab.sim.sensor_plugins import sensor_plugins
@@ -165,8 +197,10 @@ class GazeboSim(Node):
                 name = request["name"] if "name" in request else request["kind"]
                 model = primitive_model(request["kind"], name, tuple(request["dims"]), **extra)
             else:
-                raise SimError(f"/spawn_entity: cannot spawn {request!r}; give a ModelSpec, a spec string "
-                               "or a dict with kind+dims or file")
+                raise SimError(
+                    f"/spawn_entity: cannot spawn {request!r}; give a ModelSpec, a spec string "
+                    "or a dict with kind+dims or file"
+                )
             self.spawn(model)
         except SimError as exc:
             return {"success": False, "status_message": str(exc)}

@@ -126,8 +126,16 @@ class ImuSensorPlugin(Node):
     configured topic every ``1/update_rate`` s, stamped with simulated time, in the IMU's frame
     (``frameName``/``bodyName``, else its link)."""
 
-    def __init__(self, executor: Executor, *, name: str = "", parameters: dict[str, Any] | None = None,
-                 namespace: str = "", sim: Simulation, index: int) -> None:  # fmt: skip
+    def __init__(
+        self,
+        executor: Executor,
+        *,
+        name: str = "",
+        parameters: dict[str, Any] | None = None,
+        namespace: str = "",
+        sim: Simulation,
+        index: int,
+    ) -> None:
         if sim.robot is None or not 0 <= index < len(sim.robot.imus):
             raise SimError(f"no imu number {index} on this robot")
         cfg = sim.robot.imus[index]
@@ -168,11 +176,14 @@ class ImuSensorPlugin(Node):
         if self._unread():
             return
         quat, gyro, accel = self.read()
-        self.pub.publish(msgs.Imu(
-            header=msgs.header(self.get_clock().now_ns(), self.frame_id),
-            orientation=msgs.quaternion_msg(quat), orientation_covariance=self.cov[0].copy(),
-            angular_velocity=msgs.Vector3(x=float(gyro[0]), y=float(gyro[1]), z=float(gyro[2])),
-            angular_velocity_covariance=self.cov[1].copy(),
-            linear_acceleration=msgs.Vector3(x=float(accel[0]), y=float(accel[1]), z=float(accel[2])),
-            linear_acceleration_covariance=self.cov[2].copy(),
-        ))  # fmt: skip
+        self.pub.publish(
+            msgs.Imu(
+                header=msgs.header(self.get_clock().now_ns(), self.frame_id),
+                orientation=msgs.quaternion_msg(quat),
+                orientation_covariance=self.cov[0].copy(),
+                angular_velocity=msgs.Vector3(x=float(gyro[0]), y=float(gyro[1]), z=float(gyro[2])),
+                angular_velocity_covariance=self.cov[1].copy(),
+                linear_acceleration=msgs.Vector3(x=float(accel[0]), y=float(accel[1]), z=float(accel[2])),
+                linear_acceleration_covariance=self.cov[2].copy(),
+            )
+        )

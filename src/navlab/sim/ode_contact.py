@@ -33,8 +33,9 @@ SKID_SOLIMP_D0 = 0.5
 SKID_SOLIMP_WIDTH = 0.002  # m: the impedance ramp's least width (1 mm still lets the robot hop)
 
 
-def contact_solref(tags: ContactTags | None, mass: float, *, timestep: float, default: tuple[float, float],
-                   skid: bool = False) -> tuple[float, float]:  # fmt: skip
+def contact_solref(
+    tags: ContactTags | None, mass: float, *, timestep: float, default: tuple[float, float], skid: bool = False
+) -> tuple[float, float]:
     """MuJoCo ``solref`` (time constant s, damping ratio) of a contact carrying ``mass`` (kg) with ODE's
     ``kp``/``kd``; ``default`` without ``kp``. The time constant is kept >= 2 ``timestep`` (MuJoCo's stable range);
     ``skid``: a skid-steer wheel, kept at least as soft as SKID_SOLREF_MIN."""

@@ -64,8 +64,16 @@ class DiffDrivePlugin(Node):
     true pose — and the tf ``odometry_frame → robot_base_frame``.
     """
 
-    def __init__(self, executor: Executor, *, name: str = "diff_drive", parameters: dict[str, Any] | None = None,
-                 namespace: str = "", sim: Simulation, config: DiffDriveConfig) -> None:
+    def __init__(
+        self,
+        executor: Executor,
+        *,
+        name: str = "diff_drive",
+        parameters: dict[str, Any] | None = None,
+        namespace: str = "",
+        sim: Simulation,
+        config: DiffDriveConfig,
+    ) -> None:
         super().__init__(executor, name=name, parameters=parameters, namespace=namespace or config.namespace)
         self.sim = sim
         self.cfg = config
@@ -115,7 +123,8 @@ class DiffDrivePlugin(Node):
         left, right = wheel_speeds(v, w, cfg.wheel_separation, cfg.wheel_diameter, legacy_mode=cfg.legacy_mode)
         measured = (self.sim.joint_velocity(cfg.left_joint), self.sim.joint_velocity(cfg.right_joint))
         self.wheel_targets, self.instructed = noetic_wheel_commands(
-            (left, right), measured, self.instructed, self.max_wheel_accel, dt, near=0.01 / (cfg.wheel_diameter / 2))
+            (left, right), measured, self.instructed, self.max_wheel_accel, dt, near=0.01 / (cfg.wheel_diameter / 2)
+        )
         self.sim.set_wheel_velocity_targets(*self.wheel_targets)
         self.publish_odometry(now, dt)
 
@@ -144,13 +153,17 @@ class DiffDrivePlugin(Node):
                 header=msgs.header(now, cfg.odometry_frame),
                 child_frame_id=cfg.robot_base_frame,
                 pose=msgs.PoseWithCovariance(
-                    pose=msgs.Pose(position=msgs.Point(x=float(position[0]), y=float(position[1]),
-                                                       z=float(position[2])), orientation=msgs.quaternion_msg(quat)),
+                    pose=msgs.Pose(
+                        position=msgs.Point(x=float(position[0]), y=float(position[1]), z=float(position[2])),
+                        orientation=msgs.quaternion_msg(quat),
+                    ),
                     covariance=_ODOM_COV.copy(),
                 ),
                 twist=msgs.TwistWithCovariance(
-                    twist=msgs.Twist(linear=msgs.Vector3(x=float(lin[0]), y=float(lin[1]), z=float(lin[2])),
-                                     angular=msgs.Vector3(x=float(ang[0]), y=float(ang[1]), z=float(ang[2]))),
+                    twist=msgs.Twist(
+                        linear=msgs.Vector3(x=float(lin[0]), y=float(lin[1]), z=float(lin[2])),
+                        angular=msgs.Vector3(x=float(ang[0]), y=float(ang[1]), z=float(ang[2])),
+                    ),
                     covariance=_ODOM_COV.copy(),
                 ),
             )
@@ -163,8 +176,16 @@ class LidarPlugin(Node):
     """``gazebo_ros_laser``: a ``sensor_msgs/LaserScan`` every ``1/update_rate`` s on the configured topic,
     for the robot's lidar number ``index`` (default name: the sensor's name + ``_plugin``)."""
 
-    def __init__(self, executor: Executor, *, name: str = "", parameters: dict[str, Any] | None = None,
-                 namespace: str = "", sim: Simulation, index: int) -> None:
+    def __init__(
+        self,
+        executor: Executor,
+        *,
+        name: str = "",
+        parameters: dict[str, Any] | None = None,
+        namespace: str = "",
+        sim: Simulation,
+        index: int,
+    ) -> None:
         assert sim.robot is not None
         cfg: LidarConfig = sim.robot.lidars[index]
         super().__init__(executor, name=name or f"{cfg.name}_plugin", parameters=parameters, namespace=namespace)
@@ -176,24 +197,42 @@ class LidarPlugin(Node):
         self.create_timer(max(1.0 / cfg.update_rate, sim.timestep), self.update)  # Gazebo: at most every step
         self._empty = np.zeros(0, dtype=np.float32)
         # the scan's fixed fields, converted once
-        self._fields = {"angle_min": float(cfg.min_angle), "angle_max": float(cfg.max_angle),
-                        "angle_increment": self.angle_increment, "time_increment": 0.0,
-                        "scan_time": 1.0 / cfg.update_rate, "range_min": float(cfg.range_min),
-                        "range_max": float(cfg.range_max)}  # fmt: skip
+        self._fields = {
+            "angle_min": float(cfg.min_angle),
+            "angle_max": float(cfg.max_angle),
+            "angle_increment": self.angle_increment,
+            "time_increment": 0.0,
+            "scan_time": 1.0 / cfg.update_rate,
+            "range_min": float(cfg.range_min),
+            "range_max": float(cfg.range_max),
+        }
 
     def update(self) -> None:
         """Cast the rays and publish the scan."""
         ranges = self.sim.scan(self.index, rng=self.rng)
-        self.pub.publish(msgs.LaserScan(header=msgs.header(self.executor.now_ns, self.frame_id), ranges=ranges,
-                                        intensities=self._empty, **self._fields))
+        self.pub.publish(
+            msgs.LaserScan(
+                header=msgs.header(self.executor.now_ns, self.frame_id),
+                ranges=ranges,
+                intensities=self._empty,
+                **self._fields,
+            )
+        )
 
 
 class JointStatePlugin(Node):
     """``gazebo_ros_joint_state_publisher``: ``/joint_states`` (position and velocity of the moving joints)
     every ``1/publish_frequency`` s (Hz, default 30; 0 = none), read from the simulator."""
 
-    def __init__(self, executor: Executor, *, name: str = "joint_state_publisher",
-                 parameters: dict[str, Any] | None = None, namespace: str = "", sim: Simulation) -> None:
+    def __init__(
+        self,
+        executor: Executor,
+        *,
+        name: str = "joint_state_publisher",
+        parameters: dict[str, Any] | None = None,
+        namespace: str = "",
+        sim: Simulation,
+    ) -> None:
         super().__init__(executor, name=name, parameters=parameters, namespace=namespace)
         assert sim.robot is not None
         self.sim = sim
@@ -207,8 +246,15 @@ class JointStatePlugin(Node):
         """Publish the joints' state."""
         pos = np.array([self.sim.joint_position(j) for j in self.joints])
         vel = np.array([self.sim.joint_velocity(j) for j in self.joints])
-        self.pub.publish(msgs.JointState(header=msgs.header(self.executor.now_ns, ""), name=list(self.joints),
-                                         position=pos, velocity=vel, effort=np.zeros(len(pos))))
+        self.pub.publish(
+            msgs.JointState(
+                header=msgs.header(self.executor.now_ns, ""),
+                name=list(self.joints),
+                position=pos,
+                velocity=vel,
+                effort=np.zeros(len(pos)),
+            )
+        )
 
 
 class RobotStatePublisher(Node):
@@ -216,13 +262,23 @@ class RobotStatePublisher(Node):
     child link) at the message's stamp; fixed joints and sensor frames once, as static tf. ``publish_tf``
     (default true; navlab's switch): the moving joints' tf."""
 
-    def __init__(self, executor: Executor, *, name: str = "robot_state_publisher",
-                 parameters: dict[str, Any] | None = None, namespace: str = "", sim: Simulation) -> None:
+    def __init__(
+        self,
+        executor: Executor,
+        *,
+        name: str = "robot_state_publisher",
+        parameters: dict[str, Any] | None = None,
+        namespace: str = "",
+        sim: Simulation,
+    ) -> None:
         super().__init__(executor, name=name, parameters=parameters, namespace=namespace)
         assert sim.robot is not None
         self.publish_tf = self.declare_parameter("publish_tf", True)
-        self.joints = {j.name: (j, _joint_constants(tuple(j.origin.rpy), tuple(j.origin.xyz), tuple(j.axis)))
-                       for j in sim.robot.joints if j.type != "fixed"}  # fmt: skip
+        self.joints = {
+            j.name: (j, _joint_constants(tuple(j.origin.rpy), tuple(j.origin.xyz), tuple(j.axis)))
+            for j in sim.robot.joints
+            if j.type != "fixed"
+        }
         self.send_static_transform(static_transforms(sim, executor.now_ns))
         self.create_subscription(msgs.JointState, "joint_states", self._on_joint_states, 10)
 
@@ -246,8 +302,9 @@ def joint_motion(joint: Any, q: float) -> tuple[tuple[float, float, float], tupl
     return _motion(joint.type, consts, q)
 
 
-def _motion(kind: str, consts: tuple[tuple, tuple, tuple],
-            q: float) -> tuple[tuple[float, float, float], tuple[float, float, float, float]]:
+def _motion(
+    kind: str, consts: tuple[tuple, tuple, tuple], q: float
+) -> tuple[tuple[float, float, float], tuple[float, float, float, float]]:
     """:func:`joint_motion` from a joint's type and :func:`_joint_constants`."""
     q0, (ox, oy, oz), (ax, ay, az) = consts
     if kind == "prismatic":  # translate along the axis, expressed in the parent via the origin
@@ -285,8 +342,15 @@ class GroundTruthPlugin(Node):
     (``/ground_truth/odom``), ``frameName`` (``world``), ``updateRate`` (Hz, 50).
     """
 
-    def __init__(self, executor: Executor, *, name: str = "ground_truth", parameters: dict[str, Any] | None = None,
-                 namespace: str = "", sim: Simulation) -> None:
+    def __init__(
+        self,
+        executor: Executor,
+        *,
+        name: str = "ground_truth",
+        parameters: dict[str, Any] | None = None,
+        namespace: str = "",
+        sim: Simulation,
+    ) -> None:
         super().__init__(executor, name=name, parameters=parameters, namespace=namespace)
         assert sim.robot is not None
         self.sim = sim
@@ -308,16 +372,19 @@ class GroundTruthPlugin(Node):
         if self._unread():
             return
         (px, py, pz), (qx, qy, qz, qw), (vx, vy, vz), (wx, wy, wz) = self.sim.link_state(self.link)
-        self.pub.publish(msgs.Odometry(
-            header=msgs.header(self.executor.now_ns, self.frame),
-            child_frame_id=self.base_frame,
-            pose=msgs.PoseWithCovariance(
-                pose=msgs.Pose(position=msgs.Point(x=px, y=py, z=pz),
-                               orientation=msgs.Quaternion(x=qx, y=qy, z=qz, w=qw)),
-                covariance=np.zeros(36),
-            ),
-            twist=msgs.TwistWithCovariance(
-                twist=msgs.Twist(linear=msgs.Vector3(x=vx, y=vy, z=vz), angular=msgs.Vector3(x=wx, y=wy, z=wz)),
-                covariance=np.zeros(36),
-            ),
-        ))  # fmt: skip
+        self.pub.publish(
+            msgs.Odometry(
+                header=msgs.header(self.executor.now_ns, self.frame),
+                child_frame_id=self.base_frame,
+                pose=msgs.PoseWithCovariance(
+                    pose=msgs.Pose(
+                        position=msgs.Point(x=px, y=py, z=pz), orientation=msgs.Quaternion(x=qx, y=qy, z=qz, w=qw)
+                    ),
+                    covariance=np.zeros(36),
+                ),
+                twist=msgs.TwistWithCovariance(
+                    twist=msgs.Twist(linear=msgs.Vector3(x=vx, y=vy, z=vz), angular=msgs.Vector3(x=wx, y=wy, z=wz)),
+                    covariance=np.zeros(36),
+                ),
+            )
+        )

@@ -219,7 +219,12 @@ def cast_planar(
 
 @njit(cache=True)
 def finish_ranges(
-    dist: np.ndarray, normals: np.ndarray, mean: float, stddev: float, range_min: float, range_max: float,
+    dist: np.ndarray,
+    normals: np.ndarray,
+    mean: float,
+    stddev: float,
+    range_min: float,
+    range_max: float,
     out: np.ndarray,
 ) -> None:
     """``out`` (float32) = hits + mean + stddev·normals clamped to [range_min, range_max]; misses stay inf."""

@@ -33,8 +33,16 @@ def _half_extents(kind: int, size: np.ndarray) -> tuple[float, float, float]:
 
 
 @njit(cache=True)
-def _plane_rows(centre: np.ndarray, xm: np.ndarray, rot: np.ndarray, origin: np.ndarray, params: np.ndarray,
-                rows: int, cols: int, bounds: np.ndarray) -> bool:
+def _plane_rows(
+    centre: np.ndarray,
+    xm: np.ndarray,
+    rot: np.ndarray,
+    origin: np.ndarray,
+    params: np.ndarray,
+    rows: int,
+    cols: int,
+    bounds: np.ndarray,
+) -> bool:
     """The image rows whose rays can reach a plane (the camera's side of it faces them): below the horizon of a
     floor. Pixel (u, v)'s ray is f x - (u - u0) y - (v - v0) z in the sensor frame (x forward, y left, z up)."""
     nx, ny, nz = xm[2], xm[5], xm[8]  # the plane's normal in the world
@@ -62,8 +70,19 @@ def _plane_rows(centre: np.ndarray, xm: np.ndarray, rot: np.ndarray, origin: np.
 
 
 @njit(cache=True)
-def _block(kind: int, size: np.ndarray, centre: np.ndarray, xm: np.ndarray, rot: np.ndarray, origin: np.ndarray,
-           mode: int, params: np.ndarray, rows: int, cols: int, bounds: np.ndarray) -> bool:
+def _block(
+    kind: int,
+    size: np.ndarray,
+    centre: np.ndarray,
+    xm: np.ndarray,
+    rot: np.ndarray,
+    origin: np.ndarray,
+    mode: int,
+    params: np.ndarray,
+    rows: int,
+    cols: int,
+    bounds: np.ndarray,
+) -> bool:
     """Fill ``bounds`` (r0, r1, c0, c1, wrap) with the grid block that may see the geom; False if none."""
     bounds[0], bounds[1], bounds[2], bounds[3], bounds[4] = 0, rows - 1, 0, cols - 1, 0
     if mode == PINHOLE and kind == PLANE:
@@ -162,9 +181,23 @@ def _lower_bound(kind: int, size: np.ndarray, p: np.ndarray) -> float:
 
 
 @njit(cache=True)
-def cast_grid(origin: np.ndarray, rot: np.ndarray, dirs: np.ndarray, rows: int, cols: int, mode: int,
-              params: np.ndarray, geoms: np.ndarray, geom_type: np.ndarray, geom_size: np.ndarray,
-              geom_xpos: np.ndarray, geom_xmat: np.ndarray, tmin: float, tmax: float, out: np.ndarray) -> None:
+def cast_grid(
+    origin: np.ndarray,
+    rot: np.ndarray,
+    dirs: np.ndarray,
+    rows: int,
+    cols: int,
+    mode: int,
+    params: np.ndarray,
+    geoms: np.ndarray,
+    geom_type: np.ndarray,
+    geom_size: np.ndarray,
+    geom_xpos: np.ndarray,
+    geom_xmat: np.ndarray,
+    tmin: float,
+    tmax: float,
+    out: np.ndarray,
+) -> None:
     """``out`` (rows*cols) = distance (m) along each ray ``dirs`` (rows*cols x 3, unit, sensor frame ``rot`` whose
     columns are the sensor axes in world, at world ``origin``) to the nearest geom of ``geoms``; inf if none.
 
@@ -184,8 +217,11 @@ def cast_grid(origin: np.ndarray, rot: np.ndarray, dirs: np.ndarray, rows: int, 
         if not _block(kind, geom_size[g], geom_xpos[g], xm, rot, origin, mode, params, rows, cols, bounds):
             continue
         for k in range(3):
-            p_loc[gi, k] = (xm[k] * (origin[0] - geom_xpos[g, 0]) + xm[3 + k] * (origin[1] - geom_xpos[g, 1])
-                            + xm[6 + k] * (origin[2] - geom_xpos[g, 2]))
+            p_loc[gi, k] = (
+                xm[k] * (origin[0] - geom_xpos[g, 0])
+                + xm[3 + k] * (origin[1] - geom_xpos[g, 1])
+                + xm[6 + k] * (origin[2] - geom_xpos[g, 2])
+            )
             for a in range(3):
                 m[gi, k, a] = xm[k] * rot[0, a] + xm[3 + k] * rot[1, a] + xm[6 + k] * rot[2, a]
         near[gi] = _lower_bound(kind, geom_size[g], p_loc[gi])
@@ -229,8 +265,11 @@ def cast_grid(origin: np.ndarray, rot: np.ndarray, dirs: np.ndarray, rows: int, 
                     break
                 if r < blocks_o[j, 0] or r > blocks_o[j, 1]:
                     continue
-                if not ((blocks_o[j, 2] <= c <= blocks_o[j, 3]) or (blocks_o[j, 4] <= c <= blocks_o[j, 5])
-                        or (blocks_o[j, 6] <= c <= blocks_o[j, 7])):
+                if not (
+                    (blocks_o[j, 2] <= c <= blocks_o[j, 3])
+                    or (blocks_o[j, 4] <= c <= blocks_o[j, 5])
+                    or (blocks_o[j, 6] <= c <= blocks_o[j, 7])
+                ):
                     continue
                 for k in range(3):
                     d_loc[k] = m_o[j, k, 0] * dx + m_o[j, k, 1] * dy + m_o[j, k, 2] * dz

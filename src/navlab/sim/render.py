@@ -32,8 +32,11 @@ def _world_extent(sim: Simulation) -> tuple[np.ndarray, float]:
 
     m, d = sim.model, sim.data
     plane = mujoco.mjtGeom.mjGEOM_PLANE
-    geoms = [g for g in range(m.ngeom)
-             if m.geom_group[g] == GROUP_VISUAL and m.geom_type[g] != plane and m.geom_bodyid[g] == 0]
+    geoms = [
+        g
+        for g in range(m.ngeom)
+        if m.geom_group[g] == GROUP_VISUAL and m.geom_type[g] != plane and m.geom_bodyid[g] == 0
+    ]
     if not geoms:
         return np.zeros(3), 3.0
     lo, hi = np.full(2, np.inf), np.full(2, -np.inf)

@@ -98,8 +98,10 @@ def _wheel_radius(robot: RobotModel, joint: str) -> float:
     for shape in robot.links[j.child].collisions:
         if shape.geometry.kind in ("cylinder", "sphere"):
             return float(shape.geometry.size[0])
-    raise SimError(f"diff_drive_controller: wheel_radius not given and wheel link {j.child!r} has no cylinder or "
-                   "sphere collision to read it from")  # fmt: skip
+    raise SimError(
+        f"diff_drive_controller: wheel_radius not given and wheel link {j.child!r} has no cylinder or "
+        "sphere collision to read it from"
+    )
 
 
 def drive_from_controller(robot: RobotModel, params: dict[str, Any]) -> DiffDriveConfig:
@@ -112,10 +114,19 @@ def drive_from_controller(robot: RobotModel, params: dict[str, Any]) -> DiffDriv
     radius = float(params.get("wheel_radius") or 0.0) or _wheel_radius(robot, lefts[0])
     efforts = [j.effort for j in robot.joints if j.name in (*lefts, *rights) and j.effort]
     return DiffDriveConfig(
-        left_joint=lefts[0], right_joint=rights[0], extra_left_joints=lefts[1:], extra_right_joints=rights[1:],
-        wheel_separation=separation, wheel_diameter=2.0 * radius,
+        left_joint=lefts[0],
+        right_joint=rights[0],
+        extra_left_joints=lefts[1:],
+        extra_right_joints=rights[1:],
+        wheel_separation=separation,
+        wheel_diameter=2.0 * radius,
         max_torque=float(min(efforts)) if efforts else DiffDriveConfig.max_torque,
-        command_topic="cmd_vel", odometry_topic="odom", odometry_frame=str(params.get("odom_frame_id", "odom")),
-        robot_base_frame=str(params.get("base_frame_id") or "base_link"), odometry_source="encoder",
-        publish_tf=bool(params.get("enable_odom_tf", True)), legacy_mode=False, drive="gazebo_ros_control",
-    )  # fmt: skip
+        command_topic="cmd_vel",
+        odometry_topic="odom",
+        odometry_frame=str(params.get("odom_frame_id", "odom")),
+        robot_base_frame=str(params.get("base_frame_id") or "base_link"),
+        odometry_source="encoder",
+        publish_tf=bool(params.get("enable_odom_tf", True)),
+        legacy_mode=False,
+        drive="gazebo_ros_control",
+    )

@@ -65,6 +65,7 @@ def add_world_model(spec: mujoco.MjSpec, model: ModelSpec, info: BuildInfo) -> l
 
         def place(shape: Shape, _offset: Origin | None = offset) -> Shape:
             return shape if _offset is None else replace(shape, origin=_offset.then(shape.origin))
+
         mu = DEFAULT_MU if link.mu1 is None else float(link.mu1)
         friction = np.array([mu, 0.005, 0.0001])
         for i, shape in enumerate(link.collisions):
@@ -74,16 +75,25 @@ def add_world_model(spec: mujoco.MjSpec, model: ModelSpec, info: BuildInfo) -> l
                 extra["mass"] = 1.0 / len(link.collisions)  # Gazebo's default link mass: 1 kg
             if shape.geometry.kind == "mesh":
                 # the true triangles for rays; the hull (or, if concave, convex parts) for contacts
-                geoms.add(body, place(shape), cwhere, contype=0, conaffinity=0, group=GROUP_RAY_MESH, mass=0.0,
-                          name=f"{scoped}::ray{i}")
+                geoms.add(
+                    body,
+                    place(shape),
+                    cwhere,
+                    contype=0,
+                    conaffinity=0,
+                    group=GROUP_RAY_MESH,
+                    mass=0.0,
+                    name=f"{scoped}::ray{i}",
+                )
                 geom_names.append(f"{scoped}::ray{i}")
                 hull_props = {**props, "group": GROUP_WORLD_HULL}
                 if getattr(shape.geometry, "convex", None) is False:
                     from navlab.sim.decompose import local_cut
 
                     cut = local_cut(place(shape).origin if model.static else None, info.decompose_reach)
-                    _add_convex_parts(spec, body, place(shape), cwhere, f"{scoped}::collision{i}", hull_props,
-                                      extra, geom_names, cut)
+                    _add_convex_parts(
+                        spec, body, place(shape), cwhere, f"{scoped}::collision{i}", hull_props, extra, geom_names, cut
+                    )
                     continue
                 geoms.add(body, place(shape), cwhere, **hull_props, **extra)
             else:
@@ -104,9 +114,17 @@ def add_world_model(spec: mujoco.MjSpec, model: ModelSpec, info: BuildInfo) -> l
     return bodies or geom_names
 
 
-def _add_convex_parts(spec: mujoco.MjSpec, body: mujoco.MjsBody, shape: Shape, where: str, name: str,
-                      props: dict[str, object], extra: dict[str, object], names: list[str],
-                      cut: float | None = None) -> None:
+def _add_convex_parts(
+    spec: mujoco.MjSpec,
+    body: mujoco.MjsBody,
+    shape: Shape,
+    where: str,
+    name: str,
+    props: dict[str, object],
+    extra: dict[str, object],
+    names: list[str],
+    cut: float | None = None,
+) -> None:
     """Collide a concave mesh as its convex parts, decomposed below ``cut`` (m in the mesh's frame;
     None: whole) only (see navlab.sim.decompose)."""
     from navlab.sim.decompose import convex_parts
@@ -146,19 +164,38 @@ def _add_scenery(spec: mujoco.MjSpec, world: WorldModel) -> None:
     spec.option.gravity = np.asarray(world.gravity, dtype=float)
     spec.visual.headlight.ambient = np.array([0.35, 0.35, 0.35])
     spec.add_texture(
-        name="grid", type=mujoco.mjtTexture.mjTEXTURE_2D, builtin=mujoco.mjtBuiltin.mjBUILTIN_CHECKER,
-        rgb1=np.array([0.62, 0.62, 0.62]), rgb2=np.array([0.55, 0.55, 0.55]), width=256, height=256,
+        name="grid",
+        type=mujoco.mjtTexture.mjTEXTURE_2D,
+        builtin=mujoco.mjtBuiltin.mjBUILTIN_CHECKER,
+        rgb1=np.array([0.62, 0.62, 0.62]),
+        rgb2=np.array([0.55, 0.55, 0.55]),
+        width=256,
+        height=256,
     )
     mat = spec.add_material(name="grid", texrepeat=np.array([1.0, 1.0]), texuniform=True)
     mat.textures[mujoco.mjtTextureRole.mjTEXROLE_RGB] = "grid"
-    spec.worldbody.add_light(name="sun", type=mujoco.mjtLightType.mjLIGHT_DIRECTIONAL, pos=np.array([0.0, 0.0, 10.0]),
-                             dir=np.array([0.3, 0.2, -1.0]), diffuse=np.array([0.6, 0.6, 0.6]))
+    spec.worldbody.add_light(
+        name="sun",
+        type=mujoco.mjtLightType.mjLIGHT_DIRECTIONAL,
+        pos=np.array([0.0, 0.0, 10.0]),
+        dir=np.array([0.3, 0.2, -1.0]),
+        diffuse=np.array([0.6, 0.6, 0.6]),
+    )
     if world.ground_plane:
-        spec.worldbody.add_geom(name="ground_plane", type=mujoco.mjtGeom.mjGEOM_PLANE,
-                                size=np.array([0.0, 0.0, 1.0]), **contact_props("ground", GROUP_WORLD),
-                                rgba=np.array([0.5, 0.5, 0.5, 1.0]))  # mj_ray skips transparent geoms
-        spec.worldbody.add_geom(name="ground_plane_visual", type=mujoco.mjtGeom.mjGEOM_PLANE,
-                                size=np.array([50.0, 50.0, 1.0]), material="grid", **VISUAL_PROPS)
+        spec.worldbody.add_geom(
+            name="ground_plane",
+            type=mujoco.mjtGeom.mjGEOM_PLANE,
+            size=np.array([0.0, 0.0, 1.0]),
+            **contact_props("ground", GROUP_WORLD),
+            rgba=np.array([0.5, 0.5, 0.5, 1.0]),
+        )  # mj_ray skips transparent geoms
+        spec.worldbody.add_geom(
+            name="ground_plane_visual",
+            type=mujoco.mjtGeom.mjGEOM_PLANE,
+            size=np.array([50.0, 50.0, 1.0]),
+            material="grid",
+            **VISUAL_PROPS,
+        )
 
 
 def build_spec(

@@ -30,8 +30,16 @@ OPTICAL = quat_from_rpy(-math.pi / 2, 0.0, -math.pi / 2)  # camera body frame ->
 class SensorNode(Node):
     """What the sensor plugins share: the config, a timer at the sensor's rate, its frame's static tf."""
 
-    def __init__(self, executor: Executor, *, name: str, namespace: str, sim: Simulation, config: SensorConfig,
-                 optical: bool = False) -> None:
+    def __init__(
+        self,
+        executor: Executor,
+        *,
+        name: str,
+        namespace: str,
+        sim: Simulation,
+        config: SensorConfig,
+        optical: bool = False,
+    ) -> None:
         super().__init__(executor, name=name, namespace=namespace)
         assert sim.robot is not None
         self.sim, self.cfg = sim, config
@@ -39,10 +47,18 @@ class SensorNode(Node):
         if self.frame_id not in sim.robot.links and hasattr(config, "origin"):
             o = config.origin
             q = quat_from_rpy(*o.rpy)
-            self.send_static_transform([msgs.TransformStamped(
-                header=msgs.header(executor.now_ns, config.link), child_frame_id=self.frame_id,
-                transform=msgs.Transform(translation=msgs.Vector3(x=o.xyz[0], y=o.xyz[1], z=o.xyz[2]),
-                                         rotation=msgs.quaternion_msg(qmul(q, OPTICAL) if optical else q)))])
+            self.send_static_transform(
+                [
+                    msgs.TransformStamped(
+                        header=msgs.header(executor.now_ns, config.link),
+                        child_frame_id=self.frame_id,
+                        transform=msgs.Transform(
+                            translation=msgs.Vector3(x=o.xyz[0], y=o.xyz[1], z=o.xyz[2]),
+                            rotation=msgs.quaternion_msg(qmul(q, OPTICAL) if optical else q),
+                        ),
+                    )
+                ]
+            )
         self.create_timer(max(1.0 / config.update_rate, sim.timestep), self.update)
 
     def read(self, *pubs: Any) -> bool:
@@ -59,10 +75,16 @@ def camera_info(cfg: CameraConfig, stamp_ns: int, frame_id: str) -> Any:
     cam = cfg.camera
     f, cx, cy = cam.focal_length, cam.cx, cam.cy
     return msgs.CameraInfo(
-        header=msgs.header(stamp_ns, frame_id), height=cam.height, width=cam.width, distortion_model="plumb_bob",
-        d=np.array(cfg.distortion, dtype=np.float64), k=np.array([f, 0, cx, 0, f, cy, 0, 0, 1], dtype=np.float64),
-        r=np.eye(3).ravel(), p=np.array([f, 0, cx, -f * cfg.hack_baseline, 0, f, cy, 0, 0, 0, 1, 0], dtype=np.float64),
-        binning_x=0, binning_y=0,
+        header=msgs.header(stamp_ns, frame_id),
+        height=cam.height,
+        width=cam.width,
+        distortion_model="plumb_bob",
+        d=np.array(cfg.distortion, dtype=np.float64),
+        k=np.array([f, 0, cx, 0, f, cy, 0, 0, 1], dtype=np.float64),
+        r=np.eye(3).ravel(),
+        p=np.array([f, 0, cx, -f * cfg.hack_baseline, 0, f, cy, 0, 0, 0, 1, 0], dtype=np.float64),
+        binning_x=0,
+        binning_y=0,
         roi=msgs.RegionOfInterest(x_offset=0, y_offset=0, height=0, width=0, do_rectify=False),
     )
 
@@ -72,10 +94,19 @@ class CameraPlugin(SensorNode):
     ``image_topic`` and ``CameraInfo`` on ``camera_info_topic``, rendered offscreen (see
     :mod:`navlab.sim.camera_render`), with the ``<camera><noise>`` (std dev on the 0..1 scale) per pixel."""
 
-    def __init__(self, executor: Executor, *, name: str = "", parameters: dict[str, Any] | None = None,
-                 namespace: str = "", sim: Simulation, config: CameraConfig) -> None:
-        super().__init__(executor, name=name or f"{config.name}_plugin", namespace=namespace, sim=sim,
-                         config=config, optical=True)
+    def __init__(
+        self,
+        executor: Executor,
+        *,
+        name: str = "",
+        parameters: dict[str, Any] | None = None,
+        namespace: str = "",
+        sim: Simulation,
+        config: CameraConfig,
+    ) -> None:
+        super().__init__(
+            executor, name=name or f"{config.name}_plugin", namespace=namespace, sim=sim, config=config, optical=True
+        )
         self.cam = config
         self.renderer: Any = None
         self.image_pub = self.create_publisher(msgs.Image, config.image_topic, 2)
@@ -111,8 +142,15 @@ class CameraPlugin(SensorNode):
         else:
             data = rgb[..., ::-1] if encoding == "bgr8" else rgb
         h, w = rgb.shape[:2]
-        return msgs.Image(header=msgs.header(stamp_ns, self.frame_id), height=h, width=w, encoding=encoding,
-                          is_bigendian=0, step=w * channels, data=np.ascontiguousarray(data).reshape(-1))
+        return msgs.Image(
+            header=msgs.header(stamp_ns, self.frame_id),
+            height=h,
+            width=w,
+            encoding=encoding,
+            is_bigendian=0,
+            step=w * channels,
+            data=np.ascontiguousarray(data).reshape(-1),
+        )
 
     def destroy_node(self) -> None:
         """Free the GL context with the node."""
@@ -128,8 +166,16 @@ class DepthCameraPlugin(CameraPlugin):
     ``point_cloud_topic``, ``CameraInfo`` on both info topics, the colour image (rendered) only when read.
     Depth comes from ray casting (:func:`navlab.sim.sensors3d.depth_image`), not from the renderer."""
 
-    def __init__(self, executor: Executor, *, name: str = "", parameters: dict[str, Any] | None = None,
-                 namespace: str = "", sim: Simulation, config: CameraConfig) -> None:
+    def __init__(
+        self,
+        executor: Executor,
+        *,
+        name: str = "",
+        parameters: dict[str, Any] | None = None,
+        namespace: str = "",
+        sim: Simulation,
+        config: CameraConfig,
+    ) -> None:
         super().__init__(executor, name=name, parameters=parameters, namespace=namespace, sim=sim, config=config)
         self.depth_pub = self.create_publisher(msgs.Image, config.depth_image_topic, 1)
         self.cloud_pub = self.create_publisher(msgs.PointCloud2, config.point_cloud_topic, 1)
@@ -144,9 +190,17 @@ class DepthCameraPlugin(CameraPlugin):
             depth = depth_image(self.sim, self.cam, self.rng)
             if self.read(self.depth_pub):
                 h, w = depth.shape
-                self.depth_pub.publish(msgs.Image(
-                    header=msgs.header(now, self.frame_id), height=h, width=w, encoding="32FC1", is_bigendian=0,
-                    step=4 * w, data=depth.reshape(-1).view(np.uint8)))
+                self.depth_pub.publish(
+                    msgs.Image(
+                        header=msgs.header(now, self.frame_id),
+                        height=h,
+                        width=w,
+                        encoding="32FC1",
+                        is_bigendian=0,
+                        step=4 * w,
+                        data=depth.reshape(-1).view(np.uint8),
+                    )
+                )
             if self.read(self.cloud_pub):
                 self.cloud_pub.publish(self.cloud(depth, now))
         if self.read(self.info_pub):
@@ -161,23 +215,46 @@ class DepthCameraPlugin(CameraPlugin):
         rgb = np.zeros((h * w, 4), dtype=np.uint8)
         if self.last_image is not None and self.last_image.shape[:2] == (h, w):
             rgb[:, :3] = self.last_image.reshape(-1, 3)[:, ::-1]  # PCL packs b, g, r
-        return pack_cloud(stamp_ns, self.frame_id, {
-            "x": (0, FLOAT32, pts[:, 0]), "y": (4, FLOAT32, pts[:, 1]), "z": (8, FLOAT32, pts[:, 2]),
-            "rgb": (16, FLOAT32, rgb.view(np.float32).reshape(-1))}, height=h, width=w)
+        return pack_cloud(
+            stamp_ns,
+            self.frame_id,
+            {
+                "x": (0, FLOAT32, pts[:, 0]),
+                "y": (4, FLOAT32, pts[:, 1]),
+                "z": (8, FLOAT32, pts[:, 2]),
+                "rgb": (16, FLOAT32, rgb.view(np.float32).reshape(-1)),
+            },
+            height=h,
+            width=w,
+        )
 
 
 class VelodynePlugin(SensorNode):
     """``GazeboRosVelodyneLaser``: ``sensor_msgs/PointCloud2`` (x y z intensity ring, 32-byte points) of the points
     with ``max(min_range, range_min) < r < min(max_range, range_max - range_min - 0.01)``, ring 0 the lowest."""
 
-    def __init__(self, executor: Executor, *, name: str = "", parameters: dict[str, Any] | None = None,
-                 namespace: str = "", sim: Simulation, config: Lidar3dConfig) -> None:
+    def __init__(
+        self,
+        executor: Executor,
+        *,
+        name: str = "",
+        parameters: dict[str, Any] | None = None,
+        namespace: str = "",
+        sim: Simulation,
+        config: Lidar3dConfig,
+    ) -> None:
         super().__init__(executor, name=name or f"{config.name}_plugin", namespace=namespace, sim=sim, config=config)
         self.lidar = config
         self.pub = self.create_publisher(msgs.PointCloud2, config.topic, 1)
         az, el = lidar3d_angles(config)
-        self.unit = np.stack([np.cos(el)[:, None] * np.cos(az)[None, :], np.cos(el)[:, None] * np.sin(az)[None, :],
-                              np.broadcast_to(np.sin(el)[:, None], (len(el), len(az)))], axis=-1)
+        self.unit = np.stack(
+            [
+                np.cos(el)[:, None] * np.cos(az)[None, :],
+                np.cos(el)[:, None] * np.sin(az)[None, :],
+                np.broadcast_to(np.sin(el)[:, None], (len(el), len(az))),
+            ],
+            axis=-1,
+        )
         self.ring = np.broadcast_to(np.arange(len(el), dtype=np.uint16)[:, None], (len(el), len(az)))
 
     def update(self) -> None:
@@ -199,18 +276,35 @@ class VelodynePlugin(SensorNode):
         else:
             pts, rings = xyz[keep], self.ring[keep]
             height, width = 1, len(pts)
-        return pack_cloud(stamp_ns, self.frame_id, {
-            "x": (0, FLOAT32, pts[:, 0]), "y": (4, FLOAT32, pts[:, 1]), "z": (8, FLOAT32, pts[:, 2]),
-            "intensity": (16, FLOAT32, np.zeros(len(pts), np.float32)), "ring": (20, UINT16, rings)},
-            height=height, width=width)
+        return pack_cloud(
+            stamp_ns,
+            self.frame_id,
+            {
+                "x": (0, FLOAT32, pts[:, 0]),
+                "y": (4, FLOAT32, pts[:, 1]),
+                "z": (8, FLOAT32, pts[:, 2]),
+                "intensity": (16, FLOAT32, np.zeros(len(pts), np.float32)),
+                "ring": (20, UINT16, rings),
+            },
+            height=height,
+            width=width,
+        )
 
 
 class RangePlugin(SensorNode):
     """``gazebo_ros_range``: ``sensor_msgs/Range`` (ULTRASOUND 0 / INFRARED 1, ``field_of_view`` the plugin's
     ``<fov>``, min/max the ray sensor's range) with the nearest return of the sensor's rays."""
 
-    def __init__(self, executor: Executor, *, name: str = "", parameters: dict[str, Any] | None = None,
-                 namespace: str = "", sim: Simulation, config: RangeConfig) -> None:
+    def __init__(
+        self,
+        executor: Executor,
+        *,
+        name: str = "",
+        parameters: dict[str, Any] | None = None,
+        namespace: str = "",
+        sim: Simulation,
+        config: RangeConfig,
+    ) -> None:
         super().__init__(executor, name=name or f"{config.name}_plugin", namespace=namespace, sim=sim, config=config)
         self.range = config
         self.pub = self.create_publisher(msgs.Range, config.topic, 1)
@@ -219,10 +313,16 @@ class RangePlugin(SensorNode):
         if not self.read(self.pub):
             return
         c = self.range
-        self.pub.publish(msgs.Range(
-            header=msgs.header(self.executor.now_ns, self.frame_id), radiation_type=0 if c.radiation == "ultrasound"
-            else 1, field_of_view=float(c.fov), min_range=float(c.range_min), max_range=float(c.range_max),
-            range=float(range_reading(self.sim, c, self.rng))))
+        self.pub.publish(
+            msgs.Range(
+                header=msgs.header(self.executor.now_ns, self.frame_id),
+                radiation_type=0 if c.radiation == "ultrasound" else 1,
+                field_of_view=float(c.fov),
+                min_range=float(c.range_min),
+                max_range=float(c.range_max),
+                range=float(range_reading(self.sim, c, self.rng)),
+            )
+        )
 
 
 class BumperPlugin(SensorNode):
@@ -230,16 +330,25 @@ class BumperPlugin(SensorNode):
     floor (MuJoCo contacts of the link's body: position and normal in ``frameName``'s frame — ``world`` or a
     link — depth in m, contact force as the wrench), published every update even when empty (Noetic does)."""
 
-    def __init__(self, executor: Executor, *, name: str = "", parameters: dict[str, Any] | None = None,
-                 namespace: str = "", sim: Simulation, config: BumperConfig) -> None:
+    def __init__(
+        self,
+        executor: Executor,
+        *,
+        name: str = "",
+        parameters: dict[str, Any] | None = None,
+        namespace: str = "",
+        sim: Simulation,
+        config: BumperConfig,
+    ) -> None:
         super().__init__(executor, name=name or f"{config.name}_plugin", namespace=namespace, sim=sim, config=config)
         self.bumper = config
         self.pub = self.create_publisher(msgs.ContactsState, config.topic, 1)
 
     def update(self) -> None:
         if self.read(self.pub):
-            self.pub.publish(msgs.ContactsState(header=msgs.header(self.executor.now_ns, self.frame_id),
-                                                states=self.states()))
+            self.pub.publish(
+                msgs.ContactsState(header=msgs.header(self.executor.now_ns, self.frame_id), states=self.states())
+            )
 
     def states(self) -> list[Any]:
         """One ContactState per contact of the bumper's body with a world geom."""
@@ -266,11 +375,18 @@ class BumperPlugin(SensorNode):
             f_world = frame.T @ force[:3] * (1 if mine[0] else -1)
             normal = frame[0] * (1 if mine[0] else -1)
             wrench = msgs.Wrench(force=_vec(rot.T @ f_world), torque=_vec(np.zeros(3)))
-            out.append(msgs.ContactState(
-                info=f"Debug:  i:({i}/{d.ncon})", collision1_name=self.bumper.collision,
-                collision2_name=_geom_name(m, other), wrenches=[wrench], total_wrench=wrench,
-                contact_positions=[_vec(rot.T @ (con.pos - pos0))], contact_normals=[_vec(rot.T @ normal)],
-                depths=np.array([max(0.0, -float(con.dist))])))
+            out.append(
+                msgs.ContactState(
+                    info=f"Debug:  i:({i}/{d.ncon})",
+                    collision1_name=self.bumper.collision,
+                    collision2_name=_geom_name(m, other),
+                    wrenches=[wrench],
+                    total_wrench=wrench,
+                    contact_positions=[_vec(rot.T @ (con.pos - pos0))],
+                    contact_normals=[_vec(rot.T @ normal)],
+                    depths=np.array([max(0.0, -float(con.dist))]),
+                )
+            )
         return out
 
 

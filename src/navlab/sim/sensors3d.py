@@ -31,14 +31,39 @@ def sensor_pose(sim: Simulation, link: str, origin: Origin) -> tuple[np.ndarray,
     return pos, matrix_from_quat(q)
 
 
-def cast(sim: Simulation, pos: np.ndarray, rot: np.ndarray, dirs: np.ndarray, rows: int, cols: int, mode: int,
-         params: np.ndarray, tmin: float, tmax: float) -> np.ndarray:
+def cast(
+    sim: Simulation,
+    pos: np.ndarray,
+    rot: np.ndarray,
+    dirs: np.ndarray,
+    rows: int,
+    cols: int,
+    mode: int,
+    params: np.ndarray,
+    tmin: float,
+    tmax: float,
+) -> np.ndarray:
     """Distances (m, rows*cols) along ``dirs`` (sensor frame) from ``pos``; inf without a hit in [tmin, tmax]."""
     m, d = sim.model, sim.data
     fast, slow = sim.ray_geoms()
     out = np.empty(rows * cols)
-    cast_grid(pos, rot, dirs, rows, cols, mode, params, fast, m.geom_type, m.geom_size, d.geom_xpos, d.geom_xmat,
-              tmin, tmax, out)
+    cast_grid(
+        pos,
+        rot,
+        dirs,
+        rows,
+        cols,
+        mode,
+        params,
+        fast,
+        m.geom_type,
+        m.geom_size,
+        d.geom_xpos,
+        d.geom_xmat,
+        tmin,
+        tmax,
+        out,
+    )
     if slow is not None:  # meshes: MuJoCo's ray caster, from tmin on
         world = move_points(dirs, rot, (0.0, 0.0, 0.0)).astype(np.float64)
         n = len(world)
@@ -114,8 +139,11 @@ def depth_points(depth: np.ndarray, cfg: CameraConfig) -> np.ndarray:
 def lidar3d_angles(cfg: Lidar3dConfig) -> tuple[np.ndarray, np.ndarray]:
     """(azimuths (samples,), ring elevations (rings,)) in rad, Gazebo's spacing (both ends inclusive)."""
     az = np.linspace(cfg.min_angle, cfg.max_angle, cfg.samples) if cfg.samples > 1 else np.array([cfg.min_angle])
-    el = (np.linspace(cfg.vertical_min_angle, cfg.vertical_max_angle, cfg.rings) if cfg.rings > 1
-          else np.array([cfg.vertical_min_angle]))
+    el = (
+        np.linspace(cfg.vertical_min_angle, cfg.vertical_max_angle, cfg.rings)
+        if cfg.rings > 1
+        else np.array([cfg.vertical_min_angle])
+    )
     return az, el
 
 
@@ -139,8 +167,11 @@ def lidar3d_ranges(sim: Simulation, cfg: Lidar3dConfig, rng: np.random.Generator
 def range_rays(cfg: RangeConfig) -> np.ndarray:
     """Unit directions of a range sensor's rays (its ``<scan>`` grid), sensor frame."""
     h = np.linspace(cfg.min_angle, cfg.max_angle, cfg.samples) if cfg.samples > 1 else np.array([cfg.min_angle])
-    v = (np.linspace(cfg.vertical_min_angle, cfg.vertical_max_angle, cfg.vertical_samples)
-         if cfg.vertical_samples > 1 else np.array([cfg.vertical_min_angle]))
+    v = (
+        np.linspace(cfg.vertical_min_angle, cfg.vertical_max_angle, cfg.vertical_samples)
+        if cfg.vertical_samples > 1
+        else np.array([cfg.vertical_min_angle])
+    )
     return spherical_dirs(h, v)
 
 

@@ -73,9 +73,7 @@ class Simulation:
         self.lidar_backend = lidar_backend
         self.rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
         x, y, yaw = robot_pose
-        self.spec, self.info = build_spec(
-            robot, world, timestep=timestep, robot_pose=(x, y, 0.0, yaw), visuals=visuals
-        )
+        self.spec, self.info = build_spec(robot, world, timestep=timestep, robot_pose=(x, y, 0.0, yaw), visuals=visuals)
         self.model = compile_spec(self.spec, f"world {world.name!r}")
         self.data = mujoco.MjData(self.model)
         self.dt_ns = round(self.model.opt.timestep * 1e9)
@@ -112,8 +110,9 @@ class Simulation:
         # clearance(): the robot's collision geoms against the world's (the floor is not an obstacle)
         collides = (m.geom_contype != 0) | (m.geom_conaffinity != 0)
         ground = (m.geom_contype.astype(np.int64) & GROUND_CONTACT_BIT) != 0
-        self._clear_world = np.flatnonzero(collides & (m.geom_group != GROUP_ROBOT) & ~ground
-                                           & (m.geom_type != mujoco.mjtGeom.mjGEOM_PLANE))
+        self._clear_world = np.flatnonzero(
+            collides & (m.geom_group != GROUP_ROBOT) & ~ground & (m.geom_type != mujoco.mjtGeom.mjGEOM_PLANE)
+        )
         wtype = np.bitwise_or.reduce(m.geom_contype[self._clear_world], initial=0)
         waff = np.bitwise_or.reduce(m.geom_conaffinity[self._clear_world], initial=0)
         meets = ((m.geom_contype & waff) | (m.geom_conaffinity & wtype)) != 0  # not the wheels' floor spheres
@@ -264,9 +263,9 @@ class Simulation:
         if not all(math.isfinite(v) for v in (x, y, yaw)):
             raise SimError(f"teleport pose ({x}, {y}, {yaw}) is not finite")
         q, v = self._root_qpos, self._root_dof
-        self.data.qpos[q:q + 2] = (x, y)
-        self.data.qpos[q + 3:q + 7] = wxyz_from_xyzw(quat_from_yaw(yaw))
-        self.data.qvel[v:v + 6] = 0.0
+        self.data.qpos[q : q + 2] = (x, y)
+        self.data.qpos[q + 3 : q + 7] = wxyz_from_xyzw(quat_from_yaw(yaw))
+        self.data.qvel[v : v + 6] = 0.0
         mujoco.mj_forward(self.model, self.data)
         self._synced = True
 
@@ -291,16 +290,21 @@ class Simulation:
         rot_t = rot.reshape(3, 3).T
         return rot_t @ lin, rot_t @ vel[:3]
 
-    def link_state(self, link: str | None = None) -> tuple[tuple[float, ...], tuple[float, ...], tuple[float, ...],
-                                                          tuple[float, ...]]:
+    def link_state(
+        self, link: str | None = None
+    ) -> tuple[tuple[float, ...], tuple[float, ...], tuple[float, ...], tuple[float, ...]]:
         """(position xyz, quaternion xyzw, linear velocity, angular velocity) of a robot link as floats: the
         values of :meth:`link_pose` and :meth:`link_velocity`, read at once (ground truth at 50 Hz)."""
         b, _, _, own = self._link_frame(link)
         if not own:
             pose = self.link_pose(link)
             lin, ang = self.link_velocity(link)
-            return (tuple(pose.position.tolist()), tuple(float(v) for v in pose.quaternion), tuple(lin.tolist()),
-                    tuple(ang.tolist()))  # fmt: skip
+            return (
+                tuple(pose.position.tolist()),
+                tuple(float(v) for v in pose.quaternion),
+                tuple(lin.tolist()),
+                tuple(ang.tolist()),
+            )
         self._sync()
         d = self.data
         vel = self._vel6
@@ -338,8 +342,7 @@ class Simulation:
         """(left, right) diff-drive wheel angles (rad), unwrapped: each side's mean over its wheels (a skid-steer
         robot's front and rear wheels), as diff_drive_controller averages them."""
         lefts, rights = self._diff_drive().wheel_joints()
-        return (sum(map(self.joint_position, lefts)) / len(lefts),
-                sum(map(self.joint_position, rights)) / len(rights))
+        return (sum(map(self.joint_position, lefts)) / len(lefts), sum(map(self.joint_position, rights)) / len(rights))
 
     def _diff_drive(self) -> DiffDriveConfig:
         if self.robot is None or self.robot.diff_drive is None:
@@ -385,8 +388,22 @@ class Simulation:
             return self._multiray(cfg, rot, pnt, angles, RAY_GEOMGROUP)
         dist = np.empty(n)
         inc = (cfg.max_angle - cfg.min_angle) / (n - 1) if n > 1 else 0.0
-        cast_planar(pnt, rot, angles[0], angles[1], cfg.min_angle, inc, self._ray_fast, m.geom_type,
-                    m.geom_size, d.geom_xpos, d.geom_xmat, cfg.range_min, cfg.range_max, dist)
+        cast_planar(
+            pnt,
+            rot,
+            angles[0],
+            angles[1],
+            cfg.min_angle,
+            inc,
+            self._ray_fast,
+            m.geom_type,
+            m.geom_size,
+            d.geom_xpos,
+            d.geom_xmat,
+            cfg.range_min,
+            cfg.range_max,
+            dist,
+        )
         if self._ray_slow_groups is not None:
             np.minimum(dist, self._multiray(cfg, rot, pnt, angles, self._ray_slow_groups), out=dist)
         return dist
@@ -420,9 +437,7 @@ class Simulation:
         dist[dist > cfg.range_max] = np.inf
         return dist
 
-    def imu(
-        self, index: int = 0, rng: np.random.Generator | None = None
-    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def imu(self, index: int = 0, rng: np.random.Generator | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(orientation quaternion x,y,z,w in world, angular velocity rad/s, linear acceleration m/s²) of IMU
         ``index``; rates and accelerations in the IMU frame, with the configured gaussian noise."""
         if self.robot is None or not 0 <= index < len(self.robot.imus):

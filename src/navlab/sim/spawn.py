@@ -23,15 +23,35 @@ from navlab.world import ModelSpec, WorldModel
 
 KINDS = ("box", "cylinder", "sphere", "sdf")
 _SIZES = frozenset({"size", "sx", "sy", "sz", "radius", "length", "mass"})
-_KEYS = {"name", "x", "y", "z", "yaw", "static", "mass", "size", "sx", "sy", "sz", "radius", "length", "t",
-         "file", "rgba"}
+_KEYS = {
+    "name",
+    "x",
+    "y",
+    "z",
+    "yaw",
+    "static",
+    "mass",
+    "size",
+    "sx",
+    "sy",
+    "sz",
+    "radius",
+    "length",
+    "t",
+    "file",
+    "rgba",
+}
 
 
 def _inertial(kind: str, dims: tuple[float, ...], mass: float) -> Inertial:
     if kind == "box":
         sx, sy, sz = dims
-        return Inertial(mass, ixx=mass * (sy * sy + sz * sz) / 12, iyy=mass * (sx * sx + sz * sz) / 12,
-                        izz=mass * (sx * sx + sy * sy) / 12)
+        return Inertial(
+            mass,
+            ixx=mass * (sy * sy + sz * sz) / 12,
+            iyy=mass * (sx * sx + sz * sz) / 12,
+            izz=mass * (sx * sx + sy * sy) / 12,
+        )
     if kind == "cylinder":
         r, h = dims
         side = mass * (3 * r * r + h * h) / 12
@@ -66,8 +86,7 @@ def primitive_model(
         raise SimError(f"spawn {kind} {name!r}: mass must be positive, got {mass}")
     height = {"box": lambda: dims[2], "cylinder": lambda: dims[1], "sphere": lambda: 2 * dims[0]}[kind]()
     shape = Shape(Geometry(kind, tuple(float(d) for d in dims)), rgba=rgba)
-    link = Link("link", inertial=None if static else _inertial(kind, dims, mass), collisions=[shape],
-                visuals=[shape])
+    link = Link("link", inertial=None if static else _inertial(kind, dims, mass), collisions=[shape], visuals=[shape])
     pose = (float(x), float(y), height / 2 if z is None else float(z), 0.0, 0.0, float(yaw))
     return ModelSpec(name=name, pose=pose, static=static, links=[link])
 
@@ -105,8 +124,10 @@ def parse_spawn_spec(text: str, *, default_name: str = "") -> tuple[ModelSpec, f
             raise SimError(f"spawn spec {text!r}: {key}={opts[key]!r} is not a number") from None
         ceiling = ceilings()["model_m" if key in _SIZES else "coordinate_m"]
         if not abs(value) <= ceiling.limit:  # NaN and inf fail too
-            raise SimError(f"spawn spec {text!r}: {key}={opts[key]}: expected a finite number within "
-                           f"±{ceiling.limit:g} {ceiling.unit} ({ceiling.why})")
+            raise SimError(
+                f"spawn spec {text!r}: {key}={opts[key]}: expected a finite number within "
+                f"±{ceiling.limit:g} {ceiling.unit} ({ceiling.why})"
+            )
         return value
 
     name = opts.get("name") or default_name or kind
@@ -132,7 +153,12 @@ def parse_spawn_spec(text: str, *, default_name: str = "") -> tuple[ModelSpec, f
 
 
 def load_sdf_model(
-    path: Path, *, name: str | None = None, x: float = 0.0, y: float = 0.0, z: float | None = None,
+    path: Path,
+    *,
+    name: str | None = None,
+    x: float = 0.0,
+    y: float = 0.0,
+    z: float | None = None,
     yaw: float = 0.0,
 ) -> ModelSpec:
     """An SDF model file (``model.sdf`` or a model directory) placed at (x, y, z, yaw) in the world."""
@@ -162,8 +188,11 @@ def robot_outline(robot: RobotModel) -> tuple[np.ndarray, float, float]:
             name = joint.parent
         return m
 
-    pts = [_corners(shape, root_T_link(link.name) @ shape.origin.matrix())
-           for link in robot.links.values() for shape in link.collisions]
+    pts = [
+        _corners(shape, root_T_link(link.name) @ shape.origin.matrix())
+        for link in robot.links.values()
+        for shape in link.collisions
+    ]
     if not pts:
         return np.zeros((1, 2)), 0.0, 0.0
     allp = np.vstack(pts)
@@ -188,8 +217,14 @@ def _corners(shape: Shape, root_T_shape: np.ndarray) -> np.ndarray:
     return local @ root_T_shape[:3, :3].T + root_T_shape[:3, 3]
 
 
-def check_start_pose(robot: RobotModel, world: WorldModel, pose: tuple[float, float, float], *,
-                     margin: float = 0.02, resolution: float = 0.02) -> None:
+def check_start_pose(
+    robot: RobotModel,
+    world: WorldModel,
+    pose: tuple[float, float, float],
+    *,
+    margin: float = 0.02,
+    resolution: float = 0.02,
+) -> None:
     """Refuse a start pose (x, y, yaw: m, m, rad, the root link in the world) at which the robot's
     collision outline (its convex hull seen from above, shrunk by ``margin`` m so that touching is
     allowed) overlaps a world model within the robot's height, or that is not a finite pose within the
@@ -203,9 +238,11 @@ def check_start_pose(robot: RobotModel, world: WorldModel, pose: tuple[float, fl
     if names:
         shown = ", ".join(map(repr, names[:5])) + (f" and {len(names) - 5} more" if len(names) > 5 else "")
         where = f"{world.source}: " if world.source is not None else ""
-        raise SimError(f"{where}start pose x={x:g} y={y:g} yaw={yaw:g} puts robot {robot.name!r} inside {shown} "
-                       f"of world {world.name!r}; started there, the contact solver would throw it away. Pick a "
-                       "free pose (--x/--y/--yaw, or x:= y:= yaw:=)")
+        raise SimError(
+            f"{where}start pose x={x:g} y={y:g} yaw={yaw:g} puts robot {robot.name!r} inside {shown} "
+            f"of world {world.name!r}; started there, the contact solver would throw it away. Pick a "
+            "free pose (--x/--y/--yaw, or x:= y:= yaw:=)"
+        )
 
 
 def check_spawn_clear(robot: RobotModel, robot_pose: tuple[float, float, float], model: ModelSpec) -> None:
@@ -213,12 +250,20 @@ def check_spawn_clear(robot: RobotModel, robot_pose: tuple[float, float, float],
     link; the contact solver would throw the robot away, or make the simulation unstable)."""
     if _overlapping(robot, WorldModel(name="spawn", models=[model]), robot_pose):
         x, y = model.pose[:2]
-        raise SimError(f"spawn {model.name!r} at x={x:g} y={y:g}: it would overlap robot {robot.name!r} at "
-                       f"x={robot_pose[0]:.3f} y={robot_pose[1]:.3f}; spawn it where the robot is not")
+        raise SimError(
+            f"spawn {model.name!r} at x={x:g} y={y:g}: it would overlap robot {robot.name!r} at "
+            f"x={robot_pose[0]:.3f} y={robot_pose[1]:.3f}; spawn it where the robot is not"
+        )
 
 
-def _overlapping(robot: RobotModel, world: WorldModel, pose: tuple[float, float, float], *,
-                 margin: float = 0.02, resolution: float = 0.02) -> list[str]:
+def _overlapping(
+    robot: RobotModel,
+    world: WorldModel,
+    pose: tuple[float, float, float],
+    *,
+    margin: float = 0.02,
+    resolution: float = 0.02,
+) -> list[str]:
     """The models of ``world`` that the robot's outline at ``pose`` overlaps ("an obstacle" if unnamed)."""
     from navlab.world import occupancy, shape_footprints
 
@@ -251,8 +296,13 @@ def _overlapping(robot: RobotModel, world: WorldModel, pose: tuple[float, float,
     if not inside.any():
         return []
     hit = cells[inside]
-    names = sorted({fp.name.split("::")[0] for fp in shape_footprints(world, z_min=band[0], z_max=band[1])
-                    if _overlaps(fp.bounds(), hit)})
+    names = sorted(
+        {
+            fp.name.split("::")[0]
+            for fp in shape_footprints(world, z_min=band[0], z_max=band[1])
+            if _overlaps(fp.bounds(), hit)
+        }
+    )
     return names or ["an obstacle"]
 
 

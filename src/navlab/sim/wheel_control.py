@@ -42,10 +42,16 @@ CONTROLLER_TYPE = "diff_drive_controller/DiffDriveController"
 #: navlab's default wheel PID when ``gazebo_ros_control/pid_gains`` names none (N m per rad/s, N m per rad)
 DEFAULT_PID = {"p": 1.0, "i": 5.0, "d": 0.0, "i_clamp": 5.0}
 _LIMIT_KEYS = {
-    "has_velocity_limits": False, "max_velocity": 0.0, "min_velocity": None,
-    "has_acceleration_limits": False, "max_acceleration": 0.0, "min_acceleration": None,
-    "has_jerk_limits": False, "max_jerk": 0.0, "min_jerk": None,
-}  # fmt: skip
+    "has_velocity_limits": False,
+    "max_velocity": 0.0,
+    "min_velocity": None,
+    "has_acceleration_limits": False,
+    "max_acceleration": 0.0,
+    "min_acceleration": None,
+    "has_jerk_limits": False,
+    "max_jerk": 0.0,
+    "min_jerk": None,
+}
 #: diff_drive_controller's parameters (ROS 1 names) and navlab's defaults (ROS's where ROS has one)
 CONTROLLER_DEFAULTS: dict[str, Any] = {
     "type": CONTROLLER_TYPE,
@@ -118,8 +124,11 @@ class WheelOdometry:
     """
 
     def __init__(self, separation: float, left_radius: float, right_radius: float, window: int = 10) -> None:
-        for key, v in (("wheel_separation", separation), ("left wheel radius", left_radius),
-                       ("right wheel radius", right_radius)):  # fmt: skip
+        for key, v in (
+            ("wheel_separation", separation),
+            ("left wheel radius", left_radius),
+            ("right wheel radius", right_radius),
+        ):
             if not (math.isfinite(v) and v > 0):
                 raise SimError(f"diff_drive_controller: {key} {v}: expected a finite number > 0")
         if window < 1:
@@ -199,10 +208,19 @@ class DiffDriveController(Node):
     reads each side's mean position. Subscribes ``cmd_vel`` (the plugin's command topic), publishes ``odom``
     and tf; see the module."""
 
-    def __init__(self, executor: Executor, *, name: str = "mobile_base_controller",
-                 parameters: dict[str, Any] | None = None, namespace: str = "", sim: Simulation,
-                 config: DiffDriveConfig, pid_gains: dict[str, Any] | None = None,
-                 control_period: float = 0.01, velocity_interface: bool = False) -> None:  # fmt: skip
+    def __init__(
+        self,
+        executor: Executor,
+        *,
+        name: str = "mobile_base_controller",
+        parameters: dict[str, Any] | None = None,
+        namespace: str = "",
+        sim: Simulation,
+        config: DiffDriveConfig,
+        pid_gains: dict[str, Any] | None = None,
+        control_period: float = 0.01,
+        velocity_interface: bool = False,
+    ) -> None:
         super().__init__(executor, name=name, parameters=parameters, namespace=namespace or config.namespace)
         p = self.declare_parameters(CONTROLLER_DEFAULTS)
         self.check_parameters()
@@ -211,16 +229,22 @@ class DiffDriveController(Node):
             raise SimError(f"{where}: type {p['type']!r}: navlab simulates {CONTROLLER_TYPE!r}")
         self.sim, self.cfg, self.p = sim, config, p
         lefts, rights = config.wheel_joints()
-        self.sides = (wheel_names(p["left_wheel"], f"{where} left_wheel") if p["left_wheel"] else lefts,
-                      wheel_names(p["right_wheel"], f"{where} right_wheel") if p["right_wheel"] else rights)
+        self.sides = (
+            wheel_names(p["left_wheel"], f"{where} left_wheel") if p["left_wheel"] else lefts,
+            wheel_names(p["right_wheel"], f"{where} right_wheel") if p["right_wheel"] else rights,
+        )
         if (len(self.sides[0]), len(self.sides[1])) != (len(lefts), len(rights)):
-            raise SimError(f"{where}: left_wheel {list(self.sides[0])} and right_wheel {list(self.sides[1])}: the "
-                           f"robot drives {len(lefts)} + {len(rights)} wheels")
+            raise SimError(
+                f"{where}: left_wheel {list(self.sides[0])} and right_wheel {list(self.sides[1])}: the "
+                f"robot drives {len(lefts)} + {len(rights)} wheels"
+            )
         self.joints = (*self.sides[0], *self.sides[1])
         for joint in self.joints:
             if joint not in sim.joint_names():
-                raise SimError(f"{where}: wheel joint {joint!r} is not a moving joint of the robot "
-                               f"(joints: {', '.join(sim.joint_names())})")  # fmt: skip
+                raise SimError(
+                    f"{where}: wheel joint {joint!r} is not a moving joint of the robot "
+                    f"(joints: {', '.join(sim.joint_names())})"
+                )
         for key in ("publish_rate", "cmd_vel_timeout"):
             if not (math.isfinite(p[key]) and p[key] > 0):
                 raise SimError(f"{where} {key}: expected a number > 0, got {p[key]!r}")
@@ -242,8 +266,10 @@ class DiffDriveController(Node):
         if unknown:
             raise SimError(f"gazebo_ros_control pid_gains: {unknown} are not the controller's wheels {self.joints}")
         self.velocity_interface = velocity_interface and not gains
-        self.pids = tuple(Pid(PidGains.from_params(gains.get(j, DEFAULT_PID), where=f"pid_gains.{j}"),
-                              output_limit=config.max_torque) for j in self.joints)  # fmt: skip
+        self.pids = tuple(
+            Pid(PidGains.from_params(gains.get(j, DEFAULT_PID), where=f"pid_gains.{j}"), output_limit=config.max_torque)
+            for j in self.joints
+        )
         self.actuators = [] if self.velocity_interface else use_effort_actuators(sim, config.max_torque)
         self.period = control_period
         self.cmd = (0.0, 0.0)
@@ -253,8 +279,9 @@ class DiffDriveController(Node):
         self.last_ns = executor.now_ns
         self.odometry.update(*self._angles(), 0.0)
         self.odom_pub = self.create_publisher(msgs.Odometry, config.odometry_topic, 10)
-        self.cmd_pub = self.create_publisher(msgs.Twist, "mobile_base_controller/cmd_vel_out", 10) \
-            if p["publish_cmd"] else None
+        self.cmd_pub = (
+            self.create_publisher(msgs.Twist, "mobile_base_controller/cmd_vel_out", 10) if p["publish_cmd"] else None
+        )
         self.create_subscription(msgs.Twist, config.command_topic, self.on_cmd_vel, 10)
         self.create_timer(control_period, self.update)
         self.create_timer(1.0 / p["publish_rate"], self.publish_odometry)
@@ -306,17 +333,20 @@ class DiffDriveController(Node):
             v, w = self.history[0]
         else:
             v, w = o.linear, o.angular
-        self.odom_pub.publish(msgs.Odometry(
-            header=msgs.header(now, self.odom_frame), child_frame_id=self.base_frame,
-            pose=msgs.PoseWithCovariance(pose=msgs.pose_from_2d(o.x, o.y, o.yaw), covariance=self.pose_cov.copy()),
-            twist=msgs.TwistWithCovariance(twist=msgs.twist(v, w), covariance=self.twist_cov.copy()),
-        ))  # fmt: skip
+        self.odom_pub.publish(
+            msgs.Odometry(
+                header=msgs.header(now, self.odom_frame),
+                child_frame_id=self.base_frame,
+                pose=msgs.PoseWithCovariance(pose=msgs.pose_from_2d(o.x, o.y, o.yaw), covariance=self.pose_cov.copy()),
+                twist=msgs.TwistWithCovariance(twist=msgs.twist(v, w), covariance=self.twist_cov.copy()),
+            )
+        )
         if self.p["enable_odom_tf"]:
             self.send_transform(msgs.transform_stamped(now, self.odom_frame, self.base_frame, o.x, o.y, o.yaw))
 
 
 def _axis(p: dict[str, Any], prefix: str) -> dict[str, Any]:
-    return {k[len(prefix) + 1:]: v for k, v in p.items() if k.startswith(prefix + ".")}
+    return {k[len(prefix) + 1 :]: v for k, v in p.items() if k.startswith(prefix + ".")}
 
 
 def controller_selected(params: dict[str, Any]) -> bool:

@@ -23,8 +23,12 @@ from navlab.core import Executor, Node, Subscription
 from navlab.viz.errors import VizError
 
 _log = logging.getLogger("navlab.viz.foxglove")
-PUBLISHABLE = ("geometry_msgs/msg/PoseStamped", "geometry_msgs/msg/PoseWithCovarianceStamped",
-               "geometry_msgs/msg/Twist", "geometry_msgs/msg/PointStamped")  # fmt: skip
+PUBLISHABLE = (
+    "geometry_msgs/msg/PoseStamped",
+    "geometry_msgs/msg/PoseWithCovarianceStamped",
+    "geometry_msgs/msg/Twist",
+    "geometry_msgs/msg/PointStamped",
+)
 
 
 def ros2_schema(typename: str) -> bytes:
@@ -45,8 +49,7 @@ def message_from_json(typename: str, data: dict[str, Any]) -> Any:
 
     def pose(d: dict[str, Any]) -> Any:
         q = d.get("orientation") or {"w": 1.0}
-        return msgs.Pose(position=vec(d.get("position") or {}, msgs.Point),
-                         orientation=vec(q, msgs.Quaternion, "xyzw"))  # fmt: skip
+        return msgs.Pose(position=vec(d.get("position") or {}, msgs.Point), orientation=vec(q, msgs.Quaternion, "xyzw"))
 
     if typename == "geometry_msgs/msg/PoseStamped":
         return msgs.PoseStamped(header=header(data.get("header") or {}), pose=pose(data.get("pose") or {}))
@@ -55,11 +58,14 @@ def message_from_json(typename: str, data: dict[str, Any]) -> Any:
         import numpy as np
 
         cov = np.array(inner.get("covariance") or [0.0] * 36, dtype=np.float64).reshape(36)
-        return msgs.PoseWithCovarianceStamped(header=header(data.get("header") or {}), pose=msgs.PoseWithCovariance(
-            pose=pose(inner.get("pose") or {}), covariance=cov))  # fmt: skip
+        return msgs.PoseWithCovarianceStamped(
+            header=header(data.get("header") or {}),
+            pose=msgs.PoseWithCovariance(pose=pose(inner.get("pose") or {}), covariance=cov),
+        )
     if typename == "geometry_msgs/msg/Twist":
-        return msgs.Twist(linear=vec(data.get("linear") or {}, msgs.Vector3),
-                          angular=vec(data.get("angular") or {}, msgs.Vector3))  # fmt: skip
+        return msgs.Twist(
+            linear=vec(data.get("linear") or {}, msgs.Vector3), angular=vec(data.get("angular") or {}, msgs.Vector3)
+        )
     if typename == "geometry_msgs/msg/PointStamped":
         cls = msgs.get_type("geometry_msgs/msg/PointStamped")
         return cls(header=header(data.get("header") or {}), point=vec(data.get("point") or {}, msgs.Point))
@@ -92,9 +98,14 @@ class FoxgloveBridge(ServerListener):
         self.node.create_timer(0.1, self.server_time)
         try:
             self.server = foxglove.start_server(
-                name="navlab", host=host, port=port, capabilities=[Capability.ClientPublish, Capability.Time],
-                supported_encodings=["cdr", "json"], server_listener=self, context=self.ctx,
-            )  # fmt: skip
+                name="navlab",
+                host=host,
+                port=port,
+                capabilities=[Capability.ClientPublish, Capability.Time],
+                supported_encodings=["cdr", "json"],
+                server_listener=self,
+                context=self.ctx,
+            )
         except Exception as exc:
             self.node.destroy_node()
             raise VizError(f"cannot serve Foxglove on {host}:{port} ({exc})") from None
@@ -115,8 +126,7 @@ class FoxgloveBridge(ServerListener):
                 continue
             typename = msgs.type_name(topic.msgtype)
             schema = self._foxglove.Schema(name=typename, encoding="ros2msg", data=ros2_schema(typename))
-            self.channels[name] = self._foxglove.Channel(name, schema=schema, message_encoding="cdr",
-                                                         context=self.ctx)  # fmt: skip
+            self.channels[name] = self._foxglove.Channel(name, schema=schema, message_encoding="cdr", context=self.ctx)
 
     def server_time(self) -> None:
         """Tell clients the simulated time (Foxglove's ``time`` capability)."""
@@ -166,8 +176,11 @@ class FoxgloveBridge(ServerListener):
         if "/msg/" not in typename and typename.count("/") == 1:  # ROS 1 style name
             typename = typename.replace("/", "/msg/")
         with self._lock:
-            self._client_channels[(int(client.id), int(channel.id))] = (str(channel.topic), str(channel.encoding),
-                                                                         typename)  # fmt: skip
+            self._client_channels[(int(client.id), int(channel.id))] = (
+                str(channel.topic),
+                str(channel.encoding),
+                typename,
+            )
 
     def on_client_unadvertise(self, client: Any, client_channel_id: int) -> None:
         """A client stopped publishing a channel."""

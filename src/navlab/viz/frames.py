@@ -68,10 +68,14 @@ def grid_geometry(msg: Any) -> dict[str, Any]:
     o = info.origin
     qz, qw = float(o.orientation.z), float(o.orientation.w)
     return {
-        "w": int(info.width), "h": int(info.height), "res": float(info.resolution),
-        "ox": float(o.position.x), "oy": float(o.position.y), "oyaw": 2.0 * float(np.arctan2(qz, qw)),
+        "w": int(info.width),
+        "h": int(info.height),
+        "res": float(info.resolution),
+        "ox": float(o.position.x),
+        "oy": float(o.position.y),
+        "oyaw": 2.0 * float(np.arctan2(qz, qw)),
         "frame": str(msg.header.frame_id).lstrip("/"),
-    }  # fmt: skip
+    }
 
 
 def grid_cells(msg: Any) -> np.ndarray:
@@ -144,11 +148,17 @@ def scan_frame(
     ``pose`` x, y, yaw in the ``fixed`` frame at the scan's stamp)."""
     ranges = np.asarray(msg.ranges, dtype=np.float32)
     header = {
-        "k": "scan", "topic": topic, "frame": frame or str(msg.header.frame_id).lstrip("/"),
-        "a0": float(msg.angle_min), "da": float(msg.angle_increment),
-        "rmin": float(msg.range_min), "rmax": float(msg.range_max), "n": len(ranges),
-        "pose": pose, "fixed": fixed,
-    }  # fmt: skip
+        "k": "scan",
+        "topic": topic,
+        "frame": frame or str(msg.header.frame_id).lstrip("/"),
+        "a0": float(msg.angle_min),
+        "da": float(msg.angle_increment),
+        "rmin": float(msg.range_min),
+        "rmax": float(msg.range_max),
+        "n": len(ranges),
+        "pose": pose,
+        "fixed": fixed,
+    }
     return pack(header, ranges.tobytes())
 
 

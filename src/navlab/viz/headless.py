@@ -27,8 +27,15 @@ from websockets.sync.client import connect
 from navlab.viz.errors import VizError
 
 CHROMIUM = "/usr/bin/chromium"
-CHROMIUM_ARGS = ["--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run", "--disable-background-networking",
-                 "--disable-component-update", "--disable-sync"]  # fmt: skip
+CHROMIUM_ARGS = [
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+]
 
 
 class HeadlessPage:
@@ -39,8 +46,15 @@ class HeadlessPage:
         self, url: str = "about:blank", *, width: int = 1280, height: int = 800, executable: str = CHROMIUM
     ) -> None:
         self.dir = Path(tempfile.mkdtemp(prefix="navlab-chromium-"))
-        cmd = [executable, "--headless", "--remote-debugging-port=0", f"--user-data-dir={self.dir}",
-               f"--window-size={width},{height}", *CHROMIUM_ARGS, "about:blank"]  # fmt: skip
+        cmd = [
+            executable,
+            "--headless",
+            "--remote-debugging-port=0",
+            f"--user-data-dir={self.dir}",
+            f"--window-size={width},{height}",
+            *CHROMIUM_ARGS,
+            "about:blank",
+        ]
         try:
             # its own process group: closing ends every chromium process it started, not only the first
             out = subprocess.DEVNULL

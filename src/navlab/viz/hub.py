@@ -21,8 +21,19 @@ from navlab.viz import frames as fr
 from navlab.viz import sensor_frames
 
 # kind of stream -> most frames per wall-clock second sent to one page
-RATES_HZ = {"state": 30.0, "scan": 15.0, "map": 2.0, "costmap": 4.0, "path": 10.0, "poses": 5.0,
-            "polygon": 10.0, "trace": 2.0, "graph": 0.5, "image": 5.0, "cloud": 5.0}  # fmt: skip
+RATES_HZ = {
+    "state": 30.0,
+    "scan": 15.0,
+    "map": 2.0,
+    "costmap": 4.0,
+    "path": 10.0,
+    "poses": 5.0,
+    "polygon": 10.0,
+    "trace": 2.0,
+    "graph": 0.5,
+    "image": 5.0,
+    "cloud": 5.0,
+}
 TRACE_STEP_M = 0.02  # a trace gets a point when the robot moved this far
 TRACE_MAX = 20_000  # points kept per trace
 

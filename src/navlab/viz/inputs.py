@@ -16,16 +16,16 @@ from typing import Any
 
 from navlab.drivers import MOVE_BINDINGS, SPEED_BINDINGS
 
-OPS = ("goal", "initialpose", "cancel", "key", "spawn", "move", "delete", "pause", "resume", "speed", "seek",
-       "play")  # fmt: skip
+OPS = ("goal", "initialpose", "cancel", "key", "spawn", "move", "delete", "pause", "resume", "speed", "seek", "play")
 _NAME = re.compile(r"^[A-Za-z0-9_]{1,64}$")
 _FRAME = re.compile(r"^[A-Za-z0-9_/]{0,64}$")
 MAX_COORD = 1e4  # m: farther than any world
 OBSTACLE_HEIGHT = 0.5  # m
 
 
-def _num(req: dict[str, Any], key: str, *, lo: float = -MAX_COORD, hi: float = MAX_COORD,
-         default: float | None = None) -> float:  # fmt: skip
+def _num(
+    req: dict[str, Any], key: str, *, lo: float = -MAX_COORD, hi: float = MAX_COORD, default: float | None = None
+) -> float:
     value = req.get(key, default)
     if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
         raise ValueError(f"{req.get('op')}: {key!r} must be a finite number, got {value!r}")
@@ -59,8 +59,13 @@ def check_input(req: Any) -> tuple[str, dict[str, Any]]:
             dims = [_num(req, "radius", lo=0.03, hi=2.5, default=0.2), OBSTACLE_HEIGHT]
         else:
             raise ValueError(f"spawn: 'kind' must be 'box' or 'cylinder', got {kind!r}")
-        return op, {"kind": kind, "dims": dims, "x": _num(req, "x"), "y": _num(req, "y"),
-                    "yaw": _num(req, "yaw", lo=-10, hi=10, default=0.0)}  # fmt: skip
+        return op, {
+            "kind": kind,
+            "dims": dims,
+            "x": _num(req, "x"),
+            "y": _num(req, "y"),
+            "yaw": _num(req, "yaw", lo=-10, hi=10, default=0.0),
+        }
     if op in ("move", "delete"):
         name = req.get("name")
         if not isinstance(name, str) or not _NAME.match(name):

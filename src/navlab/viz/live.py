@@ -33,8 +33,15 @@ from navlab.viz.sensor_frames import cloud_in_fixed
 
 # rviz's 2D Pose Estimate: x/y variance 0.25 m², yaw variance (pi/12)² rad²
 INITIALPOSE_COV = (0.25, 0.25, 0.0, 0.0, 0.0, 0.06853891945200942)
-KINDS = {msgs.OccupancyGrid: "grid", msgs.LaserScan: "scan", msgs.Path: "path", msgs.PoseArray: "poses",
-         msgs.PolygonStamped: "polygon", msgs.Image: "image", msgs.PointCloud2: "cloud"}  # fmt: skip
+KINDS = {
+    msgs.OccupancyGrid: "grid",
+    msgs.LaserScan: "scan",
+    msgs.Path: "path",
+    msgs.PoseArray: "poses",
+    msgs.PolygonStamped: "polygon",
+    msgs.Image: "image",
+    msgs.PointCloud2: "cloud",
+}
 ODOM_PERIOD_NS = 50_000_000  # simulated ns between odometry samples kept for the traces (20 Hz at most)
 GRAPH_WALL_PERIOD = 1.0  # wall-clock s between refreshes of the node graph (at most)
 PEEK_PERIOD = 0.2  # wall-clock s between copies of the plans and the particle cloud
@@ -132,8 +139,16 @@ class ViewerNode(Node):
     ``frame_hz`` (most state snapshots per wall-clock s, 30), ``graph_period`` (simulated s, 1.0).
     """
 
-    def __init__(self, executor: Executor, *, name: str = "navlab_viewer", parameters: dict[str, Any] | None = None,
-                 namespace: str = "", hub: Hub | None = None, pacer: Pacer | None = None) -> None:  # fmt: skip
+    def __init__(
+        self,
+        executor: Executor,
+        *,
+        name: str = "navlab_viewer",
+        parameters: dict[str, Any] | None = None,
+        namespace: str = "",
+        hub: Hub | None = None,
+        pacer: Pacer | None = None,
+    ) -> None:
         super().__init__(executor, name=name, parameters=parameters, namespace=namespace)
         self.hub = hub if hub is not None else Hub()
         self.pacer = pacer if pacer is not None else Pacer(executor.rate or 1.0)
@@ -207,8 +222,10 @@ class ViewerNode(Node):
         mb = self._move_base()
         if mb is not None and hasattr(mb, "plan_pub"):
             out[mb.plan_pub.topic_name] = (mb.global_costmap.global_frame, lambda: mb.global_plan)
-            out[mb.local_plan_pub.topic_name] = (mb.local_costmap.global_frame,
-                                                 lambda: getattr(mb.controller, "local_plan", None))  # fmt: skip
+            out[mb.local_plan_pub.topic_name] = (
+                mb.local_costmap.global_frame,
+                lambda: getattr(mb.controller, "local_plan", None),
+            )
         amcl = self._node_with("filter", "cloud_pub", "global_frame")
         if amcl is not None:
             out[amcl.cloud_pub.topic_name] = (
@@ -233,8 +250,11 @@ class ViewerNode(Node):
         if kind == "cloud":  # moved into the fixed frame here, where tf is (a few thousand points)
             fixed, frame, tf = self._fixed(), str(msg.header.frame_id).lstrip("/"), self.executor.tf
             try:
-                t = tf.lookup(fixed, frame, msgs.stamp_ns(msg)) if tf.can_transform(fixed, frame, msgs.stamp_ns(msg)) \
+                t = (
+                    tf.lookup(fixed, frame, msgs.stamp_ns(msg))
+                    if tf.can_transform(fixed, frame, msgs.stamp_ns(msg))
                     else tf.lookup(fixed, frame)
+                )
             except TfError:
                 return
             xyz = cloud_in_fixed(msg, t, self.rng)
@@ -263,8 +283,14 @@ class ViewerNode(Node):
         key = json.dumps(graph, sort_keys=True)
         if key != self._graph_key:  # the structure changed: lay it out again (dot takes ~20 ms)
             self._graph_key, self._layout = key, with_layout(graph).get("layout")
-        self.hub.set_graph({**graph, "rates": rates, "layout": self._layout,
-                            "types": {n: msgs.type_name(t.msgtype) for n, t in ex.topics.items()}})  # fmt: skip
+        self.hub.set_graph(
+            {
+                **graph,
+                "rates": rates,
+                "layout": self._layout,
+                "types": {n: msgs.type_name(t.msgtype) for n, t in ex.topics.items()},
+            }
+        )
 
     # --- pace and state -------------------------------------------------------------------------------
 
@@ -311,12 +337,21 @@ class ViewerNode(Node):
                 continue
         tf.setdefault("world", [0.0, 0.0, 0.0])  # ground truth: the world is the map (or odom's start)
         self.hub.place_scans(fixed, self._pose_at)
-        self.hub.set_state({
-            "t": ex.now_ns / 1e9, "rtf": round(self.rtf, 2), "paused": self.pacer.paused, "speed": self.pacer.speed,
-            "fixed": fixed, "base": self._base(), "tf": tf, "move_base": self._move_base_state(),
-            "obstacles": [{"name": k, **v} for k, v in self.obstacles.items()], "replay": False,
-            "teleop": {"speed": round(self.teleop.speed, 3), "turn": round(self.teleop.turn, 3)},
-        })  # fmt: skip
+        self.hub.set_state(
+            {
+                "t": ex.now_ns / 1e9,
+                "rtf": round(self.rtf, 2),
+                "paused": self.pacer.paused,
+                "speed": self.pacer.speed,
+                "fixed": fixed,
+                "base": self._base(),
+                "tf": tf,
+                "move_base": self._move_base_state(),
+                "obstacles": [{"name": k, **v} for k, v in self.obstacles.items()],
+                "replay": False,
+                "teleop": {"speed": round(self.teleop.speed, 3), "turn": round(self.teleop.turn, 3)},
+            }
+        )
 
     def _pose_at(self, frame: str, t_ns: int) -> list[float] | None:
         """(x, y, yaw) of ``frame`` in the fixed frame at ``t_ns`` (the latest if tf has none then)."""
@@ -400,10 +435,12 @@ class ViewerNode(Node):
         elif op == "initialpose":
             cov = msgs.covariance(INITIALPOSE_COV)
             frame = a.get("frame") or self._fixed()
-            self.pose_pub.publish(msgs.PoseWithCovarianceStamped(
-                header=msgs.header(now, frame),
-                pose=msgs.PoseWithCovariance(pose=msgs.pose_from_2d(a["x"], a["y"], a["yaw"]), covariance=cov),
-            ))  # fmt: skip
+            self.pose_pub.publish(
+                msgs.PoseWithCovarianceStamped(
+                    header=msgs.header(now, frame),
+                    pose=msgs.PoseWithCovariance(pose=msgs.pose_from_2d(a["x"], a["y"], a["yaw"]), covariance=cov),
+                )
+            )
         elif op == "cancel":
             mb = self._move_base()
             if mb is not None:
@@ -437,8 +474,17 @@ class ViewerNode(Node):
             name = f"viewer_{a['kind']}_{k}"
             spec = {"kind": a["kind"], "dims": list(a["dims"]), "x": a["x"], "y": a["y"], "yaw": a.get("yaw", 0.0)}
         wx, wy = self._to_world(spec["x"], spec["y"])
-        reply = ex.call_service("/spawn_entity", {"kind": spec["kind"], "name": name, "dims": tuple(spec["dims"]),
-                                                  "x": wx, "y": wy, "yaw": spec.get("yaw", 0.0)})  # fmt: skip
+        reply = ex.call_service(
+            "/spawn_entity",
+            {
+                "kind": spec["kind"],
+                "name": name,
+                "dims": tuple(spec["dims"]),
+                "x": wx,
+                "y": wy,
+                "yaw": spec.get("yaw", 0.0),
+            },
+        )
         if reply.get("success"):
             self.obstacles[name] = spec
         else:

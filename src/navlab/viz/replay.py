@@ -51,8 +51,14 @@ def load_recording(path: str | Path, *, progress: bool = False) -> Recording:
     if not (p / "metadata.yaml").is_file():
         raise VizError(f"{p}: not a rosbag2 recording (no metadata.yaml); record one with --record DIR")
     total = sum(count for _type, count in bag_topics(p).values())
-    bar = tqdm(total=total, unit="msg", desc=f"loading {p.name}", file=sys.stderr, mininterval=0.5,
-               disable=not progress or not sys.stderr.isatty())  # fmt: skip
+    bar = tqdm(
+        total=total,
+        unit="msg",
+        desc=f"loading {p.name}",
+        file=sys.stderr,
+        mininterval=0.5,
+        disable=not progress or not sys.stderr.isatty(),
+    )
     topics: dict[str, tuple[str, list[int], list[Any]]] = {}
     odom: dict[str, tuple[str, list[int], list[tuple[float, float]]]] = {}
     tf_msgs: list[tuple[int, Any, bool]] = []
@@ -88,8 +94,10 @@ def load_recording(path: str | Path, *, progress: bool = False) -> Recording:
     tf = TfBuffer(cache_ns=t1 - t0 + 10**9)
     for _t, msg, static in tf_msgs:
         tf.add_message(msg, static=static)
-    traces = {k: (f, np.array(ts, dtype=np.int64), np.array(xy, dtype=np.float32).reshape(-1, 2))
-              for k, (f, ts, xy) in odom.items()}  # fmt: skip
+    traces = {
+        k: (f, np.array(ts, dtype=np.int64), np.array(xy, dtype=np.float32).reshape(-1, 2))
+        for k, (f, ts, xy) in odom.items()
+    }
     return Recording(t0, t1, topics, traces, tf, base)
 
 
@@ -185,11 +193,22 @@ class BagPlayer:
                 continue
         tf.setdefault("world", [0.0, 0.0, 0.0])  # ground truth: the world is the map (or odom's start)
         hub.place_scans(fixed, lambda frame, stamp: self._pose_at(fixed, frame, stamp))
-        hub.set_state({
-            "t": (t_ns - rec.t0) / 1e9, "t0": 0.0, "t1": (rec.t1 - rec.t0) / 1e9, "rtf": self.speed,
-            "paused": self.paused, "speed": self.speed, "fixed": fixed, "base": rec.base_frame, "tf": tf,
-            "move_base": None, "obstacles": [], "replay": True,
-        })  # fmt: skip
+        hub.set_state(
+            {
+                "t": (t_ns - rec.t0) / 1e9,
+                "t0": 0.0,
+                "t1": (rec.t1 - rec.t0) / 1e9,
+                "rtf": self.speed,
+                "paused": self.paused,
+                "speed": self.speed,
+                "fixed": fixed,
+                "base": rec.base_frame,
+                "tf": tf,
+                "move_base": None,
+                "obstacles": [],
+                "replay": True,
+            }
+        )
 
     def _pose_at(self, fixed: str, frame: str, t_ns: int) -> list[float] | None:
         try:

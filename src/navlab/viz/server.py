@@ -35,8 +35,15 @@ from navlab.viz.hub import ClientStream, Hub
 LOOPBACK = ("127.0.0.1", "localhost", "::1")
 MAX_MESSAGE = 64 * 1024  # bytes: the largest input a page may send
 SEND_HZ = 30.0  # how often each client's streams are checked for due frames
-_TYPES = {".js": "text/javascript", ".mjs": "text/javascript", ".css": "text/css", ".html": "text/html",
-          ".svg": "image/svg+xml", ".png": "image/png", ".json": "application/json"}  # fmt: skip
+_TYPES = {
+    ".js": "text/javascript",
+    ".mjs": "text/javascript",
+    ".css": "text/css",
+    ".html": "text/html",
+    ".svg": "image/svg+xml",
+    ".png": "image/png",
+    ".json": "application/json",
+}
 _log = logging.getLogger("navlab.viz.server")
 
 
@@ -149,9 +156,18 @@ class ViewerServer:
         compression = None if self.host in LOOPBACK else "deflate"
         # close_timeout: on close, a page that does not answer the closing handshake is dropped after 1 s (the
         # default 10 s outlasts close()'s 5 s join)
-        async with serve(self._client, self.host, self.port, process_request=self._http, max_size=MAX_MESSAGE,
-                         ping_interval=20, ping_timeout=20, close_timeout=1.0, logger=_log,
-                         compression=compression) as server:  # fmt: skip
+        async with serve(
+            self._client,
+            self.host,
+            self.port,
+            process_request=self._http,
+            max_size=MAX_MESSAGE,
+            ping_interval=20,
+            ping_timeout=20,
+            close_timeout=1.0,
+            logger=_log,
+            compression=compression,
+        ) as server:
             sock = next(iter(server.sockets))
             self.port = int(sock.getsockname()[1])
             self._ready.set()
@@ -234,10 +250,15 @@ class ViewerServer:
 
 
 def _response(status: http.HTTPStatus, body: bytes, ctype: str = "text/plain; charset=utf-8") -> Response:
-    headers = Headers({
-        "Content-Type": ctype, "Content-Length": str(len(body)), "Cache-Control": "no-store",
-        "X-Content-Type-Options": "nosniff", "Referrer-Policy": "no-referrer",
-        "Content-Security-Policy": "default-src 'self'; connect-src 'self'; img-src 'self' data: blob:; "
-                                   "style-src 'self' 'unsafe-inline'",
-    })  # fmt: skip
+    headers = Headers(
+        {
+            "Content-Type": ctype,
+            "Content-Length": str(len(body)),
+            "Cache-Control": "no-store",
+            "X-Content-Type-Options": "nosniff",
+            "Referrer-Policy": "no-referrer",
+            "Content-Security-Policy": "default-src 'self'; connect-src 'self'; img-src 'self' data: blob:; "
+            "style-src 'self' 'unsafe-inline'",
+        }
+    )
     return Response(status.value, status.phrase, headers, body)

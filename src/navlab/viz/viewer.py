@@ -96,8 +96,10 @@ def host_warning(host: str) -> str | None:
     """The warning printed when the server listens beyond this machine."""
     if host in LOOPBACK:
         return None
-    return (f"warning: the viewer listens on {host}: anyone who can reach this machine can watch the run and "
-            "send goals, teleop commands and obstacles (use --host 127.0.0.1 to keep it local)")  # fmt: skip
+    return (
+        f"warning: the viewer listens on {host}: anyone who can reach this machine can watch the run and "
+        "send goals, teleop commands and obstacles (use --host 127.0.0.1 to keep it local)"
+    )
 
 
 def open_in_browser(url: str) -> bool:

@@ -101,11 +101,18 @@ class ClutterWorld:
     def summary(self) -> dict[str, object]:
         """The figures a user reads (JSON-ready): parameters, poses, counts, reference length, difficulty."""
         return {
-            "name": self.name, "seed": self.seed, "fill": self.fill, "smooth": self.smooth,
-            "robot_radius": self.robot_radius, "margin": self.margin,
-            "cylinders": len(self.cylinders), "carved": self.carved,
-            "start": list(self.start), "goal": list(self.goal),
-            "reference_path_m": round(self.reference_path_m, 4), "t_opt_s": round(self.t_opt(), 4),
+            "name": self.name,
+            "seed": self.seed,
+            "fill": self.fill,
+            "smooth": self.smooth,
+            "robot_radius": self.robot_radius,
+            "margin": self.margin,
+            "cylinders": len(self.cylinders),
+            "carved": self.carved,
+            "start": list(self.start),
+            "goal": list(self.goal),
+            "reference_path_m": round(self.reference_path_m, 4),
+            "t_opt_s": round(self.t_opt(), 4),
             "difficulty": round(self.difficulty, 4),
             "metrics": {k: round(v, 4) for k, v in self.metrics.items()},
         }
@@ -211,8 +218,9 @@ def _segment_hits_rect(a: np.ndarray, ends: np.ndarray, lo: np.ndarray, hi: np.n
 
 
 # ------------------------------------------------------------------------------ cellular automaton
-def cellular_automaton(rng: np.random.Generator, fill: float, smooth: int, *, fill_threshold: int = 5,
-                       clear_threshold: int = 1) -> np.ndarray:
+def cellular_automaton(
+    rng: np.random.Generator, fill: float, smooth: int, *, fill_threshold: int = 5, clear_threshold: int = 1
+) -> np.ndarray:
     """(30, 30) bool field: random fill with probability ``fill``, then ``smooth`` rounds of the rule.
 
     Each round, a cell with >= ``fill_threshold`` filled neighbours (of 8) fills, one with <=
@@ -229,8 +237,9 @@ def cellular_automaton(rng: np.random.Generator, fill: float, smooth: int, *, fi
 
 
 # ------------------------------------------------------------------------------------ grid search
-def _grid_dijkstra(passable: np.ndarray, enter_cost: np.ndarray, step: float,
-                   source: int, target: int) -> list[int] | None:
+def _grid_dijkstra(
+    passable: np.ndarray, enter_cost: np.ndarray, step: float, source: int, target: int
+) -> list[int] | None:
     """Cheapest 8-connected path of flat cell indices from ``source`` to ``target``, or None.
 
     A move costs its length (``step`` or ``step`` sqrt 2) times ``1 + enter_cost`` of the cell entered.
@@ -249,8 +258,9 @@ def _grid_dijkstra(passable: np.ndarray, enter_cost: np.ndarray, step: float,
         rows += [a, b]
         cols += [b, a]
         weights += [length * (1.0 + cost[b]), length * (1.0 + cost[a])]
-    graph = coo_matrix((np.concatenate(weights), (np.concatenate(rows), np.concatenate(cols))),
-                       shape=(ny * nx, ny * nx)).tocsr()
+    graph = coo_matrix(
+        (np.concatenate(weights), (np.concatenate(rows), np.concatenate(cols))), shape=(ny * nx, ny * nx)
+    ).tocsr()
     dist, pred = dijkstra(graph, indices=source, return_predecessors=True)
     if not np.isfinite(dist[target]):
         return None
@@ -271,8 +281,9 @@ def _segment_distances(points: np.ndarray, path: np.ndarray) -> np.ndarray:
     return np.linalg.norm(points[:, None, :] - closest, axis=2).min(axis=1)
 
 
-def _carve(cylinders: np.ndarray, walls: list[Box], start: np.ndarray, goal: np.ndarray,
-           clear: float) -> tuple[np.ndarray, np.ndarray]:
+def _carve(
+    cylinders: np.ndarray, walls: list[Box], start: np.ndarray, goal: np.ndarray, clear: float
+) -> tuple[np.ndarray, np.ndarray]:
     """Keep-mask of cylinders after clearing a corridor of half-width ``clear`` (m), and its polyline.
 
     The corridor follows the cheapest path over the 0.15 m grid from start to goal, where entering a
@@ -292,8 +303,9 @@ def _carve(cylinders: np.ndarray, walls: list[Box], start: np.ndarray, goal: np.
     cost = _CARVE_WEIGHT * count.reshape(gx.shape)
     ys_ok = np.flatnonzero(passable[:, np.argmin(np.abs(xs - FIELD / 2))])  # rows usable between the walls
     if not len(ys_ok):
-        raise WorldError(f"clutter: robot_radius + margin = {clear - _REF_RES:.3f} m does not fit between the "
-                         f"walls {FIELD} m apart")
+        raise WorldError(
+            f"clutter: robot_radius + margin = {clear - _REF_RES:.3f} m does not fit between the walls {FIELD} m apart"
+        )
 
     def nearest(p: np.ndarray) -> int:
         i = ys_ok[np.argmin(np.abs(ys[ys_ok] - p[1]))]
@@ -319,8 +331,9 @@ def _search_grid(walls: list[Box], goal: np.ndarray) -> tuple[np.ndarray, np.nda
     return xs, ys
 
 
-def _free_grid(clearance: _Clearance, walls: list[Box], goal: np.ndarray, radius: float
-               ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+def _free_grid(
+    clearance: _Clearance, walls: list[Box], goal: np.ndarray, radius: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     xs, ys = _search_grid(walls, goal)
     gx, gy = np.meshgrid(xs, ys)
     pts = np.c_[gx.ravel(), gy.ravel()]
@@ -332,8 +345,9 @@ def _cell_of(xs: np.ndarray, ys: np.ndarray, p: np.ndarray) -> int:
     return int(np.argmin(np.abs(ys - p[1])) * len(xs) + np.argmin(np.abs(xs - p[0])))
 
 
-def reference_path(clearance: _Clearance, walls: list[Box], start: np.ndarray, goal: np.ndarray,
-                   radius: float) -> np.ndarray | None:
+def reference_path(
+    clearance: _Clearance, walls: list[Box], start: np.ndarray, goal: np.ndarray, radius: float
+) -> np.ndarray | None:
     """Shortest collision-free path (n, 2) for a disc of ``radius`` from start to goal, or None.
 
     8-connected Dijkstra over the 0.05 m grid cells whose exact clearance is >= ``radius``, then
@@ -350,7 +364,7 @@ def reference_path(clearance: _Clearance, walls: list[Box], start: np.ndarray, g
     raw = np.vstack([start, pts[cells[1:-1]], goal])
     out, i = [raw[0]], 0
     while i < len(raw) - 1:
-        seen = np.flatnonzero(clearance.segments_clear(raw[i], raw[i + 2:], radius))
+        seen = np.flatnonzero(clearance.segments_clear(raw[i], raw[i + 2 :], radius))
         i = i + 2 + int(seen[-1]) if len(seen) else i + 1
         out.append(raw[i])
     return np.array(out)
@@ -370,8 +384,9 @@ def corridor_exists(world: ClutterWorld, radius: float) -> bool:
     return _connected(free, _cell_of(xs, ys, np.array(world.start[:2])), _cell_of(xs, ys, goal))
 
 
-def bottleneck(clearance: _Clearance, walls: list[Box], start: np.ndarray, goal: np.ndarray,
-               tol: float = 0.005) -> float:
+def bottleneck(
+    clearance: _Clearance, walls: list[Box], start: np.ndarray, goal: np.ndarray, tol: float = 0.005
+) -> float:
     """Half-width (m) of the narrowest passage on the widest route: the largest clearance c for which
     start and goal connect through 0.05 m cells with clearance >= c (bisection to ``tol``)."""
     xs, ys = _search_grid(walls, goal)
@@ -388,8 +403,16 @@ def bottleneck(clearance: _Clearance, walls: list[Box], start: np.ndarray, goal:
 
 
 # ------------------------------------------------------------------------------------- generator
-def generate_clutter(seed: int, *, fill: float, smooth: int, robot_radius: float = 0.2, margin: float = 0.05,
-                     fill_threshold: int = 5, clear_threshold: int = 1) -> ClutterWorld:
+def generate_clutter(
+    seed: int,
+    *,
+    fill: float,
+    smooth: int,
+    robot_radius: float = 0.2,
+    margin: float = 0.05,
+    fill_threshold: int = 5,
+    clear_threshold: int = 1,
+) -> ClutterWorld:
     """A BARN-style world from ``seed`` (same seed and options, same world).
 
     ``fill``: initial fill probability of each field cell (0..1); ``smooth``: cellular-automaton rounds
@@ -404,11 +427,12 @@ def generate_clutter(seed: int, *, fill: float, smooth: int, robot_radius: float
     if not robot_radius > 0.0 or not margin >= 0.0:
         raise WorldError(f"clutter: robot_radius must be > 0 and margin >= 0 m, got {robot_radius}, {margin}")
     if not 0 <= clear_threshold < fill_threshold <= 8:
-        raise WorldError("clutter: need 0 <= clear_threshold < fill_threshold <= 8 (neighbour counts), got "
-                         f"clear_threshold {clear_threshold}, fill_threshold {fill_threshold}")
+        raise WorldError(
+            "clutter: need 0 <= clear_threshold < fill_threshold <= 8 (neighbour counts), got "
+            f"clear_threshold {clear_threshold}, fill_threshold {fill_threshold}"
+        )
     rng = np.random.default_rng(seed)
-    cells = cellular_automaton(rng, fill, int(smooth), fill_threshold=fill_threshold,
-                               clear_threshold=clear_threshold)
+    cells = cellular_automaton(rng, fill, int(smooth), fill_threshold=fill_threshold, clear_threshold=clear_threshold)
     start = np.array([-START_GAP, 0.0])
     goal = start + np.array([GOAL_DISTANCE, 0.0])
     walls = _walls()
@@ -423,12 +447,19 @@ def generate_clutter(seed: int, *, fill: float, smooth: int, robot_radius: float
     clearance = _Clearance(cylinders, walls)
     path = reference_path(clearance, walls, start, goal, robot_radius)
     if path is None:
-        raise WorldError(f"clutter: seed {seed}: no collision-free path for robot_radius {robot_radius} m "
-                         "after carving (a bug: please report the seed and options)")
+        raise WorldError(
+            f"clutter: seed {seed}: no collision-free path for robot_radius {robot_radius} m "
+            "after carving (a bug: please report the seed and options)"
+        )
     seg = np.linalg.norm(np.diff(path, axis=0), axis=1)
     length = float(seg.sum())
-    samples = np.vstack([a + t * (b - a) for a, b in itertools.pairwise(path)
-                         for t in np.linspace(0.0, 1.0, max(2, math.ceil(np.linalg.norm(b - a) / 0.05)))])
+    samples = np.vstack(
+        [
+            a + t * (b - a)
+            for a, b in itertools.pairwise(path)
+            for t in np.linspace(0.0, 1.0, max(2, math.ceil(np.linalg.norm(b - a) / 0.05)))
+        ]
+    )
     in_field = (samples[:, 0] >= 0.0) & (samples[:, 0] <= FIELD)
     along = clearance(samples[in_field]) if in_field.any() else np.array([np.inf])
     metrics = {
@@ -439,10 +470,20 @@ def generate_clutter(seed: int, *, fill: float, smooth: int, robot_radius: float
         "bottleneck_m": bottleneck(clearance, walls, start, goal),
     }
     return ClutterWorld(
-        seed=int(seed), fill=float(fill), smooth=int(smooth), robot_radius=float(robot_radius),
-        margin=float(margin), cells=cells, cylinders=cylinders, walls=walls,
-        start=(float(start[0]), float(start[1]), 0.0), goal=(float(goal[0]), float(goal[1]), 0.0),
-        reference_path=path, reference_path_m=length, difficulty=float(cells.mean()), carved=carved,
+        seed=int(seed),
+        fill=float(fill),
+        smooth=int(smooth),
+        robot_radius=float(robot_radius),
+        margin=float(margin),
+        cells=cells,
+        cylinders=cylinders,
+        walls=walls,
+        start=(float(start[0]), float(start[1]), 0.0),
+        goal=(float(goal[0]), float(goal[1]), 0.0),
+        reference_path=path,
+        reference_path_m=length,
+        difficulty=float(cells.mean()),
+        carved=carved,
         metrics=metrics,
     )
 
@@ -457,8 +498,10 @@ def suite_parameters(n: int = 50) -> list[tuple[float, int]]:
 
 def clutter_suite(n: int = 50, seed: int = 0, *, robot_radius: float = 0.2, margin: float = 0.05) -> list[ClutterWorld]:
     """``n`` worlds of graded difficulty (deterministic for ``seed``): world k has seed ``seed * 1000 + k``."""
-    return [generate_clutter(seed * 1000 + k, fill=f, smooth=s, robot_radius=robot_radius, margin=margin)
-            for k, (f, s) in enumerate(suite_parameters(n))]
+    return [
+        generate_clutter(seed * 1000 + k, fill=f, smooth=s, robot_radius=robot_radius, margin=margin)
+        for k, (f, s) in enumerate(suite_parameters(n))
+    ]
 
 
 # ------------------------------------------------------------------------------------------- SDF
@@ -472,13 +515,20 @@ def _sdf(w: ClutterWorld) -> str:
         f"     start ({sx:g}, {sy:g}, yaw 0), goal ({gx:g}, {gy:g}); reference path {w.reference_path_m:.3f} m "
         f"for robot radius {w.robot_radius} m; difficulty (fill after smoothing) {w.difficulty:.4f}"
     )
-    walls = [link(b.name, b.x, b.y, b.height / 2, box_geometry(b.sx, b.sy, b.height), "0.9 0.9 0.85",
-                  parts=f"{b.name}_") for b in w.walls]  # fmt: skip
+    walls = [
+        link(b.name, b.x, b.y, b.height / 2, box_geometry(b.sx, b.sy, b.height), "0.9 0.9 0.85", parts=f"{b.name}_")
+        for b in w.walls
+    ]
     models = [static_model("clutter_walls", walls)]
     if len(w.cylinders):
         geometry = cylinder_geometry(CYLINDER_RADIUS, CYLINDER_HEIGHT)
-        models.append(static_model("clutter_cylinders", [
-            link(f"cylinder_{k:03d}", float(x), float(y), CYLINDER_HEIGHT / 2, geometry, "0.3 0.3 0.35")
-            for k, (x, y) in enumerate(w.cylinders)
-        ]))  # fmt: skip
+        models.append(
+            static_model(
+                "clutter_cylinders",
+                [
+                    link(f"cylinder_{k:03d}", float(x), float(y), CYLINDER_HEIGHT / 2, geometry, "0.3 0.3 0.35")
+                    for k, (x, y) in enumerate(w.cylinders)
+                ],
+            )
+        )
     return world_sdf(w.name, models, comment)

@@ -55,7 +55,7 @@ def _slab_points(verts: np.ndarray, z0: float, z1: float) -> np.ndarray:
     a, b = verts[i], verts[j]
     for plane in (z0, z1):
         da, db = a[:, 2] - plane, b[:, 2] - plane
-        cross = (da * db < 0)
+        cross = da * db < 0
         if cross.any():
             t = (da[cross] / (da[cross] - db[cross]))[:, None]
             pts.append((a[cross] + t * (b[cross] - a[cross]))[:, :2])
@@ -105,8 +105,9 @@ def _prism(radius: float, length: float) -> np.ndarray:
     r = radius / math.cos(math.pi / _PRISM_SIDES)
     ang = np.arange(_PRISM_SIDES) * 2 * math.pi / _PRISM_SIDES
     ring = np.stack([r * np.cos(ang), r * np.sin(ang)], axis=1)
-    return np.concatenate([np.c_[ring, np.full(_PRISM_SIDES, -length / 2)],
-                           np.c_[ring, np.full(_PRISM_SIDES, length / 2)]])
+    return np.concatenate(
+        [np.c_[ring, np.full(_PRISM_SIDES, -length / 2)], np.c_[ring, np.full(_PRISM_SIDES, length / 2)]]
+    )
 
 
 def _footprint(shape: Shape, world_T_shape: np.ndarray, name: str, z0: float, z1: float) -> Footprint | None:
@@ -140,8 +141,9 @@ def _footprint(shape: Shape, world_T_shape: np.ndarray, name: str, z0: float, z1
     raise WorldError(f"{name}: unknown geometry kind {g.kind!r}")
 
 
-def shape_footprints(world: WorldModel, *, z_min: float = 0.05, z_max: float = 0.5,
-                     static_only: bool = False) -> list[Footprint]:
+def shape_footprints(
+    world: WorldModel, *, z_min: float = 0.05, z_max: float = 0.5, static_only: bool = False
+) -> list[Footprint]:
     """Footprints of every collision shape (models at their initial poses) in the height band."""
     out = []
     for model in world.models:
@@ -158,8 +160,9 @@ def shape_footprints(world: WorldModel, *, z_min: float = 0.05, z_max: float = 0
     return out
 
 
-def extents(world: WorldModel, *, z_min: float = 0.05, z_max: float = 0.5,
-            static_only: bool = False) -> tuple[float, float, float, float] | None:
+def extents(
+    world: WorldModel, *, z_min: float = 0.05, z_max: float = 0.5, static_only: bool = False
+) -> tuple[float, float, float, float] | None:
     """(x_min, y_min, x_max, y_max) of every collision shape in the height band; None if there is none.
 
     Pass ``z_min=-math.inf, z_max=math.inf`` for the full extents regardless of height.
@@ -198,8 +201,12 @@ class _Grid:
             return
         si, sj, cx, cy = win
         h, eps = self.res / 2, (_EPS if strict else -_EPS)
-        ok = ((cx + h > pts[:, 0].min() + eps) & (cx - h < pts[:, 0].max() - eps)
-              & (cy + h > pts[:, 1].min() + eps) & (cy - h < pts[:, 1].max() - eps))
+        ok = (
+            (cx + h > pts[:, 0].min() + eps)
+            & (cx - h < pts[:, 0].max() - eps)
+            & (cy + h > pts[:, 1].min() + eps)
+            & (cy - h < pts[:, 1].max() - eps)
+        )
         edges = np.roll(pts, -1, axis=0) - pts
         for e in edges[np.linalg.norm(edges, axis=1) > 1e-12]:
             n = np.array([-e[1], e[0]]) / np.linalg.norm(e)
@@ -271,8 +278,12 @@ class _Grid:
             j = j0[t] + local % np.maximum(width[t], 1)
             cx = self.x0 + (j + 0.5) * self.res
             cy = self.y0 + (i + 0.5) * self.res
-            hit = ((cx + h >= lo[t, 0] - eps) & (cx - h <= hi[t, 0] + eps)
-                   & (cy + h >= lo[t, 1] - eps) & (cy - h <= hi[t, 1] + eps))
+            hit = (
+                (cx + h >= lo[t, 0] - eps)
+                & (cx - h <= hi[t, 0] + eps)
+                & (cy + h >= lo[t, 1] - eps)
+                & (cy - h <= hi[t, 1] + eps)
+            )
             ax = axes[t]  # (P, A, 2)
             c = ax[..., 0] * cx[:, None] + ax[..., 1] * cy[:, None]
             r = h * (np.abs(ax[..., 0]) + np.abs(ax[..., 1]))
@@ -296,7 +307,7 @@ class _Grid:
             inside = np.zeros((cy.shape[0], cx.shape[1]), dtype=bool)
             for chunk in np.array_split(segs, max(1, len(segs) // 256)):
                 (ax, ay), (bx, by) = chunk[:, 0].T, chunk[:, 1].T
-                spans = ((ay[None, None, :] <= cy[..., None]) != (by[None, None, :] <= cy[..., None]))
+                spans = (ay[None, None, :] <= cy[..., None]) != (by[None, None, :] <= cy[..., None])
                 with np.errstate(divide="ignore", invalid="ignore"):
                     xc = ax + (cy[..., None] - ay) * (bx - ax) / (by - ay)
                 inside ^= (np.count_nonzero(spans & (xc > cx[..., None]), axis=-1) % 2).astype(bool)
@@ -318,8 +329,15 @@ def _slice(tris: np.ndarray, z: float) -> np.ndarray:
     return np.array(segs).reshape(-1, 2, 2)
 
 
-def occupancy(world: WorldModel, resolution: float, bounds: tuple[float, float, float, float], *,
-              z_min: float = 0.05, z_max: float = 0.5, static_only: bool = False) -> np.ndarray:
+def occupancy(
+    world: WorldModel,
+    resolution: float,
+    bounds: tuple[float, float, float, float],
+    *,
+    z_min: float = 0.05,
+    z_max: float = 0.5,
+    static_only: bool = False,
+) -> np.ndarray:
     """Boolean grid (ny, nx) of the world's true occupancy between ``z_min`` and ``z_max`` (m).
 
     ``bounds`` = (x_min, y_min, x_max, y_max) in the world frame (m); ``resolution`` in m/cell. Models

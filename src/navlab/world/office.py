@@ -75,10 +75,22 @@ class OfficeWorld:
 
     def to_sdf(self) -> str:
         """The world as SDF 1.6 text (ground plane, sun, one static model of wall boxes)."""
-        geo = [link(f"wall_{k:03d}", w.x, w.y, WALL_HEIGHT / 2, box_geometry(w.sx, w.sy, WALL_HEIGHT),
-                    "0.9 0.9 0.85", parts=f"wall_{k:03d}_") for k, w in enumerate(self.walls)]  # fmt: skip
-        comment = (f"navlab office floor {self.width:g} m x {self.depth:g} m: {self.rooms} rooms of {self.room:g} m, "
-                   f"corridors {self.corridor:g} m wide closing two loops, doors {self.door:g} m")  # fmt: skip
+        geo = [
+            link(
+                f"wall_{k:03d}",
+                w.x,
+                w.y,
+                WALL_HEIGHT / 2,
+                box_geometry(w.sx, w.sy, WALL_HEIGHT),
+                "0.9 0.9 0.85",
+                parts=f"wall_{k:03d}_",
+            )
+            for k, w in enumerate(self.walls)
+        ]
+        comment = (
+            f"navlab office floor {self.width:g} m x {self.depth:g} m: {self.rooms} rooms of {self.room:g} m, "
+            f"corridors {self.corridor:g} m wide closing two loops, doors {self.door:g} m"
+        )
         return world_sdf(self.name, [static_model("office_walls", geo)], comment)
 
     def write_world(self, path: str | os.PathLike[str]) -> Path:
@@ -132,8 +144,10 @@ def generate_office(
     if rooms_per_block < 1:
         raise WorldError(f"office: rooms_per_block must be >= 1, got {rooms_per_block}")
     if corridor < 1.2 or door < 0.8 or door > room - 2 * wall or block_depth < 2 * door:
-        raise WorldError(f"office: corridor {corridor} m (>= 1.2), door {door} m (0.8 .. room - 2 wall = "
-                         f"{room - 2 * wall:g}) and block_depth {block_depth} m (>= 2 doors) do not fit")  # fmt: skip
+        raise WorldError(
+            f"office: corridor {corridor} m (>= 1.2), door {door} m (0.8 .. room - 2 wall = "
+            f"{room - 2 * wall:g}) and block_depth {block_depth} m (>= 2 doors) do not fit"
+        )
     block = rooms_per_block * room
     width = 3 * corridor + 2 * block
     depth = 2 * outer_depth + 2 * corridor + block_depth
@@ -186,8 +200,16 @@ def generate_office(
         for k in range(1, rooms_per_block):
             vwall(b0 + room * k, ya1, yb0)
     return OfficeWorld(
-        width=width, depth=depth, corridor=corridor, room=room, door=door, wall=wall, walls=walls,
-        corridor_a=(ya0 + ya1) / 2, corridor_b=(yb0 + yb1) / 2,
+        width=width,
+        depth=depth,
+        corridor=corridor,
+        room=room,
+        door=door,
+        wall=wall,
+        walls=walls,
+        corridor_a=(ya0 + ya1) / 2,
+        corridor_b=(yb0 + yb1) / 2,
         corridor_x=(corridor / 2, corridor + block + corridor / 2, width - corridor / 2),
-        rooms=2 * n_outer + 4 * rooms_per_block, doors=doors,
-    )  # fmt: skip
+        rooms=2 * n_outer + 4 * rooms_per_block,
+        doors=doors,
+    )

@@ -27,8 +27,21 @@ from navlab.world.errors import WorldError
 from navlab.world.model import ModelSpec, Pose6, WorldModel
 
 SUPPORTED_VERSIONS = ("1.4", "1.5", "1.6", "1.7")
-_IGNORED_WORLD_TAGS = ("light", "scene", "gui", "audio", "wind", "atmosphere", "spherical_coordinates",
-                       "magnetic_field", "physics", "gravity", "state", "road", "frame")
+_IGNORED_WORLD_TAGS = (
+    "light",
+    "scene",
+    "gui",
+    "audio",
+    "wind",
+    "atmosphere",
+    "spherical_coordinates",
+    "magnetic_field",
+    "physics",
+    "gravity",
+    "state",
+    "road",
+    "frame",
+)
 
 
 MAX_NESTING = 32  # models and includes inside each other (xacro's include depth too)
@@ -104,7 +117,7 @@ class _Loader:
         beyond ``MAX_NESTING`` (either would recurse until Python's stack runs out)."""
         real = file.resolve() if file is not None else None
         if real is not None and real in self.files:
-            chain = " -> ".join(p.name for p in [*self.files[self.files.index(real):], real])
+            chain = " -> ".join(p.name for p in [*self.files[self.files.index(real) :], real])
             raise WorldError(f"{where}: {file} includes itself (include loop {chain})")
         if self.depth >= MAX_NESTING:
             raise WorldError(f"{where}: models and includes nest deeper than {MAX_NESTING} levels")
@@ -156,8 +169,9 @@ class _Loader:
         for name in ("model.sdf", f"{model_dir.name}.sdf"):
             if (model_dir / name).is_file():
                 return model_dir / name
-        raise WorldError(f"{where}: model directory {model_dir} has no model.config naming an SDF file "
-                         "(nor a model.sdf)")
+        raise WorldError(
+            f"{where}: model directory {model_dir} has no model.config naming an SDF file (nor a model.sdf)"
+        )
 
     def include(self, el: ET.Element, base_dir: Path, where: str) -> list[ModelSpec]:
         """An ``<include>``: load the model file and apply the include's name, pose and static."""
@@ -182,15 +196,25 @@ class _Loader:
         return self.model(model_el, sdf_file, name=name, pose=pose, static=static)
 
     # ------------------------------------------------------------------------------- models
-    def model(self, el: ET.Element, file: Path, *, name: str | None = None, pose: Pose6 | None = None,
-              static: bool | None = None) -> list[ModelSpec]:
+    def model(
+        self,
+        el: ET.Element,
+        file: Path,
+        *,
+        name: str | None = None,
+        pose: Pose6 | None = None,
+        static: bool | None = None,
+    ) -> list[ModelSpec]:
         """A ``<model>`` (nested models and includes flattened into it). Returns [] if it had only planes."""
         name = name or el.get("name") or ""
         where = f'{file}: <model name="{name}">'
         if not name:
             raise WorldError(f"{file}: a <model> has no name attribute")
-        spec = ModelSpec(name=name, pose=pose if pose is not None else _pose(el, where, self.warnings),
-                         static=static if static is not None else _bool(el, "static", False))
+        spec = ModelSpec(
+            name=name,
+            pose=pose if pose is not None else _pose(el, where, self.warnings),
+            static=static if static is not None else _bool(el, "static", False),
+        )
         self._fill(spec, el, file, where, prefix="", frame=(0.0, 0.0, 0.0, 0.0, 0.0, 0.0))
         return [spec] if spec.links else []
 
@@ -221,11 +245,14 @@ class _Loader:
                         model_T_inc = compose6(frame, inc.pose)
                         spec.link_origins[link.name] = Origin.from_pose6(compose6(model_T_inc, o.as_pose6()))
             elif tag == "joint" and not spec.static:
-                self.warnings.append(f'{where}/<joint name="{child.get("name")}">: joints of world models are not '
-                                     "simulated; the links move freely")
+                self.warnings.append(
+                    f'{where}/<joint name="{child.get("name")}">: joints of world models are not '
+                    "simulated; the links move freely"
+                )
             elif tag == "plugin":
-                self.warnings.append(f'{where}/<plugin filename="{child.get("filename")}">: model plugins are '
-                                     "not simulated; ignored")
+                self.warnings.append(
+                    f'{where}/<plugin filename="{child.get("filename")}">: model plugins are not simulated; ignored'
+                )
 
     def link(self, el: ET.Element, file: Path, where: str, static: bool) -> tuple[Link | None, Pose6]:
         """A ``<link>``: collisions, visuals, inertial (SDF default 1 kg, unit inertia)."""
@@ -240,8 +267,10 @@ class _Loader:
             mass = _num(inertial, "mass", iw, 1.0)
             if mass <= 0:
                 raise WorldError(f"{iw}/<mass>: must be > 0 kg, got {mass}")
-            vals = {k: _num(inertia, k, iw + "/<inertia>", 1.0 if k in ("ixx", "iyy", "izz") else 0.0)
-                    for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")}
+            vals = {
+                k: _num(inertia, k, iw + "/<inertia>", 1.0 if k in ("ixx", "iyy", "izz") else 0.0)
+                for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
+            }
             o = _pose(inertial, iw) if inertial is not None else (0.0,) * 6
             link.inertial = Inertial(mass=mass, origin=Origin(xyz=o[:3], rpy=o[3:]), **vals)
         had_shapes = False
@@ -294,14 +323,19 @@ class _Loader:
                 return None
             geometry = mesh
         else:
-            self.warnings.append(f"{gw}: geometry <{g.tag}> is not supported (box, cylinder, sphere, mesh, "
-                                 "plane); ignored")
+            self.warnings.append(
+                f"{gw}: geometry <{g.tag}> is not supported (box, cylinder, sphere, mesh, plane); ignored"
+            )
             return None
         if g.tag != "mesh" and any(v <= 0 for v in geometry.size):
             raise WorldError(f"{gw}: sizes must be positive, got {geometry.size}")
         p = _pose(el, where, self.warnings)
-        return Shape(geometry=geometry, origin=Origin(xyz=p[:3], rpy=p[3:]), name=el.get("name", ""),
-                     rgba=None if collision else self.rgba(el, where))
+        return Shape(
+            geometry=geometry,
+            origin=Origin(xyz=p[:3], rpy=p[3:]),
+            name=el.get("name", ""),
+            rgba=None if collision else self.rgba(el, where),
+        )
 
     def mesh(self, g: ET.Element, file: Path, where: str, collision: bool) -> Geometry | None:
         """A ``<mesh><uri>`` resolved through the model path; DAE converted; convexity checked.
@@ -326,8 +360,13 @@ class _Loader:
         warning = up_axis_warning(named, where)
         if warning and warning not in self.warnings:
             self.warnings.append(warning)
-        return Geometry("mesh", mesh_path=sim_path, mesh_scale=(scale[0] * unit, scale[1] * unit, scale[2] * unit),
-                        mesh_source=named, convex=convex)
+        return Geometry(
+            "mesh",
+            mesh_path=sim_path,
+            mesh_scale=(scale[0] * unit, scale[1] * unit, scale[2] * unit),
+            mesh_source=named,
+            convex=convex,
+        )
 
     def rgba(self, el: ET.Element, where: str) -> tuple[float, float, float, float] | None:
         mat = el.find("material")
@@ -417,8 +456,10 @@ def load_world(path: str | os.PathLike[str], *, model_path: Iterable[str | os.Pa
                 by_name[m.get("name", "")].pose = _pose(m, sw)
             scale = m.findtext("scale")
             if m.get("name") in by_name and scale and _floats(scale, 3, sw + "/<scale>") != (1.0, 1.0, 1.0):
-                world.warnings.append(f"{sw}/<scale>: {scale.strip()} is not applied; the model keeps the "
-                                      "sizes in its <geometry> (resize it there)")
+                world.warnings.append(
+                    f"{sw}/<scale>: {scale.strip()} is not applied; the model keeps the "
+                    "sizes in its <geometry> (resize it there)"
+                )
     world.ground_plane = loader.ground_plane
     world.warnings = loader.warnings + world.warnings
     if not world.ground_plane:
@@ -449,6 +490,6 @@ def load_model(path: str | os.PathLike[str], *, model_path: Iterable[str | os.Pa
         raise WorldError(f"{sdf_file}: no <model> element (expected <sdf><model name=...>)")
     models = loader.model(model_el, sdf_file)
     if not models:
-        raise WorldError(f"{sdf_file}: <model name=\"{model_el.get('name')}\"> has no links with shapes")
+        raise WorldError(f'{sdf_file}: <model name="{model_el.get("name")}"> has no links with shapes')
     models[0].warnings = loader.warnings
     return models[0]

@@ -20,25 +20,28 @@ def link(name: str, x: float, y: float, z: float, geometry: str, rgb: str, *, pa
     """A link at (x, y, z) with one collision and one visual of ``geometry`` coloured ``rgb`` ("r g b").
 
     ``parts`` prefixes the collision and visual names (``wall_0_`` gives ``wall_0_collision``)."""
-    return (f'      <link name="{name}">\n        <pose>{x:.4f} {y:.4f} {z:.4f} 0 0 0</pose>\n'
-            f'        <collision name="{parts}collision">{geometry}</collision>\n'
-            f'        <visual name="{parts}visual">{geometry}\n'
-            f"          <material><ambient>{rgb} 1</ambient><diffuse>{rgb} 1</diffuse></material>\n"
-            "        </visual>\n      </link>\n")  # fmt: skip
+    return (
+        f'      <link name="{name}">\n        <pose>{x:.4f} {y:.4f} {z:.4f} 0 0 0</pose>\n'
+        f'        <collision name="{parts}collision">{geometry}</collision>\n'
+        f'        <visual name="{parts}visual">{geometry}\n'
+        f"          <material><ambient>{rgb} 1</ambient><diffuse>{rgb} 1</diffuse></material>\n"
+        "        </visual>\n      </link>\n"
+    )
 
 
 def static_model(name: str, links: Sequence[str]) -> str:
     """A static model at the origin holding ``links``."""
-    return (f'    <model name="{name}">\n      <static>true</static>\n      <pose>0 0 0 0 0 0</pose>\n'
-            + "".join(links) + "    </model>\n")  # fmt: skip
+    return (
+        f'    <model name="{name}">\n      <static>true</static>\n      <pose>0 0 0 0 0 0</pose>\n'
+        + "".join(links)
+        + "    </model>\n"
+    )
 
 
 def world_sdf(name: str, models: Sequence[str], comment: str = "") -> str:
     """A whole ``.world``: ground plane, sun, gravity, ODE physics at 1 ms and the ``models``."""
     return (
-        '<?xml version="1.0" ?>\n'
-        + (f"<!-- {comment} -->\n" if comment else "")
-        + '<sdf version="1.6">\n'
+        '<?xml version="1.0" ?>\n' + (f"<!-- {comment} -->\n" if comment else "") + '<sdf version="1.6">\n'
         f'  <world name="{name}">\n'
         "    <include>\n      <uri>model://ground_plane</uri>\n    </include>\n"
         "    <include>\n      <uri>model://sun</uri>\n    </include>\n"

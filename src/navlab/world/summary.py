@@ -15,10 +15,17 @@ def world_summary(world: WorldModel) -> dict[str, Any]:
     models = []
     for m in world.models:
         shapes = [shape_summary(s) for link in m.links for s in link.collisions]
-        models.append({"name": m.name, "static": m.static, "pose": list(m.pose), "links": len(m.links),
-                       "collision_shapes": len(shapes),
-                       "kinds": sorted({s["kind"] for s in shapes}),
-                       "non_convex_meshes": [s["mesh"] for s in shapes if s.get("convex") is False]})
+        models.append(
+            {
+                "name": m.name,
+                "static": m.static,
+                "pose": list(m.pose),
+                "links": len(m.links),
+                "collision_shapes": len(shapes),
+                "kinds": sorted({s["kind"] for s in shapes}),
+                "non_convex_meshes": [s["mesh"] for s in shapes if s.get("convex") is False],
+            }
+        )
     box = extents(world, z_min=-math.inf, z_max=math.inf)
     ext = None
     if box is not None:
@@ -38,14 +45,17 @@ def world_summary(world: WorldModel) -> dict[str, Any]:
 
 def format_world(s: dict[str, Any]) -> str:
     """Human-readable text of :func:`world_summary`."""
-    lines = [f"world {s['name']}  ({s['source']})",
-             f"  ground plane {'yes' if s['ground_plane'] else 'NO'}, gravity {s['gravity']}, "
-             f"step {s['max_step_size']} s",
-             f"  models ({len(s['models'])}):"]
+    lines = [
+        f"world {s['name']}  ({s['source']})",
+        f"  ground plane {'yes' if s['ground_plane'] else 'NO'}, gravity {s['gravity']}, step {s['max_step_size']} s",
+        f"  models ({len(s['models'])}):",
+    ]
     for m in s["models"]:
         x, y, z = m["pose"][:3]
-        lines.append(f"    {m['name']:<22} {'static' if m['static'] else 'dynamic':<8} at ({x:g}, {y:g}, {z:g}), "
-                     f"{m['links']} link(s), {m['collision_shapes']} collision shape(s) {', '.join(m['kinds'])}")
+        lines.append(
+            f"    {m['name']:<22} {'static' if m['static'] else 'dynamic':<8} at ({x:g}, {y:g}, {z:g}), "
+            f"{m['links']} link(s), {m['collision_shapes']} collision shape(s) {', '.join(m['kinds'])}"
+        )
         for mesh in m["non_convex_meshes"]:
             lines.append(f"      concave collision mesh (decomposed for physics): {mesh}")
     if s["extents"]:

@@ -9,5 +9,4 @@ from navlab.navigation.controllers.dwa import DWAPlannerROS, DWBLocalPlanner
 from navlab.navigation.controllers.params import DWAPlannerParams, TrajectoryPlannerParams
 from navlab.navigation.controllers.trajectory import TrajectoryPlannerROS
 
-__all__ = ["DWAPlannerParams", "DWAPlannerROS", "DWBLocalPlanner", "TrajectoryPlannerParams",
-           "TrajectoryPlannerROS"]
+__all__ = ["DWAPlannerParams", "DWAPlannerROS", "DWBLocalPlanner", "TrajectoryPlannerParams", "TrajectoryPlannerROS"]

@@ -108,8 +108,12 @@ def goal_of(plan: np.ndarray) -> tuple[float, float, float | None]:
     return float(last[0]), float(last[1]), (float(last[2]) if plan.shape[1] == 3 else None)
 
 
-def same_goal(old: tuple[float, float, float | None] | None, new: tuple[float, float, float | None],
-              xy_tolerance: float, yaw_tolerance: float) -> bool:
+def same_goal(
+    old: tuple[float, float, float | None] | None,
+    new: tuple[float, float, float | None],
+    xy_tolerance: float,
+    yaw_tolerance: float,
+) -> bool:
     """Whether a new plan leads to the same goal as before (within the goal tolerances): a plan re-sent
     every cycle, or replanned to the same goal, keeps the goal latch and the oscillation flags."""
     if old is None or math.hypot(new[0] - old[0], new[1] - old[1]) > xy_tolerance:
@@ -174,8 +178,9 @@ def stopped(velocity: tuple[float, float], trans_stopped_vel: float, theta_stopp
     return abs(velocity[0]) <= trans_stopped_vel and abs(velocity[1]) <= theta_stopped_vel
 
 
-def stop_with_acc_limits(velocity: tuple[float, float], acc_x: float, acc_theta: float,
-                         sim_period: float) -> tuple[float, float]:
+def stop_with_acc_limits(
+    velocity: tuple[float, float], acc_x: float, acc_theta: float, sim_period: float
+) -> tuple[float, float]:
     """The command that slows (v, w) towards zero as fast as the acceleration limits allow in one period."""
     v, w = velocity
     v_new = math.copysign(max(0.0, abs(v) - acc_x * sim_period), v)
@@ -183,8 +188,9 @@ def stop_with_acc_limits(velocity: tuple[float, float], acc_x: float, acc_theta:
     return v_new, w_new
 
 
-def rotate_to_goal(yaw_error: float, w_now: float, *, max_w: float, min_in_place_w: float, acc_theta: float,
-                   sim_period: float) -> float:
+def rotate_to_goal(
+    yaw_error: float, w_now: float, *, max_w: float, min_in_place_w: float, acc_theta: float, sim_period: float
+) -> float:
     """The in-place turn rate (rad/s) towards a goal ``yaw_error`` (rad, goal - robot, wrapped) away.
 
     As base_local_planner's ``rotateToGoal``: at least ``min_in_place_w``, at most ``max_w``, within reach

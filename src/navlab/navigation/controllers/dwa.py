@@ -30,11 +30,18 @@ class DWAPlannerROS(RolloutController):
     what = "DWAPlannerROS"
     params: DWAPlannerParams
 
-    def __init__(self, params: Mapping[str, Any] | DWAPlannerParams | None = None, *, footprint: Any = None,
-                 robot_radius: float | None = None, controller_frequency: float | None = None,
-                 rng: np.random.Generator | None = None) -> None:
-        super().__init__(params, footprint=footprint, robot_radius=robot_radius,
-                         controller_frequency=controller_frequency, rng=rng)
+    def __init__(
+        self,
+        params: Mapping[str, Any] | DWAPlannerParams | None = None,
+        *,
+        footprint: Any = None,
+        robot_radius: float | None = None,
+        controller_frequency: float | None = None,
+        rng: np.random.Generator | None = None,
+    ) -> None:
+        super().__init__(
+            params, footprint=footprint, robot_radius=robot_radius, controller_frequency=controller_frequency, rng=rng
+        )
         self._stopped_vel = (self.params.trans_stopped_vel, self.params.theta_stopped_vel)
         self._accelerate = not self.params.use_dwa
 
@@ -48,8 +55,11 @@ class DWAPlannerROS(RolloutController):
     def is_goal_reached(self, pose: tuple[float, float, float], velocity: tuple[float, float]) -> bool:
         """Within the xy (possibly latched) and yaw tolerances and stopped (trans/theta_stopped_vel)."""
         v = (float(velocity[0]), float(velocity[1]))
-        return super().is_goal_reached(pose, velocity) and abs(v[0]) <= self.params.trans_stopped_vel \
+        return (
+            super().is_goal_reached(pose, velocity)
+            and abs(v[0]) <= self.params.trans_stopped_vel
             and abs(v[1]) <= self.params.theta_stopped_vel
+        )
 
     def window(self, velocity: tuple[float, float], dist_to_goal: float) -> np.ndarray:
         """The (v, w) samples (S, 2) of one cycle: the dynamic window around ``velocity``, sampled as
@@ -68,8 +78,11 @@ class DWAPlannerROS(RolloutController):
         vs, ws = velocity_samples(vlo, vhi, p.vx_samples), velocity_samples(wlo, whi, p.vth_samples)
         pairs = np.stack([np.repeat(vs, len(ws)), np.tile(ws, len(vs))], axis=1)
         speed, turn = np.abs(pairs[:, 0]), np.abs(pairs[:, 1])
-        keep = ~(((speed + _EPS < p.min_vel_trans) & (turn + _EPS < p.min_vel_theta))
-                 | (speed - _EPS > p.max_vel_trans) | ((speed < _EPS) & (turn < _EPS)))
+        keep = ~(
+            ((speed + _EPS < p.min_vel_trans) & (turn + _EPS < p.min_vel_theta))
+            | (speed - _EPS > p.max_vel_trans)
+            | ((speed < _EPS) & (turn < _EPS))
+        )
         return pairs[keep]
 
     def _front_goal_dist(self, scene: LocalScene) -> np.ndarray:
@@ -89,8 +102,9 @@ class DWAPlannerROS(RolloutController):
         """``SimpleTrajectoryGenerator``: ceil(max(|v| sim_time / sim_granularity, |w| sim_time /
         angular_sim_granularity)), at least 1."""
         p = self.params
-        need = p.sim_time * np.maximum(np.abs(targets[:, 0]) / p.sim_granularity,
-                                       np.abs(targets[:, 1]) / p.angular_sim_granularity)
+        need = p.sim_time * np.maximum(
+            np.abs(targets[:, 0]) / p.sim_granularity, np.abs(targets[:, 1]) / p.angular_sim_granularity
+        )
         return np.maximum(1, np.ceil(need - 1e-9)).astype(np.int64)
 
     def _check(self, scene: LocalScene, targets: np.ndarray, traj: np.ndarray) -> np.ndarray:
@@ -104,7 +118,7 @@ class DWAPlannerROS(RolloutController):
         pdist, gdist = res * p.path_distance_bias, res * p.goal_distance_bias
         g = scene.local_goal()
         sq_dist = (scene.pose[0] - g[0]) ** 2 + (scene.pose[1] - g[1]) ** 2
-        near = sq_dist <= p.forward_point_distance ** 2 * p.cheat_factor
+        near = sq_dist <= p.forward_point_distance**2 * p.cheat_factor
         align = 0.0 if near else pdist
         total = np.zeros(len(targets))
         rejected = ~self._osc.allowed(targets[:, 0], targets[:, 1])
@@ -134,16 +148,28 @@ class DWAPlannerROS(RolloutController):
         total[rejected] = -1.0
         return total
 
-    def _drive(self, scene: LocalScene, pose: tuple[float, float, float], velocity: tuple[float, float],
-               goal: tuple[float, float, float | None]) -> tuple[float, float]:
+    def _drive(
+        self,
+        scene: LocalScene,
+        pose: tuple[float, float, float],
+        velocity: tuple[float, float],
+        goal: tuple[float, float, float | None],
+    ) -> tuple[float, float]:
         p = self.params
         g = scene.local_goal()
         targets = self.window(velocity, math.hypot(g[0] - scene.pose[0], g[1] - scene.pose[1]))
         if len(targets) == 0:
             return self._finish(scene, targets, np.zeros((0, 0, 3)), np.zeros(0), -1, pose)
         steps = self._steps(targets)
-        traj = rollout(scene.pose, velocity, targets, steps, p.sim_time, (p.acc_lim_x, p.acc_lim_theta),
-                       accelerate=self._accelerate)
+        traj = rollout(
+            scene.pose,
+            velocity,
+            targets,
+            steps,
+            p.sim_time,
+            (p.acc_lim_x, p.acc_lim_theta),
+            accelerate=self._accelerate,
+        )
         if not p.use_dwa:  # continued acceleration: ROS commands the velocity reached after the first step
             dt = (p.sim_time / steps)[:, None]
             now = np.array(velocity)

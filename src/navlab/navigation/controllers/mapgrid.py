@@ -16,8 +16,9 @@ from navlab.grid import COST_INSCRIBED, COST_UNKNOWN
 
 
 @numba.njit(cache=True)
-def _wave(cost: np.ndarray, seeds_i: np.ndarray, seeds_j: np.ndarray, free_i: np.ndarray,
-          free_j: np.ndarray, out: np.ndarray) -> None:  # pragma: no cover - compiled
+def _wave(
+    cost: np.ndarray, seeds_i: np.ndarray, seeds_j: np.ndarray, free_i: np.ndarray, free_j: np.ndarray, out: np.ndarray
+) -> None:  # pragma: no cover - compiled
     h, w = cost.shape
     obstacle = float(h * w)
     out[:, :] = obstacle + 1.0
@@ -106,6 +107,5 @@ def distance_map(cost: np.ndarray, seeds: np.ndarray, free: np.ndarray | None = 
     out = np.empty(cost.shape, dtype=np.float64)
     seeds = np.asarray(seeds, dtype=np.int64).reshape(-1, 2)
     free = np.zeros((0, 2), dtype=np.int64) if free is None else np.asarray(free, dtype=np.int64).reshape(-1, 2)
-    _wave(np.ascontiguousarray(cost), seeds[:, 0].copy(), seeds[:, 1].copy(), free[:, 0].copy(),
-          free[:, 1].copy(), out)
+    _wave(np.ascontiguousarray(cost), seeds[:, 0].copy(), seeds[:, 1].copy(), free[:, 0].copy(), free[:, 1].copy(), out)
     return out

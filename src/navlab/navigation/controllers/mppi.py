@@ -54,9 +54,21 @@ from navlab.plugins import ControlResult, PluginContext
 
 WHAT = "MPPIController"
 PATH_SPACING = 0.05  # m: plans are resampled to this (Nav2's path-index offsets assume costmap cells)
-_IGNORED = frozenset({"plugin", "visualize", "publish_optimal_trajectory", "regenerate_noises", "reset_period",
-                      "transform_tolerance", "enforce_path_inversion", "use_sim_time", "TrajectoryVisualizer",
-                      "open_loop", "shift_control_sequence"})
+_IGNORED = frozenset(
+    {
+        "plugin",
+        "visualize",
+        "publish_optimal_trajectory",
+        "regenerate_noises",
+        "reset_period",
+        "transform_tolerance",
+        "enforce_path_inversion",
+        "use_sim_time",
+        "TrajectoryVisualizer",
+        "open_loop",
+        "shift_control_sequence",
+    }
+)
 
 
 @dataclass
@@ -88,9 +100,18 @@ class MppiParams:
     xy_goal_tolerance: float = 0.25
     yaw_goal_tolerance: float = 0.25
     stateful: bool = True
-    critics: list[str] = field(default_factory=lambda: [
-        "ConstraintCritic", "CostCritic", "GoalCritic", "GoalAngleCritic", "PathAlignCritic", "PathFollowCritic",
-        "PathAngleCritic", "PreferForwardCritic"])
+    critics: list[str] = field(
+        default_factory=lambda: [
+            "ConstraintCritic",
+            "CostCritic",
+            "GoalCritic",
+            "GoalAngleCritic",
+            "PathAlignCritic",
+            "PathFollowCritic",
+            "PathAngleCritic",
+            "PreferForwardCritic",
+        ]
+    )
     critic_params: dict[str, Any] = field(default_factory=dict)
 
     PARAMS: ClassVar[ParamSpec]
@@ -106,8 +127,17 @@ class MppiParams:
                 raise bad(WHAT, key, getattr(self, key), ">= 1")
         if self.time_steps < 2:
             raise bad(WHAT, "time_steps", self.time_steps, ">= 2")
-        for key in ("model_dt", "temperature", "vx_std", "wz_std", "wz_max", "ax_max", "az_max", "prune_distance",
-                    "controller_frequency"):
+        for key in (
+            "model_dt",
+            "temperature",
+            "vx_std",
+            "wz_std",
+            "wz_max",
+            "ax_max",
+            "az_max",
+            "prune_distance",
+            "controller_frequency",
+        ):
             if not getattr(self, key) > 0:
                 raise bad(WHAT, key, getattr(self, key), "> 0")
         for key in ("gamma", "xy_goal_tolerance", "yaw_goal_tolerance"):
@@ -122,8 +152,13 @@ class MppiParams:
         if self.vx_min > self.vx_max:
             raise bad(WHAT, "vx_min", self.vx_min, f"<= vx_max ({self.vx_max})")
         check_ceiling(NavigationError, WHAT, "controller_frequency", self.controller_frequency, "rate")
-        check_ceiling(NavigationError, WHAT, "batch_size x time_steps x iteration_count",
-                      self.batch_size * self.time_steps * self.iteration_count, "rollout_poses")
+        check_ceiling(
+            NavigationError,
+            WHAT,
+            "batch_size x time_steps x iteration_count",
+            self.batch_size * self.time_steps * self.iteration_count,
+            "rollout_poses",
+        )
         if self.motion_model != "DiffDrive":
             raise bad(WHAT, "motion_model", self.motion_model, "'DiffDrive' (navlab's controllers drive (v, w))")
         for name in self.critics:
@@ -156,10 +191,28 @@ MppiParams.PARAMS = ParamSpec(WHAT, NavigationError, ignored=_IGNORED, prepare=_
 
 
 @numba.njit(cache=True)
-def _sample_rollout(rng: np.random.Generator, seq: np.ndarray, std: np.ndarray, corr: float, v0: float, w0: float,
-                    x0: float, y0: float, th0: float, dt: float, limits: np.ndarray, cost: np.ndarray, res: float,
-                    u: np.ndarray, xs: np.ndarray, ys: np.ndarray, ths: np.ndarray, cs: np.ndarray,
-                    arc: np.ndarray, dots: np.ndarray) -> None:  # pragma: no cover - compiled
+def _sample_rollout(
+    rng: np.random.Generator,
+    seq: np.ndarray,
+    std: np.ndarray,
+    corr: float,
+    v0: float,
+    w0: float,
+    x0: float,
+    y0: float,
+    th0: float,
+    dt: float,
+    limits: np.ndarray,
+    cost: np.ndarray,
+    res: float,
+    u: np.ndarray,
+    xs: np.ndarray,
+    ys: np.ndarray,
+    ths: np.ndarray,
+    cs: np.ndarray,
+    arc: np.ndarray,
+    dots: np.ndarray,
+) -> None:  # pragma: no cover - compiled
     """Sample controls ``seq`` (T, 2) + noise from ``rng`` (N(0, std) at every step, AR(1)-correlated over time
     with coefficient ``corr``), constrain them into ``u`` (S, T, 2), roll every sample out (poses, cost under
     each point, distance travelled) and sum ``seq · (u - seq) / std²`` into ``dots`` (S,) for the control cost."""
@@ -224,8 +277,13 @@ class MPPIController:
 
     what = WHAT
 
-    def __init__(self, params: Mapping[str, Any] | MppiParams | None = None, *, rng: np.random.Generator | None = None,
-                 footprint: Any = None) -> None:
+    def __init__(
+        self,
+        params: Mapping[str, Any] | MppiParams | None = None,
+        *,
+        rng: np.random.Generator | None = None,
+        footprint: Any = None,
+    ) -> None:
         if not isinstance(rng, np.random.Generator):
             raise NavigationError(f"{WHAT} needs rng=numpy.random.Generator (seeded), got {type(rng).__name__}")
         self.params = read_params(MppiParams, params)
@@ -278,10 +336,10 @@ class MPPIController:
         along it (Nav2's path handler), in the costmap frame."""
         assert self._plan is not None
         plan = self._plan
-        ahead = plan[self._progress: self._progress + int(4.0 / PATH_SPACING)]
+        ahead = plan[self._progress : self._progress + int(4.0 / PATH_SPACING)]
         d = np.hypot(ahead[:, 0] - pose[0], ahead[:, 1] - pose[1])
         self._progress += int(np.argmin(d))
-        rest = plan[self._progress:]
+        rest = plan[self._progress :]
         seg = np.hypot(*np.diff(rest, axis=0).T)
         n = int(np.searchsorted(np.cumsum(seg), self.params.prune_distance)) + 2
         return rest[:n]
@@ -293,15 +351,17 @@ class MPPIController:
         fp = context.footprint
         return cls(params, rng=context.rng, footprint=None if fp is None else fp.polygon)
 
-    def compute_velocity(self, pose: tuple[float, float, float], velocity: tuple[float, float],
-                         costmap: Grid | None) -> ControlResult:
+    def compute_velocity(
+        self, pose: tuple[float, float, float], velocity: tuple[float, float], costmap: Grid | None
+    ) -> ControlResult:
         """The command (v m/s, w rad/s) for the robot at ``pose`` (costmap frame) moving at ``velocity`` (v, w),
         with ``valid`` and the optimal trajectory as ``local_plan``."""
         v, w = self._command(pose, velocity, costmap)
         return ControlResult(v, w, self.valid, self.local_plan)
 
-    def _command(self, pose: tuple[float, float, float], velocity: tuple[float, float],
-                 costmap: Grid | None) -> tuple[float, float]:
+    def _command(
+        self, pose: tuple[float, float, float], velocity: tuple[float, float], costmap: Grid | None
+    ) -> tuple[float, float]:
         if self._plan is None:
             raise NavigationError(f"{WHAT}: compute_velocity called before set_plan")
         if costmap is None:
@@ -328,10 +388,46 @@ class MPPIController:
         attempts = 0
         iteration = 0
         while iteration < p.iteration_count:
-            _sample_rollout(self.rng, self.sequence, self._std, p.noise_correlation, v0, w0, px, py, pth, p.model_dt,
-                            self._limits, grid, res, u, xs, ys, ths, cs, arc, dots)
-            batch = critics.Batch(xs, ys, ths, u[..., 0], u[..., 1], cs, arc, (px, py, pth), path, goal,
-                                  dist_to_goal, p.model_dt, (p.vx_min, p.vx_max), grid, res, outline)
+            _sample_rollout(
+                self.rng,
+                self.sequence,
+                self._std,
+                p.noise_correlation,
+                v0,
+                w0,
+                px,
+                py,
+                pth,
+                p.model_dt,
+                self._limits,
+                grid,
+                res,
+                u,
+                xs,
+                ys,
+                ths,
+                cs,
+                arc,
+                dots,
+            )
+            batch = critics.Batch(
+                xs,
+                ys,
+                ths,
+                u[..., 0],
+                u[..., 1],
+                cs,
+                arc,
+                (px, py, pth),
+                path,
+                goal,
+                dist_to_goal,
+                p.model_dt,
+                (p.vx_min, p.vx_max),
+                grid,
+                res,
+                outline,
+            )
             costs = self._score(batch)
             if bool((cs >= COST_INSCRIBED).any(axis=1).all()):  # every sample collides
                 attempts += 1

@@ -120,9 +120,20 @@ class TwirlingCritic:
     cost_power: int = 1
 
 
-CRITICS: dict[str, type] = {c.__name__: c for c in (
-    ConstraintCritic, CostCritic, GoalCritic, GoalAngleCritic, PathAlignCritic, PathFollowCritic,
-    PathAngleCritic, PreferForwardCritic, TwirlingCritic)}
+CRITICS: dict[str, type] = {
+    c.__name__: c
+    for c in (
+        ConstraintCritic,
+        CostCritic,
+        GoalCritic,
+        GoalAngleCritic,
+        PathAlignCritic,
+        PathFollowCritic,
+        PathAngleCritic,
+        PreferForwardCritic,
+        TwirlingCritic,
+    )
+}
 for _name, _cls in CRITICS.items():  # each critic's section is read as "MPPIController <critic>"
     _cls.PARAMS = ParamSpec(f"MPPIController {_name}", NavigationError)  # type: ignore[attr-defined]
 
@@ -162,7 +173,6 @@ class Batch:
                 self._furthest = int(np.argmin(dx * dx + dy * dy, axis=1).max())
         return self._furthest
 
-
     @property
     def path_valid(self) -> np.ndarray:
         """Mask (P,) of the path points on cells the robot may occupy (cost < INSCRIBED, inside the map)."""
@@ -184,7 +194,7 @@ class Batch:
 
 def _out(c: Any, term: np.ndarray) -> np.ndarray:
     val = c.cost_weight * term
-    return val if c.cost_power == 1 else val ** c.cost_power
+    return val if c.cost_power == 1 else val**c.cost_power
 
 
 def constraint(c: ConstraintCritic, b: Batch) -> np.ndarray | None:
@@ -196,7 +206,7 @@ def constraint(c: ConstraintCritic, b: Batch) -> np.ndarray | None:
 
 
 def cost(c: CostCritic, b: Batch) -> np.ndarray | None:
-    pts = b.cost[:, ::max(1, c.trajectory_point_step)]
+    pts = b.cost[:, :: max(1, c.trajectory_point_step)]
     if c.consider_footprint and b.outline is not None:
         hit = pts >= COST_LETHAL
         check = (pts > 0) & ~hit  # only cells near obstacles can put an edge on one
@@ -245,10 +255,10 @@ def path_align(c: PathAlignCritic, b: Batch) -> np.ndarray | None:
     seg = np.hypot(*np.diff(reach, axis=0).T)
     path_s = np.concatenate([[0.0], np.cumsum(seg)])
     step = max(1, c.trajectory_point_step)
-    traj_s = b.arc[:, step - 1::step]
+    traj_s = b.arc[:, step - 1 :: step]
     idx = np.clip(np.searchsorted(path_s, traj_s), 0, len(reach) - 1)
     px, py = reach[idx, 0], reach[idx, 1]
-    return _out(c, np.hypot(b.x[:, step - 1::step] - px, b.y[:, step - 1::step] - py).mean(axis=1))
+    return _out(c, np.hypot(b.x[:, step - 1 :: step] - px, b.y[:, step - 1 :: step] - py).mean(axis=1))
 
 
 def path_angle(c: PathAngleCritic, b: Batch) -> np.ndarray | None:
@@ -274,6 +284,13 @@ def twirling(c: TwirlingCritic, b: Batch) -> np.ndarray | None:
 
 Scorer = Callable[[Any, Batch], np.ndarray | None]  # (a critic's parameters, batch) -> costs (S,) or None
 SCORERS: dict[str, Scorer] = {
-    "ConstraintCritic": constraint, "CostCritic": cost, "GoalCritic": goal, "GoalAngleCritic": goal_angle,
-    "PathAlignCritic": path_align, "PathFollowCritic": path_follow, "PathAngleCritic": path_angle,
-    "PreferForwardCritic": prefer_forward, "TwirlingCritic": twirling}
+    "ConstraintCritic": constraint,
+    "CostCritic": cost,
+    "GoalCritic": goal,
+    "GoalAngleCritic": goal_angle,
+    "PathAlignCritic": path_align,
+    "PathFollowCritic": path_follow,
+    "PathAngleCritic": path_angle,
+    "PreferForwardCritic": prefer_forward,
+    "TwirlingCritic": twirling,
+}

@@ -27,8 +27,17 @@ from navlab.navigation.errors import NavigationError
 
 TP = "TrajectoryPlannerROS"
 DWA = "DWAPlannerROS"
-_VIEW_ONLY = frozenset({"publish_cost_grid_pc", "publish_traj_pc", "publish_cost_grid", "global_frame_id",
-                        "restore_defaults", "plugin", "use_sim_time"})
+_VIEW_ONLY = frozenset(
+    {
+        "publish_cost_grid_pc",
+        "publish_traj_pc",
+        "publish_cost_grid",
+        "global_frame_id",
+        "restore_defaults",
+        "plugin",
+        "use_sim_time",
+    }
+)
 
 
 class _Periodic:
@@ -84,8 +93,13 @@ class TrajectoryPlannerParams(_Periodic):
     def validate(self) -> None:
         """Raise ``NavigationError`` naming the first bad parameter."""
         ang = self.angular_sim_granularity if self.angular_sim_granularity > 0 else self.sim_granularity
-        steps = max(max(abs(self.max_vel_x), abs(self.escape_vel)) * self.sim_time / self.sim_granularity,
-                    max(abs(self.max_vel_theta), abs(self.min_vel_theta)) / ang) + 1
+        steps = (
+            max(
+                max(abs(self.max_vel_x), abs(self.escape_vel)) * self.sim_time / self.sim_granularity,
+                max(abs(self.max_vel_theta), abs(self.min_vel_theta)) / ang,
+            )
+            + 1
+        )
         _sized(TP, self, steps, "vx_samples", "vtheta_samples")
         _ordered(TP, self, "min_vel_x", "max_vel_x")
         _ordered(TP, self, "min_vel_theta", "max_vel_theta")
@@ -140,8 +154,14 @@ class DWAPlannerParams(_Periodic):
 
     def validate(self) -> None:
         """Raise ``NavigationError`` naming the first bad parameter."""
-        steps = self.sim_time * max(max(abs(self.max_vel_x), abs(self.min_vel_x), self.max_vel_trans)
-                                    / self.sim_granularity, self.max_vel_theta / self.angular_sim_granularity) + 1
+        steps = (
+            self.sim_time
+            * max(
+                max(abs(self.max_vel_x), abs(self.min_vel_x), self.max_vel_trans) / self.sim_granularity,
+                self.max_vel_theta / self.angular_sim_granularity,
+            )
+            + 1
+        )
         _sized(DWA, self, steps, "vx_samples", "vth_samples")
         _ordered(DWA, self, "min_vel_x", "max_vel_x")
         _ordered(DWA, self, "min_vel_trans", "max_vel_trans")
@@ -152,8 +172,13 @@ def _sized(what: str, obj: Any, steps: float, *sample_keys: str) -> None:
     """The ceilings of the work one control cycle does (samples x steps poses) and of its rate."""
     check_ceiling(NavigationError, what, "controller_frequency", obj.controller_frequency, "rate")
     samples = math.prod(getattr(obj, k) for k in sample_keys)
-    check_ceiling(NavigationError, what, f"{' x '.join(sample_keys)} x steps (sim_time / sim_granularity)",
-                  samples * steps, "rollout_poses")
+    check_ceiling(
+        NavigationError,
+        what,
+        f"{' x '.join(sample_keys)} x steps (sim_time / sim_granularity)",
+        samples * steps,
+        "rollout_poses",
+    )
 
 
 def _ordered(what: str, obj: Any, low: str, high: str) -> None:
@@ -167,31 +192,103 @@ def _oldest_spelling(values: dict[str, Any]) -> dict[str, Any]:
         values = dict(values)
         vmax = values.pop("max_rotational_vel")
         values.setdefault("max_vel_theta", vmax)
-        values.setdefault("min_vel_theta", -vmax if isinstance(vmax, int | float) and not isinstance(vmax, bool)
-                          else vmax)
+        values.setdefault(
+            "min_vel_theta", -vmax if isinstance(vmax, int | float) and not isinstance(vmax, bool) else vmax
+        )
     return values
 
 
 # a sample count <= 0 becomes 1 with a warning, as both ROS 1 planners do
 TrajectoryPlannerParams.PARAMS = ParamSpec(
-    TP, NavigationError, ignored=_VIEW_ONLY, prepare=_oldest_spelling,
+    TP,
+    NavigationError,
+    ignored=_VIEW_ONLY,
+    prepare=_oldest_spelling,
     clamp_at_least={"vx_samples": 1, "vtheta_samples": 1},
-    above=dict.fromkeys(("acc_lim_x", "acc_lim_theta", "sim_time", "sim_granularity", "controller_frequency",
-                         "max_vel_x", "max_vel_theta"), 0.0),
-    at_least=dict.fromkeys(("acc_lim_y", "min_in_place_vel_theta", "pdist_scale", "gdist_scale", "occdist_scale",
-                            "heading_lookahead", "oscillation_reset_dist", "xy_goal_tolerance", "yaw_goal_tolerance",
-                            "escape_reset_dist", "escape_reset_theta", "min_vel_x"), 0.0),
-    aliases={"backup_vel": "escape_vel", "acc_lim_th": "acc_lim_theta", "path_distance_bias": "pdist_scale",
-             "goal_distance_bias": "gdist_scale", "vth_samples": "vtheta_samples"})
+    above=dict.fromkeys(
+        (
+            "acc_lim_x",
+            "acc_lim_theta",
+            "sim_time",
+            "sim_granularity",
+            "controller_frequency",
+            "max_vel_x",
+            "max_vel_theta",
+        ),
+        0.0,
+    ),
+    at_least=dict.fromkeys(
+        (
+            "acc_lim_y",
+            "min_in_place_vel_theta",
+            "pdist_scale",
+            "gdist_scale",
+            "occdist_scale",
+            "heading_lookahead",
+            "oscillation_reset_dist",
+            "xy_goal_tolerance",
+            "yaw_goal_tolerance",
+            "escape_reset_dist",
+            "escape_reset_theta",
+            "min_vel_x",
+        ),
+        0.0,
+    ),
+    aliases={
+        "backup_vel": "escape_vel",
+        "acc_lim_th": "acc_lim_theta",
+        "path_distance_bias": "pdist_scale",
+        "goal_distance_bias": "gdist_scale",
+        "vth_samples": "vtheta_samples",
+    },
+)
 DWAPlannerParams.PARAMS = ParamSpec(
-    DWA, NavigationError, ignored=_VIEW_ONLY, clamp_at_least={"vx_samples": 1, "vy_samples": 1, "vth_samples": 1},
-    above=dict.fromkeys(("acc_lim_x", "acc_lim_theta", "sim_time", "sim_granularity", "angular_sim_granularity",
-                         "controller_frequency", "max_vel_trans", "max_vel_x"), 0.0),
-    at_least=dict.fromkeys(("min_vel_trans", "min_vel_theta", "max_vel_theta", "path_distance_bias",
-                            "goal_distance_bias", "occdist_scale", "twirling_scale", "forward_point_distance",
-                            "oscillation_reset_dist", "xy_goal_tolerance", "yaw_goal_tolerance", "trans_stopped_vel",
-                            "theta_stopped_vel", "stop_time_buffer"), 0.0),
-    aliases={"max_trans_vel": "max_vel_trans", "min_trans_vel": "min_vel_trans", "max_rot_vel": "max_vel_theta",
-             "min_rot_vel": "min_vel_theta", "acc_lim_th": "acc_lim_theta", "rot_stopped_vel": "theta_stopped_vel",
-             "pdist_scale": "path_distance_bias", "gdist_scale": "goal_distance_bias",
-             "vtheta_samples": "vth_samples", "dwa": "use_dwa"})
+    DWA,
+    NavigationError,
+    ignored=_VIEW_ONLY,
+    clamp_at_least={"vx_samples": 1, "vy_samples": 1, "vth_samples": 1},
+    above=dict.fromkeys(
+        (
+            "acc_lim_x",
+            "acc_lim_theta",
+            "sim_time",
+            "sim_granularity",
+            "angular_sim_granularity",
+            "controller_frequency",
+            "max_vel_trans",
+            "max_vel_x",
+        ),
+        0.0,
+    ),
+    at_least=dict.fromkeys(
+        (
+            "min_vel_trans",
+            "min_vel_theta",
+            "max_vel_theta",
+            "path_distance_bias",
+            "goal_distance_bias",
+            "occdist_scale",
+            "twirling_scale",
+            "forward_point_distance",
+            "oscillation_reset_dist",
+            "xy_goal_tolerance",
+            "yaw_goal_tolerance",
+            "trans_stopped_vel",
+            "theta_stopped_vel",
+            "stop_time_buffer",
+        ),
+        0.0,
+    ),
+    aliases={
+        "max_trans_vel": "max_vel_trans",
+        "min_trans_vel": "min_vel_trans",
+        "max_rot_vel": "max_vel_theta",
+        "min_rot_vel": "min_vel_theta",
+        "acc_lim_th": "acc_lim_theta",
+        "rot_stopped_vel": "theta_stopped_vel",
+        "pdist_scale": "path_distance_bias",
+        "gdist_scale": "goal_distance_bias",
+        "vtheta_samples": "vth_samples",
+        "dwa": "use_dwa",
+    },
+)

@@ -62,9 +62,12 @@ class PurePursuitParams:
     max_vel_theta: float = 1.2
     xy_goal_tolerance: float = 0.1
     stop_distance: float = 0.35
-    PARAMS: ClassVar[ParamSpec] = ParamSpec("PurePursuit", NavigationError, above={"lookahead": 0.0},
-                                            at_least={"max_vel_x": 0.0, "max_vel_theta": 0.0,
-                                                      "xy_goal_tolerance": 0.0, "stop_distance": 0.0})
+    PARAMS: ClassVar[ParamSpec] = ParamSpec(
+        "PurePursuit",
+        NavigationError,
+        above={"lookahead": 0.0},
+        at_least={"max_vel_x": 0.0, "max_vel_theta": 0.0, "xy_goal_tolerance": 0.0, "stop_distance": 0.0},
+    )
 
 
 class PurePursuit(BuiltFromParams):
@@ -89,8 +92,15 @@ class PurePursuit(BuiltFromParams):
         if len(self.path) == 0 or self.is_goal_reached(pose, velocity):
             return ControlResult(0.0, 0.0)
         p = self.params
-        v, w, _ = follow_path(pose, self.path, lookahead=p.lookahead, max_v=p.max_vel_x, max_w=p.max_vel_theta,
-                              min_front_range=self.min_front_range, stop_distance=p.stop_distance)  # fmt: skip
+        v, w, _ = follow_path(
+            pose,
+            self.path,
+            lookahead=p.lookahead,
+            max_v=p.max_vel_x,
+            max_w=p.max_vel_theta,
+            min_front_range=self.min_front_range,
+            stop_distance=p.stop_distance,
+        )
         return ControlResult(v, w)
 
     def is_goal_reached(self, pose: tuple[float, float, float], velocity: tuple[float, float] = (0.0, 0.0)) -> bool:

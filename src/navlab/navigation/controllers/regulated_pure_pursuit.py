@@ -44,18 +44,34 @@ from navlab.plugins import ControlResult
 WHAT = "RegulatedPurePursuitController"
 SPACING = 0.05  # m: plans are resampled to this
 SEARCH_M = 5.0  # m of path ahead of the last nearest point searched for the robot's nearest point
-_IGNORED = frozenset({"plugin", "transform_tolerance", "use_sim_time", "max_robot_pose_search_dist",
-                      "use_interpolation"})
+_IGNORED = frozenset(
+    {"plugin", "transform_tolerance", "use_sim_time", "max_robot_pose_search_dist", "use_interpolation"}
+)
 
 
 @dataclass
 class RppParams:
     """nav2_regulated_pure_pursuit_controller's parameters (Nav2 names and defaults)."""
 
-    PARAMS: ClassVar[ParamSpec] = ParamSpec(WHAT, NavigationError, ignored=_IGNORED, above={
-        k: 0.0 for k in ("desired_linear_vel", "lookahead_dist", "min_lookahead_dist", "max_lookahead_dist",
-                         "rotate_to_heading_angular_vel", "max_angular_accel", "controller_frequency",
-                         "max_angular_vel", "inflation_cost_scaling_factor")})
+    PARAMS: ClassVar[ParamSpec] = ParamSpec(
+        WHAT,
+        NavigationError,
+        ignored=_IGNORED,
+        above={
+            k: 0.0
+            for k in (
+                "desired_linear_vel",
+                "lookahead_dist",
+                "min_lookahead_dist",
+                "max_lookahead_dist",
+                "rotate_to_heading_angular_vel",
+                "max_angular_accel",
+                "controller_frequency",
+                "max_angular_vel",
+                "inflation_cost_scaling_factor",
+            )
+        },
+    )
     desired_linear_vel: float = 0.5
     lookahead_dist: float = 0.6
     min_lookahead_dist: float = 0.3
@@ -87,8 +103,12 @@ class RppParams:
     def validate(self) -> None:
         """Refuse values Nav2 could not run with (one-line errors naming the key)."""
         if self.min_lookahead_dist > self.max_lookahead_dist:
-            raise bad(WHAT, "min_lookahead_dist", self.min_lookahead_dist,
-                      f"<= max_lookahead_dist ({self.max_lookahead_dist})")
+            raise bad(
+                WHAT,
+                "min_lookahead_dist",
+                self.min_lookahead_dist,
+                f"<= max_lookahead_dist ({self.max_lookahead_dist})",
+            )
         if self.allow_reversing:
             raise bad(WHAT, "allow_reversing", True, "false (navlab's RPP drives forward only)")
 
@@ -117,8 +137,14 @@ class RegulatedPurePursuitController:
 
     what = WHAT
 
-    def __init__(self, params: Mapping[str, Any] | RppParams | None = None, *, footprint: Any = None,
-                 robot_radius: float | None = None, controller_frequency: float | None = None) -> None:  # fmt: skip
+    def __init__(
+        self,
+        params: Mapping[str, Any] | RppParams | None = None,
+        *,
+        footprint: Any = None,
+        robot_radius: float | None = None,
+        controller_frequency: float | None = None,
+    ) -> None:
         values = dict(params) if isinstance(params, Mapping) else params
         if isinstance(values, dict) and controller_frequency is not None:
             values.setdefault("controller_frequency", controller_frequency)
@@ -140,8 +166,12 @@ class RegulatedPurePursuitController:
     def from_params(cls, params: Mapping[str, Any] | None, *, context: Any = None) -> RegulatedPurePursuitController:
         """The plugin contract's constructor: ``context.footprint`` and ``context.controller_frequency``."""
         fp = getattr(context, "footprint", None)
-        return cls(params, footprint=getattr(fp, "polygon", None), robot_radius=getattr(fp, "radius", None),
-                   controller_frequency=getattr(context, "controller_frequency", None))
+        return cls(
+            params,
+            footprint=getattr(fp, "polygon", None),
+            robot_radius=getattr(fp, "radius", None),
+            controller_frequency=getattr(context, "controller_frequency", None),
+        )
 
     def set_plan(self, path: np.ndarray) -> None:
         """The global plan (N, 2) or (N, 3) in the costmap's frame; a plan to a new goal resets the goal latch."""
@@ -159,18 +189,21 @@ class RegulatedPurePursuitController:
 
     def is_goal_reached(self, pose: tuple[float, float, float], velocity: tuple[float, float]) -> bool:
         """Nav2's SimpleGoalChecker: within xy tolerance (latched if ``stateful``) and yaw tolerance."""
-        return self._plan is not None and self._latch.reached((float(pose[0]), float(pose[1]), float(pose[2])),
-                                                              self._goal)
+        return self._plan is not None and self._latch.reached(
+            (float(pose[0]), float(pose[1]), float(pose[2])), self._goal
+        )
 
-    def compute_velocity(self, pose: tuple[float, float, float], velocity: tuple[float, float],
-                         costmap: Grid | None) -> ControlResult:
+    def compute_velocity(
+        self, pose: tuple[float, float, float], velocity: tuple[float, float], costmap: Grid | None
+    ) -> ControlResult:
         """The command for the robot at ``pose`` (costmap frame) moving at ``velocity`` (v m/s, w rad/s), with the
         projected arc as its local plan; not ``valid`` when a collision is ahead."""
         v, w = self._command(pose, velocity, costmap)
         return ControlResult(v, w, self.valid, self.local_plan)
 
-    def _command(self, pose: tuple[float, float, float], velocity: tuple[float, float],
-                 costmap: Grid | None) -> tuple[float, float]:
+    def _command(
+        self, pose: tuple[float, float, float], velocity: tuple[float, float], costmap: Grid | None
+    ) -> tuple[float, float]:
         if self._plan is None:
             raise NavigationError(f"{WHAT}: compute_velocity called before set_plan")
         p = self.params
@@ -183,8 +216,11 @@ class RegulatedPurePursuitController:
         rel = ahead - (x, y)
         robot = np.column_stack([c * rel[:, 0] + s * rel[:, 1], -s * rel[:, 0] + c * rel[:, 1]])
         v_now = float(velocity[0])
-        lookahead = (min(max(abs(v_now) * p.lookahead_time, p.min_lookahead_dist), p.max_lookahead_dist)
-                     if p.use_velocity_scaled_lookahead_dist else p.lookahead_dist)  # fmt: skip
+        lookahead = (
+            min(max(abs(v_now) * p.lookahead_time, p.min_lookahead_dist), p.max_lookahead_dist)
+            if p.use_velocity_scaled_lookahead_dist
+            else p.lookahead_dist
+        )
         carrot = carrot_on(robot, lookahead)
         self.carrot = np.array([x + c * carrot[0] - s * carrot[1], y + s * carrot[0] + c * carrot[1]])
         goal_dist = math.hypot(self._goal[0] - x, self._goal[1] - y)
@@ -207,28 +243,36 @@ class RegulatedPurePursuitController:
         """The plan from the point nearest the robot (searched within ``SEARCH_M`` of path ahead of the last one)
         onwards (Nav2's ``max_robot_pose_search_dist``)."""
         assert self._plan is not None
-        plan = self._plan[self._progress:]
+        plan = self._plan[self._progress :]
         along = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(plan, axis=0).T))])
         window = plan[: int(np.searchsorted(along, SEARCH_M)) + 1]
         self._progress += int(np.argmin(np.hypot(window[:, 0] - x, window[:, 1] - y)))
-        return self._plan[self._progress:]
+        return self._plan[self._progress :]
 
-    def _rotate(self, angle: float, w_now: float, dt: float, pose: tuple[float, float, float],
-                costmap: Grid | None) -> tuple[float, float]:
+    def _rotate(
+        self, angle: float, w_now: float, dt: float, pose: tuple[float, float, float], costmap: Grid | None
+    ) -> tuple[float, float]:
         """Turn in place toward ``angle`` (rad, robot frame) at ``rotate_to_heading_angular_vel``, within
         ``max_angular_accel`` of the current turn rate."""
         p = self.params
         if abs(angle) <= 1e-3:
             return self._checked(0.0, 0.0, pose, costmap, 0.0)
         # slow down into the heading as an acceleration-limited stop allows (Nav2's rotate-to-heading)
-        target = math.copysign(min(p.rotate_to_heading_angular_vel, math.sqrt(2 * p.max_angular_accel * abs(angle))),
-                               angle)
+        target = math.copysign(
+            min(p.rotate_to_heading_angular_vel, math.sqrt(2 * p.max_angular_accel * abs(angle))), angle
+        )
         step = p.max_angular_accel * dt
         w = min(max(target, w_now - step), w_now + step)
         return self._checked(0.0, w, pose, costmap, 0.0)
 
-    def _regulated_speed(self, curvature: float, pose: tuple[float, float, float], costmap: Grid | None,
-                         remaining: float, goal_dist: float) -> float:
+    def _regulated_speed(
+        self,
+        curvature: float,
+        pose: tuple[float, float, float],
+        costmap: Grid | None,
+        remaining: float,
+        goal_dist: float,
+    ) -> float:
         """``desired_linear_vel`` regulated by curvature, proximity to obstacles and the approach to the goal."""
         p = self.params
         v = p.desired_linear_vel
@@ -251,8 +295,9 @@ class RegulatedPurePursuitController:
             v = max(v * left / p.approach_velocity_scaling_dist, p.min_approach_linear_velocity)
         return min(v, p.desired_linear_vel)
 
-    def _checked(self, v: float, w: float, pose: tuple[float, float, float], costmap: Grid | None,
-                 carrot_dist: float) -> tuple[float, float]:
+    def _checked(
+        self, v: float, w: float, pose: tuple[float, float, float], costmap: Grid | None, carrot_dist: float
+    ) -> tuple[float, float]:
         """(v, w) after Nav2's ``isCollisionImminent``: the arc projected for
         ``max_allowed_time_to_collision_up_to_carrot`` s (not past the carrot) must stay off lethal cells."""
         p = self.params

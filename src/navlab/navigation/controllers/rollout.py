@@ -20,8 +20,16 @@ from navlab.navigation.controllers.common import footprint_outline
 # --- rollout and footprint cost (pure, vectorised over samples) --------------------------------------
 
 
-def rollout(pose: tuple[float, float, float], velocity: tuple[float, float], targets: np.ndarray,
-            steps: int | np.ndarray, sim_time: float, acc: tuple[float, float], *, accelerate: bool) -> np.ndarray:
+def rollout(
+    pose: tuple[float, float, float],
+    velocity: tuple[float, float],
+    targets: np.ndarray,
+    steps: int | np.ndarray,
+    sim_time: float,
+    acc: tuple[float, float],
+    *,
+    accelerate: bool,
+) -> np.ndarray:
     """Poses (S, max(steps), 3) of a unicycle starting at ``pose`` with ``velocity``: sample ``s`` at
     t = 0, dt, ..., (n - 1) dt with n = ``steps[s]`` and dt = ``sim_time`` / n (ROS's rollouts end one step
     short of sim_time), then its last pose repeated up to the longest sample's length.
@@ -33,16 +41,42 @@ def rollout(pose: tuple[float, float, float], velocity: tuple[float, float], tar
     n = np.broadcast_to(np.maximum(np.asarray(steps, dtype=np.int64), 1), (len(targets),)).copy()
     out = np.empty((len(targets), int(n.max()) if len(n) else 1, 3))
     none = np.zeros((0, 0))
-    integrate_rollouts(float(pose[0]), float(pose[1]), float(pose[2]), float(velocity[0]), float(velocity[1]),
-             np.ascontiguousarray(targets, dtype=np.float64), n, float(sim_time), float(acc[0]), float(acc[1]),
-             accelerate, out, none, none)
+    integrate_rollouts(
+        float(pose[0]),
+        float(pose[1]),
+        float(pose[2]),
+        float(velocity[0]),
+        float(velocity[1]),
+        np.ascontiguousarray(targets, dtype=np.float64),
+        n,
+        float(sim_time),
+        float(acc[0]),
+        float(acc[1]),
+        accelerate,
+        out,
+        none,
+        none,
+    )
     return out
 
 
 @numba.njit(cache=True)
-def integrate_rollouts(x0: float, y0: float, th0: float, v0: float, w0: float, targets: np.ndarray, steps: np.ndarray,
-             sim_time: float, ax: float, ath: float, accelerate: bool, out: np.ndarray, cos: np.ndarray,
-             sin: np.ndarray) -> None:  # pragma: no cover - compiled
+def integrate_rollouts(
+    x0: float,
+    y0: float,
+    th0: float,
+    v0: float,
+    w0: float,
+    targets: np.ndarray,
+    steps: np.ndarray,
+    sim_time: float,
+    ax: float,
+    ath: float,
+    accelerate: bool,
+    out: np.ndarray,
+    cos: np.ndarray,
+    sin: np.ndarray,
+) -> None:  # pragma: no cover - compiled
     """:func:`rollout`'s integration into ``out``; ``cos``/``sin`` (the poses' shape, or empty: not kept) get the
     cosine and sine of each pose's heading, which the integration works out anyway."""
     keep = cos.size > 0
@@ -76,14 +110,21 @@ def lookup(grid: np.ndarray, resolution: float, x: np.ndarray, y: np.ndarray) ->
     shape = np.shape(x)
     vals = np.empty(shape, dtype=grid.dtype)
     inside = np.empty(shape, dtype=np.bool_)
-    _lookup(grid, 1.0 / resolution, np.ascontiguousarray(x, dtype=np.float64).reshape(-1),
-            np.ascontiguousarray(y, dtype=np.float64).reshape(-1), vals.reshape(-1), inside.reshape(-1))
+    _lookup(
+        grid,
+        1.0 / resolution,
+        np.ascontiguousarray(x, dtype=np.float64).reshape(-1),
+        np.ascontiguousarray(y, dtype=np.float64).reshape(-1),
+        vals.reshape(-1),
+        inside.reshape(-1),
+    )
     return vals, inside
 
 
 @numba.njit(cache=True)
-def _lookup(grid: np.ndarray, inv: float, x: np.ndarray, y: np.ndarray, vals: np.ndarray,
-            inside: np.ndarray) -> None:  # pragma: no cover - compiled
+def _lookup(
+    grid: np.ndarray, inv: float, x: np.ndarray, y: np.ndarray, vals: np.ndarray, inside: np.ndarray
+) -> None:  # pragma: no cover - compiled
     h, w = grid.shape
     for k in range(x.size):
         i, j = math.floor(x[k] * inv), math.floor(y[k] * inv)
@@ -92,8 +133,14 @@ def _lookup(grid: np.ndarray, inv: float, x: np.ndarray, y: np.ndarray, vals: np
         vals[k] = grid[j, i] if ok else grid[0, 0]
 
 
-def footprint_costs(cost: np.ndarray, resolution: float, poses: np.ndarray, outline: np.ndarray | None, *,
-                    near_max: np.ndarray | None = None) -> np.ndarray:
+def footprint_costs(
+    cost: np.ndarray,
+    resolution: float,
+    poses: np.ndarray,
+    outline: np.ndarray | None,
+    *,
+    near_max: np.ndarray | None = None,
+) -> np.ndarray:
     """costmap_2d's footprint cost at each grid-local pose (..., 3): -1 where the robot may not be.
 
     Circular robot (``outline`` None): the centre cell's cost, -1 if LETHAL, INSCRIBED, unknown or off the
@@ -104,8 +151,14 @@ def footprint_costs(cost: np.ndarray, resolution: float, poses: np.ndarray, outl
     return _pose_costs(cost, resolution, poses, outline, near_max, with_centre=False)
 
 
-def occupancy_costs(cost: np.ndarray, resolution: float, poses: np.ndarray, outline: np.ndarray | None, *,
-                    near_max: np.ndarray | None = None) -> np.ndarray:
+def occupancy_costs(
+    cost: np.ndarray,
+    resolution: float,
+    poses: np.ndarray,
+    outline: np.ndarray | None,
+    *,
+    near_max: np.ndarray | None = None,
+) -> np.ndarray:
     """base_local_planner's obstacle cost of each grid-local pose (..., 3): -1 where the robot may not be.
 
     Polygon: ``max(footprint cost, centre cell cost)`` (``TrajectoryPlanner::generateTrajectory``,
@@ -125,8 +178,15 @@ def outline_reach_max(cost: np.ndarray, resolution: float, outline: np.ndarray) 
     return maximum_filter(np.asarray(cost, dtype=np.uint8), size=2 * reach + 1, mode="constant", cval=COST_UNKNOWN)
 
 
-def _pose_costs(cost: np.ndarray, resolution: float, poses: np.ndarray, outline: np.ndarray | None,
-                near_max: np.ndarray | None, *, with_centre: bool) -> np.ndarray:
+def _pose_costs(
+    cost: np.ndarray,
+    resolution: float,
+    poses: np.ndarray,
+    outline: np.ndarray | None,
+    near_max: np.ndarray | None,
+    *,
+    with_centre: bool,
+) -> np.ndarray:
     """:func:`footprint_costs` (``with_centre`` False) or :func:`occupancy_costs` (True), one compiled pass."""
     poses = np.asarray(poses, dtype=np.float64)
     shape = poses.shape[:-1]
@@ -136,21 +196,44 @@ def _pose_costs(cost: np.ndarray, resolution: float, poses: np.ndarray, outline:
     x, y = np.ascontiguousarray(flat[:, 0]), np.ascontiguousarray(flat[:, 1])
     if outline is None:
         empty = np.zeros(0)
-        _footprint_pass(grid, grid, 1.0 / resolution, x, y, empty, empty, empty, empty, False, False, with_centre,
-                        out)
+        _footprint_pass(grid, grid, 1.0 / resolution, x, y, empty, empty, empty, empty, False, False, with_centre, out)
     else:
         ol = np.asarray(outline, dtype=np.float64)
         near = grid if near_max is None else np.ascontiguousarray(near_max, dtype=grid.dtype)
         # numpy's cos/sin (as before); the edge points are formed in the kernel in the same operation order
-        _footprint_pass(grid, near, 1.0 / resolution, x, y, np.cos(flat[:, 2]), np.sin(flat[:, 2]),
-                        np.ascontiguousarray(ol[:, 0]), np.ascontiguousarray(ol[:, 1]), True, near_max is not None,
-                        with_centre, out)
+        _footprint_pass(
+            grid,
+            near,
+            1.0 / resolution,
+            x,
+            y,
+            np.cos(flat[:, 2]),
+            np.sin(flat[:, 2]),
+            np.ascontiguousarray(ol[:, 0]),
+            np.ascontiguousarray(ol[:, 1]),
+            True,
+            near_max is not None,
+            with_centre,
+            out,
+        )
     return out.reshape(shape)
 
 
 @numba.njit(cache=True, inline="always")
-def _pose_cost(grid: np.ndarray, near: np.ndarray, inv: float, x: float, y: float, c: float, s: float, ox: np.ndarray,
-               oy: np.ndarray, polygon: bool, use_near: bool, with_centre: bool) -> float:  # pragma: no cover
+def _pose_cost(
+    grid: np.ndarray,
+    near: np.ndarray,
+    inv: float,
+    x: float,
+    y: float,
+    c: float,
+    s: float,
+    ox: np.ndarray,
+    oy: np.ndarray,
+    polygon: bool,
+    use_near: bool,
+    with_centre: bool,
+) -> float:  # pragma: no cover
     """One pose's footprint (``with_centre`` False) or occupancy (True) cost, -1 where the robot may not be."""
     h, w = grid.shape
     i, j = math.floor(x * inv), math.floor(y * inv)
@@ -181,9 +264,21 @@ def _pose_cost(grid: np.ndarray, near: np.ndarray, inv: float, x: float, y: floa
 
 
 @numba.njit(cache=True)
-def _footprint_pass(grid: np.ndarray, near: np.ndarray, inv: float, x: np.ndarray, y: np.ndarray, c: np.ndarray,
-                    s: np.ndarray, ox: np.ndarray, oy: np.ndarray, polygon: bool, use_near: bool, with_centre: bool,
-                    out: np.ndarray) -> None:  # pragma: no cover - compiled
+def _footprint_pass(
+    grid: np.ndarray,
+    near: np.ndarray,
+    inv: float,
+    x: np.ndarray,
+    y: np.ndarray,
+    c: np.ndarray,
+    s: np.ndarray,
+    ox: np.ndarray,
+    oy: np.ndarray,
+    polygon: bool,
+    use_near: bool,
+    with_centre: bool,
+    out: np.ndarray,
+) -> None:  # pragma: no cover - compiled
     for k in range(x.size):
         if k > 0 and x[k] == x[k - 1] and y[k] == y[k - 1] and (not polygon or (c[k] == c[k - 1] and s[k] == s[k - 1])):
             out[k] = out[k - 1]  # a rollout's last pose repeated: the same cost
@@ -193,10 +288,24 @@ def _footprint_pass(grid: np.ndarray, near: np.ndarray, inv: float, x: np.ndarra
 
 
 @numba.njit(cache=True)
-def rollout_scores(grid: np.ndarray, near: np.ndarray, path_dist: np.ndarray, goal_dist: np.ndarray, inv: float,
-                    traj: np.ndarray, c: np.ndarray, s: np.ndarray, ox: np.ndarray, oy: np.ndarray, polygon: bool,
-                    use_near: bool, weights: np.ndarray, impossible: float, at: np.ndarray,
-                    out: np.ndarray) -> None:  # pragma: no cover - compiled
+def rollout_scores(
+    grid: np.ndarray,
+    near: np.ndarray,
+    path_dist: np.ndarray,
+    goal_dist: np.ndarray,
+    inv: float,
+    traj: np.ndarray,
+    c: np.ndarray,
+    s: np.ndarray,
+    ox: np.ndarray,
+    oy: np.ndarray,
+    polygon: bool,
+    use_near: bool,
+    weights: np.ndarray,
+    impossible: float,
+    at: np.ndarray,
+    out: np.ndarray,
+) -> None:  # pragma: no cover - compiled
     """TrajectoryPlanner's cost of each rollout (S, n, 3): ``weights`` = (scale, pdist, gdist, occdist). As
     ``generateTrajectory``, the poses are checked in time order and the first failure decides: -1 when the pose
     is off the map or its footprint blocked, -2 when its cell has no path to the plan or goal. ``at`` (S,): -1
@@ -218,8 +327,12 @@ def rollout_scores(grid: np.ndarray, near: np.ndarray, path_dist: np.ndarray, go
                 bound = near[j, i]  # no edge of this pose costs more: it cannot raise the rollout's cost
                 skip = bound < COST_LETHAL and bound <= top
             if not skip:
-                same = k > 0 and x == traj[r, k - 1, 0] and y == traj[r, k - 1, 1] and (
-                    not polygon or (c[r, k] == c[r, k - 1] and s[r, k] == s[r, k - 1]))
+                same = (
+                    k > 0
+                    and x == traj[r, k - 1, 0]
+                    and y == traj[r, k - 1, 1]
+                    and (not polygon or (c[r, k] == c[r, k - 1] and s[r, k] == s[r, k - 1]))
+                )
                 if not same:  # a rollout's last pose repeated has the same cost
                     fp = _pose_cost(grid, near, inv, x, y, c[r, k], s[r, k], ox, oy, polygon, use_near, True)
                 if fp < 0:
@@ -281,8 +394,14 @@ def _line_clear(cost: np.ndarray, x0: int, x1: int, y0: int, y1: int) -> bool:  
     return True
 
 
-def footprint_cells(shape: tuple[int, int], resolution: float, pose: tuple[float, float, float],
-                    polygon: np.ndarray | None, *, edges: np.ndarray | None = None) -> np.ndarray:
+def footprint_cells(
+    shape: tuple[int, int],
+    resolution: float,
+    pose: tuple[float, float, float],
+    polygon: np.ndarray | None,
+    *,
+    edges: np.ndarray | None = None,
+) -> np.ndarray:
     """Cells (K, 2) as (i, j) under the robot at grid-local ``pose``: the centre cell, and with a polygon
     (base frame, m) every cell whose centre lies inside it (even-odd rule) or that its edges cross (ROS's
     filled ``getFootprintCells``), sorted by i then j. ``edges``: the polygon's ``footprint_outline`` at
@@ -300,13 +419,15 @@ def footprint_cells(shape: tuple[int, int], resolution: float, pose: tuple[float
     poly = np.column_stack([x + c * polygon[:, 0] - s * polygon[:, 1], y + s * polygon[:, 0] + c * polygon[:, 1]])
     ex = x + c * edges[:, 0] - s * edges[:, 1]
     ey = y + s * edges[:, 0] + c * edges[:, 1]
-    return _footprint_cells(int(h), int(w), float(resolution), float(x), float(y), poly, np.ascontiguousarray(ex),
-                            np.ascontiguousarray(ey))
+    return _footprint_cells(
+        int(h), int(w), float(resolution), float(x), float(y), poly, np.ascontiguousarray(ex), np.ascontiguousarray(ey)
+    )
 
 
 @numba.njit(cache=True)
-def _footprint_cells(h: int, w: int, res: float, x: float, y: float, poly: np.ndarray, ex: np.ndarray,
-                     ey: np.ndarray) -> np.ndarray:  # pragma: no cover - compiled
+def _footprint_cells(
+    h: int, w: int, res: float, x: float, y: float, poly: np.ndarray, ex: np.ndarray, ey: np.ndarray
+) -> np.ndarray:  # pragma: no cover - compiled
     ci, cj = math.floor(x / res), math.floor(y / res)
     lo_i, lo_j = math.floor(poly[:, 0].min() / res), math.floor(poly[:, 1].min() / res)
     hi_i, hi_j = math.floor(poly[:, 0].max() / res), math.floor(poly[:, 1].max() / res)
@@ -356,5 +477,5 @@ def velocity_samples(low: float, high: float, n: int) -> np.ndarray:
     out = list(np.linspace(low, high, n))
     for k in range(n - 1):
         if out[k] < 0.0 < out[k + 1]:
-            return np.array([*out[: k + 1], 0.0, *out[k + 1:]])
+            return np.array([*out[: k + 1], 0.0, *out[k + 1 :]])
     return np.array(out)

@@ -124,9 +124,15 @@ class RolloutController:
     _stopped_vel = (0.01, 0.01)
     _accelerate = True
 
-    def __init__(self, params: Mapping[str, Any] | Any | None = None, *, footprint: Any = None,
-                 robot_radius: float | None = None, controller_frequency: float | None = None,
-                 rng: np.random.Generator | None = None) -> None:
+    def __init__(
+        self,
+        params: Mapping[str, Any] | Any | None = None,
+        *,
+        footprint: Any = None,
+        robot_radius: float | None = None,
+        controller_frequency: float | None = None,
+        rng: np.random.Generator | None = None,
+    ) -> None:
         if controller_frequency is not None and (params is None or isinstance(params, Mapping)):
             params = {"controller_frequency": controller_frequency, **(params or {})}  # its own value wins
         self.params = self._parse(params)
@@ -169,8 +175,9 @@ class RolloutController:
         oscillation flags; the same plan sent again every cycle keeps them."""
         plan = as_plan(path)
         p = self.params
-        if self._plan is None or not same_goal(goal_of(self._plan), goal_of(plan), p.xy_goal_tolerance,
-                                               p.yaw_goal_tolerance):
+        if self._plan is None or not same_goal(
+            goal_of(self._plan), goal_of(plan), p.xy_goal_tolerance, p.yaw_goal_tolerance
+        ):
             self._latch.reset()
             self._osc.reset()
             self._rotating_to_goal = False
@@ -191,18 +198,25 @@ class RolloutController:
         """From the planner's parameter namespace, move_base's ``controller_frequency`` and the local costmap's
         footprint (its polygon, else a round robot's radius)."""
         fp = context.footprint
-        return cls(params, footprint=None if fp is None else fp.polygon, robot_radius=None if fp is None else fp.radius,
-                   controller_frequency=context.controller_frequency, rng=context.rng)
+        return cls(
+            params,
+            footprint=None if fp is None else fp.polygon,
+            robot_radius=None if fp is None else fp.radius,
+            controller_frequency=context.controller_frequency,
+            rng=context.rng,
+        )
 
-    def compute_velocity(self, pose: tuple[float, float, float], velocity: tuple[float, float],
-                         costmap: Grid | None) -> ControlResult:
+    def compute_velocity(
+        self, pose: tuple[float, float, float], velocity: tuple[float, float], costmap: Grid | None
+    ) -> ControlResult:
         """The command (v m/s, w rad/s) for the robot at ``pose`` (costmap frame) moving at ``velocity`` (v, w),
         with ``valid`` and the chosen rollout as ``local_plan``."""
         v, w = self._command(pose, velocity, costmap)
         return ControlResult(v, w, self.valid, self.local_plan)
 
-    def _command(self, pose: tuple[float, float, float], velocity: tuple[float, float],
-                 costmap: Grid | None) -> tuple[float, float]:
+    def _command(
+        self, pose: tuple[float, float, float], velocity: tuple[float, float], costmap: Grid | None
+    ) -> tuple[float, float]:
         if self._plan is None:
             raise NavigationError(f"{self.what}: compute_velocity called before set_plan")
         if costmap is None:
@@ -238,20 +252,31 @@ class RolloutController:
         if len(cells) == 0:
             return None  # ROS: "None of the points of the global plan were in the local costmap"
         free = self._free_cells(cost, pose_l, res)
-        return LocalScene(frame, pose_l, cost, res, plan, cells, mapgrid.distance_map(cost, cells, free),
-                          self._goal_dist(cost, cells[-1:]))
+        return LocalScene(
+            frame,
+            pose_l,
+            cost,
+            res,
+            plan,
+            cells,
+            mapgrid.distance_map(cost, cells, free),
+            self._goal_dist(cost, cells[-1:]),
+        )
 
     def _goal_dist(self, cost: np.ndarray, goal: np.ndarray) -> np.ndarray:
         """The local goal cell's distance map, kept while the costs and that cell stay the same (the robot moves
         a few cells per costmap update; the goal cell moves less often)."""
         cached = self._goal_map
-        if (cached is not None and np.array_equal(cached[1], goal) and cached[0].shape == cost.shape
-                and np.array_equal(cached[0], cost)):
+        if (
+            cached is not None
+            and np.array_equal(cached[1], goal)
+            and cached[0].shape == cost.shape
+            and np.array_equal(cached[0], cost)
+        ):
             return cached[2]
         dist = mapgrid.distance_map(cost, goal)
         self._goal_map = (cost.copy(), goal.copy(), dist)
         return dist
-
 
     def _free_cells(self, cost: np.ndarray, pose_l: tuple[float, float, float], res: float) -> np.ndarray | None:
         """Cells never obstacles for the path map's wave (None: none)."""
@@ -271,15 +296,24 @@ class RolloutController:
         if outline is None:
             return None
         cached = self._near
-        if (cached is not None and cached[0] is outline and cached[1].shape == scene.cost.shape
-                and np.array_equal(cached[1], scene.cost)):
+        if (
+            cached is not None
+            and cached[0] is outline
+            and cached[1].shape == scene.cost.shape
+            and np.array_equal(cached[1], scene.cost)
+        ):
             return cached[2]
         near = outline_reach_max(scene.cost, scene.resolution, outline)
         self._near = (outline, scene.cost.copy(), near)
         return near
 
-    def _stop_rotate(self, pose: tuple[float, float, float], velocity: tuple[float, float],
-                     goal: tuple[float, float, float | None], scene: LocalScene | None) -> tuple[float, float]:
+    def _stop_rotate(
+        self,
+        pose: tuple[float, float, float],
+        velocity: tuple[float, float],
+        goal: tuple[float, float, float | None],
+        scene: LocalScene | None,
+    ) -> tuple[float, float]:
         """At the goal position: stop within the acceleration limits, then turn in place to the goal yaw."""
         p = self.params
         err = self._latch.yaw_error(pose, goal)
@@ -291,8 +325,17 @@ class RolloutController:
         else:
             self._rotating_to_goal = True
             max_w, min_w = self._in_place_limits(err)
-            cmd = (0.0, rotate_to_goal(err, velocity[1], max_w=max_w, min_in_place_w=min_w,
-                                       acc_theta=p.acc_lim_theta, sim_period=p.sim_period))
+            cmd = (
+                0.0,
+                rotate_to_goal(
+                    err,
+                    velocity[1],
+                    max_w=max_w,
+                    min_in_place_w=min_w,
+                    acc_theta=p.acc_lim_theta,
+                    sim_period=p.sim_period,
+                ),
+            )
         if scene is not None and not self._command_valid(scene, velocity, cmd):
             self.valid = False
             return 0.0, 0.0
@@ -305,8 +348,15 @@ class RolloutController:
         """Whether rolling ``cmd`` out for sim_time scores as a legal trajectory (ROS's ``checkTrajectory``)."""
         p = self.params
         targets = np.array([cmd])
-        traj = rollout(scene.pose, velocity, targets, self._steps(targets), p.sim_time,
-                       (p.acc_lim_x, p.acc_lim_theta), accelerate=self._accelerate)
+        traj = rollout(
+            scene.pose,
+            velocity,
+            targets,
+            self._steps(targets),
+            p.sim_time,
+            (p.acc_lim_x, p.acc_lim_theta),
+            accelerate=self._accelerate,
+        )
         return bool(self._check(scene, targets, traj)[0] >= 0)
 
     def _check(self, scene: LocalScene, targets: np.ndarray, traj: np.ndarray) -> np.ndarray:
@@ -317,8 +367,15 @@ class RolloutController:
         """Rollout steps (S,) of each sample, as the ROS planner counts them."""
         raise NotImplementedError
 
-    def _finish(self, scene: LocalScene, targets: np.ndarray, traj: np.ndarray, costs: np.ndarray, best: int,
-                pose: tuple[float, float, float]) -> tuple[float, float]:
+    def _finish(
+        self,
+        scene: LocalScene,
+        targets: np.ndarray,
+        traj: np.ndarray,
+        costs: np.ndarray,
+        best: int,
+        pose: tuple[float, float, float],
+    ) -> tuple[float, float]:
         """Store the cycle's outputs; command sample ``best`` (or stop and flag failure if it is -1)."""
         self.samples, self.costs, self._traj = targets, costs, traj
         if best < 0:
@@ -329,6 +386,11 @@ class RolloutController:
         self.local_plan = scene.frame.poses_out(path[: (int(moved[-1]) + 2) if len(moved) else 1])
         return float(targets[best, 0]), float(targets[best, 1])
 
-    def _drive(self, scene: LocalScene, pose: tuple[float, float, float], velocity: tuple[float, float],
-               goal: tuple[float, float, float | None]) -> tuple[float, float]:
+    def _drive(
+        self,
+        scene: LocalScene,
+        pose: tuple[float, float, float],
+        velocity: tuple[float, float],
+        goal: tuple[float, float, float | None],
+    ) -> tuple[float, float]:
         raise NotImplementedError

@@ -19,8 +19,14 @@ from navlab.grid import COST_INSCRIBED, COST_LETHAL, Grid
 from navlab.navigation.errors import NavigationError
 
 
-def inflated(obstacles: np.ndarray, resolution: float, *, inscribed_radius: float = 0.2,
-             inflation_radius: float = 0.55, cost_scaling_factor: float = 10.0) -> np.ndarray:
+def inflated(
+    obstacles: np.ndarray,
+    resolution: float,
+    *,
+    inscribed_radius: float = 0.2,
+    inflation_radius: float = 0.55,
+    cost_scaling_factor: float = 10.0,
+) -> np.ndarray:
     """costmap_2d costs (uint8, same shape) of a boolean obstacle mask (rows = y)."""
     d = ndimage.distance_transform_edt(~obstacles) * resolution
     cost = np.zeros(obstacles.shape, dtype=np.uint8)
@@ -31,8 +37,13 @@ def inflated(obstacles: np.ndarray, resolution: float, *, inscribed_radius: floa
     return cost
 
 
-def disc_mask(shape: tuple[int, int], resolution: float, centres: np.ndarray, radii: np.ndarray,
-              origin: tuple[float, float] = (0.0, 0.0)) -> np.ndarray:
+def disc_mask(
+    shape: tuple[int, int],
+    resolution: float,
+    centres: np.ndarray,
+    radii: np.ndarray,
+    origin: tuple[float, float] = (0.0, 0.0),
+) -> np.ndarray:
     """Boolean mask of the cells whose centres lie in any of the discs (centres (K, 2), radii (K,), m)."""
     h, w = shape
     ys, xs = (np.arange(h) + 0.5) * resolution + origin[1], (np.arange(w) + 0.5) * resolution + origin[0]
@@ -42,9 +53,17 @@ def disc_mask(shape: tuple[int, int], resolution: float, centres: np.ndarray, ra
     return mask
 
 
-def clutter(rng: np.random.Generator, *, size: float = 8.0, resolution: float = 0.05, count: int = 30,
-            radius: tuple[float, float] = (0.1, 0.25), keep_clear: tuple[tuple[float, float], ...] = (),
-            clear_radius: float = 0.6, walls: bool = True) -> np.ndarray:
+def clutter(
+    rng: np.random.Generator,
+    *,
+    size: float = 8.0,
+    resolution: float = 0.05,
+    count: int = 30,
+    radius: tuple[float, float] = (0.1, 0.25),
+    keep_clear: tuple[tuple[float, float], ...] = (),
+    clear_radius: float = 0.6,
+    walls: bool = True,
+) -> np.ndarray:
     """An obstacle mask (n, n) of a ``size`` m square room with ``count`` round obstacles (radii in
     ``radius``) placed from ``rng``, none within ``clear_radius`` of the ``keep_clear`` points."""
     n = round(size / resolution)
@@ -62,8 +81,9 @@ def clutter(rng: np.random.Generator, *, size: float = 8.0, resolution: float = 
     return mask
 
 
-def grid_plan(costmap: Grid, start: tuple[float, float], goal: tuple[float, float], *,
-              cost_factor: float = 3.0 / 252.0) -> np.ndarray:
+def grid_plan(
+    costmap: Grid, start: tuple[float, float], goal: tuple[float, float], *, cost_factor: float = 3.0 / 252.0
+) -> np.ndarray:
     """A path (N, 3) from ``start`` to ``goal`` over a costmap: 8-connected Dijkstra (no cutting corners),
     step length times (1 + cost_factor * cost), cells >= INSCRIBED forbidden; yaw along the path, the last
     one repeated.
@@ -112,5 +132,5 @@ def window(costmap: Grid, x: float, y: float, size: float = 4.0) -> Grid:
     data = np.zeros((n, n), dtype=np.uint8)
     h, w = costmap.data.shape
     si, sj = slice(max(0, i0), min(w, i0 + n)), slice(max(0, j0), min(h, j0 + n))
-    data[sj.start - j0:sj.stop - j0, si.start - i0:si.stop - i0] = costmap.data[sj, si]
+    data[sj.start - j0 : sj.stop - j0, si.start - i0 : si.stop - i0] = costmap.data[sj, si]
     return Grid(data, costmap.resolution, costmap.sub_origin(int(i0), int(j0)), "odom")

@@ -32,11 +32,18 @@ class TrajectoryPlannerROS(RolloutController):
     what = "TrajectoryPlannerROS"
     params: TrajectoryPlannerParams
 
-    def __init__(self, params: Mapping[str, Any] | TrajectoryPlannerParams | None = None, *, footprint: Any = None,
-                 robot_radius: float | None = None, controller_frequency: float | None = None,
-                 rng: np.random.Generator | None = None) -> None:
-        super().__init__(params, footprint=footprint, robot_radius=robot_radius,
-                         controller_frequency=controller_frequency, rng=rng)
+    def __init__(
+        self,
+        params: Mapping[str, Any] | TrajectoryPlannerParams | None = None,
+        *,
+        footprint: Any = None,
+        robot_radius: float | None = None,
+        controller_frequency: float | None = None,
+        rng: np.random.Generator | None = None,
+    ) -> None:
+        super().__init__(
+            params, footprint=footprint, robot_radius=robot_radius, controller_frequency=controller_frequency, rng=rng
+        )
         self._escaping = False
         self._escape_pose = (0.0, 0.0, 0.0)
         self._spin = InPlaceFlags(self.params.oscillation_reset_dist)
@@ -102,17 +109,38 @@ class TrajectoryPlannerROS(RolloutController):
         weights = self._weights(res)
         cost = np.empty(traj.shape[0])
         at = self._heading_step(traj.shape[1])
-        rollout_scores(grid, grid if near is None else near, np.ascontiguousarray(scene.path_dist),
-                        np.ascontiguousarray(scene.goal_dist), 1.0 / res, traj, c, s, ox, oy, outline is not None,
-                        near is not None, weights, scene.impossible, np.full(len(traj), at, dtype=np.int64), cost)
+        rollout_scores(
+            grid,
+            grid if near is None else near,
+            np.ascontiguousarray(scene.path_dist),
+            np.ascontiguousarray(scene.goal_dist),
+            1.0 / res,
+            traj,
+            c,
+            s,
+            ox,
+            oy,
+            outline is not None,
+            near is not None,
+            weights,
+            scene.impossible,
+            np.full(len(traj), at, dtype=np.int64),
+            cost,
+        )
         if at >= 0:  # ROS: + 0.3 * headingDiff at the scored step (not scaled by meter_scoring)
             ok = cost >= 0
-            cost[ok] += 0.3 * heading_diffs(grid, res, np.ascontiguousarray(scene.plan[:, :2]),
-                                            np.ascontiguousarray(traj[ok, at]))
+            cost[ok] += 0.3 * heading_diffs(
+                grid, res, np.ascontiguousarray(scene.plan[:, :2]), np.ascontiguousarray(traj[ok, at])
+            )
         return cost
 
-    def _drive(self, scene: LocalScene, pose: tuple[float, float, float], velocity: tuple[float, float],
-               goal: tuple[float, float, float | None]) -> tuple[float, float]:
+    def _drive(
+        self,
+        scene: LocalScene,
+        pose: tuple[float, float, float],
+        velocity: tuple[float, float],
+        goal: tuple[float, float, float | None],
+    ) -> tuple[float, float]:
         p = self.params
         v0, w0 = velocity
         x, y, _ = scene.pose
@@ -130,25 +158,50 @@ class TrajectoryPlannerROS(RolloutController):
         outline = self._outline(res)
         near = self._near_max(scene)
         ang = p.angular_sim_granularity if p.angular_sim_granularity > 0 else p.sim_granularity
-        limits = np.array([vmin, vmax, wmin, wmax, p.min_in_place_vel_theta, p.escape_vel, p.acc_lim_x,
-                           p.acc_lim_theta])
+        limits = np.array(
+            [vmin, vmax, wmin, wmax, p.min_in_place_vel_theta, p.escape_vel, p.acc_lim_x, p.acc_lim_theta]
+        )
         steps = max(1, int(p.sim_time / p.sim_granularity + 0.5)) if p.heading_scoring else 0
         at = self._heading_step(steps) if p.heading_scoring else -1
         empty = np.zeros(0)
         targets, traj, costs, ws, dw = cycle.score_samples(
-            scene.cost, scene.cost if near is None else near, scene.path_dist, scene.goal_dist, res, scene.pose,
-            velocity, limits, (p.vx_samples, p.vtheta_samples), np.array([p.sim_time, p.sim_granularity, ang,
-                                                                          float(p.heading_scoring)]),
+            scene.cost,
+            scene.cost if near is None else near,
+            scene.path_dist,
+            scene.goal_dist,
+            res,
+            scene.pose,
+            velocity,
+            limits,
+            (p.vx_samples, p.vtheta_samples),
+            np.array([p.sim_time, p.sim_granularity, ang, float(p.heading_scoring)]),
             empty if outline is None else np.ascontiguousarray(outline[:, 0]),
             empty if outline is None else np.ascontiguousarray(outline[:, 1]),
-            outline is not None, near is not None, self._weights(res), scene.impossible, at)
+            outline is not None,
+            near is not None,
+            self._weights(res),
+            scene.impossible,
+            at,
+        )
         if at >= 0:  # ROS: + 0.3 * headingDiff at the scored step (not scaled by meter_scoring)
             ok = costs >= 0
-            costs[ok] += 0.3 * heading_diffs(scene.cost, res, np.ascontiguousarray(scene.plan[:, :2]),
-                                             np.ascontiguousarray(traj[ok, at]))
+            costs[ok] += 0.3 * heading_diffs(
+                scene.cost, res, np.ascontiguousarray(scene.plan[:, :2]), np.ascontiguousarray(traj[ok, at])
+            )
         nf = len(targets) - len(ws) - 1
-        best = cycle.choose(costs, traj, ws, dw, nf, self._escaping, scene.goal_dist, res, p.heading_lookahead,
-                            self._spin.stuck_left, self._spin.stuck_right)
+        best = cycle.choose(
+            costs,
+            traj,
+            ws,
+            dw,
+            nf,
+            self._escaping,
+            scene.goal_dist,
+            res,
+            p.heading_lookahead,
+            self._spin.stuck_left,
+            self._spin.stuck_right,
+        )
         if best >= 0:
             self._spin.update(pose, float(targets[best, 0]), float(targets[best, 1]))
             self._end_escape(pose)

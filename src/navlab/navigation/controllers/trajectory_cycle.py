@@ -33,11 +33,25 @@ def _linspace(start: float, stop: float, num: int, out: np.ndarray) -> None:  # 
 
 
 @numba.njit(cache=True)
-def score_samples(grid: np.ndarray, near: np.ndarray, path_dist: np.ndarray, goal_dist: np.ndarray,
-                  resolution: float, pose: tuple[float, float, float], velocity: tuple[float, float],
-                  limits: np.ndarray, counts: tuple[int, int], timing: np.ndarray, ox: np.ndarray, oy: np.ndarray,
-                  polygon: bool, use_near: bool, weights: np.ndarray, impossible: float,
-                  at: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, float]:  # pragma: no cover
+def score_samples(
+    grid: np.ndarray,
+    near: np.ndarray,
+    path_dist: np.ndarray,
+    goal_dist: np.ndarray,
+    resolution: float,
+    pose: tuple[float, float, float],
+    velocity: tuple[float, float],
+    limits: np.ndarray,
+    counts: tuple[int, int],
+    timing: np.ndarray,
+    ox: np.ndarray,
+    oy: np.ndarray,
+    polygon: bool,
+    use_near: bool,
+    weights: np.ndarray,
+    impossible: float,
+    at: int,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, float]:  # pragma: no cover
     """TrajectoryPlanner's samples, rollouts and costs: (targets (S, 2), rollouts (S, n, 3), costs (S,), turn
     rates ws (nw,), their spacing dw).
 
@@ -45,8 +59,16 @@ def score_samples(grid: np.ndarray, near: np.ndarray, path_dist: np.ndarray, goa
     ``counts`` = (vx_samples, vtheta_samples); ``timing`` = (sim_time, sim_granularity, angular granularity,
     heading_scoring 0/1). Rows: per speed the straight rollout then ``nw - 1`` turn rates from the lowest up,
     then the ``nw`` in-place turns, then the escape. ``at``: the scored step (``_heading_step``)."""
-    vmin, vmax, wmin, wmax, min_ip, escape_vel, ax, ath = (limits[0], limits[1], limits[2], limits[3], limits[4],
-                                                          limits[5], limits[6], limits[7])
+    vmin, vmax, wmin, wmax, min_ip, escape_vel, ax, ath = (
+        limits[0],
+        limits[1],
+        limits[2],
+        limits[3],
+        limits[4],
+        limits[5],
+        limits[6],
+        limits[7],
+    )
     nvx, nw = max(counts[0], 1), max(counts[1], 1)
     vxs = np.empty(nvx)
     ws = np.empty(nw)
@@ -75,18 +97,45 @@ def score_samples(grid: np.ndarray, near: np.ndarray, path_dist: np.ndarray, goa
     traj = np.empty((n, steps.max(), 3))
     c = np.empty(traj.shape[:2])
     s = np.empty(traj.shape[:2])
-    integrate_rollouts(pose[0], pose[1], pose[2], velocity[0], velocity[1], targets, steps, sim_time, ax, ath, True,
-                       traj, c, s)
+    integrate_rollouts(
+        pose[0], pose[1], pose[2], velocity[0], velocity[1], targets, steps, sim_time, ax, ath, True, traj, c, s
+    )
     costs = np.empty(n)
-    rollout_scores(grid, near, path_dist, goal_dist, 1.0 / resolution, traj, c, s, ox, oy, polygon, use_near,
-                    weights, impossible, np.full(n, at, dtype=np.int64), costs)
+    rollout_scores(
+        grid,
+        near,
+        path_dist,
+        goal_dist,
+        1.0 / resolution,
+        traj,
+        c,
+        s,
+        ox,
+        oy,
+        polygon,
+        use_near,
+        weights,
+        impossible,
+        np.full(n, at, dtype=np.int64),
+        costs,
+    )
     return targets, traj, costs, ws, dw
 
 
 @numba.njit(cache=True)
-def choose(costs: np.ndarray, traj: np.ndarray, ws: np.ndarray, dw: float, nf: int, escaping: bool,
-           goal_dist: np.ndarray, resolution: float, lookahead: float, stuck_left: bool,
-           stuck_right: bool) -> int:  # pragma: no cover - compiled
+def choose(
+    costs: np.ndarray,
+    traj: np.ndarray,
+    ws: np.ndarray,
+    dw: float,
+    nf: int,
+    escaping: bool,
+    goal_dist: np.ndarray,
+    resolution: float,
+    lookahead: float,
+    stuck_left: bool,
+    stuck_right: bool,
+) -> int:  # pragma: no cover - compiled
     """The chosen row of ``score_samples``' samples, -1 for none: the cheapest valid forward rollout (not while
     escaping), unless an in-place turn costs no more; among those turns (faster than one sample step, allowed by
     the stuck flags, look-ahead point on the grid) the one whose look-ahead point (``lookahead`` m ahead of its

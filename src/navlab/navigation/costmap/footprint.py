@@ -34,8 +34,9 @@ class Footprint:
         if self.polygon is None:
             return float(self.radius or 0.0)
         pts = self.polygon
-        return float(min(_point_segment_distance(np.zeros(2), pts[k], pts[(k + 1) % len(pts)])
-                         for k in range(len(pts))))
+        return float(
+            min(_point_segment_distance(np.zeros(2), pts[k], pts[(k + 1) % len(pts)]) for k in range(len(pts)))
+        )
 
     @property
     def circumscribed_radius(self) -> float:
@@ -63,8 +64,9 @@ class Footprint:
         x, y, _ = pose
         reach = self.circumscribed_radius
         if self.polygon is None:  # a round robot: one compiled pass
-            return circle_cells(float(x), float(y), reach, grid.origin[0], grid.origin[1], grid.resolution,
-                                grid.width, grid.height)
+            return circle_cells(
+                float(x), float(y), reach, grid.origin[0], grid.origin[1], grid.resolution, grid.width, grid.height
+            )
         lo = grid.world_to_cell(np.array([[x - reach, y - reach]]))[0]
         hi = grid.world_to_cell(np.array([[x + reach, y + reach]]))[0]
         ii, jj = np.meshgrid(np.arange(lo[0], hi[0] + 1), np.arange(lo[1], hi[1] + 1))
@@ -114,8 +116,10 @@ def parse_polygon(value: Any, *, key: str = "footprint") -> np.ndarray | None:
                 raise ValueError("too long")
             raw = ast.literal_eval(text)
         except (ValueError, SyntaxError, TypeError, MemoryError, RecursionError):
-            raise NavigationError(f"costmap parameter {key}: expected a list of [x, y] points such as "
-                                  f"'[[0.2, 0.2], [0.2, -0.2], [-0.2, -0.2], [-0.2, 0.2]]', got {value!r}") from None
+            raise NavigationError(
+                f"costmap parameter {key}: expected a list of [x, y] points such as "
+                f"'[[0.2, 0.2], [0.2, -0.2], [-0.2, -0.2], [-0.2, 0.2]]', got {value!r}"
+            ) from None
     try:
         pts = np.asarray(raw, dtype=np.float64)
     except (TypeError, ValueError):
@@ -129,8 +133,13 @@ def parse_polygon(value: Any, *, key: str = "footprint") -> np.ndarray | None:
     if not np.isfinite(pts).all():
         raise NavigationError(f"costmap parameter {key}: points must be finite numbers, got {value!r}")
     check_ceiling(NavigationError, "costmap", f"{key} (number of points)", len(pts), "polygon_points")
-    check_ceiling(NavigationError, "costmap", f"{key} (a point's distance from the centre)",
-                  float(np.hypot(pts[:, 0], pts[:, 1]).max()), "footprint_m")
+    check_ceiling(
+        NavigationError,
+        "costmap",
+        f"{key} (a point's distance from the centre)",
+        float(np.hypot(pts[:, 0], pts[:, 1]).max()),
+        "footprint_m",
+    )
     return pts
 
 
@@ -139,8 +148,7 @@ def pad_polygon(polygon: np.ndarray, padding: float) -> np.ndarray:
     return polygon + np.sign(polygon) * padding
 
 
-def make_footprint(*, robot_radius: float = 0.46, footprint: Any = None, footprint_padding: float = 0.01
-                   ) -> Footprint:  # fmt: skip
+def make_footprint(*, robot_radius: float = 0.46, footprint: Any = None, footprint_padding: float = 0.01) -> Footprint:
     """The padded footprint from costmap_2d's parameters: ``footprint`` if non-empty, else ``robot_radius``."""
     if not math.isfinite(footprint_padding):
         raise NavigationError(f"costmap parameter footprint_padding: expected a finite number, got {footprint_padding}")
@@ -148,13 +156,17 @@ def make_footprint(*, robot_radius: float = 0.46, footprint: Any = None, footpri
     if polygon is not None:
         padded = pad_polygon(polygon, footprint_padding)
         if not points_in_polygon(np.zeros((1, 2)), padded)[0]:
-            raise NavigationError(f"costmap parameter footprint: the robot's centre (0, 0) must lie inside the "
-                                  f"polygon, got {polygon.tolist()}")
+            raise NavigationError(
+                f"costmap parameter footprint: the robot's centre (0, 0) must lie inside the "
+                f"polygon, got {polygon.tolist()}"
+            )
         return Footprint(None, padded)
     if not (math.isfinite(robot_radius) and robot_radius > 0):
         raise NavigationError(f"costmap parameter robot_radius: expected a positive number (m), got {robot_radius}")
     radius = robot_radius + footprint_padding
     if radius <= 0:
-        raise NavigationError(f"costmap parameters robot_radius {robot_radius} + footprint_padding "
-                              f"{footprint_padding}: expected a positive padded radius")
+        raise NavigationError(
+            f"costmap parameters robot_radius {robot_radius} + footprint_padding "
+            f"{footprint_padding}: expected a positive padded radius"
+        )
     return Footprint(radius, None)

@@ -1,5 +1,4 @@
-"""costmap_2d::InflationLayer: costs falling off with the distance to the nearest lethal cell (see ``layer``).
-"""
+"""costmap_2d::InflationLayer: costs falling off with the distance to the nearest lethal cell (see ``layer``)."""
 
 from __future__ import annotations
 
@@ -49,8 +48,9 @@ class InflationLayer(Layer):
     def from_params(cls, params: Mapping[str, Any] | None, *, context: PluginContext) -> Self:
         name = context.name or "inflation_layer"
         footprint = context.footprint if isinstance(context.footprint, Footprint) else None
-        return cls(layer_params(InflationLayerParams, costmap_of(params, context), name), name=name,
-                   footprint=footprint)
+        return cls(
+            layer_params(InflationLayerParams, costmap_of(params, context), name), name=name, footprint=footprint
+        )
 
     @property
     def inscribed_radius(self) -> float:
@@ -74,8 +74,7 @@ class InflationLayer(Layer):
     def _table(self, resolution: float, reach: int) -> np.ndarray:
         """Costs (uint8) by squared distance in cells, 0 .. reach² (0 from there on): ``cost_at`` of the distance
         a distance transform gives (sqrt of the squared cell distance, times the resolution)."""
-        key = (resolution, reach, self.params.inflation_radius, self.params.cost_scaling_factor,
-               self.inscribed_radius)
+        key = (resolution, reach, self.params.inflation_radius, self.params.cost_scaling_factor, self.inscribed_radius)
         if self._costs is None or self._costs[0] != key:
             d2 = np.arange(reach * reach + 1, dtype=np.float64)
             self._costs = (key, self.cost_at(np.sqrt(d2) * resolution))
@@ -116,8 +115,9 @@ class InflationLayer(Layer):
         o0, o1 = max(0, j0 - reach), min(h, j1 + reach)
         p0, p1 = max(0, i0 - reach), min(w, i1 + reach)
         if seeds[o0:o1, p0:p1].any():  # the squared distance (cells) to each cell's nearest seed, its cost
-            inflate_box(seeds, (o0, o1, p0, p1), (j0, j1, i0, i1), self._table(master.resolution, reach),
-                        cost[j0:j1, i0:i1])
+            inflate_box(
+                seeds, (o0, o1, p0, p1), (j0, j1, i0, i1), self._table(master.resolution, reach), cost[j0:j1, i0:i1]
+            )
         else:  # no obstacle within reach of the box: nothing to inflate there
             cost[j0:j1, i0:i1] = 0
         self._inflated = (key, seeds, cost)

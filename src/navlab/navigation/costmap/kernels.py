@@ -22,8 +22,13 @@ _FAR = 1 << 40  # "no seed in this column": beyond any real squared distance of 
 
 
 @numba.njit(cache=True)
-def inflate_box(seeds: np.ndarray, region: tuple[int, int, int, int], box: tuple[int, int, int, int],
-                table: np.ndarray, out: np.ndarray) -> None:  # pragma: no cover - compiled
+def inflate_box(
+    seeds: np.ndarray,
+    region: tuple[int, int, int, int],
+    box: tuple[int, int, int, int],
+    table: np.ndarray,
+    out: np.ndarray,
+) -> None:  # pragma: no cover - compiled
     """``out`` (the box's shape) = ``table[d2]`` for each cell of ``box`` = (j0, j1, i0, i1), ``d2`` its squared
     distance in cells to the nearest true cell of ``seeds`` inside ``region`` = (o0, o1, p0, p1) (which holds the
     box), the table's last entry from its end on (and where the region has no seed)."""
@@ -96,8 +101,9 @@ def combine(master: np.ndarray, layer: np.ndarray, maximum: bool) -> None:  # pr
 
 
 @numba.njit(cache=True)
-def circle_cells(x: float, y: float, radius: float, origin_x: float, origin_y: float, resolution: float,
-                 width: int, height: int) -> np.ndarray:  # pragma: no cover - compiled
+def circle_cells(
+    x: float, y: float, radius: float, origin_x: float, origin_y: float, resolution: float, width: int, height: int
+) -> np.ndarray:  # pragma: no cover - compiled
     """Cells (i, j) (K, 2), row by row, of a ``width`` x ``height`` grid (origin yaw 0) whose centres lie within
     ``radius`` m of (x, y), plus the cell under (x, y) itself; off-grid cells left out (``Footprint.cells`` of a
     round robot, in the same float operations)."""
@@ -118,9 +124,19 @@ def circle_cells(x: float, y: float, radius: float, origin_x: float, origin_y: f
 
 
 @numba.njit(cache=True)
-def mark_returns(data: np.ndarray, pts: np.ndarray, ok: np.ndarray, sensor_x: float, sensor_y: float,
-                 origin_x: float, origin_y: float, resolution: float, min_range: float, max_range: float,
-                 value: np.uint8) -> None:  # pragma: no cover - compiled
+def mark_returns(
+    data: np.ndarray,
+    pts: np.ndarray,
+    ok: np.ndarray,
+    sensor_x: float,
+    sensor_y: float,
+    origin_x: float,
+    origin_y: float,
+    resolution: float,
+    min_range: float,
+    max_range: float,
+    value: np.uint8,
+) -> None:  # pragma: no cover - compiled
     """``data`` = ``value`` at the cells of the points (N, 2) (m, the grid's frame, origin yaw 0) marked ``ok``
     whose distance from the sensor lies in [min_range, max_range) (the obstacle layer's marking)."""
     h, w = data.shape
@@ -137,8 +153,9 @@ def mark_returns(data: np.ndarray, pts: np.ndarray, ok: np.ndarray, sensor_x: fl
 
 
 @numba.njit(cache=True)
-def lethal_changes(data: np.ndarray, lethal: np.uint8, seeds: np.ndarray,
-                   previous: np.ndarray) -> tuple[int, int, int, int, int]:  # pragma: no cover - compiled
+def lethal_changes(
+    data: np.ndarray, lethal: np.uint8, seeds: np.ndarray, previous: np.ndarray
+) -> tuple[int, int, int, int, int]:  # pragma: no cover - compiled
     """``seeds`` = ``data == lethal``; returns (how many seeds, then the bounding rows and columns j0, j1, i0, i1,
     ends exclusive, of the cells where ``seeds`` differs from ``previous``: all 0 where nothing changed).
     ``previous`` of another shape: every seed counts as changed."""

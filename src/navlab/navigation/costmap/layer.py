@@ -48,16 +48,22 @@ class Layer:
         ``context.costmap`` (parsed ``CostmapParams``) with the robot's padded ``context.footprint``."""
         if getattr(cls.from_costmap_params, "__func__", None) is _OLD_HOOK:
             raise NotImplementedError(f"{cls.__name__} has no from_params(params, *, context)")
-        warnings.warn(f"{cls.__name__}.from_costmap_params is deprecated: implement from_params(params, *, context)",
-                      DeprecationWarning, stacklevel=2)  # a layer written for the old hook: one release
+        warnings.warn(
+            f"{cls.__name__}.from_costmap_params is deprecated: implement from_params(params, *, context)",
+            DeprecationWarning,
+            stacklevel=2,
+        )  # a layer written for the old hook: one release
         footprint = context.footprint if isinstance(context.footprint, Footprint) else make_footprint()
         return cls.from_costmap_params(context.name, costmap_of(params, context), footprint)
 
     @classmethod
     def from_costmap_params(cls, name: str, costmap: CostmapParams, footprint: Footprint) -> Self:
         """Deprecated (one release): ``from_params`` with the layer's namespace and a ``PluginContext``."""
-        warnings.warn("Layer.from_costmap_params is deprecated: use from_params(params, *, context)",
-                      DeprecationWarning, stacklevel=2)
+        warnings.warn(
+            "Layer.from_costmap_params is deprecated: use from_params(params, *, context)",
+            DeprecationWarning,
+            stacklevel=2,
+        )
         context = PluginContext(name=name, footprint=footprint, costmap=costmap)
         return cls.from_params(costmap.namespaces.get(name), context=context)
 

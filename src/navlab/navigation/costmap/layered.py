@@ -32,8 +32,9 @@ class LayeredCostmap:
     def __init__(self, params: CostmapParams | dict[str, Any] | None = None) -> None:
         self.params = params if isinstance(params, CostmapParams) else costmap_params(params)
         p = self.params
-        self.footprint: Footprint = make_footprint(robot_radius=p.robot_radius, footprint=p.footprint,
-                                                   footprint_padding=p.footprint_padding)
+        self.footprint: Footprint = make_footprint(
+            robot_radius=p.robot_radius, footprint=p.footprint, footprint_padding=p.footprint_padding
+        )
         w, h = self._cells(p.width), self._cells(p.height)
         default = COST_UNKNOWN if p.track_unknown_space else COST_FREE
         frame = p.global_frame.lstrip("/") or "map"
@@ -41,8 +42,13 @@ class LayeredCostmap:
         self.layers: list[Layer] = []
         for k, spec in enumerate(p.plugins):
             context = PluginContext(name=spec.name, footprint=self.footprint, costmap=p)
-            layer = make_plugin("costmap_layer", spec.type, p.namespaces.get(spec.name), context=context,
-                                param=f"plugins[{k}] ({spec.name}) type")
+            layer = make_plugin(
+                "costmap_layer",
+                spec.type,
+                p.namespaces.get(spec.name),
+                context=context,
+                param=f"plugins[{k}] ({spec.name}) type",
+            )
             layer.match_size(self.master)
             self.layers.append(layer)
         # the layers that take a map, and those that take scans (capabilities, by what they implement)
@@ -83,10 +89,15 @@ class LayeredCostmap:
     def resize(self, width: int, height: int, resolution: float, origin: tuple[float, float]) -> None:
         """New master geometry (``width`` x ``height`` cells, m/cell, lower-left corner in m); layers reset."""
         if width < 1 or height < 1 or not (math.isfinite(resolution) and resolution > 0):
-            raise NavigationError(f"costmap resize: expected positive size and resolution, got {width} x {height} "
-                                  f"at {resolution} m/cell")
-        self.master = Grid(np.full((height, width), self.default_value, np.uint8), resolution,
-                           (float(origin[0]), float(origin[1]), 0.0), self.master.frame_id)
+            raise NavigationError(
+                f"costmap resize: expected positive size and resolution, got {width} x {height} at {resolution} m/cell"
+            )
+        self.master = Grid(
+            np.full((height, width), self.default_value, np.uint8),
+            resolution,
+            (float(origin[0]), float(origin[1]), 0.0),
+            self.master.frame_id,
+        )
         for layer in self.layers:
             layer.match_size(self.master)
 
@@ -110,13 +121,18 @@ class LayeredCostmap:
         origin (as costmap_2d does). ``map_in_costmap``: pose of the map frame in the costmap frame."""
         statics = self.map_layers
         if not statics:
-            raise NavigationError("costmap has no static layer to take a map (set static_map: true or add "
-                                  "costmap_2d::StaticLayer to plugins)")
+            raise NavigationError(
+                "costmap has no static layer to take a map (set static_map: true or add "
+                "costmap_2d::StaticLayer to plugins)"
+            )
         if grid.origin[2] != 0.0:
             raise NavigationError(f"map origin yaw must be 0 for a costmap, got {grid.origin[2]}")
         if not self.rolling:
-            same = (self.master.data.shape == grid.data.shape and self.master.resolution == grid.resolution
-                    and self.master.origin[:2] == grid.origin[:2])
+            same = (
+                self.master.data.shape == grid.data.shape
+                and self.master.resolution == grid.resolution
+                and self.master.origin[:2] == grid.origin[:2]
+            )
             if not same:
                 self.resize(grid.width, grid.height, grid.resolution, grid.origin[:2])
         for layer in statics:

@@ -1,5 +1,4 @@
-"""costmap_2d::ObstacleLayer: marking and ray clearing from laser scans (see ``layer`` for the interface).
-"""
+"""costmap_2d::ObstacleLayer: marking and ray clearing from laser scans (see ``layer`` for the interface)."""
 
 from __future__ import annotations
 
@@ -50,8 +49,12 @@ class ObstacleLayer(Layer):
         settings = layer_params(ObstacleLayerParams, costmap, name)
         names = (settings.observation_sources or costmap.observation_sources).split()
         footprint = context.footprint if isinstance(context.footprint, Footprint) else None
-        return cls(settings, name=name, sources={n: costmap.sources[n] for n in names if n in costmap.sources},
-                   footprint=footprint)
+        return cls(
+            settings,
+            name=name,
+            sources={n: costmap.sources[n] for n in names if n in costmap.sources},
+            footprint=footprint,
+        )
 
     @property
     def default_value(self) -> int:
@@ -84,9 +87,14 @@ class ObstacleLayer(Layer):
     def _source_settings(self, source: str | None) -> ObservationSource:
         p = self.params
         if source is None:
-            return ObservationSource(marking=True, clearing=True, obstacle_range=p.obstacle_range,
-                                     raytrace_range=p.raytrace_range, obstacle_min_range=p.obstacle_min_range,
-                                     raytrace_min_range=p.raytrace_min_range)
+            return ObservationSource(
+                marking=True,
+                clearing=True,
+                obstacle_range=p.obstacle_range,
+                raytrace_range=p.raytrace_range,
+                obstacle_min_range=p.obstacle_min_range,
+                raytrace_min_range=p.raytrace_min_range,
+            )
         if source not in self.sources:
             known = ", ".join(self.sources) or "none"
             raise NavigationError(f"{self.name}: unknown observation source {source!r} (sources: {known})")
@@ -121,11 +129,29 @@ class ObstacleLayer(Layer):
         finite = np.isfinite(pts).all(axis=1)
         if src.clearing:
             cells = (pts[finite] - (ox, oy)) / res
-            clear_rays(g.data, (o[0] - ox) / res, (o[1] - oy) / res, np.ascontiguousarray(cells),
-                       src.raytrace_range / res, src.raytrace_min_range / res, np.uint8(COST_FREE))
+            clear_rays(
+                g.data,
+                (o[0] - ox) / res,
+                (o[1] - oy) / res,
+                np.ascontiguousarray(cells),
+                src.raytrace_range / res,
+                src.raytrace_min_range / res,
+                np.uint8(COST_FREE),
+            )
         if src.marking:
-            mark_returns(g.data, pts, ok, float(o[0]), float(o[1]), ox, oy, res, src.obstacle_min_range,
-                         src.obstacle_range, np.uint8(COST_LETHAL))
+            mark_returns(
+                g.data,
+                pts,
+                ok,
+                float(o[0]),
+                float(o[1]),
+                ox,
+                oy,
+                res,
+                src.obstacle_min_range,
+                src.obstacle_range,
+                np.uint8(COST_LETHAL),
+            )
 
     def clear_outside(self, xy: tuple[float, float], size: float) -> None:
         """Forget what lies outside the ``size`` x ``size`` m square centred on ``xy`` (m, costmap frame):

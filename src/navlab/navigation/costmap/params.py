@@ -35,11 +35,24 @@ ALIASES: dict[str, str] = {
     "inflate_around_unknown": "inflate_unknown",
 }
 # accepted and ignored (runtime or Nav2-only settings with no effect on the pure layers)
-IGNORED: frozenset[str] = frozenset({"use_sim_time", "filters", "plugin", "map_subscribe_transient_local",
-                                     "initial_transform_timeout", "clearable_layers", "footprint_topic",
-                                     # map_type: voxel's 3-D settings (a planar lidar fills one layer)
-                                     "origin_z", "z_resolution", "z_voxels", "unknown_threshold",
-                                     "mark_threshold", "publish_voxel_map"})
+IGNORED: frozenset[str] = frozenset(
+    {
+        "use_sim_time",
+        "filters",
+        "plugin",
+        "map_subscribe_transient_local",
+        "initial_transform_timeout",
+        "clearable_layers",
+        "footprint_topic",
+        # map_type: voxel's 3-D settings (a planar lidar fills one layer)
+        "origin_z",
+        "z_resolution",
+        "z_voxels",
+        "unknown_threshold",
+        "mark_threshold",
+        "publish_voxel_map",
+    }
+)
 
 
 @dataclass
@@ -162,8 +175,17 @@ class CostmapParams:
 
     def validate(self) -> None:
         """Raise ``NavigationError`` naming the first bad parameter, its value and what was expected."""
-        for name in ("update_frequency", "publish_frequency", "transform_tolerance", "width", "height",
-                     "obstacle_range", "raytrace_range", "inflation_radius", "cost_scaling_factor"):
+        for name in (
+            "update_frequency",
+            "publish_frequency",
+            "transform_tolerance",
+            "width",
+            "height",
+            "obstacle_range",
+            "raytrace_range",
+            "inflation_radius",
+            "cost_scaling_factor",
+        ):
             _non_negative("costmap", name, getattr(self, name))
         for name in ("width", "height", "resolution"):
             if getattr(self, name) <= 0:
@@ -172,8 +194,13 @@ class CostmapParams:
             _finite("costmap", name, getattr(self, name))
         for name in ("update_frequency", "publish_frequency"):
             check_ceiling(NavigationError, "costmap", name, getattr(self, name), "rate")
-        check_ceiling(NavigationError, "costmap", "width x height / resolution²",
-                      (self.width / self.resolution) * (self.height / self.resolution), "grid_cells")
+        check_ceiling(
+            NavigationError,
+            "costmap",
+            "width x height / resolution²",
+            (self.width / self.resolution) * (self.height / self.resolution),
+            "grid_cells",
+        )
         for name in ("robot_radius", "footprint_padding"):
             check_ceiling(NavigationError, "costmap", name, abs(getattr(self, name)), "footprint_m")
         if self.map_type not in ("costmap", "voxel"):
@@ -231,8 +258,10 @@ def _parse_plugins(raw: Any, namespaces: dict[str, Any]) -> list[PluginSpec]:
         elif isinstance(item, str):
             ns = namespaces.get(item)
             if not isinstance(ns, dict) or "plugin" not in ns:
-                raise NavigationError(f"costmap parameter plugins[{k}] {item!r}: Nav2 style needs "
-                                      f"'{item}: {{plugin: <type>}}' (or write {{name: {item}, type: <type>}})")
+                raise NavigationError(
+                    f"costmap parameter plugins[{k}] {item!r}: Nav2 style needs "
+                    f"'{item}: {{plugin: <type>}}' (or write {{name: {item}, type: <type>}})"
+                )
             out.append(PluginSpec(item, str(ns["plugin"])))
         else:
             raise NavigationError(f"costmap parameter plugins[{k}]: expected {{name, type}} or a name, got {item!r}")
@@ -277,20 +306,24 @@ def costmap_params(values: dict[str, Any] | None = None) -> CostmapParams:
     for plugin in params.plugins:
         ns = namespaces.get(plugin.name, {})
         listed = ns.get("observation_sources", "")
-        for src in (listed.split() if isinstance(listed, str) else list(map(str, listed))):
+        for src in listed.split() if isinstance(listed, str) else list(map(str, listed)):
             owner[src] = ns
     for src, ns in owner.items():
         raw = namespaces.get(src, ns.get(src))  # ROS 1: costmap level; Nav2: inside the layer's namespace
         if not isinstance(raw, dict):
-            raise NavigationError(f"costmap parameter observation_sources names {src!r} but there is no "
-                                  f"'{src}: {{topic: ..., data_type: LaserScan, ...}}'")
-        params.sources[src] = observation_source(raw, params, name=src,
-                                                 layer=canonical_params(ns, LAYER_SPEC, what=src))
+            raise NavigationError(
+                f"costmap parameter observation_sources names {src!r} but there is no "
+                f"'{src}: {{topic: ..., data_type: LaserScan, ...}}'"
+            )
+        params.sources[src] = observation_source(
+            raw, params, name=src, layer=canonical_params(ns, LAYER_SPEC, what=src)
+        )
     known = {p.name for p in params.plugins} | set(params.sources)
     for key, ns in namespaces.items():
         if key not in known:  # another plugin's section (ROS ignores it) or a misspelt layer: check_unknown_key
-            check_unknown_key(key, sorted(known) + [f.name for f in fields(CostmapParams)],
-                              what="costmap", error=NavigationError)
+            check_unknown_key(
+                key, sorted(known) + [f.name for f in fields(CostmapParams)], what="costmap", error=NavigationError
+            )
             continue
         params.namespaces[key] = ns
     return params
@@ -307,31 +340,41 @@ def _layer_keys(values: dict[str, Any]) -> dict[str, Any]:
 
 _RANGES = dict.fromkeys(("obstacle_range", "raytrace_range", "obstacle_min_range", "raytrace_min_range"), 0.0)
 LAYER_SPEC = ParamSpec("layer", NavigationError, aliases=ALIASES, ignored=IGNORED, prepare=_layer_keys)
-StaticLayerParams.PARAMS = replace(LAYER_SPEC, what="static_layer", at_least={"lethal_cost_threshold": 1},
-                                   at_most={"lethal_cost_threshold": 100})
-ObstacleLayerParams.PARAMS = replace(LAYER_SPEC, what="obstacle_layer", at_least=_RANGES,
-                                     choices={"combination_method": (0, 1)})  # overwrite, maximum
-InflationLayerParams.PARAMS = replace(LAYER_SPEC, what="inflation_layer",
-                                      at_least={"inflation_radius": 0.0, "cost_scaling_factor": 0.0})
+StaticLayerParams.PARAMS = replace(
+    LAYER_SPEC, what="static_layer", at_least={"lethal_cost_threshold": 1}, at_most={"lethal_cost_threshold": 100}
+)
+ObstacleLayerParams.PARAMS = replace(
+    LAYER_SPEC, what="obstacle_layer", at_least=_RANGES, choices={"combination_method": (0, 1)}
+)  # overwrite, maximum
+InflationLayerParams.PARAMS = replace(
+    LAYER_SPEC, what="inflation_layer", at_least={"inflation_radius": 0.0, "cost_scaling_factor": 0.0}
+)
 ObservationSource.PARAMS = replace(LAYER_SPEC, what="observation source", at_least=_RANGES)
 CostmapParams.PARAMS = ParamSpec("costmap", NavigationError)
 
 
-def observation_source(values: dict[str, Any], costmap: CostmapParams, *, name: str,
-                       layer: dict[str, Any] | None = None) -> ObservationSource:
+def observation_source(
+    values: dict[str, Any], costmap: CostmapParams, *, name: str, layer: dict[str, Any] | None = None
+) -> ObservationSource:
     """One observation source; its ranges default to its layer's (else the costmap's) ``obstacle_range``,
     ``raytrace_range`` and ``max_obstacle_height``."""
-    inherited = {key: (layer or {}).get(key, getattr(costmap, key))
-                 for key in ("obstacle_range", "raytrace_range", "max_obstacle_height")}
+    inherited = {
+        key: (layer or {}).get(key, getattr(costmap, key))
+        for key in ("obstacle_range", "raytrace_range", "max_obstacle_height")
+    }
     what = f"observation source {name}"
     own = canonical_params(values, LAYER_SPEC, what=what)
     src = read_params(ObservationSource, {**inherited, **own}, what=what)
     if src.min_obstacle_height > src.max_obstacle_height:
-        raise NavigationError(f"observation source {name} parameters min_obstacle_height {src.min_obstacle_height} > "
-                              f"max_obstacle_height {src.max_obstacle_height}: expected min <= max")
+        raise NavigationError(
+            f"observation source {name} parameters min_obstacle_height {src.min_obstacle_height} > "
+            f"max_obstacle_height {src.max_obstacle_height}: expected min <= max"
+        )
     if src.data_type not in ("LaserScan", "PointCloud", "PointCloud2"):
-        raise NavigationError(f"observation source {name} parameter data_type: expected LaserScan, PointCloud or "
-                              f"PointCloud2, got {src.data_type!r}")
+        raise NavigationError(
+            f"observation source {name} parameter data_type: expected LaserScan, PointCloud or "
+            f"PointCloud2, got {src.data_type!r}"
+        )
     return src
 
 

@@ -46,8 +46,10 @@ class RangeSensorLayerParams:
     def validate(self) -> None:
         """What spans two parameters (one error line)."""
         if not self.clear_threshold < self.mark_threshold:
-            raise NavigationError(f"range_sensor_layer parameters clear_threshold {self.clear_threshold} and "
-                                  f"mark_threshold {self.mark_threshold}: expected clear < mark")
+            raise NavigationError(
+                f"range_sensor_layer parameters clear_threshold {self.clear_threshold} and "
+                f"mark_threshold {self.mark_threshold}: expected clear < mark"
+            )
 
 
 def _topics_joined(values: dict[str, Any]) -> dict[str, Any]:
@@ -58,13 +60,20 @@ def _topics_joined(values: dict[str, Any]) -> dict[str, Any]:
 
 
 RangeSensorLayerParams.PARAMS = ParamSpec(
-    "range_sensor_layer", NavigationError, prepare=_topics_joined, ignored=frozenset({"enabled_topics"}),
-    at_least={"clear_threshold": 0.0, "no_readings_timeout": 0.0}, at_most={"mark_threshold": 1.0},
-    above={"inflate_cone": 0.0}, choices={"input_sensor_type": ("ALL", "VARIABLE", "FIXED")})
+    "range_sensor_layer",
+    NavigationError,
+    prepare=_topics_joined,
+    ignored=frozenset({"enabled_topics"}),
+    at_least={"clear_threshold": 0.0, "no_readings_timeout": 0.0},
+    at_most={"mark_threshold": 1.0},
+    above={"inflate_cone": 0.0},
+    choices={"input_sensor_type": ("ALL", "VARIABLE", "FIXED")},
+)
 
 
-def sensor_model(r: float, d: np.ndarray, theta: np.ndarray, half_angle: float, phi_v: float,
-                 resolution: float) -> np.ndarray:
+def sensor_model(
+    r: float, d: np.ndarray, theta: np.ndarray, half_angle: float, phi_v: float, resolution: float
+) -> np.ndarray:
     """range_sensor_layer's ``sensor_model``: probability of occupancy of cells at distance ``d`` (m) and angle
     ``theta`` (rad off the axis) given a reading ``r`` (m)."""
     gamma = np.where(np.abs(theta) > half_angle, 0.0, 1.0 - (theta / half_angle) ** 2)
@@ -84,8 +93,9 @@ def sensor_model(r: float, d: np.ndarray, theta: np.ndarray, half_angle: float, 
 class RangeSensorLayer(Layer):
     """``range_sensor_layer::RangeSensorLayer`` (see the module docstring)."""
 
-    def __init__(self, params: RangeSensorLayerParams | dict[str, Any] | None = None, *,
-                 name: str = "range_sensor_layer") -> None:
+    def __init__(
+        self, params: RangeSensorLayerParams | dict[str, Any] | None = None, *, name: str = "range_sensor_layer"
+    ) -> None:
         self.params: RangeSensorLayerParams = read_params(RangeSensorLayerParams, params, what=name)
         self.name = name
         self.enabled = self.params.enabled
@@ -103,8 +113,7 @@ class RangeSensorLayer(Layer):
         return [t if t.startswith("/") or not ns else f"{ns}/{t}" for t in self.params.topics.split()]
 
     def match_size(self, master: Grid) -> None:
-        self.prob = Grid(np.full(master.data.shape, 128, np.uint8), master.resolution, master.origin,
-                         master.frame_id)
+        self.prob = Grid(np.full(master.data.shape, 128, np.uint8), master.resolution, master.origin, master.frame_id)
 
     def update_origin(self, master: Grid) -> None:
         old = self.prob
@@ -116,11 +125,18 @@ class RangeSensorLayer(Layer):
         new = np.full((h, w), 128, np.uint8)
         i0, i1, j0, j1 = max(0, -di), min(w, w - di), max(0, -dj), min(h, h - dj)
         if i0 < i1 and j0 < j1:
-            new[j0:j1, i0:i1] = old.data[j0 + dj:j1 + dj, i0 + di:i1 + di]
+            new[j0:j1, i0:i1] = old.data[j0 + dj : j1 + dj, i0 + di : i1 + di]
         self.prob = Grid(new, master.resolution, master.origin, master.frame_id)
 
-    def add_range(self, sensor_pose: tuple[float, float, float], reading: float, *, field_of_view: float,
-                  min_range: float, max_range: float) -> None:
+    def add_range(
+        self,
+        sensor_pose: tuple[float, float, float],
+        reading: float,
+        *,
+        field_of_view: float,
+        min_range: float,
+        max_range: float,
+    ) -> None:
         """One ``sensor_msgs/Range`` reading (m) from a sensor at ``sensor_pose`` (x, y, yaw; costmap frame)."""
         if self.prob is None:
             raise NavigationError(f"{self.name}: no grid yet; call match_size(master) before add_range")
@@ -151,7 +167,7 @@ class RangeSensorLayer(Layer):
         s = sensor_model(r, d[cone], theta[cone], max(half, 1e-9), self.params.phi, g.resolution)
         if clear:
             s = np.minimum(s, 0.5)
-        block = g.data[j0:j1 + 1, i0:i1 + 1]
+        block = g.data[j0 : j1 + 1, i0 : i1 + 1]
         prior = block[cone] / 255.0
         occ, free = s * prior, (1 - s) * (1 - prior)
         block[cone] = np.clip(np.rint(255.0 * occ / np.maximum(occ + free, 1e-12)), 0, 255).astype(np.uint8)

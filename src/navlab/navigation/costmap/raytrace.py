@@ -13,8 +13,9 @@ import numpy as np
 
 
 @numba.njit(cache=True)
-def clear_rays(data: np.ndarray, x0: float, y0: float, ends: np.ndarray, max_cells: float, min_cells: float,
-               value: np.uint8) -> int:  # fmt: skip
+def clear_rays(
+    data: np.ndarray, x0: float, y0: float, ends: np.ndarray, max_cells: float, min_cells: float, value: np.uint8
+) -> int:
     """Set to ``value`` every cell on the Bresenham line from ``(x0, y0)`` to each of ``ends`` (N, 2), endpoint
     cell included (the caller marks afterwards, as costmap_2d does). Each ray is cut to ``max_cells`` cells of
     length; cells nearer than ``min_cells`` to the origin are left alone; a ray stops where it leaves the grid.

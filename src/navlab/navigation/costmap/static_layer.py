@@ -1,5 +1,4 @@
-"""costmap_2d::StaticLayer: costs from the occupancy map on ``/map`` (see ``layer`` for the interface).
-"""
+"""costmap_2d::StaticLayer: costs from the occupancy map on ``/map`` (see ``layer`` for the interface)."""
 
 from __future__ import annotations
 

@@ -49,14 +49,18 @@ class VoxelLayerParams(ObstacleLayerParams):
         """The obstacle layer's checks (ranges, combination_method) come from the spec; nothing spans fields."""
 
 
-VOXEL_KEYS = frozenset({"origin_z", "z_resolution", "z_voxels", "unknown_threshold", "mark_threshold",
-                        "publish_voxel_map"})
+VOXEL_KEYS = frozenset(
+    {"origin_z", "z_resolution", "z_voxels", "unknown_threshold", "mark_threshold", "publish_voxel_map"}
+)
 # the obstacle layer's spec, with the voxel keys read (the costmap level ignores them) and their ranges
 VoxelLayerParams.PARAMS = dataclasses.replace(
-    ObstacleLayerParams.PARAMS, what="voxel_layer", ignored=IGNORED - VOXEL_KEYS,
+    ObstacleLayerParams.PARAMS,
+    what="voxel_layer",
+    ignored=IGNORED - VOXEL_KEYS,
     above={**ObstacleLayerParams.PARAMS.above, "z_resolution": 0.0},
     at_least={**ObstacleLayerParams.PARAMS.at_least, "z_voxels": 1, "unknown_threshold": 0, "mark_threshold": 0},
-    at_most={**ObstacleLayerParams.PARAMS.at_most, "z_voxels": 16})  # costmap_2d's voxel grid: 16 per column
+    at_most={**ObstacleLayerParams.PARAMS.at_most, "z_voxels": 16},
+)  # costmap_2d's voxel grid: 16 per column
 
 
 @numba.njit(cache=True)
@@ -69,8 +73,16 @@ def _popcount(v: np.int64) -> int:
 
 
 @numba.njit(cache=True)
-def clear_voxel_rays(columns: np.ndarray, cost: np.ndarray, origin: np.ndarray, ends: np.ndarray, z_voxels: int,
-                     mark_threshold: int, unknown_threshold: int, free: np.uint8) -> None:
+def clear_voxel_rays(
+    columns: np.ndarray,
+    cost: np.ndarray,
+    origin: np.ndarray,
+    ends: np.ndarray,
+    z_voxels: int,
+    mark_threshold: int,
+    unknown_threshold: int,
+    free: np.uint8,
+) -> None:
     """Clear the voxels on each segment ``origin`` -> ``ends[k]`` (continuous voxel coordinates: x, y in cells,
     z in voxels) by a 3-D DDA; each cell touched becomes ``free`` in ``cost`` when its column allows it."""
     h, w = columns.shape
@@ -112,8 +124,15 @@ def clear_voxel_rays(columns: np.ndarray, cost: np.ndarray, origin: np.ndarray, 
 
 
 @numba.njit(cache=True)
-def ray_end_voxels(origin: np.ndarray, pts: np.ndarray, base: np.ndarray, scale: np.ndarray, dims: np.ndarray,
-                   max_range: float, seen: np.ndarray) -> None:
+def ray_end_voxels(
+    origin: np.ndarray,
+    pts: np.ndarray,
+    base: np.ndarray,
+    scale: np.ndarray,
+    dims: np.ndarray,
+    max_range: float,
+    seen: np.ndarray,
+) -> None:
     """Flag in ``seen`` (flat, k-major: (k h + j) w + i) the voxel where each ray ``origin`` -> ``pts[n]`` (m) ends:
     cut to ``max_range`` and to the grid (``base`` its lowest corner, ``scale`` the voxel size, ``dims`` w, h, d)."""
     w, h, nz = dims[0], dims[1], dims[2]
@@ -141,9 +160,20 @@ def ray_end_voxels(origin: np.ndarray, pts: np.ndarray, base: np.ndarray, scale:
 
 
 @numba.njit(cache=True)
-def mark_voxels(columns: np.ndarray, cost: np.ndarray, origin: np.ndarray, pts: np.ndarray, base: np.ndarray,
-                scale: np.ndarray, z_voxels: int, max_range: float, min_z: float, max_z: float,
-                mark_threshold: int, lethal: np.uint8) -> None:
+def mark_voxels(
+    columns: np.ndarray,
+    cost: np.ndarray,
+    origin: np.ndarray,
+    pts: np.ndarray,
+    base: np.ndarray,
+    scale: np.ndarray,
+    z_voxels: int,
+    max_range: float,
+    min_z: float,
+    max_z: float,
+    mark_threshold: int,
+    lethal: np.uint8,
+) -> None:
     """Mark the voxel of each point (m) nearer than ``max_range`` with its height in [``min_z``, ``max_z``]; its cell
     turns ``lethal`` when its column holds more than ``mark_threshold`` marked voxels."""
     h, w = columns.shape
@@ -167,8 +197,14 @@ def mark_voxels(columns: np.ndarray, cost: np.ndarray, origin: np.ndarray, pts: 
 class VoxelLayer(Layer):
     """``costmap_2d::VoxelLayer`` (see the module docstring). ``sources``: its observation sources by name."""
 
-    def __init__(self, params: VoxelLayerParams | dict[str, Any] | None = None, *, name: str = "obstacle_layer",
-                 sources: dict[str, ObservationSource] | None = None, footprint: Footprint | None = None) -> None:
+    def __init__(
+        self,
+        params: VoxelLayerParams | dict[str, Any] | None = None,
+        *,
+        name: str = "obstacle_layer",
+        sources: dict[str, ObservationSource] | None = None,
+        footprint: Footprint | None = None,
+    ) -> None:
         self.params: VoxelLayerParams = read_params(VoxelLayerParams, params, what=name)
         self.name = name
         self.enabled = self.params.enabled
@@ -187,8 +223,12 @@ class VoxelLayer(Layer):
         settings = layer_params(VoxelLayerParams, costmap, name)
         names = (settings.observation_sources or costmap.observation_sources).split()
         footprint = context.footprint if isinstance(context.footprint, Footprint) else None
-        return cls(settings, name=name, sources={n: costmap.sources[n] for n in names if n in costmap.sources},
-                   footprint=footprint)
+        return cls(
+            settings,
+            name=name,
+            sources={n: costmap.sources[n] for n in names if n in costmap.sources},
+            footprint=footprint,
+        )
 
     @property
     def default_value(self) -> int:
@@ -204,8 +244,9 @@ class VoxelLayer(Layer):
         self.footprint = footprint
 
     def match_size(self, master: Grid) -> None:
-        self.grid = Grid(np.full(master.data.shape, self.default_value, np.uint8), master.resolution, master.origin,
-                         master.frame_id)
+        self.grid = Grid(
+            np.full(master.data.shape, self.default_value, np.uint8), master.resolution, master.origin, master.frame_id
+        )
         self.columns = np.full(master.data.shape, UNKNOWN_COLUMN, np.uint32)
 
     def update_origin(self, master: Grid) -> None:
@@ -219,8 +260,8 @@ class VoxelLayer(Layer):
         cols = np.full((h, w), UNKNOWN_COLUMN, np.uint32)
         i0, i1, j0, j1 = max(0, -di), min(w, w - di), max(0, -dj), min(h, h - dj)
         if i0 < i1 and j0 < j1:
-            cost[j0:j1, i0:i1] = old.data[j0 + dj:j1 + dj, i0 + di:i1 + di]
-            cols[j0:j1, i0:i1] = self.columns[j0 + dj:j1 + dj, i0 + di:i1 + di]
+            cost[j0:j1, i0:i1] = old.data[j0 + dj : j1 + dj, i0 + di : i1 + di]
+            cols[j0:j1, i0:i1] = self.columns[j0 + dj : j1 + dj, i0 + di : i1 + di]
         self.grid = Grid(cost, master.resolution, master.origin, master.frame_id)
         self.columns = cols
 
@@ -243,20 +284,46 @@ class VoxelLayer(Layer):
             ray_end_voxels(o, pts, base, scale, np.array([w, h, p.z_voxels]), src.raytrace_range, seen)
             key = np.flatnonzero(seen)
             vox = np.stack([key % w, (key // w) % h, key // (w * h)], axis=1)
-            clear_voxel_rays(self.columns, g.data, (o - base) / scale, vox + 0.5, p.z_voxels, p.mark_threshold,
-                             p.unknown_threshold, np.uint8(COST_FREE))
+            clear_voxel_rays(
+                self.columns,
+                g.data,
+                (o - base) / scale,
+                vox + 0.5,
+                p.z_voxels,
+                p.mark_threshold,
+                p.unknown_threshold,
+                np.uint8(COST_FREE),
+            )
         if src.marking and len(pts):
-            mark_voxels(self.columns, g.data, o, pts, base, scale, p.z_voxels, src.obstacle_range,
-                        src.min_obstacle_height, src.max_obstacle_height, p.mark_threshold, np.uint8(COST_LETHAL))
+            mark_voxels(
+                self.columns,
+                g.data,
+                o,
+                pts,
+                base,
+                scale,
+                p.z_voxels,
+                src.obstacle_range,
+                src.min_obstacle_height,
+                src.max_obstacle_height,
+                p.mark_threshold,
+                np.uint8(COST_LETHAL),
+            )
 
     def _source(self, source: str | None) -> ObservationSource:
         p = self.params
         if source is None:
-            return ObservationSource(marking=True, clearing=True, obstacle_range=p.obstacle_range,
-                                     raytrace_range=p.raytrace_range, max_obstacle_height=p.max_obstacle_height)
+            return ObservationSource(
+                marking=True,
+                clearing=True,
+                obstacle_range=p.obstacle_range,
+                raytrace_range=p.raytrace_range,
+                max_obstacle_height=p.max_obstacle_height,
+            )
         if source not in self.sources:
-            raise NavigationError(f"{self.name}: unknown observation source {source!r} "
-                                  f"(sources: {', '.join(self.sources) or 'none'})")
+            raise NavigationError(
+                f"{self.name}: unknown observation source {source!r} (sources: {', '.join(self.sources) or 'none'})"
+            )
         return self.sources[source]
 
     def update_bounds(self, robot_pose: tuple[float, float, float]) -> None:
@@ -302,10 +369,14 @@ class VoxelLayer(Layer):
             return None
         g, p = self.grid, self.params
         return msgs.VoxelGrid(
-            header=msgs.header(stamp_ns, g.frame_id), data=self.columns.reshape(-1).astype(np.uint32),
+            header=msgs.header(stamp_ns, g.frame_id),
+            data=self.columns.reshape(-1).astype(np.uint32),
             origin=msgs.Point32(x=float(g.origin[0]), y=float(g.origin[1]), z=float(p.origin_z)),
             resolutions=msgs.Vector3(x=g.resolution, y=g.resolution, z=p.z_resolution),
-            size_x=g.width, size_y=g.height, size_z=p.z_voxels)
+            size_x=g.width,
+            size_y=g.height,
+            size_z=p.z_voxels,
+        )
 
     def marked_voxels(self) -> np.ndarray:
         """Centres (N, 3) in the costmap frame (m) of the marked voxels (what ``publish_voxel_map`` shows)."""
@@ -314,5 +385,11 @@ class VoxelLayer(Layer):
         g, p = self.grid, self.params
         marked = (self.columns >> 16)[..., None] & (np.uint32(1) << np.arange(p.z_voxels, dtype=np.uint32))
         j, i, k = np.nonzero(marked)
-        return np.stack([g.origin[0] + (i + 0.5) * g.resolution, g.origin[1] + (j + 0.5) * g.resolution,
-                         p.origin_z + (k + 0.5) * p.z_resolution], axis=1)
+        return np.stack(
+            [
+                g.origin[0] + (i + 0.5) * g.resolution,
+                g.origin[1] + (j + 0.5) * g.resolution,
+                p.origin_z + (k + 0.5) * p.z_resolution,
+            ],
+            axis=1,
+        )

@@ -21,5 +21,13 @@ def make_planner(name: str, params: dict[str, Any] | None = None) -> Any:
     return make_plugin("global_planner", name, params, param="base_global_planner")
 
 
-__all__ = ["GlobalPlanner", "GlobalPlannerParams", "NavfnParams", "NavfnPlanner", "ThetaStarParams",
-           "ThetaStarPlanner", "make_planner", "path_length"]
+__all__ = [
+    "GlobalPlanner",
+    "GlobalPlannerParams",
+    "NavfnParams",
+    "NavfnPlanner",
+    "ThetaStarParams",
+    "ThetaStarPlanner",
+    "make_planner",
+    "path_length",
+]

@@ -20,8 +20,9 @@ def check_costmap(costmap: Grid, who: str) -> np.ndarray:
     """The costmap's uint8 cost array; refuses other dtypes, empty grids and a rotated origin."""
     data = np.asarray(costmap.data)
     if data.dtype != np.uint8 or data.ndim != 2 or data.size == 0:
-        raise NavigationError(f"{who}: costmap must be a 2-D uint8 grid of costmap_2d costs, got {data.dtype} "
-                              f"{data.shape}")
+        raise NavigationError(
+            f"{who}: costmap must be a 2-D uint8 grid of costmap_2d costs, got {data.dtype} {data.shape}"
+        )
     if costmap.origin[2] != 0.0:
         raise NavigationError(f"{who}: costmap origin yaw must be 0, got {costmap.origin[2]}")
     return data
@@ -38,8 +39,10 @@ def pose_cell(costmap: Grid, pose: Any, what: str, who: str) -> tuple[int, int, 
     ij = costmap.world_to_cell(np.array([[x, y]]))
     if not costmap.in_bounds(ij)[0]:
         xmin, ymin, xmax, ymax = costmap.bounds()
-        raise NavigationError(f"{who}: {what} ({x:.3f}, {y:.3f}) is outside the costmap "
-                              f"[{xmin:.2f}, {xmax:.2f}] x [{ymin:.2f}, {ymax:.2f}] m ({costmap.frame_id} frame)")
+        raise NavigationError(
+            f"{who}: {what} ({x:.3f}, {y:.3f}) is outside the costmap "
+            f"[{xmin:.2f}, {xmax:.2f}] x [{ymin:.2f}, {ymax:.2f}] m ({costmap.frame_id} frame)"
+        )
     res = costmap.resolution
     u = (x - costmap.origin[0]) / res - 0.5
     v = (y - costmap.origin[1]) / res - 0.5
@@ -50,8 +53,10 @@ def check_start(data: np.ndarray, i: int, j: int, start: Any, who: str) -> None:
     """A start on a lethal cell is an error (the robot's centre cannot be in an obstacle); an inscribed start
     is fine (the planner clears the robot's cell, as navfn's ``clearRobotCell`` does)."""
     if data[j, i] == COST_LETHAL:
-        raise NavigationError(f"{who}: start ({float(start[0]):.3f}, {float(start[1]):.3f}) is in an obstacle "
-                              f"(cost {COST_LETHAL} at cell ({i}, {j})); is the robot localized?")
+        raise NavigationError(
+            f"{who}: start ({float(start[0]):.3f}, {float(start[1]):.3f}) is in an obstacle "
+            f"(cost {COST_LETHAL} at cell ({i}, {j})); is the robot localized?"
+        )
 
 
 def path_length(path: np.ndarray | None) -> float:

@@ -62,12 +62,16 @@ def _step(x: float, y: float, th: float, kind: str, length: float, radius: float
         return x + length * math.cos(th), y + length * math.sin(th), th
     sign = 1.0 if kind == "L" else -1.0
     dth = sign * length / radius
-    return (x + sign * radius * (math.sin(th + dth) - math.sin(th)),
-            y - sign * radius * (math.cos(th + dth) - math.cos(th)), th + dth)  # fmt: skip
+    return (
+        x + sign * radius * (math.sin(th + dth) - math.sin(th)),
+        y - sign * radius * (math.cos(th + dth) - math.cos(th)),
+        th + dth,
+    )
 
 
-def sample(start: tuple[float, float, float], word: str, lengths: tuple[float, float, float], radius: float,
-           step: float) -> np.ndarray:
+def sample(
+    start: tuple[float, float, float], word: str, lengths: tuple[float, float, float], radius: float, step: float
+) -> np.ndarray:
     """Poses (N, 3) every ``step`` m along a Dubins path (``lengths`` in m), the start excluded, the end included."""
     out = []
     x, y, th = start
@@ -80,8 +84,9 @@ def sample(start: tuple[float, float, float], word: str, lengths: tuple[float, f
     return np.array(out, dtype=np.float64).reshape(-1, 3)
 
 
-def shortest(start: tuple[float, float, float], goal: tuple[float, float, float], radius: float
-             ) -> tuple[str, tuple[float, float, float]] | None:  # fmt: skip
+def shortest(
+    start: tuple[float, float, float], goal: tuple[float, float, float], radius: float
+) -> tuple[str, tuple[float, float, float]] | None:
     """The shortest Dubins path from ``start`` to ``goal`` with turning radius ``radius`` m: (word, segment
     lengths in m), or None if no word checks out."""
     dx, dy = goal[0] - start[0], goal[1] - start[1]
@@ -95,8 +100,10 @@ def shortest(start: tuple[float, float, float], goal: tuple[float, float, float]
         if len(end) == 0:
             end = np.array([start])
         ex, ey, eth = end[-1]
-        if math.hypot(ex - goal[0], ey - goal[1]) < 1e-3 * max(radius, 1.0) and abs(
-                math.remainder(eth - goal[2], TWO_PI)) < 1e-3:  # fmt: skip
+        if (
+            math.hypot(ex - goal[0], ey - goal[1]) < 1e-3 * max(radius, 1.0)
+            and abs(math.remainder(eth - goal[2], TWO_PI)) < 1e-3
+        ):
             best = (sum(lengths), word, lengths)
             break
     return None if best is None else (best[1], best[2])

@@ -82,8 +82,9 @@ class GlobalPlannerParams(NavfnParams):
     def validate(self, what: str = "global_planner") -> None:
         super().validate(what)
         if self.use_grid_path:
-            raise NavigationError(f"{what} parameter use_grid_path: only false (gradient-descent paths) is "
-                                  "supported, got true")
+            raise NavigationError(
+                f"{what} parameter use_grid_path: only false (gradient-descent paths) is supported, got true"
+            )
 
 
 def _use_astar(values: dict[str, Any]) -> dict[str, Any]:
@@ -97,9 +98,14 @@ def _use_astar(values: dict[str, Any]) -> dict[str, Any]:
     return values
 
 
-NavfnParams.PARAMS = ParamSpec("navfn", NavigationError, aliases={"tolerance": "default_tolerance"},
-                               prepare=_use_astar, above={"neutral_cost": 0.0},
-                               at_least={"default_tolerance": 0.0, "cost_factor": 0.0})
+NavfnParams.PARAMS = ParamSpec(
+    "navfn",
+    NavigationError,
+    aliases={"tolerance": "default_tolerance"},
+    prepare=_use_astar,
+    above={"neutral_cost": 0.0},
+    at_least={"default_tolerance": 0.0, "cost_factor": 0.0},
+)
 GlobalPlannerParams.PARAMS = replace(NavfnParams.PARAMS, what="global_planner")
 
 
@@ -107,8 +113,9 @@ GlobalPlannerParams.PARAMS = replace(NavfnParams.PARAMS, what="global_planner")
 
 
 @numba.njit(cache=True)
-def _propagate(cost: np.ndarray, start: int, goal: int, astar: bool, h_scale: float, stop_at_goal: bool,
-               margin: float) -> tuple[np.ndarray, int]:  # fmt: skip
+def _propagate(
+    cost: np.ndarray, start: int, goal: int, astar: bool, h_scale: float, stop_at_goal: bool, margin: float
+) -> tuple[np.ndarray, int]:
     """Fast marching from ``start`` over ``cost`` (H, W) per cell (inf = obstacle). Returns the potential
     (exact where settled, an upper bound on the front, inf beyond) and the number of settled cells. With
     ``stop_at_goal`` it stops once the queue's keys pass the goal's by ``margin``, so the goal sits inside
@@ -335,8 +342,9 @@ class NavfnPlanner(BuiltFromParams):
             cost[unknown] = ceiling
         return cost
 
-    def make_plan(self, costmap: Grid, start: tuple[float, float, float], goal: tuple[float, float, float]
-                  ) -> np.ndarray | None:  # fmt: skip
+    def make_plan(
+        self, costmap: Grid, start: tuple[float, float, float], goal: tuple[float, float, float]
+    ) -> np.ndarray | None:
         """A path (N, 2) in metres from ``start`` to ``goal`` (both included) in the costmap's frame, or None
         when the goal cannot be reached (``last_failure`` says why). A start outside the map or in a lethal
         cell, and a goal outside the map, raise ``NavigationError``."""
@@ -354,8 +362,15 @@ class NavfnPlanner(BuiltFromParams):
         # A*'s heuristic: the cheapest cell cost per cell of distance, over sqrt(2) because one quadratic update
         # can raise the potential by as little as cost / sqrt(2) per step (keeps the heuristic consistent)
         h_scale = float(self.params.neutral_cost) / math.sqrt(2.0)
-        pot, settled = _propagate(cost, sj * w + si, gj * w + gi, not self.params.use_dijkstra,
-                                  h_scale, goal_ok, 4.0 * self.params.neutral_cost)
+        pot, settled = _propagate(
+            cost,
+            sj * w + si,
+            gj * w + gi,
+            not self.params.use_dijkstra,
+            h_scale,
+            goal_ok,
+            4.0 * self.params.neutral_cost,
+        )
         self.potential = pot
         self.stats = {"cells": int(settled)}
         end_xy = (float(goal[0]), float(goal[1]))
@@ -381,8 +396,9 @@ class NavfnPlanner(BuiltFromParams):
         return dedupe(path)
 
 
-def _nearest_reached(pot: np.ndarray, costmap: Grid, goal_xy: tuple[float, float], tol: float
-                     ) -> tuple[int, int] | None:  # fmt: skip
+def _nearest_reached(
+    pot: np.ndarray, costmap: Grid, goal_xy: tuple[float, float], tol: float
+) -> tuple[int, int] | None:
     """The reached cell (i, j) nearest to ``goal_xy`` within ``tol`` m (centre distance), or None."""
     if tol <= 0:
         return None

@@ -77,16 +77,20 @@ class SmacHybridParams:
     def validate(self) -> None:
         """Refuse values the planner cannot run with (one-line errors naming the key)."""
         if self.motion_model_for_search not in ("DUBIN", "REEDS_SHEPP"):
-            raise NavigationError(f"{WHAT} parameter motion_model_for_search: expected DUBIN or REEDS_SHEPP, got "
-                                  f"{self.motion_model_for_search!r}")  # fmt: skip
+            raise NavigationError(
+                f"{WHAT} parameter motion_model_for_search: expected DUBIN or REEDS_SHEPP, got "
+                f"{self.motion_model_for_search!r}"
+            )
         for key in ("minimum_turning_radius", "analytic_expansion_ratio", "non_straight_penalty", "reverse_penalty"):
             v = getattr(self, key)
             if not (math.isfinite(v) and v > 0):
                 raise NavigationError(f"{WHAT} parameter {key}: expected > 0, got {v}")
         if self.angle_quantization_bins < 4 or self.max_iterations < 1 or self.downsampling_factor < 1:
-            raise NavigationError(f"{WHAT} parameters angle_quantization_bins >= 4, max_iterations >= 1 and "
-                                  "downsampling_factor >= 1 expected, got "
-                                  f"{self.angle_quantization_bins}, {self.max_iterations}, {self.downsampling_factor}")
+            raise NavigationError(
+                f"{WHAT} parameters angle_quantization_bins >= 4, max_iterations >= 1 and "
+                "downsampling_factor >= 1 expected, got "
+                f"{self.angle_quantization_bins}, {self.max_iterations}, {self.downsampling_factor}"
+            )
         for key in ("tolerance", "cost_penalty", "change_penalty", "analytic_expansion_max_length"):
             v = getattr(self, key)
             if not (math.isfinite(v) and v >= 0):
@@ -160,8 +164,11 @@ class _Search:
         k = max(1, math.ceil(2 * math.asin(s) / bin_size - 1e-9))
         a = k * bin_size
         arc = r * a
-        prims = [(arc, 0.0, 0, arc, False, 0), (r * math.sin(a), r * (1 - math.cos(a)), k, arc, False, 1),
-                 (r * math.sin(a), -r * (1 - math.cos(a)), -k, arc, False, -1)]  # fmt: skip
+        prims = [
+            (arc, 0.0, 0, arc, False, 0),
+            (r * math.sin(a), r * (1 - math.cos(a)), k, arc, False, 1),
+            (r * math.sin(a), -r * (1 - math.cos(a)), -k, arc, False, -1),
+        ]
         if p.motion_model_for_search == "REEDS_SHEPP":
             prims += [(-dx, dy, -db, length, True, -t) for dx, dy, db, length, _, t in prims]
         return prims
@@ -222,8 +229,9 @@ class SmacPlannerHybrid:
         """The plugin contract's constructor: ``context.footprint`` (its polygon, if any)."""
         return cls(params, footprint=getattr(getattr(context, "footprint", None), "polygon", None))
 
-    def make_plan(self, costmap: Grid, start: tuple[float, float, float], goal: tuple[float, float, float]
-                  ) -> np.ndarray | None:  # fmt: skip
+    def make_plan(
+        self, costmap: Grid, start: tuple[float, float, float], goal: tuple[float, float, float]
+    ) -> np.ndarray | None:
         """A path (N, 3) of poses from ``start`` to ``goal`` in the costmap's frame whose turns respect
         ``minimum_turning_radius``, or None (``last_failure`` says why). A start or goal outside the map raises
         ``NavigationError``."""
@@ -237,8 +245,10 @@ class SmacPlannerHybrid:
         if not s.free(*goal):
             near = self._nearest_free_goal(s, goal)
             if near is None:
-                self.last_failure = (f"goal ({goal[0]:.3f}, {goal[1]:.3f}) is in collision for the footprint and no "
-                                     f"free pose within tolerance {self.params.tolerance} m")  # fmt: skip
+                self.last_failure = (
+                    f"goal ({goal[0]:.3f}, {goal[1]:.3f}) is in collision for the footprint and no "
+                    f"free pose within tolerance {self.params.tolerance} m"
+                )
                 return None
             goal = near
             gi, gj = s.cell(goal[0], goal[1])
@@ -265,8 +275,9 @@ class SmacPlannerHybrid:
                     best = (d, (x, y, goal[2]))
         return None if best is None else best[1]
 
-    def _search(self, s: _Search, start: tuple[float, float, float], goal: tuple[float, float, float],
-                h2d: np.ndarray) -> np.ndarray | None:
+    def _search(
+        self, s: _Search, start: tuple[float, float, float], goal: tuple[float, float, float], h2d: np.ndarray
+    ) -> np.ndarray | None:
         p = self.params
         gi, gj = s.cell(goal[0], goal[1])
         gbin = s.bin_of(goal[2])
@@ -304,7 +315,8 @@ class SmacPlannerHybrid:
                 best = (h, n)
                 approach = expansions if approach is None else approach
             if expansions > p.max_iterations or (
-                    approach is not None and expansions - approach > p.max_on_approach_iterations):  # fmt: skip
+                approach is not None and expansions - approach > p.max_on_approach_iterations
+            ):
                 break
             countdown -= 1
             if countdown <= 0:
@@ -323,8 +335,11 @@ class SmacPlannerHybrid:
                 if nkey in closed:
                     continue
                 i, j = nkey[0], nkey[1]
-                step = length * (1.0 + p.cost_penalty * min(s.cell_cost(i, j), COST_INSCRIBED - 1) / 252.0
-                                 if s.cell_cost(i, j) != COST_UNKNOWN else 1.0)
+                step = length * (
+                    1.0 + p.cost_penalty * min(s.cell_cost(i, j), COST_INSCRIBED - 1) / 252.0
+                    if s.cell_cost(i, j) != COST_UNKNOWN
+                    else 1.0
+                )
                 if sign != 0:
                     step *= p.non_straight_penalty
                     if turn[n] != 0 and turn[n] != sign:
@@ -346,8 +361,9 @@ class SmacPlannerHybrid:
         self.last_failure = f"no kinematically feasible path found in {expansions} expansions"
         return None
 
-    def _analytic(self, s: _Search, pose: tuple[float, float, float], goal: tuple[float, float, float]
-                  ) -> np.ndarray | None:  # fmt: skip
+    def _analytic(
+        self, s: _Search, pose: tuple[float, float, float], goal: tuple[float, float, float]
+    ) -> np.ndarray | None:
         """A collision-free Dubins tail (N, 3) from ``pose`` to ``goal`` (pose excluded), or None."""
         r = self.params.minimum_turning_radius
         best = dubins.shortest(pose, goal, r)
@@ -359,8 +375,9 @@ class SmacPlannerHybrid:
         return None
 
     @staticmethod
-    def _path(poses: list[tuple[float, float, float]], parent: list[int], n: int,
-              goal: tuple[float, float, float] | None) -> np.ndarray:
+    def _path(
+        poses: list[tuple[float, float, float]], parent: list[int], n: int, goal: tuple[float, float, float] | None
+    ) -> np.ndarray:
         out = []
         while n >= 0:
             out.append(poses[n])

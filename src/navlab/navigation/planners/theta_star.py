@@ -49,14 +49,19 @@ class ThetaStarParams:
     allow_unknown: bool = True
     use_final_approach_orientation: bool = False
     terminal_checking_interval: int = 5000
-    PARAMS: ClassVar[ParamSpec] = ParamSpec("theta_star", NavigationError, above={"w_euc_cost": 0.0},
-                                            at_least={"w_traversal_cost": 0.0, "w_heuristic_cost": 0.0})
+    PARAMS: ClassVar[ParamSpec] = ParamSpec(
+        "theta_star",
+        NavigationError,
+        above={"w_euc_cost": 0.0},
+        at_least={"w_traversal_cost": 0.0, "w_heuristic_cost": 0.0},
+    )
 
     def validate(self) -> None:
         """Refuse a bad value naming the key."""
         if self.how_many_corners not in (4, 8):
-            raise NavigationError("theta_star parameter how_many_corners: expected 4 or 8, "
-                                  f"got {self.how_many_corners}")
+            raise NavigationError(
+                f"theta_star parameter how_many_corners: expected 4 or 8, got {self.how_many_corners}"
+            )
 
 
 @numba.njit(cache=True)
@@ -100,8 +105,16 @@ def _line(blocked: np.ndarray, trav: np.ndarray, a: int, b: int, w: int) -> floa
 
 
 @numba.njit(cache=True)
-def _theta_star(blocked: np.ndarray, trav: np.ndarray, start: int, goal: int, corners: int, w_euc: float,
-                w_trav: float, w_heur: float) -> tuple[np.ndarray, int]:  # fmt: skip
+def _theta_star(
+    blocked: np.ndarray,
+    trav: np.ndarray,
+    start: int,
+    goal: int,
+    corners: int,
+    w_euc: float,
+    w_trav: float,
+    w_heur: float,
+) -> tuple[np.ndarray, int]:
     """Parents (flat, -1 unreached) of the Theta* search from ``start`` and the number of expanded cells."""
     h, w = blocked.shape
     n = h * w
@@ -179,8 +192,9 @@ class ThetaStarPlanner(BuiltFromParams):
         c = np.where(unknown, MAX_NON_OBSTACLE, np.minimum(data, MAX_NON_OBSTACLE)).astype(np.float64)
         return blocked, (c / MAX_NON_OBSTACLE) ** 2
 
-    def make_plan(self, costmap: Grid, start: tuple[float, float, float], goal: tuple[float, float, float]
-                  ) -> np.ndarray | None:  # fmt: skip
+    def make_plan(
+        self, costmap: Grid, start: tuple[float, float, float], goal: tuple[float, float, float]
+    ) -> np.ndarray | None:
         """A path (N, 2) in metres from ``start`` to ``goal`` (both included), points at most one cell apart, or
         None when the goal is in an obstacle or cut off (``last_failure`` says which). A start outside the map
         or in a lethal cell, and a goal outside the map, raise ``NavigationError``."""
@@ -200,8 +214,16 @@ class ThetaStarPlanner(BuiltFromParams):
             return None
         w = data.shape[1]
         p = self.params
-        parent, expanded = _theta_star(blocked, np.ascontiguousarray(trav), sj * w + si, gj * w + gi,
-                                       p.how_many_corners, p.w_euc_cost, p.w_traversal_cost, p.w_heuristic_cost)
+        parent, expanded = _theta_star(
+            blocked,
+            np.ascontiguousarray(trav),
+            sj * w + si,
+            gj * w + gi,
+            p.how_many_corners,
+            p.w_euc_cost,
+            p.w_traversal_cost,
+            p.w_heuristic_cost,
+        )
         if parent[gj * w + gi] < 0:
             self.last_failure = f"goal ({gxy[0]:.3f}, {gxy[1]:.3f}) is cut off from the start"
             self.stats = {"cells": int(expanded), "corners": 0}
