@@ -23,7 +23,6 @@ costmap's frame. This module is a leaf: it imports nothing of navlab but errors 
 
 from __future__ import annotations
 
-import difflib
 import functools
 import importlib
 import warnings
@@ -34,7 +33,7 @@ from typing import TYPE_CHECKING, Any, Protocol, Self, runtime_checkable
 
 import numpy as np
 
-from navlab.errors import NavlabError
+from navlab.errors import NavlabError, did_you_mean
 
 if TYPE_CHECKING:
     from navlab.grid import Grid, GridMap
@@ -405,8 +404,7 @@ def load_plugin(kind: str, name: str, *, param: str | None = None) -> Any:
     ep = table.get(resolve_name(kind, name))
     if ep is None:
         known = sorted(table) + sorted(ALIASES.get(kind, {}))
-        close = difflib.get_close_matches(name, known, n=1, cutoff=0.5)
-        hint = f"did you mean {close[0]!r}? " if close else ""
+        hint = did_you_mean(name, known, template="did you mean {!r}? ", cutoff=0.5)
         what = f"{param} {name!r}" if param else f"{kind} {name!r}"
         raise PluginError(f"unknown {what} ({hint}known: {', '.join(known)})")
     try:

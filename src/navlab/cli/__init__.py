@@ -8,7 +8,6 @@ them and turns ``NavlabError`` into a one-line message.
 from __future__ import annotations
 
 import argparse
-import difflib
 import importlib
 import logging
 import re
@@ -16,7 +15,7 @@ import sys
 from typing import NoReturn
 
 from navlab.cli.options import check_named_inputs
-from navlab.errors import NavlabError
+from navlab.errors import NavlabError, did_you_mean
 
 # Modules that define ``register(subparsers: argparse._SubParsersAction) -> None``, one per verb group.
 COMMAND_MODULES = (  # in the order of the paper's pipeline, then the ROS-style tools
@@ -44,9 +43,8 @@ class _Parser(argparse.ArgumentParser):
         wrong = re.match(r"argument (\S+): invalid choice: '([^']*)' \(choose from (.*)\)$", message)
         if wrong:  # a mistyped verb or choice: the closest one, as git does
             choices = re.findall(r"'([^']*)'", wrong.group(3))
-            close = difflib.get_close_matches(wrong.group(2), choices, n=1, cutoff=0.5)
             what = "verb" if wrong.group(1) == "VERB" else wrong.group(1)
-            hint = f"; did you mean {close[0]!r}?" if close else f" (one of: {', '.join(choices)})"
+            hint = did_you_mean(wrong.group(2), choices, cutoff=0.5) or f" (one of: {', '.join(choices)})"
             message = f"unknown {what} {wrong.group(2)!r}{hint}"
         self.exit(2, f"navlab: error: {verb + ': ' if verb else ''}{message} (see `{self.prog} --help`)\n")
 
