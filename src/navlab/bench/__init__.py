@@ -3,9 +3,9 @@ the verb in :mod:`navlab.cli.bench`, prints them as JSON).
 
 Each benchmark is a function ``run(args) -> dict`` registered in ``BENCHES`` by import path.
 ``navlab bench all --json`` runs them all (but ``soak``) and adds
-``summary``: the headline figures (``nav_rtf``, ``sim_rtf``, ``nav_sim_ratio``, ``start_s``,
-``slam_peak_rss_mb``, ...). ``navlab bench compare OLD.json NEW.json`` prints every figure the two share
-with its ratio new / old.
+``summary``: the headline figures (``nav_rtf``, ``nav_rtf_cpu``, ``sim_rtf``, ``nav_sim_ratio`` = nav_rtf_cpu /
+sim_rtf, both per CPU second, ``start_s``, ``slam_peak_rss_mb``, ...). ``navlab bench compare OLD.json
+NEW.json`` prints every figure the two share with its ratio new / old.
 """
 
 from __future__ import annotations
@@ -40,6 +40,7 @@ BENCHES: dict[str, str] = {
 # summary key -> (bench, key) of ``navlab bench all``
 SUMMARY = {
     "nav_rtf": ("nav", "rtf"),
+    "nav_rtf_cpu": ("nav", "rtf_cpu"),
     "sim_rtf": ("sim", "rtf"),
     "start_s": ("startup", "sim_start_cpu_s"),
     "help_s": ("startup", "help_cpu_s"),
