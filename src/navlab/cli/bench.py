@@ -95,7 +95,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--controller",
         default=None,
         help="clutter: local planner to drive with (trajectory, dwa, mppi, rpp or a ROS plugin name; "
-        "default mppi for jackal and mybot, else the robot's own files')",
+        "default mppi for jackal and mybot, else the robot's own files)",
     )
     p.add_argument("--worlds", type=int, default=50, help="clutter: how many generated worlds (default 50)")
     p.add_argument(
