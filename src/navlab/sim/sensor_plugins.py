@@ -74,6 +74,12 @@ class SensorNode(Node, Generic[C]):
         """Whether any of ``pubs`` has a subscriber, or a recorder/viewer listens."""
         return self.executor.has_listeners or any(p.get_subscription_count() for p in pubs)
 
+    def cloud_msg(self, stamp_ns: int, pts: np.ndarray, extra: dict[str, Any], height: int, width: int) -> Any:
+        """``sensor_msgs/PointCloud2`` in the sensor's frame: float32 x y z at offsets 0 4 8 (``pts``, n x 3), then
+        the ``extra`` fields (name: (offset, datatype, values), as :func:`navlab.io.pointcloud.pack_cloud`)."""
+        fields = {"x": (0, FLOAT32, pts[:, 0]), "y": (4, FLOAT32, pts[:, 1]), "z": (8, FLOAT32, pts[:, 2])}
+        return pack_cloud(stamp_ns, self.frame_id, {**fields, **extra}, height=height, width=width)
+
     def update(self) -> None:
         """One sensor update."""
         raise NotImplementedError
@@ -207,18 +213,7 @@ class DepthCameraPlugin(CameraPlugin):
         rgb = np.zeros((h * w, 4), dtype=np.uint8)
         if self.last_image is not None and self.last_image.shape[:2] == (h, w):
             rgb[:, :3] = self.last_image.reshape(-1, 3)[:, ::-1]  # PCL packs b, g, r
-        return pack_cloud(
-            stamp_ns,
-            self.frame_id,
-            {
-                "x": (0, FLOAT32, pts[:, 0]),
-                "y": (4, FLOAT32, pts[:, 1]),
-                "z": (8, FLOAT32, pts[:, 2]),
-                "rgb": (16, FLOAT32, rgb.view(np.float32).reshape(-1)),
-            },
-            height=h,
-            width=w,
-        )
+        return self.cloud_msg(stamp_ns, pts, {"rgb": (16, FLOAT32, rgb.view(np.float32).reshape(-1))}, h, w)
 
 
 class VelodynePlugin(SensorNode[Lidar3dConfig]):
@@ -259,19 +254,8 @@ class VelodynePlugin(SensorNode[Lidar3dConfig]):
         else:
             pts, rings = xyz[keep], self.ring[keep]
             height, width = 1, len(pts)
-        return pack_cloud(
-            stamp_ns,
-            self.frame_id,
-            {
-                "x": (0, FLOAT32, pts[:, 0]),
-                "y": (4, FLOAT32, pts[:, 1]),
-                "z": (8, FLOAT32, pts[:, 2]),
-                "intensity": (16, FLOAT32, np.zeros(len(pts), np.float32)),
-                "ring": (20, UINT16, rings),
-            },
-            height=height,
-            width=width,
-        )
+        extra = {"intensity": (16, FLOAT32, np.zeros(len(pts), np.float32)), "ring": (20, UINT16, rings)}
+        return self.cloud_msg(stamp_ns, pts, extra, height, width)
 
 
 class RangePlugin(SensorNode[RangeConfig]):
