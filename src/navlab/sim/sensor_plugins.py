@@ -9,7 +9,7 @@ tf from their link (a camera's optical frame turned z forward, x right, y down).
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import Any, Generic, TypeVar
 
 import mujoco
 import numpy as np
@@ -25,22 +25,27 @@ from navlab.sim.simulation import Simulation
 
 ENCODINGS = {"R8G8B8": ("rgb8", 3), "B8G8R8": ("bgr8", 3), "L8": ("mono8", 1)}
 OPTICAL = quat_from_rpy(-math.pi / 2, 0.0, -math.pi / 2)  # camera body frame -> optical frame
+C = TypeVar("C", bound=SensorConfig)
 
 
-class SensorNode(Node):
-    """What the sensor plugins share: the config, a timer at the sensor's rate, its frame's static tf."""
+class SensorNode(Node, Generic[C]):
+    """What the sensor plugins share: the config, the node's name (default: the sensor's name + ``_plugin``),
+    a timer at the sensor's rate, its frame's static tf (turned to the optical frame if ``optical``);
+    a plugin adds its publishers in :meth:`setup`. ``parameters`` is accepted as every plugin's is, and unused."""
+
+    optical = False
 
     def __init__(
         self,
         executor: Executor,
         *,
-        name: str,
-        namespace: str,
+        name: str = "",
+        parameters: dict[str, Any] | None = None,
+        namespace: str = "",
         sim: Simulation,
-        config: SensorConfig,
-        optical: bool = False,
+        config: C,
     ) -> None:
-        super().__init__(executor, name=name, namespace=namespace)
+        super().__init__(executor, name=name or f"{config.name}_plugin", namespace=namespace)
         assert sim.robot is not None
         self.sim, self.cfg = sim, config
         self.frame_id = getattr(config, "frame_id", "") or config.link
@@ -54,16 +59,26 @@ class SensorNode(Node):
                         child_frame_id=self.frame_id,
                         transform=msgs.Transform(
                             translation=msgs.Vector3(x=o.xyz[0], y=o.xyz[1], z=o.xyz[2]),
-                            rotation=msgs.quaternion_msg(qmul(q, OPTICAL) if optical else q),
+                            rotation=msgs.quaternion_msg(qmul(q, OPTICAL) if self.optical else q),
                         ),
                     )
                 ]
             )
         self.create_timer(max(1.0 / config.update_rate, sim.timestep), self.update)
+        self.setup()
+
+    def setup(self) -> None:
+        """Create the plugin's publishers (``self.cfg`` its config)."""
 
     def read(self, *pubs: Any) -> bool:
         """Whether any of ``pubs`` has a subscriber, or a recorder/viewer listens."""
         return self.executor.has_listeners or any(p.get_subscription_count() for p in pubs)
+
+    def cloud_msg(self, stamp_ns: int, pts: np.ndarray, extra: dict[str, Any], height: int, width: int) -> Any:
+        """``sensor_msgs/PointCloud2`` in the sensor's frame: float32 x y z at offsets 0 4 8 (``pts``, n x 3), then
+        the ``extra`` fields (name: (offset, datatype, values), as :func:`navlab.io.pointcloud.pack_cloud`)."""
+        fields = {"x": (0, FLOAT32, pts[:, 0]), "y": (4, FLOAT32, pts[:, 1]), "z": (8, FLOAT32, pts[:, 2])}
+        return pack_cloud(stamp_ns, self.frame_id, {**fields, **extra}, height=height, width=width)
 
     def update(self) -> None:
         """One sensor update."""
@@ -89,25 +104,16 @@ def camera_info(cfg: CameraConfig, stamp_ns: int, frame_id: str) -> Any:
     )
 
 
-class CameraPlugin(SensorNode):
+class CameraPlugin(SensorNode[CameraConfig]):
     """``libgazebo_ros_camera.so`` (and the colour image of a depth camera): ``sensor_msgs/Image`` on
     ``image_topic`` and ``CameraInfo`` on ``camera_info_topic``, rendered offscreen (see
     :mod:`navlab.sim.camera_render`), with the ``<camera><noise>`` (std dev on the 0..1 scale) per pixel."""
 
-    def __init__(
-        self,
-        executor: Executor,
-        *,
-        name: str = "",
-        parameters: dict[str, Any] | None = None,
-        namespace: str = "",
-        sim: Simulation,
-        config: CameraConfig,
-    ) -> None:
-        super().__init__(
-            executor, name=name or f"{config.name}_plugin", namespace=namespace, sim=sim, config=config, optical=True
-        )
-        self.cam = config
+    optical = True
+
+    def setup(self) -> None:
+        super().setup()
+        config = self.cam = self.cfg
         self.renderer: Any = None
         self.image_pub = self.create_publisher(msgs.Image, config.image_topic, 2)
         self.info_pub = self.create_publisher(msgs.CameraInfo, config.camera_info_topic, 2)
@@ -166,17 +172,9 @@ class DepthCameraPlugin(CameraPlugin):
     ``point_cloud_topic``, ``CameraInfo`` on both info topics, the colour image (rendered) only when read.
     Depth comes from ray casting (:func:`navlab.sim.sensors3d.depth_image`), not from the renderer."""
 
-    def __init__(
-        self,
-        executor: Executor,
-        *,
-        name: str = "",
-        parameters: dict[str, Any] | None = None,
-        namespace: str = "",
-        sim: Simulation,
-        config: CameraConfig,
-    ) -> None:
-        super().__init__(executor, name=name, parameters=parameters, namespace=namespace, sim=sim, config=config)
+    def setup(self) -> None:
+        super().setup()
+        config = self.cfg
         self.depth_pub = self.create_publisher(msgs.Image, config.depth_image_topic, 1)
         self.cloud_pub = self.create_publisher(msgs.PointCloud2, config.point_cloud_topic, 1)
         self.depth_info_pub = self.create_publisher(msgs.CameraInfo, config.depth_info_topic, 1)
@@ -215,36 +213,16 @@ class DepthCameraPlugin(CameraPlugin):
         rgb = np.zeros((h * w, 4), dtype=np.uint8)
         if self.last_image is not None and self.last_image.shape[:2] == (h, w):
             rgb[:, :3] = self.last_image.reshape(-1, 3)[:, ::-1]  # PCL packs b, g, r
-        return pack_cloud(
-            stamp_ns,
-            self.frame_id,
-            {
-                "x": (0, FLOAT32, pts[:, 0]),
-                "y": (4, FLOAT32, pts[:, 1]),
-                "z": (8, FLOAT32, pts[:, 2]),
-                "rgb": (16, FLOAT32, rgb.view(np.float32).reshape(-1)),
-            },
-            height=h,
-            width=w,
-        )
+        return self.cloud_msg(stamp_ns, pts, {"rgb": (16, FLOAT32, rgb.view(np.float32).reshape(-1))}, h, w)
 
 
-class VelodynePlugin(SensorNode):
+class VelodynePlugin(SensorNode[Lidar3dConfig]):
     """``GazeboRosVelodyneLaser``: ``sensor_msgs/PointCloud2`` (x y z intensity ring, 32-byte points) of the points
     with ``max(min_range, range_min) < r < min(max_range, range_max - range_min - 0.01)``, ring 0 the lowest."""
 
-    def __init__(
-        self,
-        executor: Executor,
-        *,
-        name: str = "",
-        parameters: dict[str, Any] | None = None,
-        namespace: str = "",
-        sim: Simulation,
-        config: Lidar3dConfig,
-    ) -> None:
-        super().__init__(executor, name=name or f"{config.name}_plugin", namespace=namespace, sim=sim, config=config)
-        self.lidar = config
+    def setup(self) -> None:
+        super().setup()
+        config = self.lidar = self.cfg
         self.pub = self.create_publisher(msgs.PointCloud2, config.topic, 1)
         az, el = lidar3d_angles(config)
         self.unit = np.stack(
@@ -276,37 +254,17 @@ class VelodynePlugin(SensorNode):
         else:
             pts, rings = xyz[keep], self.ring[keep]
             height, width = 1, len(pts)
-        return pack_cloud(
-            stamp_ns,
-            self.frame_id,
-            {
-                "x": (0, FLOAT32, pts[:, 0]),
-                "y": (4, FLOAT32, pts[:, 1]),
-                "z": (8, FLOAT32, pts[:, 2]),
-                "intensity": (16, FLOAT32, np.zeros(len(pts), np.float32)),
-                "ring": (20, UINT16, rings),
-            },
-            height=height,
-            width=width,
-        )
+        extra = {"intensity": (16, FLOAT32, np.zeros(len(pts), np.float32)), "ring": (20, UINT16, rings)}
+        return self.cloud_msg(stamp_ns, pts, extra, height, width)
 
 
-class RangePlugin(SensorNode):
+class RangePlugin(SensorNode[RangeConfig]):
     """``gazebo_ros_range``: ``sensor_msgs/Range`` (ULTRASOUND 0 / INFRARED 1, ``field_of_view`` the plugin's
     ``<fov>``, min/max the ray sensor's range) with the nearest return of the sensor's rays."""
 
-    def __init__(
-        self,
-        executor: Executor,
-        *,
-        name: str = "",
-        parameters: dict[str, Any] | None = None,
-        namespace: str = "",
-        sim: Simulation,
-        config: RangeConfig,
-    ) -> None:
-        super().__init__(executor, name=name or f"{config.name}_plugin", namespace=namespace, sim=sim, config=config)
-        self.range = config
+    def setup(self) -> None:
+        super().setup()
+        config = self.range = self.cfg
         self.pub = self.create_publisher(msgs.Range, config.topic, 1)
 
     def update(self) -> None:
@@ -325,23 +283,14 @@ class RangePlugin(SensorNode):
         )
 
 
-class BumperPlugin(SensorNode):
+class BumperPlugin(SensorNode[BumperConfig]):
     """``gazebo_ros_bumper``: ``gazebo_msgs/ContactsState`` of the bumper link's contacts with anything but the
     floor (MuJoCo contacts of the link's body: position and normal in ``frameName``'s frame — ``world`` or a
     link — depth in m, contact force as the wrench), published every update even when empty (Noetic does)."""
 
-    def __init__(
-        self,
-        executor: Executor,
-        *,
-        name: str = "",
-        parameters: dict[str, Any] | None = None,
-        namespace: str = "",
-        sim: Simulation,
-        config: BumperConfig,
-    ) -> None:
-        super().__init__(executor, name=name or f"{config.name}_plugin", namespace=namespace, sim=sim, config=config)
-        self.bumper = config
+    def setup(self) -> None:
+        super().setup()
+        config = self.bumper = self.cfg
         self.pub = self.create_publisher(msgs.ContactsState, config.topic, 1)
 
     def update(self) -> None:

@@ -18,6 +18,24 @@ from navlab.navigation.errors import NavigationError
 from navlab.plugins import PluginContext
 
 
+def observation_layer_args(
+    params: Mapping[str, Any] | None, context: PluginContext, kind: type[ObstacleLayerParams]
+) -> dict[str, Any]:
+    """The constructor arguments of an obstacle or voxel layer named ``context.name`` (its ``plugins:`` name) from
+    its namespace ``params`` (ROS names, read as ``kind``), in the costmap ``context.costmap`` (its observation
+    sources: the layer's ``observation_sources``, else the costmap's) with the padded ``context.footprint``."""
+    name = context.name or "obstacle_layer"
+    costmap = costmap_of(params, context)
+    settings = layer_params(kind, costmap, name)
+    names = (settings.observation_sources or costmap.observation_sources).split()
+    return {
+        "params": settings,
+        "name": name,
+        "sources": {n: costmap.sources[n] for n in names if n in costmap.sources},
+        "footprint": context.footprint if isinstance(context.footprint, Footprint) else None,
+    }
+
+
 class ObstacleLayer(Layer):
     """``costmap_2d::ObstacleLayer``: marks scan endpoints nearer than ``obstacle_range`` as lethal and clears
     the cells along each ray up to ``raytrace_range`` (Bresenham, Numba); clears the cells under the robot's
@@ -44,17 +62,7 @@ class ObstacleLayer(Layer):
 
     @classmethod
     def from_params(cls, params: Mapping[str, Any] | None, *, context: PluginContext) -> Self:
-        name = context.name or "obstacle_layer"
-        costmap = costmap_of(params, context)
-        settings = layer_params(ObstacleLayerParams, costmap, name)
-        names = (settings.observation_sources or costmap.observation_sources).split()
-        footprint = context.footprint if isinstance(context.footprint, Footprint) else None
-        return cls(
-            settings,
-            name=name,
-            sources={n: costmap.sources[n] for n in names if n in costmap.sources},
-            footprint=footprint,
-        )
+        return cls(**observation_layer_args(params, context, ObstacleLayerParams))
 
     @property
     def default_value(self) -> int:

@@ -26,8 +26,9 @@ import numpy as np
 from navlab.core.params import read_params
 from navlab.grid import COST_FREE, COST_LETHAL, COST_UNKNOWN, Grid
 from navlab.navigation.costmap.footprint import Footprint, make_footprint
-from navlab.navigation.costmap.layer import Layer, costmap_of
-from navlab.navigation.costmap.params import IGNORED, ObservationSource, ObstacleLayerParams, layer_params
+from navlab.navigation.costmap.layer import Layer
+from navlab.navigation.costmap.obstacle_layer import observation_layer_args
+from navlab.navigation.costmap.params import IGNORED, ObservationSource, ObstacleLayerParams
 from navlab.navigation.errors import NavigationError
 from navlab.plugins import PluginContext
 
@@ -218,17 +219,7 @@ class VoxelLayer(Layer):
     def from_params(cls, params: Mapping[str, Any] | None, *, context: PluginContext) -> Self:
         """The layer named ``context.name`` (its ``plugins:`` name) from its namespace ``params`` (ROS names), in the
         costmap ``context.costmap`` (its observation sources) with the padded ``context.footprint``."""
-        name = context.name or "obstacle_layer"
-        costmap = costmap_of(params, context)
-        settings = layer_params(VoxelLayerParams, costmap, name)
-        names = (settings.observation_sources or costmap.observation_sources).split()
-        footprint = context.footprint if isinstance(context.footprint, Footprint) else None
-        return cls(
-            settings,
-            name=name,
-            sources={n: costmap.sources[n] for n in names if n in costmap.sources},
-            footprint=footprint,
-        )
+        return cls(**observation_layer_args(params, context, VoxelLayerParams))
 
     @property
     def default_value(self) -> int:
