@@ -20,39 +20,22 @@ import numpy as np
 
 from navlab import msgs
 from navlab.core import Executor, Node, TfError
-from navlab.core.limits import check_ceiling
 from navlab.geometry import transform_points2, wrap_angle
 from navlab.navigation.costmap_ros import Costmap2DROS
 from navlab.navigation.errors import NavigationError
 from navlab.navigation.goal import STATUS, GoalHandle, GoalState, MoveBaseState, RecoveryTrigger, with_headings
+from navlab.navigation.move_base_config import (
+    MOVE_BASE_DEFAULTS,
+    check_move_base_params,
+    make_recoveries,
+    short_name,
+)
 from navlab.navigation.progress_checker import STUCK_PREFIX, SimpleProgressChecker
-from navlab.navigation.recovery import DEFAULT_RECOVERIES, ClearCostmapRecovery
+from navlab.navigation.recovery import DEFAULT_RECOVERIES
 from navlab.navigation.scan_points import ScanPoints
-from navlab.plugins import ControlResult, PluginContext, load_plugin, make_plugin, plugin_names, resolve_name
+from navlab.plugins import ControlResult, PluginContext, make_plugin, plugin_names, resolve_name
 
 Pose = tuple[float, float, float]
-_MB_DEFAULTS: dict[str, Any] = {
-    "base_global_planner": "navfn/NavfnROS",
-    "base_local_planner": "base_local_planner/TrajectoryPlannerROS",
-    "controller_frequency": 20.0,
-    "planner_frequency": 0.0,
-    "planner_patience": 5.0,
-    "controller_patience": 15.0,
-    "max_planning_retries": -1,
-    "conservative_reset_dist": 3.0,
-    "recovery_behavior_enabled": True,
-    "clearing_rotation_allowed": True,
-    "shutdown_costmaps": False,
-    "oscillation_timeout": 0.0,
-    "oscillation_distance": 0.5,
-    "make_plan_clear_costmap": True,
-    "make_plan_add_unreachable_goal": True,
-}
-
-
-def short_name(plugin: str) -> str:
-    """The parameter namespace of a plugin: ``navfn/NavfnROS`` -> ``NavfnROS``."""
-    return plugin.replace("::", "/").rsplit("/", 1)[-1]
 
 
 class MoveBase(Node):
@@ -68,16 +51,9 @@ class MoveBase(Node):
     ) -> None:
         super().__init__(executor, name=name, parameters=parameters, namespace=namespace)
         self.listen_tf()  # a tf2 TransformListener, as in ROS: the graph shows it reading /tf
-        p = {k: self.declare_parameter(k, v) for k, v in _MB_DEFAULTS.items()}
+        p = {k: self.declare_parameter(k, v) for k, v in MOVE_BASE_DEFAULTS.items()}
         self.p = p
-        for key in ("controller_frequency", "planner_patience", "controller_patience", "oscillation_distance"):
-            if not (math.isfinite(p[key]) and p[key] > 0):
-                raise NavigationError(f"move_base parameter {key}: expected > 0, got {p[key]}")
-        for key in ("planner_frequency", "oscillation_timeout", "conservative_reset_dist"):
-            if not (math.isfinite(p[key]) and p[key] >= 0):
-                raise NavigationError(f"move_base parameter {key}: expected >= 0, got {p[key]}")
-        for key in ("controller_frequency", "planner_frequency"):
-            check_ceiling(NavigationError, "move_base", key, p[key], "rate")
+        check_move_base_params(p)
         raw_recoveries = self.declare_parameter("recovery_behaviors", [dict(r) for r in DEFAULT_RECOVERIES])
         private = self.fully_qualified_name
         self._scan_points = ScanPoints()  # both costmaps read the same scans: their points are worked out once
@@ -105,7 +81,13 @@ class MoveBase(Node):
         self.controller = make_plugin(
             "controller", lp, self._namespace(self.controller_name), context=context, param="base_local_planner"
         )
-        self.recoveries = self._recoveries(raw_recoveries)
+        self.recoveries = make_recoveries(
+            raw_recoveries,
+            self._namespace,
+            conservative_reset_dist=p["conservative_reset_dist"],
+            circumscribed_radius=self.local_costmap.layered.circumscribed_radius,
+            rng=self.rng,
+        )
         # Nav2's progress checker beside ROS 1's oscillation timeout: no progress -> the next recovery, then `stuck`
         self.progress_checker = SimpleProgressChecker(self._namespace("progress_checker"))
         # a parameter file may configure several planners (TrajectoryPlannerROS: and DWAPlannerROS:); ROS ignores
@@ -144,26 +126,6 @@ class MoveBase(Node):
         return Costmap2DROS(
             self, name, self._namespace(name), topic_prefix=f"{private}/{name}", scan_points=self._scan_points
         )
-
-    def _recoveries(self, raw: Any) -> list[tuple[str, Any]]:
-        if not isinstance(raw, list) or not all(isinstance(r, dict) and {"name", "type"} <= set(r) for r in raw):
-            raise NavigationError(
-                f"move_base parameter recovery_behaviors: expected a list of {{name, type}}, got {raw!r}"
-            )
-        out = []
-        for k, spec in enumerate(raw):
-            name, kind = str(spec["name"]), str(spec["type"])
-            params = self._namespace(name)
-            if load_plugin("recovery", kind, param=f"recovery_behaviors[{k}] type") is ClearCostmapRecovery:
-                # as ROS 1 move_base sets <name>/reset_distance for its resets (unless the file does)
-                default = (
-                    self.p["conservative_reset_dist"]
-                    if name == "conservative_reset"
-                    else (4.0 * self.local_costmap.layered.circumscribed_radius)
-                )
-                params = {"reset_distance": default, **params}
-            out.append((name, make_plugin("recovery", kind, params, context=PluginContext(name=name, rng=self.rng))))
-        return out
 
     # --- goals ---------------------------------------------------------------------------------------
 

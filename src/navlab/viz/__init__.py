@@ -14,7 +14,7 @@ _EXPORTS = {
     "attach": "navlab.viz.viewer",
     "Viewer": "navlab.viz.viewer",
     "ViewerNode": "navlab.viz.live",
-    "Pacer": "navlab.viz.live",
+    "Pacer": "navlab.viz.pacer",
     "Hub": "navlab.viz.hub",
     "ViewerServer": "navlab.viz.server",
     "play_bag": "navlab.viz.replay",

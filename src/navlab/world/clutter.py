@@ -30,6 +30,7 @@ from scipy.sparse.csgraph import dijkstra
 from scipy.spatial import cKDTree
 
 from navlab.io.files import write_text_atomic
+from navlab.world.clutter_geometry import Clearance
 from navlab.world.errors import WorldError
 from navlab.world.sdf_writer import box_geometry, cylinder_geometry, link, static_model, world_sdf
 
@@ -129,7 +130,7 @@ class ClutterWorld:
 
     def clearance(self, points: np.ndarray) -> np.ndarray:
         """Distance (m) from each (x, y) point to the nearest cylinder or wall surface (0 inside one)."""
-        return _Clearance(self.cylinders, self.walls)(np.asarray(points, dtype=float).reshape(-1, 2))
+        return Clearance(self.cylinders, self.walls, CYLINDER_RADIUS)(np.asarray(points, dtype=float).reshape(-1, 2))
 
 
 def barn_score(success: bool, time_s: float, t_opt: float) -> float:
@@ -157,64 +158,6 @@ def _walls() -> list[Box]:
         Box("wall_right", cx, -half - t / 2, length, t),
         Box("wall_back", x_back - t / 2, 0.0, t, FIELD + 2 * t),
     ]
-
-
-class _Clearance:
-    """Exact distance to the nearest obstacle surface: cylinders through a k-d tree, walls as boxes."""
-
-    def __init__(self, cylinders: np.ndarray, walls: list[Box]) -> None:
-        self.tree = cKDTree(cylinders) if len(cylinders) else None
-        self.boxes = np.array([[w.x, w.y, w.sx / 2, w.sy / 2] for w in walls]).reshape(-1, 4)
-
-    def __call__(self, pts: np.ndarray) -> np.ndarray:
-        d = np.full(len(pts), np.inf)
-        if self.tree is not None:
-            d = self.tree.query(pts)[0] - CYLINDER_RADIUS
-        for cx, cy, hx, hy in self.boxes:
-            dx = np.maximum(np.abs(pts[:, 0] - cx) - hx, 0.0)
-            dy = np.maximum(np.abs(pts[:, 1] - cy) - hy, 0.0)
-            d = np.minimum(d, np.hypot(dx, dy))
-        return np.maximum(d, 0.0)
-
-    def segments_clear(self, a: np.ndarray, ends: np.ndarray, radius: float) -> np.ndarray:
-        """Exact test, for each segment ``a`` -> ``ends[k]``, that every point has clearance >= ``radius``."""
-        ok = np.ones(len(ends), dtype=bool)
-        if self.tree is not None:
-            ok &= _point_segment_distance(self.tree.data, a, ends).min(axis=1) >= radius + CYLINDER_RADIUS
-        for cx, cy, hx, hy in self.boxes:  # the box grown by a disc of radius: two rectangles, four discs
-            lo, hi = np.array([cx - hx, cy - hy]), np.array([cx + hx, cy + hy])
-            for grow in (np.array([radius, 0.0]), np.array([0.0, radius])):
-                ok &= ~_segment_hits_rect(a, ends, lo - grow, hi + grow)
-            corners = np.array([[lo[0], lo[1]], [lo[0], hi[1]], [hi[0], lo[1]], [hi[0], hi[1]]])
-            ok &= _point_segment_distance(corners, a, ends).min(axis=1) >= radius
-        return ok
-
-
-def _point_segment_distance(points: np.ndarray, a: np.ndarray, ends: np.ndarray) -> np.ndarray:
-    """(n, k) distances from k points to the n segments ``a`` -> ``ends[n]``."""
-    ab = ends - a  # (n, 2)
-    ap = points - a  # (k, 2)
-    denom = np.maximum((ab * ab).sum(axis=1), 1e-18)[:, None]
-    t = np.clip((ab @ ap.T) / denom, 0.0, 1.0)  # (n, k)
-    dx = ap[None, :, 0] - t * ab[:, None, 0]
-    dy = ap[None, :, 1] - t * ab[:, None, 1]
-    return np.hypot(dx, dy)
-
-
-def _segment_hits_rect(a: np.ndarray, ends: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
-    """Whether each segment ``a`` -> ``ends[n]`` meets the open rectangle (lo, hi) (Liang-Barsky clip)."""
-    d = ends - a
-    t0, t1 = np.zeros(len(ends)), np.ones(len(ends))
-    hit = np.ones(len(ends), dtype=bool)
-    for ax in (0, 1):
-        p = d[:, ax]
-        flat = np.abs(p) < 1e-15
-        hit &= ~(flat & ((a[ax] <= lo[ax]) | (a[ax] >= hi[ax])))
-        with np.errstate(divide="ignore", invalid="ignore"):
-            ta, tb = (lo[ax] - a[ax]) / p, (hi[ax] - a[ax]) / p
-        t0 = np.where(flat, t0, np.maximum(t0, np.minimum(ta, tb)))
-        t1 = np.where(flat, t1, np.minimum(t1, np.maximum(ta, tb)))
-    return hit & (t0 < t1 - 1e-12)
 
 
 # ------------------------------------------------------------------------------ cellular automaton
@@ -295,7 +238,7 @@ def _carve(
     ys = field_centres()[1]
     gx, gy = np.meshgrid(xs, ys)
     pts = np.c_[gx.ravel(), gy.ravel()]
-    passable = (_Clearance(np.zeros((0, 2)), walls)(pts) >= clear).reshape(gx.shape)
+    passable = (Clearance(np.zeros((0, 2)), walls, CYLINDER_RADIUS)(pts) >= clear).reshape(gx.shape)
     reach = clear + CYLINDER_RADIUS
     count = np.zeros(len(pts))
     if len(cylinders):
@@ -332,7 +275,7 @@ def _search_grid(walls: list[Box], goal: np.ndarray) -> tuple[np.ndarray, np.nda
 
 
 def _free_grid(
-    clearance: _Clearance, walls: list[Box], goal: np.ndarray, radius: float
+    clearance: Clearance, walls: list[Box], goal: np.ndarray, radius: float
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     xs, ys = _search_grid(walls, goal)
     gx, gy = np.meshgrid(xs, ys)
@@ -346,7 +289,7 @@ def _cell_of(xs: np.ndarray, ys: np.ndarray, p: np.ndarray) -> int:
 
 
 def reference_path(
-    clearance: _Clearance, walls: list[Box], start: np.ndarray, goal: np.ndarray, radius: float
+    clearance: Clearance, walls: list[Box], start: np.ndarray, goal: np.ndarray, radius: float
 ) -> np.ndarray | None:
     """Shortest collision-free path (n, 2) for a disc of ``radius`` from start to goal, or None.
 
@@ -378,14 +321,14 @@ def _connected(free: np.ndarray, a: int, b: int) -> bool:
 
 def corridor_exists(world: ClutterWorld, radius: float) -> bool:
     """Whether start and goal are connected through cells with clearance >= ``radius`` (0.05 m grid)."""
-    clearance = _Clearance(world.cylinders, world.walls)
+    clearance = Clearance(world.cylinders, world.walls, CYLINDER_RADIUS)
     goal = np.array(world.goal[:2])
     xs, ys, _, free = _free_grid(clearance, world.walls, goal, radius)
     return _connected(free, _cell_of(xs, ys, np.array(world.start[:2])), _cell_of(xs, ys, goal))
 
 
 def bottleneck(
-    clearance: _Clearance, walls: list[Box], start: np.ndarray, goal: np.ndarray, tol: float = 0.005
+    clearance: Clearance, walls: list[Box], start: np.ndarray, goal: np.ndarray, tol: float = 0.005
 ) -> float:
     """Half-width (m) of the narrowest passage on the widest route: the largest clearance c for which
     start and goal connect through 0.05 m cells with clearance >= c (bisection to ``tol``)."""
@@ -444,7 +387,7 @@ def generate_clutter(
     carved = int((~keep).sum())
     cells[ii[~keep], jj[~keep]] = False
     cylinders = cylinders[keep] if len(cylinders) else cylinders
-    clearance = _Clearance(cylinders, walls)
+    clearance = Clearance(cylinders, walls, CYLINDER_RADIUS)
     path = reference_path(clearance, walls, start, goal, robot_radius)
     if path is None:
         raise WorldError(
