@@ -4,12 +4,9 @@ shared rollout, distance maps and goal handling, and the cost it minimises)."""
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
-from typing import Any
 
 import numpy as np
 
-from navlab.core import read_params
 from navlab.navigation.controllers import mapgrid
 from navlab.navigation.controllers.params import DWAPlannerParams
 from navlab.navigation.controllers.rollout import lookup, occupancy_costs, rollout, velocity_samples
@@ -19,35 +16,16 @@ _EPS = 1e-4
 
 
 class DWAPlannerROS(RolloutController):
-    """dwa_local_planner's DWAPlanner behind the Controller protocol.
-
-    ``params``: a DWAPlannerROS parameter dict (ROS 1 names, old and new spellings) or
-    ``DWAPlannerParams``; ``footprint``: polygon [[x, y], ...] (m, base frame), else ``robot_radius`` (m:
-    costmap_2d's 16-gon), else a point robot (centre cell); ``controller_frequency``: move_base's (Hz), used
-    unless ``params`` sets it. ``rng`` is accepted for a uniform constructor and not used.
-    """
+    """dwa_local_planner's DWAPlanner behind the Controller protocol (``params``: a DWAPlannerROS parameter dict,
+    ROS 1 names, or ``DWAPlannerParams``; the other arguments as ``RolloutController``'s)."""
 
     what = "DWAPlannerROS"
+    params_class = DWAPlannerParams
     params: DWAPlannerParams
 
-    def __init__(
-        self,
-        params: Mapping[str, Any] | DWAPlannerParams | None = None,
-        *,
-        footprint: Any = None,
-        robot_radius: float | None = None,
-        controller_frequency: float | None = None,
-        rng: np.random.Generator | None = None,
-    ) -> None:
-        super().__init__(
-            params, footprint=footprint, robot_radius=robot_radius, controller_frequency=controller_frequency, rng=rng
-        )
+    def _setup(self) -> None:
         self._stopped_vel = (self.params.trans_stopped_vel, self.params.theta_stopped_vel)
         self._accelerate = not self.params.use_dwa
-
-    @staticmethod
-    def _parse(params: Any) -> DWAPlannerParams:
-        return read_params(DWAPlannerParams, params)
 
     def _in_place_limits(self, err: float) -> tuple[float, float]:
         return self.params.max_vel_theta, self.params.min_vel_theta

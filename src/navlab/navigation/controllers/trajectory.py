@@ -5,12 +5,9 @@ base_local_planner does it (see ``rollout_controller`` for the shared cycle and 
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
-from typing import Any
 
 import numpy as np
 
-from navlab.core import read_params
 from navlab.navigation.controllers import trajectory_cycle as cycle
 from navlab.navigation.controllers.common import InPlaceFlags
 from navlab.navigation.controllers.params import TrajectoryPlannerParams
@@ -21,36 +18,18 @@ from navlab.navigation.controllers.rollout_controller import LocalScene, Rollout
 
 
 class TrajectoryPlannerROS(RolloutController):
-    """base_local_planner's trajectory rollout / DWA planner (``dwa`` flag) behind the Controller protocol.
-
-    ``params``: a TrajectoryPlannerROS parameter dict (ROS 1 names) or ``TrajectoryPlannerParams``;
-    ``footprint``: polygon [[x, y], ...] (m, base frame), else ``robot_radius`` (m: costmap_2d's 16-gon), else
-    a point robot (centre cell); ``controller_frequency``: move_base's (Hz), used unless ``params`` sets it.
-    ``rng`` is accepted for a uniform constructor and not used (the planner is deterministic).
-    """
+    """base_local_planner's trajectory rollout / DWA planner (``dwa`` flag) behind the Controller protocol
+    (``params``: a TrajectoryPlannerROS parameter dict, ROS 1 names, or ``TrajectoryPlannerParams``; the other
+    arguments as ``RolloutController``'s)."""
 
     what = "TrajectoryPlannerROS"
+    params_class = TrajectoryPlannerParams
     params: TrajectoryPlannerParams
 
-    def __init__(
-        self,
-        params: Mapping[str, Any] | TrajectoryPlannerParams | None = None,
-        *,
-        footprint: Any = None,
-        robot_radius: float | None = None,
-        controller_frequency: float | None = None,
-        rng: np.random.Generator | None = None,
-    ) -> None:
-        super().__init__(
-            params, footprint=footprint, robot_radius=robot_radius, controller_frequency=controller_frequency, rng=rng
-        )
+    def _setup(self) -> None:
         self._escaping = False
         self._escape_pose = (0.0, 0.0, 0.0)
         self._spin = InPlaceFlags(self.params.oscillation_reset_dist)
-
-    @staticmethod
-    def _parse(params: Any) -> TrajectoryPlannerParams:
-        return read_params(TrajectoryPlannerParams, params)
 
     def _new_goal(self) -> None:
         self._escaping = False
