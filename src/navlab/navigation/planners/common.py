@@ -7,13 +7,15 @@ put cell centres on integers. Paths are float (N, 2) arrays in metres in the cos
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import Any, ClassVar
 
 import numba
 import numpy as np
 
+from navlab.core import read_params
 from navlab.grid import COST_LETHAL, Grid
 from navlab.navigation.errors import NavigationError
+from navlab.plugins import BuiltFromParams
 
 
 def check_costmap(costmap: Grid, who: str) -> np.ndarray:
@@ -57,6 +59,31 @@ def check_start(data: np.ndarray, i: int, j: int, start: Any, who: str) -> None:
             f"{who}: start ({float(start[0]):.3f}, {float(start[1]):.3f}) is in an obstacle "
             f"(cost {COST_LETHAL} at cell ({i}, {j})); is the robot localized?"
         )
+
+
+def check_request(
+    costmap: Grid, start: Any, goal: Any, who: str
+) -> tuple[np.ndarray, tuple[int, int, float, float], tuple[int, int, float, float]]:
+    """The costmap's cost array and the start's and goal's (i, j, u, v) (:func:`pose_cell`), checked as navfn checks
+    a request: the costmap (:func:`check_costmap`), both poses on it, the start not in an obstacle."""
+    data = check_costmap(costmap, who)
+    s = pose_cell(costmap, start, "start", who)
+    g = pose_cell(costmap, goal, "goal", who)
+    check_start(data, s[0], s[1], start, who)
+    return data, s, g
+
+
+class GridPlanner(BuiltFromParams):
+    """What the grid planners share: their parameters (``params_class``, from a ROS parameter dict or an instance),
+    ``last_failure`` (why the last call found no path, "" on success) and ``stats`` (the last search's counts)."""
+
+    params_class: ClassVar[type[Any]]
+    name = ""
+
+    def __init__(self, params: Any = None) -> None:
+        self.params = read_params(self.params_class, params)
+        self.last_failure = ""
+        self.stats: dict[str, int] = {}
 
 
 def path_length(path: np.ndarray | None) -> float:

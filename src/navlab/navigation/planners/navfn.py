@@ -22,19 +22,10 @@ from typing import Any, ClassVar
 import numba
 import numpy as np
 
-from navlab.core import ParamSpec, read_params
+from navlab.core import ParamSpec
 from navlab.grid import COST_INSCRIBED, COST_UNKNOWN, Grid
 from navlab.navigation.errors import NavigationError
-from navlab.navigation.planners.common import (
-    check_costmap,
-    check_start,
-    dedupe,
-    iheap_pop,
-    iheap_update,
-    pose_cell,
-    to_world,
-)
-from navlab.plugins import BuiltFromParams
+from navlab.navigation.planners.common import GridPlanner, check_request, dedupe, iheap_pop, iheap_update, to_world
 
 COST_NEUTRAL = 50.0
 COST_FACTOR = 0.8
@@ -314,21 +305,17 @@ def _descend(pot: np.ndarray, u: float, v: float, tu: float, tv: float, step: fl
 # --- the planner ---------------------------------------------------------------------------------
 
 
-class NavfnPlanner(BuiltFromParams):
+class NavfnPlanner(GridPlanner):
     """``navfn/NavfnROS`` as a pure planner: :meth:`make_plan` over a costmap ``Grid`` (uint8 costs).
 
     After a call, ``last_failure`` says why there was no path ("" on success), ``stats`` holds the
     settled-cell count, and ``potential`` the potential field (H, W; inf where not reached).
     """
 
-    params_class: type[NavfnParams] = NavfnParams
+    params_class = NavfnParams
+    params: NavfnParams
     name = "navfn"
-
-    def __init__(self, params: NavfnParams | dict[str, Any] | None = None) -> None:
-        self.params = read_params(self.params_class, params)
-        self.last_failure = ""
-        self.stats: dict[str, int] = {}
-        self.potential: np.ndarray | None = None
+    potential: np.ndarray | None = None
 
     def cell_costs(self, data: np.ndarray) -> np.ndarray:
         """Per-cell traversal cost (float64; inf = obstacle) from costmap_2d costs, as navfn's ``setCostmap``."""
@@ -348,11 +335,7 @@ class NavfnPlanner(BuiltFromParams):
         """A path (N, 2) in metres from ``start`` to ``goal`` (both included) in the costmap's frame, or None
         when the goal cannot be reached (``last_failure`` says why). A start outside the map or in a lethal
         cell, and a goal outside the map, raise ``NavigationError``."""
-        who = self.name
-        data = check_costmap(costmap, who)
-        si, sj, su, sv = pose_cell(costmap, start, "start", who)
-        gi, gj, gu, gv = pose_cell(costmap, goal, "goal", who)
-        check_start(data, si, sj, start, who)
+        data, (si, sj, su, sv), (gi, gj, gu, gv) = check_request(costmap, start, goal, self.name)
         self.last_failure = ""
         cost = self.cell_costs(data)
         cost[sj, si] = self.params.neutral_cost  # navfn clears the robot's cell
@@ -422,4 +405,5 @@ class GlobalPlanner(NavfnPlanner):
     ``use_dijkstra: false`` for A*)."""
 
     params_class = GlobalPlannerParams
+    params: GlobalPlannerParams
     name = "global_planner"
