@@ -9,7 +9,7 @@ import numpy as np
 
 from navlab.navigation.controllers import mapgrid
 from navlab.navigation.controllers.params import DWAPlannerParams
-from navlab.navigation.controllers.rollout import lookup, occupancy_costs, rollout, velocity_samples
+from navlab.navigation.controllers.rollout import footprint_costs, lookup, velocity_samples
 from navlab.navigation.controllers.rollout_controller import LocalScene, RolloutController
 
 _EPS = 1e-4
@@ -101,7 +101,8 @@ class DWAPlannerROS(RolloutController):
         total = np.zeros(len(targets))
         rejected = ~self._osc.allowed(targets[:, 0], targets[:, 1])
         if p.occdist_scale > 0:
-            fp = occupancy_costs(scene.cost, res, traj, self._outline(res), near_max=self._near_max(scene))
+            outline, near = self._outline(res), self._near_max(scene)
+            fp = footprint_costs(scene.cost, res, traj, outline, near_max=near, with_centre=True)
             rejected |= (fp < 0).any(axis=1)
             total += p.occdist_scale * fp.max(axis=1)
         # the nose: every pose moved forward_point_distance ahead (MapGrid critics with an x shift read the
@@ -127,11 +128,7 @@ class DWAPlannerROS(RolloutController):
         return total
 
     def _drive(
-        self,
-        scene: LocalScene,
-        pose: tuple[float, float, float],
-        velocity: tuple[float, float],
-        goal: tuple[float, float, float | None],
+        self, scene: LocalScene, pose: tuple[float, float, float], velocity: tuple[float, float]
     ) -> tuple[float, float]:
         p = self.params
         g = scene.local_goal()
@@ -139,15 +136,7 @@ class DWAPlannerROS(RolloutController):
         if len(targets) == 0:
             return self._finish(scene, targets, np.zeros((0, 0, 3)), np.zeros(0), -1, pose)
         steps = self._steps(targets)
-        traj = rollout(
-            scene.pose,
-            velocity,
-            targets,
-            steps,
-            p.sim_time,
-            (p.acc_lim_x, p.acc_lim_theta),
-            accelerate=self._accelerate,
-        )
+        traj = self._rollout(scene, velocity, targets, steps)
         if not p.use_dwa:  # continued acceleration: ROS commands the velocity reached after the first step
             dt = (p.sim_time / steps)[:, None]
             now = np.array(velocity)

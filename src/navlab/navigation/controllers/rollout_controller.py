@@ -215,7 +215,7 @@ class RolloutController(ControllerBase):
         if scene is None:
             self.valid = False
             return 0.0, 0.0
-        return self._drive(scene, pose, velocity, goal)
+        return self._drive(scene, pose, velocity)
 
     # --- pieces -----------------------------------------------------------------------------------
 
@@ -328,18 +328,17 @@ class RolloutController(ControllerBase):
 
     def _command_valid(self, scene: LocalScene, velocity: tuple[float, float], cmd: tuple[float, float]) -> bool:
         """Whether rolling ``cmd`` out for sim_time scores as a legal trajectory (ROS's ``checkTrajectory``)."""
-        p = self.params
         targets = np.array([cmd])
-        traj = rollout(
-            scene.pose,
-            velocity,
-            targets,
-            self._steps(targets),
-            p.sim_time,
-            (p.acc_lim_x, p.acc_lim_theta),
-            accelerate=self._accelerate,
-        )
-        return bool(self._check(scene, targets, traj)[0] >= 0)
+        return bool(self._check(scene, targets, self._rollout(scene, velocity, targets, self._steps(targets)))[0] >= 0)
+
+    def _rollout(
+        self, scene: LocalScene, velocity: tuple[float, float], targets: np.ndarray, steps: np.ndarray
+    ) -> np.ndarray:
+        """The samples ``targets`` (S, 2) rolled out from the scene's pose at ``velocity`` in ``steps`` (S,) steps over
+        sim_time, within the acceleration limits as the planner applies them."""
+        p = self.params
+        acc = (p.acc_lim_x, p.acc_lim_theta)
+        return rollout(scene.pose, velocity, targets, steps, p.sim_time, acc, accelerate=self._accelerate)
 
     def _check(self, scene: LocalScene, targets: np.ndarray, traj: np.ndarray) -> np.ndarray:
         """Costs (S,) of rollouts checked outside the sampling loop (< 0: illegal)."""
@@ -369,10 +368,7 @@ class RolloutController(ControllerBase):
         return float(targets[best, 0]), float(targets[best, 1])
 
     def _drive(
-        self,
-        scene: LocalScene,
-        pose: tuple[float, float, float],
-        velocity: tuple[float, float],
-        goal: tuple[float, float, float | None],
+        self, scene: LocalScene, pose: tuple[float, float, float], velocity: tuple[float, float]
     ) -> tuple[float, float]:
+        """One sampling cycle away from the goal: the command of the best rollout (``_finish``)."""
         raise NotImplementedError

@@ -82,7 +82,7 @@ class TrajectoryPlannerROS(RolloutController):
         if outline is None:
             c = s = np.zeros(traj.shape[:2])
             ox = oy = np.zeros(0)
-        else:  # numpy's cos/sin, as occupancy_costs
+        else:  # numpy's cos/sin, as footprint_costs
             c, s = np.cos(traj[..., 2]), np.sin(traj[..., 2])
             ox, oy = np.ascontiguousarray(outline[:, 0]), np.ascontiguousarray(outline[:, 1])
         weights = self._weights(res)
@@ -106,19 +106,11 @@ class TrajectoryPlannerROS(RolloutController):
             np.full(len(traj), at, dtype=np.int64),
             cost,
         )
-        if at >= 0:  # ROS: + 0.3 * headingDiff at the scored step (not scaled by meter_scoring)
-            ok = cost >= 0
-            cost[ok] += 0.3 * heading_diffs(
-                grid, res, np.ascontiguousarray(scene.plan[:, :2]), np.ascontiguousarray(traj[ok, at])
-            )
+        self._add_heading(scene, cost, traj, at)
         return cost
 
     def _drive(
-        self,
-        scene: LocalScene,
-        pose: tuple[float, float, float],
-        velocity: tuple[float, float],
-        goal: tuple[float, float, float | None],
+        self, scene: LocalScene, pose: tuple[float, float, float], velocity: tuple[float, float]
     ) -> tuple[float, float]:
         p = self.params
         v0, w0 = velocity
@@ -162,11 +154,7 @@ class TrajectoryPlannerROS(RolloutController):
             scene.impossible,
             at,
         )
-        if at >= 0:  # ROS: + 0.3 * headingDiff at the scored step (not scaled by meter_scoring)
-            ok = costs >= 0
-            costs[ok] += 0.3 * heading_diffs(
-                scene.cost, res, np.ascontiguousarray(scene.plan[:, :2]), np.ascontiguousarray(traj[ok, at])
-            )
+        self._add_heading(scene, costs, traj, at)
         nf = len(targets) - len(ws) - 1
         best = cycle.choose(
             costs,
@@ -192,6 +180,15 @@ class TrajectoryPlannerROS(RolloutController):
             self._escaping, self._escape_pose = True, pose
         self._end_escape(pose)
         return self._finish(scene, targets, traj, costs, esc if costs[esc] > -2.0 else -1, pose)
+
+    @staticmethod
+    def _add_heading(scene: LocalScene, costs: np.ndarray, traj: np.ndarray, at: int) -> None:
+        """With ``heading_scoring`` (scored step ``at`` >= 0): + 0.3 x headingDiff at that step to every valid cost,
+        in place (ROS; not scaled by meter_scoring)."""
+        if at >= 0:
+            ok = costs >= 0
+            plan = np.ascontiguousarray(scene.plan[:, :2])
+            costs[ok] += 0.3 * heading_diffs(scene.cost, scene.resolution, plan, np.ascontiguousarray(traj[ok, at]))
 
     def _weights(self, res: float) -> np.ndarray:
         """The scoring kernel's (1, pdist, gdist, occdist) weights (m or cell units for the distances)."""
