@@ -76,21 +76,16 @@ class TrajectoryPlannerROS(RolloutController):
         with ``heading_scoring``); -1 blocked, -2 no path."""
         res = scene.resolution
         traj = np.ascontiguousarray(traj, dtype=np.float64)
-        outline = self._outline(res)
-        near = self._near_max(scene)
-        grid = scene.cost
-        if outline is None:
-            c = s = np.zeros(traj.shape[:2])
-            ox = oy = np.zeros(0)
-        else:  # numpy's cos/sin, as footprint_costs
+        near, ox, oy, polygon, use_near = self._edges(scene)
+        if polygon:  # numpy's cos/sin, as footprint_costs
             c, s = np.cos(traj[..., 2]), np.sin(traj[..., 2])
-            ox, oy = np.ascontiguousarray(outline[:, 0]), np.ascontiguousarray(outline[:, 1])
-        weights = self._weights(res)
+        else:
+            c = s = np.zeros(traj.shape[:2])
         cost = np.empty(traj.shape[0])
         at = self._heading_step(traj.shape[1])
         rollout_scores(
-            grid,
-            grid if near is None else near,
+            scene.cost,
+            near,
             np.ascontiguousarray(scene.path_dist),
             np.ascontiguousarray(scene.goal_dist),
             1.0 / res,
@@ -99,9 +94,9 @@ class TrajectoryPlannerROS(RolloutController):
             s,
             ox,
             oy,
-            outline is not None,
-            near is not None,
-            weights,
+            polygon,
+            use_near,
+            self._weights(res),
             scene.impossible,
             np.full(len(traj), at, dtype=np.int64),
             cost,
@@ -126,18 +121,16 @@ class TrajectoryPlannerROS(RolloutController):
         wmin = min(max(p.min_vel_theta, w0 - p.acc_lim_theta * horizon), wmax)
         # samples, rollouts and costs in one compiled call (trajectory_cycle), then the choice in another
         res = scene.resolution
-        outline = self._outline(res)
-        near = self._near_max(scene)
+        near, ox, oy, polygon, use_near = self._edges(scene)
         ang = p.angular_sim_granularity if p.angular_sim_granularity > 0 else p.sim_granularity
         limits = np.array(
             [vmin, vmax, wmin, wmax, p.min_in_place_vel_theta, p.escape_vel, p.acc_lim_x, p.acc_lim_theta]
         )
         steps = max(1, int(p.sim_time / p.sim_granularity + 0.5)) if p.heading_scoring else 0
         at = self._heading_step(steps) if p.heading_scoring else -1
-        empty = np.zeros(0)
         targets, traj, costs, ws, dw = cycle.score_samples(
             scene.cost,
-            scene.cost if near is None else near,
+            near,
             scene.path_dist,
             scene.goal_dist,
             res,
@@ -146,10 +139,10 @@ class TrajectoryPlannerROS(RolloutController):
             limits,
             (p.vx_samples, p.vtheta_samples),
             np.array([p.sim_time, p.sim_granularity, ang, float(p.heading_scoring)]),
-            empty if outline is None else np.ascontiguousarray(outline[:, 0]),
-            empty if outline is None else np.ascontiguousarray(outline[:, 1]),
-            outline is not None,
-            near is not None,
+            ox,
+            oy,
+            polygon,
+            use_near,
             self._weights(res),
             scene.impossible,
             at,
@@ -180,6 +173,17 @@ class TrajectoryPlannerROS(RolloutController):
             self._escaping, self._escape_pose = True, pose
         self._end_escape(pose)
         return self._finish(scene, targets, traj, costs, esc if costs[esc] > -2.0 else -1, pose)
+
+    def _edges(self, scene: LocalScene) -> tuple[np.ndarray, np.ndarray, np.ndarray, bool, bool]:
+        """The scoring kernels' footprint inputs: (``near_max`` or the costs, the outline's x and y (empty for a point
+        robot), whether the robot is a polygon, whether ``near_max`` is given)."""
+        outline = self._outline(scene.resolution)
+        near = self._near_max(scene)
+        if outline is None:
+            ox = oy = np.zeros(0)
+        else:
+            ox, oy = np.ascontiguousarray(outline[:, 0]), np.ascontiguousarray(outline[:, 1])
+        return (scene.cost if near is None else near), ox, oy, outline is not None, near is not None
 
     @staticmethod
     def _add_heading(scene: LocalScene, costs: np.ndarray, traj: np.ndarray, at: int) -> None:

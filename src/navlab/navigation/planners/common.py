@@ -112,6 +112,14 @@ def dedupe(path: np.ndarray, eps: float = 1e-9) -> np.ndarray:
 
 
 @numba.njit(cache=True, inline="always")
+def _put(keys: np.ndarray, vals: np.ndarray, pos: np.ndarray, k: int, key: float, val: int) -> None:  # pragma: no cover
+    """Entry ``val`` with ``key`` at heap slot ``k`` (its ``pos`` follows)."""
+    keys[k] = key
+    vals[k] = val
+    pos[val] = k
+
+
+@numba.njit(cache=True, inline="always")
 def _sift_up(keys: np.ndarray, vals: np.ndarray, pos: np.ndarray, k: int) -> None:
     key = keys[k]
     val = vals[k]
@@ -119,13 +127,9 @@ def _sift_up(keys: np.ndarray, vals: np.ndarray, pos: np.ndarray, k: int) -> Non
         parent = (k - 1) >> 1
         if keys[parent] <= key:
             break
-        keys[k] = keys[parent]
-        vals[k] = vals[parent]
-        pos[vals[k]] = k
+        _put(keys, vals, pos, k, keys[parent], vals[parent])
         k = parent
-    keys[k] = key
-    vals[k] = val
-    pos[val] = k
+    _put(keys, vals, pos, k, key, val)
 
 
 @numba.njit(cache=True, inline="always")
@@ -163,11 +167,7 @@ def iheap_pop(keys: np.ndarray, vals: np.ndarray, pos: np.ndarray, size: int) ->
             child = left + 1
         if key <= keys[child]:
             break
-        keys[k] = keys[child]
-        vals[k] = vals[child]
-        pos[vals[k]] = k
+        _put(keys, vals, pos, k, keys[child], vals[child])
         k = child
-    keys[k] = key
-    vals[k] = val
-    pos[val] = k
+    _put(keys, vals, pos, k, key, val)
     return size

@@ -198,6 +198,19 @@ def _interp(pot: np.ndarray, u: float, v: float) -> float:
     return (a * (1 - fu) + b * fu) * (1 - fv) + (c * (1 - fu) + d * fu) * fv
 
 
+@numba.njit(cache=True, inline="always")
+def _slope(lo: float, c: float, hi: float) -> float:  # pragma: no cover - compiled
+    """dP along one axis at a cell of potential ``c`` between neighbours ``lo`` and ``hi``: the central difference,
+    one-sided next to an obstacle or unreached cell (inf), 0 between two."""
+    if math.isfinite(lo) and math.isfinite(hi):
+        return 0.5 * (hi - lo)
+    if math.isfinite(hi):
+        return hi - c
+    if math.isfinite(lo):
+        return c - lo
+    return 0.0
+
+
 @numba.njit(cache=True)
 def _cell_gradient(pot: np.ndarray, i: int, j: int) -> tuple[float, float]:
     """(dP/di, dP/dj) at a settled cell: central differences, one-sided next to obstacles or unreached cells."""
@@ -207,21 +220,7 @@ def _cell_gradient(pot: np.ndarray, i: int, j: int) -> tuple[float, float]:
     right = pot[j, i + 1] if i < w - 1 else np.inf
     down = pot[j - 1, i] if j > 0 else np.inf
     up = pot[j + 1, i] if j < h - 1 else np.inf
-    gx = 0.0
-    if math.isfinite(left) and math.isfinite(right):
-        gx = 0.5 * (right - left)
-    elif math.isfinite(right):
-        gx = right - c
-    elif math.isfinite(left):
-        gx = c - left
-    gy = 0.0
-    if math.isfinite(down) and math.isfinite(up):
-        gy = 0.5 * (up - down)
-    elif math.isfinite(up):
-        gy = up - c
-    elif math.isfinite(down):
-        gy = c - down
-    return gx, gy
+    return _slope(left, c, right), _slope(down, c, up)
 
 
 @numba.njit(cache=True)
