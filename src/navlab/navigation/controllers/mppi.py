@@ -112,28 +112,8 @@ class MppiParams:
         return self.critic_params.get(name) or critics.CRITICS[name]()
 
     def validate(self) -> None:
-        """Raise ``NavigationError`` naming the first bad parameter."""
-        for key in ("batch_size", "iteration_count", "retry_attempt_limit"):
-            if getattr(self, key) < 1:
-                raise bad(WHAT, key, getattr(self, key), ">= 1")
-        if self.time_steps < 2:
-            raise bad(WHAT, "time_steps", self.time_steps, ">= 2")
-        for key in (
-            "model_dt",
-            "temperature",
-            "vx_std",
-            "wz_std",
-            "wz_max",
-            "ax_max",
-            "az_max",
-            "prune_distance",
-            "controller_frequency",
-        ):
-            if not getattr(self, key) > 0:
-                raise bad(WHAT, key, getattr(self, key), "> 0")
-        for key in ("gamma", "xy_goal_tolerance", "yaw_goal_tolerance"):
-            if not getattr(self, key) >= 0:
-                raise bad(WHAT, key, getattr(self, key), ">= 0")
+        """Raise ``NavigationError`` naming the first bad parameter (what spans fields or needs its own words; the
+        ranges are in ``PARAMS``)."""
         if not 0.0 <= self.noise_correlation < 1.0:
             raise bad(WHAT, "noise_correlation", self.noise_correlation, "0 <= value < 1")
         if self.ax_min > 0:
@@ -178,7 +158,44 @@ def _critic_sections(values: dict[str, Any]) -> dict[str, Any]:
     return flat
 
 
-MppiParams.PARAMS = ParamSpec(WHAT, NavigationError, ignored=_IGNORED, prepare=_critic_sections)
+MppiParams.PARAMS = ParamSpec(
+    WHAT,
+    NavigationError,
+    ignored=_IGNORED,
+    prepare=_critic_sections,
+    at_least={
+        **dict.fromkeys(("batch_size", "iteration_count", "retry_attempt_limit"), 1),
+        "time_steps": 2,
+        **dict.fromkeys(("gamma", "xy_goal_tolerance", "yaw_goal_tolerance"), 0),
+    },
+    above=dict.fromkeys(
+        (
+            "model_dt",
+            "temperature",
+            "vx_std",
+            "wz_std",
+            "wz_max",
+            "ax_max",
+            "az_max",
+            "prune_distance",
+            "controller_frequency",
+        ),
+        0,
+    ),
+)
+
+
+@numba.njit(cache=True, inline="always")
+def _reachable(
+    cv: float, cw: float, v: float, om: float, dt: float, acc: float, dec: float, aw: float
+) -> tuple[float, float]:  # pragma: no cover - compiled
+    """The control (cv, cw) limited to what the accelerations allow in ``dt`` from (v, om): ``acc`` speeding up and
+    ``dec`` (<= 0) slowing down, in either direction of travel, ``aw`` for the turn rate."""
+    if v >= 0.0:
+        cv = min(max(cv, v + dec * dt), v + acc * dt)
+    else:
+        cv = min(max(cv, v - acc * dt), v - dec * dt)
+    return cv, min(max(cw, om - aw * dt), om + aw * dt)
 
 
 @numba.njit(cache=True)
@@ -228,13 +245,7 @@ def _sample_rollout(
             xs[s, t], ys[s, t], ths[s, t], arc[s, t] = x, y, th, d
             i, j = math.floor(x * inv), math.floor(y * inv)
             cs[s, t] = cost[j, i] if 0 <= i < w and 0 <= j < h else 255
-            cv = seq[t, 0] + std[0] * ev
-            if v >= 0.0:
-                cv = min(max(cv, v + dec * dt), v + acc * dt)
-            else:
-                cv = min(max(cv, v - acc * dt), v - dec * dt)
-            cw = seq[t, 1] + std[1] * ew
-            cw = min(max(cw, om - aw * dt), om + aw * dt)
+            cv, cw = _reachable(seq[t, 0] + std[0] * ev, seq[t, 1] + std[1] * ew, v, om, dt, acc, dec, aw)
             u[s, t, 0], u[s, t, 1] = cv, cw
             dot += seq[t, 0] * (cv - seq[t, 0]) * iv + seq[t, 1] * (cw - seq[t, 1]) * iw
             v, om = cv, cw
@@ -247,11 +258,7 @@ def _accel_limit(seq: np.ndarray, v0: float, w0: float, dt: float, limits: np.nd
     acc, dec, aw = limits[3], limits[4], limits[5]
     v, om = v0, w0
     for t in range(seq.shape[0]):
-        if v >= 0.0:
-            seq[t, 0] = min(max(seq[t, 0], v + dec * dt), v + acc * dt)
-        else:
-            seq[t, 0] = min(max(seq[t, 0], v - acc * dt), v - dec * dt)
-        seq[t, 1] = min(max(seq[t, 1], om - aw * dt), om + aw * dt)
+        seq[t, 0], seq[t, 1] = _reachable(seq[t, 0], seq[t, 1], v, om, dt, acc, dec, aw)
         v, om = seq[t, 0], seq[t, 1]
 
 
