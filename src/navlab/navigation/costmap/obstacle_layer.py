@@ -60,6 +60,7 @@ class ObservationLayer(Layer):
         self.footprint = footprint or make_footprint()
         self.grid: Grid | None = None
         self.robot_pose: tuple[float, float, float] | None = None
+        self._new_cells((0, 0))
 
     @classmethod
     def from_params(cls, params: Mapping[str, Any] | None, *, context: PluginContext) -> Self:
@@ -78,6 +79,7 @@ class ObservationLayer(Layer):
     def match_size(self, master: Grid) -> None:
         data = np.full(master.data.shape, self.default_value, dtype=np.uint8)
         self.grid = Grid(data, master.resolution, master.origin, master.frame_id)
+        self._new_cells(data.shape)
 
     def update_origin(self, master: Grid) -> None:
         shift = origin_shift(self.grid, master)
@@ -88,6 +90,9 @@ class ObservationLayer(Layer):
         data = shifted(self.grid.data, *shift, self.default_value)
         self.grid = Grid(data, master.resolution, master.origin, master.frame_id)
         self._shift(*shift)
+
+    def _new_cells(self, shape: tuple[int, ...]) -> None:
+        """Per-cell state beside the costs starts afresh for a grid of ``shape`` (rows, columns)."""
 
     def _shift(self, di: int, dj: int) -> None:
         """Per-cell state beside the costs follows a rolling window's move (new cell (i, j) is old (i + di, j + dj))."""

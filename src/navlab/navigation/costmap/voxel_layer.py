@@ -22,11 +22,10 @@ from typing import Any
 import numba
 import numpy as np
 
-from navlab.grid import COST_FREE, COST_LETHAL, Grid
-from navlab.navigation.costmap.footprint import Footprint
+from navlab.grid import COST_FREE, COST_LETHAL
 from navlab.navigation.costmap.layer import shifted
 from navlab.navigation.costmap.obstacle_layer import ObservationLayer
-from navlab.navigation.costmap.params import IGNORED, ObservationSource, ObstacleLayerParams
+from navlab.navigation.costmap.params import IGNORED, ObstacleLayerParams
 
 UNKNOWN_COLUMN = np.uint32(0xFFFF)  # every voxel unknown (voxel_grid's reset)
 
@@ -197,25 +196,13 @@ class VoxelLayer(ObservationLayer):
     params: VoxelLayerParams
     params_class = VoxelLayerParams
 
-    def __init__(
-        self,
-        params: VoxelLayerParams | dict[str, Any] | None = None,
-        *,
-        name: str = "obstacle_layer",
-        sources: dict[str, ObservationSource] | None = None,
-        footprint: Footprint | None = None,
-    ) -> None:
-        super().__init__(params, name=name, sources=sources, footprint=footprint)
-        self.columns = np.zeros((0, 0), dtype=np.uint32)
-
     @property
     def z_top(self) -> float:
         """Height (m) of the top of the voxel columns."""
         return self.params.origin_z + self.params.z_voxels * self.params.z_resolution
 
-    def match_size(self, master: Grid) -> None:
-        super().match_size(master)
-        self.columns = np.full(master.data.shape, UNKNOWN_COLUMN, np.uint32)
+    def _new_cells(self, shape: tuple[int, ...]) -> None:
+        self.columns = np.full(shape, UNKNOWN_COLUMN, np.uint32)
 
     def _shift(self, di: int, dj: int) -> None:
         self.columns = shifted(self.columns, di, dj, UNKNOWN_COLUMN)
