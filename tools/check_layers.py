@@ -30,7 +30,10 @@ from dataclasses import dataclass
 from pathlib import Path
 
 LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
-    ("leaves", ("errors", "msgs", "geometry", "grid", "gridline", "io", "resources", "nodes", "plugins", "lazy", "deprecation")),
+    (
+        "leaves",
+        ("errors", "msgs", "geometry", "grid", "gridline", "io", "resources", "nodes", "plugins", "lazy", "deprecation"),
+    ),
     ("core", ("core",)),
     ("description/world/ros1", ("description", "world", "ros1")),
     ("sim/mapping/localization", ("sim", "mapping", "localization")),

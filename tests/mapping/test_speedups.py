@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 
 from navlab.geometry import wrap_angle
+from navlab.gridline import EXACT_STEPS
 from navlab.mapping.gmapping_match import draw_motion, match_score, optimize
 from navlab.mapping.gmapping_tiles import TILE, TilePool, from_dense, raycast_tiles, to_dense
-from navlab.gridline import EXACT_STEPS
 from navlab.mapping.occupancy import L_CLAMP, L_FREE, L_OCC, _raycast, integrate_scan
 from navlab.mapping.scanmatch import LookupField, correlative_search
 
