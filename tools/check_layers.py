@@ -32,7 +32,19 @@ from pathlib import Path
 LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     (
         "leaves",
-        ("errors", "msgs", "geometry", "grid", "gridline", "io", "resources", "nodes", "plugins", "lazy", "deprecation"),
+        (
+            "errors",
+            "msgs",
+            "geometry",
+            "grid",
+            "gridline",
+            "io",
+            "resources",
+            "nodes",
+            "plugins",
+            "lazy",
+            "deprecation",
+        ),
     ),
     ("core", ("core",)),
     ("description/world/ros1", ("description", "world", "ros1")),
