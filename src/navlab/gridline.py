@@ -13,7 +13,8 @@ A line from cell (i0, j0) to (i1, j1) has ``steps + 1`` cells, ``steps = max(|i1
 
 ``line(i0, j0, i1, j1, tie)`` sets a line up once; ``line_cell(ln, n)`` is its cell ``n`` (0 = the start,
 ``steps`` = the end) in closed form, without division (an exact fixed-point one), so no cell waits on
-the one before. Both are inlined into the compiled caller.
+the one before (``line_strides`` + ``line_minor``: the same as a flat index). All are inlined into the
+compiled caller.
 """
 
 from __future__ import annotations
@@ -48,9 +49,22 @@ def line(i0: int, j0: int, i1: int, j1: int, tie: int) -> Line:  # pragma: no co
 
 
 @numba.njit(cache=True, inline="always")
+def line_minor(ln: Line, n: int) -> int:  # pragma: no cover - compiled
+    """How many minor-axis steps the line ``ln`` has taken at its cell ``n`` (0 .. steps)."""
+    x = ln[7] + n * ln[8]
+    mul = ln[10]
+    return (x * mul) >> _FIXED_BITS if mul else (x // ln[9] if ln[9] else 0)
+
+
+@numba.njit(cache=True, inline="always")
 def line_cell(ln: Line, n: int) -> tuple[int, int]:  # pragma: no cover - compiled
     """Cell ``n`` (0 .. steps) of the line ``ln`` (from :func:`line`), as (i, j)."""
-    _, i0, j0, mi, mj, ni, nj, x0, dmin2, dmaj2, mul = ln
-    x = x0 + n * dmin2
-    q = (x * mul) >> _FIXED_BITS if mul else (x // dmaj2 if dmaj2 else 0)
-    return i0 + n * mi + q * ni, j0 + n * mj + q * nj
+    q = line_minor(ln, n)
+    return ln[1] + n * ln[3] + q * ln[5], ln[2] + n * ln[4] + q * ln[6]
+
+
+@numba.njit(cache=True, inline="always")
+def line_strides(ln: Line, width: int) -> tuple[int, int, int]:  # pragma: no cover - compiled
+    """(flat index of the start, flat stride of a major step, of a minor step) of the line ``ln`` in a
+    C-contiguous grid ``width`` cells wide: cell ``n`` is at ``start + n * major + line_minor(ln, n) * minor``."""
+    return ln[2] * width + ln[1], ln[4] * width + ln[3], ln[6] * width + ln[5]

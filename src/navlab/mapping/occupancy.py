@@ -18,7 +18,7 @@ import numba
 import numpy as np
 
 from navlab.grid import GridMap
-from navlab.gridline import TIE_LATE, line, line_cell
+from navlab.gridline import TIE_LATE, line, line_cell, line_minor, line_strides
 
 L_OCC = 0.85  # log-odds increment of a hit
 L_FREE = -0.4  # log-odds increment of a traversed cell
@@ -64,9 +64,9 @@ def _raycast(
         # the line's cells from (i0, j0), the end cell excluded
         ln = line(i0, j0, i1, j1, TIE_LATE)
         if start_inside and 0 <= i1 < w and 0 <= j1 < h:  # the whole line is inside: no per-cell checks
+            idx, smaj, smin = line_strides(ln, w)
             for n in range(ln[0]):
-                i, j = line_cell(ln, n)
-                c = numba.uint64(j * w + i)
+                c = numba.uint64(idx + n * smaj + line_minor(ln, n) * smin)
                 v = flat[c] + l_free
                 flat[c] = v if v > -clamp else -clamp
         else:
