@@ -14,17 +14,14 @@ from __future__ import annotations
 
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 
 from navlab import msgs
-from navlab.core import Executor
 from navlab.description import ImuConfig, RobotModel
 from navlab.geometry import xyzw_from_wxyz
 from navlab.sim.errors import SimError
-from navlab.sim.plugins import SensorPlugin, robot_sensor
-from navlab.sim.simulation import Simulation
+from navlab.sim.plugins import SensorPlugin
 
 AXES = ("x", "y", "z")
 
@@ -128,20 +125,7 @@ class ImuSensorPlugin(SensorPlugin[ImuConfig]):
 
     static_frame = False
     idle_unread = True
-
-    def __init__(
-        self,
-        executor: Executor,
-        *,
-        name: str = "",
-        parameters: dict[str, Any] | None = None,
-        namespace: str = "",
-        sim: Simulation,
-        index: int,
-    ) -> None:
-        self.index = index
-        config = robot_sensor(sim, "imus", index)
-        super().__init__(executor, name=name, parameters=parameters, namespace=namespace, sim=sim, config=config)
+    robot_sensors = "imus"
 
     def setup(self) -> None:
         cfg, sim = self.cfg, self.sim

@@ -71,11 +71,15 @@ class SensorPlugin(Node, Generic[C]):
     its frame (``frame_id``, else the link), a timer at the sensor's rate (at most once per physics step, as
     Gazebo's sensors) calling :meth:`update`, and, with ``static_frame``, the frame's static tf from its link
     when the frame is not a link (turned to the optical frame if ``optical``). A plugin adds its publishers in
-    :meth:`setup`; with ``idle_unread`` the timer idles while :meth:`unread`."""
+    :meth:`setup`; with ``idle_unread`` the timer idles while :meth:`unread`.
+
+    The sensor is ``config`` (its description), or the robot's sensor number ``index`` in the plugin's
+    ``robot_sensors`` list (``lidars``, ``imus``)."""
 
     optical = False
     static_frame = True  # False where robot_state_publisher sends it (lidars, IMUs: plugins.static_transforms)
     idle_unread = False
+    robot_sensors = ""
 
     def __init__(
         self,
@@ -85,8 +89,14 @@ class SensorPlugin(Node, Generic[C]):
         parameters: dict[str, Any] | None = None,
         namespace: str = "",
         sim: Simulation,
-        config: C,
+        config: C | None = None,
+        index: int | None = None,
     ) -> None:
+        if self.robot_sensors:
+            config = robot_sensor(sim, self.robot_sensors, index)
+        if config is None:
+            raise SimError(f"{type(self).__name__}: no sensor config given")
+        self.index = -1 if index is None else index
         super().__init__(executor, name=name or f"{config.name}_plugin", parameters=parameters, namespace=namespace)
         assert sim.robot is not None
         self.sim, self.cfg = sim, config
@@ -121,10 +131,10 @@ class SensorPlugin(Node, Generic[C]):
         raise NotImplementedError
 
 
-def robot_sensor(sim: Simulation, kind: str, index: int) -> Any:
+def robot_sensor(sim: Simulation, kind: str, index: int | None) -> Any:
     """The robot's sensor number ``index`` of ``kind`` (``lidars``, ``imus``: a ``RobotModel`` list)."""
     sensors = getattr(sim.robot, kind, None) or []
-    if not 0 <= index < len(sensors):
+    if index is None or not 0 <= index < len(sensors):
         raise SimError(f"no {kind.removesuffix('s')} number {index} on this robot")
     return sensors[index]
 
@@ -244,20 +254,7 @@ class LidarPlugin(SensorPlugin[LidarConfig]):
     for the robot's lidar number ``index`` (default name: the sensor's name + ``_plugin``)."""
 
     static_frame = False
-
-    def __init__(
-        self,
-        executor: Executor,
-        *,
-        name: str = "",
-        parameters: dict[str, Any] | None = None,
-        namespace: str = "",
-        sim: Simulation,
-        index: int,
-    ) -> None:
-        self.index = index
-        config = robot_sensor(sim, "lidars", index)
-        super().__init__(executor, name=name, parameters=parameters, namespace=namespace, sim=sim, config=config)
+    robot_sensors = "lidars"
 
     def setup(self) -> None:
         cfg = self.cfg
