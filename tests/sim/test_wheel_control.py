@@ -67,6 +67,13 @@ def test_pid_bad_gains_are_refused(params: dict, message: str) -> None:
         PidGains.from_params(params, where="pid_gains.left_wheel_hinge")
 
 
+def test_pid_gains_built_in_code_get_the_same_checks() -> None:
+    with pytest.raises(SimError, match="pid parameter p: expected >= 0"):
+        PidGains(p="fast")  # type: ignore[arg-type]
+    with pytest.raises(SimError, match="pid parameter i_clamp_min: expected <= 0"):
+        PidGains(i_clamp_max=1.0, i_clamp_min=0.5)
+
+
 def test_speed_limiter_acceleration_velocity_and_jerk() -> None:
     lim = SpeedLimiter(
         {"has_velocity_limits": True, "max_velocity": 0.5, "has_acceleration_limits": True, "max_acceleration": 1.0}

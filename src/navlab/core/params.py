@@ -15,6 +15,7 @@ import math
 import warnings
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, fields
+from operator import ge, gt, le
 from pathlib import Path
 from typing import Any, TypeVar
 
@@ -328,15 +329,11 @@ def read_params(cls: type[T], values: Mapping[str, Any] | T | None, *, what: str
                 f"{what}: {key} is {getattr(out, key)}; it is set to {low} (as ROS does)"
             )
             setattr_(out, key, type(getattr(out, key))(low))
-    for key, low in spec.at_least.items():
-        if not getattr(out, key) >= low:
-            raise param_error(what, key, getattr(out, key), f">= {low}", spec.error)
-    for key, low in spec.above.items():
-        if not getattr(out, key) > low:
-            raise param_error(what, key, getattr(out, key), f"> {low}", spec.error)
-    for key, high in spec.at_most.items():
-        if not getattr(out, key) <= high:
-            raise param_error(what, key, getattr(out, key), f"<= {high}", spec.error)
+    for bounds, within, sign in ((spec.at_least, ge, ">="), (spec.above, gt, ">"), (spec.at_most, le, "<=")):
+        for key, bound in bounds.items():
+            val = getattr(out, key)
+            if not _within(within, val, bound):
+                raise param_error(what, key, val, f"{sign} {bound}", spec.error)
     for key, allowed in spec.choices.items():
         if getattr(out, key) not in allowed:
             raise param_error(what, key, getattr(out, key), f"one of {', '.join(map(repr, allowed))}", spec.error)
@@ -344,6 +341,14 @@ def read_params(cls: type[T], values: Mapping[str, Any] | T | None, *, what: str
     if callable(validate):
         validate()
     return out
+
+
+def _within(compare: Callable[[Any, Any], Any], value: Any, bound: Any) -> bool:
+    """``compare(value, bound)``, False for a value that does not compare (a string set by code, not a file)."""
+    try:
+        return bool(compare(value, bound))
+    except TypeError:
+        return False
 
 
 def merge_params(*layers: dict[str, Any]) -> dict[str, Any]:
