@@ -86,6 +86,38 @@ def test_voxel_layer_from_costmap_params_and_into_the_master() -> None:
         LayeredCostmap({**params, "obstacle_layer": {**params["obstacle_layer"], "z_voxels": 20}})
 
 
+def test_voxel_layer_keeps_its_voxels_in_place_when_the_window_rolls_and_takes_no_2d_scans() -> None:
+    params = {
+        "global_frame": "odom",
+        "static_map": False,
+        "rolling_window": True,
+        "width": 4.0,
+        "height": 4.0,
+        "resolution": 0.1,
+        "robot_radius": 0.2,
+        "plugins": [
+            {"name": "obstacle_layer", "type": "costmap_2d::ObstacleLayer"},
+            {"name": "voxel_layer", "type": "costmap_2d::VoxelLayer"},
+        ],
+        "voxel_layer": {"z_voxels": 10, "z_resolution": 0.1, "cam": {"data_type": "PointCloud2", "clearing": True}},
+        "voxel_layer.observation_sources": "cam",
+    }
+    layered = LayeredCostmap(params)
+    voxel = layered.layer("voxel_layer")
+    assert isinstance(voxel, VoxelLayer) and [x.name for x in layered.scan_layers] == ["obstacle_layer"]
+    layered.update_map((0.0, 0.0, 0.0))
+    voxel.add_cloud((0.0, 0.0, 0.3), np.array([[1.05, 0.55, 0.25]]), source="cam")
+    layered.add_scan((0.0, 0.0), np.array([[-1.05, -0.55]]))  # 2-D scans: the obstacle layer only
+    grid = layered.update_map((0.0, 0.0, 0.0))
+    assert _cell(grid, 1.05, 0.55) == COST_LETHAL and _cell(grid, -1.05, -0.55) == COST_LETHAL
+    assert _cell(voxel.grid, -1.05, -0.55) != COST_LETHAL
+    grid = layered.update_map((0.73, 0.41, 0.0))  # the window moves by whole cells; what it still covers stays
+    assert grid.origin[:2] == pytest.approx((-1.3, -1.6))
+    assert _cell(grid, 1.05, 0.55) == COST_LETHAL and _cell(grid, -1.05, -0.55) == COST_LETHAL
+    marked = voxel.marked_voxels()
+    assert marked.shape == (1, 3) and marked[0] == pytest.approx((1.05, 0.55, 0.25))
+
+
 def test_range_sensor_layer_marks_the_reading_and_clears_short_of_it() -> None:
     layer = RangeSensorLayer({"topics": ["/sonar_front"], "clear_on_max_reading": True}, name="sonar")
     assert layer.topics == ["/sonar_front"] and layer.params.phi == 1.2 and layer.params.mark_threshold == 0.8
