@@ -2,7 +2,7 @@
 
 import warnings
 
-from navlab.world.truth import (  # noqa: F401 - re-exported for the old import path
+from navlab.world import (  # noqa: F401 - re-exported for the old import path
     true_map,
     true_occupancy,
     truth_grid,

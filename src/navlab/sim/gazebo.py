@@ -8,7 +8,7 @@ from typing import Any
 
 from navlab.core import Executor, Node
 from navlab.description import RobotModel
-from navlab.description.loader import load_robot_named as _load_robot_named
+from navlab.description import load_robot_named as _load_robot_named
 from navlab.sim.contacts import CollisionPlugin
 from navlab.sim.errors import SimError
 from navlab.sim.extensions import SimExtensions

@@ -29,7 +29,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import dijkstra
 from scipy.spatial import cKDTree
 
-from navlab.io.files import write_text_atomic
+from navlab.io import write_text_atomic
 from navlab.world.clutter_geometry import Clearance
 from navlab.world.errors import WorldError
 from navlab.world.sdf_writer import box_geometry, cylinder_geometry, link, static_model, world_sdf

@@ -23,7 +23,7 @@ from typing import Any, Self
 import numba
 import numpy as np
 
-from navlab.core.params import read_params
+from navlab.core import read_params
 from navlab.grid import COST_FREE, COST_LETHAL, COST_UNKNOWN, Grid
 from navlab.navigation.costmap.footprint import Footprint, make_footprint
 from navlab.navigation.costmap.layer import Layer
