@@ -19,7 +19,7 @@ import numpy as np
 
 import navlab
 from navlab import msgs
-from navlab.core import Executor, Node
+from navlab.core import Context, Executor, Node
 from navlab.sim import primitive_model
 
 parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -36,7 +36,7 @@ class SquareDriver(Node):
     """Open-loop teleop: forward SIDE metres, turn 90 degrees left, four times (10 Hz cmd_vel)."""
 
     def __init__(self, executor: Executor) -> None:
-        super().__init__(executor, name="square_driver")
+        super().__init__("square_driver", context=Context(executor))
         self.cmd = self.create_publisher(msgs.Twist, "cmd_vel", 10)
         leg, turn = SIDE / SPEED, (math.pi / 2) / TURN_RATE
         self.plan = [(leg, SPEED, 0.0), (turn, 0.0, TURN_RATE)] * 4  # (seconds, v, w)
@@ -54,7 +54,7 @@ class Recorder(Node):
     """Keeps the ground-truth and odometry paths and the last scan."""
 
     def __init__(self, executor: Executor) -> None:
-        super().__init__(executor, name="recorder")
+        super().__init__("recorder", context=Context(executor))
         self.truth, self.odom, self.scan = [], [], None
         self.create_subscription(msgs.Odometry, "/ground_truth/odom", self.on_truth)
         self.create_subscription(msgs.Odometry, "odom", self.on_odom)
@@ -107,8 +107,7 @@ fig.savefig(args.out, dpi=120)
 print(f"wrote {args.out}")
 
 if args.render:
-    from navlab.sim.render import render_image, save_png
-    from navlab.sim.simulation import Simulation
+    from navlab.sim import Simulation, render_image, save_png
 
     view = Simulation(gazebo.sim.robot, gazebo.sim.world, robot_pose=(x, y, yaw), visuals=True)
     view.spawn(LATE_OBSTACLE)

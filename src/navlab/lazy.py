@@ -17,6 +17,8 @@ import warnings
 from collections.abc import Callable
 from typing import Any
 
+from navlab.deprecation import NavlabDeprecationWarning
+
 
 def lazy_exports(package: str, exports: dict[str, str]) -> tuple[Callable[[str], Any], Callable[[], list[str]]]:
     """``(__getattr__, __dir__)`` for ``package`` exporting ``name -> module`` (or ``module:attr``) lazily."""
@@ -48,7 +50,7 @@ def moved_exports(old: str, exports: dict[str, str]) -> Callable[[str], Any]:
             raise AttributeError(f"module {old!r} has no attribute {name!r}")
         warnings.warn(
             f"{old}.{name} moved to {module}.{name}; the old name goes in the next release",
-            DeprecationWarning,
+            NavlabDeprecationWarning,
             stacklevel=2,
         )
         return getattr(importlib.import_module(module), name)

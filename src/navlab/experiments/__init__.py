@@ -11,7 +11,7 @@ from navlab.lazy import lazy_exports
 if TYPE_CHECKING:
     from navlab.experiments.clutter_protocol import JACKAL_MAX_SPEED, run_protocol
     from navlab.experiments.errors import ExperimentError
-    from navlab.experiments.localize_run import plot_result, run_localization
+    from navlab.experiments.localize_run import DEFAULT_ROUTE, plot_result, run_localization
     from navlab.experiments.mapping_run import read_trajectory as read_map_trajectory
     from navlab.experiments.mapping_run import run_mapping
     from navlab.experiments.metrics import (
@@ -35,6 +35,7 @@ if TYPE_CHECKING:
     from navlab.experiments.trials import run_experiment
 
 _EXPORTS = {
+    "DEFAULT_ROUTE": "navlab.experiments.localize_run",
     "read_poses": "navlab.experiments.metrics",
     "read_relations": "navlab.experiments.metrics",
     "relations_error": "navlab.experiments.metrics",
@@ -70,6 +71,7 @@ _EXPORTS = {
     "trajectory_error": "navlab.experiments.metrics",
 }
 __all__ = [
+    "DEFAULT_ROUTE",
     "JACKAL_MAX_SPEED",
     "ROBOTS",
     "ROUTES",

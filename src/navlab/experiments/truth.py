@@ -2,6 +2,7 @@
 
 import warnings
 
+from navlab.deprecation import NavlabDeprecationWarning
 from navlab.world import (  # noqa: F401 - re-exported for the old import path
     true_map,
     true_occupancy,
@@ -13,6 +14,6 @@ from navlab.world import (  # noqa: F401 - re-exported for the old import path
 
 warnings.warn(
     "navlab.experiments.truth moved to navlab.world (navlab.world.truth); the old path works until the next release",
-    DeprecationWarning,
+    NavlabDeprecationWarning,
     stacklevel=2,
 )

@@ -34,6 +34,7 @@ __all__ = [
     "ThetaStarPlanner",
     "TrajectoryPlannerROS",
     "VoxelLayer",
+    "check_plugin",
     "costmap_params",
     "iheap_pop",
     "iheap_update",
@@ -52,8 +53,10 @@ if TYPE_CHECKING:
     from navlab.navigation.costmap.voxel_layer import VoxelLayer
     from navlab.navigation.move_base import MoveBase
     from navlab.navigation.planners.common import iheap_pop, iheap_update
+    from navlab.navigation.plugin_check import check_plugin
 
 _EXPORTS = {
+    "check_plugin": "navlab.navigation.plugin_check",
     "DWAPlannerROS": "navlab.navigation.controllers",
     "Footprint": "navlab.navigation.costmap",
     "InflationLayer": "navlab.navigation.costmap",

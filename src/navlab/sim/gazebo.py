@@ -34,8 +34,12 @@ def load_world_named(name_or_path: str) -> WorldModel:
 def _moved(name: str, new: str) -> None:
     import warnings
 
+    from navlab.deprecation import NavlabDeprecationWarning
+
     warnings.warn(
-        f"navlab.sim.{name} moved to {new}; the old name works until the next release", DeprecationWarning, stacklevel=3
+        f"navlab.sim.{name} moved to {new}; the old name works until the next release",
+        NavlabDeprecationWarning,
+        stacklevel=3,
     )
 
 
