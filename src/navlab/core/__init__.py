@@ -1,4 +1,7 @@
-"""The simulated-time runtime: executor, nodes, topics, tf, parameters (see docs/core-api.md)."""
+"""The simulated-time runtime: executor, nodes, topics, tf, parameters (see docs/core-api.md).
+
+The runtime's classes load with the package; the rest (launch, runner, introspection, recording, rclpy's
+module API, ...) in ``_EXPORTS`` load their module on first use, so ``navlab --help`` stays light."""
 
 from typing import TYPE_CHECKING
 

@@ -1,7 +1,8 @@
 """File formats and data: rosbag2 (``rosbag``), CARMEN logs (``carmen``), pose files (``poses``), atomic
 writes (``files``) and where datasets live (``datasets``, the ``NAVLAB_DATA`` setting).
 
-A leaf package: it imports nothing of navlab above errors, msgs and geometry.
+A leaf package: it imports nothing of navlab above errors, msgs, geometry and lazy. Names in ``_EXPORTS`` load
+their module on first use (the rosbag2 reader loads rosbags, the CARMEN reader numpy).
 """
 
 from typing import TYPE_CHECKING

@@ -2,6 +2,7 @@
 
 Subpackages: ``costmap`` (layers and the layered master grid), ``planners`` (global planners),
 ``controllers`` (local planners). The algorithms are pure (numpy in, numpy out); nodes wire them to topics.
+Names in ``_EXPORTS`` (move_base, the controllers, ...) load their module on first use.
 """
 
 from typing import TYPE_CHECKING
