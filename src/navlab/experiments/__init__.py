@@ -31,10 +31,12 @@ if TYPE_CHECKING:
     from navlab.experiments.scenario import load_scenario
     from navlab.experiments.session import rounded, start_run
     from navlab.experiments.sweep import parse_params, run_sweep
-    from navlab.experiments.trajectory import apply_se2, ate, read_trajectory, trajectory_ate
+    from navlab.experiments.trajectory import align_se2, apply_se2, associate, ate, read_trajectory, trajectory_ate
     from navlab.experiments.trials import run_experiment
 
 _EXPORTS = {
+    "align_se2": "navlab.experiments.trajectory",
+    "associate": "navlab.experiments.trajectory",
     "DEFAULT_ROUTE": "navlab.experiments.localize_run",
     "read_poses": "navlab.experiments.metrics",
     "read_relations": "navlab.experiments.metrics",
@@ -77,7 +79,9 @@ __all__ = [
     "ROUTES",
     "ExperimentError",
     "Track",
+    "align_se2",
     "apply_se2",
+    "associate",
     "ate",
     "free_coverage",
     "load_scenario",
