@@ -5,12 +5,15 @@ from __future__ import annotations
 import warnings
 from typing import Any
 
+from navlab.errors import NavlabError
 
-class NavlabDeprecationWarning(DeprecationWarning):
-    """navlab's own deprecations (an old name, keyword or return shape that goes in the next release); a
-    ``DeprecationWarning``, so filters and ``pytest.warns(DeprecationWarning)`` see it, and a category of its
-    own, so ``-W error::navlab.deprecation.NavlabDeprecationWarning`` finds your uses of old forms (navlab's
-    tests run so) without turning third-party libraries' deprecations into errors."""
+
+class NavlabDeprecationWarning(NavlabError, DeprecationWarning):
+    """navlab's own deprecations (an old name, keyword or return shape that goes in the next release): a
+    ``NavlabError`` as every navlab exception class, and a ``DeprecationWarning``, so filters and
+    ``pytest.warns(DeprecationWarning)`` see it; a category of its own, so ``-W
+    error::navlab.deprecation.NavlabDeprecationWarning`` finds your uses of old forms (navlab's tests run so)
+    without turning third-party libraries' deprecations into errors."""
 
 
 def renamed(value: Any, old_value: Any, *, old: str, new: str, where: str) -> Any:
