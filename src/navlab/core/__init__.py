@@ -64,6 +64,7 @@ __all__ = [
     "seconds_to_ns",
     "start",
     "subscribe",
+    "typed_value",
     "with_layout",
 ]
 
@@ -75,7 +76,7 @@ if TYPE_CHECKING:
     from navlab.core.launch import Session, declared_args, start
     from navlab.core.limits import ceilings, check_ceiling
     from navlab.core.node import flatten_params
-    from navlab.core.params import canonical_params, check_unknown_key, param_error, parse_yaml, read_yaml
+    from navlab.core.params import canonical_params, check_unknown_key, param_error, parse_yaml, read_yaml, typed_value
     from navlab.core.rclpy_api import Context
     from navlab.core.record import Recorder
     from navlab.core.runner import parse_launch_args, run_for
@@ -107,5 +108,6 @@ _EXPORTS = {
     "start": "navlab.core.launch",
     "subscribe": "navlab.core.introspect",
     "with_layout": "navlab.core.graph",
+    "typed_value": "navlab.core.params",
 }
 __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)
