@@ -7,6 +7,7 @@ import math
 import numpy as np
 import pytest
 
+from navlab.core import Context
 from navlab.grid import COST_FREE, COST_LETHAL, COST_UNKNOWN, Grid
 from navlab.navigation.costmap.layered import LayeredCostmap
 from navlab.navigation.costmap.params import ObservationSource
@@ -210,7 +211,7 @@ def test_pointcloud_to_laserscan_node_publishes_a_scan_in_the_target_frame() -> 
 
     class Probe(Node):
         def __init__(self, ex: Executor) -> None:
-            super().__init__(ex, name="probe")
+            super().__init__("probe", context=Context(ex))
             self.scans: list = []
             self.pub = self.create_publisher(msgs.PointCloud2, "cloud_in", 1)
             self.create_subscription(msgs.LaserScan, "scan", self.scans.append, 1)

@@ -10,7 +10,7 @@ import pytest
 from sim_helpers import make_room
 
 from navlab import msgs, resources
-from navlab.core import Executor, Node
+from navlab.core import Context, Executor, Node
 from navlab.description import load_robot
 from navlab.sim import launch_sim
 from navlab.world import load_world
@@ -29,7 +29,7 @@ class _Driver:
     def __init__(self, ex: Executor, scan_topic: str) -> None:
         self.cmd = (0.0, 0.0)
         self.scans: list[object] = []
-        node = Node(ex, name="driver")
+        node = Node("driver", context=Context(ex))
         node.create_subscription(msgs.LaserScan, scan_topic, self.scans.append)
         pub = node.create_publisher(msgs.Twist, "cmd_vel")
         node.create_timer(0.05, lambda: pub.publish(msgs.twist(*self.cmd)))

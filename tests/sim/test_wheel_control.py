@@ -9,7 +9,7 @@ import pytest
 from sim_helpers import make_mybot, make_room
 
 from navlab import msgs
-from navlab.core import Executor, Node, load_params
+from navlab.core import Context, Executor, Node, load_params
 from navlab.resources import root as resources_root
 from navlab.sim import SimError, launch_sim
 from navlab.sim.disturbances import parse_disturbances
@@ -115,7 +115,7 @@ def _drive(
 ) -> tuple[Executor, object, dict]:
     ex = Executor(seed=0)
     gazebo = launch_sim(ex, world=make_room(), robot=robot or make_mybot(), **params)  # type: ignore[arg-type]
-    probe = Node(ex, name="probe")
+    probe = Node("probe", context=Context(ex))
     got: dict = {"odom": [], "truth": []}
     probe.create_subscription(msgs.Odometry, "odom", got["odom"].append)
     probe.create_subscription(msgs.Odometry, "/ground_truth/odom", got["truth"].append)

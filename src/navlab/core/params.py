@@ -23,8 +23,7 @@ import yaml
 
 from navlab.core.errors import ParameterError
 from navlab.errors import NavlabError, did_you_mean
-from navlab.io.errors import IoError
-from navlab.io.files import read_text_checked
+from navlab.io import IoError, read_text_checked
 
 T = TypeVar("T")
 
