@@ -6,27 +6,17 @@ touches anything but the floor, and nothing while it touches nothing; ``collisio
 
 from __future__ import annotations
 
-from typing import Any
-
 from navlab import msgs
-from navlab.core import Executor, Node
+from navlab.sim.plugins import SimPlugin
 
 
-class CollisionPlugin(Node):
+class CollisionPlugin(SimPlugin):
     """Reports the robot's contacts with world models on ``/collisions`` (see the module docstring)."""
 
-    def __init__(
-        self,
-        executor: Executor,
-        *,
-        name: str = "collisions",
-        parameters: dict[str, Any] | None = None,
-        namespace: str = "",
-        sim: Any = None,
-    ) -> None:
-        super().__init__(executor, name=name, parameters=parameters, namespace=namespace)
+    default_name = "collisions"
+
+    def setup(self) -> None:
         rate = float(self.declare_parameter("rate", 20.0))
-        self.sim = sim
         self.touching: list[str] = []
         self.collisions = 0  # episodes: from touching nothing to touching something
         self.pub = self.create_publisher(msgs.String, "/collisions", 10)

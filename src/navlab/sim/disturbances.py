@@ -22,10 +22,11 @@ from typing import Any
 import mujoco
 import numpy as np
 
-from navlab.core import Executor, Node
+from navlab.core import Executor
 from navlab.description import Geometry, RobotModel
 from navlab.errors import did_you_mean
 from navlab.sim.errors import SimError
+from navlab.sim.plugins import SimPlugin
 from navlab.sim.simulation import Simulation
 
 KEYS = ("wheel_radius_error", "payload_mass", "max_torque", "slip_patches", "slip_rate")
@@ -177,7 +178,7 @@ def add_payload(sim: Simulation, mass: float) -> None:
     mujoco.mj_forward(sim.model, d)
 
 
-class SlipPatchPlugin(Node):
+class SlipPatchPlugin(SimPlugin):
     """Sets the wheels' floor friction from the slip patches under them, ``rate`` times a second.
 
     ``wheel_friction`` holds the current (left, right) sliding friction, for tests and monitors.
@@ -194,10 +195,9 @@ class SlipPatchPlugin(Node):
         patches: list[SlipPatch],
         rate: float = 100.0,
     ) -> None:
-        super().__init__(executor, name=name, parameters=parameters, namespace=namespace)
-        assert sim.robot is not None
-        self.sim, self.patches = sim, list(patches)
-        self.links = wheel_links(sim.robot)
+        super().__init__(executor, name=name, parameters=parameters, namespace=namespace, sim=sim)
+        self.patches = list(patches)
+        self.links = wheel_links(self.robot)
         self._model: Any = None
         self._geoms: list[np.ndarray] = []
         self._base_mu: list[np.ndarray] = []

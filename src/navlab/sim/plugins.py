@@ -17,7 +17,7 @@ import numpy as np
 
 from navlab import msgs
 from navlab.core import Executor, Node
-from navlab.description import DiffDriveConfig, ImuConfig, LidarConfig, Origin
+from navlab.description import DiffDriveConfig, ImuConfig, LidarConfig, Origin, RobotModel
 from navlab.geometry import Vec, qmul, qrotate, quat_from_rpy, quat_from_yaw
 from navlab.sim.diffdrive import (
     ODOM_COVARIANCE_DIAG,
@@ -131,6 +131,34 @@ class SensorPlugin(Node, Generic[C]):
         raise NotImplementedError
 
 
+class SimPlugin(Node):
+    """What the non-sensor plugins share: every node's constructor ``(executor, *, name, parameters, namespace)``
+    then ``sim=`` (a simulation with its robot loaded), ``name`` defaulting to the class's ``default_name``;
+    ``self.sim`` and ``self.robot`` (its ``RobotModel``). A plugin declares its parameters and creates its
+    publishers, subscriptions and timers in :meth:`setup`, or, when it takes more arguments, in its own
+    ``__init__`` after this one."""
+
+    default_name = ""
+
+    def __init__(
+        self,
+        executor: Executor,
+        *,
+        name: str = "",
+        parameters: dict[str, Any] | None = None,
+        namespace: str = "",
+        sim: Simulation,
+    ) -> None:
+        super().__init__(executor, name=name or self.default_name, parameters=parameters, namespace=namespace)
+        assert sim.robot is not None
+        self.sim: Simulation = sim
+        self.robot: RobotModel = sim.robot
+        self.setup()
+
+    def setup(self) -> None:
+        """Declare the parameters, create the publishers, subscriptions and timers."""
+
+
 def robot_sensor(sim: Simulation, kind: str, index: int | None) -> Any:
     """The robot's sensor number ``index`` of ``kind`` (``lidars``, ``imus``: a ``RobotModel`` list)."""
     sensors = getattr(sim.robot, kind, None) or []
@@ -145,7 +173,7 @@ def base_frame_link(sim: Simulation, frame: str) -> str:
     return frame if frame in sim.robot.links else sim.robot.root_link
 
 
-class DiffDrivePlugin(Node):
+class DiffDrivePlugin(SimPlugin):
     """``libgazebo_ros_diff_drive``: ``cmd_vel`` → wheel velocity targets (torque-limited), odometry and tf.
 
     Every ``1/update_rate`` s: stop the wheels if navlab's ``cmd_timeout`` watchdog is set (s > 0) and no
@@ -166,8 +194,7 @@ class DiffDrivePlugin(Node):
         sim: Simulation,
         config: DiffDriveConfig,
     ) -> None:
-        super().__init__(executor, name=name, parameters=parameters, namespace=namespace or config.namespace)
-        self.sim = sim
+        super().__init__(executor, name=name, parameters=parameters, namespace=namespace or config.namespace, sim=sim)
         self.cfg = config
         self.base_link = base_frame_link(sim, config.robot_base_frame)
         if self.base_link != config.robot_base_frame:
@@ -286,24 +313,15 @@ class LidarPlugin(SensorPlugin[LidarConfig]):
         )
 
 
-class JointStatePlugin(Node):
+class JointStatePlugin(SimPlugin):
     """``gazebo_ros_joint_state_publisher``: ``/joint_states`` (position and velocity of the moving joints)
     every ``1/publish_frequency`` s (Hz, default 30; 0 = none), read from the simulator."""
 
-    def __init__(
-        self,
-        executor: Executor,
-        *,
-        name: str = "joint_state_publisher",
-        parameters: dict[str, Any] | None = None,
-        namespace: str = "",
-        sim: Simulation,
-    ) -> None:
-        super().__init__(executor, name=name, parameters=parameters, namespace=namespace)
-        assert sim.robot is not None
-        self.sim = sim
+    default_name = "joint_state_publisher"
+
+    def setup(self) -> None:
         rate = float(self.declare_parameter("publish_frequency", 30.0))
-        self.joints = [j.name for j in sim.robot.joints if j.name in set(sim.joint_names())]
+        self.joints = [j.name for j in self.robot.joints if j.name in set(self.sim.joint_names())]
         self.pub = self.create_publisher(msgs.JointState, "joint_states", 10)
         if rate > 0 and self.joints:
             self.create_timer(1.0 / rate, self.update)
@@ -323,29 +341,21 @@ class JointStatePlugin(Node):
         )
 
 
-class RobotStatePublisher(Node):
+class RobotStatePublisher(SimPlugin):
     """``robot_state_publisher``: subscribes ``/joint_states`` and publishes each moving joint's tf (parent link →
     child link) at the message's stamp; fixed joints and sensor frames once, as static tf. ``publish_tf``
     (default true; navlab's switch): the moving joints' tf."""
 
-    def __init__(
-        self,
-        executor: Executor,
-        *,
-        name: str = "robot_state_publisher",
-        parameters: dict[str, Any] | None = None,
-        namespace: str = "",
-        sim: Simulation,
-    ) -> None:
-        super().__init__(executor, name=name, parameters=parameters, namespace=namespace)
-        assert sim.robot is not None
+    default_name = "robot_state_publisher"
+
+    def setup(self) -> None:
         self.publish_tf = self.declare_parameter("publish_tf", True)
         self.joints = {
             j.name: (j, _joint_constants(tuple(j.origin.rpy), tuple(j.origin.xyz), tuple(j.axis)))
-            for j in sim.robot.joints
+            for j in self.robot.joints
             if j.type != "fixed"
         }
-        self.send_static_transform(static_transforms(sim, executor.now_ns))
+        self.send_static_transform(static_transforms(self.sim, self.executor.now_ns))
         self.create_subscription(msgs.JointState, "joint_states", self._on_joint_states, 10)
 
     def _on_joint_states(self, msg: Any) -> None:
@@ -401,30 +411,21 @@ def static_transforms(sim: Simulation, stamp_ns: int) -> list[Any]:
     return out
 
 
-class GroundTruthPlugin(Node):
+class GroundTruthPlugin(SimPlugin):
     """``libgazebo_ros_p3d``: the true pose and twist of a link, ``nav_msgs/Odometry`` (for evaluation only).
 
     Parameters (p3d's): ``bodyName`` (the link; default the robot's root link), ``topicName``
     (``/ground_truth/odom``), ``frameName`` (``world``), ``updateRate`` (Hz, 50).
     """
 
-    def __init__(
-        self,
-        executor: Executor,
-        *,
-        name: str = "ground_truth",
-        parameters: dict[str, Any] | None = None,
-        namespace: str = "",
-        sim: Simulation,
-    ) -> None:
-        super().__init__(executor, name=name, parameters=parameters, namespace=namespace)
-        assert sim.robot is not None
-        self.sim = sim
-        self.base_frame = self.declare_parameter("bodyName", sim.robot.root_link)
+    default_name = "ground_truth"
+
+    def setup(self) -> None:
+        self.base_frame = self.declare_parameter("bodyName", self.robot.root_link)
         topic = self.declare_parameter("topicName", "/ground_truth/odom")
         self.frame = self.declare_parameter("frameName", "world")
         rate = float(self.declare_parameter("updateRate", 50.0))
-        self.link = base_frame_link(sim, self.base_frame)
+        self.link = base_frame_link(self.sim, self.base_frame)
         self.pub = self.create_publisher(msgs.Odometry, topic, 10)
         self.create_timer(1.0 / rate, self.update, idle=self._unread)
 

@@ -31,10 +31,11 @@ import mujoco
 import numpy as np
 
 from navlab import msgs
-from navlab.core import Executor, Node
+from navlab.core import Executor
 from navlab.description import DiffDriveConfig
 from navlab.sim.errors import SimError
 from navlab.sim.pid import Pid, PidGains
+from navlab.sim.plugins import SimPlugin
 from navlab.sim.ros_control import wheel_names
 from navlab.sim.simulation import Simulation
 
@@ -200,7 +201,7 @@ def _diag(values: Any, key: str) -> np.ndarray:
     return msgs.covariance(tuple(float(x) for x in v))
 
 
-class DiffDriveController(Node):
+class DiffDriveController(SimPlugin):
     """``diff_drive_controller/DiffDriveController`` with ``gazebo_ros_control``'s per-wheel velocity PID on
     effort, or (``velocity_interface``: ``hardware_interface/VelocityJointInterface`` without ``pid_gains``) the
     joints' velocity motors capped at their effort limit, as DefaultRobotHWSim drives them. Each side may have
@@ -221,13 +222,13 @@ class DiffDriveController(Node):
         control_period: float = 0.01,
         velocity_interface: bool = False,
     ) -> None:
-        super().__init__(executor, name=name, parameters=parameters, namespace=namespace or config.namespace)
+        super().__init__(executor, name=name, parameters=parameters, namespace=namespace or config.namespace, sim=sim)
         p = self.declare_parameters(CONTROLLER_DEFAULTS)
         self.check_parameters()
         where = f"{self.fully_qualified_name}"
         if p["type"] != CONTROLLER_TYPE:
             raise SimError(f"{where}: type {p['type']!r}: navlab simulates {CONTROLLER_TYPE!r}")
-        self.sim, self.cfg, self.p = sim, config, p
+        self.cfg, self.p = config, p
         lefts, rights = config.wheel_joints()
         self.sides = (
             wheel_names(p["left_wheel"], f"{where} left_wheel") if p["left_wheel"] else lefts,
