@@ -17,7 +17,9 @@ from navlab.description.model import Origin
 from navlab.description.sensor_model import CameraConfig, Lidar3dConfig, RangeConfig
 from navlab.geometry import matrix_from_quat, qmul, qrotate, quat_from_rpy
 from navlab.io.pointcloud import move_points
-from navlab.sim.raycast3d import ALL, PINHOLE, SPHERICAL, cast_grid, pinhole_dirs, spherical_dirs
+from navlab.sim.gauss import seed_state
+from navlab.sim.raster import draw_depth, finish_depth
+from navlab.sim.raycast3d import ALL, SPHERICAL, cast_grid, pinhole_dirs, spherical_dirs
 from navlab.sim.simulation import Simulation
 
 
@@ -65,20 +67,29 @@ def cast(
         out,
     )
     if slow is not None:  # meshes: MuJoCo's ray caster, from tmin on
-        world = move_points(dirs, rot, (0.0, 0.0, 0.0)).astype(np.float64)
-        n = len(world)
-        dist = np.empty(n)
-        geomid = np.empty(n, dtype=np.int32)
-        mujoco.mj_multiRay(m, d, pos + 0.0, world.ravel(), slow, 1, -1, geomid, dist, None, n, tmax)
-        dist[geomid < 0] = np.inf
-        near = np.flatnonzero(dist < tmin)
-        one = np.empty(1, dtype=np.int32)
-        for i in near:
-            r = mujoco.mj_ray(m, d, pos + tmin * world[i], world[i], slow, 1, -1, one)
-            dist[i] = tmin + r if r >= 0 else np.inf
-        dist[dist > tmax] = np.inf
-        np.minimum(out, dist, out=out)
+        np.minimum(out, _cast_meshes(sim, pos, rot, dirs, slow, tmin, tmax), out=out)
     return out
+
+
+def _cast_meshes(
+    sim: Simulation, pos: np.ndarray, rot: np.ndarray, dirs: np.ndarray, groups: np.ndarray, tmin: float, tmax: float
+) -> np.ndarray:
+    """Distances (m) along ``dirs`` (sensor frame) to the geoms of ``groups`` by ``mj_multiRay``, from ``tmin`` on;
+    inf without a hit up to ``tmax``."""
+    m, d = sim.model, sim.data
+    world = move_points(dirs, rot, (0.0, 0.0, 0.0)).astype(np.float64)
+    n = len(world)
+    dist = np.empty(n)
+    geomid = np.empty(n, dtype=np.int32)
+    mujoco.mj_multiRay(m, d, pos + 0.0, world.ravel(), groups, 1, -1, geomid, dist, None, n, tmax)
+    dist[geomid < 0] = np.inf
+    near = np.flatnonzero(dist < tmin)
+    one = np.empty(1, dtype=np.int32)
+    for i in near:
+        r = mujoco.mj_ray(m, d, pos + tmin * world[i], world[i], groups, 1, -1, one)
+        dist[i] = tmin + r if r >= 0 else np.inf
+    dist[dist > tmax] = np.inf
+    return dist
 
 
 @functools.lru_cache(maxsize=16)
@@ -95,30 +106,39 @@ def _spherical_dirs(azimuths: tuple[float, ...], elevations: tuple[float, ...]) 
     return dirs
 
 
-def _pinhole(cfg: CameraConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(ray directions, their cosine to the optical axis, grid params) of a camera (directions cached by geometry)."""
-    cam = cfg.camera
-    dirs = _pinhole_dirs(cam.width, cam.height, cam.focal_length)
-    params = np.array([cam.focal_length, (cam.width - 1) / 2.0, (cam.height - 1) / 2.0])
-    return dirs, dirs[:, 0], params
+@functools.lru_cache(maxsize=16)
+def _pinhole_norm(width: int, height: int, focal: float) -> np.ndarray:
+    """Length (height x width) of each pixel's ray (1, -(u - u0)/f, -(v - v0)/f): 1 / cos(angle to the axis)."""
+    norm = 1.0 / _pinhole_dirs(width, height, focal)[:, 0].reshape(height, width)
+    norm.flags.writeable = False
+    return norm
 
 
 def depth_image(sim: Simulation, cfg: CameraConfig, rng: np.random.Generator | None = None) -> np.ndarray:
     """Depth (float32, height x width, m along the optical axis) as ``gazebo_ros_openni_kinect`` publishes it:
-    surfaces between the clip planes, plus the ``<camera><noise>`` (m, from ``rng``), and NaN where the depth
-    is not inside (``pointCloudCutoff``, ``pointCloudCutoffMax``)."""
+    surfaces between the clip planes, plus the ``<camera><noise>`` (m, drawn from a stream seeded by ``rng``), and
+    NaN where the depth is not inside (``pointCloudCutoff``, ``pointCloudCutoffMax``). Primitive shapes are drawn
+    into a depth buffer (:mod:`navlab.sim.raster`); meshes are ray cast."""
     cam = cfg.camera
-    dirs, cos, params = _pinhole(cfg)
+    norm = _pinhole_norm(cam.width, cam.height, cam.focal_length)
     pos, rot = sensor_pose(sim, cfg.link, cfg.origin)
-    # rays begin at the near clip plane and end at the far one (depth = t cos)
-    t = cast(sim, pos, rot, dirs, cam.height, cam.width, PINHOLE, params, cam.near / 1.0, cam.far / cos.min())
-    depth = t * cos
-    depth[depth > cam.far] = np.inf
-    depth[t * cos < cam.near] = np.inf
-    if cam.noise_stddev > 0 and rng is not None:
-        depth += cam.noise_mean + cam.noise_stddev * rng.standard_normal(depth.shape)
-    out = depth.astype(np.float32).reshape(cam.height, cam.width)
-    out[~((out > cfg.point_cloud_cutoff) & (out < cfg.point_cloud_cutoff_max))] = np.nan
+    tmax = cam.far * float(norm.max())  # the longest ray that can end before the far clip
+    m, d = sim.model, sim.data
+    fast, slow = sim.ray_geoms()
+    depth = np.empty((cam.height, cam.width))
+    params = np.array([cam.focal_length, (cam.width - 1) / 2.0, (cam.height - 1) / 2.0])
+    draw_depth(pos, rot, params, norm, fast, m.geom_type, m.geom_size, d.geom_xpos, d.geom_xmat, cam.near, tmax, depth)
+    if slow is not None:  # meshes: rays along the unit directions, their distances turned into depths
+        dirs = _pinhole_dirs(cam.width, cam.height, cam.focal_length)
+        t = _cast_meshes(sim, pos, rot, dirs, slow, cam.near, tmax).reshape(depth.shape)
+        np.minimum(depth, t / norm, out=depth)
+    noisy = cam.noise_stddev > 0 and rng is not None
+    seed = seed_state(rng) if noisy and rng is not None else np.uint64(0)
+    out = np.empty(depth.shape, dtype=np.float32)
+    std = cam.noise_stddev if noisy else 0.0
+    finish_depth(
+        depth, cam.near, cam.far, cam.noise_mean, std, seed, cfg.point_cloud_cutoff, cfg.point_cloud_cutoff_max, out
+    )
     return out
 
 
