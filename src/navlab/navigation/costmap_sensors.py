@@ -111,7 +111,7 @@ class CostmapSensorFeeds:
             place = self._in_costmap(frame, msgs.stamp_ns(msg))
             if place is None:
                 continue
-            pts = scan_points(msg) if msgs.type_name(msg).endswith("LaserScan") else read_xyz(msg)
+            pts = scan_points(msg) if msgs.type_name(msg).endswith("LaserScan") else read_xyz(msg, copy=False)
             origin, rot = place
             self.voxel[k].add_cloud(origin, move_points(pts, rot, origin), source=src_name)  # NaNs: skipped there
         self.pending.clear()

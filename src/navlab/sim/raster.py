@@ -35,32 +35,31 @@ def _face(
     near: float,
     clip_x: float,
     cam: np.ndarray,
-    p: np.ndarray,
-    a: np.ndarray,
-    bc: np.ndarray,
-    br: np.ndarray,
+    geo: np.ndarray,
     g: np.ndarray,
     k: int,
     level: float,
     ej: float,
     el: float,
     disk: bool,
-    poly: np.ndarray,
-    proj: np.ndarray,
 ) -> None:
     """Draw the face ``q_k = level`` of a geom (geom-frame point q; in-plane half extents ``ej``, ``el`` along the
-    next two axes, or a disk of radius ``ej``) seen from ``p`` (the camera in the geom frame). The pixel ray in the
-    geom frame is ``a + bc c + br r``; ``g`` (3x3) turns geom-frame offsets into the sensor frame."""
+    next two axes, or a disk of radius ``ej``). ``geo`` rows: the camera p in the geom frame, then a, bc, br (the
+    pixel ray in the geom frame is ``a + bc c + br r``); ``g`` (3x3) turns geom-frame offsets into the sensor
+    frame; ``cam`` = (f, u0, v0)."""
     rows, cols = out.shape
     f, u0, v0 = cam[0], cam[1], cam[2]
-    j, l = (k + 1) % 3, (k + 2) % 3
+    p, a, bc, br = geo[0], geo[1], geo[2], geo[3]
+    poly = np.empty((4, 3))
+    proj = np.empty((5, 2))
+    j, jj = (k + 1) % 3, (k + 2) % 3
     # the outline (a rectangle; a disk's bounding square) in the sensor frame, in order around it
     n = 0
     for corner in range(4):
         sj = -1.0 if corner == 0 or corner == 3 else 1.0
         sl = -1.0 if corner < 2 else 1.0
         dq0, dq1, dq2 = 0.0, 0.0, 0.0
-        off_k, off_j, off_l = level - p[k], sj * ej - p[j], sl * el - p[l]
+        off_k, off_j, off_l = level - p[k], sj * ej - p[j], sl * el - p[jj]
         if k == 0:
             dq0, dq1, dq2 = off_k, off_j, off_l
         elif k == 1:
@@ -107,7 +106,7 @@ def _face(
             continue
         c0 = max(math.floor(max(umin, -1.0)), 0)
         c1 = min(math.ceil(min(umax, cols + 0.0)), cols - 1)
-        ak, aj, al = a[k] + br[k] * r, a[j] + br[j] * r, a[l] + br[l] * r
+        ak, aj, ajj = a[k] + br[k] * r, a[j] + br[j] * r, a[jj] + br[jj] * r
         for c in range(c0, c1 + 1):
             dk = ak + bc[k] * c
             if dk == 0.0:
@@ -116,11 +115,11 @@ def _face(
             if s <= 0.0 or s >= out[r, c]:
                 continue
             qj = p[j] + s * (aj + bc[j] * c)
-            ql = p[l] + s * (al + bc[l] * c)
+            qjj = p[jj] + s * (ajj + bc[jj] * c)
             if disk:
-                if qj * qj + ql * ql > ej * ej:
+                if qj * qj + qjj * qjj > ej * ej:
                     continue
-            elif abs(qj) > ej or abs(ql) > el:
+            elif abs(qj) > ej or abs(qjj) > el:
                 continue
             if s * norm[r, c] >= near:
                 out[r, c] = s
@@ -193,13 +192,9 @@ def draw_depth(
     out[:] = np.inf
     f, u0, v0 = cam[0], cam[1], cam[2]
     clip_x = near * 0.999 / max(norm[0, 0], norm[rows - 1, cols - 1], norm[0, cols - 1], norm[rows - 1, 0])
-    p = np.empty(3)
-    a = np.empty(3)
-    bc = np.empty(3)
-    br = np.empty(3)
+    geo = np.empty((4, 3))  # the camera in the geom frame, then the pixel ray's a, bc, br (see _face)
+    p, a, bc, br = geo[0], geo[1], geo[2], geo[3]
     g = np.empty((3, 3))
-    poly = np.empty((4, 3))
-    proj = np.empty((5, 2))
     bounds = np.zeros(5, dtype=np.int64)
     params = np.array([f, u0, v0])
     for gi in range(geoms.shape[0]):
@@ -227,21 +222,21 @@ def draw_depth(
                 ej, el = size[0], size[1]
             else:  # unbounded: a square reaching past the far clip
                 ej = el = abs(p[0]) + abs(p[1]) + tmax + _PLANE_REACH
-            _face(out, norm, near, clip_x, cam, p, a, bc, br, g, 2, 0.0, ej, el, False, poly, proj)
+            _face(out, norm, near, clip_x, cam, geo, g, 2, 0.0, ej, el, False)
         elif kind == BOX:
             for k in range(3):
                 for side in (-1.0, 1.0):
                     if side * p[k] > size[k]:  # the face turned towards the camera
-                        j, l = (k + 1) % 3, (k + 2) % 3
-                        _face(out, norm, near, clip_x, cam, p, a, bc, br, g, k, side * size[k], size[j], size[l], False, poly, proj)
-        elif kind == CYLINDER or kind == SPHERE:
+                        ej, el = size[(k + 1) % 3], size[(k + 2) % 3]
+                        _face(out, norm, near, clip_x, cam, geo, g, k, side * size[k], ej, el, False)
+        elif kind in (CYLINDER, SPHERE):
             if not _block(kind, size, geom_xpos[gid], xm, rot, origin, PINHOLE, params, rows, cols, bounds):
                 continue
             _curved(out, norm, near, kind, size, p, a, bc, br, bounds)
             if kind == CYLINDER:
                 for side in (-1.0, 1.0):
                     if side * p[2] > size[1]:  # the cap turned towards the camera
-                        _face(out, norm, near, clip_x, cam, p, a, bc, br, g, 2, side * size[1], size[0], size[0], True, poly, proj)
+                        _face(out, norm, near, clip_x, cam, geo, g, 2, side * size[1], size[0], size[0], True)
 
 
 @njit(cache=True)
@@ -272,3 +267,35 @@ def finish_depth(
                 d += noise_mean + noise_stddev * n
             v = np.float32(d)
             out[r, c] = v if cutoff < v < cutoff_max else np.nan
+
+
+@njit(cache=True)
+def depth_cloud(depth: np.ndarray, focal: float, rgb: np.ndarray, words: np.ndarray, bits: np.ndarray) -> bool:
+    """Fill the organised cloud of a depth image (m, float32, NaN: no point): ``words`` (height*width x 8,
+    float32) x y z at 0 1 2 in the optical frame (x right, y down, z forward: x = d (c - u0)/f, y = d (r - v0)/f,
+    z = d, as ``FillPointCloudHelper``), word 4 PCL's packed b g r from ``rgb`` (height x width x 3, or 0 rows: 0),
+    the rest 0; ``bits`` is the same buffer as uint32. Returns whether every point is finite (``is_dense``)."""
+    rows, cols = depth.shape
+    colour = rgb.shape[0] == rows and rgb.shape[1] == cols
+    u0, v0 = np.float32(0.5 * (cols - 1)), np.float32(0.5 * (rows - 1))
+    fl = np.float32(focal)
+    dense = True
+    for r in range(rows):
+        ys = (np.float32(r) - v0) / fl
+        for c in range(cols):
+            i = r * cols + c
+            d = depth[r, c]
+            words[i, 0] = d * ((np.float32(c) - u0) / fl)
+            words[i, 1] = d * ys
+            words[i, 2] = d
+            bits[i, 3] = 0
+            if colour:
+                bits[i, 4] = np.uint32(rgb[r, c, 2]) | (np.uint32(rgb[r, c, 1]) << 8) | (np.uint32(rgb[r, c, 0]) << 16)
+            else:
+                bits[i, 4] = 0
+            bits[i, 5] = 0
+            bits[i, 6] = 0
+            bits[i, 7] = 0
+            if d != d:
+                dense = False
+    return dense

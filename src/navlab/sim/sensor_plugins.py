@@ -19,13 +19,16 @@ from navlab.core import Executor, Node
 from navlab.description.model import Origin
 from navlab.description.sensor_model import BumperConfig, CameraConfig, Lidar3dConfig, RangeConfig, SensorConfig
 from navlab.geometry import qmul, quat_from_rpy
-from navlab.io.pointcloud import FLOAT32, UINT16, pack_cloud
-from navlab.sim.sensors3d import depth_image, depth_points, lidar3d_angles, lidar3d_ranges, range_reading, sensor_pose
+from navlab.io.pointcloud import FLOAT32, UINT16, cloud_message, pack_cloud, point_field
+from navlab.sim.raster import depth_cloud
+from navlab.sim.sensors3d import depth_image, lidar3d_angles, lidar3d_ranges, range_reading, sensor_pose
 from navlab.sim.simulation import Simulation
 
 ENCODINGS = {"R8G8B8": ("rgb8", 3), "B8G8R8": ("bgr8", 3), "L8": ("mono8", 1)}
 OPTICAL = quat_from_rpy(-math.pi / 2, 0.0, -math.pi / 2)  # camera body frame -> optical frame
 C = TypeVar("C", bound=SensorConfig)
+# the openni_kinect cloud's fields: setPointCloud2FieldsByString(2, "xyz", "rgb"), 32-byte points
+DEPTH_FIELDS = [point_field(name, offset, FLOAT32) for name, offset in (("x", 0), ("y", 4), ("z", 8), ("rgb", 16))]
 
 
 class SensorNode(Node, Generic[C]):
@@ -209,11 +212,10 @@ class DepthCameraPlugin(CameraPlugin):
     def cloud(self, depth: np.ndarray, stamp_ns: int) -> Any:
         """The organised PointCloud2 of a depth image (rgb from the last colour image when sizes match, else 0)."""
         h, w = depth.shape
-        pts = depth_points(depth, self.cam).reshape(-1, 3)
-        rgb = np.zeros((h * w, 4), dtype=np.uint8)
-        if self.last_image is not None and self.last_image.shape[:2] == (h, w):
-            rgb[:, :3] = self.last_image.reshape(-1, 3)[:, ::-1]  # PCL packs b, g, r
-        return self.cloud_msg(stamp_ns, pts, {"rgb": (16, FLOAT32, rgb.view(np.float32).reshape(-1))}, h, w)
+        rgb = self.last_image if self.last_image is not None else np.zeros((0, 0, 3), np.uint8)
+        words = np.empty((h * w, 8), dtype=np.float32)
+        dense = depth_cloud(depth, self.cam.camera.focal_length, rgb, words, words.view(np.uint32))
+        return cloud_message(stamp_ns, self.frame_id, words, DEPTH_FIELDS, height=h, width=w, dense=dense)
 
 
 class VelodynePlugin(SensorNode[Lidar3dConfig]):
