@@ -19,16 +19,19 @@ from navlab.core import Executor, Node
 from navlab.description.model import Origin
 from navlab.description.sensor_model import BumperConfig, CameraConfig, Lidar3dConfig, RangeConfig, SensorConfig
 from navlab.geometry import qmul, quat_from_rpy
-from navlab.io.pointcloud import FLOAT32, UINT16, cloud_message, pack_cloud, point_field
+from navlab.io.pointcloud import FLOAT32, UINT16, cloud_message, point_field
 from navlab.sim.raster import depth_cloud
 from navlab.sim.sensors3d import depth_image, lidar3d_angles, lidar3d_ranges, range_reading, sensor_pose
 from navlab.sim.simulation import Simulation
+from navlab.sim.sweep import scan_cloud
 
 ENCODINGS = {"R8G8B8": ("rgb8", 3), "B8G8R8": ("bgr8", 3), "L8": ("mono8", 1)}
 OPTICAL = quat_from_rpy(-math.pi / 2, 0.0, -math.pi / 2)  # camera body frame -> optical frame
 C = TypeVar("C", bound=SensorConfig)
 # the openni_kinect cloud's fields: setPointCloud2FieldsByString(2, "xyz", "rgb"), 32-byte points
 DEPTH_FIELDS = [point_field(name, offset, FLOAT32) for name, offset in (("x", 0), ("y", 4), ("z", 8), ("rgb", 16))]
+# GazeboRosVelodyneLaser's: x y z intensity (float32) and ring (uint16) in 32-byte points
+VELODYNE_FIELDS = [*DEPTH_FIELDS[:3], point_field("intensity", 16, FLOAT32), point_field("ring", 20, UINT16)]
 
 
 class SensorNode(Node, Generic[C]):
@@ -76,12 +79,6 @@ class SensorNode(Node, Generic[C]):
     def read(self, *pubs: Any) -> bool:
         """Whether any of ``pubs`` has a subscriber, or a recorder/viewer listens."""
         return self.executor.has_listeners or any(p.get_subscription_count() for p in pubs)
-
-    def cloud_msg(self, stamp_ns: int, pts: np.ndarray, extra: dict[str, Any], height: int, width: int) -> Any:
-        """``sensor_msgs/PointCloud2`` in the sensor's frame: float32 x y z at offsets 0 4 8 (``pts``, n x 3), then
-        the ``extra`` fields (name: (offset, datatype, values), as :func:`navlab.io.pointcloud.pack_cloud`)."""
-        fields = {"x": (0, FLOAT32, pts[:, 0]), "y": (4, FLOAT32, pts[:, 1]), "z": (8, FLOAT32, pts[:, 2])}
-        return pack_cloud(stamp_ns, self.frame_id, {**fields, **extra}, height=height, width=width)
 
     def update(self) -> None:
         """One sensor update."""
@@ -235,7 +232,6 @@ class VelodynePlugin(SensorNode[Lidar3dConfig]):
             ],
             axis=-1,
         )
-        self.ring = np.broadcast_to(np.arange(len(el), dtype=np.uint16)[:, None], (len(el), len(az)))
 
     def update(self) -> None:
         if self.read(self.pub):
@@ -244,20 +240,15 @@ class VelodynePlugin(SensorNode[Lidar3dConfig]):
     def cloud(self, ranges: np.ndarray, stamp_ns: int) -> Any:
         """The plugin's cloud from ranges (rings x samples); organised (NaN: dropped) if ``organize_cloud``."""
         c = self.lidar
+        words = np.empty((ranges.size, 8), dtype=np.float32)
         lo = max(c.min_range, c.range_min)
         hi = min(c.max_range, c.range_max - c.range_min - 0.01)
-        r = np.minimum(ranges, c.range_max - c.range_min)
-        keep = (lo < r) & (r < hi)
-        xyz = (r[..., None] * self.unit).astype(np.float32)
-        if c.organize_cloud:
-            xyz[~keep] = np.nan
-            pts, rings = xyz.reshape(-1, 3), self.ring.reshape(-1)
-            height, width = c.rings, c.samples
-        else:
-            pts, rings = xyz[keep], self.ring[keep]
-            height, width = 1, len(pts)
-        extra = {"intensity": (16, FLOAT32, np.zeros(len(pts), np.float32)), "ring": (20, UINT16, rings)}
-        return self.cloud_msg(stamp_ns, pts, extra, height, width)
+        cap = c.range_max - c.range_min
+        n = scan_cloud(ranges, self.unit, lo, hi, cap, c.organize_cloud, words, words.view(np.uint32))
+        height, width = (c.rings, c.samples) if c.organize_cloud else (1, n)
+        dense = n == 0 or not np.isnan(words[:n, 0]).any()
+        fields = VELODYNE_FIELDS
+        return cloud_message(stamp_ns, self.frame_id, words[:n], fields, height=height, width=width, dense=dense)
 
 
 class RangePlugin(SensorNode[RangeConfig]):

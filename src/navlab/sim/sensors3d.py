@@ -19,8 +19,9 @@ from navlab.geometry import matrix_from_quat, qmul, qrotate, quat_from_rpy
 from navlab.io.pointcloud import move_points
 from navlab.sim.gauss import seed_state
 from navlab.sim.raster import draw_depth, finish_depth
-from navlab.sim.raycast3d import ALL, SPHERICAL, cast_grid, pinhole_dirs, spherical_dirs
+from navlab.sim.raycast3d import ALL, cast_grid, pinhole_dirs, spherical_dirs
 from navlab.sim.simulation import Simulation
+from navlab.sim.sweep import finish_scan, sweep_grid
 
 
 def sensor_pose(sim: Simulation, link: str, origin: Origin) -> tuple[np.ndarray, np.ndarray]:
@@ -167,21 +168,49 @@ def lidar3d_angles(cfg: Lidar3dConfig) -> tuple[np.ndarray, np.ndarray]:
     return az, el
 
 
+@functools.lru_cache(maxsize=16)
+def _trig(angles: tuple[float, ...]) -> tuple[np.ndarray, np.ndarray]:
+    a = np.array(angles)
+    c, s = np.cos(a), np.sin(a)
+    c.flags.writeable = s.flags.writeable = False
+    return c, s
+
+
 def lidar3d_ranges(sim: Simulation, cfg: Lidar3dConfig, rng: np.random.Generator | None = None) -> np.ndarray:
     """Ranges (rings x samples, m) of a 3D lidar: the sensor's ray hits from ``range_min`` with noise added
-    (``rng``); misses are ``range_max``, as Gazebo's ray sensor reports them."""
+    (drawn from a stream seeded by ``rng``); misses are ``range_max``, as Gazebo's ray sensor reports them.
+    Primitive shapes are swept block by block (:mod:`navlab.sim.sweep`); meshes are ray cast."""
     az, el = lidar3d_angles(cfg)
-    dirs = _spherical_dirs(tuple(az.tolist()), tuple(el.tolist()))
-    d_az = (az[-1] - az[0]) / (len(az) - 1) if len(az) > 1 else 0.0
-    d_el = (el[-1] - el[0]) / (len(el) - 1) if len(el) > 1 else 0.0
-    params = np.array([az[0], d_az, el[0], d_el])
+    cos_az, sin_az = _trig(tuple(az.tolist()))
+    cos_el, sin_el = _trig(tuple(el.tolist()))
     pos, rot = sensor_pose(sim, cfg.link, cfg.origin)
-    r = cast(sim, pos, rot, dirs, cfg.rings, cfg.samples, SPHERICAL, params, cfg.range_min, cfg.range_max)
-    hit = np.isfinite(r)
-    if cfg.noise_stddev > 0 and rng is not None:
-        r[hit] += cfg.noise_stddev * rng.standard_normal(int(hit.sum()))
-    r[~hit] = cfg.range_max
-    return r.reshape(cfg.rings, cfg.samples)
+    m, d = sim.model, sim.data
+    fast, slow = sim.ray_geoms()
+    r = np.empty((cfg.rings, cfg.samples))
+    sweep_grid(
+        pos,
+        rot,
+        cos_az,
+        sin_az,
+        cos_el,
+        sin_el,
+        fast,
+        m.geom_type,
+        m.geom_size,
+        d.geom_xpos,
+        d.geom_xmat,
+        cfg.range_min,
+        cfg.range_max,
+        r,
+    )
+    if slow is not None:
+        dirs = _spherical_dirs(tuple(az.tolist()), tuple(el.tolist()))
+        t = _cast_meshes(sim, pos, rot, dirs, slow, cfg.range_min, cfg.range_max)
+        np.minimum(r, t.reshape(r.shape), out=r)
+    noisy = cfg.noise_stddev > 0 and rng is not None
+    seed = seed_state(rng) if noisy and rng is not None else np.uint64(0)
+    finish_scan(r, cfg.noise_stddev if noisy else 0.0, seed, cfg.range_max)
+    return r
 
 
 def range_rays(cfg: RangeConfig) -> np.ndarray:

@@ -1,4 +1,5 @@
-"""The depth buffer (sim/raster.py) against the exact ray caster, ray by ray, and its seeded noise."""
+"""The depth buffer (sim/raster.py) and the lidar sweep (sim/sweep.py) against the exact ray caster, ray by ray
+(every ray against every geom), and their seeded noise."""
 
 from __future__ import annotations
 
@@ -11,7 +12,8 @@ from navlab.geometry import matrix_from_quat, quat_from_rpy
 from navlab.sim.gauss import fill_normal, seed_state
 from navlab.sim.raster import draw_depth, finish_depth
 from navlab.sim.raycast import BOX, CYLINDER, PLANE, SPHERE
-from navlab.sim.raycast3d import ALL, cast_grid, pinhole_dirs
+from navlab.sim.raycast3d import ALL, cast_grid, pinhole_dirs, spherical_dirs
+from navlab.sim.sweep import finish_scan, sweep_grid
 
 W, H, FOV, NEAR = 96, 72, 1.4, 0.05
 
@@ -68,6 +70,36 @@ def test_drawn_depth_equals_the_ray_cast_of_every_pixel(seed: int) -> None:
     assert seen_px > W * H  # surfaces in view, not an empty comparison
 
 
+@pytest.mark.parametrize(
+    ("az_span", "samples", "rings"), [((-math.pi, math.pi), 360, 16), ((-1.2, 0.9), 151, 7), ((2.5, 4.0), 40, 1)]
+)
+def test_swept_lidar_equals_the_ray_cast_of_every_ray(az_span: tuple[float, float], samples: int, rings: int) -> None:
+    rng = np.random.default_rng(samples)
+    az = np.linspace(*az_span, samples)
+    el = np.linspace(-0.4, 0.3, rings) if rings > 1 else np.array([0.05])
+    dirs = spherical_dirs(az, el)
+    hits = 0
+    for _ in range(4):
+        kinds, sizes, centres, mats = _scene(rng)
+        geoms = np.arange(len(kinds), dtype=np.int32)
+        for _ in range(6):  # level, tilted, upside down; inside shapes or not
+            pos = np.array([rng.uniform(-3, 3), rng.uniform(-3, 3), rng.uniform(-0.3, 1.5)])
+            rot = matrix_from_quat(quat_from_rpy(*rng.uniform(-math.pi, math.pi, 3)))
+            every = np.empty(len(dirs))
+            cast_grid(
+                pos, rot, dirs, 1, len(dirs), ALL, np.zeros(4), geoms, kinds, sizes, centres, mats, 0.3, 9.0, every
+            )
+            swept = np.empty((len(el), len(az)))
+            trig = np.cos(az), np.sin(az), np.cos(el), np.sin(el)
+            sweep_grid(pos, rot, *trig, geoms, kinds, sizes, centres, mats, 0.3, 9.0, swept)
+            every = every.reshape(swept.shape)
+            assert (np.isfinite(every) != np.isfinite(swept)).sum() <= 2  # a ray exactly along an edge
+            both = np.isfinite(every) & np.isfinite(swept)
+            assert np.abs(every[both] - swept[both]).max(initial=0.0) < 1e-9
+            hits += int(both.sum())
+    assert hits > 2 * len(dirs)
+
+
 def test_a_camera_inside_a_box_or_nearer_than_the_clip_sees_past_it() -> None:
     box = (np.array([BOX], np.int32), np.array([[0.5, 0.5, 0.5]]), np.zeros((1, 3)), np.eye(3).reshape(1, 9))
     inside, _ = _views(np.zeros(3), np.eye(3), box, 10.0)
@@ -88,6 +120,9 @@ def test_noise_is_seeded_gaussian_and_the_cutoffs_apply() -> None:
     assert np.isnan(a[0, :3]).all()
     noise = (a.astype(np.float64) - 2.0)[1:]
     assert abs(noise.mean()) < 2e-4 and noise.std() == pytest.approx(0.01, rel=0.02)
+    ranges = np.array([[1.0, np.inf, 2.0], [np.inf, 3.0, 4.0]])
+    finish_scan(ranges, 0.0, np.uint64(0), 30.0)
+    assert ranges.tolist() == [[1.0, 30.0, 2.0], [30.0, 3.0, 4.0]]  # misses at range_max, no noise: hits as they are
     draws = np.empty(400_000)
     fill_normal(seed_state(np.random.default_rng(0)), draws)
     assert abs(draws.mean()) < 0.01 and draws.std() == pytest.approx(1.0, abs=0.01)
