@@ -80,6 +80,7 @@ def observe(
     cost: np.ndarray,
     origin: np.ndarray,
     pts: np.ndarray,
+    place: np.ndarray,
     base: np.ndarray,
     scale: np.ndarray,
     clearing: bool,
@@ -92,72 +93,74 @@ def observe(
     unknown_threshold: int,
     free: np.uint8,
     lethal: np.uint8,
-    seen: np.ndarray,
+    flags: np.ndarray,
 ) -> None:
-    """One observation: the sensor at ``origin`` and its points ``pts`` (N x 3, m, NaN: skipped), both in the
-    costmap frame; the grid's lowest corner is ``base`` and a voxel ``scale`` (m) in size. ``seen`` is scratch
-    (one flag per voxel, all false, and left so).
+    """One observation: the sensor at ``origin`` (costmap frame) and its points ``pts`` (N x 3 or wider, any
+    strides; m; NaN: skipped) in a frame placed by ``place`` (4 x 3: rows 0-2 the rotation into the costmap frame,
+    row 3 the translation); the grid's lowest corner is ``base`` and a voxel ``scale`` (m) in size. ``flags`` is
+    scratch (a uint8 per voxel, all 0, and left so).
 
     Clearing: each voxel where a ray ends — cut at ``raytrace_range`` and where it leaves the grid — is traced once,
     from the origin to that voxel's centre (rays ending in the same voxel trace the same cells). Marking, after it:
     the voxel of each point nearer than ``obstacle_range`` with its height in [``min_z``, ``max_z``]; its cell
-    turns ``lethal`` when its column holds more than ``mark_threshold`` marked voxels."""
+    turns ``lethal`` when its column holds more than ``mark_threshold`` marked voxels. One pass over the points
+    finds both sets of voxels (each voxel once)."""
     h, w = columns.shape
-    nz = seen.shape[0] // (h * w)
-    dims = (w, h, nz)
+    nz = flags.shape[0] // (h * w)
     n = pts.shape[0]
-    if clearing:
-        ends = np.empty(n, dtype=np.int64)
-        count = 0
-        lo = np.empty(3)
-        hi = np.empty(3)
-        for a in range(3):
-            lo[a] = base[a] + 1e-6
-            hi[a] = base[a] + dims[a] * scale[a] - 1e-6
-        r2 = raytrace_range * raytrace_range
-        for k in range(n):
-            px, py, pz = pts[k, 0], pts[k, 1], pts[k, 2]
-            dx, dy, dz = px - origin[0], py - origin[1], pz - origin[2]
-            if not (math.isfinite(dx) and math.isfinite(dy) and math.isfinite(dz)):
-                continue
-            d2 = dx * dx + dy * dy + dz * dz
-            if not (d2 <= r2 and lo[0] <= px <= hi[0] and lo[1] <= py <= hi[1] and lo[2] <= pz <= hi[2]):
-                t = 1.0 if d2 <= r2 else raytrace_range / math.sqrt(d2)
-                for a, da in ((0, dx), (1, dy), (2, dz)):
-                    if da > 0:
-                        t = min(t, (hi[a] - origin[a]) / da)
-                    elif da < 0:
-                        t = min(t, (lo[a] - origin[a]) / da)
-                t = max(t, 0.0)
-                px, py, pz = origin[0] + t * dx, origin[1] + t * dy, origin[2] + t * dz
-            i = min(max(math.floor((px - base[0]) / scale[0]), 0), w - 1)
-            j = min(max(math.floor((py - base[1]) / scale[1]), 0), h - 1)
-            m = min(max(math.floor((pz - base[2]) / scale[2]), 0), nz - 1)
+    ends = np.empty(n if clearing else 0, dtype=np.int64)
+    marks = np.empty(n if marking else 0, dtype=np.int64)
+    n_ends = n_marks = 0
+    ox, oy, oz = origin[0], origin[1], origin[2]
+    lx, ly, lz = base[0] + 1e-6, base[1] + 1e-6, base[2] + 1e-6
+    hx, hy, hz = base[0] + w * scale[0] - 1e-6, base[1] + h * scale[1] - 1e-6, base[2] + nz * scale[2] - 1e-6
+    rr2, or2 = raytrace_range * raytrace_range, obstacle_range * obstacle_range
+    for k in range(n):
+        qx, qy, qz = np.float64(pts[k, 0]), np.float64(pts[k, 1]), np.float64(pts[k, 2])
+        px = place[0, 0] * qx + place[0, 1] * qy + place[0, 2] * qz + place[3, 0]
+        py = place[1, 0] * qx + place[1, 1] * qy + place[1, 2] * qz + place[3, 1]
+        pz = place[2, 0] * qx + place[2, 1] * qy + place[2, 2] * qz + place[3, 2]
+        dx, dy, dz = px - ox, py - oy, pz - oz
+        d2 = dx * dx + dy * dy + dz * dz
+        if not math.isfinite(d2):
+            continue
+        i = math.floor((px - base[0]) / scale[0])
+        j = math.floor((py - base[1]) / scale[1])
+        m = math.floor((pz - base[2]) / scale[2])
+        if marking and d2 < or2 and min_z <= pz <= max_z and 0 <= i < w and 0 <= j < h and 0 <= m < nz:
             key = (m * h + j) * w + i
-            if not seen[key]:
-                seen[key] = True
-                ends[count] = key
-                count += 1
-        ox, oy = (origin[0] - base[0]) / scale[0], (origin[1] - base[1]) / scale[1]
-        oz = (origin[2] - base[2]) / scale[2]
-        for e in range(count):
-            key = ends[e]
-            seen[key] = False
-            i, j, m = key % w, (key // w) % h, key // (w * h)
-            clear_ray(columns, cost, ox, oy, oz, i + 0.5, j + 0.5, m + 0.5, nz, mark_threshold, unknown_threshold, free)
-    if marking:
-        r2 = obstacle_range * obstacle_range
-        for k in range(n):
-            x, y, z = pts[k, 0], pts[k, 1], pts[k, 2]
-            dx, dy, dz = x - origin[0], y - origin[1], z - origin[2]
-            if not (dx * dx + dy * dy + dz * dz < r2 and min_z <= z <= max_z):
-                continue  # NaN fails too
-            i = math.floor((x - base[0]) / scale[0])
-            j = math.floor((y - base[1]) / scale[1])
-            m = math.floor((z - base[2]) / scale[2])
-            if i < 0 or j < 0 or m < 0 or i >= w or j >= h or m >= nz:
-                continue
-            col = np.int64(columns[j, i]) | np.int64((1 << m) | (1 << (m + 16)))
-            columns[j, i] = col
-            if popcount16(col >> 16) > mark_threshold:
-                cost[j, i] = lethal
+            if not flags[key] & 2:
+                flags[key] |= 2
+                marks[n_marks] = key
+                n_marks += 1
+        if not clearing:
+            continue
+        if not (d2 <= rr2 and lx <= px <= hx and ly <= py <= hy and lz <= pz <= hz):  # cut the ray
+            t = 1.0 if d2 <= rr2 else raytrace_range / math.sqrt(d2)
+            t = min(t, (hx - ox) / dx) if dx > 0 else (min(t, (lx - ox) / dx) if dx < 0 else t)
+            t = min(t, (hy - oy) / dy) if dy > 0 else (min(t, (ly - oy) / dy) if dy < 0 else t)
+            t = min(t, (hz - oz) / dz) if dz > 0 else (min(t, (lz - oz) / dz) if dz < 0 else t)
+            t = max(t, 0.0)
+            i = math.floor((ox + t * dx - base[0]) / scale[0])
+            j = math.floor((oy + t * dy - base[1]) / scale[1])
+            m = math.floor((oz + t * dz - base[2]) / scale[2])
+        i, j, m = min(max(i, 0), w - 1), min(max(j, 0), h - 1), min(max(m, 0), nz - 1)
+        key = (m * h + j) * w + i
+        if not flags[key] & 1:
+            flags[key] |= 1
+            ends[n_ends] = key
+            n_ends += 1
+    gx, gy, gz = (ox - base[0]) / scale[0], (oy - base[1]) / scale[1], (oz - base[2]) / scale[2]
+    for e in range(n_ends):
+        key = ends[e]
+        flags[key] = 0
+        i, j, m = key % w, (key // w) % h, key // (w * h)
+        clear_ray(columns, cost, gx, gy, gz, i + 0.5, j + 0.5, m + 0.5, nz, mark_threshold, unknown_threshold, free)
+    for e in range(n_marks):
+        key = marks[e]
+        flags[key] = 0
+        i, j, m = key % w, (key // w) % h, key // (w * h)
+        col = np.int64(columns[j, i]) | np.int64((1 << m) | (1 << (m + 16)))
+        columns[j, i] = col
+        if popcount16(col >> 16) > mark_threshold:
+            cost[j, i] = lethal

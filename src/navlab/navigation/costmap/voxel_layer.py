@@ -81,7 +81,7 @@ class VoxelLayer(Layer):
         self.footprint = footprint or make_footprint()
         self.grid: Grid | None = None
         self.columns = np.zeros((0, 0), dtype=np.uint32)
-        self._seen = np.zeros(0, dtype=bool)  # observe()'s scratch: one flag per voxel
+        self._flags = np.zeros(0, dtype=np.uint8)  # observe()'s scratch: one per voxel
         self.robot_pose: tuple[float, float, float] | None = None
 
     @classmethod
@@ -128,21 +128,42 @@ class VoxelLayer(Layer):
     def add_cloud(self, origin_xyz: Any, points_xyz: np.ndarray, *, source: str | None = None) -> None:
         """One observation in the costmap frame: the sensor at ``origin_xyz`` and its points (N, 3), m; NaN points
         are skipped. ``source``: one of :attr:`sources` (its marking, clearing, ranges and heights apply)."""
+        self.add_sensor_cloud(origin_xyz, np.eye(3), points_xyz, source=source, moved=False)
+
+    def add_sensor_cloud(
+        self,
+        origin_xyz: Any,
+        rotation: np.ndarray,
+        points: np.ndarray,
+        *,
+        source: str | None = None,
+        moved: bool = True,
+    ) -> None:
+        """One observation with its points (N x 3 or wider, any strides: only x y z are read) in the sensor's
+        frame, which sits at ``origin_xyz`` turned by ``rotation`` (3 x 3) in the costmap frame; ``moved=False``:
+        the points are in the costmap frame already. Each point is moved as it is read (no copy of the cloud)."""
         if self.grid is None:
             raise NavigationError(f"{self.name}: no grid yet; call match_size(master) before add_cloud")
         src = self._source(source)
         o = np.asarray(origin_xyz, dtype=np.float64).reshape(3)
-        pts = np.asarray(points_xyz).reshape(-1, 3)
-        pts = np.ascontiguousarray(pts if pts.dtype in (np.float32, np.float64) else pts.astype(np.float64))
+        pts = np.asarray(points)
+        pts = pts.reshape(-1, 3) if pts.ndim != 2 else pts
+        if pts.dtype not in (np.float32, np.float64):
+            pts = pts.astype(np.float64)
+        place = np.zeros((4, 3))
+        place[:3] = rotation
+        if moved:
+            place[3] = o
         g, p = self.grid, self.params
         h, w = g.data.shape
-        if self._seen.shape[0] != h * w * p.z_voxels:
-            self._seen = np.zeros(h * w * p.z_voxels, dtype=bool)
+        if self._flags.shape[0] != h * w * p.z_voxels:
+            self._flags = np.zeros(h * w * p.z_voxels, dtype=np.uint8)
         observe(
             self.columns,
             g.data,
             o,
             pts,
+            place,
             np.array([g.origin[0], g.origin[1], p.origin_z]),
             np.array([g.resolution, g.resolution, p.z_resolution]),
             bool(src.clearing),
@@ -155,7 +176,7 @@ class VoxelLayer(Layer):
             p.unknown_threshold,
             np.uint8(COST_FREE),
             np.uint8(COST_LETHAL),
-            self._seen,
+            self._flags,
         )
 
     def _source(self, source: str | None) -> ObservationSource:
