@@ -74,7 +74,7 @@ def clear_ray(
             tz += tdz
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, error_model="numpy")
 def observe(
     columns: np.ndarray,
     cost: np.ndarray,
@@ -115,6 +115,7 @@ def observe(
     lx, ly, lz = base[0] + 1e-6, base[1] + 1e-6, base[2] + 1e-6
     hx, hy, hz = base[0] + w * scale[0] - 1e-6, base[1] + h * scale[1] - 1e-6, base[2] + nz * scale[2] - 1e-6
     rr2, or2 = raytrace_range * raytrace_range, obstacle_range * obstacle_range
+    inv0, inv1, inv2 = 1.0 / scale[0], 1.0 / scale[1], 1.0 / scale[2]
     for k in range(n):
         qx, qy, qz = np.float64(pts[k, 0]), np.float64(pts[k, 1]), np.float64(pts[k, 2])
         px = place[0, 0] * qx + place[0, 1] * qy + place[0, 2] * qz + place[3, 0]
@@ -124,27 +125,31 @@ def observe(
         d2 = dx * dx + dy * dy + dz * dz
         if not math.isfinite(d2):
             continue
-        i = math.floor((px - base[0]) / scale[0])
-        j = math.floor((py - base[1]) / scale[1])
-        m = math.floor((pz - base[2]) / scale[2])
-        if marking and d2 < or2 and min_z <= pz <= max_z and 0 <= i < w and 0 <= j < h and 0 <= m < nz:
-            key = (m * h + j) * w + i
-            if not flags[key] & 2:
-                flags[key] |= 2
-                marks[n_marks] = key
-                n_marks += 1
+        if marking and d2 < or2 and min_z <= pz <= max_z:
+            i = math.floor((px - base[0]) * inv0)
+            j = math.floor((py - base[1]) * inv1)
+            m = math.floor((pz - base[2]) * inv2)
+            if 0 <= i < w and 0 <= j < h and 0 <= m < nz:
+                key = (m * h + j) * w + i
+                if not flags[key] & 2:
+                    flags[key] |= 2
+                    marks[n_marks] = key
+                    n_marks += 1
         if not clearing:
             continue
-        if not (d2 <= rr2 and lx <= px <= hx and ly <= py <= hy and lz <= pz <= hz):  # cut the ray
-            t = 1.0 if d2 <= rr2 else raytrace_range / math.sqrt(d2)
+        # where the ray ends: t = min(1, range cut, the grid's faces) along d; the height cut without a branch
+        # (points scattered about the floor would make one unpredictable)
+        t = 1.0 if d2 <= rr2 else raytrace_range / math.sqrt(d2)
+        tz = ((hz if dz > 0 else lz) - oz) / dz
+        t = min(t, tz if dz != 0 else np.inf)
+        ex, ey = ox + t * dx, oy + t * dy
+        if not (lx <= ex <= hx and ly <= ey <= hy):
             t = min(t, (hx - ox) / dx) if dx > 0 else (min(t, (lx - ox) / dx) if dx < 0 else t)
             t = min(t, (hy - oy) / dy) if dy > 0 else (min(t, (ly - oy) / dy) if dy < 0 else t)
-            t = min(t, (hz - oz) / dz) if dz > 0 else (min(t, (lz - oz) / dz) if dz < 0 else t)
-            t = max(t, 0.0)
-            i = math.floor((ox + t * dx - base[0]) / scale[0])
-            j = math.floor((oy + t * dy - base[1]) / scale[1])
-            m = math.floor((oz + t * dz - base[2]) / scale[2])
-        i, j, m = min(max(i, 0), w - 1), min(max(j, 0), h - 1), min(max(m, 0), nz - 1)
+        t = max(t, 0.0)
+        i = min(max(math.floor((ox + t * dx - base[0]) * inv0), 0), w - 1)
+        j = min(max(math.floor((oy + t * dy - base[1]) * inv1), 0), h - 1)
+        m = min(max(math.floor((oz + t * dz - base[2]) * inv2), 0), nz - 1)
         key = (m * h + j) * w + i
         if not flags[key] & 1:
             flags[key] |= 1
