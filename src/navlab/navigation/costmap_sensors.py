@@ -122,11 +122,11 @@ class CostmapSensorFeeds:
                 continue
             pts = scan_points(msg) if msgs.type_name(msg).endswith("LaserScan") else read_xyz(msg, copy=False)
             origin, rot = place
-            layer = self.voxel[k]
-            if isinstance(layer, SensorFrameCloudLayer):  # moved point by point as the layer reads them
-                layer.add_sensor_cloud(origin, rot, pts, source=src_name)
-            else:
-                layer.add_cloud(origin, move_points(pts, rot, origin), source=src_name)  # NaNs: skipped there
+            cloud_layer = self.voxel[k]
+            if isinstance(cloud_layer, SensorFrameCloudLayer):  # moved point by point as the layer reads them
+                cloud_layer.add_sensor_cloud(origin, rot, pts, source=src_name)
+            else:  # NaNs: skipped there
+                cloud_layer.add_cloud(origin, move_points(pts, rot, origin), source=src_name)
         self.pending.clear()
         for k, pub in self.voxel_pubs.items():
             grid = self.voxel[k].voxel_grid_msg(self.node.executor.now_ns)

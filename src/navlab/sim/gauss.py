@@ -62,7 +62,7 @@ def _uniform(z: np.uint64) -> float:
 
 
 @njit(cache=True)
-def _tail_or_wedge(z: np.uint64, hz: int, iz: int) -> tuple[float, np.uint64]:
+def _tail_or_wedge(z: np.uint64, hz: np.int64, iz: int) -> tuple[float, np.uint64]:
     while True:
         x = hz * WN[iz]
         if iz == 0:  # the tail beyond R
