@@ -8,8 +8,7 @@ tf from their link (a camera's optical frame turned z forward, x right, y down).
 
 from __future__ import annotations
 
-import math
-from typing import Any, Generic, TypeVar
+from typing import Any
 
 import mujoco
 import numpy as np
@@ -17,72 +16,19 @@ import numpy as np
 from navlab import msgs
 from navlab.core import Executor, Node
 from navlab.description.model import Origin
-from navlab.description.sensor_model import BumperConfig, CameraConfig, Lidar3dConfig, RangeConfig, SensorConfig
-from navlab.geometry import qmul, quat_from_rpy
+from navlab.description.sensor_model import BumperConfig, CameraConfig, Lidar3dConfig, RangeConfig
 from navlab.io.pointcloud import FLOAT32, UINT16, cloud_message, point_field
+from navlab.sim.plugins import SensorPlugin
 from navlab.sim.raster import depth_cloud
 from navlab.sim.sensors3d import depth_image, lidar3d_angles, lidar3d_ranges, range_reading, sensor_pose
 from navlab.sim.simulation import Simulation
 from navlab.sim.sweep import scan_cloud
 
 ENCODINGS = {"R8G8B8": ("rgb8", 3), "B8G8R8": ("bgr8", 3), "L8": ("mono8", 1)}
-OPTICAL = quat_from_rpy(-math.pi / 2, 0.0, -math.pi / 2)  # camera body frame -> optical frame
-C = TypeVar("C", bound=SensorConfig)
 # the openni_kinect cloud's fields: setPointCloud2FieldsByString(2, "xyz", "rgb"), 32-byte points
 DEPTH_FIELDS = [point_field(name, offset, FLOAT32) for name, offset in (("x", 0), ("y", 4), ("z", 8), ("rgb", 16))]
 # GazeboRosVelodyneLaser's: x y z intensity (float32) and ring (uint16) in 32-byte points
 VELODYNE_FIELDS = [*DEPTH_FIELDS[:3], point_field("intensity", 16, FLOAT32), point_field("ring", 20, UINT16)]
-
-
-class SensorNode(Node, Generic[C]):
-    """What the sensor plugins share: the config, the node's name (default: the sensor's name + ``_plugin``),
-    a timer at the sensor's rate, its frame's static tf (turned to the optical frame if ``optical``);
-    a plugin adds its publishers in :meth:`setup`. ``parameters`` is accepted as every plugin's is, and unused."""
-
-    optical = False
-
-    def __init__(
-        self,
-        executor: Executor,
-        *,
-        name: str = "",
-        parameters: dict[str, Any] | None = None,
-        namespace: str = "",
-        sim: Simulation,
-        config: C,
-    ) -> None:
-        super().__init__(executor, name=name or f"{config.name}_plugin", namespace=namespace)
-        assert sim.robot is not None
-        self.sim, self.cfg = sim, config
-        self.frame_id = getattr(config, "frame_id", "") or config.link
-        if self.frame_id not in sim.robot.links and hasattr(config, "origin"):
-            o = config.origin
-            q = quat_from_rpy(*o.rpy)
-            self.send_static_transform(
-                [
-                    msgs.TransformStamped(
-                        header=msgs.header(executor.now_ns, config.link),
-                        child_frame_id=self.frame_id,
-                        transform=msgs.Transform(
-                            translation=msgs.Vector3(x=o.xyz[0], y=o.xyz[1], z=o.xyz[2]),
-                            rotation=msgs.quaternion_msg(qmul(q, OPTICAL) if self.optical else q),
-                        ),
-                    )
-                ]
-            )
-        self.create_timer(max(1.0 / config.update_rate, sim.timestep), self.update)
-        self.setup()
-
-    def setup(self) -> None:
-        """Create the plugin's publishers (``self.cfg`` its config)."""
-
-    def read(self, *pubs: Any) -> bool:
-        """Whether any of ``pubs`` has a subscriber, or a recorder/viewer listens."""
-        return self.executor.has_listeners or any(p.get_subscription_count() for p in pubs)
-
-    def update(self) -> None:
-        """One sensor update."""
-        raise NotImplementedError
 
 
 def camera_info(cfg: CameraConfig, stamp_ns: int, frame_id: str) -> Any:
@@ -104,7 +50,7 @@ def camera_info(cfg: CameraConfig, stamp_ns: int, frame_id: str) -> Any:
     )
 
 
-class CameraPlugin(SensorNode[CameraConfig]):
+class CameraPlugin(SensorPlugin[CameraConfig]):
     """``libgazebo_ros_camera.so`` (and the colour image of a depth camera): ``sensor_msgs/Image`` on
     ``image_topic`` and ``CameraInfo`` on ``camera_info_topic``, rendered offscreen (see
     :mod:`navlab.sim.camera_render`), with the ``<camera><noise>`` (std dev on the 0..1 scale) per pixel."""
@@ -215,7 +161,7 @@ class DepthCameraPlugin(CameraPlugin):
         return cloud_message(stamp_ns, self.frame_id, words, DEPTH_FIELDS, height=h, width=w, dense=dense)
 
 
-class VelodynePlugin(SensorNode[Lidar3dConfig]):
+class VelodynePlugin(SensorPlugin[Lidar3dConfig]):
     """``GazeboRosVelodyneLaser``: ``sensor_msgs/PointCloud2`` (x y z intensity ring, 32-byte points) of the points
     with ``max(min_range, range_min) < r < min(max_range, range_max - range_min - 0.01)``, ring 0 the lowest."""
 
@@ -251,7 +197,7 @@ class VelodynePlugin(SensorNode[Lidar3dConfig]):
         return cloud_message(stamp_ns, self.frame_id, words[:n], fields, height=height, width=width, dense=dense)
 
 
-class RangePlugin(SensorNode[RangeConfig]):
+class RangePlugin(SensorPlugin[RangeConfig]):
     """``gazebo_ros_range``: ``sensor_msgs/Range`` (ULTRASOUND 0 / INFRARED 1, ``field_of_view`` the plugin's
     ``<fov>``, min/max the ray sensor's range) with the nearest return of the sensor's rays."""
 
@@ -276,7 +222,7 @@ class RangePlugin(SensorNode[RangeConfig]):
         )
 
 
-class BumperPlugin(SensorNode[BumperConfig]):
+class BumperPlugin(SensorPlugin[BumperConfig]):
     """``gazebo_ros_bumper``: ``gazebo_msgs/ContactsState`` of the bumper link's contacts with anything but the
     floor (MuJoCo contacts of the link's body: position and normal in ``frameName``'s frame — ``world`` or a
     link — depth in m, contact force as the wrench), published every update even when empty (Noetic does)."""
@@ -316,7 +262,7 @@ class BumperPlugin(SensorNode[BumperConfig]):
             frame = con.frame.reshape(3, 3)
             f_world = frame.T @ force[:3] * (1 if mine[0] else -1)
             normal = frame[0] * (1 if mine[0] else -1)
-            wrench = msgs.Wrench(force=_vec(rot.T @ f_world), torque=_vec(np.zeros(3)))
+            wrench = msgs.Wrench(force=msgs.vector3(rot.T @ f_world), torque=msgs.vector3(np.zeros(3)))
             out.append(
                 msgs.ContactState(
                     info=f"Debug:  i:({i}/{d.ncon})",
@@ -324,16 +270,12 @@ class BumperPlugin(SensorNode[BumperConfig]):
                     collision2_name=_geom_name(m, other),
                     wrenches=[wrench],
                     total_wrench=wrench,
-                    contact_positions=[_vec(rot.T @ (con.pos - pos0))],
-                    contact_normals=[_vec(rot.T @ normal)],
+                    contact_positions=[msgs.vector3(rot.T @ (con.pos - pos0))],
+                    contact_normals=[msgs.vector3(rot.T @ normal)],
                     depths=np.array([max(0.0, -float(con.dist))]),
                 )
             )
         return out
-
-
-def _vec(v: np.ndarray) -> Any:
-    return msgs.Vector3(x=float(v[0]), y=float(v[1]), z=float(v[2]))
 
 
 def _geom_name(m: mujoco.MjModel, g: int) -> str:
