@@ -1,4 +1,6 @@
-"""Ray casting for grids of rays in 3-D (depth cameras, 3D lidars, range cones) over MuJoCo's primitives (Numba).
+"""Ray casting for grids of rays in 3-D over MuJoCo's primitives (Numba): range cones, and the reference that the
+depth buffer (:mod:`navlab.sim.raster`) and the lidar sweep (:mod:`navlab.sim.sweep`) are tested against, whose
+grid blocks (:func:`_block`) they share.
 
 A sensor's rays form a grid: ``rows`` x ``cols`` unit directions in the sensor frame (x forward, y left, z up).
 For each geom the caster bounds the block of the grid that can touch it — for a pinhole grid (``PINHOLE``)

@@ -1,9 +1,12 @@
-"""Depth cameras, 3D lidars and range cones by exact ray casting against the world's geometry (no rendering).
+"""Depth cameras, 3D lidars and range cones, exact against the world's geometry (no rendering).
 
 Pure functions over a :class:`~navlab.sim.simulation.Simulation`: each places the sensor at its link's true
-pose composed with the sensor's ``<pose>``, casts its grid of rays (:mod:`navlab.sim.raycast3d` for primitives,
-``mj_multiRay`` for meshes) and applies Gazebo's semantics (rays start at the near clip / ``range_min``,
-gaussian noise from the given generator). Frames: the sensor frame is Gazebo's (x forward, y left, z up).
+pose composed with the sensor's ``<pose>``, finds what its grid of rays hits among the primitives — a depth
+camera by drawing them into a depth buffer (:mod:`navlab.sim.raster`), a 3D lidar by sweeping each shape's
+block of rays (:mod:`navlab.sim.sweep`), a range cone's few rays by :mod:`navlab.sim.raycast3d` — and among
+meshes by ``mj_multiRay``, then applies Gazebo's semantics (rays start at the near clip / ``range_min``,
+gaussian noise drawn from a stream seeded by the given generator). Frames: the sensor frame is Gazebo's (x
+forward, y left, z up).
 """
 
 from __future__ import annotations

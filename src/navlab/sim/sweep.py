@@ -45,8 +45,8 @@ def _face_columns(
     frame; every column when the face spans the sensor's vertical axis)."""
     j, jj = (k + 1) % 3, (k + 2) % 3
     first, amin, amax = 0.0, 0.0, 0.0
+    q = np.empty(3)
     for corner in range(4):
-        q = np.zeros(3)
         q[k] = level - p[k]
         q[j] = (size[j] if corner & 1 else -size[j]) - p[j]
         q[jj] = (size[jj] if corner & 2 else -size[jj]) - p[jj]
