@@ -61,6 +61,12 @@ def _uniform(z: np.uint64) -> float:
     return (float(mix(z) >> uint64(11)) + 0.5) * (1.0 / 9007199254740992.0)
 
 
+@njit(cache=True, inline="always")
+def _layer(bits: np.uint64) -> tuple[np.int64, int]:
+    """(the signed 32-bit value, the layer index) of a draw: independent bits (high half, low 7 bits)."""
+    return np.int64(np.int32(np.uint32(bits >> uint64(32)))), int(bits & uint64(127))
+
+
 @njit(cache=True)
 def _tail_or_wedge(z: np.uint64, hz: np.int64, iz: int) -> tuple[float, np.uint64]:
     while True:
@@ -78,9 +84,7 @@ def _tail_or_wedge(z: np.uint64, hz: np.int64, iz: int) -> tuple[float, np.uint6
         if FN[iz] + _uniform(z) * (FN[iz - 1] - FN[iz]) < math.exp(-0.5 * x * x):
             return x, z
         z += _GOLDEN
-        bits = mix(z)
-        iz = int(bits & uint64(127))
-        hz = np.int64(np.int32(np.uint32(bits >> uint64(32))))
+        hz, iz = _layer(mix(z))
         if abs(hz) < KN[iz]:
             return hz * WN[iz], z
 
@@ -89,9 +93,7 @@ def _tail_or_wedge(z: np.uint64, hz: np.int64, iz: int) -> tuple[float, np.uint6
 def normal(z: np.uint64) -> tuple[float, np.uint64]:
     """(a standard normal draw, the stream's next state) from the SplitMix64 state ``z``."""
     z += _GOLDEN
-    bits = mix(z)
-    iz = int(bits & uint64(127))
-    hz = np.int64(np.int32(np.uint32(bits >> uint64(32))))
+    hz, iz = _layer(mix(z))
     if abs(hz) < KN[iz]:
         return hz * WN[iz], z
     return _tail_or_wedge(z, hz, iz)

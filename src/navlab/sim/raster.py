@@ -23,7 +23,7 @@ from numba import njit, uint64
 
 from navlab.sim.gauss import normal
 from navlab.sim.raycast import BOX, CYLINDER, PLANE, SPHERE
-from navlab.sim.raycast3d import PINHOLE, _block, _lower_bound
+from navlab.sim.raycast3d import PINHOLE, _block, _lower_bound, in_geom_frame
 
 _PLANE_REACH = 1.0  # m beyond the far clip that an unbounded plane is drawn to
 
@@ -202,14 +202,8 @@ def draw_depth(
         kind = geom_type[gid]
         size = geom_size[gid]
         xm = geom_xmat[gid]
+        in_geom_frame(origin, rot, geom_xpos[gid], xm, p, g)
         for k in range(3):
-            p[k] = (
-                xm[k] * (origin[0] - geom_xpos[gid, 0])
-                + xm[3 + k] * (origin[1] - geom_xpos[gid, 1])
-                + xm[6 + k] * (origin[2] - geom_xpos[gid, 2])
-            )
-            for ax in range(3):  # the sensor's axes in the geom frame
-                g[k, ax] = xm[k] * rot[0, ax] + xm[3 + k] * rot[1, ax] + xm[6 + k] * rot[2, ax]
             a[k] = g[k, 0] + (u0 * g[k, 1] + v0 * g[k, 2]) / f
             bc[k] = -g[k, 1] / f
             br[k] = -g[k, 2] / f

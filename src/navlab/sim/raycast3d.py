@@ -182,6 +182,19 @@ def _lower_bound(kind: int, size: np.ndarray, p: np.ndarray) -> float:
     return math.sqrt(dx * dx + dy * dy + dz * dz)
 
 
+@njit(cache=True, inline="always")
+def in_geom_frame(
+    origin: np.ndarray, rot: np.ndarray, centre: np.ndarray, xm: np.ndarray, p: np.ndarray, m: np.ndarray
+) -> None:
+    """The sensor (at world ``origin``, axes the columns of ``rot``) in the frame of a geom at ``centre`` turned by
+    ``xm`` (row-major 3x3): ``p`` = its origin there, ``m[k, a]`` = component k of its axis a there."""
+    rx, ry, rz = origin[0] - centre[0], origin[1] - centre[1], origin[2] - centre[2]
+    for k in range(3):
+        p[k] = xm[k] * rx + xm[3 + k] * ry + xm[6 + k] * rz
+        for a in range(3):
+            m[k, a] = xm[k] * rot[0, a] + xm[3 + k] * rot[1, a] + xm[6 + k] * rot[2, a]
+
+
 @njit(cache=True)
 def cast_grid(
     origin: np.ndarray,
@@ -218,14 +231,7 @@ def cast_grid(
         xm = geom_xmat[g]
         if not _block(kind, geom_size[g], geom_xpos[g], xm, rot, origin, mode, params, rows, cols, bounds):
             continue
-        for k in range(3):
-            p_loc[gi, k] = (
-                xm[k] * (origin[0] - geom_xpos[g, 0])
-                + xm[3 + k] * (origin[1] - geom_xpos[g, 1])
-                + xm[6 + k] * (origin[2] - geom_xpos[g, 2])
-            )
-            for a in range(3):
-                m[gi, k, a] = xm[k] * rot[0, a] + xm[3 + k] * rot[1, a] + xm[6 + k] * rot[2, a]
+        in_geom_frame(origin, rot, geom_xpos[g], xm, p_loc[gi], m[gi])
         near[gi] = _lower_bound(kind, geom_size[g], p_loc[gi])
         blocks[gi, 0], blocks[gi, 1] = bounds[0], bounds[1]
         for w in range(3):

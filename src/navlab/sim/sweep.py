@@ -19,7 +19,7 @@ from numba import njit, uint64
 
 from navlab.sim.gauss import normal
 from navlab.sim.raycast import BOX, PLANE, ray_hit
-from navlab.sim.raycast3d import SPHERICAL, _block, _lower_bound
+from navlab.sim.raycast3d import SPHERICAL, _block, _lower_bound, in_geom_frame
 
 
 @njit(cache=True)
@@ -109,14 +109,7 @@ def sweep_grid(
         kind = geom_type[g]
         size = geom_size[g]
         xm = geom_xmat[g]
-        for k in range(3):
-            p[k] = (
-                xm[k] * (origin[0] - geom_xpos[g, 0])
-                + xm[3 + k] * (origin[1] - geom_xpos[g, 1])
-                + xm[6 + k] * (origin[2] - geom_xpos[g, 2])
-            )
-            for a in range(3):
-                m[k, a] = xm[k] * rot[0, a] + xm[3 + k] * rot[1, a] + xm[6 + k] * rot[2, a]
+        in_geom_frame(origin, rot, geom_xpos[g], xm, p, m)
         if _lower_bound(kind, size, p) > tmax:
             continue
         if not _block(kind, size, geom_xpos[g], xm, rot, origin, SPHERICAL, params, rows, cols, bounds):
