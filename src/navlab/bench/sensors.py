@@ -68,7 +68,7 @@ RGB = """<?xml version="1.0"?>
 
 def _nav_rtf(robot: str, seed: int, topic: str | None = None, params: str | None = None) -> dict[str, Any]:
     """RTF (CPU) of the navigation run to ``GOALS`` with ``topic`` subscribed (a reader keeps the sensor on)."""
-    from navlab.experiments.navigate_run import run_navigation
+    from navlab.experiments import run_navigation
 
     def reader(run: Any) -> None:
         if topic:
@@ -125,12 +125,9 @@ def _frames() -> dict[str, float]:
     from navlab.core import Executor
     from navlab.description import load_robot
     from navlab.grid import Grid
-    from navlab.io.pointcloud import read_xyz
-    from navlab.navigation.costmap.params import ObservationSource
-    from navlab.navigation.costmap.voxel_layer import VoxelLayer
-    from navlab.sim.sensor_plugins import DepthCameraPlugin, VelodynePlugin
-    from navlab.sim.sensors3d import depth_image, lidar3d_ranges, sensor_pose
-    from navlab.sim.simulation import Simulation
+    from navlab.io import read_xyz
+    from navlab.navigation import ObservationSource, VoxelLayer
+    from navlab.sim import DepthCameraPlugin, Simulation, VelodynePlugin, depth_image, lidar3d_ranges, sensor_pose
     from navlab.world import load_world
 
     with tempfile.TemporaryDirectory(prefix="navlab-bench-sensors-") as tmp:
@@ -153,7 +150,7 @@ def _frames() -> dict[str, float]:
     out["velodyne_scan_ms"] = _per_frame(lambda: lidar3d_ranges(sim, lidar, rng))
     out["velodyne_cloud_ms"] = _per_frame(lambda: velodyne.cloud(ranges, 0))
     try:
-        from navlab.sim.camera_render import CameraRenderer
+        from navlab.sim import CameraRenderer
 
         renderer = CameraRenderer(sim, cam)
         out["rgb_frame_ms"] = _per_frame(renderer.render)

@@ -16,10 +16,9 @@ import functools
 import mujoco
 import numpy as np
 
-from navlab.description.model import Origin
-from navlab.description.sensor_model import CameraConfig, Lidar3dConfig, RangeConfig
+from navlab.description import CameraConfig, Lidar3dConfig, Origin, RangeConfig
 from navlab.geometry import matrix_from_quat, qmul, qrotate, quat_from_rpy
-from navlab.io.pointcloud import move_points
+from navlab.io import move_points
 from navlab.sim.gauss import seed_state
 from navlab.sim.raster import draw_depth, finish_depth
 from navlab.sim.raycast3d import ALL, cast_grid, pinhole_dirs, spherical_dirs
