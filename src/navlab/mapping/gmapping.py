@@ -294,30 +294,10 @@ class GMapping:
         self, table: np.ndarray, pose: np.ndarray, r: np.ndarray, ang: np.ndarray, max_urange: float, max_range: float
     ) -> None:
         """Ray-cast the scan into the map of ``table`` (copying the tiles it shares before writing them)."""
-        ox, oy, oi, oj, _res = self._lattice()
-        free = self.pool.free(self._scan_tiles)
-        raycast_tiles(
-            self.pool.tiles,
-            table,
-            self.pool.refs,
-            free,
-            np.zeros(1, dtype=np.int64),
-            ox,
-            oy,
-            oi,
-            oj,
-            self.p.delta,
-            float(pose[0]),
-            float(pose[1]),
-            float(pose[2]),
-            r,
-            ang,
-            max_urange,
-            max_range,
-            L_OCC,
-            L_FREE,
-            L_CLAMP,
-        )
+        free = self.pool.free(self._scan_tiles)  # (may grow the pool: its arrays are read after)
+        cow = (self.pool.tiles, table, self.pool.refs, free, np.zeros(1, dtype=np.int64))
+        at = (float(pose[0]), float(pose[1]), float(pose[2]))
+        raycast_tiles(*cow, *self._lattice(), *at, r, ang, max_urange, max_range, L_OCC, L_FREE, L_CLAMP)
 
     def _lattice(self) -> tuple[float, float, int, int, float]:
         """(anchor x, anchor y, offset column, offset row, cell size) as the numba kernels take them."""
