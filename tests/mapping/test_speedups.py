@@ -189,7 +189,8 @@ def test_the_tiled_ray_cast_writes_the_dense_cells_and_copies_only_shared_tiles(
     in_use = pool.in_use()
     for _ in range(2):  # the second time every tile written is already private: no copies
         free = pool.free(mine.size)  # (may grow the pool: its arrays are read after)
-        raycast_tiles(pool.tiles, mine, pool.refs, free, np.zeros(1, dtype=np.int64), 0.0, 0.0, 0, 0, *args)
+        cow = (pool.tiles, mine, pool.refs, free, np.zeros(1, dtype=np.int64))
+        raycast_tiles(*cow, (0.0, 0.0, 0, 0, 0.05), (2.5, 2.0, 0.1), (r, ang, 8.0, 10.0), (L_OCC, L_FREE, L_CLAMP))
     whole = grid.copy()
     _raycast(whole, 0.0, 0.0, 0, 0, *args)
     _raycast(whole, 0.0, 0.0, 0, 0, *args)

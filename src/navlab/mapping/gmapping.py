@@ -297,7 +297,7 @@ class GMapping:
         free = self.pool.free(self._scan_tiles)  # (may grow the pool: its arrays are read after)
         cow = (self.pool.tiles, table, self.pool.refs, free, np.zeros(1, dtype=np.int64))
         at = (float(pose[0]), float(pose[1]), float(pose[2]))
-        raycast_tiles(*cow, *self._lattice(), *at, r, ang, max_urange, max_range, L_OCC, L_FREE, L_CLAMP)
+        raycast_tiles(*cow, self._lattice(), at, (r, ang, max_urange, max_range), (L_OCC, L_FREE, L_CLAMP))
 
     def _lattice(self) -> tuple[float, float, int, int, float]:
         """(anchor x, anchor y, offset column, offset row, cell size) as the numba kernels take them."""

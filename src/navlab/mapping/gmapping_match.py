@@ -322,8 +322,6 @@ def warmup() -> None:
     lattice, pose, scan, model = (0.0, 0.0, 0, 0, 0.05), (0.1, 0.1, 0.0), (r, c, c, 1.0), (1, 0.05, 0.075, 0)
     optimize(tiles, table, lattice, pose, scan, model, (0.05, 0.05, 1))
     match_score(tiles, table, lattice, pose, scan, model)
-    raycast_tiles(
-        tiles, table, pool.refs, free, used, 0.0, 0.0, 0, 0, 0.05, 0.1, 0.1, 0.0, r, c, 1.0, 2.0, L_OCC, L_FREE, L_CLAMP
-    )
+    raycast_tiles(tiles, table, pool.refs, free, used, lattice, pose, (r, c, 1.0, 2.0), (L_OCC, L_FREE, L_CLAMP))
     draw_motion(np.zeros((2, 3)), np.zeros((2, 3)), 0.1, 0.0, 0.0, 0.1, 0.1, 0.1)
     scan_cells(np.zeros((2, 3)), r, c, (0.0, 0.0), 0.05, max_urange=1.0, max_range=2.0)
