@@ -13,13 +13,11 @@ Lattice conventions as in ``mapping.occupancy``: the map holds the cells of a fi
 
 from __future__ import annotations
 
-import math
-
 import numba
 import numpy as np
 
 from navlab.gridline import TIE_LATE, line, line_cell
-from navlab.mapping.occupancy import beam_end
+from navlab.mapping.occupancy import beam_end, is_return, lattice_cell
 
 SHIFT = 6
 TILE = 1 << SHIFT  # cells per tile side (64 cells: 3.2 m at 5 cm, 16 KiB of float32)
@@ -132,20 +130,16 @@ def raycast_tiles(
     of the cells it crosses (Bresenham, end cell excluded) by ``l_free`` and, if shorter than max_urange,
     raises its end cell by ``l_occ`` (``update``: (l_occ, l_free, clamp); clamped to ±clamp); cells
     outside the map are skipped. Tiles written are made private first."""
-    ox, oy, oi, oj, res = lattice
-    px, py, _pt = pose
     ranges, angles, max_urange, max_range = scan
     l_occ, l_free, clamp = update
     th, tw = table.shape
     h, w = th * TILE, tw * TILE
-    i0 = math.floor((px - ox) / res) - oi
-    j0 = math.floor((py - oy) / res) - oj
+    i0, j0 = lattice_cell(lattice, pose[0], pose[1])
     last_tj, last_ti, t = -1, -1, 0  # the tile written last (rays cross few tiles: mostly the same one)
     for k in range(ranges.shape[0]):
-        r = ranges[k]
-        if not (r > 0.0) or r >= max_range:
+        if not is_return(ranges[k], max_range):
             continue
-        i1, j1, hit = beam_end(lattice, pose, r, angles[k], max_urange)
+        i1, j1, hit = beam_end(lattice, pose, ranges[k], angles[k], max_urange)
         ln = line(i0, j0, i1, j1, TIE_LATE)
         for n in range(ln[0]):  # the end cell excluded
             i, j = line_cell(ln, n)

@@ -26,21 +26,42 @@ L_CLAMP = 5.0
 
 
 @numba.njit(cache=True, inline="always")
-def beam_end(
-    lattice: tuple[float, float, int, int, float], pose: tuple[float, float, float], r: float, angle: float, cut: float
-) -> tuple[int, int, bool]:
-    """The cell (column, row) where a beam of range ``r`` at ``angle`` from the laser at ``pose`` (x, y, theta)
-    ends, cut to ``cut`` (``max_urange``), and whether it ends on a hit (shorter than ``cut``); ``lattice``:
-    (anchor x, y, offset column, row, cell size), cells counted from the offset cell."""
+def is_return(r: float, max_range: float) -> bool:
+    """Whether a beam of range ``r`` (m) is cast: a return in (0, ``max_range``); 0, NaN and ranges at or
+    beyond ``max_range`` are no-returns."""
+    return r > 0.0 and r < max_range
+
+
+@numba.njit(cache=True, inline="always")
+def lattice_cell(lattice: tuple[float, float, int, int, float], x: float, y: float) -> tuple[int, int]:
+    """The cell (column, row) holding the point (``x``, ``y``) (m), counted from the offset cell; ``lattice``:
+    (anchor x, y, offset column, row, cell size)."""
     ox, oy, oi, oj, res = lattice
+    return math.floor((x - ox) / res) - oi, math.floor((y - oy) / res) - oj
+
+
+@numba.njit(cache=True, inline="always")
+def beam_point(pose: tuple[float, float, float], r: float, angle: float, cut: float) -> tuple[float, float, bool]:
+    """The point (x, y) (m) where a beam of range ``r`` at ``angle`` (rad, laser frame) from the laser at
+    ``pose`` (x, y, theta) ends, cut to ``cut`` (``max_urange``), and whether it ends on a hit (shorter than
+    ``cut``)."""
     px, py, pt = pose
     hit = r < cut
     if not hit:
         r = cut
     a = pt + angle
-    ex = px + r * math.cos(a)
-    ey = py + r * math.sin(a)
-    return math.floor((ex - ox) / res) - oi, math.floor((ey - oy) / res) - oj, hit
+    return px + r * math.cos(a), py + r * math.sin(a), hit
+
+
+@numba.njit(cache=True, inline="always")
+def beam_end(
+    lattice: tuple[float, float, int, int, float], pose: tuple[float, float, float], r: float, angle: float, cut: float
+) -> tuple[int, int, bool]:
+    """:func:`beam_point` as the cell (column, row) of ``lattice`` (:func:`lattice_cell`) it ends in, and whether
+    it ends on a hit."""
+    ex, ey, hit = beam_point(pose, r, angle, cut)
+    i, j = lattice_cell(lattice, ex, ey)
+    return i, j, hit
 
 
 @numba.njit(cache=True)
@@ -63,15 +84,14 @@ def _raycast(
     clamp: float,
 ) -> None:
     h, w = logodds.shape
-    i0 = math.floor((px - ox) / res) - oi
-    j0 = math.floor((py - oy) / res) - oj
+    lattice, pose = (ox, oy, oi, oj, res), (px, py, pt)
+    i0, j0 = lattice_cell(lattice, px, py)
     start_inside = 0 <= i0 < w and 0 <= j0 < h
     flat = logodds.reshape(-1)  # a view (C-contiguous): the fast path below walks it by flat index
     for k in range(ranges.shape[0]):
-        r = ranges[k]
-        if not (r > 0.0) or r >= max_range:
+        if not is_return(ranges[k], max_range):
             continue
-        i1, j1, hit = beam_end((ox, oy, oi, oj, res), (px, py, pt), r, angles[k], max_urange)
+        i1, j1, hit = beam_end(lattice, pose, ranges[k], angles[k], max_urange)
         # the line's cells from (i0, j0), the end cell excluded
         ln = line(i0, j0, i1, j1, TIE_LATE)
         if start_inside and 0 <= i1 < w and 0 <= j1 < h:  # the whole line is inside: no per-cell checks
@@ -135,13 +155,9 @@ def _scan_extent(
         px, py, pt = poses[n, 0], poses[n, 1], poses[n, 2]
         xmin, xmax, ymin, ymax = min(xmin, px), max(xmax, px), min(ymin, py), max(ymax, py)
         for k in range(ranges.shape[0]):
-            r = ranges[k]
-            if not (r > 0.0 and r < max_range):
+            if not is_return(ranges[k], max_range):
                 continue
-            rr = r if r < max_urange else max_urange
-            a = pt + angles[k]
-            x = px + rr * math.cos(a)
-            y = py + rr * math.sin(a)
+            x, y, _hit = beam_point((px, py, pt), ranges[k], angles[k], max_urange)
             xmin, xmax, ymin, ymax = min(xmin, x), max(xmax, x), min(ymin, y), max(ymax, y)
     return xmin, xmax, ymin, ymax
 
