@@ -63,14 +63,13 @@ from typing import Any, Self
 import numpy as np
 
 from navlab.grid import Grid
-from navlab.navigation.controllers import mapgrid
+from navlab.navigation.controllers import mapgrid, scene_kernel
 from navlab.navigation.controllers.common import (
     GoalLatch,
     LocalFrame,
     OscillationFlags,
     as_plan,
     circle_footprint,
-    crop_plan,
     footprint_outline,
     goal_of,
     prune_plan,
@@ -82,6 +81,9 @@ from navlab.navigation.controllers.common import (
 from navlab.navigation.controllers.rollout import outline_reach_max, rollout
 from navlab.navigation.errors import NavigationError
 from navlab.plugins import ControlResult, PluginContext
+
+_NO_POINTS = np.zeros((0, 2))  # no polygon, no outline (path_scene's typed empties)
+_NO_POINTS.flags.writeable = False
 
 # --- the shared cycle ------------------------------------------------------------------------------
 
@@ -145,8 +147,9 @@ class RolloutController:
         self._plan: np.ndarray | None = None
         self._rotating_to_goal = False
         self._outlines: dict[tuple[float, bytes | None], np.ndarray | None] = {}
-        self._near: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
-        self._goal_map: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None  # (costs, goal cell, distances)
+        self._near: tuple[np.ndarray, np.ndarray | None, np.ndarray] | None = None  # (outline, costs, reach max)
+        self._goal_map: tuple[np.ndarray | None, np.ndarray, np.ndarray] | None = None  # (costs, goal cell, distances)
+        self._costs_seen: np.ndarray | None = None  # the local costs last seen (see _note_costs)
         self._clear_outputs()
 
     @staticmethod
@@ -244,43 +247,49 @@ class RolloutController:
         cost = np.ascontiguousarray(costmap.data, dtype=np.uint8)
         res = costmap.resolution
         pose_l = frame.pose_in(pose)
-        reach = 0.5 * res * max(cost.shape)
-        plan = crop_plan(frame.points_in(self._plan[:, :2]), pose_l[0], pose_l[1], reach)
+        self._note_costs(cost)
+        mode, polygon, edges = self._free_mode(res)
+        plan, cells, path_dist = scene_kernel.path_scene(
+            cost,
+            np.ascontiguousarray(self._plan[:, :2]),
+            frame.ox,
+            frame.oy,
+            frame.oyaw,
+            res,
+            pose_l,
+            0.5 * res * max(cost.shape),
+            mode,
+            _NO_POINTS if polygon is None else polygon,
+            _NO_POINTS if edges is None else edges,
+        )
         if len(plan) == 0:
             return None  # ROS: an empty transformed plan (no pose of the plan near the robot)
-        cells = mapgrid.plan_cells(cost, plan, res)
         if len(cells) == 0:
             return None  # ROS: "None of the points of the global plan were in the local costmap"
-        free = self._free_cells(cost, pose_l, res)
-        return LocalScene(
-            frame,
-            pose_l,
-            cost,
-            res,
-            plan,
-            cells,
-            mapgrid.distance_map(cost, cells, free),
-            self._goal_dist(cost, cells[-1:]),
-        )
+        return LocalScene(frame, pose_l, cost, res, plan, cells, path_dist, self._goal_dist(cost, cells[-1:]))
+
+    def _note_costs(self, cost: np.ndarray) -> None:
+        """Keep a copy of the local costs in ``_costs_seen``, a new one only when they changed: what is computed
+        from them (the goal's distance map, the footprint's reach maximum) is kept with that copy and reused while
+        it is still the one (the costmap updates less often than the controller runs)."""
+        seen = self._costs_seen
+        if seen is None or seen.shape != cost.shape or not np.array_equal(seen, cost):
+            self._costs_seen = cost.copy()
 
     def _goal_dist(self, cost: np.ndarray, goal: np.ndarray) -> np.ndarray:
         """The local goal cell's distance map, kept while the costs and that cell stay the same (the robot moves
         a few cells per costmap update; the goal cell moves less often)."""
         cached = self._goal_map
-        if (
-            cached is not None
-            and np.array_equal(cached[1], goal)
-            and cached[0].shape == cost.shape
-            and np.array_equal(cached[0], cost)
-        ):
+        if cached is not None and cached[0] is self._costs_seen and np.array_equal(cached[1], goal):
             return cached[2]
         dist = mapgrid.distance_map(cost, goal)
-        self._goal_map = (cost.copy(), goal.copy(), dist)
+        self._goal_map = (self._costs_seen, goal.copy(), dist)
         return dist
 
-    def _free_cells(self, cost: np.ndarray, pose_l: tuple[float, float, float], res: float) -> np.ndarray | None:
-        """Cells never obstacles for the path map's wave (None: none)."""
-        return None
+    def _free_mode(self, res: float) -> tuple[int, np.ndarray | None, np.ndarray | None]:
+        """Which cells never block the path map's wave, as ``scene_kernel.path_scene`` takes it: (0 none | 1 the
+        centre cell | 2 the cells under the polygon, the polygon (K, 2) (base frame, m), its outline at ``res``)."""
+        return 0, None, None
 
     def _outline(self, res: float) -> np.ndarray | None:
         """The footprint's edge points at ``res`` (cached: the same footprint and resolution every cycle)."""
@@ -296,15 +305,10 @@ class RolloutController:
         if outline is None:
             return None
         cached = self._near
-        if (
-            cached is not None
-            and cached[0] is outline
-            and cached[1].shape == scene.cost.shape
-            and np.array_equal(cached[1], scene.cost)
-        ):
+        if cached is not None and cached[0] is outline and cached[1] is self._costs_seen:
             return cached[2]
         near = outline_reach_max(scene.cost, scene.resolution, outline)
-        self._near = (outline, scene.cost.copy(), near)
+        self._near = (outline, self._costs_seen, near)
         return near
 
     def _stop_rotate(
@@ -382,8 +386,7 @@ class RolloutController:
             self.valid = False
             return 0.0, 0.0
         path = traj[best]
-        moved = np.nonzero(np.any(path[1:] != path[:-1], axis=1))[0]
-        self.local_plan = scene.frame.poses_out(path[: (int(moved[-1]) + 2) if len(moved) else 1])
+        self.local_plan = scene.frame.poses_out(path[: scene_kernel.moved_length(path)])
         return float(targets[best, 0]), float(targets[best, 1])
 
     def _drive(

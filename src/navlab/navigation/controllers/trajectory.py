@@ -14,7 +14,7 @@ from navlab.core import read_params
 from navlab.navigation.controllers import trajectory_cycle as cycle
 from navlab.navigation.controllers.common import InPlaceFlags
 from navlab.navigation.controllers.params import TrajectoryPlannerParams
-from navlab.navigation.controllers.rollout import footprint_cells, heading_diffs, rollout_scores
+from navlab.navigation.controllers.rollout import heading_diffs, rollout_scores
 from navlab.navigation.controllers.rollout_controller import LocalScene, RolloutController
 
 # --- base_local_planner/TrajectoryPlannerROS ----------------------------------------------------------
@@ -60,10 +60,11 @@ class TrajectoryPlannerROS(RolloutController):
         p = self.params
         return (p.max_vel_theta if err > 0 else -p.min_vel_theta), p.min_in_place_vel_theta
 
-    def _free_cells(self, cost: np.ndarray, pose_l: tuple[float, float, float], res: float) -> np.ndarray | None:
-        """Cells under the robot now, never obstacles for the path map's wave (ROS's ``within_robot``)."""
+    def _free_mode(self, res: float) -> tuple[int, np.ndarray | None, np.ndarray | None]:
+        """The cells under the robot now never block the path map's wave (ROS's ``within_robot``): its centre cell
+        for a point robot, else the cells under its polygon."""
         edges = self._outline(res)
-        return footprint_cells(cost.shape, res, pose_l, self.footprint if edges is not None else None, edges=edges)
+        return (1, None, None) if edges is None or self.footprint is None else (2, self.footprint, edges)
 
     def _check(self, scene: LocalScene, targets: np.ndarray, traj: np.ndarray) -> np.ndarray:
         return self._score(scene, traj)
