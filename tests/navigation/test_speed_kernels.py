@@ -117,7 +117,7 @@ def test_controller_scene_kernel_equals_the_plain_steps() -> None:
     from navlab.navigation.controllers import mapgrid
     from navlab.navigation.controllers.common import LocalFrame, circle_footprint, crop_plan, footprint_outline
     from navlab.navigation.controllers.rollout import footprint_cells
-    from navlab.navigation.controllers.scene_kernel import moved_length, path_scene
+    from navlab.navigation.controllers.scene_kernel import moved_length, path_scene, poses_out
 
     rng = np.random.default_rng(4)
     square = np.array([[0.25, 0.2], [-0.2, 0.2], [-0.2, -0.2], [0.25, -0.2]])
@@ -150,3 +150,8 @@ def test_controller_scene_kernel_equals_the_plain_steps() -> None:
     for path in (np.zeros((4, 3)), np.array([[0, 0, 0], [0.1, 0, 0], [0.2, 0, 0], [0.2, 0, 0]], float)):
         moved = np.nonzero(np.any(path[1:] != path[:-1], axis=1))[0]  # _finish's plain form
         assert moved_length(path) == ((int(moved[-1]) + 2) if len(moved) else 1)
+    for oyaw in (0.0, 0.7, -2.9):
+        frame = LocalFrame(1.25, -3.5, oyaw)
+        poses = rng.uniform(-7, 7, (40, 3))
+        got = poses_out(poses, 25, frame.ox, frame.oy, oyaw, math.cos(oyaw), math.sin(oyaw))
+        np.testing.assert_array_equal(got, frame.poses_out(poses[:25]))

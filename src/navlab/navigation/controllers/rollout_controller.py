@@ -56,6 +56,7 @@ rather than Bresenham-rasterised.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any, Self
@@ -386,7 +387,9 @@ class RolloutController:
             self.valid = False
             return 0.0, 0.0
         path = traj[best]
-        self.local_plan = scene.frame.poses_out(path[: scene_kernel.moved_length(path)])
+        f = scene.frame
+        c, s = math.cos(f.oyaw), math.sin(f.oyaw)
+        self.local_plan = scene_kernel.poses_out(path, scene_kernel.moved_length(path), f.ox, f.oy, f.oyaw, c, s)
         return float(targets[best, 0]), float(targets[best, 1])
 
     def _drive(

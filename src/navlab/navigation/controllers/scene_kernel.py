@@ -97,3 +97,18 @@ def moved_length(path: np.ndarray) -> int:  # pragma: no cover - compiled
         if path[k + 1, 0] != path[k, 0] or path[k + 1, 1] != path[k, 1] or path[k + 1, 2] != path[k, 2]:
             return k + 2
     return 1
+
+
+@numba.njit(cache=True)
+def poses_out(
+    poses: np.ndarray, count: int, ox: float, oy: float, oyaw: float, c: float, s: float
+) -> np.ndarray:  # pragma: no cover - compiled
+    """The first ``count`` grid-local poses (n, 3) in the costmap frame (``LocalFrame.poses_out``: the grid's
+    origin (ox, oy, oyaw), ``c``/``s`` its yaw's cosine and sine; yaw wrapped to [-pi, pi) as ``wrap_angle``)."""
+    out = np.empty((count, 3))
+    for k in range(count):
+        x, y = poses[k, 0], poses[k, 1]
+        out[k, 0] = ox + c * x - s * y
+        out[k, 1] = oy + s * x + c * y
+        out[k, 2] = (poses[k, 2] + oyaw + math.pi) % (2.0 * math.pi) - math.pi
+    return out
