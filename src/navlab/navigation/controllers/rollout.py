@@ -1,9 +1,9 @@
 """Rollouts and footprint costs of the local planners, pure and compiled (Numba), vectorised over samples.
 
-``rollout`` integrates (v, w) samples as base_local_planner does; ``footprint_costs``/``occupancy_costs``
-read a costmap under a robot's outline (costmap_2d's 16-gon for a round robot) at many poses; the
-``rollout_scores`` kernel scores whole rollouts (path/goal distance, occupancy) in one pass. Poses are in
-grid-local metres (the costmap's origin at 0, its axes), costs the costmap's uint8 values.
+``rollout`` integrates (v, w) samples as base_local_planner does; ``footprint_costs`` reads a costmap under a
+robot's outline (costmap_2d's 16-gon for a round robot) at many poses (``with_centre``: base_local_planner's
+obstacle cost); the ``rollout_scores`` kernel scores whole rollouts (path/goal distance, occupancy) in one
+pass. Poses are in grid-local metres (the costmap's origin at 0, its axes), costs the costmap's uint8 values.
 """
 
 from __future__ import annotations
@@ -15,6 +15,7 @@ import numpy as np
 from scipy.ndimage import maximum_filter
 
 from navlab.grid import COST_INSCRIBED, COST_LETHAL, COST_UNKNOWN
+from navlab.gridline import TIE_EARLY, line, line_cell
 from navlab.navigation.controllers.common import footprint_outline
 
 # --- rollout and footprint cost (pure, vectorised over samples) --------------------------------------
@@ -140,54 +141,18 @@ def footprint_costs(
     outline: np.ndarray | None,
     *,
     near_max: np.ndarray | None = None,
+    with_centre: bool = False,
 ) -> np.ndarray:
     """costmap_2d's footprint cost at each grid-local pose (..., 3): -1 where the robot may not be.
 
     Circular robot (``outline`` None): the centre cell's cost, -1 if LETHAL, INSCRIBED, unknown or off the
     map. Polygon: the highest cost under its edges (``outline`` (M, 2) base-frame points), -1 if any is
-    LETHAL or unknown or the robot is off the map. ``near_max``: :func:`outline_reach_max` of ``cost`` and
-    ``outline``, if the caller has it (poses with nothing but free cells around skip their edges).
+    LETHAL or unknown or the robot is off the map; ``with_centre``: base_local_planner's obstacle cost,
+    ``max(footprint cost, centre cell cost)`` (``TrajectoryPlanner::generateTrajectory``,
+    ``ObstacleCostFunction::footprintCost``). ``near_max``: :func:`outline_reach_max` of ``cost`` and
+    ``outline``, if the caller has it (poses with nothing but free cells around, or with ``with_centre`` whose
+    centre cell holds the highest cost around, skip their edges). One compiled pass.
     """
-    return _pose_costs(cost, resolution, poses, outline, near_max, with_centre=False)
-
-
-def occupancy_costs(
-    cost: np.ndarray,
-    resolution: float,
-    poses: np.ndarray,
-    outline: np.ndarray | None,
-    *,
-    near_max: np.ndarray | None = None,
-) -> np.ndarray:
-    """base_local_planner's obstacle cost of each grid-local pose (..., 3): -1 where the robot may not be.
-
-    Polygon: ``max(footprint cost, centre cell cost)`` (``TrajectoryPlanner::generateTrajectory``,
-    ``ObstacleCostFunction::footprintCost``), the footprint cost being costmap_2d's ``footprintCost``
-    (the highest cost under the edges, -1 when one is LETHAL or unknown). Point robot: :func:`footprint_costs`.
-    ``near_max``: :func:`outline_reach_max` of ``cost`` and ``outline``, if the caller has it (poses whose
-    centre cell holds the highest cost around skip their edges).
-    """
-    return _pose_costs(cost, resolution, poses, outline, near_max, with_centre=True)
-
-
-def outline_reach_max(cost: np.ndarray, resolution: float, outline: np.ndarray) -> np.ndarray:
-    """The highest cost (uint8, ``cost``'s shape; unknown for cells off the grid) in the square of cells that
-    the ``outline``'s points can fall in while the robot's centre is in each cell: where it equals the centre
-    cell's cost, no edge can cost more (the footprint cost needs no edge lookups)."""
-    reach = math.ceil(float(np.hypot(outline[:, 0], outline[:, 1]).max()) / resolution) + 1
-    return maximum_filter(np.asarray(cost, dtype=np.uint8), size=2 * reach + 1, mode="constant", cval=COST_UNKNOWN)
-
-
-def _pose_costs(
-    cost: np.ndarray,
-    resolution: float,
-    poses: np.ndarray,
-    outline: np.ndarray | None,
-    near_max: np.ndarray | None,
-    *,
-    with_centre: bool,
-) -> np.ndarray:
-    """:func:`footprint_costs` (``with_centre`` False) or :func:`occupancy_costs` (True), one compiled pass."""
     poses = np.asarray(poses, dtype=np.float64)
     shape = poses.shape[:-1]
     flat = poses.reshape(-1, 3)
@@ -217,6 +182,14 @@ def _pose_costs(
             out,
         )
     return out.reshape(shape)
+
+
+def outline_reach_max(cost: np.ndarray, resolution: float, outline: np.ndarray) -> np.ndarray:
+    """The highest cost (uint8, ``cost``'s shape; unknown for cells off the grid) in the square of cells that
+    the ``outline``'s points can fall in while the robot's centre is in each cell: where it equals the centre
+    cell's cost, no edge can cost more (the footprint cost needs no edge lookups)."""
+    reach = math.ceil(float(np.hypot(outline[:, 0], outline[:, 1]).max()) / resolution) + 1
+    return maximum_filter(np.asarray(cost, dtype=np.uint8), size=2 * reach + 1, mode="constant", cval=COST_UNKNOWN)
 
 
 @numba.njit(cache=True, inline="always")
@@ -373,24 +346,11 @@ def heading_diffs(cost: np.ndarray, resolution: float, plan: np.ndarray, poses: 
 def _line_clear(cost: np.ndarray, x0: int, x1: int, y0: int, y1: int) -> bool:  # pragma: no cover - compiled
     """Whether TrajectoryPlanner's ``lineCost`` (its Bresenham walk) from cell (x0, y0) to (x1, y1) meets no
     LETHAL, INSCRIBED or unknown cell."""
-    dx, dy = abs(x1 - x0), abs(y1 - y0)
-    sx = 1 if x1 >= x0 else -1
-    sy = 1 if y1 >= y0 else -1
-    if dx >= dy:  # one x step per pixel, y steps when the numerator overflows
-        xi1, xi2, yi1, yi2, den, num, add, pixels = 0, sx, sy, 0, dx, dx // 2, dy, dx
-    else:
-        xi1, xi2, yi1, yi2, den, num, add, pixels = sx, 0, 0, sy, dy, dy // 2, dx, dy
-    x, y = x0, y0
-    for _ in range(pixels + 1):
+    ln = line(x0, y0, x1, y1, TIE_EARLY)
+    for n in range(ln[0] + 1):
+        x, y = line_cell(ln, n)
         if cost[y, x] >= COST_INSCRIBED:
             return False
-        num += add
-        if num >= den:
-            num -= den
-            x += xi1
-            y += yi1
-        x += xi2
-        y += yi2
     return True
 
 
