@@ -16,9 +16,9 @@ import math
 import numba
 import numpy as np
 
-from navlab.navigation.controllers.common import _crop_span
-from navlab.navigation.controllers.mapgrid import _plan_cells, _wave
-from navlab.navigation.controllers.rollout import _footprint_cells
+from navlab.navigation.controllers.common import crop_span
+from navlab.navigation.controllers.mapgrid import cells_along, wave
+from navlab.navigation.controllers.rollout import cells_under
 
 
 @numba.njit(cache=True)
@@ -52,7 +52,7 @@ def path_scene(
         else:
             local[k, 0], local[k, 1] = c * dx + s * dy, -s * dx + c * dy
     x, y, th = pose
-    first, end = _crop_span(local, x, y, reach)
+    first, end = crop_span(local, x, y, reach)
     cropped = local[first:end].copy()
     empty_cells = np.zeros((0, 2), dtype=np.int64)
     if cropped.shape[0] == 0:
@@ -62,7 +62,7 @@ def path_scene(
     for k in range(m - 1):
         d = math.hypot(cropped[k + 1, 0] - cropped[k, 0], cropped[k + 1, 1] - cropped[k, 1])
         steps[k] = max(1, math.ceil(d / res))
-    cells = _plan_cells(cost, cropped, steps, res)
+    cells = cells_along(cost, cropped, steps, res)
     if cells.shape[0] == 0:
         return cropped, cells, np.empty((0, 0))
     if free_mode == 2:
@@ -76,7 +76,7 @@ def path_scene(
         for k in range(edges.shape[0]):
             ex[k] = x + ct * edges[k, 0] - st * edges[k, 1]
             ey[k] = y + st * edges[k, 0] + ct * edges[k, 1]
-        free = _footprint_cells(h, w, res, x, y, poly, ex, ey)
+        free = cells_under(h, w, res, x, y, poly, ex, ey)
     elif free_mode == 1:
         i, j = math.floor(x / res), math.floor(y / res)
         free = np.zeros((1 if 0 <= i < w and 0 <= j < h else 0, 2), dtype=np.int64)
@@ -85,7 +85,7 @@ def path_scene(
     else:
         free = empty_cells
     dist = np.empty((h, w))
-    _wave(cost, cells[:, 0].copy(), cells[:, 1].copy(), free[:, 0].copy(), free[:, 1].copy(), dist)
+    wave(cost, cells[:, 0].copy(), cells[:, 1].copy(), free[:, 0].copy(), free[:, 1].copy(), dist)
     return cropped, cells, dist
 
 
