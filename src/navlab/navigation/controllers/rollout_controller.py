@@ -19,8 +19,8 @@ best one's velocity:
   highest cost under the edges or at the centre cell (``occdist`` takes the highest along the rollout).
   Without a polygon or radius the robot is a point: its centre cell, blocked from INSCRIBED up;
 - *TrajectoryPlanner cost* = pdist_scale * path_dist + gdist_scale * goal_dist + occdist_scale *
-  max_cost, distances at the rollout's end (in cells; ``meter_scoring`` multiplies pdist_scale and gdist_scale
-  by the resolution, occdist_scale stays as given, as in ROS 1 noetic); a rollout that
+  max_cost, distances at the rollout's end (in cells; ``meter_scoring`` multiplies the three biases by the
+  resolution, as noetic scores after its start-up reconfigure); a rollout that
   leaves the map, is blocked, or passes a cell with no path to the plan or goal is rejected (the first failure
   in time decides the code, -1 or -2). With ``heading_scoring`` every rollout has sim_time / sim_granularity
   steps, the distances count at the step at ``heading_scoring_timestep`` only, and 0.3 x the angle from the

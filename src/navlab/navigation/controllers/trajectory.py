@@ -198,10 +198,14 @@ class TrajectoryPlannerROS(RolloutController):
     def _weights(self, res: float) -> np.ndarray:
         """The scoring kernel's (1, pdist, gdist, occdist) weights (m or cell units for the distances)."""
         p = self.params
-        # meter_scoring scales the distance biases by the resolution, not occdist_scale (ROS 1 since the biases'
-        # renaming: TrajectoryPlannerROS::initialize and TrajectoryPlanner::reconfigure)
+        # meter_scoring scales all three biases by the resolution: what noetic scores with after start-up.
+        # TrajectoryPlannerROS::initialize scales pdist and gdist alone, but its dynamic-reconfigure callback runs
+        # once at start-up and TrajectoryPlanner::reconfigure re-reads the three biases from the parameters and
+        # scales all three when its (never initialised) meter_scoring_ reads true, none when it reads false: the
+        # same ratios either way, so the same choices (the heading_scoring term aside). Melodic's initialize
+        # scaled all three too.
         scale = res if p.meter_scoring else 1.0
-        return np.array([1.0, scale * p.pdist_scale, scale * p.gdist_scale, p.occdist_scale])
+        return np.array([1.0, scale * p.pdist_scale, scale * p.gdist_scale, scale * p.occdist_scale])
 
     def _end_escape(self, pose: tuple[float, float, float]) -> None:
         """Leave escape mode once ``escape_reset_dist`` m or ``escape_reset_theta`` rad from where it began."""
