@@ -23,6 +23,25 @@ def test_progress_checker_counts_time_near_one_pose() -> None:
         SimpleProgressChecker({"required_movement_radius": -1.0})
 
 
+def test_progress_toward_the_goal_catches_a_robot_that_shuttles_in_and_out_of_a_pocket() -> None:
+    """Driving 1 m into a pocket and back out every 4 s is movement (Nav2's checker is content) but never
+    brings the goal nearer: with navlab's goal-progress allowance the checker reports no progress."""
+    params = {"required_movement_radius": 0.5, "movement_time_allowance": 10.0}
+    nav2 = SimpleProgressChecker(params)
+    toward = SimpleProgressChecker({**params, "required_goal_progress": 0.5, "goal_progress_time_allowance": 20.0})
+    verdicts = []
+    for k in range(61):  # 30 s, a check every 0.5 s
+        x = abs((k % 8) - 4) * 0.25  # 0 -> 1 m -> 0 every 4 s
+        pose, goal_distance = (x, 0.0, 0.0), 5.0 + 0.2 * (x - 0.5) ** 2  # the pocket leads no nearer
+        assert nav2.check(pose, k * 0.5)
+        verdicts.append(toward.check(pose, k * 0.5, goal_distance))
+    assert all(verdicts[:41]) and not verdicts[-1] and toward.toward_goal
+    toward.restart_clocks(30.0)  # after a recovery the robot has its allowance again
+    assert toward.check((0.0, 0.0, 0.0), 31.0, 5.0)
+    assert toward.check((2.0, 0.0, 0.0), 49.0, 4.4) and toward.progressed  # 0.6 m nearer: progress
+    assert toward.check((2.0, 0.0, 0.0), 52.0, None)  # no goal distance known: Nav2's check alone
+
+
 def test_stuck_window_reads_a_true_path() -> None:
     still = [(t * 0.1, 1.0 + 0.001 * t, 2.0) for t in range(300)]  # 30 s within a few cm
     assert stuck_window(still, 20.0, 0.5)

@@ -17,7 +17,9 @@ from navlab.sim import launch_sim
 
 
 def _start(ex: Executor) -> object:
-    return launch_sim(ex, world=make_room(12.0, 4.0), robot=load_robot(resources.robot("jackal")), pose=(-4.0, 0.0, 0.0))
+    return launch_sim(
+        ex, world=make_room(12.0, 4.0), robot=load_robot(resources.robot("jackal")), pose=(-4.0, 0.0, 0.0)
+    )
 
 
 def test_jackal_rests_on_its_wheels() -> None:

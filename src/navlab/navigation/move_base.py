@@ -340,11 +340,12 @@ class MoveBase(Node):
             if self.recovery_trigger == RecoveryTrigger.OSCILLATION:
                 self.recovery_index = 0
 
-    def _progressing(self, pose: Pose, now: int) -> bool:
-        """The progress checker's verdict; progress since the last PROGRESS recovery starts the recoveries over."""
-        baseline = self.progress_checker.baseline
-        ok = self.progress_checker.check(pose, now / 1e9)
-        if self.progress_checker.baseline is not baseline and self.recovery_trigger == RecoveryTrigger.PROGRESS:
+    def _progressing(self, pose: Pose, now: int, local: np.ndarray | None) -> bool:
+        """The progress checker's verdict (``local``: the plan in the local frame, which ends at the goal);
+        progress since the last PROGRESS recovery starts the recoveries over."""
+        goal_distance = math.dist(pose[:2], local[-1][:2]) if local is not None and len(local) else None
+        ok = self.progress_checker.check(pose, now / 1e9, goal_distance)
+        if self.progress_checker.progressed and self.recovery_trigger == RecoveryTrigger.PROGRESS:
             self.recovery_index = 0
         return ok
 
@@ -369,7 +370,7 @@ class MoveBase(Node):
         if p["oscillation_timeout"] > 0 and self._timed_out(self.last_oscillation_reset_ns, p["oscillation_timeout"]):
             self._enter_clearing(RecoveryTrigger.OSCILLATION)
             return
-        if not self._progressing(pose, now):
+        if not self._progressing(pose, now, local):
             self._enter_clearing(RecoveryTrigger.PROGRESS)
             return
         try:
@@ -423,10 +424,8 @@ class MoveBase(Node):
                 RecoveryTrigger.PLANNING: "Failed to find a valid plan. Even after executing recovery behaviors.",
                 RecoveryTrigger.CONTROLLING: "Failed to find a valid control. Even after executing recovery behaviors.",
                 RecoveryTrigger.OSCILLATION: "Robot is oscillating. Even after executing recovery behaviors.",
-                RecoveryTrigger.PROGRESS: f"{STUCK_PREFIX}: the robot moved less than "
-                f"{self.progress_checker.params.required_movement_radius:g} m in "
-                f"{self.progress_checker.idle_s(self.executor.now_ns / 1e9):.1f} s, "
-                "even after executing recovery behaviors.",
+                RecoveryTrigger.PROGRESS: f"{STUCK_PREFIX}: {self._no_progress()}, even after executing recovery "
+                "behaviors.",
             }[trigger]
             if trigger == RecoveryTrigger.PLANNING and self.plan_failure:
                 reason += f" ({self.plan_failure})"
@@ -455,8 +454,18 @@ class MoveBase(Node):
         self.oscillation_pose = pose
         # Nav2 restarts the progress clock with each new control run, from where the robot is now (the
         # baseline pose stays: a recovery that only wiggles does not count as progress)
-        self.progress_checker.baseline_t = now / 1e9
+        self.progress_checker.restart_clocks(now / 1e9)
         self.state = MoveBaseState.PLANNING
+
+    def _no_progress(self) -> str:
+        """What the progress checker saw when it last failed (the start of a ``stuck`` reason)."""
+        pc, now = self.progress_checker, self.executor.now_ns / 1e9
+        if pc.toward_goal:
+            return (
+                f"the robot came no nearer the goal by {pc.params.required_goal_progress:g} m in "
+                f"{now - pc.closest_t:.1f} s"
+            )
+        return f"the robot moved less than {pc.params.required_movement_radius:g} m in {pc.idle_s(now):.1f} s"
 
     # --- services and status ---------------------------------------------------------------------------
 
