@@ -76,14 +76,14 @@ class SimpleProgressChecker:
         """Give the robot its allowances again from ``t`` (after a recovery), keeping the baselines."""
         self.baseline_t = self.closest_t = t
 
-    def check(self, pose: Pose, t: float, goal_distance: float | None = None) -> bool:
-        """Whether the robot is making progress at ``pose`` at time ``t`` (s); ``goal_distance`` (m): how far the
-        goal is (None: not known, no check toward the goal)."""
+    def check(self, pose: Pose, t: float, goal: Any = None) -> bool:
+        """Whether the robot is making progress at ``pose`` at time ``t`` (s); ``goal``: where the goal is (x, y
+        in the pose's frame; None: not known, no check toward the goal)."""
         p = self.params
         self.toward_goal = self.progressed = False
-        toward = p.goal_progress_time_allowance > 0 and goal_distance is not None
+        toward = p.goal_progress_time_allowance > 0 and goal is not None
         if toward:
-            assert goal_distance is not None
+            goal_distance = math.dist(pose[:2], goal[:2])
             if self.closest is None or goal_distance < self.closest - p.required_goal_progress:
                 self.closest, self.closest_t, self.progressed = goal_distance, t, True
             elif t - self.closest_t > p.goal_progress_time_allowance:
@@ -94,6 +94,15 @@ class SimpleProgressChecker:
             self.progressed = self.progressed or not toward
             return True
         return not self.enabled or t - self.baseline_t <= p.movement_time_allowance
+
+    def stuck_reason(self, t: float) -> str:
+        """Why a goal ends ``stuck`` at ``t`` when the recoveries did not help: what the checker saw last."""
+        p = self.params
+        if self.toward_goal:
+            saw = f"the robot came no nearer the goal by {p.required_goal_progress:g} m in {t - self.closest_t:.1f} s"
+        else:
+            saw = f"the robot moved less than {p.required_movement_radius:g} m in {self.idle_s(t):.1f} s"
+        return f"{STUCK_PREFIX}: {saw}, even after executing recovery behaviors."
 
     def idle_s(self, t: float) -> float:
         """How long (s) the robot has stayed near the baseline at ``t``."""
