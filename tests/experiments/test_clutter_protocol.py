@@ -27,8 +27,9 @@ def test_speed_limit_goes_to_the_controllers_own_parameter() -> None:
 
 
 def test_a_world_that_defeated_the_jackals_mppi_is_now_reached() -> None:
-    """Test world 21: before, move_base reported success 3.14 m from the true goal (odometry alone); with the
-    IMU fused by the EKF (mapless default for a robot with an IMU) the robot truly arrives, with no contact."""
+    """Test world 21: in the suite before BARN's generator, move_base reported success 3.14 m from the true goal
+    (odometry alone); with the IMU fused by the EKF (mapless default for a robot with an IMU) the robot truly
+    arrives, with no contact (in the BARN-generated world 21 too)."""
     fill, smooth = suite_parameters(50)[21]
     world = generate_clutter(21, fill=fill, smooth=smooth)
     r = run_clutter_world(world, controller="mppi", robot="jackal")

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -56,7 +57,8 @@ def save_png(world: ClutterWorld, path: str | Path) -> None:
         ax.set_xlabel("x (m)")
         ax.set_ylabel("y (m)")
         ax.set_title(
-            f"{world.name}: {len(world.cylinders)} cylinders ({world.carved} carved), difficulty {world.difficulty:.3f}"
+            f"{world.name}: {len(world.cylinders)} cylinders ({world.attempts} draws), "
+            f"difficulty {world.difficulty:.3f}"
         )
         ax.legend(loc="upper right", fontsize=8)
         fig.tight_layout()
@@ -68,8 +70,15 @@ def save_png(world: ClutterWorld, path: str | Path) -> None:
 def _cmd_clutter(args: argparse.Namespace) -> int:
     from navlab.world.clutter import generate_clutter
 
+    if args.margin is not None:
+        print(
+            "navlab: DeprecationWarning: --margin is ignored and goes in the next release: nothing is carved any "
+            "more; each world is drawn until the robot's configuration space (--robot-cells) connects the field's "
+            "ends, as BARN's",
+            file=sys.stderr,
+        )
     world = generate_clutter(
-        args.seed, fill=args.fill, smooth=args.smooth, robot_radius=args.robot_radius, margin=args.margin
+        args.seed, fill=args.fill, smooth=args.smooth, robot_radius=args.robot_radius, robot_cells=args.robot_cells
     )
     out = world.write_world(out_file(args.out, "clutter.world", old_suffixes=(".world", ".sdf")))
     png = optional_out(args.png, out.parent, "clutter.png")
@@ -81,8 +90,8 @@ def _cmd_clutter(args: argparse.Namespace) -> int:
         return 0
     (sx, sy, syaw), (gx, gy, gyaw) = world.start, world.goal
     print(
-        f"{world.name}: {len(world.cylinders)} cylinders ({world.carved} carved for the corridor), "
-        f"difficulty {world.difficulty:.3f}"
+        f"{world.name}: {len(world.cylinders)} cylinders ({world.attempts} automaton draws until a way through "
+        f"for robot_cells {world.robot_cells}), difficulty {world.difficulty:.3f}"
     )
     print(f"start  x {sx:.3f} y {sy:.3f} yaw {syaw:.3f}")
     print(f"goal   x {gx:.3f} y {gy:.3f} yaw {gyaw:.3f}")
@@ -128,13 +137,14 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="a BARN-style field of cylinders between walls, with start, goal and reference path",
         formatter_class=argparse.RawDescriptionHelpFormatter,
         description="A 4.5 x 4.5 m field of 0.075 m-radius cylinders on a 0.15 m grid, grown by a cellular\n"
-        "automaton (random --fill, then --smooth rounds), between two walls, as in the BARN benchmark\n"
-        "(Perille et al. 2020). The robot starts at (-2, 0) facing +x, 2 m before the field; the goal\n"
-        "is (8, 0), 10 m away. A corridor wide enough for --robot-radius + --margin is always carved.\n"
-        "Prints start, goal and the reference (shortest collision-free) path length.",
+        "automaton (random --fill, then --smooth rounds) between two rows of wall cylinders, as BARN's\n"
+        "dataset generator makes it (Perille et al. 2020); drawn again until the robot's configuration\n"
+        "space (no cylinder within --robot-cells cells of its centre: 2 for the Jackal) connects the\n"
+        "field's ends. The robot starts at (-2.1, -0.25) facing +x, 2.1 m before the field; the goal is\n"
+        "(7.9, -0.25), 10 m away. Prints start, goal and the reference (shortest collision-free) path length.",
         epilog="examples:\n"
         "  navlab world clutter --seed 3 --fill 0.3 --smooth 2 --out clutter --png   # clutter/clutter.world, .png\n"
-        "  navlab sim --world clutter/clutter.world --x -2 --y 0 --duration 5",
+        "  navlab sim --world clutter/clutter.world --x -2.1 --y -0.25 --duration 5",
     )
     add_run_options(c, seed=0, json=True)
     c.add_argument("--fill", type=_fraction, default=0.25, help="initial fill probability per cell (default 0.25)")
@@ -146,11 +156,13 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="radius of the robot disc the reference path is planned for (m, default 0.2: mybot)",
     )
     c.add_argument(
-        "--margin",
-        type=float,
-        default=0.05,
-        help="extra clearance of the carved corridor beyond the robot radius (m, default 0.05)",
+        "--robot-cells",
+        type=_count,
+        default=2,
+        help="cells the robot reaches beyond its centre cell; the world keeps a way through for it (default 2: "
+        "BARN's Jackal, 0.375 m clearance)",
     )
+    c.add_argument("--margin", type=float, default=None, help=argparse.SUPPRESS)  # deprecated: nothing is carved
     c.add_argument(
         "--out",
         required=True,

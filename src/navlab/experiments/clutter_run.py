@@ -1,6 +1,6 @@
 """Mapless navigation through BARN-style clutter worlds (Perille et al. 2020), scored as BARN scores.
 
-Each world (``world.clutter``) is written as an SDF ``.world``, the robot starts 2 m before the field and
+Each world (``world.clutter``) is written as an SDF ``.world``, the robot starts 2.1 m before the field and
 drives with ``move_base`` on a rolling global costmap to the goal 10 m ahead (given in ``odom``). A trial
 succeeds when the robot ends within 1 m of the goal without a collision inside ``timeout`` s; its score is
 ``success x T_opt / clip(T, 2 T_opt, 8 T_opt)`` with ``T_opt`` = reference path length / 2 m/s and ``T`` on BARN's

@@ -25,9 +25,9 @@ from navlab.geometry import wrap_angle
 
 ROBOTS = ("mybot", "jackal", "jackal_skid")
 ROUTES = ("room", "clutter")
-# a winding course (reference path 1.14 x the 10 m, 29 % of the field filled) carved for a 0.3 m disc, so a
-# Jackal-sized robot (half-width 0.215 m) following it brushes past the clutter without getting stuck
-CLUTTER = {"seed": 8, "fill": 0.35, "smooth": 3, "robot_radius": 0.3}
+# a winding BARN course (reference path for a 0.3 m disc 1.07 x the 10 m, 20 % of the field filled; BARN's densest
+# fill 0.30), so a Jackal-sized robot (half-width 0.215 m) following it brushes past the clutter without getting stuck
+CLUTTER = {"seed": 6, "fill": 0.3, "smooth": 3, "robot_radius": 0.3}
 SPEED = 0.5  # m/s: the benchmark's max_vel_x
 
 

@@ -1,18 +1,26 @@
-"""BARN-style cluttered worlds (Perille et al. 2020, "Benchmarking Metric Ground Navigation").
+"""BARN's cluttered worlds (Perille et al. 2020, "Benchmarking Metric Ground Navigation"), generated as its
+dataset generator (jackal-map-creation) makes them.
 
-A 4.5 m x 4.5 m field of 30 x 30 cells of 0.15 m, each cell holding a static cylinder of radius
-0.075 m or not, filled by a cellular automaton (random fill at ``fill``, then ``smooth`` rounds in
-which a cell with >= 5 of its 8 neighbours filled fills and one with <= 1 clears: clustered clutter
-with scattered cylinders between). Walls run along both long sides and close the start end, so the
-only way to the goal is through the field. A collision-free corridor for a disc of ``robot_radius + margin`` is carved
-by removing the fewest cylinders along a cheapest path (a grid search), so every world is solvable.
+A 30 x 30 grid of 0.15 m cells, each holding a static cylinder of radius 0.075 m (1 m tall) or not. The first
+and last rows are filled (the field's side walls); the others are filled at random with probability ``fill``, then
+``smooth`` rounds of a cellular automaton run: a cell with >= 5 of its 8 neighbours filled fills, one with <= 1
+clears, the others keep their state (neighbours beyond the side walls count as filled, beyond the ends as empty).
+The robot's configuration space is the cells whose (2 ``robot_cells`` + 1)^2 window holds no cylinder (BARN's
+Jackal: 2 cells, a 5 x 5 window, so its centre keeps >= 0.375 m from every cylinder surface); a draw is kept only
+when the largest 4-connected free region touching the first column is the largest one touching the last, else the
+automaton is drawn again (BARN throws such worlds away). Nothing is carved. Cylinders inside a filled block (all 8
+neighbours filled) are not written, as BARN writes none there. The grid order of parameters is BARN's 300 worlds':
+fill 0.15, 0.20, 0.25, 0.30 x 2, 3, 4 smoothing rounds.
 
-World frame (m, rad): the field spans x in [0, 4.5], y in [-2.25, 2.25]; the robot starts 2 m
-before it at (-2, 0) facing +x and the goal is 10 m from the start at (8, 0), 3.5 m past the field.
-``ClutterWorld.reference_path_m`` is the length of the shortest collision-free path for a disc of
-``robot_radius`` (8-connected Dijkstra on a 0.05 m grid of exact clearances, then shortened by line of
-sight), BARN's T_opt = reference length / 2 m/s. Worlds are written as SDF 1.6 ``.world`` files that
-navlab's :func:`navlab.world.load_world` and Gazebo classic both load.
+World frame (m, rad; BARN's y forward is navlab's x): the field's cells span x in [0, 4.5], y in [-2.25, 2.25];
+touching rows of cylinders (here boxes 0.15 m thick along their tangents) close a 4.95 m x 4.2 m start zone before
+the field: its sides in line with the field's wall rows, its back 2.925 m behind the start, as BARN's containment
+walls. The robot starts 2.1 m before the field facing +x, 0.25 m off its centre line (the challenge's
+INIT_POSITION (-2, 3) against the field's centre -2.25), and the goal is 10 m straight ahead, past the field in
+the open. ``ClutterWorld.reference_path_m`` is the length of the shortest collision-free path for a disc of
+``robot_radius`` (8-connected Dijkstra on a 0.05 m grid of exact clearances, then shortened by line of sight),
+BARN's T_opt = reference length / 2 m/s. Worlds are written as SDF 1.6 ``.world`` files that navlab's
+:func:`navlab.world.load_world` and Gazebo classic both load.
 """
 
 from __future__ import annotations
@@ -20,6 +28,7 @@ from __future__ import annotations
 import itertools
 import math
 import os
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -27,26 +36,30 @@ import numpy as np
 from scipy import ndimage
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import dijkstra
-from scipy.spatial import cKDTree
 
 from navlab.io.files import write_text_atomic
 from navlab.world.clutter_geometry import Clearance
 from navlab.world.errors import WorldError
 from navlab.world.sdf_writer import box_geometry, cylinder_geometry, link, static_model, world_sdf
 
-CELL = 0.15  # m: BARN's grid cell
+CELL = 0.15  # m: BARN's grid cell (one cylinder's diameter)
 CELLS = 30  # cells per side of the field (4.5 m)
 FIELD = CELL * CELLS  # m
 CYLINDER_RADIUS = 0.075  # m
-CYLINDER_HEIGHT = 0.8  # m
-WALL_THICKNESS = 0.2  # m
+CYLINDER_HEIGHT = 1.0  # m: BARN's unit cylinders
+WALL_THICKNESS = CELL  # m: a containment wall is a row of touching cylinders
 WALL_HEIGHT = 1.0  # m
-START_GAP = 2.0  # m from the start to the field's near edge
-GOAL_DISTANCE = 10.0  # m from the start to the goal
+START_GAP = 2.1  # m from the start to the field's near edge (BARN: start y 3, first cells from y 5.1)
+START_Y = -0.25  # m: the start's offset from the field's centre line (BARN: x -2 against -2.25)
+START_ZONE = 4.95  # m from the back wall's inner face to the field (BARN: containment from y 0.15 to 5.1)
+GOAL_DISTANCE = 10.0  # m from the start to the goal, straight ahead
 BARN_SPEED = 2.0  # m/s: BARN's T_opt speed
-_BEHIND = 0.75  # m of floor behind the start, inside the back wall
+ROBOT_CELLS = 2  # BARN's jackal_radius: cells the robot reaches beyond its centre cell
+BARN_FILLS = (0.15, 0.20, 0.25, 0.30)  # BARN's initial fill levels
+BARN_SMOOTHS = (2, 3, 4)  # BARN's smoothing rounds
+MAX_DRAWS = 50_000  # automaton draws before a world's parameters are refused
+_BATCH = 256  # automaton fields drawn at once
 _REF_RES = 0.05  # m: grid of the reference-path search and the corridor check
-_CARVE_WEIGHT = 20.0  # extra cost per cylinder a carving step would remove
 
 
 @dataclass(frozen=True)
@@ -66,19 +79,20 @@ class ClutterWorld:
     """One generated world (all in the world frame: m, rad).
 
     ``cells``: (30, 30) bool, ``cells[i, j]`` is the field cell at x = (j + 0.5) 0.15, y = -2.25 +
-    (i + 0.5) 0.15 (row 0 lowest y); ``cylinders``: (k, 2) centres of the cells that hold one;
-    ``reference_path``: (n, 2) shortest collision-free path for a disc of ``robot_radius``;
-    ``difficulty``: fraction of the field's cells holding a cylinder (after smoothing and carving);
-    ``metrics``: more figures: ``fill_initial``, ``fill_final``, ``tortuosity`` (reference length / 10 m),
-    ``mean_clearance_m`` (robot centre to the nearest surface along the reference path in the field) and
-    ``bottleneck_m`` (half-width of the narrowest passage on the widest route).
+    (i + 0.5) 0.15 (row 0 lowest y; rows 0 and 29 are the side walls); ``cylinders``: (k, 2) centres of the
+    cylinders written (the filled cells but those inside a filled block); ``reference_path``: (n, 2) shortest
+    collision-free path for a disc of ``robot_radius``; ``robot_cells``: the configuration space's reach (cells);
+    ``attempts``: automaton draws until one had a way through; ``difficulty``: fraction of the 28 inner rows'
+    cells holding a cylinder; ``metrics``: more figures: ``fill_initial``, ``fill_final`` (= difficulty),
+    ``tortuosity`` (reference length / 10 m), ``mean_clearance_m`` (robot centre to the nearest surface along
+    the reference path in the field) and ``bottleneck_m`` (half-width of the narrowest passage on the widest route).
     """
 
     seed: int
     fill: float
     smooth: int
     robot_radius: float
-    margin: float
+    robot_cells: int
     cells: np.ndarray
     cylinders: np.ndarray
     walls: list[Box]
@@ -87,7 +101,7 @@ class ClutterWorld:
     reference_path: np.ndarray
     reference_path_m: float
     difficulty: float
-    carved: int
+    attempts: int
     metrics: dict[str, float] = field(default_factory=dict)
 
     @property
@@ -107,9 +121,9 @@ class ClutterWorld:
             "fill": self.fill,
             "smooth": self.smooth,
             "robot_radius": self.robot_radius,
-            "margin": self.margin,
+            "robot_cells": self.robot_cells,
             "cylinders": len(self.cylinders),
-            "carved": self.carved,
+            "attempts": self.attempts,
             "start": list(self.start),
             "goal": list(self.goal),
             "reference_path_m": round(self.reference_path_m, 4),
@@ -148,35 +162,90 @@ def field_centres() -> tuple[np.ndarray, np.ndarray]:
 
 
 def _walls() -> list[Box]:
-    """Side walls along the field and the start zone, and a back wall behind the start."""
+    """BARN's containment walls around the start zone: both sides in line with the field's wall rows, from the back
+    wall up to the field, and the back wall across the field's whole width."""
     t, half = WALL_THICKNESS, FIELD / 2
-    x_back = -START_GAP - _BEHIND
-    length = FIELD - x_back
-    cx = (FIELD + x_back) / 2
+    x_back = -START_ZONE - t  # the back wall's outer face
     return [
-        Box("wall_left", cx, half + t / 2, length, t),
-        Box("wall_right", cx, -half - t / 2, length, t),
-        Box("wall_back", x_back - t / 2, 0.0, t, FIELD + 2 * t),
+        Box("wall_left", x_back / 2, half - t / 2, -x_back, t),
+        Box("wall_right", x_back / 2, -half + t / 2, -x_back, t),
+        Box("wall_back", x_back + t / 2, 0.0, t, FIELD),
     ]
 
 
 # ------------------------------------------------------------------------------ cellular automaton
 def cellular_automaton(
-    rng: np.random.Generator, fill: float, smooth: int, *, fill_threshold: int = 5, clear_threshold: int = 1
+    rng: np.random.Generator,
+    fill: float,
+    smooth: int,
+    *,
+    fill_threshold: int = 5,
+    clear_threshold: int = 1,
+    count: int | None = None,
 ) -> np.ndarray:
-    """(30, 30) bool field: random fill with probability ``fill``, then ``smooth`` rounds of the rule.
+    """(30, 30) bool field: rows 0 and 29 filled, the others at random with probability ``fill``, then ``smooth``
+    rounds of the rule; ``count`` fields at once ((count, 30, 30), the same as ``count`` calls in a row).
 
     Each round, a cell with >= ``fill_threshold`` filled neighbours (of 8) fills, one with <=
-    ``clear_threshold`` clears, the others keep their state (5 and 3 make the usual 4-5 cave rule);
-    cells outside the field count as empty.
+    ``clear_threshold`` clears, the others keep their state (BARN's 5 and 1); beyond the wall rows counts as
+    filled, beyond the first and last columns as empty.
     """
-    cells = rng.random((CELLS, CELLS)) < fill
-    kernel = np.ones((3, 3), dtype=np.int16)
-    kernel[1, 1] = 0
+    n_fields = 1 if count is None else count
+    cells = np.ones((n_fields, CELLS, CELLS), dtype=bool)
+    cells[:, 1:-1] = rng.random((n_fields, CELLS - 2, CELLS)) < fill
     for _ in range(smooth):
-        n = ndimage.convolve(cells.astype(np.int16), kernel, mode="constant", cval=0)
+        padded = np.pad(cells, ((0, 0), (1, 1), (1, 1)), constant_values=False).view(np.uint8)
+        padded[:, [0, -1], :] = 1  # beyond the wall rows counts as filled
+        n = sum(
+            padded[:, 1 + di : CELLS + 1 + di, 1 + dj : CELLS + 1 + dj].astype(np.int8)
+            for di in (-1, 0, 1)
+            for dj in (-1, 0, 1)
+            if di or dj
+        )
         cells = (cells | (n >= fill_threshold)) & (n > clear_threshold)
-    return cells
+    return cells[0] if count is None else cells
+
+
+def configuration_space(cells: np.ndarray, robot_cells: int = ROBOT_CELLS) -> np.ndarray:
+    """Where the robot's centre may sit (bool, like ``cells``, one field or a stack): no filled cell within
+    ``robot_cells`` cells in either direction (a square window, clipped to the field: beyond its ends is open)."""
+    k = robot_cells
+    padded = np.pad(cells, [(0, 0)] * (cells.ndim - 2) + [(k, k), (k, k)], constant_values=False)
+    rows = np.zeros((*padded.shape[:-2], CELLS, padded.shape[-1]), dtype=bool)
+    for d in range(2 * k + 1):  # a square window's maximum: along the rows, then along the columns
+        rows |= padded[..., d : d + CELLS, :]
+    near = np.zeros(cells.shape, dtype=bool)
+    for d in range(2 * k + 1):
+        near |= rows[..., d : d + CELLS]
+    return ~near
+
+
+def way_through(free: np.ndarray) -> np.ndarray | bool:
+    """BARN's test of a world (of each in a stack): the largest 4-connected free region touching the first column
+    is the largest one touching the last column."""
+    stack = free.reshape(-1, *free.shape[-2:])
+    structure = np.zeros((3, 3, 3), dtype=bool)
+    structure[1] = ndimage.generate_binary_structure(2, 1)  # 4-connected within a field, never across fields
+    labels, _ = ndimage.label(stack, structure=structure)
+    ok = np.zeros(len(stack), dtype=bool)
+    first, last = labels[:, :, 0], labels[:, :, -1]
+    both = np.intersect1d(first[first > 0], last[last > 0])  # labels are unique across the stack
+    if not both.size:
+        return bool(ok[0]) if free.ndim == 2 else ok
+    sizes = np.bincount(labels.ravel())
+    for k in np.unique(np.nonzero(np.isin(first, both))[0]):
+        ids_first, ids_last = np.unique(first[k][first[k] > 0]), np.unique(last[k][last[k] > 0])
+        ok[k] = ids_first[np.argmax(sizes[ids_first])] == ids_last[np.argmax(sizes[ids_last])]
+    return bool(ok[0]) if free.ndim == 2 else ok
+
+
+def written_cylinders(cells: np.ndarray) -> np.ndarray:
+    """(k, 2) centres (m) of the cylinders a world holds: its filled cells but those whose 8 neighbours are all
+    filled and inside the field (hidden in a block, as BARN writes none there)."""
+    full = ndimage.minimum_filter(cells.astype(np.uint8), size=3, mode="constant", cval=0).astype(bool)
+    ii, jj = np.nonzero(cells & ~full)
+    xc, yc = field_centres()
+    return np.c_[xc[jj], yc[ii]]
 
 
 # ------------------------------------------------------------------------------------ grid search
@@ -211,56 +280,6 @@ def _grid_dijkstra(
     while path[-1] != source:
         path.append(int(pred[path[-1]]))
     return path[::-1]
-
-
-def _segment_distances(points: np.ndarray, path: np.ndarray) -> np.ndarray:
-    """Distance from each point (k, 2) to the polyline ``path`` (n, 2)."""
-    a, b = path[:-1], path[1:]
-    ab = b - a
-    denom = np.maximum((ab * ab).sum(axis=1), 1e-12)
-    ap = points[:, None, :] - a[None, :, :]
-    t = np.clip((ap * ab[None]).sum(axis=2) / denom[None], 0.0, 1.0)
-    closest = a[None] + t[..., None] * ab[None]
-    return np.linalg.norm(points[:, None, :] - closest, axis=2).min(axis=1)
-
-
-def _carve(
-    cylinders: np.ndarray, walls: list[Box], start: np.ndarray, goal: np.ndarray, clear: float
-) -> tuple[np.ndarray, np.ndarray]:
-    """Keep-mask of cylinders after clearing a corridor of half-width ``clear`` (m), and its polyline.
-
-    The corridor follows the cheapest path over the 0.15 m grid from start to goal, where entering a
-    cell costs extra for every cylinder that would have to go; rows too close to the side walls are
-    not used.
-    """
-    x_lo = start[0] - CELL / 2
-    xs = np.arange(math.floor(x_lo / CELL), math.ceil((goal[0] + CELL) / CELL)) * CELL + CELL / 2
-    ys = field_centres()[1]
-    gx, gy = np.meshgrid(xs, ys)
-    pts = np.c_[gx.ravel(), gy.ravel()]
-    passable = (Clearance(np.zeros((0, 2)), walls, CYLINDER_RADIUS)(pts) >= clear).reshape(gx.shape)
-    reach = clear + CYLINDER_RADIUS
-    count = np.zeros(len(pts))
-    if len(cylinders):
-        count = np.array([len(n) for n in cKDTree(cylinders).query_ball_point(pts, reach - 1e-9)], dtype=float)
-    cost = _CARVE_WEIGHT * count.reshape(gx.shape)
-    ys_ok = np.flatnonzero(passable[:, np.argmin(np.abs(xs - FIELD / 2))])  # rows usable between the walls
-    if not len(ys_ok):
-        raise WorldError(
-            f"clutter: robot_radius + margin = {clear - _REF_RES:.3f} m does not fit between the walls {FIELD} m apart"
-        )
-
-    def nearest(p: np.ndarray) -> int:
-        i = ys_ok[np.argmin(np.abs(ys[ys_ok] - p[1]))]
-        return int(i * len(xs) + np.argmin(np.abs(xs - p[0])))
-
-    cells = _grid_dijkstra(passable, cost, CELL, nearest(start), nearest(goal))
-    if cells is None:  # cannot happen: the rows between the walls are all passable
-        raise WorldError("clutter: no corridor between the walls")
-    poly = np.vstack([start, pts[cells], goal])
-    if not len(cylinders):
-        return np.zeros(0, dtype=bool), poly
-    return _segment_distances(cylinders, poly) >= reach, poly
 
 
 # ------------------------------------------------------------------------------- reference path
@@ -346,53 +365,86 @@ def bottleneck(
 
 
 # ------------------------------------------------------------------------------------- generator
+def guaranteed_clearance(robot_cells: int = ROBOT_CELLS) -> float:
+    """Clearance (m) every world keeps for the robot's centre along its way through: (robot_cells + 1) cells to
+    the nearest cylinder centre, less its radius (0.375 m for BARN's Jackal, 2 cells)."""
+    return (robot_cells + 1) * CELL - CYLINDER_RADIUS
+
+
+def _check_options(fill: float, smooth: int, robot_radius: float, robot_cells: int, ft: int, ct: int) -> None:
+    if not 0.0 <= fill <= 1.0:
+        raise WorldError(f"clutter: fill must be in [0, 1], got {fill}")
+    if smooth < 0 or int(smooth) != smooth:
+        raise WorldError(f"clutter: smooth must be an integer >= 0, got {smooth}")
+    if not 0 < robot_radius <= FIELD / 2 - CELL:
+        raise WorldError(
+            f"clutter: robot_radius must be > 0 m and fit between the walls {FIELD - 2 * CELL:g} m apart, "
+            f"got {robot_radius}"
+        )
+    if robot_cells < 0 or int(robot_cells) != robot_cells or 2 * robot_cells + 1 > CELLS - 2:
+        raise WorldError(f"clutter: robot_cells must be an integer in 0..{(CELLS - 3) // 2}, got {robot_cells}")
+    if not 0 <= ct < ft <= 8:
+        raise WorldError(
+            "clutter: need 0 <= clear_threshold < fill_threshold <= 8 (neighbour counts), got "
+            f"clear_threshold {ct}, fill_threshold {ft}"
+        )
+
+
 def generate_clutter(
     seed: int,
     *,
     fill: float,
     smooth: int,
     robot_radius: float = 0.2,
-    margin: float = 0.05,
+    robot_cells: int = ROBOT_CELLS,
     fill_threshold: int = 5,
     clear_threshold: int = 1,
+    margin: float | None = None,
 ) -> ClutterWorld:
-    """A BARN-style world from ``seed`` (same seed and options, same world).
+    """A BARN world from ``seed`` (same seed and options, same world).
 
-    ``fill``: initial fill probability of each field cell (0..1); ``smooth``: cellular-automaton rounds
-    (>= 0); ``robot_radius`` (m): the disc the reference path is planned for; the carved corridor is
-    clear for ``robot_radius + margin``; ``fill_threshold``/``clear_threshold``: the automaton's
-    neighbour counts (see :func:`cellular_automaton`).
+    ``fill``: initial fill probability of each inner cell (0..1); ``smooth``: cellular-automaton rounds (>= 0);
+    ``robot_cells``: the configuration space's reach that must connect the field's ends (BARN's Jackal: 2);
+    ``robot_radius`` (m): the disc the reference path is planned for (at most :func:`guaranteed_clearance`, or
+    a world may have none); ``fill_threshold``/``clear_threshold``: the automaton's neighbour counts (see
+    :func:`cellular_automaton`). The automaton is drawn again from the same random stream until the way
+    through exists (``attempts``). ``margin`` is deprecated and ignored (nothing is carved any more).
     """
-    if not 0.0 <= fill <= 1.0:
-        raise WorldError(f"clutter: fill must be in [0, 1], got {fill}")
-    if smooth < 0 or int(smooth) != smooth:
-        raise WorldError(f"clutter: smooth must be an integer >= 0, got {smooth}")
-    if not robot_radius > 0.0 or not margin >= 0.0:
-        raise WorldError(f"clutter: robot_radius must be > 0 and margin >= 0 m, got {robot_radius}, {margin}")
-    if not 0 <= clear_threshold < fill_threshold <= 8:
-        raise WorldError(
-            "clutter: need 0 <= clear_threshold < fill_threshold <= 8 (neighbour counts), got "
-            f"clear_threshold {clear_threshold}, fill_threshold {fill_threshold}"
+    if margin is not None:
+        warnings.warn(
+            "generate_clutter(margin=...) is ignored and will be removed: worlds are no longer carved; each is "
+            "drawn until the robot's configuration space (robot_cells) connects the field's ends, as BARN's",
+            DeprecationWarning,
+            stacklevel=2,
         )
+    _check_options(fill, smooth, robot_radius, robot_cells, fill_threshold, clear_threshold)
     rng = np.random.default_rng(seed)
-    cells = cellular_automaton(rng, fill, int(smooth), fill_threshold=fill_threshold, clear_threshold=clear_threshold)
-    start = np.array([-START_GAP, 0.0])
+    attempts = 0
+    while True:  # draw in batches from one stream: the first field with a way through, as drawn one by one
+        batch = min(_BATCH, MAX_DRAWS - attempts)
+        stack = cellular_automaton(
+            rng, fill, int(smooth), fill_threshold=fill_threshold, clear_threshold=clear_threshold, count=batch
+        )
+        hits = np.flatnonzero(way_through(configuration_space(stack, int(robot_cells))))
+        if len(hits):
+            cells, attempts = stack[hits[0]], attempts + int(hits[0]) + 1
+            break
+        attempts += batch
+        if attempts >= MAX_DRAWS:
+            raise WorldError(
+                f"clutter: seed {seed}: no way through for robot_cells {robot_cells} in {MAX_DRAWS} draws of fill "
+                f"{fill}, smooth {smooth} (BARN's worlds use fill 0.15..0.30); lower fill or robot_cells"
+            )
+    start = np.array([-START_GAP, START_Y])
     goal = start + np.array([GOAL_DISTANCE, 0.0])
     walls = _walls()
-    xc, yc = field_centres()
-    ii, jj = np.nonzero(cells)
-    cylinders = np.c_[xc[jj], yc[ii]]
-    # Carve with one fine cell to spare, so the corridor survives discretisation in checks.
-    keep, _ = _carve(cylinders, walls, start, goal, robot_radius + margin + _REF_RES)
-    carved = int((~keep).sum())
-    cells[ii[~keep], jj[~keep]] = False
-    cylinders = cylinders[keep] if len(cylinders) else cylinders
+    cylinders = written_cylinders(cells)
     clearance = Clearance(cylinders, walls, CYLINDER_RADIUS)
     path = reference_path(clearance, walls, start, goal, robot_radius)
     if path is None:
         raise WorldError(
-            f"clutter: seed {seed}: no collision-free path for robot_radius {robot_radius} m "
-            "after carving (a bug: please report the seed and options)"
+            f"clutter: seed {seed}: no collision-free path for robot_radius {robot_radius} m (every world keeps "
+            f"{guaranteed_clearance(int(robot_cells)):.3f} m for robot_cells {robot_cells}); raise robot_cells"
         )
     seg = np.linalg.norm(np.diff(path, axis=0), axis=1)
     length = float(seg.sum())
@@ -405,9 +457,10 @@ def generate_clutter(
     )
     in_field = (samples[:, 0] >= 0.0) & (samples[:, 0] <= FIELD)
     along = clearance(samples[in_field]) if in_field.any() else np.array([np.inf])
+    difficulty = float(cells[1:-1].mean())
     metrics = {
         "fill_initial": float(fill),
-        "fill_final": float(cells.mean()),
+        "fill_final": difficulty,
         "tortuosity": length / GOAL_DISTANCE,
         "mean_clearance_m": float(np.mean(np.minimum(along, FIELD / 2))),
         "bottleneck_m": bottleneck(clearance, walls, start, goal),
@@ -417,7 +470,7 @@ def generate_clutter(
         fill=float(fill),
         smooth=int(smooth),
         robot_radius=float(robot_radius),
-        margin=float(margin),
+        robot_cells=int(robot_cells),
         cells=cells,
         cylinders=cylinders,
         walls=walls,
@@ -425,24 +478,33 @@ def generate_clutter(
         goal=(float(goal[0]), float(goal[1]), 0.0),
         reference_path=path,
         reference_path_m=length,
-        difficulty=float(cells.mean()),
-        carved=carved,
+        difficulty=difficulty,
+        attempts=attempts,
         metrics=metrics,
     )
 
 
 def suite_parameters(n: int = 50) -> list[tuple[float, int]]:
-    """(fill, smooth) of the suite's worlds, easiest first: fill rises from 0.10 to 0.45 while the
-    smoothing cycles through 1..4 rounds (scattered to clustered clutter at every level)."""
+    """(fill, smooth) of the suite's worlds, in BARN's order: its 12 parameter sets (fill 0.15, 0.20, 0.25, 0.30,
+    each with 2, 3 and 4 smoothing rounds) in equal shares, world k of n taking set 12 k // n."""
     if n < 1:
         raise WorldError(f"clutter_suite: n must be >= 1, got {n}")
-    return [(round(0.10 + 0.35 * k / max(n - 1, 1), 4), 1 + k % 4) for k in range(n)]
+    sets = [(f, s) for f in BARN_FILLS for s in BARN_SMOOTHS]
+    return [sets[k * len(sets) // n] for k in range(n)]
 
 
-def clutter_suite(n: int = 50, seed: int = 0, *, robot_radius: float = 0.2, margin: float = 0.05) -> list[ClutterWorld]:
+def clutter_suite(
+    n: int = 50, seed: int = 0, *, robot_radius: float = 0.2, margin: float | None = None
+) -> list[ClutterWorld]:
     """``n`` worlds of graded difficulty (deterministic for ``seed``): world k has seed ``seed * 1000 + k``."""
+    if margin is not None:
+        warnings.warn(
+            "clutter_suite(margin=...) is ignored and will be removed (nothing is carved any more)",
+            DeprecationWarning,
+            stacklevel=2,
+        )
     return [
-        generate_clutter(seed * 1000 + k, fill=f, smooth=s, robot_radius=robot_radius, margin=margin)
+        generate_clutter(seed * 1000 + k, fill=f, smooth=s, robot_radius=robot_radius)
         for k, (f, s) in enumerate(suite_parameters(n))
     ]
 
@@ -452,11 +514,11 @@ def _sdf(w: ClutterWorld) -> str:
     sx, sy, _ = w.start
     gx, gy, _ = w.goal
     comment = (
-        f"navlab BARN-style clutter world: seed {w.seed}, fill {w.fill}, smooth {w.smooth}; "
-        f"{len(w.cylinders)} cylinders r {CYLINDER_RADIUS} m on a {CELL} m grid over x 0..{FIELD}, "
-        f"y {-FIELD / 2}..{FIELD / 2};\n"
+        f"navlab BARN clutter world: seed {w.seed}, fill {w.fill}, smooth {w.smooth}, robot_cells {w.robot_cells} "
+        f"({w.attempts} draws); {len(w.cylinders)} cylinders r {CYLINDER_RADIUS} m on a {CELL} m grid over "
+        f"x 0..{FIELD}, y {-FIELD / 2}..{FIELD / 2};\n"
         f"     start ({sx:g}, {sy:g}, yaw 0), goal ({gx:g}, {gy:g}); reference path {w.reference_path_m:.3f} m "
-        f"for robot radius {w.robot_radius} m; difficulty (fill after smoothing) {w.difficulty:.4f}"
+        f"for robot radius {w.robot_radius} m; difficulty (fill of the inner rows) {w.difficulty:.4f}"
     )
     walls = [
         link(b.name, b.x, b.y, b.height / 2, box_geometry(b.sx, b.sy, b.height), "0.9 0.9 0.85", parts=f"{b.name}_")
