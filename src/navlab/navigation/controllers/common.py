@@ -10,8 +10,9 @@ m/s, rad/s.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Self
 
 import numba
 import numpy as np
@@ -20,6 +21,7 @@ from navlab.core.params import param_error
 from navlab.geometry import wrap_angle
 from navlab.grid import Grid
 from navlab.navigation.errors import NavigationError
+from navlab.plugins import ControlResult, PluginContext
 
 
 def bad(what: str, key: str, value: Any, expected: str) -> NavigationError:
@@ -339,3 +341,83 @@ class InPlaceFlags:
                 self.rotating_left = True
             self.prev = (pose[0], pose[1])
         self.moved(pose)
+
+
+class ControllerBase:
+    """What the local controllers share behind ``plugins.Controller``: :meth:`compute_velocity` runs the
+    controller's ``_command`` and returns its (v, w) with ``valid`` and ``local_plan``; :meth:`from_params` builds
+    it from its parameter namespace and the host's context."""
+
+    what = ""
+    valid: bool
+    local_plan: np.ndarray
+
+    @classmethod
+    def from_params(cls, params: Mapping[str, Any] | None, *, context: PluginContext) -> Self:
+        """From the controller's parameter namespace, move_base's ``controller_frequency``, the host's seeded
+        ``rng`` and the local costmap's footprint (its polygon, else a round robot's radius)."""
+        fp = context.footprint
+        return cls(  # type: ignore[call-arg]
+            params,
+            footprint=None if fp is None else fp.polygon,
+            robot_radius=None if fp is None else fp.radius,
+            controller_frequency=context.controller_frequency,
+            rng=context.rng,
+        )
+
+    def compute_velocity(
+        self, pose: tuple[float, float, float], velocity: tuple[float, float], costmap: Grid | None
+    ) -> ControlResult:
+        """The command (v m/s, w rad/s) for the robot at ``pose`` (costmap frame) moving at ``velocity`` (v, w),
+        with ``valid`` and the controller's ``local_plan`` (costmap frame)."""
+        v, w = self._command(pose, velocity, costmap)
+        return ControlResult(v, w, self.valid, self.local_plan)
+
+    def _command(
+        self, pose: tuple[float, float, float], velocity: tuple[float, float], costmap: Grid | None
+    ) -> tuple[float, float]:
+        raise NotImplementedError
+
+    def _check_call(self, plan: np.ndarray | None, costmap: Grid | None, *, needs_costmap: bool = True) -> None:
+        """Refuse a cycle before ``set_plan`` (and, if the controller needs one, without a local costmap)."""
+        if plan is None:
+            raise NavigationError(f"{self.what}: compute_velocity called before set_plan")
+        if needs_costmap and costmap is None:
+            raise NavigationError(f"{self.what}: needs a local costmap (got None)")
+
+
+class Nav2PlanController(ControllerBase):
+    """The plan handling of Nav2's controllers (MPPI, Regulated Pure Pursuit): the plan resampled every
+    ``spacing`` m, the progress along it kept when a plan to the same goal is sent again, and Nav2's
+    SimpleGoalChecker (xy tolerance, latched if ``stateful``, and yaw tolerance)."""
+
+    spacing = 0.05  # m between the resampled plan's points
+
+    def _plan_state(self, xy_goal_tolerance: float, yaw_goal_tolerance: float, stateful: bool) -> None:
+        """Start without a plan (call from ``__init__``)."""
+        self._latch = GoalLatch(xy_goal_tolerance, yaw_goal_tolerance, stateful)
+        self._plan: np.ndarray | None = None
+        self._goal: tuple[float, float, float | None] = (0.0, 0.0, None)
+        self._progress = 0
+
+    def set_plan(self, path: np.ndarray) -> None:
+        """The global plan (N, 2) or (N, 3) in the costmap's frame (resampled at ``spacing``); an (N, 3) plan's last
+        yaw is the goal yaw. A plan to a new goal (beyond the goal tolerances) resets the goal latch; one to the same
+        goal keeps the progress made along the old one."""
+        plan = as_plan(path)
+        goal = goal_of(plan)
+        dense = densify(plan[:, :2], self.spacing)
+        latch = self._latch
+        if self._plan is not None and same_goal(self._goal, goal, latch.xy_tolerance, latch.yaw_tolerance):
+            anchor = self._plan[self._progress]  # keep the progress along a plan re-sent to the same goal
+            self._progress = int(np.argmin(np.hypot(dense[:, 0] - anchor[0], dense[:, 1] - anchor[1])))
+        else:
+            latch.reset()
+            self._progress = 0
+        self._goal, self._plan = goal, dense
+
+    def is_goal_reached(self, pose: tuple[float, float, float], velocity: tuple[float, float]) -> bool:
+        """Nav2's SimpleGoalChecker: within xy tolerance (latched if ``stateful``) and yaw tolerance."""
+        if self._plan is None:
+            return False
+        return self._latch.reached((float(pose[0]), float(pose[1]), float(pose[2])), self._goal)

@@ -4,50 +4,28 @@ shared rollout, distance maps and goal handling, and the cost it minimises)."""
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
-from typing import Any
 
 import numpy as np
 
-from navlab.core import read_params
 from navlab.navigation.controllers import mapgrid
 from navlab.navigation.controllers.params import DWAPlannerParams
-from navlab.navigation.controllers.rollout import lookup, occupancy_costs, rollout, velocity_samples
+from navlab.navigation.controllers.rollout import footprint_costs, lookup, velocity_samples
 from navlab.navigation.controllers.rollout_controller import LocalScene, RolloutController
 
 _EPS = 1e-4
 
 
 class DWAPlannerROS(RolloutController):
-    """dwa_local_planner's DWAPlanner behind the Controller protocol.
-
-    ``params``: a DWAPlannerROS parameter dict (ROS 1 names, old and new spellings) or
-    ``DWAPlannerParams``; ``footprint``: polygon [[x, y], ...] (m, base frame), else ``robot_radius`` (m:
-    costmap_2d's 16-gon), else a point robot (centre cell); ``controller_frequency``: move_base's (Hz), used
-    unless ``params`` sets it. ``rng`` is accepted for a uniform constructor and not used.
-    """
+    """dwa_local_planner's DWAPlanner behind the Controller protocol (``params``: a DWAPlannerROS parameter dict,
+    ROS 1 names, or ``DWAPlannerParams``; the other arguments as ``RolloutController``'s)."""
 
     what = "DWAPlannerROS"
+    params_class = DWAPlannerParams
     params: DWAPlannerParams
 
-    def __init__(
-        self,
-        params: Mapping[str, Any] | DWAPlannerParams | None = None,
-        *,
-        footprint: Any = None,
-        robot_radius: float | None = None,
-        controller_frequency: float | None = None,
-        rng: np.random.Generator | None = None,
-    ) -> None:
-        super().__init__(
-            params, footprint=footprint, robot_radius=robot_radius, controller_frequency=controller_frequency, rng=rng
-        )
+    def _setup(self) -> None:
         self._stopped_vel = (self.params.trans_stopped_vel, self.params.theta_stopped_vel)
         self._accelerate = not self.params.use_dwa
-
-    @staticmethod
-    def _parse(params: Any) -> DWAPlannerParams:
-        return read_params(DWAPlannerParams, params)
 
     def _in_place_limits(self, err: float) -> tuple[float, float]:
         return self.params.max_vel_theta, self.params.min_vel_theta
@@ -123,7 +101,8 @@ class DWAPlannerROS(RolloutController):
         total = np.zeros(len(targets))
         rejected = ~self._osc.allowed(targets[:, 0], targets[:, 1])
         if p.occdist_scale > 0:
-            fp = occupancy_costs(scene.cost, res, traj, self._outline(res), near_max=self._near_max(scene))
+            outline, near = self._outline(res), self._near_max(scene)
+            fp = footprint_costs(scene.cost, res, traj, outline, near_max=near, with_centre=True)
             rejected |= (fp < 0).any(axis=1)
             total += p.occdist_scale * fp.max(axis=1)
         # the nose: every pose moved forward_point_distance ahead (MapGrid critics with an x shift read the
@@ -149,11 +128,7 @@ class DWAPlannerROS(RolloutController):
         return total
 
     def _drive(
-        self,
-        scene: LocalScene,
-        pose: tuple[float, float, float],
-        velocity: tuple[float, float],
-        goal: tuple[float, float, float | None],
+        self, scene: LocalScene, pose: tuple[float, float, float], velocity: tuple[float, float]
     ) -> tuple[float, float]:
         p = self.params
         g = scene.local_goal()
@@ -161,15 +136,7 @@ class DWAPlannerROS(RolloutController):
         if len(targets) == 0:
             return self._finish(scene, targets, np.zeros((0, 0, 3)), np.zeros(0), -1, pose)
         steps = self._steps(targets)
-        traj = rollout(
-            scene.pose,
-            velocity,
-            targets,
-            steps,
-            p.sim_time,
-            (p.acc_lim_x, p.acc_lim_theta),
-            accelerate=self._accelerate,
-        )
+        traj = self._rollout(scene, velocity, targets, steps)
         if not p.use_dwa:  # continued acceleration: ROS commands the velocity reached after the first step
             dt = (p.sim_time / steps)[:, None]
             now = np.array(velocity)

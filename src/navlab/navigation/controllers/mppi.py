@@ -39,18 +39,9 @@ from navlab.core.limits import check_ceiling
 from navlab.errors import did_you_mean
 from navlab.grid import COST_INSCRIBED, Grid
 from navlab.navigation.controllers import mppi_critics as critics
-from navlab.navigation.controllers.common import (
-    GoalLatch,
-    LocalFrame,
-    as_plan,
-    bad,
-    densify,
-    footprint_outline,
-    goal_of,
-    same_goal,
-)
+from navlab.navigation.controllers.common import LocalFrame, Nav2PlanController, bad, footprint_outline
 from navlab.navigation.errors import NavigationError
-from navlab.plugins import ControlResult, PluginContext
+from navlab.plugins import PluginContext
 
 WHAT = "MPPIController"
 PATH_SPACING = 0.05  # m: plans are resampled to this (Nav2's path-index offsets assume costmap cells)
@@ -121,28 +112,8 @@ class MppiParams:
         return self.critic_params.get(name) or critics.CRITICS[name]()
 
     def validate(self) -> None:
-        """Raise ``NavigationError`` naming the first bad parameter."""
-        for key in ("batch_size", "iteration_count", "retry_attempt_limit"):
-            if getattr(self, key) < 1:
-                raise bad(WHAT, key, getattr(self, key), ">= 1")
-        if self.time_steps < 2:
-            raise bad(WHAT, "time_steps", self.time_steps, ">= 2")
-        for key in (
-            "model_dt",
-            "temperature",
-            "vx_std",
-            "wz_std",
-            "wz_max",
-            "ax_max",
-            "az_max",
-            "prune_distance",
-            "controller_frequency",
-        ):
-            if not getattr(self, key) > 0:
-                raise bad(WHAT, key, getattr(self, key), "> 0")
-        for key in ("gamma", "xy_goal_tolerance", "yaw_goal_tolerance"):
-            if not getattr(self, key) >= 0:
-                raise bad(WHAT, key, getattr(self, key), ">= 0")
+        """Raise ``NavigationError`` naming the first bad parameter (what spans fields or needs its own words; the
+        ranges are in ``PARAMS``)."""
         if not 0.0 <= self.noise_correlation < 1.0:
             raise bad(WHAT, "noise_correlation", self.noise_correlation, "0 <= value < 1")
         if self.ax_min > 0:
@@ -187,7 +158,44 @@ def _critic_sections(values: dict[str, Any]) -> dict[str, Any]:
     return flat
 
 
-MppiParams.PARAMS = ParamSpec(WHAT, NavigationError, ignored=_IGNORED, prepare=_critic_sections)
+MppiParams.PARAMS = ParamSpec(
+    WHAT,
+    NavigationError,
+    ignored=_IGNORED,
+    prepare=_critic_sections,
+    at_least={
+        **dict.fromkeys(("batch_size", "iteration_count", "retry_attempt_limit"), 1),
+        "time_steps": 2,
+        **dict.fromkeys(("gamma", "xy_goal_tolerance", "yaw_goal_tolerance"), 0),
+    },
+    above=dict.fromkeys(
+        (
+            "model_dt",
+            "temperature",
+            "vx_std",
+            "wz_std",
+            "wz_max",
+            "ax_max",
+            "az_max",
+            "prune_distance",
+            "controller_frequency",
+        ),
+        0,
+    ),
+)
+
+
+@numba.njit(cache=True, inline="always")
+def _reachable(
+    cv: float, cw: float, v: float, om: float, dt: float, acc: float, dec: float, aw: float
+) -> tuple[float, float]:  # pragma: no cover - compiled
+    """The control (cv, cw) limited to what the accelerations allow in ``dt`` from (v, om): ``acc`` speeding up and
+    ``dec`` (<= 0) slowing down, in either direction of travel, ``aw`` for the turn rate."""
+    if v >= 0.0:
+        cv = min(max(cv, v + dec * dt), v + acc * dt)
+    else:
+        cv = min(max(cv, v - acc * dt), v - dec * dt)
+    return cv, min(max(cw, om - aw * dt), om + aw * dt)
 
 
 @numba.njit(cache=True)
@@ -237,13 +245,7 @@ def _sample_rollout(
             xs[s, t], ys[s, t], ths[s, t], arc[s, t] = x, y, th, d
             i, j = math.floor(x * inv), math.floor(y * inv)
             cs[s, t] = cost[j, i] if 0 <= i < w and 0 <= j < h else 255
-            cv = seq[t, 0] + std[0] * ev
-            if v >= 0.0:
-                cv = min(max(cv, v + dec * dt), v + acc * dt)
-            else:
-                cv = min(max(cv, v - acc * dt), v - dec * dt)
-            cw = seq[t, 1] + std[1] * ew
-            cw = min(max(cw, om - aw * dt), om + aw * dt)
+            cv, cw = _reachable(seq[t, 0] + std[0] * ev, seq[t, 1] + std[1] * ew, v, om, dt, acc, dec, aw)
             u[s, t, 0], u[s, t, 1] = cv, cw
             dot += seq[t, 0] * (cv - seq[t, 0]) * iv + seq[t, 1] * (cw - seq[t, 1]) * iw
             v, om = cv, cw
@@ -256,15 +258,11 @@ def _accel_limit(seq: np.ndarray, v0: float, w0: float, dt: float, limits: np.nd
     acc, dec, aw = limits[3], limits[4], limits[5]
     v, om = v0, w0
     for t in range(seq.shape[0]):
-        if v >= 0.0:
-            seq[t, 0] = min(max(seq[t, 0], v + dec * dt), v + acc * dt)
-        else:
-            seq[t, 0] = min(max(seq[t, 0], v - acc * dt), v - dec * dt)
-        seq[t, 1] = min(max(seq[t, 1], om - aw * dt), om + aw * dt)
+        seq[t, 0], seq[t, 1] = _reachable(seq[t, 0], seq[t, 1], v, om, dt, acc, dec, aw)
         v, om = seq[t, 0], seq[t, 1]
 
 
-class MPPIController:
+class MPPIController(Nav2PlanController):
     """The MPPI controller behind the Controller protocol.
 
     ``params``: a Nav2 MPPI parameter dict or ``MppiParams``; ``rng``: the seeded generator every noise
@@ -276,6 +274,7 @@ class MPPIController:
     """
 
     what = WHAT
+    spacing = PATH_SPACING
 
     def __init__(
         self,
@@ -294,10 +293,7 @@ class MPPIController:
         self._limits = np.array([p.vx_min, p.vx_max, p.wz_max, p.ax_max, p.ax_min, p.az_max])
         self._std = np.array([p.vx_std, p.wz_std])
         self._sg = savgol_coeffs(9, 2)  # Nav2 smooths with a 9-point quadratic Savitzky-Golay filter
-        self._latch = GoalLatch(p.xy_goal_tolerance, p.yaw_goal_tolerance, p.stateful)
-        self._plan: np.ndarray | None = None
-        self._goal: tuple[float, float, float | None] = (0.0, 0.0, None)
-        self._progress = 0
+        self._plan_state(p.xy_goal_tolerance, p.yaw_goal_tolerance, p.stateful)
         self.reset()
 
     def reset(self) -> None:
@@ -307,29 +303,6 @@ class MPPIController:
         self.local_plan = np.zeros((0, 3))
         self.costs = np.zeros(0)
         self.valid = True
-
-    def set_plan(self, path: np.ndarray) -> None:
-        """The global plan (N, 2) or (N, 3) in the costmap's frame (resampled at 5 cm); an (N, 3) plan's last
-        yaw is the goal yaw. A plan to a new goal (beyond the goal tolerances) resets the goal latch; one to
-        the same goal keeps the progress made along the old one."""
-        plan = as_plan(path)
-        goal = goal_of(plan)
-        dense = densify(plan[:, :2], PATH_SPACING)
-        p = self.params
-        if self._plan is not None and same_goal(self._goal, goal, p.xy_goal_tolerance, p.yaw_goal_tolerance):
-            anchor = self._plan[self._progress]  # keep the progress along a plan re-sent to the same goal
-            self._progress = int(np.argmin(np.hypot(dense[:, 0] - anchor[0], dense[:, 1] - anchor[1])))
-        else:
-            self._latch.reset()
-            self._progress = 0
-        self._goal = goal
-        self._plan = dense
-
-    def is_goal_reached(self, pose: tuple[float, float, float], velocity: tuple[float, float]) -> bool:
-        """Nav2's SimpleGoalChecker: within xy tolerance (latched if ``stateful``) and yaw tolerance."""
-        if self._plan is None:
-            return False
-        return self._latch.reached((float(pose[0]), float(pose[1]), float(pose[2])), self._goal)
 
     def _local_path(self, pose: tuple[float, float, float]) -> np.ndarray:
         """The plan from the point nearest the robot (searched ahead of the last one) to ``prune_distance``
@@ -351,21 +324,11 @@ class MPPIController:
         fp = context.footprint
         return cls(params, rng=context.rng, footprint=None if fp is None else fp.polygon)
 
-    def compute_velocity(
-        self, pose: tuple[float, float, float], velocity: tuple[float, float], costmap: Grid | None
-    ) -> ControlResult:
-        """The command (v m/s, w rad/s) for the robot at ``pose`` (costmap frame) moving at ``velocity`` (v, w),
-        with ``valid`` and the optimal trajectory as ``local_plan``."""
-        v, w = self._command(pose, velocity, costmap)
-        return ControlResult(v, w, self.valid, self.local_plan)
-
     def _command(
         self, pose: tuple[float, float, float], velocity: tuple[float, float], costmap: Grid | None
     ) -> tuple[float, float]:
-        if self._plan is None:
-            raise NavigationError(f"{WHAT}: compute_velocity called before set_plan")
-        if costmap is None:
-            raise NavigationError(f"{WHAT}: needs a local costmap (got None)")
+        self._check_call(self._plan, costmap)
+        assert costmap is not None
         p = self.params
         pose = (float(pose[0]), float(pose[1]), float(pose[2]))
         v0, w0 = float(velocity[0]), float(velocity[1])

@@ -37,17 +37,29 @@ from navlab.navigation.errors import NavigationError
 
 
 @dataclass
-class ConstraintCritic:
+class Critic:
+    """What every critic reads: ``enabled``, and its cost ``(cost_weight * term) ** cost_power``."""
+
     enabled: bool = True
-    cost_weight: float = 4.0
+    cost_weight: float = 1.0
     cost_power: int = 1
 
 
 @dataclass
-class CostCritic:
-    enabled: bool = True
+class NearCritic(Critic):
+    """A critic that applies only nearer to (or farther from) the goal than ``threshold_to_consider`` m."""
+
+    threshold_to_consider: float = 0.5
+
+
+@dataclass
+class ConstraintCritic(Critic):
+    cost_weight: float = 4.0
+
+
+@dataclass
+class CostCritic(Critic):
     cost_weight: float = 3.81
-    cost_power: int = 1
     consider_footprint: bool = False
     critical_cost: float = 300.0
     collision_cost: float = 1000000.0
@@ -58,27 +70,19 @@ class CostCritic:
 
 
 @dataclass
-class GoalCritic:
-    enabled: bool = True
+class GoalCritic(NearCritic):
     cost_weight: float = 5.0
-    cost_power: int = 1
     threshold_to_consider: float = 1.4
 
 
 @dataclass
-class GoalAngleCritic:
-    enabled: bool = True
+class GoalAngleCritic(NearCritic):
     cost_weight: float = 3.0
-    cost_power: int = 1
-    threshold_to_consider: float = 0.5
 
 
 @dataclass
-class PathAlignCritic:
-    enabled: bool = True
+class PathAlignCritic(NearCritic):
     cost_weight: float = 10.0
-    cost_power: int = 1
-    threshold_to_consider: float = 0.5
     offset_from_furthest: int = 20
     trajectory_point_step: int = 4
     max_path_occupancy_ratio: float = 0.07
@@ -86,38 +90,28 @@ class PathAlignCritic:
 
 
 @dataclass
-class PathFollowCritic:
-    enabled: bool = True
+class PathFollowCritic(NearCritic):
     cost_weight: float = 5.0
-    cost_power: int = 1
     threshold_to_consider: float = 1.4
     offset_from_furthest: int = 6
 
 
 @dataclass
-class PathAngleCritic:
-    enabled: bool = True
+class PathAngleCritic(NearCritic):
     cost_weight: float = 2.2
-    cost_power: int = 1
-    threshold_to_consider: float = 0.5
     offset_from_furthest: int = 4
     max_angle_to_furthest: float = 0.785398
     mode: int = 0
 
 
 @dataclass
-class PreferForwardCritic:
-    enabled: bool = True
+class PreferForwardCritic(NearCritic):
     cost_weight: float = 5.0
-    cost_power: int = 1
-    threshold_to_consider: float = 0.5
 
 
 @dataclass
-class TwirlingCritic:
-    enabled: bool = True
+class TwirlingCritic(Critic):
     cost_weight: float = 10.0
-    cost_power: int = 1
 
 
 CRITICS: dict[str, type] = {
@@ -192,7 +186,7 @@ class Batch:
         return self.path[k + int(ahead[0])] if len(ahead) else self.path[-1]
 
 
-def _out(c: Any, term: np.ndarray) -> np.ndarray:
+def _out(c: Critic, term: np.ndarray) -> np.ndarray:
     val = c.cost_weight * term
     return val if c.cost_power == 1 else val**c.cost_power
 

@@ -27,19 +27,9 @@ import numpy as np
 
 from navlab.core import ParamSpec, read_params
 from navlab.grid import COST_INSCRIBED, COST_UNKNOWN, Grid
-from navlab.navigation.controllers.common import (
-    GoalLatch,
-    LocalFrame,
-    as_plan,
-    bad,
-    densify,
-    footprint_outline,
-    goal_of,
-    same_goal,
-)
+from navlab.navigation.controllers.common import LocalFrame, Nav2PlanController, bad, footprint_outline
 from navlab.navigation.controllers.rollout import footprint_costs
 from navlab.navigation.errors import NavigationError
-from navlab.plugins import ControlResult
 
 WHAT = "RegulatedPurePursuitController"
 SPACING = 0.05  # m: plans are resampled to this
@@ -132,10 +122,17 @@ def carrot_on(path: np.ndarray, lookahead: float) -> np.ndarray:
     return a + min(max(t, 0.0), 1.0) * ab
 
 
-class RegulatedPurePursuitController:
-    """``nav2_regulated_pure_pursuit_controller::RegulatedPurePursuitController`` (see the module docstring)."""
+class RegulatedPurePursuitController(Nav2PlanController):
+    """``nav2_regulated_pure_pursuit_controller::RegulatedPurePursuitController`` (see the module docstring).
+
+    ``params``: a Nav2 RPP parameter dict or ``RppParams``; ``footprint``: polygon [[x, y], ...] (m, base frame),
+    else ``robot_radius`` (m); ``controller_frequency``: move_base's (Hz), used unless ``params`` sets it. ``rng``
+    is accepted for a uniform constructor and not used. Its ``local_plan`` is the projected arc; ``valid`` is False
+    when a collision is ahead.
+    """
 
     what = WHAT
+    spacing = SPACING
 
     def __init__(
         self,
@@ -144,6 +141,7 @@ class RegulatedPurePursuitController:
         footprint: Any = None,
         robot_radius: float | None = None,
         controller_frequency: float | None = None,
+        rng: np.random.Generator | None = None,
     ) -> None:
         values = dict(params) if isinstance(params, Mapping) else params
         if isinstance(values, dict) and controller_frequency is not None:
@@ -153,59 +151,16 @@ class RegulatedPurePursuitController:
         footprint_outline(self.footprint, SPACING)  # validate now
         self.inscribed_radius = _inscribed(self.footprint, robot_radius)
         p = self.params
-        self._latch = GoalLatch(p.xy_goal_tolerance, p.yaw_goal_tolerance, p.stateful)
-        self._plan: np.ndarray | None = None
-        self._goal: tuple[float, float, float | None] = (0.0, 0.0, None)
-        self._progress = 0
+        self._plan_state(p.xy_goal_tolerance, p.yaw_goal_tolerance, p.stateful)
         self.local_plan = np.zeros((0, 3))
         self.carrot: np.ndarray | None = None
         self.valid = True
         self.last_failure = ""
 
-    @classmethod
-    def from_params(cls, params: Mapping[str, Any] | None, *, context: Any = None) -> RegulatedPurePursuitController:
-        """The plugin contract's constructor: ``context.footprint`` and ``context.controller_frequency``."""
-        fp = getattr(context, "footprint", None)
-        return cls(
-            params,
-            footprint=getattr(fp, "polygon", None),
-            robot_radius=getattr(fp, "radius", None),
-            controller_frequency=getattr(context, "controller_frequency", None),
-        )
-
-    def set_plan(self, path: np.ndarray) -> None:
-        """The global plan (N, 2) or (N, 3) in the costmap's frame; a plan to a new goal resets the goal latch."""
-        plan = as_plan(path)
-        goal = goal_of(plan)
-        dense = densify(plan[:, :2], SPACING)
-        p = self.params
-        if self._plan is not None and same_goal(self._goal, goal, p.xy_goal_tolerance, p.yaw_goal_tolerance):
-            anchor = self._plan[self._progress]
-            self._progress = int(np.argmin(np.hypot(dense[:, 0] - anchor[0], dense[:, 1] - anchor[1])))
-        else:
-            self._latch.reset()
-            self._progress = 0
-        self._goal, self._plan = goal, dense
-
-    def is_goal_reached(self, pose: tuple[float, float, float], velocity: tuple[float, float]) -> bool:
-        """Nav2's SimpleGoalChecker: within xy tolerance (latched if ``stateful``) and yaw tolerance."""
-        return self._plan is not None and self._latch.reached(
-            (float(pose[0]), float(pose[1]), float(pose[2])), self._goal
-        )
-
-    def compute_velocity(
-        self, pose: tuple[float, float, float], velocity: tuple[float, float], costmap: Grid | None
-    ) -> ControlResult:
-        """The command for the robot at ``pose`` (costmap frame) moving at ``velocity`` (v m/s, w rad/s), with the
-        projected arc as its local plan; not ``valid`` when a collision is ahead."""
-        v, w = self._command(pose, velocity, costmap)
-        return ControlResult(v, w, self.valid, self.local_plan)
-
     def _command(
         self, pose: tuple[float, float, float], velocity: tuple[float, float], costmap: Grid | None
     ) -> tuple[float, float]:
-        if self._plan is None:
-            raise NavigationError(f"{WHAT}: compute_velocity called before set_plan")
+        self._check_call(self._plan, costmap, needs_costmap=False)
         p = self.params
         x, y, th = (float(v) for v in pose[:3])
         dt = 1.0 / p.controller_frequency

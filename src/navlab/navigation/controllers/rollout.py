@@ -1,9 +1,9 @@
 """Rollouts and footprint costs of the local planners, pure and compiled (Numba), vectorised over samples.
 
-``rollout`` integrates (v, w) samples as base_local_planner does; ``footprint_costs``/``occupancy_costs``
-read a costmap under a robot's outline (costmap_2d's 16-gon for a round robot) at many poses; the
-``rollout_scores`` kernel scores whole rollouts (path/goal distance, occupancy) in one pass. Poses are in
-grid-local metres (the costmap's origin at 0, its axes), costs the costmap's uint8 values.
+``rollout`` integrates (v, w) samples as base_local_planner does; ``footprint_costs`` reads a costmap under a
+robot's outline (costmap_2d's 16-gon for a round robot) at many poses (``with_centre``: base_local_planner's
+obstacle cost); the ``rollout_scores`` kernel scores whole rollouts (path/goal distance, occupancy) in one
+pass. Poses are in grid-local metres (the costmap's origin at 0, its axes), costs the costmap's uint8 values.
 """
 
 from __future__ import annotations
@@ -140,54 +140,18 @@ def footprint_costs(
     outline: np.ndarray | None,
     *,
     near_max: np.ndarray | None = None,
+    with_centre: bool = False,
 ) -> np.ndarray:
     """costmap_2d's footprint cost at each grid-local pose (..., 3): -1 where the robot may not be.
 
     Circular robot (``outline`` None): the centre cell's cost, -1 if LETHAL, INSCRIBED, unknown or off the
     map. Polygon: the highest cost under its edges (``outline`` (M, 2) base-frame points), -1 if any is
-    LETHAL or unknown or the robot is off the map. ``near_max``: :func:`outline_reach_max` of ``cost`` and
-    ``outline``, if the caller has it (poses with nothing but free cells around skip their edges).
+    LETHAL or unknown or the robot is off the map; ``with_centre``: base_local_planner's obstacle cost,
+    ``max(footprint cost, centre cell cost)`` (``TrajectoryPlanner::generateTrajectory``,
+    ``ObstacleCostFunction::footprintCost``). ``near_max``: :func:`outline_reach_max` of ``cost`` and
+    ``outline``, if the caller has it (poses with nothing but free cells around, or with ``with_centre`` whose
+    centre cell holds the highest cost around, skip their edges). One compiled pass.
     """
-    return _pose_costs(cost, resolution, poses, outline, near_max, with_centre=False)
-
-
-def occupancy_costs(
-    cost: np.ndarray,
-    resolution: float,
-    poses: np.ndarray,
-    outline: np.ndarray | None,
-    *,
-    near_max: np.ndarray | None = None,
-) -> np.ndarray:
-    """base_local_planner's obstacle cost of each grid-local pose (..., 3): -1 where the robot may not be.
-
-    Polygon: ``max(footprint cost, centre cell cost)`` (``TrajectoryPlanner::generateTrajectory``,
-    ``ObstacleCostFunction::footprintCost``), the footprint cost being costmap_2d's ``footprintCost``
-    (the highest cost under the edges, -1 when one is LETHAL or unknown). Point robot: :func:`footprint_costs`.
-    ``near_max``: :func:`outline_reach_max` of ``cost`` and ``outline``, if the caller has it (poses whose
-    centre cell holds the highest cost around skip their edges).
-    """
-    return _pose_costs(cost, resolution, poses, outline, near_max, with_centre=True)
-
-
-def outline_reach_max(cost: np.ndarray, resolution: float, outline: np.ndarray) -> np.ndarray:
-    """The highest cost (uint8, ``cost``'s shape; unknown for cells off the grid) in the square of cells that
-    the ``outline``'s points can fall in while the robot's centre is in each cell: where it equals the centre
-    cell's cost, no edge can cost more (the footprint cost needs no edge lookups)."""
-    reach = math.ceil(float(np.hypot(outline[:, 0], outline[:, 1]).max()) / resolution) + 1
-    return maximum_filter(np.asarray(cost, dtype=np.uint8), size=2 * reach + 1, mode="constant", cval=COST_UNKNOWN)
-
-
-def _pose_costs(
-    cost: np.ndarray,
-    resolution: float,
-    poses: np.ndarray,
-    outline: np.ndarray | None,
-    near_max: np.ndarray | None,
-    *,
-    with_centre: bool,
-) -> np.ndarray:
-    """:func:`footprint_costs` (``with_centre`` False) or :func:`occupancy_costs` (True), one compiled pass."""
     poses = np.asarray(poses, dtype=np.float64)
     shape = poses.shape[:-1]
     flat = poses.reshape(-1, 3)
@@ -217,6 +181,14 @@ def _pose_costs(
             out,
         )
     return out.reshape(shape)
+
+
+def outline_reach_max(cost: np.ndarray, resolution: float, outline: np.ndarray) -> np.ndarray:
+    """The highest cost (uint8, ``cost``'s shape; unknown for cells off the grid) in the square of cells that
+    the ``outline``'s points can fall in while the robot's centre is in each cell: where it equals the centre
+    cell's cost, no edge can cost more (the footprint cost needs no edge lookups)."""
+    reach = math.ceil(float(np.hypot(outline[:, 0], outline[:, 1]).max()) / resolution) + 1
+    return maximum_filter(np.asarray(cost, dtype=np.uint8), size=2 * reach + 1, mode="constant", cval=COST_UNKNOWN)
 
 
 @numba.njit(cache=True, inline="always")

@@ -58,13 +58,15 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any, Self
+from typing import Any
 
 import numpy as np
 
+from navlab.core import read_params
 from navlab.grid import Grid
 from navlab.navigation.controllers import mapgrid
 from navlab.navigation.controllers.common import (
+    ControllerBase,
     GoalLatch,
     LocalFrame,
     OscillationFlags,
@@ -80,8 +82,6 @@ from navlab.navigation.controllers.common import (
     stopped,
 )
 from navlab.navigation.controllers.rollout import outline_reach_max, rollout
-from navlab.navigation.errors import NavigationError
-from navlab.plugins import ControlResult, PluginContext
 
 # --- the shared cycle ------------------------------------------------------------------------------
 
@@ -110,8 +110,13 @@ class LocalScene:
         return self.plan[-1].copy()
 
 
-class RolloutController:
+class RolloutController(ControllerBase):
     """What TrajectoryPlannerROS and DWAPlannerROS share: plan, goal handling, outputs.
+
+    ``params``: the planner's ROS 1 parameter dict (old and new spellings) or its ``params_class``;
+    ``footprint``: polygon [[x, y], ...] (m, base frame), else ``robot_radius`` (m: costmap_2d's 16-gon), else a
+    point robot (centre cell); ``controller_frequency``: move_base's (Hz), used unless ``params`` sets it.
+    ``rng`` is accepted for a uniform constructor and not used (the planners are deterministic).
 
     After each :meth:`compute_velocity`: ``local_plan`` (N, 3) chosen rollout (costmap frame; empty when
     stopping, turning at the goal or failing), ``samples`` (S, 2) the (v, w) tried, ``costs`` (S,) their
@@ -119,7 +124,7 @@ class RolloutController:
     returning false: move_base's cue for recovery).
     """
 
-    what = ""
+    params_class: type[Any]
     params: Any
     _stopped_vel = (0.01, 0.01)
     _accelerate = True
@@ -135,7 +140,7 @@ class RolloutController:
     ) -> None:
         if controller_frequency is not None and (params is None or isinstance(params, Mapping)):
             params = {"controller_frequency": controller_frequency, **(params or {})}  # its own value wins
-        self.params = self._parse(params)
+        self.params = read_params(self.params_class, params)
         self.footprint = None if footprint is None else np.asarray(footprint, dtype=np.float64)
         if footprint_outline(self.footprint, 0.05) is None:  # validate now; no polygon: the round robot's 16-gon
             self.footprint = None if robot_radius is None else circle_footprint(float(robot_radius))
@@ -148,10 +153,10 @@ class RolloutController:
         self._near: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
         self._goal_map: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None  # (costs, goal cell, distances)
         self._clear_outputs()
+        self._setup()
 
-    @staticmethod
-    def _parse(params: Any) -> Any:
-        raise NotImplementedError
+    def _setup(self) -> None:
+        """The planner's own state (called at the end of ``__init__``)."""
 
     def _clear_outputs(self) -> None:
         self.local_plan = np.zeros((0, 3))
@@ -193,34 +198,11 @@ class RolloutController:
             return False
         return self._latch.reached(tuple(map(float, pose)), goal_of(self._plan))  # type: ignore[arg-type]
 
-    @classmethod
-    def from_params(cls, params: Mapping[str, Any] | None, *, context: PluginContext) -> Self:
-        """From the planner's parameter namespace, move_base's ``controller_frequency`` and the local costmap's
-        footprint (its polygon, else a round robot's radius)."""
-        fp = context.footprint
-        return cls(
-            params,
-            footprint=None if fp is None else fp.polygon,
-            robot_radius=None if fp is None else fp.radius,
-            controller_frequency=context.controller_frequency,
-            rng=context.rng,
-        )
-
-    def compute_velocity(
-        self, pose: tuple[float, float, float], velocity: tuple[float, float], costmap: Grid | None
-    ) -> ControlResult:
-        """The command (v m/s, w rad/s) for the robot at ``pose`` (costmap frame) moving at ``velocity`` (v, w),
-        with ``valid`` and the chosen rollout as ``local_plan``."""
-        v, w = self._command(pose, velocity, costmap)
-        return ControlResult(v, w, self.valid, self.local_plan)
-
     def _command(
         self, pose: tuple[float, float, float], velocity: tuple[float, float], costmap: Grid | None
     ) -> tuple[float, float]:
-        if self._plan is None:
-            raise NavigationError(f"{self.what}: compute_velocity called before set_plan")
-        if costmap is None:
-            raise NavigationError(f"{self.what}: needs a local costmap (got None)")
+        self._check_call(self._plan, costmap)
+        assert self._plan is not None and costmap is not None
         pose = (float(pose[0]), float(pose[1]), float(pose[2]))
         velocity = (float(velocity[0]), float(velocity[1]))
         self._clear_outputs()
@@ -233,7 +215,7 @@ class RolloutController:
         if scene is None:
             self.valid = False
             return 0.0, 0.0
-        return self._drive(scene, pose, velocity, goal)
+        return self._drive(scene, pose, velocity)
 
     # --- pieces -----------------------------------------------------------------------------------
 
@@ -346,18 +328,17 @@ class RolloutController:
 
     def _command_valid(self, scene: LocalScene, velocity: tuple[float, float], cmd: tuple[float, float]) -> bool:
         """Whether rolling ``cmd`` out for sim_time scores as a legal trajectory (ROS's ``checkTrajectory``)."""
-        p = self.params
         targets = np.array([cmd])
-        traj = rollout(
-            scene.pose,
-            velocity,
-            targets,
-            self._steps(targets),
-            p.sim_time,
-            (p.acc_lim_x, p.acc_lim_theta),
-            accelerate=self._accelerate,
-        )
-        return bool(self._check(scene, targets, traj)[0] >= 0)
+        return bool(self._check(scene, targets, self._rollout(scene, velocity, targets, self._steps(targets)))[0] >= 0)
+
+    def _rollout(
+        self, scene: LocalScene, velocity: tuple[float, float], targets: np.ndarray, steps: np.ndarray
+    ) -> np.ndarray:
+        """The samples ``targets`` (S, 2) rolled out from the scene's pose at ``velocity`` in ``steps`` (S,) steps over
+        sim_time, within the acceleration limits as the planner applies them."""
+        p = self.params
+        acc = (p.acc_lim_x, p.acc_lim_theta)
+        return rollout(scene.pose, velocity, targets, steps, p.sim_time, acc, accelerate=self._accelerate)
 
     def _check(self, scene: LocalScene, targets: np.ndarray, traj: np.ndarray) -> np.ndarray:
         """Costs (S,) of rollouts checked outside the sampling loop (< 0: illegal)."""
@@ -387,10 +368,7 @@ class RolloutController:
         return float(targets[best, 0]), float(targets[best, 1])
 
     def _drive(
-        self,
-        scene: LocalScene,
-        pose: tuple[float, float, float],
-        velocity: tuple[float, float],
-        goal: tuple[float, float, float | None],
+        self, scene: LocalScene, pose: tuple[float, float, float], velocity: tuple[float, float]
     ) -> tuple[float, float]:
+        """One sampling cycle away from the goal: the command of the best rollout (``_finish``)."""
         raise NotImplementedError

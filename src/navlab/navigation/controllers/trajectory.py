@@ -5,12 +5,9 @@ base_local_planner does it (see ``rollout_controller`` for the shared cycle and 
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
-from typing import Any
 
 import numpy as np
 
-from navlab.core import read_params
 from navlab.navigation.controllers import trajectory_cycle as cycle
 from navlab.navigation.controllers.common import InPlaceFlags
 from navlab.navigation.controllers.params import TrajectoryPlannerParams
@@ -21,36 +18,18 @@ from navlab.navigation.controllers.rollout_controller import LocalScene, Rollout
 
 
 class TrajectoryPlannerROS(RolloutController):
-    """base_local_planner's trajectory rollout / DWA planner (``dwa`` flag) behind the Controller protocol.
-
-    ``params``: a TrajectoryPlannerROS parameter dict (ROS 1 names) or ``TrajectoryPlannerParams``;
-    ``footprint``: polygon [[x, y], ...] (m, base frame), else ``robot_radius`` (m: costmap_2d's 16-gon), else
-    a point robot (centre cell); ``controller_frequency``: move_base's (Hz), used unless ``params`` sets it.
-    ``rng`` is accepted for a uniform constructor and not used (the planner is deterministic).
-    """
+    """base_local_planner's trajectory rollout / DWA planner (``dwa`` flag) behind the Controller protocol
+    (``params``: a TrajectoryPlannerROS parameter dict, ROS 1 names, or ``TrajectoryPlannerParams``; the other
+    arguments as ``RolloutController``'s)."""
 
     what = "TrajectoryPlannerROS"
+    params_class = TrajectoryPlannerParams
     params: TrajectoryPlannerParams
 
-    def __init__(
-        self,
-        params: Mapping[str, Any] | TrajectoryPlannerParams | None = None,
-        *,
-        footprint: Any = None,
-        robot_radius: float | None = None,
-        controller_frequency: float | None = None,
-        rng: np.random.Generator | None = None,
-    ) -> None:
-        super().__init__(
-            params, footprint=footprint, robot_radius=robot_radius, controller_frequency=controller_frequency, rng=rng
-        )
+    def _setup(self) -> None:
         self._escaping = False
         self._escape_pose = (0.0, 0.0, 0.0)
         self._spin = InPlaceFlags(self.params.oscillation_reset_dist)
-
-    @staticmethod
-    def _parse(params: Any) -> TrajectoryPlannerParams:
-        return read_params(TrajectoryPlannerParams, params)
 
     def _new_goal(self) -> None:
         self._escaping = False
@@ -97,21 +76,16 @@ class TrajectoryPlannerROS(RolloutController):
         with ``heading_scoring``); -1 blocked, -2 no path."""
         res = scene.resolution
         traj = np.ascontiguousarray(traj, dtype=np.float64)
-        outline = self._outline(res)
-        near = self._near_max(scene)
-        grid = scene.cost
-        if outline is None:
-            c = s = np.zeros(traj.shape[:2])
-            ox = oy = np.zeros(0)
-        else:  # numpy's cos/sin, as occupancy_costs
+        near, ox, oy, polygon, use_near = self._edges(scene)
+        if polygon:  # numpy's cos/sin, as footprint_costs
             c, s = np.cos(traj[..., 2]), np.sin(traj[..., 2])
-            ox, oy = np.ascontiguousarray(outline[:, 0]), np.ascontiguousarray(outline[:, 1])
-        weights = self._weights(res)
+        else:
+            c = s = np.zeros(traj.shape[:2])
         cost = np.empty(traj.shape[0])
         at = self._heading_step(traj.shape[1])
         rollout_scores(
-            grid,
-            grid if near is None else near,
+            scene.cost,
+            near,
             np.ascontiguousarray(scene.path_dist),
             np.ascontiguousarray(scene.goal_dist),
             1.0 / res,
@@ -120,26 +94,18 @@ class TrajectoryPlannerROS(RolloutController):
             s,
             ox,
             oy,
-            outline is not None,
-            near is not None,
-            weights,
+            polygon,
+            use_near,
+            self._weights(res),
             scene.impossible,
             np.full(len(traj), at, dtype=np.int64),
             cost,
         )
-        if at >= 0:  # ROS: + 0.3 * headingDiff at the scored step (not scaled by meter_scoring)
-            ok = cost >= 0
-            cost[ok] += 0.3 * heading_diffs(
-                grid, res, np.ascontiguousarray(scene.plan[:, :2]), np.ascontiguousarray(traj[ok, at])
-            )
+        self._add_heading(scene, cost, traj, at)
         return cost
 
     def _drive(
-        self,
-        scene: LocalScene,
-        pose: tuple[float, float, float],
-        velocity: tuple[float, float],
-        goal: tuple[float, float, float | None],
+        self, scene: LocalScene, pose: tuple[float, float, float], velocity: tuple[float, float]
     ) -> tuple[float, float]:
         p = self.params
         v0, w0 = velocity
@@ -155,18 +121,16 @@ class TrajectoryPlannerROS(RolloutController):
         wmin = min(max(p.min_vel_theta, w0 - p.acc_lim_theta * horizon), wmax)
         # samples, rollouts and costs in one compiled call (trajectory_cycle), then the choice in another
         res = scene.resolution
-        outline = self._outline(res)
-        near = self._near_max(scene)
+        near, ox, oy, polygon, use_near = self._edges(scene)
         ang = p.angular_sim_granularity if p.angular_sim_granularity > 0 else p.sim_granularity
         limits = np.array(
             [vmin, vmax, wmin, wmax, p.min_in_place_vel_theta, p.escape_vel, p.acc_lim_x, p.acc_lim_theta]
         )
         steps = max(1, int(p.sim_time / p.sim_granularity + 0.5)) if p.heading_scoring else 0
         at = self._heading_step(steps) if p.heading_scoring else -1
-        empty = np.zeros(0)
         targets, traj, costs, ws, dw = cycle.score_samples(
             scene.cost,
-            scene.cost if near is None else near,
+            near,
             scene.path_dist,
             scene.goal_dist,
             res,
@@ -175,19 +139,15 @@ class TrajectoryPlannerROS(RolloutController):
             limits,
             (p.vx_samples, p.vtheta_samples),
             np.array([p.sim_time, p.sim_granularity, ang, float(p.heading_scoring)]),
-            empty if outline is None else np.ascontiguousarray(outline[:, 0]),
-            empty if outline is None else np.ascontiguousarray(outline[:, 1]),
-            outline is not None,
-            near is not None,
+            ox,
+            oy,
+            polygon,
+            use_near,
             self._weights(res),
             scene.impossible,
             at,
         )
-        if at >= 0:  # ROS: + 0.3 * headingDiff at the scored step (not scaled by meter_scoring)
-            ok = costs >= 0
-            costs[ok] += 0.3 * heading_diffs(
-                scene.cost, res, np.ascontiguousarray(scene.plan[:, :2]), np.ascontiguousarray(traj[ok, at])
-            )
+        self._add_heading(scene, costs, traj, at)
         nf = len(targets) - len(ws) - 1
         best = cycle.choose(
             costs,
@@ -213,6 +173,26 @@ class TrajectoryPlannerROS(RolloutController):
             self._escaping, self._escape_pose = True, pose
         self._end_escape(pose)
         return self._finish(scene, targets, traj, costs, esc if costs[esc] > -2.0 else -1, pose)
+
+    def _edges(self, scene: LocalScene) -> tuple[np.ndarray, np.ndarray, np.ndarray, bool, bool]:
+        """The scoring kernels' footprint inputs: (``near_max`` or the costs, the outline's x and y (empty for a point
+        robot), whether the robot is a polygon, whether ``near_max`` is given)."""
+        outline = self._outline(scene.resolution)
+        near = self._near_max(scene)
+        if outline is None:
+            ox = oy = np.zeros(0)
+        else:
+            ox, oy = np.ascontiguousarray(outline[:, 0]), np.ascontiguousarray(outline[:, 1])
+        return (scene.cost if near is None else near), ox, oy, outline is not None, near is not None
+
+    @staticmethod
+    def _add_heading(scene: LocalScene, costs: np.ndarray, traj: np.ndarray, at: int) -> None:
+        """With ``heading_scoring`` (scored step ``at`` >= 0): + 0.3 x headingDiff at that step to every valid cost,
+        in place (ROS; not scaled by meter_scoring)."""
+        if at >= 0:
+            ok = costs >= 0
+            plan = np.ascontiguousarray(scene.plan[:, :2])
+            costs[ok] += 0.3 * heading_diffs(scene.cost, scene.resolution, plan, np.ascontiguousarray(traj[ok, at]))
 
     def _weights(self, res: float) -> np.ndarray:
         """The scoring kernel's (1, pdist, gdist, occdist) weights (m or cell units for the distances)."""

@@ -14,6 +14,8 @@ import warnings
 from collections.abc import Mapping
 from typing import Any, Self
 
+import numpy as np
+
 from navlab.grid import Grid
 from navlab.navigation.costmap.footprint import Footprint, make_footprint
 from navlab.navigation.costmap.params import CostmapParams
@@ -33,6 +35,27 @@ def costmap_of(params: Mapping[str, Any] | None, context: PluginContext) -> Cost
 def same_geometry(a: Grid, b: Grid) -> bool:
     """Whether two grids have the same shape, resolution and origin."""
     return a.data.shape == b.data.shape and a.resolution == b.resolution and a.origin == b.origin
+
+
+def origin_shift(old: Grid | None, master: Grid) -> tuple[int, int] | None:
+    """Whole cells (di, dj) a rolling master's origin moved from ``old``'s; None when there is no ``old`` or its
+    size or resolution differs (the layer starts afresh: ``match_size``)."""
+    if old is None or old.data.shape != master.data.shape or old.resolution != master.resolution:
+        return None
+    shift = np.rint((np.array(master.origin[:2]) - np.array(old.origin[:2])) / master.resolution).astype(int)
+    return int(shift[0]), int(shift[1])
+
+
+def shifted(data: np.ndarray, di: int, dj: int, fill: Any) -> np.ndarray:
+    """A copy of ``data`` (H, W) whose cell (i, j) is ``data``'s cell (i + di, j + dj); ``fill`` where that lies
+    outside (what a rolling window newly covers)."""
+    h, w = data.shape
+    new = np.full((h, w), fill, dtype=data.dtype)
+    i0, i1 = max(0, -di), min(w, w - di)
+    j0, j1 = max(0, -dj), min(h, h - dj)
+    if i0 < i1 and j0 < j1:
+        new[j0:j1, i0:i1] = data[j0 + dj : j1 + dj, i0 + di : i1 + di]
+    return new
 
 
 class Layer:

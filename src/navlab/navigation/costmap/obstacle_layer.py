@@ -11,7 +11,7 @@ from navlab.core import read_params
 from navlab.grid import COST_FREE, COST_LETHAL, COST_UNKNOWN, Grid
 from navlab.navigation.costmap.footprint import Footprint, make_footprint
 from navlab.navigation.costmap.kernels import combine, mark_returns
-from navlab.navigation.costmap.layer import Layer, costmap_of, same_geometry
+from navlab.navigation.costmap.layer import Layer, costmap_of, origin_shift, same_geometry, shifted
 from navlab.navigation.costmap.params import ObservationSource, ObstacleLayerParams, layer_params
 from navlab.navigation.costmap.raytrace import clear_rays
 from navlab.navigation.errors import NavigationError
@@ -36,13 +36,14 @@ def observation_layer_args(
     }
 
 
-class ObstacleLayer(Layer):
-    """``costmap_2d::ObstacleLayer``: marks scan endpoints nearer than ``obstacle_range`` as lethal and clears
-    the cells along each ray up to ``raytrace_range`` (Bresenham, Numba); clears the cells under the robot's
-    footprint (``footprint_clearing_enabled``); combines into the master by maximum (``combination_method``
-    1, unknown cells of the layer skipped) or overwrite (0). Call :meth:`match_size` (the layered costmap
-    does) before :meth:`add_scan`.
-    """
+class ObservationLayer(Layer):
+    """What costmap_2d's ObstacleLayer and VoxelLayer share: a grid of the master's geometry kept across rolling
+    window moves, observation sources by name, footprint clearing, and the combination into the master
+    (``combination_method`` 1: maximum, unknown cells of the layer skipped; 0: overwrite). Subclasses add how
+    observations mark and clear (and any per-cell state beside the costs: :meth:`_reset_cells`, :meth:`_shift`)."""
+
+    params: ObstacleLayerParams
+    params_class: type[ObstacleLayerParams] = ObstacleLayerParams
 
     def __init__(
         self,
@@ -52,17 +53,20 @@ class ObstacleLayer(Layer):
         sources: dict[str, ObservationSource] | None = None,
         footprint: Footprint | None = None,
     ) -> None:
-        self.params: ObstacleLayerParams = read_params(ObstacleLayerParams, params, what=name)
+        self.params = read_params(self.params_class, params, what=name)
         self.name = name
         self.enabled = self.params.enabled
-        self.sources = dict(sources or {})
+        self.sources: dict[str, ObservationSource] = dict(sources or {})
         self.footprint = footprint or make_footprint()
         self.grid: Grid | None = None
         self.robot_pose: tuple[float, float, float] | None = None
+        self._new_cells((0, 0))
 
     @classmethod
     def from_params(cls, params: Mapping[str, Any] | None, *, context: PluginContext) -> Self:
-        return cls(**observation_layer_args(params, context, ObstacleLayerParams))
+        """The layer named ``context.name`` (its ``plugins:`` name) from its namespace ``params`` (ROS names), in the
+        costmap ``context.costmap`` (its observation sources) with the padded ``context.footprint``."""
+        return cls(**observation_layer_args(params, context, cls.params_class))
 
     @property
     def default_value(self) -> int:
@@ -75,24 +79,29 @@ class ObstacleLayer(Layer):
     def match_size(self, master: Grid) -> None:
         data = np.full(master.data.shape, self.default_value, dtype=np.uint8)
         self.grid = Grid(data, master.resolution, master.origin, master.frame_id)
+        self._new_cells(data.shape)
 
     def update_origin(self, master: Grid) -> None:
-        old = self.grid
-        if old is None or old.data.shape != master.data.shape or old.resolution != master.resolution:
+        shift = origin_shift(self.grid, master)
+        if shift is None:
             self.match_size(master)
             return
-        shift = np.rint((np.array(master.origin[:2]) - np.array(old.origin[:2])) / master.resolution).astype(int)
-        di, dj = int(shift[0]), int(shift[1])
-        h, w = old.data.shape
-        new = np.full((h, w), self.default_value, dtype=np.uint8)
-        # new cell (i, j) is old cell (i + di, j + dj)
-        i0, i1 = max(0, -di), min(w, w - di)
-        j0, j1 = max(0, -dj), min(h, h - dj)
-        if i0 < i1 and j0 < j1:
-            new[j0:j1, i0:i1] = old.data[j0 + dj : j1 + dj, i0 + di : i1 + di]
-        self.grid = Grid(new, master.resolution, master.origin, master.frame_id)
+        assert self.grid is not None
+        data = shifted(self.grid.data, *shift, self.default_value)
+        self.grid = Grid(data, master.resolution, master.origin, master.frame_id)
+        self._shift(*shift)
+
+    def _new_cells(self, shape: tuple[int, ...]) -> None:
+        """Per-cell state beside the costs starts afresh for a grid of ``shape`` (rows, columns)."""
+
+    def _shift(self, di: int, dj: int) -> None:
+        """Per-cell state beside the costs follows a rolling window's move (new cell (i, j) is old (i + di, j + dj))."""
+
+    def _reset_cells(self, where: Any) -> None:
+        """Per-cell state beside the costs forgets the cells ``where`` (a mask or a slice)."""
 
     def _source_settings(self, source: str | None) -> ObservationSource:
+        """Source ``source``'s settings; None: the layer's own ranges and height, marking and clearing."""
         p = self.params
         if source is None:
             return ObservationSource(
@@ -102,11 +111,58 @@ class ObstacleLayer(Layer):
                 raytrace_range=p.raytrace_range,
                 obstacle_min_range=p.obstacle_min_range,
                 raytrace_min_range=p.raytrace_min_range,
+                max_obstacle_height=p.max_obstacle_height,
             )
         if source not in self.sources:
             known = ", ".join(self.sources) or "none"
             raise NavigationError(f"{self.name}: unknown observation source {source!r} (sources: {known})")
         return self.sources[source]
+
+    def _need_grid(self, call: str) -> Grid:
+        """The layer's grid; before ``match_size`` an error naming ``call``."""
+        if self.grid is None:
+            raise NavigationError(f"{self.name}: no grid yet; call match_size(master) before {call}")
+        return self.grid
+
+    def clear_outside(self, xy: tuple[float, float], size: float) -> None:
+        """Forget what lies outside the ``size`` x ``size`` m square centred on ``xy`` (m, costmap frame):
+        clear_costmap_recovery's reset."""
+        g = self.grid
+        if g is None:
+            return
+        cx = g.origin[0] + (np.arange(g.width) + 0.5) * g.resolution
+        cy = g.origin[1] + (np.arange(g.height) + 0.5) * g.resolution
+        outside = (np.abs(cx[None, :] - xy[0]) > size / 2) | (np.abs(cy[:, None] - xy[1]) > size / 2)
+        g.data[outside] = self.default_value
+        self._reset_cells(outside)
+
+    def update_bounds(self, robot_pose: tuple[float, float, float]) -> None:
+        self.robot_pose = (float(robot_pose[0]), float(robot_pose[1]), float(robot_pose[2]))
+
+    def update_costs(self, master: Grid) -> None:
+        if self.grid is None:
+            return
+        if not same_geometry(self.grid, master):
+            self.update_origin(master)
+        g = self.grid
+        if self.params.footprint_clearing_enabled and self.robot_pose is not None:
+            ij = self.footprint.cells(g, self.robot_pose)
+            g.data[ij[:, 1], ij[:, 0]] = COST_FREE
+        combine(master.data, g.data, self.params.combination_method != 0)
+
+    def reset(self) -> None:
+        if self.grid is not None:
+            self.grid.data[:] = self.default_value
+            self._reset_cells(slice(None))
+
+
+class ObstacleLayer(ObservationLayer):
+    """``costmap_2d::ObstacleLayer``: marks scan endpoints nearer than ``obstacle_range`` as lethal and clears
+    the cells along each ray up to ``raytrace_range`` (Bresenham, Numba); clears the cells under the robot's
+    footprint (``footprint_clearing_enabled``); combines into the master by maximum (``combination_method``
+    1, unknown cells of the layer skipped) or overwrite (0). Call :meth:`match_size` (the layered costmap
+    does) before :meth:`add_scan`.
+    """
 
     def add_scan(
         self,
@@ -122,8 +178,7 @@ class ObstacleLayer(Layer):
         Without ``source`` the layer's own ranges apply and the scan both marks and clears; with a source name
         its ``marking``, ``clearing`` and ranges apply. Clearing runs first, then marking.
         """
-        if self.grid is None:
-            raise NavigationError(f"{self.name}: no grid yet; call match_size(master) before add_scan")
+        g = self._need_grid("add_scan")
         pts = np.asarray(endpoints_xy, dtype=np.float64).reshape(-1, 2)
         ok = np.ones(len(pts), bool) if valid is None else np.asarray(valid, bool).reshape(-1)
         if len(ok) != len(pts):
@@ -132,7 +187,6 @@ class ObstacleLayer(Layer):
         if not np.isfinite(o).all():
             raise NavigationError(f"{self.name}.add_scan: sensor origin must be finite, got {o.tolist()}")
         src = self._source_settings(source)
-        g = self.grid
         res, (ox, oy, _) = g.resolution, g.origin
         finite = np.isfinite(pts).all(axis=1)
         if src.clearing:
@@ -160,31 +214,3 @@ class ObstacleLayer(Layer):
                 src.obstacle_range,
                 np.uint8(COST_LETHAL),
             )
-
-    def clear_outside(self, xy: tuple[float, float], size: float) -> None:
-        """Forget what lies outside the ``size`` x ``size`` m square centred on ``xy`` (m, costmap frame):
-        clear_costmap_recovery's reset."""
-        g = self.grid
-        if g is None:
-            return
-        centres = g.centers(np.ones(g.data.shape, bool)).reshape(g.height, g.width, 2)
-        outside = (np.abs(centres[..., 0] - xy[0]) > size / 2) | (np.abs(centres[..., 1] - xy[1]) > size / 2)
-        g.data[outside] = self.default_value
-
-    def update_bounds(self, robot_pose: tuple[float, float, float]) -> None:
-        self.robot_pose = (float(robot_pose[0]), float(robot_pose[1]), float(robot_pose[2]))
-
-    def update_costs(self, master: Grid) -> None:
-        if self.grid is None:
-            return
-        if not same_geometry(self.grid, master):
-            self.update_origin(master)
-        g = self.grid
-        if self.params.footprint_clearing_enabled and self.robot_pose is not None:
-            ij = self.footprint.cells(g, self.robot_pose)
-            g.data[ij[:, 1], ij[:, 0]] = COST_FREE
-        combine(master.data, g.data, self.params.combination_method != 0)
-
-    def reset(self) -> None:
-        if self.grid is not None:
-            self.grid.data[:] = self.default_value

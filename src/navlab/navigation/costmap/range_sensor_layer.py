@@ -22,7 +22,8 @@ import numpy as np
 
 from navlab.core.params import ParamSpec, read_params
 from navlab.grid import COST_FREE, COST_LETHAL, COST_UNKNOWN, Grid
-from navlab.navigation.costmap.layer import Layer
+from navlab.navigation.costmap.kernels import combine
+from navlab.navigation.costmap.layer import Layer, origin_shift, same_geometry, shifted
 from navlab.navigation.errors import NavigationError
 from navlab.plugins import PluginContext
 
@@ -116,17 +117,11 @@ class RangeSensorLayer(Layer):
         self.prob = Grid(np.full(master.data.shape, 128, np.uint8), master.resolution, master.origin, master.frame_id)
 
     def update_origin(self, master: Grid) -> None:
-        old = self.prob
-        if old is None or old.data.shape != master.data.shape or old.resolution != master.resolution:
+        shift = origin_shift(self.prob, master)
+        if shift is None or self.prob is None:
             self.match_size(master)
             return
-        di, dj = np.rint((np.array(master.origin[:2]) - np.array(old.origin[:2])) / master.resolution).astype(int)
-        h, w = old.data.shape
-        new = np.full((h, w), 128, np.uint8)
-        i0, i1, j0, j1 = max(0, -di), min(w, w - di), max(0, -dj), min(h, h - dj)
-        if i0 < i1 and j0 < j1:
-            new[j0:j1, i0:i1] = old.data[j0 + dj : j1 + dj, i0 + di : i1 + di]
-        self.prob = Grid(new, master.resolution, master.origin, master.frame_id)
+        self.prob = Grid(shifted(self.prob.data, *shift, 128), master.resolution, master.origin, master.frame_id)
 
     def add_range(
         self,
@@ -175,15 +170,13 @@ class RangeSensorLayer(Layer):
     def update_costs(self, master: Grid) -> None:
         if self.prob is None:
             return
-        if self.prob.data.shape != master.data.shape or self.prob.origin != master.origin:
+        if not same_geometry(self.prob, master):
             self.update_origin(master)
         p = self.prob.data / 255.0
-        current = np.full(p.shape, -1, np.int16)
+        current = np.full(p.shape, COST_UNKNOWN, np.uint8)  # unknown: the master's cell untouched
         current[p > self.params.mark_threshold] = COST_LETHAL
         current[p < self.params.clear_threshold] = COST_FREE
-        old = master.data
-        take = (current >= 0) & ((old == COST_UNKNOWN) | (old < current))
-        old[take] = current[take].astype(np.uint8)
+        combine(master.data, current, True)
 
     def reset(self) -> None:
         if self.prob is not None:

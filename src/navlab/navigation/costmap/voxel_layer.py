@@ -16,21 +16,16 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any, Self
+from typing import Any
 
 import numba
 import numpy as np
 
-from navlab.core.params import read_params
-from navlab.grid import COST_FREE, COST_LETHAL, COST_UNKNOWN, Grid
-from navlab.navigation.costmap.footprint import Footprint, make_footprint
-from navlab.navigation.costmap.layer import Layer
-from navlab.navigation.costmap.obstacle_layer import observation_layer_args
-from navlab.navigation.costmap.params import IGNORED, ObservationSource, ObstacleLayerParams
-from navlab.navigation.errors import NavigationError
-from navlab.plugins import PluginContext
+from navlab.grid import COST_FREE, COST_LETHAL
+from navlab.navigation.costmap.layer import shifted
+from navlab.navigation.costmap.obstacle_layer import ObservationLayer
+from navlab.navigation.costmap.params import IGNORED, ObstacleLayerParams
 
 UNKNOWN_COLUMN = np.uint32(0xFFFF)  # every voxel unknown (voxel_grid's reset)
 
@@ -195,77 +190,35 @@ def mark_voxels(
             cost[j, i] = lethal
 
 
-class VoxelLayer(Layer):
+class VoxelLayer(ObservationLayer):
     """``costmap_2d::VoxelLayer`` (see the module docstring). ``sources``: its observation sources by name."""
 
-    def __init__(
-        self,
-        params: VoxelLayerParams | dict[str, Any] | None = None,
-        *,
-        name: str = "obstacle_layer",
-        sources: dict[str, ObservationSource] | None = None,
-        footprint: Footprint | None = None,
-    ) -> None:
-        self.params: VoxelLayerParams = read_params(VoxelLayerParams, params, what=name)
-        self.name = name
-        self.enabled = self.params.enabled
-        self.sources: Mapping[str, ObservationSource] = dict(sources or {})
-        self.footprint = footprint or make_footprint()
-        self.grid: Grid | None = None
-        self.columns = np.zeros((0, 0), dtype=np.uint32)
-        self.robot_pose: tuple[float, float, float] | None = None
-
-    @classmethod
-    def from_params(cls, params: Mapping[str, Any] | None, *, context: PluginContext) -> Self:
-        """The layer named ``context.name`` (its ``plugins:`` name) from its namespace ``params`` (ROS names), in the
-        costmap ``context.costmap`` (its observation sources) with the padded ``context.footprint``."""
-        return cls(**observation_layer_args(params, context, VoxelLayerParams))
-
-    @property
-    def default_value(self) -> int:
-        """A never-observed cell: unknown with ``track_unknown_space``, else free."""
-        return COST_UNKNOWN if self.params.track_unknown_space else COST_FREE
+    params: VoxelLayerParams
+    params_class = VoxelLayerParams
 
     @property
     def z_top(self) -> float:
         """Height (m) of the top of the voxel columns."""
         return self.params.origin_z + self.params.z_voxels * self.params.z_resolution
 
-    def on_footprint_changed(self, footprint: Footprint) -> None:
-        self.footprint = footprint
+    def _new_cells(self, shape: tuple[int, ...]) -> None:
+        self.columns = np.full(shape, UNKNOWN_COLUMN, np.uint32)
 
-    def match_size(self, master: Grid) -> None:
-        self.grid = Grid(
-            np.full(master.data.shape, self.default_value, np.uint8), master.resolution, master.origin, master.frame_id
-        )
-        self.columns = np.full(master.data.shape, UNKNOWN_COLUMN, np.uint32)
+    def _shift(self, di: int, dj: int) -> None:
+        self.columns = shifted(self.columns, di, dj, UNKNOWN_COLUMN)
 
-    def update_origin(self, master: Grid) -> None:
-        old = self.grid
-        if old is None or old.data.shape != master.data.shape or old.resolution != master.resolution:
-            self.match_size(master)
-            return
-        di, dj = np.rint((np.array(master.origin[:2]) - np.array(old.origin[:2])) / master.resolution).astype(int)
-        h, w = old.data.shape
-        cost = np.full((h, w), self.default_value, np.uint8)
-        cols = np.full((h, w), UNKNOWN_COLUMN, np.uint32)
-        i0, i1, j0, j1 = max(0, -di), min(w, w - di), max(0, -dj), min(h, h - dj)
-        if i0 < i1 and j0 < j1:
-            cost[j0:j1, i0:i1] = old.data[j0 + dj : j1 + dj, i0 + di : i1 + di]
-            cols[j0:j1, i0:i1] = self.columns[j0 + dj : j1 + dj, i0 + di : i1 + di]
-        self.grid = Grid(cost, master.resolution, master.origin, master.frame_id)
-        self.columns = cols
+    def _reset_cells(self, where: Any) -> None:
+        self.columns[where] = UNKNOWN_COLUMN
 
     def add_cloud(self, origin_xyz: Any, points_xyz: np.ndarray, *, source: str | None = None) -> None:
         """One observation in the costmap frame: the sensor at ``origin_xyz`` and its points (N, 3), m; NaN points
         are skipped. ``source``: one of :attr:`sources` (its marking, clearing, ranges and heights apply)."""
-        if self.grid is None:
-            raise NavigationError(f"{self.name}: no grid yet; call match_size(master) before add_cloud")
-        src = self._source(source)
+        g = self._need_grid("add_cloud")
+        src = self._source_settings(source)
         o = np.asarray(origin_xyz, dtype=np.float64).reshape(3)
         pts = np.asarray(points_xyz).reshape(-1, 3)
         pts = np.ascontiguousarray(pts if pts.dtype in (np.float32, np.float64) else pts.astype(np.float64))
-        g, p = self.grid, self.params
+        p = self.params
         scale = np.array([g.resolution, g.resolution, p.z_resolution])
         base = np.array([g.origin[0], g.origin[1], p.origin_z])
         h, w = g.data.shape
@@ -300,57 +253,6 @@ class VoxelLayer(Layer):
                 p.mark_threshold,
                 np.uint8(COST_LETHAL),
             )
-
-    def _source(self, source: str | None) -> ObservationSource:
-        p = self.params
-        if source is None:
-            return ObservationSource(
-                marking=True,
-                clearing=True,
-                obstacle_range=p.obstacle_range,
-                raytrace_range=p.raytrace_range,
-                max_obstacle_height=p.max_obstacle_height,
-            )
-        if source not in self.sources:
-            raise NavigationError(
-                f"{self.name}: unknown observation source {source!r} (sources: {', '.join(self.sources) or 'none'})"
-            )
-        return self.sources[source]
-
-    def update_bounds(self, robot_pose: tuple[float, float, float]) -> None:
-        self.robot_pose = (float(robot_pose[0]), float(robot_pose[1]), float(robot_pose[2]))
-
-    def update_costs(self, master: Grid) -> None:
-        if self.grid is None:
-            return
-        if self.grid.data.shape != master.data.shape or self.grid.origin != master.origin:
-            self.update_origin(master)
-        g = self.grid
-        if self.params.footprint_clearing_enabled and self.robot_pose is not None:
-            ij = self.footprint.cells(g, self.robot_pose)
-            g.data[ij[:, 1], ij[:, 0]] = COST_FREE
-        known = g.data != COST_UNKNOWN
-        if self.params.combination_method == 0:
-            master.data[known] = g.data[known]
-        else:
-            take = known & ((master.data == COST_UNKNOWN) | (master.data < g.data))
-            master.data[take] = g.data[take]
-
-    def reset(self) -> None:
-        if self.grid is not None:
-            self.grid.data[:] = self.default_value
-            self.columns[:] = UNKNOWN_COLUMN
-
-    def clear_outside(self, xy: tuple[float, float], size: float) -> None:
-        """Forget what lies outside the ``size`` x ``size`` m square centred on ``xy`` (clear_costmap_recovery)."""
-        if self.grid is None:
-            return
-        g = self.grid
-        cx = g.origin[0] + (np.arange(g.width) + 0.5) * g.resolution
-        cy = g.origin[1] + (np.arange(g.height) + 0.5) * g.resolution
-        out = (np.abs(cx[None, :] - xy[0]) > size / 2) | (np.abs(cy[:, None] - xy[1]) > size / 2)
-        g.data[out] = self.default_value
-        self.columns[out] = UNKNOWN_COLUMN
 
     def voxel_grid_msg(self, stamp_ns: int) -> Any:
         """``costmap_2d/VoxelGrid`` of the layer (what ``publish_voxel_map`` publishes), or None before a grid."""

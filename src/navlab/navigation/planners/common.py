@@ -7,13 +7,15 @@ put cell centres on integers. Paths are float (N, 2) arrays in metres in the cos
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import Any, ClassVar
 
 import numba
 import numpy as np
 
+from navlab.core import read_params
 from navlab.grid import COST_LETHAL, Grid
 from navlab.navigation.errors import NavigationError
+from navlab.plugins import BuiltFromParams
 
 
 def check_costmap(costmap: Grid, who: str) -> np.ndarray:
@@ -59,6 +61,31 @@ def check_start(data: np.ndarray, i: int, j: int, start: Any, who: str) -> None:
         )
 
 
+def check_request(
+    costmap: Grid, start: Any, goal: Any, who: str
+) -> tuple[np.ndarray, tuple[int, int, float, float], tuple[int, int, float, float]]:
+    """The costmap's cost array and the start's and goal's (i, j, u, v) (:func:`pose_cell`), checked as navfn checks
+    a request: the costmap (:func:`check_costmap`), both poses on it, the start not in an obstacle."""
+    data = check_costmap(costmap, who)
+    s = pose_cell(costmap, start, "start", who)
+    g = pose_cell(costmap, goal, "goal", who)
+    check_start(data, s[0], s[1], start, who)
+    return data, s, g
+
+
+class GridPlanner(BuiltFromParams):
+    """What the grid planners share: their parameters (``params_class``, from a ROS parameter dict or an instance),
+    ``last_failure`` (why the last call found no path, "" on success) and ``stats`` (the last search's counts)."""
+
+    params_class: ClassVar[type[Any]]
+    name = ""
+
+    def __init__(self, params: Any = None) -> None:
+        self.params = read_params(self.params_class, params)
+        self.last_failure = ""
+        self.stats: dict[str, int] = {}
+
+
 def path_length(path: np.ndarray | None) -> float:
     """Length (m) of a polyline (N, 2); 0 for None or a single point."""
     if path is None or len(path) < 2:
@@ -85,6 +112,14 @@ def dedupe(path: np.ndarray, eps: float = 1e-9) -> np.ndarray:
 
 
 @numba.njit(cache=True, inline="always")
+def _put(keys: np.ndarray, vals: np.ndarray, pos: np.ndarray, k: int, key: float, val: int) -> None:  # pragma: no cover
+    """Entry ``val`` with ``key`` at heap slot ``k`` (its ``pos`` follows)."""
+    keys[k] = key
+    vals[k] = val
+    pos[val] = k
+
+
+@numba.njit(cache=True, inline="always")
 def _sift_up(keys: np.ndarray, vals: np.ndarray, pos: np.ndarray, k: int) -> None:
     key = keys[k]
     val = vals[k]
@@ -92,13 +127,9 @@ def _sift_up(keys: np.ndarray, vals: np.ndarray, pos: np.ndarray, k: int) -> Non
         parent = (k - 1) >> 1
         if keys[parent] <= key:
             break
-        keys[k] = keys[parent]
-        vals[k] = vals[parent]
-        pos[vals[k]] = k
+        _put(keys, vals, pos, k, keys[parent], vals[parent])
         k = parent
-    keys[k] = key
-    vals[k] = val
-    pos[val] = k
+    _put(keys, vals, pos, k, key, val)
 
 
 @numba.njit(cache=True, inline="always")
@@ -136,11 +167,7 @@ def iheap_pop(keys: np.ndarray, vals: np.ndarray, pos: np.ndarray, size: int) ->
             child = left + 1
         if key <= keys[child]:
             break
-        keys[k] = keys[child]
-        vals[k] = vals[child]
-        pos[vals[k]] = k
+        _put(keys, vals, pos, k, keys[child], vals[child])
         k = child
-    keys[k] = key
-    vals[k] = val
-    pos[val] = k
+    _put(keys, vals, pos, k, key, val)
     return size

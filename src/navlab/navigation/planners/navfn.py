@@ -22,19 +22,10 @@ from typing import Any, ClassVar
 import numba
 import numpy as np
 
-from navlab.core import ParamSpec, read_params
+from navlab.core import ParamSpec
 from navlab.grid import COST_INSCRIBED, COST_UNKNOWN, Grid
 from navlab.navigation.errors import NavigationError
-from navlab.navigation.planners.common import (
-    check_costmap,
-    check_start,
-    dedupe,
-    iheap_pop,
-    iheap_update,
-    pose_cell,
-    to_world,
-)
-from navlab.plugins import BuiltFromParams
+from navlab.navigation.planners.common import GridPlanner, check_request, dedupe, iheap_pop, iheap_update, to_world
 
 COST_NEUTRAL = 50.0
 COST_FACTOR = 0.8
@@ -207,6 +198,19 @@ def _interp(pot: np.ndarray, u: float, v: float) -> float:
     return (a * (1 - fu) + b * fu) * (1 - fv) + (c * (1 - fu) + d * fu) * fv
 
 
+@numba.njit(cache=True, inline="always")
+def _slope(lo: float, c: float, hi: float) -> float:  # pragma: no cover - compiled
+    """dP along one axis at a cell of potential ``c`` between neighbours ``lo`` and ``hi``: the central difference,
+    one-sided next to an obstacle or unreached cell (inf), 0 between two."""
+    if math.isfinite(lo) and math.isfinite(hi):
+        return 0.5 * (hi - lo)
+    if math.isfinite(hi):
+        return hi - c
+    if math.isfinite(lo):
+        return c - lo
+    return 0.0
+
+
 @numba.njit(cache=True)
 def _cell_gradient(pot: np.ndarray, i: int, j: int) -> tuple[float, float]:
     """(dP/di, dP/dj) at a settled cell: central differences, one-sided next to obstacles or unreached cells."""
@@ -216,21 +220,7 @@ def _cell_gradient(pot: np.ndarray, i: int, j: int) -> tuple[float, float]:
     right = pot[j, i + 1] if i < w - 1 else np.inf
     down = pot[j - 1, i] if j > 0 else np.inf
     up = pot[j + 1, i] if j < h - 1 else np.inf
-    gx = 0.0
-    if math.isfinite(left) and math.isfinite(right):
-        gx = 0.5 * (right - left)
-    elif math.isfinite(right):
-        gx = right - c
-    elif math.isfinite(left):
-        gx = c - left
-    gy = 0.0
-    if math.isfinite(down) and math.isfinite(up):
-        gy = 0.5 * (up - down)
-    elif math.isfinite(up):
-        gy = up - c
-    elif math.isfinite(down):
-        gy = c - down
-    return gx, gy
+    return _slope(left, c, right), _slope(down, c, up)
 
 
 @numba.njit(cache=True)
@@ -314,21 +304,17 @@ def _descend(pot: np.ndarray, u: float, v: float, tu: float, tv: float, step: fl
 # --- the planner ---------------------------------------------------------------------------------
 
 
-class NavfnPlanner(BuiltFromParams):
+class NavfnPlanner(GridPlanner):
     """``navfn/NavfnROS`` as a pure planner: :meth:`make_plan` over a costmap ``Grid`` (uint8 costs).
 
     After a call, ``last_failure`` says why there was no path ("" on success), ``stats`` holds the
     settled-cell count, and ``potential`` the potential field (H, W; inf where not reached).
     """
 
-    params_class: type[NavfnParams] = NavfnParams
+    params_class = NavfnParams
+    params: NavfnParams
     name = "navfn"
-
-    def __init__(self, params: NavfnParams | dict[str, Any] | None = None) -> None:
-        self.params = read_params(self.params_class, params)
-        self.last_failure = ""
-        self.stats: dict[str, int] = {}
-        self.potential: np.ndarray | None = None
+    potential: np.ndarray | None = None
 
     def cell_costs(self, data: np.ndarray) -> np.ndarray:
         """Per-cell traversal cost (float64; inf = obstacle) from costmap_2d costs, as navfn's ``setCostmap``."""
@@ -348,11 +334,7 @@ class NavfnPlanner(BuiltFromParams):
         """A path (N, 2) in metres from ``start`` to ``goal`` (both included) in the costmap's frame, or None
         when the goal cannot be reached (``last_failure`` says why). A start outside the map or in a lethal
         cell, and a goal outside the map, raise ``NavigationError``."""
-        who = self.name
-        data = check_costmap(costmap, who)
-        si, sj, su, sv = pose_cell(costmap, start, "start", who)
-        gi, gj, gu, gv = pose_cell(costmap, goal, "goal", who)
-        check_start(data, si, sj, start, who)
+        data, (si, sj, su, sv), (gi, gj, gu, gv) = check_request(costmap, start, goal, self.name)
         self.last_failure = ""
         cost = self.cell_costs(data)
         cost[sj, si] = self.params.neutral_cost  # navfn clears the robot's cell
@@ -422,4 +404,5 @@ class GlobalPlanner(NavfnPlanner):
     ``use_dijkstra: false`` for A*)."""
 
     params_class = GlobalPlannerParams
+    params: GlobalPlannerParams
     name = "global_planner"

@@ -25,23 +25,19 @@ from __future__ import annotations
 
 import heapq
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any, ClassVar
+from typing import Any, ClassVar, Self
 
 import numba
 import numpy as np
 
-from navlab.core import ParamSpec, read_params
+from navlab.core import ParamSpec
 from navlab.grid import COST_INSCRIBED, COST_LETHAL, COST_UNKNOWN, Grid
 from navlab.navigation.controllers.common import footprint_outline
 from navlab.navigation.errors import NavigationError
 from navlab.navigation.planners import dubins
-from navlab.navigation.planners.common import (
-    check_costmap,
-    iheap_pop,
-    iheap_update,
-    pose_cell,
-)
+from navlab.navigation.planners.common import GridPlanner, check_costmap, iheap_pop, iheap_update, pose_cell
 
 WHAT = "SmacPlannerHybrid"
 
@@ -212,20 +208,20 @@ class _Search:
         return _dijkstra8(step, gj * self.w + gi) * self.res
 
 
-class SmacPlannerHybrid:
+class SmacPlannerHybrid(GridPlanner):
     """``nav2_smac_planner/SmacPlannerHybrid`` (see the module docstring). ``footprint``: the robot's polygon
     (N, 2; base frame, m) or None for a round robot (the costmap's inflation then stands for its radius)."""
 
+    params_class = SmacHybridParams
+    params: SmacHybridParams
     name = WHAT
 
-    def __init__(self, params: SmacHybridParams | dict[str, Any] | None = None, *, footprint: Any = None) -> None:
-        self.params = read_params(SmacHybridParams, params)
+    def __init__(self, params: SmacHybridParams | Mapping[str, Any] | None = None, *, footprint: Any = None) -> None:
+        super().__init__(params)
         self.footprint = None if footprint is None else np.asarray(footprint, dtype=np.float64)
-        self.last_failure = ""
-        self.stats: dict[str, int] = {}
 
     @classmethod
-    def from_params(cls, params: dict[str, Any] | None, *, context: Any = None) -> SmacPlannerHybrid:
+    def from_params(cls, params: Mapping[str, Any] | None, *, context: Any = None) -> Self:
         """The plugin contract's constructor: ``context.footprint`` (its polygon, if any)."""
         return cls(params, footprint=getattr(getattr(context, "footprint", None), "polygon", None))
 

@@ -16,24 +16,15 @@ from __future__ import annotations
 import itertools
 import math
 from dataclasses import dataclass
-from typing import Any, ClassVar
+from typing import ClassVar
 
 import numba
 import numpy as np
 
-from navlab.core import ParamSpec, read_params
+from navlab.core import ParamSpec
 from navlab.grid import COST_INSCRIBED, COST_UNKNOWN, Grid
 from navlab.navigation.errors import NavigationError
-from navlab.navigation.planners.common import (
-    check_costmap,
-    check_start,
-    dedupe,
-    iheap_pop,
-    iheap_update,
-    pose_cell,
-    to_world,
-)
-from navlab.plugins import BuiltFromParams
+from navlab.navigation.planners.common import GridPlanner, check_request, dedupe, iheap_pop, iheap_update, to_world
 
 MAX_NON_OBSTACLE = 252.0
 
@@ -170,19 +161,16 @@ def _theta_star(
     return parent, expanded
 
 
-class ThetaStarPlanner(BuiltFromParams):
+class ThetaStarPlanner(GridPlanner):
     """``nav2_theta_star_planner/ThetaStarPlanner`` as a pure planner over a costmap ``Grid`` (uint8 costs).
 
     After a call, ``last_failure`` says why there was no path ("" on success) and ``stats`` holds the
     expanded-cell count and the number of corners.
     """
 
+    params_class = ThetaStarParams
+    params: ThetaStarParams
     name = "theta_star"
-
-    def __init__(self, params: ThetaStarParams | dict[str, Any] | None = None) -> None:
-        self.params: ThetaStarParams = read_params(ThetaStarParams, params)
-        self.last_failure = ""
-        self.stats: dict[str, int] = {}
 
     def _grids(self, data: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         blocked = (data >= COST_INSCRIBED) & (data != COST_UNKNOWN)
@@ -198,11 +186,7 @@ class ThetaStarPlanner(BuiltFromParams):
         """A path (N, 2) in metres from ``start`` to ``goal`` (both included), points at most one cell apart, or
         None when the goal is in an obstacle or cut off (``last_failure`` says which). A start outside the map
         or in a lethal cell, and a goal outside the map, raise ``NavigationError``."""
-        who = self.name
-        data = check_costmap(costmap, who)
-        si, sj, _, _ = pose_cell(costmap, start, "start", who)
-        gi, gj, _, _ = pose_cell(costmap, goal, "goal", who)
-        check_start(data, si, sj, start, who)
+        data, (si, sj, _, _), (gi, gj, _, _) = check_request(costmap, start, goal, self.name)
         self.last_failure = ""
         blocked, trav = self._grids(data)
         blocked[sj, si] = False  # the robot's own cell, as navfn clears it
