@@ -4,7 +4,7 @@ and no two packages import each other.
 
 Layers, bottom to top::
 
-    0 leaves       errors msgs geometry grid io resources nodes plugins lazy deprecation
+    0 leaves       errors msgs geometry grid gridline io resources nodes plugins lazy deprecation
     1 core
     2 description world ros1
     3 sim mapping localization
@@ -30,7 +30,22 @@ from dataclasses import dataclass
 from pathlib import Path
 
 LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
-    ("leaves", ("errors", "msgs", "geometry", "grid", "io", "resources", "nodes", "plugins", "lazy", "deprecation")),
+    (
+        "leaves",
+        (
+            "errors",
+            "msgs",
+            "geometry",
+            "grid",
+            "gridline",
+            "io",
+            "resources",
+            "nodes",
+            "plugins",
+            "lazy",
+            "deprecation",
+        ),
+    ),
     ("core", ("core",)),
     ("description/world/ros1", ("description", "world", "ros1")),
     ("sim/mapping/localization", ("sim", "mapping", "localization")),

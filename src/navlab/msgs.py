@@ -189,6 +189,71 @@ def twist(vx: float = 0.0, wz: float = 0.0, vy: float = 0.0) -> Any:
     return Twist(linear=Vector3(x=float(vx), y=float(vy), z=0.0), angular=Vector3(x=0.0, y=0.0, z=float(wz)))
 
 
+def vector3(v: Any) -> Any:
+    """``geometry_msgs/Vector3`` from (x, y, z)."""
+    return Vector3(x=float(v[0]), y=float(v[1]), z=float(v[2]))
+
+
+def odometry(
+    stamp_ns: int,
+    frame_id: str,
+    child_frame_id: str,
+    position: Any,
+    orientation: Any,
+    linear: Any,
+    angular: Any,
+    pose_covariance: np.ndarray,
+    twist_covariance: np.ndarray,
+) -> Any:
+    """``nav_msgs/Odometry``: the pose of ``child_frame_id`` in ``frame_id`` (``position`` x, y, z m;
+    ``orientation`` x, y, z, w), its velocity in the child frame (``linear`` m/s, ``angular`` rad/s, x, y, z),
+    and the 36-float row-major covariances (taken as they are: pass a copy)."""
+    return Odometry(
+        header=header(stamp_ns, frame_id),
+        child_frame_id=child_frame_id,
+        pose=PoseWithCovariance(
+            pose=Pose(
+                position=Point(x=float(position[0]), y=float(position[1]), z=float(position[2])),
+                orientation=quaternion_msg(orientation),
+            ),
+            covariance=pose_covariance,
+        ),
+        twist=TwistWithCovariance(
+            twist=Twist(linear=vector3(linear), angular=vector3(angular)), covariance=twist_covariance
+        ),
+    )
+
+
+# rosbags' base type names -> the numpy dtype of their arrays (ROS 2's; a ROS 1 bool is a uint8 on the wire)
+NUMPY_DTYPES: dict[str, type] = {
+    "float64": np.float64,
+    "float32": np.float32,
+    "double": np.float64,
+    "float": np.float32,
+    "int8": np.int8,
+    "uint8": np.uint8,
+    "int16": np.int16,
+    "uint16": np.uint16,
+    "int32": np.int32,
+    "uint32": np.uint32,
+    "int64": np.int64,
+    "uint64": np.uint64,
+    "byte": np.uint8,
+    "octet": np.uint8,
+    "char": np.uint8,
+    "bool": np.bool_,
+}
+
+
+def zero_value(base_type: str) -> Any:
+    """The value a field of rosbags' base type ``base_type`` takes when it is not given ("", False, 0.0 or 0)."""
+    if base_type in ("string", "wstring"):
+        return ""
+    if base_type == "bool":
+        return False
+    return 0.0 if base_type.startswith(("float", "double")) else 0
+
+
 def covariance(diag: tuple[float, ...] | None = None) -> np.ndarray:
     """A 6×6 row-major covariance (36 float64) with the given diagonal (zeros if None)."""
     cov = np.zeros(36, dtype=np.float64)

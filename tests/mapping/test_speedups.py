@@ -11,9 +11,10 @@ import numpy as np
 import pytest
 
 from navlab.geometry import wrap_angle
+from navlab.gridline import EXACT_STEPS
 from navlab.mapping.gmapping_match import draw_motion, match_score, optimize
 from navlab.mapping.gmapping_tiles import TILE, TilePool, from_dense, raycast_tiles, to_dense
-from navlab.mapping.occupancy import FAST_WALK_CELLS, L_CLAMP, L_FREE, L_OCC, _raycast, integrate_scan
+from navlab.mapping.occupancy import L_CLAMP, L_FREE, L_OCC, _raycast, integrate_scan
 from navlab.mapping.scanmatch import LookupField, correlative_search
 
 
@@ -159,16 +160,16 @@ def test_the_unchecked_ray_walk_equals_the_checked_one() -> None:
             _raycast(part, 0.0, 0.0, oi, oj, *args)
             _raycast(part, 0.0, 0.0, oi, oj, *args)
             np.testing.assert_array_equal(part, whole[oj : oj + h, oi : oi + w])
-    # lines longer than the fixed-point walk takes (FAST_WALK_CELLS) walk by the error term
-    r_long = np.array([FAST_WALK_CELLS * 0.05 + 3.0, 150.0, 40.0])
+    # lines longer than the fixed-point division covers (EXACT_STEPS) divide exactly
+    r_long = np.array([EXACT_STEPS * 0.05 + 3.0, 150.0, 40.0])
     ang_long = np.array([0.0, 0.002, -0.004])
     args = (0.05, 0.26, 0.3, 0.0, r_long, ang_long, 300.0, 400.0, L_OCC, L_FREE, L_CLAMP)
-    whole = np.zeros((12, FAST_WALK_CELLS + 80), dtype=np.float32)
+    whole = np.zeros((12, EXACT_STEPS + 80), dtype=np.float32)
     _raycast(whole, 0.0, 0.0, 0, 0, *args)
-    part = np.zeros((12, FAST_WALK_CELLS + 70), dtype=np.float32)
+    part = np.zeros((12, EXACT_STEPS + 70), dtype=np.float32)
     _raycast(part, 0.0, 0.0, 10, 0, *args)
     np.testing.assert_array_equal(part, whole[:, 10:])
-    assert np.count_nonzero(whole) > FAST_WALK_CELLS
+    assert np.count_nonzero(whole) > EXACT_STEPS
     with pytest.raises(ValueError, match="C-contiguous"):
         integrate_scan(
             np.zeros((20, 20))[:, ::2], (0.0, 0.0), 0.05, np.zeros(3), r, ang, max_urange=8.0, max_range=10.0

@@ -52,11 +52,14 @@ def test_pid_proportional_only_leaves_an_offset() -> None:
 @pytest.mark.parametrize(
     "params, message",
     [
-        ({"p": -1.0}, "p: expected a finite number >= 0"),
-        ({"p": 1.0, "i": -0.5}, "i: expected a finite number >= 0"),
-        ({"p": 1.0, "i_clamp": -1.0}, "i_clamp: expected a number >= 0"),
+        ({"p": -1.0}, "left_wheel_hinge parameter p: expected >= 0"),
+        ({"p": 1.0, "i": -0.5}, "parameter i: expected >= 0"),
+        ({"p": 1.0, "i_clamp": -1.0}, "parameter i_clamp: expected >= 0"),
+        ({"p": 1.0, "i_clamp_min": 0.5}, "parameter i_clamp_min: expected <= 0"),
         ({"p": 1.0, "kp": 2.0}, "did you mean 'p'"),
-        ({"d": "fast"}, "d: expected a finite number"),
+        ({"p": 1.0, "gain": 2.0}, "unknown pid_gains.left_wheel_hinge parameter 'gain'"),
+        ({"d": "fast"}, "parameter d: expected a number"),
+        ({"antiwindup": "yes"}, "parameter antiwindup: expected true or false"),
     ],
 )
 def test_pid_bad_gains_are_refused(params: dict, message: str) -> None:
@@ -159,7 +162,7 @@ def test_controller_stops_after_cmd_vel_timeout() -> None:
                 "mobile_base_controller": {"type": "diff_drive_controller/DiffDriveController"},
                 "gazebo_ros_control": {"pid_gains": {"left_wheel_hinge": {"p": -1.0}}},
             },
-            "pid_gains.left_wheel_hinge: pid gain p",
+            "pid_gains.left_wheel_hinge parameter p: expected >= 0",
         ),
         (
             {

@@ -23,19 +23,17 @@ def _cmd_experiment(args: argparse.Namespace) -> int:
 
     sc = load_scenario(args.file)
     out = args.out or f"runs/{sc.name}"
+    trials = {
+        "trials": args.trials,
+        "seed": args.seed,
+        "workers": args.workers,
+        "backend": args.backend,
+        "progress": not args.quiet and sys.stderr.isatty(),
+    }
     if args.action == "sweep":
         from navlab.experiments.sweep import parse_params, run_sweep
 
-        rows = run_sweep(
-            sc,
-            parse_params(args.param),
-            out,
-            trials=args.trials,
-            seed=args.seed,
-            workers=args.workers,
-            backend=args.backend,
-            progress=not args.quiet and sys.stderr.isatty(),
-        )
+        rows = run_sweep(sc, parse_params(args.param), out, **trials)
         if not args.json:
             print(f"{len(rows)} combinations of {sc.name}: {out}/sweep.md (+ sweep.csv, a PNG per parameter)")
             print((Path(out) / "sweep.md").read_text())
@@ -44,15 +42,7 @@ def _cmd_experiment(args: argparse.Namespace) -> int:
         return 0
     if args.param:
         raise ExperimentError("--param is for `navlab experiment sweep`")
-    summary = run_experiment(
-        sc,
-        out,
-        trials=args.trials,
-        seed=args.seed,
-        workers=args.workers,
-        backend=args.backend,
-        progress=not args.quiet and sys.stderr.isatty(),
-    )
+    summary = run_experiment(sc, out, **trials)
     if not args.json:
         print(f"{summary['trials']} trials of {sc.name}: results in {out}/results.jsonl, summary in {out}/summary.json")
     print_figures(summary, args.json)

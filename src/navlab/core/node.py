@@ -15,7 +15,7 @@ from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 from navlab.core.clock import Clock, Time
-from navlab.core.errors import ParameterError
+from navlab.core.errors import ParameterError, TfError
 from navlab.core.executor import Executor
 from navlab.core.parameter import Parameter, SetParametersResult
 from navlab.core.params import ParameterWarning, likely_typo, typed_value
@@ -326,6 +326,16 @@ class Node:
             self.listen_tf()
             pose = self._sensor_poses[key] = self.executor.tf.lookup_pose2d(base_frame, sensor_frame)
         return pose
+
+    def scan_sensor_pose(self, base_frame: str, msg: Any) -> Pose2 | None:
+        """:meth:`sensor_pose` of the frame of a sensor message ``msg`` (its header's, else ``base_frame``), or
+        None with a warning naming the transform while tf lacks it."""
+        frame = str(msg.header.frame_id).lstrip("/") or base_frame
+        try:
+            return self.sensor_pose(base_frame, frame)
+        except TfError as exc:
+            self.get_logger().warning(f"no transform {base_frame} → {frame} for the scan: {exc}")
+            return None
 
     # --- clock, logger ---------------------------------------------------------------------------
 

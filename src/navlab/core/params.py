@@ -21,7 +21,7 @@ from typing import Any, TypeVar
 import yaml
 
 from navlab.core.errors import ParameterError
-from navlab.errors import NavlabError
+from navlab.errors import NavlabError, did_you_mean
 from navlab.io.errors import IoError
 from navlab.io.files import read_text_checked
 
@@ -204,6 +204,8 @@ class ParamSpec:
       (``vy_samples: 0`` in TurtleBot3's DWA files).
     - ``prepare``: a function from the raw dict to the dict read (one key that sets two fields, nested
       sections parsed by their own reader).
+    - ``strict``: every unknown key is refused (naming the known ones), not only a likely typo
+      (``check_unknown_key``): for a short, closed set of keys such as a PID's gains.
 
     After reading, a class's own ``validate()`` (if it has one) checks what spans several fields.
     """
@@ -218,6 +220,7 @@ class ParamSpec:
     choices: Mapping[str, tuple[Any, ...]] = field(default_factory=dict)
     clamp_at_least: Mapping[str, float] = field(default_factory=dict)
     prepare: Callable[[dict[str, Any]], dict[str, Any]] | None = None
+    strict: bool = False
 
 
 def param_error(what: str, key: str, value: Any, expected: str, error: type[Exception] = ParameterError) -> Exception:
@@ -291,10 +294,13 @@ def read_params(cls: type[T], values: Mapping[str, Any] | T | None, *, what: str
 
     Each value takes its default's type (``typed_value``); an unknown key follows ``check_unknown_key`` (a likely
     typo raises with "did you mean", any other key warns and is ignored); then the spec's ranges and
-    clamps, then the class's ``validate()``. Every refusal is one line naming the key.
+    clamps, then the class's ``validate()``. Every refusal is one line naming the key. A frozen class's
+    fields are set as its own ``__init__`` sets them.
     """
     spec: ParamSpec = getattr(cls, "PARAMS", None) or ParamSpec(cls.__name__)
     what = what or spec.what
+    frozen = getattr(getattr(cls, "__dataclass_params__", None), "frozen", False)
+    setattr_ = object.__setattr__ if frozen else setattr
     if isinstance(values, cls):
         out = values
     else:
@@ -306,9 +312,12 @@ def read_params(cls: type[T], values: Mapping[str, Any] | T | None, *, what: str
         names = [f.name for f in fields(cls)]  # type: ignore[arg-type]
         for key, val in canon.items():
             if key not in names:
+                if spec.strict:
+                    hint = did_you_mean(key, names)
+                    raise spec.error(f"unknown {what} parameter '{key}'{hint} (known: {', '.join(names)})")
                 check_unknown_key(str(key), names, what=what, error=spec.error)
                 continue
-            setattr(out, key, typed_value(type(getattr(out, key)), key, val, what=what, error=spec.error))
+            setattr_(out, key, typed_value(type(getattr(out, key)), key, val, what=what, error=spec.error))
     for f in fields(out):  # type: ignore[arg-type]
         val = getattr(out, f.name)
         if isinstance(val, float) and not math.isfinite(val):
@@ -318,7 +327,7 @@ def read_params(cls: type[T], values: Mapping[str, Any] | T | None, *, what: str
             logging.getLogger("navlab.params").warning(
                 f"{what}: {key} is {getattr(out, key)}; it is set to {low} (as ROS does)"
             )
-            setattr(out, key, type(getattr(out, key))(low))
+            setattr_(out, key, type(getattr(out, key))(low))
     for key, low in spec.at_least.items():
         if not getattr(out, key) >= low:
             raise param_error(what, key, getattr(out, key), f">= {low}", spec.error)

@@ -26,43 +26,19 @@ from typing import Any
 
 import numpy as np
 
-from navlab.msgs import TYPESTORE
-
-_NUMERIC = {
-    "float64": np.float64,
-    "float32": np.float32,
-    "double": np.float64,
-    "float": np.float32,
-    "int8": np.int8,
-    "uint8": np.uint8,
-    "int16": np.int16,
-    "uint16": np.uint16,
-    "int32": np.int32,
-    "uint32": np.uint32,
-    "int64": np.int64,
-    "uint64": np.uint64,
-    "byte": np.uint8,
-    "octet": np.uint8,
-    "char": np.uint8,
-    "bool": np.bool_,
-}
+from navlab.msgs import NUMPY_DTYPES, TYPESTORE, zero_value
 
 
 def _default(node: tuple[Any, Any]) -> Any:
     """The value rclpy gives a field of this rosbags field definition when it is not passed."""
     kind, spec = int(node[0]), node[1]
     if kind == 1:  # BASE: (name, string bound)
-        name = spec[0]
-        if name in ("string", "wstring"):
-            return ""
-        if name == "bool":
-            return False
-        return 0.0 if name.startswith(("float", "double")) else 0
+        return zero_value(spec[0])
     if kind == 2:  # NAME: a nested message
         return message_class(spec)()
     (sub_kind, sub_spec), length = spec
-    if int(sub_kind) == 1 and sub_spec[0] in _NUMERIC:
-        return np.zeros(length if kind == 3 else 0, dtype=_NUMERIC[sub_spec[0]])
+    if int(sub_kind) == 1 and sub_spec[0] in NUMPY_DTYPES:
+        return np.zeros(length if kind == 3 else 0, dtype=NUMPY_DTYPES[sub_spec[0]])
     return [_default((sub_kind, sub_spec)) for _ in range(length if kind == 3 else 0)]
 
 

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 import xml.etree.ElementTree as ET
+from typing import Any
 
 from navlab.core.limits import check_ceiling
 from navlab.description.errors import DescriptionError
@@ -214,6 +215,23 @@ def _ray_grid(sensor: ET.Element, where: str) -> tuple[ET.Element, dict[str, flo
     return ray, out
 
 
+def _ray_fields(sensor: ET.Element, plugin: ET.Element, link: str, where: str, g: dict[str, Any]) -> dict[str, Any]:
+    """The description fields a 3D lidar and a range sensor share: pose, rate and the ``<ray>`` grid ``g``'s
+    angles and range (its vertical sample count is ``rings`` of one, ``vertical_samples`` of the other)."""
+    return {
+        "link": link,
+        "origin": _pose(sensor, where),
+        "update_rate": _rate(sensor, plugin, where),
+        "samples": int(g["horizontal_samples"]),
+        "min_angle": g["horizontal_min"],
+        "max_angle": g["horizontal_max"],
+        "vertical_min_angle": g["vertical_min"],
+        "vertical_max_angle": g["vertical_max"],
+        "range_min": g["min"],
+        "range_max": g["max"],
+    }
+
+
 def parse_velodyne(sensor: ET.Element, plugin: ET.Element, link: str, where: str, warnings: list[str]) -> Lidar3dConfig:
     """``GazeboRosVelodyneLaser`` (velodyne_gazebo_plugins): ``<topicName>`` (default ``/world``), ``<frameName>``
     (``/world``), ``<min_range>`` (0), ``<max_range>`` (inf), ``<gaussianNoise>`` (0), ``<robotNamespace>``,
@@ -227,17 +245,8 @@ def parse_velodyne(sensor: ET.Element, plugin: ET.Element, link: str, where: str
         raise DescriptionError(f"{where}/<gaussianNoise>: must be >= 0, got {noise}")
     organize = plugin.findtext("organize_cloud")
     return Lidar3dConfig(
-        link=link,
-        origin=_pose(sensor, where),
-        update_rate=_rate(sensor, plugin, where),
-        samples=int(g["horizontal_samples"]),
-        min_angle=g["horizontal_min"],
-        max_angle=g["horizontal_max"],
+        **_ray_fields(sensor, plugin, link, where, g),
         rings=int(g["vertical_samples"]),
-        vertical_min_angle=g["vertical_min"],
-        vertical_max_angle=g["vertical_max"],
-        range_min=g["min"],
-        range_max=g["max"],
         min_range=number(plugin.find("min_range"), where + "/<min_range>", 0.0),
         max_range=number(plugin.find("max_range"), where + "/<max_range>", math.inf),
         noise_stddev=math.hypot(noise, g["noise"]),
@@ -263,17 +272,8 @@ def parse_range(sensor: ET.Element, plugin: ET.Element, link: str, where: str, w
     if not 0 < fov < math.pi or noise < 0:
         raise DescriptionError(f"{where}: expected 0 < <fov> < pi and <gaussianNoise> >= 0, got {fov} and {noise}")
     return RangeConfig(
-        link=link,
-        origin=_pose(sensor, where),
-        update_rate=_rate(sensor, plugin, where),
-        samples=int(g["horizontal_samples"]),
-        min_angle=g["horizontal_min"],
-        max_angle=g["horizontal_max"],
+        **_ray_fields(sensor, plugin, link, where, g),
         vertical_samples=int(g["vertical_samples"]),
-        vertical_min_angle=g["vertical_min"],
-        vertical_max_angle=g["vertical_max"],
-        range_min=g["min"],
-        range_max=g["max"],
         radiation=radiation,
         fov=fov,
         noise_stddev=math.hypot(noise, g["noise"]),

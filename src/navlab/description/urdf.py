@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import math
 import xml.etree.ElementTree as ET
-from collections.abc import Callable
+from collections.abc import Callable, Container
 from pathlib import Path
 
 from navlab.description.errors import DescriptionError, NotFoundError
@@ -237,6 +237,17 @@ def parse_joint(el: ET.Element, where: str) -> Joint:
     )
 
 
+def _element_name(el: ET.Element, source: str, seen: Container[str]) -> tuple[str, str]:
+    """(name, where for messages) of a ``<link>`` or ``<joint>``, refusing a missing or repeated name."""
+    tag, name = el.tag, el.get("name")
+    if not name:
+        raise DescriptionError(f"{source}: a <{tag}> has no name attribute")
+    where = f'{source}: <{tag} name="{name}">'
+    if name in seen:
+        raise DescriptionError(f"{where}: duplicate {tag} name")
+    return name, where
+
+
 def parse_urdf(
     root: ET.Element, source: str, resolve_mesh: MeshResolver, *, warnings: list[str] | None = None
 ) -> tuple[str, dict[str, Link], list[Joint], str]:
@@ -259,12 +270,7 @@ def parse_urdf(
             materials[m.get("name", "")] = (r[0], r[1], r[2], r[3])
     links: dict[str, Link] = {}
     for el in root.findall("link"):
-        lname = el.get("name")
-        if not lname:
-            raise DescriptionError(f"{source}: a <link> has no name attribute")
-        where = f'{source}: <link name="{lname}">'
-        if lname in links:
-            raise DescriptionError(f"{where}: duplicate link name")
+        lname, where = _element_name(el, source, links)
         links[lname] = parse_link(el, where, resolve_mesh, materials, warnings)
     if not links:
         raise DescriptionError(f'{source}: <robot name="{name}"> has no <link>')
@@ -272,12 +278,7 @@ def parse_urdf(
     seen: set[str] = set()
     parent_of: dict[str, str] = {}
     for el in root.findall("joint"):
-        jname = el.get("name")
-        if not jname:
-            raise DescriptionError(f"{source}: a <joint> has no name attribute")
-        where = f'{source}: <joint name="{jname}">'
-        if jname in seen:
-            raise DescriptionError(f"{where}: duplicate joint name")
+        jname, where = _element_name(el, source, seen)
         seen.add(jname)
         joint = parse_joint(el, where)
         for role, lname in (("parent", joint.parent), ("child", joint.child)):

@@ -20,7 +20,7 @@ import yaml
 
 from navlab.experiments.errors import ExperimentError
 from navlab.experiments.scenario import Scenario
-from navlab.experiments.trials import run_experiments
+from navlab.experiments.trials import run_experiments, with_run_options
 
 # "trials_with_collision" counts trials (as success and failures do); "collisions" counts contact episodes
 COLUMNS = (
@@ -80,11 +80,7 @@ def run_sweep(
                 variant.controller = str(value)
             else:
                 variant.overrides[name] = value
-        if trials is not None:
-            variant.trials = trials
-        if seed is not None:
-            variant.seed = seed
-        jobs.append((variant, folder / ",".join(f"{k}={v}" for k, v in combo.items())))
+        jobs.append((with_run_options(variant, trials, seed), folder / ",".join(f"{k}={v}" for k, v in combo.items())))
     summaries = run_experiments(jobs, workers=workers, backend=backend, progress=progress, desc=f"{sc.name} sweep")
     columns = [c for c in COLUMNS if c != "score_mean" or any(s.get(c) is not None for s in summaries)]
     rows = [{**combo, **{c: s.get(c) for c in columns}} for combo, s in zip(combos, summaries, strict=True)]

@@ -298,11 +298,17 @@ def run_experiment(
     """Run the scenario's trials not yet in ``out``/results.jsonl (in ``workers`` processes, or on Ray with
     ``backend="ray"``), append each as it finishes, and return (and write ``summary.json``) the summary over
     all of them."""
+    job = (with_run_options(sc, trials, seed), Path(out))
+    return run_experiments([job], workers=workers, backend=backend, progress=progress, desc=sc.name)[0]
+
+
+def with_run_options(sc: Scenario, trials: int | None, seed: int | None) -> Scenario:
+    """``sc`` with its trial count and seed set, where given (in place; returned for chaining)."""
     if trials is not None:
         sc.trials = trials
     if seed is not None:
         sc.seed = seed
-    return run_experiments([(sc, Path(out))], workers=workers, backend=backend, progress=progress, desc=sc.name)[0]
+    return sc
 
 
 def run_experiments(

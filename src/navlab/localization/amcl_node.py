@@ -159,11 +159,8 @@ class Amcl(Node):
 
     def _poses(self, msg: Any) -> tuple[tuple[float, float, float], tuple[float, float, float]] | None:
         """(odometry pose at the scan's stamp, laser pose in the base frame), or None (logged) if tf lacks one."""
-        frame = str(msg.header.frame_id).lstrip("/") or self.base_frame
-        try:
-            laser = self.sensor_pose(self.base_frame, frame)
-        except TfError as exc:
-            self.get_logger().warning(f"no transform {self.base_frame} → {frame} for the scan: {exc}")
+        laser = self.scan_sensor_pose(self.base_frame, msg)
+        if laser is None:
             return None
         try:
             odom = self.pose_at(self.odom_frame, self.base_frame, msgs.stamp_ns(msg))

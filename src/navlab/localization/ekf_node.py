@@ -267,25 +267,9 @@ class EkfNode(Node):
     def _publish(self, t_ns: int) -> None:
         s, p = self.filter.state, self.filter.covariance
         q = quat_from_rpy(s[3], s[4], s[5])
+        pose_cov, twist_cov = p[:6, :6].ravel().copy(), p[6:12, 6:12].ravel().copy()
         self.pub.publish(
-            msgs.Odometry(
-                header=msgs.header(t_ns, self.world_frame),
-                child_frame_id=self.base_frame,
-                pose=msgs.PoseWithCovariance(
-                    pose=msgs.Pose(
-                        position=msgs.Point(x=float(s[0]), y=float(s[1]), z=float(s[2])),
-                        orientation=msgs.quaternion_msg(q),
-                    ),
-                    covariance=p[:6, :6].ravel().copy(),
-                ),
-                twist=msgs.TwistWithCovariance(
-                    twist=msgs.Twist(
-                        linear=msgs.Vector3(x=float(s[6]), y=float(s[7]), z=float(s[8])),
-                        angular=msgs.Vector3(x=float(s[9]), y=float(s[10]), z=float(s[11])),
-                    ),
-                    covariance=p[6:12, 6:12].ravel().copy(),
-                ),
-            )
+            msgs.odometry(t_ns, self.world_frame, self.base_frame, s[0:3], q, s[6:9], s[9:12], pose_cov, twist_cov)
         )
         if not self.publish_tf:
             return

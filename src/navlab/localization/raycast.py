@@ -12,6 +12,15 @@ import numpy as np
 from numba import njit
 
 
+@njit(cache=True, inline="always")
+def _axis_start(g: float, cell: int, d: float) -> tuple[float, float]:
+    """Along one axis of a ray at cell coordinate ``g`` (in cell ``cell``) with direction component ``d``: the
+    ray parameter of the first cell boundary it crosses, and between two crossings (1e30: never)."""
+    if d == 0.0:
+        return 1e30, 1e30
+    return ((cell + 1 - g) / d) if d > 0 else ((g - cell) / -d), abs(1.0 / d)
+
+
 @njit(cache=True)
 def cast_one(occ: np.ndarray, inv_res: float, res: float, x: float, y: float, ang: float, max_range: float) -> float:
     h, w = occ.shape
@@ -25,19 +34,8 @@ def cast_one(occ: np.ndarray, inv_res: float, res: float, x: float, y: float, an
     dy = math.sin(ang)
     step_i = 1 if dx > 0 else -1
     step_j = 1 if dy > 0 else -1
-    big = 1e30
-    if dx != 0.0:
-        t_max_x = ((i + 1 - gx) / dx) if dx > 0 else ((gx - i) / -dx)
-        t_dx = abs(1.0 / dx)
-    else:
-        t_max_x = big
-        t_dx = big
-    if dy != 0.0:
-        t_max_y = ((j + 1 - gy) / dy) if dy > 0 else ((gy - j) / -dy)
-        t_dy = abs(1.0 / dy)
-    else:
-        t_max_y = big
-        t_dy = big
+    t_max_x, t_dx = _axis_start(gx, i, dx)
+    t_max_y, t_dy = _axis_start(gy, j, dy)
     limit = max_range * inv_res
     while True:
         if t_max_x < t_max_y:

@@ -18,6 +18,8 @@ import math
 import numba
 import numpy as np
 
+from navlab.gridline import TIE_LATE, line, line_cell
+
 SHIFT = 6
 TILE = 1 << SHIFT  # cells per tile side (64 cells: 3.2 m at 5 cm, 16 KiB of float32)
 MASK = TILE - 1
@@ -155,13 +157,9 @@ def raycast_tiles(
         ey = py + r * math.sin(a)
         i1 = math.floor((ex - ox) / res) - oi
         j1 = math.floor((ey - oy) / res) - oj
-        di = abs(i1 - i0)
-        dj = abs(j1 - j0)
-        si = 1 if i1 > i0 else -1
-        sj = 1 if j1 > j0 else -1
-        err = di - dj
-        i, j = i0, j0
-        while i != i1 or j != j1:
+        ln = line(i0, j0, i1, j1, TIE_LATE)
+        for n in range(ln[0]):  # the end cell excluded
+            i, j = line_cell(ln, n)
             if 0 <= i < w and 0 <= j < h:
                 tj, ti = j >> SHIFT, i >> SHIFT
                 if tj != last_tj or ti != last_ti:
@@ -169,13 +167,6 @@ def raycast_tiles(
                     last_tj, last_ti = tj, ti
                 v = tiles[t, j & MASK, i & MASK] + l_free
                 tiles[t, j & MASK, i & MASK] = v if v > -clamp else -clamp
-            e2 = 2 * err
-            if e2 > -dj:
-                err -= dj
-                i += si
-            if e2 < di:
-                err += di
-                j += sj
         if hit and 0 <= i1 < w and 0 <= j1 < h:
             tj, ti = j1 >> SHIFT, i1 >> SHIFT
             if tj != last_tj or ti != last_ti:

@@ -18,11 +18,11 @@ import numba
 import numpy as np
 
 from navlab.grid import GridMap
+from navlab.gridline import TIE_LATE, line, line_cell, line_minor, line_strides
 
 L_OCC = 0.85  # log-odds increment of a hit
 L_FREE = -0.4  # log-odds increment of a traversed cell
 L_CLAMP = 5.0
-FAST_WALK_CELLS = 4096  # lines shorter than this (in cells along their major axis) take the fixed-point walk
 
 
 @numba.njit(cache=True)
@@ -61,40 +61,20 @@ def _raycast(
         ey = py + r * math.sin(a)
         i1 = math.floor((ex - ox) / res) - oi
         j1 = math.floor((ey - oy) / res) - oj
-        # Bresenham from (i0, j0) to (i1, j1), excluding the end cell
-        di = abs(i1 - i0)
-        dj = abs(j1 - j0)
-        si = 1 if i1 > i0 else -1
-        sj = 1 if j1 > j0 else -1
-        err = di - dj
-        i, j = i0, j0
-        dmaj, dmin = max(di, dj), min(di, dj)
-        if start_inside and 0 <= i1 < w and 0 <= j1 < h and dmaj < FAST_WALK_CELLS:
-            # The whole line is inside: no per-cell checks, a flat index, and no error term: this Bresenham
-            # steps along the major axis every time, so its cell n (of dmaj) is n steps along it and
-            # ceil((2 dmin n - dmaj) / (2 dmaj)) along the minor one, here an exact fixed-point division
-            # (x * mul >> 40 = x // (2 dmaj) while x * 2 dmaj < 2**40), so no step waits on the one before.
-            idx = j * w + i
-            smaj, smin = (si, sj * w) if di >= dj else (sj * w, si)
-            mul = ((1 << 40) + 2 * dmaj - 1) // (2 * dmaj) if dmaj else 0
-            x = dmaj - 1
-            for n in range(dmaj):
-                c = numba.uint64(idx + n * smaj + ((x * mul) >> 40) * smin)
+        # the line's cells from (i0, j0), the end cell excluded
+        ln = line(i0, j0, i1, j1, TIE_LATE)
+        if start_inside and 0 <= i1 < w and 0 <= j1 < h:  # the whole line is inside: no per-cell checks
+            idx, smaj, smin = line_strides(ln, w)
+            for n in range(ln[0]):
+                c = numba.uint64(idx + n * smaj + line_minor(ln, n) * smin)
                 v = flat[c] + l_free
                 flat[c] = v if v > -clamp else -clamp
-                x += 2 * dmin
-            i, j = i1, j1
-        while i != i1 or j != j1:
-            if 0 <= i < w and 0 <= j < h:
-                v = logodds[j, i] + l_free
-                logodds[j, i] = v if v > -clamp else -clamp
-            e2 = 2 * err
-            if e2 > -dj:
-                err -= dj
-                i += si
-            if e2 < di:
-                err += di
-                j += sj
+        else:
+            for n in range(ln[0]):
+                i, j = line_cell(ln, n)
+                if 0 <= i < w and 0 <= j < h:
+                    v = logodds[j, i] + l_free
+                    logodds[j, i] = v if v > -clamp else -clamp
         if hit and 0 <= i1 < w and 0 <= j1 < h:
             v = logodds[j1, i1] + l_occ
             logodds[j1, i1] = v if v < clamp else clamp

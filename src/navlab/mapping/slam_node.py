@@ -139,11 +139,8 @@ class SlamGMapping(Node):
     def _odom_laser(self, msg: Any) -> np.ndarray | None:
         """The laser's pose in the odom frame at the scan's stamp, or the latest one (tf odom→base ∘ base→laser),
         or None."""
-        frame = str(msg.header.frame_id).lstrip("/") or self.base_frame
-        try:
-            laser = self.sensor_pose(self.base_frame, frame)
-        except TfError as exc:
-            self.get_logger().warning(f"no transform {self.base_frame} → {frame}: {exc}")
+        laser = self.scan_sensor_pose(self.base_frame, msg)
+        if laser is None:
             return None
         stamp = msgs.stamp_ns(msg)
         # A scan stamped now (as live) is level with or ahead of the newest odometry, where the lookup at its

@@ -18,6 +18,7 @@ import numpy as np
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 from rosbags.typesys.base import Nodetype
 
+from navlab.msgs import NUMPY_DTYPES, zero_value
 from navlab.msgs import TYPESTORE as ROS2_STORE
 from navlab.ros1.errors import Ros1Error
 
@@ -206,21 +207,7 @@ class Ros1Types:
 
 _ROS1_TIME = {"builtin_interfaces/msg/Time": "time", "builtin_interfaces/msg/Duration": "duration"}
 _MISSING = object()
-_NUMPY = {
-    "bool": np.uint8,
-    "byte": np.uint8,
-    "char": np.uint8,
-    "int8": np.int8,
-    "uint8": np.uint8,
-    "int16": np.int16,
-    "uint16": np.uint16,
-    "int32": np.int32,
-    "uint32": np.uint32,
-    "int64": np.int64,
-    "uint64": np.uint64,
-    "float32": np.float32,
-    "float64": np.float64,
-}
+_NUMPY = {**NUMPY_DTYPES, "bool": np.uint8}  # ROS 1 arrays of bool are uint8 on the wire
 
 
 def _same(v: Any) -> Any:
@@ -230,16 +217,8 @@ def _same(v: Any) -> Any:
 def _default(store: Any, desc: Any) -> Callable[[], Any]:
     """The zero value of a field missing on the other side (ROS 1's Header.seq, ...)."""
     if desc[0] == Nodetype.BASE:
-        kind = desc[1][0]
-        return (
-            (lambda: "")
-            if kind == "string"
-            else (lambda: False)
-            if kind == "bool"
-            else (lambda: 0.0)
-            if kind.startswith("float")
-            else (lambda: 0)
-        )
+        zero = zero_value(desc[1][0])
+        return lambda: zero
     if desc[0] == Nodetype.NAME:
         sub = str(desc[1])
         return lambda: store.types[sub](**{n: _default(store, d)() for n, d in store.fielddefs[sub][1]})

@@ -12,19 +12,16 @@ angular velocity's, as the ROS 1 plugin sets ``gaussianNoise²``).
 
 from __future__ import annotations
 
-import math
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 
 from navlab import msgs
-from navlab.core import Executor, Node
 from navlab.description import ImuConfig, RobotModel
 from navlab.geometry import xyzw_from_wxyz
 from navlab.sim.errors import SimError
-from navlab.sim.simulation import Simulation
+from navlab.sim.plugins import SensorPlugin
 
 AXES = ("x", "y", "z")
 
@@ -121,42 +118,27 @@ def _find_sensor(urdf_xml: str, cfg: ImuConfig) -> ET.Element | None:
     return None
 
 
-class ImuSensorPlugin(Node):
+class ImuSensorPlugin(SensorPlugin[ImuConfig]):
     """``gazebo_ros_imu_sensor`` for the robot's IMU number ``index``: ``sensor_msgs/Imu`` on the
     configured topic every ``1/update_rate`` s, stamped with simulated time, in the IMU's frame
     (``frameName``/``bodyName``, else its link)."""
 
-    def __init__(
-        self,
-        executor: Executor,
-        *,
-        name: str = "",
-        parameters: dict[str, Any] | None = None,
-        namespace: str = "",
-        sim: Simulation,
-        index: int,
-    ) -> None:
-        if sim.robot is None or not 0 <= index < len(sim.robot.imus):
-            raise SimError(f"no imu number {index} on this robot")
-        cfg = sim.robot.imus[index]
-        super().__init__(executor, name=name or f"{cfg.name}_plugin", parameters=parameters, namespace=namespace)
-        self.frame_id = (cfg.frame_id or cfg.link).strip()
-        if not self.frame_id:
-            raise SimError(f"imu {cfg.name!r}: no frame (frameName/bodyName) and no link to publish in")
-        if not (math.isfinite(cfg.update_rate) and cfg.update_rate > 0):
-            raise SimError(f"imu {cfg.name!r}: update rate {cfg.update_rate!r}: expected Hz > 0")
-        self.sim, self.index, self.cfg = sim, index, cfg
+    static_frame = False
+    idle_unread = True
+    robot_sensors = "imus"
+
+    def setup(self) -> None:
+        cfg, sim = self.cfg, self.sim
+        assert sim.robot is not None
         gyro, accel = noise_from_description(sim.robot, cfg)
         self.noise_model = (gyro, accel)
         self.noise: ImuNoise | None = None  # drawn at the first reading, from the node's (seeded) generator
-        self.site = sim.info.imu_sites[index]
+        self.site = sim.info.imu_sites[self.index]
         g2, a2 = np.square(gyro.stddev), np.square(accel.stddev)
         self.cov = (np.diag(g2).ravel(), np.diag(g2).ravel(), np.diag(a2).ravel())
         self.pub = self.create_publisher(msgs.Imu, cfg.topic, 10)
-        # Gazebo: a sensor updates at most once per physics step
-        self.create_timer(max(1.0 / cfg.update_rate, sim.timestep), self.update, idle=self._unread)
 
-    def read(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def reading(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(quaternion x y z w in the world, noisy angular velocity rad/s, noisy acceleration m/s²)."""
         d = self.sim.data
         site = self.site
@@ -166,24 +148,24 @@ class ImuSensorPlugin(Node):
         gyro, accel = self.noise.apply(d.sensor(f"{site}_gyro").data, d.sensor(f"{site}_accel").data)
         return np.array(xyzw_from_wxyz(quat)), gyro, accel
 
-    def _unread(self) -> bool:
+    def unread(self) -> bool:
         """Whether nobody subscribes or listens (a recorder, ``topic echo``): the timer then idles."""
-        return not (self.pub.get_subscription_count() or self.executor.has_listeners)
+        return not self.read(self.pub)
 
     def update(self) -> None:
         """Read the IMU and publish, when anyone subscribes or listens: a 100 Hz message nobody reads cost ~6 %
         of a navigation run's CPU (navlab bench nav), and its timer events ~1 % of a mapping run's."""
-        if self._unread():
+        if self.unread():
             return
-        quat, gyro, accel = self.read()
+        quat, gyro, accel = self.reading()
         self.pub.publish(
             msgs.Imu(
                 header=msgs.header(self.get_clock().now_ns(), self.frame_id),
                 orientation=msgs.quaternion_msg(quat),
                 orientation_covariance=self.cov[0].copy(),
-                angular_velocity=msgs.Vector3(x=float(gyro[0]), y=float(gyro[1]), z=float(gyro[2])),
+                angular_velocity=msgs.vector3(gyro),
                 angular_velocity_covariance=self.cov[1].copy(),
-                linear_acceleration=msgs.Vector3(x=float(accel[0]), y=float(accel[1]), z=float(accel[2])),
+                linear_acceleration=msgs.vector3(accel),
                 linear_acceleration_covariance=self.cov[2].copy(),
             )
         )

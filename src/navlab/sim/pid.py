@@ -10,10 +10,12 @@ the command (a motor's torque limit); with ``antiwindup`` the integral stops gro
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, ClassVar
 
-from navlab.errors import did_you_mean
+from navlab.core import ParamSpec, read_params
+from navlab.core.params import param_error, typed_value
 from navlab.sim.errors import SimError
 
 
@@ -28,42 +30,32 @@ class PidGains:
     i_clamp_min: float = 0.0
     antiwindup: bool = False
 
+    PARAMS: ClassVar[ParamSpec]
+
     def __post_init__(self) -> None:
-        for key in ("p", "i", "d", "i_clamp_max"):
-            v = getattr(self, key)
-            if not (isinstance(v, int | float) and math.isfinite(v) and v >= 0):
-                raise SimError(f"pid gain {key}: expected a finite number >= 0, got {v!r}")
-        if not (math.isfinite(self.i_clamp_min) and self.i_clamp_min <= 0):
-            raise SimError(f"pid gain i_clamp_min: expected a finite number <= 0, got {self.i_clamp_min!r}")
+        read_params(type(self), self)  # the ranges of PARAMS
 
     @classmethod
-    def from_params(cls, params: dict[str, Any], *, where: str = "pid") -> PidGains:
-        """Gains from ROS parameters ``{p, i, d, i_clamp}`` (or ``i_clamp_min``/``i_clamp_max``, ``antiwindup``)."""
-        known = ("p", "i", "d", "i_clamp", "i_clamp_min", "i_clamp_max", "antiwindup")
-        for key in params:
-            if key not in known:
-                hint = did_you_mean(key, known)
-                raise SimError(f"{where}: unknown pid parameter '{key}'{hint} (known: {', '.join(known)})")
-        values: dict[str, Any] = {}
-        for key in ("p", "i", "d"):
-            if key in params:
-                values[key] = _number(params[key], f"{where}.{key}")
-        clamp = _number(params.get("i_clamp", 0.0), f"{where}.i_clamp")
-        if clamp < 0:
-            raise SimError(f"{where}.i_clamp: expected a number >= 0, got {clamp!r}")
-        values["i_clamp_max"] = _number(params.get("i_clamp_max", clamp), f"{where}.i_clamp_max")
-        values["i_clamp_min"] = _number(params.get("i_clamp_min", -clamp), f"{where}.i_clamp_min")
-        values["antiwindup"] = bool(params.get("antiwindup", False))
-        try:
-            return cls(**values)
-        except SimError as exc:
-            raise SimError(f"{where}: {exc}") from None
+    def from_params(cls, params: Mapping[str, Any], *, where: str = "pid") -> PidGains:
+        """Gains from ROS parameters ``{p, i, d, i_clamp}`` (or ``i_clamp_min``/``i_clamp_max``, ``antiwindup``):
+        ``i_clamp`` (>= 0) sets the ends not given, symmetric, as ``control_toolbox`` does."""
+        values = dict(params)
+        if "i_clamp" in values:
+            clamp = typed_value(float, "i_clamp", values.pop("i_clamp"), what=where, error=SimError)
+            if not clamp >= 0:
+                raise param_error(where, "i_clamp", clamp, ">= 0", SimError)
+            values.setdefault("i_clamp_max", clamp)
+            values.setdefault("i_clamp_min", -clamp)
+        return read_params(cls, values, what=where)
 
 
-def _number(value: Any, where: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
-        raise SimError(f"{where}: expected a finite number, got {value!r}")
-    return float(value)
+PidGains.PARAMS = ParamSpec(
+    "pid",
+    SimError,
+    at_least={"p": 0.0, "i": 0.0, "d": 0.0, "i_clamp_max": 0.0},
+    at_most={"i_clamp_min": 0.0},
+    strict=True,
+)
 
 
 class Pid:

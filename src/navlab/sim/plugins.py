@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import functools
 import math
-from typing import Any
+from typing import Any, Generic, Protocol, TypeVar
 
 import numpy as np
 
@@ -26,9 +26,22 @@ from navlab.sim.diffdrive import (
     noetic_wheel_commands,
     wheel_speeds,
 )
+from navlab.sim.errors import SimError
 from navlab.sim.simulation import Simulation, lidar_angles
 
 _ODOM_COV = msgs.covariance(ODOM_COVARIANCE_DIAG)
+OPTICAL = quat_from_rpy(-math.pi / 2, 0.0, -math.pi / 2)  # camera body frame -> optical frame
+
+
+class SensorDescription(Protocol):
+    """What every sensor's description holds (``LidarConfig``, ``ImuConfig``, ``CameraConfig``, ...)."""
+
+    name: str
+    link: str
+    update_rate: float  # Hz
+
+
+C = TypeVar("C", bound=SensorDescription)
 
 
 def _transform(stamp_ns: int, parent: str, child: str, xyz: Any, q: Any) -> Any:
@@ -37,7 +50,7 @@ def _transform(stamp_ns: int, parent: str, child: str, xyz: Any, q: Any) -> Any:
         header=msgs.header(stamp_ns, parent),
         child_frame_id=child,
         transform=msgs.Transform(
-            translation=msgs.Vector3(x=float(xyz[0]), y=float(xyz[1]), z=float(xyz[2])),
+            translation=msgs.vector3(xyz),
             rotation=msgs.quaternion_msg(q),
         ),
     )
@@ -45,6 +58,85 @@ def _transform(stamp_ns: int, parent: str, child: str, xyz: Any, q: Any) -> Any:
 
 def _origin_transform(stamp_ns: int, parent: str, child: str, origin: Origin) -> Any:
     return _transform(stamp_ns, parent, child, origin.xyz, quat_from_rpy(*origin.rpy))
+
+
+def listened(node: Node, *pubs: Any) -> bool:
+    """Whether any of ``pubs`` has a subscriber, or a recorder/viewer listens to ``node``'s executor: a sensor
+    publishes only then, as Gazebo's sensors do."""
+    return node.executor.has_listeners or any(p.get_subscription_count() for p in pubs)
+
+
+class SensorPlugin(Node, Generic[C]):
+    """What the sensor plugins share: the config, the node's name (default: the sensor's name + ``_plugin``),
+    its frame (``frame_id``, else the link), a timer at the sensor's rate (at most once per physics step, as
+    Gazebo's sensors) calling :meth:`update`, and, with ``static_frame``, the frame's static tf from its link
+    when the frame is not a link (turned to the optical frame if ``optical``). A plugin adds its publishers in
+    :meth:`setup`; with ``idle_unread`` the timer idles while :meth:`unread`.
+
+    The sensor is ``config`` (its description), or the robot's sensor number ``index`` in the plugin's
+    ``robot_sensors`` list (``lidars``, ``imus``)."""
+
+    optical = False
+    static_frame = True  # False where robot_state_publisher sends it (lidars, IMUs: plugins.static_transforms)
+    idle_unread = False
+    robot_sensors = ""
+
+    def __init__(
+        self,
+        executor: Executor,
+        *,
+        name: str = "",
+        parameters: dict[str, Any] | None = None,
+        namespace: str = "",
+        sim: Simulation,
+        config: C | None = None,
+        index: int | None = None,
+    ) -> None:
+        if self.robot_sensors:
+            config = robot_sensor(sim, self.robot_sensors, index)
+        if config is None:
+            raise SimError(f"{type(self).__name__}: no sensor config given")
+        self.index = -1 if index is None else index
+        super().__init__(executor, name=name or f"{config.name}_plugin", parameters=parameters, namespace=namespace)
+        assert sim.robot is not None
+        self.sim, self.cfg = sim, config
+        self.frame_id = (getattr(config, "frame_id", "") or config.link).strip()
+        kind = type(config).__name__.removesuffix("Config").lower()
+        if not self.frame_id:
+            raise SimError(f"{kind} {config.name!r}: no frame (frameName/bodyName) and no link to publish in")
+        if not (math.isfinite(config.update_rate) and config.update_rate > 0):
+            raise SimError(f"{kind} {config.name!r}: update rate {config.update_rate!r}: expected Hz > 0")
+        if self.static_frame and self.frame_id not in sim.robot.links and hasattr(config, "origin"):
+            o = config.origin
+            q = quat_from_rpy(*o.rpy)
+            q = qmul(q, OPTICAL) if self.optical else q
+            self.send_static_transform([_transform(executor.now_ns, config.link, self.frame_id, o.xyz, q)])
+        idle = self.unread if self.idle_unread else None
+        self.create_timer(max(1.0 / config.update_rate, sim.timestep), self.update, idle=idle)
+        self.setup()
+
+    def setup(self) -> None:
+        """Create the plugin's publishers (``self.cfg`` its config)."""
+
+    def read(self, *pubs: Any) -> bool:
+        """Whether any of ``pubs`` has a subscriber, or a recorder/viewer listens (:func:`listened`)."""
+        return listened(self, *pubs)
+
+    def unread(self) -> bool:
+        """Whether nobody reads what the plugin publishes (its timer then idles, with ``idle_unread``)."""
+        return False
+
+    def update(self) -> None:
+        """One sensor update."""
+        raise NotImplementedError
+
+
+def robot_sensor(sim: Simulation, kind: str, index: int | None) -> Any:
+    """The robot's sensor number ``index`` of ``kind`` (``lidars``, ``imus``: a ``RobotModel`` list)."""
+    sensors = getattr(sim.robot, kind, None) or []
+    if index is None or not 0 <= index < len(sensors):
+        raise SimError(f"no {kind.removesuffix('s')} number {index} on this robot")
+    return sensors[index]
 
 
 def base_frame_link(sim: Simulation, frame: str) -> str:
@@ -144,57 +236,31 @@ class DiffDrivePlugin(Node):
         if not cfg.publish_odom:  # Noetic's <publishTf>false: no odometry topic and no tf
             return
         # the message only when anyone reads it (the mapping launch's nodes take odometry from tf)
-        if self.odom_pub.get_subscription_count() or self.executor.has_listeners:
+        if listened(self, self.odom_pub):
             if world:
                 lin, ang = self.sim.link_velocity(self.base_link)
             else:
                 lin, ang = np.array([v, 0.0, 0.0]), np.array([0.0, 0.0, w])
-            odom = msgs.Odometry(
-                header=msgs.header(now, cfg.odometry_frame),
-                child_frame_id=cfg.robot_base_frame,
-                pose=msgs.PoseWithCovariance(
-                    pose=msgs.Pose(
-                        position=msgs.Point(x=float(position[0]), y=float(position[1]), z=float(position[2])),
-                        orientation=msgs.quaternion_msg(quat),
-                    ),
-                    covariance=_ODOM_COV.copy(),
-                ),
-                twist=msgs.TwistWithCovariance(
-                    twist=msgs.Twist(
-                        linear=msgs.Vector3(x=float(lin[0]), y=float(lin[1]), z=float(lin[2])),
-                        angular=msgs.Vector3(x=float(ang[0]), y=float(ang[1]), z=float(ang[2])),
-                    ),
-                    covariance=_ODOM_COV.copy(),
-                ),
+            frames = (cfg.odometry_frame, cfg.robot_base_frame)
+            self.odom_pub.publish(
+                msgs.odometry(now, *frames, position, quat, lin, ang, _ODOM_COV.copy(), _ODOM_COV.copy())
             )
-            self.odom_pub.publish(odom)
         if cfg.publish_tf:
             self.send_transform(_transform(now, cfg.odometry_frame, cfg.robot_base_frame, position, quat))
 
 
-class LidarPlugin(Node):
+class LidarPlugin(SensorPlugin[LidarConfig]):
     """``gazebo_ros_laser``: a ``sensor_msgs/LaserScan`` every ``1/update_rate`` s on the configured topic,
     for the robot's lidar number ``index`` (default name: the sensor's name + ``_plugin``)."""
 
-    def __init__(
-        self,
-        executor: Executor,
-        *,
-        name: str = "",
-        parameters: dict[str, Any] | None = None,
-        namespace: str = "",
-        sim: Simulation,
-        index: int,
-    ) -> None:
-        assert sim.robot is not None
-        cfg: LidarConfig = sim.robot.lidars[index]
-        super().__init__(executor, name=name or f"{cfg.name}_plugin", parameters=parameters, namespace=namespace)
-        self.sim, self.index, self.cfg = sim, index, cfg
-        self.frame_id = cfg.frame_id or cfg.link
+    static_frame = False
+    robot_sensors = "lidars"
+
+    def setup(self) -> None:
+        cfg = self.cfg
         n = cfg.samples
         self.angle_increment = float(np.diff(lidar_angles(cfg))[0]) if n > 1 else 0.0
         self.pub = self.create_publisher(msgs.LaserScan, cfg.topic, 10)
-        self.create_timer(max(1.0 / cfg.update_rate, sim.timestep), self.update)  # Gazebo: at most every step
         self._empty = np.zeros(0, dtype=np.float32)
         # the scan's fixed fields, converted once
         self._fields = {
@@ -364,27 +430,14 @@ class GroundTruthPlugin(Node):
 
     def _unread(self) -> bool:
         """Whether nobody subscribes or listens (a recorder, ``topic echo``): the timer then idles."""
-        return not (self.pub.get_subscription_count() or self.executor.has_listeners)
+        return not listened(self, self.pub)
 
     def update(self) -> None:
         """Publish the true pose, when anyone subscribes or listens: 50 messages a second that nobody read were
         ~5 % of a navigation run's CPU (navlab bench nav), and their timer events a fifth of its events."""
         if self._unread():
             return
-        (px, py, pz), (qx, qy, qz, qw), (vx, vy, vz), (wx, wy, wz) = self.sim.link_state(self.link)
+        state = self.sim.link_state(self.link)  # position, quaternion (x, y, z, w), linear, angular velocity
         self.pub.publish(
-            msgs.Odometry(
-                header=msgs.header(self.executor.now_ns, self.frame),
-                child_frame_id=self.base_frame,
-                pose=msgs.PoseWithCovariance(
-                    pose=msgs.Pose(
-                        position=msgs.Point(x=px, y=py, z=pz), orientation=msgs.Quaternion(x=qx, y=qy, z=qz, w=qw)
-                    ),
-                    covariance=np.zeros(36),
-                ),
-                twist=msgs.TwistWithCovariance(
-                    twist=msgs.Twist(linear=msgs.Vector3(x=vx, y=vy, z=vz), angular=msgs.Vector3(x=wx, y=wy, z=wz)),
-                    covariance=np.zeros(36),
-                ),
-            )
+            msgs.odometry(self.executor.now_ns, self.frame, self.base_frame, *state, np.zeros(36), np.zeros(36))
         )

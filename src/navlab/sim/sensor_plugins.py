@@ -8,8 +8,7 @@ tf from their link (a camera's optical frame turned z forward, x right, y down).
 
 from __future__ import annotations
 
-import math
-from typing import Any, Generic, TypeVar
+from typing import Any, TypeVar
 
 import mujoco
 import numpy as np
@@ -18,71 +17,24 @@ from navlab import msgs
 from navlab.core import Executor, Node
 from navlab.description.model import Origin
 from navlab.description.sensor_model import BumperConfig, CameraConfig, Lidar3dConfig, RangeConfig, SensorConfig
-from navlab.geometry import qmul, quat_from_rpy
 from navlab.io.pointcloud import FLOAT32, UINT16, pack_cloud
+from navlab.sim.plugins import SensorPlugin
 from navlab.sim.sensors3d import depth_image, depth_points, lidar3d_angles, lidar3d_ranges, range_reading, sensor_pose
 from navlab.sim.simulation import Simulation
 
 ENCODINGS = {"R8G8B8": ("rgb8", 3), "B8G8R8": ("bgr8", 3), "L8": ("mono8", 1)}
-OPTICAL = quat_from_rpy(-math.pi / 2, 0.0, -math.pi / 2)  # camera body frame -> optical frame
 C = TypeVar("C", bound=SensorConfig)
 
 
-class SensorNode(Node, Generic[C]):
-    """What the sensor plugins share: the config, the node's name (default: the sensor's name + ``_plugin``),
-    a timer at the sensor's rate, its frame's static tf (turned to the optical frame if ``optical``);
-    a plugin adds its publishers in :meth:`setup`. ``parameters`` is accepted as every plugin's is, and unused."""
-
-    optical = False
-
-    def __init__(
-        self,
-        executor: Executor,
-        *,
-        name: str = "",
-        parameters: dict[str, Any] | None = None,
-        namespace: str = "",
-        sim: Simulation,
-        config: C,
-    ) -> None:
-        super().__init__(executor, name=name or f"{config.name}_plugin", namespace=namespace)
-        assert sim.robot is not None
-        self.sim, self.cfg = sim, config
-        self.frame_id = getattr(config, "frame_id", "") or config.link
-        if self.frame_id not in sim.robot.links and hasattr(config, "origin"):
-            o = config.origin
-            q = quat_from_rpy(*o.rpy)
-            self.send_static_transform(
-                [
-                    msgs.TransformStamped(
-                        header=msgs.header(executor.now_ns, config.link),
-                        child_frame_id=self.frame_id,
-                        transform=msgs.Transform(
-                            translation=msgs.Vector3(x=o.xyz[0], y=o.xyz[1], z=o.xyz[2]),
-                            rotation=msgs.quaternion_msg(qmul(q, OPTICAL) if self.optical else q),
-                        ),
-                    )
-                ]
-            )
-        self.create_timer(max(1.0 / config.update_rate, sim.timestep), self.update)
-        self.setup()
-
-    def setup(self) -> None:
-        """Create the plugin's publishers (``self.cfg`` its config)."""
-
-    def read(self, *pubs: Any) -> bool:
-        """Whether any of ``pubs`` has a subscriber, or a recorder/viewer listens."""
-        return self.executor.has_listeners or any(p.get_subscription_count() for p in pubs)
+class SensorNode(SensorPlugin[C]):
+    """A gazebo_ros sensor plugin of the robot's sensor suite (:class:`~navlab.sim.plugins.SensorPlugin`), with
+    the point-cloud builder the depth camera and the 3D lidar share."""
 
     def cloud_msg(self, stamp_ns: int, pts: np.ndarray, extra: dict[str, Any], height: int, width: int) -> Any:
         """``sensor_msgs/PointCloud2`` in the sensor's frame: float32 x y z at offsets 0 4 8 (``pts``, n x 3), then
         the ``extra`` fields (name: (offset, datatype, values), as :func:`navlab.io.pointcloud.pack_cloud`)."""
         fields = {"x": (0, FLOAT32, pts[:, 0]), "y": (4, FLOAT32, pts[:, 1]), "z": (8, FLOAT32, pts[:, 2])}
         return pack_cloud(stamp_ns, self.frame_id, {**fields, **extra}, height=height, width=width)
-
-    def update(self) -> None:
-        """One sensor update."""
-        raise NotImplementedError
 
 
 def camera_info(cfg: CameraConfig, stamp_ns: int, frame_id: str) -> Any:
@@ -323,7 +275,7 @@ class BumperPlugin(SensorNode[BumperConfig]):
             frame = con.frame.reshape(3, 3)
             f_world = frame.T @ force[:3] * (1 if mine[0] else -1)
             normal = frame[0] * (1 if mine[0] else -1)
-            wrench = msgs.Wrench(force=_vec(rot.T @ f_world), torque=_vec(np.zeros(3)))
+            wrench = msgs.Wrench(force=msgs.vector3(rot.T @ f_world), torque=msgs.vector3(np.zeros(3)))
             out.append(
                 msgs.ContactState(
                     info=f"Debug:  i:({i}/{d.ncon})",
@@ -331,16 +283,12 @@ class BumperPlugin(SensorNode[BumperConfig]):
                     collision2_name=_geom_name(m, other),
                     wrenches=[wrench],
                     total_wrench=wrench,
-                    contact_positions=[_vec(rot.T @ (con.pos - pos0))],
-                    contact_normals=[_vec(rot.T @ normal)],
+                    contact_positions=[msgs.vector3(rot.T @ (con.pos - pos0))],
+                    contact_normals=[msgs.vector3(rot.T @ normal)],
                     depths=np.array([max(0.0, -float(con.dist))]),
                 )
             )
         return out
-
-
-def _vec(v: np.ndarray) -> Any:
-    return msgs.Vector3(x=float(v[0]), y=float(v[1]), z=float(v[2]))
 
 
 def _geom_name(m: mujoco.MjModel, g: int) -> str:

@@ -15,6 +15,7 @@ import numpy as np
 from scipy.ndimage import maximum_filter
 
 from navlab.grid import COST_INSCRIBED, COST_LETHAL, COST_UNKNOWN
+from navlab.gridline import TIE_EARLY, line, line_cell
 from navlab.navigation.controllers.common import footprint_outline
 
 # --- rollout and footprint cost (pure, vectorised over samples) --------------------------------------
@@ -345,24 +346,11 @@ def heading_diffs(cost: np.ndarray, resolution: float, plan: np.ndarray, poses: 
 def _line_clear(cost: np.ndarray, x0: int, x1: int, y0: int, y1: int) -> bool:  # pragma: no cover - compiled
     """Whether TrajectoryPlanner's ``lineCost`` (its Bresenham walk) from cell (x0, y0) to (x1, y1) meets no
     LETHAL, INSCRIBED or unknown cell."""
-    dx, dy = abs(x1 - x0), abs(y1 - y0)
-    sx = 1 if x1 >= x0 else -1
-    sy = 1 if y1 >= y0 else -1
-    if dx >= dy:  # one x step per pixel, y steps when the numerator overflows
-        xi1, xi2, yi1, yi2, den, num, add, pixels = 0, sx, sy, 0, dx, dx // 2, dy, dx
-    else:
-        xi1, xi2, yi1, yi2, den, num, add, pixels = sx, 0, 0, sy, dy, dy // 2, dx, dy
-    x, y = x0, y0
-    for _ in range(pixels + 1):
+    ln = line(x0, y0, x1, y1, TIE_EARLY)
+    for n in range(ln[0] + 1):
+        x, y = line_cell(ln, n)
         if cost[y, x] >= COST_INSCRIBED:
             return False
-        num += add
-        if num >= den:
-            num -= den
-            x += xi1
-            y += yi1
-        x += xi2
-        y += yi2
     return True
 
 

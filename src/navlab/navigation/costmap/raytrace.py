@@ -11,6 +11,8 @@ import math
 import numba
 import numpy as np
 
+from navlab.gridline import TIE_LATE, line, line_cell
+
 
 @numba.njit(cache=True)
 def clear_rays(
@@ -41,24 +43,12 @@ def clear_rays(
             ey = y0 + dy * s
         i1 = math.floor(ex)
         j1 = math.floor(ey)
-        di = abs(i1 - i0)
-        dj = abs(j1 - j0)
-        si = 1 if i1 > i0 else -1
-        sj = 1 if j1 > j0 else -1
-        err = di - dj
-        i = i0
-        j = j0
-        for _ in range(max(di, dj) + 1):
+        ln = line(i0, j0, i1, j1, TIE_LATE)
+        for n in range(ln[0] + 1):
+            i, j = line_cell(ln, n)
             if i < 0 or j < 0 or i >= w or j >= h:
                 break
             if min_sq <= 0.0 or (i - i0) * (i - i0) + (j - j0) * (j - j0) >= min_sq:
                 data[j, i] = value
                 written += 1
-            e2 = 2 * err
-            if e2 > -dj:
-                err -= dj
-                i += si
-            if e2 < di:
-                err += di
-                j += sj
     return written
