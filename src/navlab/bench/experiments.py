@@ -9,7 +9,7 @@ import time
 from pathlib import Path
 from typing import Any
 
-from navlab.experiments.clutter_protocol import clutter_speed, run_protocol
+from navlab.experiments.clutter_protocol import JACKAL_MAX_SPEED, run_protocol
 from navlab.experiments.mapping_run import run_mapping
 from navlab.experiments.navigate_run import run_navigation
 from navlab.experiments.odom_run import ROBOTS, ROUTES, run_drift
@@ -55,8 +55,7 @@ def run_nav(args: Any) -> dict[str, Any]:
 def run_clutter(args: Any) -> dict[str, Any]:
     """``navlab bench clutter``: the clutter benchmark's protocol (``experiments.clutter_protocol``): ``--set``
     (test | tuning), ``--worlds``, ``--robot`` (jackal), ``--controller`` (mppi for the robots whose files tune it,
-    else the robot's own), ``--max-speed`` (``clutter_speed``: the Jackal 1.5 m/s, else 2; 0 keeps the files'),
-    ``--out`` (a picture of each failure)."""
+    else the robot's own), ``--max-speed`` (2 m/s; 0 keeps the files'), ``--out`` (a picture of each failure)."""
     robot = getattr(args, "robot", None) or "jackal"
     controller = getattr(args, "controller", None) or ("mppi" if robot in ("mybot", "jackal") else None)
     speed = getattr(args, "max_speed", None)
@@ -65,7 +64,7 @@ def run_clutter(args: Any) -> dict[str, Any]:
         which=getattr(args, "set", None) or "test",
         robot=robot,
         controller=controller,
-        max_speed=(clutter_speed(robot) if controller else None) if speed is None else (speed or None),
+        max_speed=(JACKAL_MAX_SPEED if controller else None) if speed is None else (speed or None),
         out=getattr(args, "out", None),
         seed=getattr(args, "seed", 0),
         progress=not getattr(args, "quiet", False),

@@ -114,8 +114,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         type=float,
         default=None,
         metavar="M_S",
-        help="clutter: the controller's top speed (default: 1.5 for the jackal, tuned; 2.0, the challenge's limit, "
-        "for others; 0 keeps the files')",
+        help="clutter: the controller's top speed (default 2.0, the Jackal's; 0 keeps the files')",
     )
     p.add_argument("--out", default=None, metavar="DIR", help="clutter: a picture of each failure in DIR")
     p.add_argument(

@@ -21,17 +21,6 @@ from navlab.experiments.errors import ExperimentError
 
 SETS = {"test": 0, "tuning": 1}  # clutter_suite seed of each set
 JACKAL_MAX_SPEED = 2.0  # m/s: the Jackal's top speed, the challenge's limit
-# m/s: the top speed bench clutter gives a robot's controller by default, where tuned below the limit. BARN's
-# score stops rising at 2 x T_opt (~1 m/s on average), which the Jackal makes at 1.5 m/s in all but the densest
-# worlds, where 2 m/s cost a collision on the tuning set.
-CLUTTER_SPEEDS = {"jackal": 1.5}
-
-
-def clutter_speed(robot: str) -> float:
-    """The top speed (m/s) bench clutter drives ``robot`` at unless told (``CLUTTER_SPEEDS``, else 2 m/s)."""
-    return CLUTTER_SPEEDS.get(robot, JACKAL_MAX_SPEED)
-
-
 # the parameter that caps forward speed, per local planner (its ROS namespace and name)
 SPEED_KEYS: dict[str, tuple[str, ...]] = {
     "nav2_mppi_controller::MPPIController": ("MPPIController.vx_max",),

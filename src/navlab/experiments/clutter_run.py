@@ -47,20 +47,6 @@ CLUTTER_PARAMS: dict[str, Any] = {
     "progress_checker.movement_time_allowance": 10.0,
 }
 CLUTTER_ROBOTS = ("mybot", "jackal")
-# The Jackal at speed (tuned on bench clutter's tuning set, with its wheels gripping): an 8 m local window, the
-# laser marking to 4 m (2.5 m is 1.3 s at 2 m/s) and MPPI following the plan beyond its horizon (vx x 2.8 s), so
-# that it does not slow down for the end of a pruned plan.
-CLUTTER_ROBOT_PARAMS: dict[str, dict[str, Any]] = {
-    "jackal": {
-        "local_costmap.width": 8.0,
-        "local_costmap.height": 8.0,
-        "local_costmap.obstacle_range": 4.0,
-        "local_costmap.raytrace_range": 5.0,
-        "global_costmap.obstacle_range": 4.0,
-        "global_costmap.raytrace_range": 5.0,
-        "MPPIController.prune_distance": 6.0,
-    }
-}
 
 
 def run_clutter_world(
@@ -83,8 +69,7 @@ def run_clutter_world(
         path = world.write_world(Path(tmp) / f"{world.name}.world")
         gx, gy, gyaw = (float(v) for v in between2(world.start, world.goal))  # the goal in odom (= the start)
         sx, sy, syaw = (float(v) for v in world.start)
-        own = {**CLUTTER_PARAMS, **CLUTTER_ROBOT_PARAMS.get(robot, {})} if robot in CLUTTER_ROBOTS else {}
-        params = {**own, **(move_base_params or {})}
+        params = {**(CLUTTER_PARAMS if robot in CLUTTER_ROBOTS else {}), **(move_base_params or {})}
         r = run_navigation(
             [(gx, gy, gyaw)],
             world=str(path),
