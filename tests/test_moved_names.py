@@ -47,3 +47,40 @@ def test_drivers_moved_out_of_mapping(old: str, name: str, new: str) -> None:
     assert got is getattr(importlib.import_module(new), name)
     with pytest.raises(AttributeError, match="ClearanceLayer"):
         importlib.import_module("navlab.mapping.explore").ClearanceLayer  # noqa: B018 - gone, not moved
+
+
+def test_navlab_deprecations_are_errors_in_the_tests_and_others_are_not() -> None:
+    """pyproject's filterwarnings: a use of an old form in a test fails it (outside pytest.warns); a
+    third-party library's DeprecationWarning stays a warning."""
+    import warnings
+
+    from navlab.deprecation import NavlabDeprecationWarning
+
+    with pytest.raises(NavlabDeprecationWarning):
+        warnings.warn("old", NavlabDeprecationWarning, stacklevel=1)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.warn("a library's", DeprecationWarning, stacklevel=1)
+    assert [w.category for w in caught] == [DeprecationWarning]
+
+
+def test_every_navlab_deprecation_warning_has_navlabs_category() -> None:
+    """So the filter above catches them all: no plain DeprecationWarning is raised in src/navlab."""
+    import ast
+    from pathlib import Path
+
+    def category(call: ast.Call) -> ast.expr | None:
+        if not (isinstance(call.func, ast.Attribute) and call.func.attr == "warn"):  # warnings.warn(...)
+            return None
+        given = [k.value for k in call.keywords if k.arg == "category"] + call.args[1:2]
+        return given[0] if given else None
+
+    src = Path(__file__).resolve().parents[1] / "src" / "navlab"
+    calls = [
+        (f"{path.relative_to(src)}:{node.lineno}", category(node))
+        for path in src.rglob("*.py")
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8")))
+        if isinstance(node, ast.Call)
+    ]
+    plain = [where for where, cat in calls if isinstance(cat, ast.Name) and cat.id == "DeprecationWarning"]
+    assert plain == [], plain
+    assert sum(isinstance(c, ast.Name) and c.id == "NavlabDeprecationWarning" for _, c in calls) >= 9

@@ -123,6 +123,7 @@ def test_readme_teleop_drives_from_a_terminal(tmp_path: Path) -> None:
     """`navlab teleop` with no launch running starts the sim here; keys come from a terminal (a pty)."""
     import pty
     import signal
+    import threading
     import time
 
     master, slave = pty.openpty()
@@ -137,11 +138,24 @@ def test_readme_teleop_drives_from_a_terminal(tmp_path: Path) -> None:
         text=True,
     )
     os.close(slave)
-    time.sleep(3.0)
+    err_parts: list[str] = []
+    reader = threading.Thread(target=lambda: err_parts.extend(iter(lambda: proc.stderr.read(1), "")), daemon=True)
+    reader.start()
+
+    def wait_for(text: str, seconds: float) -> None:  # a loaded machine starts slowly: wait for what it shows
+        deadline = time.monotonic() + seconds
+        while text not in "".join(err_parts) and time.monotonic() < deadline and proc.poll() is None:
+            time.sleep(0.1)
+
+    wait_for("sending linear.x", 120.0)  # its status line: it reads keys now
     os.write(master, b"i")
+    wait_for("sending linear.x +0.50", 60.0)
     time.sleep(1.5)
     proc.send_signal(signal.SIGINT)  # Ctrl-C at the terminal
-    out, err = proc.communicate(timeout=60)
+    out = proc.stdout.read()
+    proc.wait(timeout=60)
+    reader.join(timeout=10)
+    err = "".join(err_parts)
     os.close(master)
     assert proc.returncode == 0, err
     assert "stopped at" in out and "Traceback" not in err

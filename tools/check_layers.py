@@ -17,6 +17,11 @@ Every import statement counts: module level, inside functions, under ``if TYPE_C
 (the lazy names of ``navlab/__init__.py``, the ``module:Class`` strings of the registries) are not
 imports. Nothing below imports cli or bench: they are each package's only outside faces.
 
+Each package's ``__init__`` is its only public entry: from outside a package, import what its ``__init__``
+exports (``from navlab.io import write_text_atomic``), not its modules (``from navlab.io.files import ...``,
+``from navlab.sim import decompose``). A lazy export (:func:`navlab.lazy.lazy_exports`) keeps such an import
+as cheap as the deep one. ``DEEP_ALLOWED`` lists the few deep imports that start-up time still needs.
+
 Usage: ``python tools/check_layers.py [SRC_NAVLAB_DIR]`` (default: ``src/navlab`` of this checkout).
 Prints each violation as ``file:line: a -> b (why)`` and exits 1 if there is any, 0 otherwise.
 """
@@ -55,6 +60,9 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("top", ("cli", "bench", "demo", "__main__")),
 )
 LAYER_OF: dict[str, int] = {pkg: i for i, (_, pkgs) in enumerate(LAYERS) for pkg in pkgs}
+# (importing module, imported module) -> why the import may reach past the package's __init__. Only for
+# laziness: where loading the package's __init__ would load what the importer must not (say why).
+DEEP_ALLOWED: dict[tuple[str, str], str] = {}
 TOP = len(LAYERS) - 1
 ROOT = "navlab"
 
@@ -102,31 +110,87 @@ def _exists(src: Path, parts: tuple[str, ...]) -> bool:
     return base.is_dir() or base.with_suffix(".py").is_file()
 
 
+def from_base(node: ast.ImportFrom, parts: tuple[str, ...], is_package: bool) -> tuple[str, ...] | None:
+    """The module under navlab (as parts) that ``from X import ...`` names as X; None when X is not navlab's."""
+    if node.level:  # relative: resolve against this module's package
+        package = list(parts if is_package else parts[:-1])
+        if node.level - 1 > len(package):
+            return None
+        return (*package[: len(package) - (node.level - 1)], *(node.module.split(".") if node.module else []))
+    dotted = node.module.split(".") if node.module else []
+    return tuple(dotted[1:]) if dotted and dotted[0] == ROOT else None
+
+
 def imported_targets(node: ast.Import | ast.ImportFrom, parts: tuple[str, ...], is_package: bool,
                      src: Path) -> list[tuple[str, ...]]:
     """Module paths under navlab (as parts) that one import statement loads; others are dropped."""
     if isinstance(node, ast.Import):
         names = [alias.name.split(".") for alias in node.names]
         return [tuple(n[1:]) for n in names if n[0] == ROOT]
-    if node.level:  # relative: resolve against this module's package
-        package = list(parts if is_package else parts[:-1])
-        if node.level - 1 > len(package):
-            return []
-        base = package[: len(package) - (node.level - 1)]
-        base += node.module.split(".") if node.module else []
-    else:
-        if not node.module:
-            return []
-        dotted = node.module.split(".")
-        if dotted[0] != ROOT:
-            return []
-        base = dotted[1:]
+    base = from_base(node, parts, is_package)
+    if base is None:
+        return []
     targets = []
     for alias in node.names:
         candidate = (*base, alias.name)
         # ``from navlab import msgs`` loads the module navlab.msgs; ``from navlab.core import Node`` a name
         targets.append(candidate if alias.name != "*" and _exists(src, candidate) else tuple(base))
     return targets
+
+
+def public_names(src: Path, package: str) -> set[str]:
+    """Names a package's ``__init__`` offers: what it binds (imports, also under ``if TYPE_CHECKING``, defs,
+    assignments) and the strings of its ``__all__``."""
+    tree = ast.parse((src / package / "__init__.py").read_text(encoding="utf-8"))
+    names: set[str] = set()
+    body = list(tree.body)
+    while body:
+        node = body.pop()
+        if isinstance(node, ast.If):
+            body.extend(node.body + node.orelse)
+        elif isinstance(node, ast.Import | ast.ImportFrom):
+            names.update((a.asname or a.name).split(".")[0] for a in node.names)
+        elif isinstance(node, ast.FunctionDef | ast.ClassDef):
+            names.add(node.name)
+        elif isinstance(node, ast.Assign | ast.AnnAssign):
+            targets = node.targets if isinstance(node, ast.Assign) else [node.target]
+            names.update(n.id for target in targets for n in ast.walk(target) if isinstance(n, ast.Name))
+            if any(isinstance(n, ast.Name) and n.id == "__all__" for n in targets) and node.value is not None:
+                names.update(c.value for c in ast.walk(node.value) if isinstance(c, ast.Constant))
+    return names
+
+
+def deep_imports(src: Path) -> list[str]:
+    """``file:line: a -> b (deep: ...)`` for each import of a module inside another package (past its
+    ``__init__``), but those in ``DEEP_ALLOWED``. navlab/__init__.py, the facade over every package, is exempt."""
+    out = []
+    exported: dict[str, set[str]] = {}
+    for path in sorted(src.rglob("*.py")):
+        parts = module_parts(path, src)
+        if not parts:
+            continue
+        source = ".".join(parts)
+        tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
+        for node in ast.walk(tree):
+            if not isinstance(node, ast.Import | ast.ImportFrom):
+                continue
+            is_package = path.name == "__init__.py"
+            base = from_base(node, parts, is_package) if isinstance(node, ast.ImportFrom) else None
+            for target in imported_targets(node, parts, is_package, src):
+                package = target[0] if target else ""
+                if len(target) < 2 or package == parts[0] or not (src / package / "__init__.py").is_file():
+                    continue
+                if base == (package,):  # ``from navlab.world import occupancy``: a name the package may export
+                    if package not in exported:
+                        exported[package] = public_names(src, package)
+                    if target[1] in exported[package]:
+                        continue
+                dotted = ".".join(target)
+                if (source, dotted) in DEEP_ALLOWED:
+                    continue
+                out.append(f"{_shown(path)}:{node.lineno}: {source} -> {dotted} (deep: import it from "
+                           f"navlab.{package}, which exports it in {package}/__init__.py)")
+    return sorted(set(out))
 
 
 def collect_edges(src: Path) -> list[Edge]:
@@ -196,7 +260,7 @@ def violations(src: Path) -> list[str]:
         elif a in component and component[a] == component.get(b):
             cycle = ", ".join(sorted(n for n, c in component.items() if c == component[a]))
             report(edge, f"circle: import cycle among {cycle}")
-    return [f"{path}:{line}: {text}" for path, line, text in sorted(set(out))]
+    return [f"{path}:{line}: {text}" for path, line, text in sorted(set(out))] + deep_imports(src)
 
 
 def _components(graph: dict[str, set[str]]) -> dict[str, int]:

@@ -8,9 +8,8 @@ from tempfile import mkdtemp
 
 import navlab
 from navlab import msgs
-from navlab.core import Node
-from navlab.core.record import Recorder
-from navlab.io.rosbag import read_bag
+from navlab.core import Node, Recorder
+from navlab.io import read_bag
 
 
 class Counter(Node):

@@ -20,10 +20,9 @@ from pathlib import Path
 import numpy as np
 
 from navlab.errors import NavlabError
-from navlab.experiments.metrics import read_relations, relations_error
-from navlab.io.carmen import read_carmen
-from navlab.io.datasets import dataset
-from navlab.mapping.slam import run_offline, write_outputs
+from navlab.experiments import read_relations, relations_error
+from navlab.io import dataset, read_carmen
+from navlab.mapping import run_offline, write_outputs
 
 try:
     DATA = dataset("mit-csail")  # under NAVLAB_DATA (default: ../shared/datasets beside the repository)

@@ -19,7 +19,7 @@ import numpy as np
 
 import navlab
 from navlab import msgs
-from navlab.core import Executor, Node
+from navlab.core import Node
 from navlab.sim import primitive_model
 
 parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -35,8 +35,8 @@ LATE_OBSTACLE = primitive_model("cylinder", "late_obstacle", (0.2, 0.6), x=-1.5,
 class SquareDriver(Node):
     """Open-loop teleop: forward SIDE metres, turn 90 degrees left, four times (10 Hz cmd_vel)."""
 
-    def __init__(self, executor: Executor) -> None:
-        super().__init__(executor, name="square_driver")
+    def __init__(self) -> None:
+        super().__init__("square_driver")  # rclpy's constructor: joins the run navlab.init() started
         self.cmd = self.create_publisher(msgs.Twist, "cmd_vel", 10)
         leg, turn = SIDE / SPEED, (math.pi / 2) / TURN_RATE
         self.plan = [(leg, SPEED, 0.0), (turn, 0.0, TURN_RATE)] * 4  # (seconds, v, w)
@@ -53,8 +53,8 @@ class SquareDriver(Node):
 class Recorder(Node):
     """Keeps the ground-truth and odometry paths and the last scan."""
 
-    def __init__(self, executor: Executor) -> None:
-        super().__init__(executor, name="recorder")
+    def __init__(self) -> None:
+        super().__init__("recorder")
         self.truth, self.odom, self.scan = [], [], None
         self.create_subscription(msgs.Odometry, "/ground_truth/odom", self.on_truth)
         self.create_subscription(msgs.Odometry, "odom", self.on_odom)
@@ -71,12 +71,12 @@ class Recorder(Node):
 
 
 start = (-0.4, -0.4, 0.0)
-# the shipped sim launch (like `ros2 launch ... sim.launch.yaml world:=room_obstacles x:=-0.4 y:=-0.4`)
-session = navlab.launch("sim", world="room_obstacles", robot="mybot", x=start[0], y=start[1], seed=args.seed)
-ex = session.executor
-gazebo = session.node("gazebo")
-SquareDriver(ex)
-rec = Recorder(ex)
+# rclpy.init() with the shipped sim launch (like `ros2 launch ... sim.launch.yaml world:=room_obstacles x:=-0.4 ...`)
+ctx = navlab.init(launch="sim", world="room_obstacles", robot="mybot", x=start[0], y=start[1], seed=args.seed)
+ex = ctx.executor
+gazebo = ctx.session.node("gazebo")
+SquareDriver()
+rec = Recorder()
 
 ex.run(7.0)
 gazebo.spawn(LATE_OBSTACLE)  # the paper adds obstacles after the map is made
@@ -107,8 +107,7 @@ fig.savefig(args.out, dpi=120)
 print(f"wrote {args.out}")
 
 if args.render:
-    from navlab.sim.render import render_image, save_png
-    from navlab.sim.simulation import Simulation
+    from navlab.sim import Simulation, render_image, save_png
 
     view = Simulation(gazebo.sim.robot, gazebo.sim.world, robot_pose=(x, y, yaw), visuals=True)
     view.spawn(LATE_OBSTACLE)

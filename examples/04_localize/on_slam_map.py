@@ -11,9 +11,8 @@ import json
 from pathlib import Path
 
 from navlab.drivers import RouteFollower
-from navlab.experiments.localize_run import DEFAULT_ROUTE, plot_result, run_localization
-from navlab.experiments.session import start_run
-from navlab.mapping.mapfile import save_map
+from navlab.experiments import DEFAULT_ROUTE, plot_result, run_localization, start_run
+from navlab.mapping import save_map
 
 OUT = Path("out/examples/04_localize")
 

@@ -16,9 +16,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
-from navlab.experiments.localize_run import plot_result, run_localization
-from navlab.localization import Amcl, AmclParams
-from navlab.localization.synthetic import room_field, simulated_scan
+from navlab.experiments import plot_result, run_localization
+from navlab.localization import Amcl, AmclParams, room_field, simulated_scan
 
 OUT = Path("out/examples/04_localize")
 OUT.mkdir(parents=True, exist_ok=True)

@@ -12,13 +12,12 @@ import tempfile
 from pathlib import Path
 
 import navlab
-from navlab.experiments.truth import true_map
 from navlab.mapping import save_map
-from navlab.sim import load_world_named
+from navlab.world import load_world, true_map
 
 # 1. a map of the empty room (what the mapping step of example 05 saves; here the world's true one)
 map_yaml = Path(tempfile.mkdtemp()) / "room.yaml"
-save_map(true_map(load_world_named("room"), (0.0, 0.0)), map_yaml)
+save_map(true_map(load_world("room"), (0.0, 0.0)), map_yaml)
 
 # 2. navigate in the room WITH obstacles on that map: they were added after mapping, as in the paper
 session = navlab.launch("navigation", world="room_obstacles", map=str(map_yaml), seed=0)

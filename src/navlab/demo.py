@@ -38,9 +38,7 @@ def run_demo(
     on_start: Any = None,
 ) -> dict[str, Any]:
     """Run the four steps, writing the report folder ``out``; returns the figures (also in report.json)."""
-    from navlab.experiments.localize_run import plot_result, run_localization
-    from navlab.experiments.mapping_run import run_mapping
-    from navlab.experiments.navigate_run import run_navigation, save_goal_pictures
+    from navlab.experiments import plot_result, run_localization, run_mapping, run_navigation, save_goal_pictures
     from navlab.sim import primitive_model
 
     out = Path(out)
@@ -88,8 +86,8 @@ def write_report(summary: dict[str, Any], out: Path) -> None:
     from them by ``navlab report``'s renderer."""
     import shutil
 
-    from navlab.experiments.report import render_report
-    from navlab.io.files import write_text_atomic
+    from navlab.experiments import render_report
+    from navlab.io import write_text_atomic
 
     if Path(summary["mapping"]["picture"]).is_file():
         shutil.copyfile(summary["mapping"]["picture"], out / "map.png")
@@ -104,8 +102,7 @@ DEMO_GOALS = [(4.3, 1.0, 0.0), (-3.5, -0.5, 3.14), (1.5, -2.5, 0.0)]
 def _render(path: Path) -> str:
     """Picture of the paper's robot among the obstacles; skipped (with the reason) without OpenGL."""
     from navlab.description import load_robot_named
-    from navlab.sim import Simulation
-    from navlab.sim.render import render_image, save_png
+    from navlab.sim import Simulation, render_image, save_png
     from navlab.world import load_world
 
     try:

@@ -33,6 +33,7 @@ from typing import TYPE_CHECKING, Any, Protocol, Self, runtime_checkable
 
 import numpy as np
 
+from navlab.deprecation import NavlabDeprecationWarning
 from navlab.errors import NavlabError, did_you_mean
 
 if TYPE_CHECKING:
@@ -122,7 +123,7 @@ class ControlResult:
             return out
         warnings.warn(
             "a controller returning (v, w) is deprecated: return navlab.plugins.ControlResult",
-            DeprecationWarning,
+            NavlabDeprecationWarning,
             stacklevel=3,
         )
         v, w = out
@@ -435,7 +436,7 @@ def __getattr__(name: str) -> Any:
     if name == "REGISTRY":  # the dict of navlab <= 0.x; one release of read-only compatibility
         warnings.warn(
             "navlab.plugins.REGISTRY is deprecated: plugins are entry points (plugin_names, load_plugin)",
-            DeprecationWarning,
+            NavlabDeprecationWarning,
             stacklevel=2,
         )
         return {kind: {n: ep.value for n, ep in _entry_points(group).items()} for kind, (group, _) in KINDS.items()}

@@ -8,12 +8,12 @@ import time
 import pytest
 
 from navlab import msgs
-from navlab.core import CoreError, Executor, Node
+from navlab.core import Context, CoreError, Executor, Node
 
 
 def test_timers_fire_at_simulated_rate():
     ex = Executor()
-    node = Node(ex, name="n")
+    node = Node("n", context=Context(ex))
     stamps: list[int] = []
     node.create_timer(0.025, lambda: stamps.append(ex.now_ns))  # 40 Hz
     ex.run(2.0)
@@ -24,7 +24,7 @@ def test_timers_fire_at_simulated_rate():
 
 def test_order_is_time_then_priority_then_sequence():
     ex = Executor()
-    node = Node(ex, name="n")
+    node = Node("n", context=Context(ex))
     order: list[str] = []
     node.create_timer(0.1, lambda: order.append("b0"), priority=0)
     node.create_timer(0.1, lambda: order.append("a-1"), priority=-1)
@@ -37,7 +37,7 @@ def test_order_is_time_then_priority_then_sequence():
 
 def test_messages_delivered_in_publish_order_before_time_advances():
     ex = Executor()
-    a, b = Node(ex, name="a"), Node(ex, name="b")
+    a, b = Node("a", context=Context(ex)), Node("b", context=Context(ex))
     pub = a.create_publisher(msgs.Float64, "x")
     seen: list[tuple[float, int]] = []
     b.create_subscription(msgs.Float64, "x", lambda m: seen.append((m.data, ex.now_ns)))
@@ -57,13 +57,13 @@ def _stream_hash(seed: int) -> str:
 
     class Noisy(Node):
         def __init__(self, ex: Executor, i: int) -> None:
-            super().__init__(ex, name=f"noisy{i}")
+            super().__init__(f"noisy{i}", context=Context(ex))
             self.pub = self.create_publisher(msgs.Float64, "noise")
             self.create_timer(0.01 * (i + 1), lambda: self.pub.publish(msgs.Float64(data=self.rng.normal())))
 
     for i in range(3):
         Noisy(ex, i)
-    sink = Node(ex, name="sink")
+    sink = Node("sink", context=Context(ex))
     sink.create_subscription(msgs.Float64, "noise", lambda m: h.update(f"{ex.now_ns}:{m.data!r}".encode()))
     ex.run(5.0)
     return h.hexdigest()
@@ -76,19 +76,19 @@ def test_same_seed_same_stream_different_seed_different_stream():
 
 def test_latched_topic_reaches_late_subscriber():
     ex = Executor()
-    pub = Node(ex, name="map_server").create_publisher(msgs.String, "map", latched=True)
+    pub = Node("map_server", context=Context(ex)).create_publisher(msgs.String, "map", latched=True)
     pub.publish(msgs.String(data="the map"))
     got: list[str] = []
-    Node(ex, name="late").create_subscription(msgs.String, "/map", lambda m: got.append(m.data))
+    Node("late", context=Context(ex)).create_subscription(msgs.String, "/map", lambda m: got.append(m.data))
     ex.run(0.1)
     assert got == ["the map"]
 
 
 def test_topic_type_conflict_is_refused():
     ex = Executor()
-    Node(ex, name="a").create_publisher(msgs.Float64, "x")
+    Node("a", context=Context(ex)).create_publisher(msgs.Float64, "x")
     with pytest.raises(CoreError, match="std_msgs/msg/Float64"):
-        Node(ex, name="b").create_subscription(msgs.String, "x", print)
+        Node("b", context=Context(ex)).create_subscription(msgs.String, "x", print)
 
 
 def test_unknown_message_type_is_refused_with_suggestion():
@@ -105,7 +105,7 @@ def test_steppers_advance_to_each_event_time():
             calls.append(t_ns)
 
     ex.add_stepper(Physics())
-    Node(ex, name="n").create_timer(0.25, lambda: None)
+    Node("n", context=Context(ex)).create_timer(0.25, lambda: None)
     ex.run(1.0)
     assert calls == [250_000_000, 500_000_000, 750_000_000, 1_000_000_000]
 
@@ -113,7 +113,7 @@ def test_steppers_advance_to_each_event_time():
 @pytest.mark.parametrize("rate", [2.0, 5.0])
 def test_pacing_keeps_asked_rate(rate: float):
     ex = Executor(rate=rate)
-    Node(ex, name="n").create_timer(0.01, lambda: None)
+    Node("n", context=Context(ex)).create_timer(0.01, lambda: None)
     t0 = time.perf_counter()
     ex.run(1.0)
     wall = time.perf_counter() - t0
@@ -122,7 +122,7 @@ def test_pacing_keeps_asked_rate(rate: float):
 
 def test_inbox_runs_inputs_from_other_threads():
     ex = Executor(rate=10.0)
-    node = Node(ex, name="n")
+    node = Node("n", context=Context(ex))
     pub = node.create_publisher(msgs.String, "cmd")
     got: list[str] = []
     node.create_subscription(msgs.String, "cmd", lambda m: got.append(m.data))
@@ -136,7 +136,7 @@ def test_inbox_runs_inputs_from_other_threads():
 
 def test_run_until_stops_when_condition_holds():
     ex = Executor()
-    node = Node(ex, name="n")
+    node = Node("n", context=Context(ex))
     count = [0]
     node.create_timer(0.1, lambda: count.__setitem__(0, count[0] + 1))
     assert ex.run_until(lambda: count[0] >= 5, timeout=10.0)
@@ -148,7 +148,7 @@ def test_stop_from_another_thread_ends_chunked_runs():
     from navlab.core.runner import run_for
 
     ex = Executor(rate=10.0)
-    Node(ex, name="n").create_timer(0.05, lambda: None)
+    Node("n", context=Context(ex)).create_timer(0.05, lambda: None)
     threading.Timer(0.05, lambda: ex.post(ex.stop)).start()
     run_for(ex, 100.0, quiet=True, chunk=0.2)  # 10 s of wall time if the stop were lost
     assert ex.stopped and ex.now_ns < 2_000_000_000
@@ -163,7 +163,7 @@ def test_idle_timer_firings_run_nothing_and_step_no_physics() -> None:
             steps.append(t_ns)
 
     ex.add_stepper(Stepper())
-    node = Node(ex, name="sensor")
+    node = Node("sensor", context=Context(ex))
     readers: list[int] = []
     fired: list[int] = []
     node.create_timer(0.01, lambda: fired.append(ex.now_ns), idle=lambda: not readers)

@@ -8,7 +8,7 @@ import yaml
 
 from navlab import msgs
 from navlab.cli import main
-from navlab.core import Executor, LaunchError, Node
+from navlab.core import Context, Executor, LaunchError, Node
 from navlab.core.launch import start
 from navlab.core.record import Recorder
 from navlab.io.rosbag import bag_graph, read_bag
@@ -63,7 +63,7 @@ def test_launch_errors(tmp_path):
 
 def test_recording_round_trip(tmp_path):
     ex = Executor(seed=3)
-    node = Node(ex, name="odom_pub")
+    node = Node("odom_pub", context=Context(ex))
     pub = node.create_publisher(msgs.Odometry, "odom")
     scan_pub = node.create_publisher(msgs.LaserScan, "scan")
     sent = []
@@ -114,10 +114,12 @@ def test_recording_round_trip(tmp_path):
 
 def test_recording_keeps_latched_messages_published_before_it_started(tmp_path):
     ex = Executor()
-    node = Node(ex, name="map_server")
+    node = Node("map_server", context=Context(ex))
     node.create_publisher(msgs.String, "map", latched=True).publish(msgs.String(data="the map"))
     node.send_static_transform(msgs.transform_stamped(0, "chassis", "laser", 0.1, 0.0, 0.0))
-    Node(ex, name="robot_state_publisher").send_static_transform(msgs.transform_stamped(0, "chassis", "imu", 0, 0, 0))
+    Node("robot_state_publisher", context=Context(ex)).send_static_transform(
+        msgs.transform_stamped(0, "chassis", "imu", 0, 0, 0)
+    )
     with Recorder(ex, tmp_path / "bag"):
         ex.run(0.5)
     got = list(read_bag(tmp_path / "bag"))

@@ -10,6 +10,7 @@ from importlib.metadata import version
 import pytest
 
 import navlab
+from navlab.core import Context
 
 
 def test_import_navlab_is_light():
@@ -38,7 +39,7 @@ def test_user_node_on_a_launch():
 
     class Watch(navlab.Node):
         def __init__(self, executor: navlab.Executor) -> None:
-            super().__init__(executor, name="watch")
+            super().__init__("watch", context=Context(executor))
             self.create_subscription(navlab.msgs.Odometry, "/ground_truth/odom", heard.append, 10)
             pub = self.create_publisher(navlab.msgs.Twist, "/cmd_vel", 1)
             self.create_timer(0.1, lambda: pub.publish(navlab.msgs.twist(0.3, 0.0)))

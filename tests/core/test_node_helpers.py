@@ -11,7 +11,7 @@ from dataclasses import dataclass
 import pytest
 
 from navlab import msgs
-from navlab.core import CoreError, Executor, Node, ParameterError, TfError, dataclass_parameters
+from navlab.core import Context, CoreError, Executor, Node, ParameterError, TfError, dataclass_parameters
 from navlab.nodes import NODES
 
 
@@ -42,7 +42,7 @@ def test_every_node_class_takes_executor_then_name_parameters_namespace(cls: typ
 
 def test_pose_at_a_stamp_interpolates_and_falls_back_on_the_latest() -> None:
     ex = Executor()
-    node = Node(ex, name="n")
+    node = Node("n", context=Context(ex))
     node.send_transform(msgs.transform_stamped(1_000_000_000, "odom", "base_link", 1.0, 0.0, 0.0))
     node.send_transform(msgs.transform_stamped(2_000_000_000, "odom", "base_link", 2.0, 0.0, 0.2))
     x, y, yaw = node.pose_at("odom", "base_link", 1_500_000_000)
@@ -56,7 +56,7 @@ def test_pose_at_a_stamp_interpolates_and_falls_back_on_the_latest() -> None:
 
 def test_sensor_pose_is_looked_up_once() -> None:
     ex = Executor()
-    node = Node(ex, name="n")
+    node = Node("n", context=Context(ex))
     with pytest.raises(TfError):
         node.sensor_pose("base_link", "laser")
     node.send_static_transform(msgs.transform_stamped(0, "base_link", "laser", 0.1, 0.0, math.pi / 2))
@@ -79,11 +79,11 @@ def test_parameters_declared_from_a_dataclass_with_aliases() -> None:
         "pf.laser_model_type": "likelihood_field",
     }
     ex = Executor()
-    node = Node(ex, name="amcl", parameters={"pf_err": 0.05, "min_particles": 7})
+    node = Node("amcl", context=Context(ex), parameter_overrides={"pf_err": 0.05, "min_particles": 7})
     values = node.declare_parameters(dataclass_parameters(_FilterParams), aliases={"kld_err": ("pf_err",)})
-    assert _FilterParams(**values) == _FilterParams(min_particles=7, kld_err=0.05)
+    assert _FilterParams(**{k: p.value for k, p in values.items()}) == _FilterParams(min_particles=7, kld_err=0.05)
     with pytest.raises(ParameterError, match="min_particles"):
-        Node(ex, name="bad", parameters={"min_particles": "many"}).declare_parameters(
+        Node("bad", context=Context(ex), parameter_overrides={"min_particles": "many"}).declare_parameters(
             dataclass_parameters(_FilterParams)
         )
     with pytest.raises(ParameterError, match="not a dataclass"):
@@ -94,11 +94,11 @@ def test_executor_public_node_api() -> None:
     ex = Executor()
     with ex.node_context(remappings={"scan": "/mybot/laser/scan"}):
         assert ex.construction_remappings() == {"scan": "/mybot/laser/scan"}
-        node = Node(ex, name="amcl")
+        node = Node("amcl", context=Context(ex))
     assert ex.construction_remappings() == {}
     assert node.resolve_topic_name("scan") == "/mybot/laser/scan" and ex.nodes["/amcl"] is node
     with pytest.raises(CoreError, match="already exists"):
-        Node(ex, name="amcl")
+        Node("amcl", context=Context(ex))
     assert not ex.has_listeners
 
     def listener(topic: str, msg: object, t: int) -> None:

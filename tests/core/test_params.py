@@ -4,7 +4,7 @@ import re
 
 import pytest
 
-from navlab.core import Executor, Node, ParameterError, load_params, read_params
+from navlab.core import Context, Executor, Node, ParameterError, load_params, read_params
 
 ROS1 = """\
 controller_frequency: 5.0
@@ -30,12 +30,12 @@ controller_server:
 
 class Planner(Node):
     def __init__(self, ex: Executor, **kw):
-        super().__init__(ex, name="move_base", **kw)
-        self.freq = self.declare_parameter("controller_frequency", 20.0)
-        self.max_vel = self.declare_parameter("TrajectoryPlannerROS/max_vel_x", 0.5)
-        self.min_vel = self.declare_parameter("TrajectoryPlannerROS.min_vel_x", 0.1)
-        self.upd = self.declare_parameter("global_costmap/update_frequency", 5.0)
-        self.infl = self.declare_parameter("global_costmap/inflation_radius", 0.55)
+        super().__init__("move_base", context=Context(ex), **kw)
+        self.freq = self.declare_parameter("controller_frequency", 20.0).value
+        self.max_vel = self.declare_parameter("TrajectoryPlannerROS/max_vel_x", 0.5).value
+        self.min_vel = self.declare_parameter("TrajectoryPlannerROS.min_vel_x", 0.1).value
+        self.upd = self.declare_parameter("global_costmap/update_frequency", 5.0).value
+        self.infl = self.declare_parameter("global_costmap/inflation_radius", 0.55).value
 
 
 def test_ros1_layout(tmp_path):

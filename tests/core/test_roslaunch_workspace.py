@@ -13,7 +13,7 @@ import pytest
 
 from navlab import msgs
 from navlab.cli import main
-from navlab.core import Node
+from navlab.core import Context, Node
 from navlab.core.launch import Session, start
 
 WS = Path(__file__).parents[1] / "fixtures" / "ros_ws"
@@ -63,7 +63,7 @@ def test_world_launch_spawns_the_xacro_robot_where_spawn_model_says() -> None:
 
 
 def _drive(session: Session, v: float, w: float) -> None:
-    node = Node(session.executor, name="teleop")
+    node = Node("teleop", context=Context(session.executor))
     pub = node.create_publisher(msgs.Twist, "/cmd_vel", 1)
     node.create_timer(0.1, lambda: pub.publish(msgs.twist(v, w)))
 
@@ -73,7 +73,7 @@ def test_my_slam_maps_the_room() -> None:
     slam = session.node("my_slam_gmapping")
     assert slam.params.particles == 10 and slam.base_frame == "base_footprint"  # from the package's files
     maps: list[object] = []
-    probe = Node(session.executor, name="probe")
+    probe = Node("probe", context=Context(session.executor))
     probe.create_subscription(msgs.OccupancyGrid, "/map", maps.append, 1)
     _drive(session, 0.0, 0.6)  # turn on the spot: the lidar sweeps the room
     session.run(8.0)
@@ -104,7 +104,7 @@ def test_my_navigation_reaches_a_goal_with_the_models_costmap_files(tmp_path: Pa
         assert costmap.layered.footprint.polygon.max() == pytest.approx(0.2 + 0.01)  # + footprint_padding
     assert any("rviz" in n for n in session.notes)
     goal = (1.2, -0.6)
-    node = Node(session.executor, name="rviz_goal")
+    node = Node("rviz_goal", context=Context(session.executor))
     pub = node.create_publisher(msgs.PoseStamped, "/move_base_simple/goal", 1)
     session.run(0.5)
     pub.publish(

@@ -11,7 +11,7 @@ from scipy import ndimage
 
 from navlab import msgs
 from navlab.cli import main
-from navlab.core import LaunchError, Node, load_params
+from navlab.core import Context, LaunchError, Node, load_params
 from navlab.core.launch import resources_dir, start
 from navlab.drivers import RouteFollower
 from navlab.mapping import GridMap, save_map
@@ -23,7 +23,7 @@ class _Recorder(Node):
     """Keeps the latest map, every amcl_pose and the latest true pose."""
 
     def __init__(self, executor) -> None:
-        super().__init__(executor, name="test_recorder")
+        super().__init__("test_recorder", context=Context(executor))
         self.maps: list = []
         self.amcl: list = []
         self.truth: tuple[float, float, float] | None = None

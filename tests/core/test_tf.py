@@ -5,7 +5,7 @@ import math
 import pytest
 
 from navlab import msgs
-from navlab.core import Executor, Node, TfBuffer, TfError
+from navlab.core import Context, Executor, Node, TfBuffer, TfError
 
 
 def _buf() -> TfBuffer:
@@ -59,7 +59,7 @@ def test_disconnected_frames():
 
 def test_executor_feeds_tf_from_topics():
     ex = Executor()
-    node = Node(ex, name="pub")
+    node = Node("pub", context=Context(ex))
     node.send_static_transform(msgs.transform_stamped(0, "chassis", "laser", 0.0, 0.0, 0.0, 0.06))
     node.create_timer(
         0.1,

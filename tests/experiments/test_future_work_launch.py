@@ -11,7 +11,7 @@ import pytest
 
 from navlab import msgs
 from navlab.cli import main
-from navlab.core import Node
+from navlab.core import Context, Node
 from navlab.core.launch import start
 from navlab.errors import NavlabError
 from navlab.experiments.navigate_run import sim_launch_args
@@ -24,7 +24,7 @@ class _Watch(Node):
     """Drives in a curve and keeps every tf odom -> chassis and every /odometry/filtered and /odom message."""
 
     def __init__(self, executor: Any) -> None:
-        super().__init__(executor, name="test_watch")
+        super().__init__("test_watch", context=Context(executor))
         self.odom_tf: list[tuple[int, float, float]] = []  # (stamp ns, x, y)
         self.filtered: dict[int, tuple[float, float]] = {}
         self.odom = 0

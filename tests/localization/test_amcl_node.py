@@ -10,7 +10,7 @@ import pytest
 from amcl_synth import odometry, room_field, route, scan_at
 
 from navlab import msgs
-from navlab.core import Executor, Node, ParameterError
+from navlab.core import Context, Executor, Node, ParameterError
 from navlab.grid import GridMap
 from navlab.localization import LocalizationError
 from navlab.localization.amcl_node import Amcl
@@ -22,7 +22,7 @@ class FakeRobot(Node):
     """Drives the synthetic route at 10 Hz: publishes tf odom→base_link, base_link→laser and scans."""
 
     def __init__(self, executor: Executor, *, name: str = "fake_robot", truth: list, odo: list) -> None:
-        super().__init__(executor, name=name)
+        super().__init__(name, context=Context(executor))
         self.truth, self.odo, self.k = truth, odo, 0
         self.field = room_field()
         self.scan_rng = np.random.default_rng(0)
@@ -66,7 +66,7 @@ def _setup(params: dict[str, Any], n: int = 300, seed: int = 0) -> tuple[Executo
     got: dict[str, list] = {"pose": [], "tf": []}
     amcl = Amcl(ex, parameters=params)
     robot = FakeRobot(ex, truth=truth, odo=odo)
-    probe = Node(ex, name="probe")
+    probe = Node("probe", context=Context(ex))
     probe.create_subscription(msgs.PoseWithCovarianceStamped, "amcl_pose", got["pose"].append)
     probe.create_subscription(
         msgs.TFMessage, "/tf", lambda m: got["tf"].extend(t for t in m.transforms if t.child_frame_id == "odom")
@@ -149,7 +149,7 @@ def test_bad_initial_pose_is_refused_and_all_inf_scans_do_not_update() -> None:
 def test_map_without_free_cells_is_refused_and_unknown_parameters_are_named() -> None:
     ex = Executor(seed=0)
     amcl = Amcl(ex)
-    probe = Node(ex, name="probe")
+    probe = Node("probe", context=Context(ex))
     probe.create_publisher(msgs.OccupancyGrid, "map", latched=True).publish(
         _map_msg(np.full((50, 50), 100, dtype=np.int8))
     )
@@ -180,7 +180,7 @@ def test_malformed_map_is_refused_in_one_line_naming_the_topic(mangle, words, ca
     keeps waiting for a map, and takes the next good one."""
     ex = Executor(seed=0)
     amcl = Amcl(ex)
-    pub = Node(ex, name="probe").create_publisher(msgs.OccupancyGrid, "map", latched=True)
+    pub = Node("probe", context=Context(ex)).create_publisher(msgs.OccupancyGrid, "map", latched=True)
     bad = _map_msg()
     mangle(bad)
     pub.publish(bad)

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from navlab import msgs
-from navlab.core import Executor, Node, load_params
+from navlab.core import Context, Executor, Node, load_params
 from navlab.geometry import wrap_angle
 from navlab.localization import ekf
 from navlab.localization.ekf_node import EkfNode
@@ -112,7 +112,7 @@ def test_bad_parameters_get_clear_errors(params: dict, message: str) -> None:
 def test_imu_without_a_frame_is_reported_and_ignored() -> None:
     ex = Executor(seed=0)
     node = EkfNode(ex, parameters={"imu0": "imu", "imu0_config": list(_mask("vyaw")), "base_link_frame": "chassis"})
-    pub = Node(ex, name="probe").create_publisher(msgs.Imu, "imu")
+    pub = Node("probe", context=Context(ex)).create_publisher(msgs.Imu, "imu")
     for frame in ("", "imu_link"):
         node.last_error = None
         pub.publish(
@@ -149,7 +149,7 @@ def test_slip_patch_heading_drift_smaller_with_imu_fusion_than_wheel_odometry() 
         disturbances={"slip_patches": [{"x": 0.0, "y": 0.0, "radius": 1.0, "mu": 0.03}]},
     )
     node = EkfNode(ex, parameters=load_params(PARAMS / "ekf.yaml"))
-    probe = Node(ex, name="probe")
+    probe = Node("probe", context=Context(ex))
     got: dict = {"odom": [], "odometry/filtered": [], "/ground_truth/odom": []}
     for topic, store in got.items():
         probe.create_subscription(msgs.Odometry, topic, store.append)

@@ -12,7 +12,7 @@ import pytest
 
 from navlab import msgs
 from navlab.cli import main
-from navlab.core import Executor, Node
+from navlab.core import Context, Executor, Node
 from navlab.localization.amcl_node import Amcl
 from navlab.mapping.slam_node import SlamGMapping
 
@@ -22,7 +22,7 @@ EMPTY_WORLD = """<?xml version="1.0"?>
 
 
 def _scans(ex: Executor, ranges: np.ndarray, seconds: float) -> None:
-    pub = Node(ex, name="fake_laser").create_publisher(msgs.LaserScan, "scan", 5)
+    pub = Node("fake_laser", context=Context(ex)).create_publisher(msgs.LaserScan, "scan", 5)
 
     def send() -> None:
         pub.publish(
@@ -40,7 +40,7 @@ def _scans(ex: Executor, ranges: np.ndarray, seconds: float) -> None:
             )
         )
 
-    Node(ex, name="laser_timer").create_timer(0.1, send)
+    Node("laser_timer", context=Context(ex)).create_timer(0.1, send)
     ex.run(seconds)
 
 

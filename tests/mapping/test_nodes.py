@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from navlab import msgs
-from navlab.core import Executor, Node
+from navlab.core import Context, Executor, Node
 from navlab.geometry import compose2, inverse2
 from navlab.mapping import GridMap, MappingError, save_map
 from navlab.mapping.map_server import MapServer
@@ -17,7 +17,7 @@ from navlab.mapping.slam_node import SlamGMapping
 
 class _Listener(Node):
     def __init__(self, executor: Executor) -> None:
-        super().__init__(executor, name="listener")
+        super().__init__("listener", context=Context(executor))
         self.maps: list = []
         self.paths: list = []
         self.create_subscription(msgs.OccupancyGrid, "/map", self.maps.append, 1)
@@ -30,7 +30,7 @@ class _FakeRobot(Node):
     LASER = (0.1, 0.0, 0.0)  # laser 10 cm ahead of base_link
 
     def __init__(self, executor: Executor, world, gt: np.ndarray, odo: np.ndarray, rng) -> None:
-        super().__init__(executor, name="fake_robot")
+        super().__init__("fake_robot", context=Context(executor))
         self.world, self.gt, self.odo, self.rng = world, gt, odo, rng
         self.k = 0
         self.scan_pub = self.create_publisher(msgs.LaserScan, "/mybot/laser/scan", 10)

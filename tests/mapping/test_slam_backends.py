@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from navlab import msgs, plugins
-from navlab.core import Executor, Node
+from navlab.core import Context, Executor, Node
 from navlab.geometry import compose2
 from navlab.grid import GridMap
 from navlab.mapping import MappingError
@@ -115,7 +115,7 @@ def test_a_new_mode_is_one_class_and_one_entry_point(install_plugin_package) -> 
     ex = Executor(seed=0)
     slam = SlamGMapping(ex, parameters={"mode": "dead_reckoning", "delta": 0.2, "map_update_interval": 0.0})
     assert slam.params == {"delta": 0.2}
-    robot = Node(ex, name="robot")
+    robot = Node("robot", context=Context(ex))
     scans = robot.create_publisher(msgs.LaserScan, "scan")
     robot.send_static_transform(msgs.transform_stamped(0, "base_link", "laser", 0.1, 0.0, 0.0))
     maps: list = []

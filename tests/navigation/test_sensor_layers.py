@@ -7,6 +7,7 @@ import math
 import numpy as np
 import pytest
 
+from navlab.core import Context
 from navlab.grid import COST_FREE, COST_LETHAL, COST_UNKNOWN, Grid
 from navlab.navigation.costmap.layered import LayeredCostmap
 from navlab.navigation.costmap.params import ObservationSource
@@ -84,6 +85,38 @@ def test_voxel_layer_from_costmap_params_and_into_the_master() -> None:
     assert _cell(grid, 1.0, 1.0) == COST_LETHAL and 0 < _cell(grid, 1.25, 1.0) < COST_LETHAL  # inflated around it
     with pytest.raises(NavigationError, match=r"z_voxels: expected <= 16, got 20"):
         LayeredCostmap({**params, "obstacle_layer": {**params["obstacle_layer"], "z_voxels": 20}})
+
+
+def test_voxel_layer_keeps_its_voxels_in_place_when_the_window_rolls_and_takes_no_2d_scans() -> None:
+    params = {
+        "global_frame": "odom",
+        "static_map": False,
+        "rolling_window": True,
+        "width": 4.0,
+        "height": 4.0,
+        "resolution": 0.1,
+        "robot_radius": 0.2,
+        "plugins": [
+            {"name": "obstacle_layer", "type": "costmap_2d::ObstacleLayer"},
+            {"name": "voxel_layer", "type": "costmap_2d::VoxelLayer"},
+        ],
+        "voxel_layer": {"z_voxels": 10, "z_resolution": 0.1, "cam": {"data_type": "PointCloud2", "clearing": True}},
+        "voxel_layer.observation_sources": "cam",
+    }
+    layered = LayeredCostmap(params)
+    voxel = layered.layer("voxel_layer")
+    assert isinstance(voxel, VoxelLayer) and [x.name for x in layered.scan_layers] == ["obstacle_layer"]
+    layered.update_map((0.0, 0.0, 0.0))
+    voxel.add_cloud((0.0, 0.0, 0.3), np.array([[1.05, 0.55, 0.25]]), source="cam")
+    layered.add_scan((0.0, 0.0), np.array([[-1.05, -0.55]]))  # 2-D scans: the obstacle layer only
+    grid = layered.update_map((0.0, 0.0, 0.0))
+    assert _cell(grid, 1.05, 0.55) == COST_LETHAL and _cell(grid, -1.05, -0.55) == COST_LETHAL
+    assert _cell(voxel.grid, -1.05, -0.55) != COST_LETHAL
+    grid = layered.update_map((0.73, 0.41, 0.0))  # the window moves by whole cells; what it still covers stays
+    assert grid.origin[:2] == pytest.approx((-1.3, -1.6))
+    assert _cell(grid, 1.05, 0.55) == COST_LETHAL and _cell(grid, -1.05, -0.55) == COST_LETHAL
+    marked = voxel.marked_voxels()
+    assert marked.shape == (1, 3) and marked[0] == pytest.approx((1.05, 0.55, 0.25))
 
 
 def test_range_sensor_layer_marks_the_reading_and_clears_short_of_it() -> None:
@@ -178,7 +211,7 @@ def test_pointcloud_to_laserscan_node_publishes_a_scan_in_the_target_frame() -> 
 
     class Probe(Node):
         def __init__(self, ex: Executor) -> None:
-            super().__init__(ex, name="probe")
+            super().__init__("probe", context=Context(ex))
             self.scans: list = []
             self.pub = self.create_publisher(msgs.PointCloud2, "cloud_in", 1)
             self.create_subscription(msgs.LaserScan, "scan", self.scans.append, 1)

@@ -7,7 +7,7 @@ import pytest
 from sim_helpers import make_mybot, make_room
 
 from navlab import msgs
-from navlab.core import Executor, Node
+from navlab.core import Context, Executor, Node
 from navlab.description import ImuConfig, load_robot_named
 from navlab.sim import SimError, launch_sim
 from navlab.sim.imu import AxisNoise, ImuNoise, noise_from_description
@@ -48,7 +48,7 @@ def test_plugin_publishes_noisy_imu_in_its_frame_with_covariances() -> None:
     ex = Executor(seed=0)
     gazebo = launch_sim(ex, world=make_room(), robot=robot, seed=3)
     got: list = []
-    Node(ex, name="probe").create_subscription(msgs.Imu, "imu", got.append)
+    Node("probe", context=Context(ex)).create_subscription(msgs.Imu, "imu", got.append)
     ex.run(21.0)  # the last 10,000 samples at 500 Hz, at rest (the first second: the robot settles on the floor)
     assert len(got) == pytest.approx(10_500, abs=1)
     got = got[-10_000:]

@@ -8,7 +8,7 @@ from typing import Any
 import pytest
 
 from navlab import msgs
-from navlab.core import Node
+from navlab.core import Context, Node
 from navlab.core.launch import start
 
 
@@ -25,7 +25,7 @@ def test_sensor_publishes_for_subscribers_and_listeners_only(
     s.run(0.5)
     assert topic.count == 0  # nobody reads it: no message built
     seen: list[Any] = []
-    node = Node(ex, name="reader")
+    node = Node("reader", context=Context(ex))
     node.create_subscription(msgtype, name, seen.append, 10)
     s.run(0.5)
     assert len(seen) == per_half_s and seen[-1].header.frame_id == frame  # at its rate once subscribed

@@ -9,7 +9,7 @@ import pytest
 from sim_helpers import make_mybot, make_room
 
 from navlab import msgs
-from navlab.core import Executor, Node
+from navlab.core import Context, Executor, Node
 from navlab.geometry import wrap_angle
 from navlab.sim import launch_sim
 from navlab.world import WorldModel
@@ -19,7 +19,7 @@ class Probe(Node):
     """Publishes a constant cmd_vel at 10 Hz (until ``stop_at`` s) and keeps what the plugins publish."""
 
     def __init__(self, ex: Executor, v: float, w: float, stop_at: float = math.inf) -> None:
-        super().__init__(ex, name="probe")
+        super().__init__("probe", context=Context(ex))
         self.v, self.w, self.stop_at = v, w, stop_at
         self.cmd = self.create_publisher(msgs.Twist, "cmd_vel", 10)
         self.scans: list = []

@@ -9,7 +9,7 @@ import pytest
 from sim_helpers import make_mybot, make_room
 
 from navlab import msgs
-from navlab.core import Executor, Node
+from navlab.core import Context, Executor, Node
 from navlab.description import ImuConfig, Joint, Link, Origin
 from navlab.sim import Simulation, launch_sim
 from navlab.sim.diffdrive import EncoderOdometry, ramp, wheel_speeds
@@ -32,7 +32,7 @@ def test_massless_root_imu_and_world_odometry() -> None:
     sim = gazebo.sim
     assert sim.link_pose("base_footprint").position[2] == pytest.approx(0.0, abs=0.005)  # on the floor
     imu, odom = [], []
-    probe = Node(ex, name="probe")
+    probe = Node("probe", context=Context(ex))
     probe.create_subscription(msgs.Imu, "imu", imu.append)
     probe.create_subscription(msgs.Odometry, "odom", odom.append)
     cmd = probe.create_publisher(msgs.Twist, "cmd_vel")
@@ -54,7 +54,7 @@ def test_wheel_acceleration_limit_ramps_speed() -> None:
     robot.diff_drive.max_accel = 0.5  # type: ignore[union-attr]  # m/s² at the wheel rim, as Gazebo applies it
     ex = Executor(seed=0)
     gazebo = launch_sim(ex, world=make_room(), robot=robot)
-    probe = Node(ex, name="probe")
+    probe = Node("probe", context=Context(ex))
     cmd = probe.create_publisher(msgs.Twist, "cmd_vel")
     probe.create_timer(0.05, lambda: cmd.publish(msgs.twist(0.5, 0.0)))
     ex.run(0.55)
@@ -97,7 +97,7 @@ def test_turtlebot3_fixture_drives_and_scans() -> None:
     ex = Executor(seed=0)
     gazebo = launch_sim(ex, world=make_room(), robot=load_robot(top), pose=(3.0, 0.0, 0.0))
     scans = []
-    probe = Node(ex, name="probe")
+    probe = Node("probe", context=Context(ex))
     probe.create_subscription(msgs.LaserScan, "scan", scans.append)
     cmd = probe.create_publisher(msgs.Twist, "cmd_vel")
     probe.create_timer(0.1, lambda: cmd.publish(msgs.twist(0.2, 0.0)))

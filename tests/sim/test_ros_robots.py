@@ -14,7 +14,7 @@ import pytest
 from sim_helpers import make_room
 
 from navlab import msgs
-from navlab.core import Executor, Node
+from navlab.core import Context, Executor, Node
 from navlab.description import load_robot
 from navlab.sim import launch_sim
 
@@ -28,7 +28,7 @@ def _drive(
     """Run the robot in the test room; publish each (t, v, w) once at time t."""
     ex = Executor(seed=0)
     gazebo = launch_sim(ex, world=make_room(), robot=robot, **params)  # type: ignore[arg-type]
-    node = Node(ex, name="rostopic_pub")
+    node = Node("rostopic_pub", context=Context(ex))
     pub = node.create_publisher(msgs.Twist, "cmd_vel", 10)
     for t, v, w in twists:
         holder: dict[str, object] = {}
@@ -106,7 +106,7 @@ def test_mapping_launch_takes_base_frame_and_scan_topic_from_the_robot() -> None
     session = navlab.launch("mapping", robot=str(XACRO), explore="false")
     assert session.args["base_frame"] == "base_link"
     assert session.args["scan_topic"] == "/tutorial_bot/laser/scan"
-    node = Node(session.executor, name="drv")
+    node = Node("drv", context=Context(session.executor))
     pub = node.create_publisher(msgs.Twist, "cmd_vel", 10)
     node.create_timer(0.1, lambda: pub.publish(msgs.twist(0.0, 0.6)))
     session.run(4.0)
@@ -163,7 +163,7 @@ def test_p3d_plugins_publish_where_noetic_publishes(tmp_path: Path) -> None:
     assert any("no <topicName>" in w and "does not load" in w for w in robot.warnings)
     ex, _ = _drive(robot, [(0.05, 0.2, 0.0)], 0.05)
     got: list[object] = []
-    Node(ex, name="listener").create_subscription(msgs.Odometry, "/my_robot/truth/odom", got.append, 10)
+    Node("listener", context=Context(ex)).create_subscription(msgs.Odometry, "/my_robot/truth/odom", got.append, 10)
     ex.run(1.0)
     assert len(got) == 20 and got[-1].header.frame_id == "world"  # type: ignore[attr-defined]
     assert got[-1].pose.pose.position.x > 0.05  # type: ignore[attr-defined]
@@ -188,7 +188,7 @@ def test_publish_tf_and_publish_odom_tf_as_noetic(tmp_path: Path, tag: str, odom
     ex = Executor(seed=0)
     launch_sim(ex, world=make_room(), robot=load_robot(pkg / "urdf" / "my_robot.urdf.xacro"))
     got: list[object] = []
-    Node(ex, name="listener").create_subscription(msgs.Odometry, "/odom", got.append, 10)
+    Node("listener", context=Context(ex)).create_subscription(msgs.Odometry, "/odom", got.append, 10)
     ex.run(0.5)
     assert bool(got) is odom
     assert ex.tf.can_transform("odom", "base_footprint") is tf

@@ -10,7 +10,7 @@ import pytest
 from sim_helpers import make_mybot
 
 from navlab import msgs
-from navlab.core import Executor, Node
+from navlab.core import Context, Executor, Node
 from navlab.description.model import Origin
 from navlab.description.sensor_model import BumperConfig, CameraConfig, CameraModel, Lidar3dConfig, RangeConfig
 from navlab.io.pointcloud import read_field, read_xyz
@@ -222,7 +222,7 @@ class Probe(Node):
     """Keeps the newest sonar reading and bumper state."""
 
     def __init__(self, ex: Executor) -> None:
-        super().__init__(ex, name="probe")
+        super().__init__("probe", context=Context(ex))
         self.got: dict[str, Any] = {}
         self.create_subscription(msgs.Range, "/sonar_front", lambda m: self.got.__setitem__("range", m), 1)
         self.create_subscription(msgs.ContactsState, "/bumper", lambda m: self.got.__setitem__("bumper", m), 1)

@@ -6,7 +6,7 @@ import numpy as np
 from scipy.ndimage import binary_dilation
 
 from navlab import msgs
-from navlab.core import Node
+from navlab.core import Context, Node
 from navlab.core.launch import start
 from navlab.world import occupancy
 
@@ -27,7 +27,7 @@ def test_sim_launch_scans_land_on_the_worlds_walls() -> None:
         world = sim.data.site_xpos[site] + local @ sim.data.site_xmat[site].reshape(3, 3).T
         points.append(world[:, :2])
 
-    probe = Node(ex, name="probe")
+    probe = Node("probe", context=Context(ex))
     probe.create_subscription(msgs.LaserScan, "/mybot/laser/scan", on_scan)
     cmd = probe.create_publisher(msgs.Twist, "cmd_vel")
     probe.create_timer(0.1, lambda: cmd.publish(msgs.twist(0.3, 0.5)))

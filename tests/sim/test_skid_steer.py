@@ -18,7 +18,7 @@ import pytest
 import yaml
 
 from navlab import msgs
-from navlab.core import Executor, Node
+from navlab.core import Context, Executor, Node
 from navlab.core.node import flatten_params
 from navlab.description import load_robot
 from navlab.sim import launch_sim
@@ -57,7 +57,7 @@ def drive(
         params = flatten_params(yaml.safe_load((FIXTURE / "config" / "control.yaml").read_text()))
         params["skidbot_velocity_controller.wheel_separation_multiplier"] = multiplier
     gz = launch_sim(ex, world="room", robot=robot, ground_truth_rate=0.0, **params)
-    node = Node(ex, name="driver")
+    node = Node("driver", context=Context(ex))
     pub = node.create_publisher(msgs.Twist, "cmd_vel")
     odom: list = []
     node.create_subscription(msgs.Odometry, "odom", odom.append, 10)
@@ -138,7 +138,7 @@ def test_robot_files_turn_on_the_controller_and_the_ekf_by_default() -> None:
     s = start("sim", launch_args={"robot": "jackal_skid"})
     senders: set[str] = set()
     filtered: list = []
-    watch = Node(s.executor, name="watch")
+    watch = Node("watch", context=Context(s.executor))
     watch.create_subscription(
         msgs.TFMessage,
         "/tf",

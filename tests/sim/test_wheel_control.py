@@ -9,7 +9,7 @@ import pytest
 from sim_helpers import make_mybot, make_room
 
 from navlab import msgs
-from navlab.core import Executor, Node, load_params
+from navlab.core import Context, Executor, Node, load_params
 from navlab.resources import root as resources_root
 from navlab.sim import SimError, launch_sim
 from navlab.sim.disturbances import parse_disturbances
@@ -67,6 +67,13 @@ def test_pid_bad_gains_are_refused(params: dict, message: str) -> None:
         PidGains.from_params(params, where="pid_gains.left_wheel_hinge")
 
 
+def test_pid_gains_built_in_code_get_the_same_checks() -> None:
+    with pytest.raises(SimError, match="pid parameter p: expected >= 0"):
+        PidGains(p="fast")  # type: ignore[arg-type]
+    with pytest.raises(SimError, match="pid parameter i_clamp_min: expected <= 0"):
+        PidGains(i_clamp_max=1.0, i_clamp_min=0.5)
+
+
 def test_speed_limiter_acceleration_velocity_and_jerk() -> None:
     lim = SpeedLimiter(
         {"has_velocity_limits": True, "max_velocity": 0.5, "has_acceleration_limits": True, "max_acceleration": 1.0}
@@ -108,7 +115,7 @@ def _drive(
 ) -> tuple[Executor, object, dict]:
     ex = Executor(seed=0)
     gazebo = launch_sim(ex, world=make_room(), robot=robot or make_mybot(), **params)  # type: ignore[arg-type]
-    probe = Node(ex, name="probe")
+    probe = Node("probe", context=Context(ex))
     got: dict = {"odom": [], "truth": []}
     probe.create_subscription(msgs.Odometry, "odom", got["odom"].append)
     probe.create_subscription(msgs.Odometry, "/ground_truth/odom", got["truth"].append)

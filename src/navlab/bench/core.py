@@ -68,7 +68,7 @@ def run_soak(args: argparse.Namespace) -> dict[str, Any]:
     minutes; RSS (MB) after the first simulated minute and at the end, and every 10 minutes between."""
     import gc
 
-    from navlab.core.launch import start
+    from navlab.core import start
 
     minutes = float(getattr(args, "minutes", None) or 60.0)
     session = start("mapping", seed=getattr(args, "seed", 0))

@@ -116,7 +116,7 @@ def _self_cpu() -> float:
 
 def _load_here(world_file: str, cache: str, effort: str, workers: int, reach: str) -> dict[str, Any]:
     """Load the world and build its simulation with the cache at ``cache`` (in a fresh process)."""
-    from navlab.sim import Simulation, decompose
+    from navlab.sim import Simulation, concave_meshes, convex_parts, default_reach
     from navlab.world import load_world
 
     os.environ["NAVLAB_CACHE"] = cache
@@ -128,8 +128,8 @@ def _load_here(world_file: str, cache: str, effort: str, workers: int, reach: st
     sim = Simulation(None, world, visuals=False)  # decomposes (in parallel), then builds
     wall = time.perf_counter() - wall0
     cpu = _self_cpu() - cpu0 + _children_cpu() - child0
-    meshes = decompose.concave_meshes(world, decompose.default_reach())
-    parts = [len(decompose.convex_parts(p, s, cut=c)) for p, s, c in meshes]
+    meshes = concave_meshes(world, default_reach())
+    parts = [len(convex_parts(p, s, cut=c)) for p, s, c in meshes]
     mb = 1024.0 if os.uname().sysname != "Darwin" else 1024.0 * 1024.0  # ru_maxrss: KiB on Linux, bytes on macOS
     return {
         "wall_s": round(wall, 1),
@@ -155,12 +155,12 @@ def _first_load(world_file: Path, cache: Path, effort: str, workers: int, reach:
 def run(args: argparse.Namespace) -> dict[str, Any]:
     """Measure and return {"before", "after", "warm_s", ...} (see the module docstring)."""
     from navlab.description import load_robot_named
-    from navlab.sim import decompose
+    from navlab.sim import default_reach, default_workers, robot_reach
 
     seed = int(getattr(args, "seed", 0))
-    reach = decompose.robot_reach(load_robot_named(ROBOT)) if not os.environ.get("NAVLAB_DECOMPOSE_REACH") else None
-    reach_s = str(reach if reach is not None else decompose.default_reach() or "off")
-    workers = decompose.default_workers()
+    reach = robot_reach(load_robot_named(ROBOT)) if not os.environ.get("NAVLAB_DECOMPOSE_REACH") else None
+    reach_s = str(reach if reach is not None else default_reach() or "off")
+    workers = default_workers()
     with tempfile.TemporaryDirectory() as tmp:
         folder = Path(tmp)
         world = furnished_world(folder / "world", MESHES, seed)

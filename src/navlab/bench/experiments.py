@@ -9,10 +9,7 @@ import time
 from pathlib import Path
 from typing import Any
 
-from navlab.experiments.clutter_protocol import JACKAL_MAX_SPEED, run_protocol
-from navlab.experiments.mapping_run import run_mapping
-from navlab.experiments.navigate_run import run_navigation
-from navlab.experiments.odom_run import ROBOTS, ROUTES, run_drift
+from navlab.experiments import JACKAL_MAX_SPEED, ROBOTS, ROUTES, run_drift, run_mapping, run_navigation, run_protocol
 
 WARMUP_S = 5.0  # simulated s of `bench mapping`'s untimed warm-up run
 

@@ -15,8 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from navlab.localization import Amcl, AmclParams
-from navlab.localization.synthetic import room_field, simulated_scan
+from navlab.localization import Amcl, AmclParams, room_field, simulated_scan
 
 N_PARTICLES = 2000
 N_BEAMS = 60

@@ -23,11 +23,9 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
 
     A missing log raises ``DatasetNotFoundError`` saying where it was looked for and how to provide it.
     """
-    from navlab.experiments.metrics import read_relations, relations_closure, relations_error
-    from navlab.io import dataset
-    from navlab.io.carmen import read_carmen
-    from navlab.mapping.scanmatch import warmup
-    from navlab.mapping.slam import run_offline
+    from navlab.experiments import read_relations, relations_closure, relations_error
+    from navlab.io import dataset, read_carmen
+    from navlab.mapping import run_offline, warmup
 
     log = read_carmen(dataset(CSAIL))
     warmup()  # numba compilation is not part of the figure (it is cached on disk after the first run)
@@ -53,8 +51,7 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
 
 def office_truth(resolution: float = 0.05) -> Any:
     """The default office floor's true occupancy (a boolean ``Grid``, world frame)."""
-    from navlab.world import load_world, occupancy, truth_grid
-    from navlab.world.office import generate_office
+    from navlab.world import generate_office, load_world, occupancy, truth_grid
 
     office = generate_office()
     with tempfile.TemporaryDirectory(prefix="navlab-office-") as tmp:
@@ -68,8 +65,7 @@ def office_scores(sim_log: Any, result: Any, truth: Any) -> dict[str, float]:
     """ATE of a SLAM ``result``'s robot poses against the log's truth, and the map's precision and recall
     against ``truth`` (``office_truth``) with the map placed by the same rigid alignment (a map's gauge,
     its first pose, is free)."""
-    from navlab.experiments.metrics import score_map
-    from navlab.experiments.trajectory import apply_se2, ate
+    from navlab.experiments import apply_se2, ate, score_map
     from navlab.geometry import compose2, inverse2
 
     truth_in_map = apply_se2(tuple(inverse2(sim_log.start)), sim_log.truth)  # map frame = the start pose
@@ -88,9 +84,7 @@ def office_scores(sim_log: Any, result: Any, truth: Any) -> dict[str, float]:
 def run_office(args: argparse.Namespace) -> dict[str, Any]:
     """Both SLAM modes on the office floor's sparse logs (seeds ``seed`` .. ``seed + 4``): per mode the
     worst and mean ATE RMSE, the worst ATE max, the worst map precision, and SLAM's CPU time per log."""
-    from navlab.mapping.scanmatch import warmup
-    from navlab.mapping.simlog import office_log
-    from navlab.mapping.slam import run_offline
+    from navlab.mapping import office_log, run_offline, warmup
 
     warmup()
     seed0 = getattr(args, "seed", 0)

@@ -21,10 +21,16 @@ from typing import Any
 import numpy as np
 
 from navlab.grid import Grid, GridMap
-from navlab.navigation import LayeredCostmap, NavfnPlanner, ThetaStarPlanner, path_length
-from navlab.navigation.controllers import DWAPlannerROS, TrajectoryPlannerROS
-from navlab.navigation.controllers import synthetic as syn
-from navlab.navigation.controllers.mppi import MPPIController
+from navlab.navigation import (
+    DWAPlannerROS,
+    LayeredCostmap,
+    MPPIController,
+    NavfnPlanner,
+    ThetaStarPlanner,
+    TrajectoryPlannerROS,
+    path_length,
+)
+from navlab.navigation import synthetic as syn
 
 # --- controllers ------------------------------------------------------------------------------------
 

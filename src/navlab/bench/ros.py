@@ -26,7 +26,7 @@ from typing import Any
 
 from navlab.core import Timer
 from navlab.errors import NavlabError
-from navlab.ros1.live import LiveRun
+from navlab.ros1 import LiveRun
 
 HZ_WINDOW_S = 10.0
 GOALS = [(1.5, 0.0, 0.0), (1.5, 1.5, 1.57), (-1.0, 1.0, 3.14)]

@@ -66,7 +66,7 @@ RGB = """<?xml version="1.0"?>
 
 def _nav_rtf(robot: str, seed: int, topic: str | None = None, params: str | None = None) -> dict[str, Any]:
     """RTF (CPU) of the navigation run to ``GOALS`` with ``topic`` subscribed (a reader keeps the sensor on)."""
-    from navlab.experiments.navigate_run import run_navigation
+    from navlab.experiments import run_navigation
 
     def reader(run: Any) -> None:
         if topic:
@@ -122,11 +122,9 @@ def _frames() -> dict[str, float]:
     """Per-frame CPU costs of the sensors and the voxel update, in room_obstacles from the origin."""
     from navlab.description import load_robot
     from navlab.grid import Grid
-    from navlab.io.pointcloud import move_points
-    from navlab.navigation.costmap.params import ObservationSource
-    from navlab.navigation.costmap.voxel_layer import VoxelLayer
-    from navlab.sim.sensors3d import depth_image, depth_points, lidar3d_ranges, sensor_pose
-    from navlab.sim.simulation import Simulation
+    from navlab.io import move_points
+    from navlab.navigation import ObservationSource, VoxelLayer
+    from navlab.sim import Simulation, depth_image, depth_points, lidar3d_ranges, sensor_pose
     from navlab.world import load_world
 
     with tempfile.TemporaryDirectory(prefix="navlab-bench-sensors-") as tmp:
@@ -140,7 +138,7 @@ def _frames() -> dict[str, float]:
     lidar.link = "chassis"
     out["velodyne_scan_ms"] = _per_frame(lambda: lidar3d_ranges(sim, lidar, np.random.default_rng(0)))
     try:
-        from navlab.sim.camera_render import CameraRenderer
+        from navlab.sim import CameraRenderer
 
         renderer = CameraRenderer(sim, cam)
         out["rgb_frame_ms"] = _per_frame(renderer.render)

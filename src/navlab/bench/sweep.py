@@ -13,7 +13,7 @@ from typing import Any
 
 import yaml
 
-from navlab.experiments.errors import ExperimentError
+from navlab.experiments import ExperimentError
 
 BENCH_TRIALS = 10  # per combination: 2 x 10 trials, a small real sweep (the shipped sweeps run 20 per value)
 RAY_COSTS = """import json, time

@@ -23,8 +23,7 @@ import time
 from pathlib import Path
 from typing import Any
 
-from navlab.viz import VizError
-from navlab.viz.headless import CHROMIUM, HeadlessPage
+from navlab.viz import CHROMIUM, HeadlessPage, VizError
 
 GOALS = [(4.3, 1.0, 0.0), (-3.5, -0.5, 3.14), (1.5, -2.5, 0.0)]
 SIM_S = 40.0  # simulated s measured per drive
@@ -37,7 +36,7 @@ def _drive(
     """One drive of SIM_S simulated s; with ``page``, watched by it (the browser's tab opens the viewer, and a
     blank page after the drive; ``setup``: JavaScript run in it once it drew the map, e.g.
     ``navlab.settings.maxFps = 20``). Wall time excludes the screenshot."""
-    from navlab.experiments.session import start_run
+    from navlab.experiments import start_run
     from navlab.viz import attach
 
     run = start_run("navigation", world="room_obstacles", map=map_yaml, seed=seed)

@@ -22,14 +22,12 @@ def _xacro_args(pairs: list[str]) -> dict[str, str]:
 def _cmd(args: argparse.Namespace) -> int:
     path = args.file  # a path, package:// URI or shipped name: the loaders resolve it (one resolver)
     if args.kind == "robot":
-        from navlab.description import load_robot
-        from navlab.description.summary import format_robot, robot_summary
+        from navlab.description import format_robot, load_robot, robot_summary
 
         summary = robot_summary(load_robot(path, search_paths=args.package_path, args=_xacro_args(args.arg)))
         text = format_robot(summary)
     else:
-        from navlab.world import load_world
-        from navlab.world.summary import format_world, world_summary
+        from navlab.world import format_world, load_world, world_summary
 
         summary = world_summary(load_world(path, model_path=args.model_path))
         text = format_world(summary)

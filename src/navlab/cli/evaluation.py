@@ -25,11 +25,10 @@ DEPRECATED_RELATION_KEYS = {
 
 
 def _cmd_eval_relations(args: argparse.Namespace) -> int:
-    from navlab.experiments.metrics import read_relations, relations_closure, relations_error
-    from navlab.experiments.trajectory import read_trajectory
+    from navlab.experiments import read_relations, read_trajectory, relations_closure, relations_error
 
     ts, poses = read_trajectory(args.poses, carmen=args.carmen)
-    from navlab.io.datasets import data_file
+    from navlab.io import data_file
 
     rel = read_relations(data_file(args.relations))
     out = relations_error(ts, poses, rel, time_tolerance=args.tolerance)
@@ -54,7 +53,7 @@ def _cmd_eval_relations(args: argparse.Namespace) -> int:
 
 
 def _cmd_eval_trajectory(args: argparse.Namespace) -> int:
-    from navlab.experiments.trajectory import read_trajectory, trajectory_ate
+    from navlab.experiments import read_trajectory, trajectory_ate
 
     est = read_trajectory(args.estimate, carmen=args.carmen)
     truth = read_trajectory(
@@ -76,9 +75,7 @@ def _cmd_eval_trajectory(args: argparse.Namespace) -> int:
 def _cmd_eval_map(args: argparse.Namespace) -> int:
     """Score a saved map against a world's true occupancy (start pose known, no alignment)."""
     from navlab.description import load_robot_named
-    from navlab.experiments.mapping_run import read_trajectory
-    from navlab.experiments.metrics import free_coverage, score_map, trajectory_error
-    from navlab.experiments.session import rounded
+    from navlab.experiments import free_coverage, read_map_trajectory, rounded, score_map, trajectory_error
     from navlab.mapping import load_map
     from navlab.world import load_world, true_occupancy, world_T_map
 
@@ -92,7 +89,7 @@ def _cmd_eval_map(args: argparse.Namespace) -> int:
     scores["coverage"] = free_coverage(grid, truth, world_T_map=map_in_world, start_xy=start[:2])
     traj = Path(args.trajectory) if args.trajectory else Path(args.map).with_name("trajectory.txt")
     if args.trajectory or traj.is_file():
-        est, true = read_trajectory(traj)
+        est, true = read_map_trajectory(traj)
         scores.update(trajectory_error(est, true))
     print_figures(rounded(scores), args.json)
     return 0

@@ -17,9 +17,7 @@ from navlab.cli.options import (
 
 def _cmd_experiment(args: argparse.Namespace) -> int:
     apply_resource_paths(args)  # --package-path / --model-path, for this process and its workers
-    from navlab.experiments.errors import ExperimentError
-    from navlab.experiments.scenario import load_scenario
-    from navlab.experiments.trials import run_experiment
+    from navlab.experiments import ExperimentError, load_scenario, run_experiment
 
     sc = load_scenario(args.file)
     out = args.out or f"runs/{sc.name}"
@@ -31,7 +29,7 @@ def _cmd_experiment(args: argparse.Namespace) -> int:
         "progress": not args.quiet and sys.stderr.isatty(),
     }
     if args.action == "sweep":
-        from navlab.experiments.sweep import parse_params, run_sweep
+        from navlab.experiments import parse_params, run_sweep
 
         rows = run_sweep(sc, parse_params(args.param), out, **trials)
         if not args.json:
@@ -50,7 +48,7 @@ def _cmd_experiment(args: argparse.Namespace) -> int:
 
 
 def _cmd_report(args: argparse.Namespace) -> int:
-    from navlab.experiments.report import render_report
+    from navlab.experiments import render_report
 
     out = render_report(args.dir)
     if not args.json:

@@ -15,7 +15,7 @@ from navlab.cli.options import add_resource_path_arguments, add_run_options, app
 
 
 def _show_args(file: str) -> int:
-    from navlab.core.launch import declared_args
+    from navlab.core import declared_args
 
     rows = declared_args(file)
     if not rows:
@@ -35,8 +35,7 @@ def _split_files(first: str, items: list[str]) -> tuple[list[str], list[str]]:
 def find_in_package(pkg: str, name: str) -> Path:
     """roslaunch's ``roslaunch PKG FILE``: the file called ``name`` anywhere inside package ``pkg``."""
     from navlab.core import LaunchError
-    from navlab.description import DescriptionError
-    from navlab.description.packages import find_package
+    from navlab.description import DescriptionError, find_package
 
     try:
         root = find_package(pkg)
@@ -58,8 +57,7 @@ def _cmd_roslaunch(args: argparse.Namespace) -> int:
 
 
 def _cmd_launch(args: argparse.Namespace) -> int:
-    from navlab.core.launch import start  # (not at import: --help loads no numpy)
-    from navlab.core.runner import parse_launch_args, run_for
+    from navlab.core import parse_launch_args, run_for, start  # (not at import: --help loads no numpy)
 
     if args.show_args:
         return _show_args(args.file)
@@ -76,7 +74,7 @@ def _cmd_launch(args: argparse.Namespace) -> int:
     session = start(files, seed=args.seed, rate=rate, launch_args=launch_args, ros=ros)
     ex = session.executor
     duration = math.inf if args.duration is None else args.duration
-    from navlab.core.introspect import IntrospectionServer
+    from navlab.core import IntrospectionServer
 
     # `navlab topic/node/graph` in another shell look into this launch while it runs; SIGTERM ends it
     # cleanly like Ctrl-C (the recording is closed, the socket removed)
@@ -107,32 +105,29 @@ def _cmd_launch(args: argparse.Namespace) -> int:
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
-    from navlab.core.launch import start
-    from navlab.core.runner import parse_launch_args
-
     """``navlab run FILE.py``: an rclpy-style node file, unchanged, in a launch's simulation."""
     import runpy
     import sys
 
-    from navlab.core import rclpy_api
-    from navlab.core.ros_imports import install
+    from navlab import init, install_ros_imports, shutdown
+    from navlab.core import Context, parse_launch_args, start
 
     apply_resource_paths(args)
-    install()
+    install_ros_imports()
     files, items = _split_files(args.launch, args.args) if args.launch else ([], args.args)
     if files:
         session = start(files, seed=args.seed, launch_args=parse_launch_args(items))
-        ctx = rclpy_api.Context(session.executor, session, args.duration, prepared=True)
+        ctx = Context(session.executor, session, args.duration, prepared=True)
     else:
-        ctx = rclpy_api.Context(duration=args.duration, prepared=True)
-    rclpy_api.init(context=ctx)
+        ctx = Context(duration=args.duration, prepared=True)
+    init(context=ctx)
     argv = sys.argv
     sys.argv = [args.file]
     try:
         runpy.run_path(args.file, run_name="__main__")
     finally:
         sys.argv = argv
-        rclpy_api.shutdown(context=ctx)
+        shutdown(context=ctx)
     ex = ctx.executor
     summary = {
         "sim_s": round(ex.now_ns / 1e9, 3),

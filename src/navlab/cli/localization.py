@@ -35,7 +35,7 @@ def _amcl_params(path: str | None, sets: list[str]) -> dict[str, Any]:
 
 def _cmd_localize(args: argparse.Namespace) -> int:
     apply_resource_paths(args)  # --package-path / --model-path, for this process and its workers
-    from navlab.experiments.localize_run import plot_result, run_localization
+    from navlab.experiments import plot_result, run_localization
 
     with view_hook(args) as view, ros_hook(args, view) as on_start:
         result = run_localization(

@@ -28,7 +28,7 @@ def _cmd_map(args: argparse.Namespace) -> int:
     apply_resource_paths(args)  # --package-path / --model-path, for this process and its workers
     if args.action == "save":
         return _cmd_map_save(args)
-    from navlab.experiments.mapping_run import run_mapping
+    from navlab.experiments import run_mapping
 
     driver = "teleop" if args.teleop else "route" if args.route else "explore"
     with view_hook(args) as view, ros_hook(args, view) as on_start:
@@ -57,14 +57,13 @@ def _cmd_map(args: argparse.Namespace) -> int:
 def _cmd_map_save(args: argparse.Namespace) -> int:
     """map_saver: save the current ``/map`` of a running ``navlab launch``, or of one started here."""
     from navlab import msgs
-    from navlab.core.launch import start
-    from navlab.core.runner import parse_launch_args, run_for
+    from navlab.core import parse_launch_args, run_for, start
     from navlab.grid import GridMap
     from navlab.mapping import MappingError, save_map
 
     path = Path(args.out) / "map.yaml"
     if not args.launch:  # the launch running in another shell: /map is latched, so its current map comes first
-        from navlab.core.introspect import find_running, subscribe
+        from navlab.core import find_running, subscribe
 
         for _t, msg in subscribe(find_running(args.pid), "/map"):
             save_map(GridMap.from_msg(msg), path)
@@ -86,7 +85,7 @@ def _cmd_map_save(args: argparse.Namespace) -> int:
 def _params_file(path: str | None) -> dict:
     if not path:
         return {}
-    from navlab.core.params import read_yaml
+    from navlab.core import read_yaml
     from navlab.mapping import MappingError
 
     doc = read_yaml(path) or {}  # a regular UTF-8 file of bounded size and nesting (no FIFO, no alias bomb)
@@ -100,14 +99,12 @@ def _params_file(path: str | None) -> dict:
 
 
 def _cmd_slam(args: argparse.Namespace) -> int:
-    from navlab.io.carmen import read_carmen, skipped_summary
-    from navlab.io.datasets import data_file
+    from navlab.io import data_file, read_carmen, skipped_summary
 
     log = read_carmen(data_file(args.log))  # a bad log is reported before the SLAM's and the plots' imports
 
-    from navlab.experiments.plots import Track, plot_run
-    from navlab.experiments.session import rounded
-    from navlab.mapping.slam import run_offline, write_outputs
+    from navlab.experiments import Track, plot_run, rounded
+    from navlab.mapping import run_offline, write_outputs
 
     note = skipped_summary(log)
     if note:
@@ -153,10 +150,9 @@ def _cmd_teleop(args: argparse.Namespace) -> int:
     """Drive the robot from the keyboard (teleop_twist_keyboard) or a joystick, in real time: the robot
     of a `navlab launch` running in another shell, or (with --world, or when none runs) a simulator
     started here."""
-    from navlab.core import CoreError, Executor
-    from navlab.core.introspect import RemotePublisher, find_running
+    from navlab.core import CoreError, Executor, RemotePublisher, find_running
     from navlab.drivers import HELP, TeleopKeyboard, terminal_keys
-    from navlab.experiments.session import start_run
+    from navlab.experiments import start_run
 
     gazebo = remote = None
     if args.world is None:

@@ -22,7 +22,7 @@ from navlab.cli.runs import ros_hook, view_hook
 
 def _cmd_navigate(args: argparse.Namespace) -> int:
     apply_resource_paths(args)  # --package-path / --model-path, for this process and its workers
-    from navlab.experiments.navigate_run import run_navigation, save_goal_pictures
+    from navlab.experiments import run_navigation, save_goal_pictures
     from navlab.sim import parse_spawn_spec
 
     spawns = []

@@ -45,7 +45,7 @@ def finite_float(text: str) -> float:
 def coordinate(text: str) -> float:
     """argparse ``type=`` for a pose coordinate: a finite number within the ``coordinate_m`` ceiling (m or rad;
     beyond it poses overflow or lose all precision)."""
-    from navlab.core.limits import ceilings
+    from navlab.core import ceilings
 
     value = finite_float(text)
     limit = ceilings()["coordinate_m"].limit

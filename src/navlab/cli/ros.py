@@ -18,11 +18,10 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from navlab.cli.options import add_run_options, out_file, positive_seconds
-from navlab.io.files import write_text_atomic
+from navlab.io import write_text_atomic
 
 if TYPE_CHECKING:  # navlab.core loads numpy and rosbags: imported where a verb runs, so --help stays quick
-    from navlab.core.graph import Graph
-    from navlab.core.launch import Session
+    from navlab.core import Graph, Session
 
 
 def _add_source(p: argparse.ArgumentParser) -> None:
@@ -51,8 +50,7 @@ def _watch_seconds(args: argparse.Namespace) -> None:
 
 
 def _start(args: argparse.Namespace) -> Session:
-    from navlab.core.launch import start
-    from navlab.core.runner import parse_launch_args
+    from navlab.core import parse_launch_args, start
 
     file, *items = args.launch
     return start(file, seed=args.seed, launch_args=parse_launch_args(items))
@@ -60,14 +58,14 @@ def _start(args: argparse.Namespace) -> Session:
 
 def _running(args: argparse.Namespace) -> Path | None:
     """The socket of a launch running in another process, when neither --launch nor --bag is given."""
-    from navlab.core.introspect import find_running
+    from navlab.core import find_running
 
     return None if args.launch or args.bag else find_running(args.pid)
 
 
 def _live_messages(path: Path, topic: str, duration: float) -> Iterator[tuple[int, Any]]:
     """Messages of a running launch until ``duration`` simulated seconds passed."""
-    from navlab.core.introspect import subscribe
+    from navlab.core import subscribe
 
     t0 = None
     for t_ns, msg in subscribe(path, topic):
@@ -79,11 +77,10 @@ def _live_messages(path: Path, topic: str, duration: float) -> Iterator[tuple[in
 
 def _messages(args: argparse.Namespace, topic: str) -> Iterator[tuple[int, Any]] | list[tuple[int, Any]]:
     """(t_ns, msg) on ``topic`` from the bag, a running launch, or a launch started here."""
-    from navlab.core import CoreError
-    from navlab.core.runner import run_for
+    from navlab.core import CoreError, run_for
 
     if args.bag:
-        from navlab.io.rosbag import read_bag
+        from navlab.io import read_bag
 
         return [(t, m) for _, t, m in read_bag(args.bag, topics=[topic])]
     live = _running(args)
@@ -106,17 +103,16 @@ def _messages(args: argparse.Namespace, topic: str) -> Iterator[tuple[int, Any]]
 def _cmd_topic(args: argparse.Namespace) -> int:
     import numpy as np
 
-    from navlab.core import CoreError
-    from navlab.core.runner import run_for
+    from navlab.core import CoreError, run_for
 
     _watch_seconds(args)
     if args.action == "list":
         if args.bag:
-            from navlab.io.rosbag import bag_topics
+            from navlab.io import bag_topics
 
             rows = {k: v for k, v in bag_topics(args.bag).items()}
         elif (live := _running(args)) is not None:
-            from navlab.core.introspect import request
+            from navlab.core import request
 
             rows = {k: tuple(v) for k, v in request(live, "graph")["types"].items()}
         else:
@@ -132,14 +128,14 @@ def _cmd_topic(args: argparse.Namespace) -> int:
     if not args.topic:
         raise CoreError(f"navlab topic {args.action} needs a TOPIC name")
     if args.action == "echo":
-        from navlab.core import echo
+        from navlab.core import EchoPrinter, echo_bag, echo_launch, echo_live
 
-        out = echo.Printer(args.count)
+        out = EchoPrinter(args.count)
         if args.bag:
-            return echo.echo_bag(args.bag, args.topic, out, args.duration)
+            return echo_bag(args.bag, args.topic, out, args.duration)
         if (live := _running(args)) is not None:
-            return echo.echo_live(live, args.topic, out, args.duration)
-        return echo.echo_launch(args.launch, args.topic, out, args.duration, args.seed, run_for)
+            return echo_live(live, args.topic, out, args.duration)
+        return echo_launch(args.launch, args.topic, out, args.duration, args.seed, run_for)
     msgs = _messages(args, args.topic)
     # hz
     times = np.array([t for t, _ in msgs], dtype=np.int64)  # simulated time stamps
@@ -165,12 +161,11 @@ def _cmd_topic(args: argparse.Namespace) -> int:
 
 
 def _graph_of(args: argparse.Namespace) -> Graph:
-    from navlab.core.graph import Graph
-    from navlab.core.runner import run_for
+    from navlab.core import Graph, run_for
 
     _watch_seconds(args)
     if args.bag:
-        from navlab.io.rosbag import bag_graph, bag_topics
+        from navlab.io import bag_graph, bag_topics
 
         data = bag_graph(args.bag)
         if data is not None:
@@ -178,7 +173,7 @@ def _graph_of(args: argparse.Namespace) -> Graph:
         return Graph(topics={t: ([], []) for t in bag_topics(args.bag)})
     live = _running(args)
     if live is not None:
-        from navlab.core.introspect import request
+        from navlab.core import request
 
         return Graph.from_json(request(live, "graph"))
     session = _start(args)
@@ -204,7 +199,7 @@ def _cmd_graph(args: argparse.Namespace) -> int:
 
 
 def _cmd_bag(args: argparse.Namespace) -> int:
-    from navlab.io.rosbag import reindex_bag
+    from navlab.io import reindex_bag
 
     res = reindex_bag(args.dir, args.out)
     if args.json:
@@ -219,8 +214,7 @@ def _cmd_bag(args: argparse.Namespace) -> int:
 
 
 def _cmd_roscore(args: argparse.Namespace) -> int:
-    from navlab.ros1 import Master
-    from navlab.ros1.net import host_port, master_uri
+    from navlab.ros1 import Master, host_port, master_uri
 
     port = args.port if args.port is not None else host_port(master_uri())[1]
     master = Master(port=port)

@@ -78,7 +78,7 @@ def _open_bridge(executor: Any, nodes: dict[str, Any], *, follow_clock: bool = F
 
 def start_viewer(args: argparse.Namespace, executor: Any, *, host: str, port: int, rate: float | None = None) -> Any:
     """Attach the viewer, print its URL (and a warning off loopback), open a browser where there is a desktop."""
-    from navlab.viz.viewer import attach, host_warning, open_in_browser
+    from navlab.viz import attach, host_warning, open_in_browser
 
     warning = host_warning(host)
     if warning:

@@ -114,7 +114,7 @@ def _parse_cmd_vel(text: str | None) -> tuple[float, float] | None:
 def _cmd_sim(args: argparse.Namespace) -> int:
     from navlab import msgs
     from navlab.core import Node
-    from navlab.experiments.session import start_run
+    from navlab.experiments import start_run
     from navlab.sim import parse_spawn_spec
 
     apply_resource_paths(args)
@@ -190,9 +190,7 @@ def _one_shot(node: Any, t: float, fn: Any) -> None:
 
 def _cmd_render(args: argparse.Namespace) -> int:
     from navlab.description import load_robot_named
-    from navlab.sim import Simulation
-    from navlab.sim.render import render_image, save_png
-    from navlab.sim.spawn import check_start_pose, parse_spawn_spec
+    from navlab.sim import Simulation, check_start_pose, parse_spawn_spec, render_image, save_png
     from navlab.world import load_world
 
     apply_resource_paths(args)

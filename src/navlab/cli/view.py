@@ -67,9 +67,8 @@ def _cmd_view(args: argparse.Namespace) -> int:
             raise VizError("--ros serves a live launch, not a --bag replay (play the recording with `rosbag play`)")
         return _replay(args)
     apply_resource_paths(args)
-    from navlab.core.launch import declared_args
-    from navlab.core.runner import parse_launch_args
-    from navlab.experiments.session import start_run
+    from navlab.core import declared_args, parse_launch_args
+    from navlab.experiments import start_run
     from navlab.mapping import save_true_map
 
     launch_args: dict[str, Any] = parse_launch_args(args.args)
@@ -93,8 +92,7 @@ def _cmd_view(args: argparse.Namespace) -> int:
 def _replay(args: argparse.Namespace) -> int:
     import time
 
-    from navlab.viz import Hub, ViewerServer, play_bag
-    from navlab.viz.viewer import host_warning, open_in_browser
+    from navlab.viz import Hub, ViewerServer, host_warning, open_in_browser, play_bag
 
     warning = host_warning(args.host)
     if warning:

@@ -12,21 +12,21 @@ from typing import TYPE_CHECKING
 from navlab.cli.options import add_run_options, optional_out, out_file, print_figures
 
 if TYPE_CHECKING:
-    from navlab.world.clutter import ClutterWorld
+    from navlab.world import ClutterWorld
 
 
 def save_png(world: ClutterWorld, path: str | Path) -> None:
     """Top view (world frame, m): walls, cylinders, start, goal and the reference path."""
     import matplotlib
 
-    from navlab.world.clutter import CYLINDER_RADIUS, FIELD
+    from navlab.world import CYLINDER_RADIUS, FIELD
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     from matplotlib.collections import PatchCollection
     from matplotlib.patches import Circle, Rectangle
 
-    from navlab.io.files import save_figure_atomic
+    from navlab.io import save_figure_atomic
 
     fig, ax = plt.subplots(figsize=(10, 5.2))
     try:
@@ -68,7 +68,7 @@ def save_png(world: ClutterWorld, path: str | Path) -> None:
 
 
 def _cmd_clutter(args: argparse.Namespace) -> int:
-    from navlab.world.clutter import generate_clutter
+    from navlab.world import generate_clutter
 
     if args.margin is not None:
         print(
@@ -182,11 +182,10 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def _cmd_world_office(args: argparse.Namespace) -> int:
-    from navlab.experiments.session import rounded
-    from navlab.io.carmen import write_carmen
-    from navlab.io.poses import write_poses
-    from navlab.mapping.simlog import OdometryNoise, record_log
-    from navlab.world.office import generate_office
+    from navlab.experiments import rounded
+    from navlab.io import write_carmen, write_poses
+    from navlab.mapping import OdometryNoise, record_log
+    from navlab.world import generate_office
 
     office = generate_office()
     world = office.write_world(out_file(args.out, "office.world", old_suffixes=(".world", ".sdf")))
@@ -214,7 +213,7 @@ def _cmd_world_office(args: argparse.Namespace) -> int:
         )
         summary.update(log=str(log), scans=len(rec.log.scans), log_s=rec.log.duration)
         if truth:
-            from navlab.experiments.trajectory import apply_se2
+            from navlab.experiments import apply_se2
             from navlab.geometry import inverse2
 
             # the truth in the log's odometry frame (the start pose), as the SLAM output is

@@ -99,7 +99,7 @@ def _short_of(out: Printer, topic: str, what: str) -> int:
 
 def echo_bag(bag: str, topic: str, out: Printer, duration: float) -> int:
     """Echo ``topic`` from a recording: every message (or the first ``--count``, or ``duration`` s of them)."""
-    from navlab.io.rosbag import bag_topics, read_bag
+    from navlab.io import bag_topics, read_bag
 
     if topic not in bag_topics(bag):
         raise CoreError(f"no topic {topic!r} in the recording {bag} (topics: {', '.join(sorted(bag_topics(bag)))})")

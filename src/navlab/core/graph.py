@@ -8,7 +8,7 @@ from typing import Any
 
 from navlab.core.errors import CoreError
 from navlab.core.executor import Executor
-from navlab.io.files import write_text_atomic
+from navlab.io import write_text_atomic
 
 HIDDEN_NODES = ("/_tf_buffer",)
 

@@ -28,7 +28,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from navlab.errors import NavlabError
-from navlab.io.files import machine_memory_bytes
+from navlab.io import machine_memory_bytes
 
 MEMORY_SHARE = 4  # one structure may take at most 1/MEMORY_SHARE of the machine's physical memory
 

@@ -21,6 +21,7 @@ from navlab.core.parameter import Parameter, SetParametersResult
 from navlab.core.params import ParameterWarning, likely_typo, typed_value
 from navlab.core.tf import Pose2
 from navlab.core.topics import Publisher, Subscription, Timer, seconds_to_ns
+from navlab.deprecation import NavlabDeprecationWarning
 from navlab.msgs import TFMessage
 
 __all__ = [
@@ -53,7 +54,7 @@ def _renamed_keywords(**renames: str) -> Callable[[Callable[..., Any]], Callable
                 warnings.warn(
                     f"{method.__name__}({'=..., '.join(used)}=...) is deprecated and goes in the next "
                     f"release: write {'=..., '.join(renames[o] for o in used)}=... (rclpy's names)",
-                    DeprecationWarning,
+                    NavlabDeprecationWarning,
                     stacklevel=2,
                 )
             return method(*args, **kwargs)
@@ -162,7 +163,7 @@ class Node:
                 warnings.warn(
                     "Node(executor, name=...) is deprecated and goes in the next release: write "
                     "Node('name', parameter_overrides=...) after navlab.init(), as rclpy does",
-                    DeprecationWarning,
+                    NavlabDeprecationWarning,
                     stacklevel=2,
                 )
             self._rclpy_style = False

@@ -15,6 +15,7 @@ import math
 import warnings
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, fields
+from operator import ge, gt, le
 from pathlib import Path
 from typing import Any, TypeVar
 
@@ -22,8 +23,7 @@ import yaml
 
 from navlab.core.errors import ParameterError
 from navlab.errors import NavlabError, did_you_mean
-from navlab.io.errors import IoError
-from navlab.io.files import read_text_checked
+from navlab.io import IoError, read_text_checked
 
 T = TypeVar("T")
 
@@ -328,15 +328,11 @@ def read_params(cls: type[T], values: Mapping[str, Any] | T | None, *, what: str
                 f"{what}: {key} is {getattr(out, key)}; it is set to {low} (as ROS does)"
             )
             setattr_(out, key, type(getattr(out, key))(low))
-    for key, low in spec.at_least.items():
-        if not getattr(out, key) >= low:
-            raise param_error(what, key, getattr(out, key), f">= {low}", spec.error)
-    for key, low in spec.above.items():
-        if not getattr(out, key) > low:
-            raise param_error(what, key, getattr(out, key), f"> {low}", spec.error)
-    for key, high in spec.at_most.items():
-        if not getattr(out, key) <= high:
-            raise param_error(what, key, getattr(out, key), f"<= {high}", spec.error)
+    for bounds, within, sign in ((spec.at_least, ge, ">="), (spec.above, gt, ">"), (spec.at_most, le, "<=")):
+        for key, bound in bounds.items():
+            val = getattr(out, key)
+            if not _within(within, val, bound):
+                raise param_error(what, key, val, f"{sign} {bound}", spec.error)
     for key, allowed in spec.choices.items():
         if getattr(out, key) not in allowed:
             raise param_error(what, key, getattr(out, key), f"one of {', '.join(map(repr, allowed))}", spec.error)
@@ -344,6 +340,14 @@ def read_params(cls: type[T], values: Mapping[str, Any] | T | None, *, what: str
     if callable(validate):
         validate()
     return out
+
+
+def _within(compare: Callable[[Any, Any], Any], value: Any, bound: Any) -> bool:
+    """``compare(value, bound)``, False for a value that does not compare (a string set by code, not a file)."""
+    try:
+        return bool(compare(value, bound))
+    except TypeError:
+        return False
 
 
 def merge_params(*layers: dict[str, Any]) -> dict[str, Any]:

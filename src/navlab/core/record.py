@@ -14,7 +14,7 @@ from typing import Any
 
 from navlab.core.executor import Executor
 from navlab.core.graph import Graph
-from navlab.io.rosbag import GRAPH_KEY, BagWriter
+from navlab.io import GRAPH_KEY, BagWriter
 
 
 class Recorder:

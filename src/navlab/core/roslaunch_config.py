@@ -13,8 +13,7 @@ from typing import Any
 
 from navlab.core.errors import LaunchError, ParameterError
 from navlab.core.params import parse_yaml
-from navlab.io import IoError
-from navlab.io.files import read_text_checked
+from navlab.io import IoError, read_text_checked
 
 #: ``$(find PKG)``: a function ``(package) -> directory`` (ROS_PACKAGE_PATH, then navlab's shipped
 #: packages), and xacro's expansion ``(file, {arg: value}) -> URDF text``; strings, so core does not

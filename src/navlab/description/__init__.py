@@ -11,9 +11,12 @@ from typing import TYPE_CHECKING
 from navlab.lazy import lazy_exports
 
 if TYPE_CHECKING:
-    from navlab.description.errors import DescriptionError
+    from navlab.description.errors import DescriptionError, NotFoundError
     from navlab.description.loader import load_robot, load_robot_named
+    from navlab.description.materials import gazebo_material
+    from navlab.description.meshes import cache_dir, is_convex, prepare_mesh, read_mesh, up_axis_warning
     from navlab.description.model import (
+        ContactTags,
         DiffDriveConfig,
         Geometry,
         ImuConfig,
@@ -24,8 +27,11 @@ if TYPE_CHECKING:
         Origin,
         RobotModel,
         Shape,
+        is_geometry_kind,
     )
-    from navlab.description.packages import PackageIndex
+    from navlab.description.packages import PackageIndex, find_package
+    from navlab.description.sensor_model import BumperConfig, CameraConfig, Lidar3dConfig, RangeConfig, SensorConfig
+    from navlab.description.summary import format_robot, robot_summary, shape_summary
 
 _EXPORTS = {
     "DescriptionError": "navlab.description.errors",
@@ -42,21 +48,57 @@ _EXPORTS = {
     "Shape": "navlab.description.model",
     "load_robot": "navlab.description.loader",
     "load_robot_named": "navlab.description.loader",
+    "BumperConfig": "navlab.description.sensor_model",
+    "CameraConfig": "navlab.description.sensor_model",
+    "ContactTags": "navlab.description.model",
+    "Lidar3dConfig": "navlab.description.sensor_model",
+    "NotFoundError": "navlab.description.errors",
+    "RangeConfig": "navlab.description.sensor_model",
+    "SensorConfig": "navlab.description.sensor_model",
+    "cache_dir": "navlab.description.meshes",
+    "find_package": "navlab.description.packages",
+    "format_robot": "navlab.description.summary",
+    "gazebo_material": "navlab.description.materials",
+    "is_convex": "navlab.description.meshes",
+    "is_geometry_kind": "navlab.description.model",
+    "prepare_mesh": "navlab.description.meshes",
+    "read_mesh": "navlab.description.meshes",
+    "robot_summary": "navlab.description.summary",
+    "shape_summary": "navlab.description.summary",
+    "up_axis_warning": "navlab.description.meshes",
 }
 __all__ = [
+    "BumperConfig",
+    "CameraConfig",
+    "ContactTags",
     "DescriptionError",
     "DiffDriveConfig",
     "Geometry",
     "ImuConfig",
     "Inertial",
     "Joint",
+    "Lidar3dConfig",
     "LidarConfig",
     "Link",
+    "NotFoundError",
     "Origin",
     "PackageIndex",
+    "RangeConfig",
     "RobotModel",
+    "SensorConfig",
     "Shape",
+    "cache_dir",
+    "find_package",
+    "format_robot",
+    "gazebo_material",
+    "is_convex",
+    "is_geometry_kind",
     "load_robot",
     "load_robot_named",
+    "prepare_mesh",
+    "read_mesh",
+    "robot_summary",
+    "shape_summary",
+    "up_axis_warning",
 ]
 __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

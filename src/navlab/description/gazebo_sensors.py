@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import xml.etree.ElementTree as ET
 
-from navlab.core.limits import check_ceiling
+from navlab.core import check_ceiling
 from navlab.description.errors import DescriptionError
 from navlab.description.gazebo_values import number, plugin_file, plugin_rate, ros_remaps, scoped
 from navlab.description.model import ImuConfig, LidarConfig, Origin, P3dConfig

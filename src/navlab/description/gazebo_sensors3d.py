@@ -10,7 +10,7 @@ import math
 import xml.etree.ElementTree as ET
 from typing import Any
 
-from navlab.core.limits import check_ceiling
+from navlab.core import check_ceiling
 from navlab.description.errors import DescriptionError
 from navlab.description.gazebo_sensors import noetic_default, sensor_noise
 from navlab.description.gazebo_values import number, parse_bool, plugin_file, plugin_rate, scoped

@@ -20,8 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from navlab.description.errors import DescriptionError, NotFoundError
-from navlab.io import IoError
-from navlab.io.files import check_regular_file, read_bytes_checked, write_text_atomic
+from navlab.io import IoError, check_regular_file, read_bytes_checked, write_text_atomic
 
 MESH_SUFFIXES = (".stl", ".obj", ".dae")
 _DAE_VERSION = "2"  # bump when the conversion changes (v2: <up_axis> ignored, as in Gazebo classic)

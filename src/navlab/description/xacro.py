@@ -25,11 +25,10 @@ from typing import Any
 import xacro
 from xacro import substitution_args
 
-from navlab.core.safe_eval import MATH_NAMES, ExpressionError, safe_eval
+from navlab.core import MATH_NAMES, ExpressionError, safe_eval
 from navlab.description.errors import DescriptionError
 from navlab.description.packages import PackageIndex
-from navlab.io import IoError
-from navlab.io.files import read_bytes_checked, read_text_checked
+from navlab.io import IoError, read_bytes_checked, read_text_checked
 
 MAX_INCLUDE_DEPTH = 32
 MAX_DESCRIPTION_BYTES = 16 << 20

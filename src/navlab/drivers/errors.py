@@ -1,6 +1,6 @@
 """The drivers' error."""
 
-from navlab.mapping.errors import MappingError
+from navlab.mapping import MappingError
 
 
 class DriverError(MappingError):

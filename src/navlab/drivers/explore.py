@@ -11,7 +11,7 @@ from navlab import msgs
 from navlab.core import Executor, Node, TfError
 from navlab.drivers.frontiers import FrontierSearch, plan_to_frontier, prepare_frontier_search
 from navlab.grid import GridMap
-from navlab.navigation.controllers.pure_pursuit import PurePursuit
+from navlab.navigation import PurePursuit
 
 
 class Explore(Node):

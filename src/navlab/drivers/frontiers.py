@@ -17,8 +17,7 @@ import numpy as np
 from scipy import ndimage
 
 from navlab.grid import COST_INSCRIBED, Grid, GridMap
-from navlab.navigation.costmap import Footprint, InflationLayer, StaticLayer
-from navlab.navigation.planners.common import iheap_pop, iheap_update
+from navlab.navigation import Footprint, InflationLayer, StaticLayer, iheap_pop, iheap_update
 
 OCCUPIED_THRESHOLD = 65  # occupancy (%) from which a cell is an obstacle (map_server's occupied_thresh 0.65)
 COMFORT = 0.4  # m beyond the robot radius over which the costs fall to 0 (plans keep to the middle)

@@ -11,10 +11,9 @@ from typing import Any
 import numpy as np
 
 from navlab import msgs
-from navlab.core import Executor, Node, TfError
-from navlab.core.params import read_yaml
+from navlab.core import Executor, Node, TfError, read_yaml
 from navlab.drivers.errors import DriverError
-from navlab.navigation.controllers.pure_pursuit import PurePursuit
+from navlab.navigation import PurePursuit
 
 
 def load_route(path: str | Path) -> tuple[list[tuple[float, float, float]], np.ndarray]:

@@ -64,7 +64,7 @@ def run_protocol(
     ``collision_monitor``: Nav2's velocity smoother and collision monitor between move_base and the wheels."""
     from tqdm import tqdm
 
-    from navlab.world.clutter import clutter_suite
+    from navlab.world import clutter_suite
 
     if which not in SETS:
         raise ExperimentError(f"bench clutter: --set must be one of {', '.join(SETS)}, got {which!r}")

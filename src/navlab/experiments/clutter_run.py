@@ -118,7 +118,7 @@ def run_clutter_world(
 def barn_outcome(world: Any, goals: list[dict[str, Any]]) -> dict[str, Any]:
     """BARN's judgement of a drive through ``world`` (its goals' figures from ``run_navigation``): success (the
     last goal ended within 1 m, no collision on the way), failure, score, T_opt, the world and its difficulty."""
-    from navlab.world.clutter import barn_score
+    from navlab.world import barn_score
 
     g = goals[-1]
     collisions = sum(x["collisions"] for x in goals)
@@ -155,7 +155,7 @@ def clutter_for_trial(world: str, index: int) -> Any:
     """The generated world of trial ``index`` for a scenario's ``world`` (``clutter:...`` the same world every
     trial; ``clutter_suite:n=N,seed=S`` world ``index mod N`` of ``clutter_suite(N, S)``), None for a file."""
     from navlab.experiments.scenario import clutter_world_spec
-    from navlab.world.clutter import generate_clutter, suite_parameters
+    from navlab.world import generate_clutter, suite_parameters
 
     spec = clutter_world_spec(world)
     if spec is None:

@@ -193,10 +193,10 @@ def run_localization(
         grid=grid,
         unmapped=None if map_yaml is None else unmapped_obstacles(run.sim.world, grid, pose[:2]),
     )
-    from navlab.localization.amcl_node import Amcl
+    from navlab.localization import AmclNode
 
     node = run.node("amcl")
-    assert isinstance(node, Amcl)  # the shipped launch's amcl
+    assert isinstance(node, AmclNode)  # the shipped launch's amcl
     res.summary = rounded(
         {
             "world": world,

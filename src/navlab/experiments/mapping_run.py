@@ -21,7 +21,7 @@ from navlab.experiments.plots import Marks, Track, plot_run
 from navlab.experiments.session import Run, rounded, start_run
 from navlab.geometry import inverse_transform_points2, wrap_angle
 from navlab.grid import GridMap
-from navlab.io.files import check_regular_file
+from navlab.io import check_regular_file
 from navlab.mapping import MappingError, save_map
 from navlab.world import true_occupancy, world_T_map
 
@@ -117,7 +117,7 @@ def run_mapping(
     is_done = _add_driver(run, driver, route)
     monitor = run.add(PoseMonitor, parameters={"base_frame": run.base_frame, "odom_frame": run.odom_frame})
     run.run(duration, until=is_done, record=record, quiet=quiet, desc=f"mapping {world}")
-    from navlab.mapping.slam_node import SlamGMapping
+    from navlab.mapping import SlamGMapping
 
     slam = run.node("slam_gmapping")
     assert isinstance(slam, SlamGMapping)  # the shipped launch's slam_gmapping
@@ -182,7 +182,7 @@ def run_mapping(
 
 def write_trajectory(path: Path, t: np.ndarray, est: np.ndarray, truth: np.ndarray) -> None:
     """The SLAM trajectory beside the true one, one line per sample (read by ``navlab eval map``)."""
-    from navlab.io.files import write_text_atomic
+    from navlab.io import write_text_atomic
 
     ok = np.isfinite(est).all(axis=1)
     rows = np.column_stack([t, est, truth])[ok]

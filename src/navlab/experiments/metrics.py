@@ -21,7 +21,7 @@ from scipy import ndimage
 from navlab.experiments.trajectory import ate
 from navlab.geometry import inverse_transform_points2, transform_points2, wrap_angle
 from navlab.grid import Grid, GridMap
-from navlab.io.poses import read_poses, read_table, write_poses
+from navlab.io import read_poses, read_table, write_poses
 from navlab.mapping import MappingError
 from navlab.world import visible_surface
 

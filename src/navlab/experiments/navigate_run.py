@@ -24,8 +24,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from navlab.core import Node, TfError
-from navlab.core.record import Recorder
+from navlab.core import Node, Recorder, TfError
 from navlab.experiments.navigate_monitor import SAFETY_DISTANCE_M, SAMPLE_S, NavMonitor
 from navlab.experiments.plots import NavSnapshot
 from navlab.experiments.session import Run, rounded, start_run
@@ -35,7 +34,7 @@ from navlab.navigation import STUCK_PREFIX, GoalOutcome, NavigationError, stuck_
 from navlab.world import true_map, unmapped_obstacles
 
 if TYPE_CHECKING:
-    from navlab.navigation.move_base import MoveBase
+    from navlab.navigation import MoveBase
 
 Pose = tuple[float, float, float]
 
@@ -59,7 +58,7 @@ class NavigateResult:
 
 def _move_base(run: Run) -> MoveBase:
     """The run's move_base node (navlab's, as the shipped launch starts it)."""
-    from navlab.navigation.move_base import MoveBase
+    from navlab.navigation import MoveBase
 
     mb = run.node("move_base")
     assert isinstance(mb, MoveBase)

@@ -92,7 +92,7 @@ def route_of(name: str) -> tuple[str, tuple[float, float, float], list[list[floa
 
         return "room", (0.0, 0.0, 0.0), [list(p) for p in (*DEFAULT_ROUTE, DEFAULT_ROUTE[0])], None
     if name == "clutter":
-        from navlab.world.clutter import generate_clutter
+        from navlab.world import generate_clutter
 
         world = generate_clutter(
             int(CLUTTER["seed"]),

@@ -14,7 +14,7 @@ from navlab.geometry import Pose2
 from navlab.grid import Grid, GridMap
 
 if TYPE_CHECKING:
-    from navlab.navigation.costmap.footprint import Footprint
+    from navlab.navigation import Footprint
 
 
 @dataclass
@@ -110,7 +110,7 @@ def plot_run(
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from navlab.io.files import save_figure_atomic
+    from navlab.io import save_figure_atomic
 
     if error is None:
         fig, ax = plt.subplots(figsize=(8, 7))
@@ -291,7 +291,7 @@ def plot_navigation(
     """Save :func:`navigation_figure` as a PNG at ``path`` (atomically); returns the path."""
     import matplotlib.pyplot as plt
 
-    from navlab.io.files import save_figure_atomic
+    from navlab.io import save_figure_atomic
 
     fig = navigation_figure(grid, shot, title=title, goal=goal)
     out = Path(path)

@@ -138,7 +138,7 @@ def folder_kind(folder: Path) -> str:
 
 def render_report(folder: str | Path) -> dict[str, Any]:
     """Re-render ``folder``'s report: ``report.md``, its PNG figures and ``report.html``; returns what it wrote."""
-    from navlab.io.files import write_text_atomic
+    from navlab.io import write_text_atomic
 
     folder = Path(folder)
     if not folder.is_dir():
@@ -257,7 +257,7 @@ def plot_trials(results: list[dict[str, Any]], path: Path, *, title: str = "") -
     import matplotlib.pyplot as plt
     from matplotlib.ticker import MaxNLocator
 
-    from navlab.io.files import save_figure_atomic
+    from navlab.io import save_figure_atomic
 
     trials = [int(r["trial"]) for r in results]
     colours = ["tab:green" if r["success"] else "tab:red" for r in results]

@@ -216,7 +216,7 @@ def scenario_from_dict(data: Any, *, where: str = "scenario", path: Path | None 
 def _future_work_keys(sc: Scenario, data: dict[str, Any], where: str) -> None:
     """wheel_controller, ekf and disturbances, checked here so a bad value fails before any trial."""
     from navlab.errors import NavlabError
-    from navlab.sim.disturbances import parse_disturbances
+    from navlab.sim import parse_disturbances
 
     if "wheel_controller" in data:
         if not isinstance(data["wheel_controller"], str) or not data["wheel_controller"]:
@@ -241,7 +241,7 @@ def load_scenario(name_or_path: str | Path) -> Scenario:
     """A scenario file, or a shipped one by name (``empty_room``, ``obstacles_after_mapping``, ``refresh_rate``,
     ``clutter_suite``)."""
     from navlab import resources
-    from navlab.core.params import read_yaml
+    from navlab.core import read_yaml
 
     p = Path(name_or_path)
     if not p.is_file():

@@ -15,9 +15,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from navlab.core import Executor, Node
-from navlab.core.launch import Session, start
-from navlab.core.runner import run_for
+from navlab.core import Executor, Node, Session, run_for, start
 
 
 @dataclass
@@ -118,7 +116,7 @@ def start_run(
     is called once the launch started (``--view`` attaches the viewer there). ``rate``: the pace (0 = as fast as
     possible, 1 = real time; ``pace``, its old name, is deprecated).
     """
-    from navlab.core.launch import declared_args
+    from navlab.core import declared_args
     from navlab.deprecation import renamed
 
     rate = renamed(rate, pace, old="pace", new="rate", where="start_run")

@@ -91,7 +91,7 @@ def run_sweep(
 
 def write_table(rows: list[dict[str, Any]], names: list[str], folder: Path) -> None:
     """``sweep.csv`` and ``sweep.md``: one row per combination."""
-    from navlab.io.files import write_text_atomic
+    from navlab.io import write_text_atomic
 
     header = [*names, *(c for c in COLUMNS if rows and c in rows[0])]
 
@@ -116,7 +116,7 @@ def plot_sweep(rows: list[dict[str, Any]], names: list[str], folder: Path) -> li
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from navlab.io.files import save_figure_atomic
+    from navlab.io import save_figure_atomic
 
     out = []
     for name in names:

@@ -19,9 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from navlab.geometry import wrap_angle
-from navlab.io import IoError
-from navlab.io.files import check_regular_file
-from navlab.io.poses import read_table
+from navlab.io import IoError, check_regular_file, read_table
 from navlab.mapping import MappingError
 
 CARMEN_SOURCES = ("flaser", "odom", "laser")
@@ -138,7 +136,7 @@ def read_trajectory(
     """
     p = Path(path)
     if _is_carmen(p):
-        from navlab.io.carmen import read_carmen
+        from navlab.io import read_carmen
 
         if carmen not in CARMEN_SOURCES:
             raise IoError(f"CARMEN pose source must be one of {', '.join(CARMEN_SOURCES)}, got {carmen!r}")

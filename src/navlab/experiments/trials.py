@@ -325,7 +325,7 @@ def run_experiments(
     from tqdm import tqdm
 
     from navlab.experiments.backends import run_tasks
-    from navlab.io.files import write_text_atomic
+    from navlab.io import write_text_atomic
 
     done: list[dict[int, dict[str, Any]]] = []
     tasks: list[tuple[Scenario, int]] = []

@@ -2,6 +2,7 @@
 
 import warnings
 
+from navlab.deprecation import NavlabDeprecationWarning
 from navlab.lazy import lazy_exports
 
 _MOVED = ("true_map", "true_occupancy", "truth_grid", "unmapped_obstacles", "visible_surface", "world_T_map")
@@ -9,6 +10,6 @@ __getattr__, __dir__ = lazy_exports(__name__, dict.fromkeys(_MOVED, "navlab.worl
 
 warnings.warn(
     "navlab.experiments.truth moved to navlab.world (navlab.world.truth); the old path works until the next release",
-    DeprecationWarning,
+    NavlabDeprecationWarning,
     stacklevel=2,
 )

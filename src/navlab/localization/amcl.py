@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 from numba import njit
 
-from navlab.core.limits import check_ceiling
+from navlab.core import check_ceiling
 from navlab.geometry import wrap_angle
 from navlab.localization import sampling
 from navlab.localization.errors import LocalizationError

@@ -23,8 +23,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from navlab.core import ParamSpec
-from navlab.core.limits import check_ceiling
+from navlab.core import ParamSpec, check_ceiling
 from navlab.geometry import between2, compose2, wrap_angle
 from navlab.grid import GridMap
 from navlab.mapping.errors import MappingError

@@ -27,12 +27,10 @@ from typing import Any
 
 import numpy as np
 
-from navlab.core import ParameterError
-from navlab.core.params import parse_yaml
+from navlab.core import ParameterError, parse_yaml
 from navlab.errors import closest
 from navlab.grid import GridMap
-from navlab.io import IoError
-from navlab.io.files import read_bytes_checked, read_text_checked, write_bytes_atomic, write_text_atomic
+from navlab.io import IoError, read_bytes_checked, read_text_checked, write_bytes_atomic, write_text_atomic
 from navlab.mapping.errors import MappingError
 
 MODES = ("trinary", "scale", "raw")

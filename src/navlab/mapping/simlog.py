@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from navlab.geometry import between2, compose2, wrap_angle
-from navlab.io.carmen import CarmenLog, LaserScan2D, OdomRecord
+from navlab.io import CarmenLog, LaserScan2D, OdomRecord
 from navlab.mapping.errors import MappingError
 
 
@@ -144,7 +144,7 @@ def record_log(
     """Record a sparse log along ``waypoints`` in the world file (see the module docstring). ``seed`` drives
     the lidar noise and the odometry noise (``noise``, default 5 % scale errors and heading drift)."""
     from navlab.description import load_robot_named
-    from navlab.sim.simulation import Simulation, lidar_angles
+    from navlab.sim import Simulation, lidar_angles
     from navlab.world import load_world
 
     rng = np.random.default_rng(seed)
@@ -190,7 +190,7 @@ def record_log(
 def office_log(seed: int = 0, *, noise: OdometryNoise | None = None, workdir: str | Path | None = None) -> SimLog:
     """``record_log`` on the default generated office floor along its route (``workdir``: where the
     ``.world`` file is written; default a temporary directory, removed afterwards)."""
-    from navlab.world.office import generate_office
+    from navlab.world import generate_office
 
     office = generate_office()
     if workdir is not None:

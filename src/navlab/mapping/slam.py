@@ -15,10 +15,10 @@ from typing import Any
 
 import numpy as np
 
-from navlab.core.node import flatten_params
+from navlab.core import flatten_params
 from navlab.geometry import compose2, inverse2
 from navlab.grid import GridMap
-from navlab.io.carmen import CarmenLog
+from navlab.io import CarmenLog
 from navlab.mapping.errors import MappingError
 from navlab.mapping.mapfile import save_map
 from navlab.mapping.occupancy import build_map
@@ -91,7 +91,7 @@ def run_offline(
 def write_outputs(result: SlamResult, out_dir: str | Path) -> dict[str, Path]:
     """Write map.yaml, map.pgm and poses.txt into ``out_dir`` (created if needed); a picture of them is
     ``experiments.plots.plot_run``'s job."""
-    from navlab.io.poses import write_poses
+    from navlab.io import write_poses
 
     out = Path(out_dir)
     try:

@@ -10,7 +10,7 @@ from typing import Any
 
 import numpy as np
 
-from navlab.core.limits import check_ceiling
+from navlab.core import check_ceiling
 from navlab.navigation.errors import NavigationError
 from navlab.navigation.recovery import ClearCostmapRecovery
 from navlab.plugins import PluginContext, load_plugin, make_plugin

@@ -18,9 +18,7 @@ import numpy as np
 from navlab.core import Executor, Node
 from navlab.errors import NavlabError
 from navlab.grid import COST_FREE, COST_LETHAL, Grid, GridMap
-from navlab.localization.amcl import AmclParams
-from navlab.localization.field import field_from_map
-from navlab.localization.models import Beams
+from navlab.localization import AmclParams, Beams, field_from_map
 from navlab.navigation.costmap.footprint import make_footprint
 from navlab.navigation.costmap.params import costmap_params
 from navlab.navigation.costmap_ros import Costmap2DROS

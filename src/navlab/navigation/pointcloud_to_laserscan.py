@@ -20,7 +20,7 @@ import numpy as np
 from navlab import msgs
 from navlab.core import Node, TfError
 from navlab.geometry import matrix_from_quat
-from navlab.io.pointcloud import move_points, read_xyz
+from navlab.io import move_points, read_xyz
 from navlab.navigation.errors import NavigationError
 
 DOUBLE_MIN, DOUBLE_MAX = sys.float_info.min, sys.float_info.max

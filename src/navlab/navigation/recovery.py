@@ -20,6 +20,11 @@ from navlab.plugins import BuiltFromParams
 Pose = tuple[float, float, float]
 
 
+def _collides(costmaps: dict[str, Any], pose: Pose) -> bool:
+    """Whether the footprint at ``pose`` (local costmap frame) covers a lethal or unknown cell of the local costmap."""
+    return bool(costmaps["local"].footprint_cost(pose) >= COST_INSCRIBED + 1)
+
+
 @dataclass
 class ClearCostmapParams:
     """clear_costmap_recovery: obstacles farther than ``reset_distance``/2 (m, square) are forgotten."""
@@ -90,8 +95,7 @@ class RotateRecovery(BuiltFromParams):
         left = 2 * math.pi - self._turned
         if left < p.tolerance:
             return None
-        ahead = (pose[0], pose[1], pose[2] + min(left, 0.3))
-        if costmaps["local"].footprint_cost(ahead) >= COST_INSCRIBED + 1:
+        if _collides(costmaps, (pose[0], pose[1], pose[2] + min(left, 0.3))):
             return None  # ROS: "Rotation in place would collide"
         w = min(p.max_rotational_vel, max(p.min_in_place_rotational_vel, math.sqrt(2 * p.acc_lim_th * left)))
         return 0.0, w
@@ -125,8 +129,7 @@ class BackUpRecovery(BuiltFromParams):
         self._steps += 1
         if math.dist(pose[:2], self._start[:2]) >= p.backup_dist or self._steps > p.time_allowance * 20:
             return None
-        behind = (pose[0] - 0.1 * math.cos(pose[2]), pose[1] - 0.1 * math.sin(pose[2]), pose[2])
-        if costmaps["local"].footprint_cost(behind) >= COST_INSCRIBED + 1:
+        if _collides(costmaps, (pose[0] - 0.1 * math.cos(pose[2]), pose[1] - 0.1 * math.sin(pose[2]), pose[2])):
             return None
         return -p.backup_speed, 0.0
 

@@ -8,7 +8,7 @@ import time
 from collections.abc import Callable
 from typing import Any, TypeVar
 
-from navlab.core.launch import start
+from navlab.core import start
 from navlab.ros1.bridge import RosBridge, session_params
 from navlab.ros1.services import call_in_executor
 

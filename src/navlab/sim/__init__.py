@@ -11,10 +11,15 @@ from typing import TYPE_CHECKING
 from navlab.lazy import lazy_exports
 
 if TYPE_CHECKING:
+    from navlab.sim.camera_render import CameraRenderer
+    from navlab.sim.decompose import concave_meshes, convex_parts, default_reach, default_workers, robot_reach
+    from navlab.sim.disturbances import parse_disturbances
     from navlab.sim.errors import SimError
     from navlab.sim.gazebo import GazeboSim, launch_sim, load_robot_named, load_world_named
-    from navlab.sim.simulation import Pose3D, Simulation
-    from navlab.sim.spawn import parse_spawn_spec, primitive_model
+    from navlab.sim.render import render_image, save_png
+    from navlab.sim.sensors3d import depth_image, depth_points, lidar3d_ranges, sensor_pose
+    from navlab.sim.simulation import Pose3D, Simulation, lidar_angles
+    from navlab.sim.spawn import check_start_pose, parse_spawn_spec, primitive_model
 
 _EXPORTS = {
     "GazeboSim": "navlab.sim.gazebo",
@@ -26,16 +31,46 @@ _EXPORTS = {
     "load_world_named": "navlab.sim.gazebo",
     "parse_spawn_spec": "navlab.sim.spawn",
     "primitive_model": "navlab.sim.spawn",
+    "CameraRenderer": "navlab.sim.camera_render",
+    "check_start_pose": "navlab.sim.spawn",
+    "concave_meshes": "navlab.sim.decompose",
+    "convex_parts": "navlab.sim.decompose",
+    "default_reach": "navlab.sim.decompose",
+    "default_workers": "navlab.sim.decompose",
+    "depth_image": "navlab.sim.sensors3d",
+    "depth_points": "navlab.sim.sensors3d",
+    "lidar3d_ranges": "navlab.sim.sensors3d",
+    "lidar_angles": "navlab.sim.simulation",
+    "parse_disturbances": "navlab.sim.disturbances",
+    "render_image": "navlab.sim.render",
+    "robot_reach": "navlab.sim.decompose",
+    "save_png": "navlab.sim.render",
+    "sensor_pose": "navlab.sim.sensors3d",
 }
 __all__ = [
+    "CameraRenderer",
     "GazeboSim",
     "Pose3D",
     "SimError",
     "Simulation",
+    "check_start_pose",
+    "concave_meshes",
+    "convex_parts",
+    "default_reach",
+    "default_workers",
+    "depth_image",
+    "depth_points",
     "launch_sim",
+    "lidar3d_ranges",
+    "lidar_angles",
     "load_robot_named",
     "load_world_named",
+    "parse_disturbances",
     "parse_spawn_spec",
     "primitive_model",
+    "render_image",
+    "robot_reach",
+    "save_png",
+    "sensor_pose",
 ]
 __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

@@ -14,7 +14,7 @@ import math
 import mujoco
 import numpy as np
 
-from navlab.description.sensor_model import CameraConfig
+from navlab.description import CameraConfig
 from navlab.sim.builder import GROUP_VISUAL
 from navlab.sim.render import gl_context
 from navlab.sim.sensors3d import sensor_pose

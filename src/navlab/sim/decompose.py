@@ -40,8 +40,7 @@ from typing import Any
 import numpy as np
 
 from navlab.description import Origin
-from navlab.io import IoError
-from navlab.io.files import MAX_TEXT_BYTES, atomic_path, read_bytes_checked
+from navlab.io import MAX_TEXT_BYTES, IoError, atomic_path, read_bytes_checked
 from navlab.sim.errors import SimError
 from navlab.world import WorldModel
 
@@ -73,7 +72,7 @@ MeshKey = tuple[Path, tuple[float, float, float], float | None]
 
 
 def _cache_dir() -> Path:
-    from navlab.description.meshes import cache_dir
+    from navlab.description import cache_dir
 
     return cache_dir().parent / "convex"
 
@@ -178,7 +177,7 @@ def _coacd(path: Path, verts: np.ndarray, faces: np.ndarray, threshold: float, s
 def _compute(
     path: Path, scale: tuple[float, float, float], threshold: float, seed: int, effort: str, cut: float | None = None
 ) -> Parts:
-    from navlab.description.meshes import read_mesh
+    from navlab.description import read_mesh
 
     verts, faces = read_mesh(Path(path))
     verts, faces = weld(verts * np.asarray(scale, dtype=float), faces)

@@ -8,7 +8,7 @@ from typing import Any
 
 from navlab.core import Executor, Node
 from navlab.description import RobotModel
-from navlab.description.loader import load_robot_named as _load_robot_named
+from navlab.description import load_robot_named as _load_robot_named
 from navlab.sim.contacts import CollisionPlugin
 from navlab.sim.errors import SimError
 from navlab.sim.extensions import SimExtensions
@@ -34,8 +34,12 @@ def load_world_named(name_or_path: str) -> WorldModel:
 def _moved(name: str, new: str) -> None:
     import warnings
 
+    from navlab.deprecation import NavlabDeprecationWarning
+
     warnings.warn(
-        f"navlab.sim.{name} moved to {new}; the old name works until the next release", DeprecationWarning, stacklevel=3
+        f"navlab.sim.{name} moved to {new}; the old name works until the next release",
+        NavlabDeprecationWarning,
+        stacklevel=3,
     )
 
 

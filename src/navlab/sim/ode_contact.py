@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import math
 
-from navlab.description.model import ContactTags
+from navlab.description import ContactTags
 
 ODE_STEP = 0.001  # s: Gazebo's default max_step_size, the step whose implicit Euler damps ODE's contacts
 

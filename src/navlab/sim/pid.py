@@ -14,8 +14,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
-from navlab.core import ParamSpec, read_params
-from navlab.core.params import param_error, typed_value
+from navlab.core import ParamSpec, param_error, read_params, typed_value
 from navlab.sim.errors import SimError
 
 

@@ -121,7 +121,7 @@ def save_png(image: np.ndarray, out: str | os.PathLike[str]) -> Path:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from navlab.io.files import write_bytes_atomic
+    from navlab.io import write_bytes_atomic
 
     buf = io.BytesIO()
     plt.imsave(buf, image, format="png")

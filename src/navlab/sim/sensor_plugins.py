@@ -15,9 +15,8 @@ import numpy as np
 
 from navlab import msgs
 from navlab.core import Executor, Node
-from navlab.description.model import Origin
-from navlab.description.sensor_model import BumperConfig, CameraConfig, Lidar3dConfig, RangeConfig, SensorConfig
-from navlab.io.pointcloud import FLOAT32, UINT16, pack_cloud
+from navlab.description import BumperConfig, CameraConfig, Lidar3dConfig, Origin, RangeConfig, SensorConfig
+from navlab.io import FLOAT32, UINT16, pack_cloud
 from navlab.sim.plugins import SensorPlugin
 from navlab.sim.sensors3d import depth_image, depth_points, lidar3d_angles, lidar3d_ranges, range_reading, sensor_pose
 from navlab.sim.simulation import Simulation

@@ -13,10 +13,9 @@ import functools
 import mujoco
 import numpy as np
 
-from navlab.description.model import Origin
-from navlab.description.sensor_model import CameraConfig, Lidar3dConfig, RangeConfig
+from navlab.description import CameraConfig, Lidar3dConfig, Origin, RangeConfig
 from navlab.geometry import matrix_from_quat, qmul, qrotate, quat_from_rpy
-from navlab.io.pointcloud import move_points
+from navlab.io import move_points
 from navlab.sim.raycast3d import ALL, PINHOLE, SPHERICAL, cast_grid, pinhole_dirs, spherical_dirs
 from navlab.sim.simulation import Simulation
 

@@ -15,8 +15,8 @@ from typing import Any
 
 import numpy as np
 
-from navlab.core.limits import ceilings
-from navlab.description.model import Geometry, Inertial, Link, RobotModel, Shape, is_geometry_kind
+from navlab.core import ceilings
+from navlab.description import Geometry, Inertial, Link, RobotModel, Shape, is_geometry_kind
 from navlab.errors import did_you_mean
 from navlab.sim.errors import SimError
 from navlab.world import ModelSpec, WorldModel
@@ -203,7 +203,7 @@ def _corners(shape: Shape, root_T_shape: np.ndarray) -> np.ndarray:
     """Points (k, 3) in the root frame whose convex hull covers the shape (boxes around round shapes)."""
     g = shape.geometry
     if g.kind == "mesh" and g.mesh_path is not None:
-        from navlab.description.meshes import read_mesh
+        from navlab.description import read_mesh
 
         local = read_mesh(g.mesh_path)[0] * np.asarray(g.mesh_scale)
     else:

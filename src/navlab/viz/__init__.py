@@ -7,8 +7,21 @@ Names are imported on first use, so ``navlab --help`` stays fast.
 
 from __future__ import annotations
 
-import importlib
-from typing import Any
+from typing import TYPE_CHECKING
+
+from navlab.lazy import lazy_exports
+
+if TYPE_CHECKING:
+    from navlab.viz.errors import VizError
+    from navlab.viz.foxglove_bridge import FoxgloveBridge
+    from navlab.viz.headless import CHROMIUM, HeadlessPage
+    from navlab.viz.hub import Hub
+    from navlab.viz.live import ViewerNode
+    from navlab.viz.pacer import Pacer
+    from navlab.viz.replay import load_recording, play_bag
+    from navlab.viz.server import ViewerServer
+    from navlab.viz.viewer import Viewer, attach, host_warning, open_in_browser
+
 
 _EXPORTS = {
     "attach": "navlab.viz.viewer",
@@ -21,11 +34,26 @@ _EXPORTS = {
     "load_recording": "navlab.viz.replay",
     "FoxgloveBridge": "navlab.viz.foxglove_bridge",
     "VizError": "navlab.viz.errors",
+    "CHROMIUM": "navlab.viz.headless",
+    "HeadlessPage": "navlab.viz.headless",
+    "host_warning": "navlab.viz.viewer",
+    "open_in_browser": "navlab.viz.viewer",
 }
-__all__ = sorted(_EXPORTS)
+__all__ = [
+    "CHROMIUM",
+    "FoxgloveBridge",
+    "HeadlessPage",
+    "Hub",
+    "Pacer",
+    "Viewer",
+    "ViewerNode",
+    "ViewerServer",
+    "VizError",
+    "attach",
+    "host_warning",
+    "load_recording",
+    "open_in_browser",
+    "play_bag",
+]
 
-
-def __getattr__(name: str) -> Any:
-    if name in _EXPORTS:
-        return getattr(importlib.import_module(_EXPORTS[name]), name)
-    raise AttributeError(f"module 'navlab.viz' has no attribute {name!r}")
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

@@ -22,8 +22,7 @@ from typing import Any
 import numpy as np
 
 from navlab import msgs
-from navlab.core import Executor, Node, TfError
-from navlab.core.graph import Graph, with_layout
+from navlab.core import Executor, Graph, Node, TfError, with_layout
 from navlab.drivers import MOVE_BINDINGS, SPEED_BINDINGS, TeleopState
 from navlab.viz.hub import Hub
 from navlab.viz.inputs import check_input

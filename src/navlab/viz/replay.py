@@ -17,9 +17,8 @@ from typing import Any
 import numpy as np
 
 from navlab import msgs
-from navlab.core import TfBuffer, TfError
-from navlab.core.graph import with_layout
-from navlab.io.rosbag import bag_graph, bag_topics, read_bag
+from navlab.core import TfBuffer, TfError, with_layout
+from navlab.io import bag_graph, bag_topics, read_bag
 from navlab.viz.errors import VizError
 from navlab.viz.hub import Hub
 from navlab.viz.inputs import check_input

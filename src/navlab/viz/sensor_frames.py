@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-from navlab.io.pointcloud import move_points, read_xyz
+from navlab.io import move_points, read_xyz
 from navlab.viz.frames import pack
 
 IMAGE_MAX_W = 160

@@ -37,7 +37,8 @@ from scipy import ndimage
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import dijkstra
 
-from navlab.io.files import write_text_atomic
+from navlab.deprecation import NavlabDeprecationWarning
+from navlab.io import write_text_atomic
 from navlab.world.clutter_geometry import Clearance
 from navlab.world.errors import WorldError
 from navlab.world.sdf_writer import box_geometry, cylinder_geometry, link, static_model, world_sdf
@@ -414,7 +415,7 @@ def generate_clutter(
         warnings.warn(
             "generate_clutter(margin=...) is ignored and will be removed: worlds are no longer carved; each is "
             "drawn until the robot's configuration space (robot_cells) connects the field's ends, as BARN's",
-            DeprecationWarning,
+            NavlabDeprecationWarning,
             stacklevel=2,
         )
     _check_options(fill, smooth, robot_radius, robot_cells, fill_threshold, clear_threshold)
@@ -500,7 +501,7 @@ def clutter_suite(
     if margin is not None:
         warnings.warn(
             "clutter_suite(margin=...) is ignored and will be removed (nothing is carved any more)",
-            DeprecationWarning,
+            NavlabDeprecationWarning,
             stacklevel=2,
         )
     return [

@@ -13,8 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from navlab.description import Shape
-from navlab.description.meshes import read_mesh
+from navlab.description import Shape, read_mesh
 from navlab.geometry import matrix_from_pose6
 from navlab.world.errors import WorldError
 from navlab.world.model import WorldModel

@@ -29,7 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
-from navlab.io.files import write_text_atomic
+from navlab.io import write_text_atomic
 from navlab.world.errors import WorldError
 from navlab.world.sdf_writer import box_geometry, link, static_model, world_sdf
 

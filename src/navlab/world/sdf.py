@@ -18,10 +18,21 @@ from collections.abc import Iterable, Iterator
 from pathlib import Path
 
 from navlab import resources
-from navlab.description import Geometry, Inertial, Link, Origin, PackageIndex, Shape
-from navlab.description.errors import DescriptionError, NotFoundError
-from navlab.description.materials import gazebo_material
-from navlab.description.meshes import is_convex, prepare_mesh, read_mesh, up_axis_warning
+from navlab.description import (
+    DescriptionError,
+    Geometry,
+    Inertial,
+    Link,
+    NotFoundError,
+    Origin,
+    PackageIndex,
+    Shape,
+    gazebo_material,
+    is_convex,
+    prepare_mesh,
+    read_mesh,
+    up_axis_warning,
+)
 from navlab.geometry import compose6
 from navlab.world.errors import WorldError
 from navlab.world.model import ModelSpec, Pose6, WorldModel

@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from navlab.description.summary import shape_summary
+from navlab.description import shape_summary
 from navlab.world.model import WorldModel
 from navlab.world.occupancy import extents
 

@@ -17,7 +17,7 @@ from typing import Any, Self
 import numba
 import numpy as np
 
-from navlab.core.params import param_error
+from navlab.core import param_error
 from navlab.geometry import wrap_angle
 from navlab.grid import Grid
 from navlab.navigation.errors import NavigationError

@@ -34,8 +34,7 @@ import numba
 import numpy as np
 from scipy.signal import savgol_coeffs
 
-from navlab.core import ParamSpec, read_params
-from navlab.core.limits import check_ceiling
+from navlab.core import ParamSpec, check_ceiling, read_params
 from navlab.errors import did_you_mean
 from navlab.grid import COST_INSCRIBED, Grid
 from navlab.navigation.controllers import mppi_critics as critics

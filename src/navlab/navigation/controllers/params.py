@@ -20,8 +20,7 @@ import math
 from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
-from navlab.core import ParamSpec
-from navlab.core.limits import check_ceiling
+from navlab.core import ParamSpec, check_ceiling
 from navlab.navigation.controllers.common import bad
 from navlab.navigation.errors import NavigationError
 

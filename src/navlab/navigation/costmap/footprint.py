@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from navlab.core.limits import check_ceiling
+from navlab.core import check_ceiling
 from navlab.grid import Grid
 from navlab.navigation.costmap.kernels import circle_cells
 from navlab.navigation.errors import NavigationError

@@ -16,6 +16,7 @@ from typing import Any, Self
 
 import numpy as np
 
+from navlab.deprecation import NavlabDeprecationWarning
 from navlab.grid import Grid
 from navlab.navigation.costmap.footprint import Footprint, make_footprint
 from navlab.navigation.costmap.params import CostmapParams
@@ -73,7 +74,7 @@ class Layer:
             raise NotImplementedError(f"{cls.__name__} has no from_params(params, *, context)")
         warnings.warn(
             f"{cls.__name__}.from_costmap_params is deprecated: implement from_params(params, *, context)",
-            DeprecationWarning,
+            NavlabDeprecationWarning,
             stacklevel=2,
         )  # a layer written for the old hook: one release
         footprint = context.footprint if isinstance(context.footprint, Footprint) else make_footprint()
@@ -84,7 +85,7 @@ class Layer:
         """Deprecated (one release): ``from_params`` with the layer's namespace and a ``PluginContext``."""
         warnings.warn(
             "Layer.from_costmap_params is deprecated: use from_params(params, *, context)",
-            DeprecationWarning,
+            NavlabDeprecationWarning,
             stacklevel=2,
         )
         context = PluginContext(name=name, footprint=footprint, costmap=costmap)

@@ -15,8 +15,7 @@ import math
 from dataclasses import dataclass, field, fields, replace
 from typing import TYPE_CHECKING, Any, ClassVar, TypeVar
 
-from navlab.core.limits import check_ceiling
-from navlab.core.params import ParamSpec, canonical_params, check_unknown_key, read_params
+from navlab.core import ParamSpec, canonical_params, check_ceiling, check_unknown_key, read_params
 from navlab.navigation.errors import NavigationError
 
 if TYPE_CHECKING:

@@ -20,7 +20,7 @@ from typing import Any, ClassVar, Self
 
 import numpy as np
 
-from navlab.core.params import ParamSpec, read_params
+from navlab.core import ParamSpec, read_params
 from navlab.grid import COST_FREE, COST_LETHAL, COST_UNKNOWN, Grid
 from navlab.navigation.costmap.kernels import combine
 from navlab.navigation.costmap.layer import Layer, origin_shift, same_geometry, shifted
