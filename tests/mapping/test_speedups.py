@@ -24,9 +24,9 @@ def _tiled(grid: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return pool.tiles, table
 
 
-def _plain_climb(tiled, args, x0, y0, t0, lstep, astep, iterations):
+def _plain_climb(tiled, lattice, scan, model, x0, y0, t0, lstep, astep, iterations):
     """GMapping's ScanMatcher::optimize scoring every candidate in full (the reference)."""
-    cur = match_score(*tiled, *args[:5], x0, y0, t0, *args[5:])[0]
+    cur = match_score(*tiled, lattice, (x0, y0, t0), scan, model)[0]
     cx, cy, ct = x0, y0, t0
     ld, ad, refinement, best = lstep, astep, 0, -1.0
     while True:
@@ -45,7 +45,7 @@ def _plain_climb(tiled, args, x0, y0, t0, lstep, astep, iterations):
             (cx, cy, ct + ad),
             (cx, cy, ct - ad),
         ):
-            sc = match_score(*tiled, *args[:5], nx, ny, nt, *args[5:])[0]
+            sc = match_score(*tiled, lattice, (nx, ny, nt), scan, model)[0]
             if sc > cur:
                 cur, bx, by, bt = sc, nx, ny, nt
         cx, cy, ct = bx, by, bt
@@ -76,11 +76,11 @@ def test_the_hill_climb_equals_gmappings_plain_climb() -> None:
     for skip in (0, 4):
         for k in range(12):
             x0, y0, t0 = 2.5 + rng.normal(0, 0.08), 2.0 + rng.normal(0, 0.08), 0.1 + rng.normal(0, 0.05)
-            args = (0.0, 0.0, 0, 0, 0.05, r, np.cos(ang), np.sin(ang), 8.0, 1, 0.05, 0.075, skip)
-            got = optimize(*tiled, *args[:5], x0, y0, t0, *args[5:], 0.05, 0.05, 5)
-            want = _plain_climb(tiled, args, x0, y0, t0, 0.05, 0.05, 5)
+            lattice, scan, model = (0.0, 0.0, 0, 0, 0.05), (r, np.cos(ang), np.sin(ang), 8.0), (1, 0.05, 0.075, skip)
+            got = optimize(*tiled, lattice, (x0, y0, t0), scan, model, (0.05, 0.05, 5))
+            want = _plain_climb(tiled, lattice, scan, model, x0, y0, t0, 0.05, 0.05, 5)
             assert got[:4] == want, (skip, k)
-            assert got[4] == match_score(*tiled, *args[:5], *got[:3], *args[5:])[1]  # the log-likelihood at the result
+            assert got[4] == match_score(*tiled, lattice, got[:3], scan, model)[1]  # the log-likelihood at the result
 
 
 def _plain_score(grid, ox, oy, res, x, y, t, r, ang, max_urange, kernel, sigma, lsigma, skip):
@@ -122,7 +122,8 @@ def test_the_score_equals_gmappings_plain_score_for_every_kernel_and_near_the_ed
     for x, y, t in ((2.5, 2.0, 0.1), (2.2, 1.7, -0.4), (0.3, 0.2, 0.0), (5.2, 4.2, 2.0)):
         for kernel in (0, 1, 2):
             for skip in (0, 3):
-                got = match_score(*tiled, 0.0, 0.0, 0, 0, 0.05, x, y, t, r, cb, sb, 8.0, kernel, 0.05, 0.075, skip)
+                scan, model = (r, cb, sb, 8.0), (kernel, 0.05, 0.075, skip)
+                got = match_score(*tiled, (0.0, 0.0, 0, 0, 0.05), (x, y, t), scan, model)
                 want = _plain_score(grid, 0.0, 0.0, 0.05, x, y, t, r, ang, 8.0, kernel, 0.05, 0.075, skip)
                 assert got == want, (x, y, t, kernel, skip)
 
@@ -188,7 +189,8 @@ def test_the_tiled_ray_cast_writes_the_dense_cells_and_copies_only_shared_tiles(
     in_use = pool.in_use()
     for _ in range(2):  # the second time every tile written is already private: no copies
         free = pool.free(mine.size)  # (may grow the pool: its arrays are read after)
-        raycast_tiles(pool.tiles, mine, pool.refs, free, np.zeros(1, dtype=np.int64), 0.0, 0.0, 0, 0, *args)
+        cow = (pool.tiles, mine, pool.refs, free, np.zeros(1, dtype=np.int64))
+        raycast_tiles(*cow, (0.0, 0.0, 0, 0, 0.05), (2.5, 2.0, 0.1), (r, ang, 8.0, 10.0), (L_OCC, L_FREE, L_CLAMP))
     whole = grid.copy()
     _raycast(whole, 0.0, 0.0, 0, 0, *args)
     _raycast(whole, 0.0, 0.0, 0, 0, *args)

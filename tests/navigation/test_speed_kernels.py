@@ -109,3 +109,49 @@ def test_kld_bin_count_and_tracking_distance_equal_their_plain_forms() -> None:
     t = np.clip(((pts[:, None] - a) * ab).sum(axis=2) / (ab**2).sum(axis=1), 0, 1)
     expected = np.hypot(*(pts[:, None] - (a + t[..., None] * ab)).transpose(2, 0, 1)).min(axis=1)
     np.testing.assert_allclose(distance_to_path(pts, path), expected, rtol=1e-12)
+
+
+def test_controller_scene_kernel_equals_the_plain_steps() -> None:
+    """The rollout controllers' compiled scene set-up gives the plan stretch, plan cells and path distances the
+    separate steps give (frame change, crop, cells, cells under the robot, wave), for every free-cell mode."""
+    from navlab.navigation.controllers import mapgrid
+    from navlab.navigation.controllers.common import LocalFrame, circle_footprint, crop_plan, footprint_outline
+    from navlab.navigation.controllers.rollout import footprint_cells
+    from navlab.navigation.controllers.scene_kernel import moved_length, path_scene, poses_out
+
+    rng = np.random.default_rng(4)
+    square = np.array([[0.25, 0.2], [-0.2, 0.2], [-0.2, -0.2], [0.25, -0.2]])
+    for trial in range(60):
+        cost = np.where(rng.random((60, 70)) < 0.08, 254, rng.integers(0, 200, (60, 70))).astype(np.uint8)
+        cost[rng.random(cost.shape) < 0.01] = 255
+        origin = (float(rng.uniform(-3, 3)), float(rng.uniform(-3, 3)), 0.0)
+        frame = LocalFrame(*origin)
+        pose = (origin[0] + float(rng.uniform(0, 3.5)), origin[1] + float(rng.uniform(0, 3.0)), rng.uniform(-3, 3))
+        plan = np.cumsum(rng.normal(0, 0.08, (int(rng.integers(1, 120)), 2)), axis=0) + pose[:2]
+        if trial % 7 == 0:
+            plan += 5.0  # far from the robot: nothing to crop
+        pose_l = frame.pose_in(pose)
+        polygon = square if trial % 2 else circle_footprint(0.2)
+        edges = footprint_outline(polygon, RES)
+        for mode in (0, 1, 2):
+            got_plan, got_cells, got_dist = path_scene(
+                cost, plan, *origin, RES, pose_l, 0.5 * RES * 70, mode, polygon, edges
+            )
+            want_plan = crop_plan(frame.points_in(plan), pose_l[0], pose_l[1], 0.5 * RES * 70)
+            np.testing.assert_array_equal(got_plan, want_plan)
+            if len(want_plan) == 0:
+                continue
+            want_cells = mapgrid.plan_cells(cost, want_plan, RES)
+            np.testing.assert_array_equal(got_cells, want_cells)
+            if len(want_cells) == 0:
+                continue
+            free = None if mode == 0 else footprint_cells(cost.shape, RES, pose_l, polygon if mode == 2 else None)
+            np.testing.assert_array_equal(got_dist, mapgrid.distance_map(cost, want_cells, free))
+    for path in (np.zeros((4, 3)), np.array([[0, 0, 0], [0.1, 0, 0], [0.2, 0, 0], [0.2, 0, 0]], float)):
+        moved = np.nonzero(np.any(path[1:] != path[:-1], axis=1))[0]  # _finish's plain form
+        assert moved_length(path) == ((int(moved[-1]) + 2) if len(moved) else 1)
+    for oyaw in (0.0, 0.7, -2.9):
+        frame = LocalFrame(1.25, -3.5, oyaw)
+        poses = rng.uniform(-7, 7, (40, 3))
+        got = poses_out(poses, 25, frame.ox, frame.oy, oyaw, math.cos(oyaw), math.sin(oyaw))
+        np.testing.assert_array_equal(got, frame.poses_out(poses[:25]))

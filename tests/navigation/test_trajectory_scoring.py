@@ -41,23 +41,24 @@ def planner(**over: object) -> TrajectoryPlannerROS:
     return TrajectoryPlannerROS(benchmark_params(**over), footprint=FOOTPRINT)
 
 
-def test_meter_scoring_scales_the_distance_biases_not_occdist():
-    """ROS 1: meter_scoring multiplies pdist_scale and gdist_scale by the resolution; occdist_scale stays as given."""
+def test_meter_scoring_scales_all_three_biases_as_noetic_scores_once_running():
+    """Noetic's start-up reconfigure re-reads the biases and scales pdist, gdist and occdist together (its
+    meter_scoring_ reading true) or none (reading false): costs x resolution, the same choice, either way."""
     world = gap_world(0.7)
     start = (0.1, 0.0, 0.0)  # facing the gap: every rollout's footprint reaches the inflated band
     plan = syn.grid_plan(world, start[:2], (3.0, 0.0))
-    costs = {}
+    costs, commands = {}, {}
     for meter in (True, False):
-        for weights in ((0.0, 0.0, 0.1), (0.75, 1.0, 0.0)):
+        for weights in ((0.0, 0.0, 0.1), (0.75, 1.0, 0.0), (0.75, 1.0, 0.1)):
             tp = planner(meter_scoring=meter, pdist_scale=weights[0], gdist_scale=weights[1], occdist_scale=weights[2])
             tp.set_plan(plan)
-            tp.compute_velocity(start, (0.0, 0.0), syn.window(world, *start[:2], 6.0))
-            costs[meter, weights[2] > 0] = tp.costs
-    ok = costs[False, True] >= 0
-    assert ok.sum() > 10 and costs[False, True][ok].max() > 0  # obstacle costs are in play
-    np.testing.assert_allclose(costs[True, True][ok], costs[False, True][ok])  # occupancy: not scaled
-    ok = costs[False, False] >= 0
-    np.testing.assert_allclose(costs[True, False][ok], RES * costs[False, False][ok])  # distances: x resolution
+            commands[meter, weights] = tp.compute_velocity(start, (0.0, 0.0), syn.window(world, *start[:2], 6.0))[:2]
+            costs[meter, weights] = tp.costs
+    for weights in ((0.0, 0.0, 0.1), (0.75, 1.0, 0.0), (0.75, 1.0, 0.1)):
+        ok = costs[False, weights] >= 0
+        assert ok.sum() > 10 and costs[False, weights][ok].max() > 0
+        np.testing.assert_allclose(costs[True, weights][ok], RES * costs[False, weights][ok])
+        assert commands[True, weights] == commands[False, weights]
 
 
 def test_in_place_turn_scores_the_standstill_distances_and_wins_only_when_no_dearer():
@@ -80,19 +81,41 @@ def test_in_place_turn_scores_the_standstill_distances_and_wins_only_when_no_dea
         assert (tp.costs[in_place].min() <= tp.costs[forward].min()) == turns
 
 
+def closed_loop(world: Grid, tp: TrajectoryPlannerROS, start: tuple[float, float, float], seconds: float = 30.0):
+    """The controller alone (no move_base: no oscillation timeout, no recovery) driving a kinematic robot from
+    rest at ``start`` to (3, 0) at 20 Hz, the commanded velocity being the next cycle's; (reached, in-place
+    turns commanded, final pose)."""
+    tp.set_plan(syn.grid_plan(world, start[:2], (3.0, 0.0)))
+    pose, vel, turns = start, (0.0, 0.0), 0
+    for _ in range(round(seconds * 20)):
+        if math.hypot(pose[0] - 3.0, pose[1]) <= 0.25:
+            return True, turns, pose
+        vel = tuple(tp.compute_velocity(pose, vel, syn.window(world, pose[0], pose[1], 6.0))[:2])
+        assert tp.valid
+        turns += vel[0] == 0.0 and vel[1] != 0.0
+        x, y, th = pose
+        pose = (x + vel[0] * math.cos(th) * 0.05, y + vel[0] * math.sin(th) * 0.05, th + vel[1] * 0.05)
+    return False, turns, pose
+
+
 def test_benchmark_settings_drive_through_a_gap_wider_than_the_padded_robot_and_its_inflation():
     """dwa: true at 0.5 m/s, no oscillation timeout (the controller alone): through a 1.2 m gap to the goal 3 m
     past the start, in a kinematic closed loop (the commanded velocity is the next cycle's)."""
-    world = gap_world(1.2)
-    start = (-1.0, 0.2, 0.3)
-    tp = planner()
-    tp.set_plan(syn.grid_plan(world, start[:2], (3.0, 0.0)))
-    pose, vel = start, (0.0, 0.0)
-    for _ in range(600):  # 30 s
-        if math.hypot(pose[0] - 3.0, pose[1]) <= 0.25:
-            break
-        vel = tp.compute_velocity(pose, vel, syn.window(world, pose[0], pose[1], 6.0))
-        assert tp.valid
-        x, y, th = pose
-        pose = (x + vel[0] * math.cos(th) * 0.05, y + vel[0] * math.sin(th) * 0.05, th + vel[1] * 0.05)
-    assert math.hypot(pose[0] - 3.0, pose[1]) <= 0.25, pose
+    reached, _, pose = closed_loop(gap_world(1.2), planner(), (-1.0, 0.2, 0.3))
+    assert reached, pose
+
+
+def test_a_spot_where_the_old_scoring_spun_now_moves_on():
+    """The benchmark's settings (dwa: true, 0.5 m/s, meter_scoring, the controller alone: oscillation timeout 0),
+    at rest 0.55 m before an 0.8 m gap, turned 0.5 rad away from it: turning in place sweeps the padded corners
+    through the blocks' inflation (cost ~200). Scored as noetic scores once running (the three biases x the
+    resolution), a forward move through the gap (occdist x 253 in the inscribed band, less 1 m of progress) is
+    cheaper than that turn, and the robot drives through. The old scoring (pdist and gdist x the resolution,
+    occdist as given: initialize's values, which noetic's start-up reconfigure replaces) valued the same metre of
+    progress 20 times less: the turn won, cycle after cycle, and the robot spun for ever."""
+    world, start = gap_world(0.8), (0.25, 0.0, 0.5)
+    reached, turns, pose = closed_loop(world, planner(), start)
+    assert reached and turns <= 20, (turns, pose)
+    old = planner(meter_scoring=False, pdist_scale=0.75 * RES, gdist_scale=1.0 * RES)  # the old weights
+    reached, turns, pose = closed_loop(world, old, start)
+    assert not reached and turns > 300 and pose[0] < 0.8, (turns, pose)  # never into the gap

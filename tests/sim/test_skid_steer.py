@@ -181,3 +181,30 @@ def test_controllers_are_found_by_type() -> None:
     assert set(found.names) == {"base", "arm", "joints"}  # their keys are the YAML's, not unknown parameters
     assert found.ignored == ("arm (position_controllers/JointTrajectoryController)",)
     assert find_controllers({"mobile_base_controller.left_wheel": "w"}).diff_drive == "mobile_base_controller"
+
+
+def test_turning_in_place_pivots_nearer_the_heavier_front_axle() -> None:
+    """jackal_skid's centre of mass sits 12 mm ahead of the chassis centre, as the Jackal's: its front wheels carry
+    more load and grip harder sideways, so turning in place it pivots about a point ahead of base_link, which
+    circles round it instead of standing still (a centred robot's base_link stays within a few millimetres)."""
+    from navlab.core.launch import start
+
+    s = start("sim", launch_args={"robot": "jackal_skid", "ekf": "false"})
+    truth: list = []
+    watch = Node(s.executor, name="watch")
+    watch.create_subscription(msgs.Odometry, "/ground_truth/odom", truth.append, 100)
+    cmd = watch.create_publisher(msgs.Twist, "/cmd_vel", 1)
+    watch.create_timer(0.05, lambda: cmd.publish(msgs.twist(0.0, 0.314)))  # the benchmark's in-place turn rate
+    s.run(12.0)
+    xy = np.array([(m.pose.pose.position.x, m.pose.pose.position.y) for m in truth])[len(truth) // 6 :]
+    yaw = np.array([2 * math.atan2(m.pose.pose.orientation.z, m.pose.pose.orientation.w) for m in truth])
+    yaw = yaw[len(truth) // 6 :]
+    # the circle base_link runs on (least squares), and its centre seen from the robot
+    a = np.c_[2 * xy, np.ones(len(xy))]
+    cx, cy, _ = np.linalg.lstsq(a, (xy**2).sum(axis=1), rcond=None)[0]
+    dx, dy = cx - xy[:, 0], cy - xy[:, 1]
+    ahead = np.cos(yaw) * dx + np.sin(yaw) * dy
+    aside = -np.sin(yaw) * dx + np.cos(yaw) * dy
+    assert np.ptp(yaw) > 2.0  # it turned (0.314 rad/s for 10 s)
+    assert 0.02 < np.median(ahead) < 0.131 and abs(np.median(aside)) < 0.02, (np.median(ahead), np.median(aside))
+    assert np.ptp(ahead) < 0.02, np.ptp(ahead)  # one pivot, fixed in the robot

@@ -12,9 +12,11 @@ room_obstacles.world) on the paper's robot with one sensor added and read every 
   subscribed;
 - ``lidar_nav_rtf``: mybot alone, for comparison.
 
-Per-frame costs (ms, CPU, medians): ``depth_frame_ms`` (ray casting 320 x 240), ``velodyne_scan_ms``
-(30,000 rays), ``rgb_frame_ms`` (render + read), ``voxel_update_ms`` (one depth cloud into a 4 x 4 m voxel
-layer). ``goals_succeeded`` per run shows the stack still drove.
+Per-frame costs (ms, CPU, medians): ``depth_frame_ms`` (the 320 x 240 depth image: shapes drawn into a depth
+buffer, noise), ``depth_cloud_ms`` (its organised PointCloud2), ``velodyne_scan_ms`` (30,000 rays swept shape by
+shape, noise), ``velodyne_cloud_ms`` (its PointCloud2), ``rgb_frame_ms`` (render + read), ``voxel_update_ms`` (one
+depth cloud message into a 4 x 4 m voxel layer, as a costmap takes it: read in the camera's frame and moved point
+by point). ``goals_succeeded`` per run shows the stack still drove.
 """
 
 from __future__ import annotations
@@ -120,11 +122,12 @@ def _per_frame(fn: Any, repeat: int = 20) -> float:
 
 def _frames() -> dict[str, float]:
     """Per-frame CPU costs of the sensors and the voxel update, in room_obstacles from the origin."""
+    from navlab.core import Executor
     from navlab.description import load_robot
     from navlab.grid import Grid
-    from navlab.io import move_points
+    from navlab.io import read_xyz
     from navlab.navigation import ObservationSource, VoxelLayer
-    from navlab.sim import Simulation, depth_image, depth_points, lidar3d_ranges, sensor_pose
+    from navlab.sim import DepthCameraPlugin, Simulation, VelodynePlugin, depth_image, lidar3d_ranges, sensor_pose
     from navlab.world import load_world
 
     with tempfile.TemporaryDirectory(prefix="navlab-bench-sensors-") as tmp:
@@ -134,9 +137,18 @@ def _frames() -> dict[str, float]:
     robot = load_robot("mybot_depth")
     cam = robot.sensors.cameras[0]
     sim = Simulation(robot, load_world("room_obstacles"), visuals=True)
-    out = {"depth_frame_ms": _per_frame(lambda: depth_image(sim, cam, np.random.default_rng(0)))}
+    rng = np.random.default_rng(0)
+    depth = depth_image(sim, cam, rng)
+    camera = DepthCameraPlugin(Executor(), sim=sim, config=cam)
+    out = {
+        "depth_frame_ms": _per_frame(lambda: depth_image(sim, cam, rng)),
+        "depth_cloud_ms": _per_frame(lambda: camera.cloud(depth, 0)),
+    }
     lidar.link = "chassis"
-    out["velodyne_scan_ms"] = _per_frame(lambda: lidar3d_ranges(sim, lidar, np.random.default_rng(0)))
+    ranges = lidar3d_ranges(sim, lidar, rng)
+    velodyne = VelodynePlugin(Executor(), sim=sim, config=lidar)
+    out["velodyne_scan_ms"] = _per_frame(lambda: lidar3d_ranges(sim, lidar, rng))
+    out["velodyne_cloud_ms"] = _per_frame(lambda: velodyne.cloud(ranges, 0))
     try:
         from navlab.sim import CameraRenderer
 
@@ -145,10 +157,9 @@ def _frames() -> dict[str, float]:
         renderer.close()
     except Exception:  # no offscreen GL here
         out["rgb_frame_ms"] = float("nan")
-    pts = depth_points(depth_image(sim, cam), cam).reshape(-1, 3)
     pos, rot = sensor_pose(sim, cam.link, cam.origin)
-    body = np.stack([pts[:, 2], -pts[:, 0], -pts[:, 1]], axis=1)  # optical -> camera body
-    cloud = move_points(body[np.isfinite(body.sum(axis=1))], rot, pos)
+    optical = np.array([[0.0, 0.0, 1.0], [-1.0, 0.0, 0.0], [0.0, -1.0, 0.0]])  # optical -> camera body axes
+    points = read_xyz(camera.cloud(depth, 0), copy=False)
     layer = VoxelLayer(
         {"z_resolution": 0.05, "z_voxels": 8},
         name="voxel",
@@ -159,7 +170,7 @@ def _frames() -> dict[str, float]:
         },
     )
     layer.match_size(Grid(np.zeros((80, 80), np.uint8), 0.05, (-2.0, -2.0, 0.0), "odom"))
-    out["voxel_update_ms"] = _per_frame(lambda: layer.add_cloud(pos, cloud, source="cam"))
+    out["voxel_update_ms"] = _per_frame(lambda: layer.add_sensor_cloud(pos, rot @ optical, points, source="cam"))
     return out
 
 

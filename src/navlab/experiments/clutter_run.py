@@ -47,6 +47,10 @@ CLUTTER_PARAMS: dict[str, Any] = {
     "progress_checker.movement_time_allowance": 10.0,
 }
 CLUTTER_ROBOTS = ("mybot", "jackal")
+# Any other robot drives with its files as ROS 1's move_base reads them: that move_base has no progress checker (a
+# robot that stops making progress goes on until its oscillation timeout, recoveries or the 100 s limit), so
+# navlab's Nav2-style one is off for them unless the caller's parameters ask for it.
+OWN_FILES_PARAMS: dict[str, Any] = {"progress_checker.movement_time_allowance": 0.0}
 
 
 def run_clutter_world(
@@ -69,7 +73,8 @@ def run_clutter_world(
         path = world.write_world(Path(tmp) / f"{world.name}.world")
         gx, gy, gyaw = (float(v) for v in between2(world.start, world.goal))  # the goal in odom (= the start)
         sx, sy, syaw = (float(v) for v in world.start)
-        params = {**(CLUTTER_PARAMS if robot in CLUTTER_ROBOTS else {}), **(move_base_params or {})}
+        own = CLUTTER_PARAMS if robot in CLUTTER_ROBOTS else OWN_FILES_PARAMS
+        params = {**own, **(move_base_params or {})}
         r = run_navigation(
             [(gx, gy, gyaw)],
             world=str(path),

@@ -89,6 +89,7 @@ def run_trial(sc: Scenario, index: int) -> dict[str, Any]:
     from navlab.experiments.clutter_run import (
         CLUTTER_PARAMS,
         CLUTTER_ROBOTS,
+        OWN_FILES_PARAMS,
         SUCCESS_M,
         barn_outcome,
         clutter_for_trial,
@@ -104,7 +105,7 @@ def run_trial(sc: Scenario, index: int) -> dict[str, Any]:
         map_yaml: str | Path | None = None
         if clutter is not None:
             world = str(clutter.write_world(Path(tmp) / f"{clutter.name}.world"))
-            own = CLUTTER_PARAMS if sc.robot in CLUTTER_ROBOTS else {}  # other robots: their own files (clutter_run)
+            own = CLUTTER_PARAMS if sc.robot in CLUTTER_ROBOTS else OWN_FILES_PARAMS  # their own files (clutter_run)
             start, overrides = clutter.start, {**own, **sc.overrides}
         if sc.map == "map_first":
             mapped = run_mapping(

@@ -27,12 +27,14 @@ __all__ = [
     "bag_graph",
     "bag_topics",
     "check_regular_file",
+    "cloud_message",
     "data_dir",
     "data_file",
     "dataset",
     "machine_memory_bytes",
     "move_points",
     "pack_cloud",
+    "point_field",
     "read_bag",
     "read_bytes_checked",
     "read_carmen",
@@ -63,7 +65,7 @@ if TYPE_CHECKING:
         write_bytes_atomic,
         write_text_atomic,
     )
-    from navlab.io.pointcloud import FLOAT32, UINT16, move_points, pack_cloud, read_xyz
+    from navlab.io.pointcloud import FLOAT32, UINT16, cloud_message, move_points, pack_cloud, point_field, read_xyz
     from navlab.io.poses import read_poses, read_table, write_poses
     from navlab.io.rosbag import GRAPH_KEY, BagWriter, bag_graph, bag_topics, read_bag, reindex_bag
 
@@ -80,10 +82,12 @@ _EXPORTS = {
     "bag_graph": "navlab.io.rosbag",
     "bag_topics": "navlab.io.rosbag",
     "check_regular_file": "navlab.io.files",
+    "cloud_message": "navlab.io.pointcloud",
     "data_file": "navlab.io.datasets",
     "machine_memory_bytes": "navlab.io.files",
     "move_points": "navlab.io.pointcloud",
     "pack_cloud": "navlab.io.pointcloud",
+    "point_field": "navlab.io.pointcloud",
     "read_bag": "navlab.io.rosbag",
     "read_bytes_checked": "navlab.io.files",
     "read_carmen": "navlab.io.carmen",

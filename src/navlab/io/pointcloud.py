@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from typing import Any
 
+import numba
 import numpy as np
 
 from navlab import msgs
@@ -28,7 +29,8 @@ _DTYPES = {
 POINT_STEP = 32
 
 
-def _field(name: str, offset: int, datatype: int) -> Any:
+def point_field(name: str, offset: int, datatype: int) -> Any:
+    """A ``sensor_msgs/PointField`` of one value."""
     return msgs.PointField(name=name, offset=offset, datatype=datatype, count=1)
 
 
@@ -52,10 +54,20 @@ def pack_cloud(
             words[:, offset // 4] = values
         else:
             buf[:, offset : offset + dt.itemsize] = np.ascontiguousarray(values, dtype=dt).view(np.uint8).reshape(n, -1)
-        fields.append(_field(name, offset, datatype))
-    w = n // height if width is None else width
+        fields.append(point_field(name, offset, datatype))
     xs = columns.get("x")
     dense = xs is None or not np.isnan(np.asarray(xs[2], dtype=np.float32)).any()
+    return cloud_message(stamp_ns, frame_id, buf, fields, height=height, width=width, dense=dense)
+
+
+def cloud_message(
+    stamp_ns: int, frame_id: str, buf: np.ndarray, fields: list[Any], *, height: int, width: int | None, dense: bool
+) -> Any:
+    """A PointCloud2 over ``buf`` (n x 32 bytes, any dtype: its bytes are the points) with ``fields``
+    (``PointField`` messages), ``height`` x ``width`` organised (``width`` None: n // height)."""
+    data = buf.reshape(-1).view(np.uint8)
+    n = len(data) // POINT_STEP
+    w = n // height if width is None else width
     return msgs.PointCloud2(
         header=msgs.header(stamp_ns, frame_id),
         height=height,
@@ -64,7 +76,7 @@ def pack_cloud(
         is_bigendian=False,
         point_step=POINT_STEP,
         row_step=POINT_STEP * w,
-        data=buf.reshape(-1),
+        data=data,
         is_dense=bool(dense),
     )
 
@@ -83,8 +95,9 @@ def read_field(msg: Any, name: str) -> np.ndarray:
     raise IoError(f"PointCloud2 has no field {name!r} (fields: {names})")
 
 
-def read_xyz(msg: Any) -> np.ndarray:
-    """Points (N, 3) float32 of a PointCloud2's x, y, z fields (NaNs kept)."""
+def read_xyz(msg: Any, *, copy: bool = True) -> np.ndarray:
+    """Points (N, 3) float32 of a PointCloud2's x, y, z fields (NaNs kept). With ``copy=False`` the usual layout
+    (float32 x y z at offsets 0 4 8, little-endian) comes back as a read-only strided view of the message's data."""
     offsets = {f.name: (int(f.offset), int(f.datatype)) for f in msg.fields}
     step = int(msg.point_step)
     if (
@@ -94,16 +107,26 @@ def read_xyz(msg: Any) -> np.ndarray:
     ):  # the usual layout: one strided view, no per-field copies
         n = int(msg.height) * int(msg.width)
         flat = np.asarray(msg.data, dtype=np.uint8)[: n * step].view("<f4").reshape(n, step // 4)
+        if not copy:
+            view = flat[:, :3]
+            view.flags.writeable = False
+            return view
         return flat[:, :3].astype(np.float32)
     return np.stack([read_field(msg, k).astype(np.float32) for k in ("x", "y", "z")], axis=1)
 
 
+@numba.njit(cache=True)
+def _move(points: np.ndarray, rot: np.ndarray, t: np.ndarray, out: np.ndarray) -> None:
+    for i in range(points.shape[0]):
+        x, y, z = points[i, 0], points[i, 1], points[i, 2]
+        for k in range(3):
+            out[i, k] = x * rot[k, 0] + y * rot[k, 1] + z * rot[k, 2] + t[k]
+
+
 def move_points(points: np.ndarray, rot: np.ndarray, t: np.ndarray | tuple[float, ...]) -> np.ndarray:
-    """``rot @ p + t`` for every point (N, 3), float32: column by column (numpy's matmul hands an (N, 3) x (3, 3)
-    product to a threaded BLAS, 20x slower on a busy machine)."""
-    p = np.asarray(points, dtype=np.float32)
-    out = np.empty_like(p)
-    x, y, z = p[:, 0], p[:, 1], p[:, 2]
-    for k in range(3):
-        out[:, k] = x * float(rot[k, 0]) + y * float(rot[k, 1]) + z * float(rot[k, 2]) + float(t[k])
+    """``rot @ p + t`` for every point (N, 3; any strides), float32, in one compiled pass (numpy's matmul hands an
+    (N, 3) x (3, 3) product to a threaded BLAS, 20x slower on a busy machine)."""
+    p = np.asarray(points, dtype=np.float32)  # (a float32 view stays a view)
+    out = np.empty((p.shape[0], 3), dtype=np.float32)
+    _move(p, np.asarray(rot, dtype=np.float32), np.asarray(t, dtype=np.float32), out)
     return out

@@ -273,13 +273,7 @@ class Amcl:
             raise LocalizationError(f"odometry pose {odom_pose} is not finite")
         p = self.params
         odom = (float(odom_pose[0]), float(odom_pose[1]), float(odom_pose[2]))
-        moved = False
-        if self.odom_ref is not None:
-            dx = odom[0] - self.odom_ref[0]
-            dy = odom[1] - self.odom_ref[1]
-            da = float(wrap_angle(odom[2] - self.odom_ref[2]))
-            moved = abs(dx) > p.update_min_d or abs(dy) > p.update_min_d or abs(da) > p.update_min_a
-        if not (moved or self._force or self.odom_ref is None):
+        if not self.wants_update(odom):
             return False
         beams = self._beams(scan)
         if beams is None:
@@ -311,6 +305,19 @@ class Amcl:
                 self._resample()
         self._estimate()
         return True
+
+    def wants_update(self, odom_pose: tuple[float, float, float]) -> bool:
+        """Whether a scan at odometry pose ``odom_pose`` would update the filter: the first scan, a forced update,
+        or a move of more than ``update_min_d`` (m, along x or y) or ``update_min_a`` (rad) since the last update
+        (what :meth:`update` checks first; the node builds the scan only then)."""
+        ref = self.odom_ref
+        if ref is None or self._force:
+            return True
+        p = self.params
+        dx = float(odom_pose[0]) - ref[0]
+        dy = float(odom_pose[1]) - ref[1]
+        da = float(wrap_angle(float(odom_pose[2]) - ref[2]))
+        return abs(dx) > p.update_min_d or abs(dy) > p.update_min_d or abs(da) > p.update_min_a
 
     def _resample(self) -> None:
         """KLD-sampling with low-variance draws and random-particle recovery."""

@@ -82,6 +82,7 @@ class Amcl(Node):
         self._invalid_logged_ns: int | None = None
         self.last_error: str | None = None
         self._map_to_odom: tuple[float, float, float] | None = None
+        self._tf_body: tuple[tuple[float, float, float], Any] | None = None  # (map->odom, its Transform message)
         self._pending_global = False
         self._odom_failures = 0
         self.pose_pub = self.create_publisher(msgs.PoseWithCovarianceStamped, "amcl_pose", 2)
@@ -196,19 +197,36 @@ class Amcl(Node):
         if poses is None:
             return
         odom, laser = poses
-        scan = pf.Scan(
-            ranges=np.asarray(msg.ranges, dtype=np.float64),
-            angle_min=float(msg.angle_min),
-            angle_increment=float(msg.angle_increment),
-            range_min=float(msg.range_min),
-            range_max=float(msg.range_max),
-        )
-        if f.update(odom, scan, laser):
-            self._map_to_odom = f.map_to_odom()
-            self._publish_estimate(t_ns)
+        if f.wants_update(odom):  # the scan is built only for an update (most scans come before enough motion)
+            scan = pf.Scan(
+                ranges=np.asarray(msg.ranges, dtype=np.float64),
+                angle_min=float(msg.angle_min),
+                angle_increment=float(msg.angle_increment),
+                range_min=float(msg.range_min),
+                range_max=float(msg.range_max),
+            )
+            if f.update(odom, scan, laser):
+                self._map_to_odom = f.map_to_odom()
+                self._publish_estimate(t_ns)
         if self._map_to_odom is not None and self.tf_broadcast:
-            stamp = t_ns + round(self.transform_tolerance * 1e9)
-            self.send_transform(msgs.transform_stamped(stamp, self.global_frame, self.odom_frame, *self._map_to_odom))
+            self._send_map_to_odom(t_ns + round(self.transform_tolerance * 1e9))
+
+    def _send_map_to_odom(self, stamp_ns: int) -> None:
+        """tf ``global_frame -> odom_frame`` (the latest map->odom) stamped ``stamp_ns``: ROS amcl sends it with
+        every scan, so its transform part is built once per new estimate and shared by the messages."""
+        assert self._map_to_odom is not None
+        cached = self._tf_body
+        if cached is None or cached[0] != self._map_to_odom:
+            x, y, yaw = self._map_to_odom
+            cached = self._tf_body = (
+                self._map_to_odom,
+                msgs.transform_stamped(0, self.global_frame, self.odom_frame, x, y, yaw).transform,
+            )
+        self.send_transform(
+            msgs.TransformStamped(
+                header=msgs.header(stamp_ns, self.global_frame), child_frame_id=self.odom_frame, transform=cached[1]
+            )
+        )
 
     # --- outputs --------------------------------------------------------------------------------
 

@@ -27,7 +27,7 @@ from navlab.core import ParamSpec, check_ceiling
 from navlab.geometry import between2, compose2, wrap_angle
 from navlab.grid import GridMap
 from navlab.mapping.errors import MappingError
-from navlab.mapping.gmapping_match import draw_motion, match_score, optimize
+from navlab.mapping.gmapping_match import Scan, draw_motion, match_score, optimize
 from navlab.mapping.gmapping_tiles import TILE, TilePool, raycast_tiles, tiles_for, to_dense
 from navlab.mapping.occupancy import L_CLAMP, L_FREE, L_OCC, logodds_to_grid, scan_cells
 
@@ -293,34 +293,19 @@ class GMapping:
         self, table: np.ndarray, pose: np.ndarray, r: np.ndarray, ang: np.ndarray, max_urange: float, max_range: float
     ) -> None:
         """Ray-cast the scan into the map of ``table`` (copying the tiles it shares before writing them)."""
-        ox, oy, oi, oj = self._lattice()
-        free = self.pool.free(self._scan_tiles)
-        raycast_tiles(
-            self.pool.tiles,
-            table,
-            self.pool.refs,
-            free,
-            np.zeros(1, dtype=np.int64),
-            ox,
-            oy,
-            oi,
-            oj,
-            self.p.delta,
-            float(pose[0]),
-            float(pose[1]),
-            float(pose[2]),
-            r,
-            ang,
-            max_urange,
-            max_range,
-            L_OCC,
-            L_FREE,
-            L_CLAMP,
-        )
+        free = self.pool.free(self._scan_tiles)  # (may grow the pool: its arrays are read after)
+        cow = (self.pool.tiles, table, self.pool.refs, free, np.zeros(1, dtype=np.int64))
+        at = (float(pose[0]), float(pose[1]), float(pose[2]))
+        raycast_tiles(*cow, self._lattice(), at, (r, ang, max_urange, max_range), (L_OCC, L_FREE, L_CLAMP))
 
-    def _lattice(self) -> tuple[float, float, int, int]:
-        """(anchor x, anchor y, offset column, offset row) as the numba kernels take them."""
-        return float(self._anchor[0]), float(self._anchor[1]), int(self._offset[0]), int(self._offset[1])
+    def _lattice(self) -> tuple[float, float, int, int, float]:
+        """(anchor x, anchor y, offset column, offset row, cell size) as the numba kernels take them."""
+        return float(self._anchor[0]), float(self._anchor[1]), int(self._offset[0]), int(self._offset[1]), self.p.delta
+
+    def _model(self) -> tuple[int, float, float, int]:
+        """The matcher's (kernelSize, sigma, lsigma, lskip) as the numba kernels take them."""
+        p = self.p
+        return p.kernelSize, p.sigma, p.lsigma, p.lskip
 
     def _mark_update(self, k: int) -> None:
         if self.keep_history:
@@ -330,37 +315,17 @@ class GMapping:
     def _update(self, k: int, r: np.ndarray, ang: np.ndarray, max_urange: float, max_range: float) -> None:
         p = self.p
         self.updates += 1
-        ox, oy, oi, oj = self._lattice()
-        res = p.delta
-        cb, sb = np.cos(ang), np.sin(ang)
+        lattice = self._lattice()
+        scan, model = (r, np.cos(ang), np.sin(ang), max_urange), self._model()
         poses = self.poses
         tiles = self.pool.tiles
         for part, pose in zip(self.particles, poses, strict=True):
-            x, y, t, score, lik = self._match(part.table, pose, r, cb, sb, max_urange)
+            x, y, t, score, lik = self._match(part.table, pose, scan)
             matched = score > p.minimumScore
             if matched:
                 pose[:] = x, y, wrap_angle(t)
             if not matched or pose[2] != t:  # the weight takes the log-likelihood at another pose
-                _s, lik, _n = match_score(
-                    tiles,
-                    part.table,
-                    ox,
-                    oy,
-                    oi,
-                    oj,
-                    res,
-                    pose[0],
-                    pose[1],
-                    pose[2],
-                    r,
-                    cb,
-                    sb,
-                    max_urange,
-                    p.kernelSize,
-                    p.sigma,
-                    p.lsigma,
-                    p.lskip,
-                )
+                _s, lik, _n = match_score(tiles, part.table, lattice, (pose[0], pose[1], pose[2]), scan, model)
             part.weight += lik
         # normalise (GMapping: gain 1 / (ogain * N)) and resample on N_eff
         lw = np.array([q.weight for q in self.particles])
@@ -437,23 +402,22 @@ class GMapping:
         self, table: np.ndarray, pose: np.ndarray, r: np.ndarray, ang: np.ndarray, max_urange: float
     ) -> np.ndarray:
         """``pose`` improved by the scan matcher against ``grid`` (unchanged if the match scores too low)."""
-        x, y, t, score, _lik = self._match(table, pose, r, np.cos(ang), np.sin(ang), max_urange)
+        x, y, t, score, _lik = self._match(table, pose, (r, np.cos(ang), np.sin(ang), max_urange))
         return np.array([x, y, wrap_angle(t)]) if score > self.p.minimumScore else pose
 
-    def _match(
-        self, table: np.ndarray, pose: np.ndarray, r: np.ndarray, cb: np.ndarray, sb: np.ndarray, max_urange: float
-    ) -> tuple[float, float, float, float, float]:
+    def _match(self, table: np.ndarray, pose: np.ndarray, scan: Scan) -> tuple[float, float, float, float, float]:
         """GMapping's hill climb of the scan from ``pose`` against the map of ``table``: (x, y, theta, score,
         log-likelihood). A climb that ends under ``wideScore`` per scored beam (stuck: the start was turned
         too far for its steps to reach the scan's place) is repeated from starts turned by ``wideStep``,
         ``2 wideStep``, ... up to ``wideTurn`` either way; a turned result is kept only if it scores higher,
         so the scan turns away from its odometry only where the map matches it better there."""
         p = self.p
-        ox, oy, oi, oj = self._lattice()
-        args = (r, cb, sb, max_urange, p.kernelSize, p.sigma, p.lsigma, p.lskip, p.lstep, p.astep, p.iterations)
-        best = optimize(self.pool.tiles, table, ox, oy, oi, oj, p.delta, pose[0], pose[1], pose[2], *args)
+        fixed = (self.pool.tiles, table, self._lattice())
+        model, steps = self._model(), (p.lstep, p.astep, p.iterations)
+        best = optimize(*fixed, (pose[0], pose[1], pose[2]), scan, model, steps)
         if p.wideScore <= 0 or p.wideStep <= 0:
             return best
+        r, max_urange = scan[0], scan[3]
         scored = r[:: p.lskip + 1]
         enough = p.wideScore * np.count_nonzero((scored > 0) & (scored < max_urange))
         if best[3] >= enough:
@@ -461,8 +425,7 @@ class GMapping:
         # the nearest turns first; stop at a result that scores well enough
         for n in range(1, int(p.wideTurn / p.wideStep + 1e-9) + 1):
             for turn in (n * p.wideStep, -n * p.wideStep):
-                t0 = pose[2] + turn
-                got = optimize(self.pool.tiles, table, ox, oy, oi, oj, p.delta, pose[0], pose[1], t0, *args)
+                got = optimize(*fixed, (pose[0], pose[1], pose[2] + turn), scan, model, steps)
                 if got[3] > best[3]:
                     best = got
             if best[3] >= enough:

@@ -17,15 +17,21 @@ import numpy as np
 from navlab.mapping.gmapping_tiles import MASK, SHIFT, TILE, cell, from_dense, raycast_tiles
 from navlab.mapping.occupancy import L_CLAMP, L_FREE, L_OCC, scan_cells
 
+# the kernels' argument groups (numba tuples)
+Lattice = tuple[float, float, int, int, float]  # the lattice: anchor x, y (m), offset column, row, cell size (m)
+Pose = tuple[float, float, float]  # x, y (m), theta (rad)
+Beams = tuple[np.ndarray, np.ndarray, np.ndarray]  # the scored beams' ranges (m), cos and sin (laser frame)
+Scan = tuple[np.ndarray, np.ndarray, np.ndarray, float]  # all ranges, cos and sin of the angles, max_urange (m)
+Model = tuple[int, float, float, int]  # GMapping's kernelSize, sigma, lsigma, lskip
+
 SEEN_POSES = 256  # poses whose score one hill climb remembers (it re-visits neighbours it scored before)
 
 
 @numba.njit(cache=True)
-def _valid_beams(
-    ranges: np.ndarray, cb: np.ndarray, sb: np.ndarray, max_urange: float, skip: int
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _valid_beams(scan: Scan, skip: int) -> Beams:
     """(range, cos, sin) of the beams the matcher scores, in order: every ``skip + 1``-th, with a range in
-    (0, ``max_urange``)."""
+    (0, max_urange)."""
+    ranges, cb, sb, max_urange = scan
     n = 0
     for k in range(0, ranges.shape[0], skip + 1):
         if ranges[k] > 0.0 and ranges[k] < max_urange:
@@ -40,26 +46,15 @@ def _valid_beams(
 
 
 @numba.njit(cache=True, inline="always")
-def _endpoints(
-    ox: float,
-    oy: float,
-    oi: int,
-    oj: int,
-    res: float,
-    px: float,
-    py: float,
-    pt: float,
-    rv: np.ndarray,
-    cv: np.ndarray,
-    sv: np.ndarray,
-    fw: np.ndarray,
-    iw: np.ndarray,
-) -> None:
-    """For every beam at pose (``px``, ``py``, ``pt``), into ``fw`` (8, n): its end point (x, y) and the
-    squared x distances from it to the centres of the end cell's column and its two neighbours, then the
-    squared y distances to the row and its neighbours; into ``iw`` (4, n): the end cell (i, j) and the cell
-    one step back along the beam (i, j), as array indices. One branch-free loop (the compiler vectorises
-    it); ``_score_above`` then reads them beam by beam."""
+def _endpoints(lattice: Lattice, pose: Pose, beams: Beams, fw: np.ndarray, iw: np.ndarray) -> None:
+    """For every beam (``beams``: range, cos, sin, laser frame) at ``pose`` (x, y, theta), into ``fw`` (8, n):
+    its end point (x, y) and the squared x distances from it to the centres of the end cell's column and
+    its two neighbours, then the squared y distances to the row and its neighbours; into ``iw`` (4, n): the
+    end cell (i, j) and the cell one step back along the beam (i, j), as array indices. One branch-free loop
+    (the compiler vectorises it); ``_score_above`` then reads them beam by beam."""
+    ox, oy, oi, oj, res = lattice
+    px, py, pt = pose
+    rv, cv, sv = beams
     ct, st = math.cos(pt), math.sin(pt)
     for k in range(rv.shape[0]):
         r = rv[k]
@@ -85,30 +80,20 @@ def _endpoints(
 def _score_above(
     tiles: np.ndarray,
     table: np.ndarray,
-    ox: float,
-    oy: float,
-    oi: int,
-    oj: int,
-    res: float,
-    px: float,
-    py: float,
-    pt: float,
-    rv: np.ndarray,
-    cv: np.ndarray,
-    sv: np.ndarray,
-    kernel: int,
-    sigma: float,
-    lsigma: float,
+    lattice: Lattice,
+    pose: Pose,
+    beams: Beams,
+    model: tuple[int, float, float],
     bound: float,
     fw: np.ndarray,
     iw: np.ndarray,
     order: np.ndarray,
 ) -> tuple[float, float, int]:
     """GMapping's score and log-likelihood of a scan at a pose: for each beam endpoint, the nearest
-    occupied cell within ``kernel`` cells whose cell one step back along the beam is free. ``rv``, ``cv``,
-    ``sv``: range, cosine and sine (laser frame) of the beams to score (``_valid_beams``); ``fw`` (10, n),
-    ``iw`` (4, n): work arrays (``_endpoints``; rows 8 and 9 of ``fw`` get each beam's score term and
-    its match's squared distance, -1 if none).
+    occupied cell within ``kernel`` cells whose cell one step back along the beam is free. ``beams``: range,
+    cosine and sine (laser frame) of the beams to score (``_valid_beams``); ``model``: (kernel, sigma,
+    lsigma); ``fw`` (10, n), ``iw`` (4, n): work arrays (``_endpoints``; rows 8 and 9 of ``fw`` get each
+    beam's score term and its match's squared distance, -1 if none).
 
     A beam adds at most 1 to the score, so once the score so far plus one per beam left cannot exceed
     ``bound`` (rounding included), this returns (-1, 0, -1) without scoring the rest: the hill climb only
@@ -116,10 +101,13 @@ def _score_above(
     ``order`` (a permutation: the hill climb puts first those that scored worst at the pose it climbs from,
     which stops a worse neighbour sooner); the score and log-likelihood are summed in beam order all the
     same, so the order changes nothing but when a pose is given up."""
+    ox, oy, oi, oj, res = lattice
+    kernel, sigma, lsigma = model
+    rv = beams[0]
     th, tw = table.shape
     h, w = th * TILE, tw * TILE
     flat = tiles.reshape(-1)  # a view (C-contiguous)
-    _endpoints(ox, oy, oi, oj, res, px, py, pt, rv, cv, sv, fw, iw)
+    _endpoints(lattice, pose, beams, fw, iw)
     s = 0.0
     null_l = -0.5 / lsigma  # GMapping: nullLikelihood = -0.5
     left = rv.shape[0]
@@ -216,77 +204,45 @@ def _worst_first(terms: np.ndarray, order: np.ndarray, counts: np.ndarray) -> No
 
 @numba.njit(cache=True)
 def match_score(
-    tiles: np.ndarray,
-    table: np.ndarray,
-    ox: float,
-    oy: float,
-    oi: int,
-    oj: int,
-    res: float,
-    px: float,
-    py: float,
-    pt: float,
-    ranges: np.ndarray,
-    cb: np.ndarray,
-    sb: np.ndarray,
-    max_urange: float,
-    kernel: int,
-    sigma: float,
-    lsigma: float,
-    skip: int,
+    tiles: np.ndarray, table: np.ndarray, lattice: Lattice, pose: Pose, scan: Scan, model: Model
 ) -> tuple[float, float, int]:
-    """(score, log-likelihood, matched beams) of the scan at pose (``px``, ``py``, ``pt``), scoring every
-    ``skip + 1``-th beam with a range in (0, ``max_urange``); ``cb``, ``sb``: cosine and sine of the beam
-    angles (laser frame). See ``_score_above``."""
-    rv, cv, sv = _valid_beams(ranges, cb, sb, max_urange, skip)
-    nb = rv.shape[0]
+    """(score, log-likelihood, matched beams) of the scan at ``pose`` (x, y, theta). ``scan``: (ranges, cos
+    and sin of the beam angles (laser frame), max_urange); ``model``: (kernel, sigma, lsigma, skip): every
+    ``skip + 1``-th beam with a range in (0, max_urange) is scored. See ``_score_above``."""
+    beams = _valid_beams(scan, model[3])
+    nb = beams[0].shape[0]
     fw, iw = np.empty((10, nb)), np.empty((4, nb), dtype=np.int64)
-    return _score_above(
-        tiles, table, ox, oy, oi, oj, res, px, py, pt, rv, cv, sv, kernel, sigma, lsigma, -1.0, fw, iw, np.arange(nb)
-    )
+    return _score_above(tiles, table, lattice, pose, beams, model[:3], -1.0, fw, iw, np.arange(nb))
 
 
 @numba.njit(cache=True)
 def optimize(
     tiles: np.ndarray,
     table: np.ndarray,
-    ox: float,
-    oy: float,
-    oi: int,
-    oj: int,
-    res: float,
-    x0: float,
-    y0: float,
-    t0: float,
-    ranges: np.ndarray,
-    cb: np.ndarray,
-    sb: np.ndarray,
-    max_urange: float,
-    kernel: int,
-    sigma: float,
-    lsigma: float,
-    skip: int,
-    lstep: float,
-    astep: float,
-    iterations: int,
+    lattice: Lattice,
+    start: Pose,
+    scan: Scan,
+    model: Model,
+    steps: tuple[float, float, int],
 ) -> tuple[float, float, float, float, float]:
-    """GMapping's hill climbing: try ±lstep in x, y and ±astep in theta; halve the steps when no move
-    improves the score, ``iterations`` times. Returns the pose, its score and its log-likelihood.
+    """GMapping's hill climbing from ``start`` (``scan``, ``model``: as ``match_score``'s): try ±lstep in x,
+    y and ±astep in theta; halve the steps when no move improves the score, ``iterations`` times
+    (``steps``: (lstep, astep, iterations)). Returns the pose, its score and its log-likelihood.
 
     A pose already scored in this climb (bit for bit: the one just left, a neighbour tried before) is
     not scored again, and a candidate's scoring stops once it cannot beat the best so far (its beams
     visited worst first, as they scored at the pose climbed from); the result is the same as scoring every
     candidate in full."""
-    rv, cv, sv = _valid_beams(ranges, cb, sb, max_urange, skip)
-    nb = rv.shape[0]
+    lstep, astep, iterations = steps
+    beams = _valid_beams(scan, model[3])
+    scoring = model[:3]
+    nb = beams[0].shape[0]
     fw, iw = np.empty((10, nb)), np.empty((4, nb), dtype=np.int64)
     order, counts = np.arange(nb), np.empty(64, dtype=np.int64)
     terms = np.empty(nb)  # the score terms of the best pose found in this step of the climb
     seen = np.empty((SEEN_POSES, 5))  # x, y, theta, score (-1: no better than the pose it was tried from), lik
-    cx, cy, ct = x0, y0, t0
-    cur, cur_lik, _n = _score_above(
-        tiles, table, ox, oy, oi, oj, res, cx, cy, ct, rv, cv, sv, kernel, sigma, lsigma, -1.0, fw, iw, order
-    )
+    cx, cy, ct = start
+    cur, cur_lik, _n = _score_above(tiles, table, lattice, start, beams, scoring, -1.0, fw, iw, order)
     _worst_first(fw[8], order, counts)
     seen[0, 0], seen[0, 1], seen[0, 2], seen[0, 3], seen[0, 4] = cx, cy, ct, cur, cur_lik
     n_seen = 1
@@ -322,9 +278,7 @@ def optimize(
             if q < n_seen:
                 sc, lik = seen[q, 3], seen[q, 4]
             else:
-                sc, lik, _n = _score_above(
-                    tiles, table, ox, oy, oi, oj, res, nx, ny, nt, rv, cv, sv, kernel, sigma, lsigma, cur, fw, iw, order
-                )
+                sc, lik, _n = _score_above(tiles, table, lattice, (nx, ny, nt), beams, scoring, cur, fw, iw, order)
                 if n_seen < SEEN_POSES:
                     seen[n_seen, 0], seen[n_seen, 1], seen[n_seen, 2] = nx, ny, nt
                     seen[n_seen, 3], seen[n_seen, 4] = sc, lik
@@ -365,10 +319,9 @@ def warmup() -> None:
     free, used = pool.free(1), np.zeros(1, dtype=np.int64)
     tiles = pool.tiles  # (after free(), which may grow the pool)
     r, c = np.ones(2), np.ones(2)
-    optimize(tiles, table, 0.0, 0.0, 0, 0, 0.05, 0.1, 0.1, 0.0, r, c, c, 1.0, 1, 0.05, 0.075, 0, 0.05, 0.05, 1)
-    match_score(tiles, table, 0.0, 0.0, 0, 0, 0.05, 0.1, 0.1, 0.0, r, c, c, 1.0, 1, 0.05, 0.075, 0)
-    raycast_tiles(
-        tiles, table, pool.refs, free, used, 0.0, 0.0, 0, 0, 0.05, 0.1, 0.1, 0.0, r, c, 1.0, 2.0, L_OCC, L_FREE, L_CLAMP
-    )
+    lattice, pose, scan, model = (0.0, 0.0, 0, 0, 0.05), (0.1, 0.1, 0.0), (r, c, c, 1.0), (1, 0.05, 0.075, 0)
+    optimize(tiles, table, lattice, pose, scan, model, (0.05, 0.05, 1))
+    match_score(tiles, table, lattice, pose, scan, model)
+    raycast_tiles(tiles, table, pool.refs, free, used, lattice, pose, (r, c, 1.0, 2.0), (L_OCC, L_FREE, L_CLAMP))
     draw_motion(np.zeros((2, 3)), np.zeros((2, 3)), 0.1, 0.0, 0.0, 0.1, 0.1, 0.1)
     scan_cells(np.zeros((2, 3)), r, c, (0.0, 0.0), 0.05, max_urange=1.0, max_range=2.0)

@@ -19,6 +19,7 @@ import numba
 import numpy as np
 
 from navlab.gridline import TIE_LATE, line, line_cell
+from navlab.mapping.occupancy import beam_end
 
 SHIFT = 6
 TILE = 1 << SHIFT  # cells per tile side (64 cells: 3.2 m at 5 cm, 16 KiB of float32)
@@ -120,26 +121,21 @@ def raycast_tiles(
     refs: np.ndarray,
     free: np.ndarray,
     used: np.ndarray,
-    ox: float,
-    oy: float,
-    oi: int,
-    oj: int,
-    res: float,
-    px: float,
-    py: float,
-    pt: float,
-    ranges: np.ndarray,
-    angles: np.ndarray,
-    max_urange: float,
-    max_range: float,
-    l_occ: float,
-    l_free: float,
-    clamp: float,
+    lattice: tuple[float, float, int, int, float],
+    pose: tuple[float, float, float],
+    scan: tuple[np.ndarray, np.ndarray, float, float],
+    update: tuple[float, float, float],
 ) -> None:
-    """``occupancy._raycast`` into a tiled map (the same cells, the same values, in the same order): every
-    beam with a range in (0, ``max_range``) lowers the log-odds of the cells it crosses (Bresenham, end
-    cell excluded) by ``l_free`` and, if shorter than ``max_urange``, raises its end cell by ``l_occ``
-    (clamped to ±``clamp``); cells outside the map are skipped. Tiles written are made private first."""
+    """``occupancy._raycast`` into a tiled map (the same cells, the same values, in the same order), for the
+    laser at ``pose`` (x, y, theta) on ``lattice`` (anchor x, y, offset column, row, cell size): every beam
+    of ``scan`` (ranges, angles, max_urange, max_range) with a range in (0, max_range) lowers the log-odds
+    of the cells it crosses (Bresenham, end cell excluded) by ``l_free`` and, if shorter than max_urange,
+    raises its end cell by ``l_occ`` (``update``: (l_occ, l_free, clamp); clamped to ±clamp); cells
+    outside the map are skipped. Tiles written are made private first."""
+    ox, oy, oi, oj, res = lattice
+    px, py, _pt = pose
+    ranges, angles, max_urange, max_range = scan
+    l_occ, l_free, clamp = update
     th, tw = table.shape
     h, w = th * TILE, tw * TILE
     i0 = math.floor((px - ox) / res) - oi
@@ -149,14 +145,7 @@ def raycast_tiles(
         r = ranges[k]
         if not (r > 0.0) or r >= max_range:
             continue
-        hit = r < max_urange
-        if not hit:
-            r = max_urange
-        a = pt + angles[k]
-        ex = px + r * math.cos(a)
-        ey = py + r * math.sin(a)
-        i1 = math.floor((ex - ox) / res) - oi
-        j1 = math.floor((ey - oy) / res) - oj
+        i1, j1, hit = beam_end(lattice, pose, r, angles[k], max_urange)
         ln = line(i0, j0, i1, j1, TIE_LATE)
         for n in range(ln[0]):  # the end cell excluded
             i, j = line_cell(ln, n)

@@ -25,6 +25,24 @@ L_FREE = -0.4  # log-odds increment of a traversed cell
 L_CLAMP = 5.0
 
 
+@numba.njit(cache=True, inline="always")
+def beam_end(
+    lattice: tuple[float, float, int, int, float], pose: tuple[float, float, float], r: float, angle: float, cut: float
+) -> tuple[int, int, bool]:
+    """The cell (column, row) where a beam of range ``r`` at ``angle`` from the laser at ``pose`` (x, y, theta)
+    ends, cut to ``cut`` (``max_urange``), and whether it ends on a hit (shorter than ``cut``); ``lattice``:
+    (anchor x, y, offset column, row, cell size), cells counted from the offset cell."""
+    ox, oy, oi, oj, res = lattice
+    px, py, pt = pose
+    hit = r < cut
+    if not hit:
+        r = cut
+    a = pt + angle
+    ex = px + r * math.cos(a)
+    ey = py + r * math.sin(a)
+    return math.floor((ex - ox) / res) - oi, math.floor((ey - oy) / res) - oj, hit
+
+
 @numba.njit(cache=True)
 def _raycast(
     logodds: np.ndarray,
@@ -53,14 +71,7 @@ def _raycast(
         r = ranges[k]
         if not (r > 0.0) or r >= max_range:
             continue
-        hit = r < max_urange
-        if not hit:
-            r = max_urange
-        a = pt + angles[k]
-        ex = px + r * math.cos(a)
-        ey = py + r * math.sin(a)
-        i1 = math.floor((ex - ox) / res) - oi
-        j1 = math.floor((ey - oy) / res) - oj
+        i1, j1, hit = beam_end((ox, oy, oi, oj, res), (px, py, pt), r, angles[k], max_urange)
         # the line's cells from (i0, j0), the end cell excluded
         ln = line(i0, j0, i1, j1, TIE_LATE)
         if start_inside and 0 <= i1 < w and 0 <= j1 < h:  # the whole line is inside: no per-cell checks

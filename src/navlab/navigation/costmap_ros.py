@@ -159,6 +159,8 @@ class Costmap2DROS:
         g = self.costmap
         occ = GridMap(self._table[g.data], g.resolution, g.origin, self.global_frame)
         self.costmap_pub.publish(occ.to_msg(now))
+        if not (self.footprint_pub.get_subscription_count() or self.node.executor.has_listeners):
+            return  # the polygon (not latched) only when someone reads it
         pose = self.layered.robot_pose or self.robot_pose()
         if pose is not None:
             poly = self.layered.footprint_at(pose)

@@ -38,6 +38,15 @@ class CloudLayer(Protocol):
 
 
 @runtime_checkable
+class SensorFrameCloudLayer(Protocol):
+    """A cloud layer that also takes the points in the sensor's frame with the sensor's pose (no moved copy)."""
+
+    def add_sensor_cloud(
+        self, origin_xyz: Any, rotation: np.ndarray, points: np.ndarray, *, source: str | None = None
+    ) -> None: ...
+
+
+@runtime_checkable
 class RangeLayer(Protocol):
     """A layer that takes ``sensor_msgs/Range`` readings (a capability; ``range_sensor_layer``) on ``topics``."""
 
@@ -111,9 +120,13 @@ class CostmapSensorFeeds:
             place = self._in_costmap(frame, msgs.stamp_ns(msg))
             if place is None:
                 continue
-            pts = scan_points(msg) if msgs.type_name(msg).endswith("LaserScan") else read_xyz(msg)
+            pts = scan_points(msg) if msgs.type_name(msg).endswith("LaserScan") else read_xyz(msg, copy=False)
             origin, rot = place
-            self.voxel[k].add_cloud(origin, move_points(pts, rot, origin), source=src_name)  # NaNs: skipped there
+            cloud_layer = self.voxel[k]
+            if isinstance(cloud_layer, SensorFrameCloudLayer):  # moved point by point as the layer reads them
+                cloud_layer.add_sensor_cloud(origin, rot, pts, source=src_name)
+            else:  # NaNs: skipped there
+                cloud_layer.add_cloud(origin, move_points(pts, rot, origin), source=src_name)
         self.pending.clear()
         for k, pub in self.voxel_pubs.items():
             grid = self.voxel[k].voxel_grid_msg(self.node.executor.now_ns)

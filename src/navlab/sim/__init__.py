@@ -17,6 +17,7 @@ if TYPE_CHECKING:
     from navlab.sim.errors import SimError
     from navlab.sim.gazebo import GazeboSim, launch_sim, load_robot_named, load_world_named
     from navlab.sim.render import render_image, save_png
+    from navlab.sim.sensor_plugins import DepthCameraPlugin, VelodynePlugin
     from navlab.sim.sensors3d import depth_image, depth_points, lidar3d_ranges, sensor_pose
     from navlab.sim.simulation import Pose3D, Simulation, lidar_angles
     from navlab.sim.spawn import check_start_pose, parse_spawn_spec, primitive_model
@@ -32,6 +33,8 @@ _EXPORTS = {
     "parse_spawn_spec": "navlab.sim.spawn",
     "primitive_model": "navlab.sim.spawn",
     "CameraRenderer": "navlab.sim.camera_render",
+    "DepthCameraPlugin": "navlab.sim.sensor_plugins",
+    "VelodynePlugin": "navlab.sim.sensor_plugins",
     "check_start_pose": "navlab.sim.spawn",
     "concave_meshes": "navlab.sim.decompose",
     "convex_parts": "navlab.sim.decompose",
@@ -49,10 +52,12 @@ _EXPORTS = {
 }
 __all__ = [
     "CameraRenderer",
+    "DepthCameraPlugin",
     "GazeboSim",
     "Pose3D",
     "SimError",
     "Simulation",
+    "VelodynePlugin",
     "check_start_pose",
     "concave_meshes",
     "convex_parts",

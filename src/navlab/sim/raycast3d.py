@@ -1,4 +1,6 @@
-"""Ray casting for grids of rays in 3-D (depth cameras, 3D lidars, range cones) over MuJoCo's primitives (Numba).
+"""Ray casting for grids of rays in 3-D over MuJoCo's primitives (Numba): range cones, and the reference that the
+depth buffer (:mod:`navlab.sim.raster`) and the lidar sweep (:mod:`navlab.sim.sweep`) are tested against, whose
+grid blocks (:func:`_block`) they share.
 
 A sensor's rays form a grid: ``rows`` x ``cols`` unit directions in the sensor frame (x forward, y left, z up).
 For each geom the caster bounds the block of the grid that can touch it — for a pinhole grid (``PINHOLE``)
@@ -180,6 +182,19 @@ def _lower_bound(kind: int, size: np.ndarray, p: np.ndarray) -> float:
     return math.sqrt(dx * dx + dy * dy + dz * dz)
 
 
+@njit(cache=True, inline="always")
+def in_geom_frame(
+    origin: np.ndarray, rot: np.ndarray, centre: np.ndarray, xm: np.ndarray, p: np.ndarray, m: np.ndarray
+) -> None:
+    """The sensor (at world ``origin``, axes the columns of ``rot``) in the frame of a geom at ``centre`` turned by
+    ``xm`` (row-major 3x3): ``p`` = its origin there, ``m[k, a]`` = component k of its axis a there."""
+    rx, ry, rz = origin[0] - centre[0], origin[1] - centre[1], origin[2] - centre[2]
+    for k in range(3):
+        p[k] = xm[k] * rx + xm[3 + k] * ry + xm[6 + k] * rz
+        for a in range(3):
+            m[k, a] = xm[k] * rot[0, a] + xm[3 + k] * rot[1, a] + xm[6 + k] * rot[2, a]
+
+
 @njit(cache=True)
 def cast_grid(
     origin: np.ndarray,
@@ -216,14 +231,7 @@ def cast_grid(
         xm = geom_xmat[g]
         if not _block(kind, geom_size[g], geom_xpos[g], xm, rot, origin, mode, params, rows, cols, bounds):
             continue
-        for k in range(3):
-            p_loc[gi, k] = (
-                xm[k] * (origin[0] - geom_xpos[g, 0])
-                + xm[3 + k] * (origin[1] - geom_xpos[g, 1])
-                + xm[6 + k] * (origin[2] - geom_xpos[g, 2])
-            )
-            for a in range(3):
-                m[gi, k, a] = xm[k] * rot[0, a] + xm[3 + k] * rot[1, a] + xm[6 + k] * rot[2, a]
+        in_geom_frame(origin, rot, geom_xpos[g], xm, p_loc[gi], m[gi])
         near[gi] = _lower_bound(kind, geom_size[g], p_loc[gi])
         blocks[gi, 0], blocks[gi, 1] = bounds[0], bounds[1]
         for w in range(3):

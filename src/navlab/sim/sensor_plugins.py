@@ -8,32 +8,26 @@ tf from their link (a camera's optical frame turned z forward, x right, y down).
 
 from __future__ import annotations
 
-from typing import Any, TypeVar
+from typing import Any
 
 import mujoco
 import numpy as np
 
 from navlab import msgs
 from navlab.core import Executor, Node
-from navlab.description import BumperConfig, CameraConfig, Lidar3dConfig, Origin, RangeConfig, SensorConfig
-from navlab.io import FLOAT32, UINT16, pack_cloud
+from navlab.description import BumperConfig, CameraConfig, Lidar3dConfig, Origin, RangeConfig
+from navlab.io import FLOAT32, UINT16, cloud_message, point_field
 from navlab.sim.plugins import SensorPlugin
-from navlab.sim.sensors3d import depth_image, depth_points, lidar3d_angles, lidar3d_ranges, range_reading, sensor_pose
+from navlab.sim.raster import depth_cloud
+from navlab.sim.sensors3d import depth_image, lidar3d_angles, lidar3d_ranges, range_reading, sensor_pose
 from navlab.sim.simulation import Simulation
+from navlab.sim.sweep import scan_cloud
 
 ENCODINGS = {"R8G8B8": ("rgb8", 3), "B8G8R8": ("bgr8", 3), "L8": ("mono8", 1)}
-C = TypeVar("C", bound=SensorConfig)
-
-
-class SensorNode(SensorPlugin[C]):
-    """A gazebo_ros sensor plugin of the robot's sensor suite (:class:`~navlab.sim.plugins.SensorPlugin`), with
-    the point-cloud builder the depth camera and the 3D lidar share."""
-
-    def cloud_msg(self, stamp_ns: int, pts: np.ndarray, extra: dict[str, Any], height: int, width: int) -> Any:
-        """``sensor_msgs/PointCloud2`` in the sensor's frame: float32 x y z at offsets 0 4 8 (``pts``, n x 3), then
-        the ``extra`` fields (name: (offset, datatype, values), as :func:`navlab.io.pointcloud.pack_cloud`)."""
-        fields = {"x": (0, FLOAT32, pts[:, 0]), "y": (4, FLOAT32, pts[:, 1]), "z": (8, FLOAT32, pts[:, 2])}
-        return pack_cloud(stamp_ns, self.frame_id, {**fields, **extra}, height=height, width=width)
+# the openni_kinect cloud's fields: setPointCloud2FieldsByString(2, "xyz", "rgb"), 32-byte points
+DEPTH_FIELDS = [point_field(name, offset, FLOAT32) for name, offset in (("x", 0), ("y", 4), ("z", 8), ("rgb", 16))]
+# GazeboRosVelodyneLaser's: x y z intensity (float32) and ring (uint16) in 32-byte points
+VELODYNE_FIELDS = [*DEPTH_FIELDS[:3], point_field("intensity", 16, FLOAT32), point_field("ring", 20, UINT16)]
 
 
 def camera_info(cfg: CameraConfig, stamp_ns: int, frame_id: str) -> Any:
@@ -55,7 +49,7 @@ def camera_info(cfg: CameraConfig, stamp_ns: int, frame_id: str) -> Any:
     )
 
 
-class CameraPlugin(SensorNode[CameraConfig]):
+class CameraPlugin(SensorPlugin[CameraConfig]):
     """``libgazebo_ros_camera.so`` (and the colour image of a depth camera): ``sensor_msgs/Image`` on
     ``image_topic`` and ``CameraInfo`` on ``camera_info_topic``, rendered offscreen (see
     :mod:`navlab.sim.camera_render`), with the ``<camera><noise>`` (std dev on the 0..1 scale) per pixel."""
@@ -160,14 +154,13 @@ class DepthCameraPlugin(CameraPlugin):
     def cloud(self, depth: np.ndarray, stamp_ns: int) -> Any:
         """The organised PointCloud2 of a depth image (rgb from the last colour image when sizes match, else 0)."""
         h, w = depth.shape
-        pts = depth_points(depth, self.cam).reshape(-1, 3)
-        rgb = np.zeros((h * w, 4), dtype=np.uint8)
-        if self.last_image is not None and self.last_image.shape[:2] == (h, w):
-            rgb[:, :3] = self.last_image.reshape(-1, 3)[:, ::-1]  # PCL packs b, g, r
-        return self.cloud_msg(stamp_ns, pts, {"rgb": (16, FLOAT32, rgb.view(np.float32).reshape(-1))}, h, w)
+        rgb = self.last_image if self.last_image is not None else np.zeros((0, 0, 3), np.uint8)
+        words = np.empty((h * w, 8), dtype=np.float32)
+        dense = depth_cloud(depth, self.cam.camera.focal_length, rgb, words, words.view(np.uint32))
+        return cloud_message(stamp_ns, self.frame_id, words, DEPTH_FIELDS, height=h, width=w, dense=dense)
 
 
-class VelodynePlugin(SensorNode[Lidar3dConfig]):
+class VelodynePlugin(SensorPlugin[Lidar3dConfig]):
     """``GazeboRosVelodyneLaser``: ``sensor_msgs/PointCloud2`` (x y z intensity ring, 32-byte points) of the points
     with ``max(min_range, range_min) < r < min(max_range, range_max - range_min - 0.01)``, ring 0 the lowest."""
 
@@ -184,7 +177,6 @@ class VelodynePlugin(SensorNode[Lidar3dConfig]):
             ],
             axis=-1,
         )
-        self.ring = np.broadcast_to(np.arange(len(el), dtype=np.uint16)[:, None], (len(el), len(az)))
 
     def update(self) -> None:
         if self.read(self.pub):
@@ -193,23 +185,18 @@ class VelodynePlugin(SensorNode[Lidar3dConfig]):
     def cloud(self, ranges: np.ndarray, stamp_ns: int) -> Any:
         """The plugin's cloud from ranges (rings x samples); organised (NaN: dropped) if ``organize_cloud``."""
         c = self.lidar
+        words = np.empty((ranges.size, 8), dtype=np.float32)
         lo = max(c.min_range, c.range_min)
         hi = min(c.max_range, c.range_max - c.range_min - 0.01)
-        r = np.minimum(ranges, c.range_max - c.range_min)
-        keep = (lo < r) & (r < hi)
-        xyz = (r[..., None] * self.unit).astype(np.float32)
-        if c.organize_cloud:
-            xyz[~keep] = np.nan
-            pts, rings = xyz.reshape(-1, 3), self.ring.reshape(-1)
-            height, width = c.rings, c.samples
-        else:
-            pts, rings = xyz[keep], self.ring[keep]
-            height, width = 1, len(pts)
-        extra = {"intensity": (16, FLOAT32, np.zeros(len(pts), np.float32)), "ring": (20, UINT16, rings)}
-        return self.cloud_msg(stamp_ns, pts, extra, height, width)
+        cap = c.range_max - c.range_min
+        n = scan_cloud(ranges, self.unit, lo, hi, cap, c.organize_cloud, words, words.view(np.uint32))
+        height, width = (c.rings, c.samples) if c.organize_cloud else (1, n)
+        dense = n == 0 or not np.isnan(words[:n, 0]).any()
+        fields = VELODYNE_FIELDS
+        return cloud_message(stamp_ns, self.frame_id, words[:n], fields, height=height, width=width, dense=dense)
 
 
-class RangePlugin(SensorNode[RangeConfig]):
+class RangePlugin(SensorPlugin[RangeConfig]):
     """``gazebo_ros_range``: ``sensor_msgs/Range`` (ULTRASOUND 0 / INFRARED 1, ``field_of_view`` the plugin's
     ``<fov>``, min/max the ray sensor's range) with the nearest return of the sensor's rays."""
 
@@ -234,7 +221,7 @@ class RangePlugin(SensorNode[RangeConfig]):
         )
 
 
-class BumperPlugin(SensorNode[BumperConfig]):
+class BumperPlugin(SensorPlugin[BumperConfig]):
     """``gazebo_ros_bumper``: ``gazebo_msgs/ContactsState`` of the bumper link's contacts with anything but the
     floor (MuJoCo contacts of the link's body: position and normal in ``frameName``'s frame — ``world`` or a
     link — depth in m, contact force as the wrench), published every update even when empty (Noetic does)."""

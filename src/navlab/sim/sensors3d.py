@@ -1,9 +1,12 @@
-"""Depth cameras, 3D lidars and range cones by exact ray casting against the world's geometry (no rendering).
+"""Depth cameras, 3D lidars and range cones, exact against the world's geometry (no rendering).
 
 Pure functions over a :class:`~navlab.sim.simulation.Simulation`: each places the sensor at its link's true
-pose composed with the sensor's ``<pose>``, casts its grid of rays (:mod:`navlab.sim.raycast3d` for primitives,
-``mj_multiRay`` for meshes) and applies Gazebo's semantics (rays start at the near clip / ``range_min``,
-gaussian noise from the given generator). Frames: the sensor frame is Gazebo's (x forward, y left, z up).
+pose composed with the sensor's ``<pose>``, finds what its grid of rays hits among the primitives — a depth
+camera by drawing them into a depth buffer (:mod:`navlab.sim.raster`), a 3D lidar by sweeping each shape's
+block of rays (:mod:`navlab.sim.sweep`), a range cone's few rays by :mod:`navlab.sim.raycast3d` — and among
+meshes by ``mj_multiRay``, then applies Gazebo's semantics (rays start at the near clip / ``range_min``,
+gaussian noise drawn from a stream seeded by the given generator). Frames: the sensor frame is Gazebo's (x
+forward, y left, z up).
 """
 
 from __future__ import annotations
@@ -16,8 +19,11 @@ import numpy as np
 from navlab.description import CameraConfig, Lidar3dConfig, Origin, RangeConfig
 from navlab.geometry import matrix_from_quat, qmul, qrotate, quat_from_rpy
 from navlab.io import move_points
-from navlab.sim.raycast3d import ALL, PINHOLE, SPHERICAL, cast_grid, pinhole_dirs, spherical_dirs
+from navlab.sim.gauss import seed_state
+from navlab.sim.raster import draw_depth, finish_depth
+from navlab.sim.raycast3d import ALL, cast_grid, pinhole_dirs, spherical_dirs
 from navlab.sim.simulation import Simulation
+from navlab.sim.sweep import finish_scan, sweep_grid
 
 
 def sensor_pose(sim: Simulation, link: str, origin: Origin) -> tuple[np.ndarray, np.ndarray]:
@@ -64,20 +70,29 @@ def cast(
         out,
     )
     if slow is not None:  # meshes: MuJoCo's ray caster, from tmin on
-        world = move_points(dirs, rot, (0.0, 0.0, 0.0)).astype(np.float64)
-        n = len(world)
-        dist = np.empty(n)
-        geomid = np.empty(n, dtype=np.int32)
-        mujoco.mj_multiRay(m, d, pos + 0.0, world.ravel(), slow, 1, -1, geomid, dist, None, n, tmax)
-        dist[geomid < 0] = np.inf
-        near = np.flatnonzero(dist < tmin)
-        one = np.empty(1, dtype=np.int32)
-        for i in near:
-            r = mujoco.mj_ray(m, d, pos + tmin * world[i], world[i], slow, 1, -1, one)
-            dist[i] = tmin + r if r >= 0 else np.inf
-        dist[dist > tmax] = np.inf
-        np.minimum(out, dist, out=out)
+        np.minimum(out, _cast_meshes(sim, pos, rot, dirs, slow, tmin, tmax), out=out)
     return out
+
+
+def _cast_meshes(
+    sim: Simulation, pos: np.ndarray, rot: np.ndarray, dirs: np.ndarray, groups: np.ndarray, tmin: float, tmax: float
+) -> np.ndarray:
+    """Distances (m) along ``dirs`` (sensor frame) to the geoms of ``groups`` by ``mj_multiRay``, from ``tmin`` on;
+    inf without a hit up to ``tmax``."""
+    m, d = sim.model, sim.data
+    world = move_points(dirs, rot, (0.0, 0.0, 0.0)).astype(np.float64)
+    n = len(world)
+    dist = np.empty(n)
+    geomid = np.empty(n, dtype=np.int32)
+    mujoco.mj_multiRay(m, d, pos + 0.0, world.ravel(), groups, 1, -1, geomid, dist, None, n, tmax)
+    dist[geomid < 0] = np.inf
+    near = np.flatnonzero(dist < tmin)
+    one = np.empty(1, dtype=np.int32)
+    for i in near:
+        r = mujoco.mj_ray(m, d, pos + tmin * world[i], world[i], groups, 1, -1, one)
+        dist[i] = tmin + r if r >= 0 else np.inf
+    dist[dist > tmax] = np.inf
+    return dist
 
 
 @functools.lru_cache(maxsize=16)
@@ -94,30 +109,39 @@ def _spherical_dirs(azimuths: tuple[float, ...], elevations: tuple[float, ...]) 
     return dirs
 
 
-def _pinhole(cfg: CameraConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(ray directions, their cosine to the optical axis, grid params) of a camera (directions cached by geometry)."""
-    cam = cfg.camera
-    dirs = _pinhole_dirs(cam.width, cam.height, cam.focal_length)
-    params = np.array([cam.focal_length, (cam.width - 1) / 2.0, (cam.height - 1) / 2.0])
-    return dirs, dirs[:, 0], params
+@functools.lru_cache(maxsize=16)
+def _pinhole_norm(width: int, height: int, focal: float) -> np.ndarray:
+    """Length (height x width) of each pixel's ray (1, -(u - u0)/f, -(v - v0)/f): 1 / cos(angle to the axis)."""
+    norm = 1.0 / _pinhole_dirs(width, height, focal)[:, 0].reshape(height, width)
+    norm.flags.writeable = False
+    return norm
 
 
 def depth_image(sim: Simulation, cfg: CameraConfig, rng: np.random.Generator | None = None) -> np.ndarray:
     """Depth (float32, height x width, m along the optical axis) as ``gazebo_ros_openni_kinect`` publishes it:
-    surfaces between the clip planes, plus the ``<camera><noise>`` (m, from ``rng``), and NaN where the depth
-    is not inside (``pointCloudCutoff``, ``pointCloudCutoffMax``)."""
+    surfaces between the clip planes, plus the ``<camera><noise>`` (m, drawn from a stream seeded by ``rng``), and
+    NaN where the depth is not inside (``pointCloudCutoff``, ``pointCloudCutoffMax``). Primitive shapes are drawn
+    into a depth buffer (:mod:`navlab.sim.raster`); meshes are ray cast."""
     cam = cfg.camera
-    dirs, cos, params = _pinhole(cfg)
+    norm = _pinhole_norm(cam.width, cam.height, cam.focal_length)
     pos, rot = sensor_pose(sim, cfg.link, cfg.origin)
-    # rays begin at the near clip plane and end at the far one (depth = t cos)
-    t = cast(sim, pos, rot, dirs, cam.height, cam.width, PINHOLE, params, cam.near / 1.0, cam.far / cos.min())
-    depth = t * cos
-    depth[depth > cam.far] = np.inf
-    depth[t * cos < cam.near] = np.inf
-    if cam.noise_stddev > 0 and rng is not None:
-        depth += cam.noise_mean + cam.noise_stddev * rng.standard_normal(depth.shape)
-    out = depth.astype(np.float32).reshape(cam.height, cam.width)
-    out[~((out > cfg.point_cloud_cutoff) & (out < cfg.point_cloud_cutoff_max))] = np.nan
+    tmax = cam.far * float(norm.max())  # the longest ray that can end before the far clip
+    m, d = sim.model, sim.data
+    fast, slow = sim.ray_geoms()
+    depth = np.empty((cam.height, cam.width))
+    params = np.array([cam.focal_length, (cam.width - 1) / 2.0, (cam.height - 1) / 2.0])
+    draw_depth(pos, rot, params, norm, fast, m.geom_type, m.geom_size, d.geom_xpos, d.geom_xmat, cam.near, tmax, depth)
+    if slow is not None:  # meshes: rays along the unit directions, their distances turned into depths
+        dirs = _pinhole_dirs(cam.width, cam.height, cam.focal_length)
+        t = _cast_meshes(sim, pos, rot, dirs, slow, cam.near, tmax).reshape(depth.shape)
+        np.minimum(depth, t / norm, out=depth)
+    noisy = cam.noise_stddev > 0 and rng is not None
+    seed = seed_state(rng) if noisy and rng is not None else np.uint64(0)
+    out = np.empty(depth.shape, dtype=np.float32)
+    std = cam.noise_stddev if noisy else 0.0
+    finish_depth(
+        depth, cam.near, cam.far, cam.noise_mean, std, seed, cfg.point_cloud_cutoff, cfg.point_cloud_cutoff_max, out
+    )
     return out
 
 
@@ -146,21 +170,49 @@ def lidar3d_angles(cfg: Lidar3dConfig) -> tuple[np.ndarray, np.ndarray]:
     return az, el
 
 
+@functools.lru_cache(maxsize=16)
+def _trig(angles: tuple[float, ...]) -> tuple[np.ndarray, np.ndarray]:
+    a = np.array(angles)
+    c, s = np.cos(a), np.sin(a)
+    c.flags.writeable = s.flags.writeable = False
+    return c, s
+
+
 def lidar3d_ranges(sim: Simulation, cfg: Lidar3dConfig, rng: np.random.Generator | None = None) -> np.ndarray:
     """Ranges (rings x samples, m) of a 3D lidar: the sensor's ray hits from ``range_min`` with noise added
-    (``rng``); misses are ``range_max``, as Gazebo's ray sensor reports them."""
+    (drawn from a stream seeded by ``rng``); misses are ``range_max``, as Gazebo's ray sensor reports them.
+    Primitive shapes are swept block by block (:mod:`navlab.sim.sweep`); meshes are ray cast."""
     az, el = lidar3d_angles(cfg)
-    dirs = _spherical_dirs(tuple(az.tolist()), tuple(el.tolist()))
-    d_az = (az[-1] - az[0]) / (len(az) - 1) if len(az) > 1 else 0.0
-    d_el = (el[-1] - el[0]) / (len(el) - 1) if len(el) > 1 else 0.0
-    params = np.array([az[0], d_az, el[0], d_el])
+    cos_az, sin_az = _trig(tuple(az.tolist()))
+    cos_el, sin_el = _trig(tuple(el.tolist()))
     pos, rot = sensor_pose(sim, cfg.link, cfg.origin)
-    r = cast(sim, pos, rot, dirs, cfg.rings, cfg.samples, SPHERICAL, params, cfg.range_min, cfg.range_max)
-    hit = np.isfinite(r)
-    if cfg.noise_stddev > 0 and rng is not None:
-        r[hit] += cfg.noise_stddev * rng.standard_normal(int(hit.sum()))
-    r[~hit] = cfg.range_max
-    return r.reshape(cfg.rings, cfg.samples)
+    m, d = sim.model, sim.data
+    fast, slow = sim.ray_geoms()
+    r = np.empty((cfg.rings, cfg.samples))
+    sweep_grid(
+        pos,
+        rot,
+        cos_az,
+        sin_az,
+        cos_el,
+        sin_el,
+        fast,
+        m.geom_type,
+        m.geom_size,
+        d.geom_xpos,
+        d.geom_xmat,
+        cfg.range_min,
+        cfg.range_max,
+        r,
+    )
+    if slow is not None:
+        dirs = _spherical_dirs(tuple(az.tolist()), tuple(el.tolist()))
+        t = _cast_meshes(sim, pos, rot, dirs, slow, cfg.range_min, cfg.range_max)
+        np.minimum(r, t.reshape(r.shape), out=r)
+    noisy = cfg.noise_stddev > 0 and rng is not None
+    seed = seed_state(rng) if noisy and rng is not None else np.uint64(0)
+    finish_scan(r, cfg.noise_stddev if noisy else 0.0, seed, cfg.range_max)
+    return r
 
 
 def range_rays(cfg: RangeConfig) -> np.ndarray:

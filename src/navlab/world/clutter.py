@@ -294,14 +294,16 @@ def _search_grid(walls: list[Box], goal: np.ndarray) -> tuple[np.ndarray, np.nda
     return xs, ys
 
 
-def _free_grid(
-    clearance: Clearance, walls: list[Box], goal: np.ndarray, radius: float
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+Grid = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]  # x, y, points (n, 2), clearance (len(y), len(x))
+
+
+def clearance_grid(clearance: Clearance, walls: list[Box], goal: np.ndarray) -> Grid:
+    """The search grid's cell centres and their exact clearances (m), for :func:`reference_path` and
+    :func:`bottleneck` (compute once, pass to both)."""
     xs, ys = _search_grid(walls, goal)
     gx, gy = np.meshgrid(xs, ys)
     pts = np.c_[gx.ravel(), gy.ravel()]
-    clear = clearance(pts).reshape(gx.shape)
-    return xs, ys, pts, clear >= radius
+    return xs, ys, pts, clearance(pts).reshape(gx.shape)
 
 
 def _cell_of(xs: np.ndarray, ys: np.ndarray, p: np.ndarray) -> int:
@@ -309,15 +311,22 @@ def _cell_of(xs: np.ndarray, ys: np.ndarray, p: np.ndarray) -> int:
 
 
 def reference_path(
-    clearance: Clearance, walls: list[Box], start: np.ndarray, goal: np.ndarray, radius: float
+    clearance: Clearance,
+    walls: list[Box],
+    start: np.ndarray,
+    goal: np.ndarray,
+    radius: float,
+    *,
+    grid: Grid | None = None,
 ) -> np.ndarray | None:
     """Shortest collision-free path (n, 2) for a disc of ``radius`` from start to goal, or None.
 
     8-connected Dijkstra over the 0.05 m grid cells whose exact clearance is >= ``radius``, then
     shortened by line of sight: from each vertex, on to the farthest grid-path point it sees (exact
-    segment tests against the cylinders and walls).
+    segment tests against the cylinders and walls). ``grid``: :func:`clearance_grid`'s, if the caller has it.
     """
-    xs, ys, pts, free = _free_grid(clearance, walls, goal, radius)
+    xs, ys, pts, clear = clearance_grid(clearance, walls, goal) if grid is None else grid
+    free = clear >= radius
     s, g = _cell_of(xs, ys, start), _cell_of(xs, ys, goal)
     if not (free.ravel()[s] and free.ravel()[g]):
         return None
@@ -343,18 +352,23 @@ def corridor_exists(world: ClutterWorld, radius: float) -> bool:
     """Whether start and goal are connected through cells with clearance >= ``radius`` (0.05 m grid)."""
     clearance = Clearance(world.cylinders, world.walls, CYLINDER_RADIUS)
     goal = np.array(world.goal[:2])
-    xs, ys, _, free = _free_grid(clearance, world.walls, goal, radius)
-    return _connected(free, _cell_of(xs, ys, np.array(world.start[:2])), _cell_of(xs, ys, goal))
+    xs, ys, _, clear = clearance_grid(clearance, world.walls, goal)
+    return _connected(clear >= radius, _cell_of(xs, ys, np.array(world.start[:2])), _cell_of(xs, ys, goal))
 
 
 def bottleneck(
-    clearance: Clearance, walls: list[Box], start: np.ndarray, goal: np.ndarray, tol: float = 0.005
+    clearance: Clearance,
+    walls: list[Box],
+    start: np.ndarray,
+    goal: np.ndarray,
+    tol: float = 0.005,
+    *,
+    grid: Grid | None = None,
 ) -> float:
     """Half-width (m) of the narrowest passage on the widest route: the largest clearance c for which
-    start and goal connect through 0.05 m cells with clearance >= c (bisection to ``tol``)."""
-    xs, ys = _search_grid(walls, goal)
-    gx, gy = np.meshgrid(xs, ys)
-    clear = clearance(np.c_[gx.ravel(), gy.ravel()]).reshape(gx.shape)
+    start and goal connect through 0.05 m cells with clearance >= c (bisection to ``tol``). ``grid``:
+    :func:`clearance_grid`'s, if the caller has it."""
+    xs, ys, _, clear = clearance_grid(clearance, walls, goal) if grid is None else grid
     a, b = _cell_of(xs, ys, start), _cell_of(xs, ys, goal)
     lo, hi = 0.0, float(min(clear.ravel()[a], clear.ravel()[b]))
     if _connected(clear >= hi, a, b):
@@ -441,7 +455,8 @@ def generate_clutter(
     walls = _walls()
     cylinders = written_cylinders(cells)
     clearance = Clearance(cylinders, walls, CYLINDER_RADIUS)
-    path = reference_path(clearance, walls, start, goal, robot_radius)
+    grid = clearance_grid(clearance, walls, goal)
+    path = reference_path(clearance, walls, start, goal, robot_radius, grid=grid)
     if path is None:
         raise WorldError(
             f"clutter: seed {seed}: no collision-free path for robot_radius {robot_radius} m (every world keeps "
@@ -464,7 +479,7 @@ def generate_clutter(
         "fill_final": difficulty,
         "tortuosity": length / GOAL_DISTANCE,
         "mean_clearance_m": float(np.mean(np.minimum(along, FIELD / 2))),
-        "bottleneck_m": bottleneck(clearance, walls, start, goal),
+        "bottleneck_m": bottleneck(clearance, walls, start, goal, grid=grid),
     }
     return ClutterWorld(
         seed=int(seed),

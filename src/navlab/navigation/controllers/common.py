@@ -143,7 +143,7 @@ def _first_near(plan: np.ndarray, x: float, y: float, distance: float) -> int:  
 
 
 @numba.njit(cache=True)
-def _crop_span(plan: np.ndarray, x: float, y: float, radius: float) -> tuple[int, int]:  # pragma: no cover
+def crop_span(plan: np.ndarray, x: float, y: float, radius: float) -> tuple[int, int]:  # pragma: no cover
     """(first, end) of ``crop_plan``'s stretch; (0, 0) when no pose lies within ``radius`` m."""
     r2 = radius * radius
     first = -1
@@ -162,7 +162,7 @@ def crop_plan(plan: np.ndarray, x: float, y: float, radius: float) -> np.ndarray
     the first pose within ``radius`` m (half the local costmap's larger side) up to the first pose beyond it
     again, that one included (ROS's loop keeps it). Empty when no pose is that close (ROS: an empty
     transformed plan, no command)."""
-    first, end = _crop_span(plan, x, y, radius)
+    first, end = crop_span(plan, x, y, radius)
     return plan[first:end]
 
 

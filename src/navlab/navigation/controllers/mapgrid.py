@@ -16,9 +16,11 @@ from navlab.grid import COST_INSCRIBED, COST_UNKNOWN
 
 
 @numba.njit(cache=True)
-def _wave(
+def wave(
     cost: np.ndarray, seeds_i: np.ndarray, seeds_j: np.ndarray, free_i: np.ndarray, free_j: np.ndarray, out: np.ndarray
 ) -> None:  # pragma: no cover - compiled
+    """:func:`distance_map` into ``out`` from the seed cells (columns ``seeds_i``, rows ``seeds_j``), the cells
+    (``free_i``, ``free_j``) never obstacles."""
     h, w = cost.shape
     obstacle = float(h * w)
     out[:, :] = obstacle + 1.0
@@ -67,11 +69,12 @@ def plan_cells(cost: np.ndarray, plan_xy: np.ndarray, resolution: float) -> np.n
         n = np.maximum(1, np.ceil(np.hypot(seg[:, 0], seg[:, 1]) / resolution).astype(np.int64))
     else:
         n = np.zeros(0, dtype=np.int64)
-    return _plan_cells(np.ascontiguousarray(cost), xy, n, float(resolution))
+    return cells_along(np.ascontiguousarray(cost), xy, n, float(resolution))
 
 
 @numba.njit(cache=True)
-def _plan_cells(cost: np.ndarray, xy: np.ndarray, n: np.ndarray, res: float) -> np.ndarray:  # pragma: no cover
+def cells_along(cost: np.ndarray, xy: np.ndarray, n: np.ndarray, res: float) -> np.ndarray:  # pragma: no cover
+    """:func:`plan_cells` of the grid-local points ``xy`` (N, 2) whose segments are cut in ``n`` (N - 1,) steps."""
     h, w = cost.shape
     total = n.sum() + 1 if xy.shape[0] >= 2 else xy.shape[0]
     out = np.empty((total, 2), dtype=np.int64)
@@ -107,5 +110,5 @@ def distance_map(cost: np.ndarray, seeds: np.ndarray, free: np.ndarray | None = 
     out = np.empty(cost.shape, dtype=np.float64)
     seeds = np.asarray(seeds, dtype=np.int64).reshape(-1, 2)
     free = np.zeros((0, 2), dtype=np.int64) if free is None else np.asarray(free, dtype=np.int64).reshape(-1, 2)
-    _wave(np.ascontiguousarray(cost), seeds[:, 0].copy(), seeds[:, 1].copy(), free[:, 0].copy(), free[:, 1].copy(), out)
+    wave(np.ascontiguousarray(cost), seeds[:, 0].copy(), seeds[:, 1].copy(), free[:, 0].copy(), free[:, 1].copy(), out)
     return out

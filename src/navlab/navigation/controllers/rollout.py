@@ -379,15 +379,17 @@ def footprint_cells(
     poly = np.column_stack([x + c * polygon[:, 0] - s * polygon[:, 1], y + s * polygon[:, 0] + c * polygon[:, 1]])
     ex = x + c * edges[:, 0] - s * edges[:, 1]
     ey = y + s * edges[:, 0] + c * edges[:, 1]
-    return _footprint_cells(
+    return cells_under(
         int(h), int(w), float(resolution), float(x), float(y), poly, np.ascontiguousarray(ex), np.ascontiguousarray(ey)
     )
 
 
 @numba.njit(cache=True)
-def _footprint_cells(
+def cells_under(
     h: int, w: int, res: float, x: float, y: float, poly: np.ndarray, ex: np.ndarray, ey: np.ndarray
 ) -> np.ndarray:  # pragma: no cover - compiled
+    """:func:`footprint_cells` of an ``h`` x ``w`` grid for the robot centred at grid-local (x, y): its polygon
+    ``poly`` (K, 2) and outline points (``ex``, ``ey``) already placed in grid-local coordinates."""
     ci, cj = math.floor(x / res), math.floor(y / res)
     lo_i, lo_j = math.floor(poly[:, 0].min() / res), math.floor(poly[:, 1].min() / res)
     hi_i, hi_j = math.floor(poly[:, 0].max() / res), math.floor(poly[:, 1].max() / res)

@@ -19,8 +19,8 @@ best one's velocity:
   highest cost under the edges or at the centre cell (``occdist`` takes the highest along the rollout).
   Without a polygon or radius the robot is a point: its centre cell, blocked from INSCRIBED up;
 - *TrajectoryPlanner cost* = pdist_scale * path_dist + gdist_scale * goal_dist + occdist_scale *
-  max_cost, distances at the rollout's end (in cells; ``meter_scoring`` multiplies pdist_scale and gdist_scale
-  by the resolution, occdist_scale stays as given, as in ROS 1 noetic); a rollout that
+  max_cost, distances at the rollout's end (in cells; ``meter_scoring`` multiplies the three biases by the
+  resolution, as noetic scores after its start-up reconfigure); a rollout that
   leaves the map, is blocked, or passes a cell with no path to the plan or goal is rejected (the first failure
   in time decides the code, -1 or -2). With ``heading_scoring`` every rollout has sim_time / sim_granularity
   steps, the distances count at the step at ``heading_scoring_timestep`` only, and 0.3 x the angle from the
@@ -56,6 +56,7 @@ rather than Bresenham-rasterised.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
@@ -64,7 +65,7 @@ import numpy as np
 
 from navlab.core import read_params
 from navlab.grid import Grid
-from navlab.navigation.controllers import mapgrid
+from navlab.navigation.controllers import mapgrid, scene_kernel
 from navlab.navigation.controllers.common import (
     ControllerBase,
     GoalLatch,
@@ -72,7 +73,6 @@ from navlab.navigation.controllers.common import (
     OscillationFlags,
     as_plan,
     circle_footprint,
-    crop_plan,
     footprint_outline,
     goal_of,
     prune_plan,
@@ -82,6 +82,9 @@ from navlab.navigation.controllers.common import (
     stopped,
 )
 from navlab.navigation.controllers.rollout import outline_reach_max, rollout
+
+_NO_POINTS = np.zeros((0, 2))  # no polygon, no outline (path_scene's typed empties)
+_NO_POINTS.flags.writeable = False
 
 # --- the shared cycle ------------------------------------------------------------------------------
 
@@ -150,8 +153,9 @@ class RolloutController(ControllerBase):
         self._plan: np.ndarray | None = None
         self._rotating_to_goal = False
         self._outlines: dict[tuple[float, bytes | None], np.ndarray | None] = {}
-        self._near: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
-        self._goal_map: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None  # (costs, goal cell, distances)
+        self._near: tuple[np.ndarray, np.ndarray | None, np.ndarray] | None = None  # (outline, costs, reach max)
+        self._goal_map: tuple[np.ndarray | None, np.ndarray, np.ndarray] | None = None  # (costs, goal cell, distances)
+        self._costs_seen: np.ndarray | None = None  # the local costs last seen (see _note_costs)
         self._clear_outputs()
         self._setup()
 
@@ -226,43 +230,49 @@ class RolloutController(ControllerBase):
         cost = np.ascontiguousarray(costmap.data, dtype=np.uint8)
         res = costmap.resolution
         pose_l = frame.pose_in(pose)
-        reach = 0.5 * res * max(cost.shape)
-        plan = crop_plan(frame.points_in(self._plan[:, :2]), pose_l[0], pose_l[1], reach)
+        self._note_costs(cost)
+        mode, polygon, edges = self._free_mode(res)
+        plan, cells, path_dist = scene_kernel.path_scene(
+            cost,
+            np.ascontiguousarray(self._plan[:, :2]),
+            frame.ox,
+            frame.oy,
+            frame.oyaw,
+            res,
+            pose_l,
+            0.5 * res * max(cost.shape),
+            mode,
+            _NO_POINTS if polygon is None else polygon,
+            _NO_POINTS if edges is None else edges,
+        )
         if len(plan) == 0:
             return None  # ROS: an empty transformed plan (no pose of the plan near the robot)
-        cells = mapgrid.plan_cells(cost, plan, res)
         if len(cells) == 0:
             return None  # ROS: "None of the points of the global plan were in the local costmap"
-        free = self._free_cells(cost, pose_l, res)
-        return LocalScene(
-            frame,
-            pose_l,
-            cost,
-            res,
-            plan,
-            cells,
-            mapgrid.distance_map(cost, cells, free),
-            self._goal_dist(cost, cells[-1:]),
-        )
+        return LocalScene(frame, pose_l, cost, res, plan, cells, path_dist, self._goal_dist(cost, cells[-1:]))
+
+    def _note_costs(self, cost: np.ndarray) -> None:
+        """Keep a copy of the local costs in ``_costs_seen``, a new one only when they changed: what is computed
+        from them (the goal's distance map, the footprint's reach maximum) is kept with that copy and reused while
+        it is still the one (the costmap updates less often than the controller runs)."""
+        seen = self._costs_seen
+        if seen is None or seen.shape != cost.shape or not np.array_equal(seen, cost):
+            self._costs_seen = cost.copy()
 
     def _goal_dist(self, cost: np.ndarray, goal: np.ndarray) -> np.ndarray:
         """The local goal cell's distance map, kept while the costs and that cell stay the same (the robot moves
         a few cells per costmap update; the goal cell moves less often)."""
         cached = self._goal_map
-        if (
-            cached is not None
-            and np.array_equal(cached[1], goal)
-            and cached[0].shape == cost.shape
-            and np.array_equal(cached[0], cost)
-        ):
+        if cached is not None and cached[0] is self._costs_seen and np.array_equal(cached[1], goal):
             return cached[2]
         dist = mapgrid.distance_map(cost, goal)
-        self._goal_map = (cost.copy(), goal.copy(), dist)
+        self._goal_map = (self._costs_seen, goal.copy(), dist)
         return dist
 
-    def _free_cells(self, cost: np.ndarray, pose_l: tuple[float, float, float], res: float) -> np.ndarray | None:
-        """Cells never obstacles for the path map's wave (None: none)."""
-        return None
+    def _free_mode(self, res: float) -> tuple[int, np.ndarray | None, np.ndarray | None]:
+        """Which cells never block the path map's wave, as ``scene_kernel.path_scene`` takes it: (0 none | 1 the
+        centre cell | 2 the cells under the polygon, the polygon (K, 2) (base frame, m), its outline at ``res``)."""
+        return 0, None, None
 
     def _outline(self, res: float) -> np.ndarray | None:
         """The footprint's edge points at ``res`` (cached: the same footprint and resolution every cycle)."""
@@ -278,15 +288,10 @@ class RolloutController(ControllerBase):
         if outline is None:
             return None
         cached = self._near
-        if (
-            cached is not None
-            and cached[0] is outline
-            and cached[1].shape == scene.cost.shape
-            and np.array_equal(cached[1], scene.cost)
-        ):
+        if cached is not None and cached[0] is outline and cached[1] is self._costs_seen:
             return cached[2]
         near = outline_reach_max(scene.cost, scene.resolution, outline)
-        self._near = (outline, scene.cost.copy(), near)
+        self._near = (outline, self._costs_seen, near)
         return near
 
     def _stop_rotate(
@@ -363,8 +368,9 @@ class RolloutController(ControllerBase):
             self.valid = False
             return 0.0, 0.0
         path = traj[best]
-        moved = np.nonzero(np.any(path[1:] != path[:-1], axis=1))[0]
-        self.local_plan = scene.frame.poses_out(path[: (int(moved[-1]) + 2) if len(moved) else 1])
+        f = scene.frame
+        c, s = math.cos(f.oyaw), math.sin(f.oyaw)
+        self.local_plan = scene_kernel.poses_out(path, scene_kernel.moved_length(path), f.ox, f.oy, f.oyaw, c, s)
         return float(targets[best, 0]), float(targets[best, 1])
 
     def _drive(

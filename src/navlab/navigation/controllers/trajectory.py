@@ -11,7 +11,7 @@ import numpy as np
 from navlab.navigation.controllers import trajectory_cycle as cycle
 from navlab.navigation.controllers.common import InPlaceFlags
 from navlab.navigation.controllers.params import TrajectoryPlannerParams
-from navlab.navigation.controllers.rollout import footprint_cells, heading_diffs, rollout_scores
+from navlab.navigation.controllers.rollout import heading_diffs, rollout_scores
 from navlab.navigation.controllers.rollout_controller import LocalScene, RolloutController
 
 # --- base_local_planner/TrajectoryPlannerROS ----------------------------------------------------------
@@ -39,10 +39,11 @@ class TrajectoryPlannerROS(RolloutController):
         p = self.params
         return (p.max_vel_theta if err > 0 else -p.min_vel_theta), p.min_in_place_vel_theta
 
-    def _free_cells(self, cost: np.ndarray, pose_l: tuple[float, float, float], res: float) -> np.ndarray | None:
-        """Cells under the robot now, never obstacles for the path map's wave (ROS's ``within_robot``)."""
+    def _free_mode(self, res: float) -> tuple[int, np.ndarray | None, np.ndarray | None]:
+        """The cells under the robot now never block the path map's wave (ROS's ``within_robot``): its centre cell
+        for a point robot, else the cells under its polygon."""
         edges = self._outline(res)
-        return footprint_cells(cost.shape, res, pose_l, self.footprint if edges is not None else None, edges=edges)
+        return (1, None, None) if edges is None or self.footprint is None else (2, self.footprint, edges)
 
     def _check(self, scene: LocalScene, targets: np.ndarray, traj: np.ndarray) -> np.ndarray:
         return self._score(scene, traj)
@@ -197,10 +198,14 @@ class TrajectoryPlannerROS(RolloutController):
     def _weights(self, res: float) -> np.ndarray:
         """The scoring kernel's (1, pdist, gdist, occdist) weights (m or cell units for the distances)."""
         p = self.params
-        # meter_scoring scales the distance biases by the resolution, not occdist_scale (ROS 1 since the biases'
-        # renaming: TrajectoryPlannerROS::initialize and TrajectoryPlanner::reconfigure)
+        # meter_scoring scales all three biases by the resolution: what noetic scores with after start-up.
+        # TrajectoryPlannerROS::initialize scales pdist and gdist alone, but its dynamic-reconfigure callback runs
+        # once at start-up and TrajectoryPlanner::reconfigure re-reads the three biases from the parameters and
+        # scales all three when its (never initialised) meter_scoring_ reads true, none when it reads false: the
+        # same ratios either way, so the same choices (the heading_scoring term aside). Melodic's initialize
+        # scaled all three too.
         scale = res if p.meter_scoring else 1.0
-        return np.array([1.0, scale * p.pdist_scale, scale * p.gdist_scale, p.occdist_scale])
+        return np.array([1.0, scale * p.pdist_scale, scale * p.gdist_scale, scale * p.occdist_scale])
 
     def _end_escape(self, pose: tuple[float, float, float]) -> None:
         """Leave escape mode once ``escape_reset_dist`` m or ``escape_reset_theta`` rad from where it began."""

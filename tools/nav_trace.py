@@ -1,0 +1,128 @@
+"""Record or compare a bit-level trace of ``navlab bench nav``'s run, to show a speed-up changes no result.
+
+    python tools/nav_trace.py record OUT.json [--seed N] [--controller trajectory|dwa|mppi]
+    python tools/nav_trace.py compare OLD.json NEW.json
+
+The trace holds every cmd_vel (hex floats), the tf map -> odom and odom -> base sent, every amcl_pose, a hash of
+every global plan, of both costmaps after each update and of the controller's local plan each cycle, and the true
+path at 10 Hz. Record with the old code (e.g. ``PYTHONPATH=/tmp/old/src``, a ``git archive`` of the base), then
+with the new, and compare: ``compare`` names the first difference of each part and exits 1 if there is one.
+"""
+
+from __future__ import annotations
+
+import argparse
+import hashlib
+import json
+import sys
+from typing import Any
+
+import numpy as np
+
+GOALS = [(4.3, 1.0, 0.0), (-3.5, -0.5, 3.14), (1.5, -2.5, 0.0), (0.0, 0.0, 0.0)]  # bench nav's
+
+
+def _digest(data: bytes) -> str:
+    return hashlib.sha1(data).hexdigest()[:16]
+
+
+def record(out: str, seed: int, controller: str | None) -> None:
+    """Run bench nav's goals with hooks on the executor, the costmaps and move_base; write the trace to ``out``."""
+    from navlab.core.executor import Executor
+    from navlab.experiments.navigate_run import run_navigation
+    from navlab.navigation.costmap_ros import Costmap2DROS
+    from navlab.navigation.move_base import MoveBase
+
+    rec: dict[str, Any] = {k: [] for k in ("cmd", "tf", "amcl", "plan", "costmap", "local")}
+    publish, update, make_plan = Executor.publish, Costmap2DROS.update, MoveBase.make_plan
+
+    def on_publish(self: Any, topic: Any, msg: Any, *, latch_key: int | None = None) -> None:
+        t, name = self.now_ns, topic.name
+        if name.endswith("cmd_vel"):
+            rec["cmd"].append((t, name, msg.linear.x.hex(), msg.angular.z.hex()))
+        elif name.endswith("amcl_pose"):
+            p = msg.pose.pose
+            rec["amcl"].append((t, *(v.hex() for v in (p.position.x, p.position.y, p.orientation.z, p.orientation.w))))
+        elif name == "/tf":
+            for tr in msg.transforms:
+                q = tr.transform
+                rec["tf"].append(
+                    (t, tr.child_frame_id, q.translation.x.hex(), q.translation.y.hex(), q.rotation.z.hex())
+                )
+        publish(self, topic, msg, latch_key=latch_key)
+
+    def on_update(self: Any) -> Any:
+        g = update(self)
+        if g is not None:
+            rec["costmap"].append(
+                (self.node.executor.now_ns, self.name, _digest(g.data.tobytes() + repr(g.origin).encode()))
+            )
+        return g
+
+    def on_make_plan(self: Any, start: Any, goal: Any) -> Any:
+        p = make_plan(self, start, goal)
+        rec["plan"].append((self.executor.now_ns, None if p is None else _digest(np.ascontiguousarray(p).tobytes())))
+        return p
+
+    def on_start(run: Any) -> None:
+        ctl = run.node("move_base").controller
+        compute = ctl.compute_velocity
+
+        def on_compute(*a: Any, **k: Any) -> Any:
+            res = compute(*a, **k)
+            lp = np.ascontiguousarray(res.local_plan, dtype=np.float64)
+            rec["local"].append((run.executor.now_ns, bool(res.valid), _digest(lp.tobytes())))
+            return res
+
+        ctl.compute_velocity = on_compute
+
+    Executor.publish, Costmap2DROS.update, MoveBase.make_plan = on_publish, on_update, on_make_plan  # type: ignore[method-assign]
+    r = run_navigation(
+        GOALS, world="room_obstacles", goal_timeout=90, seed=seed, controller=controller, on_start=on_start
+    )
+    rec["path"] = [[float(v).hex() for v in row] for row in r.path]
+    rec["summary"] = {k: r.summary[k] for k in ("sim_s", "goals_succeeded", "collisions")}
+    with open(out, "w") as f:
+        json.dump(rec, f)
+    print(out, {k: len(v) for k, v in rec.items()})
+
+
+def compare(old: str, new: str) -> bool:
+    """Print each part as identical or its first difference; True if everything is identical."""
+    with open(old) as f, open(new) as g:
+        a, b = json.load(f), json.load(g)
+    same = True
+    for key in sorted(set(a) | set(b)):
+        x, y = a.get(key), b.get(key)
+        if x == y:
+            print(f"{key}: identical ({len(x)})")
+            continue
+        same = False
+        if isinstance(x, list) and isinstance(y, list):
+            k = next((i for i, (p, q) in enumerate(zip(x, y, strict=False)) if p != q), min(len(x), len(y)))
+            print(f"{key}: first difference at {k} ({len(x)} vs {len(y)} entries)")
+        else:
+            print(f"{key}: {x} vs {y}")
+    print("IDENTICAL" if same else "DIFFERENT")
+    return same
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    sub = ap.add_subparsers(dest="verb", required=True)
+    r = sub.add_parser("record")
+    r.add_argument("out")
+    r.add_argument("--seed", type=int, default=0)
+    r.add_argument("--controller", default=None)
+    c = sub.add_parser("compare")
+    c.add_argument("old")
+    c.add_argument("new")
+    args = ap.parse_args()
+    if args.verb == "record":
+        record(args.out, args.seed, args.controller)
+    else:
+        sys.exit(0 if compare(args.old, args.new) else 1)
+
+
+if __name__ == "__main__":
+    main()
