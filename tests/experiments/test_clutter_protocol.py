@@ -6,7 +6,7 @@ from __future__ import annotations
 import pytest
 
 from navlab.experiments.clutter_protocol import SETS, speed_overrides
-from navlab.experiments.clutter_run import run_clutter_world
+from navlab.experiments.clutter_run import barn_clock, run_clutter_world
 from navlab.experiments.errors import ExperimentError
 from navlab.world.clutter import clutter_suite, generate_clutter, suite_parameters
 
@@ -36,3 +36,13 @@ def test_a_world_that_defeated_the_jackals_mppi_is_now_reached() -> None:
     assert r["success"] and r["false_success"] == 0 and r["collisions"] == 0, r
     assert r["final_error_m"] <= 1.0 and r["near_goal_m"] <= r["final_error_m"]
     assert not r["near_miss"] and r["min_clearance_m"] >= 0.05
+    # BARN's clock (first 0.1 m moved -> first within 1 m) is shorter than move_base's (sent -> stopped at it)
+    assert 0 < r["barn_time_s"] < r["time_s"] and r["score"] >= r["score_to_stop"]
+
+
+def test_barn_clock_runs_from_the_first_move_until_first_within_a_metre() -> None:
+    one = {"time_s": 14.0, "moved_s": 0.6, "within_tolerance_s": 12.1}
+    assert barn_clock([one]) == pytest.approx(11.5)
+    first, second = {**one, "within_tolerance_s": 13.0}, {"time_s": 9.0, "moved_s": 0.2, "within_tolerance_s": 7.0}
+    assert barn_clock([first, second]) == pytest.approx(14.0 - 0.6 + 7.0)  # a tour: the first goal's whole time
+    assert barn_clock([{**one, "within_tolerance_s": None}]) is None  # never came within 1 m

@@ -40,9 +40,12 @@ def test_a_clutter_trial_is_scored_as_barn_scores_it() -> None:
     r = run_trial(sc, 0)
     assert r["success"] and r["collisions"] == 0 and r["world"] == "clutter_s4_f10_k1", r
     assert r["t_opt_s"] == pytest.approx(5.0, abs=0.1)  # a straight 10 m at BARN's 2 m/s
+    # BARN's clock: from the first 0.1 m moved until first within 1 m (shorter than move_base's time to stop)
+    assert 0.0 < r["barn_time_s"] < r["time_s"]
     assert 0.0 < r["score"] <= 0.5 and r["score"] == pytest.approx(
-        r["t_opt_s"] / max(r["time_s"], 2 * r["t_opt_s"]), abs=1e-3
+        r["t_opt_s"] / max(r["barn_time_s"], 2 * r["t_opt_s"]), abs=1e-3
     )
+    assert r["score_to_stop"] == pytest.approx(r["t_opt_s"] / max(r["time_s"], 2 * r["t_opt_s"]), abs=1e-3)
 
 
 def test_a_slow_local_costmap_hits_the_cylinder_that_a_fast_one_avoids() -> None:

@@ -3,10 +3,13 @@ progress reported ``stuck`` (not ``timeout``), and the closest approach to the g
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 from navlab.experiments.navigate_run import run_navigation
+from navlab.grid import COST_LETHAL, Grid
 from navlab.navigation.errors import NavigationError
+from navlab.navigation.keepout import held_up_at, with_keepouts
 from navlab.navigation.progress_checker import SimpleProgressChecker, stuck_window
 
 
@@ -21,6 +24,37 @@ def test_progress_checker_counts_time_near_one_pose() -> None:
     assert off.check((0.0, 0.0, 0.0), 0.0) and off.check((0.0, 0.0, 0.0), 1e6)
     with pytest.raises(NavigationError, match="required_movement_radius"):
         SimpleProgressChecker({"required_movement_radius": -1.0})
+
+
+def test_progress_toward_the_goal_catches_a_robot_that_shuttles_in_and_out_of_a_pocket() -> None:
+    """Driving 1 m into a pocket and back out every 4 s is movement (Nav2's checker is content) but never
+    brings the goal nearer: with navlab's goal-progress allowance the checker reports no progress."""
+    params = {"required_movement_radius": 0.5, "movement_time_allowance": 10.0}
+    nav2 = SimpleProgressChecker(params)
+    toward = SimpleProgressChecker({**params, "required_goal_progress": 0.5, "goal_progress_time_allowance": 20.0})
+    goal, verdicts = (-5.0, 0.0), []  # the pocket leads away from the goal
+    for k in range(61):  # 30 s, a check every 0.5 s
+        pose = (abs((k % 8) - 4) * 0.25, 0.0, 0.0)  # 0 -> 1 m -> 0 every 4 s
+        assert nav2.check(pose, k * 0.5)
+        verdicts.append(toward.check(pose, k * 0.5, goal))
+    assert all(verdicts[:41]) and not verdicts[-1] and toward.toward_goal
+    assert toward.stuck_reason(30.0).startswith("stuck: the robot came no nearer the goal by 0.5 m in 28.5 s")
+    toward.restart_clocks(30.0)  # after a recovery the robot has its allowance again
+    assert toward.check((0.0, 0.0, 0.0), 31.0, goal)
+    assert toward.check((-0.6, 0.0, 0.0), 49.0, goal) and toward.progressed  # 0.6 m nearer: progress
+    assert toward.check((-0.6, 0.0, 0.0), 52.0, None)  # no goal known: Nav2's check alone
+
+
+def test_a_keepout_closes_the_gap_that_held_the_robot_up() -> None:
+    """The costliest cell of the plan ahead becomes a lethal disc for the planner; the costmap itself is kept."""
+    costmap = Grid(np.zeros((40, 60), dtype=np.uint8), 0.05, (-1.0, -1.0, 0.0), "odom")
+    costmap.data[20, 30] = 200  # a gap's costly middle at (0.525, 0.025)
+    plan = np.stack([np.linspace(-0.9, 1.9, 57), np.full(57, 0.025)], axis=1)
+    assert held_up_at(plan, costmap, (-0.9, 0.0, 0.0)) == pytest.approx((0.5, 0.025))
+    assert held_up_at(plan, costmap, (1.5, 0.0, 0.0)) is None  # past it: nothing ahead holds the robot up
+    blocked = with_keepouts(costmap, [(0.525, 0.025)])
+    assert blocked.value_at(np.array([[0.525, 0.025], [0.525, 0.35]]), outside=0).tolist() == [COST_LETHAL, 0]
+    assert costmap.data.max() == 200 and with_keepouts(costmap, []) is costmap
 
 
 def test_stuck_window_reads_a_true_path() -> None:

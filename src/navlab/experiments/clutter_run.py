@@ -3,7 +3,8 @@
 Each world (``world.clutter``) is written as an SDF ``.world``, the robot starts 2.1 m before the field and
 drives with ``move_base`` on a rolling global costmap to the goal 10 m ahead (given in ``odom``). A trial
 succeeds when the robot ends within 1 m of the goal without a collision inside ``timeout`` s; its score is
-``success x T_opt / clip(T, 2 T_opt, 8 T_opt)`` with ``T_opt`` = reference path length / 2 m/s. The judgement
+``success x T_opt / clip(T, 2 T_opt, 8 T_opt)`` with ``T_opt`` = reference path length / 2 m/s and ``T`` on BARN's
+clock (from the robot's first 0.1 m until it is first within 1 m of the goal: ``barn_clock``). The judgement
 is the simulator's truth; move_base's own verdict is beside it (``move_base_success``, ``false_success``: it
 reported the goal reached while the robot truly ended more than 1 m away).
 """
@@ -128,6 +129,7 @@ def barn_outcome(world: Any, goals: list[dict[str, Any]]) -> dict[str, Any]:
     collisions = sum(x["collisions"] for x in goals)
     time_s = sum(x["time_s"] for x in goals)
     success = collisions == 0 and g["final_error_m"] is not None and g["final_error_m"] <= SUCCESS_M
+    barn_time = barn_clock(goals)
     missed = "missed" if g["outcome"] == "succeeded" else g["outcome"]  # move_base's tolerance is not BARN's
     failure = "" if success else ("collision" if collisions else missed)
     return {
@@ -138,8 +140,20 @@ def barn_outcome(world: Any, goals: list[dict[str, Any]]) -> dict[str, Any]:
         "move_base_success": collisions == 0 and all(x["move_base_outcome"] == "succeeded" for x in goals),
         "false_success": sum(x["move_base_outcome"] == "succeeded" and x["final_error_m"] > SUCCESS_M for x in goals),
         "t_opt_s": world.t_opt(),
-        "score": barn_score(success, time_s, world.t_opt()),
+        "barn_time_s": barn_time,
+        "score": barn_score(success, time_s if barn_time is None else barn_time, world.t_opt()),
+        "score_to_stop": barn_score(success, time_s, world.t_opt()),
     }
+
+
+def barn_clock(goals: list[dict[str, Any]]) -> float | None:
+    """The time BARN's run.py scores (s): from when the robot has moved 0.1 m from its start until it is first
+    within the goal tolerance of the last goal (by the truth; it need not stop there), None if it never was.
+    navlab's ``time_s`` runs from the goal's sending until move_base ends it (stopped at the goal, turned)."""
+    first, last = goals[0], goals[-1]
+    if first.get("moved_s") is None or last.get("within_tolerance_s") is None:
+        return None
+    return sum(x["time_s"] for x in goals[:-1]) - first["moved_s"] + last["within_tolerance_s"]
 
 
 def clutter_for_trial(world: str, index: int) -> Any:
@@ -158,8 +172,14 @@ def clutter_for_trial(world: str, index: int) -> Any:
     return generate_clutter(spec.get("seed", 0) * 1000 + k, fill=fill, smooth=smooth)  # as clutter_suite(n, seed)
 
 
+def _mean(values: Any) -> float | None:
+    xs = [float(v) for v in values if v is not None]
+    return sum(xs) / len(xs) if xs else None
+
+
 def summarize(trials: list[dict[str, Any]]) -> dict[str, Any]:
-    """BARN's figures over trials: success, collision and timeout rates, mean score."""
+    """BARN's figures over trials: success, collision and timeout rates, mean score (BARN's clock, see
+    ``barn_clock``; ``score_to_stop`` with ``time_s``, the time until move_base ended the goal)."""
     n = len(trials)
     if n == 0:
         return {"worlds": 0}
@@ -175,7 +195,9 @@ def summarize(trials: list[dict[str, Any]]) -> dict[str, Any]:
             "move_base_success": sum(t["move_base_success"] for t in trials) / n,
             "false_success": sum(t["false_success"] for t in trials),
             "score": sum(t["score"] for t in trials) / n,
+            "score_to_stop": sum(t.get("score_to_stop", t["score"]) for t in trials) / n,
             "mean_time_s": sum(t["time_s"] for t in trials if t["success"]) / max(1, sum(t["success"] for t in trials)),
+            "mean_barn_time_s": _mean(t.get("barn_time_s") for t in trials if t["success"]),
             "min_clearance_m": min(
                 (t["min_clearance_m"] for t in trials if t["min_clearance_m"] is not None), default=None
             ),

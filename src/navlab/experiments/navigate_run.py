@@ -71,6 +71,21 @@ def _episodes(times: Sequence[float], t0: float, t1: float, gap: float = 0.25) -
     return sum(1 for k, t in enumerate(ts) if k == 0 or t - ts[k - 1] > gap)
 
 
+def _benchmark_times(
+    path: Sequence[tuple[float, float, float]], goal: Any, tolerance: float, start_m: float = 0.1
+) -> tuple[float | None, float | None]:
+    """When (s, the monitor's clock) the true path ``(t, x, y)`` first left ``start_m`` m of its first point, and
+    when it first came within ``tolerance`` m of ``goal`` after that (None: never) — the clock BARN's run.py keeps."""
+    if not path:
+        return None, None
+    pts = np.asarray(path, dtype=np.float64)
+    left = np.flatnonzero(np.hypot(*(pts[:, 1:3] - pts[0, 1:3]).T) >= start_m)
+    if not left.size:
+        return None, None
+    near = np.flatnonzero(np.hypot(*(pts[left[0] :, 1:3] - np.asarray(goal[:2])).T) <= tolerance)
+    return float(pts[left[0], 0]), (float(pts[left[0] + near[0], 0]) if near.size else None)
+
+
 def _drive_goal(
     run: Run,
     mon: NavMonitor,
@@ -124,6 +139,7 @@ def _drive_goal(
         )
     clearance = np.asarray(mon.clearance[k0:], dtype=np.float64)
     collisions = _episodes(mon.contacts, t0, t1)
+    moved_s, within_s = _benchmark_times(mon.path[k0:], goal_world, tolerance)
     min_clearance = float(clearance.min()) if clearance.size else math.inf
     return {
         "goal": list(goal),
@@ -144,6 +160,8 @@ def _drive_goal(
         ),
         "goal_tolerance_m": tolerance,
         "tracking_error_m": _nanmean(mon.tracking[k0:]),
+        "moved_s": None if moved_s is None else moved_s - t0,
+        "within_tolerance_s": None if within_s is None else within_s - t0,
     }
 
 

@@ -24,13 +24,14 @@ from navlab.geometry import transform_points2, wrap_angle
 from navlab.navigation.costmap_ros import Costmap2DROS
 from navlab.navigation.errors import NavigationError
 from navlab.navigation.goal import STATUS, GoalHandle, GoalState, MoveBaseState, RecoveryTrigger, with_headings
+from navlab.navigation.keepout import held_up_at, with_keepouts
 from navlab.navigation.move_base_config import (
     MOVE_BASE_DEFAULTS,
     check_move_base_params,
     make_recoveries,
     short_name,
 )
-from navlab.navigation.progress_checker import STUCK_PREFIX, SimpleProgressChecker
+from navlab.navigation.progress_checker import SimpleProgressChecker
 from navlab.navigation.recovery import DEFAULT_RECOVERIES
 from navlab.navigation.scan_points import ScanPoints
 from navlab.plugins import ControlResult, PluginContext, make_plugin, plugin_names, resolve_name
@@ -140,6 +141,7 @@ class MoveBase(Node):
         self.planning_retries = 0
         self.plan_failure = ""
         self.recovery_log: list[str] = []  # the recovery behaviors run for this goal, in order
+        self.keepouts: list[tuple[float, float]] = []  # gaps that held the robot up (navigation.keepout)
         self.oscillation_pose: Pose | None = None
         self.last_oscillation_reset_ns = now
         if hasattr(self, "progress_checker"):
@@ -256,7 +258,7 @@ class MoveBase(Node):
     def make_plan(self, start: Pose, goal: Pose) -> np.ndarray | None:
         """A global plan (N, 2+) in the global costmap's frame, or None."""
         try:
-            plan = self.planner.make_plan(self.global_costmap.costmap, start, goal)
+            plan = self.planner.make_plan(with_keepouts(self.global_costmap.costmap, self.keepouts), start, goal)
         except NavigationError as exc:
             self.get_logger().debug(f"planner: {exc}")
             return None
@@ -340,11 +342,10 @@ class MoveBase(Node):
             if self.recovery_trigger == RecoveryTrigger.OSCILLATION:
                 self.recovery_index = 0
 
-    def _progressing(self, pose: Pose, now: int) -> bool:
-        """The progress checker's verdict; progress since the last PROGRESS recovery starts the recoveries over."""
-        baseline = self.progress_checker.baseline
-        ok = self.progress_checker.check(pose, now / 1e9)
-        if self.progress_checker.baseline is not baseline and self.recovery_trigger == RecoveryTrigger.PROGRESS:
+    def _progressing(self, pose: Pose, now: int, local: np.ndarray | None) -> bool:
+        """The progress checker's verdict (``local``: the plan, to the goal); progress restarts the recoveries."""
+        ok = self.progress_checker.check(pose, now / 1e9, local[-1][:2] if local is not None and len(local) else None)
+        if self.progress_checker.progressed and self.recovery_trigger == RecoveryTrigger.PROGRESS:
             self.recovery_index = 0
         return ok
 
@@ -369,7 +370,7 @@ class MoveBase(Node):
         if p["oscillation_timeout"] > 0 and self._timed_out(self.last_oscillation_reset_ns, p["oscillation_timeout"]):
             self._enter_clearing(RecoveryTrigger.OSCILLATION)
             return
-        if not self._progressing(pose, now):
+        if not self._progressing(pose, now, local):
             self._enter_clearing(RecoveryTrigger.PROGRESS)
             return
         try:
@@ -412,6 +413,10 @@ class MoveBase(Node):
 
     def _enter_clearing(self, trigger: RecoveryTrigger) -> None:
         self.recovery_trigger = trigger
+        if trigger == RecoveryTrigger.PROGRESS and self.progress_checker.toward_goal:  # plan around the hold-up
+            gap = held_up_at(self.global_plan, self.global_costmap.costmap, self.global_costmap.robot_pose())
+            if gap is not None:
+                self.keepouts.append(gap)
         self.cmd_pub.publish(msgs.twist(0.0, 0.0))
         usable = [
             (n, r)
@@ -423,10 +428,7 @@ class MoveBase(Node):
                 RecoveryTrigger.PLANNING: "Failed to find a valid plan. Even after executing recovery behaviors.",
                 RecoveryTrigger.CONTROLLING: "Failed to find a valid control. Even after executing recovery behaviors.",
                 RecoveryTrigger.OSCILLATION: "Robot is oscillating. Even after executing recovery behaviors.",
-                RecoveryTrigger.PROGRESS: f"{STUCK_PREFIX}: the robot moved less than "
-                f"{self.progress_checker.params.required_movement_radius:g} m in "
-                f"{self.progress_checker.idle_s(self.executor.now_ns / 1e9):.1f} s, "
-                "even after executing recovery behaviors.",
+                RecoveryTrigger.PROGRESS: self.progress_checker.stuck_reason(self.executor.now_ns / 1e9),
             }[trigger]
             if trigger == RecoveryTrigger.PLANNING and self.plan_failure:
                 reason += f" ({self.plan_failure})"
@@ -455,7 +457,7 @@ class MoveBase(Node):
         self.oscillation_pose = pose
         # Nav2 restarts the progress clock with each new control run, from where the robot is now (the
         # baseline pose stays: a recovery that only wiggles does not count as progress)
-        self.progress_checker.baseline_t = now / 1e9
+        self.progress_checker.restart_clocks(now / 1e9)
         self.state = MoveBaseState.PLANNING
 
     # --- services and status ---------------------------------------------------------------------------
