@@ -40,8 +40,8 @@ demo: $(STAMP)
 	$(BIN)/navlab demo
 
 test: $(STAMP) $(CHROMIUM) $(DOT) $(ROS_TOOLS)
-	$(BIN)/ruff check src tests
-	$(BIN)/ruff format --check src tests
+	$(BIN)/ruff check src tests examples
+	$(BIN)/ruff format --check src tests examples
 	$(BIN)/python tools/check_layers.py
 	$(BIN)/mypy
 	$(BIN)/python -m pytest
@@ -51,8 +51,8 @@ fuzz: $(STAMP)
 	$(BIN)/python -m tests.fuzz --cases 3200
 
 lint: $(STAMP)
-	$(BIN)/ruff check src tests
-	$(BIN)/ruff format --check src tests
+	$(BIN)/ruff check src tests examples
+	$(BIN)/ruff format --check src tests examples
 
 bench: $(STAMP)
 	$(BIN)/navlab bench all --json

@@ -30,9 +30,7 @@ ctx = navlab.init(seed=0, rate=0.0)  # rclpy.init(); rate=0: as fast as the CPU 
 ex = ctx.executor
 Counter()
 printer = Node("printer")
-printer.create_subscription(
-    msgs.Float64, "count", lambda m: printer.get_logger().warning("heard %s", m.data)
-)
+printer.create_subscription(msgs.Float64, "count", lambda m: printer.get_logger().warning("heard %s", m.data))
 bag = Path(mkdtemp()) / "count_bag"
 with Recorder(ex, bag):
     ex.run(1.0)  # one simulated second: five messages

@@ -28,11 +28,15 @@ for link in robot.links.values():
     g = link.collisions[0].geometry
     print(f"  {link.name:<13} {g.kind:<9} {g.size}  {link.inertial.mass:g} kg")
 dd = robot.diff_drive
-print(f"diff drive: separation {dd.wheel_separation} m, wheel diameter {dd.wheel_diameter} m, "
-      f"torque {dd.max_torque} N m, {dd.command_topic} -> {dd.odometry_topic} ({dd.robot_base_frame})")
+print(
+    f"diff drive: separation {dd.wheel_separation} m, wheel diameter {dd.wheel_diameter} m, "
+    f"torque {dd.max_torque} N m, {dd.command_topic} -> {dd.odometry_topic} ({dd.robot_base_frame})"
+)
 lidar = robot.lidars[0]
-print(f"lidar: {lidar.samples} beams at {lidar.update_rate} Hz, {lidar.range_min}-{lidar.range_max} m "
-      f"-> {lidar.topic} [{lidar.frame_id}]")
+print(
+    f"lidar: {lidar.samples} beams at {lidar.update_rate} Hz, {lidar.range_min}-{lidar.range_max} m "
+    f"-> {lidar.topic} [{lidar.frame_id}]"
+)
 
 # 2. The world: an SDF file with included ground plane and sun, walls and obstacles.
 world = load_world(resources.world(args.world) if "." not in args.world else args.world)
@@ -47,8 +51,11 @@ fig, ax = plt.subplots(figsize=(7, 6))
 ax.imshow(grid, origin="lower", extent=(bounds[0], bounds[2], bounds[1], bounds[3]), cmap="Greys")
 r = robot.links["chassis"].collisions[0].geometry.size[0]
 ax.add_patch(plt.Circle((0, 0), r, color="tab:orange", label=f"{robot.name} (r {r} m)"))
-ax.add_patch(plt.Circle((0, 0), lidar.range_min, fill=False, ls="--", color="tab:red",
-                        label=f"lidar min range {lidar.range_min} m"))
+ax.add_patch(
+    plt.Circle(
+        (0, 0), lidar.range_min, fill=False, ls="--", color="tab:red", label=f"lidar min range {lidar.range_min} m"
+    )
+)
 ax.arrow(0, 0, 0.4 * math.cos(0), 0.4 * math.sin(0), width=0.03, color="k")
 ax.set(xlabel="x (m)", ylabel="y (m)", title=f"{world.name}: true occupancy at 0.05-0.5 m")
 ax.legend(loc="upper left", fontsize=8)

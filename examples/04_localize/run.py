@@ -51,8 +51,9 @@ fig.tight_layout()
 fig.savefig(OUT / "particles.png", dpi=90)
 
 # --- part 2: the whole stack in the simulator ----------------------------------------------------
-result = run_localization("room_obstacles", global_localization=True, duration=30.0, seed=0,
-                          amcl_params={"odom_model_type": "diff-corrected"})
+result = run_localization(
+    "room_obstacles", global_localization=True, duration=30.0, seed=0, amcl_params={"odom_model_type": "diff-corrected"}
+)
 for key in ("converged_s", "position_error_mean_m", "yaw_error_mean_deg", "rtf"):
     print(f"{key}: {result.summary[key]}")
 print("figure:", plot_result(result, OUT / "localize.png"))

@@ -31,11 +31,15 @@ for x, y, yaw in [(4.3, 1.0, 0.0), (-3.5, -0.5, 3.14)]:
         session.node("gazebo").spawn_primitive("cylinder", "late", (0.15, 0.6), x=-1.0, y=-0.45)
     ex.run_until(goal.done, timeout=90.0)
     truth = session.node("gazebo").sim.base_pose2d()
-    print(f"goal ({x}, {y}): {goal.state} after {ex.now_ns / 1e9:.1f} simulated s {goal.reason}".rstrip()
-          + f"; robot at ({truth[0]:.2f}, {truth[1]:.2f})")
+    print(
+        f"goal ({x}, {y}): {goal.state} after {ex.now_ns / 1e9:.1f} simulated s {goal.reason}".rstrip()
+        + f"; robot at ({truth[0]:.2f}, {truth[1]:.2f})"
+    )
     print(f"  recoveries used: {move_base.recovery_log or 'none'}")
 
 # 3. the global costmap and plan as rviz would show them
 costmap = move_base.global_costmap.costmap
-print(f"global costmap: {costmap.width} x {costmap.height} cells in {costmap.frame_id}; "
-      f"{int((costmap.data >= 253).sum())} cells lethal or inscribed")
+print(
+    f"global costmap: {costmap.width} x {costmap.height} cells in {costmap.frame_id}; "
+    f"{int((costmap.data >= 253).sum())} cells lethal or inscribed"
+)

@@ -11,7 +11,7 @@ import numpy as np
 from sim_helpers import make_room
 
 from navlab import msgs, resources
-from navlab.core import Executor, Node
+from navlab.core import Context, Executor, Node
 from navlab.description import load_robot
 from navlab.sim import launch_sim
 
@@ -40,7 +40,7 @@ def test_jackal_rests_on_its_wheels() -> None:
 def test_jackal_starts_at_2_m_s_without_wheel_spin() -> None:
     ex = Executor(seed=0)
     sim = _start(ex).sim  # type: ignore[attr-defined]
-    node = Node(ex, name="driver")
+    node = Node("driver", context=Context(ex))
     odom: list[tuple[float, float, float]] = []
     node.create_subscription(msgs.Odometry, "odom", lambda m: odom.append(msgs.pose2d(m.pose.pose)))
     pub = node.create_publisher(msgs.Twist, "cmd_vel")

@@ -191,7 +191,7 @@ def test_turning_in_place_pivots_nearer_the_heavier_front_axle() -> None:
 
     s = start("sim", launch_args={"robot": "jackal_skid", "ekf": "false"})
     truth: list = []
-    watch = Node(s.executor, name="watch")
+    watch = Node("watch", context=Context(s.executor))
     watch.create_subscription(msgs.Odometry, "/ground_truth/odom", truth.append, 100)
     cmd = watch.create_publisher(msgs.Twist, "/cmd_vel", 1)
     watch.create_timer(0.05, lambda: cmd.publish(msgs.twist(0.0, 0.314)))  # the benchmark's in-place turn rate
