@@ -19,8 +19,6 @@ from typing import Any
 
 import numpy as np
 
-GOALS = [(4.3, 1.0, 0.0), (-3.5, -0.5, 3.14), (1.5, -2.5, 0.0), (0.0, 0.0, 0.0)]  # bench nav's
-
 
 def _digest(data: bytes) -> str:
     return hashlib.sha1(data).hexdigest()[:16]
@@ -28,6 +26,7 @@ def _digest(data: bytes) -> str:
 
 def record(out: str, seed: int, controller: str | None) -> None:
     """Run bench nav's goals with hooks on the executor, the costmaps and move_base; write the trace to ``out``."""
+    from navlab.bench.experiments import NAV_GOALS
     from navlab.core.executor import Executor
     from navlab.experiments.navigate_run import run_navigation
     from navlab.navigation.costmap_ros import Costmap2DROS
@@ -78,7 +77,7 @@ def record(out: str, seed: int, controller: str | None) -> None:
 
     Executor.publish, Costmap2DROS.update, MoveBase.make_plan = on_publish, on_update, on_make_plan  # type: ignore[method-assign]
     r = run_navigation(
-        GOALS, world="room_obstacles", goal_timeout=90, seed=seed, controller=controller, on_start=on_start
+        list(NAV_GOALS), world="room_obstacles", goal_timeout=90, seed=seed, controller=controller, on_start=on_start
     )
     rec["path"] = [[float(v).hex() for v in row] for row in r.path]
     rec["summary"] = {k: r.summary[k] for k in ("sim_s", "goals_succeeded", "collisions")}

@@ -32,11 +32,14 @@ def run_mapping_bench(args: Any) -> dict[str, Any]:
     return out
 
 
+NAV_GOALS = ((4.3, 1.0, 0.0), (-3.5, -0.5, 3.14), (1.5, -2.5, 0.0), (0.0, 0.0, 0.0))  # room_obstacles, map frame
+
+
 def run_nav(args: Any) -> dict[str, Any]:
     """``navlab bench nav``: the whole navigation stack (sim + lidar + amcl + costmaps + planner + controller)
     driving across room_obstacles.world to four goals; real-time factor of the run loop by wall time (``rtf``) and
     by this process's CPU time (``rtf_cpu``: what one free core gives, as ``bench sim``'s ``rtf``)."""
-    goals = [(4.3, 1.0, 0.0), (-3.5, -0.5, 3.14), (1.5, -2.5, 0.0), (0.0, 0.0, 0.0)]
+    goals = list(NAV_GOALS)
     run_navigation(goals[:1], world="room_obstacles", goal_timeout=5, seed=getattr(args, "seed", 0))  # warm-up: Numba
     r = run_navigation(goals, world="room_obstacles", goal_timeout=90, seed=getattr(args, "seed", 0))
     s = r.summary

@@ -31,9 +31,10 @@ from typing import Any
 import numpy as np
 
 from navlab import msgs
+from navlab.bench.experiments import NAV_GOALS
 from navlab.core import Node
 
-GOALS = [(4.3, 1.0, 0.0), (-3.5, -0.5, 3.14), (1.5, -2.5, 0.0), (0.0, 0.0, 0.0)]
+GOALS = NAV_GOALS  # bench nav's
 
 VELODYNE = """<?xml version="1.0"?>
 <robot name="mybot_velodyne" xmlns:xacro="http://www.ros.org/wiki/xacro">
@@ -78,9 +79,9 @@ def _nav_rtf(robot: str, seed: int, topic: str | None = None, params: str | None
     kw: dict[str, Any] = {"world": "room_obstacles", "robot": robot, "seed": seed, "on_start": reader}
     if params:
         kw["params_dir"] = params
-    run_navigation(GOALS[:1], goal_timeout=3, **kw)  # warm-up: Numba's caches, the GL context
+    run_navigation(list(GOALS[:1]), goal_timeout=3, **kw)  # warm-up: Numba's caches, the GL context
     cpu0 = time.process_time()
-    r = run_navigation(GOALS, goal_timeout=90, **kw)
+    r = run_navigation(list(GOALS), goal_timeout=90, **kw)
     cpu = time.process_time() - cpu0
     return {
         "rtf": round(r.summary["sim_s"] / cpu, 1),

@@ -23,9 +23,10 @@ import time
 from pathlib import Path
 from typing import Any
 
+from navlab.bench.experiments import NAV_GOALS
 from navlab.viz import CHROMIUM, HeadlessPage, VizError
 
-GOALS = [(4.3, 1.0, 0.0), (-3.5, -0.5, 3.14), (1.5, -2.5, 0.0)]
+GOALS = NAV_GOALS[:3]  # the demo's three
 SIM_S = 40.0  # simulated s measured per drive
 ROUNDS = 3  # drives with and without the page each
 
