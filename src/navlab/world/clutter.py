@@ -39,13 +39,19 @@ from scipy.sparse.csgraph import dijkstra
 
 from navlab.deprecation import NavlabDeprecationWarning
 from navlab.io import write_text_atomic
+from navlab.world.barn_grid import CELL as CELL
+from navlab.world.barn_grid import CELLS as CELLS
+from navlab.world.barn_grid import FIELD as FIELD
+from navlab.world.barn_grid import ROBOT_CELLS as ROBOT_CELLS
+from navlab.world.barn_grid import cellular_automaton as cellular_automaton
+from navlab.world.barn_grid import configuration_space as configuration_space
+from navlab.world.barn_grid import field_centres as field_centres
+from navlab.world.barn_grid import way_through as way_through
+from navlab.world.barn_grid import written_cylinders as written_cylinders
 from navlab.world.clutter_geometry import Clearance
 from navlab.world.errors import WorldError
 from navlab.world.sdf_writer import box_geometry, cylinder_geometry, link, static_model, world_sdf
 
-CELL = 0.15  # m: BARN's grid cell (one cylinder's diameter)
-CELLS = 30  # cells per side of the field (4.5 m)
-FIELD = CELL * CELLS  # m
 CYLINDER_RADIUS = 0.075  # m
 CYLINDER_HEIGHT = 1.0  # m: BARN's unit cylinders
 WALL_THICKNESS = CELL  # m: a containment wall is a row of touching cylinders
@@ -55,7 +61,6 @@ START_Y = -0.25  # m: the start's offset from the field's centre line (BARN: x -
 START_ZONE = 4.95  # m from the back wall's inner face to the field (BARN: containment from y 0.15 to 5.1)
 GOAL_DISTANCE = 10.0  # m from the start to the goal, straight ahead
 BARN_SPEED = 2.0  # m/s: BARN's T_opt speed
-ROBOT_CELLS = 2  # BARN's jackal_radius: cells the robot reaches beyond its centre cell
 BARN_FILLS = (0.15, 0.20, 0.25, 0.30)  # BARN's initial fill levels
 BARN_SMOOTHS = (2, 3, 4)  # BARN's smoothing rounds
 MAX_DRAWS = 50_000  # automaton draws before a world's parameters are refused
@@ -156,12 +161,6 @@ def barn_score(success: bool, time_s: float, t_opt: float) -> float:
 
 
 # ------------------------------------------------------------------------------------------ layout
-def field_centres() -> tuple[np.ndarray, np.ndarray]:
-    """x of the field's columns and y of its rows (m): cell centres on the 0.15 m grid."""
-    c = (np.arange(CELLS) + 0.5) * CELL
-    return c, c - FIELD / 2
-
-
 def _walls() -> list[Box]:
     """BARN's containment walls around the start zone: both sides in line with the field's wall rows, from the back
     wall up to the field, and the back wall across the field's whole width."""
@@ -172,81 +171,6 @@ def _walls() -> list[Box]:
         Box("wall_right", x_back / 2, -half + t / 2, -x_back, t),
         Box("wall_back", x_back + t / 2, 0.0, t, FIELD),
     ]
-
-
-# ------------------------------------------------------------------------------ cellular automaton
-def cellular_automaton(
-    rng: np.random.Generator,
-    fill: float,
-    smooth: int,
-    *,
-    fill_threshold: int = 5,
-    clear_threshold: int = 1,
-    count: int | None = None,
-) -> np.ndarray:
-    """(30, 30) bool field: rows 0 and 29 filled, the others at random with probability ``fill``, then ``smooth``
-    rounds of the rule; ``count`` fields at once ((count, 30, 30), the same as ``count`` calls in a row).
-
-    Each round, a cell with >= ``fill_threshold`` filled neighbours (of 8) fills, one with <=
-    ``clear_threshold`` clears, the others keep their state (BARN's 5 and 1); beyond the wall rows counts as
-    filled, beyond the first and last columns as empty.
-    """
-    n_fields = 1 if count is None else count
-    cells = np.ones((n_fields, CELLS, CELLS), dtype=bool)
-    cells[:, 1:-1] = rng.random((n_fields, CELLS - 2, CELLS)) < fill
-    for _ in range(smooth):
-        padded = np.pad(cells, ((0, 0), (1, 1), (1, 1)), constant_values=False).view(np.uint8)
-        padded[:, [0, -1], :] = 1  # beyond the wall rows counts as filled
-        n = sum(
-            padded[:, 1 + di : CELLS + 1 + di, 1 + dj : CELLS + 1 + dj].astype(np.int8)
-            for di in (-1, 0, 1)
-            for dj in (-1, 0, 1)
-            if di or dj
-        )
-        cells = (cells | (n >= fill_threshold)) & (n > clear_threshold)
-    return cells[0] if count is None else cells
-
-
-def configuration_space(cells: np.ndarray, robot_cells: int = ROBOT_CELLS) -> np.ndarray:
-    """Where the robot's centre may sit (bool, like ``cells``, one field or a stack): no filled cell within
-    ``robot_cells`` cells in either direction (a square window, clipped to the field: beyond its ends is open)."""
-    k = robot_cells
-    padded = np.pad(cells, [(0, 0)] * (cells.ndim - 2) + [(k, k), (k, k)], constant_values=False)
-    rows = np.zeros((*padded.shape[:-2], CELLS, padded.shape[-1]), dtype=bool)
-    for d in range(2 * k + 1):  # a square window's maximum: along the rows, then along the columns
-        rows |= padded[..., d : d + CELLS, :]
-    near = np.zeros(cells.shape, dtype=bool)
-    for d in range(2 * k + 1):
-        near |= rows[..., d : d + CELLS]
-    return ~near
-
-
-def way_through(free: np.ndarray) -> np.ndarray | bool:
-    """BARN's test of a world (of each in a stack): the largest 4-connected free region touching the first column
-    is the largest one touching the last column."""
-    stack = free.reshape(-1, *free.shape[-2:])
-    structure = np.zeros((3, 3, 3), dtype=bool)
-    structure[1] = ndimage.generate_binary_structure(2, 1)  # 4-connected within a field, never across fields
-    labels, _ = ndimage.label(stack, structure=structure)
-    ok = np.zeros(len(stack), dtype=bool)
-    first, last = labels[:, :, 0], labels[:, :, -1]
-    both = np.intersect1d(first[first > 0], last[last > 0])  # labels are unique across the stack
-    if not both.size:
-        return bool(ok[0]) if free.ndim == 2 else ok
-    sizes = np.bincount(labels.ravel())
-    for k in np.unique(np.nonzero(np.isin(first, both))[0]):
-        ids_first, ids_last = np.unique(first[k][first[k] > 0]), np.unique(last[k][last[k] > 0])
-        ok[k] = ids_first[np.argmax(sizes[ids_first])] == ids_last[np.argmax(sizes[ids_last])]
-    return bool(ok[0]) if free.ndim == 2 else ok
-
-
-def written_cylinders(cells: np.ndarray) -> np.ndarray:
-    """(k, 2) centres (m) of the cylinders a world holds: its filled cells but those whose 8 neighbours are all
-    filled and inside the field (hidden in a block, as BARN writes none there)."""
-    full = ndimage.minimum_filter(cells.astype(np.uint8), size=3, mode="constant", cval=0).astype(bool)
-    ii, jj = np.nonzero(cells & ~full)
-    xc, yc = field_centres()
-    return np.c_[xc[jj], yc[ii]]
 
 
 # ------------------------------------------------------------------------------------ grid search
