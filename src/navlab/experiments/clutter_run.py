@@ -35,9 +35,15 @@ CLUTTER_RECOVERIES: list[dict[str, str]] = [
     {"name": "spin", "type": "rotate_recovery/RotateRecovery"},
     {"name": "back_up_far", "type": "nav2_behaviors/BackUp"},
 ]
+# The global costmap marks returns out to 4.5 m (a whole field's length; the shipped 2.5 m leaves the planner to
+# guess at the field's far half), so plans turn before a dead end instead of in it. Jackal tuning set: score
+# 0.478 -> 0.486, worlds at the 0.5 cap 42 -> 46 (world 36's collision became a stuck run). The local window keeps
+# the files' ranges.
 CLUTTER_PARAMS: dict[str, Any] = {
     "local_costmap.width": 6.0,
     "local_costmap.height": 6.0,
+    "global_costmap.obstacle_range": 4.5,
+    "global_costmap.raytrace_range": 5.0,
     "recovery_behaviors": CLUTTER_RECOVERIES,
     "clear_local.affected_maps": "local",
     "clear_local.reset_distance": 0.0,
