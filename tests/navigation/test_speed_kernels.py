@@ -39,21 +39,24 @@ def test_inflation_kernel_equals_a_euclidean_distance_transform() -> None:
 
 
 def test_incremental_and_rolling_inflation_equals_a_fresh_layer() -> None:
-    """Obstacles come and go and the window moves: the layer that keeps its last inflation and recomputes only
-    around the changes writes the same master as a layer inflating from scratch each time."""
+    """Obstacles come and go and the window moves over the world: the layer that keeps its last inflation and
+    recomputes only around the changes and the window's edges writes the same master as a layer inflating from
+    scratch each time."""
     rng = np.random.default_rng(0)
     params = {"inflation_radius": 0.55, "cost_scaling_factor": 10.0}
     kept = InflationLayer(params, footprint=make_footprint(robot_radius=0.2))
-    lethal = rng.random((60, 70)) < 0.01
-    origin = (0.0, 0.0)
-    for step in range(12):
-        if step % 3 == 2:  # a rolling window moved by whole cells
-            origin = (origin[0] + RES * int(rng.integers(-3, 4)), origin[1] + RES * int(rng.integers(-3, 4)))
-        flip = rng.random(lethal.shape) < 0.002
-        lethal = lethal ^ flip
+    world = rng.random((300, 300)) < 0.01
+    j, i = 100, 100  # the window's lower-left cell in the world
+    for step in range(40):
+        if step % 3 != 0:  # the window moved by whole cells, now and then by more than the inflation's reach
+            far = 40 if step % 9 == 8 else 4
+            j, i = j + int(rng.integers(-far, far + 1)), i + int(rng.integers(-far, far + 1))
+        flip = rng.random(world.shape) < (0.05 if step % 7 == 6 else 0.0005)  # now and then many changes at once
+        world ^= flip
+        lethal = world[j : j + 60, i : i + 70] & (step % 11 != 10)  # and now and then no obstacle at all
         data = np.where(lethal, COST_LETHAL, rng.integers(0, 3, lethal.shape)).astype(np.uint8)
-        a = Grid(data.copy(), RES, (origin[0], origin[1], 0.0), "odom")
-        b = Grid(data.copy(), RES, (origin[0], origin[1], 0.0), "odom")
+        a = Grid(data.copy(), RES, (i * RES, j * RES, 0.0), "odom")
+        b = Grid(data.copy(), RES, (i * RES, j * RES, 0.0), "odom")
         kept.update_costs(a)
         InflationLayer(params, footprint=make_footprint(robot_radius=0.2)).update_costs(b)
         np.testing.assert_array_equal(a.data, b.data, err_msg=f"step {step}")

@@ -151,7 +151,7 @@ class LayeredCostmap:
         (or to the one named ``layer``); see ``ObstacleLayer.add_scan``."""
         targets = [self.layer(layer)] if layer else self.scan_layers
         for target in targets:
-            if not isinstance(target, ScanLayer):
+            if layer and not isinstance(target, ScanLayer):  # scan_layers hold only ScanLayers already
                 raise NavigationError(f"costmap layer {layer!r} is not an obstacle layer")
             if source is not None and source not in target.sources and layer is None:
                 continue
