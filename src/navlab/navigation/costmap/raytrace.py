@@ -1,7 +1,9 @@
-"""Bresenham ray clearing for the obstacle layer (Numba).
+"""Ray clearing and marking for the obstacle layer (Numba).
 
 Coordinates are continuous cell coordinates: ``(x - origin_x) / resolution``, so cell ``(i, j)`` spans
 ``[i, i + 1) x [j, j + 1)``. ``data[j, i]`` is column ``i``, row ``j`` (``navlab.grid`` convention).
+``clear_rays`` clears along given endpoints; ``observe_ranges`` takes a laser scan's ranges as they come and
+does the whole observation in one call: the endpoints, clearing along every ray, then marking the returns.
 """
 
 from __future__ import annotations
@@ -14,6 +16,39 @@ import numpy as np
 from navlab.gridline import TIE_LATE, line, line_cell
 
 
+@numba.njit(cache=True, inline="always")
+def _ray_end(x0: float, y0: float, ex: float, ey: float, max_cells: float) -> tuple[bool, int, int]:
+    """(whether the ray has a finite length, end cell i, j) of a ray from (x0, y0) to (ex, ey), cut to
+    ``max_cells`` cells of length."""
+    dx = ex - x0
+    dy = ey - y0
+    length = math.sqrt(dx * dx + dy * dy)
+    if not math.isfinite(length):
+        return False, 0, 0
+    if length > max_cells:
+        s = max_cells / length
+        ex = x0 + dx * s
+        ey = y0 + dy * s
+    return True, math.floor(ex), math.floor(ey)
+
+
+@numba.njit(cache=True, inline="always")
+def _walk(data: np.ndarray, i0: int, j0: int, i1: int, j1: int, min_sq: float, value: np.uint8) -> int:
+    """Set the cells of the Bresenham line (i0, j0) -> (i1, j1) to ``value``, end included, up to where it leaves
+    the grid, leaving those nearer the start than sqrt(``min_sq``) cells; returns how many were written."""
+    h, w = data.shape
+    written = 0
+    ln = line(i0, j0, i1, j1, TIE_LATE)
+    for n in range(ln[0] + 1):
+        i, j = line_cell(ln, n)
+        if i < 0 or j < 0 or i >= w or j >= h:
+            break
+        if min_sq <= 0.0 or (i - i0) * (i - i0) + (j - j0) * (j - j0) >= min_sq:
+            data[j, i] = value
+            written += 1
+    return written
+
+
 @numba.njit(cache=True)
 def clear_rays(
     data: np.ndarray, x0: float, y0: float, ends: np.ndarray, max_cells: float, min_cells: float, value: np.uint8
@@ -21,7 +56,8 @@ def clear_rays(
     """Set to ``value`` every cell on the Bresenham line from ``(x0, y0)`` to each of ``ends`` (N, 2), endpoint
     cell included (the caller marks afterwards, as costmap_2d does). Each ray is cut to ``max_cells`` cells of
     length; cells nearer than ``min_cells`` to the origin are left alone; a ray stops where it leaves the grid.
-    Returns the number of cells written."""
+    A ray ending in the cell of the ray before it is the same line and is not walked again. Returns the number
+    of cell writes."""
     h, w = data.shape
     i0 = math.floor(x0)
     j0 = math.floor(y0)
@@ -29,26 +65,85 @@ def clear_rays(
         return 0
     written = 0
     min_sq = min_cells * min_cells
+    last_i, last_j = i0, j0
+    walked = False
     for k in range(ends.shape[0]):
-        ex = ends[k, 0]
-        ey = ends[k, 1]
-        dx = ex - x0
-        dy = ey - y0
-        length = math.sqrt(dx * dx + dy * dy)
-        if not math.isfinite(length):
+        ok, i1, j1 = _ray_end(x0, y0, ends[k, 0], ends[k, 1], max_cells)
+        if not ok or (walked and i1 == last_i and j1 == last_j):
             continue
-        if length > max_cells:
-            s = max_cells / length
-            ex = x0 + dx * s
-            ey = y0 + dy * s
-        i1 = math.floor(ex)
-        j1 = math.floor(ey)
-        ln = line(i0, j0, i1, j1, TIE_LATE)
-        for n in range(ln[0] + 1):
-            i, j = line_cell(ln, n)
-            if i < 0 or j < 0 or i >= w or j >= h:
-                break
-            if min_sq <= 0.0 or (i - i0) * (i - i0) + (j - j0) * (j - j0) >= min_sq:
-                data[j, i] = value
-                written += 1
+        written += _walk(data, i0, j0, i1, j1, min_sq, value)
+        last_i, last_j, walked = i1, j1, True
     return written
+
+
+@numba.njit(cache=True)
+def observe_ranges(
+    data: np.ndarray,
+    ranges: np.ndarray,
+    beam_cos: np.ndarray,
+    beam_sin: np.ndarray,
+    scan_limits: tuple[float, float, float],
+    sensor: tuple[float, float, float, float],
+    grid: tuple[float, float, float],
+    clearing: tuple[bool, float, float, np.uint8],
+    marking: tuple[bool, float, float, np.uint8],
+) -> None:  # pragma: no cover - compiled
+    """One laser scan into an obstacle layer's ``data``, all in one pass (the same arithmetic as the endpoints
+    of ``ScanPoints.points`` moved into the grid's frame, then ``clear_rays`` and ``mark_returns``).
+
+    ``ranges`` (N,) m along the beams (``beam_cos``, ``beam_sin`` in the sensor frame); ``scan_limits`` =
+    (range_min, range_max, clear_to): a real return lies in [range_min, range_max), a ray without one (inf, at
+    or over range_max) only clears, out to clear_to m; NaN readings are left out. ``sensor`` = (x, y, cos yaw,
+    sin yaw) in the grid's frame; ``grid`` = (origin x, origin y, resolution) (origin yaw 0). ``clearing`` =
+    (on, raytrace_range m, raytrace_min_range m, free value), ``marking`` = (on, obstacle_min_range m,
+    obstacle_range m, lethal value). Clearing runs over every ray first, then marking."""
+    n = ranges.shape[0]
+    sx, sy, c, s = sensor
+    ox, oy, res = grid
+    range_min, range_max, clear_to = scan_limits
+    px = np.empty(n)
+    py = np.empty(n)
+    ok = np.empty(n, np.bool_)
+    m = 0
+    for k in range(n):
+        r = float(ranges[k])
+        valid = math.isfinite(r) and r >= range_min and r < range_max
+        if valid:
+            d = r
+        elif math.isnan(r):
+            continue
+        else:
+            d = clear_to
+        if not math.isfinite(d):
+            continue
+        lx = d * beam_cos[k]
+        ly = d * beam_sin[k]
+        px[m] = sx + c * lx - s * ly
+        py[m] = sy + s * lx + c * ly
+        ok[m] = valid
+        m += 1
+    h, w = data.shape
+    if clearing[0]:
+        x0, y0 = (sx - ox) / res, (sy - oy) / res
+        i0, j0 = math.floor(x0), math.floor(y0)
+        if 0 <= i0 < w and 0 <= j0 < h:
+            max_cells, min_cells = clearing[1] / res, clearing[2] / res
+            min_sq = min_cells * min_cells
+            last_i, last_j = i0, j0
+            walked = False
+            for k in range(m):
+                fine, i1, j1 = _ray_end(x0, y0, (px[k] - ox) / res, (py[k] - oy) / res, max_cells)
+                if not fine or (walked and i1 == last_i and j1 == last_j):
+                    continue
+                _walk(data, i0, j0, i1, j1, min_sq, clearing[3])
+                last_i, last_j, walked = i1, j1, True
+    if marking[0]:
+        for k in range(m):
+            if not ok[k]:
+                continue
+            dist = math.hypot(px[k] - sx, py[k] - sy)
+            if not (dist < marking[2] and dist >= marking[1]):
+                continue
+            i, j = math.floor((px[k] - ox) / res), math.floor((py[k] - oy) / res)
+            if 0 <= i < w and 0 <= j < h:
+                data[j, i] = marking[3]
