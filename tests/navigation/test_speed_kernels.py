@@ -158,3 +158,36 @@ def test_controller_scene_kernel_equals_the_plain_steps() -> None:
         poses = rng.uniform(-7, 7, (40, 3))
         got = poses_out(poses, 25, frame.ox, frame.oy, oyaw, math.cos(oyaw), math.sin(oyaw))
         np.testing.assert_array_equal(got, frame.poses_out(poses[:25]))
+
+
+def test_obstacle_layer_takes_ranges_in_one_call_as_it_takes_their_endpoints() -> None:
+    """A scan's ranges into the obstacle layer (one compiled call) give the grid its endpoints give, bit for bit:
+    returns, inf, NaN, readings under range_min and at range_max, sensors inside and outside the grid."""
+    from navlab.geometry import transform_points2
+    from navlab.navigation.costmap import ObstacleLayer
+
+    rng = np.random.default_rng(4)
+    marked = cleared = 0
+    params = {"obstacle_range": 2.5, "raytrace_range": 3.0, "raytrace_min_range": 0.1, "obstacle_min_range": 0.05}
+    for trial in range(30):
+        ranges = rng.uniform(0.0, 4.5, 360).astype(np.float32)
+        ranges[rng.random(360) < 0.1] = np.inf
+        ranges[rng.random(360) < 0.05] = np.nan
+        msg = SimpleNamespace(ranges=ranges, angle_min=-3.1, angle_increment=0.0172, range_min=0.12, range_max=4.0)
+        sensor = np.array([rng.uniform(-1.0, 5.0), rng.uniform(-1.0, 4.0), rng.uniform(-np.pi, np.pi)])
+        clear_to = 3.0 if trial % 2 else 4.0
+        layers = [ObstacleLayer(params), ObstacleLayer(params)]
+        before = rng.integers(1, 256, (80, 90)).astype(np.uint8)  # what clearing and marking overwrite
+        for layer in layers:
+            layer.match_size(Grid(np.zeros((80, 90), np.uint8), RES, (0.0, -0.5, 0.0), "map"))
+            assert layer.grid is not None
+            layer.grid.data[:] = before
+        points = ScanPoints()
+        pts, valid = points.points(msg, clear_to)
+        layers[0].add_scan(sensor[:2], transform_points2(sensor, pts), valid)
+        layers[1].add_ranges(sensor, ranges, points.beams(msg), (0.12, 4.0, clear_to))
+        assert layers[0].grid is not None and layers[1].grid is not None
+        np.testing.assert_array_equal(layers[1].grid.data, layers[0].grid.data, err_msg=f"trial {trial}")
+        marked += int((layers[0].grid.data == COST_LETHAL).sum())
+        cleared += int((layers[0].grid.data == 0).sum())
+    assert marked > 1000 and cleared > 10000  # the scans did mark and clear
