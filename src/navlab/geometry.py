@@ -210,26 +210,26 @@ def inverse3(a: Tf) -> Tf:
 
 def interpolate3(a: Tf, b: Tf, s: float) -> Tf:
     """Linear interpolation of translation and slerp of rotation, ``s`` in [0, 1]."""
-    qa: tuple[float, ...] = a[3:]
-    qb: tuple[float, ...] = b[3:]
-    dot = sum(x * y for x, y in zip(qa, qb, strict=True))
+    ax, ay, az, aw = a[3], a[4], a[5], a[6]
+    bx, by, bz, bw = b[3], b[4], b[5], b[6]
+    dot = 0.0 + ax * bx + ay * by + az * bz + aw * bw  # summed left to right from 0.0, as sum() does
     if dot < 0.0:
-        qb, dot = tuple(-x for x in qb), -dot
+        bx, by, bz, bw, dot = -bx, -by, -bz, -bw, -dot
     if dot > 0.9995:
-        q = [x + s * (y - x) for x, y in zip(qa, qb, strict=True)]
+        qx, qy, qz, qw = ax + s * (bx - ax), ay + s * (by - ay), az + s * (bz - az), aw + s * (bw - aw)
     else:
         th = math.acos(min(1.0, dot))
         sa, sb = math.sin((1 - s) * th) / math.sin(th), math.sin(s * th) / math.sin(th)
-        q = [sa * x + sb * y for x, y in zip(qa, qb, strict=True)]
-    n = math.sqrt(sum(x * x for x in q))
+        qx, qy, qz, qw = sa * ax + sb * bx, sa * ay + sb * by, sa * az + sb * bz, sa * aw + sb * bw
+    n = math.sqrt(0.0 + qx * qx + qy * qy + qz * qz + qw * qw)
     return (
         a[0] + s * (b[0] - a[0]),
         a[1] + s * (b[1] - a[1]),
         a[2] + s * (b[2] - a[2]),
-        q[0] / n,
-        q[1] / n,
-        q[2] / n,
-        q[3] / n,
+        qx / n,
+        qy / n,
+        qz / n,
+        qw / n,
     )
 
 
