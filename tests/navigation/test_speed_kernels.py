@@ -83,6 +83,8 @@ def test_round_footprint_cells_are_the_centres_within_the_radius() -> None:
         )
         expected = np.stack([ii.ravel(), jj.ravel()], axis=1)[inside]
         assert sorted(map(tuple, cells.tolist())) == sorted(map(tuple, expected.tolist()))
+        Footprint(radius, None).fill(grid, (x, y, 0.0), 7)  # the footprint clearing: exactly those cells
+        assert sorted(map(tuple, np.argwhere(grid.data == 7)[:, ::-1].tolist())) == sorted(map(tuple, cells.tolist()))
 
 
 def test_scan_points_are_worked_out_once_per_message() -> None:

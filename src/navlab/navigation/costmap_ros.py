@@ -120,9 +120,9 @@ class Costmap2DROS:
             except TfError as exc:
                 self.node.get_logger().warning(f"{self.name}: no transform {self.base_frame} -> {frame}: {exc}")
                 return
-        stamp = msgs.stamp_ns(msg)
-        base = self.robot_pose(stamp) or self.robot_pose()
-        if base is None:
+        try:  # the robot at the scan's stamp, else the latest (a scan stamped after the newest odometry)
+            base = tf.lookup_pose2d_or_latest(self.global_frame, self.base_frame, msgs.stamp_ns(msg))
+        except TfError:
             return
         sensor = compose2(base, self._sensor_in_base[frame])
         src = self.layered.params.sources[source]

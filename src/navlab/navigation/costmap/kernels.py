@@ -117,6 +117,16 @@ def circle_cells(
 
 
 @numba.njit(cache=True)
+def fill_circle(
+    data: np.ndarray, x: float, y: float, radius: float, origin_x: float, origin_y: float, resolution: float, value: int
+) -> None:  # pragma: no cover - compiled
+    """``data`` = ``value`` at the ``circle_cells`` of (x, y, ``radius``) (a round footprint's cells cleared)."""
+    cells = circle_cells(x, y, radius, origin_x, origin_y, resolution, data.shape[1], data.shape[0])
+    for k in range(cells.shape[0]):
+        data[cells[k, 1], cells[k, 0]] = value
+
+
+@numba.njit(cache=True)
 def mark_returns(
     data: np.ndarray,
     pts: np.ndarray,

@@ -147,8 +147,7 @@ class ObservationLayer(Layer):
             self.update_origin(master)
         g = self.grid
         if self.params.footprint_clearing_enabled and self.robot_pose is not None:
-            ij = self.footprint.cells(g, self.robot_pose)
-            g.data[ij[:, 1], ij[:, 0]] = COST_FREE
+            self.footprint.fill(g, self.robot_pose, COST_FREE)
         combine(master.data, g.data, self.params.combination_method != 0)
 
     def reset(self) -> None:
