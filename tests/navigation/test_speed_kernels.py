@@ -103,11 +103,16 @@ def test_scan_points_are_worked_out_once_per_message() -> None:
 
 def test_kld_bin_count_and_tracking_distance_equal_their_plain_forms() -> None:
     rng = np.random.default_rng(2)
-    keys = rng.integers(0, 40, 500)
-    _, first = np.unique(keys, return_index=True)
-    is_new = np.zeros(keys.size, np.int64)
-    is_new[first] = 1
-    np.testing.assert_array_equal(sampling.bins_so_far(keys), np.cumsum(is_new))
+    poses = np.column_stack([rng.normal(0, 3, 3000), rng.normal(0, 3, 3000), rng.uniform(-4, 4, 3000)])
+    poses[::3, :2] = np.round(poses[::3, :2] * 2) / 2  # on the bins' edges
+    ix, iy = (np.floor(poses[:, k] / sampling.BIN_XY).astype(np.int64) + sampling._OFF for k in (0, 1))
+    it = np.floor(poses[:, 2] / sampling.BIN_YAW).astype(np.int64) % sampling.N_YAW_BINS
+    np.testing.assert_array_equal(sampling.bin_keys(poses), (ix * sampling._SPAN + iy) * sampling.N_YAW_BINS + it)
+    for keys in (rng.integers(0, 40, 500), sampling.bin_keys(poses)):
+        _, first = np.unique(keys, return_index=True)
+        is_new = np.zeros(keys.size, np.int64)
+        is_new[first] = 1
+        np.testing.assert_array_equal(sampling.bins_so_far(keys), np.cumsum(is_new))
     path = np.cumsum(rng.normal(0, 0.1, (80, 2)), axis=0)
     pts = rng.normal(0, 1, (5, 2))
     a, ab = path[:-1], np.diff(path, axis=0)

@@ -46,10 +46,19 @@ def kld_limit(k: np.ndarray, kld_err: float, kld_z: float, min_n: int, max_n: in
 
 def bin_keys(poses: np.ndarray) -> np.ndarray:
     """One int64 key per pose for its (x, y, yaw) histogram bin."""
-    ix = np.floor(poses[:, 0] / BIN_XY).astype(np.int64) + _OFF
-    iy = np.floor(poses[:, 1] / BIN_XY).astype(np.int64) + _OFF
-    it = np.floor(poses[:, 2] / BIN_YAW).astype(np.int64) % N_YAW_BINS
-    return (ix * _SPAN + iy) * N_YAW_BINS + it
+    return _bin_keys(np.ascontiguousarray(poses, dtype=np.float64))
+
+
+@njit(cache=True)
+def _bin_keys(poses: np.ndarray) -> np.ndarray:  # pragma: no cover - compiled
+    """:func:`bin_keys`, compiled (floor of x / BIN_XY, y / BIN_XY and yaw / BIN_YAW; yaw bins wrap)."""
+    out = np.empty(poses.shape[0], dtype=np.int64)
+    for k in range(poses.shape[0]):
+        ix = np.int64(math.floor(poses[k, 0] / BIN_XY)) + _OFF
+        iy = np.int64(math.floor(poses[k, 1] / BIN_XY)) + _OFF
+        it = np.int64(math.floor(poses[k, 2] / BIN_YAW)) % N_YAW_BINS
+        out[k] = (ix * _SPAN + iy) * N_YAW_BINS + it
+    return out
 
 
 def kld_count(candidates: np.ndarray, kld_err: float, kld_z: float, min_n: int, max_n: int) -> int:
@@ -65,11 +74,23 @@ def kld_count(candidates: np.ndarray, kld_err: float, kld_z: float, min_n: int, 
 @njit(cache=True)
 def bins_so_far(keys: np.ndarray) -> np.ndarray:  # pragma: no cover - compiled
     """``out[m]``: how many distinct keys ``keys[: m + 1]`` holds (the bins the first m + 1 samples occupy)."""
-    seen = set()
+    size = 16
+    while size < 2 * keys.shape[0]:
+        size *= 2
+    table = np.empty(size, dtype=np.int64)  # open addressing, linear probing; ``used`` marks the taken slots
+    used = np.zeros(size, dtype=np.bool_)
     out = np.empty(keys.shape[0], dtype=np.int64)
+    n = 0
     for m in range(keys.shape[0]):
-        seen.add(keys[m])
-        out[m] = len(seen)
+        key = keys[m]
+        slot = (key * 0x9E3779B97F4A7C15) >> 40 & (size - 1)
+        while used[slot] and table[slot] != key:
+            slot = (slot + 1) & (size - 1)
+        if not used[slot]:
+            used[slot] = True
+            table[slot] = key
+            n += 1
+        out[m] = n
     return out
 
 
