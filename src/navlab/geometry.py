@@ -196,16 +196,39 @@ def pose2_from_tf(tf: Vec) -> Pose2:
 
 def compose3(a: Tf, b: Tf) -> Tf:
     """``a ∘ b``: with ``a = A_T_B`` and ``b = B_T_C`` the result is ``A_T_C``."""
-    t = qrotate(a[3:], b[:3])
-    q = qmul(a[3:], b[3:])
-    return (a[0] + t[0], a[1] + t[1], a[2] + t[2], *q)
+    qx, qy, qz, qw = a[3], a[4], a[5], a[6]
+    vx, vy, vz, bx, by, bz, bw = b[0], b[1], b[2], b[3], b[4], b[5], b[6]
+    # qrotate(a's rotation, b's translation) and qmul(a's rotation, b's), written out (tf lookups run this often)
+    tx = 2.0 * (qy * vz - qz * vy)
+    ty = 2.0 * (qz * vx - qx * vz)
+    tz = 2.0 * (qx * vy - qy * vx)
+    return (
+        a[0] + (vx + qw * tx + (qy * tz - qz * ty)),
+        a[1] + (vy + qw * ty + (qz * tx - qx * tz)),
+        a[2] + (vz + qw * tz + (qx * ty - qy * tx)),
+        qw * bx + qx * bw + qy * bz - qz * by,
+        qw * by - qx * bz + qy * bw + qz * bx,
+        qw * bz + qx * by - qy * bx + qz * bw,
+        qw * bw - qx * bx - qy * by - qz * bz,
+    )
 
 
 def inverse3(a: Tf) -> Tf:
     """``B_T_A`` from ``A_T_B``."""
-    qi = (-a[3], -a[4], -a[5], a[6])
-    t = qrotate(qi, (-a[0], -a[1], -a[2]))
-    return (*t, *qi)
+    qx, qy, qz, qw = -a[3], -a[4], -a[5], a[6]
+    vx, vy, vz = -a[0], -a[1], -a[2]
+    tx = 2.0 * (qy * vz - qz * vy)  # qrotate(inverse rotation, -translation), written out
+    ty = 2.0 * (qz * vx - qx * vz)
+    tz = 2.0 * (qx * vy - qy * vx)
+    return (
+        vx + qw * tx + (qy * tz - qz * ty),
+        vy + qw * ty + (qz * tx - qx * tz),
+        vz + qw * tz + (qx * ty - qy * tx),
+        qx,
+        qy,
+        qz,
+        qw,
+    )
 
 
 def interpolate3(a: Tf, b: Tf, s: float) -> Tf:
