@@ -259,18 +259,27 @@ def reinflate(
 
     A cell's cost is ``table[d2]`` of its nearest seed, the largest ``table`` value over the seeds (the table
     falls with distance), and only seeds within ``reach`` cells count. So the cells within ``reach`` of a
-    vanished seed, and the extra ``boxes`` (K, 4) = (j0, j1, i0, i1) (what a rolling window newly covers or had
-    its seeds just beyond), are recomputed from the seeds around them (``inflate_box``, clustered: overlapping
-    boxes merged); then every appeared seed raises the cells within reach to its own cost. The result equals an
+    vanished seed whose cost equals that seed's own there (the others owe their cost to another seed), and the
+    extra ``boxes`` (K, 4) = (j0, j1, i0, i1) (what a rolling window newly covers), are recomputed from the seeds
+    around them (``inflate_box`` over the bounding box of each, clustered: overlapping boxes merged); then every
+    appeared seed raises the cells within reach to its own cost. The result equals an
     inflation of ``seeds`` from scratch, cell for cell."""
     h, w = seeds.shape
     m = changes.shape[0]
+    last = table.size - 1
     k = vanished + boxes.shape[0]
     todo = np.empty((k, 4), np.int64)
-    for t in range(vanished):
+    for t in range(vanished):  # the cells whose cost may have come from this seed: it equals the seed's own there
         i, j = changes[m - 1 - t, 0], changes[m - 1 - t, 1]
-        todo[t, 0], todo[t, 1] = max(0, j - reach), min(h, j + reach + 1)
-        todo[t, 2], todo[t, 3] = max(0, i - reach), min(w, i + reach + 1)
+        j0, j1, i0, i1 = h, -1, w, -1
+        for jj in range(max(0, j - reach + 1), min(h, j + reach)):
+            dy2 = (jj - j) * (jj - j)
+            for ii in range(max(0, i - reach + 1), min(w, i + reach)):
+                d2 = dy2 + (ii - i) * (ii - i)
+                c = cost[jj, ii]
+                if c > 0 and c == table[d2 if d2 < last else last]:
+                    j0, j1, i0, i1 = min(j0, jj), max(j1, jj), min(i0, ii), max(i1, ii)
+        todo[t, 0], todo[t, 1], todo[t, 2], todo[t, 3] = j0, j1 + 1, i0, i1 + 1  # empty when there is none
     todo[vanished:] = boxes
     alive = _merge_boxes(todo)
     for t in range(k):
@@ -278,7 +287,6 @@ def reinflate(
         if alive[t] and j0 < j1 and i0 < i1:
             region = (max(0, j0 - reach), min(h, j1 + reach), max(0, i0 - reach), min(w, i1 + reach))
             inflate_box(seeds, region, (j0, j1, i0, i1), table, cost[j0:j1, i0:i1])
-    last = table.size - 1
     for t in range(appeared):
         i, j = changes[t, 0], changes[t, 1]
         for jj in range(max(0, j - reach + 1), min(h, j + reach)):
