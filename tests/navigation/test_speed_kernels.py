@@ -113,6 +113,10 @@ def test_kld_bin_count_and_tracking_distance_equal_their_plain_forms() -> None:
         is_new = np.zeros(keys.size, np.int64)
         is_new[first] = 1
         np.testing.assert_array_equal(sampling.bins_so_far(keys), np.cumsum(is_new))
+        ukeys, inverse = np.unique(keys, return_inverse=True)
+        hashed = sampling.unique_inverse(keys)
+        np.testing.assert_array_equal(hashed[0], ukeys)
+        np.testing.assert_array_equal(hashed[1], inverse.ravel())
     path = np.cumsum(rng.normal(0, 0.1, (80, 2)), axis=0)
     pts = rng.normal(0, 1, (5, 2))
     a, ab = path[:-1], np.diff(path, axis=0)

@@ -71,27 +71,68 @@ def kld_count(candidates: np.ndarray, kld_err: float, kld_z: float, min_n: int, 
     return max(min(n, max_n), min_n)
 
 
+@njit(cache=True, inline="always")
+def _slot(table: np.ndarray, used: np.ndarray, key: np.int64) -> int:  # pragma: no cover - compiled
+    """The slot of ``key`` in an open-addressing hash table (linear probing; ``used`` marks the taken slots, the
+    table's size a power of two): where it is, else the free slot where it goes."""
+    size = table.shape[0]
+    slot = (key * 0x9E3779B97F4A7C15) >> 40 & (size - 1)
+    while used[slot] and table[slot] != key:
+        slot = (slot + 1) & (size - 1)
+    return slot
+
+
+@njit(cache=True)
+def _table_size(n: int) -> int:  # pragma: no cover - compiled
+    """A power of two at least twice ``n`` (and 16): the hash table's size for ``n`` keys."""
+    size = 16
+    while size < 2 * n:
+        size *= 2
+    return size
+
+
 @njit(cache=True)
 def bins_so_far(keys: np.ndarray) -> np.ndarray:  # pragma: no cover - compiled
     """``out[m]``: how many distinct keys ``keys[: m + 1]`` holds (the bins the first m + 1 samples occupy)."""
-    size = 16
-    while size < 2 * keys.shape[0]:
-        size *= 2
-    table = np.empty(size, dtype=np.int64)  # open addressing, linear probing; ``used`` marks the taken slots
+    size = _table_size(keys.shape[0])
+    table = np.empty(size, dtype=np.int64)
     used = np.zeros(size, dtype=np.bool_)
     out = np.empty(keys.shape[0], dtype=np.int64)
     n = 0
     for m in range(keys.shape[0]):
-        key = keys[m]
-        slot = (key * 0x9E3779B97F4A7C15) >> 40 & (size - 1)
-        while used[slot] and table[slot] != key:
-            slot = (slot + 1) & (size - 1)
+        slot = _slot(table, used, keys[m])
         if not used[slot]:
             used[slot] = True
-            table[slot] = key
+            table[slot] = keys[m]
             n += 1
         out[m] = n
     return out
+
+
+@njit(cache=True)
+def unique_inverse(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:  # pragma: no cover - compiled
+    """``np.unique(keys, return_inverse=True)`` by hashing: the sorted distinct keys, and each key's index among
+    them (only the distinct keys are sorted)."""
+    size = _table_size(keys.shape[0])
+    table = np.empty(size, dtype=np.int64)
+    used = np.zeros(size, dtype=np.bool_)
+    index = np.empty(size, dtype=np.int64)
+    distinct = np.empty(keys.shape[0], dtype=np.int64)
+    n = 0
+    for m in range(keys.shape[0]):
+        slot = _slot(table, used, keys[m])
+        if not used[slot]:
+            used[slot] = True
+            table[slot] = keys[m]
+            distinct[n] = keys[m]
+            n += 1
+    ukeys = np.sort(distinct[:n])
+    for u in range(n):
+        index[_slot(table, used, ukeys[u])] = u
+    inverse = np.empty(keys.shape[0], dtype=np.int64)
+    for m in range(keys.shape[0]):
+        inverse[m] = index[_slot(table, used, keys[m])]
+    return ukeys, inverse
 
 
 @dataclass(frozen=True)
@@ -175,7 +216,7 @@ def _cluster_sums(labels: np.ndarray, n_comp: int, poses: np.ndarray, w: np.ndar
 
 def cluster(poses: np.ndarray, weights: np.ndarray) -> Clusters:
     """Group particles into clusters of touching histogram bins and compute their statistics."""
-    ukeys, inv = np.unique(bin_keys(poses), return_inverse=True)
+    ukeys, inv = unique_inverse(bin_keys(poses))
     bin_label = _label_bins(ukeys)
     n_comp = int(bin_label.max()) + 1
     labels = bin_label[inv]
