@@ -52,7 +52,7 @@ def quat_from_yaw(yaw: float) -> Quat:
 
 def yaw_from_quat(q: Vec) -> float:
     """Yaw (rad, about z) of a unit quaternion (x, y, z, w)."""
-    x, y, z, w = (float(v) for v in q)
+    x, y, z, w = float(q[0]), float(q[1]), float(q[2]), float(q[3])
     return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
 
 
