@@ -215,20 +215,9 @@ def compose3(a: Tf, b: Tf) -> Tf:
 
 def inverse3(a: Tf) -> Tf:
     """``B_T_A`` from ``A_T_B``."""
-    qx, qy, qz, qw = -a[3], -a[4], -a[5], a[6]
-    vx, vy, vz = -a[0], -a[1], -a[2]
-    tx = 2.0 * (qy * vz - qz * vy)  # qrotate(inverse rotation, -translation), written out
-    ty = 2.0 * (qz * vx - qx * vz)
-    tz = 2.0 * (qx * vy - qy * vx)
-    return (
-        vx + qw * tx + (qy * tz - qz * ty),
-        vy + qw * ty + (qz * tx - qx * tz),
-        vz + qw * tz + (qx * ty - qy * tx),
-        qx,
-        qy,
-        qz,
-        qw,
-    )
+    qi = (-a[3], -a[4], -a[5], a[6])
+    t = qrotate(qi, (-a[0], -a[1], -a[2]))
+    return (*t, *qi)
 
 
 def interpolate3(a: Tf, b: Tf, s: float) -> Tf:

@@ -82,28 +82,34 @@ def _slot(table: np.ndarray, used: np.ndarray, key: np.int64) -> int:  # pragma:
     return slot
 
 
+@njit(cache=True, inline="always")
+def _add(table: np.ndarray, used: np.ndarray, key: np.int64) -> bool:  # pragma: no cover - compiled
+    """Put ``key`` in the hash table (see :func:`_slot`); whether it was not there yet."""
+    slot = _slot(table, used, key)
+    if used[slot]:
+        return False
+    used[slot] = True
+    table[slot] = key
+    return True
+
+
 @njit(cache=True)
-def _table_size(n: int) -> int:  # pragma: no cover - compiled
-    """A power of two at least twice ``n`` (and 16): the hash table's size for ``n`` keys."""
+def _hash_table(n: int) -> tuple[np.ndarray, np.ndarray]:  # pragma: no cover - compiled
+    """An empty hash table (keys, used) for ``n`` keys: a power of two at least twice ``n`` (and 16) slots."""
     size = 16
     while size < 2 * n:
         size *= 2
-    return size
+    return np.empty(size, dtype=np.int64), np.zeros(size, dtype=np.bool_)
 
 
 @njit(cache=True)
 def bins_so_far(keys: np.ndarray) -> np.ndarray:  # pragma: no cover - compiled
     """``out[m]``: how many distinct keys ``keys[: m + 1]`` holds (the bins the first m + 1 samples occupy)."""
-    size = _table_size(keys.shape[0])
-    table = np.empty(size, dtype=np.int64)
-    used = np.zeros(size, dtype=np.bool_)
+    table, used = _hash_table(keys.shape[0])
     out = np.empty(keys.shape[0], dtype=np.int64)
     n = 0
     for m in range(keys.shape[0]):
-        slot = _slot(table, used, keys[m])
-        if not used[slot]:
-            used[slot] = True
-            table[slot] = keys[m]
+        if _add(table, used, keys[m]):
             n += 1
         out[m] = n
     return out
@@ -113,20 +119,15 @@ def bins_so_far(keys: np.ndarray) -> np.ndarray:  # pragma: no cover - compiled
 def unique_inverse(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:  # pragma: no cover - compiled
     """``np.unique(keys, return_inverse=True)`` by hashing: the sorted distinct keys, and each key's index among
     them (only the distinct keys are sorted)."""
-    size = _table_size(keys.shape[0])
-    table = np.empty(size, dtype=np.int64)
-    used = np.zeros(size, dtype=np.bool_)
-    index = np.empty(size, dtype=np.int64)
+    table, used = _hash_table(keys.shape[0])
     distinct = np.empty(keys.shape[0], dtype=np.int64)
     n = 0
     for m in range(keys.shape[0]):
-        slot = _slot(table, used, keys[m])
-        if not used[slot]:
-            used[slot] = True
-            table[slot] = keys[m]
+        if _add(table, used, keys[m]):
             distinct[n] = keys[m]
             n += 1
     ukeys = np.sort(distinct[:n])
+    index = np.empty(table.shape[0], dtype=np.int64)  # slot -> the key's place in ukeys
     for u in range(n):
         index[_slot(table, used, ukeys[u])] = u
     inverse = np.empty(keys.shape[0], dtype=np.int64)

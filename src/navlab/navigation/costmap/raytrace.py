@@ -14,39 +14,7 @@ import numba
 import numpy as np
 
 from navlab.gridline import TIE_LATE, line, line_cell
-
-
-@numba.njit(cache=True, inline="always")
-def _ray_end(x0: float, y0: float, ex: float, ey: float, max_cells: float) -> tuple[bool, int, int]:
-    """(whether the ray has a finite length, end cell i, j) of a ray from (x0, y0) to (ex, ey), cut to
-    ``max_cells`` cells of length."""
-    dx = ex - x0
-    dy = ey - y0
-    length = math.sqrt(dx * dx + dy * dy)
-    if not math.isfinite(length):
-        return False, 0, 0
-    if length > max_cells:
-        s = max_cells / length
-        ex = x0 + dx * s
-        ey = y0 + dy * s
-    return True, math.floor(ex), math.floor(ey)
-
-
-@numba.njit(cache=True, inline="always")
-def _walk(data: np.ndarray, i0: int, j0: int, i1: int, j1: int, min_sq: float, value: np.uint8) -> int:
-    """Set the cells of the Bresenham line (i0, j0) -> (i1, j1) to ``value``, end included, up to where it leaves
-    the grid, leaving those nearer the start than sqrt(``min_sq``) cells; returns how many were written."""
-    h, w = data.shape
-    written = 0
-    ln = line(i0, j0, i1, j1, TIE_LATE)
-    for n in range(ln[0] + 1):
-        i, j = line_cell(ln, n)
-        if i < 0 or j < 0 or i >= w or j >= h:
-            break
-        if min_sq <= 0.0 or (i - i0) * (i - i0) + (j - j0) * (j - j0) >= min_sq:
-            data[j, i] = value
-            written += 1
-    return written
+from navlab.navigation.costmap.kernels import mark_returns
 
 
 @numba.njit(cache=True)
@@ -65,14 +33,32 @@ def clear_rays(
         return 0
     written = 0
     min_sq = min_cells * min_cells
-    last_i, last_j = i0, j0
-    walked = False
+    last_i, last_j, walked = i0, j0, False
     for k in range(ends.shape[0]):
-        ok, i1, j1 = _ray_end(x0, y0, ends[k, 0], ends[k, 1], max_cells)
-        if not ok or (walked and i1 == last_i and j1 == last_j):
+        ex = ends[k, 0]
+        ey = ends[k, 1]
+        dx = ex - x0
+        dy = ey - y0
+        length = math.sqrt(dx * dx + dy * dy)
+        if not math.isfinite(length):
             continue
-        written += _walk(data, i0, j0, i1, j1, min_sq, value)
+        if length > max_cells:
+            s = max_cells / length
+            ex = x0 + dx * s
+            ey = y0 + dy * s
+        i1 = math.floor(ex)
+        j1 = math.floor(ey)
+        if walked and i1 == last_i and j1 == last_j:
+            continue
         last_i, last_j, walked = i1, j1, True
+        ln = line(i0, j0, i1, j1, TIE_LATE)
+        for n in range(ln[0] + 1):
+            i, j = line_cell(ln, n)
+            if i < 0 or j < 0 or i >= w or j >= h:
+                break
+            if min_sq <= 0.0 or (i - i0) * (i - i0) + (j - j0) * (j - j0) >= min_sq:
+                data[j, i] = value
+                written += 1
     return written
 
 
@@ -88,8 +74,8 @@ def observe_ranges(
     clearing: tuple[bool, float, float, np.uint8],
     marking: tuple[bool, float, float, np.uint8],
 ) -> None:  # pragma: no cover - compiled
-    """One laser scan into an obstacle layer's ``data``, all in one pass (the same arithmetic as the endpoints
-    of ``ScanPoints.points`` moved into the grid's frame, then ``clear_rays`` and ``mark_returns``).
+    """One laser scan into an obstacle layer's ``data`` in one call: the endpoints (the arithmetic of
+    ``ScanPoints.points`` moved into the grid's frame), then ``clear_rays`` and ``mark_returns`` on them.
 
     ``ranges`` (N,) m along the beams (``beam_cos``, ``beam_sin`` in the sensor frame); ``scan_limits`` =
     (range_min, range_max, clear_to): a real return lies in [range_min, range_max), a ray without one (inf, at
@@ -101,8 +87,7 @@ def observe_ranges(
     sx, sy, c, s = sensor
     ox, oy, res = grid
     range_min, range_max, clear_to = scan_limits
-    px = np.empty(n)
-    py = np.empty(n)
+    pts = np.empty((n, 2))
     ok = np.empty(n, np.bool_)
     m = 0
     for k in range(n):
@@ -118,32 +103,14 @@ def observe_ranges(
             continue
         lx = d * beam_cos[k]
         ly = d * beam_sin[k]
-        px[m] = sx + c * lx - s * ly
-        py[m] = sy + s * lx + c * ly
+        pts[m, 0] = sx + c * lx - s * ly
+        pts[m, 1] = sy + s * lx + c * ly
         ok[m] = valid
         m += 1
-    h, w = data.shape
     if clearing[0]:
-        x0, y0 = (sx - ox) / res, (sy - oy) / res
-        i0, j0 = math.floor(x0), math.floor(y0)
-        if 0 <= i0 < w and 0 <= j0 < h:
-            max_cells, min_cells = clearing[1] / res, clearing[2] / res
-            min_sq = min_cells * min_cells
-            last_i, last_j = i0, j0
-            walked = False
-            for k in range(m):
-                fine, i1, j1 = _ray_end(x0, y0, (px[k] - ox) / res, (py[k] - oy) / res, max_cells)
-                if not fine or (walked and i1 == last_i and j1 == last_j):
-                    continue
-                _walk(data, i0, j0, i1, j1, min_sq, clearing[3])
-                last_i, last_j, walked = i1, j1, True
-    if marking[0]:
+        cells = np.empty((m, 2))
         for k in range(m):
-            if not ok[k]:
-                continue
-            dist = math.hypot(px[k] - sx, py[k] - sy)
-            if not (dist < marking[2] and dist >= marking[1]):
-                continue
-            i, j = math.floor((px[k] - ox) / res), math.floor((py[k] - oy) / res)
-            if 0 <= i < w and 0 <= j < h:
-                data[j, i] = marking[3]
+            cells[k, 0], cells[k, 1] = (pts[k, 0] - ox) / res, (pts[k, 1] - oy) / res
+        clear_rays(data, (sx - ox) / res, (sy - oy) / res, cells, clearing[1] / res, clearing[2] / res, clearing[3])
+    if marking[0]:
+        mark_returns(data, pts[:m], ok[:m], sx, sy, ox, oy, res, marking[1], marking[2], marking[3])
