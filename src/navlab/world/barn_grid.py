@@ -1,6 +1,7 @@
 """BARN's 30 x 30 grid of 0.15 m cells (Perille et al. 2020): the cellular automaton that fills it, the robot's
-configuration space on it, BARN's test that a world has a way through, and which filled cells hold a written
-cylinder. Pure numpy; field frame as in :mod:`navlab.world.clutter` (columns along x from 0, rows along y centred)."""
+configuration space on it, BARN's test that a world has a way through, which filled cells hold a written
+cylinder, and the path its generator saves (path_N.npy, BARN's T_opt). Pure numpy; field frame as in
+:mod:`navlab.world.clutter` (columns along x from 0, rows along y centred)."""
 
 from __future__ import annotations
 

@@ -18,9 +18,10 @@ the field: its sides in line with the field's wall rows, its back 2.925 m behind
 walls. The robot starts 2.1 m before the field facing +x, 0.25 m off its centre line (the challenge's
 INIT_POSITION (-2, 3) against the field's centre -2.25), and the goal is 10 m straight ahead, past the field in
 the open. ``ClutterWorld.reference_path_m`` is the length of the shortest collision-free path for a disc of
-``robot_radius`` (8-connected Dijkstra on a 0.05 m grid of exact clearances, then shortened by line of sight),
-BARN's T_opt = reference length / 2 m/s. Worlds are written as SDF 1.6 ``.world`` files that navlab's
-:func:`navlab.world.load_world` and Gazebo classic both load.
+``robot_radius`` (8-connected Dijkstra on a 0.05 m grid of exact clearances, then shortened by line of
+sight): navlab's stricter T_opt = reference length / 2 m/s. BARN's own T_opt comes from the path its generator
+saves (``ClutterWorld.barn_path``, ``barn_t_opt``: :func:`navlab.world.barn_grid.barn_path`). Worlds are written
+as SDF 1.6 ``.world`` files that navlab's :func:`navlab.world.load_world` and Gazebo classic both load.
 """
 
 from __future__ import annotations
@@ -124,7 +125,8 @@ class ClutterWorld:
 
     def t_opt(self, speed: float = BARN_SPEED) -> float:
         """navlab's optimal traversal time (s): the shortest collision-free path (``reference_path_m``) /
-        ``speed`` (m/s); at most :meth:`barn_t_opt`, so a score with it is stricter than BARN's."""
+        ``speed`` (m/s); shorter than :meth:`barn_t_opt` but by run.py's offset (see ``barn_grid.RUNNER_OFFSET``), so a
+        score with it is stricter than BARN's."""
         return self.reference_path_m / speed
 
     def barn_t_opt(self, speed: float = BARN_SPEED) -> float:
