@@ -15,6 +15,7 @@ import math
 import numba
 import numpy as np
 
+from navlab.navigation.controllers.ring_bounds import ring_scores
 from navlab.navigation.controllers.rollout import integrate_rollouts, rollout_scores
 
 
@@ -35,7 +36,9 @@ def _linspace(start: float, stop: float, num: int, out: np.ndarray) -> None:  # 
 @numba.njit(cache=True)
 def score_samples(
     grid: np.ndarray,
-    near: np.ndarray,
+    memo: np.ndarray,
+    rings: np.ndarray,
+    ring_counts: np.ndarray,
     path_dist: np.ndarray,
     goal_dist: np.ndarray,
     resolution: float,
@@ -47,7 +50,6 @@ def score_samples(
     ox: np.ndarray,
     oy: np.ndarray,
     polygon: bool,
-    use_near: bool,
     weights: np.ndarray,
     impossible: float,
     at: int,
@@ -57,8 +59,10 @@ def score_samples(
 
     ``limits`` = (vmin, vmax, wmin, wmax, min_in_place_vel_theta, escape_vel, acc_lim_x, acc_lim_theta);
     ``counts`` = (vx_samples, vtheta_samples); ``timing`` = (sim_time, sim_granularity, angular granularity,
-    heading_scoring 0/1). Rows: per speed the straight rollout then ``nw - 1`` turn rates from the lowest up,
-    then the ``nw`` in-place turns, then the escape. ``at``: the scored step (``_heading_step``)."""
+    heading_scoring 0/1). A polygon robot's footprint is checked with ``ring_bounds.ring_scores`` (``memo``,
+    ``rings``, ``ring_counts``: its bound memo and rings), a point robot's centre cell alone. Rows: per speed the
+    straight rollout then ``nw - 1`` turn rates from the lowest up, then the ``nw`` in-place turns, then the escape.
+    ``at``: the scored step (``_heading_step``)."""
     vmin, vmax, wmin, wmax, min_ip, escape_vel, ax, ath = (
         limits[0],
         limits[1],
@@ -101,24 +105,31 @@ def score_samples(
         pose[0], pose[1], pose[2], velocity[0], velocity[1], targets, steps, sim_time, ax, ath, True, traj, c, s
     )
     costs = np.empty(n)
-    rollout_scores(
-        grid,
-        near,
-        path_dist,
-        goal_dist,
-        1.0 / resolution,
-        traj,
-        c,
-        s,
-        ox,
-        oy,
-        polygon,
-        use_near,
-        weights,
-        impossible,
-        np.full(n, at, dtype=np.int64),
-        costs,
-    )
+    ats = np.full(n, at, dtype=np.int64)
+    inv = 1.0 / resolution
+    if polygon:
+        ring_scores(
+            grid,
+            memo,
+            rings,
+            ring_counts,
+            path_dist,
+            goal_dist,
+            inv,
+            traj,
+            c,
+            s,
+            ox,
+            oy,
+            weights,
+            impossible,
+            ats,
+            costs,
+        )
+    else:
+        rollout_scores(
+            grid, grid, path_dist, goal_dist, inv, traj, c, s, ox, oy, False, False, weights, impossible, ats, costs
+        )
     return targets, traj, costs, ws, dw
 
 
