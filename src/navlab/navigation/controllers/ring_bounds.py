@@ -20,7 +20,8 @@ import math
 import numba
 import numpy as np
 
-from navlab.grid import COST_LETHAL, COST_UNKNOWN
+from navlab.grid import COST_INSCRIBED, COST_LETHAL, COST_UNKNOWN
+from navlab.navigation.controllers.mapgrid import grow
 
 QUARTERS = 2  # the centre's cell is split QUARTERS x QUARTERS ways: tighter rings than one ring per cell
 _EPS = 1e-6  # cells: room for the rounding of the outline points' coordinates
@@ -110,24 +111,29 @@ def ring_scores(
     memo: np.ndarray,
     offsets: np.ndarray,
     counts: np.ndarray,
-    path_dist: np.ndarray,
-    goal_dist: np.ndarray,
+    path_wave: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray],
+    goal_wave: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray],
     inv: float,
     traj: np.ndarray,
     c: np.ndarray,
     s: np.ndarray,
     ox: np.ndarray,
     oy: np.ndarray,
+    polygon: bool,
     weights: np.ndarray,
     impossible: float,
     at: np.ndarray,
     out: np.ndarray,
 ) -> None:  # pragma: no cover - compiled
-    """``rollout.rollout_scores`` of a polygon robot (the same arguments, ``memo``/``offsets``/``counts`` in place
-    of ``near``): the cost of each rollout (S, n, 3) into ``out``; -1 blocked or off the map, -2 no path."""
-    h, w = path_dist.shape
+    """``rollout.rollout_scores`` with ``with_centre`` (the same arguments, ``memo``/``offsets``/``counts`` in place
+    of ``near`` and ``use_near``, which a point robot (``polygon`` False) does without; the distance waves to the
+    path and to the goal (``mapgrid.wave_start``) in place of their maps, grown as far as the rollouts need): the
+    cost of each rollout (S, n, 3) into ``out``; -1 blocked or off the map, -2 no path."""
+    h, w = grid.shape
     n = traj.shape[1]
     q = QUARTERS
+    path_dist, path_reached, path_free, path_queue, path_ends = path_wave
+    goal_dist, goal_reached, goal_free, goal_queue, goal_ends = goal_wave
     bounds = np.empty(n, dtype=np.int64)
     for r in range(traj.shape[0]):
         top = -math.inf
@@ -139,28 +145,40 @@ def ring_scores(
             fx, fy = x * inv, y * inv
             i, j = math.floor(fx), math.floor(fy)
             inside = 0 <= i < w and 0 <= j < h
-            pd, gd = (path_dist[j, i], goal_dist[j, i]) if inside else (path_dist[0, 0], goal_dist[0, 0])
             bounds[k] = -1
             same = k > 0 and x == traj[r, k - 1, 0] and y == traj[r, k - 1, 1]
             if not (same and c[r, k] == c[r, k - 1] and s[r, k] == s[r, k - 1]):  # a pose repeated adds nothing
                 if not inside:
                     fail = -1.0
                     break
-                part = min(q - 1, int((fy - j) * q)) * q + min(q - 1, int((fx - i) * q))
-                b = np.int64(memo[part, j, i])
-                if b < 0:
-                    b = ring_bound(grid, memo, offsets, counts, part, i, j)
-                if b >= COST_LETHAL:  # it may fail: check it now, in time order
-                    fp = _exact(grid, inv, x, y, c[r, k], s[r, k], ox, oy, b)
-                    if fp < 0:
+                if not polygon:  # a point robot: its centre cell, blocked from INSCRIBED up
+                    if grid[j, i] >= COST_INSCRIBED:
                         fail = -1.0
                         break
-                    top = max(top, fp)
+                    top = max(top, float(grid[j, i]))
                 else:
-                    bounds[k] = b
-                    if b > first_bound:
-                        first, first_bound = k, b
+                    part = min(q - 1, int((fy - j) * q)) * q + min(q - 1, int((fx - i) * q))
+                    b = np.int64(memo[part, j, i])
+                    if b < 0:
+                        b = ring_bound(grid, memo, offsets, counts, part, i, j)
+                    if b >= COST_LETHAL:  # it may fail: check it now, in time order
+                        fp = _exact(grid, inv, x, y, c[r, k], s[r, k], ox, oy, b)
+                        if fp < 0:
+                            fail = -1.0
+                            break
+                        top = max(top, fp)
+                    else:
+                        bounds[k] = b
+                        if b > first_bound:
+                            first, first_bound = k, b
             if at[r] == -1 or at[r] == k:
+                pi, pj = (i, j) if inside else (0, 0)
+                pd = path_dist[pj, pi]
+                if not path_reached[pj, pi]:
+                    pd = grow(grid, path_dist, path_reached, path_free, path_queue, path_ends, pi, pj)
+                gd = goal_dist[pj, pi]
+                if not goal_reached[pj, pi]:
+                    gd = grow(grid, goal_dist, goal_reached, goal_free, goal_queue, goal_ends, pi, pj)
                 spd, sgd = pd, gd
                 if pd >= impossible or gd >= impossible:
                     fail = -2.0

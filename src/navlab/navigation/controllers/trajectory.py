@@ -12,7 +12,7 @@ from navlab.navigation.controllers import ring_bounds
 from navlab.navigation.controllers import trajectory_cycle as cycle
 from navlab.navigation.controllers.common import InPlaceFlags
 from navlab.navigation.controllers.params import TrajectoryPlannerParams
-from navlab.navigation.controllers.rollout import heading_diffs, rollout_scores
+from navlab.navigation.controllers.rollout import heading_diffs
 from navlab.navigation.controllers.rollout_controller import LocalScene, RolloutController
 
 _NO_MEMO, _NO_OFFSETS, _NO_COUNTS = (  # a point robot's (typed) empties
@@ -95,15 +95,8 @@ class TrajectoryPlannerROS(RolloutController):
         at = self._heading_step(traj.shape[1])
         args = (1.0 / res, traj, c, s, ox, oy)
         ats = np.full(len(traj), at, dtype=np.int64)
-        path, goal = np.ascontiguousarray(scene.path_dist), np.ascontiguousarray(scene.goal_dist)
-        if polygon:
-            ring_bounds.ring_scores(
-                scene.cost, memo, offsets, counts, path, goal, *args, self._weights(res), scene.impossible, ats, cost
-            )
-        else:
-            rollout_scores(
-                scene.cost, scene.cost, path, goal, *args, False, False, self._weights(res), scene.impossible, ats, cost
-            )
+        scored = (scene.goal_wave, *args, polygon, self._weights(res), scene.impossible, ats, cost)
+        ring_bounds.ring_scores(scene.cost, memo, offsets, counts, scene.path_wave, *scored)
         self._add_heading(scene, cost, traj, at)
         return cost
 
@@ -136,8 +129,8 @@ class TrajectoryPlannerROS(RolloutController):
             memo,
             offsets,
             counts,
-            scene.path_dist,
-            scene.goal_dist,
+            scene.path_wave,
+            scene.goal_wave,
             res,
             scene.pose,
             velocity,
@@ -160,7 +153,8 @@ class TrajectoryPlannerROS(RolloutController):
             dw,
             nf,
             self._escaping,
-            scene.goal_dist,
+            scene.cost,
+            scene.goal_wave,
             res,
             p.heading_lookahead,
             self._spin.stuck_left,
