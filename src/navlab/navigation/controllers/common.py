@@ -75,9 +75,12 @@ class LocalFrame:
         return np.stack([c * d[:, 0] + s * d[:, 1], -s * d[:, 0] + c * d[:, 1]], axis=1)
 
     def pose_in(self, pose: tuple[float, float, float]) -> tuple[float, float, float]:
-        """A costmap-frame pose -> grid-local."""
-        p = self.points_in(np.array([[pose[0], pose[1]]]))[0]
-        return float(p[0]), float(p[1]), float(pose[2]) - self.oyaw
+        """A costmap-frame pose -> grid-local (``points_in``'s arithmetic on one point)."""
+        dx, dy = float(pose[0]) - self.ox, float(pose[1]) - self.oy
+        if self.oyaw != 0.0:
+            c, s = math.cos(self.oyaw), math.sin(self.oyaw)
+            dx, dy = c * dx + s * dy, -s * dx + c * dy
+        return dx, dy, float(pose[2]) - self.oyaw
 
     def poses_out(self, poses: np.ndarray) -> np.ndarray:
         """Grid-local poses (N, 3) -> costmap frame (N, 3), yaw wrapped to [-pi, pi)."""

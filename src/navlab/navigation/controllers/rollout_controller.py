@@ -168,7 +168,7 @@ class RolloutController(ControllerBase):
         self._rotating_to_goal = False
         self._outlines: dict[tuple[float, bytes | None], np.ndarray | None] = {}
         self._near: tuple[np.ndarray, np.ndarray | None, np.ndarray] | None = None  # (outline, costs, reach max)
-        self._goal_map: tuple[np.ndarray | None, np.ndarray, mapgrid.Wave] | None = None  # (costs, goal cell, wave)
+        self._goal_map: tuple[np.ndarray | None, tuple[int, int], mapgrid.Wave] | None = None  # costs, goal cell, wave
         self._costs_seen: np.ndarray | None = None  # the local costs last seen (see _note_costs)
         self._clear_outputs()
         self._setup()
@@ -276,12 +276,13 @@ class RolloutController(ControllerBase):
     def _goal_wave(self, cost: np.ndarray, goal: np.ndarray) -> mapgrid.Wave:
         """The local goal cell's (i, j) distance wave, kept (and grown further as lookups need) while the costs and
         that cell stay the same (the robot moves a few cells per costmap update; the goal cell moves less often)."""
+        cell = (int(goal[0]), int(goal[1]))
         cached = self._goal_map
-        if cached is not None and cached[0] is self._costs_seen and np.array_equal(cached[1], goal):
+        if cached is not None and cached[0] is self._costs_seen and cached[1] == cell:
             return cached[2]
         none = np.zeros(0, dtype=np.int64)
         wave = mapgrid.wave_start(cost, goal[:1].copy(), goal[1:].copy(), none, none)
-        self._goal_map = (self._costs_seen, goal.copy(), wave)
+        self._goal_map = (self._costs_seen, cell, wave)
         return wave
 
     def _free_mode(self, res: float) -> tuple[int, np.ndarray | None, np.ndarray | None]:
