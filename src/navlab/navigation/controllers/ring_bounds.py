@@ -142,12 +142,15 @@ def ring_scores(
         first, first_bound = -1, -1  # the deferred pose of highest bound
         for k in range(n):
             x, y = traj[r, k, 0], traj[r, k, 1]
+            bounds[k] = -1
+            moved = k == 0 or x != traj[r, k - 1, 0] or y != traj[r, k - 1, 1]
+            turned = moved or c[r, k] != c[r, k - 1] or s[r, k] != s[r, k - 1]
+            if not (turned or at[r] == k):
+                continue  # the pose before, repeated: nothing new (its distances passed already)
             fx, fy = x * inv, y * inv
             i, j = math.floor(fx), math.floor(fy)
             inside = 0 <= i < w and 0 <= j < h
-            bounds[k] = -1
-            same = k > 0 and x == traj[r, k - 1, 0] and y == traj[r, k - 1, 1]
-            if not (same and c[r, k] == c[r, k - 1] and s[r, k] == s[r, k - 1]):  # a pose repeated adds nothing
+            if turned:
                 if not inside:
                     fail = -1.0
                     break
@@ -171,7 +174,7 @@ def ring_scores(
                         bounds[k] = b
                         if b > first_bound:
                             first, first_bound = k, b
-            if at[r] == -1 or at[r] == k:
+            if at[r] == k or (at[r] == -1 and moved):  # (unmoved, the distances are those that passed)
                 pi, pj = (i, j) if inside else (0, 0)
                 pd = path_dist[pj, pi]
                 if not path_reached[pj, pi]:
