@@ -34,9 +34,28 @@ def as_plan(path: Any) -> np.ndarray:
     arr = np.asarray(path, dtype=np.float64)
     if arr.ndim != 2 or arr.shape[1] not in (2, 3) or len(arr) == 0:
         raise NavigationError(f"plan: expected an array (N, 2) or (N, 3) with N >= 1, got shape {arr.shape}")
-    if not np.all(np.isfinite(arr)):
+    arr = arr.copy()  # C-contiguous
+    if not all_finite(arr.reshape(-1)):
         raise NavigationError("plan: expected finite coordinates, got NaN or inf")
-    return arr.copy()
+    return arr
+
+
+@numba.njit(cache=True)
+def all_finite(values: np.ndarray) -> bool:  # pragma: no cover - compiled
+    """Whether every value of the 1-D float array is finite (``np.all(np.isfinite(...))`` in one pass)."""
+    for v in values:  # noqa: SIM110 - a compiled loop that stops at the first (Numba has no all() of a generator)
+        if not math.isfinite(v):
+            return False
+    return True
+
+
+@numba.njit(cache=True)
+def same_values(a: np.ndarray, b: np.ndarray) -> bool:  # pragma: no cover - compiled
+    """Whether two 1-D arrays of one length hold the same values (``np.array_equal`` without its temporaries)."""
+    for k in range(a.size):  # noqa: SIM110 - as all_finite
+        if a[k] != b[k]:
+            return False
+    return True
 
 
 def densify(xy: np.ndarray, step: float) -> np.ndarray:

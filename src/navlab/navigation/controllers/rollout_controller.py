@@ -78,6 +78,7 @@ from navlab.navigation.controllers.common import (
     prune_plan,
     rotate_to_goal,
     same_goal,
+    same_values,
     stop_with_acc_limits,
     stopped,
 )
@@ -270,7 +271,7 @@ class RolloutController(ControllerBase):
         from them (the goal's distance map, the footprint's reach maximum) is kept with that copy and reused while
         it is still the one (the costmap updates less often than the controller runs)."""
         seen = self._costs_seen
-        if seen is None or seen.shape != cost.shape or not np.array_equal(seen, cost):
+        if seen is None or seen.shape != cost.shape or not same_values(seen.reshape(-1), cost.reshape(-1)):
             self._costs_seen = cost.copy()
 
     def _goal_wave(self, cost: np.ndarray, goal: np.ndarray) -> mapgrid.Wave:
