@@ -8,8 +8,8 @@ the centre in a given quarter of a cell the points can only fall in a fixed ring
 up once per (cell, quarter) and kept while the costs stay the same (:func:`ring_bound`). A pose is checked point
 by point only when its bound can still fail it (LETHAL or unknown in the ring) or raise the rollout's cost
 above what its other poses already cost: first, in time order, the poses that may fail (the first failure
-decides, as ``rollout.rollout_scores``), then the highest bound of the rest, then any pose whose bound is still
-above. The costs are those of ``rollout.rollout_scores`` bit for bit: the maximum does not depend on the order.
+decides, as ``rollout.rollout_scores``), then the highest bound of the rest, then (latest first) any pose whose bound
+is still above. The costs are those of ``rollout.rollout_scores`` bit for bit: the maximum does not depend on the order.
 Poses are grid-local (m, rad); cells (i, j) = (column, row).
 """
 
@@ -194,7 +194,7 @@ def ring_scores(
                 top,
                 _exact(grid, inv, traj[r, first, 0], traj[r, first, 1], c[r, first], s[r, first], ox, oy, first_bound),
             )
-        for k in range(n):
+        for k in range(n - 1, -1, -1):  # latest first: a rollout's cost tends to grow along it
             if bounds[k] > top and k != first:
                 top = max(top, _exact(grid, inv, traj[r, k, 0], traj[r, k, 1], c[r, k], s[r, k], ox, oy, bounds[k]))
         out[r] = weights[0] * (weights[1] * spd + weights[2] * sgd + weights[3] * top)
