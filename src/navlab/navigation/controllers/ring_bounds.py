@@ -70,13 +70,13 @@ def ring_bound(
     """The highest cost of the centre cell (i, j) and its ring ``q`` (unknown if the ring leaves the grid); kept
     in ``memo``."""
     h, w = grid.shape
-    top = np.int64(grid[j, i])
+    top = int(grid[j, i])
     for m in range(counts[q]):
         pi, pj = i + offsets[q, m, 0], j + offsets[q, m, 1]
         if pi < 0 or pj < 0 or pi >= w or pj >= h:
             top = COST_UNKNOWN
         else:
-            top = max(top, np.int64(grid[pj, pi]))
+            top = max(top, int(grid[pj, pi]))
     memo[q, j, i] = top
     return top
 
@@ -161,7 +161,7 @@ def ring_scores(
                     top = max(top, float(grid[j, i]))
                 else:
                     part = min(q - 1, int((fy - j) * q)) * q + min(q - 1, int((fx - i) * q))
-                    b = np.int64(memo[part, j, i])
+                    b = int(memo[part, j, i])
                     if b < 0:
                         b = ring_bound(grid, memo, offsets, counts, part, i, j)
                     if b >= COST_LETHAL:  # it may fail: check it now, in time order
