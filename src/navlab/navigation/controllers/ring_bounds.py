@@ -93,7 +93,8 @@ def _exact(
         return float(bound)  # nothing under the outline costs more than the centre
     best = np.uint8(0)
     off = False
-    for m in range(ox.size):  # every point, branch-free, as _pose_cost
+    # every point, branch-free: rollout._pose_cost's loop, kept here (calling _pose_cost costs this kernel ~20 %)
+    for m in range(ox.size):
         px = x + c * ox[m] - s * oy[m]
         py = y + s * ox[m] + c * oy[m]
         pi, pj = np.int64(math.floor(px * inv)), np.int64(math.floor(py * inv))
