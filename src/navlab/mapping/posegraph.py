@@ -176,6 +176,7 @@ class _System:
         rows = np.concatenate([rows[keep] - 3, diag])  # node 0's rows and columns dropped; a 1e-9 diagonal
         cols = np.concatenate([cols[keep] - 3, diag])
         self.keep, self.m, self.ridge = keep, m, np.full(m, 1e-9)
+        # the order depends on the pattern alone: factor it with values that need no pivoting
         pattern = sp.csc_matrix((np.ones(len(rows)), (rows, cols)), shape=(m, m))
         order = splu(pattern + sp.identity(m, format="csc") * m, permc_spec="MMD_AT_PLUS_A", **_SYMMETRIC).perm_c
         self.order = np.argsort(order)  # unknown k of the permuted system is unknown order[k] of H
