@@ -48,6 +48,32 @@ def test_depth_pixel_is_the_range_to_a_known_box_within_noise() -> None:
     assert depth[row, 16] == pytest.approx(pos[2] * f / (row - 11.5), abs=0.05)
 
 
+def test_a_held_depth_cloud_never_changes_and_dropped_ones_are_reused() -> None:
+    from navlab.sim.sensor_plugins import DepthCameraPlugin
+
+    box = primitive_model("box", "box", (0.4, 2.0, 1.0), x=2.0)
+    sim = _sim(box)
+    cfg = CameraConfig(
+        link="chassis", kind="depth", origin=CAM_ORIGIN, camera=CameraModel(width=32, height=24, far=10.0)
+    )
+    camera = DepthCameraPlugin(Executor(), sim=sim, config=cfg)
+    depth = depth_image(sim, cfg)
+
+    def address(msg: Any) -> int:
+        return int(msg.data.__array_interface__["data"][0])
+
+    held = camera.cloud(depth, 0)
+    seen = read_xyz(held, copy=False)  # a view into the message, as a costmap keeps it
+    first, kept = address(held), read_xyz(held)
+    del held
+    others = [camera.cloud(depth * (k + 2), k + 1) for k in range(3)]
+    assert first not in {address(m) for m in others}  # the view still holds the first frame's points
+    np.testing.assert_array_equal(seen, kept)
+    spent = {address(m) for m in others}
+    del seen, others
+    assert address(camera.cloud(depth, 9)) in spent | {first}  # nobody holds them: a buffer is reused
+
+
 def test_3d_lidar_rings_at_the_configured_angles() -> None:
     from navlab.core import Executor
     from navlab.sim.sensor_plugins import VelodynePlugin

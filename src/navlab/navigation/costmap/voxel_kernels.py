@@ -167,12 +167,11 @@ def observe(
                     seen[cell] = was | bit
         if not clearing:
             continue
-        # where the ray ends: t = min(1, range cut, the grid's faces) along d; the height cut's division only where
-        # it can be below 1 (the quotient of two same-signed numbers, the first not smaller, is at least 1 exactly)
+        # where the ray ends: t = min(1, range cut, the grid's faces) along d; the height cut without a branch
+        # (points scattered about the floor would make one unpredictable: dividing always is cheaper)
         t = 1.0 if d2 <= rr2 else raytrace_range / math.sqrt(d2)
-        face_z = (hz if dz > 0 else lz) - oz
-        if (dz > 0 and face_z < dz) or (dz < 0 and face_z > dz):
-            t = min(t, face_z / dz)
+        tz = ((hz if dz > 0 else lz) - oz) / dz
+        t = min(t, tz if dz != 0 else np.inf)
         ex, ey = ox + t * dx, oy + t * dy
         if not (lx <= ex <= hx and ly <= ey <= hy):
             t = min(t, (hx - ox) / dx) if dx > 0 else (min(t, (lx - ox) / dx) if dx < 0 else t)
