@@ -125,6 +125,7 @@ class DepthCameraPlugin(CameraPlugin):
         self.cloud_pub = self.create_publisher(msgs.PointCloud2, config.point_cloud_topic, 1)
         self.depth_info_pub = self.create_publisher(msgs.CameraInfo, config.depth_info_topic, 1)
         self._scratch = np.empty((config.camera.height, config.camera.width))  # depth_image's float64 buffer
+        self._image = np.empty((config.camera.height, config.camera.width), np.float32)  # an unpublished image
         self._spares: list[np.ndarray] = []  # clouds' point buffers, reused once no message holds them
 
     def update(self) -> None:
@@ -133,8 +134,10 @@ class DepthCameraPlugin(CameraPlugin):
         if colour:
             self.image_pub.publish(self.image_msg(self.image(), now))
         if self.read(self.depth_pub, self.cloud_pub):
-            depth = depth_image(self.sim, self.cam, self.rng, scratch=self._scratch)
-            if self.read(self.depth_pub):
+            published = self.read(self.depth_pub)  # else the image is only the cloud's: drawn into a kept buffer
+            image = None if published else self._image
+            depth = depth_image(self.sim, self.cam, self.rng, scratch=self._scratch, out=image)
+            if published:
                 h, w = depth.shape
                 self.depth_pub.publish(
                     msgs.Image(
