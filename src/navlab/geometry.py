@@ -52,7 +52,7 @@ def quat_from_yaw(yaw: float) -> Quat:
 
 def yaw_from_quat(q: Vec) -> float:
     """Yaw (rad, about z) of a unit quaternion (x, y, z, w)."""
-    x, y, z, w = (float(v) for v in q)
+    x, y, z, w = float(q[0]), float(q[1]), float(q[2]), float(q[3])
     return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
 
 
@@ -196,9 +196,21 @@ def pose2_from_tf(tf: Vec) -> Pose2:
 
 def compose3(a: Tf, b: Tf) -> Tf:
     """``a ∘ b``: with ``a = A_T_B`` and ``b = B_T_C`` the result is ``A_T_C``."""
-    t = qrotate(a[3:], b[:3])
-    q = qmul(a[3:], b[3:])
-    return (a[0] + t[0], a[1] + t[1], a[2] + t[2], *q)
+    qx, qy, qz, qw = a[3], a[4], a[5], a[6]
+    vx, vy, vz, bx, by, bz, bw = b[0], b[1], b[2], b[3], b[4], b[5], b[6]
+    # qrotate(a's rotation, b's translation) and qmul(a's rotation, b's), written out (tf lookups run this often)
+    tx = 2.0 * (qy * vz - qz * vy)
+    ty = 2.0 * (qz * vx - qx * vz)
+    tz = 2.0 * (qx * vy - qy * vx)
+    return (
+        a[0] + (vx + qw * tx + (qy * tz - qz * ty)),
+        a[1] + (vy + qw * ty + (qz * tx - qx * tz)),
+        a[2] + (vz + qw * tz + (qx * ty - qy * tx)),
+        qw * bx + qx * bw + qy * bz - qz * by,
+        qw * by - qx * bz + qy * bw + qz * bx,
+        qw * bz + qx * by - qy * bx + qz * bw,
+        qw * bw - qx * bx - qy * by - qz * bz,
+    )
 
 
 def inverse3(a: Tf) -> Tf:
@@ -210,26 +222,26 @@ def inverse3(a: Tf) -> Tf:
 
 def interpolate3(a: Tf, b: Tf, s: float) -> Tf:
     """Linear interpolation of translation and slerp of rotation, ``s`` in [0, 1]."""
-    qa: tuple[float, ...] = a[3:]
-    qb: tuple[float, ...] = b[3:]
-    dot = sum(x * y for x, y in zip(qa, qb, strict=True))
+    ax, ay, az, aw = a[3], a[4], a[5], a[6]
+    bx, by, bz, bw = b[3], b[4], b[5], b[6]
+    dot = 0.0 + ax * bx + ay * by + az * bz + aw * bw  # summed left to right from 0.0, as sum() does
     if dot < 0.0:
-        qb, dot = tuple(-x for x in qb), -dot
+        bx, by, bz, bw, dot = -bx, -by, -bz, -bw, -dot
     if dot > 0.9995:
-        q = [x + s * (y - x) for x, y in zip(qa, qb, strict=True)]
+        qx, qy, qz, qw = ax + s * (bx - ax), ay + s * (by - ay), az + s * (bz - az), aw + s * (bw - aw)
     else:
         th = math.acos(min(1.0, dot))
         sa, sb = math.sin((1 - s) * th) / math.sin(th), math.sin(s * th) / math.sin(th)
-        q = [sa * x + sb * y for x, y in zip(qa, qb, strict=True)]
-    n = math.sqrt(sum(x * x for x in q))
+        qx, qy, qz, qw = sa * ax + sb * bx, sa * ay + sb * by, sa * az + sb * bz, sa * aw + sb * bw
+    n = math.sqrt(0.0 + qx * qx + qy * qy + qz * qz + qw * qw)
     return (
         a[0] + s * (b[0] - a[0]),
         a[1] + s * (b[1] - a[1]),
         a[2] + s * (b[2] - a[2]),
-        q[0] / n,
-        q[1] / n,
-        q[2] / n,
-        q[3] / n,
+        qx / n,
+        qy / n,
+        qz / n,
+        qw / n,
     )
 
 

@@ -39,21 +39,24 @@ def test_inflation_kernel_equals_a_euclidean_distance_transform() -> None:
 
 
 def test_incremental_and_rolling_inflation_equals_a_fresh_layer() -> None:
-    """Obstacles come and go and the window moves: the layer that keeps its last inflation and recomputes only
-    around the changes writes the same master as a layer inflating from scratch each time."""
+    """Obstacles come and go and the window moves over the world: the layer that keeps its last inflation and
+    recomputes only around the changes and the window's edges writes the same master as a layer inflating from
+    scratch each time."""
     rng = np.random.default_rng(0)
     params = {"inflation_radius": 0.55, "cost_scaling_factor": 10.0}
     kept = InflationLayer(params, footprint=make_footprint(robot_radius=0.2))
-    lethal = rng.random((60, 70)) < 0.01
-    origin = (0.0, 0.0)
-    for step in range(12):
-        if step % 3 == 2:  # a rolling window moved by whole cells
-            origin = (origin[0] + RES * int(rng.integers(-3, 4)), origin[1] + RES * int(rng.integers(-3, 4)))
-        flip = rng.random(lethal.shape) < 0.002
-        lethal = lethal ^ flip
+    world = rng.random((300, 300)) < 0.01
+    j, i = 100, 100  # the window's lower-left cell in the world
+    for step in range(40):
+        if step % 3 != 0:  # the window moved by whole cells, now and then by more than the inflation's reach
+            far = 40 if step % 9 == 8 else 4
+            j, i = j + int(rng.integers(-far, far + 1)), i + int(rng.integers(-far, far + 1))
+        flip = rng.random(world.shape) < (0.05 if step % 7 == 6 else 0.0005)  # now and then many changes at once
+        world ^= flip
+        lethal = world[j : j + 60, i : i + 70] & (step % 11 != 10)  # and now and then no obstacle at all
         data = np.where(lethal, COST_LETHAL, rng.integers(0, 3, lethal.shape)).astype(np.uint8)
-        a = Grid(data.copy(), RES, (origin[0], origin[1], 0.0), "odom")
-        b = Grid(data.copy(), RES, (origin[0], origin[1], 0.0), "odom")
+        a = Grid(data.copy(), RES, (i * RES, j * RES, 0.0), "odom")
+        b = Grid(data.copy(), RES, (i * RES, j * RES, 0.0), "odom")
         kept.update_costs(a)
         InflationLayer(params, footprint=make_footprint(robot_radius=0.2)).update_costs(b)
         np.testing.assert_array_equal(a.data, b.data, err_msg=f"step {step}")
@@ -80,6 +83,8 @@ def test_round_footprint_cells_are_the_centres_within_the_radius() -> None:
         )
         expected = np.stack([ii.ravel(), jj.ravel()], axis=1)[inside]
         assert sorted(map(tuple, cells.tolist())) == sorted(map(tuple, expected.tolist()))
+        Footprint(radius, None).fill(grid, (x, y, 0.0), 7)  # the footprint clearing: exactly those cells
+        assert sorted(map(tuple, np.argwhere(grid.data == 7)[:, ::-1].tolist())) == sorted(map(tuple, cells.tolist()))
 
 
 def test_scan_points_are_worked_out_once_per_message() -> None:
@@ -98,11 +103,20 @@ def test_scan_points_are_worked_out_once_per_message() -> None:
 
 def test_kld_bin_count_and_tracking_distance_equal_their_plain_forms() -> None:
     rng = np.random.default_rng(2)
-    keys = rng.integers(0, 40, 500)
-    _, first = np.unique(keys, return_index=True)
-    is_new = np.zeros(keys.size, np.int64)
-    is_new[first] = 1
-    np.testing.assert_array_equal(sampling.bins_so_far(keys), np.cumsum(is_new))
+    poses = np.column_stack([rng.normal(0, 3, 3000), rng.normal(0, 3, 3000), rng.uniform(-4, 4, 3000)])
+    poses[::3, :2] = np.round(poses[::3, :2] * 2) / 2  # on the bins' edges
+    ix, iy = (np.floor(poses[:, k] / sampling.BIN_XY).astype(np.int64) + sampling._OFF for k in (0, 1))
+    it = np.floor(poses[:, 2] / sampling.BIN_YAW).astype(np.int64) % sampling.N_YAW_BINS
+    np.testing.assert_array_equal(sampling.bin_keys(poses), (ix * sampling._SPAN + iy) * sampling.N_YAW_BINS + it)
+    for keys in (rng.integers(0, 40, 500), sampling.bin_keys(poses)):
+        _, first = np.unique(keys, return_index=True)
+        is_new = np.zeros(keys.size, np.int64)
+        is_new[first] = 1
+        np.testing.assert_array_equal(sampling.bins_so_far(keys), np.cumsum(is_new))
+        ukeys, inverse = np.unique(keys, return_inverse=True)
+        hashed = sampling.unique_inverse(keys)
+        np.testing.assert_array_equal(hashed[0], ukeys)
+        np.testing.assert_array_equal(hashed[1], inverse.ravel())
     path = np.cumsum(rng.normal(0, 0.1, (80, 2)), axis=0)
     pts = rng.normal(0, 1, (5, 2))
     a, ab = path[:-1], np.diff(path, axis=0)
@@ -155,3 +169,36 @@ def test_controller_scene_kernel_equals_the_plain_steps() -> None:
         poses = rng.uniform(-7, 7, (40, 3))
         got = poses_out(poses, 25, frame.ox, frame.oy, oyaw, math.cos(oyaw), math.sin(oyaw))
         np.testing.assert_array_equal(got, frame.poses_out(poses[:25]))
+
+
+def test_obstacle_layer_takes_ranges_in_one_call_as_it_takes_their_endpoints() -> None:
+    """A scan's ranges into the obstacle layer (one compiled call) give the grid its endpoints give, bit for bit:
+    returns, inf, NaN, readings under range_min and at range_max, sensors inside and outside the grid."""
+    from navlab.geometry import transform_points2
+    from navlab.navigation.costmap import ObstacleLayer
+
+    rng = np.random.default_rng(4)
+    marked = cleared = 0
+    params = {"obstacle_range": 2.5, "raytrace_range": 3.0, "raytrace_min_range": 0.1, "obstacle_min_range": 0.05}
+    for trial in range(30):
+        ranges = rng.uniform(0.0, 4.5, 360).astype(np.float32)
+        ranges[rng.random(360) < 0.1] = np.inf
+        ranges[rng.random(360) < 0.05] = np.nan
+        msg = SimpleNamespace(ranges=ranges, angle_min=-3.1, angle_increment=0.0172, range_min=0.12, range_max=4.0)
+        sensor = np.array([rng.uniform(-1.0, 5.0), rng.uniform(-1.0, 4.0), rng.uniform(-np.pi, np.pi)])
+        clear_to = 3.0 if trial % 2 else 4.0
+        layers = [ObstacleLayer(params), ObstacleLayer(params)]
+        before = rng.integers(1, 256, (80, 90)).astype(np.uint8)  # what clearing and marking overwrite
+        for layer in layers:
+            layer.match_size(Grid(np.zeros((80, 90), np.uint8), RES, (0.0, -0.5, 0.0), "map"))
+            assert layer.grid is not None
+            layer.grid.data[:] = before
+        points = ScanPoints()
+        pts, valid = points.points(msg, clear_to)
+        layers[0].add_scan(sensor[:2], transform_points2(sensor, pts), valid)
+        layers[1].add_ranges(sensor, ranges, points.beams(msg), (0.12, 4.0, clear_to))
+        assert layers[0].grid is not None and layers[1].grid is not None
+        np.testing.assert_array_equal(layers[1].grid.data, layers[0].grid.data, err_msg=f"trial {trial}")
+        marked += int((layers[0].grid.data == COST_LETHAL).sum())
+        cleared += int((layers[0].grid.data == 0).sum())
+    assert marked > 1000 and cleared > 10000  # the scans did mark and clear

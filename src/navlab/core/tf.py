@@ -223,6 +223,9 @@ class TfBuffer:
             # without raising and catching (a scan stamped after the newest odometry is the common case)
             edges_t, edges_s = self._chain(target.lstrip("/"), source.lstrip("/"))
             tol = self.tolerance_ns
-            if all(e.static or e.times[0] - tol <= t_ns <= e.times[-1] + tol for _, e in (*edges_t, *edges_s)):
-                return self.lookup_pose2d(target, source, t_ns)
+            for edges in (edges_t, edges_s):
+                for _, e in edges:
+                    if not (e.static or e.times[0] - tol <= t_ns <= e.times[-1] + tol):
+                        return self.lookup_pose2d(target, source, None)
+            return self.lookup_pose2d(target, source, t_ns)
         return self.lookup_pose2d(target, source, None)

@@ -186,6 +186,9 @@ class Amcl:
         self.estimate: tuple[float, float, float] = (math.nan, math.nan, math.nan)
         self.covariance = np.full((3, 3), math.nan)
         self.clusters: sampling.Clusters | None = None
+        # the beams laser_max_beams picks, by (beam count, angle_min, angle_increment, laser_max_beams): (indices,
+        # bearings)
+        self._picked: tuple[tuple[int, float, float, int], np.ndarray, np.ndarray] | None = None
 
     # --- initialisation -------------------------------------------------------------------------
 
@@ -244,9 +247,12 @@ class Amcl:
         n = ranges.shape[0]
         if n == 0:
             return None
-        idx = np.unique(np.round(np.linspace(0, n - 1, min(p.laser_max_beams, n))).astype(np.int64))
+        key = (n, scan.angle_min, scan.angle_increment, p.laser_max_beams)
+        if self._picked is None or self._picked[0] != key:  # the same for every scan of one laser: worked out once
+            idx = np.unique(np.round(np.linspace(0, n - 1, min(p.laser_max_beams, n))).astype(np.int64))
+            self._picked = (key, idx, scan.angle_min + idx * scan.angle_increment)
+        _, idx, bearings = self._picked
         r = ranges[idx]
-        bearings = scan.angle_min + idx * scan.angle_increment
         rmin = p.laser_min_range if p.laser_min_range > 0 else scan.range_min
         rmax = min(p.laser_max_range, scan.range_max) if p.laser_max_range > 0 else scan.range_max
         hit = np.isfinite(r) & (r >= rmin) & (r < rmax)

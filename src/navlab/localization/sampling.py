@@ -46,10 +46,19 @@ def kld_limit(k: np.ndarray, kld_err: float, kld_z: float, min_n: int, max_n: in
 
 def bin_keys(poses: np.ndarray) -> np.ndarray:
     """One int64 key per pose for its (x, y, yaw) histogram bin."""
-    ix = np.floor(poses[:, 0] / BIN_XY).astype(np.int64) + _OFF
-    iy = np.floor(poses[:, 1] / BIN_XY).astype(np.int64) + _OFF
-    it = np.floor(poses[:, 2] / BIN_YAW).astype(np.int64) % N_YAW_BINS
-    return (ix * _SPAN + iy) * N_YAW_BINS + it
+    return _bin_keys(np.ascontiguousarray(poses, dtype=np.float64))
+
+
+@njit(cache=True)
+def _bin_keys(poses: np.ndarray) -> np.ndarray:  # pragma: no cover - compiled
+    """:func:`bin_keys`, compiled (floor of x / BIN_XY, y / BIN_XY and yaw / BIN_YAW; yaw bins wrap)."""
+    out = np.empty(poses.shape[0], dtype=np.int64)
+    for k in range(poses.shape[0]):
+        ix = np.int64(math.floor(poses[k, 0] / BIN_XY)) + _OFF
+        iy = np.int64(math.floor(poses[k, 1] / BIN_XY)) + _OFF
+        it = np.int64(math.floor(poses[k, 2] / BIN_YAW)) % N_YAW_BINS
+        out[k] = (ix * _SPAN + iy) * N_YAW_BINS + it
+    return out
 
 
 def kld_count(candidates: np.ndarray, kld_err: float, kld_z: float, min_n: int, max_n: int) -> int:
@@ -62,15 +71,69 @@ def kld_count(candidates: np.ndarray, kld_err: float, kld_z: float, min_n: int, 
     return max(min(n, max_n), min_n)
 
 
+@njit(cache=True, inline="always")
+def _slot(table: np.ndarray, used: np.ndarray, key: np.int64) -> int:  # pragma: no cover - compiled
+    """The slot of ``key`` in an open-addressing hash table (linear probing; ``used`` marks the taken slots, the
+    table's size a power of two): where it is, else the free slot where it goes."""
+    size = table.shape[0]
+    slot = (key * 0x9E3779B97F4A7C15) >> 40 & (size - 1)
+    while used[slot] and table[slot] != key:
+        slot = (slot + 1) & (size - 1)
+    return slot
+
+
+@njit(cache=True, inline="always")
+def _add(table: np.ndarray, used: np.ndarray, key: np.int64) -> bool:  # pragma: no cover - compiled
+    """Put ``key`` in the hash table (see :func:`_slot`); whether it was not there yet."""
+    slot = _slot(table, used, key)
+    if used[slot]:
+        return False
+    used[slot] = True
+    table[slot] = key
+    return True
+
+
+@njit(cache=True)
+def _hash_table(n: int) -> tuple[np.ndarray, np.ndarray]:  # pragma: no cover - compiled
+    """An empty hash table (keys, used) for ``n`` keys: a power of two at least twice ``n`` (and 16) slots."""
+    size = 16
+    while size < 2 * n:
+        size *= 2
+    return np.empty(size, dtype=np.int64), np.zeros(size, dtype=np.bool_)
+
+
 @njit(cache=True)
 def bins_so_far(keys: np.ndarray) -> np.ndarray:  # pragma: no cover - compiled
     """``out[m]``: how many distinct keys ``keys[: m + 1]`` holds (the bins the first m + 1 samples occupy)."""
-    seen = set()
+    table, used = _hash_table(keys.shape[0])
     out = np.empty(keys.shape[0], dtype=np.int64)
+    n = 0
     for m in range(keys.shape[0]):
-        seen.add(keys[m])
-        out[m] = len(seen)
+        if _add(table, used, keys[m]):
+            n += 1
+        out[m] = n
     return out
+
+
+@njit(cache=True)
+def unique_inverse(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:  # pragma: no cover - compiled
+    """``np.unique(keys, return_inverse=True)`` by hashing: the sorted distinct keys, and each key's index among
+    them (only the distinct keys are sorted)."""
+    table, used = _hash_table(keys.shape[0])
+    distinct = np.empty(keys.shape[0], dtype=np.int64)
+    n = 0
+    for m in range(keys.shape[0]):
+        if _add(table, used, keys[m]):
+            distinct[n] = keys[m]
+            n += 1
+    ukeys = np.sort(distinct[:n])
+    index = np.empty(table.shape[0], dtype=np.int64)  # slot -> the key's place in ukeys
+    for u in range(n):
+        index[_slot(table, used, ukeys[u])] = u
+    inverse = np.empty(keys.shape[0], dtype=np.int64)
+    for m in range(keys.shape[0]):
+        inverse[m] = index[_slot(table, used, keys[m])]
+    return ukeys, inverse
 
 
 @dataclass(frozen=True)
@@ -154,7 +217,7 @@ def _cluster_sums(labels: np.ndarray, n_comp: int, poses: np.ndarray, w: np.ndar
 
 def cluster(poses: np.ndarray, weights: np.ndarray) -> Clusters:
     """Group particles into clusters of touching histogram bins and compute their statistics."""
-    ukeys, inv = np.unique(bin_keys(poses), return_inverse=True)
+    ukeys, inv = unique_inverse(bin_keys(poses))
     bin_label = _label_bins(ukeys)
     n_comp = int(bin_label.max()) + 1
     labels = bin_label[inv]

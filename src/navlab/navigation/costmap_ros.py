@@ -19,6 +19,7 @@ from navlab.core import Node, TfError
 from navlab.geometry import compose2, transform_points2
 from navlab.grid import COST_INSCRIBED, COST_LETHAL, COST_UNKNOWN, Grid, GridMap
 from navlab.navigation.costmap.layered import LayeredCostmap
+from navlab.navigation.costmap.obstacle_layer import ObstacleLayer
 from navlab.navigation.costmap_sensors import CostmapSensorFeeds
 from navlab.navigation.scan_points import ScanPoints
 
@@ -119,16 +120,24 @@ class Costmap2DROS:
             except TfError as exc:
                 self.node.get_logger().warning(f"{self.name}: no transform {self.base_frame} -> {frame}: {exc}")
                 return
-        stamp = msgs.stamp_ns(msg)
-        base = self.robot_pose(stamp) or self.robot_pose()
-        if base is None:
+        try:  # the robot at the scan's stamp, else the latest (a scan stamped after the newest odometry)
+            base = tf.lookup_pose2d_or_latest(self.global_frame, self.base_frame, msgs.stamp_ns(msg))
+        except TfError:
             return
         sensor = compose2(base, self._sensor_in_base[frame])
         src = self.layered.params.sources[source]
         # rays without a return clear out to raytrace_range (inf_is_valid), others end at their return
         clear_to = src.raytrace_range if src.inf_is_valid else float(msg.range_max)
-        pts, valid = self.scan_points.points(msg, clear_to)
-        self.layered.add_scan(sensor[:2], transform_points2(sensor, pts), valid, source=source)
+        world: tuple[np.ndarray, np.ndarray] | None = None
+        for layer in self.layered.scan_targets(source):
+            if isinstance(layer, ObstacleLayer):  # the whole observation in one compiled call
+                limits = (float(msg.range_min), float(msg.range_max), clear_to)
+                layer.add_ranges(sensor, np.asarray(msg.ranges), self.scan_points.beams(msg), limits, source=source)
+                continue
+            if world is None:  # any other ScanLayer plugin takes the endpoints
+                pts, valid = self.scan_points.points(msg, clear_to)
+                world = (transform_points2(sensor, pts), valid)
+            layer.add_scan(sensor[:2], *world, source=source)
 
     def _on_scan(self, source: str, msg: Any) -> None:
         """Keep the newest scan of each observation source for the next update."""

@@ -264,10 +264,12 @@ class DiffDrivePlugin(SimPlugin):
             return
         # the message only when anyone reads it (the mapping launch's nodes take odometry from tf)
         if listened(self, self.odom_pub):
+            lin: Vec
+            ang: Vec
             if world:
                 lin, ang = self.sim.link_velocity(self.base_link)
             else:
-                lin, ang = np.array([v, 0.0, 0.0]), np.array([0.0, 0.0, w])
+                lin, ang = (v, 0.0, 0.0), (0.0, 0.0, w)
             frames = (cfg.odometry_frame, cfg.robot_base_frame)
             self.odom_pub.publish(
                 msgs.odometry(now, *frames, position, quat, lin, ang, _ODOM_COV.copy(), _ODOM_COV.copy())

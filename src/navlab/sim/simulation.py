@@ -92,6 +92,7 @@ class Simulation:
         m = self.model
         name2id = mujoco.mj_name2id
         self._act = [name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, n) for n in (self.info.wheel_actuators or ())]
+        self._act_sides: tuple[np.ndarray, np.ndarray] | None = None  # (left, right) actuator ids, as arrays
         self._lidar_site = [name2id(m, mujoco.mjtObj.mjOBJ_SITE, n) for n in self.info.lidar_sites]
         self._imu_site = [name2id(m, mujoco.mjtObj.mjOBJ_SITE, n) for n in self.info.imu_sites]
         in_rays = RAY_GEOMGROUP[np.clip(m.geom_group, 0, 5)].astype(bool) & (m.geom_group < 6)
@@ -175,9 +176,11 @@ class Simulation:
         """Target angular velocities (rad/s) of the diff-drive wheel joints; torque capped by the motors."""
         if not self._act:
             raise SimError("this robot has no diff_drive wheels to command")
-        n = self.info.left_wheel_count
-        self.data.ctrl[self._act[:n]] = left
-        self.data.ctrl[self._act[n:]] = right
+        if self._act_sides is None:
+            n = self.info.left_wheel_count
+            self._act_sides = (np.array(self._act[:n], dtype=np.intp), np.array(self._act[n:], dtype=np.intp))
+        self.data.ctrl[self._act_sides[0]] = left
+        self.data.ctrl[self._act_sides[1]] = right
 
     # --- state ------------------------------------------------------------------------------------
 

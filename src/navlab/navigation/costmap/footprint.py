@@ -17,7 +17,7 @@ import numpy as np
 
 from navlab.core import check_ceiling
 from navlab.grid import Grid
-from navlab.navigation.costmap.kernels import circle_cells
+from navlab.navigation.costmap.kernels import circle_cells, fill_circle
 from navlab.navigation.errors import NavigationError
 
 
@@ -53,6 +53,15 @@ class Footprint:
         c, s = math.cos(yaw), math.sin(yaw)
         p = self.polygon
         return np.stack([x + c * p[:, 0] - s * p[:, 1], y + s * p[:, 0] + c * p[:, 1]], axis=1)
+
+    def fill(self, grid: Grid, pose: tuple[float, float, float], value: int) -> None:
+        """Set the :meth:`cells` under the footprint at ``pose`` to ``value`` (a round robot's in one compiled call)."""
+        if self.polygon is not None or grid.origin[2] != 0.0:
+            ij = self.cells(grid, pose)
+            grid.data[ij[:, 1], ij[:, 0]] = value
+            return
+        x, y, _ = pose
+        fill_circle(grid.data, float(x), float(y), float(self.radius or 0.0), *grid.origin[:2], grid.resolution, value)
 
     def cells(self, grid: Grid, pose: tuple[float, float, float]) -> np.ndarray:
         """Cells (i column, j row) (M, 2) of ``grid`` whose centres lie under the footprint at ``pose``.

@@ -12,8 +12,8 @@ import numpy as np
 from navlab.core import read_params
 from navlab.grid import COST_FREE, COST_INSCRIBED, COST_LETHAL, COST_UNKNOWN, Grid
 from navlab.navigation.costmap.footprint import Footprint, make_footprint
-from navlab.navigation.costmap.kernels import inflate_box, lethal_changes
-from navlab.navigation.costmap.layer import Layer, costmap_of
+from navlab.navigation.costmap.kernels import lethal_diff, reinflate
+from navlab.navigation.costmap.layer import Layer, costmap_of, shifted
 from navlab.navigation.costmap.params import InflationLayerParams, layer_params
 from navlab.plugins import PluginContext
 
@@ -40,8 +40,9 @@ class InflationLayer(Layer):
         self.name = name
         self.enabled = self.params.enabled
         self.footprint = footprint or make_footprint()
-        # the last inflation: ((origin, resolution, shape), lethal seeds, costs over the whole grid)
-        self._inflated: tuple[Any, np.ndarray, np.ndarray] | None = None
+        # the last inflation: ((origin, resolution, shape), lethal seeds, costs over the whole grid, a buffer of
+        # changed cells for lethal_diff)
+        self._inflated: tuple[Any, np.ndarray, np.ndarray, np.ndarray] | None = None
         self._costs: tuple[Any, np.ndarray] | None = None  # cost by squared cell distance (see _table)
 
     @classmethod
@@ -81,47 +82,60 @@ class InflationLayer(Layer):
         return self._costs[1]
 
     def update_costs(self, master: Grid) -> None:
+        """Inflate the master's lethal cells into it. After the first update only what changed is recomputed (see
+        ``reinflate``): around seeds that appeared or vanished and, in a rolling window, along the edges its move
+        uncovered or left; the rest of the last inflation is kept (shifted with the window)."""
         data = master.data
         reach = math.ceil(self.params.inflation_radius / master.resolution) + 1
         reach = min(reach, math.ceil(math.hypot(*data.shape)) + 1)  # no cell is further: the table stays grid-sized
-        key = (master.origin, master.resolution, data.shape)
         cached = self._inflated
-        fresh = cached is None or cached[0] != key
-        seeds = np.empty(data.shape, dtype=np.bool_)
-        previous = np.zeros((0, 0), np.bool_) if fresh or cached is None else cached[1]  # none: every seed is new
-        count, *changed = lethal_changes(data, np.uint8(COST_LETHAL), seeds, previous)
+        shift = None if cached is None else _shift(cached[0], master)
+        di, dj = shift or (0, 0)
+        seeds = np.empty(data.shape, dtype=np.uint8)
+        if cached is None or shift is None:  # afresh: every cell is recomputed, none counts as changed
+            then, changes = np.zeros((0, 0), np.uint8), np.empty((2 * data.size, 2), np.int64)
+        else:
+            then, changes = cached[1], cached[3]
+        count, appeared, vanished = lethal_diff(data, np.uint8(COST_LETHAL), seeds, then, di, dj, changes)
         if count == 0:
             return
-        cost = self._inflation(master, seeds, reach, key, changed)
+        table = self._table(master.resolution, reach)
+        if cached is None or shift is None:
+            cost = np.zeros(data.shape, np.uint8)
+            whole = np.array([[0, data.shape[0], 0, data.shape[1]]], np.int64)
+            reinflate(seeds, cost, table, reach, changes, 0, 0, whole)
+        else:
+            cost = cached[2] if shift == (0, 0) else shifted(cached[2], di, dj, 0)
+            boxes = _new_edges(data.shape, di, dj)
+            if appeared or vanished or len(boxes):
+                reinflate(seeds, cost, table, reach, changes, appeared, vanished, boxes)
+        self._inflated = ((master.origin, master.resolution, data.shape), seeds, cost, changes)
         _merge(data, cost, bool(self.params.inflate_unknown))
 
-    def _inflation(self, master: Grid, seeds: np.ndarray, reach: int, key: Any, changed: list[int]) -> np.ndarray:
-        """Inflation costs (uint8, the master's shape; 0 beyond ``inflation_radius``) of the lethal ``seeds``.
 
-        A cell's cost depends only on the seeds within ``reach`` cells of it, so after the first update only
-        the cells within ``reach`` of a seed that appeared or vanished (``changed``: their bounding rows and
-        columns) are recomputed, from the seeds within ``reach`` of those (exactly what a transform of the whole
-        grid gives them)."""
-        cached = self._inflated
-        if cached is None or cached[0] != key:
-            cost = np.zeros(seeds.shape, dtype=np.uint8)
-        else:
-            cost = cached[2]
-            if changed[1] == 0:
-                return cost  # the same obstacles as last update: the same inflation (skips the transform)
-        h, w = seeds.shape
-        j0, j1 = max(0, changed[0] - reach), min(h, changed[1] + reach)
-        i0, i1 = max(0, changed[2] - reach), min(w, changed[3] + reach)
-        o0, o1 = max(0, j0 - reach), min(h, j1 + reach)
-        p0, p1 = max(0, i0 - reach), min(w, i1 + reach)
-        if seeds[o0:o1, p0:p1].any():  # the squared distance (cells) to each cell's nearest seed, its cost
-            inflate_box(
-                seeds, (o0, o1, p0, p1), (j0, j1, i0, i1), self._table(master.resolution, reach), cost[j0:j1, i0:i1]
-            )
-        else:  # no obstacle within reach of the box: nothing to inflate there
-            cost[j0:j1, i0:i1] = 0
-        self._inflated = (key, seeds, cost)
-        return cost
+def _shift(then: tuple[Any, float, tuple[int, ...]], master: Grid) -> tuple[int, int] | None:
+    """Whole cells (di, dj) the master's origin moved since the inflation ``then`` (origin, resolution, shape) was
+    made (a rolling window; (0, 0) for a fixed one); None when its size or resolution differs or it moved by a
+    whole window (the inflation starts afresh)."""
+    origin, resolution, shape = then
+    if shape != master.data.shape or resolution != master.resolution:
+        return None
+    if origin == master.origin:
+        return 0, 0
+    di = round((master.origin[0] - origin[0]) / resolution)
+    dj = round((master.origin[1] - origin[1]) / resolution)
+    return (di, dj) if abs(di) < shape[1] and abs(dj) < shape[0] else None
+
+
+def _new_edges(shape: tuple[int, ...], di: int, dj: int) -> np.ndarray:
+    """The boxes (K, 4) = (j0, j1, i0, i1) of what a rolling window newly covers after moving by (di, dj) cells."""
+    h, w = shape
+    out = []
+    if di:
+        out.append((0, h, *((w - di, w) if di > 0 else (0, -di))))
+    if dj:
+        out.append((*((h - dj, h) if dj > 0 else (0, -dj)), 0, w))
+    return np.array(out, np.int64).reshape(-1, 4)
 
 
 @numba.njit(cache=True)

@@ -43,8 +43,8 @@ def origin_shift(old: Grid | None, master: Grid) -> tuple[int, int] | None:
     size or resolution differs (the layer starts afresh: ``match_size``)."""
     if old is None or old.data.shape != master.data.shape or old.resolution != master.resolution:
         return None
-    shift = np.rint((np.array(master.origin[:2]) - np.array(old.origin[:2])) / master.resolution).astype(int)
-    return int(shift[0]), int(shift[1])
+    res = master.resolution
+    return round((master.origin[0] - old.origin[0]) / res), round((master.origin[1] - old.origin[1]) / res)
 
 
 def shifted(data: np.ndarray, di: int, dj: int, fill: Any) -> np.ndarray:

@@ -149,13 +149,18 @@ class LayeredCostmap:
     ) -> None:
         """Give one scan (sensor origin and endpoints (N, 2), m, costmap frame) to the obstacle layers
         (or to the one named ``layer``); see ``ObstacleLayer.add_scan``."""
-        targets = [self.layer(layer)] if layer else self.scan_layers
-        for target in targets:
+        for target in self.scan_targets(source, layer):
+            target.add_scan(origin_xy, endpoints_xy, valid, source=source)
+
+    def scan_targets(self, source: str | None = None, layer: str | None = None) -> list[ScanLayer]:
+        """The layers a scan of ``source`` goes to (see :meth:`add_scan`): the one named ``layer``, else every
+        obstacle layer observing ``source`` (every one without a source)."""
+        if layer:
+            target = self.layer(layer)
             if not isinstance(target, ScanLayer):
                 raise NavigationError(f"costmap layer {layer!r} is not an obstacle layer")
-            if source is not None and source not in target.sources and layer is None:
-                continue
-            target.add_scan(origin_xy, endpoints_xy, valid, source=source)
+            return [target]
+        return [t for t in self.scan_layers if source is None or source in t.sources]
 
     # --- the update -------------------------------------------------------------------------------
 
