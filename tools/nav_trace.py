@@ -1,6 +1,6 @@
 """Record or compare a bit-level trace of ``navlab bench nav``'s run, to show a speed-up changes no result.
 
-    python tools/nav_trace.py record OUT.json [--seed N] [--controller trajectory|dwa|mppi]
+    python tools/nav_trace.py record OUT.json [--seed N] [--controller trajectory|dwa|mppi] [--robot mybot_depth]
     python tools/nav_trace.py compare OLD.json NEW.json
 
 The trace holds every cmd_vel (hex floats), the tf map -> odom and odom -> base sent, every amcl_pose, a hash of
@@ -24,7 +24,7 @@ def _digest(data: bytes) -> str:
     return hashlib.sha1(data).hexdigest()[:16]
 
 
-def record(out: str, seed: int, controller: str | None) -> None:
+def record(out: str, seed: int, controller: str | None, robot: str = "mybot") -> None:
     """Run bench nav's goals with hooks on the executor, the costmaps and move_base; write the trace to ``out``."""
     from navlab.bench.experiments import NAV_GOALS
     from navlab.core.executor import Executor
@@ -77,7 +77,13 @@ def record(out: str, seed: int, controller: str | None) -> None:
 
     Executor.publish, Costmap2DROS.update, MoveBase.make_plan = on_publish, on_update, on_make_plan  # type: ignore[method-assign]
     r = run_navigation(
-        list(NAV_GOALS), world="room_obstacles", goal_timeout=90, seed=seed, controller=controller, on_start=on_start
+        list(NAV_GOALS),
+        world="room_obstacles",
+        robot=robot,
+        goal_timeout=90,
+        seed=seed,
+        controller=controller,
+        on_start=on_start,
     )
     rec["path"] = [[float(v).hex() for v in row] for row in r.path]
     rec["summary"] = {k: r.summary[k] for k in ("sim_s", "goals_succeeded", "collisions")}
@@ -113,12 +119,13 @@ def main() -> None:
     r.add_argument("out")
     r.add_argument("--seed", type=int, default=0)
     r.add_argument("--controller", default=None)
+    r.add_argument("--robot", default="mybot")
     c = sub.add_parser("compare")
     c.add_argument("old")
     c.add_argument("new")
     args = ap.parse_args()
     if args.verb == "record":
-        record(args.out, args.seed, args.controller)
+        record(args.out, args.seed, args.controller, args.robot)
     else:
         sys.exit(0 if compare(args.old, args.new) else 1)
 

@@ -42,6 +42,11 @@ def test_camera_defaults_are_noetics(tmp_path) -> None:
     assert (cam.camera.cx, cam.camera.cy) == (32.5, 24.5)  # gazebo_ros_camera_utils: (width + 1) / 2
     assert cam.frame_id == "sensor_link"
     assert any("<frameName>" in w for w in robot.warnings)
+    assert cam.camera.anti_aliasing == 4  # SDF 1.9's <image><anti_aliasing> default
+    aa = CAMERA.replace("</format>", "</format><anti_aliasing>0</anti_aliasing>")
+    plugin = '<plugin name="c" filename="libgazebo_ros_camera.so"/>'
+    (sharp,) = _load(tmp_path, aa.format(plugin=plugin)).sensors.cameras
+    assert sharp.camera.anti_aliasing == 0
 
 
 def test_camera_topics_under_namespace_and_camera_name(tmp_path) -> None:
@@ -148,6 +153,12 @@ def test_bumper_defaults(tmp_path) -> None:
                 plugin='<plugin name="c" filename="libgazebo_ros_camera.so"/>'
             ),
             "<horizontal_fov>: expected 0 < fov < pi",
+        ),
+        (
+            CAMERA.replace("</format>", "</format><anti_aliasing>2.5</anti_aliasing>").format(
+                plugin='<plugin name="c" filename="libgazebo_ros_camera.so"/>'
+            ),
+            "<anti_aliasing>: expected a whole number of samples per pixel from 0 (off) to 16, got 2.5",
         ),
         (
             CAMERA.format(plugin='<plugin name="c" filename="libgazebo_ros_velodyne_laser.so"/>'),

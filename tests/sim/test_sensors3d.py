@@ -48,6 +48,32 @@ def test_depth_pixel_is_the_range_to_a_known_box_within_noise() -> None:
     assert depth[row, 16] == pytest.approx(pos[2] * f / (row - 11.5), abs=0.05)
 
 
+def test_a_held_depth_cloud_never_changes_and_dropped_ones_are_reused() -> None:
+    from navlab.sim.sensor_plugins import DepthCameraPlugin
+
+    box = primitive_model("box", "box", (0.4, 2.0, 1.0), x=2.0)
+    sim = _sim(box)
+    cfg = CameraConfig(
+        link="chassis", kind="depth", origin=CAM_ORIGIN, camera=CameraModel(width=32, height=24, far=10.0)
+    )
+    camera = DepthCameraPlugin(Executor(), sim=sim, config=cfg)
+    depth = depth_image(sim, cfg)
+
+    def address(msg: Any) -> int:
+        return int(msg.data.__array_interface__["data"][0])
+
+    held = camera.cloud(depth, 0)
+    seen = read_xyz(held, copy=False)  # a view into the message, as a costmap keeps it
+    first, kept = address(held), read_xyz(held)
+    del held
+    others = [camera.cloud(depth * (k + 2), k + 1) for k in range(3)]
+    assert first not in {address(m) for m in others}  # the view still holds the first frame's points
+    np.testing.assert_array_equal(seen, kept)
+    spent = {address(m) for m in others}
+    del seen, others
+    assert address(camera.cloud(depth, 9)) in spent | {first}  # nobody holds them: a buffer is reused
+
+
 def test_3d_lidar_rings_at_the_configured_angles() -> None:
     from navlab.core import Executor
     from navlab.sim.sensor_plugins import VelodynePlugin
@@ -138,6 +164,34 @@ def test_a_coloured_box_appears_where_the_camera_model_puts_it() -> None:
     vs, us = np.nonzero(redness)
     assert abs(us.mean() - u) < 3 and abs(vs.mean() - v) < 3
     assert not redness[:, 40:].any()  # nothing red on the right half (the box is to the left)
+
+
+def test_anti_aliasing_only_blends_the_edges_of_the_box() -> None:
+    pytest.importorskip("mujoco.egl")
+    from navlab.sim.camera_render import CameraRenderer
+
+    red = primitive_model("box", "red", (0.3, 0.3, 0.3), x=2.0, y=0.5, z=0.3, rgba=(1.0, 0.0, 0.0, 1.0))
+    sim = _sim(red, visuals=True)
+    images = {}
+    for samples in (0, 4):
+        model = CameraModel(width=64, height=48, horizontal_fov=1.2, far=20.0, anti_aliasing=samples)
+        try:
+            renderer = CameraRenderer(sim, CameraConfig(link="chassis", origin=CAM_ORIGIN, camera=model))
+        except Exception as exc:  # no EGL/OSMesa on this machine
+            pytest.skip(f"no offscreen renderer: {exc}")
+        try:
+            images[samples] = renderer.render().astype(int)
+        finally:
+            renderer.close()
+    sharp, smooth = images[0], images[4]
+    padded = np.pad(sharp, ((1, 1), (1, 1), (0, 0)), mode="edge")
+    window = np.lib.stride_tricks.sliding_window_view(padded, (3, 3), axis=(0, 1))  # each pixel's 3 x 3
+    edge = (window.max(axis=(-2, -1)) - window.min(axis=(-2, -1))).max(axis=-1) > 8  # outlines, face borders
+    changed = np.abs(smooth - sharp).max(axis=-1) > 8
+    red_px = (sharp[..., 0] > 2 * sharp[..., 1] + 30) & (sharp[..., 0] > 100)
+    assert (changed & edge & red_px).sum() >= 5  # 4x multisampling (SDF's default) blends the box's edges
+    assert not (changed & ~edge).any()  # and nothing else
+    assert sim.model.vis.quality.offsamples == 4  # the model's own setting is kept
 
 
 def test_bumper_reports_the_contact_with_the_box() -> None:

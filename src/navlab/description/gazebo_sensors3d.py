@@ -32,6 +32,8 @@ RANGE_PLUGINS = ("libgazebo_ros_range.so",)
 BUMPER_PLUGINS = ("libgazebo_ros_bumper.so",)
 SENSOR_PLUGINS = (*CAMERA_PLUGINS, *DEPTH_PLUGINS, *VELODYNE_PLUGINS, *RANGE_PLUGINS, *BUMPER_PLUGINS)
 IMAGE_FORMATS = ("R8G8B8", "B8G8R8", "L8")
+#: the most samples per pixel ``<image><anti_aliasing>`` may ask for (OpenGL's usual multisampling ceiling)
+MAX_ANTI_ALIASING = 16
 #: the most image pixels / rays of one sensor navlab accepts
 MAX_PIXELS = 4096 * 4096
 
@@ -83,7 +85,8 @@ def _pose(sensor: ET.Element, where: str) -> Origin:
 
 
 def parse_camera_model(cam: ET.Element | None, where: str) -> CameraModel:
-    """The SDF ``<camera>`` element (``<horizontal_fov>``, ``<image>``, ``<clip>``, ``<noise>``)."""
+    """The SDF ``<camera>`` element (``<horizontal_fov>``, ``<image>`` with SDF 1.9's ``<anti_aliasing>``,
+    ``<clip>``, ``<noise>``)."""
     if cam is None:
         raise DescriptionError(f"{where}: a camera sensor needs a <camera> element")
     w = where + "/<camera>"
@@ -102,6 +105,12 @@ def parse_camera_model(cam: ET.Element | None, where: str) -> CameraModel:
     fmt = (cam.findtext("image/format") or "R8G8B8").strip()
     if fmt not in IMAGE_FORMATS:
         raise DescriptionError(f"{w}/<image>/<format>: {fmt!r} not supported; expected one of {IMAGE_FORMATS}")
+    aa = number(cam.find("image/anti_aliasing"), w + "/<image>/<anti_aliasing>", 4)
+    if aa != int(aa) or not 0 <= aa <= MAX_ANTI_ALIASING:
+        raise DescriptionError(
+            f"{w}/<image>/<anti_aliasing>: expected a whole number of samples per pixel from 0 (off) to "
+            f"{MAX_ANTI_ALIASING}, got {aa}"
+        )
     near = number(cam.find("clip/near"), w + "/<clip>/<near>", 0.1)
     far = number(cam.find("clip/far"), w + "/<clip>/<far>", 100.0)
     if not 0 < near < far:
@@ -118,6 +127,7 @@ def parse_camera_model(cam: ET.Element | None, where: str) -> CameraModel:
         format=fmt,
         noise_mean=mean,
         noise_stddev=std,
+        anti_aliasing=int(aa),
     )
 
 

@@ -16,8 +16,9 @@ from navlab.description.model import Origin
 
 @dataclass(frozen=True)
 class CameraModel:
-    """The ``<camera>`` element: image size (px), horizontal field of view (rad), clip planes (m), pixel format
-    and gaussian noise on each pixel value (std dev on the 0..1 scale, as Gazebo's image noise)."""
+    """The ``<camera>`` element: image size (px), horizontal field of view (rad), clip planes (m), pixel format,
+    gaussian noise on each pixel value (std dev on the 0..1 scale, as Gazebo's image noise) and the colour
+    image's multisample anti-aliasing (``<image><anti_aliasing>``, SDF 1.9: samples per pixel; 0 or 1: off)."""
 
     width: int = 320
     height: int = 240
@@ -27,6 +28,7 @@ class CameraModel:
     format: str = "R8G8B8"
     noise_mean: float = 0.0
     noise_stddev: float = 0.0
+    anti_aliasing: int = 4  # SDF's default
 
     @property
     def focal_length(self) -> float:

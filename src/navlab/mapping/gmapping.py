@@ -77,10 +77,13 @@ class GMappingParams:
     refine: bool = True
     # navlab: a match that scores under ``wideScore`` per scored beam is retried from starts turned by
     # ``wideStep`` up to ``wideTurn`` rad either way (the hill climb's reach is a few astep; real odometry
-    # can be 20-30 degrees off in a fast turn), and the best-scoring result is kept; 0 turns this off
+    # can be 20-30 degrees off in a fast turn), and the best-scoring result is kept; 0 turns this off.
+    # The turned starts are climbed on every (wideSkip + 1)-th scored beam (a cheap look at where each
+    # leads), then the best of them once on every beam; wideSkip 0 climbs every turned start in full
     wideScore: float = 0.7
     wideStep: float = 0.0873
     wideTurn: float = 0.524
+    wideSkip: int = 3
 
     PARAMS: ClassVar[ParamSpec] = ParamSpec("gmapping", MappingError, at_least={"particles": 1})
 
@@ -114,6 +117,12 @@ def _between(a: np.ndarray, b: np.ndarray) -> tuple[float, float, float]:
     c, s = math.cos(i2), math.sin(i2)
     b0, b1, b2 = float(b[0]), float(b[1]), float(b[2])
     return i0 + c * b0 - s * b1, i1 + s * b0 + c * b1, (i2 + b2 + math.pi) % (2.0 * math.pi) - math.pi
+
+
+def _scored_beams(scan: Scan, skip: int) -> int:
+    """How many beams the matcher scores with ``skip``: every ``skip + 1``-th with a range in (0, max_urange)."""
+    scored = scan[0][:: skip + 1]
+    return int(np.count_nonzero((scored > 0) & (scored < scan[3])))
 
 
 class GMapping:
@@ -408,29 +417,35 @@ class GMapping:
     def _match(self, table: np.ndarray, pose: np.ndarray, scan: Scan) -> tuple[float, float, float, float, float]:
         """GMapping's hill climb of the scan from ``pose`` against the map of ``table``: (x, y, theta, score,
         log-likelihood). A climb that ends under ``wideScore`` per scored beam (stuck: the start was turned
-        too far for its steps to reach the scan's place) is repeated from starts turned by ``wideStep``,
-        ``2 wideStep``, ... up to ``wideTurn`` either way; a turned result is kept only if it scores higher,
-        so the scan turns away from its odometry only where the map matches it better there."""
+        too far for its steps to reach the scan's place) is retried from starts turned by ``wideStep``,
+        ``2 wideStep``, ... up to ``wideTurn`` either way, nearest first, each climbed on every
+        ``wideSkip + 1``-th scored beam, until one scores ``wideScore`` per beam it scores; the best of them
+        is then climbed on every beam and kept only if it beats the first climb, so the scan turns away
+        from its odometry only where the map matches it better there."""
         p = self.p
         fixed = (self.pool.tiles, table, self._lattice())
         model, steps = self._model(), (p.lstep, p.astep, p.iterations)
         best = optimize(*fixed, (pose[0], pose[1], pose[2]), scan, model, steps)
         if p.wideScore <= 0 or p.wideStep <= 0:
             return best
-        r, max_urange = scan[0], scan[3]
-        scored = r[:: p.lskip + 1]
-        enough = p.wideScore * np.count_nonzero((scored > 0) & (scored < max_urange))
-        if best[3] >= enough:
+        if best[3] >= p.wideScore * _scored_beams(scan, p.lskip):
             return best
-        # the nearest turns first; stop at a result that scores well enough
+        skip = (p.lskip + 1) * (max(p.wideSkip, 0) + 1) - 1
+        look = (model[0], model[1], model[2], skip)
+        enough = p.wideScore * _scored_beams(scan, skip)
+        top = None
         for n in range(1, int(p.wideTurn / p.wideStep + 1e-9) + 1):
             for turn in (n * p.wideStep, -n * p.wideStep):
-                got = optimize(*fixed, (pose[0], pose[1], pose[2] + turn), scan, model, steps)
-                if got[3] > best[3]:
-                    best = got
-            if best[3] >= enough:
+                got = optimize(*fixed, (pose[0], pose[1], pose[2] + turn), scan, look, steps)
+                if top is None or got[3] > top[3]:
+                    top = got
+            if top is not None and top[3] >= enough:
                 break
-        return best
+        if top is None:
+            return best
+        if skip != p.lskip:  # the look was cheap: climb the best of it on every beam
+            top = optimize(*fixed, (top[0], top[1], top[2]), scan, model, steps)
+        return top if top[3] > best[3] else best
 
     def map(self, *, frame_id: str = "map") -> GridMap:
         """The best particle's occupancy grid: the cells any scan reached plus ``MAP_MARGIN_CELLS``."""

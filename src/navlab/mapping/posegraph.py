@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.sparse.linalg import spsolve
+from scipy.sparse.linalg import splu
 
 from navlab.geometry import wrap_angle
 
@@ -127,14 +127,9 @@ class PoseGraph:
             return 0
         i, j, _, info = self._edge_arrays()
         robust = np.asarray(self.edges_robust)
-        # the sparsity pattern of H's 3 x 3 blocks (i, i), (i, j), (j, i), (j, j) of every edge
+        system = _System(i, j, n)
         r3 = np.arange(3)
-        rows = np.concatenate(
-            [(3 * bi[:, None, None] + r3[None, :, None]).repeat(3, axis=2).ravel() for bi in (i, i, j, j)]
-        )
-        cols = np.concatenate(
-            [(3 * bj[:, None, None] + r3[None, None, :]).repeat(3, axis=1).ravel() for bj in (i, j, i, j)]
-        )
+        slots = np.concatenate([(3 * i[:, None] + r3[None, :]).ravel(), (3 * j[:, None] + r3[None, :]).ravel()])
         for it in range(iterations):
             e, a, b, i, j = self.residuals()
             d2 = np.einsum("mi,mij,mj->m", e, info, e)
@@ -149,16 +144,59 @@ class PoseGraph:
             ga = (at_om @ e[:, :, None])[:, :, 0]
             gb = (bt_om @ e[:, :, None])[:, :, 0]
             vals = np.concatenate([blk.ravel() for blk in (haa, hab, hab.transpose(0, 2, 1), hbb)])
-            h = sp.coo_matrix((vals, (rows, cols)), shape=(3 * n, 3 * n)).tocsr()
-            g = np.zeros(3 * n)
-            np.add.at(g, (3 * i[:, None] + r3[None, :]).ravel(), ga.ravel())
-            np.add.at(g, (3 * j[:, None] + r3[None, :]).ravel(), gb.ravel())
-            # fix node 0
-            hh = h[3:, 3:] + sp.identity(3 * n - 3, format="csr") * 1e-9
-            dx = spsolve(hh.tocsc(), -g[3:])
-            step = dx.reshape(-1, 3)
+            # (bincount sums in input order, as np.add.at does, at a fraction of its cost)
+            g = np.bincount(slots, weights=np.concatenate([ga.ravel(), gb.ravel()]), minlength=3 * n)
+            step = system.solve(vals, -g[3:]).reshape(-1, 3)  # node 0 fixed
             self.poses[1:] += step
             self.poses[:, 2] = wrap_angle(self.poses[:, 2])
             if np.abs(step).max() < tol:
                 return it + 1
         return iterations
+
+
+class _System:
+    """The Gauss-Newton system H dx = g of a graph whose edges stay the same (one ``optimize`` call), node 0
+    held fixed: H's sparsity pattern and a fill-reducing order of its unknowns are worked out once, so each
+    iteration only sums the edges' 3 x 3 blocks into place and factors (SuperLU, symmetric mode, the rows
+    and columns pre-permuted by a minimum-degree order of H + H^T: about a quarter of the work of
+    ``spsolve``'s default column order on a pose graph)."""
+
+    def __init__(self, i: np.ndarray, j: np.ndarray, n: int) -> None:
+        r3 = np.arange(3)
+        # the (row, column) of every block entry (A^T A, A^T B, B^T A, B^T B of every edge), as vals is laid out
+        rows = np.concatenate(
+            [(3 * bi[:, None, None] + r3[None, :, None]).repeat(3, axis=2).ravel() for bi in (i, i, j, j)]
+        )
+        cols = np.concatenate(
+            [(3 * bj[:, None, None] + r3[None, None, :]).repeat(3, axis=1).ravel() for bj in (i, j, i, j)]
+        )
+        m = 3 * n - 3
+        keep = (rows >= 3) & (cols >= 3)
+        diag = np.arange(m)
+        rows = np.concatenate([rows[keep] - 3, diag])  # node 0's rows and columns dropped; a 1e-9 diagonal
+        cols = np.concatenate([cols[keep] - 3, diag])
+        self.keep, self.m, self.ridge = keep, m, np.full(m, 1e-9)
+        # the order depends on the pattern alone: factor it with values that need no pivoting
+        pattern = sp.csc_matrix((np.ones(len(rows)), (rows, cols)), shape=(m, m))
+        order = splu(pattern + sp.identity(m, format="csc") * m, permc_spec="MMD_AT_PLUS_A", **_SYMMETRIC).perm_c
+        self.order = np.argsort(order)  # unknown k of the permuted system is unknown order[k] of H
+        where = np.empty(m, dtype=np.int64)
+        where[self.order] = diag
+        pr, pc = where[rows], where[cols]
+        # each entry's slot among the permuted matrix's stored entries (column major, rows ascending)
+        keys, self.slot = np.unique(pc * m + pr, return_inverse=True)
+        self.indices = keys % m
+        self.indptr = np.searchsorted(keys // m, np.arange(m + 1)).astype(np.int64)
+
+    def solve(self, vals: np.ndarray, rhs: np.ndarray) -> np.ndarray:
+        """dx (3 n - 3,) with H (from the blocks ``vals``, laid out as in ``optimize``) dx = ``rhs``."""
+        entries = np.concatenate([vals[self.keep], self.ridge])
+        data = np.bincount(self.slot, weights=entries, minlength=len(self.indices))
+        h = sp.csc_matrix((data, self.indices, self.indptr), shape=(self.m, self.m))
+        y = splu(h, permc_spec="NATURAL", **_SYMMETRIC).solve(rhs[self.order])
+        dx = np.empty_like(y)
+        dx[self.order] = y
+        return dx
+
+
+_SYMMETRIC = {"diag_pivot_thresh": 0.0, "options": {"SymmetricMode": True}}

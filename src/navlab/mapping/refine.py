@@ -20,6 +20,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numba
 import numpy as np
 
 from navlab.geometry import between2, wrap_angle
@@ -54,12 +55,48 @@ class RefineParams:
     # 0.1 mm in 9 pairs of 10, the rest within ~1 cm); 0: every round matches every pair again
     rematch_xy: float = 0.0
     rematch_theta: float = 0.0
+    # a verified match's information is ``sigma_xy``/``sigma_theta``'s shaped by its ICP Hessian: weaker along
+    # directions the scans do not pin down (a corridor's axis), never stronger. ``shape_xy`` is the Hessian's
+    # xy eigenvalue per matched point of a match that pins both directions (normals spread evenly: 1/2); 0:
+    # every verified match gets the plain sigma_xy / sigma_theta
+    shape_xy: float = 0.0
 
 
-def _match(a: ScanPoints, b: ScanPoints, rel: np.ndarray, p: RefineParams) -> tuple[np.ndarray, bool]:
-    """Pose of scan ``b`` in scan ``a``'s frame, refined by ICP from ``rel``, and whether it is verified."""
+def _strong(p: RefineParams) -> np.ndarray:
+    """The information matrix of a verified match that pins every direction (the plain sigmas')."""
+    return np.diag([p.sigma_xy**-2, p.sigma_xy**-2, p.sigma_theta**-2])
+
+
+def _information(hessian: np.ndarray, theta: float, points: float, p: RefineParams) -> np.ndarray:
+    """A verified match's information (in the pose graph's edge-error frame) from its ICP Hessian (over
+    the pose (x, y, theta) of the scan in the other's frame, summed over ``points`` matched points): the
+    Hessian per point, normalised (xy by ``shape_xy``, theta by its own diagonal), its eigenvalues capped
+    at 1, scales ``_strong``. A match whose normals spread evenly keeps the plain sigmas; one along a
+    corridor is weak along the corridor's axis, where the start pose, not the scans, placed it."""
+    if p.shape_xy <= 0:
+        return _strong(p)
+    return _shaped(hessian, theta, max(points, 1.0), p.shape_xy, p.sigma_xy, p.sigma_theta)
+
+
+@numba.njit(cache=True)
+def _shaped(
+    hessian: np.ndarray, theta: float, points: float, shape_xy: float, sigma_xy: float, sigma_theta: float
+) -> np.ndarray:
+    """``_information``'s arithmetic (numba: it runs for each of ~10,000 verified matches a round)."""
+    c, s = math.cos(theta), math.sin(theta)
+    rot = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])  # edge error (scan j's frame) -> scan i's frame
+    per_point = rot.T @ hessian @ rot / points
+    ref = np.array([1.0 / math.sqrt(shape_xy), 1.0 / math.sqrt(shape_xy), math.sqrt(max(per_point[2, 2], 1e-12))])
+    w, v = np.linalg.eigh(per_point / np.outer(ref, ref))
+    scale = np.array([1.0 / sigma_xy, 1.0 / sigma_xy, 1.0 / sigma_theta])
+    return (v * np.minimum(w, 1.0)) @ v.T * np.outer(scale, scale)
+
+
+def _match(a: ScanPoints, b: ScanPoints, rel: np.ndarray, p: RefineParams) -> tuple[np.ndarray, bool, np.ndarray]:
+    """Pose of scan ``b`` in scan ``a``'s frame, refined by ICP from ``rel``, whether it is verified, and its
+    information (``_information``)."""
     if len(a.xy) < 20 or len(b.xy) < 20:
-        return rel, False
+        return rel, False, _strong(p)
     res = icp_point_to_line(
         a.xy, a.normals, b.xy, rel, max_dist=p.icp_max_dist, min_dist=p.icp_min_dist, iterations=p.icp_iterations
     )
@@ -70,7 +107,9 @@ def _match(a: ScanPoints, b: ScanPoints, rel: np.ndarray, p: RefineParams) -> tu
         and math.hypot(corr[0], corr[1]) <= p.max_correction
         and abs(wrap_angle(corr[2])) <= p.max_correction_ang
     )
-    return res.pose, ok
+    if not ok:
+        return res.pose, False, _strong(p)
+    return res.pose, True, _information(res.hessian, float(res.pose[2]), res.inlier_fraction * len(b.xy), p)
 
 
 class _Matches:
@@ -79,18 +118,18 @@ class _Matches:
 
     def __init__(self, scans: list[ScanPoints], p: RefineParams) -> None:
         self.scans, self.p = scans, p
-        self.done: dict[tuple[int, int], tuple[np.ndarray, np.ndarray, bool]] = {}
+        self.done: dict[tuple[int, int], tuple[np.ndarray, tuple[np.ndarray, bool, np.ndarray]]] = {}
 
-    def get(self, j: int, k: int, rel: np.ndarray) -> tuple[np.ndarray, bool]:
+    def get(self, j: int, k: int, rel: np.ndarray) -> tuple[np.ndarray, bool, np.ndarray]:
         """``_match`` of scan k against scan j from ``rel``, or the earlier one from a start as near."""
         old = self.done.get((j, k))
         if old is not None:
             d = rel - old[0]
             if math.hypot(d[0], d[1]) < self.p.rematch_xy and abs(wrap_angle(d[2])) < self.p.rematch_theta:
-                return old[1], old[2]
-        z, ok = _match(self.scans[j], self.scans[k], rel, self.p)
-        self.done[(j, k)] = (rel, z, ok)
-        return z, ok
+                return old[1]
+        got = _match(self.scans[j], self.scans[k], rel, self.p)
+        self.done[(j, k)] = (rel, got)
+        return got
 
 
 def refine_poses(
@@ -105,7 +144,6 @@ def refine_poses(
     stats = {"refine_edges": 0, "refine_rejected": 0}
     if n < 3:
         return cur, stats
-    strong = np.diag([p.sigma_xy**-2, p.sigma_xy**-2, p.sigma_theta**-2])
     weak = np.diag([p.weak_sigma_xy**-2, p.weak_sigma_xy**-2, p.weak_sigma_theta**-2])
     matches = _Matches(scans, p)
     for _ in range(p.rounds):
@@ -115,17 +153,17 @@ def refine_poses(
         kept = rejected = 0
         for k in range(1, n):
             rel = between2(cur[k - 1], cur[k])
-            z, ok = matches.get(k - 1, k, rel)
-            g.add_edge(k - 1, k, z if ok else rel, strong if ok else weak)
+            z, ok, info = matches.get(k - 1, k, rel)
+            g.add_edge(k - 1, k, z if ok else rel, info if ok else weak)
             # nearest earlier nodes in space, not the previous one
             d = np.hypot(cur[: k - 1, 0] - cur[k, 0], cur[: k - 1, 1] - cur[k, 1])
             dth = np.abs(wrap_angle(cur[: k - 1, 2] - cur[k, 2]))
             back = travel[k] - travel[: k - 1]
             cand = np.flatnonzero((d < p.radius) & (dth < p.max_heading) & (back >= p.min_travel))
             for j in cand[np.argsort(d[cand])][: p.neighbours]:
-                z, ok = matches.get(int(j), k, between2(cur[j], cur[k]))
+                z, ok, info = matches.get(int(j), k, between2(cur[j], cur[k]))
                 if ok:
-                    g.add_edge(int(j), k, z, strong, robust=True)
+                    g.add_edge(int(j), k, z, info, robust=True)
                     kept += 1
                 else:
                     rejected += 1

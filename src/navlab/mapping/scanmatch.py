@@ -270,9 +270,10 @@ def _icp(
     iterations: int,
     huber: float,
 ) -> tuple[float, float, float, float, float, np.ndarray]:
-    # the nearest map point within the search radius (at most max_dist), from the bins of half max_dist that
-    # reach within the radius (equally near points: the first in bin order)
-    cell = max_dist / 2.0
+    # the nearest map point within the search radius (at most max_dist), from the bins of max_dist that reach
+    # within the radius (equally near points: the first in bin order); 3 x 3 bins per point at most (bins of
+    # half max_dist, up to 5 x 5 of them, cost CSAIL's refinement 20 % more ICP time)
+    cell = max_dist
     order, start, ox, oy, w, h = _build_hash(map_xy, cell)
     x, y, t = x0, y0, t0
     n = scan.shape[0]

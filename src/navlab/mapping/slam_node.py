@@ -57,6 +57,7 @@ _NON_NEGATIVE = (
     "wideScore",
     "wideStep",
     "wideTurn",
+    "wideSkip",
 )
 
 

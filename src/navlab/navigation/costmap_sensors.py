@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import functools
 from collections.abc import Mapping
-from typing import Any, Protocol, runtime_checkable
+from typing import Any, Protocol, cast, runtime_checkable
 
 import numpy as np
 
@@ -64,12 +64,27 @@ class RangeLayer(Protocol):
     ) -> None: ...
 
 
-def scan_points(msg: Any) -> np.ndarray:
-    """A LaserScan's returns (N, 3) in its own frame (finite ranges in [range_min, range_max))."""
+Beams = dict[tuple[int, float, float], tuple[np.ndarray, np.ndarray]]  # (count, angle_min, increment) -> cos, sin
+
+
+def scan_points(msg: Any, trig: Beams | None = None) -> np.ndarray:
+    """A LaserScan's returns (N, 3) in its own frame (finite ranges in [range_min, range_max)). ``trig``: a cache of
+    the beams' cosines and sines by (beam count, angle_min, angle_increment), kept for the scan's geometry."""
     r = np.asarray(msg.ranges, dtype=np.float64)
-    a = float(msg.angle_min) + float(msg.angle_increment) * np.arange(len(r))
-    ok = np.isfinite(r) & (r >= float(msg.range_min)) & (r < float(msg.range_max))
-    return np.stack([r[ok] * np.cos(a[ok]), r[ok] * np.sin(a[ok]), np.zeros(int(ok.sum()))], axis=1)
+    key = (len(r), float(msg.angle_min), float(msg.angle_increment))
+    beams = trig.get(key) if trig is not None else None
+    if beams is None:
+        a = key[1] + key[2] * np.arange(key[0])
+        beams = (np.cos(a), np.sin(a))
+        if trig is not None:
+            trig.clear()
+            trig[key] = beams
+    ok = (r >= float(msg.range_min)) & (r < float(msg.range_max))  # NaN and inf fail one of them
+    hit = r[ok]
+    out = np.zeros((len(hit), 3))
+    out[:, 0] = hit * beams[0][ok]
+    out[:, 1] = hit * beams[1][ok]
+    return out
 
 
 class CostmapSensorFeeds:
@@ -78,10 +93,12 @@ class CostmapSensorFeeds:
     def __init__(self, node: Node, name: str, frame: str, layers: list[Any], *, prefix: str | None = None) -> None:
         self.node, self.name, self.frame = node, name, frame
         self.voxel: list[CloudLayer] = [x for x in layers if isinstance(x, CloudLayer)]
+        self._in_place = [isinstance(x, SensorFrameCloudLayer) for x in self.voxel]  # (a protocol check is slow)
         self.range: list[RangeLayer] = [x for x in layers if isinstance(x, RangeLayer)]
         self.pending: dict[tuple[int, str], Any] = {}
         self.readings: list[Any] = []
         self.sources: set[str] = set()
+        self._trig: Beams = {}  # scan_points' beams
         # publish_voxel_map: <costmap>/<layer>/voxel_grid (costmap_2d/VoxelGrid), after each update's observations
         self.voxel_pubs = {
             k: node.create_publisher(msgs.VoxelGrid, f"{prefix or name}/{layer.name}/voxel_grid", 1)
@@ -120,11 +137,12 @@ class CostmapSensorFeeds:
             place = self._in_costmap(frame, msgs.stamp_ns(msg))
             if place is None:
                 continue
-            pts = scan_points(msg) if msgs.type_name(msg).endswith("LaserScan") else read_xyz(msg, copy=False)
+            scan = msgs.type_name(msg).endswith("LaserScan")
+            pts = scan_points(msg, self._trig) if scan else read_xyz(msg, copy=False)
             origin, rot = place
             cloud_layer = self.voxel[k]
-            if isinstance(cloud_layer, SensorFrameCloudLayer):  # moved point by point as the layer reads them
-                cloud_layer.add_sensor_cloud(origin, rot, pts, source=src_name)
+            if self._in_place[k]:  # moved point by point as the layer reads them
+                cast(SensorFrameCloudLayer, cloud_layer).add_sensor_cloud(origin, rot, pts, source=src_name)
             else:  # NaNs: skipped there
                 cloud_layer.add_cloud(origin, move_points(pts, rot, origin), source=src_name)
         self.pending.clear()

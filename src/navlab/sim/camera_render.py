@@ -3,7 +3,8 @@
 The camera sits at its link's true pose composed with the sensor's ``<pose>`` and looks along the sensor's +x
 (Gazebo's camera convention), with the vertical field of view that the ``<horizontal_fov>`` and the image's
 aspect give. Only visual geoms (group 2) are drawn; shadows, reflections, fog and skybox are off (the cost of
-a frame on a software renderer). The GL context is made once and kept; a recompiled model (spawn/delete)
+a frame on a software renderer); edges are multisampled with ``<image><anti_aliasing>`` samples per pixel
+(SDF's default 4; 0 or 1: off). The GL context is made once and kept; a recompiled model (spawn/delete)
 rebuilds the render context.
 """
 
@@ -51,7 +52,12 @@ class CameraRenderer:
         cam = self.cfg.camera
         m.vis.global_.offwidth = max(m.vis.global_.offwidth, cam.width)
         m.vis.global_.offheight = max(m.vis.global_.offheight, cam.height)
-        self.mjr = mujoco.MjrContext(m, mujoco.mjtFontScale.mjFONTSCALE_100)
+        samples = m.vis.quality.offsamples
+        m.vis.quality.offsamples = cam.anti_aliasing  # the context's multisampling; the model's own is kept
+        try:
+            self.mjr = mujoco.MjrContext(m, mujoco.mjtFontScale.mjFONTSCALE_100)
+        finally:
+            m.vis.quality.offsamples = samples
         mujoco.mjr_setBuffer(mujoco.mjtFramebuffer.mjFB_OFFSCREEN, self.mjr)
         self.scene = mujoco.MjvScene(m, maxgeom=max(1000, 2 * m.ngeom))
         for flag in _OFF:

@@ -28,7 +28,7 @@ from navlab.sim.raycast3d import PINHOLE, _block, _lower_bound, in_geom_frame
 _PLANE_REACH = 1.0  # m beyond the far clip that an unbounded plane is drawn to
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _face(
     out: np.ndarray,
     norm: np.ndarray,
@@ -90,6 +90,7 @@ def _face(
     r0 = max(math.ceil(vmin - 1e-7), 0)
     r1 = min(math.floor(vmax + 1e-7), rows - 1)
     depth_num = level - p[k]
+    bck, bcj, bcjj, pj, pjj, ej2 = bc[k], bc[j], bc[jj], p[j], p[jj], ej * ej
     for r in range(r0, r1 + 1):
         umin, umax = np.inf, -np.inf
         for i in range(n):
@@ -107,22 +108,20 @@ def _face(
         c0 = max(math.floor(max(umin, -1.0)), 0)
         c1 = min(math.ceil(min(umax, cols + 0.0)), cols - 1)
         ak, aj, ajj = a[k] + br[k] * r, a[j] + br[j] * r, a[jj] + br[jj] * r
-        for c in range(c0, c1 + 1):
-            dk = ak + bc[k] * c
-            if dk == 0.0:
-                continue
+        # the row without branches (each pixel's depth kept or not by a select) and with unsigned indices, so
+        # that the compiler vectorises it; a pixel whose ray is parallel to the face (dk 0) is never kept
+        row, norm_row = out[r, c0 : c1 + 1], norm[r, c0 : c1 + 1]
+        for u in range(c1 + 1 - c0):
+            cu = uint64(u)
+            c = float(c0 + u)
+            dk = ak + bck * c
             s = depth_num / dk
-            if s <= 0.0 or s >= out[r, c]:
-                continue
-            qj = p[j] + s * (aj + bc[j] * c)
-            qjj = p[jj] + s * (ajj + bc[jj] * c)
-            if disk:
-                if qj * qj + qjj * qjj > ej * ej:
-                    continue
-            elif abs(qj) > ej or abs(qjj) > el:
-                continue
-            if s * norm[r, c] >= near:
-                out[r, c] = s
+            qj = pj + s * (aj + bcj * c)
+            qjj = pjj + s * (ajj + bcjj * c)
+            old = row[cu]
+            inside = (qj * qj + qjj * qjj <= ej2) if disk else ((abs(qj) <= ej) & (abs(qjj) <= el))
+            keep = (dk != 0.0) & (s > 0.0) & (s < old) & inside & (s * norm_row[cu] >= near)
+            row[cu] = s if keep else old
 
 
 @njit(cache=True)

@@ -8,6 +8,7 @@ tf from their link (a camera's optical frame turned z forward, x right, y down).
 
 from __future__ import annotations
 
+import sys
 from typing import Any
 
 import mujoco
@@ -123,6 +124,9 @@ class DepthCameraPlugin(CameraPlugin):
         self.depth_pub = self.create_publisher(msgs.Image, config.depth_image_topic, 1)
         self.cloud_pub = self.create_publisher(msgs.PointCloud2, config.point_cloud_topic, 1)
         self.depth_info_pub = self.create_publisher(msgs.CameraInfo, config.depth_info_topic, 1)
+        self._scratch = np.empty((config.camera.height, config.camera.width))  # depth_image's float64 buffer
+        self._image = np.empty((config.camera.height, config.camera.width), np.float32)  # an unpublished image
+        self._spares: list[np.ndarray] = []  # clouds' point buffers, reused once no message holds them
 
     def update(self) -> None:
         now = self.executor.now_ns
@@ -130,8 +134,10 @@ class DepthCameraPlugin(CameraPlugin):
         if colour:
             self.image_pub.publish(self.image_msg(self.image(), now))
         if self.read(self.depth_pub, self.cloud_pub):
-            depth = depth_image(self.sim, self.cam, self.rng)
-            if self.read(self.depth_pub):
+            published = self.read(self.depth_pub)  # else the image is only the cloud's: drawn into a kept buffer
+            image = None if published else self._image
+            depth = depth_image(self.sim, self.cam, self.rng, scratch=self._scratch, out=image)
+            if published:
                 h, w = depth.shape
                 self.depth_pub.publish(
                     msgs.Image(
@@ -155,9 +161,19 @@ class DepthCameraPlugin(CameraPlugin):
         """The organised PointCloud2 of a depth image (rgb from the last colour image when sizes match, else 0)."""
         h, w = depth.shape
         rgb = self.last_image if self.last_image is not None else np.zeros((0, 0, 3), np.uint8)
-        words = np.empty((h * w, 8), dtype=np.float32)
+        words = self._points_buffer(h * w)
         dense = depth_cloud(depth, self.cam.camera.focal_length, rgb, words, words.view(np.uint32))
         return cloud_message(stamp_ns, self.frame_id, words, DEPTH_FIELDS, height=h, width=w, dense=dense)
+
+    def _points_buffer(self, n: int) -> np.ndarray:
+        """An (n x 8) float32 buffer for the next cloud: a spare one that no message (nor any view of one) holds
+        any more — nobody can see it change — else a new one (a fresh 2.4 MB buffer costs its page faults)."""
+        for buf in self._spares:
+            if len(buf) == n and sys.getrefcount(buf) <= 3:  # the list, the loop variable, getrefcount's argument
+                return buf
+        buf = np.empty((n, 8), dtype=np.float32)
+        self._spares = [buf, *self._spares[:2]]
+        return buf
 
 
 class VelodynePlugin(SensorPlugin[Lidar3dConfig]):

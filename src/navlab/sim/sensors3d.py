@@ -117,18 +117,29 @@ def _pinhole_norm(width: int, height: int, focal: float) -> np.ndarray:
     return norm
 
 
-def depth_image(sim: Simulation, cfg: CameraConfig, rng: np.random.Generator | None = None) -> np.ndarray:
+def depth_image(
+    sim: Simulation,
+    cfg: CameraConfig,
+    rng: np.random.Generator | None = None,
+    *,
+    scratch: np.ndarray | None = None,
+    out: np.ndarray | None = None,
+) -> np.ndarray:
     """Depth (float32, height x width, m along the optical axis) as ``gazebo_ros_openni_kinect`` publishes it:
     surfaces between the clip planes, plus the ``<camera><noise>`` (m, drawn from a stream seeded by ``rng``), and
     NaN where the depth is not inside (``pointCloudCutoff``, ``pointCloudCutoffMax``). Primitive shapes are drawn
-    into a depth buffer (:mod:`navlab.sim.raster`); meshes are ray cast."""
+    into a depth buffer (:mod:`navlab.sim.raster`); meshes are ray cast. ``scratch``: a float64 height x width
+    array to draw into, ``out``: a float32 one for the image (kept by a caller that draws every frame); else they
+    are made."""
     cam = cfg.camera
     norm = _pinhole_norm(cam.width, cam.height, cam.focal_length)
     pos, rot = sensor_pose(sim, cfg.link, cfg.origin)
     tmax = cam.far * float(norm.max())  # the longest ray that can end before the far clip
     m, d = sim.model, sim.data
     fast, slow = sim.ray_geoms()
-    depth = np.empty((cam.height, cam.width))
+    shape = (cam.height, cam.width)
+    fits = scratch is not None and scratch.shape == shape and scratch.dtype == np.float64
+    depth = scratch if fits and scratch is not None else np.empty(shape)
     params = np.array([cam.focal_length, (cam.width - 1) / 2.0, (cam.height - 1) / 2.0])
     draw_depth(pos, rot, params, norm, fast, m.geom_type, m.geom_size, d.geom_xpos, d.geom_xmat, cam.near, tmax, depth)
     if slow is not None:  # meshes: rays along the unit directions, their distances turned into depths
@@ -137,7 +148,8 @@ def depth_image(sim: Simulation, cfg: CameraConfig, rng: np.random.Generator | N
         np.minimum(depth, t / norm, out=depth)
     noisy = cam.noise_stddev > 0 and rng is not None
     seed = seed_state(rng) if noisy and rng is not None else np.uint64(0)
-    out = np.empty(depth.shape, dtype=np.float32)
+    if out is None or out.shape != shape or out.dtype != np.float32:
+        out = np.empty(shape, dtype=np.float32)
     std = cam.noise_stddev if noisy else 0.0
     finish_depth(
         depth, cam.near, cam.far, cam.noise_mean, std, seed, cfg.point_cloud_cutoff, cfg.point_cloud_cutoff_max, out

@@ -71,7 +71,8 @@ class VoxelLayer(ObservationLayer):
 
     def _new_cells(self, shape: tuple[int, ...]) -> None:
         self.columns = np.full(shape, UNKNOWN_COLUMN, np.uint32)
-        self._flags = np.zeros(int(np.prod(shape)) * self.params.z_voxels, np.uint8)  # observe()'s scratch
+        self._seen = np.zeros(int(np.prod(shape)), np.uint32)  # observe()'s scratch
+        self._clear = np.zeros(int(np.prod(shape)), np.uint32)
 
     def _shift(self, di: int, dj: int) -> None:
         self.columns = shifted(self.columns, di, dj, UNKNOWN_COLUMN)
@@ -126,7 +127,9 @@ class VoxelLayer(ObservationLayer):
             p.unknown_threshold,
             np.uint8(COST_FREE),
             np.uint8(COST_LETHAL),
-            self._flags,
+            p.z_voxels,
+            self._seen,
+            self._clear,
         )
 
     def voxel_grid_msg(self, stamp_ns: int) -> Any:
