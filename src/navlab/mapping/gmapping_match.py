@@ -282,7 +282,8 @@ def optimize(
             if q < n_seen:
                 sc, lik = seen[q, 3], seen[q, 4]
             else:
-                sc, lik, _n = _score_above(tiles, masks, table, lattice, (nx, ny, nt), beams, scoring, cur, fw, iw, order)
+                at = (nx, ny, nt)
+                sc, lik, _n = _score_above(tiles, masks, table, lattice, at, beams, scoring, cur, fw, iw, order)
                 if n_seen < SEEN_POSES:
                     seen[n_seen, 0], seen[n_seen, 1], seen[n_seen, 2] = nx, ny, nt
                     seen[n_seen, 3], seen[n_seen, 4] = sc, lik
