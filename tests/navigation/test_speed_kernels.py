@@ -109,14 +109,19 @@ def test_kld_bin_count_and_tracking_distance_equal_their_plain_forms() -> None:
     it = np.floor(poses[:, 2] / sampling.BIN_YAW).astype(np.int64) % sampling.N_YAW_BINS
     np.testing.assert_array_equal(sampling.bin_keys(poses), (ix * sampling._SPAN + iy) * sampling.N_YAW_BINS + it)
     for keys in (rng.integers(0, 40, 500), sampling.bin_keys(poses)):
-        _, first = np.unique(keys, return_index=True)
-        is_new = np.zeros(keys.size, np.int64)
-        is_new[first] = 1
-        np.testing.assert_array_equal(sampling.bins_so_far(keys), np.cumsum(is_new))
         ukeys, inverse = np.unique(keys, return_inverse=True)
         hashed = sampling.unique_inverse(keys)
         np.testing.assert_array_equal(hashed[0], ukeys)
         np.testing.assert_array_equal(hashed[1], inverse.ravel())
+    for spread in (3.0, 0.2, 0.1):  # KLD's count: the first count above the limit for the bins occupied so far
+        cand = poses * (spread / 3.0)
+        _, first = np.unique(sampling.bin_keys(cand), return_index=True)
+        is_new = np.zeros(len(cand), np.int64)
+        is_new[first] = 1
+        counts = np.arange(1, len(cand) + 1)
+        over = np.flatnonzero(counts > sampling.kld_limit(np.cumsum(is_new), 0.01, 0.99, 100, 5000))
+        plain = max(min(int(counts[over[0]]) if over.size else len(cand), 5000), 100)
+        assert sampling.kld_count(cand, 0.01, 0.99, 100, 5000) == plain
     path = np.cumsum(rng.normal(0, 0.1, (80, 2)), axis=0)
     pts = rng.normal(0, 1, (5, 2))
     a, ab = path[:-1], np.diff(path, axis=0)
