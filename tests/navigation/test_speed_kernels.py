@@ -122,6 +122,14 @@ def test_kld_bin_count_and_tracking_distance_equal_their_plain_forms() -> None:
         over = np.flatnonzero(counts > sampling.kld_limit(np.cumsum(is_new), 0.01, 0.99, 100, 5000))
         plain = max(min(int(counts[over[0]]) if over.size else len(cand), 5000), 100)
         assert sampling.kld_count(cand, 0.01, 0.99, 100, 5000) == plain
+    for size in (1, 7, 300):  # low-variance draws: searchsorted on the running sums, from one rng.random()
+        w = rng.random(size) ** 3
+        w[rng.random(size) < 0.3] = 0.0
+        u = np.random.default_rng(size).random()
+        cum = np.cumsum(w)
+        plain_idx = np.minimum(np.searchsorted(cum, (u + np.arange(500)) * (cum[-1] / 500), side="right"), size - 1)
+        drawn = sampling.low_variance_indices(w, 500, np.random.default_rng(size))
+        np.testing.assert_array_equal(drawn, plain_idx)
     path = np.cumsum(rng.normal(0, 0.1, (80, 2)), axis=0)
     pts = rng.normal(0, 1, (5, 2))
     a, ab = path[:-1], np.diff(path, axis=0)

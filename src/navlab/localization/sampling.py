@@ -27,12 +27,30 @@ _SPAN = 1 << 21
 
 
 def low_variance_indices(weights: np.ndarray, n: int, rng: np.random.Generator) -> np.ndarray:
-    """Indices of ``n`` draws by low-variance (systematic) resampling; ``weights`` need not sum to 1."""
+    """Indices of ``n`` draws by low-variance (systematic) resampling; ``weights`` need not sum to 1. The draws
+    sit at ``(u + i) * total / n`` for one uniform ``u`` (one ``rng.random()``), each taking the first weight
+    whose running sum exceeds it."""
+    return _low_variance(np.ascontiguousarray(weights, dtype=np.float64), int(n), rng.random())
+
+
+@njit(cache=True)
+def _low_variance(weights: np.ndarray, n: int, u: float) -> np.ndarray:  # pragma: no cover - compiled
+    """:func:`low_variance_indices` from its uniform ``u``: ``searchsorted(cumsum(weights), points, "right")``
+    clipped to the last index, by one merge walk (the points are sorted)."""
     cum = np.cumsum(weights)
-    total = cum[-1]
-    points = (rng.random() + np.arange(n)) * (total / n)
-    idx = np.searchsorted(cum, points, side="right")
-    return np.minimum(idx, weights.shape[0] - 1)
+    step = cum[-1] / n
+    last = weights.shape[0] - 1
+    out = np.empty(n, dtype=np.int64)
+    j = 0
+    for i in range(n):
+        p = (u + i) * step
+        if p != p:  # NaN sorts after every number
+            out[i] = last
+            continue
+        while j <= last and cum[j] <= p:
+            j += 1
+        out[i] = min(j, last)
+    return out
 
 
 def kld_limit(k: np.ndarray, kld_err: float, kld_z: float, min_n: int, max_n: int) -> np.ndarray:
