@@ -215,3 +215,33 @@ def test_obstacle_layer_takes_ranges_in_one_call_as_it_takes_their_endpoints() -
         marked += int((layers[0].grid.data == COST_LETHAL).sum())
         cleared += int((layers[0].grid.data == 0).sum())
     assert marked > 1000 and cleared > 10000  # the scans did mark and clear
+
+
+def test_ray_clearing_writes_the_cells_of_the_plain_walk() -> None:
+    """Rays whose both ends lie in the grid are walked without per-cell bounds checks: the same cells as the
+    plain walk (cut to max_cells, stopped where it leaves the grid, min_cells kept), rays in and out of it."""
+    from navlab.gridline import TIE_LATE, line, line_cell
+    from navlab.navigation.costmap.raytrace import clear_rays
+
+    rng = np.random.default_rng(5)
+    for trial in range(12):
+        data = np.zeros((40, 50), np.uint8)
+        x0, y0 = rng.uniform(0, 50), rng.uniform(0, 40)
+        ends = np.column_stack([rng.uniform(-20, 70, 60), rng.uniform(-20, 60, 60)])
+        min_cells = 0.0 if trial % 2 == 0 else 3.0
+        clear_rays(data, x0, y0, ends, 30.0, min_cells, np.uint8(7))
+        plain = np.zeros_like(data)
+        i0, j0 = math.floor(x0), math.floor(y0)
+        for ex, ey in ends:
+            dx, dy = ex - x0, ey - y0
+            length = math.sqrt(dx * dx + dy * dy)
+            if length > 30.0:
+                ex, ey = x0 + dx * (30.0 / length), y0 + dy * (30.0 / length)
+            ln = line(i0, j0, math.floor(ex), math.floor(ey), TIE_LATE)
+            for n in range(ln[0] + 1):
+                i, j = line_cell(ln, n)
+                if not (0 <= i < 50 and 0 <= j < 40):
+                    break
+                if (i - i0) ** 2 + (j - j0) ** 2 >= min_cells**2:
+                    plain[j, i] = 7
+        np.testing.assert_array_equal(data, plain, err_msg=f"trial {trial}")
