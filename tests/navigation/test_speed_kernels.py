@@ -161,7 +161,7 @@ def test_controller_scene_kernel_equals_the_plain_steps() -> None:
         polygon = square if trial % 2 else circle_footprint(0.2)
         edges = footprint_outline(polygon, RES)
         for mode in (0, 1, 2):
-            got_plan, got_cells, got_dist = path_scene(
+            got_plan, got_cells, got_wave = path_scene(
                 cost, plan, *origin, RES, pose_l, 0.5 * RES * 70, mode, polygon, edges
             )
             want_plan = crop_plan(frame.points_in(plan), pose_l[0], pose_l[1], 0.5 * RES * 70)
@@ -173,7 +173,8 @@ def test_controller_scene_kernel_equals_the_plain_steps() -> None:
             if len(want_cells) == 0:
                 continue
             free = None if mode == 0 else footprint_cells(cost.shape, RES, pose_l, polygon if mode == 2 else None)
-            np.testing.assert_array_equal(got_dist, mapgrid.distance_map(cost, want_cells, free))
+            mapgrid.wave_to(cost, got_wave, -1, -1)  # grown whole
+            np.testing.assert_array_equal(got_wave[0], mapgrid.distance_map(cost, want_cells, free))
     for path in (np.zeros((4, 3)), np.array([[0, 0, 0], [0.1, 0, 0], [0.2, 0, 0], [0.2, 0, 0]], float)):
         moved = np.nonzero(np.any(path[1:] != path[:-1], axis=1))[0]  # _finish's plain form
         assert moved_length(path) == ((int(moved[-1]) + 2) if len(moved) else 1)

@@ -34,9 +34,28 @@ def as_plan(path: Any) -> np.ndarray:
     arr = np.asarray(path, dtype=np.float64)
     if arr.ndim != 2 or arr.shape[1] not in (2, 3) or len(arr) == 0:
         raise NavigationError(f"plan: expected an array (N, 2) or (N, 3) with N >= 1, got shape {arr.shape}")
-    if not np.all(np.isfinite(arr)):
+    arr = arr.copy()  # C-contiguous
+    if not all_finite(arr.reshape(-1)):
         raise NavigationError("plan: expected finite coordinates, got NaN or inf")
-    return arr.copy()
+    return arr
+
+
+@numba.njit(cache=True)
+def all_finite(values: np.ndarray) -> bool:  # pragma: no cover - compiled
+    """Whether every value of the 1-D float array is finite (``np.all(np.isfinite(...))`` in one pass)."""
+    for v in values:  # noqa: SIM110 - a compiled loop that stops at the first (Numba has no all() of a generator)
+        if not math.isfinite(v):
+            return False
+    return True
+
+
+@numba.njit(cache=True)
+def same_values(a: np.ndarray, b: np.ndarray) -> bool:  # pragma: no cover - compiled
+    """Whether two 1-D arrays of one length hold the same values (``np.array_equal`` without its temporaries)."""
+    for k in range(a.size):  # noqa: SIM110 - as all_finite
+        if a[k] != b[k]:
+            return False
+    return True
 
 
 def densify(xy: np.ndarray, step: float) -> np.ndarray:
@@ -75,9 +94,12 @@ class LocalFrame:
         return np.stack([c * d[:, 0] + s * d[:, 1], -s * d[:, 0] + c * d[:, 1]], axis=1)
 
     def pose_in(self, pose: tuple[float, float, float]) -> tuple[float, float, float]:
-        """A costmap-frame pose -> grid-local."""
-        p = self.points_in(np.array([[pose[0], pose[1]]]))[0]
-        return float(p[0]), float(p[1]), float(pose[2]) - self.oyaw
+        """A costmap-frame pose -> grid-local (``points_in``'s arithmetic on one point)."""
+        dx, dy = float(pose[0]) - self.ox, float(pose[1]) - self.oy
+        if self.oyaw != 0.0:
+            c, s = math.cos(self.oyaw), math.sin(self.oyaw)
+            dx, dy = c * dx + s * dy, -s * dx + c * dy
+        return dx, dy, float(pose[2]) - self.oyaw
 
     def poses_out(self, poses: np.ndarray) -> np.ndarray:
         """Grid-local poses (N, 3) -> costmap frame (N, 3), yaw wrapped to [-pi, pi)."""

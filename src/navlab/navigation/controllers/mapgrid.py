@@ -14,35 +14,66 @@ import numpy as np
 
 from navlab.grid import COST_INSCRIBED, COST_UNKNOWN
 
+Wave = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]  # wave_start's (dist, mark, free, queue, ends)
+
 
 @numba.njit(cache=True)
-def wave(
-    cost: np.ndarray, seeds_i: np.ndarray, seeds_j: np.ndarray, free_i: np.ndarray, free_j: np.ndarray, out: np.ndarray
-) -> None:  # pragma: no cover - compiled
-    """:func:`distance_map` into ``out`` from the seed cells (columns ``seeds_i``, rows ``seeds_j``), the cells
-    (``free_i``, ``free_j``) never obstacles."""
+def wave_start(
+    cost: np.ndarray, seeds_i: np.ndarray, seeds_j: np.ndarray, free_i: np.ndarray, free_j: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:  # pragma: no cover - compiled
+    """A :func:`distance_map` wave from the seed cells (columns ``seeds_i``, rows ``seeds_j``), the cells
+    (``free_i``, ``free_j``) never obstacles, seeded but not grown: (distances (H, W), reached (H, W), free (H, W),
+    the queue (2, H * W), its (head, tail)). :func:`wave_to` grows it as far as a lookup needs; a cell's distance is
+    final once it is reached, the same whenever the wave stops, so a wave grown in part reads as the whole."""
     h, w = cost.shape
-    obstacle = float(h * w)
-    out[:, :] = obstacle + 1.0
+    out = np.full((h, w), float(h * w) + 1.0)
     mark = np.zeros((h, w), dtype=np.bool_)
     free = np.zeros((h, w), dtype=np.bool_)
     for k in range(free_i.size):
         free[free_j[k], free_i[k]] = True
-    qi = np.empty(h * w, dtype=np.int64)
-    qj = np.empty(h * w, dtype=np.int64)
-    head = 0
+    queue = np.empty((2, h * w), dtype=np.int64)
     tail = 0
     for k in range(seeds_i.size):
         i, j = seeds_i[k], seeds_j[k]
         if not mark[j, i]:
             mark[j, i] = True
             out[j, i] = 0.0
-            qi[tail], qj[tail] = i, j
+            queue[0, tail], queue[1, tail] = i, j
             tail += 1
+    return out, mark, free, queue, np.array([0, tail], dtype=np.int64)
+
+
+@numba.njit(cache=True)
+def wave_to(
+    cost: np.ndarray, wave: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray], i: int, j: int
+) -> float:  # pragma: no cover - compiled
+    """The wave's distance at cell (i, j) (inside the grid), grown (breadth first, 4-connected, LETHAL/INSCRIBED/
+    unknown cells stop it) until it reaches that cell or can grow no further; ``i`` < 0: grow it to the end."""
+    out, mark, free, queue, ends = wave
+    return grow(cost, out, mark, free, queue, ends, i, j)
+
+
+@numba.njit(cache=True)
+def grow(
+    cost: np.ndarray,
+    out: np.ndarray,
+    mark: np.ndarray,
+    free: np.ndarray,
+    queue: np.ndarray,
+    ends: np.ndarray,
+    i: int,
+    j: int,
+) -> float:  # pragma: no cover - compiled
+    """:func:`wave_to` on the wave's arrays."""
+    if i >= 0 and mark[j, i]:
+        return out[j, i]
+    h, w = cost.shape
+    obstacle = float(h * w)
+    head, tail = ends[0], ends[1]
     di = (-1, 1, 0, 0)
     dj = (0, 0, -1, 1)
-    while head < tail:
-        ci, cj = qi[head], qj[head]
+    while head < tail and (i < 0 or not mark[j, i]):
+        ci, cj = queue[0, head], queue[1, head]
         head += 1
         for n in range(4):
             ni, nj = ci + di[n], cj + dj[n]
@@ -53,8 +84,21 @@ def wave(
                 out[nj, ni] = obstacle
                 continue
             out[nj, ni] = out[cj, ci] + 1.0
-            qi[tail], qj[tail] = ni, nj
+            queue[0, tail], queue[1, tail] = ni, nj
             tail += 1
+    ends[0], ends[1] = head, tail
+    return out[j, i] if i >= 0 else 0.0
+
+
+@numba.njit(cache=True)
+def wave(
+    cost: np.ndarray, seeds_i: np.ndarray, seeds_j: np.ndarray, free_i: np.ndarray, free_j: np.ndarray, out: np.ndarray
+) -> None:  # pragma: no cover - compiled
+    """:func:`distance_map` into ``out`` from the seed cells (columns ``seeds_i``, rows ``seeds_j``), the cells
+    (``free_i``, ``free_j``) never obstacles."""
+    grown = wave_start(cost, seeds_i, seeds_j, free_i, free_j)
+    wave_to(cost, grown, -1, -1)
+    out[:, :] = grown[0]
 
 
 def plan_cells(cost: np.ndarray, plan_xy: np.ndarray, resolution: float) -> np.ndarray:

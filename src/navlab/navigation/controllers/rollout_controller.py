@@ -78,6 +78,7 @@ from navlab.navigation.controllers.common import (
     prune_plan,
     rotate_to_goal,
     same_goal,
+    same_values,
     stop_with_acc_limits,
     stopped,
 )
@@ -92,7 +93,9 @@ _NO_POINTS.flags.writeable = False
 @dataclass
 class LocalScene:
     """One cycle's inputs in grid-local coordinates: pose, cost array, the plan as ROS's planners get it
-    (``plan`` (N, 2), cropped around the robot), its cells and the distance maps."""
+    (``plan`` (N, 2), cropped around the robot), its cells and the distance maps to the path and to the local goal
+    as waves that compiled lookups grow as far as they need (``mapgrid.wave_to``; ``path_dist`` and ``goal_dist``
+    grow them whole)."""
 
     frame: LocalFrame
     pose: tuple[float, float, float]
@@ -100,8 +103,20 @@ class LocalScene:
     resolution: float
     plan: np.ndarray
     path_cells: np.ndarray
-    path_dist: np.ndarray
-    goal_dist: np.ndarray
+    path_wave: mapgrid.Wave
+    goal_wave: mapgrid.Wave
+
+    @property
+    def path_dist(self) -> np.ndarray:
+        """The path distance map (cost's shape), the whole wave."""
+        mapgrid.wave_to(self.cost, self.path_wave, -1, -1)
+        return self.path_wave[0]
+
+    @property
+    def goal_dist(self) -> np.ndarray:
+        """The local goal's distance map (cost's shape), the whole wave."""
+        mapgrid.wave_to(self.cost, self.goal_wave, -1, -1)
+        return self.goal_wave[0]
 
     @property
     def impossible(self) -> float:
@@ -154,7 +169,7 @@ class RolloutController(ControllerBase):
         self._rotating_to_goal = False
         self._outlines: dict[tuple[float, bytes | None], np.ndarray | None] = {}
         self._near: tuple[np.ndarray, np.ndarray | None, np.ndarray] | None = None  # (outline, costs, reach max)
-        self._goal_map: tuple[np.ndarray | None, np.ndarray, np.ndarray] | None = None  # (costs, goal cell, distances)
+        self._goal_map: tuple[np.ndarray | None, tuple[int, int], mapgrid.Wave] | None = None  # costs, goal cell, wave
         self._costs_seen: np.ndarray | None = None  # the local costs last seen (see _note_costs)
         self._clear_outputs()
         self._setup()
@@ -232,7 +247,7 @@ class RolloutController(ControllerBase):
         pose_l = frame.pose_in(pose)
         self._note_costs(cost)
         mode, polygon, edges = self._free_mode(res)
-        plan, cells, path_dist = scene_kernel.path_scene(
+        plan, cells, wave = scene_kernel.path_scene(
             cost,
             np.ascontiguousarray(self._plan[:, :2]),
             frame.ox,
@@ -249,25 +264,27 @@ class RolloutController(ControllerBase):
             return None  # ROS: an empty transformed plan (no pose of the plan near the robot)
         if len(cells) == 0:
             return None  # ROS: "None of the points of the global plan were in the local costmap"
-        return LocalScene(frame, pose_l, cost, res, plan, cells, path_dist, self._goal_dist(cost, cells[-1:]))
+        return LocalScene(frame, pose_l, cost, res, plan, cells, wave, self._goal_wave(cost, cells[-1]))
 
     def _note_costs(self, cost: np.ndarray) -> None:
         """Keep a copy of the local costs in ``_costs_seen``, a new one only when they changed: what is computed
         from them (the goal's distance map, the footprint's reach maximum) is kept with that copy and reused while
         it is still the one (the costmap updates less often than the controller runs)."""
         seen = self._costs_seen
-        if seen is None or seen.shape != cost.shape or not np.array_equal(seen, cost):
+        if seen is None or seen.shape != cost.shape or not same_values(seen.reshape(-1), cost.reshape(-1)):
             self._costs_seen = cost.copy()
 
-    def _goal_dist(self, cost: np.ndarray, goal: np.ndarray) -> np.ndarray:
-        """The local goal cell's distance map, kept while the costs and that cell stay the same (the robot moves
-        a few cells per costmap update; the goal cell moves less often)."""
+    def _goal_wave(self, cost: np.ndarray, goal: np.ndarray) -> mapgrid.Wave:
+        """The local goal cell's (i, j) distance wave, kept (and grown further as lookups need) while the costs and
+        that cell stay the same (the robot moves a few cells per costmap update; the goal cell moves less often)."""
+        cell = (int(goal[0]), int(goal[1]))
         cached = self._goal_map
-        if cached is not None and cached[0] is self._costs_seen and np.array_equal(cached[1], goal):
+        if cached is not None and cached[0] is self._costs_seen and cached[1] == cell:
             return cached[2]
-        dist = mapgrid.distance_map(cost, goal)
-        self._goal_map = (self._costs_seen, goal.copy(), dist)
-        return dist
+        none = np.zeros(0, dtype=np.int64)
+        wave = mapgrid.wave_start(cost, goal[:1].copy(), goal[1:].copy(), none, none)
+        self._goal_map = (self._costs_seen, cell, wave)
+        return wave
 
     def _free_mode(self, res: float) -> tuple[int, np.ndarray | None, np.ndarray | None]:
         """Which cells never block the path map's wave, as ``scene_kernel.path_scene`` takes it: (0 none | 1 the

@@ -4,9 +4,10 @@
 plan into grid-local coordinates (``LocalFrame.points_in``), ``transformGlobalPlan``'s stretch around the robot
 (``crop_plan``), the plan's cells (``mapgrid.plan_cells``), the cells under the robot that never block the
 wave (``rollout.footprint_cells``, TrajectoryPlanner's ``within_robot``) and the path distance map
-(``mapgrid.distance_map``). ``moved_length`` is ``_finish``'s cut of the chosen rollout where it stops
-moving. Same float operations in the same order as the numpy steps they replace, so the same results bit for
-bit. Poses are grid-local (m, rad) unless said otherwise; cells are (i, j) = (column, row).
+(``mapgrid.wave_start``: seeded, grown only as far as lookups need). ``moved_length`` is ``_finish``'s cut of
+the chosen rollout where it stops moving. Same float operations in the same order as the numpy steps they
+replace, so the same results bit for bit. Poses are grid-local (m, rad) unless said otherwise; cells are
+(i, j) = (column, row).
 """
 
 from __future__ import annotations
@@ -17,7 +18,7 @@ import numba
 import numpy as np
 
 from navlab.navigation.controllers.common import crop_span
-from navlab.navigation.controllers.mapgrid import cells_along, wave
+from navlab.navigation.controllers.mapgrid import cells_along, wave_start
 from navlab.navigation.controllers.rollout import cells_under
 
 
@@ -34,13 +35,16 @@ def path_scene(
     free_mode: int,
     polygon: np.ndarray,
     edges: np.ndarray,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:  # pragma: no cover - compiled
-    """(cropped grid-local plan (M, 2), its cells (K, 2), path distances (cost's shape)) for the costmap-frame
+) -> tuple[
+    np.ndarray, np.ndarray, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+]:  # pragma: no cover - compiled
+    """(cropped grid-local plan (M, 2), its cells (K, 2), the path distances' wave (``mapgrid.wave_start``; read
+    with ``mapgrid.wave_to``)) for the costmap-frame
     ``plan`` (N, >= 2) on the grid ``cost`` whose origin is (ox, oy, oyaw), the robot at grid-local ``pose``.
 
     ``reach``: the crop radius (m); ``free_mode``: 0 no cells are kept free of obstacles, 1 the robot's centre
     cell, 2 the cells under ``polygon`` (base frame, m) with its ``edges`` (``footprint_outline``). An empty plan
-    (no pose within ``reach``) or no plan cell in the grid gives empty arrays (and an empty distance map)."""
+    (no pose within ``reach``) or no plan cell in the grid gives empty arrays (and an empty wave)."""
     h, w = cost.shape
     n = plan.shape[0]
     local = np.empty((n, 2))
@@ -55,8 +59,9 @@ def path_scene(
     first, end = crop_span(local, x, y, reach)
     cropped = local[first:end].copy()
     empty_cells = np.zeros((0, 2), dtype=np.int64)
+    none = np.zeros(0, dtype=np.int64)
     if cropped.shape[0] == 0:
-        return cropped, empty_cells, np.empty((0, 0))
+        return cropped, empty_cells, wave_start(np.zeros((0, 0), dtype=cost.dtype), none, none, none, none)
     m = cropped.shape[0]
     steps = np.zeros(max(m - 1, 0), dtype=np.int64)
     for k in range(m - 1):
@@ -64,7 +69,7 @@ def path_scene(
         steps[k] = max(1, math.ceil(d / res))
     cells = cells_along(cost, cropped, steps, res)
     if cells.shape[0] == 0:
-        return cropped, cells, np.empty((0, 0))
+        return cropped, cells, wave_start(np.zeros((0, 0), dtype=cost.dtype), none, none, none, none)
     if free_mode == 2:
         ct, st = math.cos(th), math.sin(th)
         poly = np.empty(polygon.shape)
@@ -84,9 +89,11 @@ def path_scene(
             free[0, 0], free[0, 1] = i, j
     else:
         free = empty_cells
-    dist = np.empty((h, w))
-    wave(cost, cells[:, 0].copy(), cells[:, 1].copy(), free[:, 0].copy(), free[:, 1].copy(), dist)
-    return cropped, cells, dist
+    return (
+        cropped,
+        cells,
+        wave_start(cost, cells[:, 0].copy(), cells[:, 1].copy(), free[:, 0].copy(), free[:, 1].copy()),
+    )
 
 
 @numba.njit(cache=True)

@@ -8,11 +8,18 @@ import math
 
 import numpy as np
 
+from navlab.navigation.controllers import ring_bounds
 from navlab.navigation.controllers import trajectory_cycle as cycle
 from navlab.navigation.controllers.common import InPlaceFlags
 from navlab.navigation.controllers.params import TrajectoryPlannerParams
-from navlab.navigation.controllers.rollout import heading_diffs, rollout_scores
+from navlab.navigation.controllers.rollout import heading_diffs
 from navlab.navigation.controllers.rollout_controller import LocalScene, RolloutController
+
+_NO_MEMO, _NO_OFFSETS, _NO_COUNTS = (  # a point robot's (typed) empties
+    np.zeros((0, 0, 0), dtype=np.int16),
+    np.zeros((0, 0, 2), dtype=np.int64),
+    np.zeros(0, dtype=np.int64),
+)
 
 # --- base_local_planner/TrajectoryPlannerROS ----------------------------------------------------------
 
@@ -30,6 +37,8 @@ class TrajectoryPlannerROS(RolloutController):
         self._escaping = False
         self._escape_pose = (0.0, 0.0, 0.0)
         self._spin = InPlaceFlags(self.params.oscillation_reset_dist)
+        self._rings: dict[float, tuple[np.ndarray, ...]] = {}  # resolution: ring offsets, counts, outline x, y
+        self._memo: tuple[np.ndarray | None, np.ndarray] | None = None  # (costs seen, ring bound memo)
 
     def _new_goal(self) -> None:
         self._escaping = False
@@ -77,31 +86,17 @@ class TrajectoryPlannerROS(RolloutController):
         with ``heading_scoring``); -1 blocked, -2 no path."""
         res = scene.resolution
         traj = np.ascontiguousarray(traj, dtype=np.float64)
-        near, ox, oy, polygon, use_near = self._edges(scene)
+        memo, offsets, counts, ox, oy, polygon = self._footprint(scene)
         if polygon:  # numpy's cos/sin, as footprint_costs
             c, s = np.cos(traj[..., 2]), np.sin(traj[..., 2])
         else:
             c = s = np.zeros(traj.shape[:2])
         cost = np.empty(traj.shape[0])
         at = self._heading_step(traj.shape[1])
-        rollout_scores(
-            scene.cost,
-            near,
-            np.ascontiguousarray(scene.path_dist),
-            np.ascontiguousarray(scene.goal_dist),
-            1.0 / res,
-            traj,
-            c,
-            s,
-            ox,
-            oy,
-            polygon,
-            use_near,
-            self._weights(res),
-            scene.impossible,
-            np.full(len(traj), at, dtype=np.int64),
-            cost,
-        )
+        args = (1.0 / res, traj, c, s, ox, oy)
+        ats = np.full(len(traj), at, dtype=np.int64)
+        scored = (scene.goal_wave, *args, polygon, self._weights(res), scene.impossible, ats, cost)
+        ring_bounds.ring_scores(scene.cost, memo, offsets, counts, scene.path_wave, *scored)
         self._add_heading(scene, cost, traj, at)
         return cost
 
@@ -122,7 +117,7 @@ class TrajectoryPlannerROS(RolloutController):
         wmin = min(max(p.min_vel_theta, w0 - p.acc_lim_theta * horizon), wmax)
         # samples, rollouts and costs in one compiled call (trajectory_cycle), then the choice in another
         res = scene.resolution
-        near, ox, oy, polygon, use_near = self._edges(scene)
+        memo, offsets, counts, ox, oy, polygon = self._footprint(scene)
         ang = p.angular_sim_granularity if p.angular_sim_granularity > 0 else p.sim_granularity
         limits = np.array(
             [vmin, vmax, wmin, wmax, p.min_in_place_vel_theta, p.escape_vel, p.acc_lim_x, p.acc_lim_theta]
@@ -131,9 +126,11 @@ class TrajectoryPlannerROS(RolloutController):
         at = self._heading_step(steps) if p.heading_scoring else -1
         targets, traj, costs, ws, dw = cycle.score_samples(
             scene.cost,
-            near,
-            scene.path_dist,
-            scene.goal_dist,
+            memo,
+            offsets,
+            counts,
+            scene.path_wave,
+            scene.goal_wave,
             res,
             scene.pose,
             velocity,
@@ -143,7 +140,6 @@ class TrajectoryPlannerROS(RolloutController):
             ox,
             oy,
             polygon,
-            use_near,
             self._weights(res),
             scene.impossible,
             at,
@@ -157,7 +153,8 @@ class TrajectoryPlannerROS(RolloutController):
             dw,
             nf,
             self._escaping,
-            scene.goal_dist,
+            scene.cost,
+            scene.goal_wave,
             res,
             p.heading_lookahead,
             self._spin.stuck_left,
@@ -175,16 +172,23 @@ class TrajectoryPlannerROS(RolloutController):
         self._end_escape(pose)
         return self._finish(scene, targets, traj, costs, esc if costs[esc] > -2.0 else -1, pose)
 
-    def _edges(self, scene: LocalScene) -> tuple[np.ndarray, np.ndarray, np.ndarray, bool, bool]:
-        """The scoring kernels' footprint inputs: (``near_max`` or the costs, the outline's x and y (empty for a point
-        robot), whether the robot is a polygon, whether ``near_max`` is given)."""
-        outline = self._outline(scene.resolution)
-        near = self._near_max(scene)
+    def _footprint(self, scene: LocalScene) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, bool]:
+        """The scoring kernels' footprint inputs: (the ring bound memo of the scene's costs, the rings' offsets and
+        counts (``ring_bounds``), the outline's x and y, whether the robot is a polygon); empty for a point robot."""
+        res = scene.resolution
+        outline = self._outline(res)
         if outline is None:
-            ox = oy = np.zeros(0)
-        else:
-            ox, oy = np.ascontiguousarray(outline[:, 0]), np.ascontiguousarray(outline[:, 1])
-        return (scene.cost if near is None else near), ox, oy, outline is not None, near is not None
+            none = np.zeros(0)
+            return _NO_MEMO, _NO_OFFSETS, _NO_COUNTS, none, none, False
+        if res not in self._rings:
+            xy = (np.ascontiguousarray(outline[:, 0]), np.ascontiguousarray(outline[:, 1]))
+            self._rings[res] = (*ring_bounds.ring_offsets(outline, res), *xy)
+        offsets, counts, ox, oy = self._rings[res]
+        memo = self._memo
+        if memo is None or memo[0] is not self._costs_seen or memo[1].shape[1:] != scene.cost.shape:
+            # the bounds hold while the costs are the ones seen (the local costmap updates less often)
+            memo = self._memo = (self._costs_seen, ring_bounds.new_memo(scene.cost.shape))
+        return memo[1], offsets, counts, ox, oy, True
 
     @staticmethod
     def _add_heading(scene: LocalScene, costs: np.ndarray, traj: np.ndarray, at: int) -> None:

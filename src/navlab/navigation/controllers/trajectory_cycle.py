@@ -15,7 +15,9 @@ import math
 import numba
 import numpy as np
 
-from navlab.navigation.controllers.rollout import integrate_rollouts, rollout_scores
+from navlab.navigation.controllers.mapgrid import wave_to
+from navlab.navigation.controllers.ring_bounds import ring_scores
+from navlab.navigation.controllers.rollout import integrate_rollouts
 
 
 @numba.njit(cache=True, inline="always")
@@ -35,9 +37,11 @@ def _linspace(start: float, stop: float, num: int, out: np.ndarray) -> None:  # 
 @numba.njit(cache=True)
 def score_samples(
     grid: np.ndarray,
-    near: np.ndarray,
-    path_dist: np.ndarray,
-    goal_dist: np.ndarray,
+    memo: np.ndarray,
+    rings: np.ndarray,
+    ring_counts: np.ndarray,
+    path_wave: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray],
+    goal_wave: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray],
     resolution: float,
     pose: tuple[float, float, float],
     velocity: tuple[float, float],
@@ -47,7 +51,6 @@ def score_samples(
     ox: np.ndarray,
     oy: np.ndarray,
     polygon: bool,
-    use_near: bool,
     weights: np.ndarray,
     impossible: float,
     at: int,
@@ -57,8 +60,11 @@ def score_samples(
 
     ``limits`` = (vmin, vmax, wmin, wmax, min_in_place_vel_theta, escape_vel, acc_lim_x, acc_lim_theta);
     ``counts`` = (vx_samples, vtheta_samples); ``timing`` = (sim_time, sim_granularity, angular granularity,
-    heading_scoring 0/1). Rows: per speed the straight rollout then ``nw - 1`` turn rates from the lowest up,
-    then the ``nw`` in-place turns, then the escape. ``at``: the scored step (``_heading_step``)."""
+    heading_scoring 0/1); ``path_wave``, ``goal_wave``: the path and goal distances (``mapgrid.wave_start``). A
+    polygon robot's footprint is checked with ``ring_bounds.ring_scores`` (``memo``, ``rings``, ``ring_counts``:
+    its bound memo and rings; a point robot's centre cell alone). Rows: per speed the straight rollout then
+    ``nw - 1`` turn rates from the lowest up, then the ``nw`` in-place turns, then the escape. ``at``: the scored
+    step (``_heading_step``)."""
     vmin, vmax, wmin, wmax, min_ip, escape_vel, ax, ath = (
         limits[0],
         limits[1],
@@ -101,24 +107,10 @@ def score_samples(
         pose[0], pose[1], pose[2], velocity[0], velocity[1], targets, steps, sim_time, ax, ath, True, traj, c, s
     )
     costs = np.empty(n)
-    rollout_scores(
-        grid,
-        near,
-        path_dist,
-        goal_dist,
-        1.0 / resolution,
-        traj,
-        c,
-        s,
-        ox,
-        oy,
-        polygon,
-        use_near,
-        weights,
-        impossible,
-        np.full(n, at, dtype=np.int64),
-        costs,
-    )
+    ats = np.full(n, at, dtype=np.int64)
+    inv = 1.0 / resolution
+    scene = (path_wave, goal_wave, inv, traj, c, s, ox, oy, polygon, weights, impossible, ats, costs)
+    ring_scores(grid, memo, rings, ring_counts, *scene)
     return targets, traj, costs, ws, dw
 
 
@@ -130,7 +122,8 @@ def choose(
     dw: float,
     nf: int,
     escaping: bool,
-    goal_dist: np.ndarray,
+    grid: np.ndarray,
+    goal_wave: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray],
     resolution: float,
     lookahead: float,
     stuck_left: bool,
@@ -139,14 +132,14 @@ def choose(
     """The chosen row of ``score_samples``' samples, -1 for none: the cheapest valid forward rollout (not while
     escaping), unless an in-place turn costs no more; among those turns (faster than one sample step, allowed by
     the stuck flags, look-ahead point on the grid) the one whose look-ahead point (``lookahead`` m ahead of its
-    last pose) is nearest the goal."""
+    last pose) is nearest the goal (``goal_wave``: its distances on the costs ``grid``)."""
     best = -1
     if not escaping:
         low = math.inf
         for r in range(nf):
             if costs[r] >= 0 and costs[r] < low:
                 best, low = r, costs[r]
-    h, w = goal_dist.shape
+    h, w = grid.shape
     inv = 1.0 / resolution
     last = traj.shape[1] - 1
     best_heading = math.inf
@@ -162,6 +155,7 @@ def choose(
         i, j = math.floor(hx * inv), math.floor(hy * inv)
         if not (0 <= i < w and 0 <= j < h):
             continue
-        if goal_dist[j, i] < best_heading:
-            best, best_heading = nf + k, goal_dist[j, i]
+        d = wave_to(grid, goal_wave, i, j)
+        if d < best_heading:
+            best, best_heading = nf + k, d
     return best

@@ -301,6 +301,16 @@ def _descend(pot: np.ndarray, u: float, v: float, tu: float, tv: float, step: fl
     return out[:m], False
 
 
+@numba.njit(cache=True)
+def _cell_costs(data: np.ndarray, table: np.ndarray) -> np.ndarray:  # pragma: no cover - compiled
+    """``table`` (256,) looked up at every cell of ``data`` (uint8)."""
+    out = np.empty(data.shape)
+    for j in range(data.shape[0]):
+        for i in range(data.shape[1]):
+            out[j, i] = table[data[j, i]]
+    return out
+
+
 # --- the planner ---------------------------------------------------------------------------------
 
 
@@ -320,13 +330,12 @@ class NavfnPlanner(GridPlanner):
         """Per-cell traversal cost (float64; inf = obstacle) from costmap_2d costs, as navfn's ``setCostmap``."""
         p = self.params
         ceiling = max(float(p.lethal_cost), p.neutral_cost)  # navfn: COST_OBS - 1 = 253
-        cost = np.minimum(p.neutral_cost + p.cost_factor * data.astype(np.float64), ceiling)
-        obstacle = data >= p.lethal_cost
-        unknown = data == COST_UNKNOWN
-        cost[obstacle] = np.inf
+        levels = np.arange(256)
+        table = np.minimum(p.neutral_cost + p.cost_factor * levels.astype(np.float64), ceiling)  # per cost value
+        table[levels >= p.lethal_cost] = np.inf
         if p.allow_unknown:
-            cost[unknown] = ceiling
-        return cost
+            table[COST_UNKNOWN] = ceiling
+        return _cell_costs(np.ascontiguousarray(data, dtype=np.uint8), table)
 
     def make_plan(
         self, costmap: Grid, start: tuple[float, float, float], goal: tuple[float, float, float]

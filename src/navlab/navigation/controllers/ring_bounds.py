@@ -1,0 +1,201 @@
+"""TrajectoryPlanner's rollout scores with the footprint checked only where it can change the result.
+
+A pose's occupancy cost is the highest cost under its footprint outline's points or at its centre cell
+(``rollout._pose_cost``); the rollout's is the highest over its poses. Every outline point lies between
+``rmin`` and ``rmax`` of the centre (the outline's nearest and farthest point), whatever the heading, so with
+the centre in a given quarter of a cell the points can only fall in a fixed ring of cells around it
+(:func:`ring_offsets`). The highest cost in that ring and the centre cell is a bound on the pose's cost, looked
+up once per (cell, quarter) and kept while the costs stay the same (:func:`ring_bound`). A pose is checked point
+by point only when its bound can still fail it (LETHAL or unknown in the ring) or raise the rollout's cost
+above what its other poses already cost: first, in time order, the poses that may fail (the first failure
+decides, as ``rollout.rollout_scores``), then the highest bound of the rest, then (latest first) any pose whose bound
+is still above. The costs are those of ``rollout.rollout_scores`` bit for bit: the maximum does not depend on the order.
+Poses are grid-local (m, rad); cells (i, j) = (column, row).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+
+from navlab.grid import COST_INSCRIBED, COST_LETHAL, COST_UNKNOWN
+from navlab.navigation.controllers.mapgrid import grow
+
+QUARTERS = 2  # the centre's cell is split QUARTERS x QUARTERS ways: tighter rings than one ring per cell
+_EPS = 1e-6  # cells: room for the rounding of the outline points' coordinates
+
+
+def ring_offsets(outline: np.ndarray, resolution: float) -> tuple[np.ndarray, np.ndarray]:
+    """(offsets (Q, M, 2) as (di, dj), counts (Q,)): for each part q = qj * QUARTERS + qi of a cell, the cells
+    relative to the centre's that an outline point (base frame, m) can fall in, at any heading, while the centre
+    lies in that part of its cell."""
+    r = np.hypot(outline[:, 0], outline[:, 1]) / resolution
+    rmin, rmax = float(r.min()) - _EPS, float(r.max()) + _EPS
+    reach = math.ceil(rmax) + 2
+    q = QUARTERS
+    rings: list[list[tuple[int, int]]] = []
+    for qj in range(q):
+        for qi in range(q):
+            ring = []
+            for b in range(-reach, reach + 1):
+                for a in range(-reach, reach + 1):
+                    # the centre's offset within its cell is in [qi/q, (qi+1)/q): a point in cell a lies this far away
+                    lx, hx = a - (qi + 1) / q - _EPS, a + 1 - qi / q + _EPS
+                    ly, hy = b - (qj + 1) / q - _EPS, b + 1 - qj / q + _EPS
+                    dx = 0.0 if lx <= 0.0 <= hx else min(abs(lx), abs(hx))
+                    dy = 0.0 if ly <= 0.0 <= hy else min(abs(ly), abs(hy))
+                    far = math.hypot(max(abs(lx), abs(hx)), max(abs(ly), abs(hy)))
+                    if math.hypot(dx, dy) <= rmax and far >= rmin:
+                        ring.append((a, b))
+            rings.append(ring)
+    offsets = np.zeros((q * q, max(len(g) for g in rings), 2), dtype=np.int64)
+    counts = np.zeros(q * q, dtype=np.int64)
+    for k, ring in enumerate(rings):
+        offsets[k, : len(ring)] = ring
+        counts[k] = len(ring)
+    return offsets, counts
+
+
+def new_memo(shape: tuple[int, int]) -> np.ndarray:
+    """An empty bound memo (Q, H, W) for a grid of ``shape``: -1 = not looked up yet."""
+    return np.full((QUARTERS * QUARTERS, *shape), -1, dtype=np.int16)
+
+
+@numba.njit(cache=True)
+def ring_bound(
+    grid: np.ndarray, memo: np.ndarray, offsets: np.ndarray, counts: np.ndarray, q: int, i: int, j: int
+) -> int:  # pragma: no cover - compiled
+    """The highest cost of the centre cell (i, j) and its ring ``q`` (unknown if the ring leaves the grid); kept
+    in ``memo``."""
+    h, w = grid.shape
+    top = int(grid[j, i])
+    for m in range(counts[q]):
+        pi, pj = i + offsets[q, m, 0], j + offsets[q, m, 1]
+        if pi < 0 or pj < 0 or pi >= w or pj >= h:
+            top = COST_UNKNOWN
+        else:
+            top = max(top, int(grid[pj, pi]))
+    memo[q, j, i] = top
+    return top
+
+
+@numba.njit(cache=True, inline="always")
+def _exact(
+    grid: np.ndarray, inv: float, x: float, y: float, c: float, s: float, ox: np.ndarray, oy: np.ndarray, bound: int
+) -> float:  # pragma: no cover - compiled
+    """``rollout._pose_cost`` with the centre inside the grid and ``with_centre``, given the pose's ring bound."""
+    h, w = grid.shape
+    i, j = math.floor(x * inv), math.floor(y * inv)
+    centre = grid[j, i]
+    if bound < COST_LETHAL and (bound == 0 or bound == centre):
+        return float(bound)  # nothing under the outline costs more than the centre
+    best = np.uint8(0)
+    off = False
+    # every point, branch-free: rollout._pose_cost's loop, kept here (calling _pose_cost costs this kernel ~20 %)
+    for m in range(ox.size):
+        px = x + c * ox[m] - s * oy[m]
+        py = y + s * ox[m] + c * oy[m]
+        pi, pj = np.int64(math.floor(px * inv)), np.int64(math.floor(py * inv))
+        ok = (pi >= 0) & (pi < w) & (pj >= 0) & (pj < h)
+        off |= not ok
+        best = max(best, grid[pj if ok else 0, pi if ok else 0])
+    if off or best >= COST_LETHAL:
+        return -1.0
+    return float(max(best, centre))
+
+
+@numba.njit(cache=True)
+def ring_scores(
+    grid: np.ndarray,
+    memo: np.ndarray,
+    offsets: np.ndarray,
+    counts: np.ndarray,
+    path_wave: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray],
+    goal_wave: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray],
+    inv: float,
+    traj: np.ndarray,
+    c: np.ndarray,
+    s: np.ndarray,
+    ox: np.ndarray,
+    oy: np.ndarray,
+    polygon: bool,
+    weights: np.ndarray,
+    impossible: float,
+    at: np.ndarray,
+    out: np.ndarray,
+) -> None:  # pragma: no cover - compiled
+    """``rollout.rollout_scores`` with ``with_centre`` (the same arguments, ``memo``/``offsets``/``counts`` in place
+    of ``near`` and ``use_near``, which a point robot (``polygon`` False) does without; the distance waves to the
+    path and to the goal (``mapgrid.wave_start``) in place of their maps, grown as far as the rollouts need): the
+    cost of each rollout (S, n, 3) into ``out``; -1 blocked or off the map, -2 no path."""
+    h, w = grid.shape
+    n = traj.shape[1]
+    q = QUARTERS
+    path_dist, path_reached, path_free, path_queue, path_ends = path_wave
+    goal_dist, goal_reached, goal_free, goal_queue, goal_ends = goal_wave
+    bounds = np.empty(n, dtype=np.int64)
+    for r in range(traj.shape[0]):
+        top = -math.inf
+        fail = 0.0
+        spd = sgd = 0.0
+        first, first_bound = -1, -1  # the deferred pose of highest bound
+        for k in range(n):
+            x, y = traj[r, k, 0], traj[r, k, 1]
+            bounds[k] = -1
+            moved = k == 0 or x != traj[r, k - 1, 0] or y != traj[r, k - 1, 1]
+            turned = moved or c[r, k] != c[r, k - 1] or s[r, k] != s[r, k - 1]
+            if not (turned or at[r] == k):
+                continue  # the pose before, repeated: nothing new (its distances passed already)
+            fx, fy = x * inv, y * inv
+            i, j = math.floor(fx), math.floor(fy)
+            inside = 0 <= i < w and 0 <= j < h
+            if turned:
+                if not inside:
+                    fail = -1.0
+                    break
+                if not polygon:  # a point robot: its centre cell, blocked from INSCRIBED up
+                    if grid[j, i] >= COST_INSCRIBED:
+                        fail = -1.0
+                        break
+                    top = max(top, float(grid[j, i]))
+                else:
+                    part = min(q - 1, int((fy - j) * q)) * q + min(q - 1, int((fx - i) * q))
+                    b = int(memo[part, j, i])
+                    if b < 0:
+                        b = ring_bound(grid, memo, offsets, counts, part, i, j)
+                    if b >= COST_LETHAL:  # it may fail: check it now, in time order
+                        fp = _exact(grid, inv, x, y, c[r, k], s[r, k], ox, oy, b)
+                        if fp < 0:
+                            fail = -1.0
+                            break
+                        top = max(top, fp)
+                    else:
+                        bounds[k] = b
+                        if b > first_bound:
+                            first, first_bound = k, b
+            if at[r] == k or (at[r] == -1 and moved):  # (unmoved, the distances are those that passed)
+                pi, pj = (i, j) if inside else (0, 0)
+                pd = path_dist[pj, pi]
+                if not path_reached[pj, pi]:
+                    pd = grow(grid, path_dist, path_reached, path_free, path_queue, path_ends, pi, pj)
+                gd = goal_dist[pj, pi]
+                if not goal_reached[pj, pi]:
+                    gd = grow(grid, goal_dist, goal_reached, goal_free, goal_queue, goal_ends, pi, pj)
+                spd, sgd = pd, gd
+                if pd >= impossible or gd >= impossible:
+                    fail = -2.0
+                    break
+        if fail < 0:
+            out[r] = fail
+            continue
+        if first >= 0 and first_bound > top:
+            top = max(
+                top,
+                _exact(grid, inv, traj[r, first, 0], traj[r, first, 1], c[r, first], s[r, first], ox, oy, first_bound),
+            )
+        for k in range(n - 1, -1, -1):  # latest first: a rollout's cost tends to grow along it
+            if bounds[k] > top and k != first:
+                top = max(top, _exact(grid, inv, traj[r, k, 0], traj[r, k, 1], c[r, k], s[r, k], ox, oy, bounds[k]))
+        out[r] = weights[0] * (weights[1] * spd + weights[2] * sgd + weights[3] * top)
