@@ -5,8 +5,10 @@
 
 The trace holds every cmd_vel (hex floats), the tf map -> odom and odom -> base sent, every amcl_pose, a hash of
 every global plan, of both costmaps after each update and of the controller's local plan each cycle, the true
-path and the monitor's samples (clearance, localization error, plan tracking) at 10 Hz and each goal's figures. Record with the old code (e.g. ``PYTHONPATH=/tmp/old/src``, a ``git archive`` of the base), then
-with the new, and compare: ``compare`` names the first difference of each part and exits 1 if there is one.
+path and the monitor's samples (clearance, localization error, plan tracking) at 10 Hz, and each goal's figures.
+Record with the old code (e.g. ``PYTHONPATH=/tmp/old/src``, a ``git archive`` of the base; this tool from the new
+tree), then with the new, and compare: ``compare`` names the first difference of each part and exits 1 if there is
+one.
 """
 
 from __future__ import annotations
