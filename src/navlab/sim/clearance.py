@@ -84,9 +84,7 @@ def candidates(bound: np.ndarray, tight: np.ndarray, order: np.ndarray, max_dist
     return out[:n]
 
 
-def clearance(
-    m: mujoco.MjModel, d: mujoco.MjData, robot: np.ndarray, world: np.ndarray, max_distance: float
-) -> float:
+def clearance(m: mujoco.MjModel, d: mujoco.MjData, robot: np.ndarray, world: np.ndarray, max_distance: float) -> float:
     """Signed distance (m) between the ``robot`` geoms and the ``world`` geoms (negative: interpenetrating),
     ``max_distance`` when nothing is closer; see the module docstring."""
     if not len(robot) or not len(world):
