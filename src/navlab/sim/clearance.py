@@ -61,8 +61,8 @@ def pair_bounds(
                     qr = max(math.sqrt(lx * lx + ly * ly) - size[b, 0], 0.0)
                     qz = max(abs(lz) - size[b, 1], 0.0)
                     gap = math.sqrt(qr * qr + qz * qz)
-                tight[k] = gap - ra if gap > 0.0 else -np.inf  # a centre inside: no bound but the spheres'
-                tight[k] = max(tight[k], bound[k])
+                # a centre inside the shape: no bound but the spheres' (the geom may reach deeper than its radius)
+                tight[k] = max(gap - ra, bound[k]) if gap > 0.0 else bound[k]
             else:  # spheres: the bounding spheres' gap is exact; other shapes (meshes ...): no better bound here
                 tight[k] = bound[k]
     return bound, tight
@@ -93,8 +93,6 @@ def clearance(m: mujoco.MjModel, d: mujoco.MjData, robot: np.ndarray, world: np.
     order = np.argsort(bound)  # the order of argsort(bound table, axis=None): same values, same sort
     ks = candidates(bound, tight, order, max_distance)
     best = max_distance
-    if not len(ks):
-        return float(best)
     nw = len(world)
     bl, tl, rl, wl = bound[ks].tolist(), tight[ks].tolist(), robot.tolist(), world.tolist()
     for k, b, t in zip(ks.tolist(), bl, tl, strict=True):
