@@ -91,3 +91,18 @@ def synth_world() -> SynthWorld:
 @pytest.fixture
 def odometry_noise():
     return noisy_odometry
+
+
+@pytest.fixture
+def masks_hold():
+    """A check: every tile the given tables hold has the occupied-with-free-behind mask worked out from
+    scratch (``gmapping_tiles.mask_tile``)."""
+    from navlab.mapping.gmapping_tiles import TILE, mask_tile
+
+    def check(pool, tables: list[np.ndarray]) -> None:
+        expected = np.empty((TILE, TILE), dtype=np.uint16)
+        for t in np.unique(np.concatenate([table.ravel() for table in tables])):
+            mask_tile(pool.tiles[t], expected)
+            np.testing.assert_array_equal(pool.masks[t], expected, err_msg=f"tile {t}")
+
+    return check

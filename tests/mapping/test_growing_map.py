@@ -86,7 +86,9 @@ def test_slam_map_saves_cropped_to_what_was_seen(synth_world, odometry_noise, tm
     np.testing.assert_array_equal(saved.value_at(grid.centers(grid.occupied_mask())), 100)
 
 
-def test_resampled_maps_share_their_tiles_and_reference_counts_hold(synth_world, odometry_noise, monkeypatch):
+def test_resampled_maps_share_their_tiles_and_reference_counts_hold(
+    synth_world, odometry_noise, monkeypatch, masks_hold
+):
     # copy-on-write maps: after every update, particles drawn from one source hold the same tiles, every
     # tile's reference count is the number of tables holding it, and a tile is written by nobody else
     update = GMapping._update
@@ -99,6 +101,7 @@ def test_resampled_maps_share_their_tiles_and_reference_counts_hold(synth_world,
         counts = np.bincount(np.concatenate([t.ravel() for t in tables]), minlength=len(self.pool.refs))
         np.testing.assert_array_equal(self.pool.refs[1:], counts[1:])
         assert not self.pool.tiles[0].any()  # the unknown tile
+        masks_hold(self.pool, tables)  # (the matcher's occupied-with-free-behind bits follow the cells)
         checked["grown"] += self.map_resizes > resizes
         if self.resamples > resamples:
             checked["resampled"] += 1

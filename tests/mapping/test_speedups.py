@@ -18,10 +18,10 @@ from navlab.mapping.occupancy import L_CLAMP, L_FREE, L_OCC, _raycast, integrate
 from navlab.mapping.scanmatch import LookupField, correlative_search
 
 
-def _tiled(grid: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(tiles, table) of a dense log-odds grid: the matcher's map argument."""
+def _tiled(grid: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(tiles, masks, table) of a dense log-odds grid: the matcher's map argument."""
     pool, table = from_dense(grid)
-    return pool.tiles, table
+    return pool.tiles, pool.masks, table
 
 
 def _plain_climb(tiled, lattice, scan, model, x0, y0, t0, lstep, astep, iterations):
@@ -177,9 +177,9 @@ def test_the_unchecked_ray_walk_equals_the_checked_one() -> None:
         )
 
 
-def test_the_tiled_ray_cast_writes_the_dense_cells_and_copies_only_shared_tiles() -> None:
+def test_the_tiled_ray_cast_writes_the_dense_cells_and_copies_only_shared_tiles(masks_hold) -> None:
     """Two particles share one map's tiles; one integrates a scan: its map equals the dense ray cast's, the
-    other's is unchanged, and only the tiles the scan wrote were copied."""
+    other's is unchanged, only the tiles the scan wrote were copied, and every tile's mask holds."""
     rng = np.random.default_rng(9)
     grid, r, ang = _room_map(rng)
     args = (0.05, 2.5, 2.0, 0.1, r, ang, 8.0, 10.0, L_OCC, L_FREE, L_CLAMP)
@@ -189,13 +189,14 @@ def test_the_tiled_ray_cast_writes_the_dense_cells_and_copies_only_shared_tiles(
     in_use = pool.in_use()
     for _ in range(2):  # the second time every tile written is already private: no copies
         free = pool.free(mine.size)  # (may grow the pool: its arrays are read after)
-        cow = (pool.tiles, mine, pool.refs, free, np.zeros(1, dtype=np.int64))
+        cow = (pool.tiles, pool.masks, mine, pool.refs, free, np.zeros(1, dtype=np.int64))
         raycast_tiles(*cow, (0.0, 0.0, 0, 0, 0.05), (2.5, 2.0, 0.1), (r, ang, 8.0, 10.0), (L_OCC, L_FREE, L_CLAMP))
     whole = grid.copy()
     _raycast(whole, 0.0, 0.0, 0, 0, *args)
     _raycast(whole, 0.0, 0.0, 0, 0, *args)
     np.testing.assert_array_equal(to_dense(pool.tiles, mine)[:90, :110], whole)
     np.testing.assert_array_equal(to_dense(pool.tiles, theirs)[:90, :110], grid)
+    masks_hold(pool, [mine, theirs])
     written = np.unique(np.argwhere(whole != grid) // TILE, axis=0)
     assert pool.in_use() == in_use + len(written)
     assert np.count_nonzero(mine != theirs) == len(written)

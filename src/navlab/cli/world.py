@@ -100,6 +100,7 @@ def _cmd_clutter(args: argparse.Namespace) -> int:
         f"(T_opt {world.t_opt():.2f} s at 2 m/s; narrowest passage half-width "
         f"{world.metrics['bottleneck_m']:.3f} m)"
     )
+    print(f"BARN's path {world.barn_path_m:.3f} m, as its generator saves it (BARN's T_opt {world.barn_t_opt():.2f} s)")
     print(f"wrote {out}" + (f" and {png}" if png else ""))
     return 0
 

@@ -262,6 +262,11 @@ def summarize_trials(results: list[dict[str, Any]]) -> dict[str, Any]:
             "tracking_error_mean_m": _mean(results, "tracking_error_m"),
             "final_error_mean_m": _mean(results, "final_error_m"),
             **({"score_mean": _mean(results, "score")} if any("score" in r for r in results) else {}),  # BARN
+            **(
+                {"score_shortest_mean": _mean(results, "score_shortest")}  # navlab's stricter T_opt
+                if any("score_shortest" in r for r in results)
+                else {}
+            ),
         }
     )
 

@@ -303,7 +303,7 @@ class GMapping:
     ) -> None:
         """Ray-cast the scan into the map of ``table`` (copying the tiles it shares before writing them)."""
         free = self.pool.free(self._scan_tiles)  # (may grow the pool: its arrays are read after)
-        cow = (self.pool.tiles, table, self.pool.refs, free, np.zeros(1, dtype=np.int64))
+        cow = (self.pool.tiles, self.pool.masks, table, self.pool.refs, free, np.zeros(1, dtype=np.int64))
         at = (float(pose[0]), float(pose[1]), float(pose[2]))
         raycast_tiles(*cow, self._lattice(), at, (r, ang, max_urange, max_range), (L_OCC, L_FREE, L_CLAMP))
 
@@ -327,14 +327,14 @@ class GMapping:
         lattice = self._lattice()
         scan, model = (r, np.cos(ang), np.sin(ang), max_urange), self._model()
         poses = self.poses
-        tiles = self.pool.tiles
+        tiles, masks = self.pool.tiles, self.pool.masks
         for part, pose in zip(self.particles, poses, strict=True):
             x, y, t, score, lik = self._match(part.table, pose, scan)
             matched = score > p.minimumScore
             if matched:
                 pose[:] = x, y, wrap_angle(t)
             if not matched or pose[2] != t:  # the weight takes the log-likelihood at another pose
-                _s, lik, _n = match_score(tiles, part.table, lattice, (pose[0], pose[1], pose[2]), scan, model)
+                _s, lik, _n = match_score(tiles, masks, part.table, lattice, (pose[0], pose[1], pose[2]), scan, model)
             part.weight += lik
         # normalise (GMapping: gain 1 / (ogain * N)) and resample on N_eff
         lw = np.array([q.weight for q in self.particles])
@@ -423,7 +423,7 @@ class GMapping:
         is then climbed on every beam and kept only if it beats the first climb, so the scan turns away
         from its odometry only where the map matches it better there."""
         p = self.p
-        fixed = (self.pool.tiles, table, self._lattice())
+        fixed = (self.pool.tiles, self.pool.masks, table, self._lattice())
         model, steps = self._model(), (p.lstep, p.astep, p.iterations)
         best = optimize(*fixed, (pose[0], pose[1], pose[2]), scan, model, steps)
         if p.wideScore <= 0 or p.wideStep <= 0:

@@ -2,7 +2,8 @@
 map and the hill climbing over (x, y, theta) that maximises it (``ScanMatcher::score`` / ``optimize``) — and
 the motion model's draw for all particles at once (``MotionModel::drawFromMotion``).
 
-A particle's map is a tiled copy-on-write map (``mapping.gmapping_tiles``: ``tiles``, ``table``) whose cells
+A particle's map is a tiled copy-on-write map (``mapping.gmapping_tiles``: ``tiles``, their ``masks``, ``table``)
+whose cells
 follow the lattice conventions of ``mapping.occupancy``: a fixed lattice anchored at (``ox``, ``oy``) from
 lattice cell (``oi``, ``oj``) on; cells outside it read as unknown.
 """
@@ -14,7 +15,7 @@ import math
 import numba
 import numpy as np
 
-from navlab.mapping.gmapping_tiles import MASK, SHIFT, TILE, cell, from_dense, raycast_tiles
+from navlab.mapping.gmapping_tiles import MASK, NEIGHBOUR_BIT, SHIFT, TILE, cell, from_dense, raycast_tiles
 from navlab.mapping.occupancy import L_CLAMP, L_FREE, L_OCC, scan_cells
 
 # the kernels' argument groups (numba tuples)
@@ -79,6 +80,7 @@ def _endpoints(lattice: Lattice, pose: Pose, beams: Beams, fw: np.ndarray, iw: n
 @numba.njit(cache=True, inline="always")
 def _score_above(
     tiles: np.ndarray,
+    masks: np.ndarray,
     table: np.ndarray,
     lattice: Lattice,
     pose: Pose,
@@ -106,7 +108,7 @@ def _score_above(
     rv = beams[0]
     th, tw = table.shape
     h, w = th * TILE, tw * TILE
-    flat = tiles.reshape(-1)  # a view (C-contiguous)
+    flat = masks.reshape(-1)  # a view (C-contiguous)
     _endpoints(lattice, pose, beams, fw, iw)
     s = 0.0
     null_l = -0.5 / lsigma  # GMapping: nullLikelihood = -0.5
@@ -120,8 +122,9 @@ def _score_above(
         inside = (
             min(ei, fi) >= kernel and min(ej, fj) >= kernel and max(ei, fi) < w - kernel and max(ej, fj) < h - kernel
         )
-        # GMapping's default kernel with both 3 x 3 windows inside one tile each (nearly always): unrolled,
-        # each cell's x and y term once, flat unsigned indices (no wrap-around checks) and no branches
+        # GMapping's default kernel with both 3 x 3 windows inside one tile each (nearly always; then it is
+        # the same tile, as the cell back is a neighbour): each cell's occupied-with-free-behind bit read from
+        # the tile's mask, unrolled, each cell's x and y term once, flat unsigned indices and no branches
         if (
             inside
             and kernel == 1
@@ -131,14 +134,14 @@ def _score_above(
             and 1 <= (fj & MASK) < MASK
         ):
             ce = table[ej >> SHIFT, ei >> SHIFT] * TILE * TILE + (ej & MASK) * TILE + (ei & MASK)
-            cf = table[fj >> SHIFT, fi >> SHIFT] * TILE * TILE + (fj & MASK) * TILE + (fi & MASK)
+            bit = NEIGHBOUR_BIT[(fj - ej + 1) * 3 + fi - ei + 1]
             x0, x1, x2 = fw[2, k], fw[3, k], fw[4, k]
             for dj in range(3):
-                e, f = ce + (dj - 1) * TILE, cf + (dj - 1) * TILE
+                e = ce + (dj - 1) * TILE
                 yy = fw[5 + dj, k]
-                ok0 = (flat[numba.uint64(e - 1)] > 0.0) & (flat[numba.uint64(f - 1)] < 0.0)
-                ok1 = (flat[numba.uint64(e)] > 0.0) & (flat[numba.uint64(f)] < 0.0)
-                ok2 = (flat[numba.uint64(e + 1)] > 0.0) & (flat[numba.uint64(f + 1)] < 0.0)
+                ok0 = (flat[numba.uint64(e - 1)] & bit) != 0
+                ok1 = (flat[numba.uint64(e)] & bit) != 0
+                ok2 = (flat[numba.uint64(e + 1)] & bit) != 0
                 d2 = x0 + yy if ok0 else 1e9
                 best = d2 if d2 < best else best
                 d2 = x1 + yy if ok1 else 1e9
@@ -204,7 +207,7 @@ def _worst_first(terms: np.ndarray, order: np.ndarray, counts: np.ndarray) -> No
 
 @numba.njit(cache=True)
 def match_score(
-    tiles: np.ndarray, table: np.ndarray, lattice: Lattice, pose: Pose, scan: Scan, model: Model
+    tiles: np.ndarray, masks: np.ndarray, table: np.ndarray, lattice: Lattice, pose: Pose, scan: Scan, model: Model
 ) -> tuple[float, float, int]:
     """(score, log-likelihood, matched beams) of the scan at ``pose`` (x, y, theta). ``scan``: (ranges, cos
     and sin of the beam angles (laser frame), max_urange); ``model``: (kernel, sigma, lsigma, skip): every
@@ -212,12 +215,13 @@ def match_score(
     beams = _valid_beams(scan, model[3])
     nb = beams[0].shape[0]
     fw, iw = np.empty((10, nb)), np.empty((4, nb), dtype=np.int64)
-    return _score_above(tiles, table, lattice, pose, beams, model[:3], -1.0, fw, iw, np.arange(nb))
+    return _score_above(tiles, masks, table, lattice, pose, beams, model[:3], -1.0, fw, iw, np.arange(nb))
 
 
 @numba.njit(cache=True)
 def optimize(
     tiles: np.ndarray,
+    masks: np.ndarray,
     table: np.ndarray,
     lattice: Lattice,
     start: Pose,
@@ -242,7 +246,7 @@ def optimize(
     terms = np.empty(nb)  # the score terms of the best pose found in this step of the climb
     seen = np.empty((SEEN_POSES, 5))  # x, y, theta, score (-1: no better than the pose it was tried from), lik
     cx, cy, ct = start
-    cur, cur_lik, _n = _score_above(tiles, table, lattice, start, beams, scoring, -1.0, fw, iw, order)
+    cur, cur_lik, _n = _score_above(tiles, masks, table, lattice, start, beams, scoring, -1.0, fw, iw, order)
     _worst_first(fw[8], order, counts)
     seen[0, 0], seen[0, 1], seen[0, 2], seen[0, 3], seen[0, 4] = cx, cy, ct, cur, cur_lik
     n_seen = 1
@@ -278,7 +282,8 @@ def optimize(
             if q < n_seen:
                 sc, lik = seen[q, 3], seen[q, 4]
             else:
-                sc, lik, _n = _score_above(tiles, table, lattice, (nx, ny, nt), beams, scoring, cur, fw, iw, order)
+                at = (nx, ny, nt)
+                sc, lik, _n = _score_above(tiles, masks, table, lattice, at, beams, scoring, cur, fw, iw, order)
                 if n_seen < SEEN_POSES:
                     seen[n_seen, 0], seen[n_seen, 1], seen[n_seen, 2] = nx, ny, nt
                     seen[n_seen, 3], seen[n_seen, 4] = sc, lik
@@ -317,11 +322,11 @@ def warmup() -> None:
     that load would stall the first map update (a live run's simulation at its first second)."""
     pool, table = from_dense(np.zeros((4, 4), dtype=np.float32))
     free, used = pool.free(1), np.zeros(1, dtype=np.int64)
-    tiles = pool.tiles  # (after free(), which may grow the pool)
+    tiles, masks = pool.tiles, pool.masks  # (after free(), which may grow the pool)
     r, c = np.ones(2), np.ones(2)
     lattice, pose, scan, model = (0.0, 0.0, 0, 0, 0.05), (0.1, 0.1, 0.0), (r, c, c, 1.0), (1, 0.05, 0.075, 0)
-    optimize(tiles, table, lattice, pose, scan, model, (0.05, 0.05, 1))
-    match_score(tiles, table, lattice, pose, scan, model)
-    raycast_tiles(tiles, table, pool.refs, free, used, lattice, pose, (r, c, 1.0, 2.0), (L_OCC, L_FREE, L_CLAMP))
+    optimize(tiles, masks, table, lattice, pose, scan, model, (0.05, 0.05, 1))
+    match_score(tiles, masks, table, lattice, pose, scan, model)
+    raycast_tiles(tiles, masks, table, pool.refs, free, used, lattice, pose, (r, c, 1.0, 2.0), (L_OCC, L_FREE, L_CLAMP))
     draw_motion(np.zeros((2, 3)), np.zeros((2, 3)), 0.1, 0.0, 0.0, 0.1, 0.1, 0.1)
     scan_cells(np.zeros((2, 3)), r, c, (0.0, 0.0), 0.05, max_urange=1.0, max_range=2.0)

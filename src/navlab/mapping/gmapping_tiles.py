@@ -7,6 +7,14 @@ it shares (with another particle, or tile 0) first takes a private copy (``_own`
 particle's map by copying its small table, so 30 particles descended from one ancestor hold about one map
 plus what each changed since. Reference counts are recounted from the tables when particles change.
 
+Beside each tile the pool keeps its occupied-with-free-behind mask (``masks``, uint16, the same id): bit
+``NEIGHBOUR_BIT[(dj + 1) * 3 + di + 1]`` of cell (j, i) is set when the cell is occupied (> 0) and its neighbour
+(j + dj, i + di) *in the same tile* is free (< 0) — what GMapping's score asks of a match cell and the cell
+one step back along the beam — and ``NEAR_OCC`` when some neighbour in the tile is occupied (so a cell that
+turns free or stops being free needs no look at its neighbours unless it has that bit). A mask depends on
+its own tile only, so it follows the tile's copy-on-write; a neighbour across a tile edge is never marked
+(the matcher reads the cells themselves there).
+
 Lattice conventions as in ``mapping.occupancy``: the map holds the cells of a fixed lattice anchored at
 (``ox``, ``oy``) from lattice cell (``oi``, ``oj``) on; cells outside it read as unknown.
 """
@@ -22,6 +30,9 @@ from navlab.mapping.occupancy import beam_end, is_return, lattice_cell
 SHIFT = 6
 TILE = 1 << SHIFT  # cells per tile side (64 cells: 3.2 m at 5 cm, 16 KiB of float32)
 MASK = TILE - 1
+# the mask bit of each neighbour offset (dj + 1) * 3 + di + 1; the cell itself (4) has none
+NEIGHBOUR_BIT = np.array([1, 2, 4, 8, 0, 16, 32, 64, 128], dtype=np.uint16)
+NEAR_OCC = 256  # the mask bit of a cell with an occupied neighbour in its tile
 
 
 class TilePool:
@@ -29,6 +40,7 @@ class TilePool:
 
     def __init__(self, capacity: int = 64) -> None:
         self.tiles = np.zeros((max(capacity, 2), TILE, TILE), dtype=np.float32)
+        self.masks = np.zeros(self.tiles.shape, dtype=np.uint16)  # each tile's mask (module docstring)
         self.refs = np.zeros(len(self.tiles), dtype=np.int64)
         self.refs[0] = 1 << 40  # never freed, never written
 
@@ -40,7 +52,7 @@ class TilePool:
 
     def free(self, need: int) -> np.ndarray:
         """Ids of at least ``need`` free tiles (the pool grows by at least half when short), lowest first.
-        Growing replaces ``tiles`` and ``refs``: read them after this call."""
+        Growing replaces ``tiles``, ``masks`` and ``refs``: read them after this call."""
         ids = np.flatnonzero(self.refs == 0)
         if len(ids) < need:
             old = len(self.tiles)
@@ -48,6 +60,9 @@ class TilePool:
             tiles = np.empty((cap, TILE, TILE), dtype=np.float32)
             tiles[:old] = self.tiles
             self.tiles = tiles
+            masks = np.empty(tiles.shape, dtype=np.uint16)
+            masks[:old] = self.masks
+            self.masks = masks
             self.refs = np.concatenate([self.refs, np.zeros(cap - old, dtype=np.int64)])
             ids = np.flatnonzero(self.refs == 0)
         return ids
@@ -75,6 +90,7 @@ def from_dense(grid: np.ndarray) -> tuple[TilePool, np.ndarray]:
             block = padded[tj * TILE : (tj + 1) * TILE, ti * TILE : (ti + 1) * TILE]
             if block.any():
                 pool.tiles[n] = block
+                mask_tile(pool.tiles[n], pool.masks[n])
                 table[tj, ti] = n
                 n += 1
     pool.recount([table])
@@ -95,17 +111,96 @@ def cell(tiles: np.ndarray, table: np.ndarray, j: int, i: int) -> float:
 
 
 @numba.njit(cache=True, inline="always")
+def _cell_mask(tiles: np.ndarray, t: int, j: int, i: int) -> int:
+    """The mask word of cell (``j``, ``i``) of tile ``t`` (tile coordinates), from its in-tile neighbours."""
+    v = tiles[t, j, i]
+    m = 0
+    for dj in range(-1, 2):
+        for di in range(-1, 2):
+            jj, ii = j + dj, i + di
+            if (dj == 0 and di == 0) or not (0 <= jj < TILE and 0 <= ii < TILE):
+                continue
+            u = tiles[t, jj, ii]
+            if v > 0.0 and u < 0.0:
+                m |= NEIGHBOUR_BIT[(dj + 1) * 3 + di + 1]
+            if u > 0.0:
+                m |= NEAR_OCC
+    return m
+
+
+@numba.njit(cache=True)
+def mask_tile(tile: np.ndarray, mask: np.ndarray) -> None:
+    """``mask`` (TILE, TILE) worked out from scratch for ``tile`` (module docstring)."""
+    tiles, masks = tile.reshape(1, TILE, TILE), mask.reshape(1, TILE, TILE)
+    for j in range(TILE):
+        for i in range(TILE):
+            masks[0, j, i] = _cell_mask(tiles, 0, j, i)
+
+
+@numba.njit(cache=True, inline="always")
+def _remask(tiles: np.ndarray, masks: np.ndarray, t: int, j: int, i: int) -> None:
+    """Mend tile ``t``'s mask after its cell (``j``, ``i``) became or stopped being occupied: the cell's own
+    word and its in-tile neighbours' (rare: at beam end cells)."""
+    for jj in range(max(j - 1, 0), min(j + 2, TILE)):
+        for ii in range(max(i - 1, 0), min(i + 2, TILE)):
+            masks[t, jj, ii] = _cell_mask(tiles, t, jj, ii)
+
+
+@numba.njit(cache=True, inline="always")
+def _refree(tiles: np.ndarray, masks: np.ndarray, t: int, j: int, i: int) -> None:
+    """Mend tile ``t``'s mask after its cell (``j``, ``i``), beside an occupied cell, became or stopped being
+    free: the occupied neighbours' bits that point at it."""
+    free = tiles[t, j, i] < 0.0
+    for dj in range(-1, 2):
+        for di in range(-1, 2):
+            jj, ii = j + dj, i + di
+            if (dj == 0 and di == 0) or not (0 <= jj < TILE and 0 <= ii < TILE) or not tiles[t, jj, ii] > 0.0:
+                continue
+            back = NEIGHBOUR_BIT[(1 - dj) * 3 + 1 - di]  # the neighbour's bit pointing at this cell
+            if free:
+                masks[t, jj, ii] |= back
+            else:
+                masks[t, jj, ii] &= ~back
+
+
+@numba.njit(cache=True, inline="always")
+def _set(tiles: np.ndarray, masks: np.ndarray, t: int, j: int, i: int, add: float, clamp: float) -> None:
+    """Cell (``j``, ``i``) of tile ``t`` (tile coordinates) changed by ``add``, clamped to ±``clamp``, its
+    tile's mask mended where the cell's change between occupied, free and unknown shows. Only a cell that
+    was not already on the side ``add`` moves it to can change (a test the ray's many free cells pass
+    cheaply)."""
+    old = tiles[t, j, i]
+    v = old + add
+    tiles[t, j, i] = min(max(v, -clamp), clamp)
+    if (old >= 0.0) if add < 0.0 else (old <= 0.0):
+        new = tiles[t, j, i]  # (as stored: float32)
+        if (old > 0.0) != (new > 0.0):
+            _remask(tiles, masks, t, j, i)
+        elif (old < 0.0) != (new < 0.0) and masks[t, j, i] & NEAR_OCC:
+            _refree(tiles, masks, t, j, i)
+
+
+@numba.njit(cache=True, inline="always")
 def _own(
-    tiles: np.ndarray, table: np.ndarray, refs: np.ndarray, free: np.ndarray, used: np.ndarray, tj: int, ti: int
+    tiles: np.ndarray,
+    masks: np.ndarray,
+    table: np.ndarray,
+    refs: np.ndarray,
+    free: np.ndarray,
+    used: np.ndarray,
+    tj: int,
+    ti: int,
 ) -> int:
     """The id of tile (``tj``, ``ti``) of this particle's map after making it private: a shared tile (or
-    tile 0) is first copied into the next of the ``free`` tiles (``used[0]`` of them taken so far)."""
+    tile 0) is first copied, with its mask, into the next of the ``free`` tiles (``used[0]`` of them taken so
+    far)."""
     t = table[tj, ti]
     if refs[t] == 1:
         return t
     new = free[used[0]]
     used[0] += 1
     tiles[new] = tiles[t]
+    masks[new] = masks[t]
     refs[t] -= 1
     refs[new] = 1
     table[tj, ti] = new
@@ -115,6 +210,7 @@ def _own(
 @numba.njit(cache=True)
 def raycast_tiles(
     tiles: np.ndarray,
+    masks: np.ndarray,
     table: np.ndarray,
     refs: np.ndarray,
     free: np.ndarray,
@@ -129,7 +225,7 @@ def raycast_tiles(
     of ``scan`` (ranges, angles, max_urange, max_range) with a range in (0, max_range) lowers the log-odds
     of the cells it crosses (Bresenham, end cell excluded) by ``l_free`` and, if shorter than max_urange,
     raises its end cell by ``l_occ`` (``update``: (l_occ, l_free, clamp); clamped to ±clamp); cells
-    outside the map are skipped. Tiles written are made private first."""
+    outside the map are skipped. Tiles written are made private first; their ``masks`` follow the cells."""
     ranges, angles, max_urange, max_range = scan
     l_occ, l_free, clamp = update
     th, tw = table.shape
@@ -146,14 +242,12 @@ def raycast_tiles(
             if 0 <= i < w and 0 <= j < h:
                 tj, ti = j >> SHIFT, i >> SHIFT
                 if tj != last_tj or ti != last_ti:
-                    t = _own(tiles, table, refs, free, used, tj, ti)
+                    t = _own(tiles, masks, table, refs, free, used, tj, ti)
                     last_tj, last_ti = tj, ti
-                v = tiles[t, j & MASK, i & MASK] + l_free
-                tiles[t, j & MASK, i & MASK] = v if v > -clamp else -clamp
+                _set(tiles, masks, t, j & MASK, i & MASK, l_free, clamp)
         if hit and 0 <= i1 < w and 0 <= j1 < h:
             tj, ti = j1 >> SHIFT, i1 >> SHIFT
             if tj != last_tj or ti != last_ti:
-                t = _own(tiles, table, refs, free, used, tj, ti)
+                t = _own(tiles, masks, table, refs, free, used, tj, ti)
                 last_tj, last_ti = tj, ti
-            v = tiles[t, j1 & MASK, i1 & MASK] + l_occ
-            tiles[t, j1 & MASK, i1 & MASK] = v if v < clamp else clamp
+            _set(tiles, masks, t, j1 & MASK, i1 & MASK, l_occ, clamp)

@@ -18,9 +18,10 @@ the field: its sides in line with the field's wall rows, its back 2.925 m behind
 walls. The robot starts 2.1 m before the field facing +x, 0.25 m off its centre line (the challenge's
 INIT_POSITION (-2, 3) against the field's centre -2.25), and the goal is 10 m straight ahead, past the field in
 the open. ``ClutterWorld.reference_path_m`` is the length of the shortest collision-free path for a disc of
-``robot_radius`` (8-connected Dijkstra on a 0.05 m grid of exact clearances, then shortened by line of sight),
-BARN's T_opt = reference length / 2 m/s. Worlds are written as SDF 1.6 ``.world`` files that navlab's
-:func:`navlab.world.load_world` and Gazebo classic both load.
+``robot_radius`` (8-connected Dijkstra on a 0.05 m grid of exact clearances, then shortened by line of
+sight): navlab's stricter T_opt = reference length / 2 m/s. BARN's own T_opt comes from the path its generator
+saves (``ClutterWorld.barn_path``, ``barn_t_opt``: :func:`navlab.world.barn_grid.barn_path`). Worlds are written
+as SDF 1.6 ``.world`` files that navlab's :func:`navlab.world.load_world` and Gazebo classic both load.
 """
 
 from __future__ import annotations
@@ -43,6 +44,8 @@ from navlab.world.barn_grid import CELL as CELL
 from navlab.world.barn_grid import CELLS as CELLS
 from navlab.world.barn_grid import FIELD as FIELD
 from navlab.world.barn_grid import ROBOT_CELLS as ROBOT_CELLS
+from navlab.world.barn_grid import barn_path as barn_path
+from navlab.world.barn_grid import barn_path_length as barn_path_length
 from navlab.world.barn_grid import cellular_automaton as cellular_automaton
 from navlab.world.barn_grid import configuration_space as configuration_space
 from navlab.world.barn_grid import field_centres as field_centres
@@ -91,7 +94,10 @@ class ClutterWorld:
     ``attempts``: automaton draws until one had a way through; ``difficulty``: fraction of the 28 inner rows'
     cells holding a cylinder; ``metrics``: more figures: ``fill_initial``, ``fill_final`` (= difficulty),
     ``tortuosity`` (reference length / 10 m), ``mean_clearance_m`` (robot centre to the nearest surface along
-    the reference path in the field) and ``bottleneck_m`` (half-width of the narrowest passage on the widest route).
+    the reference path in the field) and ``bottleneck_m`` (half-width of the narrowest passage on the widest route);
+    ``barn_path``: (m, 2) (row, col) cells of the path BARN's generator saves for this field
+    (:func:`navlab.world.barn_grid.barn_path`), ``barn_path_m`` its length as the challenge's run.py measures it
+    (start, cells, goal), the length BARN's T_opt comes from.
     """
 
     seed: int
@@ -109,6 +115,8 @@ class ClutterWorld:
     difficulty: float
     attempts: int
     metrics: dict[str, float] = field(default_factory=dict)
+    barn_path: np.ndarray | None = None
+    barn_path_m: float | None = None
 
     @property
     def name(self) -> str:
@@ -116,8 +124,15 @@ class ClutterWorld:
         return f"clutter_s{self.seed}_f{round(self.fill * 100):02d}_k{self.smooth}"
 
     def t_opt(self, speed: float = BARN_SPEED) -> float:
-        """BARN's optimal traversal time (s): reference path length / ``speed`` (m/s)."""
+        """navlab's optimal traversal time (s): the shortest collision-free path (``reference_path_m``) /
+        ``speed`` (m/s); shorter than :meth:`barn_t_opt` but by run.py's offset (see ``barn_grid.RUNNER_OFFSET``), so a
+        score with it is stricter than BARN's."""
         return self.reference_path_m / speed
+
+    def barn_t_opt(self, speed: float = BARN_SPEED) -> float:
+        """BARN's optimal traversal time (s), as the challenge's run.py computes it: ``barn_path_m`` / ``speed``
+        (m/s); :meth:`t_opt` for a world made without BARN's path."""
+        return self.t_opt(speed) if self.barn_path_m is None else self.barn_path_m / speed
 
     def summary(self) -> dict[str, object]:
         """The figures a user reads (JSON-ready): parameters, poses, counts, reference length, difficulty."""
@@ -134,6 +149,8 @@ class ClutterWorld:
             "goal": list(self.goal),
             "reference_path_m": round(self.reference_path_m, 4),
             "t_opt_s": round(self.t_opt(), 4),
+            "barn_path_m": None if self.barn_path_m is None else round(self.barn_path_m, 4),
+            "barn_t_opt_s": round(self.barn_t_opt(), 4),
             "difficulty": round(self.difficulty, 4),
             "metrics": {k: round(v, 4) for k, v in self.metrics.items()},
         }
@@ -365,8 +382,11 @@ def generate_clutter(
             rng, fill, int(smooth), fill_threshold=fill_threshold, clear_threshold=clear_threshold, count=batch
         )
         hits = np.flatnonzero(way_through(configuration_space(stack, int(robot_cells))))
-        if len(hits):
-            cells, attempts = stack[hits[0]], attempts + int(hits[0]) + 1
+        # BARN also throws away a field its A* finds no path through (none of the suites' fields so far); the
+        # path's random end rows come from the same stream, after the batch
+        found = next(((int(h), p) for h in hits if (p := barn_path(stack[h], rng, int(robot_cells))) is not None), None)
+        if found is not None:
+            cells, bpath, attempts = stack[found[0]], found[1], attempts + found[0] + 1
             break
         attempts += batch
         if attempts >= MAX_DRAWS:
@@ -386,6 +406,7 @@ def generate_clutter(
             f"clutter: seed {seed}: no collision-free path for robot_radius {robot_radius} m (every world keeps "
             f"{guaranteed_clearance(int(robot_cells)):.3f} m for robot_cells {robot_cells}); raise robot_cells"
         )
+    barn_m = barn_path_length(bpath, start, goal)
     seg = np.linalg.norm(np.diff(path, axis=0), axis=1)
     length = float(seg.sum())
     samples = np.vstack(
@@ -421,6 +442,8 @@ def generate_clutter(
         difficulty=difficulty,
         attempts=attempts,
         metrics=metrics,
+        barn_path=bpath,
+        barn_path_m=barn_m,
     )
 
 
