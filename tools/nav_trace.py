@@ -4,9 +4,11 @@
     python tools/nav_trace.py compare OLD.json NEW.json
 
 The trace holds every cmd_vel (hex floats), the tf map -> odom and odom -> base sent, every amcl_pose, a hash of
-every global plan, of both costmaps after each update and of the controller's local plan each cycle, and the true
-path at 10 Hz. Record with the old code (e.g. ``PYTHONPATH=/tmp/old/src``, a ``git archive`` of the base), then
-with the new, and compare: ``compare`` names the first difference of each part and exits 1 if there is one.
+every global plan, of both costmaps after each update and of the controller's local plan each cycle, the true
+path and the monitor's samples (clearance, localization error, plan tracking) at 10 Hz, and each goal's figures.
+Record with the old code (e.g. ``PYTHONPATH=/tmp/old/src``, a ``git archive`` of the base; this tool from the new
+tree), then with the new, and compare: ``compare`` names the first difference of each part and exits 1 if there is
+one.
 """
 
 from __future__ import annotations
@@ -28,12 +30,14 @@ def record(out: str, seed: int, controller: str | None, robot: str = "mybot") ->
     """Run bench nav's goals with hooks on the executor, the costmaps and move_base; write the trace to ``out``."""
     from navlab.bench.experiments import NAV_GOALS
     from navlab.core.executor import Executor
+    from navlab.experiments.navigate_monitor import NavMonitor
     from navlab.experiments.navigate_run import run_navigation
     from navlab.navigation.costmap_ros import Costmap2DROS
     from navlab.navigation.move_base import MoveBase
 
-    rec: dict[str, Any] = {k: [] for k in ("cmd", "tf", "amcl", "plan", "costmap", "local")}
+    rec: dict[str, Any] = {k: [] for k in ("cmd", "tf", "amcl", "plan", "costmap", "local", "monitor")}
     publish, update, make_plan = Executor.publish, Costmap2DROS.update, MoveBase.make_plan
+    sample = NavMonitor._sample
 
     def on_publish(self: Any, topic: Any, msg: Any, *, latch_key: int | None = None) -> None:
         t, name = self.now_ns, topic.name
@@ -63,6 +67,11 @@ def record(out: str, seed: int, controller: str | None, robot: str = "mybot") ->
         rec["plan"].append((self.executor.now_ns, None if p is None else _digest(np.ascontiguousarray(p).tobytes())))
         return p
 
+    def on_sample(self: Any) -> None:
+        sample(self)
+        last = (self.clearance[-1], self.tracking[-1], self.localization_error[-1] if self.localization_error else 0.0)
+        rec["monitor"].append((self.executor.now_ns, *(float(v).hex() for v in last)))
+
     def on_start(run: Any) -> None:
         ctl = run.node("move_base").controller
         compute = ctl.compute_velocity
@@ -76,6 +85,7 @@ def record(out: str, seed: int, controller: str | None, robot: str = "mybot") ->
         ctl.compute_velocity = on_compute
 
     Executor.publish, Costmap2DROS.update, MoveBase.make_plan = on_publish, on_update, on_make_plan  # type: ignore[method-assign]
+    NavMonitor._sample = on_sample  # type: ignore[method-assign]
     r = run_navigation(
         list(NAV_GOALS),
         world="room_obstacles",
@@ -87,6 +97,7 @@ def record(out: str, seed: int, controller: str | None, robot: str = "mybot") ->
     )
     rec["path"] = [[float(v).hex() for v in row] for row in r.path]
     rec["summary"] = {k: r.summary[k] for k in ("sim_s", "goals_succeeded", "collisions")}
+    rec["goals"] = [{k: v.hex() if isinstance(v, float) else v for k, v in g.items()} for g in r.goals]
     with open(out, "w") as f:
         json.dump(rec, f)
     print(out, {k: len(v) for k, v in rec.items()})

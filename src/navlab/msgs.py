@@ -2,7 +2,9 @@
 
 Messages are the typestore's dataclasses with the exact ROS field names; array fields are numpy
 arrays. Helpers convert between yaw and quaternions, nanoseconds and ``builtin_interfaces/Time``,
-and build the messages navlab publishes most often.
+and build the messages navlab publishes most often. The helpers pass the fields positionally, in the
+message definition's order: a dataclass built so costs a third of one built by keywords, and these are
+built tens of thousands of times a simulated minute.
 """
 
 from __future__ import annotations
@@ -121,7 +123,7 @@ def type_name(msg_or_cls: Any) -> str:
 def time_from_ns(ns: int) -> Any:
     """``builtin_interfaces/Time`` from integer nanoseconds."""
     sec, nsec = divmod(int(ns), 1_000_000_000)
-    return Time(sec=sec, nanosec=nsec)
+    return Time(sec, nsec)
 
 
 def ns_from_time(t: Any) -> int:
@@ -131,7 +133,7 @@ def ns_from_time(t: Any) -> int:
 
 def header(stamp_ns: int, frame_id: str) -> Any:
     """``std_msgs/Header`` with a stamp in nanoseconds."""
-    return Header(stamp=time_from_ns(stamp_ns), frame_id=frame_id)
+    return Header(time_from_ns(stamp_ns), frame_id)
 
 
 # --- rotations ------------------------------------------------------------------------------------
@@ -139,7 +141,7 @@ def header(stamp_ns: int, frame_id: str) -> Any:
 
 def quaternion_msg(q: Any) -> Any:
     """``geometry_msgs/Quaternion`` from (x, y, z, w) components."""
-    return Quaternion(x=float(q[0]), y=float(q[1]), z=float(q[2]), w=float(q[3]))
+    return Quaternion(float(q[0]), float(q[1]), float(q[2]), float(q[3]))
 
 
 def xyzw(q: Any) -> tuple[float, float, float, float]:
@@ -162,7 +164,7 @@ def yaw_from_quaternion(q: Any) -> float:
 
 def pose_from_2d(x: float, y: float, yaw: float) -> Any:
     """``geometry_msgs/Pose`` in the plane."""
-    return Pose(position=Point(x=float(x), y=float(y), z=0.0), orientation=quaternion_from_yaw(yaw))
+    return Pose(Point(float(x), float(y), 0.0), quaternion_from_yaw(yaw))
 
 
 def pose2d(pose: Any) -> tuple[float, float, float]:
@@ -172,26 +174,24 @@ def pose2d(pose: Any) -> tuple[float, float, float]:
 
 def pose_stamped(stamp_ns: int, frame_id: str, x: float, y: float, yaw: float) -> Any:
     """``geometry_msgs/PoseStamped`` in the plane."""
-    return PoseStamped(header=header(stamp_ns, frame_id), pose=pose_from_2d(x, y, yaw))
+    return PoseStamped(header(stamp_ns, frame_id), pose_from_2d(x, y, yaw))
 
 
 def transform_stamped(stamp_ns: int, parent: str, child: str, x: float, y: float, yaw: float, z: float = 0.0) -> Any:
     """``geometry_msgs/TransformStamped`` ``parent_T_child`` in the plane (plus height ``z``)."""
     return TransformStamped(
-        header=header(stamp_ns, parent),
-        child_frame_id=child,
-        transform=Transform(translation=Vector3(x=float(x), y=float(y), z=float(z)), rotation=quaternion_from_yaw(yaw)),
+        header(stamp_ns, parent), child, Transform(Vector3(float(x), float(y), float(z)), quaternion_from_yaw(yaw))
     )
 
 
 def twist(vx: float = 0.0, wz: float = 0.0, vy: float = 0.0) -> Any:
     """``geometry_msgs/Twist`` for a planar robot (m/s, rad/s)."""
-    return Twist(linear=Vector3(x=float(vx), y=float(vy), z=0.0), angular=Vector3(x=0.0, y=0.0, z=float(wz)))
+    return Twist(Vector3(float(vx), float(vy), 0.0), Vector3(0.0, 0.0, float(wz)))
 
 
 def vector3(v: Any) -> Any:
     """``geometry_msgs/Vector3`` from (x, y, z)."""
-    return Vector3(x=float(v[0]), y=float(v[1]), z=float(v[2]))
+    return Vector3(float(v[0]), float(v[1]), float(v[2]))
 
 
 def odometry(
@@ -209,18 +209,13 @@ def odometry(
     ``orientation`` x, y, z, w), its velocity in the child frame (``linear`` m/s, ``angular`` rad/s, x, y, z),
     and the 36-float row-major covariances (taken as they are: pass a copy)."""
     return Odometry(
-        header=header(stamp_ns, frame_id),
-        child_frame_id=child_frame_id,
-        pose=PoseWithCovariance(
-            pose=Pose(
-                position=Point(x=float(position[0]), y=float(position[1]), z=float(position[2])),
-                orientation=quaternion_msg(orientation),
-            ),
-            covariance=pose_covariance,
+        header(stamp_ns, frame_id),
+        child_frame_id,
+        PoseWithCovariance(
+            Pose(Point(float(position[0]), float(position[1]), float(position[2])), quaternion_msg(orientation)),
+            pose_covariance,
         ),
-        twist=TwistWithCovariance(
-            twist=Twist(linear=vector3(linear), angular=vector3(angular)), covariance=twist_covariance
-        ),
+        TwistWithCovariance(Twist(vector3(linear), vector3(angular)), twist_covariance),
     )
 
 

@@ -109,14 +109,27 @@ def test_kld_bin_count_and_tracking_distance_equal_their_plain_forms() -> None:
     it = np.floor(poses[:, 2] / sampling.BIN_YAW).astype(np.int64) % sampling.N_YAW_BINS
     np.testing.assert_array_equal(sampling.bin_keys(poses), (ix * sampling._SPAN + iy) * sampling.N_YAW_BINS + it)
     for keys in (rng.integers(0, 40, 500), sampling.bin_keys(poses)):
-        _, first = np.unique(keys, return_index=True)
-        is_new = np.zeros(keys.size, np.int64)
-        is_new[first] = 1
-        np.testing.assert_array_equal(sampling.bins_so_far(keys), np.cumsum(is_new))
         ukeys, inverse = np.unique(keys, return_inverse=True)
         hashed = sampling.unique_inverse(keys)
         np.testing.assert_array_equal(hashed[0], ukeys)
         np.testing.assert_array_equal(hashed[1], inverse.ravel())
+    for spread in (3.0, 0.2, 0.1):  # KLD's count: the first count above the limit for the bins occupied so far
+        cand = poses * (spread / 3.0)
+        _, first = np.unique(sampling.bin_keys(cand), return_index=True)
+        is_new = np.zeros(len(cand), np.int64)
+        is_new[first] = 1
+        counts = np.arange(1, len(cand) + 1)
+        over = np.flatnonzero(counts > sampling.kld_limit(np.cumsum(is_new), 0.01, 0.99, 100, 5000))
+        plain = max(min(int(counts[over[0]]) if over.size else len(cand), 5000), 100)
+        assert sampling.kld_count(cand, 0.01, 0.99, 100, 5000) == plain
+    for size in (1, 7, 300):  # low-variance draws: searchsorted on the running sums, from one rng.random()
+        w = rng.random(size) ** 3
+        w[rng.random(size) < 0.3] = 0.0
+        u = np.random.default_rng(size).random()
+        cum = np.cumsum(w)
+        plain_idx = np.minimum(np.searchsorted(cum, (u + np.arange(500)) * (cum[-1] / 500), side="right"), size - 1)
+        drawn = sampling.low_variance_indices(w, 500, np.random.default_rng(size))
+        np.testing.assert_array_equal(drawn, plain_idx)
     path = np.cumsum(rng.normal(0, 0.1, (80, 2)), axis=0)
     pts = rng.normal(0, 1, (5, 2))
     a, ab = path[:-1], np.diff(path, axis=0)
@@ -203,3 +216,33 @@ def test_obstacle_layer_takes_ranges_in_one_call_as_it_takes_their_endpoints() -
         marked += int((layers[0].grid.data == COST_LETHAL).sum())
         cleared += int((layers[0].grid.data == 0).sum())
     assert marked > 1000 and cleared > 10000  # the scans did mark and clear
+
+
+def test_ray_clearing_writes_the_cells_of_the_plain_walk() -> None:
+    """Rays whose both ends lie in the grid are walked without per-cell bounds checks: the same cells as the
+    plain walk (cut to max_cells, stopped where it leaves the grid, min_cells kept), rays in and out of it."""
+    from navlab.gridline import TIE_LATE, line, line_cell
+    from navlab.navigation.costmap.raytrace import clear_rays
+
+    rng = np.random.default_rng(5)
+    for trial in range(12):
+        data = np.zeros((40, 50), np.uint8)
+        x0, y0 = rng.uniform(0, 50), rng.uniform(0, 40)
+        ends = np.column_stack([rng.uniform(-20, 70, 60), rng.uniform(-20, 60, 60)])
+        min_cells = 0.0 if trial % 2 == 0 else 3.0
+        clear_rays(data, x0, y0, ends, 30.0, min_cells, np.uint8(7))
+        plain = np.zeros_like(data)
+        i0, j0 = math.floor(x0), math.floor(y0)
+        for ex, ey in ends:
+            dx, dy = ex - x0, ey - y0
+            length = math.sqrt(dx * dx + dy * dy)
+            if length > 30.0:
+                ex, ey = x0 + dx * (30.0 / length), y0 + dy * (30.0 / length)
+            ln = line(i0, j0, math.floor(ex), math.floor(ey), TIE_LATE)
+            for n in range(ln[0] + 1):
+                i, j = line_cell(ln, n)
+                if not (0 <= i < 50 and 0 <= j < 40):
+                    break
+                if (i - i0) ** 2 + (j - j0) ** 2 >= min_cells**2:
+                    plain[j, i] = 7
+        np.testing.assert_array_equal(data, plain, err_msg=f"trial {trial}")

@@ -287,11 +287,11 @@ class Node:
 
     def send_transform(self, transforms: Any | Sequence[Any]) -> None:
         """Broadcast ``TransformStamped`` (one or a list) on ``/tf``."""
-        self._tf_publisher("/tf").publish(TFMessage(transforms=_as_list(transforms)))
+        self._tf_publisher("/tf").publish(TFMessage(_as_list(transforms)))
 
     def send_static_transform(self, transforms: Any | Sequence[Any]) -> None:
         """Broadcast ``TransformStamped`` (one or a list) on ``/tf_static``."""
-        self._tf_publisher("/tf_static").publish(TFMessage(transforms=_as_list(transforms)))
+        self._tf_publisher("/tf_static").publish(TFMessage(_as_list(transforms)))
 
     def _tf_publisher(self, topic: str) -> Publisher:
         for pub in self.publishers:

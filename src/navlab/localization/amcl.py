@@ -332,8 +332,8 @@ class Amcl:
         w_diff = 0.0
         if self.w_slow > 0.0 and p.recovery_alpha_slow > 0:
             w_diff = max(0.0, 1.0 - self.w_fast / self.w_slow)
-        cand = self.particles[sampling.low_variance_indices(self.weights, m, self.rng)]
-        cand = cand[self.rng.permutation(m)]
+        drawn = sampling.low_variance_indices(self.weights, m, self.rng)
+        cand = self.particles[drawn[self.rng.permutation(m)]]  # drawn, then shuffled: one gather
         inject = np.zeros(m, dtype=bool)
         if w_diff > 0.0:
             inject = self.rng.random(m) < w_diff

@@ -222,11 +222,7 @@ class Amcl(Node):
                 self._map_to_odom,
                 msgs.transform_stamped(0, self.global_frame, self.odom_frame, x, y, yaw).transform,
             )
-        self.send_transform(
-            msgs.TransformStamped(
-                header=msgs.header(stamp_ns, self.global_frame), child_frame_id=self.odom_frame, transform=cached[1]
-            )
-        )
+        self.send_transform(msgs.TransformStamped(msgs.header(stamp_ns, self.global_frame), self.odom_frame, cached[1]))
 
     # --- outputs --------------------------------------------------------------------------------
 

@@ -12,6 +12,7 @@ the heaviest cluster's mean.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -26,12 +27,30 @@ _SPAN = 1 << 21
 
 
 def low_variance_indices(weights: np.ndarray, n: int, rng: np.random.Generator) -> np.ndarray:
-    """Indices of ``n`` draws by low-variance (systematic) resampling; ``weights`` need not sum to 1."""
+    """Indices of ``n`` draws by low-variance (systematic) resampling; ``weights`` need not sum to 1. The draws
+    sit at ``(u + i) * total / n`` for one uniform ``u`` (one ``rng.random()``), each taking the first weight
+    whose running sum exceeds it."""
+    return _low_variance(np.ascontiguousarray(weights, dtype=np.float64), int(n), rng.random())
+
+
+@njit(cache=True)
+def _low_variance(weights: np.ndarray, n: int, u: float) -> np.ndarray:  # pragma: no cover - compiled
+    """:func:`low_variance_indices` from its uniform ``u``: ``searchsorted(cumsum(weights), points, "right")``
+    clipped to the last index, by one merge walk (the points are sorted)."""
     cum = np.cumsum(weights)
-    total = cum[-1]
-    points = (rng.random() + np.arange(n)) * (total / n)
-    idx = np.searchsorted(cum, points, side="right")
-    return np.minimum(idx, weights.shape[0] - 1)
+    step = cum[-1] / n
+    last = weights.shape[0] - 1
+    out = np.empty(n, dtype=np.int64)
+    j = 0
+    for i in range(n):
+        p = (u + i) * step
+        if p != p:  # NaN sorts after every number
+            out[i] = last
+            continue
+        while j <= last and cum[j] <= p:
+            j += 1
+        out[i] = min(j, last)
+    return out
 
 
 def kld_limit(k: np.ndarray, kld_err: float, kld_z: float, min_n: int, max_n: int) -> np.ndarray:
@@ -49,25 +68,50 @@ def bin_keys(poses: np.ndarray) -> np.ndarray:
     return _bin_keys(np.ascontiguousarray(poses, dtype=np.float64))
 
 
+@njit(cache=True, inline="always")
+def _bin_key(x: float, y: float, yaw: float) -> np.int64:  # pragma: no cover - compiled
+    """The histogram bin key of one pose (floor of x / BIN_XY, y / BIN_XY and yaw / BIN_YAW; yaw bins wrap)."""
+    ix = np.int64(math.floor(x / BIN_XY)) + _OFF
+    iy = np.int64(math.floor(y / BIN_XY)) + _OFF
+    it = np.int64(math.floor(yaw / BIN_YAW)) % N_YAW_BINS
+    return (ix * _SPAN + iy) * N_YAW_BINS + it
+
+
 @njit(cache=True)
 def _bin_keys(poses: np.ndarray) -> np.ndarray:  # pragma: no cover - compiled
-    """:func:`bin_keys`, compiled (floor of x / BIN_XY, y / BIN_XY and yaw / BIN_YAW; yaw bins wrap)."""
+    """:func:`bin_keys`, compiled."""
     out = np.empty(poses.shape[0], dtype=np.int64)
     for k in range(poses.shape[0]):
-        ix = np.int64(math.floor(poses[k, 0] / BIN_XY)) + _OFF
-        iy = np.int64(math.floor(poses[k, 1] / BIN_XY)) + _OFF
-        it = np.int64(math.floor(poses[k, 2] / BIN_YAW)) % N_YAW_BINS
-        out[k] = (ix * _SPAN + iy) * N_YAW_BINS + it
+        out[k] = _bin_key(poses[k, 0], poses[k, 1], poses[k, 2])
     return out
 
 
+@functools.lru_cache(maxsize=8)
+def _kld_limits(n: int, kld_err: float, kld_z: float, min_n: int, max_n: int) -> np.ndarray:
+    """``kld_limit(k)`` for k = 0 .. n (the same NumPy evaluation, done once per parameter set; read-only)."""
+    out = kld_limit(np.arange(n + 1), kld_err, kld_z, min_n, max_n)
+    out.flags.writeable = False
+    return out
+
+
+@njit(cache=True)
+def _first_over(poses: np.ndarray, limits: np.ndarray) -> int:  # pragma: no cover - compiled
+    """The first count c (1-based) of ``poses`` whose c samples occupy k bins with c > ``limits[k]``; else all."""
+    table, used = _hash_table(poses.shape[0])
+    k = 0
+    for m in range(poses.shape[0]):
+        if _add(table, used, _bin_key(poses[m, 0], poses[m, 1], poses[m, 2])):
+            k += 1
+        if m + 1 > limits[k]:
+            return m + 1
+    return poses.shape[0]
+
+
 def kld_count(candidates: np.ndarray, kld_err: float, kld_z: float, min_n: int, max_n: int) -> int:
-    """How many of ``candidates`` (drawn in random order) KLD-sampling keeps."""
-    keys = bin_keys(candidates)
-    k = bins_so_far(keys)
-    counts = np.arange(1, keys.shape[0] + 1)
-    over = np.flatnonzero(counts > kld_limit(k, kld_err, kld_z, min_n, max_n))
-    n = int(counts[over[0]]) if over.size else keys.shape[0]
+    """How many of ``candidates`` (drawn in random order) KLD-sampling keeps: the first count above the limit
+    for the bins occupied so far (the walk stops there; the limits are tabulated once)."""
+    poses = np.ascontiguousarray(candidates, dtype=np.float64)
+    n = _first_over(poses, _kld_limits(poses.shape[0], float(kld_err), float(kld_z), int(min_n), int(max_n)))
     return max(min(n, max_n), min_n)
 
 
@@ -100,19 +144,6 @@ def _hash_table(n: int) -> tuple[np.ndarray, np.ndarray]:  # pragma: no cover - 
     while size < 2 * n:
         size *= 2
     return np.empty(size, dtype=np.int64), np.zeros(size, dtype=np.bool_)
-
-
-@njit(cache=True)
-def bins_so_far(keys: np.ndarray) -> np.ndarray:  # pragma: no cover - compiled
-    """``out[m]``: how many distinct keys ``keys[: m + 1]`` holds (the bins the first m + 1 samples occupy)."""
-    table, used = _hash_table(keys.shape[0])
-    out = np.empty(keys.shape[0], dtype=np.int64)
-    n = 0
-    for m in range(keys.shape[0]):
-        if _add(table, used, keys[m]):
-            n += 1
-        out[m] = n
-    return out
 
 
 @njit(cache=True)

@@ -46,13 +46,8 @@ C = TypeVar("C", bound=SensorDescription)
 
 def _transform(stamp_ns: int, parent: str, child: str, xyz: Any, q: Any) -> Any:
     """``TransformStamped`` from a translation and a quaternion (x, y, z, w)."""
-    return msgs.TransformStamped(
-        header=msgs.header(stamp_ns, parent),
-        child_frame_id=child,
-        transform=msgs.Transform(
-            translation=msgs.vector3(xyz),
-            rotation=msgs.quaternion_msg(q),
-        ),
+    return msgs.TransformStamped(  # positional: see navlab.msgs
+        msgs.header(stamp_ns, parent), child, msgs.Transform(msgs.vector3(xyz), msgs.quaternion_msg(q))
     )
 
 

@@ -15,6 +15,7 @@ import numpy as np
 from navlab.description import DiffDriveConfig, LidarConfig, RobotModel
 from navlab.geometry import quat_from_rpy, quat_from_yaw, wxyz_from_xyzw, xyzw_from_wxyz, yaw_from_quat
 from navlab.sim.builder import GROUND_CONTACT_BIT, GROUP_ROBOT, GROUP_WORLD, RAY_GEOMGROUP, mj_quat_from_rpy
+from navlab.sim.clearance import clearance
 from navlab.sim.errors import SimError
 from navlab.sim.raycast import FAST_TYPES, cast_planar, finish_ranges
 from navlab.sim.scene import add_world_model, build_spec, compile_spec, remove_world_model
@@ -242,21 +243,8 @@ class Simulation:
     def clearance(self, max_distance: float = 2.0) -> float:
         """Distance (m) between the robot's collision geometry and the nearest collision geom of the world (the
         floor excluded), from MuJoCo's ``mj_geomDistance``: negative when they interpenetrate, ``max_distance``
-        when nothing is closer. Cheap: pairs are asked nearest bounding spheres first, and only while their
-        spheres could still be closer than the best distance found."""
-        m, d = self.model, self.data
-        robot, world = self._clear_robot, self._clear_world
-        if not len(robot) or not len(world):
-            return max_distance
-        centres = np.linalg.norm(d.geom_xpos[robot][:, None, :] - d.geom_xpos[world][None, :, :], axis=2)
-        bound = centres - m.geom_rbound[robot][:, None] - m.geom_rbound[world][None, :]  # <= the pair's distance
-        best = max_distance
-        for k in np.argsort(bound, axis=None):
-            i, j = divmod(int(k), len(world))
-            if bound[i, j] >= best:
-                break
-            best = min(best, mujoco.mj_geomDistance(m, d, int(robot[i]), int(world[j]), best, None))
-        return float(best)
+        when nothing is closer. Cheap: only the pairs that can still be the nearest are asked (``sim.clearance``)."""
+        return clearance(self.model, self.data, self._clear_robot, self._clear_world, max_distance)
 
     def teleport(self, x: float, y: float, yaw: float) -> None:
         """Move the robot's root to (x, y, yaw) in the world (m, rad), at rest: Gazebo's set_model_state

@@ -52,6 +52,12 @@ def clear_rays(
             continue
         last_i, last_j, walked = i1, j1, True
         ln = line(i0, j0, i1, j1, TIE_LATE)
+        if min_sq <= 0.0 and 0 <= i1 < w and 0 <= j1 < h:  # both ends inside: so is every cell between them
+            for n in range(ln[0] + 1):
+                i, j = line_cell(ln, n)
+                data[j, i] = value
+            written += ln[0] + 1
+            continue
         for n in range(ln[0] + 1):
             i, j = line_cell(ln, n)
             if i < 0 or j < 0 or i >= w or j >= h:
