@@ -22,6 +22,7 @@ import numpy as np
 
 from navlab.grid import COST_INSCRIBED, COST_LETHAL, COST_UNKNOWN
 from navlab.navigation.controllers.mapgrid import grow
+from navlab.navigation.controllers.rollout import outline_max
 
 QUARTERS = 2  # the centre's cell is split QUARTERS x QUARTERS ways: tighter rings than one ring per cell
 _EPS = 1e-6  # cells: room for the rounding of the outline points' coordinates
@@ -86,21 +87,11 @@ def _exact(
     grid: np.ndarray, inv: float, x: float, y: float, c: float, s: float, ox: np.ndarray, oy: np.ndarray, bound: int
 ) -> float:  # pragma: no cover - compiled
     """``rollout._pose_cost`` with the centre inside the grid and ``with_centre``, given the pose's ring bound."""
-    h, w = grid.shape
     i, j = math.floor(x * inv), math.floor(y * inv)
     centre = grid[j, i]
     if bound < COST_LETHAL and (bound == 0 or bound == centre):
         return float(bound)  # nothing under the outline costs more than the centre
-    best = np.uint8(0)
-    off = False
-    # every point, branch-free: rollout._pose_cost's loop, kept here (calling _pose_cost costs this kernel ~20 %)
-    for m in range(ox.size):
-        px = x + c * ox[m] - s * oy[m]
-        py = y + s * ox[m] + c * oy[m]
-        pi, pj = np.int64(math.floor(px * inv)), np.int64(math.floor(py * inv))
-        ok = (pi >= 0) & (pi < w) & (pj >= 0) & (pj < h)
-        off |= not ok
-        best = max(best, grid[pj if ok else 0, pi if ok else 0])
+    best, off = outline_max(grid, inv, x, y, c, s, ox, oy)  # rollout._pose_cost's loop, inlined
     if off or best >= COST_LETHAL:
         return -1.0
     return float(max(best, centre))

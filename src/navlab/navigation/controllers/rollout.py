@@ -193,6 +193,26 @@ def outline_reach_max(cost: np.ndarray, resolution: float, outline: np.ndarray) 
 
 
 @numba.njit(cache=True, inline="always")
+def outline_max(
+    grid: np.ndarray, inv: float, x: float, y: float, c: float, s: float, ox: np.ndarray, oy: np.ndarray
+) -> tuple[np.uint8, bool]:  # pragma: no cover
+    """The highest cost under the outline points (``ox``, ``oy``, robot frame, m) of the pose at (``x``, ``y``)
+    (grid frame, m; heading cos ``c``, sin ``s``) and whether any point falls off the grid. Every point, without
+    early exit: the loop compiles to branch-free code."""
+    h, w = grid.shape
+    best = np.uint8(0)
+    off = False
+    for m in range(ox.size):
+        px = x + c * ox[m] - s * oy[m]
+        py = y + s * ox[m] + c * oy[m]
+        pi, pj = np.int64(math.floor(px * inv)), np.int64(math.floor(py * inv))
+        ok = (pi >= 0) & (pi < w) & (pj >= 0) & (pj < h)
+        off |= not ok
+        best = max(best, grid[pj if ok else 0, pi if ok else 0])
+    return best, off
+
+
+@numba.njit(cache=True, inline="always")
 def _pose_cost(
     grid: np.ndarray,
     near: np.ndarray,
@@ -220,17 +240,8 @@ def _pose_cost(
         top = near[j, i]
         if top < COST_LETHAL and (top == 0 or (with_centre and top == centre)):
             return float(top)
-    # every edge point, without early exit (the loop compiles to branch-free code): off the grid or on a
-    # LETHAL/unknown cell is illegal, else the highest cost
-    best = np.uint8(0)
-    off = False
-    for m in range(ox.size):
-        px = x + c * ox[m] - s * oy[m]
-        py = y + s * ox[m] + c * oy[m]
-        pi, pj = np.int64(math.floor(px * inv)), np.int64(math.floor(py * inv))
-        ok = (pi >= 0) & (pi < w) & (pj >= 0) & (pj < h)
-        off |= not ok
-        best = max(best, grid[pj if ok else 0, pi if ok else 0])
+    # every edge point: off the grid or on a LETHAL/unknown cell is illegal, else the highest cost
+    best, off = outline_max(grid, inv, x, y, c, s, ox, oy)
     if off or best >= COST_LETHAL:
         return -1.0
     return float(max(best, centre)) if with_centre else float(best)
