@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import collections
 import contextlib
-import math
 import os
 import xml.etree.ElementTree as ET
 from collections.abc import Iterable, Iterator
@@ -36,6 +35,7 @@ from navlab.description import (
 from navlab.geometry import compose6
 from navlab.world.errors import WorldError
 from navlab.world.model import ModelSpec, Pose6, WorldModel
+from navlab.world.sdf_xml import flag, floats, num, parse_xml, pose_of, vec3
 
 SUPPORTED_VERSIONS = ("1.4", "1.5", "1.6", "1.7")
 _IGNORED_WORLD_TAGS = (
@@ -56,59 +56,6 @@ _IGNORED_WORLD_TAGS = (
 
 
 MAX_NESTING = 32  # models and includes inside each other (xacro's include depth too)
-
-
-def _floats(text: str | None, n: int, where: str) -> tuple[float, ...]:
-    parts = (text or "").split()
-    try:
-        vals = tuple(float(p) for p in parts)
-    except ValueError:
-        raise WorldError(f"{where}: expected {n} numbers, got {text!r}") from None
-    if len(vals) != n or not all(math.isfinite(v) and abs(v) < 1e9 for v in vals):
-        raise WorldError(f"{where}: expected {n} finite numbers (|v| < 1e9), got {text!r}")
-    return vals
-
-
-def _vec3(text: str | None, where: str) -> tuple[float, float, float]:
-    x, y, z = _floats(text, 3, where)
-    return x, y, z
-
-
-def _num(el: ET.Element | None, tag: str, where: str, default: float) -> float:
-    sub = el.find(tag) if el is not None else None
-    if sub is None or not (sub.text or "").strip():
-        return default
-    return _floats(sub.text, 1, f"{where}/<{tag}>")[0]
-
-
-def _pose(el: ET.Element, where: str, warnings: list[str] | None = None) -> Pose6:
-    """The element's ``<pose>`` (x y z roll pitch yaw) relative to its parent frame."""
-    p = el.find("pose")
-    if p is None or not (p.text or "").strip():
-        return (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
-    frame = p.get("relative_to") or p.get("frame") or ""
-    if frame and frame not in ("world", "__model__") and warnings is not None:
-        warnings.append(f"{where}/<pose>: frame {frame!r} is not supported; taken relative to the parent")
-    v = _floats(p.text, 6, f"{where}/<pose>")
-    return (v[0], v[1], v[2], v[3], v[4], v[5])
-
-
-def _bool(el: ET.Element, tag: str, default: bool) -> bool:
-    text = (el.findtext(tag) or "").strip().lower()
-    return default if not text else text in ("1", "true")
-
-
-def _parse_xml(path: Path, what: str) -> ET.Element:
-    if path.is_dir():
-        raise WorldError(f"{path}: is a directory; expected a {what}")
-    if not path.is_file():
-        if path.exists():  # a named pipe would block the parser, a device never end
-            raise WorldError(f"{path}: is not a regular file (a pipe, device or socket); expected a {what}")
-        raise WorldError(f"{path}: {what} not found")
-    try:
-        return ET.parse(path).getroot()
-    except ET.ParseError as exc:
-        raise WorldError(f"{path}: malformed XML ({exc})") from None
 
 
 class _Loader:
@@ -164,7 +111,7 @@ class _Loader:
             return model_dir
         config = model_dir / "model.config"
         if config.is_file():
-            root = _parse_xml(config, "model.config")
+            root = parse_xml(config, "model.config")
             entries = [(e.get("version", "0"), (e.text or "").strip()) for e in root.findall("sdf")]
             entries = [e for e in entries if e[1]]
 
@@ -195,15 +142,15 @@ class _Loader:
             return self._include_file(el, sdf_file, w)
 
     def _include_file(self, el: ET.Element, sdf_file: Path, w: str) -> list[ModelSpec]:
-        root = _parse_xml(sdf_file, "model SDF")
+        root = parse_xml(sdf_file, "model SDF")
         model_el = root.find("model")
         if model_el is None:
             if root.find("light") is None and root.find("actor") is None:
                 self.warnings.append(f"{w}: {sdf_file} holds no <model>; ignored")
             return []
         name = (el.findtext("name") or "").strip() or model_el.get("name", "")
-        pose = _pose(el, w) if el.find("pose") is not None else None
-        static = _bool(el, "static", _bool(model_el, "static", False))
+        pose = pose_of(el, w) if el.find("pose") is not None else None
+        static = flag(el, "static", flag(model_el, "static", False))
         return self.model(model_el, sdf_file, name=name, pose=pose, static=static)
 
     # ------------------------------------------------------------------------------- models
@@ -223,8 +170,8 @@ class _Loader:
             raise WorldError(f"{file}: a <model> has no name attribute")
         spec = ModelSpec(
             name=name,
-            pose=pose if pose is not None else _pose(el, where, self.warnings),
-            static=static if static is not None else _bool(el, "static", False),
+            pose=pose if pose is not None else pose_of(el, where, self.warnings),
+            static=static if static is not None else flag(el, "static", False),
         )
         self._fill(spec, el, file, where, prefix="", frame=(0.0, 0.0, 0.0, 0.0, 0.0, 0.0))
         return [spec] if spec.links else []
@@ -246,7 +193,7 @@ class _Loader:
                 sub = child.get("name", "")
                 w = f'{where}/<model name="{sub}">'
                 with self._nested(w):
-                    self._fill(spec, child, file, w, prefix + sub + "::", compose6(frame, _pose(child, w)))
+                    self._fill(spec, child, file, w, prefix + sub + "::", compose6(frame, pose_of(child, w)))
             elif tag == "include":
                 for inc in self.include(child, file.parent, where):
                     for link in inc.links:
@@ -275,14 +222,14 @@ class _Loader:
         if inertial is not None or not static:
             iw = f"{where}/<inertial>"
             inertia = inertial.find("inertia") if inertial is not None else None
-            mass = _num(inertial, "mass", iw, 1.0)
+            mass = num(inertial, "mass", iw, 1.0)
             if mass <= 0:
                 raise WorldError(f"{iw}/<mass>: must be > 0 kg, got {mass}")
             vals = {
-                k: _num(inertia, k, iw + "/<inertia>", 1.0 if k in ("ixx", "iyy", "izz") else 0.0)
+                k: num(inertia, k, iw + "/<inertia>", 1.0 if k in ("ixx", "iyy", "izz") else 0.0)
                 for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
             }
-            o = _pose(inertial, iw) if inertial is not None else (0.0,) * 6
+            o = pose_of(inertial, iw) if inertial is not None else (0.0,) * 6
             link.inertial = Inertial(mass=mass, origin=Origin(xyz=o[:3], rpy=o[3:]), **vals)
         had_shapes = False
         for tag in ("collision", "visual"):
@@ -296,11 +243,11 @@ class _Loader:
                 if tag == "collision" and link.mu1 is None:
                     ode = sel.find("surface/friction/ode")
                     if ode is not None and ode.find("mu") is not None:
-                        link.mu1 = _num(ode, "mu", sw, 1.0)
-                        link.mu2 = _num(ode, "mu2", sw, link.mu1)
+                        link.mu1 = num(ode, "mu", sw, 1.0)
+                        link.mu2 = num(ode, "mu2", sw, link.mu1)
         if had_shapes and not link.collisions and not link.visuals:
             return None, (0.0,) * 6  # only planes: the ground
-        return link, _pose(el, where, self.warnings)
+        return link, pose_of(el, where, self.warnings)
 
     def shape(self, el: ET.Element, file: Path, where: str, collision: bool) -> Shape | None:
         """A collision or visual; None for a plane (recorded as the ground) or unsupported geometry."""
@@ -315,19 +262,19 @@ class _Loader:
         g = kinds[0]
         gw = f"{where}/<geometry>/<{g.tag}>"
         if g.tag == "plane":
-            normal = _floats(g.findtext("normal") or "0 0 1", 3, gw + "/<normal>")
+            normal = floats(g.findtext("normal") or "0 0 1", 3, gw + "/<normal>")
             if normal[2] > 0.99 and collision:
                 self.ground_plane = True
             elif collision:
                 self.warnings.append(f"{gw}: only a horizontal ground plane is supported; ignored")
             return None
         if g.tag == "box":
-            size = _floats(g.findtext("size"), 3, gw + "/<size>")
+            size = floats(g.findtext("size"), 3, gw + "/<size>")
             geometry = Geometry("box", size=size)
         elif g.tag == "cylinder":
-            geometry = Geometry("cylinder", size=(_num(g, "radius", gw, 0.0), _num(g, "length", gw, 0.0)))
+            geometry = Geometry("cylinder", size=(num(g, "radius", gw, 0.0), num(g, "length", gw, 0.0)))
         elif g.tag == "sphere":
-            geometry = Geometry("sphere", size=(_num(g, "radius", gw, 0.0),))
+            geometry = Geometry("sphere", size=(num(g, "radius", gw, 0.0),))
         elif g.tag == "mesh":
             mesh = self.mesh(g, file, gw, collision)
             if mesh is None:
@@ -340,7 +287,7 @@ class _Loader:
             return None
         if g.tag != "mesh" and any(v <= 0 for v in geometry.size):
             raise WorldError(f"{gw}: sizes must be positive, got {geometry.size}")
-        p = _pose(el, where, self.warnings)
+        p = pose_of(el, where, self.warnings)
         return Shape(
             geometry=geometry,
             origin=Origin(xyz=p[:3], rpy=p[3:]),
@@ -356,7 +303,7 @@ class _Loader:
             raise WorldError(f"{where}: missing <uri>")
         if g.find("submesh") is not None:
             self.warnings.append(f"{where}: <submesh> not supported; the whole mesh is used")
-        scale = _floats(g.findtext("scale") or "1 1 1", 3, where + "/<scale>")
+        scale = floats(g.findtext("scale") or "1 1 1", 3, where + "/<scale>")
         try:
             named = self.index.resolve_uri(uri, base_dir=file.parent, model_paths=self.model_paths)
             sim_path, unit = prepare_mesh(named, where)
@@ -386,7 +333,7 @@ class _Loader:
         for tag in ("diffuse", "ambient"):
             text = mat.findtext(tag)
             if text and len(text.split()) in (3, 4):
-                v = _floats(text, len(text.split()), f"{where}/<material>/<{tag}>")
+                v = floats(text, len(text.split()), f"{where}/<material>/<{tag}>")
                 return (v[0], v[1], v[2], v[3] if len(v) == 4 else 1.0)
         return gazebo_material(mat.findtext("script/name") or "")
 
@@ -422,7 +369,7 @@ def load_world(path: str | os.PathLike[str], *, model_path: Iterable[str | os.Pa
     (``ground_plane``, ``sun``). Raises WorldError naming the file and element on bad input.
     """
     file = world_path(path)
-    root = _parse_xml(file, "world file")
+    root = parse_xml(file, "world file")
     if root.tag != "sdf":
         raise WorldError(f"{file}: top element is <{root.tag}>, expected <sdf>")
     version = root.get("version", "")
@@ -448,13 +395,13 @@ def load_world(path: str | os.PathLike[str], *, model_path: Iterable[str | os.Pa
     if physics:
         chosen = next((p for p in physics if p.get("default") in ("1", "true")), physics[0])
         pw = f"{where}/<physics>"
-        world.max_step_size = _num(chosen, "max_step_size", pw, 0.001)
+        world.max_step_size = num(chosen, "max_step_size", pw, 0.001)
         if world.max_step_size <= 0:
             raise WorldError(f"{pw}/<max_step_size>: must be > 0 s, got {world.max_step_size}")
         if chosen.find("gravity") is not None:  # SDF 1.4
-            world.gravity = _vec3(chosen.findtext("gravity"), pw + "/<gravity>")
+            world.gravity = vec3(chosen.findtext("gravity"), pw + "/<gravity>")
     if world_el.find("gravity") is not None:
-        world.gravity = _vec3(world_el.findtext("gravity"), f"{where}/<gravity>")
+        world.gravity = vec3(world_el.findtext("gravity"), f"{where}/<gravity>")
     dup = {n for n, k in collections.Counter(m.name for m in world.models).items() if k > 1}  # linear: BARN worlds
     if dup:
         raise WorldError(f"{where}: duplicate model names {sorted(dup)}")
@@ -464,9 +411,9 @@ def load_world(path: str | os.PathLike[str], *, model_path: Iterable[str | os.Pa
         for m in state.findall("model"):
             sw = f'{where}/<state>/<model name="{m.get("name")}">'
             if m.get("name") in by_name and m.find("pose") is not None:
-                by_name[m.get("name", "")].pose = _pose(m, sw)
+                by_name[m.get("name", "")].pose = pose_of(m, sw)
             scale = m.findtext("scale")
-            if m.get("name") in by_name and scale and _floats(scale, 3, sw + "/<scale>") != (1.0, 1.0, 1.0):
+            if m.get("name") in by_name and scale and floats(scale, 3, sw + "/<scale>") != (1.0, 1.0, 1.0):
                 world.warnings.append(
                     f"{sw}/<scale>: {scale.strip()} is not applied; the model keeps the "
                     "sizes in its <geometry> (resize it there)"
@@ -492,7 +439,7 @@ def load_model(path: str | os.PathLike[str], *, model_path: Iterable[str | os.Pa
     if not target.exists():
         raise WorldError(f"{target}: SDF model file or directory not found")
     sdf_file = loader.model_sdf_file(target.resolve(), where)
-    root = _parse_xml(sdf_file, "model SDF")
+    root = parse_xml(sdf_file, "model SDF")
     model_el = root.find("model") if root.tag == "sdf" else (root if root.tag == "model" else None)
     if model_el is None:
         world_el = root.find("world")
