@@ -46,14 +46,3 @@ def test_barn_clock_runs_from_the_first_move_until_first_within_a_metre() -> Non
     first, second = {**one, "within_tolerance_s": 13.0}, {"time_s": 9.0, "moved_s": 0.2, "within_tolerance_s": 7.0}
     assert barn_clock([first, second]) == pytest.approx(14.0 - 0.6 + 7.0)  # a tour: the first goal's whole time
     assert barn_clock([{**one, "within_tolerance_s": None}]) is None  # never came within 1 m
-
-
-def test_a_slow_tuning_world_is_now_done_within_twice_barns_optimal_time() -> None:
-    """Tuning world 43 at the Jackal's 2 m/s: with Nav2's 2.8 s MPPI horizon the robot cruised at ~1.1 m/s over the
-    3.5 m of plan it is handed and took 2.07 T_opt (score 0.483); with the Jackal's 2 s horizon it is within the
-    2 T_opt that scores the most a world can (0.5), with no contact and no near miss."""
-    fill, smooth = suite_parameters(50)[43]
-    world = generate_clutter(SETS["tuning"] * 1000 + 43, fill=fill, smooth=smooth)  # as clutter_suite(50, seed=1)
-    r = run_clutter_world(world, controller="mppi", robot="jackal", move_base_params=speed_overrides("mppi", 2.0))
-    assert r["success"] and r["collisions"] == 0 and not r["near_miss"], r
-    assert r["barn_time_s"] <= 1.8 * r["t_opt_s"] and r["score"] == pytest.approx(0.5), r

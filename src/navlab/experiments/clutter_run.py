@@ -55,12 +55,6 @@ CLUTTER_PARAMS: dict[str, Any] = {
     "progress_checker.movement_time_allowance": 10.0,
 }
 CLUTTER_ROBOTS = ("mybot", "jackal")
-# Per robot, on top of CLUTTER_PARAMS. The Jackal's MPPI looks 2 s ahead (40 x 0.05 s) instead of Nav2's 2.8 s:
-# PathFollowCritic pulls each sample's end toward the end of the 3.5 m of plan it is handed (prune_distance), so
-# over 2.8 s the best sample cruised at ~1.1 m/s of the 2 allowed; over 2 s it cruises ~1.45 m/s. Jackal tuning set:
-# worlds at the 0.5 cap 46 -> 48, the slowest capped world at 1.83 T_opt (was over 2), closest 0.073 m. mybot (round,
-# no footprint critic) kept 2.8 s: at 2 s it passed under 5 cm in 8 tuning worlds (1 before).
-CLUTTER_ROBOT_PARAMS: dict[str, dict[str, Any]] = {"jackal": {"MPPIController.time_steps": 40}}
 # Any other robot drives with its files as ROS 1's move_base reads them: that move_base has no progress checker (a
 # robot that stops making progress goes on until its oscillation timeout, recoveries or the 100 s limit), so
 # navlab's Nav2-style one is off for them unless the caller's parameters ask for it.
@@ -87,7 +81,7 @@ def run_clutter_world(
         path = world.write_world(Path(tmp) / f"{world.name}.world")
         gx, gy, gyaw = (float(v) for v in between2(world.start, world.goal))  # the goal in odom (= the start)
         sx, sy, syaw = (float(v) for v in world.start)
-        own = {**CLUTTER_PARAMS, **CLUTTER_ROBOT_PARAMS.get(robot, {})} if robot in CLUTTER_ROBOTS else OWN_FILES_PARAMS
+        own = CLUTTER_PARAMS if robot in CLUTTER_ROBOTS else OWN_FILES_PARAMS
         params = {**own, **(move_base_params or {})}
         r = run_navigation(
             [(gx, gy, gyaw)],
