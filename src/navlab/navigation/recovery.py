@@ -28,7 +28,9 @@ def _collides(costmaps: dict[str, Any], pose: Pose, move: Pose = (0.0, 0.0, 0.0)
     if costmaps["local"].footprint_cost(compose2(pose, move)) >= COST_INSCRIBED + 1:
         return True
     g = costmaps.get("global")
-    here = g.robot_pose() if g is not None and g is not costmaps["local"] else None
+    if g is None or g is costmaps["local"]:
+        return False
+    here = g.robot_pose()
     return here is not None and g.footprint_cost(compose2(here, move)) == COST_LETHAL
 
 
