@@ -22,16 +22,20 @@ Pose = tuple[float, float, float]
 
 def _collides(costmaps: dict[str, Any], pose: Pose, move: Pose = (0.0, 0.0, 0.0)) -> bool:
     """Whether the footprint at ``pose`` (local costmap frame) moved by ``move`` (x m, y m, yaw rad in the robot's
-    frame) covers a lethal or unknown cell of the local costmap, or a lethal cell of the global one. The global
-    costmap keeps what the laser saw: after the local window was cleared, the obstacles behind a 270° laser are
-    only there (unknown cells there do not block: a rolling global map has not seen everything around)."""
-    if costmaps["local"].footprint_cost(compose2(pose, move)) >= COST_INSCRIBED + 1:
+    frame) covers a lethal or unknown cell of the local costmap, or a lethal cell of a global costmap in the same
+    frame (mapless navigation's rolling map in odom). That one keeps what the laser saw: after the local window was
+    cleared, the obstacles behind a 270° laser are only there (its unknown cells do not block: a rolling map has not
+    seen everything around). A global costmap in ``map`` is not asked: it would add amcl's error to the check."""
+    local, g = costmaps["local"], costmaps.get("global")
+    at = compose2(pose, move)
+    if local.footprint_cost(at) >= COST_INSCRIBED + 1:
         return True
-    g = costmaps.get("global")
-    if g is None or g is costmaps["local"]:
-        return False
-    here = g.robot_pose()
-    return here is not None and g.footprint_cost(compose2(here, move)) == COST_LETHAL
+    return (
+        g is not None
+        and g is not local
+        and g.global_frame == local.global_frame
+        and g.footprint_cost(at) == COST_LETHAL
+    )
 
 
 @dataclass
