@@ -211,8 +211,8 @@ class RolloutController(ControllerBase):
         A plan to a new goal (beyond the goal tolerances from the last one) clears the goal latch and the
         oscillation flags; the same plan sent again every cycle keeps them."""
         given = self._given
-        again = isinstance(path, np.ndarray) and given is not None and path.shape == given.shape
-        if again and path.dtype == np.float64:
+        same_kind = isinstance(path, np.ndarray) and path.dtype == np.float64
+        if given is not None and same_kind and path.shape == given.shape:
             bits = np.ascontiguousarray(path).reshape(-1).view(np.int64)
             if same_values(bits, given.reshape(-1).view(np.int64)):  # bit for bit (the sign of zero too)
                 self._plan = given  # the plan sent again (move_base does every cycle): checked, to the same goal
