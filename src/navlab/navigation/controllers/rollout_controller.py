@@ -92,7 +92,6 @@ for _empty in (_NONE_3, _NONE_2, _NONE_1, _NO_ROLLOUTS):  # a cycle's outputs be
 _NO_FRAME = LocalFrame(0.0, 0.0, 0.0)
 
 
-
 def _words(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Two C-contiguous arrays of one shape as flat arrays to compare: 8 bytes at a time where the size allows."""
     a, b = a.reshape(-1), b.reshape(-1)
