@@ -180,7 +180,7 @@ class RolloutController(ControllerBase):
         self._osc = OscillationFlags(p.oscillation_reset_dist, getattr(p, "oscillation_reset_angle", -1.0))
         self._plan: np.ndarray | None = None
         self._given: np.ndarray | None = None  # the plan as set_plan last checked it (before pruning)
-        self._last_frame: LocalFrame | None = None  # the costmap's grid-local frame last seen
+        self._last_frame: tuple[tuple[float, float, float], LocalFrame] | None = None  # the grid-local frame seen
         self._rotating_to_goal = False
         self._outlines: dict[tuple[float, bytes | None], np.ndarray | None] = {}
         self._near: tuple[np.ndarray, np.ndarray | None, np.ndarray] | None = None  # (outline, costs, reach max)
@@ -259,9 +259,10 @@ class RolloutController(ControllerBase):
 
     def _scene(self, pose: tuple[float, float, float], costmap: Grid) -> LocalScene | None:
         assert self._plan is not None
-        frame = self._last_frame
-        if frame is None or (frame.ox, frame.oy, frame.oyaw) != costmap.origin:  # the window moved
-            frame = self._last_frame = LocalFrame.of(costmap)
+        last = self._last_frame  # (the origin tuple it was made from, the frame): kept while the window stays
+        if last is None or last[0] is not costmap.origin:
+            last = self._last_frame = (costmap.origin, LocalFrame.of(costmap))
+        frame = last[1]
         self._frame = frame
         cost = np.ascontiguousarray(costmap.data, dtype=np.uint8)
         res = costmap.resolution
