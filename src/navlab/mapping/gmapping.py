@@ -346,7 +346,7 @@ class GMapping:
         lattice = self._lattice()
         scan, model = (r, np.cos(ang), np.sin(ang), max_urange), self._model()
         poses = self.poses
-        tiles, masks, means = self.pool.tiles, self.pool.masks, self.pool.means
+        pool = self.pool  # (its arrays are read at each use: growing it moves them)
         for part, pose in zip(self.particles, poses, strict=True):
             x, y, t, score, lik = self._match(part.table, pose, scan)
             matched = score > p.minimumScore
@@ -354,7 +354,7 @@ class GMapping:
                 pose[:] = x, y, wrap_angle(t)
             if not matched or pose[2] != t:  # the weight takes the log-likelihood at another pose
                 _s, lik, _n = match_score(
-                    tiles, masks, means, part.table, lattice, (pose[0], pose[1], pose[2]), scan, model
+                    pool.tiles, pool.masks, pool.means, part.table, lattice, (pose[0], pose[1], pose[2]), scan, model
                 )
             part.weight += lik
             part.weight_sum += lik

@@ -16,10 +16,10 @@ its own tile only, so it follows the tile's copy-on-write; a neighbour across a 
 (the matcher reads the cells themselves there).
 
 Beside each tile the pool keeps, per cell, GMapping's ``PointAccumulator`` mean of the beam end points that
-fell into it (``means``, uint16, the same id): the hits counted (saturating) and the mean's offset (x, y) in
-the cell, in 1/65536 of a cell from its corner (``mean_offset``); the matcher measures a beam's end point
-against that mean, not the cell's centre (GMapping's ``cell.mean()``). A cell no scan hit has none; cells
-put in from a dense grid (``from_dense``) count as hit once at their centre.
+fell into it (``means``, uint8, the same id): the hits counted (saturating at 255: a running mean then) and
+the mean's offset (x, y) in the cell, in 1/256 of a cell (0.2 mm at 5 cm) from its corner; the matcher
+measures a beam's end point against that mean, not the cell's centre (GMapping's ``cell.mean()``). A cell no
+scan hit has none; cells put in from a dense grid (``from_dense``) count as hit once at their centre.
 
 Lattice conventions as in ``mapping.occupancy``: the map holds the cells of a fixed lattice anchored at
 (``ox``, ``oy``) from lattice cell (``oi``, ``oj``) on; cells outside it read as unknown.
@@ -39,8 +39,8 @@ MASK = TILE - 1
 # the mask bit of each neighbour offset (dj + 1) * 3 + di + 1; the cell itself (4) has none
 NEIGHBOUR_BIT = np.array([1, 2, 4, 8, 0, 16, 32, 64, 128], dtype=np.uint16)
 NEAR_OCC = 256  # the mask bit of a cell with an occupied neighbour in its tile
-MEAN_UNIT = 1.0 / 65536.0  # a mean offset's unit, in cells
-CENTRE = 32768  # the mean offset of a cell's centre
+MEAN_UNIT = 1.0 / 256.0  # a mean offset's unit, in cells
+CENTRE = 128  # the mean offset of a cell's centre
 
 
 class TilePool:
@@ -49,7 +49,7 @@ class TilePool:
     def __init__(self, capacity: int = 64) -> None:
         self.tiles = np.zeros((max(capacity, 2), TILE, TILE), dtype=np.float32)
         self.masks = np.zeros(self.tiles.shape, dtype=np.uint16)  # each tile's mask (module docstring)
-        self.means = np.zeros((*self.tiles.shape, 3), dtype=np.uint16)  # hits, mean x, y offset (docstring)
+        self.means = np.zeros((*self.tiles.shape, 3), dtype=np.uint8)  # hits, mean x, y offset (docstring)
         self.refs = np.zeros(len(self.tiles), dtype=np.int64)
         self.refs[0] = 1 << 40  # never freed, never written
 
@@ -72,7 +72,7 @@ class TilePool:
             masks = np.empty(tiles.shape, dtype=np.uint16)
             masks[:old] = self.masks
             self.masks = masks
-            means = np.empty((*tiles.shape, 3), dtype=np.uint16)
+            means = np.empty((*tiles.shape, 3), dtype=np.uint8)
             means[:old] = self.means
             self.means = means
             self.refs = np.concatenate([self.refs, np.zeros(cap - old, dtype=np.int64)])
@@ -198,12 +198,12 @@ def _set(tiles: np.ndarray, masks: np.ndarray, t: int, j: int, i: int, add: floa
 @numba.njit(cache=True, inline="always")
 def _add_hit(mean: np.ndarray, fx: float, fy: float) -> None:
     """Count one more hit in a cell's ``mean`` (hits, x, y offset: ``means[t, j, i]``) at (``fx``, ``fy``) (in
-    cells from its corner, in [0, 1)): the running mean of its hits (the count saturates at 65535)."""
-    n = min(int(mean[0]) + 1, 65535)
+    cells from its corner, in [0, 1)): the running mean of its hits (the count saturates at 255)."""
+    n = min(int(mean[0]) + 1, 255)
     mean[0] = n
     for c, f in ((1, fx), (2, fy)):
         m = mean[c] * MEAN_UNIT
-        mean[c] = min(max(round((m + (f - m) / n) * 65536.0), 0), 65535)
+        mean[c] = min(max(round((m + (f - m) / n) * 256.0), 0), 255)
 
 
 @numba.njit(cache=True, inline="always")
