@@ -17,6 +17,7 @@ from navlab.msgs import Quaternion, Transform, TransformStamped, Vector3, header
 
 Pose2 = tuple[float, float, float]  # (x m, y m, yaw rad) of a frame's origin in another frame
 LOOKUP_CACHE = 64  # lookups remembered (see TfBuffer.lookup)
+_INVERSE_IDENTITY = inverse3(IDENTITY_TF)  # what a lookup composes for a target that is the common ancestor
 
 
 def tf_from_msg(tr: Any) -> Tf:
@@ -54,10 +55,10 @@ class TfBuffer:
         self._version = 0  # bumped whenever the tree's shape changes (an edge added or re-parented)
         # (target, source) -> (version, target's edges up to the common ancestor, source's edges up to it)
         self._chains: dict[tuple[str, str], tuple[int, list[tuple[str, _Edge]], list[tuple[str, _Edge]]]] = {}
-        # lookups answered (target, source, t_ns, tolerance) -> (tree version, (edge, its changes) of each edge the
-        # answer read, the answer): valid until one of those edges changes. Many nodes ask the same question between
-        # two transforms of the edges it reads (the costmaps, move_base, amcl, monitors), while other edges change.
-        self._lookups: dict[tuple[str, str, int | None, int], tuple[int, tuple[tuple[_Edge, int], ...], Tf]] = {}
+        # lookups answered (target, source, t_ns, tolerance) -> [tree version, (edge, its changes) of each edge the
+        # answer read, the answer, its (x, y, yaw) once asked]: valid until one of those edges changes. Many nodes ask
+        # the same question between two transforms of the edges it reads (the costmaps, move_base, amcl, monitors).
+        self._lookups: dict[tuple[str, str, int | None, int], list[Any]] = {}
 
     def frames(self) -> list[str]:
         """Every frame seen, as parent or child."""
@@ -182,6 +183,10 @@ class TfBuffer:
 
     def lookup(self, target: str, source: str, t_ns: int | None = None) -> Tf:
         """``target_T_source`` at ``t_ns`` (None: the latest time every edge on the path has)."""
+        return self._answer(target, source, t_ns)[2]
+
+    def _answer(self, target: str, source: str, t_ns: int | None) -> list[Any]:
+        """The lookup's cache entry (see ``_lookups``), computed unless still valid."""
         key = (target, source, t_ns, self.tolerance_ns)
         hit = self._lookups.get(key)
         if hit is not None and hit[0] == self._version:
@@ -189,13 +194,13 @@ class TfBuffer:
                 if e.changes != n:
                     break
             else:
-                return hit[2]
+                return hit
         edges_t, edges_s = self._chain(target.lstrip("/"), source.lstrip("/"))
         out = self._lookup(edges_t, edges_s, t_ns)
         if len(self._lookups) >= LOOKUP_CACHE:  # stamped questions pile up: start again
             self._lookups.clear()
-        self._lookups[key] = (self._version, tuple((e, e.changes) for _, e in (*edges_t, *edges_s)), out)
-        return out
+        hit = self._lookups[key] = [self._version, tuple((e, e.changes) for _, e in (*edges_t, *edges_s)), out, None]
+        return hit
 
     def _lookup(self, edges_t: list[tuple[str, _Edge]], edges_s: list[tuple[str, _Edge]], t_ns: int | None) -> Tf:
         """``target_T_source`` from the chain's edges (:meth:`_chain`) at ``t_ns`` (None: the latest common)."""
@@ -203,7 +208,8 @@ class TfBuffer:
             for _, e in (*edges_s, *edges_t):
                 if not e.static:
                     t_ns = e.times[-1] if t_ns is None else min(t_ns, e.times[-1])
-        return compose3(inverse3(self._compose(edges_t, t_ns)), self._compose(edges_s, t_ns))
+        up = inverse3(self._compose(edges_t, t_ns)) if edges_t else _INVERSE_IDENTITY
+        return compose3(up, self._compose(edges_s, t_ns))
 
     def can_transform(self, target: str, source: str, t_ns: int | None = None) -> bool:
         """Whether :meth:`lookup` would succeed."""
@@ -227,8 +233,11 @@ class TfBuffer:
 
     def lookup_pose2d(self, target: str, source: str, t_ns: int | None = None) -> Pose2:
         """(x, y, yaw) of ``source``'s origin in ``target``."""
-        tf = self.lookup(target, source, t_ns)
-        return tf[0], tf[1], yaw_of(tf)
+        hit = self._answer(target, source, t_ns)
+        if hit[3] is None:
+            tf = hit[2]
+            hit[3] = (tf[0], tf[1], yaw_of(tf))
+        return hit[3]
 
     def lookup_pose2d_or_latest(self, target: str, source: str, t_ns: int | None) -> Pose2:
         """(x, y, yaw) of ``source`` in ``target`` at ``t_ns``, else at the latest time tf has.
