@@ -8,7 +8,6 @@ import numpy as np
 import pytest
 from sim_helpers import box_model, make_mybot, make_room
 
-from navlab.description import load_robot_named
 from navlab.sim import SimError, Simulation
 from navlab.sim.simulation import lidar_angles
 from navlab.world import WorldModel
@@ -224,22 +223,3 @@ def test_link_state_is_link_pose_and_link_velocity() -> None:
         v, w = sim.link_velocity(link)
         assert position == tuple(pose.position) and quaternion == tuple(pose.quaternion)
         assert lin == tuple(v) and ang == tuple(w)
-
-
-def test_sensors_computed_in_the_last_step_only_change_nothing() -> None:
-    """advance_to skips MuJoCo's sensors (the IMU's) in all but its last step: the motion and what the IMU reads
-    after each advance are those of stepping one step at a time, bit for bit."""
-    robot = load_robot_named("mybot")
-    chunked, single = (Simulation(robot, make_room(), seed=0) for _ in range(2))
-    assert chunked.model.nsensor > 0
-    for sim in (chunked, single):
-        sim.set_wheel_velocity_targets(4.0, 6.0)
-    for k in range(1, 40):
-        t_ns = k * 7 * chunked.dt_ns
-        chunked.advance_to(t_ns)
-        while single.time_ns < t_ns:
-            single.step()
-        assert np.array_equal(chunked.data.qpos, single.data.qpos)
-        assert np.array_equal(chunked.data.qvel, single.data.qvel)
-        assert np.array_equal(chunked.data.sensordata, single.data.sensordata)
-    assert np.abs(chunked.data.sensordata).max() > 0

@@ -22,7 +22,6 @@ from navlab.sim.scene import add_world_model, build_spec, compile_spec, remove_w
 from navlab.world import ModelSpec, WorldModel
 
 SPAWN_GAP = 0.0005  # m between the robot's lowest point and the floor when it is placed
-SENSORS_OFF = int(mujoco.mjtDisableBit.mjDSBL_SENSOR)
 
 
 @dataclass(frozen=True)
@@ -156,22 +155,10 @@ class Simulation:
     # --- stepping and actuation -------------------------------------------------------------------
 
     def advance_to(self, t_ns: int) -> None:
-        """Integrate physics up to simulated time ``t_ns`` (whole steps; never goes back).
-
-        MuJoCo's sensors (the IMU's) are computed in the last of the steps only: nothing can read them in between,
-        and they do not act on the motion, so every state and reading is the one of computing them at each step."""
+        """Integrate physics up to simulated time ``t_ns`` (whole steps; never goes back)."""
         n = (int(t_ns) - self.time_ns) // self.dt_ns
         if n > 0:
-            m, d = self.model, self.data
-            if n > 1 and m.nsensor:
-                opt = m.opt
-                flags = opt.disableflags
-                opt.disableflags = flags | SENSORS_OFF
-                mujoco.mj_step(m, d, nstep=int(n) - 1)
-                opt.disableflags = flags
-                mujoco.mj_step(m, d)
-            else:
-                mujoco.mj_step(m, d, nstep=int(n))
+            mujoco.mj_step(self.model, self.data, nstep=int(n))
             self.time_ns += int(n) * self.dt_ns
             self._synced = False
 
