@@ -379,10 +379,10 @@ class Simulation:
         gen = self.rng if rng is None else rng
         normals = self._no_noise
         if cfg.noise_stddev > 0:  # the draws of standard_normal(n), into a buffer kept per lidar
-            normals = self._normals.get(index)
-            if normals is None or normals.shape[0] != len(dist):
-                normals = self._normals[index] = np.empty(len(dist))
-            gen.standard_normal(out=normals)
+            kept = self._normals.get(index)
+            if kept is None or kept.shape[0] != len(dist):
+                kept = self._normals[index] = np.empty(len(dist))
+            normals = gen.standard_normal(out=kept)
         out = np.empty(len(dist), dtype=np.float32)
         finish_ranges(dist, normals, cfg.noise_mean, cfg.noise_stddev, cfg.range_min, cfg.range_max, out)
         return out
