@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from navlab.experiments import read_relations
+from navlab.experiments import read_relations, relations_error
 from navlab.geometry import wrap_angle
 from navlab.io.carmen import read_carmen
 from navlab.mapping.slam import make_slam, run_offline
@@ -29,7 +29,7 @@ def _turn_errors(scans, params: dict, relations: np.ndarray) -> dict[tuple[int, 
     return out
 
 
-@pytest.mark.parametrize(("start", "stop", "hard"), [(0, 200, (164,)), (1690, 1760, (1732, 1741))])
+@pytest.mark.parametrize(("start", "stop", "hard"), [(0, 200, (164,)), (1690, 1760, (1732,))])
 def test_no_csail_scan_is_turned_away_from_its_place(dataset, start, stop, hard):
     data = dataset("mit-csail")
     scans = read_carmen(data / "mit-csail.clf").scans
@@ -38,8 +38,9 @@ def test_no_csail_scan_is_turned_away_from_its_place(dataset, start, stop, hard)
     errors = _turn_errors(part, {}, relations)
     assert len(errors) >= 40
     assert max(errors.values()) < 5.0, {k: round(v, 1) for k, v in errors.items() if v >= 5}
-    # the plain climb (no wider search) leaves the hard scan's relations 15-25 degrees off
-    plain = _turn_errors(part, {"wideScore": 0.0}, relations)
+    # the filter's own poses with the plain climb (no wider search) leave the hard scan's relations 15-30
+    # degrees off
+    plain = _turn_errors(part, {"wideScore": 0.0, "refineSkipped": False}, relations)
     for k in hard:
         near = [v for (a, b), v in plain.items() if min(abs(a + start - k), abs(b + start - k)) <= 1]
         assert near and max(near) > 10.0, k
@@ -59,3 +60,22 @@ def test_no_return_readings_are_not_free_space_rays(dataset):
         as_rays.add_scan(s.ranges, s.angle_min, s.angle_increment, s.laser_pose)  # no range_max: 80 m rays
     assert result.stats["updates"] == as_rays.stats()["updates"] >= 3
     assert 0 < result.stats["tiles_in_use"] < as_rays.stats()["tiles_in_use"] / 5
+
+
+def test_the_final_matches_kernel_places_csail_scans_closer_than_the_filters(dataset):
+    # offline, every scan is matched once more against the best particle's finished map; with a kernel of
+    # the cells' scale (refineSigma 0: 2 delta²) rather than the proposal's sigma (0.05), the relations
+    # between the first 300 scans come out a fifth closer (0.028 vs 0.035 m)
+    data = dataset("mit-csail")
+    scans = read_carmen(data / "mit-csail.clf").scans[:300]
+    relations = read_relations(data / "mit-csail.relations")
+    stamps = np.array([s.timestamp for s in scans])
+    errors = {}
+    for sigma in (0.0, 0.05):
+        slam = make_slam("gmapping", {"refine": False, "refineSigma": sigma}, seed=0)
+        slam.keep_scans = True
+        for s in scans:
+            slam.add_scan(s.ranges, s.angle_min, s.angle_increment, s.laser_pose, range_max=s.max_range)
+        errors[sigma] = relations_error(stamps, slam.finish(), relations)["trans_abs_mean"]
+    assert errors[0.0] < 0.8 * errors[0.05], errors
+    assert errors[0.0] < 0.032, errors

@@ -1,5 +1,6 @@
 """The mapping stack's shortcuts give the results of the plain computations they replace: GMapping's hill
-climb (no re-scoring, early-stopped candidates), its score (two passes, kernel 1 unrolled), its motion draw
+climb (no re-scoring, early-stopped candidates), its score (two passes, kernel 1 read from the masks, each
+match measured to the mean of its cell's hits), its motion draw
 (one numba call), the ray caster's unchecked walk, the Dijkstra graph built in one pass, the lookup field's
 bounds and unchecked loops."""
 
@@ -13,15 +14,21 @@ import pytest
 from navlab.geometry import wrap_angle
 from navlab.gridline import EXACT_STEPS
 from navlab.mapping.gmapping_match import draw_motion, match_score, optimize
-from navlab.mapping.gmapping_tiles import TILE, TilePool, from_dense, raycast_tiles, to_dense
+from navlab.mapping.gmapping_tiles import MEAN_UNIT, TILE, TilePool, from_dense, raycast_tiles, to_dense
 from navlab.mapping.occupancy import L_CLAMP, L_FREE, L_OCC, _raycast, integrate_scan
 from navlab.mapping.scanmatch import LookupField, correlative_search
 
 
-def _tiled(grid: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(tiles, masks, table) of a dense log-odds grid: the matcher's map argument."""
+def _tiled(grid: np.ndarray, r: np.ndarray, ang: np.ndarray) -> tuple[tuple, np.ndarray, np.ndarray]:
+    """The matcher's map argument (tiles, masks, means, table) of a dense log-odds grid (its occupied cells hit
+    once at their centre) with the scan (``r``, ``ang``) from (2, 2, 0) cast into it (its hits' means off the
+    centres), and that map's dense log-odds and means."""
     pool, table = from_dense(grid)
-    return pool.tiles, pool.masks, table
+    free = pool.free(table.size)  # (may grow the pool: its arrays are read after)
+    cow = (pool.tiles, pool.masks, pool.means, table, pool.refs, free, np.zeros(1, dtype=np.int64))
+    raycast_tiles(*cow, (0.0, 0.0, 0, 0, 0.05), (2.0, 2.0, 0.0), (r, ang, 8.0, 10.0), (L_OCC, L_FREE, L_CLAMP))
+    tiled = (pool.tiles, pool.masks, pool.means, table)
+    return tiled, to_dense(pool.tiles, table), to_dense(pool.means, table)
 
 
 def _plain_climb(tiled, lattice, scan, model, x0, y0, t0, lstep, astep, iterations):
@@ -72,7 +79,7 @@ def _room_map(rng: np.random.Generator, res: float = 0.05) -> tuple[np.ndarray, 
 def test_the_hill_climb_equals_gmappings_plain_climb() -> None:
     rng = np.random.default_rng(4)
     grid, r, ang = _room_map(rng)
-    tiled = _tiled(grid)
+    tiled, _grid, _means = _tiled(grid, r, ang)
     for skip in (0, 4):
         for k in range(12):
             x0, y0, t0 = 2.5 + rng.normal(0, 0.08), 2.0 + rng.normal(0, 0.08), 0.1 + rng.normal(0, 0.05)
@@ -83,8 +90,9 @@ def test_the_hill_climb_equals_gmappings_plain_climb() -> None:
             assert got[4] == match_score(*tiled, lattice, got[:3], scan, model)[1]  # the log-likelihood at the result
 
 
-def _plain_score(grid, ox, oy, res, x, y, t, r, ang, max_urange, kernel, sigma, lsigma, skip):
-    """GMapping's ScanMatcher::score beam by beam, every cell bounds-checked (the reference)."""
+def _plain_score(grid, means, ox, oy, res, x, y, t, r, ang, max_urange, kernel, sigma, lsigma, skip):
+    """GMapping's ScanMatcher::score beam by beam, every cell bounds-checked, each match measured to the mean
+    of its cell's hits (``means``: hits, x, y offset per cell) (the reference)."""
     h, w = grid.shape
     s, lik, n = 0.0, 0.0, 0
     ct, st = math.cos(t), math.sin(t)
@@ -95,18 +103,22 @@ def _plain_score(grid, ox, oy, res, x, y, t, r, ang, max_urange, kernel, sigma, 
         ca, sa = ct * cb - st * sb, st * cb + ct * sb
         ex, ey = x + r[k] * ca, y + r[k] * sa
         fx, fy = ex - res * ca, ey - res * sa
-        ei, ej = math.floor((ex - ox) / res), math.floor((ey - oy) / res)
+        ux, uy = (ex - ox) / res, (ey - oy) / res  # cells
+        ei, ej = math.floor(ux), math.floor(uy)
         fi, fj = math.floor((fx - ox) / res), math.floor((fy - oy) / res)
         best = None
         for dj in range(-kernel, kernel + 1):
             for di in range(-kernel, kernel + 1):
                 i, j, i2, j2 = ei + di, ej + dj, fi + di, fj + dj
                 if 0 <= i < w and 0 <= j < h and 0 <= i2 < w and 0 <= j2 < h and grid[j, i] > 0 and grid[j2, i2] < 0:
-                    d2 = (ox + (i + 0.5) * res - ex) ** 2 + (oy + (j + 0.5) * res - ey) ** 2
+                    assert means[j, i, 0] > 0  # an occupied cell was hit
+                    mx, my = i + means[j, i, 1] * MEAN_UNIT, j + means[j, i, 2] * MEAN_UNIT
+                    d2 = (mx - ux) ** 2 + (my - uy) ** 2
                     best = d2 if best is None else min(best, d2)
         if best is None:
             lik += -0.5 / lsigma
         else:
+            best *= res * res
             s += math.exp(-best / sigma)
             lik += -best / lsigma
             n += 1
@@ -116,7 +128,8 @@ def _plain_score(grid, ox, oy, res, x, y, t, r, ang, max_urange, kernel, sigma, 
 def test_the_score_equals_gmappings_plain_score_for_every_kernel_and_near_the_edges() -> None:
     rng = np.random.default_rng(6)
     grid, r, ang = _room_map(rng)  # 90 x 110 cells: the room spans tile borders (64 cells), which the beams cross
-    tiled = _tiled(grid)
+    tiled, grid, means = _tiled(grid, r, ang)
+    assert np.count_nonzero((means[..., 0] > 0) & (means[..., 1] != 128)) > 100  # the scan's hits: off the centres
     cb, sb = np.cos(ang), np.sin(ang)
     # poses in the room, and near the map's edge (beams end outside it: the checked path)
     for x, y, t in ((2.5, 2.0, 0.1), (2.2, 1.7, -0.4), (0.3, 0.2, 0.0), (5.2, 4.2, 2.0)):
@@ -124,7 +137,7 @@ def test_the_score_equals_gmappings_plain_score_for_every_kernel_and_near_the_ed
             for skip in (0, 3):
                 scan, model = (r, cb, sb, 8.0), (kernel, 0.05, 0.075, skip)
                 got = match_score(*tiled, (0.0, 0.0, 0, 0, 0.05), (x, y, t), scan, model)
-                want = _plain_score(grid, 0.0, 0.0, 0.05, x, y, t, r, ang, 8.0, kernel, 0.05, 0.075, skip)
+                want = _plain_score(grid, means, 0.0, 0.0, 0.05, x, y, t, r, ang, 8.0, kernel, 0.05, 0.075, skip)
                 assert got == want, (x, y, t, kernel, skip)
 
 
@@ -179,7 +192,8 @@ def test_the_unchecked_ray_walk_equals_the_checked_one() -> None:
 
 def test_the_tiled_ray_cast_writes_the_dense_cells_and_copies_only_shared_tiles(masks_hold) -> None:
     """Two particles share one map's tiles; one integrates a scan: its map equals the dense ray cast's, the
-    other's is unchanged, only the tiles the scan wrote were copied, and every tile's mask holds."""
+    other's is unchanged, only the tiles the scan wrote were copied, every tile's mask holds, and each cell
+    the scan hit holds the mean of its hits."""
     rng = np.random.default_rng(9)
     grid, r, ang = _room_map(rng)
     args = (0.05, 2.5, 2.0, 0.1, r, ang, 8.0, 10.0, L_OCC, L_FREE, L_CLAMP)
@@ -189,7 +203,7 @@ def test_the_tiled_ray_cast_writes_the_dense_cells_and_copies_only_shared_tiles(
     in_use = pool.in_use()
     for _ in range(2):  # the second time every tile written is already private: no copies
         free = pool.free(mine.size)  # (may grow the pool: its arrays are read after)
-        cow = (pool.tiles, pool.masks, mine, pool.refs, free, np.zeros(1, dtype=np.int64))
+        cow = (pool.tiles, pool.masks, pool.means, mine, pool.refs, free, np.zeros(1, dtype=np.int64))
         raycast_tiles(*cow, (0.0, 0.0, 0, 0, 0.05), (2.5, 2.0, 0.1), (r, ang, 8.0, 10.0), (L_OCC, L_FREE, L_CLAMP))
     whole = grid.copy()
     _raycast(whole, 0.0, 0.0, 0, 0, *args)
@@ -197,6 +211,22 @@ def test_the_tiled_ray_cast_writes_the_dense_cells_and_copies_only_shared_tiles(
     np.testing.assert_array_equal(to_dense(pool.tiles, mine)[:90, :110], whole)
     np.testing.assert_array_equal(to_dense(pool.tiles, theirs)[:90, :110], grid)
     masks_hold(pool, [mine, theirs])
+    # the means: cells the scan hit that held no hit before hold its end points' mean (twice each)
+    hit = (r > 0) & (r < 8.0)
+    u = np.column_stack([2.5 + r[hit] * np.cos(0.1 + ang[hit]), 2.0 + r[hit] * np.sin(0.1 + ang[hit])]) / 0.05
+    cells = np.floor(u).astype(int)
+    means, theirs_means = to_dense(pool.means, mine), to_dense(pool.means, theirs)
+    keys, inv = np.unique(cells, axis=0, return_inverse=True)
+    fresh = 0
+    for n, (i, j) in enumerate(keys):
+        if grid[j, i] > 0:
+            continue  # hit once at its centre by from_dense
+        pts = u[inv.ravel() == n]
+        assert means[j, i, 0] == 2 * len(pts)
+        np.testing.assert_allclose(means[j, i, 1:] * MEAN_UNIT, pts.mean(axis=0) - (i, j), atol=1 / 128)
+        assert theirs_means[j, i, 0] == 0
+        fresh += 1
+    assert fresh > 20
     written = np.unique(np.argwhere(whole != grid) // TILE, axis=0)
     assert pool.in_use() == in_use + len(written)
     assert np.count_nonzero(mine != theirs) == len(written)

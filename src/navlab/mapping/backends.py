@@ -136,9 +136,15 @@ class GMappingBackend(SeededBackend):
         if self.params.refine and len(self._points) == len(poses) > 2:
             # no front end has linked neighbouring scans here: match against the nearest ones too
             # a pair that moved < 1 cm / 0.2 deg between rounds keeps its match (a third fewer ICP runs); a
-            # match's information follows its ICP Hessian (a corridor's axis is left to the other edges)
+            # match's information follows its ICP Hessian (a corridor's axis is left to the other edges); the
+            # filter's poses, each matched against the finished map, need two rounds, not three
             params = RefineParams(
-                min_travel=0.0, neighbours=6, rematch_xy=0.01, rematch_theta=math.radians(0.2), shape_xy=2.0
+                min_travel=0.0,
+                neighbours=6,
+                rematch_xy=0.01,
+                rematch_theta=math.radians(0.2),
+                shape_xy=2.0,
+                rounds=2,
             )
             poses, stats = refine_poses(poses, self._points, params)
             self.refine_edges, self.refine_rejected = stats["refine_edges"], stats["refine_rejected"]

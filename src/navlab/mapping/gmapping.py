@@ -73,6 +73,14 @@ class GMappingParams:
     # navlab: at the end, match every scan that fell between map updates against the best particle's map
     # (its pose otherwise comes from the odometry since the last update; sparse logs skip many scans)
     refineSkipped: bool = True
+    # navlab: with refineSkipped, the scans that updated the maps are matched against that map too (every
+    # pose then comes from the one final map, not some from the particles' maps as they were then)
+    refineUpdated: bool = True
+    # navlab: the kernel of those final matches (as GMapping's sigma, m²); 0: 2 delta², so that exp(-d²/sigma)
+    # falls to 1/e at one cell diagonal (GMapping's freeCellRatio cells). sigma (0.05: 1/e at 4.5 cells) suits
+    # the filter's proposal, whose particles must find a map they only partly match; against the finished map
+    # a kernel of the cells' own scale tells apart end points that sigma scores alike
+    refineSigma: float = 0.0
     # navlab: then refine all poses with dense verified scan-to-scan constraints (mapping.refine)
     refine: bool = True
     # navlab: a match that scores under ``wideScore`` per scored beam is retried from starts turned by
@@ -95,12 +103,13 @@ class GMappingParams:
 class _Particle:
     """A particle's map (its table of tiles), trajectory and weight (its pose is row n of ``GMapping.poses``)."""
 
-    __slots__ = ("node", "table", "weight")
+    __slots__ = ("node", "table", "weight", "weight_sum")
 
-    def __init__(self, table: np.ndarray, node: tuple | None, weight: float = 0.0) -> None:
+    def __init__(self, table: np.ndarray, node: tuple | None, weight: float = 0.0, weight_sum: float = 0.0) -> None:
         self.table = table
         self.node = node  # trajectory: (scan index, pose, parent node)
-        self.weight = weight
+        self.weight = weight  # log-likelihood since the last resampling
+        self.weight_sum = weight_sum  # ... over the whole trajectory (GMapping's weightSum: picks the best)
 
 
 def _readings(ranges: np.ndarray, no_return: float | None) -> np.ndarray:
@@ -242,6 +251,8 @@ class GMapping:
             r = _readings(ranges, no_return)
             ang, max_range, max_urange = self._beams(r, angle_min, angle_increment)
             self._update(k, r, ang, max_urange, max_range)
+            if p.refineSkipped and p.refineUpdated and self.keep_scans:
+                self._scan_data[k] = (r, ang, max_urange)
             self._odom_at_update = odom
             self._time_at_update = self._time
         elif self.keep_history:  # live, these per-scan records would grow by 40 a second without being read
@@ -303,7 +314,15 @@ class GMapping:
     ) -> None:
         """Ray-cast the scan into the map of ``table`` (copying the tiles it shares before writing them)."""
         free = self.pool.free(self._scan_tiles)  # (may grow the pool: its arrays are read after)
-        cow = (self.pool.tiles, self.pool.masks, table, self.pool.refs, free, np.zeros(1, dtype=np.int64))
+        cow = (
+            self.pool.tiles,
+            self.pool.masks,
+            self.pool.means,
+            table,
+            self.pool.refs,
+            free,
+            np.zeros(1, dtype=np.int64),
+        )
         at = (float(pose[0]), float(pose[1]), float(pose[2]))
         raycast_tiles(*cow, self._lattice(), at, (r, ang, max_urange, max_range), (L_OCC, L_FREE, L_CLAMP))
 
@@ -311,10 +330,10 @@ class GMapping:
         """(anchor x, anchor y, offset column, offset row, cell size) as the numba kernels take them."""
         return float(self._anchor[0]), float(self._anchor[1]), int(self._offset[0]), int(self._offset[1]), self.p.delta
 
-    def _model(self) -> tuple[int, float, float, int]:
-        """The matcher's (kernelSize, sigma, lsigma, lskip) as the numba kernels take them."""
+    def _model(self, sigma: float | None = None) -> tuple[int, float, float, int]:
+        """The matcher's (kernelSize, sigma (or ``sigma``), lsigma, lskip) as the numba kernels take them."""
         p = self.p
-        return p.kernelSize, p.sigma, p.lsigma, p.lskip
+        return p.kernelSize, p.sigma if sigma is None else sigma, p.lsigma, p.lskip
 
     def _mark_update(self, k: int) -> None:
         if self.keep_history:
@@ -327,15 +346,18 @@ class GMapping:
         lattice = self._lattice()
         scan, model = (r, np.cos(ang), np.sin(ang), max_urange), self._model()
         poses = self.poses
-        tiles, masks = self.pool.tiles, self.pool.masks
+        pool = self.pool  # (its arrays are read at each use: growing it moves them)
         for part, pose in zip(self.particles, poses, strict=True):
             x, y, t, score, lik = self._match(part.table, pose, scan)
             matched = score > p.minimumScore
             if matched:
                 pose[:] = x, y, wrap_angle(t)
             if not matched or pose[2] != t:  # the weight takes the log-likelihood at another pose
-                _s, lik, _n = match_score(tiles, masks, part.table, lattice, (pose[0], pose[1], pose[2]), scan, model)
+                _s, lik, _n = match_score(
+                    pool.tiles, pool.masks, pool.means, part.table, lattice, (pose[0], pose[1], pose[2]), scan, model
+                )
             part.weight += lik
+            part.weight_sum += lik
         # normalise (GMapping: gain 1 / (ogain * N)) and resample on N_eff
         lw = np.array([q.weight for q in self.particles])
         w = np.exp((lw - lw.max()) / (p.ogain * len(lw)))
@@ -355,7 +377,7 @@ class GMapping:
                 # (same map, same pose: the same result); until then it holds only unknown tiles
                 copy_of[n] = first.setdefault(int(i), n)
                 table = src.table.copy() if copy_of[n] == n else np.zeros_like(src.table)
-                new.append(_Particle(table, src.node, 0.0))
+                new.append(_Particle(table, src.node, 0.0, src.weight_sum))
             self.particles = new
             self.poses = self.poses[idx]  # a copy
             self.pool.recount([q.table for q in new])  # the dropped particles' tiles are free
@@ -368,7 +390,7 @@ class GMapping:
                 np.add.at(self.pool.refs, part.table.ravel(), 1)
             else:
                 self._integrate(part.table, self.poses[n], r, ang, max_urange, max_range)
-        weights = [q.weight for q in self.particles]
+        weights = [q.weight_sum for q in self.particles]
         self._best = weights.index(max(weights))
         self.tiles_in_use = self.pool.in_use()
         self._mark_update(k)
@@ -403,18 +425,23 @@ class GMapping:
                 base = self._odom_by_scan[ref]
             out[k] = compose2(base, step)
             scan = self._scan_data.get(k)
-            if scan is not None and k not in traj:  # a scan between updates: matched against the best map
+            if scan is not None:  # matched against the best map (a scan between updates; with refineUpdated, all)
                 out[k] = self._refine(self.best().table, out[k], *scan)
         return out
 
     def _refine(
         self, table: np.ndarray, pose: np.ndarray, r: np.ndarray, ang: np.ndarray, max_urange: float
     ) -> np.ndarray:
-        """``pose`` improved by the scan matcher against ``grid`` (unchanged if the match scores too low)."""
-        x, y, t, score, _lik = self._match(table, pose, (r, np.cos(ang), np.sin(ang), max_urange))
-        return np.array([x, y, wrap_angle(t)]) if score > self.p.minimumScore else pose
+        """``pose`` improved by the scan matcher, with the ``refineSigma`` kernel, against the map of ``table``
+        (unchanged if the match scores too low)."""
+        p = self.p
+        scan = (r, np.cos(ang), np.sin(ang), max_urange)
+        x, y, t, score, _lik = self._match(table, pose, scan, sigma=p.refineSigma or 2.0 * p.delta**2)
+        return np.array([x, y, wrap_angle(t)]) if score > p.minimumScore else pose
 
-    def _match(self, table: np.ndarray, pose: np.ndarray, scan: Scan) -> tuple[float, float, float, float, float]:
+    def _match(
+        self, table: np.ndarray, pose: np.ndarray, scan: Scan, *, sigma: float | None = None
+    ) -> tuple[float, float, float, float, float]:
         """GMapping's hill climb of the scan from ``pose`` against the map of ``table``: (x, y, theta, score,
         log-likelihood). A climb that ends under ``wideScore`` per scored beam (stuck: the start was turned
         too far for its steps to reach the scan's place) is retried from starts turned by ``wideStep``,
@@ -423,8 +450,8 @@ class GMapping:
         is then climbed on every beam and kept only if it beats the first climb, so the scan turns away
         from its odometry only where the map matches it better there."""
         p = self.p
-        fixed = (self.pool.tiles, self.pool.masks, table, self._lattice())
-        model, steps = self._model(), (p.lstep, p.astep, p.iterations)
+        fixed = (self.pool.tiles, self.pool.masks, self.pool.means, table, self._lattice())
+        model, steps = self._model(sigma), (p.lstep, p.astep, p.iterations)
         best = optimize(*fixed, (pose[0], pose[1], pose[2]), scan, model, steps)
         if p.wideScore <= 0 or p.wideStep <= 0:
             return best

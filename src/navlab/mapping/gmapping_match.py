@@ -15,7 +15,7 @@ import math
 import numba
 import numpy as np
 
-from navlab.mapping.gmapping_tiles import MASK, NEIGHBOUR_BIT, SHIFT, TILE, cell, from_dense, raycast_tiles
+from navlab.mapping.gmapping_tiles import MASK, MEAN_UNIT, NEIGHBOUR_BIT, SHIFT, TILE, cell, from_dense, raycast_tiles
 from navlab.mapping.occupancy import L_CLAMP, L_FREE, L_OCC, scan_cells
 
 # the kernels' argument groups (numba tuples)
@@ -48,11 +48,10 @@ def _valid_beams(scan: Scan, skip: int) -> Beams:
 
 @numba.njit(cache=True, inline="always")
 def _endpoints(lattice: Lattice, pose: Pose, beams: Beams, fw: np.ndarray, iw: np.ndarray) -> None:
-    """For every beam (``beams``: range, cos, sin, laser frame) at ``pose`` (x, y, theta), into ``fw`` (8, n):
-    its end point (x, y) and the squared x distances from it to the centres of the end cell's column and
-    its two neighbours, then the squared y distances to the row and its neighbours; into ``iw`` (4, n): the
-    end cell (i, j) and the cell one step back along the beam (i, j), as array indices. One branch-free loop
-    (the compiler vectorises it); ``_score_above`` then reads them beam by beam."""
+    """For every beam (``beams``: range, cos, sin, laser frame) at ``pose`` (x, y, theta), into ``fw`` (4, n):
+    its end point (x, y) in cells from the lattice's anchor; into ``iw`` (4, n): the end cell
+    (i, j) and the cell one step back along the beam (i, j), as array indices. One branch-free loop (the
+    compiler vectorises it); ``_score_above`` then reads them beam by beam."""
     ox, oy, oi, oj, res = lattice
     px, py, pt = pose
     rv, cv, sv = beams
@@ -63,24 +62,29 @@ def _endpoints(lattice: Lattice, pose: Pose, beams: Beams, fw: np.ndarray, iw: n
         sa = st * cv[k] + ct * sv[k]
         ex, ey = px + r * ca, py + r * sa
         fx, fy = ex - res * ca, ey - res * sa  # a point one cell back along the beam
-        bi = math.floor((ex - ox) / res)  # lattice cell
-        bj = math.floor((ey - oy) / res)
-        fw[0, k], fw[1, k] = ex, ey
-        fw[2, k] = (ox + (bi - 1 + 0.5) * res - ex) ** 2
-        fw[3, k] = (ox + (bi + 0.5) * res - ex) ** 2
-        fw[4, k] = (ox + (bi + 1 + 0.5) * res - ex) ** 2
-        fw[5, k] = (oy + (bj - 1 + 0.5) * res - ey) ** 2
-        fw[6, k] = (oy + (bj + 0.5) * res - ey) ** 2
-        fw[7, k] = (oy + (bj + 1 + 0.5) * res - ey) ** 2
+        ux, uy = (ex - ox) / res, (ey - oy) / res  # in cells from the anchor
+        bi, bj = math.floor(ux), math.floor(uy)  # lattice cell
+        fw[0, k], fw[1, k] = ux, uy
         iw[0, k], iw[1, k] = bi - oi, bj - oj
         iw[2, k] = math.floor((fx - ox) / res) - oi
         iw[3, k] = math.floor((fy - oy) / res) - oj
 
 
 @numba.njit(cache=True, inline="always")
+def _mean_d2(means: np.ndarray, e: int, i: int, j: int, ux: float, uy: float) -> float:
+    """Squared distance (cells²) from the end point (``ux``, ``uy``) (cells from the anchor) to the mean of the
+    hits of lattice cell (``i``, ``j``), whose means are at flat index ``e`` (x 3) of ``means``. In lattice
+    cells, not array ones: the same wherever the map's window starts."""
+    mx = i + means[numba.uint64(3 * e + 1)] * MEAN_UNIT
+    my = j + means[numba.uint64(3 * e + 2)] * MEAN_UNIT
+    return (mx - ux) ** 2 + (my - uy) ** 2
+
+
+@numba.njit(cache=True, inline="always")
 def _score_above(
     tiles: np.ndarray,
     masks: np.ndarray,
+    means: np.ndarray,
     table: np.ndarray,
     lattice: Lattice,
     pose: Pose,
@@ -91,11 +95,12 @@ def _score_above(
     iw: np.ndarray,
     order: np.ndarray,
 ) -> tuple[float, float, int]:
-    """GMapping's score and log-likelihood of a scan at a pose: for each beam endpoint, the nearest
-    occupied cell within ``kernel`` cells whose cell one step back along the beam is free. ``beams``: range,
-    cosine and sine (laser frame) of the beams to score (``_valid_beams``); ``model``: (kernel, sigma,
-    lsigma); ``fw`` (10, n), ``iw`` (4, n): work arrays (``_endpoints``; rows 8 and 9 of ``fw`` get each
-    beam's score term and its match's squared distance, -1 if none).
+    """GMapping's score and log-likelihood of a scan at a pose: for each beam endpoint, the nearest mean of
+    the hits of an occupied cell within ``kernel`` cells whose cell one step back along the beam is free
+    (GMapping's ``cell.mean()``). ``beams``: range, cosine and sine (laser frame) of the beams to score
+    (``_valid_beams``); ``model``: (kernel, sigma, lsigma); ``fw`` (4, n), ``iw`` (4, n): work arrays
+    (``_endpoints``; rows 2 and 3 of ``fw`` get each beam's score term and its match's squared distance (m²),
+    -1 if none).
 
     A beam adds at most 1 to the score, so once the score so far plus one per beam left cannot exceed
     ``bound`` (rounding included), this returns (-1, 0, -1) without scoring the rest: the hill climb only
@@ -103,28 +108,28 @@ def _score_above(
     ``order`` (a permutation: the hill climb puts first those that scored worst at the pose it climbs from,
     which stops a worse neighbour sooner); the score and log-likelihood are summed in beam order all the
     same, so the order changes nothing but when a pose is given up."""
-    ox, oy, oi, oj, res = lattice
+    oi, oj, res = lattice[2], lattice[3], lattice[4]
     kernel, sigma, lsigma = model
     rv = beams[0]
     th, tw = table.shape
     h, w = th * TILE, tw * TILE
-    flat = masks.reshape(-1)  # a view (C-contiguous)
+    flat = masks.reshape(-1)  # views (C-contiguous)
+    mflat = means.reshape(-1)
     _endpoints(lattice, pose, beams, fw, iw)
     s = 0.0
     null_l = -0.5 / lsigma  # GMapping: nullLikelihood = -0.5
     left = rv.shape[0]
     for q in range(rv.shape[0]):
         k = order[q]
-        ex, ey = fw[0, k], fw[1, k]
+        ux, uy = fw[0, k], fw[1, k]
         ei, ej, fi, fj = iw[0, k], iw[1, k], iw[2, k], iw[3, k]
-        best = 1e9  # the nearest match's squared distance: a minimum, so the cells' order does not matter
-        found = False
+        best = 1e9  # the nearest match's squared distance (cells²): a minimum, so the cells' order does not matter
         inside = (
             min(ei, fi) >= kernel and min(ej, fj) >= kernel and max(ei, fi) < w - kernel and max(ej, fj) < h - kernel
         )
         # GMapping's default kernel with both 3 x 3 windows inside one tile each (nearly always; then it is
         # the same tile, as the cell back is a neighbour): each cell's occupied-with-free-behind bit read from
-        # the tile's mask, unrolled, each cell's x and y term once, flat unsigned indices and no branches
+        # the tile's mask, flat unsigned indices
         if (
             inside
             and kernel == 1
@@ -135,20 +140,12 @@ def _score_above(
         ):
             ce = table[ej >> SHIFT, ei >> SHIFT] * TILE * TILE + (ej & MASK) * TILE + (ei & MASK)
             bit = NEIGHBOUR_BIT[(fj - ej + 1) * 3 + fi - ei + 1]
-            x0, x1, x2 = fw[2, k], fw[3, k], fw[4, k]
-            for dj in range(3):
-                e = ce + (dj - 1) * TILE
-                yy = fw[5 + dj, k]
-                ok0 = (flat[numba.uint64(e - 1)] & bit) != 0
-                ok1 = (flat[numba.uint64(e)] & bit) != 0
-                ok2 = (flat[numba.uint64(e + 1)] & bit) != 0
-                d2 = x0 + yy if ok0 else 1e9
-                best = d2 if d2 < best else best
-                d2 = x1 + yy if ok1 else 1e9
-                best = d2 if d2 < best else best
-                d2 = x2 + yy if ok2 else 1e9
-                best = d2 if d2 < best else best
-                found = found | ok0 | ok1 | ok2
+            for dj in range(-1, 2):
+                for di in range(-1, 2):
+                    e = ce + dj * TILE + di
+                    if flat[numba.uint64(e)] & bit:
+                        d2 = _mean_d2(mflat, e, ei + di + oi, ej + dj + oj, ux, uy)
+                        best = d2 if d2 < best else best
         else:
             for dj in range(-kernel, kernel + 1):
                 for di in range(-kernel, kernel + 1):
@@ -157,15 +154,14 @@ def _score_above(
                     if i < 0 or j < 0 or i >= w or j >= h or i2 < 0 or j2 < 0 or i2 >= w or j2 >= h:
                         continue
                     if cell(tiles, table, j, i) > 0.0 and cell(tiles, table, j2, i2) < 0.0:
-                        cx = ox + (i + oi + 0.5) * res
-                        cy = oy + (j + oj + 0.5) * res
-                        d2 = (cx - ex) ** 2 + (cy - ey) ** 2
-                        if d2 < best:
-                            best = d2
-                            found = True
+                        e = table[j >> SHIFT, i >> SHIFT] * TILE * TILE + (j & MASK) * TILE + (i & MASK)
+                        d2 = _mean_d2(mflat, e, i + oi, j + oj, ux, uy)
+                        best = d2 if d2 < best else best
+        found = best < 1e9
+        best *= res * res
         term = math.exp(-best / sigma) if found else 0.0
-        fw[8, k] = term
-        fw[9, k] = best if found else -1.0
+        fw[2, k] = term
+        fw[3, k] = best if found else -1.0
         s += term
         left -= 1
         # each later term is in [0, 1] and each rounding adds < 1e-16 relatively (<= 720 beams, in any order):
@@ -178,9 +174,9 @@ def _score_above(
     lik = 0.0
     n = 0
     for k in range(rv.shape[0]):
-        s += fw[8, k]
-        if fw[9, k] >= 0.0:
-            lik += -fw[9, k] / lsigma
+        s += fw[2, k]
+        if fw[3, k] >= 0.0:
+            lik += -fw[3, k] / lsigma
             n += 1
         else:
             lik += null_l
@@ -207,21 +203,29 @@ def _worst_first(terms: np.ndarray, order: np.ndarray, counts: np.ndarray) -> No
 
 @numba.njit(cache=True)
 def match_score(
-    tiles: np.ndarray, masks: np.ndarray, table: np.ndarray, lattice: Lattice, pose: Pose, scan: Scan, model: Model
+    tiles: np.ndarray,
+    masks: np.ndarray,
+    means: np.ndarray,
+    table: np.ndarray,
+    lattice: Lattice,
+    pose: Pose,
+    scan: Scan,
+    model: Model,
 ) -> tuple[float, float, int]:
     """(score, log-likelihood, matched beams) of the scan at ``pose`` (x, y, theta). ``scan``: (ranges, cos
     and sin of the beam angles (laser frame), max_urange); ``model``: (kernel, sigma, lsigma, skip): every
     ``skip + 1``-th beam with a range in (0, max_urange) is scored. See ``_score_above``."""
     beams = _valid_beams(scan, model[3])
     nb = beams[0].shape[0]
-    fw, iw = np.empty((10, nb)), np.empty((4, nb), dtype=np.int64)
-    return _score_above(tiles, masks, table, lattice, pose, beams, model[:3], -1.0, fw, iw, np.arange(nb))
+    fw, iw = np.empty((4, nb)), np.empty((4, nb), dtype=np.int64)
+    return _score_above(tiles, masks, means, table, lattice, pose, beams, model[:3], -1.0, fw, iw, np.arange(nb))
 
 
 @numba.njit(cache=True)
 def optimize(
     tiles: np.ndarray,
     masks: np.ndarray,
+    means: np.ndarray,
     table: np.ndarray,
     lattice: Lattice,
     start: Pose,
@@ -241,13 +245,13 @@ def optimize(
     beams = _valid_beams(scan, model[3])
     scoring = model[:3]
     nb = beams[0].shape[0]
-    fw, iw = np.empty((10, nb)), np.empty((4, nb), dtype=np.int64)
+    fw, iw = np.empty((4, nb)), np.empty((4, nb), dtype=np.int64)
     order, counts = np.arange(nb), np.empty(64, dtype=np.int64)
     terms = np.empty(nb)  # the score terms of the best pose found in this step of the climb
     seen = np.empty((SEEN_POSES, 5))  # x, y, theta, score (-1: no better than the pose it was tried from), lik
     cx, cy, ct = start
-    cur, cur_lik, _n = _score_above(tiles, masks, table, lattice, start, beams, scoring, -1.0, fw, iw, order)
-    _worst_first(fw[8], order, counts)
+    cur, cur_lik, _n = _score_above(tiles, masks, means, table, lattice, start, beams, scoring, -1.0, fw, iw, order)
+    _worst_first(fw[2], order, counts)
     seen[0, 0], seen[0, 1], seen[0, 2], seen[0, 3], seen[0, 4] = cx, cy, ct, cur, cur_lik
     n_seen = 1
     ld, ad = lstep, astep
@@ -283,13 +287,13 @@ def optimize(
                 sc, lik = seen[q, 3], seen[q, 4]
             else:
                 at = (nx, ny, nt)
-                sc, lik, _n = _score_above(tiles, masks, table, lattice, at, beams, scoring, cur, fw, iw, order)
+                sc, lik, _n = _score_above(tiles, masks, means, table, lattice, at, beams, scoring, cur, fw, iw, order)
                 if n_seen < SEEN_POSES:
                     seen[n_seen, 0], seen[n_seen, 1], seen[n_seen, 2] = nx, ny, nt
                     seen[n_seen, 3], seen[n_seen, 4] = sc, lik
                     n_seen += 1
                 if sc > cur:  # (a pose remembered from before never beats the best so far)
-                    terms[:] = fw[8]
+                    terms[:] = fw[2]
             if sc > cur:
                 cur, cur_lik = sc, lik
                 bx, by, bt = nx, ny, nt
@@ -322,11 +326,13 @@ def warmup() -> None:
     that load would stall the first map update (a live run's simulation at its first second)."""
     pool, table = from_dense(np.zeros((4, 4), dtype=np.float32))
     free, used = pool.free(1), np.zeros(1, dtype=np.int64)
-    tiles, masks = pool.tiles, pool.masks  # (after free(), which may grow the pool)
+    tiles, masks, means = pool.tiles, pool.masks, pool.means  # (after free(), which may grow the pool)
     r, c = np.ones(2), np.ones(2)
     lattice, pose, scan, model = (0.0, 0.0, 0, 0, 0.05), (0.1, 0.1, 0.0), (r, c, c, 1.0), (1, 0.05, 0.075, 0)
-    optimize(tiles, masks, table, lattice, pose, scan, model, (0.05, 0.05, 1))
-    match_score(tiles, masks, table, lattice, pose, scan, model)
-    raycast_tiles(tiles, masks, table, pool.refs, free, used, lattice, pose, (r, c, 1.0, 2.0), (L_OCC, L_FREE, L_CLAMP))
+    optimize(tiles, masks, means, table, lattice, pose, scan, model, (0.05, 0.05, 1))
+    match_score(tiles, masks, means, table, lattice, pose, scan, model)
+    raycast_tiles(
+        tiles, masks, means, table, pool.refs, free, used, lattice, pose, (r, c, 1.0, 2.0), (L_OCC, L_FREE, L_CLAMP)
+    )
     draw_motion(np.zeros((2, 3)), np.zeros((2, 3)), 0.1, 0.0, 0.0, 0.1, 0.1, 0.1)
     scan_cells(np.zeros((2, 3)), r, c, (0.0, 0.0), 0.05, max_urange=1.0, max_range=2.0)

@@ -15,6 +15,12 @@ turns free or stops being free needs no look at its neighbours unless it has tha
 its own tile only, so it follows the tile's copy-on-write; a neighbour across a tile edge is never marked
 (the matcher reads the cells themselves there).
 
+Beside each tile the pool keeps, per cell, GMapping's ``PointAccumulator`` mean of the beam end points that
+fell into it (``means``, uint8, the same id): the hits counted (saturating at 255: a running mean then) and
+the mean's offset (x, y) in the cell, in 1/256 of a cell (0.2 mm at 5 cm) from its corner; the matcher
+measures a beam's end point against that mean, not the cell's centre (GMapping's ``cell.mean()``). A cell no
+scan hit has none; cells put in from a dense grid (``from_dense``) count as hit once at their centre.
+
 Lattice conventions as in ``mapping.occupancy``: the map holds the cells of a fixed lattice anchored at
 (``ox``, ``oy``) from lattice cell (``oi``, ``oj``) on; cells outside it read as unknown.
 """
@@ -25,7 +31,7 @@ import numba
 import numpy as np
 
 from navlab.gridline import TIE_LATE, line, line_cell
-from navlab.mapping.occupancy import beam_end, is_return, lattice_cell
+from navlab.mapping.occupancy import beam_point, is_return, lattice_cell
 
 SHIFT = 6
 TILE = 1 << SHIFT  # cells per tile side (64 cells: 3.2 m at 5 cm, 16 KiB of float32)
@@ -33,6 +39,8 @@ MASK = TILE - 1
 # the mask bit of each neighbour offset (dj + 1) * 3 + di + 1; the cell itself (4) has none
 NEIGHBOUR_BIT = np.array([1, 2, 4, 8, 0, 16, 32, 64, 128], dtype=np.uint16)
 NEAR_OCC = 256  # the mask bit of a cell with an occupied neighbour in its tile
+MEAN_UNIT = 1.0 / 256.0  # a mean offset's unit, in cells
+CENTRE = 128  # the mean offset of a cell's centre
 
 
 class TilePool:
@@ -41,6 +49,7 @@ class TilePool:
     def __init__(self, capacity: int = 64) -> None:
         self.tiles = np.zeros((max(capacity, 2), TILE, TILE), dtype=np.float32)
         self.masks = np.zeros(self.tiles.shape, dtype=np.uint16)  # each tile's mask (module docstring)
+        self.means = np.zeros((*self.tiles.shape, 3), dtype=np.uint8)  # hits, mean x, y offset (docstring)
         self.refs = np.zeros(len(self.tiles), dtype=np.int64)
         self.refs[0] = 1 << 40  # never freed, never written
 
@@ -52,7 +61,7 @@ class TilePool:
 
     def free(self, need: int) -> np.ndarray:
         """Ids of at least ``need`` free tiles (the pool grows by at least half when short), lowest first.
-        Growing replaces ``tiles``, ``masks`` and ``refs``: read them after this call."""
+        Growing replaces ``tiles``, ``masks``, ``means`` and ``refs``: read them after this call."""
         ids = np.flatnonzero(self.refs == 0)
         if len(ids) < need:
             old = len(self.tiles)
@@ -63,6 +72,9 @@ class TilePool:
             masks = np.empty(tiles.shape, dtype=np.uint16)
             masks[:old] = self.masks
             self.masks = masks
+            means = np.empty((*tiles.shape, 3), dtype=np.uint8)
+            means[:old] = self.means
+            self.means = means
             self.refs = np.concatenate([self.refs, np.zeros(cap - old, dtype=np.int64)])
             ids = np.flatnonzero(self.refs == 0)
         return ids
@@ -91,6 +103,7 @@ def from_dense(grid: np.ndarray) -> tuple[TilePool, np.ndarray]:
             if block.any():
                 pool.tiles[n] = block
                 mask_tile(pool.tiles[n], pool.masks[n])
+                pool.means[n][block > 0] = (1, CENTRE, CENTRE)
                 table[tj, ti] = n
                 n += 1
     pool.recount([table])
@@ -98,10 +111,12 @@ def from_dense(grid: np.ndarray) -> tuple[TilePool, np.ndarray]:
 
 
 def to_dense(tiles: np.ndarray, table: np.ndarray) -> np.ndarray:
-    """The map a table describes, as one (rows, columns) float32 array."""
+    """The map a table describes, as one (rows, columns, ...) array (``tiles``: the pool's ``tiles``, ``masks``
+    or ``means``)."""
     th, tw = table.shape
-    out = tiles[table.ravel()].reshape(th, tw, TILE, TILE)
-    return np.ascontiguousarray(out.transpose(0, 2, 1, 3)).reshape(th * TILE, tw * TILE)
+    rest = tiles.shape[3:]
+    out = tiles[table.ravel()].reshape(th, tw, TILE, TILE, *rest)
+    return np.ascontiguousarray(np.swapaxes(out, 1, 2)).reshape(th * TILE, tw * TILE, *rest)
 
 
 @numba.njit(cache=True, inline="always")
@@ -181,9 +196,21 @@ def _set(tiles: np.ndarray, masks: np.ndarray, t: int, j: int, i: int, add: floa
 
 
 @numba.njit(cache=True, inline="always")
+def _add_hit(mean: np.ndarray, fx: float, fy: float) -> None:
+    """Count one more hit in a cell's ``mean`` (hits, x, y offset: ``means[t, j, i]``) at (``fx``, ``fy``) (in
+    cells from its corner, in [0, 1)): the running mean of its hits (the count saturates at 255)."""
+    n = min(int(mean[0]) + 1, 255)
+    mean[0] = n
+    for c, f in ((1, fx), (2, fy)):
+        m = mean[c] * MEAN_UNIT
+        mean[c] = min(max(round((m + (f - m) / n) * 256.0), 0), 255)
+
+
+@numba.njit(cache=True, inline="always")
 def _own(
     tiles: np.ndarray,
     masks: np.ndarray,
+    means: np.ndarray,
     table: np.ndarray,
     refs: np.ndarray,
     free: np.ndarray,
@@ -192,7 +219,7 @@ def _own(
     ti: int,
 ) -> int:
     """The id of tile (``tj``, ``ti``) of this particle's map after making it private: a shared tile (or
-    tile 0) is first copied, with its mask, into the next of the ``free`` tiles (``used[0]`` of them taken so
+    tile 0) is first copied, with its mask and means, into the next of the ``free`` tiles (``used[0]`` of them taken so
     far)."""
     t = table[tj, ti]
     if refs[t] == 1:
@@ -201,6 +228,7 @@ def _own(
     used[0] += 1
     tiles[new] = tiles[t]
     masks[new] = masks[t]
+    means[new] = means[t]
     refs[t] -= 1
     refs[new] = 1
     table[tj, ti] = new
@@ -211,6 +239,7 @@ def _own(
 def raycast_tiles(
     tiles: np.ndarray,
     masks: np.ndarray,
+    means: np.ndarray,
     table: np.ndarray,
     refs: np.ndarray,
     free: np.ndarray,
@@ -224,8 +253,9 @@ def raycast_tiles(
     laser at ``pose`` (x, y, theta) on ``lattice`` (anchor x, y, offset column, row, cell size): every beam
     of ``scan`` (ranges, angles, max_urange, max_range) with a range in (0, max_range) lowers the log-odds
     of the cells it crosses (Bresenham, end cell excluded) by ``l_free`` and, if shorter than max_urange,
-    raises its end cell by ``l_occ`` (``update``: (l_occ, l_free, clamp); clamped to ±clamp); cells
-    outside the map are skipped. Tiles written are made private first; their ``masks`` follow the cells."""
+    raises its end cell by ``l_occ`` (``update``: (l_occ, l_free, clamp); clamped to ±clamp) and adds the end
+    point to its cell's mean; cells outside the map are skipped. Tiles written are made private first; their
+    ``masks`` follow the cells."""
     ranges, angles, max_urange, max_range = scan
     l_occ, l_free, clamp = update
     th, tw = table.shape
@@ -235,19 +265,25 @@ def raycast_tiles(
     for k in range(ranges.shape[0]):
         if not is_return(ranges[k], max_range):
             continue
-        i1, j1, hit = beam_end(lattice, pose, ranges[k], angles[k], max_urange)
+        ex, ey, hit = beam_point(pose, ranges[k], angles[k], max_urange)
+        i1, j1 = lattice_cell(lattice, ex, ey)
         ln = line(i0, j0, i1, j1, TIE_LATE)
         for n in range(ln[0]):  # the end cell excluded
             i, j = line_cell(ln, n)
             if 0 <= i < w and 0 <= j < h:
                 tj, ti = j >> SHIFT, i >> SHIFT
                 if tj != last_tj or ti != last_ti:
-                    t = _own(tiles, masks, table, refs, free, used, tj, ti)
+                    t = _own(tiles, masks, means, table, refs, free, used, tj, ti)
                     last_tj, last_ti = tj, ti
                 _set(tiles, masks, t, j & MASK, i & MASK, l_free, clamp)
         if hit and 0 <= i1 < w and 0 <= j1 < h:
             tj, ti = j1 >> SHIFT, i1 >> SHIFT
             if tj != last_tj or ti != last_ti:
-                t = _own(tiles, masks, table, refs, free, used, tj, ti)
+                t = _own(tiles, masks, means, table, refs, free, used, tj, ti)
                 last_tj, last_ti = tj, ti
             _set(tiles, masks, t, j1 & MASK, i1 & MASK, l_occ, clamp)
+            _add_hit(
+                means[t, j1 & MASK, i1 & MASK],
+                (ex - lattice[0]) / lattice[4] - (i1 + lattice[2]),
+                (ey - lattice[1]) / lattice[4] - (j1 + lattice[3]),
+            )

@@ -58,6 +58,7 @@ _NON_NEGATIVE = (
     "wideStep",
     "wideTurn",
     "wideSkip",
+    "refineSigma",
 )
 
 
