@@ -99,3 +99,21 @@ def test_a_remembered_lookup_is_forgotten_when_a_transform_arrives():
     buf.set_transform("map", "odom", 0, (1.5, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0), static=True)  # amcl's correction
     assert buf.lookup_pose2d("map", "chassis")[:2] == pytest.approx((6.5, 2.0))
     assert buf.lookup_pose2d("map", "chassis", 500_000_000)[:2] == pytest.approx((3.5, 2.0))
+
+
+def test_a_remembered_lookup_follows_the_edges_it_read():
+    buf = _buf()
+    assert buf.lookup_pose2d("odom", "chassis")[:2] == pytest.approx((3.0, 2.0))
+    buf.set_transform("map", "odom", 0, (1.5, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0), static=True)  # not on odom -> chassis
+    assert buf.lookup_pose2d("odom", "chassis")[:2] == pytest.approx((3.0, 2.0))
+    assert buf.lookup_pose2d("map", "chassis")[:2] == pytest.approx((4.5, 2.0))
+    # messages, newest last (appended as they come) and one out of order (put in its place)
+    later = msgs.transform_stamped(2_000_000_000, "odom", "chassis", 5.0, 2.0, 0.0)
+    buf.add_message(msgs.TFMessage([later]))
+    assert buf.lookup_pose2d("odom", "chassis")[:2] == pytest.approx((5.0, 2.0))
+    assert buf.lookup_pose2d("map", "chassis")[:2] == pytest.approx((6.5, 2.0))
+    assert buf.lookup_pose2d("odom", "chassis", 1_500_000_000)[:2] == pytest.approx((4.0, 2.0))
+    between = msgs.transform_stamped(1_500_000_000, "odom", "chassis", 7.0, 2.0, 0.0)
+    buf.add_message(msgs.TFMessage([between]))
+    assert buf.lookup_pose2d("odom", "chassis", 1_500_000_000)[:2] == pytest.approx((7.0, 2.0))
+    assert buf.lookup_pose2d("odom", "chassis")[:2] == pytest.approx((5.0, 2.0))

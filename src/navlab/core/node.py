@@ -198,6 +198,7 @@ class Node:
             self.fully_qualified_name,
         )
         self._sensor_poses: dict[tuple[str, str], Pose2] = {}
+        self._tf_pubs: dict[str, Publisher] = {}  # /tf, /tf_static -> this node's publisher (made on first use)
         if automatically_declare_parameters_from_overrides:
             self._declared.update(self._overrides)
         executor.register_node(self)
@@ -294,10 +295,13 @@ class Node:
         self._tf_publisher("/tf_static").publish(TFMessage(_as_list(transforms)))
 
     def _tf_publisher(self, topic: str) -> Publisher:
-        for pub in self.publishers:
-            if pub.topic_name == topic:
-                return pub
-        return self.create_publisher(TFMessage, topic, latched=topic == "/tf_static")
+        pub = self._tf_pubs.get(topic)
+        if pub is None:
+            pub = next((p for p in self.publishers if p.topic_name == topic), None)
+            if pub is None:
+                pub = self.create_publisher(TFMessage, topic, latched=topic == "/tf_static")
+            self._tf_pubs[topic] = pub
+        return pub
 
     # --- tf ---------------------------------------------------------------------------------------
 

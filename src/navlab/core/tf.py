@@ -13,9 +13,11 @@ from typing import Any
 
 from navlab.core.errors import TfError
 from navlab.geometry import IDENTITY_TF, Tf, compose3, interpolate3, inverse3, yaw_from_quat
-from navlab.msgs import Quaternion, Transform, TransformStamped, Vector3, header, ns_from_time
+from navlab.msgs import Quaternion, Transform, TransformStamped, Vector3, header
 
 Pose2 = tuple[float, float, float]  # (x m, y m, yaw rad) of a frame's origin in another frame
+LOOKUP_CACHE = 64  # lookups remembered (see TfBuffer.lookup)
+_INVERSE_IDENTITY = inverse3(IDENTITY_TF)  # what a lookup composes for a target that is the common ancestor
 
 
 def tf_from_msg(tr: Any) -> Tf:
@@ -35,6 +37,7 @@ class _Edge:
     static: bool
     times: list[int] = field(default_factory=list)
     values: list[Tf] = field(default_factory=list)
+    changes: int = 0  # bumped by every transform added: a lookup through the edge is then computed again
 
 
 class TfBuffer:
@@ -52,11 +55,10 @@ class TfBuffer:
         self._version = 0  # bumped whenever the tree's shape changes (an edge added or re-parented)
         # (target, source) -> (version, target's edges up to the common ancestor, source's edges up to it)
         self._chains: dict[tuple[str, str], tuple[int, list[tuple[str, _Edge]], list[tuple[str, _Edge]]]] = {}
-        # lookups answered since the last transform came in (target, source, t_ns, tolerance) -> result: many nodes
-        # ask the same question at one instant (the costmaps, move_base, amcl, monitors)
-        self._data = 0  # bumped by every set_transform
-        self._lookups: dict[tuple[str, str, int | None, int], Tf] = {}
-        self._lookups_at = 0
+        # lookups answered (target, source, t_ns, tolerance) -> [tree version, (edge, its changes) of each edge the
+        # answer read, the answer, its (x, y, yaw) once asked]: valid until one of those edges changes. Many nodes ask
+        # the same question between two transforms of the edges it reads (the costmaps, move_base, amcl, monitors).
+        self._lookups: dict[tuple[str, str, int | None, int], list[Any]] = {}
 
     def frames(self) -> list[str]:
         """Every frame seen, as parent or child."""
@@ -73,12 +75,12 @@ class TfBuffer:
         """Add ``parent_T_child`` valid at ``t_ns`` (static transforms are valid at every time)."""
         if not parent or not child:
             raise TfError(f"transform needs both frame names, got parent={parent!r} child={child!r}")
-        self._data += 1
         e = self._edges.get(child)
         if e is None or e.parent != parent or e.static != static:
             e = self._edges[child] = _Edge(parent, static)
             self._parents.add(parent)
             self._version += 1
+        e.changes += 1
         if static:
             e.times, e.values = [t_ns], [tf]
             return
@@ -94,15 +96,27 @@ class TfBuffer:
             del e.times[:cut], e.values[:cut]
 
     def add_message(self, msg: Any, *, static: bool = False) -> None:
-        """Add every transform of a ``tf2_msgs/TFMessage``."""
+        """Add every transform of a ``tf2_msgs/TFMessage``. A transform newer than its edge's newest, on an edge
+        already known with the same parent (every message of a running robot but the first) is appended here:
+        what :meth:`set_transform` does then, without its checks."""
+        edges = self._edges
         for ts in msg.transforms:
-            self.set_transform(
-                ts.header.frame_id.lstrip("/"),
-                ts.child_frame_id.lstrip("/"),
-                ns_from_time(ts.header.stamp),
-                tf_from_msg(ts.transform),
-                static=static,
-            )
+            h, tr = ts.header, ts.transform
+            child, parent = ts.child_frame_id.lstrip("/"), h.frame_id.lstrip("/")
+            stamp = h.stamp
+            t_ns = int(stamp.sec) * 1_000_000_000 + int(stamp.nanosec)  # ns_from_time
+            e = edges.get(child)
+            if static or e is None or e.static or e.parent != parent or not parent or (e.times and t_ns < e.times[-1]):
+                self.set_transform(parent, child, t_ns, tf_from_msg(tr), static=static)
+                continue
+            t, r = tr.translation, tr.rotation
+            e.changes += 1
+            times = e.times
+            times.append(t_ns)
+            e.values.append((t.x, t.y, t.z, r.x, r.y, r.z, r.w))  # tf_from_msg
+            if t_ns - times[0] > self.cache_ns:
+                cut = bisect.bisect_left(times, t_ns - self.cache_ns)
+                del times[:cut], e.values[:cut]
 
     def _edge_at(self, child: str, e: _Edge, t_ns: int | None) -> Tf:
         if e.static:
@@ -169,24 +183,33 @@ class TfBuffer:
 
     def lookup(self, target: str, source: str, t_ns: int | None = None) -> Tf:
         """``target_T_source`` at ``t_ns`` (None: the latest time every edge on the path has)."""
-        if self._lookups_at != self._data:
-            self._lookups.clear()
-            self._lookups_at = self._data
+        return self._answer(target, source, t_ns)[2]
+
+    def _answer(self, target: str, source: str, t_ns: int | None) -> list[Any]:
+        """The lookup's cache entry (see ``_lookups``), computed unless still valid."""
         key = (target, source, t_ns, self.tolerance_ns)
         hit = self._lookups.get(key)
-        if hit is not None:
-            return hit
-        out = self._lookup(target, source, t_ns)
-        self._lookups[key] = out
-        return out
-
-    def _lookup(self, target: str, source: str, t_ns: int | None) -> Tf:
+        if hit is not None and hit[0] == self._version:
+            for e, n in hit[1]:
+                if e.changes != n:
+                    break
+            else:
+                return hit
         edges_t, edges_s = self._chain(target.lstrip("/"), source.lstrip("/"))
+        out = self._lookup(edges_t, edges_s, t_ns)
+        if len(self._lookups) >= LOOKUP_CACHE:  # stamped questions pile up: start again
+            self._lookups.clear()
+        hit = self._lookups[key] = [self._version, tuple((e, e.changes) for _, e in (*edges_t, *edges_s)), out, None]
+        return hit
+
+    def _lookup(self, edges_t: list[tuple[str, _Edge]], edges_s: list[tuple[str, _Edge]], t_ns: int | None) -> Tf:
+        """``target_T_source`` from the chain's edges (:meth:`_chain`) at ``t_ns`` (None: the latest common)."""
         if t_ns is None:  # the newest time every dynamic edge between the two frames has (None if all static)
             for _, e in (*edges_s, *edges_t):
                 if not e.static:
                     t_ns = e.times[-1] if t_ns is None else min(t_ns, e.times[-1])
-        return compose3(inverse3(self._compose(edges_t, t_ns)), self._compose(edges_s, t_ns))
+        up = inverse3(self._compose(edges_t, t_ns)) if edges_t else _INVERSE_IDENTITY
+        return compose3(up, self._compose(edges_s, t_ns))
 
     def can_transform(self, target: str, source: str, t_ns: int | None = None) -> bool:
         """Whether :meth:`lookup` would succeed."""
@@ -210,8 +233,11 @@ class TfBuffer:
 
     def lookup_pose2d(self, target: str, source: str, t_ns: int | None = None) -> Pose2:
         """(x, y, yaw) of ``source``'s origin in ``target``."""
-        tf = self.lookup(target, source, t_ns)
-        return tf[0], tf[1], yaw_of(tf)
+        hit = self._answer(target, source, t_ns)
+        if hit[3] is None:
+            tf = hit[2]
+            hit[3] = (tf[0], tf[1], yaw_of(tf))
+        return hit[3]
 
     def lookup_pose2d_or_latest(self, target: str, source: str, t_ns: int | None) -> Pose2:
         """(x, y, yaw) of ``source`` in ``target`` at ``t_ns``, else at the latest time tf has.

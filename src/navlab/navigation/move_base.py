@@ -484,6 +484,8 @@ class MoveBase(Node):
         return {"plan": self.make_plan(start, goal)}
 
     def _publish_status(self) -> None:
+        if not (self.status_pub.get_subscription_count() or self.executor.has_listeners):
+            return  # built only when someone listens, as the paths are
         h = self.handle
         statuses = []
         if h is not None:

@@ -12,17 +12,30 @@ from dataclasses import dataclass
 from typing import Any, ClassVar
 
 from navlab.core import ParamSpec, read_params
-from navlab.geometry import wrap_angle
-from navlab.grid import COST_INSCRIBED
+from navlab.geometry import compose2, wrap_angle
+from navlab.grid import COST_INSCRIBED, COST_LETHAL
 from navlab.navigation.errors import NavigationError
 from navlab.plugins import BuiltFromParams
 
 Pose = tuple[float, float, float]
 
 
-def _collides(costmaps: dict[str, Any], pose: Pose) -> bool:
-    """Whether the footprint at ``pose`` (local costmap frame) covers a lethal or unknown cell of the local costmap."""
-    return bool(costmaps["local"].footprint_cost(pose) >= COST_INSCRIBED + 1)
+def _collides(costmaps: dict[str, Any], pose: Pose, move: Pose = (0.0, 0.0, 0.0)) -> bool:
+    """Whether the footprint at ``pose`` (local costmap frame) moved by ``move`` (x m, y m, yaw rad in the robot's
+    frame) covers a lethal or unknown cell of the local costmap, or a lethal cell of a global costmap in the same
+    frame (mapless navigation's rolling map in odom). That one keeps what the laser saw: after the local window was
+    cleared, the obstacles behind a 270° laser are only there (its unknown cells do not block: a rolling map has not
+    seen everything around). A global costmap in ``map`` is not asked: it would add amcl's error to the check."""
+    local, g = costmaps["local"], costmaps.get("global")
+    at = compose2(pose, move)
+    if local.footprint_cost(at) >= COST_INSCRIBED + 1:
+        return True
+    return (
+        g is not None
+        and g is not local
+        and g.global_frame == local.global_frame
+        and g.footprint_cost(at) == COST_LETHAL
+    )
 
 
 @dataclass
@@ -95,7 +108,7 @@ class RotateRecovery(BuiltFromParams):
         left = 2 * math.pi - self._turned
         if left < p.tolerance:
             return None
-        if _collides(costmaps, (pose[0], pose[1], pose[2] + min(left, 0.3))):
+        if _collides(costmaps, pose, (0.0, 0.0, min(left, 0.3))):
             return None  # ROS: "Rotation in place would collide"
         w = min(p.max_rotational_vel, max(p.min_in_place_rotational_vel, math.sqrt(2 * p.acc_lim_th * left)))
         return 0.0, w
@@ -129,7 +142,7 @@ class BackUpRecovery(BuiltFromParams):
         self._steps += 1
         if math.dist(pose[:2], self._start[:2]) >= p.backup_dist or self._steps > p.time_allowance * 20:
             return None
-        if _collides(costmaps, (pose[0] - 0.1 * math.cos(pose[2]), pose[1] - 0.1 * math.sin(pose[2]), pose[2])):
+        if _collides(costmaps, pose, (-0.1, 0.0, 0.0)):
             return None
         return -p.backup_speed, 0.0
 

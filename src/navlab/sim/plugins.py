@@ -286,27 +286,24 @@ class LidarPlugin(SensorPlugin[LidarConfig]):
         self.angle_increment = float(np.diff(lidar_angles(cfg))[0]) if n > 1 else 0.0
         self.pub = self.create_publisher(msgs.LaserScan, cfg.topic, 10)
         self._empty = np.zeros(0, dtype=np.float32)
-        # the scan's fixed fields, converted once
-        self._fields = {
-            "angle_min": float(cfg.min_angle),
-            "angle_max": float(cfg.max_angle),
-            "angle_increment": self.angle_increment,
-            "time_increment": 0.0,
-            "scan_time": 1.0 / cfg.update_rate,
-            "range_min": float(cfg.range_min),
-            "range_max": float(cfg.range_max),
-        }
+        # the scan's fixed fields, converted once, in the message's order: angle_min, angle_max, angle_increment,
+        # time_increment, scan_time, range_min, range_max
+        self._fields = (
+            float(cfg.min_angle),
+            float(cfg.max_angle),
+            self.angle_increment,
+            0.0,
+            1.0 / cfg.update_rate,
+            float(cfg.range_min),
+            float(cfg.range_max),
+        )
 
     def update(self) -> None:
         """Cast the rays and publish the scan."""
         ranges = self.sim.scan(self.index, rng=self.rng)
+        # positional (see navlab.msgs): header, the fixed fields, ranges, intensities
         self.pub.publish(
-            msgs.LaserScan(
-                header=msgs.header(self.executor.now_ns, self.frame_id),
-                ranges=ranges,
-                intensities=self._empty,
-                **self._fields,
-            )
+            msgs.LaserScan(msgs.header(self.executor.now_ns, self.frame_id), *self._fields, ranges, self._empty)
         )
 
 
@@ -325,17 +322,11 @@ class JointStatePlugin(SimPlugin):
 
     def update(self) -> None:
         """Publish the joints' state."""
-        pos = np.array([self.sim.joint_position(j) for j in self.joints])
-        vel = np.array([self.sim.joint_velocity(j) for j in self.joints])
-        self.pub.publish(
-            msgs.JointState(
-                header=msgs.header(self.executor.now_ns, ""),
-                name=list(self.joints),
-                position=pos,
-                velocity=vel,
-                effort=np.zeros(len(pos)),
-            )
-        )
+        qpos, qvel = self.sim.joint_addresses(self.joints)  # looked up now: a spawn recompiles the model
+        d = self.sim.data
+        # positional: header, name, position, velocity, effort (see navlab.msgs)
+        head = msgs.header(self.executor.now_ns, "")
+        self.pub.publish(msgs.JointState(head, list(self.joints), d.qpos[qpos], d.qvel[qvel], np.zeros(len(qpos))))
 
 
 class RobotStatePublisher(SimPlugin):
@@ -359,8 +350,9 @@ class RobotStatePublisher(SimPlugin):
         if not self.publish_tf:
             return
         stamp = msgs.stamp_ns(msg)
+        position = msg.position.tolist() if isinstance(msg.position, np.ndarray) else msg.position
         out = []
-        for name, q in zip(msg.name, msg.position, strict=False):
+        for name, q in zip(msg.name, position, strict=False):
             known = self.joints.get(name)
             if known is not None:
                 joint, consts = known

@@ -82,6 +82,7 @@ class Simulation:
         self._synced = True
         self._lidar_dirs: dict[int, np.ndarray] = {}  # lidar -> (2, n) cos, sin of its beams
         self._no_noise = np.zeros(0)
+        self._normals: dict[int, np.ndarray] = {}  # lidar -> its noise draws' buffer (see scan)
         self._vel6 = np.zeros(6)  # mj_objectVelocity's output, reused
         self._refresh_ids()
         if robot is not None:
@@ -93,7 +94,8 @@ class Simulation:
         m = self.model
         name2id = mujoco.mj_name2id
         self._act = [name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, n) for n in (self.info.wheel_actuators or ())]
-        self._act_sides: tuple[np.ndarray, np.ndarray] | None = None  # (left, right) actuator ids, as arrays
+        self._act_sides: tuple[list[int], list[int]] | None = None  # (left, right) actuator ids
+        self._wheel_qpos: tuple[list[int], list[int]] | None = None  # (left, right) wheel joints' qpos addresses
         self._lidar_site = [name2id(m, mujoco.mjtObj.mjOBJ_SITE, n) for n in self.info.lidar_sites]
         self._imu_site = [name2id(m, mujoco.mjtObj.mjOBJ_SITE, n) for n in self.info.imu_sites]
         in_rays = RAY_GEOMGROUP[np.clip(m.geom_group, 0, 5)].astype(bool) & (m.geom_group < 6)
@@ -120,6 +122,7 @@ class Simulation:
         meets = ((m.geom_contype & waff) | (m.geom_conaffinity & wtype)) != 0  # not the wheels' floor spheres
         self._clear_robot = np.flatnonzero(meets & (m.geom_group == GROUP_ROBOT))
         self._joints: dict[str, tuple[int, int]] = {}
+        self._joint_arrays: dict[tuple[str, ...], tuple[np.ndarray, np.ndarray]] = {}  # see joint_addresses
         if self.robot is not None:
             for joint in self.robot.joints:
                 jid = name2id(m, mujoco.mjtObj.mjOBJ_JOINT, joint.name)
@@ -179,9 +182,12 @@ class Simulation:
             raise SimError("this robot has no diff_drive wheels to command")
         if self._act_sides is None:
             n = self.info.left_wheel_count
-            self._act_sides = (np.array(self._act[:n], dtype=np.intp), np.array(self._act[n:], dtype=np.intp))
-        self.data.ctrl[self._act_sides[0]] = left
-        self.data.ctrl[self._act_sides[1]] = right
+            self._act_sides = (list(self._act[:n]), list(self._act[n:]))
+        ctrl = self.data.ctrl
+        for i in self._act_sides[0]:  # one or two wheels a side: cheaper than an index array
+            ctrl[i] = left
+        for i in self._act_sides[1]:
+            ctrl[i] = right
 
     # --- state ------------------------------------------------------------------------------------
 
@@ -324,6 +330,19 @@ class Simulation:
         """Joint rate (rad/s or m/s)."""
         return float(self.data.qvel[self._joint(name)[1]])
 
+    def joint_addresses(self, names: list[str]) -> tuple[np.ndarray, np.ndarray]:
+        """(qpos addresses, qvel addresses) of the named joints, as index arrays: ``data.qpos[qpos]`` are their
+        positions, as :meth:`joint_position` reads them one by one (kept until the model is recompiled)."""
+        key = tuple(names)
+        hit = self._joint_arrays.get(key)
+        if hit is None:
+            adr = [self._joint(n) for n in names]
+            hit = self._joint_arrays[key] = (
+                np.array([a[0] for a in adr], dtype=np.intp),
+                np.array([a[1] for a in adr], dtype=np.intp),
+            )
+        return hit
+
     def _joint(self, name: str) -> tuple[int, int]:
         if name not in self._joints:
             raise SimError(f"unknown joint {name!r}; moving joints are {list(self._joints)}")
@@ -332,8 +351,12 @@ class Simulation:
     def wheel_angles(self) -> tuple[float, float]:
         """(left, right) diff-drive wheel angles (rad), unwrapped: each side's mean over its wheels (a skid-steer
         robot's front and rear wheels), as diff_drive_controller averages them."""
-        lefts, rights = self._diff_drive().wheel_joints()
-        return (sum(map(self.joint_position, lefts)) / len(lefts), sum(map(self.joint_position, rights)) / len(rights))
+        if self._wheel_qpos is None:
+            sides = self._diff_drive().wheel_joints()
+            self._wheel_qpos = ([self._joint(j)[0] for j in sides[0]], [self._joint(j)[0] for j in sides[1]])
+        lefts, rights = self._wheel_qpos
+        q = self.data.qpos
+        return (sum([float(q[a]) for a in lefts]) / len(lefts), sum([float(q[a]) for a in rights]) / len(rights))
 
     def _diff_drive(self) -> DiffDriveConfig:
         if self.robot is None or self.robot.diff_drive is None:
@@ -354,7 +377,12 @@ class Simulation:
         cfg = self.robot.lidars[index]
         dist = self.true_ranges(index)
         gen = self.rng if rng is None else rng
-        normals = gen.standard_normal(len(dist)) if cfg.noise_stddev > 0 else self._no_noise
+        normals = self._no_noise
+        if cfg.noise_stddev > 0:  # the draws of standard_normal(n), into a buffer kept per lidar
+            kept = self._normals.get(index)
+            if kept is None or kept.shape[0] != len(dist):
+                kept = self._normals[index] = np.empty(len(dist))
+            normals = gen.standard_normal(out=kept)
         out = np.empty(len(dist), dtype=np.float32)
         finish_ranges(dist, normals, cfg.noise_mean, cfg.noise_stddev, cfg.range_min, cfg.range_max, out)
         return out

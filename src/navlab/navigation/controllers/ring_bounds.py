@@ -127,6 +127,7 @@ def ring_scores(
     path_dist, path_reached, path_free, path_queue, path_ends = path_wave
     goal_dist, goal_reached, goal_free, goal_queue, goal_ends = goal_wave
     bounds = np.empty(n, dtype=np.int64)
+    unreached = float(h * w) + 1.0  # mapgrid's unreachable_value: a wave's cells not reached (yet)
     for r in range(traj.shape[0]):
         top = -math.inf
         fail = 0.0
@@ -169,10 +170,10 @@ def ring_scores(
             if at[r] == k or (at[r] == -1 and moved):  # (unmoved, the distances are those that passed)
                 pi, pj = (i, j) if inside else (0, 0)
                 pd = path_dist[pj, pi]
-                if not path_reached[pj, pi]:
+                if pd == unreached:  # not reached yet: wave_start's fill (cells + 1); a reached cell reads less
                     pd = grow(grid, path_dist, path_reached, path_free, path_queue, path_ends, pi, pj)
                 gd = goal_dist[pj, pi]
-                if not goal_reached[pj, pi]:
+                if gd == unreached:
                     gd = grow(grid, goal_dist, goal_reached, goal_free, goal_queue, goal_ends, pi, pj)
                 spd, sgd = pd, gd
                 if pd >= impossible or gd >= impossible:

@@ -79,12 +79,22 @@ def integrate_rollouts(
     sin: np.ndarray,
 ) -> None:  # pragma: no cover - compiled
     """:func:`rollout`'s integration into ``out``; ``cos``/``sin`` (the poses' shape, or empty: not kept) get the
-    cosine and sine of each pose's heading, which the integration works out anyway."""
+    cosine and sine of each pose's heading, which the integration works out anyway. A sample's headings depend only
+    on its turn rate and step count, not its speed: one with the same as an earlier sample (TrajectoryPlanner's
+    speeds share their turn rates) takes that one's cosines and sines, the same values, instead of working them out
+    again (a third of the integration's time on bench nav)."""
     keep = cos.size > 0
     for s in range(out.shape[0]):
         x, y, th, v, w = x0, y0, th0, v0, w0
         tv, tw = targets[s, 0], targets[s, 1]
         dt = sim_time / steps[s]
+        twin = -1  # an earlier sample with the same turn rate (bit for bit: the sign of zero too) and steps
+        if keep:
+            for q in range(s):
+                same = targets[q, 1] == tw and math.copysign(1.0, targets[q, 1]) == math.copysign(1.0, tw)
+                if same and steps[q] == steps[s]:
+                    twin = q
+                    break
         for k in range(out.shape[1]):
             if k >= steps[s]:
                 out[s, k, 0], out[s, k, 1], out[s, k, 2] = out[s, k - 1, 0], out[s, k - 1, 1], out[s, k - 1, 2]
@@ -97,7 +107,10 @@ def integrate_rollouts(
                 w = min(max(tw, w - ath * dt), w + ath * dt)
             else:
                 v, w = tv, tw
-            ch, sh = math.cos(th), math.sin(th)
+            if twin >= 0:
+                ch, sh = cos[twin, k], sin[twin, k]
+            else:
+                ch, sh = math.cos(th), math.sin(th)
             if keep:
                 cos[s, k], sin[s, k] = ch, sh
             x += v * ch * dt

@@ -86,6 +86,19 @@ from navlab.navigation.controllers.rollout import outline_reach_max, rollout
 
 _NO_POINTS = np.zeros((0, 2))  # no polygon, no outline (path_scene's typed empties)
 _NO_POINTS.flags.writeable = False
+_NONE_3, _NONE_2, _NONE_1, _NO_ROLLOUTS = np.zeros((0, 3)), np.zeros((0, 2)), np.zeros(0), np.zeros((0, 0, 3))
+for _empty in (_NONE_3, _NONE_2, _NONE_1, _NO_ROLLOUTS):  # a cycle's outputs before it has any (read-only)
+    _empty.flags.writeable = False
+_NO_FRAME = LocalFrame(0.0, 0.0, 0.0)
+
+
+def _words(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Two C-contiguous arrays of one shape as flat arrays to compare: 8 bytes at a time where the size allows."""
+    a, b = a.reshape(-1), b.reshape(-1)
+    if a.nbytes % 8 == 0:
+        return a.view(np.int64), b.view(np.int64)
+    return a, b
+
 
 # --- the shared cycle ------------------------------------------------------------------------------
 
@@ -166,6 +179,8 @@ class RolloutController(ControllerBase):
         self._latch = GoalLatch(p.xy_goal_tolerance, p.yaw_goal_tolerance, p.latch_xy_goal_tolerance)
         self._osc = OscillationFlags(p.oscillation_reset_dist, getattr(p, "oscillation_reset_angle", -1.0))
         self._plan: np.ndarray | None = None
+        self._given: np.ndarray | None = None  # the plan as set_plan last checked it (before pruning)
+        self._last_frame: tuple[tuple[float, float, float], LocalFrame] | None = None  # the grid-local frame seen
         self._rotating_to_goal = False
         self._outlines: dict[tuple[float, bytes | None], np.ndarray | None] = {}
         self._near: tuple[np.ndarray, np.ndarray | None, np.ndarray] | None = None  # (outline, costs, reach max)
@@ -178,11 +193,8 @@ class RolloutController(ControllerBase):
         """The planner's own state (called at the end of ``__init__``)."""
 
     def _clear_outputs(self) -> None:
-        self.local_plan = np.zeros((0, 3))
-        self.samples = np.zeros((0, 2))
-        self.costs = np.zeros(0)
-        self._traj = np.zeros((0, 0, 3))
-        self._frame = LocalFrame(0.0, 0.0, 0.0)
+        self.local_plan, self.samples, self.costs, self._traj = _NONE_3, _NONE_2, _NONE_1, _NO_ROLLOUTS
+        self._frame = _NO_FRAME
         self.valid = True
 
     @property
@@ -197,6 +209,13 @@ class RolloutController(ControllerBase):
 
         A plan to a new goal (beyond the goal tolerances from the last one) clears the goal latch and the
         oscillation flags; the same plan sent again every cycle keeps them."""
+        given = self._given
+        same_kind = isinstance(path, np.ndarray) and path.dtype == np.float64
+        if given is not None and same_kind and path.shape == given.shape:
+            bits = np.ascontiguousarray(path).reshape(-1).view(np.int64)
+            if same_values(bits, given.reshape(-1).view(np.int64)):  # bit for bit (the sign of zero too)
+                self._plan = given  # the plan sent again (move_base does every cycle): checked, to the same goal
+                return
         plan = as_plan(path)
         p = self.params
         if self._plan is None or not same_goal(
@@ -206,7 +225,7 @@ class RolloutController(ControllerBase):
             self._osc.reset()
             self._rotating_to_goal = False
             self._new_goal()
-        self._plan = plan
+        self._plan = self._given = plan  # never changed in place (pruning takes a view of its rows)
 
     def _new_goal(self) -> None:
         """Forget per-goal state (subclasses add theirs)."""
@@ -240,7 +259,10 @@ class RolloutController(ControllerBase):
 
     def _scene(self, pose: tuple[float, float, float], costmap: Grid) -> LocalScene | None:
         assert self._plan is not None
-        frame = LocalFrame.of(costmap)
+        last = self._last_frame  # (the origin tuple it was made from, the frame): kept while the window stays
+        if last is None or last[0] is not costmap.origin:
+            last = self._last_frame = (costmap.origin, LocalFrame.of(costmap))
+        frame = last[1]
         self._frame = frame
         cost = np.ascontiguousarray(costmap.data, dtype=np.uint8)
         res = costmap.resolution
@@ -249,7 +271,7 @@ class RolloutController(ControllerBase):
         mode, polygon, edges = self._free_mode(res)
         plan, cells, wave = scene_kernel.path_scene(
             cost,
-            np.ascontiguousarray(self._plan[:, :2]),
+            np.ascontiguousarray(self._plan),  # (N, 2) or (N, 3): path_scene reads the first two columns
             frame.ox,
             frame.oy,
             frame.oyaw,
@@ -271,7 +293,7 @@ class RolloutController(ControllerBase):
         from them (the goal's distance map, the footprint's reach maximum) is kept with that copy and reused while
         it is still the one (the costmap updates less often than the controller runs)."""
         seen = self._costs_seen
-        if seen is None or seen.shape != cost.shape or not same_values(seen.reshape(-1), cost.reshape(-1)):
+        if seen is None or seen.shape != cost.shape or not same_values(*_words(seen, cost)):
             self._costs_seen = cost.copy()
 
     def _goal_wave(self, cost: np.ndarray, goal: np.ndarray) -> mapgrid.Wave:

@@ -6,6 +6,10 @@ the escape), rolls them out and scores them in one call; ``choose`` picks the co
 numpy steps in ``trajectory.TrajectoryPlannerROS._drive`` did (``np.linspace``'s arithmetic, ROS's step
 counts, ``rollout.integrate_rollouts`` and ``rollout.rollout_scores``), without a Python step in between: one
 controller cycle makes two calls instead of some forty numpy calls. Poses are grid-local (m, rad).
+
+Numba's cache keys a kernel on its own file only: ``score_samples`` holds compiled copies of
+``rollout.integrate_rollouts`` and ``ring_bounds.ring_scores``, so after changing those, change this file too (or
+clear the ``__pycache__`` caches) or the old copies keep running.
 """
 
 from __future__ import annotations

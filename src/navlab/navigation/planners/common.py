@@ -120,14 +120,14 @@ def _put(keys: np.ndarray, vals: np.ndarray, pos: np.ndarray, k: int, key: float
 
 
 @numba.njit(cache=True, inline="always")
-def _sift_up(keys: np.ndarray, vals: np.ndarray, pos: np.ndarray, k: int) -> None:
-    key = keys[k]
-    val = vals[k]
+def _sift_up(keys: np.ndarray, vals: np.ndarray, pos: np.ndarray, k: int, key: float, val: int) -> None:
+    """Put entry ``val`` with ``key`` at slot ``k`` or above, moving larger parents down (each slot written once)."""
     while k > 0:
         parent = (k - 1) >> 1
-        if keys[parent] <= key:
+        above = keys[parent]
+        if above <= key:
             break
-        _put(keys, vals, pos, k, keys[parent], vals[parent])
+        _put(keys, vals, pos, k, above, vals[parent])
         k = parent
     _put(keys, vals, pos, k, key, val)
 
@@ -142,9 +142,7 @@ def iheap_update(keys: np.ndarray, vals: np.ndarray, pos: np.ndarray, size: int,
         size += 1
     elif keys[k] <= key:
         return size
-    keys[k] = key
-    vals[k] = val
-    _sift_up(keys, vals, pos, k)
+    _sift_up(keys, vals, pos, k, key, val)
     return size
 
 
@@ -163,11 +161,13 @@ def iheap_pop(keys: np.ndarray, vals: np.ndarray, pos: np.ndarray, size: int) ->
         if left >= size:
             break
         child = left
-        if left + 1 < size and keys[left + 1] < keys[left]:
+        below = keys[left]
+        if left + 1 < size and keys[left + 1] < below:
             child = left + 1
-        if key <= keys[child]:
+            below = keys[child]
+        if key <= below:
             break
-        _put(keys, vals, pos, k, keys[child], vals[child])
+        _put(keys, vals, pos, k, below, vals[child])
         k = child
     _put(keys, vals, pos, k, key, val)
     return size

@@ -105,19 +105,27 @@ GlobalPlannerParams.PARAMS = replace(NavfnParams.PARAMS, what="global_planner")
 
 @numba.njit(cache=True)
 def _propagate(
-    cost: np.ndarray, start: int, goal: int, astar: bool, h_scale: float, stop_at_goal: bool, margin: float
+    data: np.ndarray,
+    table: np.ndarray,
+    start: int,
+    goal: int,
+    astar: bool,
+    h_scale: float,
+    stop_at_goal: bool,
+    margin: float,
 ) -> tuple[np.ndarray, int]:
-    """Fast marching from ``start`` over ``cost`` (H, W) per cell (inf = obstacle). Returns the potential
+    """Fast marching from ``start`` over the costmap costs ``data`` (H, W) uint8, a cell costing ``table[data]``
+    (``cell_costs``, inf = obstacle; the start's own cost is never read: it is settled first). Returns the potential
     (exact where settled, an upper bound on the front, inf beyond) and the number of settled cells. With
     ``stop_at_goal`` it stops once the queue's keys pass the goal's by ``margin``, so the goal sits inside
     settled cells and the gradient around it is defined."""
-    h, w = cost.shape
+    h, w = data.shape
     n = h * w
-    c = cost.ravel()
+    c = data.ravel()
     pot = np.full(n, np.inf)
-    pos = np.full(n, -1, np.int64)  # heap slot, -1 never queued, -2 settled
+    pos = np.full(n, -1, np.int32)  # heap slot, -1 never queued, -2 settled (int32: half the memory traffic)
     keys = np.empty(n)
-    vals = np.empty(n, np.int64)
+    vals = np.empty(n, np.int32)
     gi, gj = goal % w, goal // w
     pot[start] = 0.0
     size = iheap_update(keys, vals, pos, 0, 0.0, start)
@@ -150,7 +158,7 @@ def _propagate(
             m = mj * w + mi
             if pos[m] == -2:
                 continue
-            hc = c[m]
+            hc = table[c[m]]
             if not math.isfinite(hc):
                 continue
             ta = np.inf
@@ -325,17 +333,29 @@ class NavfnPlanner(GridPlanner):
     params: NavfnParams
     name = "navfn"
     potential: np.ndarray | None = None
+    _table: tuple[tuple[float, float, int, bool], np.ndarray] | None = None  # cost_table's (parameters, table)
 
-    def cell_costs(self, data: np.ndarray) -> np.ndarray:
-        """Per-cell traversal cost (float64; inf = obstacle) from costmap_2d costs, as navfn's ``setCostmap``."""
+    def cost_table(self) -> np.ndarray:
+        """Traversal cost (256,) float64 of each costmap_2d cost value (inf = obstacle), as navfn's ``setCostmap``;
+        kept while the parameters it depends on stay the same."""
         p = self.params
+        key = (p.neutral_cost, p.cost_factor, p.lethal_cost, p.allow_unknown)
+        cached = self._table
+        if cached is not None and cached[0] == key:
+            return cached[1]
         ceiling = max(float(p.lethal_cost), p.neutral_cost)  # navfn: COST_OBS - 1 = 253
         levels = np.arange(256)
         table = np.minimum(p.neutral_cost + p.cost_factor * levels.astype(np.float64), ceiling)  # per cost value
         table[levels >= p.lethal_cost] = np.inf
         if p.allow_unknown:
             table[COST_UNKNOWN] = ceiling
-        return _cell_costs(np.ascontiguousarray(data, dtype=np.uint8), table)
+        table.flags.writeable = False
+        self._table = (key, table)
+        return table
+
+    def cell_costs(self, data: np.ndarray) -> np.ndarray:
+        """Per-cell traversal cost (float64; inf = obstacle) from costmap_2d costs, as navfn's ``setCostmap``."""
+        return _cell_costs(np.ascontiguousarray(data, dtype=np.uint8), self.cost_table())
 
     def make_plan(
         self, costmap: Grid, start: tuple[float, float, float], goal: tuple[float, float, float]
@@ -345,16 +365,18 @@ class NavfnPlanner(GridPlanner):
         cell, and a goal outside the map, raise ``NavigationError``."""
         data, (si, sj, su, sv), (gi, gj, gu, gv) = check_request(costmap, start, goal, self.name)
         self.last_failure = ""
-        cost = self.cell_costs(data)
-        cost[sj, si] = self.params.neutral_cost  # navfn clears the robot's cell
-        _h, w = cost.shape
-        goal_ok = math.isfinite(cost[gj, gi])
+        table = self.cost_table()
+        data = np.ascontiguousarray(data, dtype=np.uint8)
+        _h, w = data.shape
+        # navfn clears the robot's cell (cost neutral_cost); the wave starts there, so only the goal check reads it
+        goal_ok = (gi, gj) == (si, sj) or math.isfinite(table[data[gj, gi]])
         tol = self.params.default_tolerance
         # A*'s heuristic: the cheapest cell cost per cell of distance, over sqrt(2) because one quadratic update
         # can raise the potential by as little as cost / sqrt(2) per step (keeps the heuristic consistent)
         h_scale = float(self.params.neutral_cost) / math.sqrt(2.0)
         pot, settled = _propagate(
-            cost,
+            data,
+            table,
             sj * w + si,
             gj * w + gi,
             not self.params.use_dijkstra,
