@@ -89,3 +89,15 @@ def test_lines_whose_counts_disagree_go_backwards_or_are_huge_are_skipped(tmp_pa
     assert "bad.clf:4" in reasons and "backwards" in reasons
     assert "bad.clf:5" in reasons and "200000: expected a whole number" in reasons
     assert "bad.clf:6: skipped a line longer than" in reasons
+
+
+def test_running_median_matches_scipy_median_filter():
+    """The outlier filter's running median is scipy's mirrored median filter (which it replaces)."""
+    from scipy.ndimage import median_filter
+
+    from navlab.io.carmen import running_median
+
+    rng = np.random.default_rng(3)
+    for n in (3, 4, 6, 11, 12, 200):
+        x = np.round(rng.normal(size=n) * 5, 1)  # (ties too)
+        assert np.array_equal(running_median(x, 5), median_filter(x, size=11, mode="mirror"))

@@ -75,8 +75,15 @@ if TYPE_CHECKING:
     from navlab.core.introspect import IntrospectionServer, RemotePublisher, find_running, request, subscribe
     from navlab.core.launch import Session, declared_args, start
     from navlab.core.limits import ceilings, check_ceiling
-    from navlab.core.node import flatten_params
-    from navlab.core.params import canonical_params, check_unknown_key, param_error, parse_yaml, read_yaml, typed_value
+    from navlab.core.params import (
+        canonical_params,
+        check_unknown_key,
+        flatten_params,
+        param_error,
+        parse_yaml,
+        read_yaml,
+        typed_value,
+    )
     from navlab.core.rclpy_api import Context
     from navlab.core.record import Recorder
     from navlab.core.runner import parse_launch_args, run_for
@@ -98,7 +105,7 @@ _EXPORTS = {
     "echo_launch": "navlab.core.echo",
     "echo_live": "navlab.core.echo",
     "find_running": "navlab.core.introspect",
-    "flatten_params": "navlab.core.node",
+    "flatten_params": "navlab.core.params",
     "param_error": "navlab.core.params",
     "parse_launch_args": "navlab.core.runner",
     "parse_yaml": "navlab.core.params",

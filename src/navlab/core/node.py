@@ -6,7 +6,6 @@ needs besides its parameters (the simulation, for a Gazebo plugin) follow as key
 
 from __future__ import annotations
 
-import dataclasses
 import functools
 import logging
 import sys
@@ -18,7 +17,13 @@ from navlab.core.clock import Clock, Time
 from navlab.core.errors import ParameterError, TfError
 from navlab.core.executor import Executor
 from navlab.core.parameter import Parameter, SetParametersResult
-from navlab.core.params import ParameterWarning, likely_typo, typed_value
+from navlab.core.params import (
+    ParameterWarning,
+    dataclass_parameters,
+    flatten_params,
+    likely_typo,
+    typed_value,
+)
 from navlab.core.tf import Pose2
 from navlab.core.topics import Publisher, Subscription, Timer, seconds_to_ns
 from navlab.deprecation import NavlabDeprecationWarning
@@ -90,37 +95,6 @@ class _SimTimeAdapter(logging.LoggerAdapter[logging.Logger]):
     def fatal(self, msg: Any, *args: Any, **kwargs: Any) -> None:
         """rclpy's ``fatal``: logged as critical."""
         self.critical(msg, *args, **kwargs)
-
-
-def flatten_params(params: dict[str, Any], prefix: str = "") -> dict[str, Any]:
-    """Nested parameter dicts to dotted names (``global_costmap.update_frequency``)."""
-    out: dict[str, Any] = {}
-    for key, value in params.items():
-        name = f"{prefix}{key}"
-        if isinstance(value, dict):
-            out.update(flatten_params(value, name + "."))
-        else:
-            out[name] = value
-    return out
-
-
-def dataclass_parameters(cls: type, *, prefix: str = "") -> dict[str, Any]:
-    """Parameter names and defaults from a parameters dataclass's fields (``prefix.name`` if a prefix is given).
-
-    The dataclass is where a component writes its ROS names and defaults once; nodes declare from it.
-    """
-    if not dataclasses.is_dataclass(cls):
-        raise ParameterError(f"{cls!r} is not a dataclass of parameters")
-    out: dict[str, Any] = {}
-    for f in dataclasses.fields(cls):
-        if f.default is not dataclasses.MISSING:
-            default = f.default
-        elif f.default_factory is not dataclasses.MISSING:
-            default = f.default_factory()
-        else:
-            raise ParameterError(f"{cls.__name__}.{f.name}: a parameter needs a default")
-        out[f"{prefix}.{f.name}" if prefix else f.name] = default
-    return out
 
 
 def _coerce(name: str, value: Any, default: Any) -> Any:

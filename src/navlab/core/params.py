@@ -9,6 +9,7 @@ Two layouts are read:
 
 from __future__ import annotations
 
+import dataclasses
 import difflib
 import logging
 import math
@@ -359,4 +360,35 @@ def merge_params(*layers: dict[str, Any]) -> dict[str, Any]:
                 out[key] = merge_params(out[key], value)
             else:
                 out[key] = value
+    return out
+
+
+def flatten_params(params: dict[str, Any], prefix: str = "") -> dict[str, Any]:
+    """Nested parameter dicts to dotted names (``global_costmap.update_frequency``)."""
+    out: dict[str, Any] = {}
+    for key, value in params.items():
+        name = f"{prefix}{key}"
+        if isinstance(value, dict):
+            out.update(flatten_params(value, name + "."))
+        else:
+            out[name] = value
+    return out
+
+
+def dataclass_parameters(cls: type, *, prefix: str = "") -> dict[str, Any]:
+    """Parameter names and defaults from a parameters dataclass's fields (``prefix.name`` if a prefix is given).
+
+    The dataclass is where a component writes its ROS names and defaults once; nodes declare from it.
+    """
+    if not dataclasses.is_dataclass(cls):
+        raise ParameterError(f"{cls!r} is not a dataclass of parameters")
+    out: dict[str, Any] = {}
+    for f in dataclasses.fields(cls):
+        if f.default is not dataclasses.MISSING:
+            default = f.default
+        elif f.default_factory is not dataclasses.MISSING:
+            default = f.default_factory()
+        else:
+            raise ParameterError(f"{cls.__name__}.{f.name}: a parameter needs a default")
+        out[f"{prefix}.{f.name}" if prefix else f.name] = default
     return out

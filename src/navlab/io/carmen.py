@@ -237,6 +237,14 @@ def read_carmen(path: str | os.PathLike[str], *, max_skipped_report: int = 5) ->
     return log
 
 
+def running_median(x: np.ndarray, half: int) -> np.ndarray:
+    """The median of each element's ``2 half + 1`` window of ``x`` (1-D, at least 2 long), the ends mirrored
+    about the end elements (``d c b | a b c d | c b a``): scipy.ndimage's ``median_filter(x, 2 half + 1,
+    mode="mirror")`` without importing scipy.ndimage (~0.3 s of ``navlab slam``'s CPU)."""
+    padded = np.pad(x, half, mode="reflect")
+    return np.median(np.lib.stride_tricks.sliding_window_view(padded, 2 * half + 1), axis=1)
+
+
 def _without_outliers(
     log: CarmenLog, records: list[Any], poses: list[list[tuple[float, float, float]]], linenos: list[int]
 ) -> list[Any]:
@@ -245,15 +253,13 @@ def _without_outliers(
     allows (one wild pose would otherwise grow a SLAM map without bound); each rejected record is counted."""
     if len(records) < 3:
         return records
-    from scipy.ndimage import median_filter
-
     t = np.array([r.timestamp for r in records], dtype=np.float64)
     idx = np.arange(len(t))
     span = np.maximum(t - t[np.maximum(idx - OUTLIER_WINDOW, 0)], t[np.minimum(idx + OUTLIER_WINDOW, len(t) - 1)] - t)
     dev = np.zeros(len(t))
     for kind in poses:
         xy = np.array([p[:2] for p in kind], dtype=np.float64)
-        med = np.stack([median_filter(xy[:, k], size=2 * OUTLIER_WINDOW + 1, mode="mirror") for k in range(2)], 1)
+        med = np.stack([running_median(xy[:, k], OUTLIER_WINDOW) for k in range(2)], 1)
         dev = np.maximum(dev, np.hypot(*(xy - med).T))
     bad = dev > OUTLIER_SLACK + OUTLIER_SPEED * span
     name = log.path.name if log.path is not None else "log"

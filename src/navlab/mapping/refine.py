@@ -60,6 +60,8 @@ class RefineParams:
     # xy eigenvalue per matched point of a match that pins both directions (normals spread evenly: 1/2); 0:
     # every verified match gets the plain sigma_xy / sigma_theta
     shape_xy: float = 0.0
+    # the pose graph's Gauss-Newton stops once no pose moves more than this in a step (m, rad)
+    tol: float = 1e-6
 
 
 def _strong(p: RefineParams) -> np.ndarray:
@@ -167,13 +169,13 @@ def refine_poses(
                     kept += 1
                 else:
                     rejected += 1
-        g.optimize(iterations=15, kernel=p.kernel)
+        g.optimize(iterations=15, kernel=p.kernel, tol=p.tol)
         # switch off the constraints the optimised graph still disagrees with, then optimise again
         bad = np.flatnonzero((g.edge_distances() > p.reject) & np.asarray(g.edges_robust, dtype=bool))
         for e in bad[::-1]:
             g.remove_edge(int(e))
         if len(bad):
-            g.optimize(iterations=10, kernel=p.kernel)
+            g.optimize(iterations=10, kernel=p.kernel, tol=p.tol)
         cur = g.poses.copy()
         stats = {"refine_edges": kept - len(bad), "refine_rejected": rejected + len(bad)}
     return cur, stats

@@ -240,3 +240,33 @@ def finish_ranges(
 
 #: the exact ray-shape test (a compiled function), for the 3-D casters in :mod:`navlab.sim.raycast3d`
 ray_hit = _hit
+
+
+def multiray(
+    m: mujoco.MjModel,
+    d: mujoco.MjData,
+    range_min: float,
+    range_max: float,
+    rot: np.ndarray,
+    pnt: np.ndarray,
+    angles: np.ndarray,
+    groups: np.ndarray,
+) -> np.ndarray:
+    """Ranges (m) of planar beams by MuJoCo's own ``mj_multiRay`` over the geom ``groups`` (meshes too).
+
+    ``pnt`` and ``rot`` are the sensor's world position and rotation matrix, ``angles`` the beams'
+    (cos, sin) rows in the sensor frame. Gazebo semantics as :func:`cast_planar`: a beam starts at
+    ``range_min``, returns beyond ``range_max`` and misses are ``inf``.
+    """
+    n = angles.shape[1]
+    vec = angles.T @ rot[:, :2].T
+    dist = np.empty(n)
+    geomid = np.empty(n, dtype=np.int32)
+    mujoco.mj_multiRay(m, d, pnt, vec.ravel(), groups, 1, -1, geomid, dist, None, n, range_max)
+    dist[geomid < 0] = np.inf
+    one = np.empty(1, dtype=np.int32)
+    for i in np.flatnonzero(dist < range_min):  # Gazebo's rays begin at range_min: look past
+        r = mujoco.mj_ray(m, d, pnt + range_min * vec[i], vec[i], groups, 1, -1, one)
+        dist[i] = range_min + r if r >= 0 else np.inf
+    dist[dist > range_max] = np.inf
+    return dist

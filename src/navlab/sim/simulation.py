@@ -17,7 +17,7 @@ from navlab.geometry import quat_from_rpy, quat_from_yaw, wxyz_from_xyzw, xyzw_f
 from navlab.sim.builder import GROUND_CONTACT_BIT, GROUP_ROBOT, GROUP_WORLD, RAY_GEOMGROUP, mj_quat_from_rpy
 from navlab.sim.clearance import clearance
 from navlab.sim.errors import SimError
-from navlab.sim.raycast import FAST_TYPES, cast_planar, finish_ranges
+from navlab.sim.raycast import FAST_TYPES, cast_planar, finish_ranges, multiray
 from navlab.sim.scene import add_world_model, build_spec, compile_spec, remove_world_model
 from navlab.world import ModelSpec, WorldModel
 
@@ -404,7 +404,7 @@ class Simulation:
         rot = d.site_xmat[site].reshape(3, 3)
         pnt = d.site_xpos[site].copy()
         if (backend or self.lidar_backend) == "mujoco":
-            return self._multiray(cfg, rot, pnt, angles, RAY_GEOMGROUP)
+            return multiray(m, d, cfg.range_min, cfg.range_max, rot, pnt, angles, RAY_GEOMGROUP)
         dist = np.empty(n)
         inc = (cfg.max_angle - cfg.min_angle) / (n - 1) if n > 1 else 0.0
         cast_planar(
@@ -424,7 +424,8 @@ class Simulation:
             dist,
         )
         if self._ray_slow_groups is not None:
-            np.minimum(dist, self._multiray(cfg, rot, pnt, angles, self._ray_slow_groups), out=dist)
+            slow = multiray(m, d, cfg.range_min, cfg.range_max, rot, pnt, angles, self._ray_slow_groups)
+            np.minimum(dist, slow, out=dist)
         return dist
 
     def link_body(self, link: str) -> int:
@@ -438,23 +439,6 @@ class Simulation:
         ``mj_multiRay`` or None): what every ray sensor sees (the robot's own geoms are not seen)."""
         self._sync()
         return self._ray_fast, self._ray_slow_groups
-
-    def _multiray(
-        self, cfg: LidarConfig, rot: np.ndarray, pnt: np.ndarray, angles: np.ndarray, groups: np.ndarray
-    ) -> np.ndarray:
-        m, d = self.model, self.data
-        n = angles.shape[1]
-        vec = angles.T @ rot[:, :2].T
-        dist = np.empty(n)
-        geomid = np.empty(n, dtype=np.int32)
-        mujoco.mj_multiRay(m, d, pnt, vec.ravel(), groups, 1, -1, geomid, dist, None, n, cfg.range_max)
-        dist[geomid < 0] = np.inf
-        one = np.empty(1, dtype=np.int32)
-        for i in np.flatnonzero(dist < cfg.range_min):  # Gazebo's rays begin at range_min: look past
-            r = mujoco.mj_ray(m, d, pnt + cfg.range_min * vec[i], vec[i], groups, 1, -1, one)
-            dist[i] = cfg.range_min + r if r >= 0 else np.inf
-        dist[dist > cfg.range_max] = np.inf
-        return dist
 
     def imu(self, index: int = 0, rng: np.random.Generator | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(orientation quaternion x,y,z,w in world, angular velocity rad/s, linear acceleration m/s²) of IMU
