@@ -17,7 +17,7 @@ from navlab.navigation import NavigationError
 from navlab.navigation.controllers import DWAPlannerROS, TrajectoryPlannerROS
 from navlab.navigation.controllers import mppi_critics as critics
 from navlab.navigation.controllers import synthetic as syn
-from navlab.navigation.controllers.common import OscillationFlags, crop_plan
+from navlab.navigation.controllers.common import OscillationFlags, cost_regulated_speeds, crop_plan
 from navlab.navigation.controllers.mapgrid import distance_map
 from navlab.navigation.controllers.mppi import MPPIController
 from navlab.navigation.controllers.trajectory import InPlaceFlags
@@ -485,6 +485,48 @@ def test_mppi_cost_critic_scores_collisions_far_above_clearance():
     assert out[0] == 0.0 < out[1] < 1.0 < 100.0 < out[2]
     near = critics.goal(critics.GoalCritic(), batch)
     assert near is None  # 5 m from the goal: beyond threshold_to_consider
+
+
+FAST = {"vx_max": 2.0, "vx_std": 0.4, "time_steps": 40}  # the Jackal's clutter settings
+REGULATED = {
+    **FAST,
+    "use_cost_regulated_linear_velocity_scaling": True,
+    "cost_scaling_dist": 0.6,
+    "inflation_cost_scaling_factor": 10.0,  # syn.inflated's
+}
+
+
+def test_mppi_cost_regulated_speed_is_rpps_law():
+    v = cost_regulated_speeds(2.0, 0.6, 1.0, 10.0, 0.2, 0.25)
+    assert v[0] == v[255] == 2.0  # free and unknown cells do not slow the robot
+    # a cost stands for the distance from the robot's centre to the obstacle that drew it
+    d = 0.2 - math.log(100 / 252) / 10.0
+    assert v[100] == pytest.approx(2.0 * d / 0.6)
+    assert v[COST_LETHAL] == pytest.approx(2.0 * 0.2 / 0.6)  # as close as a centre can be: one inscribed radius
+    assert np.all(np.diff(v[1:255]) <= 0)  # the higher the cost, the slower
+    assert cost_regulated_speeds(2.0, 0.6, 0.1, 10.0, 0.2, 0.25)[COST_LETHAL] == 0.25  # never under min speed
+
+
+def test_mppi_cost_regulation_slows_through_a_gap_and_not_on_open_ground():
+    def commands(params, world, steps):
+        ctrl = MPPIController(params, rng=np.random.default_rng(3))
+        ctrl.set_plan(straight_plan(0.0, 6.0))
+        pose, vel, out = (0.0, 0.0, 0.0), (0.0, 0.0), []
+        for _ in range(steps):
+            vel = ctrl.compute_velocity(pose, vel, syn.window(world, pose[0], pose[1]))
+            pose = step(pose, vel)
+            out.append((pose[0], vel[0]))
+        return np.array(out)
+
+    open_ground = free_map(10.0, (-2.0, -5.0, 0.0))
+    off = commands(FAST, open_ground, 30)
+    assert np.array_equal(commands(REGULATED, open_ground, 30), off)  # no cost, no change
+    gap = with_disc(with_disc(open_ground, (2.5, 0.42), 0.075), (2.5, -0.42), 0.075)  # 0.69 m between them
+    fast = commands(FAST, gap, 80)
+    slow = commands(REGULATED, gap, 80)
+    assert fast[:, 0].max() > 3.0 and slow[:, 0].max() > 3.0  # both went through
+    in_gap = lambda run: run[np.abs(run[:, 0] - 2.5) < 0.1, 1].max()  # noqa: E731
+    assert in_gap(slow) < 0.8 * in_gap(fast)
 
 
 def test_mppi_parameters():

@@ -53,3 +53,30 @@ def test_a_back_up_after_the_local_window_was_cleared_stops_short_of_a_cylinder_
     x = run.sim.base_pose2d()[0]
     assert not steps and bumper.collisions == 0
     assert 0.3 < x < 1.0 - 0.075 - 0.254, x  # it backed up, and its rear (0.254 m) stopped short of the post
+
+
+def test_escalating_recoveries_restart_only_after_progress() -> None:
+    """ROS 1 restarts ``recovery_behaviors`` whenever the robot moves ``oscillation_distance`` (0.2 m in clutter), so
+    a robot rocking in a pocket runs the first recoveries over and over. With ``escalate_recoveries`` the list
+    restarts only once the progress checker has seen progress since the last recovery began."""
+    from navlab.navigation.goal import RecoveryTrigger
+
+    run = start_run("navigation_mapless", world="empty", robot="jackal")
+    mb: Any = run.node("move_base")
+    now = run.executor.now_ns
+
+    def rocked(escalate: bool) -> int:
+        """The recovery to run next after the third recovery, once the robot has moved 0.3 m."""
+        mb.p["escalate_recoveries"] = escalate
+        mb.recovery_index, mb.oscillation_pose = 3, (0.0, 0.0, 0.0)
+        mb._enter_clearing(RecoveryTrigger.OSCILLATION)  # the fourth starts: no progress since
+        mb.active_recovery, mb.recovery_index = None, 3
+        mb._check_oscillation((0.3, 0.0, 0.0), now)
+        return int(mb.recovery_index)
+
+    assert rocked(False) == 0  # ROS 1: back to the first
+    assert rocked(True) == 3  # escalating: the next one
+    mb.progress_checker.reset((0.0, 0.0, 0.0), now / 1e9)
+    mb._progressing((1.0, 0.0, 0.0), now, None)  # 1 m from the checker's baseline: progress
+    mb._check_oscillation((0.0, 0.0, 0.0), now)
+    assert mb.recovery_index == 0

@@ -53,6 +53,7 @@ CLUTTER_PARAMS: dict[str, Any] = {
     "back_up_far.backup_speed": 0.25,
     "progress_checker.required_movement_radius": 0.5,
     "progress_checker.movement_time_allowance": 10.0,
+    "escalate_recoveries": True,  # rocking 0.2 m in a pocket does not restart the list: spin and far back-up run
 }
 CLUTTER_ROBOTS = ("mybot", "jackal")
 # Any other robot drives with its files as ROS 1's move_base reads them: that move_base has no progress checker (a

@@ -4,10 +4,12 @@ As ROS 1's move_base: two ``Costmap2DROS`` (``global_costmap`` in ``map``, ``loc
 ``odom``), a global planner (``base_global_planner``) and a local controller (``base_local_planner``)
 picked by their ROS plugin names, the PLANNING / CONTROLLING / CLEARING states with
 ``planner_frequency``, ``planner_patience``, ``controller_frequency``, ``controller_patience``,
-``oscillation_timeout``/``oscillation_distance`` and ``recovery_behaviors`` in ROS order. Goals come on
-``move_base_simple/goal`` or through :meth:`MoveBase.send_goal` (actionlib's SimpleActionClient in
-spirit: feedback, cancel, result succeeded / aborted with a reason / preempted); state on
-``/move_base/status``. Services ``/move_base/clear_costmaps`` and ``/move_base/make_plan``.
+``oscillation_timeout``/``oscillation_distance`` and ``recovery_behaviors`` in ROS order (navlab's
+``escalate_recoveries``: moving ``oscillation_distance`` restarts the list only once the progress checker has
+seen progress since the last recovery). Goals come on ``move_base_simple/goal`` or through
+:meth:`MoveBase.send_goal` (actionlib's SimpleActionClient in spirit: feedback, cancel, result succeeded /
+aborted with a reason / preempted); state on ``/move_base/status``. Services ``/move_base/clear_costmaps`` and
+``/move_base/make_plan``.
 """
 
 from __future__ import annotations
@@ -144,6 +146,7 @@ class MoveBase(Node):
         self.keepouts: list[tuple[float, float]] = []  # gaps that held the robot up (navigation.keepout)
         self.oscillation_pose: Pose | None = None
         self.last_oscillation_reset_ns = now
+        self.progress_since_recovery = True  # the progress checker saw progress since the last recovery began
         if hasattr(self, "progress_checker"):
             self.progress_checker.reset(None, now / 1e9)
 
@@ -339,14 +342,18 @@ class MoveBase(Node):
         ):
             self.oscillation_pose = pose
             self.last_oscillation_reset_ns = now
-            if self.recovery_trigger == RecoveryTrigger.OSCILLATION:
+            if self.recovery_trigger == RecoveryTrigger.OSCILLATION and (
+                self.progress_since_recovery or not self.p["escalate_recoveries"]
+            ):
                 self.recovery_index = 0
 
     def _progressing(self, pose: Pose, now: int, local: np.ndarray | None) -> bool:
         """The progress checker's verdict (``local``: the plan, to the goal); progress restarts the recoveries."""
         ok = self.progress_checker.check(pose, now / 1e9, local[-1][:2] if local is not None and len(local) else None)
-        if self.progress_checker.progressed and self.recovery_trigger == RecoveryTrigger.PROGRESS:
-            self.recovery_index = 0
+        if self.progress_checker.progressed:
+            self.progress_since_recovery = True
+            if self.recovery_trigger == RecoveryTrigger.PROGRESS:
+                self.recovery_index = 0
         return ok
 
     def _controlling(self, pose: Pose, now: int) -> None:
@@ -413,6 +420,7 @@ class MoveBase(Node):
 
     def _enter_clearing(self, trigger: RecoveryTrigger) -> None:
         self.recovery_trigger = trigger
+        self.progress_since_recovery = False
         if trigger == RecoveryTrigger.PROGRESS and self.progress_checker.toward_goal:  # plan around the hold-up
             gap = held_up_at(self.global_plan, self.global_costmap.costmap, self.global_costmap.robot_pose())
             if gap is not None:

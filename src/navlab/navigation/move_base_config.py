@@ -32,6 +32,9 @@ MOVE_BASE_DEFAULTS: Mapping[str, Any] = MappingProxyType(
         "oscillation_distance": 0.5,
         "make_plan_clear_costmap": True,
         "make_plan_add_unreachable_goal": True,
+        # navlab: while the progress checker sees no progress since the last recovery, moving
+        # oscillation_distance does not restart recovery_behaviors, so they escalate (as Nav2's tree does)
+        "escalate_recoveries": False,
     }
 )
 

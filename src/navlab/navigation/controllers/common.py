@@ -443,3 +443,31 @@ class Nav2PlanController(ControllerBase):
         if self._plan is None:
             return False
         return self._latch.reached((float(pose[0]), float(pose[1]), float(pose[2])), self._goal)
+
+
+def inscribed_radius(footprint: np.ndarray | None, robot_radius: float | None) -> float:
+    """The footprint's inscribed radius (m): the nearest edge of a polygon to the centre, else the radius."""
+    if footprint is None or len(footprint) < 3:
+        return float(robot_radius or 0.0)
+    a, b = footprint, np.roll(footprint, -1, axis=0)
+    ab = b - a
+    t = np.clip(np.einsum("ij,ij->i", -a, ab) / np.maximum(np.einsum("ij,ij->i", ab, ab), 1e-12), 0.0, 1.0)
+    nearest = a + t[:, None] * ab
+    return float(np.hypot(nearest[:, 0], nearest[:, 1]).min())
+
+
+def cost_regulated_speeds(
+    v_max: float, scaling_dist: float, gain: float, cost_scaling_factor: float, inscribed: float, min_speed: float
+) -> np.ndarray:
+    """Nav2 RPP's cost-regulated speed for every costmap cost (256,), m/s: the obstacle distance a cost stands for
+    (``inscribed - ln(cost / 252) / cost_scaling_factor``, m from the robot's centre, as the inflation layer
+    draws it) under ``scaling_dist`` m slows ``v_max`` by ``gain * dist / scaling_dist``, not under
+    ``min_speed``; free (0) and unknown (255) cells keep ``v_max``."""
+    cost = np.arange(256, dtype=np.float64)
+    ratio = np.minimum(cost, 252.0) / 252.0
+    with np.errstate(divide="ignore"):
+        dist = -np.log(ratio) / cost_scaling_factor + inscribed
+    v = np.where(dist < scaling_dist, v_max * gain * dist / scaling_dist, v_max)
+    v = np.maximum(np.minimum(v, v_max), min(min_speed, v_max))
+    v[0] = v[255] = v_max
+    return v

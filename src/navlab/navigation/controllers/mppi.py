@@ -13,6 +13,12 @@ the commands already sent) and its first control is the command.
 One navlab addition: ``noise_correlation`` makes each sample's noise an AR(1) process over time
 (same per-step spread, coherent swerves instead of jitter), which finds the way round obstacles the
 path runs into (default 0.9; 0 is Nav2's white noise, which stalls in front of an obstacle on the path).
+A second, off by default: Regulated Pure Pursuit's cost-regulated linear velocity scaling with its names
+(``use_cost_regulated_linear_velocity_scaling``, ``cost_scaling_dist``, ``cost_scaling_gain``,
+``inflation_cost_scaling_factor``, ``regulated_linear_scaling_min_speed``): the costmap cost under a point
+stands for its distance to the nearest obstacle, and nearer than ``cost_scaling_dist`` the speed limit drops
+with it. The command is capped by the limit under the robot, and ConstraintCritic charges every sample's speed
+above the limit under each of its points, so the optimum slows before a gap, not in it.
 
 As in Nav2 the rollout's first step moves at the measured velocity (the command acts one
 ``model_dt`` later). Trajectories through LETHAL/INSCRIBED/unknown cells take ``collision_cost``; if
@@ -38,7 +44,14 @@ from navlab.core import ParamSpec, check_ceiling, read_params
 from navlab.errors import did_you_mean
 from navlab.grid import COST_INSCRIBED, Grid
 from navlab.navigation.controllers import mppi_critics as critics
-from navlab.navigation.controllers.common import LocalFrame, Nav2PlanController, bad, footprint_outline
+from navlab.navigation.controllers.common import (
+    LocalFrame,
+    Nav2PlanController,
+    bad,
+    cost_regulated_speeds,
+    footprint_outline,
+    inscribed_radius,
+)
 from navlab.navigation.errors import NavigationError
 from navlab.plugins import PluginContext
 
@@ -86,6 +99,12 @@ class MppiParams:
     prune_distance: float = 1.7
     retry_attempt_limit: int = 1
     noise_correlation: float = 0.9  # navlab: AR(1) coefficient of the noise over time (0: Nav2's white noise)
+    # navlab: RPP's cost-regulated speed limit (its names and defaults; off as MPPI has none)
+    use_cost_regulated_linear_velocity_scaling: bool = False
+    cost_scaling_dist: float = 0.6  # m from the robot's centre to the obstacle
+    cost_scaling_gain: float = 1.0
+    inflation_cost_scaling_factor: float = 3.0  # the inflation layer's cost_scaling_factor
+    regulated_linear_scaling_min_speed: float = 0.25  # m/s
     controller_frequency: float = 20.0
     xy_goal_tolerance: float = 0.25
     yaw_goal_tolerance: float = 0.25
@@ -165,7 +184,7 @@ MppiParams.PARAMS = ParamSpec(
     at_least={
         **dict.fromkeys(("batch_size", "iteration_count", "retry_attempt_limit"), 1),
         "time_steps": 2,
-        **dict.fromkeys(("gamma", "xy_goal_tolerance", "yaw_goal_tolerance"), 0),
+        **dict.fromkeys(("gamma", "xy_goal_tolerance", "yaw_goal_tolerance", "regulated_linear_scaling_min_speed"), 0),
     },
     above=dict.fromkeys(
         (
@@ -178,6 +197,9 @@ MppiParams.PARAMS = ParamSpec(
             "az_max",
             "prune_distance",
             "controller_frequency",
+            "cost_scaling_dist",
+            "cost_scaling_gain",
+            "inflation_cost_scaling_factor",
         ),
         0,
     ),
@@ -266,7 +288,8 @@ class MPPIController(Nav2PlanController):
 
     ``params``: a Nav2 MPPI parameter dict or ``MppiParams``; ``rng``: the seeded generator every noise
     sample comes from (required: same seed, same commands); ``footprint``: polygon [[x, y], ...] (m, base
-    frame) for CostCritic's ``consider_footprint``, or None for a circular robot.
+    frame) for CostCritic's ``consider_footprint``, or None for a circular robot of ``robot_radius`` m
+    (the cost-regulated speed limit reads the inscribed radius of either).
 
     After each cycle: ``local_plan`` (T + 1, 3) the optimal trajectory (costmap frame), ``sequence``
     (T, 2) the optimal controls, ``costs`` (S,) the samples' costs, ``valid`` False if every sample collided.
@@ -281,6 +304,7 @@ class MPPIController(Nav2PlanController):
         *,
         rng: np.random.Generator | None = None,
         footprint: Any = None,
+        robot_radius: float | None = None,
     ) -> None:
         if not isinstance(rng, np.random.Generator):
             raise NavigationError(f"{WHAT} needs rng=numpy.random.Generator (seeded), got {type(rng).__name__}")
@@ -292,6 +316,18 @@ class MPPIController(Nav2PlanController):
         self._limits = np.array([p.vx_min, p.vx_max, p.wz_max, p.ax_max, p.ax_min, p.az_max])
         self._std = np.array([p.vx_std, p.wz_std])
         self._sg = savgol_coeffs(9, 2)  # Nav2 smooths with a 9-point quadratic Savitzky-Golay filter
+        self._speed_limits = (
+            cost_regulated_speeds(
+                p.vx_max,
+                p.cost_scaling_dist,
+                p.cost_scaling_gain,
+                p.inflation_cost_scaling_factor,
+                inscribed_radius(self.footprint, robot_radius),
+                p.regulated_linear_scaling_min_speed,
+            )
+            if p.use_cost_regulated_linear_velocity_scaling
+            else None
+        )  # m/s per costmap cost, or None
         self._plan_state(p.xy_goal_tolerance, p.yaw_goal_tolerance, p.stateful)
         self.reset()
 
@@ -321,7 +357,12 @@ class MPPIController(Nav2PlanController):
         """From the controller's parameter namespace, the host's seeded ``rng`` (required) and the local costmap's
         footprint polygon (None for a round robot)."""
         fp = context.footprint
-        return cls(params, rng=context.rng, footprint=None if fp is None else fp.polygon)
+        return cls(
+            params,
+            rng=context.rng,
+            footprint=None if fp is None else fp.polygon,
+            robot_radius=None if fp is None else fp.radius,
+        )
 
     def _command(
         self, pose: tuple[float, float, float], velocity: tuple[float, float], costmap: Grid | None
@@ -389,6 +430,7 @@ class MPPIController(Nav2PlanController):
                 grid,
                 res,
                 outline,
+                None if self._speed_limits is None else self._speed_limits[cs],
             )
             costs = self._score(batch)
             if bool((cs >= COST_INSCRIBED).any(axis=1).all()):  # every sample collides
@@ -408,6 +450,10 @@ class MPPIController(Nav2PlanController):
             iteration += 1
         self._smooth()
         v = float(min(max(self.sequence[0, 0], p.vx_min), p.vx_max))
+        if self._speed_limits is not None:
+            i, j = math.floor(px / res), math.floor(py / res)
+            inside = 0 <= i < grid.shape[1] and 0 <= j < grid.shape[0]
+            v = min(v, float(self._speed_limits[grid[j, i] if inside else 255]))
         w = float(min(max(self.sequence[0, 1], -p.wz_max), p.wz_max))
         self._history = np.vstack([self._history[1:], [[v, w]]])
         self.local_plan = frame.poses_out(self._optimal_trajectory(px, py, pth, v0, w0))

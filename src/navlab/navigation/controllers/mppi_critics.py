@@ -4,6 +4,7 @@ Names, parameters and defaults are Nav2's (``CostCritic.cost_weight`` ...); each
 ``(cost_weight * term) ** cost_power`` where the term is (a distance in m, an angle in rad, a cost):
 
 - ``ConstraintCritic``: time outside [vx_min, vx_max] (s * m/s), a guard that is ~0 once samples are clipped;
+  with the controller's cost-regulated speed limit on, also the speed above the limit under each point;
 - ``CostCritic``: the costmap cost along the trajectory (every ``trajectory_point_step``-th point), with
   ``critical_cost`` at near-collision cells and ``collision_cost`` for a trajectory through LETHAL,
   INSCRIBED or unknown cells (``consider_footprint``: through a polygon footprint's edge cells); the
@@ -152,6 +153,7 @@ class Batch:
     grid: np.ndarray  # the local costmap (uint8)
     resolution: float
     outline: np.ndarray | None = None  # polygon footprint edge points (base frame) or None
+    vx_cap: np.ndarray | None = None  # (S, T) m/s, the cost-regulated speed limit under each point, or None
     _furthest: int | None = field(default=None, repr=False)
 
     @property
@@ -193,6 +195,9 @@ def _out(c: Critic, term: np.ndarray) -> np.ndarray:
 
 def constraint(c: ConstraintCritic, b: Batch) -> np.ndarray | None:
     lo, hi = b.vx_limits
+    if b.vx_cap is not None:
+        over = np.maximum(b.vx - np.minimum(b.vx_cap, hi), 0.0) + np.maximum(lo - b.vx, 0.0)
+        return _out(c, over.sum(axis=1) * b.dt)
     if b.vx.max() <= hi and b.vx.min() >= lo:
         return None
     over = np.maximum(b.vx - hi, 0.0) + np.maximum(lo - b.vx, 0.0)

@@ -27,7 +27,13 @@ import numpy as np
 
 from navlab.core import ParamSpec, read_params
 from navlab.grid import COST_INSCRIBED, COST_UNKNOWN, Grid
-from navlab.navigation.controllers.common import LocalFrame, Nav2PlanController, bad, footprint_outline
+from navlab.navigation.controllers.common import (
+    LocalFrame,
+    Nav2PlanController,
+    bad,
+    footprint_outline,
+    inscribed_radius,
+)
 from navlab.navigation.controllers.rollout import footprint_costs
 from navlab.navigation.errors import NavigationError
 
@@ -149,7 +155,7 @@ class RegulatedPurePursuitController(Nav2PlanController):
         self.params = read_params(RppParams, values)
         self.footprint = None if footprint is None else np.asarray(footprint, dtype=np.float64)
         footprint_outline(self.footprint, SPACING)  # validate now
-        self.inscribed_radius = _inscribed(self.footprint, robot_radius)
+        self.inscribed_radius = inscribed_radius(self.footprint, robot_radius)
         p = self.params
         self._plan_state(p.xy_goal_tolerance, p.yaw_goal_tolerance, p.stateful)
         self.local_plan = np.zeros((0, 3))
@@ -297,14 +303,3 @@ class RegulatedPurePursuitController(Nav2PlanController):
 def _path_length(path: np.ndarray) -> float:
     """Length (m) of a polyline (N, 2)."""
     return float(np.hypot(*np.diff(path, axis=0).T).sum()) if len(path) > 1 else 0.0
-
-
-def _inscribed(footprint: np.ndarray | None, robot_radius: float | None) -> float:
-    """The footprint's inscribed radius (m): the nearest edge of a polygon to the centre, else the radius."""
-    if footprint is None or len(footprint) < 3:
-        return float(robot_radius or 0.0)
-    a, b = footprint, np.roll(footprint, -1, axis=0)
-    ab = b - a
-    t = np.clip(np.einsum("ij,ij->i", -a, ab) / np.maximum(np.einsum("ij,ij->i", ab, ab), 1e-12), 0.0, 1.0)
-    nearest = a + t[:, None] * ab
-    return float(np.hypot(nearest[:, 0], nearest[:, 1]).min())
