@@ -177,6 +177,14 @@ def pose_stamped(stamp_ns: int, frame_id: str, x: float, y: float, yaw: float) -
     return PoseStamped(header(stamp_ns, frame_id), pose_from_2d(x, y, yaw))
 
 
+def path(stamp_ns: int, frame_id: str, poses: Any) -> Any:
+    """``nav_msgs/Path`` of (N, 2+) rows (x, y[, yaw]) in ``frame_id``; yaw 0 where the rows have none."""
+    return Path(
+        header(stamp_ns, frame_id),
+        [pose_stamped(stamp_ns, frame_id, float(q[0]), float(q[1]), float(q[2]) if len(q) > 2 else 0.0) for q in poses],
+    )
+
+
 def transform_stamped(stamp_ns: int, parent: str, child: str, x: float, y: float, yaw: float, z: float = 0.0) -> Any:
     """``geometry_msgs/TransformStamped`` ``parent_T_child`` in the plane (plus height ``z``)."""
     return TransformStamped(

@@ -127,12 +127,7 @@ class Explore(Node):
             self._last_progress = (self.executor.now_ns, math.inf)
         if self.plan_pub.get_subscription_count() or self.executor.has_listeners:  # built only for a reader
             now = self.executor.now_ns
-            self.plan_pub.publish(
-                msgs.Path(
-                    header=msgs.header(now, self.global_frame),
-                    poses=[msgs.pose_stamped(now, self.global_frame, x, y, 0.0) for x, y in path[::4]],
-                )
-            )
+            self.plan_pub.publish(msgs.path(now, self.global_frame, path[::4]))
 
     def _control(self) -> None:
         if self.done or self.path is None:

@@ -39,6 +39,12 @@ class RecoveryTrigger(StrEnum):
     OSCILLATION = "OSCILLATION"
     PROGRESS = "PROGRESS"  # Nav2's progress checker: the robot stayed near one pose too long
 
+    @property
+    def abort_reason(self) -> str:
+        """move_base's abort message when the recoveries are used up after this trigger (ROS's words)."""
+        what = {"PLANNING": "Failed to find a valid plan.", "CONTROLLING": "Failed to find a valid control."}
+        return what.get(self.value, "Robot is oscillating.") + " Even after executing recovery behaviors."
+
 
 class GoalOutcome(StrEnum):
     """How a navigation trial's goal ended (lower-case, as results files write it); ``TIMEOUT``: navlab stopped

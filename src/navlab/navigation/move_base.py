@@ -405,16 +405,7 @@ class MoveBase(Node):
         """``nav_msgs/Path`` of (N, 2+) poses, built only when someone listens (hundreds of messages each)."""
         if not (pub.get_subscription_count() or self.executor.has_listeners):
             return
-        now = self.executor.now_ns
-        pub.publish(
-            msgs.Path(
-                header=msgs.header(now, frame),
-                poses=[
-                    msgs.pose_stamped(now, frame, float(q[0]), float(q[1]), float(q[2]) if len(q) > 2 else 0.0)
-                    for q in poses
-                ],
-            )
-        )
+        pub.publish(msgs.path(self.executor.now_ns, frame, poses))
 
     # --- recoveries ------------------------------------------------------------------------------------
 
@@ -432,12 +423,11 @@ class MoveBase(Node):
             if self.p["clearing_rotation_allowed"] or "rotate" not in type(r).__name__.lower()
         ]
         if not self.p["recovery_behavior_enabled"] or self.recovery_index >= len(usable):
-            reason = {
-                RecoveryTrigger.PLANNING: "Failed to find a valid plan. Even after executing recovery behaviors.",
-                RecoveryTrigger.CONTROLLING: "Failed to find a valid control. Even after executing recovery behaviors.",
-                RecoveryTrigger.OSCILLATION: "Robot is oscillating. Even after executing recovery behaviors.",
-                RecoveryTrigger.PROGRESS: self.progress_checker.stuck_reason(self.executor.now_ns / 1e9),
-            }[trigger]
+            reason = (
+                self.progress_checker.stuck_reason(self.executor.now_ns / 1e9)
+                if trigger == RecoveryTrigger.PROGRESS
+                else trigger.abort_reason
+            )
             if trigger == RecoveryTrigger.PLANNING and self.plan_failure:
                 reason += f" ({self.plan_failure})"
             self._finish(GoalState.ABORTED, reason)

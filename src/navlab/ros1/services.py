@@ -110,14 +110,7 @@ def _get_plan(bridge: RosBridge, call: Callable[[Any], Any], request: Any, respo
     plan = call({"start": None if empty_start else start, "goal": goal}).get("plan")
     stamp = bridge.ex.now_ns
     frame = goal.header.frame_id or "map"
-    poses = (
-        []
-        if plan is None
-        else [
-            msgs.pose_stamped(stamp, frame, float(r[0]), float(r[1]), float(r[2]) if len(r) > 2 else 0.0) for r in plan
-        ]
-    )
-    path = msgs.Path(header=msgs.header(stamp, frame), poses=poses)
+    path = msgs.path(stamp, frame, [] if plan is None else plan)
     return response(plan=bridge.types.to_ros1(path, "nav_msgs/msg/Path"))
 
 
