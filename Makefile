@@ -15,7 +15,7 @@ ROS_PACKAGES := python3-rosmaster python3-rospy python3-rostopic python3-rosnode
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 export MUJOCO_GL ?= egl
 
-.PHONY: install demo test lint bench clean fuzz
+.PHONY: install demo test lint bench clean clean-cache fuzz
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -57,5 +57,10 @@ lint: $(STAMP)
 bench: $(STAMP)
 	$(BIN)/navlab bench all --json
 
-clean:
+clean: clean-cache
 	rm -rf $(VENV) build src/*.egg-info
+
+# Numba keys each cached kernel on its own source file only: a kernel that inlines one from another
+# module keeps the old copy after that module changes. Run this after a pull or checkout, before timing.
+clean-cache:
+	find src -name '*.nbi' -delete -o -name '*.nbc' -delete
