@@ -26,11 +26,12 @@ from typing import Any, ClassVar
 import numpy as np
 
 from navlab.core import ParamSpec, read_params
-from navlab.grid import COST_INSCRIBED, COST_UNKNOWN, Grid
+from navlab.grid import COST_UNKNOWN, Grid
 from navlab.navigation.controllers.common import (
     LocalFrame,
     Nav2PlanController,
     bad,
+    cost_regulated_speeds,
     footprint_outline,
     inscribed_radius,
 )
@@ -157,6 +158,14 @@ class RegulatedPurePursuitController(Nav2PlanController):
         footprint_outline(self.footprint, SPACING)  # validate now
         self.inscribed_radius = inscribed_radius(self.footprint, robot_radius)
         p = self.params
+        self._cost_speeds = cost_regulated_speeds(
+            p.desired_linear_vel,
+            p.cost_scaling_dist,
+            p.cost_scaling_gain,
+            p.inflation_cost_scaling_factor,
+            self.inscribed_radius,
+            p.regulated_linear_scaling_min_speed,
+        )  # m/s per costmap cost under the robot
         self._plan_state(p.xy_goal_tolerance, p.yaw_goal_tolerance, p.stateful)
         self.local_plan = np.zeros((0, 3))
         self.carrot: np.ndarray | None = None
@@ -243,12 +252,7 @@ class RegulatedPurePursuitController(Nav2PlanController):
             if radius < p.regulated_linear_scaling_min_radius:
                 curve_v = v * radius / p.regulated_linear_scaling_min_radius
         if p.use_cost_regulated_linear_velocity_scaling and costmap is not None:
-            cost = int(costmap.value_at(np.array([pose[:2]]), outside=COST_UNKNOWN)[0])
-            if 0 < cost < COST_UNKNOWN:
-                ratio = min(cost, COST_INSCRIBED - 1) / (COST_INSCRIBED - 1)
-                dist = -math.log(ratio) / p.inflation_cost_scaling_factor + self.inscribed_radius
-                if dist < p.cost_scaling_dist:
-                    cost_v = v * p.cost_scaling_gain * dist / p.cost_scaling_dist
+            cost_v = float(self._cost_speeds[int(costmap.value_at(np.array([pose[:2]]), outside=COST_UNKNOWN)[0])])
         if p.use_regulated_linear_velocity_scaling or p.use_cost_regulated_linear_velocity_scaling:
             v = max(min(curve_v, cost_v), p.regulated_linear_scaling_min_speed)
         left = min(remaining, goal_dist)
