@@ -13,7 +13,7 @@ from typing import Any
 
 from navlab.core.errors import TfError
 from navlab.geometry import IDENTITY_TF, Tf, compose3, interpolate3, inverse3, yaw_from_quat
-from navlab.msgs import Quaternion, Transform, TransformStamped, Vector3, header
+from navlab.msgs import Quaternion, Transform, TransformStamped, Vector3, header, ns_from_time
 
 Pose2 = tuple[float, float, float]  # (x m, y m, yaw rad) of a frame's origin in another frame
 LOOKUP_CACHE = 64  # lookups remembered (see TfBuffer.lookup)
@@ -96,27 +96,15 @@ class TfBuffer:
             del e.times[:cut], e.values[:cut]
 
     def add_message(self, msg: Any, *, static: bool = False) -> None:
-        """Add every transform of a ``tf2_msgs/TFMessage``. A transform newer than its edge's newest, on an edge
-        already known with the same parent (every message of a running robot but the first) is appended here:
-        what :meth:`set_transform` does then, without its checks."""
-        edges = self._edges
+        """Add every transform of a ``tf2_msgs/TFMessage``."""
         for ts in msg.transforms:
-            h, tr = ts.header, ts.transform
-            child, parent = ts.child_frame_id.lstrip("/"), h.frame_id.lstrip("/")
-            stamp = h.stamp
-            t_ns = int(stamp.sec) * 1_000_000_000 + int(stamp.nanosec)  # ns_from_time
-            e = edges.get(child)
-            if static or e is None or e.static or e.parent != parent or not parent or (e.times and t_ns < e.times[-1]):
-                self.set_transform(parent, child, t_ns, tf_from_msg(tr), static=static)
-                continue
-            t, r = tr.translation, tr.rotation
-            e.changes += 1
-            times = e.times
-            times.append(t_ns)
-            e.values.append((t.x, t.y, t.z, r.x, r.y, r.z, r.w))  # tf_from_msg
-            if t_ns - times[0] > self.cache_ns:
-                cut = bisect.bisect_left(times, t_ns - self.cache_ns)
-                del times[:cut], e.values[:cut]
+            self.set_transform(
+                ts.header.frame_id.lstrip("/"),
+                ts.child_frame_id.lstrip("/"),
+                ns_from_time(ts.header.stamp),
+                tf_from_msg(ts.transform),
+                static=static,
+            )
 
     def _edge_at(self, child: str, e: _Edge, t_ns: int | None) -> Tf:
         if e.static:
