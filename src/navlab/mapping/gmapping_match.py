@@ -121,10 +121,12 @@ def _score_above(
     s = 0.0
     null_l = -0.5 / lsigma  # GMapping: nullLikelihood = -0.5
     left = rv.shape[0]
+    fw0, fw1, fw3 = fw[0], fw[1], fw[3]  # rows (views), read at unsigned indices: no negative-index wrap
+    iw0, iw1, iw2, iw3 = iw[0], iw[1], iw[2], iw[3]
     for q in range(rv.shape[0]):
-        k = order[q]
-        ux, uy = fw[0, k], fw[1, k]
-        ei, ej, fi, fj = iw[0, k], iw[1, k], iw[2, k], iw[3, k]
+        k = numba.uint64(order[q])
+        ux, uy = fw0[k], fw1[k]
+        ei, ej, fi, fj = iw0[k], iw1[k], iw2[k], iw3[k]
         best = 1e9  # the nearest match's squared distance (cells²): a minimum, so the cells' order does not matter
         inside = (
             min(ei, fi) >= kernel and min(ej, fj) >= kernel and max(ei, fi) < w - kernel and max(ej, fj) < h - kernel
@@ -140,7 +142,8 @@ def _score_above(
             and 1 <= (fi & MASK) < MASK
             and 1 <= (fj & MASK) < MASK
         ):
-            ce = table[ej >> SHIFT, ei >> SHIFT] * TILE * TILE + (ej & MASK) * TILE + (ei & MASK)
+            tile = table[numba.uint64(ej >> SHIFT), numba.uint64(ei >> SHIFT)]
+            ce = tile * TILE * TILE + (ej & MASK) * TILE + (ei & MASK)
             bit = NEIGHBOUR_BIT[(fj - ej + 1) * 3 + fi - ei + 1]
             for dj in range(-1, 2):
                 for di in range(-1, 2):
@@ -162,7 +165,7 @@ def _score_above(
         left -= 1
         if best < 1e9:
             best *= res * res
-            fw[3, k] = best
+            fw3[k] = best
             x = best / sigma
             s += min(1.0 - x + 0.5 * x * x, 1.0) + 1e-15  # >= exp(-x) as computed (see above)
         else:
