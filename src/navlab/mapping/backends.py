@@ -141,9 +141,7 @@ class GMappingBackend(SeededBackend):
             # not three (CSAIL seeds 0/1/2 refined 0.0270/0.0279/0.0285 m with one, 0.0270/0.0276/0.0286 m with
             # two, for a third less of the refinement's CPU); the graph's Gauss-Newton stops at steps under 0.1 mm
             # / 1e-4 rad (a quarter fewer solves, the same poses to 0.1 mm)
-            params = RefineParams(
-                min_travel=0.0, neighbours=6, icp_iterations=8, tol=1e-4, shape_xy=2.0, rounds=1
-            )
+            params = RefineParams(min_travel=0.0, neighbours=6, icp_iterations=8, tol=1e-4, shape_xy=2.0, rounds=1)
             poses, stats = refine_poses(poses, self._points, params)
             self.refine_edges, self.refine_rejected = stats["refine_edges"], stats["refine_rejected"]
         return poses
