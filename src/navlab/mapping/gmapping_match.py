@@ -169,7 +169,7 @@ def _score_above(
             x = best / sigma
             s += min(1.0 - x + 0.5 * x * x, 1.0) + 1e-15  # >= exp(-x) as computed (see above)
         else:
-            fw[3, k] = -1.0
+            fw3[k] = -1.0
         # each later term is in [0, 1] and each rounding adds < 1e-16 relatively (<= 720 beams, in any order):
         # a safe bound
         if (s + left) * (1.0 + 1e-12) <= bound:

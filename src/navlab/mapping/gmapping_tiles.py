@@ -284,15 +284,7 @@ def raycast_tiles(
                 if not mine:
                     t = _own(tiles, masks, means, table, refs, free, used, tj, ti)
                     mine = True
-                    e = numba.uint64(((t << SHIFT) + (j & MASK)) << SHIFT) + numba.uint64(i & MASK)
-                old = flat[e]
-                flat[e] = max(old + l_free, -clamp)  # (l_free < 0: never above the clamp)
-                if old >= 0.0:  # unknown or occupied before: its class may change (as ``_set``)
-                    new = flat[e]
-                    if (old > 0.0) != (new > 0.0):
-                        _remask(tiles, masks, t, j & MASK, i & MASK)
-                    elif (old < 0.0) != (new < 0.0) and masks[t, j & MASK, i & MASK] & NEAR_OCC:
-                        _refree(tiles, masks, t, j & MASK, i & MASK)
+                _set(tiles, masks, t, j & MASK, i & MASK, l_free, clamp)
         if hit and 0 <= i1 < w and 0 <= j1 < h:
             tj, ti = j1 >> SHIFT, i1 >> SHIFT
             if tj != last_tj or ti != last_ti or not mine:
