@@ -15,6 +15,8 @@ import numpy as np
 
 from navlab import msgs
 from navlab.core import Executor, Node, TfError, dataclass_parameters
+from navlab.core.tf import tf_from_msg
+from navlab.geometry import Tf
 from navlab.grid import GridError, GridMap
 from navlab.localization import amcl as pf
 from navlab.localization.errors import LocalizationError
@@ -82,7 +84,7 @@ class Amcl(Node):
         self._invalid_logged_ns: int | None = None
         self.last_error: str | None = None
         self._map_to_odom: tuple[float, float, float] | None = None
-        self._tf_body: tuple[tuple[float, float, float], Any] | None = None  # (map->odom, its Transform message)
+        self._tf_body: tuple[tuple[float, float, float], Tf] | None = None  # (map->odom, as its Transform message)
         self._pending_global = False
         self._odom_failures = 0
         self.pose_pub = self.create_publisher(msgs.PoseWithCovarianceStamped, "amcl_pose", 2)
@@ -218,11 +220,9 @@ class Amcl(Node):
         cached = self._tf_body
         if cached is None or cached[0] != self._map_to_odom:
             x, y, yaw = self._map_to_odom
-            cached = self._tf_body = (
-                self._map_to_odom,
-                msgs.transform_stamped(0, self.global_frame, self.odom_frame, x, y, yaw).transform,
-            )
-        self.send_transform(msgs.TransformStamped(msgs.header(stamp_ns, self.global_frame), self.odom_frame, cached[1]))
+            body = msgs.transform_stamped(0, self.global_frame, self.odom_frame, x, y, yaw).transform
+            cached = self._tf_body = (self._map_to_odom, tf_from_msg(body))
+        self.send_transform_tuples(stamp_ns, ((self.global_frame, self.odom_frame, cached[1]),))
 
     # --- outputs --------------------------------------------------------------------------------
 
