@@ -288,6 +288,7 @@ class Executor:
                 continue
             if timer.idle is not None and timer.idle():  # nothing to do then: no physics step up to it either
                 if timer.parks:  # out of the queue until a subscription or a listener is added
+                    timer.parked = True
                     self._parked.append(timer)
                 else:
                     timer.skip()

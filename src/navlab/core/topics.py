@@ -105,6 +105,7 @@ class Timer:
         self.callback = callback
         self.idle = idle
         self.parks = idle is not None and idle_until_graph_changes
+        self.parked = False  # out of the queue (the executor parked it) until the graph changes
         self.priority = priority
         self.cancelled = False
         self._start = start_ns
@@ -125,6 +126,7 @@ class Timer:
     def wake(self, now_ns: int) -> None:
         """Put a parked timer (see ``idle_until_graph_changes``) back in the queue at its first tick after
         ``now_ns``: the ticks it was parked over were idle."""
+        self.parked = False
         self._k = max(self._k + 1, (now_ns - self._start) // self.period_ns + 1)
         self._queue.schedule(self, self._start + self._k * self.period_ns)
 
