@@ -178,7 +178,8 @@ class Amcl(Node):
 
     def _count_invalid(self, msg: Any, t_ns: int) -> None:
         """Count a scan without one reading in [range_min, range_max) and say so, at most every 10 s."""
-        if pf.any_in_range(np.asarray(msg.ranges), float(msg.range_min), float(msg.range_max)):
+        ranges, lo, hi = np.asarray(msg.ranges), float(msg.range_min), float(msg.range_max)
+        if (ranges.size and lo <= ranges[0] < hi) or pf.any_in_range(ranges, lo, hi):  # the first beam: most scans
             return
         self.scans_invalid += 1
         if self._invalid_logged_ns is None or t_ns - self._invalid_logged_ns >= 10_000_000_000:
