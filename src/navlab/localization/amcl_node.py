@@ -15,7 +15,6 @@ import numpy as np
 
 from navlab import msgs
 from navlab.core import Executor, Node, TfError, dataclass_parameters
-from navlab.core.tf import tf_from_msg
 from navlab.geometry import Tf
 from navlab.grid import GridError, GridMap
 from navlab.localization import amcl as pf
@@ -222,7 +221,8 @@ class Amcl(Node):
         if cached is None or cached[0] != self._map_to_odom:
             x, y, yaw = self._map_to_odom
             body = msgs.transform_stamped(0, self.global_frame, self.odom_frame, x, y, yaw).transform
-            cached = self._tf_body = (self._map_to_odom, tf_from_msg(body))
+            t, r = body.translation, body.rotation  # what tf reads from the message (core.tf.tf_from_msg)
+            cached = self._tf_body = (self._map_to_odom, (t.x, t.y, t.z, r.x, r.y, r.z, r.w))
         self.send_transform_tuples(stamp_ns, ((self.global_frame, self.odom_frame, cached[1]),))
 
     # --- outputs --------------------------------------------------------------------------------
