@@ -138,11 +138,11 @@ class Executor:
         ``/tf`` straight to the executor's tf buffer, in the queue's order, when the buffer is the topic's only
         reader (no other subscriber, no listener); False (nothing done) otherwise: the caller then publishes the
         ``TFMessage``. The buffer receives exactly what the message would give it (``TfBuffer.add_message``)."""
-        subs = topic.subscriptions
-        if self._listeners or len(subs) != 1 or subs[0] is not self._tf_sub:
+        subs, direct = topic.subscriptions, self._tf_tuples
+        if direct is None or self._listeners or len(subs) != 1 or subs[0] is not self._tf_sub:
             return False
         topic.count += 1
-        self._deliveries.append((self._tf_tuples, (stamp_ns, transforms)))
+        self._deliveries.append((direct, (stamp_ns, transforms)))
         if not self._running:
             self._drain()
         return True
