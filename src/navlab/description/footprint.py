@@ -39,9 +39,9 @@ def _corners(shape: Shape) -> np.ndarray:
 
 
 def collision_points_xy(model: RobotModel, base_frame: str | None = None) -> np.ndarray:
-    """Points (N x 2, m, in ``base_frame``, default the diff-drive plugin's base frame or the root link) whose
-    hull, seen from above, holds every box, cylinder and sphere collision shape (16 per circle). Meshes are not
-    counted."""
+    """Every box, cylinder and sphere collision shape seen from above, as points (N x 2, m, in ``base_frame``,
+    default the diff-drive plugin's base frame or the root link): a box's corners, 16 points on each circle of a
+    cylinder or sphere. Meshes are not counted."""
     poses = _link_poses(model)
     base = base_frame or (model.diff_drive.robot_base_frame if model.diff_drive else model.root_link)
     if base not in poses:
