@@ -38,10 +38,10 @@ def _corners(shape: Shape) -> np.ndarray:
     return np.zeros((0, 3))  # meshes: their links' boxes and cylinders bound most robots; skipped
 
 
-def robot_footprint(model: RobotModel, base_frame: str | None = None) -> list[list[float]]:
-    """The axis-aligned rectangle (m, in ``base_frame``, default the diff-drive plugin's base frame or the
-    root link) around every collision shape, seen from above: ``[[x, y], ...]`` as costmap_2d's
-    ``footprint`` parameter. Meshes are not counted."""
+def collision_points_xy(model: RobotModel, base_frame: str | None = None) -> np.ndarray:
+    """Every box, cylinder and sphere collision shape seen from above, as points (N x 2, m, in ``base_frame``,
+    default the diff-drive plugin's base frame or the root link): a box's corners, 16 points on each circle of a
+    cylinder or sphere. Meshes are not counted."""
     poses = _link_poses(model)
     base = base_frame or (model.diff_drive.robot_base_frame if model.diff_drive else model.root_link)
     if base not in poses:
@@ -58,6 +58,21 @@ def robot_footprint(model: RobotModel, base_frame: str | None = None) -> list[li
                 points.append(pts @ m[:3, :3].T + m[:3, 3])
     if not points:
         raise DescriptionError(f"{model.source}: no box, cylinder or sphere collision geometry to size a footprint")
-    xy = np.vstack(points)[:, :2]
+    return np.vstack(points)[:, :2]
+
+
+def collision_reach(model: RobotModel, base_frame: str | None = None) -> float:
+    """How far (m) the collision geometry reaches from the base frame's origin, seen from above: the least
+    ``robot_radius`` + ``footprint_padding`` whose circle holds the whole robot (a round robot's wheels may
+    stick out of its chassis)."""
+    xy = collision_points_xy(model, base_frame)
+    return float(np.hypot(xy[:, 0], xy[:, 1]).max())
+
+
+def robot_footprint(model: RobotModel, base_frame: str | None = None) -> list[list[float]]:
+    """The axis-aligned rectangle (m, in ``base_frame``, default the diff-drive plugin's base frame or the
+    root link) around every collision shape, seen from above: ``[[x, y], ...]`` as costmap_2d's
+    ``footprint`` parameter. Meshes are not counted."""
+    xy = collision_points_xy(model, base_frame)
     (x0, y0), (x1, y1) = np.round(xy.min(axis=0), 3), np.round(xy.max(axis=0), 3)
     return [[float(x0), float(y0)], [float(x0), float(y1)], [float(x1), float(y1)], [float(x1), float(y0)]]
