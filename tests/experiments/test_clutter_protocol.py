@@ -6,7 +6,7 @@ from __future__ import annotations
 import pytest
 
 from navlab.experiments.clutter_protocol import SETS, speed_overrides
-from navlab.experiments.clutter_run import barn_clock, run_clutter_world
+from navlab.experiments.clutter_run import OWN_FILES_PARAMS, barn_clock, clutter_params, run_clutter_world
 from navlab.experiments.errors import ExperimentError
 from navlab.world.clutter import clutter_suite, generate_clutter, suite_parameters
 
@@ -24,6 +24,15 @@ def test_speed_limit_goes_to_the_controllers_own_parameter() -> None:
     assert speed_overrides("mppi", None) == {}
     with pytest.raises(ExperimentError, match="max-speed"):
         speed_overrides("my_pkg/Unknown", 2.0)
+
+
+def test_clutter_settings_per_robot() -> None:
+    """The Jackal's local window holds its MPPI horizon at 2 m/s (2 s, 4 m); mybot keeps 6 m; any other robot drives
+    with its own files."""
+    assert clutter_params("jackal")["local_costmap.width"] == clutter_params("jackal")["local_costmap.height"] == 8.0
+    assert clutter_params("mybot")["local_costmap.width"] == 6.0
+    assert clutter_params("jackal")["recovery_behaviors"] == clutter_params("mybot")["recovery_behaviors"]
+    assert clutter_params("jackal_skid") == OWN_FILES_PARAMS
 
 
 def test_a_world_that_defeated_the_jackals_mppi_is_now_reached() -> None:
