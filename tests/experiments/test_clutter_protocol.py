@@ -49,6 +49,18 @@ def test_a_world_that_defeated_the_jackals_mppi_is_now_reached() -> None:
     assert 0 < r["barn_time_s"] < r["time_s"] and r["score"] >= r["score_to_stop"]
 
 
+def test_the_tuning_world_where_mppi_stood_still_is_now_reached() -> None:
+    """Tuning world 36 at seed 1: the Jackal backs out of a pocket into a gap facing away from its new plan, where
+    MPPI's left and right turns averaged to standing still; it stood 57 s until move_base aborted. With the rotation
+    shim (the Jackal's files) it turns in place toward the plan and reaches the goal without a contact."""
+    world = clutter_suite(50, seed=SETS["tuning"])[36]
+    r = run_clutter_world(
+        world, controller="mppi", robot="jackal", seed=1, move_base_params=speed_overrides("mppi", 2.0)
+    )
+    assert r["success"] and r["collisions"] == 0 and r["final_error_m"] <= 1.0, r
+    assert not r["near_miss"]
+
+
 def test_barn_clock_runs_from_the_first_move_until_first_within_a_metre() -> None:
     one = {"time_s": 14.0, "moved_s": 0.6, "within_tolerance_s": 12.1}
     assert barn_clock([one]) == pytest.approx(11.5)
