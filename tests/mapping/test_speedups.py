@@ -235,6 +235,37 @@ def test_the_tiled_ray_cast_writes_the_dense_cells_and_copies_only_shared_tiles(
     assert len(TilePool(2).free(40)) >= 40  # the pool grows when short of free tiles
 
 
+def test_a_ray_over_cells_at_the_clamp_copies_no_shared_tile(masks_hold) -> None:
+    """Cells already at -clamp stay as they are, so a scan cast again from the same pose into a map two particles
+    share copies only the tiles where some cell changes (here the far wall's), not the tiles its rays only
+    cross, and the map still equals the dense ray cast's."""
+    ang = np.linspace(-0.02, 0.02, 21)
+    r = 14.0 / np.cos(ang)  # a 15 m corridor's far wall, 14 m ahead of the laser at (0.5, 1.0)
+    args = (0.05, 0.5, 1.0, 0.0, r, ang, 20.0, 25.0, L_OCC, L_FREE, L_CLAMP)
+    pool, mine = from_dense(np.zeros((40, 300), dtype=np.float32))
+    whole = np.zeros((40, 300), dtype=np.float32)
+
+    def cast(table: np.ndarray) -> int:
+        free, used = pool.free(table.size), np.zeros(1, dtype=np.int64)
+        cow = (pool.tiles, pool.masks, pool.means, table, pool.refs, free, used)
+        raycast_tiles(*cow, (0.0, 0.0, 0, 0, 0.05), (0.5, 1.0, 0.0), (r, ang, 20.0, 25.0), (L_OCC, L_FREE, L_CLAMP))
+        _raycast(whole, 0.0, 0.0, 0, 0, *args)
+        return int(used[0])
+
+    for _ in range(int(L_CLAMP / -L_FREE) + 2):  # every cell the rays cross at the clamp
+        cast(mine)
+    theirs = mine.copy()
+    pool.recount([mine, theirs])
+    before = to_dense(pool.tiles, mine)
+    copied = cast(mine)
+    np.testing.assert_array_equal(to_dense(pool.tiles, mine)[:40, :300], whole)
+    np.testing.assert_array_equal(to_dense(pool.tiles, theirs), before)
+    crossed = np.unique(np.argwhere(before == -L_CLAMP) // TILE, axis=0)
+    assert len(crossed) == 5  # the corridor's five tiles
+    assert copied == np.count_nonzero(mine != theirs) == 1  # the far wall's tile only
+    masks_hold(pool, [mine, theirs])
+
+
 def test_lookup_field_and_correlative_search_near_and_off_the_edges() -> None:
     rng = np.random.default_rng(5)
     pts = rng.normal(0, 2.0, (300, 2))

@@ -134,24 +134,14 @@ class GMappingBackend(SeededBackend):
         scan-to-scan constraints (``refine``, :func:`~navlab.mapping.refine.refine_poses`)."""
         poses = self.slam.finish()
         if self.params.refine and len(self._points) == len(poses) > 2:
-            # no front end has linked neighbouring scans here: match against the nearest ones too
-            # a pair that moved < 3 cm / 0.5 deg between rounds keeps its match (ICP from there lands where it
-            # did: 0.01 m / 0.2 deg kept 1 in 10 on CSAIL, this 6 in 10); ICP runs 8 iterations, not 14 (its
-            # search radius shrinks over 4, then at most 4 at the finest: the same figures on CSAIL at 60 % of
-            # the cost); a match's information follows its ICP Hessian (a corridor's axis is left to the other
-            # edges); the filter's poses, each matched against the finished map, need two rounds, not three; the
-            # graph's Gauss-Newton stops at steps under 0.1 mm / 1e-4 rad (a quarter fewer solves, the same poses
-            # to 0.1 mm)
-            params = RefineParams(
-                min_travel=0.0,
-                neighbours=6,
-                rematch_xy=0.03,
-                rematch_theta=math.radians(0.5),
-                icp_iterations=8,
-                tol=1e-4,
-                shape_xy=2.0,
-                rounds=2,
-            )
+            # no front end has linked neighbouring scans here: match against the nearest ones too. ICP runs 8
+            # iterations, not 14 (its search radius shrinks over 4, then at most 4 at the finest: the same figures
+            # on CSAIL at 60 % of the cost); a match's information follows its ICP Hessian (a corridor's axis is
+            # left to the other edges); the filter's poses, each matched against the finished map, need one round,
+            # not three (CSAIL seeds 0/1/2 refined 0.0270/0.0279/0.0285 m with one, 0.0270/0.0276/0.0286 m with
+            # two, for a third less of the refinement's CPU); the graph's Gauss-Newton stops at steps under 0.1 mm
+            # / 1e-4 rad (a quarter fewer solves, the same poses to 0.1 mm)
+            params = RefineParams(min_travel=0.0, neighbours=6, icp_iterations=8, tol=1e-4, shape_xy=2.0, rounds=1)
             poses, stats = refine_poses(poses, self._points, params)
             self.refine_edges, self.refine_rejected = stats["refine_edges"], stats["refine_rejected"]
         return poses

@@ -99,15 +99,17 @@ def _score_above(
     the hits of an occupied cell within ``kernel`` cells whose cell one step back along the beam is free
     (GMapping's ``cell.mean()``). ``beams``: range, cosine and sine (laser frame) of the beams to score
     (``_valid_beams``); ``model``: (kernel, sigma, lsigma); ``fw`` (4, n), ``iw`` (4, n): work arrays
-    (``_endpoints``; rows 2 and 3 of ``fw`` get each beam's score term and its match's squared distance (m²),
-    -1 if none).
+    (``_endpoints``; row 3 of ``fw`` gets each beam's match's squared distance (m²), -1 if none, and row 2, when
+    the scan is scored to the end, its score term).
 
     A beam adds at most 1 to the score, so once the score so far plus one per beam left cannot exceed
     ``bound`` (rounding included), this returns (-1, 0, -1) without scoring the rest: the hill climb only
     needs to know that such a pose is no better. ``bound`` < 0 scores every beam. The beams are visited in
     ``order`` (a permutation: the hill climb puts first those that scored worst at the pose it climbs from,
-    which stops a worse neighbour sooner); the score and log-likelihood are summed in beam order all the
-    same, so the order changes nothing but when a pose is given up."""
+    which stops a worse neighbour sooner). While visiting, a term exp(-x) is bounded by 1 - x + x²/2 (its
+    Taylor polynomial, above it for x >= 0; plus 1e-15 for exp's rounding): no exp is taken for a pose
+    given up, four in five of a climb's. The score's terms and its log-likelihood are then summed in beam
+    order, so the order and the bound change nothing but when a pose is given up."""
     oi, oj, res = lattice[2], lattice[3], lattice[4]
     kernel, sigma, lsigma = model
     rv = beams[0]
@@ -119,10 +121,12 @@ def _score_above(
     s = 0.0
     null_l = -0.5 / lsigma  # GMapping: nullLikelihood = -0.5
     left = rv.shape[0]
+    fw0, fw1, fw3 = fw[0], fw[1], fw[3]  # rows (views), read at unsigned indices: no negative-index wrap
+    iw0, iw1, iw2, iw3 = iw[0], iw[1], iw[2], iw[3]
     for q in range(rv.shape[0]):
-        k = order[q]
-        ux, uy = fw[0, k], fw[1, k]
-        ei, ej, fi, fj = iw[0, k], iw[1, k], iw[2, k], iw[3, k]
+        k = numba.uint64(order[q])
+        ux, uy = fw0[k], fw1[k]
+        ei, ej, fi, fj = iw0[k], iw1[k], iw2[k], iw3[k]
         best = 1e9  # the nearest match's squared distance (cells²): a minimum, so the cells' order does not matter
         inside = (
             min(ei, fi) >= kernel and min(ej, fj) >= kernel and max(ei, fi) < w - kernel and max(ej, fj) < h - kernel
@@ -138,7 +142,8 @@ def _score_above(
             and 1 <= (fi & MASK) < MASK
             and 1 <= (fj & MASK) < MASK
         ):
-            ce = table[ej >> SHIFT, ei >> SHIFT] * TILE * TILE + (ej & MASK) * TILE + (ei & MASK)
+            tile = table[numba.uint64(ej >> SHIFT), numba.uint64(ei >> SHIFT)]
+            ce = tile * TILE * TILE + (ej & MASK) * TILE + (ei & MASK)
             bit = NEIGHBOUR_BIT[(fj - ej + 1) * 3 + fi - ei + 1]
             for dj in range(-1, 2):
                 for di in range(-1, 2):
@@ -157,29 +162,33 @@ def _score_above(
                         e = table[j >> SHIFT, i >> SHIFT] * TILE * TILE + (j & MASK) * TILE + (i & MASK)
                         d2 = _mean_d2(mflat, e, i + oi, j + oj, ux, uy)
                         best = d2 if d2 < best else best
-        found = best < 1e9
-        best *= res * res
-        term = math.exp(-best / sigma) if found else 0.0
-        fw[2, k] = term
-        fw[3, k] = best if found else -1.0
-        s += term
         left -= 1
+        if best < 1e9:
+            best *= res * res
+            fw3[k] = best
+            x = best / sigma
+            s += min(1.0 - x + 0.5 * x * x, 1.0) + 1e-15  # >= exp(-x) as computed (see above)
+        else:
+            fw3[k] = -1.0
         # each later term is in [0, 1] and each rounding adds < 1e-16 relatively (<= 720 beams, in any order):
         # a safe bound
         if (s + left) * (1.0 + 1e-12) <= bound:
             return -1.0, 0.0, -1
     if s * (1.0 + 1e-12) <= bound:  # no better, whatever the order of the sum
         return -1.0, 0.0, -1
-    s = 0.0  # the sums in beam order (a zero term leaves a sum unchanged)
+    s = 0.0  # the sums in beam order
     lik = 0.0
     n = 0
     for k in range(rv.shape[0]):
-        s += fw[2, k]
         if fw[3, k] >= 0.0:
+            term = math.exp(-fw[3, k] / sigma)
+            s += term
             lik += -fw[3, k] / lsigma
             n += 1
         else:
+            term = 0.0
             lik += null_l
+        fw[2, k] = term
     return s, lik, n
 
 

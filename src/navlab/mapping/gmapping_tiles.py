@@ -255,13 +255,15 @@ def raycast_tiles(
     of the cells it crosses (Bresenham, end cell excluded) by ``l_free`` and, if shorter than max_urange,
     raises its end cell by ``l_occ`` (``update``: (l_occ, l_free, clamp); clamped to ±clamp) and adds the end
     point to its cell's mean; cells outside the map are skipped. Tiles written are made private first; their
-    ``masks`` follow the cells."""
+    ``masks`` follow the cells. A ray's cells already at -clamp are only read: they would stay as they are,
+    so a tile the scan crosses only there stays shared (not copied for nothing)."""
     ranges, angles, max_urange, max_range = scan
     l_occ, l_free, clamp = update
     th, tw = table.shape
     h, w = th * TILE, tw * TILE
+    flat = tiles.reshape(-1)  # a view (C-contiguous)
     i0, j0 = lattice_cell(lattice, pose[0], pose[1])
-    last_tj, last_ti, t = -1, -1, 0  # the tile written last (rays cross few tiles: mostly the same one)
+    last_tj, last_ti, t, mine = -1, -1, 0, False  # the tile read last (rays cross few tiles), whether it is private
     for k in range(ranges.shape[0]):
         if not is_return(ranges[k], max_range):
             continue
@@ -273,14 +275,21 @@ def raycast_tiles(
             if 0 <= i < w and 0 <= j < h:
                 tj, ti = j >> SHIFT, i >> SHIFT
                 if tj != last_tj or ti != last_ti:
-                    t = _own(tiles, masks, means, table, refs, free, used, tj, ti)
                     last_tj, last_ti = tj, ti
+                    t = table[tj, ti]
+                    mine = refs[t] == 1
+                e = numba.uint64(((t << SHIFT) + (j & MASK)) << SHIFT) + numba.uint64(i & MASK)
+                if flat[e] <= -clamp:  # at the clamp already (most cells): it stays, and its tile is not copied
+                    continue
+                if not mine:
+                    t = _own(tiles, masks, means, table, refs, free, used, tj, ti)
+                    mine = True
                 _set(tiles, masks, t, j & MASK, i & MASK, l_free, clamp)
         if hit and 0 <= i1 < w and 0 <= j1 < h:
             tj, ti = j1 >> SHIFT, i1 >> SHIFT
-            if tj != last_tj or ti != last_ti:
+            if tj != last_tj or ti != last_ti or not mine:
                 t = _own(tiles, masks, means, table, refs, free, used, tj, ti)
-                last_tj, last_ti = tj, ti
+                last_tj, last_ti, mine = tj, ti, True
             _set(tiles, masks, t, j1 & MASK, i1 & MASK, l_occ, clamp)
             _add_hit(
                 means[t, j1 & MASK, i1 & MASK],
