@@ -42,6 +42,7 @@ def _linspace(start: float, stop: float, num: int, out: np.ndarray) -> None:  # 
 def score_samples(
     grid: np.ndarray,
     memo: np.ndarray,
+    epoch: int,
     rings: np.ndarray,
     ring_counts: np.ndarray,
     path_wave: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray],
@@ -65,10 +66,10 @@ def score_samples(
     ``limits`` = (vmin, vmax, wmin, wmax, min_in_place_vel_theta, escape_vel, acc_lim_x, acc_lim_theta);
     ``counts`` = (vx_samples, vtheta_samples); ``timing`` = (sim_time, sim_granularity, angular granularity,
     heading_scoring 0/1); ``path_wave``, ``goal_wave``: the path and goal distances (``mapgrid.wave_start``). A
-    polygon robot's footprint is checked with ``ring_bounds.ring_scores`` (``memo``, ``rings``, ``ring_counts``:
-    its bound memo and rings; a point robot's centre cell alone). Rows: per speed the straight rollout then
-    ``nw - 1`` turn rates from the lowest up, then the ``nw`` in-place turns, then the escape. ``at``: the scored
-    step (``_heading_step``)."""
+    polygon robot's footprint is checked with ``ring_bounds.ring_scores`` (``memo``, ``epoch``, ``rings``,
+    ``ring_counts``: its bound memo, the costs' epoch and rings; a point robot's centre cell alone). Rows: per
+    speed the straight rollout then ``nw - 1`` turn rates from the lowest up, then the ``nw`` in-place turns, then
+    the escape. ``at``: the scored step (``_heading_step``)."""
     vmin, vmax, wmin, wmax, min_ip, escape_vel, ax, ath = (
         limits[0],
         limits[1],
@@ -114,7 +115,7 @@ def score_samples(
     ats = np.full(n, at, dtype=np.int64)
     inv = 1.0 / resolution
     scene = (path_wave, goal_wave, inv, traj, c, s, ox, oy, polygon, weights, impossible, ats, costs)
-    ring_scores(grid, memo, rings, ring_counts, *scene)
+    ring_scores(grid, memo, epoch, rings, ring_counts, *scene)
     return targets, traj, costs, ws, dw
 
 
