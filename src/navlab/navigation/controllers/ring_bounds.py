@@ -11,8 +11,9 @@ for a pose whose coarse bound could raise its rollout's cost). A pose is checked
 bound can still fail it (LETHAL or unknown in the ring) or raise the rollout's cost above what its other poses
 already cost: first, in time order, the poses that may fail (the first failure decides, as
 ``rollout.rollout_scores``), then the highest bound of the rest, then (latest first) any pose whose bound is
-still above. Every rollout starts from the same pose, checked once a call. The costs are those of ``rollout.rollout_scores`` bit
-for bit: the maximum does not depend on the order. Poses are grid-local (m, rad); cells (i, j) = (column, row).
+still above. Every rollout starts from the same pose, checked once a call. The costs are those of
+``rollout.rollout_scores`` bit for bit: the maximum does not depend on the order. Poses are grid-local (m, rad);
+cells (i, j) = (column, row).
 """
 
 from __future__ import annotations
