@@ -5,9 +5,8 @@ A pose's occupancy cost is the highest cost under its footprint outline's points
 ``rmin`` and ``rmax`` of the centre (the outline's nearest and farthest point), whatever the heading, so with
 the centre in a given part of a cell the points can only fall in a fixed ring of cells around it
 (:func:`ring_offsets`). The highest cost in that ring and the centre cell is a bound on the pose's cost, looked
-up once per (cell, part) and kept while the costs stay the same (:func:`ring_bound`). Two levels: the cell cut
-QUARTERS x QUARTERS ways (a coarse bound, read for every pose) and FINE x FINE ways (a tighter one, read only
-for a pose whose coarse bound could raise its rollout's cost). A pose is checked point by point only when its
+up once per (cell, part) and kept while the costs stay the same (:func:`ring_bound`; a new epoch of the costs
+forgets the memo without clearing it). A pose is checked point by point only when its
 bound can still fail it (LETHAL or unknown in the ring) or raise the rollout's cost above what its other poses
 already cost: first, in time order, the poses that may fail (the first failure decides, as
 ``rollout.rollout_scores``), then the highest bound of the rest, then (latest first) any pose whose bound is
@@ -28,37 +27,34 @@ from navlab.navigation.controllers.mapgrid import grow
 from navlab.navigation.controllers.rollout import outline_max
 
 QUARTERS = 2  # the centre's cell is split QUARTERS x QUARTERS ways: tighter rings than one ring per cell
-FINE = 8  # and FINE x FINE ways for the second, tighter bound
-PARTS = QUARTERS * QUARTERS + FINE * FINE  # the rings: the coarse parts first, then the fine ones
 _EPS = 1e-6  # cells: room for the rounding of the outline points' coordinates
 
 
 def ring_offsets(outline: np.ndarray, resolution: float) -> tuple[np.ndarray, np.ndarray]:
-    """(offsets (PARTS, M, 2) as (di, dj), counts (PARTS,)): for each part of a cell, the cells relative to the
-    centre's that an outline point (base frame, m) can fall in, at any heading, while the centre lies in that part
-    of its cell: first the QUARTERS x QUARTERS parts (part qj * QUARTERS + qi), then the FINE x FINE ones (part
-    QUARTERS² + fj * FINE + fi)."""
+    """(offsets (Q, M, 2) as (di, dj), counts (Q,)): for each part q = qj * QUARTERS + qi of a cell, the cells
+    relative to the centre's that an outline point (base frame, m) can fall in, at any heading, while the centre
+    lies in that part of its cell."""
     r = np.hypot(outline[:, 0], outline[:, 1]) / resolution
     rmin, rmax = float(r.min()) - _EPS, float(r.max()) + _EPS
     reach = math.ceil(rmax) + 2
+    q = QUARTERS
     rings: list[list[tuple[int, int]]] = []
-    for q in (QUARTERS, FINE):
-        for qj in range(q):
-            for qi in range(q):
-                ring = []
-                for b in range(-reach, reach + 1):
-                    for a in range(-reach, reach + 1):
-                        # the centre's offset within its cell is in [qi/q, (qi+1)/q): a point in cell a lies this far
-                        lx, hx = a - (qi + 1) / q - _EPS, a + 1 - qi / q + _EPS
-                        ly, hy = b - (qj + 1) / q - _EPS, b + 1 - qj / q + _EPS
-                        dx = 0.0 if lx <= 0.0 <= hx else min(abs(lx), abs(hx))
-                        dy = 0.0 if ly <= 0.0 <= hy else min(abs(ly), abs(hy))
-                        far = math.hypot(max(abs(lx), abs(hx)), max(abs(ly), abs(hy)))
-                        if math.hypot(dx, dy) <= rmax and far >= rmin:
-                            ring.append((a, b))
-                rings.append(ring)
-    offsets = np.zeros((len(rings), max(len(g) for g in rings), 2), dtype=np.int64)
-    counts = np.zeros(len(rings), dtype=np.int64)
+    for qj in range(q):
+        for qi in range(q):
+            ring = []
+            for b in range(-reach, reach + 1):
+                for a in range(-reach, reach + 1):
+                    # the centre's offset within its cell is in [qi/q, (qi+1)/q): a point in cell a lies this far away
+                    lx, hx = a - (qi + 1) / q - _EPS, a + 1 - qi / q + _EPS
+                    ly, hy = b - (qj + 1) / q - _EPS, b + 1 - qj / q + _EPS
+                    dx = 0.0 if lx <= 0.0 <= hx else min(abs(lx), abs(hx))
+                    dy = 0.0 if ly <= 0.0 <= hy else min(abs(ly), abs(hy))
+                    far = math.hypot(max(abs(lx), abs(hx)), max(abs(ly), abs(hy)))
+                    if math.hypot(dx, dy) <= rmax and far >= rmin:
+                        ring.append((a, b))
+            rings.append(ring)
+    offsets = np.zeros((q * q, max(len(g) for g in rings), 2), dtype=np.int64)
+    counts = np.zeros(q * q, dtype=np.int64)
     for k, ring in enumerate(rings):
         offsets[k, : len(ring)] = ring
         counts[k] = len(ring)
@@ -66,10 +62,10 @@ def ring_offsets(outline: np.ndarray, resolution: float) -> tuple[np.ndarray, np
 
 
 def new_memo(shape: tuple[int, int]) -> np.ndarray:
-    """An empty bound memo (H, W, PARTS) int32 for a grid of ``shape``: an entry holds ``bound | epoch << 8`` and
+    """An empty bound memo (Q, H, W) int32 for a grid of ``shape``: an entry holds ``bound | epoch << 8`` and
     counts only under its epoch (see :func:`ring_scores`); 0 = never looked up. A new epoch forgets every entry
     without touching the memo (the costs changed)."""
-    return np.zeros((*shape, PARTS), dtype=np.int32)
+    return np.zeros((QUARTERS * QUARTERS, *shape), dtype=np.int32)
 
 
 MAX_EPOCH = (1 << 23) - 1  # epochs 1 .. MAX_EPOCH fit an int32 entry beside the bound; then start a new memo
@@ -89,27 +85,20 @@ def ring_bound(
             top = COST_UNKNOWN
         else:
             top = max(top, int(grid[pj, pi]))
-    memo[j, i, q] = top | (epoch << 8)
+    memo[q, j, i] = top | (epoch << 8)
     return top
 
 
 @numba.njit(cache=True)
 def bound_at(
-    grid: np.ndarray,
-    memo: np.ndarray,
-    epoch: int,
-    offsets: np.ndarray,
-    counts: np.ndarray,
-    fx: float,
-    fy: float,
-    q: int,
-    first: int,
+    grid: np.ndarray, memo: np.ndarray, epoch: int, offsets: np.ndarray, counts: np.ndarray, fx: float, fy: float
 ) -> int:  # pragma: no cover - compiled
-    """:func:`ring_bound` of the centre at cell coordinates (fx, fy) (inside the grid), the cell cut ``q`` x ``q``
-    ways (its rings from ``first`` on), from ``memo`` when looked up before in this ``epoch``."""
+    """:func:`ring_bound` of the centre at cell coordinates (fx, fy) (inside the grid), from ``memo`` when looked up
+    before in this ``epoch``."""
     i, j = math.floor(fx), math.floor(fy)
-    part = first + min(q - 1, int((fy - j) * q)) * q + min(q - 1, int((fx - i) * q))
-    kept = int(memo[j, i, part])
+    q = QUARTERS
+    part = min(q - 1, int((fy - j) * q)) * q + min(q - 1, int((fx - i) * q))
+    kept = int(memo[part, j, i])
     if kept >> 8 == epoch:
         return kept & 0xFF
     return ring_bound(grid, memo, epoch, offsets, counts, part, i, j)
@@ -158,7 +147,7 @@ def ring_scores(
     rollout (S, n, 3) into ``out``; -1 blocked or off the map, -2 no path."""
     h, w = grid.shape
     n = traj.shape[1]
-    q, fine = QUARTERS, QUARTERS * QUARTERS
+    q = QUARTERS
     path_dist, path_reached, path_free, path_queue, path_ends = path_wave
     goal_dist, goal_reached, goal_free, goal_queue, goal_ends = goal_wave
     bounds = np.empty(n, dtype=np.int64)
@@ -169,9 +158,9 @@ def ring_scores(
         x0, y0 = traj[0, 0, 0], traj[0, 0, 1]
         i0, j0 = math.floor(x0 * inv), math.floor(y0 * inv)
         inside = 0 <= i0 < w and 0 <= j0 < h
-        if inside and bound_at(grid, memo, epoch, offsets, counts, x0 * inv, y0 * inv, q, 0) < COST_LETHAL:
-            fb = bound_at(grid, memo, epoch, offsets, counts, x0 * inv, y0 * inv, FINE, fine)
-            e0 = _exact(grid, inv, x0, y0, c[0, 0], s[0, 0], ox, oy, fb)
+        b0 = bound_at(grid, memo, epoch, offsets, counts, x0 * inv, y0 * inv) if inside else COST_UNKNOWN
+        if b0 < COST_LETHAL:
+            e0 = _exact(grid, inv, x0, y0, c[0, 0], s[0, 0], ox, oy, b0)
     for r in range(traj.shape[0]):
         shared = e0 >= 0.0 and traj[r, 0, 0] == traj[0, 0, 0] and traj[r, 0, 1] == traj[0, 0, 1]
         shared = shared and c[r, 0] == c[0, 0] and s[r, 0] == s[0, 0]
@@ -200,7 +189,7 @@ def ring_scores(
                     top = max(top, float(grid[j, i]))
                 else:
                     part = min(q - 1, int((fy - j) * q)) * q + min(q - 1, int((fx - i) * q))
-                    kept = int(memo[j, i, part])  # bound_at, written out (the hot loop: a call costs more than a hit)
+                    kept = int(memo[part, j, i])  # bound_at, written out (the hot loop: a call costs more than a hit)
                     if kept >> 8 == epoch:
                         b = kept & 0xFF
                     else:
@@ -231,17 +220,10 @@ def ring_scores(
             out[r] = fail
             continue
         # the deferred poses whose bound is above the cost so far: the highest first, then the latest first (a
-        # rollout's cost tends to grow along it); the tighter bound, then (if still above) the outline itself
+        # rollout's cost tends to grow along it)
         for a in range(-1, n):
             k = first if a < 0 else n - 1 - a
             if k < 0 or bounds[k] <= top or (a >= 0 and k == first) or (k == 0 and shared):
                 continue
-            x, y = traj[r, k, 0], traj[r, k, 1]
-            fx, fy = x * inv, y * inv  # bound_at(..., FINE, fine), written out (a call costs more than a hit)
-            i, j = math.floor(fx), math.floor(fy)
-            part = fine + min(FINE - 1, int((fy - j) * FINE)) * FINE + min(FINE - 1, int((fx - i) * FINE))
-            kept = int(memo[j, i, part])
-            fb = kept & 0xFF if kept >> 8 == epoch else ring_bound(grid, memo, epoch, offsets, counts, part, i, j)
-            if fb > top:
-                top = max(top, _exact(grid, inv, x, y, c[r, k], s[r, k], ox, oy, fb))
+            top = max(top, _exact(grid, inv, traj[r, k, 0], traj[r, k, 1], c[r, k], s[r, k], ox, oy, bounds[k]))
         out[r] = weights[0] * (weights[1] * spd + weights[2] * sgd + weights[3] * top)
