@@ -166,7 +166,7 @@ class TrajectoryPlannerROS(RolloutController):
     def _constants(self, res: float) -> tuple[np.ndarray, np.ndarray, int]:
         """The cycle kernel's (timing, weights, scored step) at resolution ``res``: the same every cycle."""
         p = self.params
-        key = (res, p.sim_time, p.sim_granularity, p.angular_sim_granularity, p.heading_scoring)
+        key: tuple[Any, ...] = (res, p.sim_time, p.sim_granularity, p.angular_sim_granularity, p.heading_scoring)
         key += (p.heading_scoring_timestep, p.meter_scoring, p.pdist_scale, p.gdist_scale, p.occdist_scale)
         cached = self._consts
         if cached is None or cached[0] != key:

@@ -65,9 +65,13 @@ class LayeredCostmap:
     @property
     def costmap(self) -> Grid:
         """The master grid (updated in place by :meth:`update_map`; a deferred update is written now)."""
+        self._flush()
+        return self.master
+
+    def _flush(self) -> None:
+        """Write the master of a deferred update now (see :meth:`update_map`)."""
         if self._deferred:
             self._write_master()
-        return self.master
 
     @property
     def rolling(self) -> bool:
@@ -91,7 +95,7 @@ class LayeredCostmap:
 
     def resize(self, width: int, height: int, resolution: float, origin: tuple[float, float]) -> None:
         """New master geometry (``width`` x ``height`` cells, m/cell, lower-left corner in m); layers reset."""
-        self.costmap  # noqa: B018 - a deferred update is written with what the layers held
+        self._flush()  # before what the layers hold changes
         if width < 1 or height < 1 or not (math.isfinite(resolution) and resolution > 0):
             raise NavigationError(
                 f"costmap resize: expected positive size and resolution, got {width} x {height} at {resolution} m/cell"
@@ -107,7 +111,7 @@ class LayeredCostmap:
 
     def set_footprint(self, footprint: Footprint) -> None:
         """A new (padded) footprint for every layer."""
-        self.costmap  # noqa: B018 - a deferred update is written with what the layers held
+        self._flush()  # before what the layers hold changes
         self.footprint = footprint
         for layer in self.layers:
             layer.on_footprint_changed(footprint)
@@ -124,7 +128,7 @@ class LayeredCostmap:
     def set_map(self, grid: GridMap, *, map_in_costmap: tuple[float, float, float] = (0.0, 0.0, 0.0)) -> None:
         """A new ``/map`` for the static layers. Not rolling: the master takes the map's size, resolution and
         origin (as costmap_2d does). ``map_in_costmap``: pose of the map frame in the costmap frame."""
-        self.costmap  # noqa: B018 - a deferred update is written with what the layers held
+        self._flush()  # before what the layers hold changes
         statics = self.map_layers
         if not statics:
             raise NavigationError(
@@ -155,7 +159,7 @@ class LayeredCostmap:
     ) -> None:
         """Give one scan (sensor origin and endpoints (N, 2), m, costmap frame) to the obstacle layers
         (or to the one named ``layer``); see ``ObstacleLayer.add_scan``."""
-        self.costmap  # noqa: B018 - a deferred update is written with what the layers held
+        self._flush()  # before what the layers hold changes
         for target in self.scan_targets(source, layer):
             target.add_scan(origin_xy, endpoints_xy, valid, source=source)
 
@@ -231,7 +235,7 @@ class LayeredCostmap:
 
     def reset(self) -> None:
         """Forget every layer's observations (costmap_2d's ``resetLayers``)."""
-        self.costmap  # noqa: B018 - a deferred update is written with what the layers held
+        self._flush()  # before what the layers hold changes
         for layer in self.layers:
             layer.reset()
             layer.match_size(self.master)
