@@ -3,9 +3,10 @@
     python tools/nav_trace.py record OUT.json [--seed N] [--controller trajectory|dwa|mppi] [--robot mybot_depth]
     python tools/nav_trace.py compare OLD.json NEW.json
 
-The trace holds every cmd_vel (hex floats), the tf map -> odom and odom -> base sent, every amcl_pose, a hash of
-every global plan, of both costmaps after each update and of the controller's local plan each cycle, the true
-path and the monitor's samples (clearance, localization error, plan tracking) at 10 Hz, and each goal's figures.
+The trace holds every cmd_vel (hex floats), every transform tf received (stamp, child, x, y, rotation z),
+every amcl_pose, a hash of every global plan, of both costmaps after each update and of the controller's local
+plan each cycle, the true path and the monitor's samples (clearance, localization error, plan tracking) at 10 Hz,
+and each goal's figures.
 Record with the old code (e.g. ``PYTHONPATH=/tmp/old/src``, a ``git archive`` of the base; this tool from the new
 tree), then with the new, and compare: ``compare`` names the first difference of each part and exits 1 if there is
 one.
@@ -30,6 +31,7 @@ def record(out: str, seed: int, controller: str | None, robot: str = "mybot") ->
     """Run bench nav's goals with hooks on the executor, the costmaps and move_base; write the trace to ``out``."""
     from navlab.bench.experiments import NAV_GOALS
     from navlab.core.executor import Executor
+    from navlab.core.tf import TfBuffer
     from navlab.experiments.navigate_monitor import NavMonitor
     from navlab.experiments.navigate_run import run_navigation
     from navlab.navigation.costmap_ros import Costmap2DROS
@@ -37,6 +39,7 @@ def record(out: str, seed: int, controller: str | None, robot: str = "mybot") ->
 
     rec: dict[str, Any] = {k: [] for k in ("cmd", "tf", "amcl", "plan", "costmap", "local", "monitor")}
     publish, update, make_plan = Executor.publish, Costmap2DROS.update, MoveBase.make_plan
+    set_transform = TfBuffer.set_transform
     sample = NavMonitor._sample
 
     def on_publish(self: Any, topic: Any, msg: Any, *, latch_key: int | None = None) -> None:
@@ -46,13 +49,13 @@ def record(out: str, seed: int, controller: str | None, robot: str = "mybot") ->
         elif name.endswith("amcl_pose"):
             p = msg.pose.pose
             rec["amcl"].append((t, *(v.hex() for v in (p.position.x, p.position.y, p.orientation.z, p.orientation.w))))
-        elif name == "/tf":
-            for tr in msg.transforms:
-                q = tr.transform
-                rec["tf"].append(
-                    (t, tr.child_frame_id, q.translation.x.hex(), q.translation.y.hex(), q.rotation.z.hex())
-                )
         publish(self, topic, msg, latch_key=latch_key)
+
+    def on_set_transform(self: Any, parent: str, child: str, t_ns: int, tf: Any, *, static: bool = False) -> None:
+        # what tf receives: from a /tf message or straight to the buffer (Node.send_transform_tuples)
+        if not static:
+            rec["tf"].append((t_ns, child, float(tf[0]).hex(), float(tf[1]).hex(), float(tf[5]).hex()))
+        set_transform(self, parent, child, t_ns, tf, static=static)
 
     def on_update(self: Any, *a: Any, **k: Any) -> Any:
         out = update(self, *a, **k)
@@ -87,6 +90,7 @@ def record(out: str, seed: int, controller: str | None, robot: str = "mybot") ->
 
     Executor.publish, Costmap2DROS.update, MoveBase.make_plan = on_publish, on_update, on_make_plan  # type: ignore[method-assign]
     NavMonitor._sample = on_sample  # type: ignore[method-assign]
+    TfBuffer.set_transform = on_set_transform  # type: ignore[method-assign]
     r = run_navigation(
         list(NAV_GOALS),
         world="room_obstacles",

@@ -192,6 +192,15 @@ def transform_stamped(stamp_ns: int, parent: str, child: str, x: float, y: float
     )
 
 
+def transform_from_tuple(stamp_ns: int, parent: str, child: str, tf: Any) -> Any:
+    """``geometry_msgs/TransformStamped`` ``parent_T_child`` from ``(x, y, z, qx, qy, qz, qw)``."""
+    return TransformStamped(
+        header(stamp_ns, parent),
+        child,
+        Transform(Vector3(float(tf[0]), float(tf[1]), float(tf[2])), Quaternion(*(float(v) for v in tf[3:]))),
+    )
+
+
 def twist(vx: float = 0.0, wz: float = 0.0, vy: float = 0.0) -> Any:
     """``geometry_msgs/Twist`` for a planar robot (m/s, rad/s)."""
     return Twist(Vector3(float(vx), float(vy), 0.0), Vector3(0.0, 0.0, float(wz)))

@@ -173,3 +173,44 @@ def test_idle_timer_firings_run_nothing_and_step_no_physics() -> None:
     readers.append(1)
     ex.run(0.03)
     assert fired == [110_000_000, 120_000_000, 130_000_000]  # on the same 10 ms grid once read
+
+
+def test_a_timer_idle_until_the_graph_changes_leaves_the_queue_and_wakes_on_its_grid() -> None:
+    """A lazy sensor (idle while nobody subscribes or listens) is not asked again while parked, and fires on the
+    same ticks as a sensor asked at every tick: from the first tick after a subscription or a listener appears."""
+    runs = []
+    for parks in (False, True):
+        ex = Executor()
+        sensor, other = Node("sensor", context=Context(ex)), Node("other", context=Context(ex))
+        pub = sensor.create_publisher(msgs.String, "reading", 10)
+        fired: list[int] = []
+        asked = [0]
+
+        def idle(pub=pub, ex=ex, asked=asked) -> bool:
+            asked[0] += 1
+            return not (pub.get_subscription_count() or ex.has_listeners)
+
+        sensor.create_timer(
+            0.01, lambda fired=fired, ex=ex: fired.append(ex.now_ns), idle=idle, idle_until_graph_changes=parks
+        )
+        sub = []
+        # a subscription made inside a callback at 45 ms, between two ticks of the 10 ms grid
+        other.create_timer(
+            0.045,
+            lambda sub=sub, other=other: (
+                None if sub else sub.append(other.create_subscription(msgs.String, "reading", lambda _m: None, 10))
+            ),
+        )
+        ex.run(0.069)
+        busy = fired[:]
+        other.destroy_node()  # nobody subscribes: quiet again
+        asked[0] = 0
+        ex.run(0.05)
+        quiet = (fired[len(busy) :], asked[0])
+        ex.add_listener(lambda *_: None)  # a recorder: wakes it
+        ex.run(0.02)
+        runs.append((busy, quiet, fired[len(busy) :]))
+    (busy0, quiet0, after0), (busy1, quiet1, after1) = runs
+    assert busy1 == busy0 == [50_000_000, 60_000_000]  # the first tick after the subscription at 45 ms
+    assert quiet0 == ([], 5) and quiet1 == ([], 1)  # asked at each of the 5 ticks, or once and then parked
+    assert after1 == after0 == [120_000_000, 130_000_000]  # woken at 119 ms: the next ticks of its grid

@@ -117,3 +117,58 @@ def test_a_remembered_lookup_follows_the_edges_it_read():
     buf.add_message(msgs.TFMessage([between]))
     assert buf.lookup_pose2d("odom", "chassis", 1_500_000_000)[:2] == pytest.approx((7.0, 2.0))
     assert buf.lookup_pose2d("odom", "chassis")[:2] == pytest.approx((5.0, 2.0))
+
+
+def _tf_run(*, subscriber: bool, listener: bool) -> tuple[list[tuple[float, ...]], list, list, int]:
+    """Two nodes send odom->base as tuples; a third, fed by a topic published just before each transform, looks tf
+    up at once. Returns (lookups, /tf messages a subscriber got, messages a listener saw, /tf's count)."""
+    ex = Executor()
+    ctx = Context(ex)
+    sender, reader = Node("odom_pub", context=ctx), Node("reader", context=ctx)
+    tick = sender.create_publisher(msgs.String, "tick", 10)
+    seen: list[tuple[float, ...]] = []
+
+    def on_tick(_msg: object) -> None:
+        try:
+            seen.append(ex.tf.lookup_pose2d("odom", "base", None))
+        except TfError:
+            seen.append(())
+
+    reader.create_subscription(msgs.String, "tick", on_tick, 10)
+    got: list = []
+    if subscriber:
+        reader.create_subscription(msgs.TFMessage, "/tf", got.append, 10)
+    heard: list = []
+    if listener:
+        ex.add_listener(lambda name, msg, _t: heard.append(msg) if name == "/tf" else None)
+    k = [0]
+
+    def send() -> None:
+        k[0] += 1
+        q = msgs.quaternion_from_yaw(0.1 * k[0])
+        tick.publish(msgs.String(data=""))  # queued before the transform: its reader sees tf without it
+        sender.send_transform_tuples(ex.now_ns, [("odom", "base", (0.5 * k[0], 1.0, 0.0, 0.0, 0.0, q.z, q.w))])
+        seen.append(ex.tf.lookup_pose2d("odom", "base", None) if k[0] > 1 else ())  # still queued: the old one
+
+    sender.create_timer(0.1, send)
+    ex.run(0.5)
+    seen.append(ex.tf.lookup_pose2d("odom", "base", ex.now_ns))
+    return seen, got, heard, ex.topic("/tf", msgs.TFMessage).count
+
+
+def test_transform_tuples_reach_tf_in_queue_order_and_as_messages_for_readers():
+    alone, _, _, count = _tf_run(subscriber=False, listener=False)
+    assert count == 5 and alone[-1] == pytest.approx((2.5, 1.0, 0.5))
+    assert alone[0] == () and alone[2] == pytest.approx((0.5, 1.0, 0.1))  # delivered after the tick, as a message
+    for subscriber, listener in ((True, False), (False, True)):
+        seen, got, heard, count = _tf_run(subscriber=subscriber, listener=listener)
+        assert seen == alone and count == 5  # the same lookups, bit for bit, message or not
+        msgs_out = got or heard
+        assert len(msgs_out) == 5
+        last = msgs_out[-1].transforms[0]
+        assert (last.header.frame_id, last.child_frame_id, msgs.ns_from_time(last.header.stamp)) == (
+            "odom",
+            "base",
+            500_000_000,
+        )
+        assert (last.transform.translation.x, last.transform.rotation.z) == (2.5, msgs.quaternion_from_yaw(0.5).z)

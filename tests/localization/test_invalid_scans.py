@@ -72,3 +72,18 @@ def test_mapping_an_empty_world_reports_an_empty_map(tmp_path: Path, capsys) -> 
     out = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
     assert out["map_empty"] is True and out["finished"] is False and out["scans_invalid"] > 0
     assert "the map is empty" in out["warning"]
+
+
+@pytest.mark.parametrize(
+    ("ranges", "invalid"),
+    [
+        ([5.0, np.inf, np.nan], False),  # the first beam valid
+        ([np.inf, np.nan, 10.0, 9.99], False),  # only the last: 10.0 is range_max itself, not a reading
+        ([10.0, 0.05, np.nan, np.inf], True),  # none in [range_min, range_max)
+    ],
+)
+def test_a_scan_is_valid_when_any_beam_is_in_range(ranges: list[float], invalid: bool) -> None:
+    ex = Executor(seed=0)
+    node = Amcl(ex, parameters={})
+    _scans(ex, np.array(ranges * 10), 0.5)
+    assert node.scans_received == 5 and node.scans_invalid == (5 if invalid else 0)

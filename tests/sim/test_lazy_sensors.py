@@ -39,3 +39,29 @@ def test_sensor_publishes_for_subscribers_and_listeners_only(
     ex.add_listener(lambda topic_name, _msg, _t: heard.append(topic_name))  # a recorder's or topic echo's way in
     s.run(0.5)
     assert heard.count(name) == per_half_s and len(seen) == per_half_s
+
+
+def test_imu_read_after_sleeping_gives_what_an_imu_read_all_along_gives() -> None:
+    """While nobody reads the IMU, physics steps skip MuJoCo's sensors; the first readings after a subscriber
+    appears are the ones a run with a subscriber from the start gives (orientation: no noise), and the motion
+    is the same bit for bit."""
+    runs = []
+    for late in (False, True):
+        s = start("sim")
+        ex = s.executor
+        seen: list[Any] = []
+        node = Node("reader", context=Context(ex))
+        drive = node.create_publisher(msgs.Twist, "cmd_vel", 10)
+        node.create_timer(0.1, lambda drive=drive: drive.publish(msgs.twist(0.4, 0.8)))
+        if not late:
+            node.create_subscription(msgs.Imu, "/imu", seen.append, 10)
+        s.run(0.5)
+        if late:
+            node.create_subscription(msgs.Imu, "/imu", seen.append, 10)
+        s.run(0.1)
+        sim = s.node("gazebo").sim
+        runs.append(([(msgs.stamp_ns(m), msgs.xyzw(m.orientation)) for m in seen], sim.data.qpos.tobytes()))
+    (always, qpos0), (woken, qpos1) = runs
+    assert len(woken) == 10 and woken == always[-10:]
+    assert woken[0][1] != always[-11][1]  # the robot turns: each reading is new
+    assert qpos1 == qpos0

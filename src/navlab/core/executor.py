@@ -13,7 +13,7 @@ import queue
 import time
 import zlib
 from collections import deque
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from typing import Any, Protocol
 
@@ -22,6 +22,7 @@ import numpy as np
 from navlab.core.errors import CoreError
 from navlab.core.tf import TfBuffer
 from navlab.core.topics import NS_PER_S, Subscription, Timer, Topic, seconds_to_ns
+from navlab.geometry import Tf
 from navlab.msgs import TFMessage, type_name
 
 __all__ = ["NS_PER_S", "Executor", "ExecutorNode", "Stepper", "Topic", "seconds_to_ns"]
@@ -59,7 +60,10 @@ class Executor:
         self.services: dict[str, Callable[[Any], Any]] = {}
         self.tf = TfBuffer(cache_ns=seconds_to_ns(tf_cache_s))
         self.tf_listeners: set[str] = set()  # nodes that read tf (a tf2 TransformListener each, in ROS)
+        self._tf_sub: Subscription | None = None  # the tf buffer's subscription of /tf, and its tuple twin
+        self._tf_tuples: Subscription | None = None
         self._heap: list[tuple[int, int, int, Timer]] = []
+        self._parked: list[Timer] = []  # idle timers out of the queue until the graph changes (Timer.parks)
         self._seq = 0
         self._deliveries: deque[tuple[Subscription, Any]] = deque()
         self._steppers: list[Stepper] = []
@@ -117,7 +121,31 @@ class Executor:
         def feed(msg: Any) -> None:
             buf.add_message(msg, static=static)
 
-        topic.subscriptions.append(Subscription(topic.name, TFMessage, feed, "/_tf_buffer"))
+        sub = Subscription(topic.name, TFMessage, feed, "/_tf_buffer")
+        topic.subscriptions.append(sub)
+        if not static:
+            self._tf_sub = sub
+
+            def feed_tuples(stamped: tuple[int, Sequence[tuple[str, str, Tf]]]) -> None:
+                stamp_ns, transforms = stamped
+                for parent, child, tf in transforms:
+                    buf.set_transform(parent.lstrip("/"), child.lstrip("/"), stamp_ns, tf)
+
+            self._tf_tuples = Subscription(topic.name, TFMessage, feed_tuples, "/_tf_buffer")
+
+    def send_tf_tuples(self, topic: Topic, stamp_ns: int, transforms: Sequence[tuple[str, str, Tf]]) -> bool:
+        """Deliver transforms ``(parent, child, (x, y, z, qx, qy, qz, qw))`` stamped ``stamp_ns`` published on
+        ``/tf`` straight to the executor's tf buffer, in the queue's order, when the buffer is the topic's only
+        reader (no other subscriber, no listener); False (nothing done) otherwise: the caller then publishes the
+        ``TFMessage``. The buffer receives exactly what the message would give it (``TfBuffer.add_message``)."""
+        subs, direct = topic.subscriptions, self._tf_tuples
+        if direct is None or self._listeners or len(subs) != 1 or subs[0] is not self._tf_sub:
+            return False
+        topic.count += 1
+        self._deliveries.append((direct, (stamp_ns, transforms)))
+        if not self._running:
+            self._drain()
+        return True
 
     def publish(self, topic: Topic, msg: Any, *, latch_key: int | None = None) -> None:
         """Queue ``msg`` for every subscriber of ``topic`` (delivered before time advances).
@@ -138,6 +166,7 @@ class Executor:
     def add_listener(self, fn: Callable[[str, Any, int], None]) -> None:
         """Call ``fn(topic, msg, t_ns)`` for every message published (recording, echo, hz)."""
         self._listeners.append(fn)
+        self._wake_parked()
 
     def remove_listener(self, fn: Callable[[str, Any, int], None]) -> None:
         """Stop calling a listener added with :meth:`add_listener`."""
@@ -154,6 +183,14 @@ class Executor:
         topic.subscriptions.append(sub)
         for msg in topic.latched.values():
             self._deliveries.append((sub, msg))
+        self._wake_parked()
+
+    def _wake_parked(self) -> None:
+        """The graph changed: every parked timer goes back in the queue (it parks again if still idle)."""
+        parked, self._parked = self._parked, []
+        for timer in parked:
+            if not timer.cancelled:
+                timer.wake(self.now_ns)
 
     # --- timers, services, steppers, inbox -------------------------------------------------------
 
@@ -250,7 +287,11 @@ class Executor:
             if timer.cancelled:
                 continue
             if timer.idle is not None and timer.idle():  # nothing to do then: no physics step up to it either
-                timer.skip()
+                if timer.parks:  # out of the queue until a subscription or a listener is added
+                    timer.parked = True
+                    self._parked.append(timer)
+                else:
+                    timer.skip()
                 continue
             if t_ns > self.now_ns:
                 if self.rate > 0:

@@ -27,7 +27,8 @@ from navlab.core.params import (
 from navlab.core.tf import Pose2
 from navlab.core.topics import Publisher, Subscription, Timer, seconds_to_ns
 from navlab.deprecation import NavlabDeprecationWarning
-from navlab.msgs import TFMessage
+from navlab.geometry import Tf
+from navlab.msgs import TFMessage, transform_from_tuple
 
 __all__ = [
     "Clock",
@@ -237,12 +238,15 @@ class Node:
         *,
         priority: int = 0,
         idle: Callable[[], bool] | None = None,
+        idle_until_graph_changes: bool = False,
     ) -> Timer:
         """Call ``callback()`` every ``timer_period_sec`` simulated seconds (rclpy's signature; lower
         ``priority`` runs first on ties).
 
         ``idle()`` (navlab extension), if given, returns True when the callback would do nothing at this
-        firing (e.g. a sensor nobody reads); the firing is then skipped, physics included.
+        firing (e.g. a sensor nobody reads); the firing is then skipped, physics included. With
+        ``idle_until_graph_changes`` (``idle`` asks only who subscribes or listens, as a ROS lazy publisher asks
+        ``get_num_connections``) an idle timer leaves the queue until a subscription or a listener is added.
         """
         period = timer_period_sec
         if isinstance(period, bool) or not isinstance(period, int | float) or not 0 < period < 1e9:
@@ -250,7 +254,15 @@ class Node:
                 f"node {self.fully_qualified_name}: timer period {period!r} s: expected a "
                 "finite number > 0 (is a rate parameter 0, negative or not a number?)"
             )
-        timer = Timer(self.executor, seconds_to_ns(period), callback, priority, self.executor.now_ns, idle)
+        timer = Timer(
+            self.executor,
+            seconds_to_ns(period),
+            callback,
+            priority,
+            self.executor.now_ns,
+            idle,
+            idle_until_graph_changes=idle_until_graph_changes,
+        )
         self.timers.append(timer)
         return timer
 
@@ -263,6 +275,15 @@ class Node:
     def send_transform(self, transforms: Any | Sequence[Any]) -> None:
         """Broadcast ``TransformStamped`` (one or a list) on ``/tf``."""
         self._tf_publisher("/tf").publish(TFMessage(_as_list(transforms)))
+
+    def send_transform_tuples(self, stamp_ns: int, transforms: Sequence[tuple[str, str, Tf]]) -> None:
+        """Broadcast on ``/tf`` transforms given as ``(parent, child, (x, y, z, qx, qy, qz, qw))`` (floats) stamped
+        ``stamp_ns``: what :meth:`send_transform` sends, but the ``TFMessage`` is built only when someone besides
+        the executor's tf buffer reads ``/tf`` (a subscriber, a recorder, the viewer); otherwise the buffer gets
+        the transforms directly, in the queue's order, as from the message (the nodes of one executor share it)."""
+        pub = self._tf_publisher("/tf")
+        if not self.executor.send_tf_tuples(pub.topic, stamp_ns, transforms):
+            pub.publish(TFMessage([transform_from_tuple(stamp_ns, p, c, tf) for p, c, tf in transforms]))
 
     def send_static_transform(self, transforms: Any | Sequence[Any]) -> None:
         """Broadcast ``TransformStamped`` (one or a list) on ``/tf_static``."""

@@ -82,6 +82,9 @@ class Timer:
 
     ``idle`` (optional) tells, at a firing time, that the callback would do nothing now (a sensor nobody
     reads): the executor then skips that firing without running it or integrating physics up to it.
+    ``idle_until_graph_changes``: ``idle`` depends only on the graph (who subscribes, whether a recorder
+    listens), as ROS's lazy publishers ask ``get_num_connections``: an idle timer then leaves the queue and
+    the executor wakes it, at its next tick, when a subscription or a listener is added.
     """
 
     def __init__(
@@ -92,6 +95,8 @@ class Timer:
         priority: int,
         start_ns: int,
         idle: Callable[[], bool] | None = None,
+        *,
+        idle_until_graph_changes: bool = False,
     ) -> None:
         if period_ns <= 0:
             raise CoreError(f"timer period must be > 0 s, got {period_ns / 1e9}")
@@ -99,6 +104,8 @@ class Timer:
         self.period_ns = period_ns
         self.callback = callback
         self.idle = idle
+        self.parks = idle is not None and idle_until_graph_changes
+        self.parked = False  # out of the queue (the executor parked it) until the graph changes
         self.priority = priority
         self.cancelled = False
         self._start = start_ns
@@ -114,6 +121,13 @@ class Timer:
     def skip(self) -> None:
         """Schedule the next firing without running the callback (an idle firing)."""
         self._k += 1
+        self._queue.schedule(self, self._start + self._k * self.period_ns)
+
+    def wake(self, now_ns: int) -> None:
+        """Put a parked timer (see ``idle_until_graph_changes``) back in the queue at its first tick after
+        ``now_ns``: the ticks it was parked over were idle."""
+        self.parked = False
+        self._k = max(self._k + 1, (now_ns - self._start) // self.period_ns + 1)
         self._queue.schedule(self, self._start + self._k * self.period_ns)
 
     def cancel(self) -> None:

@@ -15,6 +15,7 @@ import numpy as np
 
 from navlab import msgs
 from navlab.core import Executor, Node, TfError, dataclass_parameters
+from navlab.geometry import Tf
 from navlab.grid import GridError, GridMap
 from navlab.localization import amcl as pf
 from navlab.localization.errors import LocalizationError
@@ -82,7 +83,7 @@ class Amcl(Node):
         self._invalid_logged_ns: int | None = None
         self.last_error: str | None = None
         self._map_to_odom: tuple[float, float, float] | None = None
-        self._tf_body: tuple[tuple[float, float, float], Any] | None = None  # (map->odom, its Transform message)
+        self._tf_body: tuple[tuple[float, float, float], Tf] | None = None  # (map->odom, as its Transform message)
         self._pending_global = False
         self._odom_failures = 0
         self.pose_pub = self.create_publisher(msgs.PoseWithCovarianceStamped, "amcl_pose", 2)
@@ -176,7 +177,8 @@ class Amcl(Node):
 
     def _count_invalid(self, msg: Any, t_ns: int) -> None:
         """Count a scan without one reading in [range_min, range_max) and say so, at most every 10 s."""
-        if pf.any_in_range(np.asarray(msg.ranges), float(msg.range_min), float(msg.range_max)):
+        ranges, lo, hi = np.asarray(msg.ranges), float(msg.range_min), float(msg.range_max)
+        if (ranges.size and lo <= ranges[0] < hi) or pf.any_in_range(ranges, lo, hi):  # the first beam: most scans
             return
         self.scans_invalid += 1
         if self._invalid_logged_ns is None or t_ns - self._invalid_logged_ns >= 10_000_000_000:
@@ -218,11 +220,10 @@ class Amcl(Node):
         cached = self._tf_body
         if cached is None or cached[0] != self._map_to_odom:
             x, y, yaw = self._map_to_odom
-            cached = self._tf_body = (
-                self._map_to_odom,
-                msgs.transform_stamped(0, self.global_frame, self.odom_frame, x, y, yaw).transform,
-            )
-        self.send_transform(msgs.TransformStamped(msgs.header(stamp_ns, self.global_frame), self.odom_frame, cached[1]))
+            body = msgs.transform_stamped(0, self.global_frame, self.odom_frame, x, y, yaw).transform
+            t, r = body.translation, body.rotation  # what tf reads from the message (core.tf.tf_from_msg)
+            cached = self._tf_body = (self._map_to_odom, (t.x, t.y, t.z, r.x, r.y, r.z, r.w))
+        self.send_transform_tuples(stamp_ns, ((self.global_frame, self.odom_frame, cached[1]),))
 
     # --- outputs --------------------------------------------------------------------------------
 

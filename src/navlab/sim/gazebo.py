@@ -117,9 +117,10 @@ class GazeboSim(Node):
         self.plugins += [
             LidarPlugin(executor, namespace=namespace, sim=self.sim, index=i) for i in range(len(robot.lidars))
         ]
-        self.plugins += [
-            ImuSensorPlugin(executor, namespace=namespace, sim=self.sim, index=i) for i in range(len(robot.imus))
-        ]
+        imus = [ImuSensorPlugin(executor, namespace=namespace, sim=self.sim, index=i) for i in range(len(robot.imus))]
+        self.plugins += imus
+        self._imu_timers = [t for imu in imus for t in imu.timers]  # MuJoCo's sensors only while one is awake
+        self._sensors_on = True
         self.plugins.append(
             JointStatePlugin(executor, parameters={"publish_frequency": js_rate}, namespace=namespace, sim=self.sim)
         )
@@ -166,7 +167,12 @@ class GazeboSim(Node):
         self.create_service("/delete_entity", self._delete_service)
 
     def advance_to(self, t_ns: int) -> None:
-        """Stepper hook: integrate physics up to ``t_ns``."""
+        """Stepper hook: integrate physics up to ``t_ns``; MuJoCo's sensors are computed only while an IMU plugin's
+        timer is awake (parked: nobody reads it), so its first reading after waking is what it always was."""
+        awake = any(not t.parked for t in self._imu_timers)
+        if awake != self._sensors_on:
+            self._sensors_on = awake
+            self.sim.compute_sensors(awake)
         self.sim.advance_to(t_ns)
 
     def spawn(self, model: ModelSpec) -> list[str]:

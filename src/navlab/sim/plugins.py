@@ -18,7 +18,7 @@ import numpy as np
 from navlab import msgs
 from navlab.core import Executor, Node
 from navlab.description import DiffDriveConfig, ImuConfig, LidarConfig, Origin, RobotModel
-from navlab.geometry import Vec, qmul, qrotate, quat_from_rpy, quat_from_yaw
+from navlab.geometry import Tf, Vec, qmul, qrotate, quat_from_rpy, quat_from_yaw
 from navlab.sim.diffdrive import (
     ODOM_COVARIANCE_DIAG,
     EncoderOdometry,
@@ -49,6 +49,11 @@ def _transform(stamp_ns: int, parent: str, child: str, xyz: Any, q: Any) -> Any:
     return msgs.TransformStamped(  # positional: see navlab.msgs
         msgs.header(stamp_ns, parent), child, msgs.Transform(msgs.vector3(xyz), msgs.quaternion_msg(q))
     )
+
+
+def _tf_tuple(xyz: Any, q: Any) -> Tf:
+    """(x, y, z, qx, qy, qz, qw) as floats, the values a ``Transform`` message of ``xyz`` and ``q`` holds."""
+    return (float(xyz[0]), float(xyz[1]), float(xyz[2]), float(q[0]), float(q[1]), float(q[2]), float(q[3]))
 
 
 def _origin_transform(stamp_ns: int, parent: str, child: str, origin: Origin) -> Any:
@@ -107,7 +112,8 @@ class SensorPlugin(Node, Generic[C]):
             q = qmul(q, OPTICAL) if self.optical else q
             self.send_static_transform([_transform(executor.now_ns, config.link, self.frame_id, o.xyz, q)])
         idle = self.unread if self.idle_unread else None
-        self.create_timer(max(1.0 / config.update_rate, sim.timestep), self.update, idle=idle)
+        period = max(1.0 / config.update_rate, sim.timestep)
+        self.create_timer(period, self.update, idle=idle, idle_until_graph_changes=True)
         self.setup()
 
     def setup(self) -> None:
@@ -118,7 +124,8 @@ class SensorPlugin(Node, Generic[C]):
         return listened(self, *pubs)
 
     def unread(self) -> bool:
-        """Whether nobody reads what the plugin publishes (its timer then idles, with ``idle_unread``)."""
+        """Whether nobody reads what the plugin publishes (its timer then idles, with ``idle_unread``, until a
+        subscription or a listener is added: the answer must depend on nothing else)."""
         return False
 
     def update(self) -> None:
@@ -270,7 +277,7 @@ class DiffDrivePlugin(SimPlugin):
                 msgs.odometry(now, *frames, position, quat, lin, ang, _ODOM_COV.copy(), _ODOM_COV.copy())
             )
         if cfg.publish_tf:
-            self.send_transform(_transform(now, cfg.odometry_frame, cfg.robot_base_frame, position, quat))
+            self.send_transform_tuples(now, ((cfg.odometry_frame, cfg.robot_base_frame, _tf_tuple(position, quat)),))
 
 
 class LidarPlugin(SensorPlugin[LidarConfig]):
@@ -356,9 +363,9 @@ class RobotStatePublisher(SimPlugin):
             known = self.joints.get(name)
             if known is not None:
                 joint, consts = known
-                out.append(_transform(stamp, joint.parent, joint.child, *_motion(joint.type, consts, float(q))))
+                out.append((joint.parent, joint.child, _tf_tuple(*_motion(joint.type, consts, float(q)))))
         if out:
-            self.send_transform(out)
+            self.send_transform_tuples(stamp, out)
 
 
 def joint_motion(joint: Any, q: float) -> tuple[tuple[float, float, float], tuple[float, float, float, float]]:
@@ -416,7 +423,7 @@ class GroundTruthPlugin(SimPlugin):
         rate = float(self.declare_parameter("updateRate", 50.0))
         self.link = base_frame_link(self.sim, self.base_frame)
         self.pub = self.create_publisher(msgs.Odometry, topic, 10)
-        self.create_timer(1.0 / rate, self.update, idle=self._unread)
+        self.create_timer(1.0 / rate, self.update, idle=self._unread, idle_until_graph_changes=True)
 
     def _unread(self) -> bool:
         """Whether nobody subscribes or listens (a recorder, ``topic echo``): the timer then idles."""

@@ -84,6 +84,7 @@ class Simulation:
         self._no_noise = np.zeros(0)
         self._normals: dict[int, np.ndarray] = {}  # lidar -> its noise draws' buffer (see scan)
         self._vel6 = np.zeros(6)  # mj_objectVelocity's output, reused
+        self._sensors_off = False  # see compute_sensors
         self._refresh_ids()
         if robot is not None:
             self._place_on_floor()
@@ -161,6 +162,13 @@ class Simulation:
             mujoco.mj_step(self.model, self.data, nstep=int(n))
             self.time_ns += int(n) * self.dt_ns
             self._synced = False
+
+    def compute_sensors(self, on: bool) -> None:
+        """Whether physics steps compute MuJoCo's sensors (the IMUs'): they feed nothing else, so turning them off
+        while no IMU is read changes no motion, bit for bit (:meth:`imu` computes them when it reads)."""
+        self._sensors_off = not on
+        flags, bit = int(self.model.opt.disableflags), int(mujoco.mjtDisableBit.mjDSBL_SENSOR)
+        self.model.opt.disableflags = flags & ~bit if on else flags | bit
 
     def _sync(self) -> None:
         """mj_step leaves poses and velocities of the state before its last integration: refresh them
@@ -447,7 +455,10 @@ class Simulation:
             raise SimError(f"no imu number {index} on this robot")
         cfg = self.robot.imus[index]
         site = self.info.imu_sites[index]
+        off = self._sensors_off
+        self.compute_sensors(True)
         mujoco.mj_forward(self.model, self.data)
+        self.compute_sensors(not off)
         quat, gyro, accel = (self.data.sensor(f"{site}_{k}").data.copy() for k in ("quat", "gyro", "accel"))
         gen = self.rng if rng is None else rng
         if cfg.gyro_noise_stddev > 0:
@@ -492,6 +503,7 @@ class Simulation:
         except ValueError as exc:
             raise SimError(f"MuJoCo could not compile the {what}: {exc}") from None
         self._refresh_ids()
+        self.compute_sensors(not self._sensors_off)
         for i, name in zip(self._act, ctrl, strict=False):
             self.data.ctrl[i] = ctrl[name]
         mujoco.mj_forward(self.model, self.data)
