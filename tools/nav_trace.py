@@ -57,13 +57,14 @@ def record(out: str, seed: int, controller: str | None, robot: str = "mybot") ->
             rec["tf"].append((t_ns, child, float(tf[0]).hex(), float(tf[1]).hex(), float(tf[5]).hex()))
         set_transform(self, parent, child, t_ns, tf, static=static)
 
-    def on_update(self: Any) -> Any:
-        g = update(self)
+    def on_update(self: Any, *a: Any, **k: Any) -> Any:
+        out = update(self, *a, **k)
+        g = None if out is None else self.costmap  # as a reader sees it after the update (a deferred write done now)
         if g is not None:
             rec["costmap"].append(
                 (self.node.executor.now_ns, self.name, _digest(g.data.tobytes() + repr(g.origin).encode()))
             )
-        return g
+        return out
 
     def on_make_plan(self: Any, start: Any, goal: Any) -> Any:
         p = make_plan(self, start, goal)

@@ -6,7 +6,7 @@ from __future__ import annotations
 import pytest
 
 from navlab.experiments.clutter_protocol import SETS, speed_overrides
-from navlab.experiments.clutter_run import barn_clock, run_clutter_world
+from navlab.experiments.clutter_run import OWN_FILES_PARAMS, barn_clock, clutter_params, run_clutter_world
 from navlab.experiments.errors import ExperimentError
 from navlab.world.clutter import clutter_suite, generate_clutter, suite_parameters
 
@@ -26,6 +26,15 @@ def test_speed_limit_goes_to_the_controllers_own_parameter() -> None:
         speed_overrides("my_pkg/Unknown", 2.0)
 
 
+def test_clutter_settings_per_robot() -> None:
+    """The Jackal's local window holds its MPPI horizon at 2 m/s (2 s, 4 m); mybot keeps 6 m; any other robot drives
+    with its own files."""
+    assert clutter_params("jackal")["local_costmap.width"] == clutter_params("jackal")["local_costmap.height"] == 8.0
+    assert clutter_params("mybot")["local_costmap.width"] == 6.0
+    assert clutter_params("jackal")["recovery_behaviors"] == clutter_params("mybot")["recovery_behaviors"]
+    assert clutter_params("jackal_skid") == OWN_FILES_PARAMS
+
+
 def test_a_world_that_defeated_the_jackals_mppi_is_now_reached() -> None:
     """Test world 21: in the suite before BARN's generator, move_base reported success 3.14 m from the true goal
     (odometry alone); with the IMU fused by the EKF (mapless default for a robot with an IMU) the robot truly
@@ -38,6 +47,18 @@ def test_a_world_that_defeated_the_jackals_mppi_is_now_reached() -> None:
     assert not r["near_miss"] and r["min_clearance_m"] >= 0.05
     # BARN's clock (first 0.1 m moved -> first within 1 m) is shorter than move_base's (sent -> stopped at it)
     assert 0 < r["barn_time_s"] < r["time_s"] and r["score"] >= r["score_to_stop"]
+
+
+def test_the_tuning_world_where_mppi_stood_still_is_now_reached() -> None:
+    """Tuning world 36 at seed 1: the Jackal backs out of a pocket into a gap facing away from its new plan, where
+    MPPI's left and right turns averaged to standing still; it stood 57 s until move_base aborted. With the rotation
+    shim (the Jackal's files) it turns in place toward the plan and reaches the goal without a contact."""
+    world = clutter_suite(50, seed=SETS["tuning"])[36]
+    r = run_clutter_world(
+        world, controller="mppi", robot="jackal", seed=1, move_base_params=speed_overrides("mppi", 2.0)
+    )
+    assert r["success"] and r["collisions"] == 0 and r["final_error_m"] <= 1.0, r
+    assert not r["near_miss"]
 
 
 def test_barn_clock_runs_from_the_first_move_until_first_within_a_metre() -> None:

@@ -30,7 +30,9 @@ def test_ring_scores_equal_every_pose_checked() -> None:
     rng = np.random.default_rng(7)
     square = np.array([[0.25, 0.2], [-0.2, 0.2], [-0.2, -0.2], [0.25, -0.2]])
     seen: set[tuple[bool, float]] = set()
+    memo = ring_bounds.new_memo((70, 80))
     for trial in range(40):
+        epoch = trial + 1
         cost = _inflated(rng, (70, 80))
         h, w = cost.shape
         x0, y0 = rng.uniform(-0.2, w * RES + 0.2), rng.uniform(-0.2, h * RES + 0.2)  # sometimes off the map
@@ -55,8 +57,7 @@ def test_ring_scores_equal_every_pose_checked() -> None:
         integrate_rollouts(x0, y0, rng.uniform(-3, 3), 0.2, 0.0, targets, counts, 1.7, 2.5, 3.2, True, traj, c, s)
         weights = np.array([0.05, 0.6, 0.8, 0.01])
         offsets, ring_counts = ring_bounds.ring_offsets(outline, RES)
-        memo = ring_bounds.new_memo(cost.shape)
-        for at in (-1, 5, -2):
+        for at in (-1, 5, -2):  # the memo kept while the costs stay, forgotten (a new epoch) when they change
             ats = np.full(n, at, dtype=np.int64)
             want, got = np.empty(n), np.empty(n)
             args = (1.0 / RES, traj, c, s, ox, oy)
@@ -64,9 +65,16 @@ def test_ring_scores_equal_every_pose_checked() -> None:
             rollout_scores(cost, cost, path, goal, *args, polygon, False, *scoring[1:], want)
             none = np.zeros(0, np.int64)
             waves = [mapgrid.wave_start(cost, z[:, 0].copy(), z[:, 1].copy(), none, none) for z in (seeds, goal_cell)]
-            ring_bounds.ring_scores(cost, memo, offsets, ring_counts, *waves, *args, *scoring, got)
+            ring_bounds.ring_scores(cost, memo, epoch, offsets, ring_counts, *waves, *args, *scoring, got)
             np.testing.assert_array_equal(got.view(np.int64), want.view(np.int64))
             seen |= {(polygon, float(v)) for v in np.minimum(want, 0.0)}
+        # the same rollouts on raised costs (the same distances): the memo of the old costs must not be read
+        raised = np.where(cost < 253, np.minimum(cost.astype(np.int64) + 60, 252), cost).astype(np.uint8)
+        ats = np.full(n, -1, dtype=np.int64)
+        rollout_scores(raised, raised, path, goal, *args, polygon, False, *scoring[1:3], ats, want)
+        waves = [mapgrid.wave_start(raised, z[:, 0].copy(), z[:, 1].copy(), none, none) for z in (seeds, goal_cell)]
+        ring_bounds.ring_scores(raised, memo, epoch + 1000, offsets, ring_counts, *waves, *args, *scoring[:3], ats, got)
+        np.testing.assert_array_equal(got.view(np.int64), want.view(np.int64))
     assert seen == {(p, v) for p in (True, False) for v in (-2.0, -1.0, 0.0)}  # every outcome, for both kinds
 
 

@@ -251,3 +251,45 @@ def test_nav2_and_ros1_range_names_are_the_same_parameter() -> None:
     assert (layer.params.obstacle_range, layer.params.raytrace_range) == (1.5, 2.0)
     with pytest.raises(NavigationError, match="two spellings"):
         LayeredCostmap({"obstacle_layer": {"obstacle_max_range": 1.5, "obstacle_range": 2.0}})
+
+
+@pytest.mark.parametrize("rolling", [False, True])
+def test_a_deferred_update_writes_the_grid_an_eager_one_writes(rolling: bool) -> None:
+    """Updates whose master is written only when read (``defer``, the costmap node's timer) give, at every read, the
+    grid of updating at once, through scans that mark, the robot's footprint clearing and a rolling
+    window's moves; a layer that is not known to write only the master keeps the updates eager."""
+    params = {**COMMON, "global_frame": "map", "robot_base_frame": "chassis", "static_map": not rolling}
+    params["laser_scan_sensor"] = {**COMMON["laser_scan_sensor"], "clearing": False}  # only the footprint clears
+    if rolling:
+        params |= {"rolling_window": True, "width": 2.0, "height": 2.0}
+    eager, deferred = LayeredCostmap(params), LayeredCostmap(params)
+    for cm in (eager, deferred):
+        if not rolling:
+            cm.set_map(_room())
+    rng = np.random.default_rng(4)
+    angles = np.linspace(-math.pi, math.pi, 90, endpoint=False)
+
+    def at(step: int) -> tuple[float, float, float]:
+        return (-0.6 + 0.12 * step, 0.8 + 0.3 * math.sin(step / 4), 0.1 * step)
+
+    for step in range(28):
+        pose = at(step)
+        ends = np.column_stack([np.cos(angles), np.sin(angles)]) * rng.uniform(0.3, 1.2, (90, 1)) + pose[:2]
+        ends[::15] = np.array(pose[:2]) + rng.uniform(-0.12, 0.12, (6, 2))  # under the robot: its footprint clears them
+        for cm in (eager, deferred):  # to the layers, as the costmap node does just before its update
+            for layer in cm.scan_targets("laser_scan_sensor"):
+                layer.add_scan(pose[:2], ends, source="laser_scan_sensor")
+        eager.update_map(pose)
+        deferred.update_map(pose, defer=True)
+        assert deferred._deferred
+        if step % 4 == 3:  # read now and then
+            g, want = deferred.costmap, eager.costmap
+            assert g.origin == want.origin
+            np.testing.assert_array_equal(g.data, want.data)
+
+    class OwnLayer(InflationLayer):  # a plugin's subclass: not known to write only the master
+        pass
+
+    deferred.layers[-1].__class__ = OwnLayer
+    deferred.update_map((0.5, 0.5, 0.0), defer=True)
+    assert not deferred._deferred

@@ -86,14 +86,7 @@ def _spawns(sc: Scenario, seed: int) -> list[tuple[float, Any]]:
 
 def run_trial(sc: Scenario, index: int) -> dict[str, Any]:
     """Trial ``index`` of ``sc`` (seed = sc.seed + index); its figures (plus BARN's in a clutter world)."""
-    from navlab.experiments.clutter_run import (
-        CLUTTER_PARAMS,
-        CLUTTER_ROBOTS,
-        OWN_FILES_PARAMS,
-        SUCCESS_M,
-        barn_outcome,
-        clutter_for_trial,
-    )
+    from navlab.experiments.clutter_run import SUCCESS_M, barn_outcome, clutter_for_trial, clutter_params
     from navlab.experiments.mapping_run import run_mapping
     from navlab.experiments.navigate_run import run_navigation
 
@@ -105,8 +98,7 @@ def run_trial(sc: Scenario, index: int) -> dict[str, Any]:
         map_yaml: str | Path | None = None
         if clutter is not None:
             world = str(clutter.write_world(Path(tmp) / f"{clutter.name}.world"))
-            own = CLUTTER_PARAMS if sc.robot in CLUTTER_ROBOTS else OWN_FILES_PARAMS  # their own files (clutter_run)
-            start, overrides = clutter.start, {**own, **sc.overrides}
+            start, overrides = clutter.start, {**clutter_params(sc.robot), **sc.overrides}
         if sc.map == "map_first":
             mapped = run_mapping(
                 world=sc.resolve(sc.map_world) or sc.map_world or world,

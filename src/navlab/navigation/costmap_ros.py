@@ -146,10 +146,14 @@ class Costmap2DROS:
     # --- update, publish, clear --------------------------------------------------------------------
 
     def _on_update_timer(self) -> None:
-        self.update()
+        self.update(write=False)
 
-    def update(self) -> Grid | None:
-        """One costmap update now (the timer's job); returns the master grid, or None without a robot pose."""
+    def update(self, *, write: bool = True) -> Grid | None:
+        """One costmap update now (the timer's job); returns the master grid, or None without a robot pose.
+
+        ``write`` False (the timer): the master is written when it is next read (``costmap``;
+        ``LayeredCostmap.update_map``'s ``defer``) and the grid returned may not be written yet: a global costmap
+        updated five times a second and planned on once a second is written about twice a second."""
         pose = self.robot_pose()
         if pose is None:
             return None
@@ -157,7 +161,7 @@ class Costmap2DROS:
             self._apply_scan(source, msg)
         self._pending.clear()
         self.feeds.apply()
-        grid = self.layered.update_map(pose)
+        grid = self.layered.update_map(pose, defer=not write)
         self.updated_ns = self.node.executor.now_ns
         self.updates += 1
         return grid

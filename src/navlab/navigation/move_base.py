@@ -234,12 +234,14 @@ class MoveBase(Node):
             return None
         last = self._plan_local
         if last is not None and last[0] is plan and last[1] == t:  # amcl moves map -> odom only now and then
-            return last[2].copy()  # the controller may keep (or change) what it is given
+            return last[2]  # the same read-only array: a controller may keep it and know it unchanged
         out = transform_points2(t, plan[:, :2])
         if plan.shape[1] > 2:
             out = np.column_stack([out, wrap_angle(plan[:, 2] + t[2])])
+        out = np.ascontiguousarray(out, dtype=np.float64)
+        out.flags.writeable = False
         self._plan_local = (plan, t, out)
-        return out.copy()
+        return out
 
     # --- planning --------------------------------------------------------------------------------------
 

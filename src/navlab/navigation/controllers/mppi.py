@@ -19,6 +19,8 @@ A second, off by default: Regulated Pure Pursuit's cost-regulated linear velocit
 stands for its distance to the nearest obstacle, and nearer than ``cost_scaling_dist`` the speed limit drops
 with it. The command is capped by the limit under the robot, and ConstraintCritic charges every sample's speed
 above the limit under each of its points, so the optimum slows before a gap, not in it.
+A third, off by default: ``use_rotation_shim``, Nav2's rotation shim for a robot standing still facing away from
+its path (``mppi_rotation``: it turns in place toward the path, then MPPI drives).
 
 As in Nav2 the rollout's first step moves at the measured velocity (the command acts one
 ``model_dt`` later). Trajectories through LETHAL/INSCRIBED/unknown cells take ``collision_cost``; if
@@ -52,6 +54,7 @@ from navlab.navigation.controllers.common import (
     footprint_outline,
     inscribed_radius,
 )
+from navlab.navigation.controllers.mppi_rotation import RotationShim
 from navlab.navigation.errors import NavigationError
 from navlab.plugins import PluginContext
 
@@ -105,6 +108,14 @@ class MppiParams:
     cost_scaling_gain: float = 1.0
     inflation_cost_scaling_factor: float = 3.0  # the inflation layer's cost_scaling_factor
     regulated_linear_scaling_min_speed: float = 0.25  # m/s
+    # navlab: Nav2's rotation shim (its names and defaults) for a robot standing facing away from its path (off)
+    use_rotation_shim: bool = False
+    angular_dist_threshold: float = 0.785  # rad
+    forward_sampling_distance: float = 0.5  # m
+    rotate_to_heading_angular_vel: float = 1.8  # rad/s
+    max_angular_accel: float = 3.2  # rad/s²
+    simulate_ahead_time: float = 1.0  # s
+    rotation_shim_max_speed: float = 0.1  # m/s: the shim turns the robot only when it moves slower
     controller_frequency: float = 20.0
     xy_goal_tolerance: float = 0.25
     yaw_goal_tolerance: float = 0.25
@@ -185,6 +196,9 @@ MppiParams.PARAMS = ParamSpec(
         **dict.fromkeys(("batch_size", "iteration_count", "retry_attempt_limit"), 1),
         "time_steps": 2,
         **dict.fromkeys(("gamma", "xy_goal_tolerance", "yaw_goal_tolerance", "regulated_linear_scaling_min_speed"), 0),
+        **dict.fromkeys(
+            ("angular_dist_threshold", "forward_sampling_distance", "simulate_ahead_time", "rotation_shim_max_speed"), 0
+        ),
     },
     above=dict.fromkeys(
         (
@@ -200,6 +214,8 @@ MppiParams.PARAMS = ParamSpec(
             "cost_scaling_dist",
             "cost_scaling_gain",
             "inflation_cost_scaling_factor",
+            "rotate_to_heading_angular_vel",
+            "max_angular_accel",
         ),
         0,
     ),
@@ -328,6 +344,7 @@ class MPPIController(Nav2PlanController):
             if p.use_cost_regulated_linear_velocity_scaling
             else None
         )  # m/s per costmap cost, or None
+        self._shim = RotationShim.of(p)
         self._plan_state(p.xy_goal_tolerance, p.yaw_goal_tolerance, p.stateful)
         self.reset()
 
@@ -381,6 +398,13 @@ class MPPIController(Nav2PlanController):
         goal = (float(g[0]), float(g[1]), None if self._goal[2] is None else self._goal[2] - frame.oyaw)
         dist_to_goal = math.hypot(pose[0] - self._goal[0], pose[1] - self._goal[1])
         outline = footprint_outline(self.footprint, res)
+        if self._shim is not None:
+            w = self._shim.command((px, py, pth), (v0, w0), path, 1.0 / p.controller_frequency, grid, res, outline)
+            if w is not None:  # turning in place toward the path: MPPI starts afresh from the new heading
+                self.sequence[:] = 0.0
+                self._history = np.vstack([self._history[1:], [[0.0, w]]])
+                self.local_plan = frame.poses_out(np.array([[px, py, pth], [px, py, pth + w / p.controller_frequency]]))
+                return 0.0, w
         s_n, t_n = p.batch_size, p.time_steps
         u = np.empty((s_n, t_n, 2))
         xs, ys, ths, arc = (np.empty((s_n, t_n)) for _ in range(4))

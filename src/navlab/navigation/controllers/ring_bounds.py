@@ -3,14 +3,16 @@
 A pose's occupancy cost is the highest cost under its footprint outline's points or at its centre cell
 (``rollout._pose_cost``); the rollout's is the highest over its poses. Every outline point lies between
 ``rmin`` and ``rmax`` of the centre (the outline's nearest and farthest point), whatever the heading, so with
-the centre in a given quarter of a cell the points can only fall in a fixed ring of cells around it
+the centre in a given part of a cell the points can only fall in a fixed ring of cells around it
 (:func:`ring_offsets`). The highest cost in that ring and the centre cell is a bound on the pose's cost, looked
-up once per (cell, quarter) and kept while the costs stay the same (:func:`ring_bound`). A pose is checked point
-by point only when its bound can still fail it (LETHAL or unknown in the ring) or raise the rollout's cost
-above what its other poses already cost: first, in time order, the poses that may fail (the first failure
-decides, as ``rollout.rollout_scores``), then the highest bound of the rest, then (latest first) any pose whose bound
-is still above. The costs are those of ``rollout.rollout_scores`` bit for bit: the maximum does not depend on the order.
-Poses are grid-local (m, rad); cells (i, j) = (column, row).
+up once per (cell, part) and kept while the costs stay the same (:func:`ring_bound`; a new epoch of the costs
+forgets the memo without clearing it). A pose is checked point by point only when its
+bound can still fail it (LETHAL or unknown in the ring) or raise the rollout's cost above what its other poses
+already cost: first, in time order, the poses that may fail (the first failure decides, as
+``rollout.rollout_scores``), then the highest bound of the rest, then (latest first) any pose whose bound is
+still above. Every rollout starts from the same pose, checked once a call. The costs are those of
+``rollout.rollout_scores`` bit for bit: the maximum does not depend on the order. Poses are grid-local (m, rad);
+cells (i, j) = (column, row).
 """
 
 from __future__ import annotations
@@ -60,16 +62,21 @@ def ring_offsets(outline: np.ndarray, resolution: float) -> tuple[np.ndarray, np
 
 
 def new_memo(shape: tuple[int, int]) -> np.ndarray:
-    """An empty bound memo (Q, H, W) for a grid of ``shape``: -1 = not looked up yet."""
-    return np.full((QUARTERS * QUARTERS, *shape), -1, dtype=np.int16)
+    """An empty bound memo (Q, H, W) int32 for a grid of ``shape``: an entry holds ``bound | epoch << 8`` and
+    counts only under its epoch (see :func:`ring_scores`); 0 = never looked up. A new epoch forgets every entry
+    without touching the memo (the costs changed)."""
+    return np.zeros((QUARTERS * QUARTERS, *shape), dtype=np.int32)
+
+
+MAX_EPOCH = (1 << 23) - 1  # epochs 1 .. MAX_EPOCH fit an int32 entry beside the bound; then start a new memo
 
 
 @numba.njit(cache=True)
 def ring_bound(
-    grid: np.ndarray, memo: np.ndarray, offsets: np.ndarray, counts: np.ndarray, q: int, i: int, j: int
+    grid: np.ndarray, memo: np.ndarray, epoch: int, offsets: np.ndarray, counts: np.ndarray, q: int, i: int, j: int
 ) -> int:  # pragma: no cover - compiled
     """The highest cost of the centre cell (i, j) and its ring ``q`` (unknown if the ring leaves the grid); kept
-    in ``memo``."""
+    in ``memo`` under ``epoch``."""
     h, w = grid.shape
     top = int(grid[j, i])
     for m in range(counts[q]):
@@ -78,8 +85,23 @@ def ring_bound(
             top = COST_UNKNOWN
         else:
             top = max(top, int(grid[pj, pi]))
-    memo[q, j, i] = top
+    memo[q, j, i] = top | (epoch << 8)
     return top
+
+
+@numba.njit(cache=True)
+def bound_at(
+    grid: np.ndarray, memo: np.ndarray, epoch: int, offsets: np.ndarray, counts: np.ndarray, fx: float, fy: float
+) -> int:  # pragma: no cover - compiled
+    """:func:`ring_bound` of the centre at cell coordinates (fx, fy) (inside the grid), from ``memo`` when looked up
+    before in this ``epoch``."""
+    i, j = math.floor(fx), math.floor(fy)
+    q = QUARTERS
+    part = min(q - 1, int((fy - j) * q)) * q + min(q - 1, int((fx - i) * q))
+    kept = int(memo[part, j, i])
+    if kept >> 8 == epoch:
+        return kept & 0xFF
+    return ring_bound(grid, memo, epoch, offsets, counts, part, i, j)
 
 
 @numba.njit(cache=True, inline="always")
@@ -101,6 +123,7 @@ def _exact(
 def ring_scores(
     grid: np.ndarray,
     memo: np.ndarray,
+    epoch: int,
     offsets: np.ndarray,
     counts: np.ndarray,
     path_wave: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray],
@@ -117,10 +140,11 @@ def ring_scores(
     at: np.ndarray,
     out: np.ndarray,
 ) -> None:  # pragma: no cover - compiled
-    """``rollout.rollout_scores`` with ``with_centre`` (the same arguments, ``memo``/``offsets``/``counts`` in place
-    of ``near`` and ``use_near``, which a point robot (``polygon`` False) does without; the distance waves to the
-    path and to the goal (``mapgrid.wave_start``) in place of their maps, grown as far as the rollouts need): the
-    cost of each rollout (S, n, 3) into ``out``; -1 blocked or off the map, -2 no path."""
+    """``rollout.rollout_scores`` with ``with_centre`` (the same arguments, ``memo``/``epoch``/``offsets``/``counts``
+    (:func:`new_memo`, :func:`ring_offsets`; the epoch names the costs ``grid`` holds) in place of ``near`` and
+    ``use_near``, which a point robot (``polygon`` False) does without; the distance waves to the path and to the
+    goal (``mapgrid.wave_start``) in place of their maps, grown as far as the rollouts need): the cost of each
+    rollout (S, n, 3) into ``out``; -1 blocked or off the map, -2 no path."""
     h, w = grid.shape
     n = traj.shape[1]
     q = QUARTERS
@@ -128,8 +152,19 @@ def ring_scores(
     goal_dist, goal_reached, goal_free, goal_queue, goal_ends = goal_wave
     bounds = np.empty(n, dtype=np.int64)
     unreached = float(h * w) + 1.0  # mapgrid's unreachable_value: a wave's cells not reached (yet)
+    # the first pose, which every rollout of a cycle shares: its cost once, when it cannot fail
+    e0 = -1.0
+    if polygon and traj.shape[0] > 0 and n > 0:
+        x0, y0 = traj[0, 0, 0], traj[0, 0, 1]
+        i0, j0 = math.floor(x0 * inv), math.floor(y0 * inv)
+        inside = 0 <= i0 < w and 0 <= j0 < h
+        b0 = bound_at(grid, memo, epoch, offsets, counts, x0 * inv, y0 * inv) if inside else COST_UNKNOWN
+        if b0 < COST_LETHAL:
+            e0 = _exact(grid, inv, x0, y0, c[0, 0], s[0, 0], ox, oy, b0)
     for r in range(traj.shape[0]):
-        top = -math.inf
+        shared = e0 >= 0.0 and traj[r, 0, 0] == traj[0, 0, 0] and traj[r, 0, 1] == traj[0, 0, 1]
+        shared = shared and c[r, 0] == c[0, 0] and s[r, 0] == s[0, 0]
+        top = e0 if shared else -math.inf  # the shared first pose's cost, known
         fail = 0.0
         spd = sgd = 0.0
         first, first_bound = -1, -1  # the deferred pose of highest bound
@@ -154,9 +189,11 @@ def ring_scores(
                     top = max(top, float(grid[j, i]))
                 else:
                     part = min(q - 1, int((fy - j) * q)) * q + min(q - 1, int((fx - i) * q))
-                    b = int(memo[part, j, i])
-                    if b < 0:
-                        b = ring_bound(grid, memo, offsets, counts, part, i, j)
+                    kept = int(memo[part, j, i])  # bound_at, written out (the hot loop: a call costs more than a hit)
+                    if kept >> 8 == epoch:
+                        b = kept & 0xFF
+                    else:
+                        b = ring_bound(grid, memo, epoch, offsets, counts, part, i, j)
                     if b >= COST_LETHAL:  # it may fail: check it now, in time order
                         fp = _exact(grid, inv, x, y, c[r, k], s[r, k], ox, oy, b)
                         if fp < 0:
@@ -182,12 +219,11 @@ def ring_scores(
         if fail < 0:
             out[r] = fail
             continue
-        if first >= 0 and first_bound > top:
-            top = max(
-                top,
-                _exact(grid, inv, traj[r, first, 0], traj[r, first, 1], c[r, first], s[r, first], ox, oy, first_bound),
-            )
-        for k in range(n - 1, -1, -1):  # latest first: a rollout's cost tends to grow along it
-            if bounds[k] > top and k != first:
-                top = max(top, _exact(grid, inv, traj[r, k, 0], traj[r, k, 1], c[r, k], s[r, k], ox, oy, bounds[k]))
+        # the deferred poses whose bound is above the cost so far: the highest first, then the latest first (a
+        # rollout's cost tends to grow along it)
+        for a in range(-1, n):
+            k = first if a < 0 else n - 1 - a
+            if k < 0 or bounds[k] <= top or (a >= 0 and k == first) or (k == 0 and shared):
+                continue
+            top = max(top, _exact(grid, inv, traj[r, k, 0], traj[r, k, 1], c[r, k], s[r, k], ox, oy, bounds[k]))
         out[r] = weights[0] * (weights[1] * spd + weights[2] * sgd + weights[3] * top)

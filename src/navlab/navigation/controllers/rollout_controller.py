@@ -180,6 +180,7 @@ class RolloutController(ControllerBase):
         self._osc = OscillationFlags(p.oscillation_reset_dist, getattr(p, "oscillation_reset_angle", -1.0))
         self._plan: np.ndarray | None = None
         self._given: np.ndarray | None = None  # the plan as set_plan last checked it (before pruning)
+        self._given_array: Any = None  # the object it came as
         self._last_frame: tuple[tuple[float, float, float], LocalFrame] | None = None  # the grid-local frame seen
         self._rotating_to_goal = False
         self._outlines: dict[tuple[float, bytes | None], np.ndarray | None] = {}
@@ -210,11 +211,14 @@ class RolloutController(ControllerBase):
         A plan to a new goal (beyond the goal tolerances from the last one) clears the goal latch and the
         oscillation flags; the same plan sent again every cycle keeps them."""
         given = self._given
+        if path is self._given_array and not path.flags.writeable and path.flags.owndata:
+            self._plan = given  # the very array checked last time, read-only: unchanged (move_base's, each cycle)
+            return
         same_kind = isinstance(path, np.ndarray) and path.dtype == np.float64
         if given is not None and same_kind and path.shape == given.shape:
             bits = np.ascontiguousarray(path).reshape(-1).view(np.int64)
             if same_values(bits, given.reshape(-1).view(np.int64)):  # bit for bit (the sign of zero too)
-                self._plan = given  # the plan sent again (move_base does every cycle): checked, to the same goal
+                self._plan, self._given_array = given, path  # the plan sent again: checked, to the same goal
                 return
         plan = as_plan(path)
         p = self.params
@@ -226,6 +230,7 @@ class RolloutController(ControllerBase):
             self._rotating_to_goal = False
             self._new_goal()
         self._plan = self._given = plan  # never changed in place (pruning takes a view of its rows)
+        self._given_array = path
 
     def _new_goal(self) -> None:
         """Forget per-goal state (subclasses add theirs)."""

@@ -5,6 +5,7 @@ base_local_planner does it (see ``rollout_controller`` for the shared cycle and 
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 
@@ -16,7 +17,7 @@ from navlab.navigation.controllers.rollout import heading_diffs
 from navlab.navigation.controllers.rollout_controller import LocalScene, RolloutController
 
 _NO_MEMO, _NO_OFFSETS, _NO_COUNTS = (  # a point robot's (typed) empties
-    np.zeros((0, 0, 0), dtype=np.int16),
+    np.zeros((0, 0, 0), dtype=np.int32),
     np.zeros((0, 0, 2), dtype=np.int64),
     np.zeros(0, dtype=np.int64),
 )
@@ -38,7 +39,8 @@ class TrajectoryPlannerROS(RolloutController):
         self._escape_pose = (0.0, 0.0, 0.0)
         self._spin = InPlaceFlags(self.params.oscillation_reset_dist)
         self._rings: dict[float, tuple[np.ndarray, ...]] = {}  # resolution: ring offsets, counts, outline x, y
-        self._memo: tuple[np.ndarray | None, np.ndarray] | None = None  # (costs seen, ring bound memo)
+        self._memo: tuple[np.ndarray | None, np.ndarray, int] | None = None  # (costs seen, ring bound memo, epoch)
+        self._consts: tuple[Any, tuple[np.ndarray, np.ndarray, int]] | None = None  # (key, _constants')
 
     def _new_goal(self) -> None:
         self._escaping = False
@@ -86,7 +88,7 @@ class TrajectoryPlannerROS(RolloutController):
         with ``heading_scoring``); -1 blocked, -2 no path."""
         res = scene.resolution
         traj = np.ascontiguousarray(traj, dtype=np.float64)
-        memo, offsets, counts, ox, oy, polygon = self._footprint(scene)
+        memo, epoch, offsets, counts, ox, oy, polygon = self._footprint(scene)
         if polygon:  # numpy's cos/sin, as footprint_costs
             c, s = np.cos(traj[..., 2]), np.sin(traj[..., 2])
         else:
@@ -96,7 +98,7 @@ class TrajectoryPlannerROS(RolloutController):
         args = (1.0 / res, traj, c, s, ox, oy)
         ats = np.full(len(traj), at, dtype=np.int64)
         scored = (scene.goal_wave, *args, polygon, self._weights(res), scene.impossible, ats, cost)
-        ring_bounds.ring_scores(scene.cost, memo, offsets, counts, scene.path_wave, *scored)
+        ring_bounds.ring_scores(scene.cost, memo, epoch, offsets, counts, scene.path_wave, *scored)
         self._add_heading(scene, cost, traj, at)
         return cost
 
@@ -115,18 +117,18 @@ class TrajectoryPlannerROS(RolloutController):
         vmin = max(p.min_vel_x, v0 - p.acc_lim_x * horizon)
         wmax = min(p.max_vel_theta, w0 + p.acc_lim_theta * horizon)
         wmin = min(max(p.min_vel_theta, w0 - p.acc_lim_theta * horizon), wmax)
-        # samples, rollouts and costs in one compiled call (trajectory_cycle), then the choice in another
+        # samples, rollouts, costs, the choice and the local plan in one compiled call (trajectory_cycle)
         res = scene.resolution
-        memo, offsets, counts, ox, oy, polygon = self._footprint(scene)
-        ang = p.angular_sim_granularity if p.angular_sim_granularity > 0 else p.sim_granularity
+        memo, epoch, offsets, counts, ox, oy, polygon = self._footprint(scene)
         limits = np.array(
             [vmin, vmax, wmin, wmax, p.min_in_place_vel_theta, p.escape_vel, p.acc_lim_x, p.acc_lim_theta]
         )
-        steps = max(1, int(p.sim_time / p.sim_granularity + 0.5)) if p.heading_scoring else 0
-        at = self._heading_step(steps) if p.heading_scoring else -1
-        targets, traj, costs, ws, dw = cycle.score_samples(
+        timing, weights, at = self._constants(res)
+        f = scene.frame
+        targets, traj, costs, best, row, local = cycle.run_cycle(
             scene.cost,
             memo,
+            epoch,
             offsets,
             counts,
             scene.path_wave,
@@ -136,59 +138,68 @@ class TrajectoryPlannerROS(RolloutController):
             velocity,
             limits,
             (p.vx_samples, p.vtheta_samples),
-            np.array([p.sim_time, p.sim_granularity, ang, float(p.heading_scoring)]),
+            timing,
             ox,
             oy,
             polygon,
-            self._weights(res),
+            weights,
             scene.impossible,
             at,
-        )
-        self._add_heading(scene, costs, traj, at)
-        nf = len(targets) - len(ws) - 1
-        best = cycle.choose(
-            costs,
-            traj,
-            ws,
-            dw,
-            nf,
-            self._escaping,
-            scene.cost,
-            scene.goal_wave,
-            res,
-            p.heading_lookahead,
-            self._spin.stuck_left,
-            self._spin.stuck_right,
+            scene.plan,
+            (self._escaping, p.heading_lookahead, self._spin.stuck_left, self._spin.stuck_right),
+            (f.ox, f.oy, f.oyaw, math.cos(f.oyaw), math.sin(f.oyaw)),
         )
         if best >= 0:
             self._spin.update(pose, float(targets[best, 0]), float(targets[best, 1]))
-            self._end_escape(pose)
-            return self._finish(scene, targets, traj, costs, best, pose)
-        # nothing valid: back off slowly, even into cost (ROS does), unless there is no path at all
-        self._spin.moved(pose)
-        esc = len(targets) - 1
-        if costs[esc] > -2.0 and not self._escaping:
-            self._escaping, self._escape_pose = True, pose
+        else:  # nothing valid: back off slowly, even into cost (ROS does), unless there is no path at all
+            self._spin.moved(pose)
+            if costs[-1] > -2.0 and not self._escaping:
+                self._escaping, self._escape_pose = True, pose
         self._end_escape(pose)
-        return self._finish(scene, targets, traj, costs, esc if costs[esc] > -2.0 else -1, pose)
+        self.samples, self.costs, self._traj = targets, costs, traj
+        if row < 0:
+            self.valid = False
+            return 0.0, 0.0
+        self.local_plan = local
+        return float(targets[row, 0]), float(targets[row, 1])
 
-    def _footprint(self, scene: LocalScene) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, bool]:
-        """The scoring kernels' footprint inputs: (the ring bound memo of the scene's costs, the rings' offsets and
-        counts (``ring_bounds``), the outline's x and y, whether the robot is a polygon); empty for a point robot."""
+    def _constants(self, res: float) -> tuple[np.ndarray, np.ndarray, int]:
+        """The cycle kernel's (timing, weights, scored step) at resolution ``res``: the same every cycle."""
+        p = self.params
+        key: tuple[Any, ...] = (res, p.sim_time, p.sim_granularity, p.angular_sim_granularity, p.heading_scoring)
+        key += (p.heading_scoring_timestep, p.meter_scoring, p.pdist_scale, p.gdist_scale, p.occdist_scale)
+        cached = self._consts
+        if cached is None or cached[0] != key:
+            ang = p.angular_sim_granularity if p.angular_sim_granularity > 0 else p.sim_granularity
+            timing = np.array([p.sim_time, p.sim_granularity, ang, float(p.heading_scoring)])
+            steps = max(1, int(p.sim_time / p.sim_granularity + 0.5)) if p.heading_scoring else 0
+            at = self._heading_step(steps) if p.heading_scoring else -1
+            cached = self._consts = (key, (timing, self._weights(res), at))
+        return cached[1]
+
+    def _footprint(
+        self, scene: LocalScene
+    ) -> tuple[np.ndarray, int, np.ndarray, np.ndarray, np.ndarray, np.ndarray, bool]:
+        """The scoring kernels' footprint inputs: (the ring bound memo and the epoch of the scene's costs, the rings'
+        offsets and counts (``ring_bounds``), the outline's x and y, whether the robot is a polygon); empty for a
+        point robot."""
         res = scene.resolution
         outline = self._outline(res)
         if outline is None:
             none = np.zeros(0)
-            return _NO_MEMO, _NO_OFFSETS, _NO_COUNTS, none, none, False
+            return _NO_MEMO, 0, _NO_OFFSETS, _NO_COUNTS, none, none, False
         if res not in self._rings:
             xy = (np.ascontiguousarray(outline[:, 0]), np.ascontiguousarray(outline[:, 1]))
             self._rings[res] = (*ring_bounds.ring_offsets(outline, res), *xy)
         offsets, counts, ox, oy = self._rings[res]
         memo = self._memo
         if memo is None or memo[0] is not self._costs_seen or memo[1].shape[1:] != scene.cost.shape:
-            # the bounds hold while the costs are the ones seen (the local costmap updates less often)
-            memo = self._memo = (self._costs_seen, ring_bounds.new_memo(scene.cost.shape))
-        return memo[1], offsets, counts, ox, oy, True
+            # the bounds hold while the costs are the ones seen (the local costmap updates less often): new costs
+            # take a new epoch, which forgets the memo's entries without clearing it
+            if memo is None or memo[1].shape[1:] != scene.cost.shape or memo[2] >= ring_bounds.MAX_EPOCH:
+                memo = (None, ring_bounds.new_memo(scene.cost.shape), 0)
+            memo = self._memo = (self._costs_seen, memo[1], memo[2] + 1)
+        return memo[1], memo[2], offsets, counts, ox, oy, True
 
     @staticmethod
     def _add_heading(scene: LocalScene, costs: np.ndarray, traj: np.ndarray, at: int) -> None:

@@ -2,7 +2,8 @@
 
 ``score_samples`` builds TrajectoryPlanner's velocity samples (forward speeds x turn rates, in-place turns,
 the escape), rolls them out and scores them in one call; ``choose`` picks the command from the scores
-(the cheapest forward rollout, else an in-place turn towards the goal). They compute exactly what the
+(the cheapest forward rollout, else an in-place turn towards the goal); ``run_cycle`` is the whole cycle in one
+call: both, the heading term in between and the chosen rollout as the local plan. They compute exactly what the
 numpy steps in ``trajectory.TrajectoryPlannerROS._drive`` did (``np.linspace``'s arithmetic, ROS's step
 counts, ``rollout.integrate_rollouts`` and ``rollout.rollout_scores``), without a Python step in between: one
 controller cycle makes two calls instead of some forty numpy calls. Poses are grid-local (m, rad).
@@ -21,7 +22,8 @@ import numpy as np
 
 from navlab.navigation.controllers.mapgrid import wave_to
 from navlab.navigation.controllers.ring_bounds import ring_scores
-from navlab.navigation.controllers.rollout import integrate_rollouts
+from navlab.navigation.controllers.rollout import heading_diffs, integrate_rollouts
+from navlab.navigation.controllers.scene_kernel import moved_length, poses_out
 
 
 @numba.njit(cache=True, inline="always")
@@ -42,6 +44,7 @@ def _linspace(start: float, stop: float, num: int, out: np.ndarray) -> None:  # 
 def score_samples(
     grid: np.ndarray,
     memo: np.ndarray,
+    epoch: int,
     rings: np.ndarray,
     ring_counts: np.ndarray,
     path_wave: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray],
@@ -65,10 +68,10 @@ def score_samples(
     ``limits`` = (vmin, vmax, wmin, wmax, min_in_place_vel_theta, escape_vel, acc_lim_x, acc_lim_theta);
     ``counts`` = (vx_samples, vtheta_samples); ``timing`` = (sim_time, sim_granularity, angular granularity,
     heading_scoring 0/1); ``path_wave``, ``goal_wave``: the path and goal distances (``mapgrid.wave_start``). A
-    polygon robot's footprint is checked with ``ring_bounds.ring_scores`` (``memo``, ``rings``, ``ring_counts``:
-    its bound memo and rings; a point robot's centre cell alone). Rows: per speed the straight rollout then
-    ``nw - 1`` turn rates from the lowest up, then the ``nw`` in-place turns, then the escape. ``at``: the scored
-    step (``_heading_step``)."""
+    polygon robot's footprint is checked with ``ring_bounds.ring_scores`` (``memo``, ``epoch``, ``rings``,
+    ``ring_counts``: its bound memo, the costs' epoch and rings; a point robot's centre cell alone). Rows: per
+    speed the straight rollout then ``nw - 1`` turn rates from the lowest up, then the ``nw`` in-place turns, then
+    the escape. ``at``: the scored step (``_heading_step``)."""
     vmin, vmax, wmin, wmax, min_ip, escape_vel, ax, ath = (
         limits[0],
         limits[1],
@@ -114,7 +117,7 @@ def score_samples(
     ats = np.full(n, at, dtype=np.int64)
     inv = 1.0 / resolution
     scene = (path_wave, goal_wave, inv, traj, c, s, ox, oy, polygon, weights, impossible, ats, costs)
-    ring_scores(grid, memo, rings, ring_counts, *scene)
+    ring_scores(grid, memo, epoch, rings, ring_counts, *scene)
     return targets, traj, costs, ws, dw
 
 
@@ -163,3 +166,83 @@ def choose(
         if d < best_heading:
             best, best_heading = nf + k, d
     return best
+
+
+@numba.njit(cache=True)
+def run_cycle(
+    grid: np.ndarray,
+    memo: np.ndarray,
+    epoch: int,
+    rings: np.ndarray,
+    ring_counts: np.ndarray,
+    path_wave: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray],
+    goal_wave: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray],
+    resolution: float,
+    pose: tuple[float, float, float],
+    velocity: tuple[float, float],
+    limits: np.ndarray,
+    counts: tuple[int, int],
+    timing: np.ndarray,
+    ox: np.ndarray,
+    oy: np.ndarray,
+    polygon: bool,
+    weights: np.ndarray,
+    impossible: float,
+    at: int,
+    plan: np.ndarray,
+    choice: tuple[bool, float, bool, bool],
+    frame: tuple[float, float, float, float, float],
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, int, int, np.ndarray]:  # pragma: no cover - compiled
+    """One TrajectoryPlanner cycle: ``score_samples`` (its arguments first), with ``heading_scoring`` (``at`` >= 0)
+    + 0.3 x ``rollout.heading_diffs`` at step ``at`` to the (grid-local) ``plan`` on every valid cost, then
+    ``choose`` (``choice`` = (escaping, heading_lookahead, stuck_left, stuck_right)). Returns (targets, rollouts,
+    costs, the chosen row (-1 none), the row to command (the chosen one, else the escape unless it has no path, else
+    -1), that row's rollout up to where it stops moving in the costmap frame (``frame`` = the grid's origin x, y,
+    yaw and the yaw's cosine and sine; empty for -1))."""
+    targets, traj, costs, ws, dw = score_samples(
+        grid,
+        memo,
+        epoch,
+        rings,
+        ring_counts,
+        path_wave,
+        goal_wave,
+        resolution,
+        pose,
+        velocity,
+        limits,
+        counts,
+        timing,
+        ox,
+        oy,
+        polygon,
+        weights,
+        impossible,
+        at,
+    )
+    n = costs.size
+    if at >= 0:  # TrajectoryPlannerROS._add_heading
+        valid = 0
+        for r in range(n):
+            valid += costs[r] >= 0
+        poses = np.empty((valid, 3))
+        k = 0
+        for r in range(n):
+            if costs[r] >= 0:
+                poses[k, 0], poses[k, 1], poses[k, 2] = traj[r, at, 0], traj[r, at, 1], traj[r, at, 2]
+                k += 1
+        diffs = heading_diffs(grid, resolution, plan, poses)
+        k = 0
+        for r in range(n):
+            if costs[r] >= 0:
+                costs[r] += 0.3 * diffs[k]
+                k += 1
+    escaping, lookahead, stuck_left, stuck_right = choice
+    nf = n - ws.size - 1
+    best = choose(costs, traj, ws, dw, nf, escaping, grid, goal_wave, resolution, lookahead, stuck_left, stuck_right)
+    row = best if best >= 0 else (n - 1 if costs[n - 1] > -2.0 else -1)
+    if row < 0:
+        return targets, traj, costs, best, row, np.zeros((0, 3))
+    ox0, oy0, oyaw, c, s = frame
+    path = traj[row]
+    return targets, traj, costs, best, row, poses_out(path, moved_length(path), ox0, oy0, oyaw, c, s)

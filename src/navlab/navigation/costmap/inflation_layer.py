@@ -29,6 +29,8 @@ class InflationLayer(Layer):
     inflation cost with ``inflate_unknown``).
     """
 
+    writes_master_only = True
+
     def __init__(
         self,
         params: InflationLayerParams | dict[str, Any] | None = None,

@@ -65,6 +65,9 @@ class Layer:
 
     name: str = "layer"
     enabled: bool = True
+    # update_costs only writes the master (and caches of its own), after prepare_costs' side effects on the layer:
+    # the layered costmap may then write the master when it is read rather than at every update
+    writes_master_only: bool = False
 
     @classmethod
     def from_params(cls, params: Mapping[str, Any] | None, *, context: PluginContext) -> Self:
@@ -103,6 +106,11 @@ class Layer:
 
     def update_bounds(self, robot_pose: tuple[float, float, float]) -> None:
         """Called once per update with the robot pose (x, y, yaw) in the costmap frame."""
+
+    def prepare_costs(self, master: Grid) -> None:
+        """What ``update_costs`` does to the layer itself before it writes ``master`` (a layer that
+        ``writes_master_only`` does it here; the layered costmap calls it at every update, ``update_costs``
+        maybe later)."""
 
     def update_costs(self, master: Grid) -> None:
         """Write this layer's costs into ``master``."""

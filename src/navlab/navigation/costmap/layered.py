@@ -55,6 +55,7 @@ class LayeredCostmap:
         self.map_layers: list[MapLayer] = [x for x in self.layers if isinstance(x, MapLayer)]
         self.scan_layers: list[ScanLayer] = [x for x in self.layers if isinstance(x, ScanLayer)]
         self.robot_pose: tuple[float, float, float] | None = None
+        self._deferred = False  # an update whose writing of the master waits for someone to read it
 
     def _cells(self, metres: float) -> int:
         return max(1, round(metres / self.params.resolution))
@@ -63,8 +64,14 @@ class LayeredCostmap:
 
     @property
     def costmap(self) -> Grid:
-        """The master grid (updated in place by :meth:`update_map`)."""
+        """The master grid (updated in place by :meth:`update_map`; a deferred update is written now)."""
+        self._flush()
         return self.master
+
+    def _flush(self) -> None:
+        """Write the master of a deferred update now (see :meth:`update_map`)."""
+        if self._deferred:
+            self._write_master()
 
     @property
     def rolling(self) -> bool:
@@ -88,6 +95,7 @@ class LayeredCostmap:
 
     def resize(self, width: int, height: int, resolution: float, origin: tuple[float, float]) -> None:
         """New master geometry (``width`` x ``height`` cells, m/cell, lower-left corner in m); layers reset."""
+        self._flush()  # before what the layers hold changes
         if width < 1 or height < 1 or not (math.isfinite(resolution) and resolution > 0):
             raise NavigationError(
                 f"costmap resize: expected positive size and resolution, got {width} x {height} at {resolution} m/cell"
@@ -103,6 +111,7 @@ class LayeredCostmap:
 
     def set_footprint(self, footprint: Footprint) -> None:
         """A new (padded) footprint for every layer."""
+        self._flush()  # before what the layers hold changes
         self.footprint = footprint
         for layer in self.layers:
             layer.on_footprint_changed(footprint)
@@ -119,6 +128,7 @@ class LayeredCostmap:
     def set_map(self, grid: GridMap, *, map_in_costmap: tuple[float, float, float] = (0.0, 0.0, 0.0)) -> None:
         """A new ``/map`` for the static layers. Not rolling: the master takes the map's size, resolution and
         origin (as costmap_2d does). ``map_in_costmap``: pose of the map frame in the costmap frame."""
+        self._flush()  # before what the layers hold changes
         statics = self.map_layers
         if not statics:
             raise NavigationError(
@@ -149,6 +159,7 @@ class LayeredCostmap:
     ) -> None:
         """Give one scan (sensor origin and endpoints (N, 2), m, costmap frame) to the obstacle layers
         (or to the one named ``layer``); see ``ObstacleLayer.add_scan``."""
+        self._flush()  # before what the layers hold changes
         for target in self.scan_targets(source, layer):
             target.add_scan(origin_xy, endpoints_xy, valid, source=source)
 
@@ -178,9 +189,15 @@ class LayeredCostmap:
         for layer in self.layers:
             layer.update_origin(self.master)
 
-    def update_map(self, robot_pose: tuple[float, float, float]) -> Grid:
+    def update_map(self, robot_pose: tuple[float, float, float], *, defer: bool = False) -> Grid:
         """One costmap update with the robot at ``robot_pose`` (x, y, yaw) in the costmap frame: re-centre a
-        rolling window, reset the master, let each enabled layer write in order. Returns the master grid."""
+        rolling window, reset the master, let each enabled layer write in order. Returns the master grid.
+
+        ``defer``: when every enabled layer only writes the master (``Layer.writes_master_only``: the static,
+        obstacle and inflation layers), the layers do their own part now (``prepare_costs``) and the master is
+        written when :attr:`costmap` is next read, unless a later update comes first (the same grid either way:
+        it is a function of what the layers hold). Then the returned master is not written yet: read
+        :attr:`costmap`."""
         pose = (float(robot_pose[0]), float(robot_pose[1]), float(robot_pose[2]))
         if not all(math.isfinite(v) for v in pose):
             raise NavigationError(f"costmap update: robot pose must be finite, got {robot_pose}")
@@ -190,11 +207,22 @@ class LayeredCostmap:
         for layer in self.layers:
             if layer.enabled:
                 layer.update_bounds(pose)
+        if defer and all(vars(type(x)).get("writes_master_only", False) for x in self.layers if x.enabled):
+            for layer in self.layers:
+                if layer.enabled:
+                    layer.prepare_costs(self.master)
+            self._deferred = True
+            return self.master
+        self._write_master()
+        return self.master
+
+    def _write_master(self) -> None:
+        """Reset the master and let each enabled layer write in order."""
+        self._deferred = False
         self.master.data[:] = self.default_value
         for layer in self.layers:
             if layer.enabled:
                 layer.update_costs(self.master)
-        return self.master
 
     def footprint_at(self, pose: tuple[float, float, float]) -> np.ndarray:
         """The footprint polygon (N, 2) at ``pose`` in the costmap frame (a 16-gon for a circular robot)."""
@@ -207,6 +235,7 @@ class LayeredCostmap:
 
     def reset(self) -> None:
         """Forget every layer's observations (costmap_2d's ``resetLayers``)."""
+        self._flush()  # before what the layers hold changes
         for layer in self.layers:
             layer.reset()
             layer.match_size(self.master)

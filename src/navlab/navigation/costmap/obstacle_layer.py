@@ -140,15 +140,21 @@ class ObservationLayer(Layer):
     def update_bounds(self, robot_pose: tuple[float, float, float]) -> None:
         self.robot_pose = (float(robot_pose[0]), float(robot_pose[1]), float(robot_pose[2]))
 
-    def update_costs(self, master: Grid) -> None:
+    def prepare_costs(self, master: Grid) -> None:
+        """Follow the master's geometry and clear the cells under the robot (``footprint_clearing_enabled``)."""
         if self.grid is None:
             return
         if not same_geometry(self.grid, master):
             self.update_origin(master)
-        g = self.grid
         if self.params.footprint_clearing_enabled and self.robot_pose is not None:
-            self.footprint.fill(g, self.robot_pose, COST_FREE)
-        combine(master.data, g.data, self.params.combination_method != 0)
+            self.footprint.fill(self.grid, self.robot_pose, COST_FREE)
+
+    def update_costs(self, master: Grid) -> None:
+        if self.grid is None:
+            return
+        self.prepare_costs(master)  # (again after the layered costmap's call: the same cells, a no-op)
+        assert self.grid is not None
+        combine(master.data, self.grid.data, self.params.combination_method != 0)
 
     def reset(self) -> None:
         if self.grid is not None:
@@ -163,6 +169,8 @@ class ObstacleLayer(ObservationLayer):
     1, unknown cells of the layer skipped) or overwrite (0). Call :meth:`match_size` (the layered costmap
     does) before :meth:`add_scan`.
     """
+
+    writes_master_only = True
 
     def add_scan(
         self,

@@ -25,6 +25,8 @@ class StaticLayer(Layer):
     has cells (``use_maximum``: keeps the larger cost).
     """
 
+    writes_master_only = True
+
     def __init__(self, params: StaticLayerParams | dict[str, Any] | None = None, *, name: str = "static_layer") -> None:
         self.params: StaticLayerParams = read_params(StaticLayerParams, params, what=name)
         self.name = name
