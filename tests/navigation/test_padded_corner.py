@@ -7,6 +7,8 @@ round the corner, so an in-place turn, which keeps the cost where it is, won eve
 from __future__ import annotations
 
 import math
+from itertools import pairwise
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -21,7 +23,7 @@ from navlab.navigation.controllers.trajectory import TrajectoryPlannerROS
 from navlab.navigation.costmap import LayeredCostmap
 from navlab.navigation.costmap.footprint import points_in_polygon
 
-FIXTURES = __import__("pathlib").Path(__file__).parents[1] / "fixtures" / "maps"
+FIXTURES = Path(__file__).parents[1] / "fixtures" / "maps"
 # the stuck trial's global plan through its local window (m, grid-local), every 8th pose: over the step's corner
 # and west to the window's edge
 PLAN = [(1.99, 1.98), (1.83, 2.11), (1.66, 2.22), (1.47, 2.29), (1.28, 2.33), (1.08, 2.35), (0.88, 2.35)]
@@ -43,7 +45,7 @@ def _drive(robot: str, occdist_scale: float | None = None, seconds: float = 10.0
     if occdist_scale is not None:
         params["occdist_scale"] = occdist_scale
     planner = TrajectoryPlannerROS(params, robot_radius=costmap.inscribed_radius, controller_frequency=20.0)
-    dense = np.vstack([np.linspace(a, b, 8, endpoint=False) for a, b in zip(PLAN[:-1], PLAN[1:])] + [PLAN[-1:]])
+    dense = np.vstack([np.linspace(a, b, 8, endpoint=False) for a, b in pairwise(PLAN)] + [PLAN[-1:]])
     planner.set_plan(dense)
     x, y, yaw, v, w, dt = 1.994, 1.984, 2.3, 0.0, 0.0, 0.05
     for _ in range(round(seconds / dt)):
