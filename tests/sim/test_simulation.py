@@ -165,6 +165,24 @@ def test_numba_lidar_matches_mj_multiray() -> None:
     assert np.nanmin(np.where(np.isfinite(ref), ref, np.nan)) < 1.0  # the tilted lidar sees the floor
 
 
+def test_scan_in_one_call_matches_the_cast_then_the_noise() -> None:
+    """Simulation.scan's fused cast + noise gives the ranges of true_ranges + finish_ranges with the same draws."""
+    from navlab.sim.raycast import finish_ranges
+
+    sim = Simulation(make_mybot(noise=0.01), make_room(), seed=3, robot_pose=(-1.0, 0.5, 0.7))
+    sim.step(20)
+    cfg = sim.robot.lidars[0]  # type: ignore[union-attr]
+    for _ in range(3):
+        got = sim.scan(0, np.random.default_rng(7))
+        dist = sim.true_ranges(0)
+        want = np.empty(len(dist), dtype=np.float32)
+        normals = np.random.default_rng(7).standard_normal(len(dist))
+        finish_ranges(dist, normals, cfg.noise_mean, cfg.noise_stddev, cfg.range_min, cfg.range_max, want)
+        assert np.isfinite(got).sum() > 500
+        assert got.tobytes() == want.tobytes()
+        sim.step(10)
+
+
 def test_fixed_links_keep_their_frames() -> None:
     sim = Simulation(make_mybot(), make_room(), seed=0, robot_pose=(1.0, 2.0, 0.7))
     _drive(sim, 0.0, 1.0, 0.5)  # turning in place

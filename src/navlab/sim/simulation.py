@@ -17,7 +17,7 @@ from navlab.geometry import quat_from_rpy, quat_from_yaw, wxyz_from_xyzw, xyzw_f
 from navlab.sim.builder import GROUND_CONTACT_BIT, GROUP_ROBOT, GROUP_WORLD, RAY_GEOMGROUP, mj_quat_from_rpy
 from navlab.sim.clearance import clearance
 from navlab.sim.errors import SimError
-from navlab.sim.raycast import FAST_TYPES, cast_planar, finish_ranges, multiray
+from navlab.sim.raycast import FAST_TYPES, cast_planar, finish_ranges, multiray, scan_planar
 from navlab.sim.scene import add_world_model, build_spec, compile_spec, remove_world_model
 from navlab.world import ModelSpec, WorldModel
 
@@ -383,17 +383,44 @@ class Simulation:
         if self.robot is None or not 0 <= index < len(self.robot.lidars):
             raise SimError(f"no lidar number {index} on this robot")
         cfg = self.robot.lidars[index]
-        dist = self.true_ranges(index)
-        gen = self.rng if rng is None else rng
-        normals = self._no_noise
-        if cfg.noise_stddev > 0:  # the draws of standard_normal(n), into a buffer kept per lidar
-            kept = self._normals.get(index)
-            if kept is None or kept.shape[0] != len(dist):
-                kept = self._normals[index] = np.empty(len(dist))
-            normals = gen.standard_normal(out=kept)
-        out = np.empty(len(dist), dtype=np.float32)
-        finish_ranges(dist, normals, cfg.noise_mean, cfg.noise_stddev, cfg.range_min, cfg.range_max, out)
+        if self.lidar_backend == "mujoco" or self._ray_slow_groups is not None:
+            dist = self.true_ranges(index)
+            normals = self._draw_normals(index, cfg, len(dist), rng)
+            out = np.empty(len(dist), dtype=np.float32)
+            finish_ranges(dist, normals, cfg.noise_mean, cfg.noise_stddev, cfg.range_min, cfg.range_max, out)
+            return out
+        # primitives only: the cast and the noise in one compiled call (the same values as the path above)
+        self._sync()
+        angles = self._beam_dirs(index, cfg)
+        n = angles.shape[1]
+        normals = self._draw_normals(index, cfg, n, rng)  # the cast draws nothing: the same draws as above
+        m, d = self.model, self.data
+        site = self._lidar_site[index]
+        out = np.empty(n, dtype=np.float32)
+        scan_planar(
+            d.site_xpos[site], d.site_xmat[site].reshape(3, 3), angles[0], angles[1], cfg.min_angle,
+            (cfg.max_angle - cfg.min_angle) / (n - 1) if n > 1 else 0.0, self._ray_fast, m.geom_type, m.geom_size,
+            d.geom_xpos, d.geom_xmat, cfg.range_min, cfg.range_max, normals, cfg.noise_mean, cfg.noise_stddev, out,
+        )  # fmt: skip
         return out
+
+    def _draw_normals(self, index: int, cfg: LidarConfig, n: int, rng: np.random.Generator | None) -> np.ndarray:
+        """Lidar ``index``'s noise draws for one scan of ``n`` beams: standard_normal(n) from ``rng`` (or the
+        simulation's generator) into a buffer kept per lidar; none without noise."""
+        if cfg.noise_stddev <= 0:
+            return self._no_noise
+        kept = self._normals.get(index)
+        if kept is None or kept.shape[0] != n:
+            kept = self._normals[index] = np.empty(n)
+        return (self.rng if rng is None else rng).standard_normal(out=kept)
+
+    def _beam_dirs(self, index: int, cfg: LidarConfig) -> np.ndarray:
+        """(2, n) cos, sin of lidar ``index``'s beam angles in its frame, worked out once."""
+        angles = self._lidar_dirs.get(index)
+        if angles is None:
+            a = lidar_angles(cfg)
+            angles = self._lidar_dirs[index] = np.ascontiguousarray(np.stack([np.cos(a), np.sin(a)]))
+        return angles
 
     def true_ranges(self, index: int = 0, *, backend: str | None = None) -> np.ndarray:
         """Noise-free ranges (m, float64) of lidar ``index``; ``backend`` "numba" (primitives by
@@ -403,11 +430,7 @@ class Simulation:
         self._sync()
         m, d = self.model, self.data
         site = self._lidar_site[index]
-        angles = self._lidar_dirs.get(index)
-        if angles is None:
-            a = lidar_angles(cfg)
-            angles = np.ascontiguousarray(np.stack([np.cos(a), np.sin(a)]))
-            self._lidar_dirs[index] = angles
+        angles = self._beam_dirs(index, cfg)
         n = angles.shape[1]
         rot = d.site_xmat[site].reshape(3, 3)
         pnt = d.site_xpos[site].copy()
