@@ -268,3 +268,26 @@ def test_a_key_ros_ignores_warns_naming_the_file_and_a_typo_still_fails(
     common.write_text(common.read_text() + "inflation_raduis: 0.3\n")
     with pytest.raises(NavlabError, match=r"did you mean 'inflation_radius'.*costmap_common_params\.yaml"):
         start_run("navigation", world="room", map=str(_room_true_map()), params=str(params))
+
+
+def test_costmaps_are_not_published_until_someone_subscribes_then_are() -> None:
+    """costmap_2d's publisher does no work without subscribers; a late subscriber gets the costmap at the next
+    publish tick (publish_frequency 1 Hz global, 2 Hz local), and move_base's status likewise."""
+    from navlab import msgs
+    from navlab.core import Node
+    from navlab.experiments.session import start_run
+
+    run = start_run("navigation", world="room", map=str(_room_true_map()))
+    topics = ["/move_base/global_costmap/costmap", "/move_base/local_costmap/costmap"]
+    run.run(2.5)
+    assert all(not run.executor.topic(t, msgs.OccupancyGrid).latched for t in topics)
+    got: dict[str, list] = {}
+    listener = run.add(Node, name="late_listener")
+    for topic in topics:
+        listener.create_subscription(msgs.OccupancyGrid, topic, lambda m, t=topic: got.setdefault(t, []).append(m))
+    listener.create_subscription(msgs.GoalStatusArray, "/move_base/status", got.setdefault("status", []).append)
+    run.run(1.0)
+    assert [len(got.get(t, [])) for t in topics] == [1, 2]
+    assert len(got["status"]) == 5  # move_base's status timer (5 Hz) parked too, and woke
+    g = got[topics[0]][-1]
+    assert g.header.frame_id == "map" and min(g.data) >= -1 and max(g.data) == 100

@@ -81,8 +81,10 @@ class Costmap2DROS:
         self.footprint_pub = node.create_publisher(msgs.PolygonStamped, f"{prefix}/footprint", 1)
         if p.update_frequency > 0:
             node.create_timer(1.0 / p.update_frequency, self._on_update_timer)
-        if p.publish_frequency > 0:
-            node.create_timer(1.0 / p.publish_frequency, self.publish)
+        if p.publish_frequency > 0:  # as costmap_2d's publisher: no work while nobody subscribes (or listens)
+            node.create_timer(
+                1.0 / p.publish_frequency, self.publish, idle=self._unwatched, idle_until_graph_changes=True
+            )
 
     @property
     def costmap(self) -> Grid:
@@ -165,6 +167,11 @@ class Costmap2DROS:
         self.updated_ns = self.node.executor.now_ns
         self.updates += 1
         return grid
+
+    def _unwatched(self) -> bool:
+        """Whether nobody subscribes to the costmap topic and no listener sees every message (the publish timer then
+        parks until one does; costmap_2d's ``publishCostmap`` returns at once without subscribers)."""
+        return not (self.costmap_pub.get_subscription_count() or self.node.executor.has_listeners)
 
     def publish(self) -> None:
         """Publish the costmap (OccupancyGrid) and the footprint polygon now."""

@@ -110,7 +110,7 @@ class MoveBase(Node):
         self.create_service(f"{private}/clear_costmaps", self._srv_clear)
         self.create_service(f"{private}/make_plan", self._srv_make_plan)
         self.create_timer(1.0 / p["controller_frequency"], self._cycle)
-        self.create_timer(0.2, self._publish_status)
+        self.create_timer(0.2, self._publish_status, idle=self._status_unwatched, idle_until_graph_changes=True)
         self.velocity = (0.0, 0.0)
         self.handle: GoalHandle | None = None
         self.state = MoveBaseState.IDLE
@@ -483,8 +483,12 @@ class MoveBase(Node):
         self.global_costmap.update()
         return {"plan": self.make_plan(start, goal)}
 
+    def _status_unwatched(self) -> bool:
+        """Whether nobody subscribes to the status or listens (the status timer then parks until one does)."""
+        return not (self.status_pub.get_subscription_count() or self.executor.has_listeners)
+
     def _publish_status(self) -> None:
-        if not (self.status_pub.get_subscription_count() or self.executor.has_listeners):
+        if self._status_unwatched():
             return  # built only when someone listens, as the paths are
         h = self.handle
         statuses = []
