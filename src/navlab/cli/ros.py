@@ -100,6 +100,7 @@ def _messages(args: argparse.Namespace, topic: str) -> Iterator[tuple[int, Any]]
     return got
 
 
+@stop_signals()  # `topic echo` runs until Ctrl-C (or SIGTERM), also as a background job
 def _cmd_topic(args: argparse.Namespace) -> int:
     import numpy as np
 
