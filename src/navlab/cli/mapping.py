@@ -24,6 +24,7 @@ from navlab.cli.options import (
 from navlab.cli.runs import ros_hook, stop_signals, view_hook
 
 
+@stop_signals()  # --teleop runs until Ctrl-C: also as a background job
 def _cmd_map(args: argparse.Namespace) -> int:
     apply_resource_paths(args)  # --package-path / --model-path, for this process and its workers
     if args.action == "save":

@@ -129,11 +129,15 @@ class TerminalKeys(threading.Thread):
         while not self._closing.is_set():  # polled, not a blocking read: close() ends it within 0.1 s
             if not select.select([self.fd], [], [], 0.1)[0]:
                 continue
-            ch = os.read(self.fd, 1).decode(errors="ignore")
-            if not ch or ch == "\x03":
+            try:
+                key = os.read(self.fd, 1)
+            except OSError:  # the terminal hung up
+                key = b""
+            if key in (b"", b"\x03"):  # end of input, or Ctrl-C as a byte (a terminal without ISIG)
                 self.ex.post(self.ex.stop)
                 return
-            self.teleop.press(ch)
+            if ch := key.decode(errors="ignore"):  # keys are ASCII; a byte of anything else is dropped
+                self.teleop.press(ch)
 
     def close(self) -> None:
         """End the reader and restore the terminal (idempotent)."""
