@@ -10,6 +10,7 @@ import re
 import shlex
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import pytest
@@ -121,43 +122,22 @@ def test_every_readme_command_from_a_folder_outside_the_checkout(tmp_path_factor
 
 def test_readme_teleop_drives_from_a_terminal(tmp_path: Path) -> None:
     """`navlab teleop` with no launch running starts the sim here; keys come from a terminal (a pty)."""
-    import pty
     import signal
-    import threading
-    import time
 
-    master, slave = pty.openpty()
-    env = {**os.environ, "TMPDIR": str(tmp_path)}  # no other launch's socket: the standalone sim
-    proc = subprocess.Popen(
-        [sys.executable, "-m", "navlab.cli", "teleop", "--world", "room"],
-        stdin=slave,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        cwd=tmp_path,
-        env=env,
-        text=True,
-    )
-    os.close(slave)
-    err_parts: list[str] = []
-    reader = threading.Thread(target=lambda: err_parts.extend(iter(lambda: proc.stderr.read(1), "")), daemon=True)
-    reader.start()
+    from cli_terminal import Terminal
 
-    def wait_for(text: str, seconds: float) -> None:  # a loaded machine starts slowly: wait for what it shows
-        deadline = time.monotonic() + seconds
-        while text not in "".join(err_parts) and time.monotonic() < deadline and proc.poll() is None:
-            time.sleep(0.1)
-
-    wait_for("sending linear.x", 120.0)  # its status line: it reads keys now
-    os.write(master, b"i")
-    wait_for("sending linear.x +0.50", 60.0)
-    time.sleep(1.5)
-    proc.send_signal(signal.SIGINT)  # Ctrl-C at the terminal
-    out = proc.stdout.read()
-    proc.wait(timeout=60)
-    reader.join(timeout=10)
-    err = "".join(err_parts)
-    os.close(master)
-    assert proc.returncode == 0, err
+    term = Terminal(["teleop", "--world", "room"], tmp_path)
+    try:
+        term.wait_for("sending linear.x", 120.0)  # its status line: it reads keys now (a loaded machine is slow)
+        term.keys(b"i")
+        term.wait_for("sending linear.x +0.50", 60.0)
+        time.sleep(1.5)
+        term.signal(signal.SIGINT)  # Ctrl-C at the terminal
+        code = term.finish(30.0, after="Ctrl-C (SIGINT)")
+    finally:
+        term.close()
+    out, err = term.stdout, term.stderr
+    assert code == 0, err
     assert "stopped at" in out and "Traceback" not in err
     assert "sending linear.x +0.50 m/s" in err  # it shows what it sends
     moved = re.search(r"stopped at x=(-?[\d.]+)", out)

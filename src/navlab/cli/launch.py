@@ -7,11 +7,11 @@ import argparse
 import contextlib
 import json
 import math
-import signal
 from pathlib import Path
 from typing import Any
 
 from navlab.cli.options import add_resource_path_arguments, add_run_options, apply_resource_paths, positive_seconds
+from navlab.cli.runs import stop_signals
 
 
 def _show_args(file: str) -> int:
@@ -56,6 +56,7 @@ def _cmd_roslaunch(args: argparse.Namespace) -> int:
     return _cmd_launch(args)
 
 
+@stop_signals()  # Ctrl-C and SIGTERM end it cleanly, also as a background job (SIGINT inherited ignored)
 def _cmd_launch(args: argparse.Namespace) -> int:
     from navlab.core import parse_launch_args, run_for, start  # (not at import: --help loads no numpy)
 
@@ -74,12 +75,10 @@ def _cmd_launch(args: argparse.Namespace) -> int:
     session = start(files, seed=args.seed, rate=rate, launch_args=launch_args, ros=ros)
     ex = session.executor
     duration = math.inf if args.duration is None else args.duration
-    from navlab.core import IntrospectionServer
-
     # `navlab topic/node/graph` in another shell look into this launch while it runs; SIGTERM ends it
-    # cleanly like Ctrl-C (the recording is closed, the socket removed)
-    signal.signal(signal.SIGTERM, lambda *_: ex.post(ex.stop))
+    # cleanly like Ctrl-C (the recording is closed, the socket removed), also as a background job
     from navlab.cli.runs import viewing
+    from navlab.core import IntrospectionServer
 
     with (
         IntrospectionServer(ex, name=args.file),

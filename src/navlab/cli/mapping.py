@@ -21,9 +21,10 @@ from navlab.cli.options import (
     print_figures,
     start_pose,
 )
-from navlab.cli.runs import ros_hook, view_hook
+from navlab.cli.runs import ros_hook, stop_signals, view_hook
 
 
+@stop_signals()  # --teleop runs until Ctrl-C: also as a background job
 def _cmd_map(args: argparse.Namespace) -> int:
     apply_resource_paths(args)  # --package-path / --model-path, for this process and its workers
     if args.action == "save":
@@ -146,15 +147,50 @@ def _cmd_slam(args: argparse.Namespace) -> int:
     return 0
 
 
+# Ctrl-C and SIGTERM end it at once, also as a background job (SIGINT inherited ignored): while it starts with
+# "navlab: interrupted", while it drives with the pose it stopped at
+@stop_signals()
 def _cmd_teleop(args: argparse.Namespace) -> int:
     """Drive the robot from the keyboard (teleop_twist_keyboard) or a joystick, in real time: the robot
     of a `navlab launch` running in another shell, or (with --world, or when none runs) a simulator
     started here."""
+    with contextlib.ExitStack() as stack:  # the terminal's settings come back, the remote publisher closes
+        ex, gazebo, remote = _teleop_executor(args)
+        if remote is not None:
+            stack.callback(remote.close)
+        if args.joy:
+            from navlab import msgs
+            from navlab.core import Node
+            from navlab.drivers import JoyMapping, joystick_thread
+
+            pub = Node(ex, name="teleop_twist_joy").create_publisher(msgs.Twist, "cmd_vel", 1)
+            joystick_thread(ex, pub, JoyMapping(scale_linear=args.speed, scale_angular=args.turn))
+            print("joystick: hold button 0 and move the left stick; Ctrl-C to quit")
+        else:
+            from navlab.drivers import HELP, TeleopKeyboard, terminal_keys
+
+            if not sys.stdin.isatty():
+                from navlab.mapping import MappingError
+
+                raise MappingError("navlab teleop reads keys from a terminal; run it in an interactive shell")
+            teleop = TeleopKeyboard(ex, parameters={"speed": args.speed, "turn": args.turn})
+            print(HELP)
+            stack.enter_context(terminal_keys(teleop, ex))
+            teleop.create_timer(0.25, lambda: _show_teleop(teleop, gazebo))
+        with contextlib.suppress(KeyboardInterrupt):
+            ex.spin()
+    if gazebo is not None:
+        x, y, yaw = gazebo.sim.base_pose2d()
+        print(f"\nstopped at x={x:.2f} y={y:.2f} yaw={yaw:.2f} after {ex.now_ns / 1e9:.1f} simulated s")
+    return 0
+
+
+def _teleop_executor(args: argparse.Namespace) -> tuple[Any, Any, Any]:
+    """The executor teleop publishes into: (executor, gazebo node or None, RemotePublisher or None)."""
     from navlab.core import CoreError, Executor, RemotePublisher, find_running
-    from navlab.drivers import HELP, TeleopKeyboard, terminal_keys
     from navlab.experiments import start_run
 
-    gazebo = remote = None
+    remote = None
     if args.world is None:
         with contextlib.suppress(CoreError):
             remote = RemotePublisher(find_running(args.pid))
@@ -162,36 +198,11 @@ def _cmd_teleop(args: argparse.Namespace) -> int:
         ex = Executor(seed=args.seed, rate=args.rate)
         ex.add_listener(lambda topic, msg, _t: remote.publish(topic, msg) if topic == "/cmd_vel" else None)
         print("driving the robot of the running navlab launch")
-    else:  # the sim launch, here, in real time
-        run = start_run(
-            "sim", world=args.world or "room", robot=args.robot, pose=start_pose(args), seed=args.seed, rate=args.rate
-        )
-        ex, gazebo = run.executor, run.gazebo
-    if args.joy:
-        from navlab import msgs
-        from navlab.core import Node
-        from navlab.drivers import JoyMapping, joystick_thread
-
-        pub = Node(ex, name="teleop_twist_joy").create_publisher(msgs.Twist, "cmd_vel", 1)
-        joystick_thread(ex, pub, JoyMapping(scale_linear=args.speed, scale_angular=args.turn))
-        print("joystick: hold button 0 and move the left stick; Ctrl-C to quit")
-    else:
-        if not sys.stdin.isatty():
-            from navlab.mapping import MappingError
-
-            raise MappingError("navlab teleop reads keys from a terminal; run it in an interactive shell")
-        teleop = TeleopKeyboard(ex, parameters={"speed": args.speed, "turn": args.turn})
-        print(HELP)
-        terminal_keys(teleop, ex)
-        teleop.create_timer(0.25, lambda: _show_teleop(teleop, gazebo))
-    with contextlib.suppress(KeyboardInterrupt):
-        ex.spin()
-    if remote is not None:
-        remote.close()
-    if gazebo is not None:
-        x, y, yaw = gazebo.sim.base_pose2d()
-        print(f"\nstopped at x={x:.2f} y={y:.2f} yaw={yaw:.2f} after {ex.now_ns / 1e9:.1f} simulated s")
-    return 0
+        return ex, None, remote
+    run = start_run(  # the sim launch, here, in real time
+        "sim", world=args.world or "room", robot=args.robot, pose=start_pose(args), seed=args.seed, rate=args.rate
+    )
+    return run.executor, run.gazebo, None
 
 
 def _show_teleop(teleop: Any, gazebo: Any) -> None:

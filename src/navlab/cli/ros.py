@@ -12,12 +12,12 @@ import argparse
 import contextlib
 import json
 import math
-import signal
 from collections.abc import Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from navlab.cli.options import add_run_options, out_file, positive_seconds
+from navlab.cli.runs import stop_signals
 from navlab.io import write_text_atomic
 
 if TYPE_CHECKING:  # navlab.core loads numpy and rosbags: imported where a verb runs, so --help stays quick
@@ -100,6 +100,7 @@ def _messages(args: argparse.Namespace, topic: str) -> Iterator[tuple[int, Any]]
     return got
 
 
+@stop_signals()  # `topic echo` runs until Ctrl-C (or SIGTERM), also as a background job
 def _cmd_topic(args: argparse.Namespace) -> int:
     import numpy as np
 
@@ -213,13 +214,13 @@ def _cmd_bag(args: argparse.Namespace) -> int:
     return 0
 
 
+@stop_signals()  # Ctrl-C and SIGTERM stop it, also as a background job (SIGINT inherited ignored)
 def _cmd_roscore(args: argparse.Namespace) -> int:
     from navlab.ros1 import Master, host_port, master_uri
 
     port = args.port if args.port is not None else host_port(master_uri())[1]
     master = Master(port=port)
     print(f"navlab roscore: ROS master at {master.uri} (Ctrl-C to stop)", flush=True)
-    signal.signal(signal.SIGTERM, lambda *_: master.close())
     with contextlib.suppress(KeyboardInterrupt):
         master.stopped.wait()
     master.close()

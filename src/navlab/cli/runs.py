@@ -1,12 +1,14 @@
-"""What run verbs wrap around a run: ``--view`` (the viewer on each run) and ``--ros`` / ``ros:=true`` (the run
-offered on ROS 1, paced by ``--rate``)."""
+"""What run verbs wrap around a run: ``--view`` (the viewer on each run), ``--ros`` / ``ros:=true`` (the run
+offered on ROS 1, paced by ``--rate``) and Ctrl-C / SIGTERM (runs until interrupted)."""
 
 from __future__ import annotations
 
 import argparse
 import contextlib
 import logging
+import signal
 import sys
+import threading
 from collections.abc import Callable, Iterator
 from typing import Any
 
@@ -21,6 +23,29 @@ def pop_ros_arg(launch_args: dict[str, str]) -> bool:
 def follows_clock(launch_args: dict[str, str]) -> bool:
     """Whether a run takes its time from the graph's ``/clock``: ``sim:=false`` (hardware in the loop)."""
     return str(launch_args.get("sim", "true")).strip().lower() not in TRUE
+
+
+@contextlib.contextmanager
+def stop_signals() -> Iterator[None]:
+    """Ctrl-C (SIGINT) and SIGTERM raise KeyboardInterrupt in the block, whatever this process inherited.
+
+    A background job of a script starts with SIGINT ignored, and Python then installs no handler of its own:
+    roslaunch and rospy install theirs for that reason, and so does every verb that runs until Ctrl-C. The main
+    thread is interrupted where it is (an executor's loop, a startup, a blocking wait); the verb suppresses the
+    KeyboardInterrupt around its loop and its ``finally`` blocks clean up. The previous handlers come back after."""
+    if threading.current_thread() is not threading.main_thread():  # only the main thread may set handlers
+        yield
+        return
+
+    def interrupt(_signum: int, _frame: Any) -> None:
+        raise KeyboardInterrupt
+
+    before = {sig: signal.signal(sig, interrupt) for sig in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        yield
+    finally:
+        for sig, handler in before.items():
+            signal.signal(sig, handler)
 
 
 @contextlib.contextmanager

@@ -25,7 +25,7 @@ from navlab.cli.options import (
     positive_seconds,
     start_pose,
 )
-from navlab.cli.runs import ros_bridge, start_viewer
+from navlab.cli.runs import ros_bridge, start_viewer, stop_signals
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -59,6 +59,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=_cmd_view)
 
 
+@stop_signals()  # Ctrl-C and SIGTERM end it (the recording closed), also as a background job
 def _cmd_view(args: argparse.Namespace) -> int:
     if args.bag:
         if args.ros:

@@ -6,6 +6,7 @@ in through :meth:`TeleopKeyboard.press` (thread-safe), from a terminal or the vi
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import threading
 from dataclasses import dataclass
@@ -101,29 +102,68 @@ class TeleopKeyboard(Node):
         self.executor.post(lambda: self.state.key(key))
 
 
-def terminal_keys(teleop: TeleopKeyboard, ex: Executor) -> threading.Thread:
-    """Read single key presses from the terminal (cbreak mode) and hand them to the teleop node."""
-    import sys
-    import termios
-    import tty
+class TerminalKeys(threading.Thread):
+    """Reads single key presses from the terminal (cbreak mode) and hands them to a teleop node.
 
-    def loop() -> None:
-        fd = sys.stdin.fileno()
-        old = termios.tcgetattr(fd)
-        try:
-            tty.setcbreak(fd)
-            while True:
-                ch = sys.stdin.read(1)
-                if not ch or ch == "\x03":
-                    ex.post(ex.stop)
-                    return
-                teleop.press(ch)
-        finally:
-            termios.tcsetattr(fd, termios.TCSADRAIN, old)
+    :meth:`close` (also on leaving a ``with`` block, and at exit) ends the reader and gives the terminal its
+    settings back; end of input (the terminal closed) stops the executor."""
 
-    t = threading.Thread(target=loop, daemon=True)
-    t.start()
-    return t
+    def __init__(self, teleop: TeleopKeyboard, ex: Executor) -> None:
+        import atexit
+        import sys
+        import termios
+        import tty
+
+        super().__init__(name="terminal_keys", daemon=True)
+        self.teleop, self.ex = teleop, ex
+        self.fd = sys.stdin.fileno()
+        self._saved = termios.tcgetattr(self.fd)
+        self._closing = threading.Event()
+        tty.setcbreak(self.fd)  # keys one at a time, no echo; Ctrl-C still sends SIGINT (ISIG stays on)
+        atexit.register(self.close)
+
+    def run(self) -> None:
+        import os
+        import select
+
+        while not self._closing.is_set():  # polled, not a blocking read: close() ends it within 0.1 s
+            if not select.select([self.fd], [], [], 0.1)[0]:
+                continue
+            try:
+                key = os.read(self.fd, 1)
+            except OSError:  # the terminal hung up
+                key = b""
+            if key in (b"", b"\x03"):  # end of input, or Ctrl-C as a byte (a terminal without ISIG)
+                self.ex.post(self.ex.stop)
+                return
+            if ch := key.decode(errors="ignore"):  # keys are ASCII; a byte of anything else is dropped
+                self.teleop.press(ch)
+
+    def close(self) -> None:
+        """End the reader and restore the terminal (idempotent)."""
+        import termios
+
+        if self._closing.is_set():
+            return
+        self._closing.set()
+        if self.is_alive() and self is not threading.current_thread():
+            self.join(timeout=1.0)
+        with contextlib.suppress(termios.error, OSError):  # the terminal may be gone (closed, hung up)
+            termios.tcsetattr(self.fd, termios.TCSADRAIN, self._saved)
+
+    def __enter__(self) -> TerminalKeys:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+def terminal_keys(teleop: TeleopKeyboard, ex: Executor) -> TerminalKeys:
+    """Read single key presses from the terminal (cbreak mode) and hand them to the teleop node; the reader,
+    started (``with terminal_keys(...)``: the terminal is restored at the block's end; else at exit)."""
+    keys = TerminalKeys(teleop, ex)
+    keys.start()
+    return keys
 
 
 @dataclass
