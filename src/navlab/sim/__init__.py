@@ -16,10 +16,11 @@ if TYPE_CHECKING:
     from navlab.sim.disturbances import parse_disturbances
     from navlab.sim.errors import SimError
     from navlab.sim.gazebo import GazeboSim, launch_sim, load_robot_named, load_world_named
+    from navlab.sim.lidar_rays import lidar_angles
     from navlab.sim.render import render_image, save_png
     from navlab.sim.sensor_plugins import DepthCameraPlugin, VelodynePlugin
     from navlab.sim.sensors3d import depth_image, depth_points, lidar3d_ranges, sensor_pose
-    from navlab.sim.simulation import Pose3D, Simulation, lidar_angles
+    from navlab.sim.simulation import Pose3D, Simulation
     from navlab.sim.spawn import check_start_pose, parse_spawn_spec, primitive_model
 
 _EXPORTS = {
@@ -43,7 +44,7 @@ _EXPORTS = {
     "depth_image": "navlab.sim.sensors3d",
     "depth_points": "navlab.sim.sensors3d",
     "lidar3d_ranges": "navlab.sim.sensors3d",
-    "lidar_angles": "navlab.sim.simulation",
+    "lidar_angles": "navlab.sim.lidar_rays",
     "parse_disturbances": "navlab.sim.disturbances",
     "render_image": "navlab.sim.render",
     "robot_reach": "navlab.sim.decompose",

@@ -14,10 +14,12 @@ import numpy as np
 
 from navlab.description import DiffDriveConfig, LidarConfig, RobotModel
 from navlab.geometry import quat_from_rpy, quat_from_yaw, wxyz_from_xyzw, xyzw_from_wxyz, yaw_from_quat
-from navlab.sim.builder import GROUND_CONTACT_BIT, GROUP_ROBOT, GROUP_WORLD, RAY_GEOMGROUP, mj_quat_from_rpy
+from navlab.sim.builder import GROUND_CONTACT_BIT, GROUP_ROBOT, RAY_GEOMGROUP, mj_quat_from_rpy
 from navlab.sim.clearance import clearance
 from navlab.sim.errors import SimError
-from navlab.sim.raycast import FAST_TYPES, cast_planar, finish_ranges, multiray, scan_planar
+from navlab.sim.lidar_rays import beam_dirs, cast_primitives, ray_geom_sets, scan_primitives
+from navlab.sim.lidar_rays import lidar_angles as lidar_angles  # re-exported: its home before the split
+from navlab.sim.raycast import finish_ranges, multiray
 from navlab.sim.scene import add_world_model, build_spec, compile_spec, remove_world_model
 from navlab.world import ModelSpec, WorldModel
 
@@ -35,15 +37,6 @@ class Pose3D:
     def yaw(self) -> float:
         """Heading about world z (rad)."""
         return yaw_from_quat(self.quaternion)
-
-
-def lidar_angles(cfg: LidarConfig) -> np.ndarray:
-    """Beam angles (rad, laser frame) as Gazebo spaces them: ``samples`` from min to max inclusive."""
-    if cfg.samples < 1:
-        raise SimError(f"lidar {cfg.name!r}: samples must be >= 1, got {cfg.samples}")
-    if cfg.samples == 1:
-        return np.array([cfg.min_angle])
-    return np.linspace(cfg.min_angle, cfg.max_angle, cfg.samples)
 
 
 class Simulation:
@@ -99,14 +92,7 @@ class Simulation:
         self._wheel_qpos: tuple[list[int], list[int]] | None = None  # (left, right) wheel joints' qpos addresses
         self._lidar_site = [name2id(m, mujoco.mjtObj.mjOBJ_SITE, n) for n in self.info.lidar_sites]
         self._imu_site = [name2id(m, mujoco.mjtObj.mjOBJ_SITE, n) for n in self.info.imu_sites]
-        in_rays = RAY_GEOMGROUP[np.clip(m.geom_group, 0, 5)].astype(bool) & (m.geom_group < 6)
-        fast = in_rays & np.isin(m.geom_type, FAST_TYPES) & (m.geom_group == GROUP_WORLD)
-        self._ray_fast = np.flatnonzero(fast).astype(np.int32)
-        slow = np.unique(m.geom_group[in_rays & ~fast])
-        self._ray_slow_groups = None
-        if len(slow):
-            self._ray_slow_groups = np.zeros(6, dtype=np.uint8)
-            self._ray_slow_groups[slow] = 1
+        self._ray_fast, self._ray_slow_groups = ray_geom_sets(m)
         self._body = self._link_frames()
         # links whose frame is their MuJoCo body's own frame (no offset): poses and twists read directly
         self._body_frame = {k: not xyz.any() and quat[0] == 1.0 for k, (_, xyz, quat) in self._body.items()}
@@ -392,17 +378,9 @@ class Simulation:
         # primitives only: the cast and the noise in one compiled call (the same values as the path above)
         self._sync()
         angles = self._beam_dirs(index, cfg)
-        n = angles.shape[1]
-        normals = self._draw_normals(index, cfg, n, rng)  # the cast draws nothing: the same draws as above
-        m, d = self.model, self.data
+        normals = self._draw_normals(index, cfg, angles.shape[1], rng)  # the cast draws nothing: the same draws
         site = self._lidar_site[index]
-        out = np.empty(n, dtype=np.float32)
-        scan_planar(
-            d.site_xpos[site], d.site_xmat[site].reshape(3, 3), angles[0], angles[1], cfg.min_angle,
-            (cfg.max_angle - cfg.min_angle) / (n - 1) if n > 1 else 0.0, self._ray_fast, m.geom_type, m.geom_size,
-            d.geom_xpos, d.geom_xmat, cfg.range_min, cfg.range_max, normals, cfg.noise_mean, cfg.noise_stddev, out,
-        )  # fmt: skip
-        return out
+        return scan_primitives(self.model, self.data, site, angles, cfg, self._ray_fast, normals)
 
     def _draw_normals(self, index: int, cfg: LidarConfig, n: int, rng: np.random.Generator | None) -> np.ndarray:
         """Lidar ``index``'s noise draws for one scan of ``n`` beams: standard_normal(n) from ``rng`` (or the
@@ -418,8 +396,7 @@ class Simulation:
         """(2, n) cos, sin of lidar ``index``'s beam angles in its frame, worked out once."""
         angles = self._lidar_dirs.get(index)
         if angles is None:
-            a = lidar_angles(cfg)
-            angles = self._lidar_dirs[index] = np.ascontiguousarray(np.stack([np.cos(a), np.sin(a)]))
+            angles = self._lidar_dirs[index] = beam_dirs(cfg)
         return angles
 
     def true_ranges(self, index: int = 0, *, backend: str | None = None) -> np.ndarray:
@@ -431,29 +408,11 @@ class Simulation:
         m, d = self.model, self.data
         site = self._lidar_site[index]
         angles = self._beam_dirs(index, cfg)
-        n = angles.shape[1]
         rot = d.site_xmat[site].reshape(3, 3)
         pnt = d.site_xpos[site].copy()
         if (backend or self.lidar_backend) == "mujoco":
             return multiray(m, d, cfg.range_min, cfg.range_max, rot, pnt, angles, RAY_GEOMGROUP)
-        dist = np.empty(n)
-        inc = (cfg.max_angle - cfg.min_angle) / (n - 1) if n > 1 else 0.0
-        cast_planar(
-            pnt,
-            rot,
-            angles[0],
-            angles[1],
-            cfg.min_angle,
-            inc,
-            self._ray_fast,
-            m.geom_type,
-            m.geom_size,
-            d.geom_xpos,
-            d.geom_xmat,
-            cfg.range_min,
-            cfg.range_max,
-            dist,
-        )
+        dist = cast_primitives(m, d, pnt, rot, angles, cfg, self._ray_fast)
         if self._ray_slow_groups is not None:
             slow = multiray(m, d, cfg.range_min, cfg.range_max, rot, pnt, angles, self._ray_slow_groups)
             np.minimum(dist, slow, out=dist)
