@@ -1,5 +1,6 @@
 """Looking into a launch running in another process: topic list/echo/hz, node list, graph, clean stop."""
 
+import contextlib
 import json
 import os
 import signal
@@ -107,17 +108,34 @@ def test_remote_cmd_vel_drives_the_robot_of_a_running_launch():
         stdout=subprocess.DEVNULL,
         stderr=subprocess.DEVNULL,
     )
+
+    def odom_now():
+        with contextlib.closing(subscribe(sock, "/ground_truth/odom")) as stream:
+            return next(stream)[1]
+
+    def stamp(odom) -> float:  # simulated seconds
+        return odom.header.stamp.sec + 1e-9 * odom.header.stamp.nanosec
+
     try:
         sock = socket_dir() / f"{proc.pid}.sock"
         deadline = time.monotonic() + 120  # a cold Numba cache on a loaded machine: start-up takes a while
-        while not sock.exists() and time.monotonic() < deadline:
+        while not sock.exists() and time.monotonic() < deadline and proc.poll() is None:
             time.sleep(0.1)
+        assert sock.exists(), "the sim launch made no introspection socket in 120 s"
         pub = RemotePublisher(sock)
-        for _ in range(30):  # 3 s of wall time at 10 Hz = 6 simulated s at rate 2
+        odom = odom_now()
+        start = stamp(odom)
+        deadline = time.monotonic() + 120  # the launch's simulated time, not wall time, decides (machine load)
+        sent = 0
+        while stamp(odom) - start < 6.0:  # 6 simulated s of 0.5 m/s commands, about 3 m
+            assert time.monotonic() < deadline, f"only {stamp(odom) - start:.2f} simulated s in 120 wall s"
             pub.publish("/cmd_vel", msgs.twist(0.5, 0.0))
+            sent += 1
             time.sleep(0.1)
+            if sent % 5 == 0:
+                odom = odom_now()
         pub.close()
-        _, odom = next(iter(subscribe(sock, "/ground_truth/odom")))
+        odom = odom_now()
     finally:
         proc.terminate()
         proc.wait(20)

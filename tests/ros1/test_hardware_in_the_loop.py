@@ -5,10 +5,11 @@ reading its scan, odom and tf and following its /clock; a rospy action client's 
 from __future__ import annotations
 
 import math
+import signal
 import subprocess
 import sys
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -54,9 +55,9 @@ def hil(ros_env: dict[str, str], room_map: Path, robot: subprocess.Popen[bytes])
 
 
 @pytest.fixture(scope="module")
-def recording(ros_env: dict[str, str], tmp_path_factory: pytest.TempPathFactory) -> Iterator[Callable[[], Path]]:
-    """What the robot sends while the first test drives it: a ROS 1 bag with /clock, for `rosbag play`
-    (call the fixture's value to wait for the bag to be closed)."""
+def drive(ros_env: dict[str, str], hil: LiveRun, tmp_path_factory: pytest.TempPathFactory) -> tuple[int, Path]:
+    """move_base drives the robot to (1.5, 0) in map while `rosbag record` records what the robot sends (with
+    /clock, for `rosbag play`) from before the goal is sent until its result: the goal's final state and the bag."""
     bag = tmp_path_factory.mktemp("bag") / "robot.bag"
     rec = subprocess.Popen(
         [
@@ -64,33 +65,40 @@ def recording(ros_env: dict[str, str], tmp_path_factory: pytest.TempPathFactory)
             "record",
             "-O",
             str(bag),
-            "--duration=10",
             "/clock",
             "/tf",
             "/tf_static",
             "/odom",
             "/mybot/laser/scan",
             "/ground_truth/odom",
+            "__name:=hil_recorder",
         ],
         env=ros_env,
         stdout=subprocess.DEVNULL,
         stderr=subprocess.DEVNULL,
     )
-    time.sleep(2.0)  # subscribed before the goal is sent
-
-    def finished() -> Path:
+    try:
+        deadline = time.monotonic() + 60  # subscribed before the goal is sent (slow on a loaded machine)
+        while "/hil_recorder" not in ros(ros_env, "rostopic", "info", "/ground_truth/odom", ok=(0, 1)):
+            assert rec.poll() is None, f"rosbag record exited ({rec.returncode})"
+            assert time.monotonic() < deadline, "rosbag record did not subscribe to /ground_truth/odom in 60 s"
+            time.sleep(0.2)
+        state = send_move_base_goal(ros_env, 1.5, 0.0, timeout=90)
+    finally:
+        rec.send_signal(signal.SIGINT)  # `rosbag record` closes the bag on SIGINT, as on Ctrl-C
         rec.wait(30)
-        return bag
-
-    yield finished
-    rec.wait(30)
+    deadline = time.monotonic() + 60  # its recorder child writes the index and renames the .active file
+    while not bag.exists():
+        assert time.monotonic() < deadline, f"rosbag record left no {bag.name} 60 s after SIGINT"
+        time.sleep(0.2)
+    return state, bag
 
 
 def test_move_base_drives_the_robot_of_another_process_to_the_goal(
-    hil: LiveRun, ros_env: dict[str, str], recording: Callable[[], Path]
+    hil: LiveRun, ros_env: dict[str, str], drive: tuple[int, Path]
 ) -> None:
     assert "/gazebo" not in hil.ex.nodes  # no simulator in this run
-    assert send_move_base_goal(ros_env, 1.5, 0.0, timeout=90) == 3  # SUCCEEDED
+    assert drive[0] == 3  # SUCCEEDED
     truth = yaml.safe_load(
         ros(ros_env, "rostopic", "echo", "-n", "1", "/ground_truth/odom/pose/pose/position").split("---")[0]
     )
@@ -98,7 +106,7 @@ def test_move_base_drives_the_robot_of_another_process_to_the_goal(
 
 
 def test_amcl_localizes_on_a_rosbag_play_of_the_robot(
-    recording: Callable[[], Path], room_map: Path, ros_env: dict[str, str], tmp_path: Path
+    drive: tuple[int, Path], room_map: Path, ros_env: dict[str, str], tmp_path: Path
 ) -> None:
     """The recording of the drive above (its map -> odom left out), played by `rosbag play` on a fresh master to
     map_server + amcl (``localization sim:=false``): amcl ends where the recorded ground truth ends."""
@@ -109,7 +117,7 @@ def test_amcl_localizes_on_a_rosbag_play_of_the_robot(
         ros_env,
         "rosbag",
         "filter",
-        str(recording()),
+        str(drive[1]),
         str(filtered),
         "topic != '/tf' or m.transforms[0].child_frame_id != 'odom'",
         timeout=60,
@@ -144,8 +152,14 @@ def test_amcl_localizes_on_a_rosbag_play_of_the_robot(
             y=str(start.y),
         )
         try:
-            play.wait(60)
-            time.sleep(1.0)  # the bag's clock has stopped, and with it the run: its tf can be read from here
+            play.wait(120)
+            stamp = truth[-1].header.stamp
+            end_ns = stamp.sec * 1_000_000_000 + stamp.nanosec
+            deadline = time.monotonic() + 60  # the run follows the bag's /clock: wait until it has caught up
+            while run.ex.now_ns < end_ns:
+                assert time.monotonic() < deadline, f"the run reached {run.ex.now_ns / 1e9:.2f} of {end_ns / 1e9:.2f} s"
+                time.sleep(0.1)
+            time.sleep(1.0)  # its last callbacks run; the clock has stopped, and with it the run: read its tf
             x, y, _ = run.ex.tf.lookup_pose2d("map", "chassis", None)
         finally:
             run.close()
