@@ -5,8 +5,11 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from enum import StrEnum
+from typing import Any
 
 import numpy as np
+
+from navlab import msgs
 
 Pose = tuple[float, float, float]
 
@@ -99,3 +102,15 @@ def with_headings(xy: np.ndarray, goal_yaw: float) -> np.ndarray:
         yaw[:-1] = np.arctan2(d[:, 1], d[:, 0])
     yaw[-1] = goal_yaw
     return np.column_stack([xy, yaw])
+
+
+def status_array(handle: GoalHandle | None) -> Any:
+    """``action_msgs/GoalStatusArray`` of move_base's current goal (empty without one): its id in the UUID's first
+    8 bytes (little-endian), its start stamp and its state's status code."""
+    statuses = []
+    if handle is not None:
+        uuid = np.zeros(16, dtype=np.uint8)
+        uuid[:8] = np.frombuffer(int(handle.id).to_bytes(8, "little"), dtype=np.uint8)
+        info = msgs.GoalInfo(goal_id=msgs.UUID(uuid=uuid), stamp=msgs.time_from_ns(round(handle.start_s * 1e9)))
+        statuses.append(msgs.GoalStatus(goal_info=info, status=STATUS[handle.state]))
+    return msgs.GoalStatusArray(status_list=statuses)

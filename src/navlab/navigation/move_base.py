@@ -25,7 +25,7 @@ from navlab.core import Executor, Node, TfError
 from navlab.geometry import transform_points2, wrap_angle
 from navlab.navigation.costmap_ros import Costmap2DROS
 from navlab.navigation.errors import NavigationError
-from navlab.navigation.goal import STATUS, GoalHandle, GoalState, MoveBaseState, RecoveryTrigger, with_headings
+from navlab.navigation.goal import GoalHandle, GoalState, MoveBaseState, RecoveryTrigger, status_array, with_headings
 from navlab.navigation.keepout import held_up_at, with_keepouts
 from navlab.navigation.move_base_config import (
     MOVE_BASE_DEFAULTS,
@@ -405,9 +405,8 @@ class MoveBase(Node):
 
     def _publish_path(self, pub: Any, poses: np.ndarray, frame: str) -> None:
         """``nav_msgs/Path`` of (N, 2+) poses, built only when someone listens (hundreds of messages each)."""
-        if not (pub.get_subscription_count() or self.executor.has_listeners):
-            return
-        pub.publish(msgs.path(self.executor.now_ns, frame, poses))
+        if not self._unwatched(pub):
+            pub.publish(msgs.path(self.executor.now_ns, frame, poses))
 
     # --- recoveries ------------------------------------------------------------------------------------
 
@@ -483,24 +482,14 @@ class MoveBase(Node):
         self.global_costmap.update()
         return {"plan": self.make_plan(start, goal)}
 
+    def _unwatched(self, pub: Any) -> bool:
+        """Whether nobody subscribes to ``pub``'s topic or listens (recorder, echo, bridge)."""
+        return not (pub.get_subscription_count() or self.executor.has_listeners)
+
     def _status_unwatched(self) -> bool:
-        """Whether nobody subscribes to the status or listens (the status timer then parks until one does)."""
-        return not (self.status_pub.get_subscription_count() or self.executor.has_listeners)
+        """The status timer's idle test: it parks until someone subscribes or listens."""
+        return self._unwatched(self.status_pub)
 
     def _publish_status(self) -> None:
-        if self._status_unwatched():
-            return  # built only when someone listens, as the paths are
-        h = self.handle
-        statuses = []
-        if h is not None:
-            uuid = np.zeros(16, dtype=np.uint8)
-            uuid[:8] = np.frombuffer(int(h.id).to_bytes(8, "little"), dtype=np.uint8)
-            statuses.append(
-                msgs.GoalStatus(
-                    goal_info=msgs.GoalInfo(
-                        goal_id=msgs.UUID(uuid=uuid), stamp=msgs.time_from_ns(round(h.start_s * 1e9))
-                    ),
-                    status=STATUS[h.state],
-                )
-            )
-        self.status_pub.publish(msgs.GoalStatusArray(status_list=statuses))
+        if not self._status_unwatched():  # built only when someone listens, as the paths are
+            self.status_pub.publish(status_array(self.handle))
