@@ -1,10 +1,12 @@
 """Ctrl-C (SIGINT) and SIGTERM stop `navlab teleop` at once and give the terminal back, also when it runs as a
-background job of a script (SIGINT inherited ignored: Python then installs no handler of its own)."""
+background job of a script (SIGINT inherited ignored: Python then installs no handler of its own); in
+`navlab map --teleop` they end the drive and save the map."""
 
 from __future__ import annotations
 
 import signal
 import termios
+import time
 from pathlib import Path
 
 import pytest
@@ -26,3 +28,34 @@ def test_teleop_stops_on_a_signal_with_sigint_inherited_ignored(tmp_path: Path, 
         assert term.lflag() == before  # the terminal's settings are back (line editing, echo)
     finally:
         term.close()
+
+
+def test_map_teleop_saves_the_map_on_ctrl_c(tmp_path: Path) -> None:
+    """gmapping + teleop, then Ctrl-C: the drive stops and the map so far is saved whole (map_saver's files,
+    the picture, the trajectory) with walls where the world's walls are, and the verb says where it went."""
+    from navlab.experiments import read_map_trajectory, score_map
+    from navlab.mapping import load_map
+    from navlab.world import load_world, true_occupancy
+
+    term = Terminal(["map", "--teleop", "--world", "room", "--out", "m"], tmp_path)
+    try:
+        before = term.lflag()
+        term.wait_for("CTRL-C: quit", 120.0, stream="stdout")  # teleop_twist_keyboard's help: driving
+        term.keys(b"i")  # forward at 0.5 m/s, in real time
+        time.sleep(4.0)
+        term.keys(b"k")
+        term.signal(signal.SIGINT)
+        code = term.finish(60.0, after="SIGINT")
+        assert code == 0, term.stderr
+        assert term.lflag() == before
+    finally:
+        term.close()
+    assert "saving the map" in term.stderr and "Traceback" not in term.stderr
+    assert "stopped by Ctrl-C after" in term.stdout and "m/map.yaml" in term.stdout
+    out = tmp_path / "m"
+    assert sorted(p.name for p in out.iterdir()) == ["map.pgm", "map.png", "map.yaml", "trajectory.txt"]  # no temp
+    _est, truth = read_map_trajectory(out / "trajectory.txt")
+    assert truth[-1, 0] - truth[0, 0] > 0.5, "the robot did not drive forward before Ctrl-C"
+    grid = load_map(out / "map.yaml")
+    score = score_map(grid, true_occupancy(load_world("room"), grid))  # mybot's odometry: map frame = world
+    assert score["occupied_cells"] > 300 and score["precision"] > 0.9, score

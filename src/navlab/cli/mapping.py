@@ -24,15 +24,17 @@ from navlab.cli.options import (
 from navlab.cli.runs import ros_hook, stop_signals, view_hook
 
 
-@stop_signals()  # --teleop runs until Ctrl-C: also as a background job
 def _cmd_map(args: argparse.Namespace) -> int:
     apply_resource_paths(args)  # --package-path / --model-path, for this process and its workers
     if args.action == "save":
         return _cmd_map_save(args)
+    if args.teleop:
+        _need_terminal("map --teleop")  # before the simulator starts
     from navlab.experiments import run_mapping
 
     driver = "teleop" if args.teleop else "route" if args.route else "explore"
-    with view_hook(args) as view, ros_hook(args, view) as on_start:
+    # Ctrl-C (or SIGTERM, also as a background job) ends the drive and saves the map so far; a second one quits
+    with stop_signals() as stop, view_hook(args) as view, ros_hook(args, view) as then:
         result = run_mapping(
             world=args.world,
             robot=args.robot,
@@ -47,14 +49,26 @@ def _cmd_map(args: argparse.Namespace) -> int:
             record=args.record,
             quiet=args.quiet,
             slam_params=parse_sets(args.set),
-            on_start=on_start,
+            on_start=stop.on_start(then, "stopping the drive; saving the map (Ctrl-C again: quit without saving)"),
         )
     if not args.json:
-        print(f"saved {result.map_yaml} (+ map.pgm, map.png) after {result.sim_s:.1f} simulated s")
+        how = "stopped by Ctrl-C" if stop.requested else "saved"
+        print(f"{how} after {result.sim_s:.1f} simulated s: {result.map_yaml} (+ map.pgm, map.png)")
     print_figures(result.scores, args.json)
     return 0
 
 
+def _need_terminal(verb: str) -> None:
+    """Keyboard teleop reads keys from a terminal: one clear line when stdin is none (a pipe, a file)."""
+    if not sys.stdin.isatty():
+        from navlab.drivers import DriverError
+
+        raise DriverError(
+            f"navlab {verb} reads keys from a terminal (stdin is not one); run it in an interactive shell"
+        )
+
+
+@stop_signals()  # waiting for a /map, or running a launch: Ctrl-C and SIGTERM end it, also as a background job
 def _cmd_map_save(args: argparse.Namespace) -> int:
     """map_saver: save the current ``/map`` of a running ``navlab launch``, or of one started here."""
     from navlab import msgs
@@ -154,6 +168,8 @@ def _cmd_teleop(args: argparse.Namespace) -> int:
     """Drive the robot from the keyboard (teleop_twist_keyboard) or a joystick, in real time: the robot
     of a `navlab launch` running in another shell, or (with --world, or when none runs) a simulator
     started here."""
+    if not args.joy:
+        _need_terminal("teleop")  # before the simulator starts
     with contextlib.ExitStack() as stack:  # the terminal's settings come back, the remote publisher closes
         ex, gazebo, remote = _teleop_executor(args)
         if remote is not None:
@@ -169,10 +185,6 @@ def _cmd_teleop(args: argparse.Namespace) -> int:
         else:
             from navlab.drivers import HELP, TeleopKeyboard, terminal_keys
 
-            if not sys.stdin.isatty():
-                from navlab.mapping import MappingError
-
-                raise MappingError("navlab teleop reads keys from a terminal; run it in an interactive shell")
             teleop = TeleopKeyboard(ex, parameters={"speed": args.speed, "turn": args.turn})
             print(HELP)
             stack.enter_context(terminal_keys(teleop, ex))
