@@ -37,6 +37,8 @@ def test_a_mistyped_verb_gets_did_you_mean(capsys: pytest.CaptureFixture[str]) -
         ),
         (["localize", "--world", "missing.world"], "navlab: error: world file not found: "),
         (["map", "--robot", "mybt"], "navlab: error: robot 'mybt': no such file here and no shipped robot"),
+        (["map", "--teleop"], "navlab: error: navlab map --teleop reads keys from a terminal (stdin is not one)"),
+        (["teleop", "--world", "room"], "navlab: error: navlab teleop reads keys from a terminal"),
     ],
 )
 def test_a_missing_world_or_robot_is_one_line_before_heavy_imports(argv: list[str], message: str, tmp_path) -> None:
@@ -44,7 +46,14 @@ def test_a_missing_world_or_robot_is_one_line_before_heavy_imports(argv: list[st
         "import sys, time; t = time.perf_counter(); from navlab.cli import main; rc = main(sys.argv[1:]); "
         "print(rc, time.perf_counter() - t, *[m for m in ('mujoco', 'numba', 'ray') if m in sys.modules])"
     )
-    proc = subprocess.run([sys.executable, "-c", code, *argv], capture_output=True, text=True, cwd=tmp_path, timeout=60)
+    proc = subprocess.run(  # stdin no terminal: keyboard teleop refuses it before the simulator starts
+        [sys.executable, "-c", code, *argv],
+        stdin=subprocess.DEVNULL,
+        capture_output=True,
+        text=True,
+        cwd=tmp_path,
+        timeout=60,
+    )
     rc, seconds, *heavy = proc.stdout.split()
     assert rc == "2" and proc.stderr.startswith(message) and proc.stderr.count("\n") == 1, proc.stderr
     assert heavy == [] and float(seconds) < 5.0
