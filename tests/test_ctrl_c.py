@@ -59,3 +59,29 @@ def test_map_teleop_saves_the_map_on_ctrl_c(tmp_path: Path) -> None:
     grid = load_map(out / "map.yaml")
     score = score_map(grid, true_occupancy(load_world("room"), grid))  # mybot's odometry: map frame = world
     assert score["occupied_cells"] > 300 and score["precision"] > 0.9, score
+
+
+def test_experiment_run_keeps_whole_trials_on_ctrl_c(tmp_path: Path) -> None:
+    """Ctrl-C reaches the driver and its worker processes (a terminal signals the whole job): the finished
+    trials stay in results.jsonl, whole, the workers leave no temporary folder, and the verb says so."""
+    import json
+
+    term = Terminal(["experiment", "run", "empty_room", "--trials", "6", "--workers", "2", "--out", "r"], tmp_path)
+    results = tmp_path / "r" / "results.jsonl"
+    try:
+        deadline = time.monotonic() + 240.0
+        while not (results.is_file() and results.read_text().count("\n") >= 1):
+            if term.proc.poll() is not None or time.monotonic() > deadline:
+                term._fail("no trial finished")
+            time.sleep(0.2)
+        term.signal(signal.SIGINT)
+        code = term.finish(60.0, after="SIGINT")
+    finally:
+        term.close()
+    lines = results.read_text().splitlines()
+    assert code == 130 and 1 <= len(lines) < 6, term.stderr
+    trials = [json.loads(line) for line in lines]  # each line one whole trial
+    assert len({t["trial"] for t in trials}) == len(lines) and all("success" in t for t in trials)
+    assert f"{len(lines)} finished trial" in term.stderr and "the same command resumes" in term.stderr
+    assert "Traceback" not in term.stderr and "leaked" not in term.stderr, term.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["r"]  # no trial's temporary folder left (TMPDIR here)

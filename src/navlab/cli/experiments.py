@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
+from typing import Any
 
 from navlab.cli.options import (
     add_resource_path_arguments,
@@ -13,14 +14,30 @@ from navlab.cli.options import (
     apply_resource_paths,
     print_figures,
 )
+from navlab.cli.runs import stop_signals
 
 
+@stop_signals()  # SIGTERM as Ctrl-C: the workers stop, the finished trials stay
 def _cmd_experiment(args: argparse.Namespace) -> int:
     apply_resource_paths(args)  # --package-path / --model-path, for this process and its workers
-    from navlab.experiments import ExperimentError, load_scenario, run_experiment
+    from navlab.experiments import load_scenario
 
     sc = load_scenario(args.file)
     out = args.out or f"runs/{sc.name}"
+    try:
+        return _run_or_sweep(args, sc, out)
+    except KeyboardInterrupt as exc:  # results.jsonl holds every finished trial whole, one line each
+        from navlab.experiments.trials import read_results
+
+        pattern = "*/results.jsonl" if args.action == "sweep" else "results.jsonl"  # a sweep: one per combination
+        n = sum(len(read_results(f)) for f in Path(out).glob(pattern))
+        exc.add_note(f"{n} finished trial{'' if n == 1 else 's'} in {out}/{pattern}, whole; the same command resumes")
+        raise
+
+
+def _run_or_sweep(args: argparse.Namespace, sc: Any, out: str) -> int:
+    from navlab.experiments import ExperimentError, run_experiment
+
     trials = {
         "trials": args.trials,
         "seed": args.seed,

@@ -57,8 +57,20 @@ def run_tasks(
         return
     import multiprocessing
 
-    with multiprocessing.get_context("spawn").Pool(n) as pool:
+    with multiprocessing.get_context("spawn").Pool(n, initializer=_worker_signals) as pool:
         yield from pool.imap_unordered(functools.partial(_indexed, fn), list(enumerate(items)))
+
+
+def _worker_signals() -> None:
+    """A worker leaves Ctrl-C to the driver (a terminal sends it to every process of the job) and ends on the
+    pool's SIGTERM as on an exception, so its ``finally`` blocks (a trial's temporary folder) still run."""
+    import signal
+
+    def end(_signum: int, _frame: Any) -> None:
+        raise SystemExit(143)
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, end)
 
 
 def _run_ray(fn: Callable[[T], R], items: Sequence[T], workers: int | None) -> Iterator[tuple[int, R]]:
