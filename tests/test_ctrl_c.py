@@ -7,6 +7,7 @@ from __future__ import annotations
 import signal
 import termios
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 import pytest
@@ -85,3 +86,17 @@ def test_experiment_run_keeps_whole_trials_on_ctrl_c(tmp_path: Path) -> None:
     assert f"{len(lines)} finished trial" in term.stderr and "the same command resumes" in term.stderr
     assert "Traceback" not in term.stderr and "leaked" not in term.stderr, term.stderr
     assert sorted(p.name for p in tmp_path.iterdir()) == ["r"]  # no trial's temporary folder left (TMPDIR here)
+
+
+def test_slam_interrupted_writes_nothing_and_says_so(tmp_path: Path, dataset: Callable[[str], Path]) -> None:
+    """SIGTERM (as Ctrl-C) in the middle of offline SLAM on CSAIL (~14 s of CPU): nothing half-written."""
+    term = Terminal(["slam", "--log", str(dataset("mit-csail/mit-csail.clf")), "--out", "o"], tmp_path)
+    try:
+        time.sleep(4.0)
+        assert term.proc.poll() is None, "navlab slam ended before it was interrupted"
+        term.signal(signal.SIGTERM)
+        code = term.finish(30.0, after="SIGTERM")
+    finally:
+        term.close()
+    assert code == 130 and "navlab: interrupted; SLAM had not finished: nothing written to o" in term.stderr
+    assert not (tmp_path / "o").exists()

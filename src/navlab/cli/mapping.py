@@ -22,6 +22,7 @@ from navlab.cli.options import (
     start_pose,
 )
 from navlab.cli.runs import ros_hook, stop_signals, view_hook
+from navlab.errors import interrupt_note
 
 
 def _cmd_map(args: argparse.Namespace) -> int:
@@ -113,6 +114,7 @@ def _params_file(path: str | None) -> dict:
     return doc
 
 
+@stop_signals()  # SIGTERM as Ctrl-C, also as a background job: the note says what is written
 def _cmd_slam(args: argparse.Namespace) -> int:
     from navlab.io import data_file, read_carmen, skipped_summary
 
@@ -125,25 +127,28 @@ def _cmd_slam(args: argparse.Namespace) -> int:
     if note:
         print(f"navlab slam: warning: {note}", file=sys.stderr)
     t0 = time.perf_counter()
-    result = run_offline(
-        log,
-        mode=args.mode,
-        params={**_params_file(args.params), **parse_sets(args.set)},
-        seed=args.seed,
-        resolution=args.resolution,
-        max_scans=args.max_scans,
-        progress=not args.quiet and sys.stderr.isatty(),
-    )
+    with interrupt_note(f"SLAM had not finished: nothing written to {args.out}"):
+        result = run_offline(
+            log,
+            mode=args.mode,
+            params={**_params_file(args.params), **parse_sets(args.set)},
+            seed=args.seed,
+            resolution=args.resolution,
+            max_scans=args.max_scans,
+            progress=not args.quiet and sys.stderr.isatty(),
+        )
     wall = time.perf_counter() - t0
-    paths = write_outputs(result, args.out)
-    paths["figure"] = Path(args.out) / "map.png"
-    plot_run(
-        result.grid,
-        [Track(result.poses, "SLAM trajectory", "r-", width=0.7)],
-        paths["figure"],
-        title=f"{log.path.name if log.path else ''} ({args.mode})",
-        crop=False,
-    )
+    # map.yaml + map.pgm, poses.txt, map.png in this order, each whole (temp name + rename) or not at all
+    with interrupt_note(f"while writing {args.out}: its map.yaml, poses.txt and map.png are each whole or old"):
+        paths = write_outputs(result, args.out)
+        paths["figure"] = Path(args.out) / "map.png"
+        plot_run(
+            result.grid,
+            [Track(result.poses, "SLAM trajectory", "r-", width=0.7)],
+            paths["figure"],
+            title=f"{log.path.name if log.path else ''} ({args.mode})",
+            crop=False,
+        )
     log_s = float(result.timestamps[-1] - result.timestamps[0])
     summary = rounded(
         {
