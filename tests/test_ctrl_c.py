@@ -100,3 +100,25 @@ def test_slam_interrupted_writes_nothing_and_says_so(tmp_path: Path, dataset: Ca
         term.close()
     assert code == 130 and "navlab: interrupted; SLAM had not finished: nothing written to o" in term.stderr
     assert not (tmp_path / "o").exists()
+
+
+def test_sim_ends_on_a_signal_as_at_its_duration_with_the_recording_whole(tmp_path: Path) -> None:
+    """`navlab sim` in real time, SIGINT (a script's background job: SIGINT inherited ignored): the run ends,
+    the summary is printed and the rosbag2 recording is closed whole, as at the end of --duration."""
+    from navlab.io import bag_topics
+
+    term = Terminal(["sim", "--duration", "600", "--rate", "1", "--record", "bag"], tmp_path, ignore_sigint=True)
+    try:
+        deadline = time.monotonic() + 120.0
+        while not any(tmp_path.glob("**/*.mcap")):  # the recording is staged: the run has started
+            if term.proc.poll() is not None or time.monotonic() > deadline:
+                term._fail("no recording started")
+            time.sleep(0.2)
+        time.sleep(2.0)
+        term.signal(signal.SIGINT)
+        code = term.finish(30.0, after="SIGINT")
+    finally:
+        term.close()
+    assert code == 0 and "stopping the simulation" in term.stderr, term.stderr
+    assert "record: bag" in term.stdout and "sim_s: " in term.stdout
+    assert bag_topics(tmp_path / "bag")["/odom"][1] > 10  # whole: indexed, readable, /odom at 20+ Hz
