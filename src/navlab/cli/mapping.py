@@ -53,8 +53,8 @@ def _cmd_map(args: argparse.Namespace) -> int:
             on_start=stop.on_start(then, "stopping the drive; saving the map (Ctrl-C again: quit without saving)"),
         )
     if not args.json:
-        how = "stopped by Ctrl-C" if stop.requested else "saved"
-        print(f"{how} after {result.sim_s:.1f} simulated s: {result.map_yaml} (+ map.pgm, map.png)")
+        stopped = f"stopped by Ctrl-C after {result.sim_s:.1f} simulated s; " if stop.requested else ""
+        print(f"{stopped}saved {result.map_yaml} (+ map.pgm, map.png) after {result.sim_s:.1f} simulated s")
     print_figures(result.scores, args.json)
     return 0
 
@@ -239,21 +239,31 @@ def _show_teleop(teleop: Any, gazebo: Any) -> None:
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add ``map``, ``slam`` and ``teleop``."""
+    from navlab.resources import shipped
+
     p = sub.add_parser(
         "map",
         help="build a map with SLAM in simulation (exploration, teleop or a route) and save it",
         description="The paper's mapping launch: simulator + slam_gmapping + a driver. Saves DIR/map.yaml, "
         "DIR/map.pgm, DIR/map.png (map with SLAM and true trajectories) and DIR/trajectory.txt, and prints the "
-        "map's score against the world. `navlab map save --out DIR` saves the current /map of a running "
+        "map's score against the world. It ends when exploration is done, the route ends or --duration passes; "
+        "Ctrl-C (or SIGTERM) ends it sooner and saves the map so far, as gmapping + map_saver would (a second "
+        "Ctrl-C quits without saving). `navlab map save --out DIR` saves the current /map of a running "
         "`navlab launch` (map_saver); with --launch FILE it starts the launch itself.",
     )
     p.add_argument("action", nargs="?", choices=["save"], help="save: run a launch and save its /map")
     add_world_robot(p, "room")
     drive = p.add_mutually_exclusive_group()
     drive.add_argument("--explore", action="store_true", help="frontier exploration (the default)")
-    drive.add_argument("--teleop", action="store_true", help="drive with the keyboard, in real time")
     drive.add_argument(
-        "--route", metavar="FILE", help="a route YAML (segments and/or waypoints) or a shipped route's name (room)"
+        "--teleop",
+        action="store_true",
+        help="drive with the keyboard (teleop_twist_keyboard's keys) in real time; Ctrl-C saves the map",
+    )
+    drive.add_argument(
+        "--route",
+        metavar="FILE",
+        help=f"a route YAML (segments and/or waypoints) or a shipped route's name ({', '.join(shipped('route'))})",
     )
     p.add_argument("--out", default="map", metavar="DIR", help="output folder (default ./map)")
     p.add_argument(
@@ -313,7 +323,9 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--world", default=None, help="start this world here (file or shipped name) instead of driving a running launch"
     )
     p.add_argument("--pid", type=int, help="which running navlab launch to drive, when several run")
-    p.add_argument("--robot", default="mybot", help="robot file or shipped name (default mybot)")
+    p.add_argument(
+        "--robot", default="mybot", help=f"robot file or shipped name: {', '.join(shipped('robot'))} (default mybot)"
+    )
     add_pose_arguments(p)
     p.add_argument("--speed", type=float, default=0.5, help="linear speed, m/s (default 0.5)")
     p.add_argument("--turn", type=float, default=1.0, help="angular speed, rad/s (default 1.0)")

@@ -29,13 +29,18 @@ _SPAWN_HELP = (
 
 
 def _add_common(p: argparse.ArgumentParser) -> None:
+    from navlab.resources import shipped
+
     p.add_argument(
-        "--world", default="room", help="shipped world (room, room_obstacles) or a .world file (default: room)"
+        "--world",
+        default="room",
+        help=f"shipped world ({', '.join(shipped('world'))}) or a .world file (default: room)",
     )
     p.add_argument(
         "--robot",
         default="mybot",
-        help="shipped robot (mybot), a .xacro/.urdf file or a package://pkg/urdf/robot.xacro URI (default: mybot)",
+        help=f"shipped robot ({', '.join(shipped('robot'))}), a .xacro/.urdf file or a "
+        "package://pkg/urdf/robot.xacro URI (default: mybot)",
     )
     add_pose_arguments(p)
     add_resource_path_arguments(p)
