@@ -41,8 +41,10 @@ def test_map_teleop_saves_the_map_on_ctrl_c(tmp_path: Path) -> None:
     term = Terminal(["map", "--teleop", "--world", "room", "--out", "m"], tmp_path)
     try:
         before = term.lflag()
-        term.wait_for("CTRL-C: quit", 120.0, stream="stdout")  # teleop_twist_keyboard's help: driving
+        term.wait_for("CTRL-C: quit", 120.0, stream="stdout")  # teleop_twist_keyboard's help
+        term.wait_for("sending linear.x", 60.0)  # its status line: the drive runs
         term.keys(b"i")  # forward at 0.5 m/s, in real time
+        term.wait_for("sending linear.x +0.50", 60.0)
         time.sleep(4.0)
         term.keys(b"k")
         term.signal(signal.SIGINT)

@@ -193,7 +193,7 @@ def _cmd_teleop(args: argparse.Namespace) -> int:
             teleop = TeleopKeyboard(ex, parameters={"speed": args.speed, "turn": args.turn})
             print(HELP)
             stack.enter_context(terminal_keys(teleop, ex))
-            teleop.create_timer(0.25, lambda: _show_teleop(teleop, gazebo))
+            teleop.show_status(gazebo.sim.base_pose2d if gazebo is not None else None)
         with contextlib.suppress(KeyboardInterrupt):
             ex.spin()
     if gazebo is not None:
@@ -220,21 +220,6 @@ def _teleop_executor(args: argparse.Namespace) -> tuple[Any, Any, Any]:
         "sim", world=args.world or "room", robot=args.robot, pose=start_pose(args), seed=args.seed, rate=args.rate
     )
     return run.executor, run.gazebo, None
-
-
-def _show_teleop(teleop: Any, gazebo: Any) -> None:
-    """One status line, rewritten in place on stderr: simulated time, the command being sent, the speeds (and
-    the robot's pose when the simulator runs here), as teleop_twist_keyboard prints its 'currently:' line."""
-    st, tw = teleop.state, teleop.state.twist()
-    where = ""
-    if gazebo is not None:
-        x, y, yaw = gazebo.sim.base_pose2d()
-        where = f"  robot at ({x:.2f}, {y:.2f}, {yaw:.2f} rad)"
-    sys.stderr.write(
-        f"\rt={teleop.executor.now_ns / 1e9:7.1f} s  sending linear.x {tw.linear.x:+.2f} m/s  angular.z "
-        f"{tw.angular.z:+.2f} rad/s  (currently: speed {st.speed:.2f} turn {st.turn:.2f}){where}  "
-    )
-    sys.stderr.flush()
 
 
 def register(sub: argparse._SubParsersAction) -> None:

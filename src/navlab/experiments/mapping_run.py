@@ -46,9 +46,9 @@ class MappingResult:
     scores: dict[str, Any] = field(default_factory=dict)
 
 
-def _add_driver(run: Run, driver: str, route: str | Path | None, stack: contextlib.ExitStack) -> Any:
+def _add_driver(run: Run, driver: str, route: str | Path | None, stack: contextlib.ExitStack, quiet: bool) -> Any:
     """Start the driver node; returns a callable telling whether it is done. What the driver holds (the
-    terminal, for teleop) is given back when ``stack`` closes."""
+    terminal, for teleop) is given back when ``stack`` closes; teleop shows its status line unless ``quiet``."""
     from navlab.drivers import HELP, RouteFollower, TeleopKeyboard, load_route, terminal_keys
 
     if driver == "explore":
@@ -74,6 +74,8 @@ def _add_driver(run: Run, driver: str, route: str | Path | None, stack: contextl
     teleop = run.add(TeleopKeyboard)
     print("teleop_twist_keyboard:\n" + HELP, flush=True)
     stack.enter_context(terminal_keys(teleop, run.executor))
+    if not quiet:  # in place of the progress bar: what is sent, where the robot is
+        teleop.show_status(run.sim.base_pose2d)
     return lambda: False
 
 
@@ -118,9 +120,10 @@ def run_mapping(
         on_start=on_start,
     )
     with contextlib.ExitStack() as stack:  # the terminal comes back as soon as the drive ends
-        is_done = _add_driver(run, driver, route, stack)
+        is_done = _add_driver(run, driver, route, stack, quiet)
         monitor = run.add(PoseMonitor, parameters={"base_frame": run.base_frame, "odom_frame": run.odom_frame})
-        run.run(duration, until=is_done, record=record, quiet=quiet, desc=f"mapping {world}")
+        no_bar = quiet or driver == "teleop"  # teleop's status line shows the time
+        run.run(duration, until=is_done, record=record, quiet=no_bar, desc=f"mapping {world}")
     from navlab.mapping import SlamGMapping
 
     slam = run.node("slam_gmapping")
