@@ -124,3 +124,30 @@ def test_sim_ends_on_a_signal_as_at_its_duration_with_the_recording_whole(tmp_pa
     assert code == 0 and "stopping the simulation" in term.stderr, term.stderr
     assert "record: bag" in term.stdout and "sim_s: " in term.stdout
     assert bag_topics(tmp_path / "bag")["/odom"][1] > 10  # whole: indexed, readable, /odom at 20+ Hz
+
+
+def test_the_first_signal_ends_a_graceful_run_between_events_the_second_interrupts(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    from navlab.cli.runs import stop_signals
+    from navlab.core import Context, Executor, Node, run_for
+
+    ex = Executor(seed=0)
+    ticks: list[int] = []
+
+    def tick() -> None:
+        ticks.append(ex.now_ns)
+        if len(ticks) == 5:
+            signal.raise_signal(signal.SIGINT)  # Ctrl-C inside a callback: the callback still ends whole
+
+    Node("ticker", context=Context(ex)).create_timer(0.1, tick)
+    with stop_signals() as stop:
+        with pytest.raises(KeyboardInterrupt):  # not graceful yet: Ctrl-C interrupts where it is
+            signal.raise_signal(signal.SIGTERM)
+        stop.graceful(ex, "stopping the ticker")
+        run_for(ex, 100.0, quiet=True)
+        assert stop.requested and ex.stopped and 5 <= len(ticks) <= 6 and ex.now_ns < 1e9
+        assert "stopping the ticker" in capsys.readouterr().err
+        with pytest.raises(KeyboardInterrupt):  # the second one quits
+            signal.raise_signal(signal.SIGINT)
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler  # the previous handler is back
