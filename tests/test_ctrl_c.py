@@ -54,7 +54,7 @@ def test_map_teleop_saves_the_map_on_ctrl_c(tmp_path: Path) -> None:
     finally:
         term.close()
     assert "saving the map" in term.stderr and "Traceback" not in term.stderr
-    assert "stopped by Ctrl-C after" in term.stdout and "m/map.yaml" in term.stdout
+    assert "stopped by Ctrl-C: saved m/map.yaml (+ map.pgm, map.png) after" in term.stdout
     out = tmp_path / "m"
     assert sorted(p.name for p in out.iterdir()) == ["map.pgm", "map.png", "map.yaml", "trajectory.txt"]  # no temp
     _est, truth = read_map_trajectory(out / "trajectory.txt")

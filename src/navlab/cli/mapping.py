@@ -36,24 +36,29 @@ def _cmd_map(args: argparse.Namespace) -> int:
     driver = "teleop" if args.teleop else "route" if args.route else "explore"
     # Ctrl-C (or SIGTERM, also as a background job) ends the drive and saves the map so far; a second one quits
     with stop_signals() as stop, view_hook(args) as view, ros_hook(args, view) as then:
-        result = run_mapping(
-            world=args.world,
-            robot=args.robot,
-            pose=start_pose(args),
-            out=args.out,
-            driver=driver,
-            route=args.route,
-            duration=args.duration,
-            mode=args.mode,
-            seed=args.seed,
-            rate=args.rate or 0.0,
-            record=args.record,
-            quiet=args.quiet,
-            slam_params=parse_sets(args.set),
-            on_start=stop.on_start(then, "stopping the drive; saving the map (Ctrl-C again: quit without saving)"),
-        )
+        try:
+            result = run_mapping(
+                world=args.world,
+                robot=args.robot,
+                pose=start_pose(args),
+                out=args.out,
+                driver=driver,
+                route=args.route,
+                duration=args.duration,
+                mode=args.mode,
+                seed=args.seed,
+                rate=args.rate or 0.0,
+                record=args.record,
+                quiet=args.quiet,
+                slam_params=parse_sets(args.set),
+                on_start=stop.on_start(then, "stopping the drive; saving the map (Ctrl-C again: quit without saving)"),
+            )
+        except KeyboardInterrupt as exc:
+            if not stop.requested:  # while the simulator was starting
+                exc.add_note(f"nothing saved to {args.out}")
+            raise
     if not args.json:
-        stopped = f"stopped by Ctrl-C after {result.sim_s:.1f} simulated s; " if stop.requested else ""
+        stopped = "stopped by Ctrl-C: " if stop.requested else ""
         print(f"{stopped}saved {result.map_yaml} (+ map.pgm, map.png) after {result.sim_s:.1f} simulated s")
     print_figures(result.scores, args.json)
     return 0
