@@ -27,7 +27,7 @@ def _cmd_experiment(args: argparse.Namespace) -> int:
     try:
         return _run_or_sweep(args, sc, out)
     except KeyboardInterrupt as exc:  # results.jsonl holds every finished trial whole, one line each
-        from navlab.experiments.trials import read_results
+        from navlab.experiments import read_results
 
         pattern = "*/results.jsonl" if args.action == "sweep" else "results.jsonl"  # a sweep: one per combination
         n = sum(len(read_results(f)) for f in Path(out).glob(pattern))

@@ -21,7 +21,7 @@ import functools
 import logging
 import os
 import threading
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Generator, Iterator, Sequence
 from typing import Any, TypeVar
 
 from navlab.experiments.errors import ExperimentError
@@ -38,9 +38,9 @@ def _indexed(fn: Callable[[T], R], job: tuple[int, T]) -> tuple[int, R]:
 
 def run_tasks(
     fn: Callable[[T], R], items: Sequence[T], *, backend: str = "local", workers: int | None = None
-) -> Iterator[tuple[int, R]]:
+) -> Generator[tuple[int, R], None, None]:
     """Yield ``(i, fn(items[i]))`` for every item as it finishes; ``workers``: processes (local, default 1) or
-    CPUs of a local Ray instance (default: all)."""
+    CPUs of a local Ray instance (default: all). Closing the generator stops the workers."""
     if backend not in BACKENDS:
         raise ExperimentError(f"backend: expected one of {', '.join(BACKENDS)}, got {backend!r}")
     if workers is not None and workers < 1:

@@ -347,8 +347,8 @@ def run_experiments(
     bar = tqdm(total=total, initial=total - len(tasks), desc=desc, unit="trial", file=sys.stderr, disable=not progress)
     try:
         # closed here, also on Ctrl-C between two results: the workers stop now, not at the interpreter's exit
-        with contextlib.closing(run_tasks(_trial_in_worker, tasks, backend=backend, workers=workers)) as finished:
-            for i, rec in finished:
+        with contextlib.closing(run_tasks(_trial_in_worker, tasks, backend=backend, workers=workers)) as outcomes:
+            for i, rec in outcomes:
                 j = owner[i]
                 done[j][int(rec["trial"])] = rec
                 _append_line(jobs[j][1] / "results.jsonl", rec)
