@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import contextlib
 import logging
+import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -76,6 +77,7 @@ def _add_driver(run: Run, driver: str, route: str | Path | None, stack: contextl
     stack.enter_context(terminal_keys(teleop, run.executor))
     if not quiet:  # in place of the progress bar: what is sent, where the robot is
         teleop.show_status(run.sim.base_pose2d)
+        stack.callback(lambda: print(file=sys.stderr))  # the status line ends when the drive does
     return lambda: False
 
 
@@ -136,7 +138,7 @@ def run_mapping(
     out_dir = Path(out)
     out_dir.mkdir(parents=True, exist_ok=True)
     map_yaml = out_dir / "map.yaml"
-    with interrupt_note(f"the map was not saved ({map_yaml} is as it was)"):  # each file: temp name + rename
+    with interrupt_note(f"while saving the map: {map_yaml} is the old map or the new one, whole"):  # temp + rename
         save_map(grid, map_yaml)  # first: the map is the result; its scores and picture follow
     result = MappingResult(map_yaml, grid, run.timing["sim_s"], bool(is_done()), cpu_s=run.timing["cpu_s"])
     with interrupt_note(f"the map is saved: {map_yaml} (+ its image); trajectory.txt and map.png may be missing"):
