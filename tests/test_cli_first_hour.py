@@ -74,3 +74,16 @@ def test_launch_arguments_may_follow_options(capsys: pytest.CaptureFixture[str])
     with pytest.raises(SystemExit):
         main(["launch", "talker_listener", "--duration", "0.5", "--bogus"])
     assert "unrecognized arguments: --bogus" in _one_line(capsys)
+
+
+def test_experiment_list_shows_every_shipped_scenario(capsys: pytest.CaptureFixture[str]) -> None:
+    from navlab import resources
+
+    assert main(["experiment", "list"]) == 0
+    out = capsys.readouterr().out
+    names = sorted(f.stem for f in (resources.root() / "scenarios").glob("*.yaml"))
+    assert len(names) >= 5 and all(f"\n{n}: world " in f"\n{out}" for n in names)
+    assert "empty_room: world room, robot mybot, map true, 4 goals; 20 trials\n    The paper's first experiment" in out
+    assert main(["experiment", "run"]) == 2  # no scenario named: one line that says where to find them
+    line = _one_line(capsys)
+    assert "which scenario?" in line and "`navlab experiment list`" in line
