@@ -87,3 +87,20 @@ def test_experiment_list_shows_every_shipped_scenario(capsys: pytest.CaptureFixt
     assert main(["experiment", "run"]) == 2  # no scenario named: one line that says where to find them
     line = _one_line(capsys)
     assert "which scenario?" in line and "`navlab experiment list`" in line
+
+
+def test_map_save_with_nothing_running_says_where_a_map_comes_from(tmp_path) -> None:
+    import os
+
+    proc = subprocess.run(
+        [sys.executable, "-m", "navlab.cli", "map", "save", "--out", "m"],
+        env={**os.environ, "TMPDIR": str(tmp_path)},  # no other launch's socket
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert proc.returncode == 2 and proc.stderr.count("\n") == 1, proc.stderr
+    assert proc.stderr.startswith("navlab: error: no running navlab launch to save a /map from")
+    assert "navlab map save --launch mapping" in proc.stderr and "navlab map --teleop" in proc.stderr
+    assert not (tmp_path / "m").exists()

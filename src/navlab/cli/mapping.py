@@ -84,9 +84,19 @@ def _cmd_map_save(args: argparse.Namespace) -> int:
 
     path = Path(args.out) / "map.yaml"
     if not args.launch:  # the launch running in another shell: /map is latched, so its current map comes first
-        from navlab.core import find_running, subscribe
+        from navlab.core import CoreError, find_running, subscribe
 
-        for _t, msg in subscribe(find_running(args.pid), "/map"):
+        try:
+            running = find_running(args.pid)
+        except CoreError as exc:
+            if args.pid is not None or not str(exc).startswith("no running"):
+                raise
+            raise MappingError(  # map_saver's own hint: where a /map can come from
+                "no running navlab launch to save a /map from: start one in another shell (navlab launch mapping), "
+                "run one here (navlab map save --launch mapping --duration 60), or map in one command "
+                "(navlab map --teleop: Ctrl-C saves)"
+            ) from None
+        for _t, msg in subscribe(running, "/map"):
             save_map(GridMap.from_msg(msg), path)
             print(f"saved {path}")
             return 0
