@@ -29,6 +29,7 @@ from navlab.sim.builder import (
     set_pose,
 )
 from navlab.sim.errors import SimError
+from navlab.sim.mjtimers import profiling_timers_off
 from navlab.world import ModelSpec, WorldModel
 
 
@@ -241,7 +242,9 @@ def build_spec(
 
 
 def compile_spec(spec: mujoco.MjSpec, what: str = "model") -> mujoco.MjModel:
-    """Compile, turning MuJoCo's compiler errors into a ``SimError``."""
+    """Compile, turning MuJoCo's compiler errors into a ``SimError``; MuJoCo's profiling timers go off (~12 % of a
+    step, read by nobody: :mod:`navlab.sim.mjtimers`)."""
+    profiling_timers_off()
     try:
         return spec.compile()
     except ValueError as exc:

@@ -19,7 +19,6 @@ from navlab.sim.clearance import clearance
 from navlab.sim.errors import SimError
 from navlab.sim.lidar_rays import beam_dirs, cast_primitives, ray_geom_sets, scan_primitives
 from navlab.sim.lidar_rays import lidar_angles as lidar_angles  # re-exported: its home before the split
-from navlab.sim.mjtimers import profiling_timers_off
 from navlab.sim.raycast import finish_ranges, multiray
 from navlab.sim.scene import add_world_model, build_spec, compile_spec, remove_world_model
 from navlab.world import ModelSpec, WorldModel
@@ -67,7 +66,6 @@ class Simulation:
         self.world = world
         self.lidar_backend = lidar_backend
         self.rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
-        profiling_timers_off()  # MuJoCo's stage timers: ~12 % of a step, read by nobody (navlab.sim.mjtimers)
         x, y, yaw = robot_pose
         self.spec, self.info = build_spec(robot, world, timestep=timestep, robot_pose=(x, y, 0.0, yaw), visuals=visuals)
         self.model = compile_spec(self.spec, f"world {world.name!r}")
