@@ -50,6 +50,11 @@ class Polygon:
     simulation_time_step: float = 0.1
     enabled: bool = True
 
+    @property
+    def reach(self) -> float:
+        """How far (m) the zone reaches from the base frame's origin."""
+        return self.radius if self.points is None else float(np.hypot(self.points[:, 0], self.points[:, 1]).max())
+
     def inside(self, pts: np.ndarray) -> np.ndarray:
         """Which of ``pts`` (M, 2; base frame) lie in the zone."""
         if self.points is None:
@@ -164,11 +169,17 @@ class CollisionMonitor:
     def check(self, v: float, w: float, points: np.ndarray) -> Verdict:
         """The command (v m/s, w rad/s) allowed with the obstacle ``points`` (M, 2; base frame, m)."""
         pts = np.asarray(points, dtype=np.float64).reshape(-1, 2)
+        dist = np.hypot(pts[:, 0], pts[:, 1])
         best = Verdict(v, w)
         for poly in self.polygons:
+            # only points the zone can reach count (the footprint moved along the arc stays within |v| T of here)
+            sweep = abs(v) * poly.time_before_collision if poly.action_type == "approach" else 0.0
+            near = pts[dist <= poly.reach + sweep + 1e-9]
+            if len(near) < poly.min_points:
+                continue
             if poly.action_type == "approach":
-                cand = self._approach(poly, v, w, pts)
-            elif int(poly.inside(pts).sum()) >= poly.min_points:
+                cand = self._approach(poly, v, w, near)
+            elif int(poly.inside(near).sum()) >= poly.min_points:
                 if poly.action_type == "stop":
                     cand = Verdict(0.0, 0.0, poly.name, "stop")
                 elif poly.action_type == "slowdown":
