@@ -169,8 +169,10 @@ class CollisionMonitor:
     def check(self, v: float, w: float, points: np.ndarray) -> Verdict:
         """The command (v m/s, w rad/s) allowed with the obstacle ``points`` (M, 2; base frame, m)."""
         pts = np.asarray(points, dtype=np.float64).reshape(-1, 2)
-        dist = np.hypot(pts[:, 0], pts[:, 1])
         best = Verdict(v, w)
+        if len(pts) == 0:
+            return best
+        dist = np.hypot(pts[:, 0], pts[:, 1])
         for poly in self.polygons:
             near = pts[dist <= self._reach(poly, v)]
             if len(near) < poly.min_points:
@@ -286,11 +288,14 @@ class CollisionMonitorNode(Node):
         msg, (x, y, yaw) = self.last_scan, self.laser
         if msg is None:
             return np.zeros((0, 2))
-        r = np.asarray(msg.ranges, dtype=np.float64)
-        ok = np.isfinite(r) & (r >= float(msg.range_min)) & (r < float(msg.range_max))
-        k = np.flatnonzero(ok & (r <= within + math.hypot(x, y)))
+        r = np.asarray(msg.ranges)
+        far, top = within + math.hypot(x, y), float(msg.range_max)  # NaN and inf fail both tests
+        if len(r) == 0 or np.fmin.reduce(r) > far:  # nothing close (the usual case): no points to make
+            return np.zeros((0, 2))
+        k = np.flatnonzero((r >= float(msg.range_min)) & ((r <= far) if far < top else (r < top)))
+        rk = r[k].astype(np.float64)
         a = float(msg.angle_min) + float(msg.angle_increment) * k
-        lx, ly = r[k] * np.cos(a), r[k] * np.sin(a)
+        lx, ly = rk * np.cos(a), rk * np.sin(a)
         c, s = math.cos(yaw), math.sin(yaw)
         return np.column_stack([x + c * lx - s * ly, y + s * lx + c * ly])
 
