@@ -15,7 +15,8 @@ params: null                 # folder of move_base's ROS 1 parameter files (defa
 overrides: {local_costmap.update_frequency: 5.0}   # move_base parameters
 obstacles: [{t: 20.0, spec: "cylinder:x=-1.0,y=-0.45,radius=0.15,length=0.6"}]   # added while running
 #   t: [lo, hi] draws the time per trial (from the trial's seed); frame: robot places x, y (and yaw) in the
-#   robot's frame at that time (e.g. x=0.7: 0.7 m ahead of it), frame: world (default) in the world
+#   robot's frame at that time (e.g. x=0.7: 0.7 m ahead of it), frame: world (default) in the world; never on the
+#   start, a goal or the robot (see scenario_obstacles: a robot-frame one about to reach a goal appears earlier)
 goals: [[4.3, 1.0, 0.0], [-3.5, -0.5, 3.14]]      # map frame (odom with map: none)
 trials: 20                   # trial k runs with seed + k
 seed: 0
