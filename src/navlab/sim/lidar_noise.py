@@ -14,9 +14,10 @@ from __future__ import annotations
 import copy
 import ctypes
 import sys
+from typing import Any
 
 import numpy as np
-from llvmlite import ir
+from llvmlite import ir  # type: ignore[import-untyped]
 from numba import njit, types
 from numba.extending import intrinsic
 
@@ -35,16 +36,15 @@ PCG64_MULT = 0x2360ED051FC65DA44385DF649FCCF645  # PCG's default 128-bit LCG mul
 CHECK_DRAWS = 4096  # draws compared with NumPy's before a generator is trusted to the compiled loop
 
 
-@intrinsic
-def _lcg_step(typingctx, hi, lo, inc_hi, inc_lo):  # type: ignore[no-untyped-def]  # pragma: no cover - compiled
+def _lcg_step_typer(typingctx: Any, hi: Any, lo: Any, inc_hi: Any, inc_lo: Any) -> Any:
     """(hi, lo) 64-bit halves of ``state * PCG64_MULT + inc`` modulo 2**128 (LLVM's 128-bit integers)."""
     sig = types.UniTuple(types.uint64, 2)(types.uint64, types.uint64, types.uint64, types.uint64)
 
-    def codegen(context, builder, signature, args):  # type: ignore[no-untyped-def]
+    def codegen(context: Any, builder: Any, signature: Any, args: Any) -> Any:  # pragma: no cover - compiled
         i64, i128 = ir.IntType(64), ir.IntType(128)
         sixty_four = ir.Constant(i128, 64)
 
-        def join(h, lo_):  # type: ignore[no-untyped-def]
+        def join(h: Any, lo_: Any) -> Any:
             return builder.or_(builder.shl(builder.zext(h, i128), sixty_four), builder.zext(lo_, i128))
 
         s = builder.add(builder.mul(join(args[0], args[1]), ir.Constant(i128, PCG64_MULT)), join(args[2], args[3]))
@@ -52,6 +52,9 @@ def _lcg_step(typingctx, hi, lo, inc_hi, inc_lo):  # type: ignore[no-untyped-def
         return context.make_tuple(builder, signature.return_type, new)
 
     return sig, codegen
+
+
+_lcg_step: Any = intrinsic(_lcg_step_typer)
 
 
 @njit(cache=True, inline="always")
@@ -129,6 +132,7 @@ class NormalDraws:
         self.gen = gen
         self.buf = np.empty(n)
         self._words = self._checked_words(gen)
+        self._tables = _TABLES if _TABLES is not None else (np.zeros(0, np.uint64), np.zeros(0), np.zeros(0))
 
     @staticmethod
     def _checked_words(gen: np.random.Generator) -> np.ndarray | None:
@@ -140,7 +144,8 @@ class NormalDraws:
         if words is None:
             return None
         mine = np.empty(CHECK_DRAWS)
-        fill_standard_normal(words, *_TABLES, float(ziggurat_nor_r), float(ziggurat_nor_inv_r), mine)
+        ki, wi, fi = _TABLES
+        fill_standard_normal(words, ki, wi, fi, float(ziggurat_nor_r), float(ziggurat_nor_inv_r), mine)
         same = np.array_equal(a.standard_normal(CHECK_DRAWS).view(np.uint64), mine.view(np.uint64))
         return _pcg64_words(gen) if same and a.bit_generator.state == b.bit_generator.state else None
 
@@ -153,5 +158,6 @@ class NormalDraws:
         """The next ``n`` standard normals (the buffer, overwritten by the next call)."""
         if self._words is None:
             return self.gen.standard_normal(out=self.buf)
-        fill_standard_normal(self._words, *_TABLES, ziggurat_nor_r, ziggurat_nor_inv_r, self.buf)
+        ki, wi, fi = self._tables
+        fill_standard_normal(self._words, ki, wi, fi, ziggurat_nor_r, ziggurat_nor_inv_r, self.buf)
         return self.buf
