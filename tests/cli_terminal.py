@@ -59,14 +59,15 @@ class Terminal:
         self.close()
         pytest.fail(f"{what}\n--- stdout:\n{self.stdout[-1500:]}\n--- stderr:\n{self.stderr[-1500:]}")
 
-    def wait_for(self, text: str, seconds: float) -> None:
-        """Wait until stderr shows ``text`` (a loaded machine starts slowly); fail if it does not in time."""
+    def wait_for(self, text: str, seconds: float, *, stream: str = "stderr") -> None:
+        """Wait until ``stream`` (stderr or stdout) shows ``text`` (a loaded machine starts slowly); fail if it
+        does not in time."""
         deadline = time.monotonic() + seconds
-        while text not in self.stderr:
+        while text not in getattr(self, stream):
             if self.proc.poll() is not None:
-                self._fail(f"navlab exited ({self.proc.returncode}) before showing {text!r}")
+                self._fail(f"navlab exited ({self.proc.returncode}) before showing {text!r} on {stream}")
             if time.monotonic() > deadline:
-                self._fail(f"navlab did not show {text!r} within {seconds:.0f} s")
+                self._fail(f"navlab did not show {text!r} on {stream} within {seconds:.0f} s")
             time.sleep(0.1)
 
     def keys(self, data: bytes) -> None:

@@ -4,7 +4,8 @@ The CLI prints a ``NavlabError`` as one line (``navlab: error: ...``) instead of
 its message must name the file, element or key and say what was expected.
 """
 
-from collections.abc import Iterable
+import contextlib
+from collections.abc import Iterable, Iterator
 
 
 class NavlabError(Exception):
@@ -25,3 +26,14 @@ def did_you_mean(
     (the ``n`` closest joined with ", "), or "" when nothing is close."""
     close = closest(key, known, n, cutoff=cutoff)
     return template.format(", ".join(close)) if close else ""
+
+
+@contextlib.contextmanager
+def interrupt_note(note: str) -> Iterator[None]:
+    """Ctrl-C inside the block leaves with ``note`` on the KeyboardInterrupt: what it left on disk (the CLI
+    prints it after "navlab: interrupted")."""
+    try:
+        yield
+    except KeyboardInterrupt as exc:
+        exc.add_note(note)
+        raise

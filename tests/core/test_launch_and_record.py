@@ -178,3 +178,4 @@ def test_launch_show_args(capsys):
     assert main(["launch", "localization", "--show-args"]) == 0
     out = capsys.readouterr().out
     assert "'map':" in out and "(required)" in out and "(default: 'room')" in out
+    assert not [line for line in out.splitlines() if line.count("(default:") > 1]  # said once, in words if given

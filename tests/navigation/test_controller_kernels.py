@@ -26,7 +26,7 @@ def _inflated(rng: np.random.Generator, shape: tuple[int, int]) -> np.ndarray:
 def test_ring_scores_equal_every_pose_checked() -> None:
     """TrajectoryPlanner's scores with ring bounds are bit for bit those of checking every pose's footprint, for a
     round and a square robot and a point robot, distances at every pose, at one step or at none, near obstacles and
-    the map's edge."""
+    the map's edge, rollouts that stop and turn on one spot among them."""
     rng = np.random.default_rng(7)
     square = np.array([[0.25, 0.2], [-0.2, 0.2], [-0.2, -0.2], [0.25, -0.2]])
     seen: set[tuple[bool, float]] = set()
@@ -51,6 +51,7 @@ def test_ring_scores_equal_every_pose_checked() -> None:
         ox, oy = np.ascontiguousarray(outline[:, 0]), np.ascontiguousarray(outline[:, 1])
         n, steps = 60, 40
         targets = np.column_stack([rng.uniform(-0.2, 0.6, n), rng.uniform(-1.5, 1.5, n)])
+        targets[::4, 0] = 0.0  # these stop, then turn on one spot (the FINE bound's case)
         counts = rng.integers(1, steps + 1, n)
         traj = np.empty((n, steps, 3))
         c, s = np.empty((n, steps)), np.empty((n, steps))

@@ -92,8 +92,8 @@ def main(argv: list[str] | None = None) -> int:
         where = f"{exc.filename}: " if exc.filename else ""
         print(f"navlab: error: {where}{exc.strerror or exc}", file=sys.stderr)
         return 2
-    except KeyboardInterrupt:
-        print("navlab: interrupted", file=sys.stderr)
+    except KeyboardInterrupt as exc:  # its notes say what the verb left on disk (``errors.interrupt_note``)
+        print("; ".join(["navlab: interrupted", *getattr(exc, "__notes__", [])]), file=sys.stderr)
         return 130
 
 

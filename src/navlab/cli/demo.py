@@ -7,11 +7,14 @@ import json
 
 from navlab import demo
 from navlab.cli.options import add_run_options
-from navlab.cli.runs import view_hook
+from navlab.cli.runs import stop_signals, view_hook
+from navlab.errors import interrupt_note
 
 
+@stop_signals()  # SIGTERM as Ctrl-C, also as a background job: a recording is closed whole
 def _cmd(args: argparse.Namespace) -> int:
-    with view_hook(args) as on_start:
+    note = f"{args.out}/ holds the steps finished so far, each file whole; no report (run it again for one)"
+    with interrupt_note(note), view_hook(args) as on_start:
         summary = demo.run_demo(
             args.out,
             seed=args.seed,

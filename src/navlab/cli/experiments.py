@@ -4,8 +4,11 @@
 from __future__ import annotations
 
 import argparse
+import re
 import sys
+import textwrap
 from pathlib import Path
+from typing import Any
 
 from navlab.cli.options import (
     add_resource_path_arguments,
@@ -13,14 +16,36 @@ from navlab.cli.options import (
     apply_resource_paths,
     print_figures,
 )
+from navlab.cli.runs import stop_signals
 
 
+@stop_signals()  # SIGTERM as Ctrl-C: the workers stop, the finished trials stay
 def _cmd_experiment(args: argparse.Namespace) -> int:
     apply_resource_paths(args)  # --package-path / --model-path, for this process and its workers
-    from navlab.experiments import ExperimentError, load_scenario, run_experiment
+    from navlab.experiments import ExperimentError, load_scenario
 
+    if args.action == "list":
+        return _list_scenarios(args.json)
+    if args.file is None:
+        raise ExperimentError(
+            f"experiment {args.action}: which scenario? a YAML file or a shipped name (`navlab experiment list`)"
+        )
     sc = load_scenario(args.file)
     out = args.out or f"runs/{sc.name}"
+    try:
+        return _run_or_sweep(args, sc, out)
+    except KeyboardInterrupt as exc:  # results.jsonl holds every finished trial whole, one line each
+        from navlab.experiments import read_results
+
+        pattern = "*/results.jsonl" if args.action == "sweep" else "results.jsonl"  # a sweep: one per combination
+        n = sum(len(read_results(f)) for f in Path(out).glob(pattern))
+        exc.add_note(f"{n} finished trial{'' if n == 1 else 's'} in {out}/{pattern}, whole; the same command resumes")
+        raise
+
+
+def _run_or_sweep(args: argparse.Namespace, sc: Any, out: str) -> int:
+    from navlab.experiments import ExperimentError, run_experiment
+
     trials = {
         "trials": args.trials,
         "seed": args.seed,
@@ -68,12 +93,50 @@ def _shipped_scenarios() -> list[str]:
     return sorted(f.stem for f in (resources.root() / "scenarios").glob("*.yaml"))
 
 
+def _list_scenarios(as_json: bool) -> int:
+    """`navlab experiment list`: each shipped scenario, what it runs, and its file's opening sentence."""
+    from navlab.experiments import load_scenario
+
+    rows: list[dict[str, Any]] = []
+    for name in _shipped_scenarios():
+        sc = load_scenario(name)
+        assert sc.path is not None  # a shipped file
+        text = " ".join(line.lstrip("# ") for line in _opening_comment(sc.path))
+        about = re.split(r"(?<=\.)\s+(?=[A-Z])", text)[0]  # its first sentence ("et al. 2020" does not end one)
+        extra = (
+            [f"controller {sc.controller}"] * bool(sc.controller)
+            + [sc.wheel_controller] * (sc.wheel_controller != "gazebo_ros_diff_drive")
+            + [f"ekf {sc.ekf}"] * bool(sc.ekf)
+        )
+        goals = f"{len(sc.goals)} goal{'s' * (len(sc.goals) != 1)}" if sc.goals else "the world's goal"
+        facts = ", ".join([f"world {sc.world}", f"robot {sc.robot}", f"map {sc.map}", goals, *extra])
+        rows.append({"name": name, "runs": f"{facts}; {sc.trials} trials", "about": about, "file": str(sc.path)})
+    if as_json:
+        print_figures({"scenarios": rows}, True)
+        return 0
+    for r in rows:
+        print(f"{r['name']}: {r['runs']}\n    {textwrap.shorten(r['about'], 110)}")
+    print("\nnavlab experiment run NAME --trials N; a scenario YAML of your own: keys in docs/experiments.md")
+    return 0
+
+
+def _opening_comment(path: Path) -> list[str]:
+    """A scenario file's opening comment lines, up to its example commands (``#   navlab ...``)."""
+    lines = []
+    for line in path.read_text().splitlines():
+        if not line.startswith("#") or line.startswith("#   "):
+            break
+        lines.append(line)
+    return lines
+
+
 def register(sub: argparse._SubParsersAction) -> None:
     """Add ``experiment`` and ``report``."""
     p = sub.add_parser(
         "experiment",
         help="run a scenario's trials headless and summarize them, or sweep parameters (the paper's Section V)",
-        description="navlab experiment run FILE: run the trials of a scenario YAML (or a shipped one: "
+        description="navlab experiment list: the shipped scenarios, one line each. "
+        "navlab experiment run FILE: run the trials of a scenario YAML (or a shipped one: "
         f"{', '.join(_shipped_scenarios())}) headless, each with its own seed, in parallel processes with "
         "--workers. Each "
         "finished trial is appended whole to DIR/results.jsonl; running again resumes and skips finished trials. "
@@ -84,10 +147,11 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument(
         "action",
-        choices=["run", "sweep"],
-        help="run: the scenario's trials; sweep: the trials for every combination of --param values",
+        choices=["run", "sweep", "list"],
+        help="run: the scenario's trials; sweep: the trials for every combination of --param values; list: the "
+        "shipped scenarios and what each shows",
     )
-    p.add_argument("file", help="scenario YAML, or a shipped scenario's name")
+    p.add_argument("file", nargs="?", help="scenario YAML, or a shipped scenario's name")
     p.add_argument("--trials", type=int, default=None, help="how many trials (default: the scenario's)")
     p.add_argument(
         "--seed", type=int, default=None, help="seed of trial 0; trial k uses seed + k (default: the scenario's)"

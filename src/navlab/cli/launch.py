@@ -21,8 +21,11 @@ def _show_args(file: str) -> int:
     if not rows:
         print(f"{file}: no arguments")
     for a in rows:
+        text = str(a.get("description", ""))
         default = f" (default: {a['default']!r})" if "default" in a else " (required)"
-        print(f"  '{a.get('name')}':\n      {a.get('description', '')}{default}")
+        if "(default:" in text:  # the description says it in words (e.g. the robot's own frame), not '$(robot ...)'
+            default = ""
+        print(f"  '{a.get('name')}':\n      {text}{default}")
     return 0
 
 

@@ -18,7 +18,7 @@ from navlab.cli.options import (
     print_figures,
     start_pose,
 )
-from navlab.cli.runs import ros_hook, view_hook
+from navlab.cli.runs import ros_hook, stop_signals, view_hook
 
 
 def _amcl_params(path: str | None, sets: list[str]) -> dict[str, Any]:
@@ -33,6 +33,7 @@ def _amcl_params(path: str | None, sets: list[str]) -> dict[str, Any]:
     return {**params, **parse_sets(sets)}
 
 
+@stop_signals()  # SIGTERM as Ctrl-C, also as a background job: a recording is closed whole
 def _cmd_localize(args: argparse.Namespace) -> int:
     apply_resource_paths(args)  # --package-path / --model-path, for this process and its workers
     from navlab.experiments import plot_result, run_localization

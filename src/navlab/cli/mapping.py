@@ -22,39 +22,59 @@ from navlab.cli.options import (
     start_pose,
 )
 from navlab.cli.runs import ros_hook, stop_signals, view_hook
+from navlab.errors import interrupt_note
 
 
-@stop_signals()  # --teleop runs until Ctrl-C: also as a background job
 def _cmd_map(args: argparse.Namespace) -> int:
     apply_resource_paths(args)  # --package-path / --model-path, for this process and its workers
     if args.action == "save":
         return _cmd_map_save(args)
+    if args.teleop:
+        _need_terminal("map --teleop")  # before the simulator starts
     from navlab.experiments import run_mapping
 
     driver = "teleop" if args.teleop else "route" if args.route else "explore"
-    with view_hook(args) as view, ros_hook(args, view) as on_start:
-        result = run_mapping(
-            world=args.world,
-            robot=args.robot,
-            pose=start_pose(args),
-            out=args.out,
-            driver=driver,
-            route=args.route,
-            duration=args.duration,
-            mode=args.mode,
-            seed=args.seed,
-            rate=args.rate or 0.0,
-            record=args.record,
-            quiet=args.quiet,
-            slam_params=parse_sets(args.set),
-            on_start=on_start,
-        )
+    # Ctrl-C (or SIGTERM, also as a background job) ends the drive and saves the map so far; a second one quits
+    with stop_signals() as stop, view_hook(args) as view, ros_hook(args, view) as then:
+        try:
+            result = run_mapping(
+                world=args.world,
+                robot=args.robot,
+                pose=start_pose(args),
+                out=args.out,
+                driver=driver,
+                route=args.route,
+                duration=args.duration,
+                mode=args.mode,
+                seed=args.seed,
+                rate=args.rate or 0.0,
+                record=args.record,
+                quiet=args.quiet,
+                slam_params=parse_sets(args.set),
+                on_start=stop.on_start(then, "stopping the drive; saving the map (Ctrl-C again: quit without saving)"),
+            )
+        except KeyboardInterrupt as exc:
+            if not stop.requested:  # while the simulator was starting
+                exc.add_note(f"nothing saved to {args.out}")
+            raise
     if not args.json:
-        print(f"saved {result.map_yaml} (+ map.pgm, map.png) after {result.sim_s:.1f} simulated s")
+        stopped = "stopped by Ctrl-C: " if stop.requested else ""
+        print(f"{stopped}saved {result.map_yaml} (+ map.pgm, map.png) after {result.sim_s:.1f} simulated s")
     print_figures(result.scores, args.json)
     return 0
 
 
+def _need_terminal(verb: str) -> None:
+    """Keyboard teleop reads keys from a terminal: one clear line when stdin is none (a pipe, a file)."""
+    if not sys.stdin.isatty():
+        from navlab.drivers import DriverError
+
+        raise DriverError(
+            f"navlab {verb} reads keys from a terminal (stdin is not one); run it in an interactive shell"
+        )
+
+
+@stop_signals()  # waiting for a /map, or running a launch: Ctrl-C and SIGTERM end it, also as a background job
 def _cmd_map_save(args: argparse.Namespace) -> int:
     """map_saver: save the current ``/map`` of a running ``navlab launch``, or of one started here."""
     from navlab import msgs
@@ -64,9 +84,19 @@ def _cmd_map_save(args: argparse.Namespace) -> int:
 
     path = Path(args.out) / "map.yaml"
     if not args.launch:  # the launch running in another shell: /map is latched, so its current map comes first
-        from navlab.core import find_running, subscribe
+        from navlab.core import CoreError, find_running, subscribe
 
-        for _t, msg in subscribe(find_running(args.pid), "/map"):
+        try:
+            running = find_running(args.pid)
+        except CoreError as exc:
+            if args.pid is not None or not str(exc).startswith("no running"):
+                raise
+            raise MappingError(  # map_saver's own hint: where a /map can come from
+                "no running navlab launch to save a /map from: start one in another shell (navlab launch mapping), "
+                "run one here (navlab map save --launch mapping --duration 60), or map in one command "
+                "(navlab map --teleop: Ctrl-C saves)"
+            ) from None
+        for _t, msg in subscribe(running, "/map"):
             save_map(GridMap.from_msg(msg), path)
             print(f"saved {path}")
             return 0
@@ -99,6 +129,7 @@ def _params_file(path: str | None) -> dict:
     return doc
 
 
+@stop_signals()  # SIGTERM as Ctrl-C, also as a background job: the note says what is written
 def _cmd_slam(args: argparse.Namespace) -> int:
     from navlab.io import data_file, read_carmen, skipped_summary
 
@@ -111,25 +142,28 @@ def _cmd_slam(args: argparse.Namespace) -> int:
     if note:
         print(f"navlab slam: warning: {note}", file=sys.stderr)
     t0 = time.perf_counter()
-    result = run_offline(
-        log,
-        mode=args.mode,
-        params={**_params_file(args.params), **parse_sets(args.set)},
-        seed=args.seed,
-        resolution=args.resolution,
-        max_scans=args.max_scans,
-        progress=not args.quiet and sys.stderr.isatty(),
-    )
+    with interrupt_note(f"SLAM had not finished: nothing written to {args.out}"):
+        result = run_offline(
+            log,
+            mode=args.mode,
+            params={**_params_file(args.params), **parse_sets(args.set)},
+            seed=args.seed,
+            resolution=args.resolution,
+            max_scans=args.max_scans,
+            progress=not args.quiet and sys.stderr.isatty(),
+        )
     wall = time.perf_counter() - t0
-    paths = write_outputs(result, args.out)
-    paths["figure"] = Path(args.out) / "map.png"
-    plot_run(
-        result.grid,
-        [Track(result.poses, "SLAM trajectory", "r-", width=0.7)],
-        paths["figure"],
-        title=f"{log.path.name if log.path else ''} ({args.mode})",
-        crop=False,
-    )
+    # map.yaml + map.pgm, poses.txt, map.png in this order, each whole (temp name + rename) or not at all
+    with interrupt_note(f"while writing {args.out}: its map.yaml, poses.txt and map.png are each whole or old"):
+        paths = write_outputs(result, args.out)
+        paths["figure"] = Path(args.out) / "map.png"
+        plot_run(
+            result.grid,
+            [Track(result.poses, "SLAM trajectory", "r-", width=0.7)],
+            paths["figure"],
+            title=f"{log.path.name if log.path else ''} ({args.mode})",
+            crop=False,
+        )
     log_s = float(result.timestamps[-1] - result.timestamps[0])
     summary = rounded(
         {
@@ -154,6 +188,8 @@ def _cmd_teleop(args: argparse.Namespace) -> int:
     """Drive the robot from the keyboard (teleop_twist_keyboard) or a joystick, in real time: the robot
     of a `navlab launch` running in another shell, or (with --world, or when none runs) a simulator
     started here."""
+    if not args.joy:
+        _need_terminal("teleop")  # before the simulator starts
     with contextlib.ExitStack() as stack:  # the terminal's settings come back, the remote publisher closes
         ex, gazebo, remote = _teleop_executor(args)
         if remote is not None:
@@ -169,14 +205,10 @@ def _cmd_teleop(args: argparse.Namespace) -> int:
         else:
             from navlab.drivers import HELP, TeleopKeyboard, terminal_keys
 
-            if not sys.stdin.isatty():
-                from navlab.mapping import MappingError
-
-                raise MappingError("navlab teleop reads keys from a terminal; run it in an interactive shell")
             teleop = TeleopKeyboard(ex, parameters={"speed": args.speed, "turn": args.turn})
             print(HELP)
             stack.enter_context(terminal_keys(teleop, ex))
-            teleop.create_timer(0.25, lambda: _show_teleop(teleop, gazebo))
+            teleop.show_status(gazebo.sim.base_pose2d if gazebo is not None else None)
         with contextlib.suppress(KeyboardInterrupt):
             ex.spin()
     if gazebo is not None:
@@ -205,38 +237,33 @@ def _teleop_executor(args: argparse.Namespace) -> tuple[Any, Any, Any]:
     return run.executor, run.gazebo, None
 
 
-def _show_teleop(teleop: Any, gazebo: Any) -> None:
-    """One status line, rewritten in place on stderr: simulated time, the command being sent, the speeds (and
-    the robot's pose when the simulator runs here), as teleop_twist_keyboard prints its 'currently:' line."""
-    st, tw = teleop.state, teleop.state.twist()
-    where = ""
-    if gazebo is not None:
-        x, y, yaw = gazebo.sim.base_pose2d()
-        where = f"  robot at ({x:.2f}, {y:.2f}, {yaw:.2f} rad)"
-    sys.stderr.write(
-        f"\rt={teleop.executor.now_ns / 1e9:7.1f} s  sending linear.x {tw.linear.x:+.2f} m/s  angular.z "
-        f"{tw.angular.z:+.2f} rad/s  (currently: speed {st.speed:.2f} turn {st.turn:.2f}){where}  "
-    )
-    sys.stderr.flush()
-
-
 def register(sub: argparse._SubParsersAction) -> None:
     """Add ``map``, ``slam`` and ``teleop``."""
+    from navlab.resources import shipped
+
     p = sub.add_parser(
         "map",
         help="build a map with SLAM in simulation (exploration, teleop or a route) and save it",
         description="The paper's mapping launch: simulator + slam_gmapping + a driver. Saves DIR/map.yaml, "
         "DIR/map.pgm, DIR/map.png (map with SLAM and true trajectories) and DIR/trajectory.txt, and prints the "
-        "map's score against the world. `navlab map save --out DIR` saves the current /map of a running "
+        "map's score against the world. It ends when exploration is done, the route ends or --duration passes; "
+        "Ctrl-C (or SIGTERM) ends it sooner and saves the map so far, as gmapping + map_saver would (a second "
+        "Ctrl-C quits without saving). `navlab map save --out DIR` saves the current /map of a running "
         "`navlab launch` (map_saver); with --launch FILE it starts the launch itself.",
     )
     p.add_argument("action", nargs="?", choices=["save"], help="save: run a launch and save its /map")
     add_world_robot(p, "room")
     drive = p.add_mutually_exclusive_group()
     drive.add_argument("--explore", action="store_true", help="frontier exploration (the default)")
-    drive.add_argument("--teleop", action="store_true", help="drive with the keyboard, in real time")
     drive.add_argument(
-        "--route", metavar="FILE", help="a route YAML (segments and/or waypoints) or a shipped route's name (room)"
+        "--teleop",
+        action="store_true",
+        help="drive with the keyboard (teleop_twist_keyboard's keys) in real time; Ctrl-C saves the map",
+    )
+    drive.add_argument(
+        "--route",
+        metavar="FILE",
+        help=f"a route YAML (segments and/or waypoints) or a shipped route's name ({', '.join(shipped('route'))})",
     )
     p.add_argument("--out", default="map", metavar="DIR", help="output folder (default ./map)")
     p.add_argument(
@@ -296,7 +323,9 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--world", default=None, help="start this world here (file or shipped name) instead of driving a running launch"
     )
     p.add_argument("--pid", type=int, help="which running navlab launch to drive, when several run")
-    p.add_argument("--robot", default="mybot", help="robot file or shipped name (default mybot)")
+    p.add_argument(
+        "--robot", default="mybot", help=f"robot file or shipped name: {', '.join(shipped('robot'))} (default mybot)"
+    )
     add_pose_arguments(p)
     p.add_argument("--speed", type=float, default=0.5, help="linear speed, m/s (default 0.5)")
     p.add_argument("--turn", type=float, default=1.0, help="angular speed, rad/s (default 1.0)")

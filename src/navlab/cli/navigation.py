@@ -17,9 +17,10 @@ from navlab.cli.options import (
     print_figures,
     start_pose,
 )
-from navlab.cli.runs import ros_hook, view_hook
+from navlab.cli.runs import ros_hook, stop_signals, view_hook
 
 
+@stop_signals()  # SIGTERM as Ctrl-C, also as a background job: a recording is closed whole
 def _cmd_navigate(args: argparse.Namespace) -> int:
     apply_resource_paths(args)  # --package-path / --model-path, for this process and its workers
     from navlab.experiments import run_navigation, save_goal_pictures

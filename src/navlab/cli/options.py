@@ -68,8 +68,16 @@ def start_pose(args: argparse.Namespace) -> tuple[float, float, float]:
 
 def add_world_robot(p: argparse.ArgumentParser, world: str) -> None:
     """``--world`` (default ``world``), ``--robot``, the start pose and the resource paths of a run verb."""
-    p.add_argument("--world", default=world, help=f"world file or shipped name (default {world})")
-    p.add_argument("--robot", default="mybot", help="robot .xacro/.urdf or shipped name (default mybot)")
+    from navlab.resources import shipped
+
+    p.add_argument(
+        "--world", default=world, help=f"world file or shipped name: {', '.join(shipped('world'))} (default {world})"
+    )
+    p.add_argument(
+        "--robot",
+        default="mybot",
+        help=f"robot .xacro/.urdf or shipped name: {', '.join(shipped('robot'))} (default mybot)",
+    )
     add_pose_arguments(p)
     add_resource_path_arguments(p)
 

@@ -25,24 +25,60 @@ def follows_clock(launch_args: dict[str, str]) -> bool:
     return str(launch_args.get("sim", "true")).strip().lower() not in TRUE
 
 
+class StopRequest:
+    """What the first Ctrl-C (or SIGTERM) does inside :func:`stop_signals`: raise KeyboardInterrupt where the
+    main thread is, or, once :meth:`graceful` named a run's executor, end that run at the next event boundary
+    (its state whole, so the verb can still save its result); a second signal then raises KeyboardInterrupt."""
+
+    def __init__(self) -> None:
+        self.requested = False  # a signal asked the graceful run to stop
+        self._executor: Any = None
+        self._message = ""
+
+    def graceful(self, executor: Any, message: str) -> None:
+        """From now on the first signal stops ``executor`` (after printing ``message`` on stderr)."""
+        self._executor, self._message = executor, message
+
+    def on_start(self, then: Callable[[Any], None] | None, message: str) -> Callable[[Any], None]:
+        """An ``on_start(run)`` for ``start_run`` that calls ``then(run)`` and makes the run's executor graceful."""
+
+        def on_start(run: Any) -> None:
+            if then is not None:
+                then(run)
+            self.graceful(run.executor, message)
+
+        return on_start
+
+    def __call__(self, _signum: int, _frame: Any) -> None:
+        ex = self._executor
+        if ex is None or self.requested:
+            raise KeyboardInterrupt
+        self.requested = True
+        message = self._message
+
+        def stop() -> None:  # in the executor's thread, between events: no print inside another write
+            print(f"\n{message}", file=sys.stderr, flush=True)
+            ex.stop()
+
+        ex.post(stop)  # the executor's inbox is a SimpleQueue: its put may interrupt its own get
+
+
 @contextlib.contextmanager
-def stop_signals() -> Iterator[None]:
-    """Ctrl-C (SIGINT) and SIGTERM raise KeyboardInterrupt in the block, whatever this process inherited.
+def stop_signals() -> Iterator[StopRequest]:
+    """Ctrl-C (SIGINT) and SIGTERM raise KeyboardInterrupt in the block, whatever this process inherited
+    (or, after ``graceful(executor, ...)`` on the yielded :class:`StopRequest`, the first one stops that run).
 
     A background job of a script starts with SIGINT ignored, and Python then installs no handler of its own:
     roslaunch and rospy install theirs for that reason, and so does every verb that runs until Ctrl-C. The main
     thread is interrupted where it is (an executor's loop, a startup, a blocking wait); the verb suppresses the
     KeyboardInterrupt around its loop and its ``finally`` blocks clean up. The previous handlers come back after."""
+    request = StopRequest()
     if threading.current_thread() is not threading.main_thread():  # only the main thread may set handlers
-        yield
+        yield request
         return
-
-    def interrupt(_signum: int, _frame: Any) -> None:
-        raise KeyboardInterrupt
-
-    before = {sig: signal.signal(sig, interrupt) for sig in (signal.SIGINT, signal.SIGTERM)}
+    before = {sig: signal.signal(sig, request) for sig in (signal.SIGINT, signal.SIGTERM)}
     try:
-        yield
+        yield request
     finally:
         for sig, handler in before.items():
             signal.signal(sig, handler)

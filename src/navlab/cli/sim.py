@@ -19,7 +19,7 @@ from navlab.cli.options import (
     seconds_or_zero,
     start_pose,
 )
-from navlab.cli.runs import ros_bridge, viewing
+from navlab.cli.runs import ros_bridge, stop_signals, viewing
 
 _SPAWN_HELP = (
     "spawn a model, KIND:key=value,... with KIND box|cylinder|sphere|sdf, e.g. 'box:name=crate,x=2,y=1,size=0.5', "
@@ -29,13 +29,18 @@ _SPAWN_HELP = (
 
 
 def _add_common(p: argparse.ArgumentParser) -> None:
+    from navlab.resources import shipped
+
     p.add_argument(
-        "--world", default="room", help="shipped world (room, room_obstacles) or a .world file (default: room)"
+        "--world",
+        default="room",
+        help=f"shipped world ({', '.join(shipped('world'))}) or a .world file (default: room)",
     )
     p.add_argument(
         "--robot",
         default="mybot",
-        help="shipped robot (mybot), a .xacro/.urdf file or a package://pkg/urdf/robot.xacro URI (default: mybot)",
+        help=f"shipped robot ({', '.join(shipped('robot'))}), a .xacro/.urdf file or a "
+        "package://pkg/urdf/robot.xacro URI (default: mybot)",
     )
     add_pose_arguments(p)
     add_resource_path_arguments(p)
@@ -150,7 +155,9 @@ def _cmd_sim(args: argparse.Namespace) -> int:
         helper.create_timer(0.1, lambda: pub.publish(msgs.twist(*cmd_vel)))
         pub.publish(msgs.twist(*cmd_vel))
     start = gazebo.sim.base_pose2d()
-    with viewing(args, ex), ros_bridge(args.ros, ex, ex.nodes):
+    # Ctrl-C (or SIGTERM, also as a background job) ends the run as --duration would: the summary, the recording
+    with stop_signals() as stop, viewing(args, ex), ros_bridge(args.ros, ex, ex.nodes):
+        stop.graceful(ex, "stopping the simulation (Ctrl-C again: quit at once)")
         run.run(args.duration, record=args.record, quiet=args.quiet, desc="sim")
     bag = run.bag
     end = gazebo.sim.base_pose2d()

@@ -58,6 +58,10 @@ def run_for(
                     bar.total = round(bar.n, 3)
                     bar.refresh()
                 break
+    except KeyboardInterrupt as exc:  # the recording is closed below: whole up to now
+        if recorder is not None:
+            exc.add_note(f"the recording {recorder.path} is closed, whole up to {ex.now_ns / 1e9:.1f} simulated s")
+        raise
     finally:
         bar.close()
         path = recorder.close() if recorder else None

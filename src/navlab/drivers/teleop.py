@@ -9,6 +9,7 @@ from __future__ import annotations
 import contextlib
 import functools
 import threading
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -100,6 +101,26 @@ class TeleopKeyboard(Node):
     def press(self, key: str) -> None:
         """Thread-safe: apply a key press before the next event."""
         self.executor.post(lambda: self.state.key(key))
+
+    def show_status(self, pose: Callable[[], tuple[float, float, float]] | None = None, period: float = 0.25) -> None:
+        """Every ``period`` simulated s, rewrite one status line in place on stderr: simulated time, the command
+        being sent, the speeds and, with ``pose``, the robot's (x, y, yaw) in m and rad, as teleop_twist_keyboard
+        prints its 'currently:' line."""
+        import sys
+
+        def show() -> None:
+            st, tw = self.state, self.state.twist()
+            where = ""
+            if pose is not None:
+                x, y, yaw = pose()
+                where = f"  robot at ({x:.2f}, {y:.2f}, {yaw:.2f} rad)"
+            sys.stderr.write(
+                f"\rt={self.executor.now_ns / 1e9:7.1f} s  sending linear.x {tw.linear.x:+.2f} m/s  angular.z "
+                f"{tw.angular.z:+.2f} rad/s  (currently: speed {st.speed:.2f} turn {st.turn:.2f}){where}  "
+            )
+            sys.stderr.flush()
+
+        self.create_timer(period, show)
 
 
 class TerminalKeys(threading.Thread):

@@ -32,7 +32,7 @@ if TYPE_CHECKING:
     from navlab.experiments.session import rounded, start_run
     from navlab.experiments.sweep import parse_params, run_sweep
     from navlab.experiments.trajectory import align_se2, apply_se2, associate, ate, read_trajectory, trajectory_ate
-    from navlab.experiments.trials import run_experiment
+    from navlab.experiments.trials import read_results, run_experiment
 
 _EXPORTS = {
     "align_se2": "navlab.experiments.trajectory",
@@ -57,6 +57,7 @@ _EXPORTS = {
     "read_map_trajectory": "navlab.experiments.mapping_run:read_trajectory",
     "read_trajectory": "navlab.experiments.trajectory",
     "relations_closure": "navlab.experiments.metrics",
+    "read_results": "navlab.experiments.trials",
     "render_report": "navlab.experiments.report",
     "rounded": "navlab.experiments.session",
     "run_drift": "navlab.experiments.odom_run",
@@ -91,6 +92,7 @@ __all__ = [
     "read_map_trajectory",
     "read_poses",
     "read_relations",
+    "read_results",
     "read_trajectory",
     "relations_closure",
     "relations_error",

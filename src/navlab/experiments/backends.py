@@ -21,7 +21,7 @@ import functools
 import logging
 import os
 import threading
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Generator, Iterator, Sequence
 from typing import Any, TypeVar
 
 from navlab.experiments.errors import ExperimentError
@@ -38,9 +38,9 @@ def _indexed(fn: Callable[[T], R], job: tuple[int, T]) -> tuple[int, R]:
 
 def run_tasks(
     fn: Callable[[T], R], items: Sequence[T], *, backend: str = "local", workers: int | None = None
-) -> Iterator[tuple[int, R]]:
+) -> Generator[tuple[int, R], None, None]:
     """Yield ``(i, fn(items[i]))`` for every item as it finishes; ``workers``: processes (local, default 1) or
-    CPUs of a local Ray instance (default: all)."""
+    CPUs of a local Ray instance (default: all). Closing the generator stops the workers."""
     if backend not in BACKENDS:
         raise ExperimentError(f"backend: expected one of {', '.join(BACKENDS)}, got {backend!r}")
     if workers is not None and workers < 1:
@@ -57,8 +57,20 @@ def run_tasks(
         return
     import multiprocessing
 
-    with multiprocessing.get_context("spawn").Pool(n) as pool:
+    with multiprocessing.get_context("spawn").Pool(n, initializer=_worker_signals) as pool:
         yield from pool.imap_unordered(functools.partial(_indexed, fn), list(enumerate(items)))
+
+
+def _worker_signals() -> None:
+    """A worker leaves Ctrl-C to the driver (a terminal sends it to every process of the job) and ends on the
+    pool's SIGTERM as on an exception, so its ``finally`` blocks (a trial's temporary folder) still run."""
+    import signal
+
+    def end(_signum: int, _frame: Any) -> None:
+        raise SystemExit(143)
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, end)
 
 
 def _run_ray(fn: Callable[[T], R], items: Sequence[T], workers: int | None) -> Iterator[tuple[int, R]]:

@@ -8,13 +8,16 @@ odometry (see ``experiments.truth.world_T_map``); scores and truth overlays are 
 
 from __future__ import annotations
 
+import contextlib
 import logging
+import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from navlab.errors import interrupt_note
 from navlab.experiments.metrics import free_coverage, score_map, trajectory_error
 from navlab.experiments.monitors import PoseMonitor
 from navlab.experiments.plots import Marks, Track, plot_run
@@ -44,8 +47,9 @@ class MappingResult:
     scores: dict[str, Any] = field(default_factory=dict)
 
 
-def _add_driver(run: Run, driver: str, route: str | Path | None) -> Any:
-    """Start the driver node; returns a callable telling whether it is done."""
+def _add_driver(run: Run, driver: str, route: str | Path | None, stack: contextlib.ExitStack, quiet: bool) -> Any:
+    """Start the driver node; returns a callable telling whether it is done. What the driver holds (the
+    terminal, for teleop) is given back when ``stack`` closes; teleop shows its status line unless ``quiet``."""
     from navlab.drivers import HELP, RouteFollower, TeleopKeyboard, load_route, terminal_keys
 
     if driver == "explore":
@@ -69,8 +73,11 @@ def _add_driver(run: Run, driver: str, route: str | Path | None) -> Any:
         )
         return lambda: follower.done
     teleop = run.add(TeleopKeyboard)
-    print("teleop_twist_keyboard:\n" + HELP)
-    terminal_keys(teleop, run.executor)
+    print("teleop_twist_keyboard:\n" + HELP, flush=True)
+    stack.enter_context(terminal_keys(teleop, run.executor))
+    if not quiet:  # in place of the progress bar: what is sent, where the robot is
+        teleop.show_status(run.sim.base_pose2d)
+        stack.callback(lambda: print(file=sys.stderr))  # the status line ends when the drive does
     return lambda: False
 
 
@@ -114,26 +121,49 @@ def run_mapping(
         explore=str(driver == "explore").lower(),
         on_start=on_start,
     )
-    is_done = _add_driver(run, driver, route)
-    monitor = run.add(PoseMonitor, parameters={"base_frame": run.base_frame, "odom_frame": run.odom_frame})
-    run.run(duration, until=is_done, record=record, quiet=quiet, desc=f"mapping {world}")
+    with contextlib.ExitStack() as stack:  # the terminal comes back as soon as the drive ends
+        is_done = _add_driver(run, driver, route, stack, quiet)
+        monitor = run.add(PoseMonitor, parameters={"base_frame": run.base_frame, "odom_frame": run.odom_frame})
+        no_bar = quiet or driver == "teleop"  # teleop's status line shows the time
+        run.run(duration, until=is_done, record=record, quiet=no_bar, desc=f"mapping {world}")
     from navlab.mapping import SlamGMapping
 
     slam = run.node("slam_gmapping")
     assert isinstance(slam, SlamGMapping)  # the shipped launch's slam_gmapping
     grid = slam.current_map()
     if grid is None:
+        if run.executor.stopped:  # Ctrl-C (or a stop) before the first scan was processed
+            raise MappingError(f"stopped after {run.timing['sim_s']:.1f} simulated s, before SLAM made a map")
         raise MappingError("SLAM produced no map: did the robot receive scans? (check the robot's lidar)")
     out_dir = Path(out)
     out_dir.mkdir(parents=True, exist_ok=True)
     map_yaml = out_dir / "map.yaml"
-    save_map(grid, map_yaml)
+    with interrupt_note(f"while saving the map: {map_yaml} is the old map or the new one, whole"):  # temp + rename
+        save_map(grid, map_yaml)  # first: the map is the result; its scores and picture follow
     result = MappingResult(map_yaml, grid, run.timing["sim_s"], bool(is_done()), cpu_s=run.timing["cpu_s"])
+    with interrupt_note(f"the map is saved: {map_yaml} (+ its image); trajectory.txt and map.png may be missing"):
+        result.scores = _score_and_plot(run, slam, grid, pose, world, mode, monitor, out_dir, finished=result.finished)
+    return result
+
+
+def _score_and_plot(
+    run: Run,
+    slam: Any,
+    grid: GridMap,
+    pose: tuple[float, float, float],
+    world: str,
+    mode: str,
+    monitor: PoseMonitor,
+    out_dir: Path,
+    *,
+    finished: bool,
+) -> dict[str, Any]:
+    """The saved map's scores against the world's truth; writes trajectory.txt and map.png into ``out_dir``."""
     truth = true_occupancy(run.sim.world, grid)
     map_in_world = world_T_map(run.sim.robot, pose)
     scores: dict[str, Any] = {
         **run.figures(),
-        "finished": result.finished,
+        "finished": finished,
         "scans_processed": slam.scans_processed,
         "scans_invalid": slam.scans_invalid,
         "map_empty": not bool(np.any(grid.data >= 65)),
@@ -176,8 +206,7 @@ def run_mapping(
             "scans had no reading within the lidar's range)"
         )
         logging.getLogger("navlab.mapping").warning(scores["warning"])
-    result.scores = rounded(scores)
-    return result
+    return rounded(scores)
 
 
 def write_trajectory(path: Path, t: np.ndarray, est: np.ndarray, truth: np.ndarray) -> None:

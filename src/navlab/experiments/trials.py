@@ -13,6 +13,7 @@ beside it), medians and quartiles.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
 import os
@@ -345,11 +346,13 @@ def run_experiments(
     total = sum(sc.trials for sc, _ in jobs)
     bar = tqdm(total=total, initial=total - len(tasks), desc=desc, unit="trial", file=sys.stderr, disable=not progress)
     try:
-        for i, rec in run_tasks(_trial_in_worker, tasks, backend=backend, workers=workers):
-            j = owner[i]
-            done[j][int(rec["trial"])] = rec
-            _append_line(jobs[j][1] / "results.jsonl", rec)
-            bar.update(1)
+        # closed here, also on Ctrl-C between two results: the workers stop now, not at the interpreter's exit
+        with contextlib.closing(run_tasks(_trial_in_worker, tasks, backend=backend, workers=workers)) as outcomes:
+            for i, rec in outcomes:
+                j = owner[i]
+                done[j][int(rec["trial"])] = rec
+                _append_line(jobs[j][1] / "results.jsonl", rec)
+                bar.update(1)
     finally:
         bar.close()
     summaries = []

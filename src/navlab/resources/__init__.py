@@ -51,11 +51,19 @@ def package_paths() -> dict[str, Path]:
     return {name: root() / rel for name, rel in _SHIPPED_PACKAGES}
 
 
+def shipped(kind: str) -> list[str]:
+    """The names of the shipped worlds, robots or routes (``kind``: world, robot or route), sorted."""
+    if kind == "robot":  # robots/NAME/NAME.xacro
+        return sorted(p.parent.name for p in (root() / "robots").glob("*/*.xacro") if p.stem == p.parent.name)
+    pattern = {"world": "worlds/*.world", "route": "routes/*.yaml"}[kind]
+    return sorted(p.stem for p in root().glob(pattern))
+
+
 def world(name: str) -> Path:
     """A shipped world by name (``"room"`` or ``"room.world"``)."""
     full = path(f"worlds/{name if name.endswith('.world') else name + '.world'}", must_exist=False)
     if not full.is_file():
-        raise _unknown("world", name, sorted(p.stem for p in (root() / "worlds").glob("*.world")))
+        raise _unknown("world", name, shipped("world"))
     return full
 
 
@@ -63,11 +71,7 @@ def robot(name: str) -> Path:
     """A shipped robot's top xacro by name (``"mybot"``)."""
     full = path(f"robots/{name}/{name}.xacro", must_exist=False)
     if not full.is_file():
-        raise _unknown(
-            "robot",
-            name,
-            sorted(p.parent.name for p in (root() / "robots").glob("*/*.xacro") if p.stem == p.parent.name),
-        )
+        raise _unknown("robot", name, shipped("robot"))
     return full
 
 
@@ -75,7 +79,7 @@ def route(name: str) -> Path:
     """A shipped mapping route by name (``"room"``: a loop through room.world for ``navlab map --route``)."""
     full = path(f"routes/{name if name.endswith('.yaml') else name + '.yaml'}", must_exist=False)
     if not full.is_file():
-        raise _unknown("route", name, sorted(p.stem for p in (root() / "routes").glob("*.yaml")))
+        raise _unknown("route", name, shipped("route"))
     return full
 
 

@@ -29,6 +29,7 @@ from navlab.sim.builder import (
     set_pose,
 )
 from navlab.sim.errors import SimError
+from navlab.sim.mjtimers import profiling_timers_off
 from navlab.world import ModelSpec, WorldModel
 
 
@@ -241,8 +242,32 @@ def build_spec(
 
 
 def compile_spec(spec: mujoco.MjSpec, what: str = "model") -> mujoco.MjModel:
-    """Compile, turning MuJoCo's compiler errors into a ``SimError``."""
+    """Compile, turning MuJoCo's compiler errors into a ``SimError``; MuJoCo's profiling timers go off (~12 % of a
+    step, read by nobody: :mod:`navlab.sim.mjtimers`), and so do its spring and damper passes when the model has
+    no spring or damper (:func:`no_passive_flags`; the spec keeps the flags for recompiles)."""
+    profiling_timers_off()
     try:
-        return spec.compile()
+        model = spec.compile()
     except ValueError as exc:
         raise SimError(f"MuJoCo could not compile the {what}: {exc}") from None
+    bits = no_passive_flags(model)
+    if bits:
+        spec.option.disableflags |= bits
+        model.opt.disableflags |= bits
+    return model
+
+
+def no_passive_flags(model: mujoco.MjModel) -> int:
+    """``mjDSBL_SPRING`` / ``mjDSBL_DAMPER`` for a model with no joint stiffness / no joint damping and none of
+    the other passive forces (tendons, flexes, gravity compensation, fluid, plugins, a passive callback): the
+    passes then only add zeros, so skipping them changes no motion, bit for bit (~3 % of a step of navlab's
+    robots). Models added at run time (``Simulation.spawn``) are free bodies: they add none either."""
+    others = model.ntendon or model.nflex or model.ngravcomp or model.nplugin
+    if others or model.opt.density or model.opt.viscosity or mujoco.get_mjcb_passive() is not None:
+        return 0
+    bits = 0
+    if not model.jnt_stiffness.any():
+        bits |= int(mujoco.mjtDisableBit.mjDSBL_SPRING)
+    if not model.dof_damping.any():
+        bits |= int(mujoco.mjtDisableBit.mjDSBL_DAMPER)
+    return bits

@@ -10,9 +10,12 @@ forgets the memo without clearing it). A pose is checked point by point only whe
 bound can still fail it (LETHAL or unknown in the ring) or raise the rollout's cost above what its other poses
 already cost: first, in time order, the poses that may fail (the first failure decides, as
 ``rollout.rollout_scores``), then the highest bound of the rest, then (latest first) any pose whose bound is
-still above. Every rollout starts from the same pose, checked once a call. The costs are those of
-``rollout.rollout_scores`` bit for bit: the maximum does not depend on the order. Poses are grid-local (m, rad);
-cells (i, j) = (column, row).
+still above. Every rollout starts from the same pose, checked once a call. A pose that stands where the pose
+before or after it stands (the robot turning in place) first takes a tighter bound, the ring of its
+``FINE`` x ``FINE`` part of the cell, looked up once for that spot: an in-place turn sweeps the outline round
+one spot, and the quarter ring's bound is above its cost at nearly every heading. The costs are those of
+``rollout.rollout_scores`` bit for bit: the maximum does not depend on the order, and a bound only decides
+which poses need no check. Poses are grid-local (m, rad); cells (i, j) = (column, row).
 """
 
 from __future__ import annotations
@@ -27,13 +30,15 @@ from navlab.navigation.controllers.mapgrid import grow
 from navlab.navigation.controllers.rollout import outline_max
 
 QUARTERS = 2  # the centre's cell is split QUARTERS x QUARTERS ways: tighter rings than one ring per cell
+FINE = 8  # an in-place turn's spot: its cell split FINE x FINE ways (rings after the quarters' in ring_offsets)
 _EPS = 1e-6  # cells: room for the rounding of the outline points' coordinates
 
 
 def ring_offsets(outline: np.ndarray, resolution: float) -> tuple[np.ndarray, np.ndarray]:
-    """(offsets (Q, M, 2) as (di, dj), counts (Q,)): for each part q = qj * QUARTERS + qi of a cell, the cells
-    relative to the centre's that an outline point (base frame, m) can fall in, at any heading, while the centre
-    lies in that part of its cell."""
+    """(offsets (Q + F, M, 2) as (di, dj), counts (Q + F,)): for each part q = qj * QUARTERS + qi of a cell, the
+    cells relative to the centre's that an outline point (base frame, m) can fall in, at any heading, while the
+    centre lies in that part of its cell; then, from row Q = QUARTERS², the same for the FINE x FINE parts
+    (part Q + qj * FINE + qi)."""
     r = np.hypot(outline[:, 0], outline[:, 1]) / resolution
     rmin, rmax = float(r.min()) - _EPS, float(r.max()) + _EPS
     reach = math.ceil(rmax) + 2
@@ -53,12 +58,30 @@ def ring_offsets(outline: np.ndarray, resolution: float) -> tuple[np.ndarray, np
                     if math.hypot(dx, dy) <= rmax and far >= rmin:
                         ring.append((a, b))
             rings.append(ring)
-    offsets = np.zeros((q * q, max(len(g) for g in rings), 2), dtype=np.int64)
-    counts = np.zeros(q * q, dtype=np.int64)
+    rings += _fine_rings(rmin, rmax, reach)
+    offsets = np.zeros((len(rings), max(len(g) for g in rings), 2), dtype=np.int64)
+    counts = np.zeros(len(rings), dtype=np.int64)
     for k, ring in enumerate(rings):
         offsets[k, : len(ring)] = ring
         counts[k] = len(ring)
     return offsets, counts
+
+
+def _fine_rings(rmin: float, rmax: float, reach: int) -> list[list[tuple[int, int]]]:
+    """:func:`ring_offsets`' rings of the FINE x FINE parts (the same test, in numpy: FINE² parts of a cell)."""
+    f = FINE
+    b, a = (g.ravel() for g in np.mgrid[-reach : reach + 1, -reach : reach + 1])
+    rings = []
+    for qj in range(f):
+        ly, hy = b - (qj + 1) / f - _EPS, b + 1 - qj / f + _EPS
+        dy = np.where((ly <= 0.0) & (hy >= 0.0), 0.0, np.minimum(np.abs(ly), np.abs(hy)))
+        for qi in range(f):
+            lx, hx = a - (qi + 1) / f - _EPS, a + 1 - qi / f + _EPS
+            dx = np.where((lx <= 0.0) & (hx >= 0.0), 0.0, np.minimum(np.abs(lx), np.abs(hx)))
+            far = np.hypot(np.maximum(np.abs(lx), np.abs(hx)), np.maximum(np.abs(ly), np.abs(hy)))
+            keep = (np.hypot(dx, dy) <= rmax) & (far >= rmin)
+            rings.append(list(zip(a[keep].tolist(), b[keep].tolist(), strict=True)))
+    return rings
 
 
 def new_memo(shape: tuple[int, int]) -> np.ndarray:
@@ -102,6 +125,33 @@ def bound_at(
     if kept >> 8 == epoch:
         return kept & 0xFF
     return ring_bound(grid, memo, epoch, offsets, counts, part, i, j)
+
+
+@numba.njit(cache=True, inline="always")
+def _stands(traj: np.ndarray, r: int, k: int, x: float, y: float) -> bool:  # pragma: no cover - compiled
+    """Whether pose ``k`` of rollout ``r`` (at x, y) stands where the pose before or after it stands."""
+    n = traj.shape[1]
+    before = k > 0 and x == traj[r, k - 1, 0] and y == traj[r, k - 1, 1]
+    return before or (k + 1 < n and x == traj[r, k + 1, 0] and y == traj[r, k + 1, 1])
+
+
+@numba.njit(cache=True)
+def _fine_bound(
+    grid: np.ndarray, offsets: np.ndarray, counts: np.ndarray, fx: float, fy: float
+) -> int:  # pragma: no cover - compiled
+    """The highest cost of the centre cell at cell coordinates (fx, fy) (inside the grid) and the ring of its FINE x
+    FINE part (``ring_offsets``' rows from QUARTERS²; unknown if the ring leaves the grid)."""
+    h, w = grid.shape
+    i, j = math.floor(fx), math.floor(fy)
+    f = FINE
+    part = QUARTERS * QUARTERS + min(f - 1, int((fy - j) * f)) * f + min(f - 1, int((fx - i) * f))
+    top = int(grid[j, i])
+    for m in range(counts[part]):
+        pi, pj = i + offsets[part, m, 0], j + offsets[part, m, 1]
+        if pi < 0 or pj < 0 or pi >= w or pj >= h:
+            return COST_UNKNOWN
+        top = max(top, int(grid[pj, pi]))
+    return top
 
 
 @numba.njit(cache=True, inline="always")
@@ -152,6 +202,9 @@ def ring_scores(
     goal_dist, goal_reached, goal_free, goal_queue, goal_ends = goal_wave
     bounds = np.empty(n, dtype=np.int64)
     unreached = float(h * w) + 1.0  # mapgrid's unreachable_value: a wave's cells not reached (yet)
+    fine = counts.size > q * q  # ring_offsets' FINE rings follow the quarters'
+    spot_x = spot_y = math.nan  # the last spot whose FINE bound was looked up, and that bound
+    spot = 0
     # the first pose, which every rollout of a cycle shares: its cost once, when it cannot fail
     e0 = -1.0
     if polygon and traj.shape[0] > 0 and n > 0:
@@ -225,5 +278,12 @@ def ring_scores(
             k = first if a < 0 else n - 1 - a
             if k < 0 or bounds[k] <= top or (a >= 0 and k == first) or (k == 0 and shared):
                 continue
-            top = max(top, _exact(grid, inv, traj[r, k, 0], traj[r, k, 1], c[r, k], s[r, k], ox, oy, bounds[k]))
+            x, y, b = traj[r, k, 0], traj[r, k, 1], bounds[k]
+            if fine and _stands(traj, r, k, x, y):  # turning on one spot: its FINE part's ring, once
+                if not (x == spot_x and y == spot_y):
+                    spot_x, spot_y, spot = x, y, _fine_bound(grid, offsets, counts, x * inv, y * inv)
+                if spot <= top:
+                    continue
+                b = min(b, spot)
+            top = max(top, _exact(grid, inv, x, y, c[r, k], s[r, k], ox, oy, b))
         out[r] = weights[0] * (weights[1] * spd + weights[2] * sgd + weights[3] * top)
