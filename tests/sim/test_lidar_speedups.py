@@ -33,6 +33,25 @@ def test_another_bit_generator_draws_with_numpy() -> None:
     assert draws.draw().tobytes() == np.random.Generator(np.random.Philox(5)).standard_normal(50).tobytes()
 
 
+def every_beam(
+    m: mujoco.MjModel, d: mujoco.MjData, geoms: np.ndarray, origin: np.ndarray, rot: np.ndarray, a: np.ndarray,
+    range_min: float, cutoff: float,
+) -> np.ndarray:  # fmt: skip
+    """The ranges of beams at angles ``a``: the kernel's arithmetic, term by term, for every beam and geom."""
+    want = np.full(a.shape[0], np.inf)
+    ca, sa = np.cos(a), np.sin(a)
+    for g in geoms:
+        xm, rel = d.geom_xmat[g], origin - d.geom_xpos[g]
+        p = np.array([xm[k] * rel[0] + xm[3 + k] * rel[1] + xm[6 + k] * rel[2] for k in range(3)])
+        u = [xm[k] * rot[0, 0] + xm[3 + k] * rot[1, 0] + xm[6 + k] * rot[2, 0] for k in range(3)]
+        v = [xm[k] * rot[0, 1] + xm[3 + k] * rot[1, 1] + xm[6 + k] * rot[2, 1] for k in range(3)]
+        for i in range(a.shape[0]):
+            dl = np.array([u[k] * ca[i] + v[k] * sa[i] for k in range(3)])
+            want[i] = min(want[i], ray_hit(m.geom_type[g], m.geom_size[g], p, dl, range_min))
+    want[want > cutoff] = np.inf
+    return want
+
+
 def test_cast_equals_every_beam_tested_against_every_geom() -> None:
     """Obstacles in rows behind each other (most beams reach a far geom only through the skip) and a tilted scan."""
     sim = Simulation(make_mybot(noise=0.0), make_room(), seed=0, robot_pose=(-3.0, 0.2, 0.3))
@@ -51,17 +70,7 @@ def test_cast_equals_every_beam_tested_against_every_geom() -> None:
         got = np.empty(n)
         cast_planar(origin, rot, np.cos(a), np.sin(a), -math.pi, 2 * math.pi / (n - 1), geoms, m.geom_type,
                     m.geom_size, d.geom_xpos, d.geom_xmat, 0.1, 10.0, got)  # fmt: skip
-        want = np.full(n, np.inf)
-        ca, sa = np.cos(a), np.sin(a)
-        for g in geoms:  # the kernel's arithmetic, term by term, for every beam and geom
-            xm, rel = d.geom_xmat[g], origin - d.geom_xpos[g]
-            p = np.array([xm[k] * rel[0] + xm[3 + k] * rel[1] + xm[6 + k] * rel[2] for k in range(3)])
-            u = [xm[k] * rot[0, 0] + xm[3 + k] * rot[1, 0] + xm[6 + k] * rot[2, 0] for k in range(3)]
-            v = [xm[k] * rot[0, 1] + xm[3 + k] * rot[1, 1] + xm[6 + k] * rot[2, 1] for k in range(3)]
-            for i in range(n):
-                dl = np.array([u[k] * ca[i] + v[k] * sa[i] for k in range(3)])
-                want[i] = min(want[i], ray_hit(m.geom_type[g], m.geom_size[g], p, dl, 0.1))
-        want[want > 10.0] = np.inf
+        want = every_beam(m, d, geoms, origin, rot, a, 0.1, 10.0)
         assert np.isfinite(got).sum() > 600
         assert got.tobytes() == want.tobytes()
 
@@ -91,15 +100,6 @@ def test_box_and_cylinder_spans_hold_every_beam_that_hits_from_any_side() -> Non
         got = np.empty(n)
         cast_planar(origin, rot, ca, sa, -math.pi, 2 * math.pi / n, geoms, m.geom_type, m.geom_size, d.geom_xpos,
                     d.geom_xmat, 0.05, 8.0, got)  # fmt: skip
-        want = np.full(n, np.inf)
-        for g in geoms:
-            xm, rel = d.geom_xmat[g], origin - d.geom_xpos[g]
-            p = np.array([xm[j] * rel[0] + xm[3 + j] * rel[1] + xm[6 + j] * rel[2] for j in range(3)])
-            u = [xm[j] * rot[0, 0] + xm[3 + j] * rot[1, 0] + xm[6 + j] * rot[2, 0] for j in range(3)]
-            v = [xm[j] * rot[0, 1] + xm[3 + j] * rot[1, 1] + xm[6 + j] * rot[2, 1] for j in range(3)]
-            for i in range(n):
-                dl = np.array([u[j] * ca[i] + v[j] * sa[i] for j in range(3)])
-                want[i] = min(want[i], ray_hit(m.geom_type[g], m.geom_size[g], p, dl, 0.05))
-        want[want > 8.0] = np.inf
+        want = every_beam(m, d, geoms, origin, rot, a, 0.05, 8.0)
         assert np.isfinite(got).sum() > 10
         assert got.tobytes() == want.tobytes(), k
