@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import pytest
 
-from navlab.experiments.clutter_protocol import SETS, speed_overrides
+from navlab.experiments.clutter_protocol import SETS, below_cap, speed_overrides
 from navlab.experiments.clutter_run import OWN_FILES_PARAMS, barn_clock, clutter_params, run_clutter_world
 from navlab.experiments.errors import ExperimentError
 from navlab.world.clutter import clutter_suite, generate_clutter, suite_parameters
@@ -67,3 +67,12 @@ def test_barn_clock_runs_from_the_first_move_until_first_within_a_metre() -> Non
     first, second = {**one, "within_tolerance_s": 13.0}, {"time_s": 9.0, "moved_s": 0.2, "within_tolerance_s": 7.0}
     assert barn_clock([first, second]) == pytest.approx(14.0 - 0.6 + 7.0)  # a tour: the first goal's whole time
     assert barn_clock([{**one, "within_tolerance_s": None}]) is None  # never came within 1 m
+
+
+def test_the_summary_names_each_success_under_the_cap_with_its_time() -> None:
+    """A success slower than 2 T_opt is listed with its time and the time that scores the cap; a success at the cap
+    and a failure are not."""
+    slow = {"world": "w36", "success": True, "score": 0.21, "barn_time_s": 27.2, "t_opt_s": 5.705}
+    fast = {"world": "w1", "success": True, "score": 0.5, "barn_time_s": 6.0, "t_opt_s": 5.3}
+    failed = {"world": "w2", "success": False, "score": 0.0, "barn_time_s": None, "t_opt_s": 5.0}
+    assert below_cap([slow, fast, failed]) == {"w36": {"barn_time_s": 27.2, "cap_time_s": 11.41}}

@@ -55,14 +55,21 @@ def test_a_clutter_trial_is_scored_as_barn_scores_it() -> None:
     assert r["score_to_stop"] == pytest.approx(r["t_opt_s"] / max(r["time_s"], 2 * r["t_opt_s"]), abs=1e-3)
 
 
-def test_a_slow_local_costmap_hits_the_cylinder_that_a_fast_one_avoids() -> None:
-    """refresh_rate.yaml: the same trial (cylinder 0.7 m ahead at the same drawn time) at 0.5 Hz and 5 Hz."""
+def test_a_slow_local_costmap_hits_the_cylinder_and_the_collision_monitor_stops_the_robot() -> None:
+    """refresh_rate.yaml: the same trial (cylinder 0.7 m ahead at the same drawn time) at 0.5 Hz without Nav2's
+    collision monitor (the paper's move_base), at 0.5 Hz with it (mybot's default), and at 5 Hz."""
     sc = load_scenario("refresh_rate")
     assert sc.obstacles[0]["frame"] == "robot" and sc.overrides["planner_frequency"] == 0.0
     sc.time_limit = 15.0  # the cylinder appears within 8 s: enough to see who hits it
     sc.overrides["local_costmap.update_frequency"] = 0.5
+    sc.collision_monitor = False
     slow = run_trial(sc, 1)
+    assert slow["collisions"] >= 1 and slow["failure"] == "collision", slow
+    sc.collision_monitor = None  # the robot's default: on for mybot, on the raw scan whatever the costmap's rate
+    guarded = run_trial(sc, 1)
+    assert guarded["collisions"] == 0 and guarded["min_clearance_m"] >= 0.05, guarded
     sc.overrides["local_costmap.update_frequency"] = 5.0
     fast = run_trial(sc, 1)
-    assert slow["collisions"] >= 1 and slow["failure"] == "collision", slow
     assert fast["collisions"] == 0, fast
+    with pytest.raises(ExperimentError, match="collision_monitor: expected true or false"):
+        scenario_from_dict({"goals": [[1, 0, 0]], "collision_monitor": "yes"})

@@ -176,10 +176,14 @@ def cases(n: int, seed: int, formats: tuple[str, ...] = FORMATS) -> list[Case]:
     return [generate(formats[k % len(formats)], seeds[formats[k % len(formats)]], rng) for k in range(n)]
 
 
+COMPILE_ALLOWANCE = 4.0  # x timeout for a format's first case (JIT compilation is not a hang)
+
+
 def run_cases(todo: list[Case], *, timeout: float = 10.0, progress: bool = False) -> list[Result]:
     """Run and classify every case (each in a fresh folder, one worker process reused)."""
     worker = Worker()
     results: list[Result] = []
+    seen: set[str] = set()
     root = Path(tempfile.mkdtemp(prefix="navlab-fuzz-"))
     try:
         for k, case in enumerate(todo):
@@ -193,7 +197,10 @@ def run_cases(todo: list[Case], *, timeout: float = 10.0, progress: bool = False
                 "marker": case.expect.get("marker"),
                 "keep": case.expect.get("keep"),
             }
-            results.append(classify(case, worker.run(req, timeout), folder))
+            # a format's first case in a worker may compile its Numba kernels (cold caches in a fresh clone): more time
+            first = case.fmt not in seen
+            seen.add(case.fmt)
+            results.append(classify(case, worker.run(req, timeout * (COMPILE_ALLOWANCE if first else 1.0)), folder))
             shutil.rmtree(folder, ignore_errors=True)
             if progress and (k + 1) % 100 == 0:
                 print(f"  {k + 1}/{len(todo)} cases", file=sys.stderr, flush=True)

@@ -174,7 +174,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         action="append",
         default=[],
         metavar="NAME=V1,V2,...",
-        help="sweep: a move_base parameter (or controller) and its values, e.g. "
+        help="sweep: a move_base parameter (or controller, or collision_monitor=false,true) and its values, e.g. "
         "local_costmap.update_frequency=0.5,1,2,5 (repeatable: the grid of all combinations)",
     )
     p.add_argument("--out", metavar="DIR", default=None, help="results folder (default runs/<scenario name>)")

@@ -12,6 +12,7 @@ from navlab.lazy import lazy_exports
 
 if TYPE_CHECKING:
     from navlab.description.errors import DescriptionError, NotFoundError
+    from navlab.description.footprint import collision_reach
     from navlab.description.loader import load_robot, load_robot_named
     from navlab.description.materials import gazebo_material
     from navlab.description.meshes import cache_dir, is_convex, prepare_mesh, read_mesh, up_axis_warning
@@ -56,6 +57,7 @@ _EXPORTS = {
     "RangeConfig": "navlab.description.sensor_model",
     "SensorConfig": "navlab.description.sensor_model",
     "cache_dir": "navlab.description.meshes",
+    "collision_reach": "navlab.description.footprint",
     "find_package": "navlab.description.packages",
     "format_robot": "navlab.description.summary",
     "gazebo_material": "navlab.description.materials",
@@ -88,6 +90,7 @@ __all__ = [
     "SensorConfig",
     "Shape",
     "cache_dir",
+    "collision_reach",
     "find_package",
     "format_robot",
     "gazebo_material",

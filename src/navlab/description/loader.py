@@ -172,6 +172,8 @@ def robot_launch_values(name_or_path: str | os.PathLike[str]) -> dict[str, str]:
         "ekf_mapless": "true" if ekf is not None or model.imus else "false",
         "imu_topic": model.imus[0].topic if model.imus else "imu",
         "ekf_params": str(ekf or resources.path("params/ekf.yaml")),
+        "collision_monitor": "true" if (params / "collision_monitor.yaml").is_file() else "false",
+        "collision_monitor_params": str(params / "collision_monitor.yaml") if own else "",
     }
     if not own:
         values["params_note"] = (

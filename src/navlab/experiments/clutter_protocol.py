@@ -5,7 +5,8 @@ results are reported on) and the **tuning** set (``clutter_suite(50, seed=1)``: 
 The robot drives mapless at its real top speed (``max_speed`` m/s; the Jackal's 2 m/s, as the challenge
 allows), 100 s per world, success = within 1 m of the goal by the simulator's truth with no contact. The
 summary has success, collision, timeout, stuck and aborted rates, BARN's mean score, the mean time of the
-successes, the closest clearance and the near misses; with ``out`` a picture of each failure (the costmap,
+successes, the closest clearance, the near misses and the successes under the score's cap (``below_cap``: each
+one's time against 2 T_opt, the time that scores the cap); with ``out`` a picture of each failure (the costmap,
 plans, the true path and the robot when it ended) goes to ``out/<world>.png``.
 """
 
@@ -16,7 +17,7 @@ import time
 from pathlib import Path
 from typing import Any
 
-from navlab.experiments.clutter_run import run_clutter_world, summarize
+from navlab.experiments.clutter_run import CAP, run_clutter_world, summarize
 from navlab.experiments.errors import ExperimentError
 
 SETS = {"test": 0, "tuning": 1}  # clutter_suite seed of each set
@@ -45,6 +46,16 @@ def speed_overrides(controller: str | None, max_speed: float | None) -> dict[str
             f"bench clutter: --max-speed needs a known local planner ({', '.join(SPEED_KEYS)}), got {controller!r}"
         )
     return dict.fromkeys(keys, float(max_speed))
+
+
+def below_cap(trials: list[dict[str, Any]]) -> dict[str, dict[str, float]]:
+    """The successes that scored under the cap: per world, its time on BARN's clock and the most it may take to
+    score the cap (2 T_opt), s."""
+    return {
+        t["world"]: {"barn_time_s": t["barn_time_s"], "cap_time_s": round(2.0 * t["t_opt_s"], 2)}
+        for t in trials
+        if t["success"] and t["score"] < CAP
+    }
 
 
 def run_protocol(
@@ -100,6 +111,7 @@ def run_protocol(
             "collision_monitor": collision_monitor,
             "wall_s": round(time.perf_counter() - t0, 1),
             "failed_worlds": {t["world"]: t["failure"] for t in trials if not t["success"]},
+            "below_cap": below_cap(trials),
         }
     )
     if folder is not None:

@@ -202,7 +202,8 @@ def run_navigation(
     ``map_yaml``: the map to navigate on (default: the world's true map). ``controller``: ``trajectory``,
     ``dwa``, ``mppi`` or a ROS plugin name (default: the parameter files'). ``move_base_params``: overrides
     (``{"local_costmap.update_frequency": 0.5}``). ``spawn``: (time s, ModelSpec) obstacles added while
-    running (or a function of the simulation that returns one, to place it relative to the robot then).
+    running (or a function of the simulation that returns one, to place it relative to the robot then; or a later
+    time in s to be asked again then; or None to place nothing).
     ``snapshots``: keep what the per-goal pictures need. ``mapless``: no map, no amcl — the global costmap
     is a rolling window in ``odom`` built from scans, and ``goals`` are in ``odom`` (the start pose).
     ``wheel_controller``: ``gazebo_ros_diff_drive`` (the robot's plugin) or ``diff_drive_controller`` (or a
@@ -281,10 +282,13 @@ def run_navigation(
     )
     dropped: list[tuple[float, float, float, str]] = []  # (x m, y m, t s, name) of what was spawned, world frame
 
-    def drop(model: Any) -> None:
+    def drop(model: Any) -> float | None:
         spec = model(run.sim) if callable(model) else model
+        if spec is None or isinstance(spec, float):  # left out, or: ask again at that time
+            return spec
         run.gazebo.spawn(spec)
         dropped.append((float(spec.pose[0]), float(spec.pose[1]), mon.now_s(), spec.name))
+        return None
 
     for t, model in spawn:
         _at(run, float(t), lambda m=model: drop(m))
@@ -427,15 +431,20 @@ def sim_launch_args(wheel_controller: str, ekf: str | Path | None) -> dict[str, 
 
 
 def _at(run: Run, t: float, fn: Any) -> None:
-    """Call ``fn`` once at simulated time ``t`` (s) of the run."""
+    """Call ``fn`` at simulated time ``t`` (s) of the run, and again at the time (s) it returns, if any."""
     node = run.add(Node, name=f"at_{t:g}_{len(run.session.nodes)}")
     holder: dict[str, Any] = {}
 
+    def arm(when: float) -> None:
+        holder["timer"] = node.create_timer(max(when - run.executor.now_ns / 1e9, 1e-3), fire)
+
     def fire() -> None:
         holder["timer"].cancel()
-        fn()
+        again = fn()
+        if again is not None:
+            arm(again)
 
-    holder["timer"] = node.create_timer(max(t - run.executor.now_ns / 1e9, 1e-3), fire)
+    arm(t)
 
 
 def _snapshot(run: Run, mon: NavMonitor, world_T_frame: Pose = (0.0, 0.0, 0.0), mapless: bool = False) -> NavSnapshot:

@@ -15,7 +15,8 @@ params: null                 # folder of move_base's ROS 1 parameter files (defa
 overrides: {local_costmap.update_frequency: 5.0}   # move_base parameters
 obstacles: [{t: 20.0, spec: "cylinder:x=-1.0,y=-0.45,radius=0.15,length=0.6"}]   # added while running
 #   t: [lo, hi] draws the time per trial (from the trial's seed); frame: robot places x, y (and yaw) in the
-#   robot's frame at that time (e.g. x=0.7: 0.7 m ahead of it), frame: world (default) in the world
+#   robot's frame at that time (e.g. x=0.7: 0.7 m ahead of it), frame: world (default) in the world; never on the
+#   start, a goal or the robot (see scenario_obstacles: a robot-frame one about to reach a goal appears earlier)
 goals: [[4.3, 1.0, 0.0], [-3.5, -0.5, 3.14]]      # map frame (odom with map: none)
 trials: 20                   # trial k runs with seed + k
 seed: 0
@@ -23,6 +24,8 @@ time_limit: 90.0             # s per goal
 goal_tolerance_m: 0.3        # the truth's goal region: a goal is reached when the robot truly ends this close
 wheel_controller: diff_drive_controller   # gazebo_ros_diff_drive (default) | diff_drive_controller | a ros_control YAML
 ekf: true                    # robot_localization's ekf_node (true: params/ekf.yaml; or a file); needs the controller
+collision_monitor: false     # Nav2's collision monitor between move_base and the wheels (default: the robot's, on
+                             #   for mybot; false: move_base drives the wheels directly, as in the paper)
 disturbances: {wheel_radius_error: [0.03, 0.0], slip_patches: [{x: 1.0, y: 0.0, radius: 0.5, mu: 0.05}]}
 ```
 Unknown keys get "did you mean"; bad values one line naming the key.
@@ -66,6 +69,7 @@ class Scenario:
     goal_tolerance_m: float = 0.3
     wheel_controller: str = "gazebo_ros_diff_drive"
     ekf: str | None = None
+    collision_monitor: bool | None = None  # None: the robot's default (the launch's)
     disturbances: dict[str, Any] = field(default_factory=dict)
     path: Path | None = None
 
@@ -77,11 +81,13 @@ class Scenario:
         return str(candidate) if candidate.exists() else value
 
     def navigation_options(self) -> dict[str, Any]:
-        """``run_navigation``'s wheel controller, EKF and disturbances keywords."""
+        """``run_navigation``'s wheel controller, EKF, disturbances and launch arguments keywords."""
+        monitor = {} if self.collision_monitor is None else {"collision_monitor": str(self.collision_monitor).lower()}
         return {
             "wheel_controller": self.resolve(self.wheel_controller) or self.wheel_controller,
             "ekf": self.resolve(self.ekf),
             "disturbances": dict(self.disturbances),
+            "launch_args": monitor,
         }
 
 
@@ -203,6 +209,11 @@ def scenario_from_dict(data: Any, *, where: str = "scenario", path: Path | None 
             if isinstance(v, bool) or not isinstance(v, int) or v < low:
                 raise ExperimentError(f"{where}: {key}: expected an integer >= {low}, got {v!r}")
             setattr(sc, key, v)
+    monitor = data.get("collision_monitor")
+    if monitor is not None:
+        if not isinstance(monitor, bool):
+            raise ExperimentError(f"{where}: collision_monitor: expected true or false, got {monitor!r}")
+        sc.collision_monitor = monitor
     for key, unit in (("time_limit", "seconds"), ("goal_tolerance_m", "metres")):
         if key in data:
             v = data[key]

@@ -78,6 +78,10 @@ def run_sweep(
         for name, value in combo.items():
             if name == "controller":
                 variant.controller = str(value)
+            elif name == "collision_monitor":  # a launch argument, not a move_base parameter
+                if not isinstance(value, bool):
+                    raise ExperimentError(f"--param collision_monitor: expected true or false, got {value!r}")
+                variant.collision_monitor = value
             else:
                 variant.overrides[name] = value
         jobs.append((with_run_options(variant, trials, seed), folder / ",".join(f"{k}={v}" for k, v in combo.items())))

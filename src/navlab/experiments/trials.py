@@ -26,6 +26,7 @@ import numpy as np
 
 from navlab.experiments.errors import ExperimentError
 from navlab.experiments.scenario import Scenario
+from navlab.experiments.scenario_obstacles import check_fixed_obstacles, placements, robot_reach
 from navlab.experiments.session import rounded
 
 
@@ -60,31 +61,6 @@ def shortest_length(
     return total
 
 
-def _spawns(sc: Scenario, seed: int) -> list[tuple[float, Any]]:
-    """The scenario's obstacles as ``run_navigation``'s (time s, model or function of the simulation): a
-    ``[lo, hi]`` time drawn from ``seed``; ``frame: robot`` placed from the robot's true pose at that time."""
-    from dataclasses import replace
-
-    from navlab.geometry import compose2
-    from navlab.sim import parse_spawn_spec
-
-    rng = np.random.default_rng([seed, 0x0B57])  # its own stream: the run's seed stays the simulator's
-    out: list[tuple[float, Any]] = []
-    for k, ob in enumerate(sc.obstacles):
-        model = parse_spawn_spec(ob["spec"], default_name=f"obstacle_{k}")[0]
-        t = float(rng.uniform(*ob["t"])) if isinstance(ob["t"], list) else float(ob["t"])
-        if ob.get("frame", "world") == "robot":
-
-            def place(sim: Any, m: Any = model) -> Any:
-                x, y, yaw = compose2(sim.base_pose2d(), (m.pose[0], m.pose[1], m.pose[5]))
-                return replace(m, pose=(x, y, m.pose[2], m.pose[3], m.pose[4], yaw))
-
-            out.append((t, place))
-        else:
-            out.append((t, model))
-    return out
-
-
 def run_trial(sc: Scenario, index: int) -> dict[str, Any]:
     """Trial ``index`` of ``sc`` (seed = sc.seed + index); its figures (plus BARN's in a clutter world)."""
     from navlab.experiments.clutter_run import SUCCESS_M, barn_outcome, clutter_for_trial, clutter_params
@@ -92,6 +68,7 @@ def run_trial(sc: Scenario, index: int) -> dict[str, Any]:
     from navlab.experiments.navigate_run import run_navigation
 
     seed = sc.seed + index
+    obstacles = placements(sc, seed)
     world = sc.resolve(sc.world) or sc.world
     clutter = clutter_for_trial(sc.world, index)
     start, overrides = sc.start, sc.overrides
@@ -121,7 +98,7 @@ def run_trial(sc: Scenario, index: int) -> dict[str, Any]:
             controller=sc.controller,
             params_dir=sc.resolve(sc.params),
             move_base_params=overrides,
-            spawn=_spawns(sc, seed),
+            spawn=[(p.first_s, p) for p in obstacles],
             goal_timeout=sc.time_limit,
             seed=seed,
             mapless=sc.map == "none",
@@ -170,6 +147,8 @@ def run_trial(sc: Scenario, index: int) -> dict[str, Any]:
             "tracking_error_m": _mean(goals, "tracking_error_m"),
             "final_error_m": _mean(goals, "final_error_m"),
             **barn,
+            # where and when each obstacle appeared ([t s, x m, y m] in the world; null: left out)
+            **({"obstacles": [p.placed and list(p.placed) for p in obstacles]} if obstacles else {}),
             "per_goal": goals,
             "world_file": str(world) if clutter is None else None,
             "start": list(start),
@@ -332,6 +311,8 @@ def run_experiments(
     for j, (sc, folder) in enumerate(jobs):
         if sc.trials < 1:
             raise ExperimentError(f"trials: expected an integer >= 1, got {sc.trials}")
+        if sc.obstacles:
+            check_fixed_obstacles(sc, robot_reach(sc.robot))
         folder.mkdir(parents=True, exist_ok=True)
         finished = {
             int(r["trial"]): r

@@ -50,6 +50,11 @@ class Polygon:
     simulation_time_step: float = 0.1
     enabled: bool = True
 
+    @property
+    def reach(self) -> float:
+        """How far (m) the zone reaches from the base frame's origin."""
+        return self.radius if self.points is None else float(np.hypot(self.points[:, 0], self.points[:, 1]).max())
+
     def inside(self, pts: np.ndarray) -> np.ndarray:
         """Which of ``pts`` (M, 2; base frame) lie in the zone."""
         if self.points is None:
@@ -165,10 +170,16 @@ class CollisionMonitor:
         """The command (v m/s, w rad/s) allowed with the obstacle ``points`` (M, 2; base frame, m)."""
         pts = np.asarray(points, dtype=np.float64).reshape(-1, 2)
         best = Verdict(v, w)
+        if len(pts) == 0:
+            return best
+        dist = np.hypot(pts[:, 0], pts[:, 1])
         for poly in self.polygons:
+            near = pts[dist <= self._reach(poly, v)]
+            if len(near) < poly.min_points:
+                continue
             if poly.action_type == "approach":
-                cand = self._approach(poly, v, w, pts)
-            elif int(poly.inside(pts).sum()) >= poly.min_points:
+                cand = self._approach(poly, v, w, near)
+            elif int(poly.inside(near).sum()) >= poly.min_points:
                 if poly.action_type == "stop":
                     cand = Verdict(0.0, 0.0, poly.name, "stop")
                 elif poly.action_type == "slowdown":
@@ -187,6 +198,16 @@ class CollisionMonitor:
             if abs(cand.v) < abs(best.v) - 1e-12 or (cand.action == "stop" and best.action != "stop"):
                 best = cand
         return best
+
+    @staticmethod
+    def _reach(poly: Polygon, v: float) -> float:
+        """How far (m) from the origin a point can count for ``poly`` at speed ``v`` (m/s): an approach zone moved
+        along the arc stays within |v| ``time_before_collision`` of here."""
+        return poly.reach + (abs(v) * poly.time_before_collision if poly.action_type == "approach" else 0.0) + 1e-9
+
+    def reach(self, v: float) -> float:
+        """How far (m) from the origin any point can change the command at speed ``v`` (m/s)."""
+        return max((self._reach(p, v) for p in self.polygons), default=0.0)
 
     def _approach(self, poly: Polygon, v: float, w: float, pts: np.ndarray) -> Verdict:
         """Scale (v, w) so the polygon moved along the arc touches the points no sooner than
@@ -245,7 +266,8 @@ class CollisionMonitorNode(Node):
         fp = np.asarray(footprint, dtype=np.float64).reshape(-1, 2) if footprint else None
         self.monitor = CollisionMonitor(parse_polygons(raw, fp))
         self.check_parameters()
-        self.points = np.zeros((0, 2))
+        self.last_scan: Any = None  # the last scan and the laser's pose (x, y, yaw) in the base frame
+        self.laser = (0.0, 0.0, 0.0)
         self.scan_ns: int | None = None
         self.last: Verdict | None = None
         self.actions: dict[str, int] = {}  # how many commands each polygon changed
@@ -255,21 +277,36 @@ class CollisionMonitorNode(Node):
 
     def _on_scan(self, msg: Any) -> None:
         try:
-            laser = self.sensor_pose(self.base_frame, str(msg.header.frame_id).lstrip("/"))
+            self.laser = self.sensor_pose(self.base_frame, str(msg.header.frame_id).lstrip("/"))
         except TfError:
             return
-        r = np.asarray(msg.ranges, dtype=np.float64)
-        a = float(msg.angle_min) + float(msg.angle_increment) * np.arange(len(r))
-        ok = np.isfinite(r) & (r >= float(msg.range_min)) & (r < float(msg.range_max))
-        lx, ly = r[ok] * np.cos(a[ok]), r[ok] * np.sin(a[ok])
-        c, s = math.cos(laser[2]), math.sin(laser[2])
-        self.points = np.column_stack([laser[0] + c * lx - s * ly, laser[1] + s * lx + c * ly])
-        self.scan_ns = self.executor.now_ns
+        self.last_scan, self.scan_ns = msg, self.executor.now_ns
+
+    def points(self, within: float = math.inf) -> np.ndarray:
+        """The last scan's returns (M, 2; base frame, m), those that may lie within ``within`` m of the origin
+        (turned into points only when a command needs them: most are farther than any zone reaches)."""
+        msg, (x, y, yaw) = self.last_scan, self.laser
+        if msg is None:
+            return np.zeros((0, 2))
+        r = np.asarray(msg.ranges)
+        far, top = within + math.hypot(x, y), float(msg.range_max)  # NaN and inf fail both tests
+        if len(r) == 0 or np.fmin.reduce(r) > far:  # nothing close (the usual case): no points to make
+            return np.zeros((0, 2))
+        k = np.flatnonzero((r >= float(msg.range_min)) & ((r <= far) if far < top else (r < top)))
+        rk = r[k].astype(np.float64)
+        a = float(msg.angle_min) + float(msg.angle_increment) * k
+        lx, ly = rk * np.cos(a), rk * np.sin(a)
+        c, s = math.cos(yaw), math.sin(yaw)
+        return np.column_stack([x + c * lx - s * ly, y + s * lx + c * ly])
 
     def _on_cmd(self, msg: Any) -> None:
         v, w = float(msg.linear.x), float(msg.angular.z)
         fresh = self.scan_ns is not None and (self.executor.now_ns - self.scan_ns) / 1e9 <= self.source_timeout
-        verdict = self.monitor.check(v, w, self.points) if fresh else Verdict(0.0, 0.0, "(no scan)", "stop")
+        verdict = (
+            self.monitor.check(v, w, self.points(self.monitor.reach(v)))
+            if fresh
+            else Verdict(0.0, 0.0, "(no scan)", "stop")
+        )
         if verdict.polygon:
             self.actions[verdict.polygon] = self.actions.get(verdict.polygon, 0) + 1
         self.last = verdict

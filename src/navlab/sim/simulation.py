@@ -17,6 +17,7 @@ from navlab.geometry import quat_from_rpy, quat_from_yaw, wxyz_from_xyzw, xyzw_f
 from navlab.sim.builder import GROUND_CONTACT_BIT, GROUP_ROBOT, RAY_GEOMGROUP, mj_quat_from_rpy
 from navlab.sim.clearance import clearance
 from navlab.sim.errors import SimError
+from navlab.sim.lidar_noise import NormalDraws
 from navlab.sim.lidar_rays import beam_dirs, cast_primitives, ray_geom_sets, scan_primitives
 from navlab.sim.lidar_rays import lidar_angles as lidar_angles  # re-exported: its home before the split
 from navlab.sim.raycast import finish_ranges, multiray
@@ -75,7 +76,7 @@ class Simulation:
         self._synced = True
         self._lidar_dirs: dict[int, np.ndarray] = {}  # lidar -> (2, n) cos, sin of its beams
         self._no_noise = np.zeros(0)
-        self._normals: dict[int, np.ndarray] = {}  # lidar -> its noise draws' buffer (see scan)
+        self._normals: dict[int, NormalDraws] = {}  # lidar -> its noise draws (see scan)
         self._vel6 = np.zeros(6)  # mj_objectVelocity's output, reused
         self._sensors_off = False  # see compute_sensors
         self._refresh_ids()
@@ -393,10 +394,11 @@ class Simulation:
         simulation's generator) into a buffer kept per lidar; none without noise."""
         if cfg.noise_stddev <= 0:
             return self._no_noise
+        gen = self.rng if rng is None else rng
         kept = self._normals.get(index)
-        if kept is None or kept.shape[0] != n:
-            kept = self._normals[index] = np.empty(n)
-        return (self.rng if rng is None else rng).standard_normal(out=kept)
+        if kept is None or kept.buf.shape[0] != n or kept.gen is not gen:
+            kept = self._normals[index] = NormalDraws(gen, n)
+        return kept.draw()
 
     def _beam_dirs(self, index: int, cfg: LidarConfig) -> np.ndarray:
         """(2, n) cos, sin of lidar ``index``'s beam angles in its frame, worked out once."""
