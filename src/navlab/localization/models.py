@@ -173,6 +173,20 @@ def _likelihood_field(xs, ys, yaws, bx, by, sdf, inv_res, max_dist, lut, lut_sca
         out[k] = p
 
 
+@njit(cache=True)
+def _grid_columns(
+    poses: np.ndarray, ox: float, oy: float, oyaw: float, c: float, s: float, out: np.ndarray
+) -> None:  # pragma: no cover - compiled
+    """``out`` (3, N): the x, y and yaw columns of ``MapField.to_grid(poses)`` (origin ``ox, oy, oyaw``, its
+    cosine ``c`` and sine ``s``), with the same operations in the same order."""
+    for k in range(poses.shape[0]):
+        dx = poses[k, 0] - ox
+        dy = poses[k, 1] - oy
+        out[0, k] = c * dx + s * dy
+        out[1, k] = -s * dx + c * dy
+        out[2, k] = poses[k, 2] - oyaw
+
+
 def likelihood_field_weights(
     poses_grid: np.ndarray,
     end_x: np.ndarray,
@@ -331,18 +345,15 @@ class LikelihoodFieldModel(FieldModel):
         ex = np.ascontiguousarray(lx + rr * np.cos(a))
         ey = np.ascontiguousarray(ly + rr * np.sin(a))
         f = self.field
-        return likelihood_field_weights(
-            f.to_grid(particles),
-            ex,
-            ey,
-            self._signed,
-            f.resolution,
-            f.max_dist,
-            self._lut,
-            self.z_hit,
-            self.z_rand,
-            beams.range_max,
-        )
+        ox, oy, oyaw = f.origin
+        cols = np.empty((3, particles.shape[0]))  # MapField.to_grid's x, y, yaw columns, in one compiled pass
+        _grid_columns(particles, ox, oy, oyaw, math.cos(oyaw), math.sin(oyaw), cols)
+        out = np.empty(particles.shape[0])
+        lut, lut_scale = self._lut
+        z_rand = self.z_rand / beams.range_max
+        _likelihood_field(cols[0], cols[1], cols[2], ex, ey, self._signed, 1.0 / f.resolution, f.max_dist, lut,
+                          lut_scale, self.z_hit, z_rand, out)  # fmt: skip
+        return out
 
 
 class BeamModel(FieldModel):
