@@ -43,6 +43,7 @@ class _Edge:
 # a lookup's edges (child frame, edge) from the target and from the source up to their common ancestor, and all of them
 _Chain = tuple[list[tuple[str, _Edge]], list[tuple[str, _Edge]], tuple[_Edge, ...]]
 
+
 class TfBuffer:
     """Stores transforms between frames and answers lookups between any two connected frames.
 
@@ -182,7 +183,7 @@ class TfBuffer:
         hit = self._lookups.get(key)
         if hit is None or hit[0] != self._version:
             return None
-        for e, n in zip(hit[1], hit[2]):
+        for e, n in zip(hit[1], hit[2], strict=True):
             if e.changes != n:
                 return None
         return hit

@@ -351,8 +351,10 @@ class LikelihoodFieldModel(FieldModel):
         out = np.empty(particles.shape[0])
         lut, lut_scale = self._lut
         z_rand = self.z_rand / beams.range_max
-        _likelihood_field(cols[0], cols[1], cols[2], ex, ey, self._signed, 1.0 / f.resolution, f.max_dist, lut,
-                          lut_scale, self.z_hit, z_rand, out)  # fmt: skip
+        inv_res, zh = 1.0 / f.resolution, self.z_hit
+        _likelihood_field(
+            cols[0], cols[1], cols[2], ex, ey, self._signed, inv_res, f.max_dist, lut, lut_scale, zh, z_rand, out
+        )
         return out
 
 
