@@ -18,6 +18,7 @@ from navlab.msgs import Quaternion, Transform, TransformStamped, Vector3, header
 Pose2 = tuple[float, float, float]  # (x m, y m, yaw rad) of a frame's origin in another frame
 LOOKUP_CACHE = 64  # lookups remembered (see TfBuffer.lookup)
 _INVERSE_IDENTITY = inverse3(IDENTITY_TF)  # what a lookup composes for a target that is the common ancestor
+_DROP_BATCH = 128  # history entries past cache_ns are deleted from an edge's lists this many at a time (cheaper)
 
 
 def tf_from_msg(tr: Any) -> Tf:
@@ -38,6 +39,7 @@ class _Edge:
     times: list[int] = field(default_factory=list)
     values: list[Tf] = field(default_factory=list)
     changes: int = 0  # bumped by every transform added: a lookup through the edge is then computed again
+    lo: int = 0  # the history is times[lo:], values[lo:]: older entries are dropped from the lists in batches
 
 
 # a lookup's edges (child frame, edge) from the target and from the source up to their common ancestor, and all of them
@@ -86,18 +88,22 @@ class TfBuffer:
             self._version += 1
         e.changes += 1
         if static:
-            e.times, e.values = [t_ns], [tf]
+            e.times, e.values, e.lo = [t_ns], [tf], 0
             return
-        if e.times and t_ns < e.times[-1]:
-            i = bisect.bisect_right(e.times, t_ns)
-            e.times.insert(i, t_ns)
-            e.values.insert(i, tf)
+        times, values = e.times, e.values
+        if times and t_ns < times[-1]:
+            i = bisect.bisect_right(times, t_ns, e.lo)
+            times.insert(i, t_ns)
+            values.insert(i, tf)
         else:
-            e.times.append(t_ns)
-            e.values.append(tf)
-        if e.times[-1] - e.times[0] > self.cache_ns:
-            cut = bisect.bisect_left(e.times, e.times[-1] - self.cache_ns)
-            del e.times[:cut], e.values[:cut]
+            times.append(t_ns)
+            values.append(tf)
+        if times[-1] - times[e.lo] > self.cache_ns:  # keep cache_ns: the entries older than that leave the history
+            lo = bisect.bisect_left(times, times[-1] - self.cache_ns, e.lo)
+            if lo >= _DROP_BATCH:
+                del times[:lo], values[:lo]
+                lo = 0
+            e.lo = lo
 
     def add_message(self, msg: Any, *, static: bool = False) -> None:
         """Add every transform of a ``tf2_msgs/TFMessage``."""
@@ -123,14 +129,15 @@ class TfBuffer:
                     f"(newest transform at {times[-1] / 1e9:.3f} s)"
                 )
             return e.values[-1]
-        if t_ns <= times[0]:
-            if times[0] - t_ns > self.tolerance_ns:
+        lo = e.lo
+        if t_ns <= times[lo]:
+            if times[lo] - t_ns > self.tolerance_ns:
                 raise TfError(
                     f"lookup of {e.parent}->{child} at t={t_ns / 1e9:.3f} s would extrapolate into the past "
-                    f"(oldest transform at {times[0] / 1e9:.3f} s)"
+                    f"(oldest transform at {times[lo] / 1e9:.3f} s)"
                 )
-            return e.values[0]
-        i = bisect.bisect_right(times, t_ns)
+            return e.values[lo]
+        i = bisect.bisect_right(times, t_ns, lo)
         t0, t1 = times[i - 1], times[i]
         return interpolate3(e.values[i - 1], e.values[i], (t_ns - t0) / (t1 - t0))
 
@@ -253,7 +260,7 @@ class TfBuffer:
             chain = self._chain(target.lstrip("/"), source.lstrip("/"))
             tol = self.tolerance_ns
             for e in chain[2]:
-                if not (e.static or e.times[0] - tol <= t_ns <= e.times[-1] + tol):
+                if not (e.static or e.times[e.lo] - tol <= t_ns <= e.times[-1] + tol):
                     return self.lookup_pose2d(target, source, None)
             hit = self._compute(key, chain, t_ns)
         return _pose2d(hit)
