@@ -172,3 +172,24 @@ def test_transform_tuples_reach_tf_in_queue_order_and_as_messages_for_readers():
             500_000_000,
         )
         assert (last.transform.translation.x, last.transform.rotation.z) == (2.5, msgs.quaternion_from_yaw(0.5).z)
+
+
+def test_history_keeps_cache_time_as_tf2_prunes_it() -> None:
+    """Entries older than ``cache_ns`` before the newest are gone (a lookup there extrapolates into the past), the
+    rest interpolate, also after out-of-order stamps and many more entries than are kept (tf2's pruneList rule)."""
+    cache, step = 1_000_000_000, 33_333_333
+    buf = TfBuffer(cache_ns=cache)
+    kept: list[int] = []  # the stamps tf2 would keep
+    stamps = [k * step for k in range(900)] + [899 * step - 5 * step // 2, 880 * step + 7]  # two out of order
+    for t in stamps:
+        buf.set_transform("odom", "chassis", t, (t / 1e9, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0))
+        kept = sorted([*kept, t])
+        kept = [s for s in kept if kept[-1] - s <= cache]
+    oldest, newest = kept[0], kept[-1]
+    assert buf.lookup("odom", "chassis", oldest)[0] == oldest / 1e9
+    assert buf.lookup("odom", "chassis", newest)[0] == newest / 1e9
+    mid = (kept[1] + kept[2]) // 2
+    assert buf.lookup("odom", "chassis", mid)[0] == pytest.approx(mid / 1e9)
+    with pytest.raises(TfError, match="into the past"):
+        buf.lookup("odom", "chassis", oldest - 1)
+    assert buf.lookup_pose2d_or_latest("odom", "chassis", oldest - 1)[0] == newest / 1e9  # falls back to the latest

@@ -18,6 +18,7 @@ from navlab.msgs import Quaternion, Transform, TransformStamped, Vector3, header
 Pose2 = tuple[float, float, float]  # (x m, y m, yaw rad) of a frame's origin in another frame
 LOOKUP_CACHE = 64  # lookups remembered (see TfBuffer.lookup)
 _INVERSE_IDENTITY = inverse3(IDENTITY_TF)  # what a lookup composes for a target that is the common ancestor
+_DROP_BATCH = 128  # history entries past cache_ns are deleted from an edge's lists this many at a time (cheaper)
 
 
 def tf_from_msg(tr: Any) -> Tf:
@@ -38,6 +39,11 @@ class _Edge:
     times: list[int] = field(default_factory=list)
     values: list[Tf] = field(default_factory=list)
     changes: int = 0  # bumped by every transform added: a lookup through the edge is then computed again
+    lo: int = 0  # the history is times[lo:], values[lo:]: older entries are dropped from the lists in batches
+
+
+# a lookup's edges (child frame, edge) from the target and from the source up to their common ancestor, and all of them
+_Chain = tuple[list[tuple[str, _Edge]], list[tuple[str, _Edge]], tuple[_Edge, ...]]
 
 
 class TfBuffer:
@@ -53,10 +59,10 @@ class TfBuffer:
         self._edges: dict[str, _Edge] = {}
         self._parents: set[str] = set()
         self._version = 0  # bumped whenever the tree's shape changes (an edge added or re-parented)
-        # (target, source) -> (version, target's edges up to the common ancestor, source's edges up to it)
-        self._chains: dict[tuple[str, str], tuple[int, list[tuple[str, _Edge]], list[tuple[str, _Edge]]]] = {}
-        # lookups answered (target, source, t_ns, tolerance) -> [tree version, (edge, its changes) of each edge the
-        # answer read, the answer, its (x, y, yaw) once asked]: valid until one of those edges changes. Many nodes ask
+        # (target, source) -> (version, the lookup's chain of edges)
+        self._chains: dict[tuple[str, str], tuple[int, _Chain]] = {}
+        # lookups answered (target, source, t_ns, tolerance) -> [tree version, the edges the answer read, their
+        # changes then, the answer, its (x, y, yaw) once asked]: valid until one of those edges changes. Many nodes ask
         # the same question between two transforms of the edges it reads (the costmaps, move_base, amcl, monitors).
         self._lookups: dict[tuple[str, str, int | None, int], list[Any]] = {}
 
@@ -82,18 +88,22 @@ class TfBuffer:
             self._version += 1
         e.changes += 1
         if static:
-            e.times, e.values = [t_ns], [tf]
+            e.times, e.values, e.lo = [t_ns], [tf], 0
             return
-        if e.times and t_ns < e.times[-1]:
-            i = bisect.bisect_right(e.times, t_ns)
-            e.times.insert(i, t_ns)
-            e.values.insert(i, tf)
+        times, values = e.times, e.values
+        if times and t_ns < times[-1]:
+            i = bisect.bisect_right(times, t_ns, e.lo)
+            times.insert(i, t_ns)
+            values.insert(i, tf)
         else:
-            e.times.append(t_ns)
-            e.values.append(tf)
-        if e.times[-1] - e.times[0] > self.cache_ns:
-            cut = bisect.bisect_left(e.times, e.times[-1] - self.cache_ns)
-            del e.times[:cut], e.values[:cut]
+            times.append(t_ns)
+            values.append(tf)
+        if times[-1] - times[e.lo] > self.cache_ns:  # keep cache_ns: the entries older than that leave the history
+            lo = bisect.bisect_left(times, times[-1] - self.cache_ns, e.lo)
+            if lo >= _DROP_BATCH:
+                del times[:lo], values[:lo]
+                lo = 0
+            e.lo = lo
 
     def add_message(self, msg: Any, *, static: bool = False) -> None:
         """Add every transform of a ``tf2_msgs/TFMessage``."""
@@ -119,14 +129,15 @@ class TfBuffer:
                     f"(newest transform at {times[-1] / 1e9:.3f} s)"
                 )
             return e.values[-1]
-        if t_ns <= times[0]:
-            if times[0] - t_ns > self.tolerance_ns:
+        lo = e.lo
+        if t_ns <= times[lo]:
+            if times[lo] - t_ns > self.tolerance_ns:
                 raise TfError(
                     f"lookup of {e.parent}->{child} at t={t_ns / 1e9:.3f} s would extrapolate into the past "
-                    f"(oldest transform at {times[0] / 1e9:.3f} s)"
+                    f"(oldest transform at {times[lo] / 1e9:.3f} s)"
                 )
-            return e.values[0]
-        i = bisect.bisect_right(times, t_ns)
+            return e.values[lo]
+        i = bisect.bisect_right(times, t_ns, lo)
         t0, t1 = times[i - 1], times[i]
         return interpolate3(e.values[i - 1], e.values[i], (t_ns - t0) / (t1 - t0))
 
@@ -140,12 +151,12 @@ class TfBuffer:
             chain.append(frame)
         return chain
 
-    def _chain(self, target: str, source: str) -> tuple[list[tuple[str, _Edge]], list[tuple[str, _Edge]]]:
+    def _chain(self, target: str, source: str) -> _Chain:
         """The edges (child frame, edge) from ``target`` and from ``source`` up to their common ancestor,
-        bottom first; remembered until the tree's shape changes."""
+        bottom first, and all those edges; remembered until the tree's shape changes."""
         hit = self._chains.get((target, source))
         if hit is not None and hit[0] == self._version:
-            return hit[1], hit[2]
+            return hit[1]
         for f in (target, source):
             if f not in self._edges and f not in self._parents:
                 known = ", ".join(self.frames()) or "none"
@@ -159,8 +170,9 @@ class TfBuffer:
         # looking up odom->base) never limits the lookup time.
         edges_t = [(f, self._edges[f]) for f in up_t[: up_t.index(common)]]
         edges_s = [(f, self._edges[f]) for f in up_s[: up_s.index(common)]]
-        self._chains[(target, source)] = (self._version, edges_t, edges_s)
-        return edges_t, edges_s
+        chain = (edges_t, edges_s, tuple(e for _, e in (*edges_t, *edges_s)))
+        self._chains[(target, source)] = (self._version, chain)
+        return chain
 
     def _compose(self, edges: list[tuple[str, _Edge]], t_ns: int | None) -> Tf:
         """``ancestor_T_frame``: compose a chain of edges (bottom first) up to its top."""
@@ -171,23 +183,33 @@ class TfBuffer:
 
     def lookup(self, target: str, source: str, t_ns: int | None = None) -> Tf:
         """``target_T_source`` at ``t_ns`` (None: the latest time every edge on the path has)."""
-        return self._answer(target, source, t_ns)[2]
+        return self._answer(target, source, t_ns)[3]
+
+    def _cached(self, key: tuple[str, str, int | None, int]) -> list[Any] | None:
+        """The lookup's cache entry (see ``_lookups``) if it is still valid, else None."""
+        hit = self._lookups.get(key)
+        if hit is None or hit[0] != self._version:
+            return None
+        for e, n in zip(hit[1], hit[2], strict=True):
+            if e.changes != n:
+                return None
+        return hit
 
     def _answer(self, target: str, source: str, t_ns: int | None) -> list[Any]:
         """The lookup's cache entry (see ``_lookups``), computed unless still valid."""
         key = (target, source, t_ns, self.tolerance_ns)
-        hit = self._lookups.get(key)
-        if hit is not None and hit[0] == self._version:
-            for e, n in hit[1]:
-                if e.changes != n:
-                    break
-            else:
-                return hit
-        edges_t, edges_s = self._chain(target.lstrip("/"), source.lstrip("/"))
+        hit = self._cached(key)
+        if hit is not None:
+            return hit
+        return self._compute(key, self._chain(target.lstrip("/"), source.lstrip("/")), t_ns)
+
+    def _compute(self, key: tuple[str, str, int | None, int], chain: _Chain, t_ns: int | None) -> list[Any]:
+        """Work out the lookup ``key`` over ``chain`` (:meth:`_chain`) at ``t_ns`` and remember it."""
+        edges_t, edges_s, edges = chain
         out = self._lookup(edges_t, edges_s, t_ns)
         if len(self._lookups) >= LOOKUP_CACHE:  # stamped questions pile up: start again
             self._lookups.clear()
-        hit = self._lookups[key] = [self._version, tuple((e, e.changes) for _, e in (*edges_t, *edges_s)), out, None]
+        hit = self._lookups[key] = [self._version, edges, tuple([e.changes for e in edges]), out, None]
         return hit
 
     def _lookup(self, edges_t: list[tuple[str, _Edge]], edges_s: list[tuple[str, _Edge]], t_ns: int | None) -> Tf:
@@ -221,11 +243,7 @@ class TfBuffer:
 
     def lookup_pose2d(self, target: str, source: str, t_ns: int | None = None) -> Pose2:
         """(x, y, yaw) of ``source``'s origin in ``target``."""
-        hit = self._answer(target, source, t_ns)
-        if hit[3] is None:
-            tf = hit[2]
-            hit[3] = (tf[0], tf[1], yaw_of(tf))
-        return hit[3]
+        return _pose2d(self._answer(target, source, t_ns))
 
     def lookup_pose2d_or_latest(self, target: str, source: str, t_ns: int | None) -> Pose2:
         """(x, y, yaw) of ``source`` in ``target`` at ``t_ns``, else at the latest time tf has.
@@ -233,13 +251,24 @@ class TfBuffer:
         The pose "at the scan's stamp" of SLAM, AMCL and the costmaps: a message stamped a little ahead
         of the newest odometry still gets a pose. Raises the latest lookup's ``TfError`` if both fail.
         """
-        if t_ns is not None:
+        if t_ns is None:
+            return self.lookup_pose2d(target, source, None)
+        key = (target, source, t_ns, self.tolerance_ns)
+        hit = self._cached(key)  # a valid answer at t_ns: every edge had t_ns
+        if hit is None:
             # without raising and catching (a scan stamped after the newest odometry is the common case)
-            edges_t, edges_s = self._chain(target.lstrip("/"), source.lstrip("/"))
+            chain = self._chain(target.lstrip("/"), source.lstrip("/"))
             tol = self.tolerance_ns
-            for edges in (edges_t, edges_s):
-                for _, e in edges:
-                    if not (e.static or e.times[0] - tol <= t_ns <= e.times[-1] + tol):
-                        return self.lookup_pose2d(target, source, None)
-            return self.lookup_pose2d(target, source, t_ns)
-        return self.lookup_pose2d(target, source, None)
+            for e in chain[2]:
+                if not (e.static or e.times[e.lo] - tol <= t_ns <= e.times[-1] + tol):
+                    return self.lookup_pose2d(target, source, None)
+            hit = self._compute(key, chain, t_ns)
+        return _pose2d(hit)
+
+
+def _pose2d(hit: list[Any]) -> Pose2:
+    """A lookup's (x, y, yaw), from its cache entry (worked out once)."""
+    if hit[4] is None:
+        tf = hit[3]
+        hit[4] = (tf[0], tf[1], yaw_of(tf))
+    return hit[4]

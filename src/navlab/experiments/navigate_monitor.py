@@ -19,8 +19,8 @@ SAMPLE_S = 0.1  # NavMonitor's sampling period (s)
 
 class NavMonitor(Node):
     """Ground truth for the goals: the true path and the clearance (m between the robot's collision geometry and
-    the world's, ``Simulation.clearance``) at 10 Hz, contact episodes on ``/collisions``; and the last scan's
-    points in the world for the pictures."""
+    the world's, ``Simulation.clearance``) at 10 Hz, contact episodes on ``/collisions``; and, with ``keep_scan``
+    (default true), the last scan's points in the world for the pictures."""
 
     def __init__(
         self,
@@ -46,7 +46,8 @@ class NavMonitor(Node):
         self.tracking: list[float] = []  # distance (m) of the true pose to move_base's current plan, per sample
         self.create_subscription(msgs.Twist, "cmd_vel", self._on_cmd, 10)
         self.create_subscription(msgs.String, "/collisions", lambda _m: self.contacts.append(self.now_s()), 10)
-        self.create_subscription(msgs.LaserScan, "scan", self._on_scan, 5)
+        if self.declare_parameter("keep_scan", True):  # for scan_points (the pictures); else no scan is delivered
+            self.create_subscription(msgs.LaserScan, "scan", self._on_scan, 5)
         self.create_timer(SAMPLE_S, self._sample)
 
     def _on_cmd(self, msg: Any) -> None:

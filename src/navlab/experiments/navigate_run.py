@@ -274,6 +274,7 @@ def run_navigation(
             "base_frame": run.base_frame,
             "safety_distance": float(safety_distance),
             "estimate_frame": "" if mapless else "map",
+            "keep_scan": bool(snapshots),  # only the pictures read the last scan
         },
         remappings={"scan": run.scan_topic},
         sim=run.sim,

@@ -333,17 +333,21 @@ class Amcl:
         if self.w_slow > 0.0 and p.recovery_alpha_slow > 0:
             w_diff = max(0.0, 1.0 - self.w_fast / self.w_slow)
         drawn = sampling.low_variance_indices(self.weights, m, self.rng)
-        cand = self.particles[drawn[self.rng.permutation(m)]]  # drawn, then shuffled: one gather
-        inject = np.zeros(m, dtype=bool)
+        order = drawn[self.rng.permutation(m)]  # drawn, then shuffled: the candidates are particles[order]
+        cand = None  # gathered only when recovery particles replace some of them
         if w_diff > 0.0:
             inject = self.rng.random(m) < w_diff
             k = int(inject.sum())
             if k:
+                cand = self.particles[order]
                 cand[inject] = self.field.random_free_poses(k, self.rng)
-        n = sampling.kld_count(cand, p.kld_err, p.kld_z, p.min_particles, m)
+        if cand is None:
+            n = sampling.kld_count(self.particles, p.kld_err, p.kld_z, p.min_particles, m, order=order)
+        else:
+            n = sampling.kld_count(cand, p.kld_err, p.kld_z, p.min_particles, m)
         new = self.particles[sampling.low_variance_indices(self.weights, n, self.rng)]
-        inj = inject[:n]
-        if inj.any():
+        if cand is not None:
+            inj = inject[:n]
             new[inj] = cand[:n][inj]
         self.particles = new
         self.weights = np.full(n, 1.0 / n)

@@ -45,6 +45,11 @@ def _angle_diff(a: np.ndarray | float, b: np.ndarray | float) -> np.ndarray:
     return wrap_angle(np.asarray(a) - np.asarray(b))
 
 
+def _scalar_diff(a: float, b: float) -> float:
+    """:func:`_angle_diff` of two numbers, in Python floats (the same operations as NumPy's on 0-d arrays)."""
+    return float(wrap_angle(float(a) - float(b)))
+
+
 def sample_motion_diff(
     particles: np.ndarray,
     odom_old: tuple[float, float, float],
@@ -63,13 +68,13 @@ def sample_motion_diff(
     a1, a2, a3, a4 = alphas
     dx = odom_new[0] - odom_old[0]
     dy = odom_new[1] - odom_old[1]
-    dth = float(_angle_diff(odom_new[2], odom_old[2]))
+    dth = _scalar_diff(odom_new[2], odom_old[2])
     trans = math.hypot(dx, dy)
-    rot1 = 0.0 if trans < 0.01 else float(_angle_diff(math.atan2(dy, dx), odom_old[2]))
-    rot2 = float(_angle_diff(dth, rot1))
+    rot1 = 0.0 if trans < 0.01 else _scalar_diff(math.atan2(dy, dx), odom_old[2])
+    rot2 = _scalar_diff(dth, rot1)
     # Treat driving backwards like forwards when sizing the noise (as ROS does).
-    rot1_n = min(abs(float(_angle_diff(rot1, 0.0))), abs(float(_angle_diff(rot1, math.pi))))
-    rot2_n = min(abs(float(_angle_diff(rot2, 0.0))), abs(float(_angle_diff(rot2, math.pi))))
+    rot1_n = min(abs(_scalar_diff(rot1, 0.0)), abs(_scalar_diff(rot1, math.pi)))
+    rot2_n = min(abs(_scalar_diff(rot2, 0.0)), abs(_scalar_diff(rot2, math.pi)))
     v_rot1 = a1 * rot1_n**2 + a2 * trans**2
     v_trans = a3 * trans**2 + a4 * rot1_n**2 + a4 * rot2_n**2
     v_rot2 = a1 * rot2_n**2 + a2 * trans**2
@@ -79,13 +84,40 @@ def sample_motion_diff(
         s_rot1, s_trans, s_rot2 = v_rot1, v_trans, v_rot2
     n = particles.shape[0]
     noise = rng.standard_normal((3, n))
-    rot1_hat = rot1 - s_rot1 * noise[0]
-    trans_hat = trans - s_trans * noise[1]
-    rot2_hat = rot2 - s_rot2 * noise[2]
-    heading = particles[:, 2] + rot1_hat
-    particles[:, 0] += trans_hat * np.cos(heading)
-    particles[:, 1] += trans_hat * np.sin(heading)
-    particles[:, 2] = wrap_angle(heading + rot2_hat)
+    # heading, trans_hat, rot2_hat into noise's rows; cos and sin of the heading by NumPy (its SIMD cos and sin
+    # differ from libm's), the rest in two compiled passes with NumPy's operations in NumPy's order
+    _motion_draws(particles, noise, rot1, s_rot1, trans, s_trans, rot2, s_rot2)
+    _motion_apply(particles, noise, np.cos(noise[0]), np.sin(noise[0]))
+
+
+@njit(cache=True)
+def _motion_draws(
+    particles: np.ndarray,
+    noise: np.ndarray,
+    rot1: float,
+    s_rot1: float,
+    trans: float,
+    s_trans: float,
+    rot2: float,
+    s_rot2: float,
+) -> None:  # pragma: no cover - compiled
+    """Rows of ``noise`` (3, N) become each particle's heading after the first turn, its translation and its second
+    turn (rad, m, rad): ``yaw + (rot1 - s_rot1 * n0)``, ``trans - s_trans * n1``, ``rot2 - s_rot2 * n2``."""
+    for k in range(particles.shape[0]):
+        noise[0, k] = particles[k, 2] + (rot1 - s_rot1 * noise[0, k])
+        noise[1, k] = trans - s_trans * noise[1, k]
+        noise[2, k] = rot2 - s_rot2 * noise[2, k]
+
+
+@njit(cache=True)
+def _motion_apply(particles: np.ndarray, moves: np.ndarray, cos_h: np.ndarray, sin_h: np.ndarray) -> None:
+    """Move each particle by its row of ``moves`` (:func:`_motion_draws`; heading cosines and sines given); the
+    new yaw wrapped to [-pi, pi) as ``geometry.wrap_angle`` does."""
+    two_pi = 2.0 * math.pi
+    for k in range(particles.shape[0]):
+        particles[k, 0] += moves[1, k] * cos_h[k]
+        particles[k, 1] += moves[1, k] * sin_h[k]
+        particles[k, 2] = ((moves[0, k] + moves[2, k]) + math.pi) % two_pi - math.pi
 
 
 def sample_motion_diff_corrected(
@@ -139,6 +171,20 @@ def _likelihood_field(xs, ys, yaws, bx, by, sdf, inv_res, max_dist, lut, lut_sca
             pz = z_hit * lut[int(d * lut_scale)] + z_rand_term
             p += pz * pz * pz
         out[k] = p
+
+
+@njit(cache=True)
+def _grid_columns(
+    poses: np.ndarray, ox: float, oy: float, oyaw: float, c: float, s: float, out: np.ndarray
+) -> None:  # pragma: no cover - compiled
+    """``out`` (3, N): the x, y and yaw columns of ``MapField.to_grid(poses)`` (origin ``ox, oy, oyaw``, its
+    cosine ``c`` and sine ``s``), with the same operations in the same order."""
+    for k in range(poses.shape[0]):
+        dx = poses[k, 0] - ox
+        dy = poses[k, 1] - oy
+        out[0, k] = c * dx + s * dy
+        out[1, k] = -s * dx + c * dy
+        out[2, k] = poses[k, 2] - oyaw
 
 
 def likelihood_field_weights(
@@ -299,18 +345,17 @@ class LikelihoodFieldModel(FieldModel):
         ex = np.ascontiguousarray(lx + rr * np.cos(a))
         ey = np.ascontiguousarray(ly + rr * np.sin(a))
         f = self.field
-        return likelihood_field_weights(
-            f.to_grid(particles),
-            ex,
-            ey,
-            self._signed,
-            f.resolution,
-            f.max_dist,
-            self._lut,
-            self.z_hit,
-            self.z_rand,
-            beams.range_max,
+        ox, oy, oyaw = f.origin
+        cols = np.empty((3, particles.shape[0]))  # MapField.to_grid's x, y, yaw columns, in one compiled pass
+        _grid_columns(particles, ox, oy, oyaw, math.cos(oyaw), math.sin(oyaw), cols)
+        out = np.empty(particles.shape[0])
+        lut, lut_scale = self._lut
+        z_rand = self.z_rand / beams.range_max
+        inv_res, zh = 1.0 / f.resolution, self.z_hit
+        _likelihood_field(
+            cols[0], cols[1], cols[2], ex, ey, self._signed, inv_res, f.max_dist, lut, lut_scale, zh, z_rand, out
         )
+        return out
 
 
 class BeamModel(FieldModel):

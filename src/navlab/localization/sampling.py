@@ -95,23 +95,35 @@ def _kld_limits(n: int, kld_err: float, kld_z: float, min_n: int, max_n: int) ->
 
 
 @njit(cache=True)
-def _first_over(poses: np.ndarray, limits: np.ndarray) -> int:  # pragma: no cover - compiled
-    """The first count c (1-based) of ``poses`` whose c samples occupy k bins with c > ``limits[k]``; else all."""
-    table, used = _hash_table(poses.shape[0])
+def _first_over(poses: np.ndarray, order: np.ndarray, limits: np.ndarray) -> int:  # pragma: no cover - compiled
+    """The first count c (1-based) of the samples ``poses[order]`` whose c samples occupy k bins with
+    c > ``limits[k]``; else all (the rows are read in place, not gathered)."""
+    table, used = _hash_table(order.shape[0])
     k = 0
-    for m in range(poses.shape[0]):
-        if _add(table, used, _bin_key(poses[m, 0], poses[m, 1], poses[m, 2])):
+    for m in range(order.shape[0]):
+        r = order[m]
+        if _add(table, used, _bin_key(poses[r, 0], poses[r, 1], poses[r, 2])):
             k += 1
         if m + 1 > limits[k]:
             return m + 1
-    return poses.shape[0]
+    return order.shape[0]
 
 
-def kld_count(candidates: np.ndarray, kld_err: float, kld_z: float, min_n: int, max_n: int) -> int:
-    """How many of ``candidates`` (drawn in random order) KLD-sampling keeps: the first count above the limit
-    for the bins occupied so far (the walk stops there; the limits are tabulated once)."""
+def kld_count(
+    candidates: np.ndarray,
+    kld_err: float,
+    kld_z: float,
+    min_n: int,
+    max_n: int,
+    order: np.ndarray | None = None,
+) -> int:
+    """How many of ``candidates`` (drawn in random order; with ``order``: the rows ``candidates[order]``)
+    KLD-sampling keeps: the first count above the limit for the bins occupied so far (the walk stops there; the
+    limits are tabulated once)."""
     poses = np.ascontiguousarray(candidates, dtype=np.float64)
-    n = _first_over(poses, _kld_limits(poses.shape[0], float(kld_err), float(kld_z), int(min_n), int(max_n)))
+    rows = np.arange(poses.shape[0]) if order is None else np.ascontiguousarray(order, dtype=np.int64)
+    limits = _kld_limits(rows.shape[0], float(kld_err), float(kld_z), int(min_n), int(max_n))
+    n = _first_over(poses, rows, limits)
     return max(min(n, max_n), min_n)
 
 
@@ -227,8 +239,13 @@ def _label_bins(ukeys: np.ndarray) -> np.ndarray:
 
 
 @njit(cache=True)
-def _cluster_sums(labels: np.ndarray, n_comp: int, poses: np.ndarray, w: np.ndarray) -> np.ndarray:
-    """Per cluster: [sum w, sum w x, sum w y, sum w cos, sum w sin, sum w xx, sum w yy, sum w xy]."""
+def _cluster_stats(
+    labels: np.ndarray, n_comp: int, poses: np.ndarray, w: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:  # pragma: no cover - compiled
+    """Per cluster: weight, mean (x, y and, in its yaw column, 0 for now), covariance (its yaw-yaw entry 0 for
+    now) and the mean direction's length r clipped to [1e-12, 1], from the sums of w, w x, w y, w cos, w sin,
+    w xx, w yy and w xy. The same operations, in the same order, as NumPy's array expressions would make; the
+    caller takes log(r) and the mean yaw's arctan2 with NumPy (its SIMD log and arctan2 differ from libm's)."""
     acc = np.zeros((n_comp, 8))
     for k in range(poses.shape[0]):
         c = labels[k]
@@ -243,26 +260,45 @@ def _cluster_sums(labels: np.ndarray, n_comp: int, poses: np.ndarray, w: np.ndar
         acc[c, 5] += wk * x * x
         acc[c, 6] += wk * y * y
         acc[c, 7] += wk * x * y
-    return acc
+    wsum = np.empty(n_comp)
+    mean = np.zeros((n_comp, 3))
+    cs = np.empty((2, n_comp))  # mean cos, mean sin
+    cov = np.zeros((n_comp, 3, 3))
+    r = np.empty(n_comp)
+    for c in range(n_comp):
+        wsum[c] = acc[c, 0]
+        safe = acc[c, 0] if acc[c, 0] > 0 else 1.0
+        mx = acc[c, 1] / safe
+        my = acc[c, 2] / safe
+        cs[0, c] = acc[c, 3] / safe
+        cs[1, c] = acc[c, 4] / safe
+        rc = math.hypot(cs[0, c], cs[1, c])
+        if rc < 1e-12:
+            rc = 1e-12
+        if rc > 1.0:
+            rc = 1.0
+        r[c] = rc
+        vx = acc[c, 5] / safe - mx * mx
+        vy = acc[c, 6] / safe - my * my
+        cov[c, 0, 0] = 0.0 if vx < 0.0 else vx
+        cov[c, 1, 1] = 0.0 if vy < 0.0 else vy
+        cov[c, 0, 1] = cov[c, 1, 0] = acc[c, 7] / safe - mx * my
+        mean[c, 0] = mx
+        mean[c, 1] = my
+    return wsum, mean, cov, np.vstack((r.reshape(1, n_comp), cs))
 
 
 def cluster(poses: np.ndarray, weights: np.ndarray) -> Clusters:
     """Group particles into clusters of touching histogram bins and compute their statistics."""
     ukeys, inv = unique_inverse(bin_keys(poses))
     bin_label = _label_bins(ukeys)
-    n_comp = int(bin_label.max()) + 1
     labels = bin_label[inv]
-    acc = _cluster_sums(
-        labels, n_comp, np.ascontiguousarray(poses, dtype=np.float64), np.ascontiguousarray(weights, dtype=np.float64)
+    wsum, mean, cov, rcs = _cluster_stats(
+        labels,
+        int(bin_label.max()) + 1,
+        np.ascontiguousarray(poses, dtype=np.float64),
+        np.ascontiguousarray(weights, dtype=np.float64),
     )
-    wsum = acc[:, 0]
-    safe = np.where(wsum > 0, wsum, 1.0)
-    mx, my, cth, sth = (acc[:, i] / safe for i in (1, 2, 3, 4))
-    r = np.clip(np.hypot(cth, sth), 1e-12, 1.0)
-    cov = np.zeros((n_comp, 3, 3))
-    cov[:, 0, 0] = np.maximum(acc[:, 5] / safe - mx**2, 0.0)
-    cov[:, 1, 1] = np.maximum(acc[:, 6] / safe - my**2, 0.0)
-    cov[:, 0, 1] = cov[:, 1, 0] = acc[:, 7] / safe - mx * my
-    cov[:, 2, 2] = -2.0 * np.log(r)
-    mean = np.stack([mx, my, np.arctan2(sth, cth)], axis=1)
+    cov[:, 2, 2] = -2.0 * np.log(rcs[0])
+    mean[:, 2] = np.arctan2(rcs[2], rcs[1])
     return Clusters(weight=wsum, mean=mean, cov=cov, labels=labels)

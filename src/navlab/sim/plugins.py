@@ -209,6 +209,7 @@ class DiffDrivePlugin(SimPlugin):
         self.wheel_targets = (0.0, 0.0)
         self.instructed = (0.0, 0.0)  # Noetic's wheel_speed_instr_ (rad/s here)
         self.max_wheel_accel = config.max_accel / (config.wheel_diameter / 2)  # rad/s² of the wheel joints
+        self._near = 0.01 / (config.wheel_diameter / 2)  # rad/s: 1 cm/s at the rim (noetic_wheel_commands)
         self.odometry = EncoderOdometry(config.wheel_separation, config.wheel_diameter, config.legacy_mode)
         # Encoder scale errors (navlab's odometry_noise): wheel angles are read as if the wheels were
         # slightly larger or smaller than described, so encoder odometry drifts as a real robot's does.
@@ -234,19 +235,19 @@ class DiffDrivePlugin(SimPlugin):
 
     def update(self) -> None:
         """One plugin update: wheel targets, odometry, tf."""
-        now = self.get_clock().now_ns()
+        now = self.executor.now_ns
         dt = (now - self.last_ns) / 1e9
         self.last_ns = now
-        cfg = self.cfg
+        cfg, sim = self.cfg, self.sim
         v, w = self.cmd
-        if not command_in_force(now, self.last_cmd_ns, cfg.cmd_timeout):
+        if cfg.cmd_timeout > 0 and not command_in_force(now, self.last_cmd_ns, cfg.cmd_timeout):
             v, w = 0.0, 0.0
         left, right = wheel_speeds(v, w, cfg.wheel_separation, cfg.wheel_diameter, legacy_mode=cfg.legacy_mode)
-        measured = (self.sim.joint_velocity(cfg.left_joint), self.sim.joint_velocity(cfg.right_joint))
+        measured = (sim.joint_velocity(cfg.left_joint), sim.joint_velocity(cfg.right_joint))
         self.wheel_targets, self.instructed = noetic_wheel_commands(
-            (left, right), measured, self.instructed, self.max_wheel_accel, dt, near=0.01 / (cfg.wheel_diameter / 2)
+            (left, right), measured, self.instructed, self.max_wheel_accel, dt, near=self._near
         )
-        self.sim.set_wheel_velocity_targets(*self.wheel_targets)
+        sim.set_wheel_velocity_targets(*self.wheel_targets)
         self.publish_odometry(now, dt)
 
     def publish_odometry(self, now: int, dt: float) -> None:
@@ -265,7 +266,8 @@ class DiffDrivePlugin(SimPlugin):
         if not cfg.publish_odom:  # Noetic's <publishTf>false: no odometry topic and no tf
             return
         # the message only when anyone reads it (the mapping launch's nodes take odometry from tf)
-        if listened(self, self.odom_pub):
+        pub = self.odom_pub
+        if pub.topic.subscriptions or self.executor.has_listeners:  # listened(self, pub), inlined: 30 Hz
             lin: Vec
             ang: Vec
             if world:
@@ -273,11 +275,10 @@ class DiffDrivePlugin(SimPlugin):
             else:
                 lin, ang = (v, 0.0, 0.0), (0.0, 0.0, w)
             frames = (cfg.odometry_frame, cfg.robot_base_frame)
-            self.odom_pub.publish(
-                msgs.odometry(now, *frames, position, quat, lin, ang, _ODOM_COV.copy(), _ODOM_COV.copy())
-            )
+            pub.publish(msgs.odometry(now, *frames, position, quat, lin, ang, _ODOM_COV.copy(), _ODOM_COV.copy()))
         if cfg.publish_tf:
-            self.send_transform_tuples(now, ((cfg.odometry_frame, cfg.robot_base_frame, _tf_tuple(position, quat)),))
+            tf = _tf_tuple(position, quat) if world else (x, y, 0.0, *quat)  # floats already: the same tuple
+            self.send_transform_tuples(now, ((cfg.odometry_frame, cfg.robot_base_frame, tf),))
 
 
 class LidarPlugin(SensorPlugin[LidarConfig]):
@@ -328,9 +329,17 @@ class JointStatePlugin(SimPlugin):
             self.create_timer(1.0 / rate, self.update)
 
     def update(self) -> None:
-        """Publish the joints' state."""
+        """Publish the joints' state; to the robot_state_publisher's joint handler directly when it is the topic's
+        only reader (no other subscriber, no listener): it gets the message's stamp, names and positions."""
         qpos, qvel = self.sim.joint_addresses(self.joints)  # looked up now: a spawn recompiles the model
         d = self.sim.data
+        subs = self.pub.topic.subscriptions
+        if len(subs) == 1 and not self.executor.has_listeners:
+            reader = getattr(subs[0].callback, "__self__", None)
+            if isinstance(reader, RobotStatePublisher) and subs[0].callback == reader._on_joint_states:
+                self.pub.topic.count += 1
+                reader.publish_joints(self.executor.now_ns, self.joints, d.qpos[qpos].tolist())
+                return
         # positional: header, name, position, velocity, effort (see navlab.msgs)
         head = msgs.header(self.executor.now_ns, "")
         self.pub.publish(msgs.JointState(head, list(self.joints), d.qpos[qpos], d.qvel[qvel], np.zeros(len(qpos))))
@@ -354,16 +363,21 @@ class RobotStatePublisher(SimPlugin):
         self.create_subscription(msgs.JointState, "joint_states", self._on_joint_states, 10)
 
     def _on_joint_states(self, msg: Any) -> None:
+        position = msg.position.tolist() if isinstance(msg.position, np.ndarray) else msg.position
+        self.publish_joints(msgs.stamp_ns(msg), msg.name, position)
+
+    def publish_joints(self, stamp: int, names: Any, position: Any) -> None:
+        """The moving joints' tf at ``stamp`` (ns) from joint ``names`` and their ``position`` (rad or m)."""
         if not self.publish_tf:
             return
-        stamp = msgs.stamp_ns(msg)
-        position = msg.position.tolist() if isinstance(msg.position, np.ndarray) else msg.position
         out = []
-        for name, q in zip(msg.name, position, strict=False):
-            known = self.joints.get(name)
+        joints = self.joints
+        for name, q in zip(names, position, strict=False):
+            known = joints.get(name)
             if known is not None:
                 joint, consts = known
-                out.append((joint.parent, joint.child, _tf_tuple(*_motion(joint.type, consts, float(q)))))
+                xyz, quat = _motion(joint.type, consts, float(q))
+                out.append((joint.parent, joint.child, (*xyz, *quat)))  # floats already (_joint_constants)
         if out:
             self.send_transform_tuples(stamp, out)
 

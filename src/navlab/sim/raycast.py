@@ -21,6 +21,7 @@ SPHERE = int(mujoco.mjtGeom.mjGEOM_SPHERE)
 BOX = int(mujoco.mjtGeom.mjGEOM_BOX)
 CYLINDER = int(mujoco.mjtGeom.mjGEOM_CYLINDER)
 FAST_TYPES = (PLANE, SPHERE, BOX, CYLINDER)
+SPAN_MARGIN = 1e-7  # rad added to each side of a box's or cylinder's azimuth span: far above atan's rounding
 
 
 @njit(cache=True, inline="always")
@@ -174,6 +175,8 @@ def cast_planar(
     p_loc = np.empty(3)
     d_loc = np.empty(3)
     rel = np.empty(3)
+    corner_x = np.empty(8)
+    corner_y = np.empty(8)
     two_pi = 2.0 * math.pi
     order, bound = _nearest_first(origin, geoms, geom_type, geom_size, geom_xpos, geom_xmat)
     for gi in range(order.shape[0]):
@@ -222,8 +225,12 @@ def cast_planar(
                 ey = geom_size[g, 0] if kind == CYLINDER else geom_size[g, 1]
                 ez = geom_size[g, 1] if kind == CYLINDER else geom_size[g, 2]
                 zmin, zmax = np.inf, -np.inf
-                amin, amax, dmin = np.inf, -np.inf, np.inf
-                centre = math.atan2(cy, cx)
+                d2min = np.inf
+                rc = math.sqrt(cx * cx + cy * cy)
+                ahead = rc > 0.0  # every corner in front of the centre's azimuth: its span needs no atan2 each
+                cu = cx / rc if ahead else 1.0
+                su = cy / rc if ahead else 0.0
+                tmin, tmax = np.inf, -np.inf  # tangents of the corners' azimuths about the centre's
                 for corner in range(8):
                     lx = ex if corner & 1 else -ex
                     ly = ey if corner & 2 else -ey
@@ -237,19 +244,39 @@ def cast_planar(
                     sz = rot[0, 2] * wx + rot[1, 2] * wy + rot[2, 2] * wz
                     zmin = min(zmin, sz)
                     zmax = max(zmax, sz)
-                    a = math.atan2(sy, sx) - centre
-                    a = (a + math.pi) % two_pi - math.pi
-                    amin = min(amin, a)
-                    amax = max(amax, a)
-                    dmin = min(dmin, math.sqrt(sx * sx + sy * sy))
+                    d2min = min(d2min, sx * sx + sy * sy)
+                    corner_x[corner] = sx
+                    corner_y[corner] = sy
+                    fx = sx * cu + sy * su
+                    if fx > 0.0:
+                        t = (sy * cu - sx * su) / fx
+                        tmin = min(tmin, t)
+                        tmax = max(tmax, t)
+                    else:
+                        ahead = False
                 if zmin > 0 or zmax < 0:
                     continue  # entirely above or below the scan plane
-                if dmin > cutoff + 2 * (ex + ey + ez):
+                if math.sqrt(d2min) > cutoff + 2 * (ex + ey + ez):  # the same test as the least of the sqrt
                     continue
-                if amax - amin < math.pi - 1e-6 and increment > 0:
-                    full = False
-                    centre += 0.5 * (amin + amax)
-                    half = 0.5 * (amax - amin) + 1e-9
+                if increment > 0:
+                    centre = math.atan2(cy, cx)
+                    if ahead:  # a span a little wider than the corners' (any beam outside it misses)
+                        amin = math.atan(tmin)
+                        amax = math.atan(tmax)
+                        full = False
+                        centre += 0.5 * (amin + amax)
+                        half = 0.5 * (amax - amin) + SPAN_MARGIN
+                    else:  # a corner abeam or behind: each corner's azimuth, wrapped about the centre's
+                        amin, amax = np.inf, -np.inf
+                        for corner in range(8):
+                            a = math.atan2(corner_y[corner], corner_x[corner]) - centre
+                            a = (a + math.pi) % two_pi - math.pi
+                            amin = min(amin, a)
+                            amax = max(amax, a)
+                        if amax - amin < math.pi - 1e-6:
+                            full = False
+                            centre += 0.5 * (amin + amax)
+                            half = 0.5 * (amax - amin) + 1e-9
         for wrap in range(-1, 2):
             if full:
                 if wrap != 0:

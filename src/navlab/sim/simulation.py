@@ -263,6 +263,12 @@ class Simulation:
 
     def base_pose2d(self, link: str | None = None) -> tuple[float, float, float]:
         """True (x, y, yaw) of a robot link in the world (m, rad)."""
+        b, _, _, own = self._link_frame(link)
+        if own:  # the body's own frame: link_pose's values, read as floats (the monitors ask at 10 Hz)
+            self._sync()
+            x, y = self.data.xpos[b, :2].tolist()
+            w, qx, qy, qz = self.data.xquat[b].tolist()
+            return x, y, yaw_from_quat((qx, qy, qz, w))
         pose = self.link_pose(link)
         return float(pose.position[0]), float(pose.position[1]), pose.yaw
 
