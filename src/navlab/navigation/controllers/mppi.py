@@ -192,6 +192,7 @@ class MPPIController(Nav2PlanController):
         self.local_plan = np.zeros((0, 3))
         self.costs = np.zeros(0)
         self.valid = True
+        self._backing = False  # the rotation shim is backing the robot out to turn
 
     def _local_path(self, pose: tuple[float, float, float]) -> np.ndarray:
         """The plan from the point nearest the robot (searched ahead of the last one) to ``prune_distance``
@@ -236,12 +237,18 @@ class MPPIController(Nav2PlanController):
         dist_to_goal = math.hypot(pose[0] - self._goal[0], pose[1] - self._goal[1])
         outline = footprint_outline(self.footprint, res)
         if self._shim is not None:
-            w = self._shim.command((px, py, pth), (v0, w0), path, 1.0 / p.controller_frequency, grid, res, outline)
-            if w is not None:  # turning in place toward the path: MPPI starts afresh from the new heading
+            cmd = self._shim.command(
+                (px, py, pth), (v0, w0), path, 1.0 / p.controller_frequency, grid, res, outline, backing=self._backing
+            )
+            self._backing = cmd is not None and cmd[0] < 0.0
+            if cmd is not None:  # turning in place toward the path (or backing out to turn): MPPI starts afresh
+                v, w = cmd
                 self.sequence[:] = 0.0
-                self._history = np.vstack([self._history[1:], [[0.0, w]]])
-                self.local_plan = frame.poses_out(np.array([[px, py, pth], [px, py, pth + w / p.controller_frequency]]))
-                return 0.0, w
+                self._history = np.vstack([self._history[1:], [[v, w]]])
+                ahead = (pth + w / p.controller_frequency, v / p.controller_frequency)
+                x1, y1 = px + ahead[1] * math.cos(pth), py + ahead[1] * math.sin(pth)
+                self.local_plan = frame.poses_out(np.array([[px, py, pth], [x1, y1, ahead[0]]]))
+                return v, w
         s_n, t_n = p.batch_size, p.time_steps
         u = np.empty((s_n, t_n, 2))
         xs, ys, ths, arc = (np.empty((s_n, t_n)) for _ in range(4))

@@ -73,6 +73,8 @@ class MppiParams:
     max_angular_accel: float = 3.2  # rad/s²
     simulate_ahead_time: float = 1.0  # s
     rotation_shim_max_speed: float = 0.1  # m/s: the shim turns the robot only when it moves slower
+    rotation_shim_backup_dist: float = 0.0  # m: where the turn is blocked, back out straight up to this far (0: never)
+    rotation_shim_backup_speed: float = 0.25  # m/s
     controller_frequency: float = 20.0
     xy_goal_tolerance: float = 0.25
     yaw_goal_tolerance: float = 0.25
@@ -154,7 +156,14 @@ MppiParams.PARAMS = ParamSpec(
         "time_steps": 2,
         **dict.fromkeys(("gamma", "xy_goal_tolerance", "yaw_goal_tolerance", "regulated_linear_scaling_min_speed"), 0),
         **dict.fromkeys(
-            ("angular_dist_threshold", "forward_sampling_distance", "simulate_ahead_time", "rotation_shim_max_speed"), 0
+            (
+                "angular_dist_threshold",
+                "forward_sampling_distance",
+                "simulate_ahead_time",
+                "rotation_shim_max_speed",
+                "rotation_shim_backup_dist",
+            ),
+            0,
         ),
     },
     above=dict.fromkeys(
@@ -172,6 +181,7 @@ MppiParams.PARAMS = ParamSpec(
             "cost_scaling_gain",
             "inflation_cost_scaling_factor",
             "rotate_to_heading_angular_vel",
+            "rotation_shim_backup_speed",
             "max_angular_accel",
         ),
         0,
