@@ -288,7 +288,8 @@ class CollisionMonitorNode(Node):
         self._scan_frame: str | None = None  # the frame_id the laser pose was looked up for
         self._laser_off = 0.0  # the laser's distance (m) from the base frame's origin
         self._closest: Any = None  # the last scan's closest range (m, the ranges' dtype), found when first needed
-        self.last: Verdict | None = None
+        self._last: Verdict | None = None  # the last verdict, or None after a pass-through of _last_in
+        self._last_in: Any = None
         self.actions: dict[str, int] = {}  # how many commands each polygon changed
         self.pub = self.create_publisher(msgs.Twist, "cmd_vel", 1)
         self.create_subscription(msgs.LaserScan, "scan", self._on_scan, 1)
@@ -333,6 +334,13 @@ class CollisionMonitorNode(Node):
             closest = self._closest = np.fmin.reduce(r) if len(r) else math.inf
         return not closest > within + self._laser_off
 
+    @property
+    def last(self) -> Verdict | None:
+        """The verdict on the last command (None before the first)."""
+        if self._last is None and self._last_in is not None:
+            return Verdict(float(self._last_in.linear.x), float(self._last_in.angular.z))
+        return self._last
+
     def _on_cmd(self, msg: Any) -> None:
         lin, ang = msg.linear, msg.angular
         v, w = float(lin.x), float(ang.z)
@@ -341,12 +349,12 @@ class CollisionMonitorNode(Node):
         elif self._any_within(within := self.monitor.reach(v)):
             verdict = self.monitor.check(v, w, self.points(within))
         else:  # no return any zone can reach: the command passes unchanged (the message itself when it is planar;
-            # subscribers never change a message they receive)
-            self.last = Verdict(v, w)
+            # subscribers never change a message they receive), nothing allocated
+            self._last, self._last_in = None, msg
             planar = v is lin.x and w is ang.z and not (lin.y or lin.z or ang.x or ang.y)
             self.pub.publish(msg if planar else msgs.twist(v, w))
             return
         if verdict.polygon:
             self.actions[verdict.polygon] = self.actions.get(verdict.polygon, 0) + 1
-        self.last = verdict
+        self._last, self._last_in = verdict, None
         self.pub.publish(msgs.twist(verdict.v, verdict.w))
