@@ -165,6 +165,15 @@ class CollisionMonitor:
 
     def __init__(self, polygons: list[Polygon]) -> None:
         self.polygons = [p for p in polygons if p.enabled]
+        # each zone's (reach m, approach s): the reach at speed v is reach + |v| approach (see _reach), derived once;
+        # when the first zone is fixed (not approach), the fixed zones' largest reach is one constant (a NaN speed
+        # cannot lead the max, so the order of the rest does not matter)
+        self._reaches = [
+            (p.reach, p.time_before_collision if p.action_type == "approach" else None) for p in self.polygons
+        ]
+        fixed = [(r + 0.0) + 1e-9 for r, t in self._reaches if t is None]
+        self._fixed = max(fixed) if self._reaches and self._reaches[0][1] is None else None
+        self._moving = [(r, t) for r, t in self._reaches if t is not None]
 
     def check(self, v: float, w: float, points: np.ndarray) -> Verdict:
         """The command (v m/s, w rad/s) allowed with the obstacle ``points`` (M, 2; base frame, m)."""
@@ -207,7 +216,14 @@ class CollisionMonitor:
 
     def reach(self, v: float) -> float:
         """How far (m) from the origin any point can change the command at speed ``v`` (m/s)."""
-        return max((self._reach(p, v) for p in self.polygons), default=0.0)
+        # the same sums as _reach, from the constants of __init__
+        av, best = abs(v), self._fixed
+        if best is None:
+            return max(((r + (av * t if t is not None else 0.0)) + 1e-9 for r, t in self._reaches), default=0.0)
+        for r, t in self._moving:
+            if (x := (r + av * t) + 1e-9) > best:
+                best = x
+        return best
 
     def _approach(self, poly: Polygon, v: float, w: float, pts: np.ndarray) -> Verdict:
         """Scale (v, w) so the polygon moved along the arc touches the points no sooner than
@@ -269,29 +285,39 @@ class CollisionMonitorNode(Node):
         self.last_scan: Any = None  # the last scan and the laser's pose (x, y, yaw) in the base frame
         self.laser = (0.0, 0.0, 0.0)
         self.scan_ns: int | None = None
-        self.last: Verdict | None = None
+        self._scan_frame: str | None = None  # the frame_id the laser pose was looked up for
+        self._laser_off = 0.0  # the laser's distance (m) from the base frame's origin
+        self._closest: Any = None  # the last scan's closest range (m, the ranges' dtype), found when first needed
+        self._last: Verdict | None = None  # the last verdict, or None after a pass-through of _last_in
+        self._last_in: Any = None
         self.actions: dict[str, int] = {}  # how many commands each polygon changed
         self.pub = self.create_publisher(msgs.Twist, "cmd_vel", 1)
         self.create_subscription(msgs.LaserScan, "scan", self._on_scan, 1)
         self.create_subscription(msgs.Twist, "cmd_vel_in", self._on_cmd, 1)
 
     def _on_scan(self, msg: Any) -> None:
-        try:
-            self.laser = self.sensor_pose(self.base_frame, str(msg.header.frame_id).lstrip("/"))
-        except TfError:
+        """Keep the scan; its pose is looked up only when its frame changes (the laser is fixed on the robot)."""
+        if msg.header.frame_id != self._scan_frame and not self._look_up_laser(msg.header.frame_id):
             return
-        self.last_scan, self.scan_ns = msg, self.executor.now_ns
+        self.last_scan, self.scan_ns, self._closest = msg, self.executor.now_ns, None
+
+    def _look_up_laser(self, frame_id: str) -> bool:
+        """The laser's pose for scans in ``frame_id``; False (the scan dropped) while tf lacks it."""
+        try:
+            self.laser = self.sensor_pose(self.base_frame, str(frame_id).lstrip("/"))
+        except TfError:
+            return False
+        self._scan_frame, self._laser_off = frame_id, math.hypot(self.laser[0], self.laser[1])
+        return True
 
     def points(self, within: float = math.inf) -> np.ndarray:
         """The last scan's returns (M, 2; base frame, m), those that may lie within ``within`` m of the origin
         (turned into points only when a command needs them: most are farther than any zone reaches)."""
         msg, (x, y, yaw) = self.last_scan, self.laser
-        if msg is None:
+        if msg is None or not self._any_within(within):  # nothing close (the usual case): no points to make
             return np.zeros((0, 2))
         r = np.asarray(msg.ranges)
-        far, top = within + math.hypot(x, y), float(msg.range_max)  # NaN and inf fail both tests
-        if len(r) == 0 or np.fmin.reduce(r) > far:  # nothing close (the usual case): no points to make
-            return np.zeros((0, 2))
+        far, top = within + self._laser_off, float(msg.range_max)  # NaN and inf fail both tests
         k = np.flatnonzero((r >= float(msg.range_min)) & ((r <= far) if far < top else (r < top)))
         rk = r[k].astype(np.float64)
         a = float(msg.angle_min) + float(msg.angle_increment) * k
@@ -299,15 +325,36 @@ class CollisionMonitorNode(Node):
         c, s = math.cos(yaw), math.sin(yaw)
         return np.column_stack([x + c * lx - s * ly, y + s * lx + c * ly])
 
+    def _any_within(self, within: float) -> bool:
+        """Whether the last scan may have a return within ``within`` m of the base frame's origin (its closest
+        range, found once a scan, against ``within`` + the laser's offset; NaN ranges never count)."""
+        closest = self._closest
+        if closest is None:
+            r = np.asarray(self.last_scan.ranges)
+            closest = self._closest = np.fmin.reduce(r) if len(r) else math.inf
+        return not closest > within + self._laser_off
+
+    @property
+    def last(self) -> Verdict | None:
+        """The verdict on the last command (None before the first)."""
+        if self._last is None and self._last_in is not None:
+            return Verdict(float(self._last_in.linear.x), float(self._last_in.angular.z))
+        return self._last
+
     def _on_cmd(self, msg: Any) -> None:
-        v, w = float(msg.linear.x), float(msg.angular.z)
-        fresh = self.scan_ns is not None and (self.executor.now_ns - self.scan_ns) / 1e9 <= self.source_timeout
-        verdict = (
-            self.monitor.check(v, w, self.points(self.monitor.reach(v)))
-            if fresh
-            else Verdict(0.0, 0.0, "(no scan)", "stop")
-        )
+        lin, ang = msg.linear, msg.angular
+        v, w = float(lin.x), float(ang.z)
+        if self.scan_ns is None or not (self.executor.now_ns - self.scan_ns) / 1e9 <= self.source_timeout:
+            verdict = Verdict(0.0, 0.0, "(no scan)", "stop")
+        elif self._any_within(within := self.monitor.reach(v)):
+            verdict = self.monitor.check(v, w, self.points(within))
+        else:  # no return any zone can reach: the command passes unchanged (the message itself when it is planar;
+            # subscribers never change a message they receive), nothing allocated
+            self._last, self._last_in = None, msg
+            planar = v is lin.x and w is ang.z and not (lin.y or lin.z or ang.x or ang.y)
+            self.pub.publish(msg if planar else msgs.twist(v, w))
+            return
         if verdict.polygon:
             self.actions[verdict.polygon] = self.actions.get(verdict.polygon, 0) + 1
-        self.last = verdict
+        self._last, self._last_in = verdict, None
         self.pub.publish(msgs.twist(verdict.v, verdict.w))
