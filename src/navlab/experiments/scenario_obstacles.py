@@ -1,7 +1,7 @@
 """A scenario's obstacles, placed as an experimenter would: never on the start, a goal or the robot.
 
 An obstacle dropped in while the robot drives is a test of navigation only if the goal stays reachable. Each
-obstacle keeps ``keep_clear_m`` (its own reach + the robot's collision reach + ``SAFETY_DISTANCE_M``, so a
+obstacle keeps :func:`keep_clear_m` (its own reach + the robot's collision reach + ``SAFETY_DISTANCE_M``, so a
 robot standing on the goal is still the safety distance from it) between its origin and the start, every goal
 and the robot at the moment it appears:
 
@@ -55,6 +55,12 @@ def robot_reach(robot: str) -> float:
     return collision_reach(load_robot_named(robot))
 
 
+def keep_clear_m(model: Any, reach_robot: float) -> float:
+    """The distance (m) ``model``'s origin keeps from the start, the goals and the robot: its reach + the robot's
+    collision reach + the safety distance."""
+    return model_reach(model) + reach_robot + SAFETY_DISTANCE_M
+
+
 def keep_clear_points(sc: Scenario) -> np.ndarray:
     """The start and every goal (K, 2) in the world frame (mapless goals are in odom, which starts at the start)."""
     from navlab.geometry import compose2
@@ -73,7 +79,7 @@ def check_fixed_obstacles(sc: Scenario, reach_robot: float) -> None:
         if ob.get("frame", "world") != "world":
             continue
         model = parse_spawn_spec(ob["spec"], default_name=f"obstacle_{k}")[0]
-        need = model_reach(model) + reach_robot + SAFETY_DISTANCE_M
+        need = keep_clear_m(model, reach_robot)
         d = np.hypot(*(points - np.asarray(model.pose[:2])).T)
         if d.min() < need:
             j = int(d.argmin())
@@ -139,9 +145,9 @@ def placements(sc: Scenario, seed: int) -> list[Placement]:
     random stream), each kept clear of the start, the goals and the robot (see the module docstring)."""
     from navlab.sim import parse_spawn_spec
 
-    rng = np.random.default_rng([seed, 0x0B57])  # its own stream: the run's seed stays the simulator's
     if not sc.obstacles:
         return []
+    rng = np.random.default_rng([seed, 0x0B57])  # its own stream: the run's seed stays the simulator's
     reach_robot = robot_reach(sc.robot)
     points = keep_clear_points(sc)
     out = []
@@ -149,6 +155,6 @@ def placements(sc: Scenario, seed: int) -> list[Placement]:
         model = parse_spawn_spec(ob["spec"], default_name=f"obstacle_{k}")[0]
         window = (float(ob["t"][0]), float(ob["t"][1])) if isinstance(ob["t"], list) else (ob["t"], ob["t"])
         t = float(rng.uniform(*window)) if isinstance(ob["t"], list) else float(ob["t"])
-        clear = model_reach(model) + reach_robot + SAFETY_DISTANCE_M
+        clear = keep_clear_m(model, reach_robot)
         out.append(Placement(model, t, window, ob.get("frame", "world") == "robot", points, clear))
     return out
