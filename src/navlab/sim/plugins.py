@@ -267,7 +267,7 @@ class DiffDrivePlugin(SimPlugin):
             return
         # the message only when anyone reads it (the mapping launch's nodes take odometry from tf)
         pub = self.odom_pub
-        if pub.topic.subscriptions or self.executor.has_listeners:  # listened(self, pub), inlined: 30 Hz
+        if listened(self, pub):
             lin: Vec
             ang: Vec
             if world:
