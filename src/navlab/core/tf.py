@@ -265,7 +265,7 @@ class TfBuffer:
             tol = self.tolerance_ns
             for e in chain[2]:
                 if not (e.static or e.times[e.lo] - tol <= t_ns <= e.times[-1] + tol):
-                    return self.lookup_pose2d(target, source, None)
+                    return _pose2d(self._answer(target, source, None))  # lookup_pose2d(target, source, None)
             hit = self._compute(key, chain, t_ns)
         return _pose2d(hit)
 
