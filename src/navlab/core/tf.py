@@ -97,8 +97,11 @@ class TfBuffer:
         else:
             times.append(t_ns)
             values.append(tf)
-        if times[-1] - times[e.lo] > self.cache_ns:  # keep cache_ns: the entries older than that leave the history
-            lo = bisect.bisect_left(times, times[-1] - self.cache_ns, e.lo)
+        lo = e.lo
+        if times[-1] - times[lo] > self.cache_ns:  # keep cache_ns: the entries older than that leave the history
+            oldest = times[-1] - self.cache_ns  # bisect_left(times, oldest, lo) by steps: one or two a transform
+            while times[lo] < oldest:
+                lo += 1
             if lo >= _DROP_BATCH:
                 del times[:lo], values[:lo]
                 lo = 0
