@@ -36,6 +36,7 @@ else:
 
 PCG64_MULT = 0x2360ED051FC65DA44385DF649FCCF645  # PCG's default 128-bit LCG multiplier (NumPy's PCG64)
 CHECK_DRAWS = 4096  # draws compared with NumPy's before a generator is trusted to the compiled loop
+CHECK_SHUFFLE = 1024  # the length of the check permutations (Draws)
 
 
 def _lcg_step_typer(typingctx: Any, hi: Any, lo: Any, inc_hi: Any, inc_lo: Any) -> Any:
@@ -180,9 +181,8 @@ def pcg64_half(gen: np.random.Generator) -> np.ndarray | None:
 
 
 class Draws:
-    """``gen.standard_normal(shape)`` and ``gen.permutation(n)`` for one generator: NumPy's values, leaving ``gen``
-    in the state NumPy's own calls would, drawn in the compiled loops when a check on copies of ``gen`` agrees
-    with NumPy (else by NumPy)."""
+    """``gen.permutation(n)`` for one generator: NumPy's values, leaving ``gen`` in the state NumPy's own call would,
+    drawn in the compiled loop when a check on copies of ``gen`` agrees with NumPy (else by NumPy)."""
 
     def __init__(self, gen: np.random.Generator) -> None:
         self.gen = gen
@@ -198,32 +198,23 @@ class Draws:
         if words is None or half is None:
             return None
         ki, wi, fi = _TABLES
-        mine_p, mine_n = np.empty(CHECK_DRAWS, dtype=np.int64), np.empty(CHECK_DRAWS + 1)
-        mine_q = np.empty(CHECK_DRAWS - 1, dtype=np.int64)  # an odd count of 32-bit draws: the spare half is used
+        mine_p, mine_n = np.empty(CHECK_SHUFFLE, dtype=np.int64), np.empty(CHECK_SHUFFLE // 8 + 1)
+        mine_q = np.empty(CHECK_SHUFFLE - 1, dtype=np.int64)  # an odd count of 32-bit draws: the spare half is used
         fill_permutation(words, half, mine_p)
-        fill_standard_normal(words, ki, wi, fi, float(ziggurat_nor_r), float(ziggurat_nor_inv_r), mine_n)
+        fill_standard_normal(words, ki, wi, fi, float(ziggurat_nor_r), float(ziggurat_nor_inv_r), mine_n)  # 64-bit
         fill_permutation(words, half, mine_q)
         same = (
-            np.array_equal(a.permutation(CHECK_DRAWS), mine_p)
-            and np.array_equal(a.standard_normal(CHECK_DRAWS + 1).view(np.uint64), mine_n.view(np.uint64))
-            and np.array_equal(a.permutation(CHECK_DRAWS - 1), mine_q)
+            np.array_equal(a.permutation(CHECK_SHUFFLE), mine_p)
+            and np.array_equal(a.standard_normal(mine_n.shape[0]).view(np.uint64), mine_n.view(np.uint64))
+            and np.array_equal(a.permutation(CHECK_SHUFFLE - 1), mine_q)
             and a.bit_generator.state == b.bit_generator.state
         )
         return None if not same else (pcg64_words(gen), pcg64_half(gen))  # type: ignore[return-value]
 
     @property
     def compiled(self) -> bool:
-        """Whether the draws run in the compiled loops (else NumPy's own calls)."""
+        """Whether the draws run in the compiled loop (else NumPy's own call)."""
         return self._state is not None
-
-    def standard_normal(self, shape: int | tuple[int, ...]) -> np.ndarray:
-        """What ``gen.standard_normal(shape)`` returns (a new array, C order)."""
-        if self._state is None:
-            return self.gen.standard_normal(shape)
-        out = np.empty(shape)
-        ki, wi, fi = _TABLES  # type: ignore[misc]
-        fill_standard_normal(self._state[0], ki, wi, fi, ziggurat_nor_r, ziggurat_nor_inv_r, out.reshape(-1))
-        return out
 
     def permutation(self, n: int) -> np.ndarray:
         """What ``gen.permutation(n)`` returns (int64)."""
