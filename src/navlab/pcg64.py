@@ -5,10 +5,11 @@ and Tsang's 256-layer ziggurat, its ``permutation(n)`` from a Fisher-Yates shuff
 partner is a masked rejection draw (``random_interval``) of 32-bit outputs, two per 64-bit output (the generator
 keeps the spare half). The loops here run the same algorithms, with NumPy's ziggurat tables, on a view of the
 generator's own memory, so the generator stays in step with every draw made here: the same values bit for bit,
-~4x faster. Whenever that cannot be sure (another bit generator, a NumPy whose PCG64 state is laid out
-differently, the tables missing), or when a check draw against NumPy disagrees, NumPy itself draws.
+faster (720 normals ~4x, a 5000-long permutation ~1.7x). Whenever that cannot be sure (another bit generator, a
+NumPy whose PCG64 state is laid out differently, the tables missing), or when a check draw against NumPy disagrees,
+NumPy itself draws.
 
-Used by the lidar's noise (``sim``) and amcl's resampling and motion model (``localization``): a leaf module.
+Used by the lidar's noise (``sim``) and amcl's resampling (``localization``): a leaf module both may import.
 """
 
 from __future__ import annotations
