@@ -99,7 +99,8 @@ def scan_with(args: tuple[Any, ...], cfg: LidarConfig, normals: np.ndarray) -> n
     """One scan (m, float32) from :func:`scan_args`: the cast and Gazebo's noise (``normals``, standard normal
     draws, or empty without noise) in one compiled call."""
     out = np.empty(args[2].shape[0], dtype=np.float32)
-    scan_planar(*args, normals, cfg.noise_mean, cfg.noise_stddev, out)
+    # mypy takes the unpacked tuple for too many arguments to numba's Dispatcher
+    scan_planar(*args, normals, cfg.noise_mean, cfg.noise_stddev, out)  # type: ignore[call-arg]
     return out
 
 
