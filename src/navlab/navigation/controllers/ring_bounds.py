@@ -184,6 +184,8 @@ def ring_scores(
     path_dist, path_reached, path_free, path_queue, path_ends = path_wave
     goal_dist, goal_reached, goal_free, goal_queue, goal_ends = goal_wave
     bounds = np.empty(n, dtype=np.int64)
+    # the memo and the distances read by flat index (part, row, column): ~7 % of a TrajectoryPlanner cycle
+    memo_flat, path_flat, goal_flat, part_size = memo.flat, path_dist.flat, goal_dist.flat, h * w
     unreached = float(h * w) + 1.0  # mapgrid's unreachable_value: a wave's cells not reached (yet)
     fine = counts.size > q * q  # ring_offsets' FINE rings follow the quarters'
     spot_x = spot_y = math.nan  # the last spot whose FINE bound was looked up, and that bound
@@ -225,7 +227,8 @@ def ring_scores(
                     top = max(top, float(grid[j, i]))
                 else:
                     part = min(q - 1, int((fy - j) * q)) * q + min(q - 1, int((fx - i) * q))
-                    kept = int(memo[part, j, i])  # bound_at, written out (the hot loop: a call costs more than a hit)
+                    # bound_at, written out (the hot loop: a call costs more than a hit)
+                    kept = int(memo_flat[part * part_size + j * w + i])
                     if kept >> 8 == epoch:
                         b = kept & 0xFF
                     else:
@@ -242,10 +245,10 @@ def ring_scores(
                             first, first_bound = k, b
             if at[r] == k or (at[r] == -1 and moved):  # (unmoved, the distances are those that passed)
                 pi, pj = (i, j) if inside else (0, 0)
-                pd = path_dist[pj, pi]
+                pd = path_flat[pj * w + pi]
                 if pd == unreached:  # not reached yet: wave_start's fill (cells + 1); a reached cell reads less
                     pd = grow(grid, path_dist, path_reached, path_free, path_queue, path_ends, pi, pj)
-                gd = goal_dist[pj, pi]
+                gd = goal_flat[pj * w + pi]
                 if gd == unreached:
                     gd = grow(grid, goal_dist, goal_reached, goal_free, goal_queue, goal_ends, pi, pj)
                 spd, sgd = pd, gd
