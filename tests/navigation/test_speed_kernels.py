@@ -219,14 +219,15 @@ def test_obstacle_layer_takes_ranges_in_one_call_as_it_takes_their_endpoints() -
 
 
 def test_ray_clearing_writes_the_cells_of_the_plain_walk() -> None:
-    """Rays whose both ends lie in the grid are walked without per-cell bounds checks: the same cells as the
-    plain walk (cut to max_cells, stopped where it leaves the grid, min_cells kept), rays in and out of it."""
+    """Rays are walked without per-cell bounds checks (up to where they leave the grid, found beforehand): the same
+    cells as the plain walk (cut to max_cells, stopped where it leaves the grid, min_cells kept), rays in and out of
+    it, on C- and Fortran-ordered grids."""
     from navlab.gridline import TIE_LATE, line, line_cell
     from navlab.navigation.costmap.raytrace import clear_rays
 
     rng = np.random.default_rng(5)
     for trial in range(12):
-        data = np.zeros((40, 50), np.uint8)
+        data = np.zeros((40, 50), np.uint8, order="F" if trial % 3 == 2 else "C")
         x0, y0 = rng.uniform(0, 50), rng.uniform(0, 40)
         ends = np.column_stack([rng.uniform(-20, 70, 60), rng.uniform(-20, 60, 60)])
         min_cells = 0.0 if trial % 2 == 0 else 3.0

@@ -429,14 +429,20 @@ def cells_under(
     for k in range(ex.size):
         mark[ei[k] - bi0, ej[k] - bj0] = True
     n = poly.shape[0]
-    for i in range(lo_i, hi_i + 1):
-        for j in range(lo_j, hi_j + 1):
-            px, py = (i + 0.5) * res, (j + 0.5) * res  # points_in_polygon's test of the cell centre
+    crosses = np.empty(n, dtype=np.bool_)
+    at_x = np.empty(n)
+    for j in range(lo_j, hi_j + 1):
+        py = (j + 0.5) * res  # points_in_polygon's test of the cell centres, the row's edge crossings worked out once
+        for m in range(n):
+            ax, ay = poly[m, 0], poly[m, 1]
+            bx, by = poly[(m + 1) % n, 0], poly[(m + 1) % n, 1]
+            crosses[m] = (ay > py) != (by > py)
+            at_x[m] = ax + (py - ay) * (bx - ax) / (by - ay) if crosses[m] else 0.0
+        for i in range(lo_i, hi_i + 1):
+            px = (i + 0.5) * res
             inside = False
             for m in range(n):
-                ax, ay = poly[m, 0], poly[m, 1]
-                bx, by = poly[(m + 1) % n, 0], poly[(m + 1) % n, 1]
-                if (ay > py) != (by > py) and px < ax + (py - ay) * (bx - ax) / (by - ay):
+                if crosses[m] and px < at_x[m]:
                     inside = not inside
             if inside:
                 mark[i - bi0, j - bj0] = True

@@ -7,7 +7,9 @@ wave (``rollout.footprint_cells``, TrajectoryPlanner's ``within_robot``) and the
 (``mapgrid.wave_start``: seeded, grown only as far as lookups need). ``moved_length`` is ``_finish``'s cut of
 the chosen rollout where it stops moving. Same float operations in the same order as the numpy steps they
 replace, so the same results bit for bit. Poses are grid-local (m, rad) unless said otherwise; cells are
-(i, j) = (column, row).
+(i, j) = (column, row). Numba keys ``path_scene``'s cache on this file only: it holds compiled copies of
+``mapgrid``'s and ``rollout.cells_under``'s code (each row's edge crossings worked out once), so after changing
+those, change this file too (or clear the caches).
 """
 
 from __future__ import annotations

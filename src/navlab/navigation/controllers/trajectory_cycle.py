@@ -9,7 +9,8 @@ counts, ``rollout.integrate_rollouts`` and ``rollout.rollout_scores``), without 
 controller cycle makes two calls instead of some forty numpy calls. Poses are grid-local (m, rad).
 
 Numba's cache keys a kernel on its own file only: ``score_samples`` holds compiled copies of
-``rollout.integrate_rollouts`` and ``ring_bounds.ring_scores`` (now with its FINE bound for in-place turns), so
+``rollout.integrate_rollouts`` and ``ring_bounds.ring_scores`` (now with its FINE bound for in-place turns and its
+flat-index reads of the memo and the distances), so
 after changing those, change this file too (or clear the ``__pycache__`` caches) or the old copies keep running.
 """
 

@@ -269,15 +269,20 @@ def reinflate(
     last = table.size - 1
     k = vanished + boxes.shape[0]
     todo = np.empty((k, 4), np.int64)
+    r1 = reach - 1
+    stencil = np.empty((2 * r1 + 1, 2 * r1 + 1), table.dtype)  # a seed's own cost around it: table[d2], capped
+    for dj in range(-r1, r1 + 1):
+        for di in range(-r1, r1 + 1):
+            d2 = dj * dj + di * di
+            stencil[dj + r1, di + r1] = table[d2 if d2 < last else last]
     for t in range(vanished):  # the cells whose cost may have come from this seed: it equals the seed's own there
         i, j = changes[m - 1 - t, 0], changes[m - 1 - t, 1]
         j0, j1, i0, i1 = h, -1, w, -1
-        for jj in range(max(0, j - reach + 1), min(h, j + reach)):
-            dy2 = (jj - j) * (jj - j)
-            for ii in range(max(0, i - reach + 1), min(w, i + reach)):
-                d2 = dy2 + (ii - i) * (ii - i)
+        for jj in range(max(0, j - r1), min(h, j + reach)):
+            srow = stencil[jj - j + r1]
+            for ii in range(max(0, i - r1), min(w, i + reach)):
                 c = cost[jj, ii]
-                if c > 0 and c == table[d2 if d2 < last else last]:
+                if c > 0 and c == srow[ii - i + r1]:
                     j0, j1, i0, i1 = min(j0, jj), max(j1, jj), min(i0, ii), max(i1, ii)
         todo[t, 0], todo[t, 1], todo[t, 2], todo[t, 3] = j0, j1 + 1, i0, i1 + 1  # empty when there is none
     todo[vanished:] = boxes
@@ -287,12 +292,11 @@ def reinflate(
         if alive[t] and j0 < j1 and i0 < i1:
             region = (max(0, j0 - reach), min(h, j1 + reach), max(0, i0 - reach), min(w, i1 + reach))
             inflate_box(seeds, region, (j0, j1, i0, i1), table, cost[j0:j1, i0:i1])
-    for t in range(appeared):
+    for t in range(appeared):  # raise the cells around to the seed's own cost (branch-free: vectorised rows)
         i, j = changes[t, 0], changes[t, 1]
-        for jj in range(max(0, j - reach + 1), min(h, j + reach)):
-            dy2 = (jj - j) * (jj - j)
-            for ii in range(max(0, i - reach + 1), min(w, i + reach)):
-                d2 = dy2 + (ii - i) * (ii - i)
-                c = table[d2 if d2 < last else last]
-                if c > cost[jj, ii]:
-                    cost[jj, ii] = c
+        a0, a1 = max(0, i - r1), min(w, i + reach)
+        for jj in range(max(0, j - r1), min(h, j + reach)):
+            srow = stencil[jj - j + r1, a0 - i + r1 : a1 - i + r1]
+            crow = cost[jj, a0:a1]
+            for q in range(a1 - a0):
+                crow[q] = max(crow[q], srow[q])

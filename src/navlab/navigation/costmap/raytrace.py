@@ -13,7 +13,7 @@ import math
 import numba
 import numpy as np
 
-from navlab.gridline import TIE_LATE, line, line_cell
+from navlab.gridline import TIE_LATE, line, line_cell, line_minor, line_strides
 from navlab.navigation.costmap.kernels import mark_returns
 
 
@@ -32,6 +32,7 @@ def clear_rays(
     if i0 < 0 or j0 < 0 or i0 >= w or j0 >= h:
         return 0
     written = 0
+    flat = data.flat  # the grid's cells by flat index (line_strides)
     min_sq = min_cells * min_cells
     last_i, last_j, walked = i0, j0, False
     for k in range(ends.shape[0]):
@@ -52,11 +53,22 @@ def clear_rays(
             continue
         last_i, last_j, walked = i1, j1, True
         ln = line(i0, j0, i1, j1, TIE_LATE)
-        if min_sq <= 0.0 and 0 <= i1 < w and 0 <= j1 < h:  # both ends inside: so is every cell between them
-            for n in range(ln[0] + 1):
-                i, j = line_cell(ln, n)
-                data[j, i] = value
-            written += ln[0] + 1
+        if min_sq <= 0.0:  # every cell from the start up to where the line leaves the grid
+            last = ln[0]
+            if not (0 <= i1 < w and 0 <= j1 < h):  # the cells go one way along each axis: once out, out for good
+                lo, hi = 0, last  # cell lo inside (the start is), cell hi outside
+                while hi - lo > 1:
+                    mid = (lo + hi) // 2
+                    i, j = line_cell(ln, mid)
+                    if 0 <= i < w and 0 <= j < h:
+                        lo = mid
+                    else:
+                        hi = mid
+                last = lo
+            start, major, minor = line_strides(ln, w)
+            for n in range(last + 1):
+                flat[start + n * major + line_minor(ln, n) * minor] = value
+            written += last + 1
             continue
         for n in range(ln[0] + 1):
             i, j = line_cell(ln, n)
