@@ -1,11 +1,11 @@
 """navfn (ROS 1 ``navfn/NavfnROS``): a potential field over the costmap, then gradient descent on it.
 
-Costs map as navfn's ``setCostmap``: a cell of cost ``c`` < 253 costs ``COST_NEUTRAL + COST_FACTOR * c`` (50 + 0.8
-c) per cell crossed; inscribed (253) and lethal (254) cells are obstacles; unknown (255) cells cost 253 with
-``allow_unknown`` (navfn's default; navlab's ``unknown_cost`` prices them otherwise) and are obstacles without it.
-The potential is the solution of the Eikonal equation ``|grad P| = cost`` grown from the start (fast marching with
-the exact two-neighbour quadratic update, Dijkstra order, or A* order with ``use_dijkstra: false``), so it
-measures Euclidean path length weighted by cost, not 8-connected steps. The path descends the interpolated
+Costs map as navfn's ``setCostmap``: a cell of cost ``c`` < 253 costs ``COST_NEUTRAL + COST_FACTOR * c``
+(50 + 0.8 c) per cell crossed; inscribed (253) and lethal (254) cells are obstacles; unknown (255) cells cost 253
+with ``allow_unknown`` (navfn's default; navlab's ``unknown_cost`` prices them otherwise) and are obstacles
+without it. The potential is the solution of the Eikonal equation ``|grad P| = cost`` grown from the start (fast
+marching with the exact two-neighbour quadratic update, Dijkstra order, or A* order with ``use_dijkstra: false``),
+so it measures Euclidean path length weighted by cost, not 8-connected steps. The path descends the interpolated
 gradient from the goal in half-cell steps (a grid step to the lowest neighbour next to obstacles or where the
 gradient fails) and is returned start to goal, in metres, in the costmap frame.
 ``default_tolerance`` (m): a goal in an obstacle or cut off is replaced by the nearest reachable cell
