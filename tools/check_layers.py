@@ -4,7 +4,7 @@ and no two packages import each other.
 
 Layers, bottom to top::
 
-    0 leaves       errors msgs geometry grid gridline io resources nodes plugins lazy deprecation
+    0 leaves       errors msgs geometry grid gridline io resources nodes plugins lazy deprecation pcg64
     1 core
     2 description world ros1
     3 sim mapping localization
@@ -49,6 +49,7 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
             "plugins",
             "lazy",
             "deprecation",
+            "pcg64",
         ),
     ),
     ("core", ("core",)),

@@ -30,9 +30,12 @@ IDENTITY_TF: Tf = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0)
 # --- angles -----------------------------------------------------------------------------------
 
 
+_NUMBER = (float, int)  # what wrap_angle wraps as a number (a tuple: cheaper to test than float | int)
+
+
 def wrap_angle(a: Any) -> Any:
     """Wrap angles (rad) to [-pi, pi): a number gives a float, an array (or list) an array."""
-    if isinstance(a, float | int):
+    if isinstance(a, _NUMBER):
         return (a + math.pi) % (2.0 * math.pi) - math.pi
     return (np.asarray(a) + math.pi) % (2.0 * math.pi) - math.pi
 

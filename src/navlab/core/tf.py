@@ -17,7 +17,6 @@ from navlab.msgs import Quaternion, Transform, TransformStamped, Vector3, header
 
 Pose2 = tuple[float, float, float]  # (x m, y m, yaw rad) of a frame's origin in another frame
 LOOKUP_CACHE = 64  # lookups remembered (see TfBuffer.lookup)
-_INVERSE_IDENTITY = inverse3(IDENTITY_TF)  # what a lookup composes for a target that is the common ancestor
 _DROP_BATCH = 128  # history entries past cache_ns are deleted from an edge's lists this many at a time (cheaper)
 
 
@@ -98,8 +97,11 @@ class TfBuffer:
         else:
             times.append(t_ns)
             values.append(tf)
-        if times[-1] - times[e.lo] > self.cache_ns:  # keep cache_ns: the entries older than that leave the history
-            lo = bisect.bisect_left(times, times[-1] - self.cache_ns, e.lo)
+        lo = e.lo
+        if times[-1] - times[lo] > self.cache_ns:  # keep cache_ns: the entries older than that leave the history
+            oldest = times[-1] - self.cache_ns  # bisect_left(times, oldest, lo) by steps: one or two a transform
+            while times[lo] < oldest:
+                lo += 1
             if lo >= _DROP_BATCH:
                 del times[:lo], values[:lo]
                 lo = 0
@@ -176,10 +178,11 @@ class TfBuffer:
 
     def _compose(self, edges: list[tuple[str, _Edge]], t_ns: int | None) -> Tf:
         """``ancestor_T_frame``: compose a chain of edges (bottom first) up to its top."""
-        out: Tf = IDENTITY_TF
+        out: Tf | None = None  # the bottom edge itself, not composed with the identity (the same values, cheaper)
         for child, e in edges:
-            out = compose3(self._edge_at(child, e, t_ns), out)
-        return out
+            tf = self._edge_at(child, e, t_ns)
+            out = tf if out is None else compose3(tf, out)
+        return IDENTITY_TF if out is None else out
 
     def lookup(self, target: str, source: str, t_ns: int | None = None) -> Tf:
         """``target_T_source`` at ``t_ns`` (None: the latest time every edge on the path has)."""
@@ -218,8 +221,12 @@ class TfBuffer:
             for _, e in (*edges_s, *edges_t):
                 if not e.static:
                     t_ns = e.times[-1] if t_ns is None else min(t_ns, e.times[-1])
-        up = inverse3(self._compose(edges_t, t_ns)) if edges_t else _INVERSE_IDENTITY
-        return compose3(up, self._compose(edges_s, t_ns))
+        # no identity is composed: a target that is the common ancestor (the usual lookup) takes the source's chain
+        down = self._compose(edges_s, t_ns)
+        if not edges_t:
+            return down
+        up = inverse3(self._compose(edges_t, t_ns))
+        return compose3(up, down) if edges_s else up
 
     def can_transform(self, target: str, source: str, t_ns: int | None = None) -> bool:
         """Whether :meth:`lookup` would succeed."""
@@ -261,7 +268,7 @@ class TfBuffer:
             tol = self.tolerance_ns
             for e in chain[2]:
                 if not (e.static or e.times[e.lo] - tol <= t_ns <= e.times[-1] + tol):
-                    return self.lookup_pose2d(target, source, None)
+                    return _pose2d(self._answer(target, source, None))  # lookup_pose2d(target, source, None)
             hit = self._compute(key, chain, t_ns)
         return _pose2d(hit)
 

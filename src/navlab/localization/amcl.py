@@ -28,6 +28,7 @@ from navlab.localization import sampling
 from navlab.localization.errors import LocalizationError
 from navlab.localization.field import MapField
 from navlab.localization.models import Beams
+from navlab.pcg64 import Draws
 from navlab.plugins import PluginContext, PluginError, load_plugin
 
 
@@ -172,6 +173,7 @@ class Amcl:
         self.params.validate()
         self.field = field
         self.rng = rng
+        self._draws_of: Draws | None = None  # see _draws
         self.motion_model = self.params.motion_model()
         context = PluginContext(map_field=field, rng=rng)
         self.laser_model = self.params.laser_model().from_params(self.params, context=context)
@@ -333,7 +335,7 @@ class Amcl:
         if self.w_slow > 0.0 and p.recovery_alpha_slow > 0:
             w_diff = max(0.0, 1.0 - self.w_fast / self.w_slow)
         drawn = sampling.low_variance_indices(self.weights, m, self.rng)
-        order = drawn[self.rng.permutation(m)]  # drawn, then shuffled: the candidates are particles[order]
+        order = drawn[self._draws().permutation(m)]  # drawn, then shuffled: the candidates are particles[order]
         cand = None  # gathered only when recovery particles replace some of them
         if w_diff > 0.0:
             inject = self.rng.random(m) < w_diff
@@ -351,6 +353,13 @@ class Amcl:
             new[inj] = cand[:n][inj]
         self.particles = new
         self.weights = np.full(n, 1.0 / n)
+
+    def _draws(self) -> Draws:
+        """``rng``'s permutations in the compiled loop (NumPy's values and generator state; see ``navlab.pcg64``)."""
+        d = self._draws_of
+        if d is None or d.gen is not self.rng:
+            d = self._draws_of = Draws(self.rng)
+        return d
 
     def _estimate(self) -> None:
         c = sampling.cluster(self.particles, self.weights)

@@ -159,13 +159,14 @@ class Amcl(Node):
             self.filter.request_nomotion_update()
         return {}
 
-    def _poses(self, msg: Any) -> tuple[tuple[float, float, float], tuple[float, float, float]] | None:
-        """(odometry pose at the scan's stamp, laser pose in the base frame), or None (logged) if tf lacks one."""
+    def _poses(self, msg: Any, t_ns: int) -> tuple[tuple[float, float, float], tuple[float, float, float]] | None:
+        """(odometry pose at the scan's stamp ``t_ns``, laser pose in the base frame), or None (logged) if tf lacks
+        one."""
         laser = self.scan_sensor_pose(self.base_frame, msg)
         if laser is None:
             return None
-        try:
-            odom = self.pose_at(self.odom_frame, self.base_frame, msgs.stamp_ns(msg))
+        try:  # Node.pose_at without its listen_tf (this node listens from the start)
+            odom = self.executor.tf.lookup_pose2d_or_latest(self.odom_frame, self.base_frame, t_ns)
         except TfError as exc:
             # Expected for the first scans before odometry arrives (debug); a warning when it persists.
             self._odom_failures += 1
@@ -195,7 +196,7 @@ class Amcl(Node):
         f = self.filter
         if f is None or f.n_particles == 0:
             return
-        poses = self._poses(msg)
+        poses = self._poses(msg, t_ns)
         if poses is None:
             return
         odom, laser = poses

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from scipy.ndimage import distance_transform_edt
+from numba import njit
 
 from navlab.geometry import wrap_angle
 from navlab.localization.errors import LocalizationError
@@ -121,8 +121,8 @@ def build_field(
             f"{name}: the map has no free cells (values 0..{FREE_MAX}); AMCL needs free space to place particles"
         )
     if occupied.any():
-        dist = distance_transform_edt(~occupied) * resolution
-        inside = distance_transform_edt(occupied) * resolution if (~occupied).any() else np.zeros(arr.shape)
+        dist = distance_to(occupied) * resolution
+        inside = distance_to(~occupied) * resolution if (~occupied).any() else np.zeros(arr.shape)
         # Obstacle surfaces lie on cell boundaries: half a cell from the centres on either side.
         signed = np.where(occupied, 0.5 * resolution - inside, dist - 0.5 * resolution)
     else:
@@ -140,6 +140,67 @@ def build_field(
         max_dist=float(max_dist),
         free_index=free_index,
     )
+
+
+def distance_to(features: np.ndarray) -> np.ndarray:
+    """Euclidean distance (cells, float64) of every cell of a 2-D grid to its nearest ``features`` cell (True; at
+    least one): what ``scipy.ndimage.distance_transform_edt(~features)`` gives, bit for bit (both are exact: the
+    square root of the same least sum of squares), by Felzenszwalb and Huttenlocher's two passes, compiled."""
+    return _distance_to(np.ascontiguousarray(features, dtype=np.bool_))
+
+
+@njit(cache=True)
+def _distance_to(features: np.ndarray) -> np.ndarray:  # pragma: no cover - compiled
+    """:func:`distance_to`: squared distances along each column, then per row the lower envelope of the parabolas
+    ``g[q] + (x - q)**2`` (columns without a feature left out), in exact integers held as floats."""
+    h, w = features.shape
+    none = -1.0  # a column without a feature: no parabola
+    g = np.empty((h, w))
+    for x in range(w):
+        d = -1
+        for y in range(h):  # distance to the nearest feature above (or on) the cell
+            if features[y, x]:
+                d = 0
+            elif d >= 0:
+                d += 1
+            g[y, x] = d
+        d = -1
+        for y in range(h - 1, -1, -1):  # ... or below it
+            if features[y, x]:
+                d = 0
+            elif d >= 0:
+                d += 1
+            if d >= 0 and (g[y, x] < 0 or d < g[y, x]):
+                g[y, x] = d
+        for y in range(h):
+            g[y, x] = g[y, x] * g[y, x] if g[y, x] >= 0 else none
+    out = np.empty((h, w))
+    v = np.empty(w, dtype=np.int64)  # the envelope's parabolas (their columns), left to right
+    z = np.empty(w + 1)  # where each takes over
+    for y in range(h):
+        f = g[y]
+        k = -1
+        for q in range(w):
+            if f[q] == none:
+                continue
+            fq = f[q] + q * q
+            while k >= 0:
+                s = (fq - (f[v[k]] + v[k] * v[k])) / (2.0 * (q - v[k]))
+                if s <= z[k]:
+                    k -= 1
+                else:
+                    break
+            k += 1
+            v[k] = q
+            z[k] = -np.inf if k == 0 else (fq - (f[v[k - 1]] + v[k - 1] * v[k - 1])) / (2.0 * (q - v[k - 1]))
+            z[k + 1] = np.inf
+        j = 0
+        for x in range(w):
+            while z[j + 1] < x:
+                j += 1
+            dx = x - v[j]
+            out[y, x] = math.sqrt(f[v[j]] + dx * dx)
+    return out
 
 
 def field_from_map(grid: Any, *, max_dist: float = 2.0, name: str = "map") -> MapField:

@@ -218,8 +218,12 @@ class CollisionMonitor:
         """How far (m) from the origin any point can change the command at speed ``v`` (m/s)."""
         # the same sums as _reach, from the constants of __init__
         av, best = abs(v), self._fixed
-        if best is None:
-            return max(((r + (av * t if t is not None else 0.0)) + 1e-9 for r, t in self._reaches), default=0.0)
+        if best is None:  # max(..., default=0.0) over every zone, as a loop (no generator a command)
+            for r, t in self._reaches:
+                x = (r + (av * t if t is not None else 0.0)) + 1e-9
+                if best is None or x > best:
+                    best = x
+            return 0.0 if best is None else best
         for r, t in self._moving:
             if (x := (r + av * t) + 1e-9) > best:
                 best = x

@@ -6,7 +6,8 @@ bound of the pair's distance) and the walk stops at the first pair whose bound i
 found so far. A pair is asked only if a tighter lower bound — the robot geom's bounding sphere against the world
 geom's own shape (box, cylinder, sphere, capsule) — is below the best distance by more than ``SKIP_MARGIN``: a
 pair skipped so could not have lowered it, so the calls made (and the distance limits passed to them) and the
-result are those of asking every pair in that order, bit for bit.
+result are those of asking every pair in that order, bit for bit. (Pairs of equal bound go in table order: NumPy's
+argsort, used before, left them in no set order.)
 """
 
 from __future__ import annotations
@@ -84,22 +85,48 @@ def candidates(bound: np.ndarray, tight: np.ndarray, order: np.ndarray, max_dist
     return out[:n]
 
 
+@njit(cache=True)
+def asked_pairs(
+    xpos: np.ndarray,
+    xmat: np.ndarray,
+    rbound: np.ndarray,
+    gtype: np.ndarray,
+    size: np.ndarray,
+    robot: np.ndarray,
+    world: np.ndarray,
+    max_distance: float,
+) -> np.ndarray:
+    """The pairs the walk may ask, as rows (robot geom, world geom, bound, tight), nearest bound first (equal bounds
+    in table order): :func:`candidates` over :func:`pair_bounds` in one compiled call, only the pairs whose bound is
+    below ``max_distance`` sorted (by insertion: a few dozen)."""
+    bound, tight = pair_bounds(xpos, xmat, rbound, gtype, size, robot, world)
+    keep = np.flatnonzero(bound < max_distance)
+    for n in range(len(keep)):  # insertion sort by bound, stable
+        k, i = keep[n], n
+        while i > 0 and bound[keep[i - 1]] > bound[k]:
+            keep[i] = keep[i - 1]
+            i -= 1
+        keep[i] = k
+    ks = candidates(bound, tight, keep, max_distance)
+    nw = len(world)
+    out = np.empty((len(ks), 4))
+    for i in range(len(ks)):
+        k = ks[i]
+        out[i, 0], out[i, 1], out[i, 2], out[i, 3] = robot[k // nw], world[k % nw], bound[k], tight[k]
+    return out
+
+
 def clearance(m: mujoco.MjModel, d: mujoco.MjData, robot: np.ndarray, world: np.ndarray, max_distance: float) -> float:
     """Signed distance (m) between the ``robot`` geoms and the ``world`` geoms (negative: interpenetrating),
     ``max_distance`` when nothing is closer; see the module docstring."""
     if not len(robot) or not len(world):
         return max_distance
-    bound, tight = pair_bounds(d.geom_xpos, d.geom_xmat, m.geom_rbound, m.geom_type, m.geom_size, robot, world)
-    order = np.argsort(bound)  # the order of argsort(bound table, axis=None): same values, same sort
-    ks = candidates(bound, tight, order, max_distance)
+    pairs = asked_pairs(d.geom_xpos, d.geom_xmat, m.geom_rbound, m.geom_type, m.geom_size, robot, world, max_distance)
     best = max_distance
-    nw = len(world)
-    bl, tl, rl, wl = bound[ks].tolist(), tight[ks].tolist(), robot.tolist(), world.tolist()
-    for k, b, t in zip(ks.tolist(), bl, tl, strict=True):
-        if b >= best:
+    for a, b, bnd, t in pairs.tolist():
+        if bnd >= best:
             break
         if t - SKIP_MARGIN >= best:
             continue
-        i, j = divmod(k, nw)
-        best = min(best, mujoco.mj_geomDistance(m, d, rl[i], wl[j], best, None))
+        best = min(best, mujoco.mj_geomDistance(m, d, int(a), int(b), best, None))
     return float(best)

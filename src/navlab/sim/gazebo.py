@@ -169,7 +169,11 @@ class GazeboSim(Node):
     def advance_to(self, t_ns: int) -> None:
         """Stepper hook: integrate physics up to ``t_ns``; MuJoCo's sensors are computed only while an IMU plugin's
         timer is awake (parked: nobody reads it), so its first reading after waking is what it always was."""
-        awake = any(not t.parked for t in self._imu_timers)
+        awake = False
+        for t in self._imu_timers:  # a loop, not any(genexpr): this runs before every event
+            if not t.parked:
+                awake = True
+                break
         if awake != self._sensors_on:
             self._sensors_on = awake
             self.sim.compute_sensors(awake)

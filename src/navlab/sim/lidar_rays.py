@@ -7,6 +7,8 @@ re-exports ``lidar_angles``). Units: m, rad; frames: the laser's (its site) and 
 
 from __future__ import annotations
 
+from typing import Any
+
 import mujoco
 import numpy as np
 
@@ -81,6 +83,27 @@ def cast_primitives(
     return dist
 
 
+def scan_args(
+    m: mujoco.MjModel, d: mujoco.MjData, site: int, angles: np.ndarray, cfg: LidarConfig, fast: np.ndarray
+) -> tuple[Any, ...]:
+    """:func:`scan_planar`'s leading arguments for the laser's ``site`` (views of ``d``'s arrays, which MuJoCo
+    updates in place: valid for every scan while ``m`` and ``d`` are the simulation's)."""
+    n = angles.shape[1]
+    return (
+        d.site_xpos[site], d.site_xmat[site].reshape(3, 3), angles[0], angles[1], cfg.min_angle, _increment(cfg, n),
+        fast, m.geom_type, m.geom_size, d.geom_xpos, d.geom_xmat, cfg.range_min, cfg.range_max,
+    )  # fmt: skip
+
+
+def scan_with(args: tuple[Any, ...], cfg: LidarConfig, normals: np.ndarray) -> np.ndarray:
+    """One scan (m, float32) from :func:`scan_args`: the cast and Gazebo's noise (``normals``, standard normal
+    draws, or empty without noise) in one compiled call."""
+    out = np.empty(args[2].shape[0], dtype=np.float32)
+    # mypy takes the unpacked tuple for too many arguments to numba's Dispatcher
+    scan_planar(*args, normals, cfg.noise_mean, cfg.noise_stddev, out)  # type: ignore[call-arg]
+    return out
+
+
 def scan_primitives(
     m: mujoco.MjModel,
     d: mujoco.MjData,
@@ -92,11 +115,4 @@ def scan_primitives(
 ) -> np.ndarray:
     """One scan (m, float32) from the laser's ``site`` against the primitive geoms ``fast``: the cast and
     Gazebo's noise (``normals``, standard normal draws, or empty without noise) in one compiled call."""
-    n = angles.shape[1]
-    out = np.empty(n, dtype=np.float32)
-    scan_planar(
-        d.site_xpos[site], d.site_xmat[site].reshape(3, 3), angles[0], angles[1], cfg.min_angle,
-        _increment(cfg, n), fast, m.geom_type, m.geom_size, d.geom_xpos, d.geom_xmat, cfg.range_min,
-        cfg.range_max, normals, cfg.noise_mean, cfg.noise_stddev, out,
-    )  # fmt: skip
-    return out
+    return scan_with(scan_args(m, d, site, angles, cfg, fast), cfg, normals)

@@ -18,7 +18,7 @@ from navlab.sim.builder import GROUND_CONTACT_BIT, GROUP_ROBOT, RAY_GEOMGROUP, m
 from navlab.sim.clearance import clearance
 from navlab.sim.errors import SimError
 from navlab.sim.lidar_noise import NormalDraws
-from navlab.sim.lidar_rays import beam_dirs, cast_primitives, ray_geom_sets, scan_primitives
+from navlab.sim.lidar_rays import beam_dirs, cast_primitives, ray_geom_sets, scan_args, scan_with
 from navlab.sim.lidar_rays import lidar_angles as lidar_angles  # re-exported: its home before the split
 from navlab.sim.raycast import finish_ranges, multiray
 from navlab.sim.scene import add_world_model, build_spec, compile_spec, remove_world_model
@@ -94,6 +94,7 @@ class Simulation:
         self._lidar_site = [name2id(m, mujoco.mjtObj.mjOBJ_SITE, n) for n in self.info.lidar_sites]
         self._imu_site = [name2id(m, mujoco.mjtObj.mjOBJ_SITE, n) for n in self.info.imu_sites]
         self._ray_fast, self._ray_slow_groups = ray_geom_sets(m)
+        self._scan_args: dict[int, tuple] = {}  # lidar -> lidar_rays.scan_args (views of this data)
         self._body = self._link_frames()
         # links whose frame is their MuJoCo body's own frame (no offset): poses and twists read directly
         self._body_frame = {k: not xyz.any() and quat[0] == 1.0 for k, (_, xyz, quat) in self._body.items()}
@@ -384,10 +385,12 @@ class Simulation:
             return out
         # primitives only: the cast and the noise in one compiled call (the same values as the path above)
         self._sync()
-        angles = self._beam_dirs(index, cfg)
-        normals = self._draw_normals(index, cfg, angles.shape[1], rng)  # the cast draws nothing: the same draws
-        site = self._lidar_site[index]
-        return scan_primitives(self.model, self.data, site, angles, cfg, self._ray_fast, normals)
+        args = self._scan_args.get(index)
+        if args is None:
+            site, dirs = self._lidar_site[index], self._beam_dirs(index, cfg)
+            args = self._scan_args[index] = scan_args(self.model, self.data, site, dirs, cfg, self._ray_fast)
+        normals = self._draw_normals(index, cfg, args[2].shape[0], rng)  # the cast draws nothing: the same draws
+        return scan_with(args, cfg, normals)
 
     def _draw_normals(self, index: int, cfg: LidarConfig, n: int, rng: np.random.Generator | None) -> np.ndarray:
         """Lidar ``index``'s noise draws for one scan of ``n`` beams: standard_normal(n) from ``rng`` (or the
