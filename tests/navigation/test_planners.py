@@ -148,6 +148,22 @@ def test_allow_unknown_decides_whether_unknown_cells_are_passable() -> None:
         assert "cut off" in closed.last_failure
 
 
+def test_unknown_cost_prices_unknown_cells_against_a_seen_detour() -> None:
+    """navfn prices an unknown cell at lethal_cost (253, ~5x a free cell): a 1 m unknown band with a seen-free way
+    round it (4.4 m) is driven round; with ``unknown_cost`` 100 (2x) the straight 2 m through it is cheaper."""
+    data = np.zeros((30, 30))
+    data[:25, 10:20] = COST_UNKNOWN  # never observed, but for a free strip along the top
+    grid = _grid(data)
+    start, goal = (0.5, 1.0, 0.0), (2.5, 1.0, 0.0)
+    around = NavfnPlanner().make_plan(grid, start, goal)
+    assert around is not None and around[:, 1].max() > 2.4
+    through = NavfnPlanner({"unknown_cost": 100.0}).make_plan(grid, start, goal)
+    assert through is not None and through[:, 1].max() < 1.2
+    assert path_length(through) == pytest.approx(2.0, abs=0.05)
+    with pytest.raises(NavigationError, match="unknown_cost: expected -1"):
+        NavfnPlanner({"unknown_cost": 0.0})
+
+
 @pytest.mark.parametrize("make", PLANNERS)
 def test_start_errors_explain_why(make) -> None:  # type: ignore[no-untyped-def]
     grid = _l_shape()

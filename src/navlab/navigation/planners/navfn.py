@@ -1,13 +1,13 @@
 """navfn (ROS 1 ``navfn/NavfnROS``): a potential field over the costmap, then gradient descent on it.
 
 Costs map as navfn's ``setCostmap``: a cell of cost ``c`` < 253 costs ``COST_NEUTRAL + COST_FACTOR * c``
-(50 + 0.8 c) per cell crossed; inscribed (253) and lethal (254) cells are obstacles; unknown (255) cells
-cost 253 with ``allow_unknown`` (navfn's default) and are obstacles without it. The potential is the
-solution of the Eikonal equation ``|grad P| = cost`` grown from the start (fast marching with the exact
-two-neighbour quadratic update, Dijkstra order, or A* order with ``use_dijkstra: false``), so it
-measures Euclidean path length weighted by cost, not 8-connected steps. The path descends the
-interpolated gradient from the goal in half-cell steps (a grid step to the lowest neighbour next to
-obstacles or where the gradient fails) and is returned start to goal, in metres, in the costmap frame.
+(50 + 0.8 c) per cell crossed; inscribed (253) and lethal (254) cells are obstacles; unknown (255) cells cost 253
+with ``allow_unknown`` (navfn's default; navlab's ``unknown_cost`` prices them otherwise) and are obstacles
+without it. The potential is the solution of the Eikonal equation ``|grad P| = cost`` grown from the start (fast
+marching with the exact two-neighbour quadratic update, Dijkstra order, or A* order with ``use_dijkstra: false``),
+so it measures Euclidean path length weighted by cost, not 8-connected steps. The path descends the interpolated
+gradient from the goal in half-cell steps (a grid step to the lowest neighbour next to obstacles or where the
+gradient fails) and is returned start to goal, in metres, in the costmap frame.
 ``default_tolerance`` (m): a goal in an obstacle or cut off is replaced by the nearest reachable cell
 within that distance. ``planner_window_x/y``, ``visualize_potential`` and the like are accepted and
 ignored (the last potential stays available as ``planner.potential``).
@@ -46,12 +46,19 @@ class NavfnParams:
     cost_factor: float = COST_FACTOR
     neutral_cost: float = COST_NEUTRAL
     lethal_cost: int = COST_INSCRIBED  # costs >= this are obstacles (navfn: COST_OBS_ROS = 253)
+    # navlab: what crossing an unknown cell costs with allow_unknown, in the units where a free cell costs neutral_cost;
+    # -1: navfn's, the ceiling max(lethal_cost, neutral_cost) (253: ~5x a free cell)
+    unknown_cost: float = -1.0
     PARAMS: ClassVar[ParamSpec]
 
     def validate(self, what: str = "navfn") -> None:
         """Refuse a bad value naming the key."""
         if not 1 <= self.lethal_cost <= COST_UNKNOWN:
             raise NavigationError(f"{what} parameter lethal_cost: expected 1..255, got {self.lethal_cost}")
+        if self.unknown_cost != -1.0 and not self.unknown_cost > 0.0:
+            raise NavigationError(
+                f"{what} parameter unknown_cost: expected -1 (navfn's) or > 0, got {self.unknown_cost}"
+            )
 
 
 @dataclass
@@ -334,13 +341,13 @@ class NavfnPlanner(GridPlanner):
     params: NavfnParams
     name = "navfn"
     potential: np.ndarray | None = None
-    _table: tuple[tuple[float, float, int, bool], np.ndarray] | None = None  # cost_table's (parameters, table)
+    _table: tuple[tuple[float, float, int, bool, float], np.ndarray] | None = None  # cost_table's (parameters, table)
 
     def cost_table(self) -> np.ndarray:
         """Traversal cost (256,) float64 of each costmap_2d cost value (inf = obstacle), as navfn's ``setCostmap``;
         kept while the parameters it depends on stay the same."""
         p = self.params
-        key = (p.neutral_cost, p.cost_factor, p.lethal_cost, p.allow_unknown)
+        key = (p.neutral_cost, p.cost_factor, p.lethal_cost, p.allow_unknown, p.unknown_cost)
         cached = self._table
         if cached is not None and cached[0] == key:
             return cached[1]
@@ -349,7 +356,7 @@ class NavfnPlanner(GridPlanner):
         table = np.minimum(p.neutral_cost + p.cost_factor * levels.astype(np.float64), ceiling)  # per cost value
         table[levels >= p.lethal_cost] = np.inf
         if p.allow_unknown:
-            table[COST_UNKNOWN] = ceiling
+            table[COST_UNKNOWN] = ceiling if p.unknown_cost == -1.0 else p.unknown_cost
         table.flags.writeable = False
         self._table = (key, table)
         return table
