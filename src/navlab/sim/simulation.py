@@ -74,7 +74,8 @@ class Simulation:
         self.dt_ns = round(self.model.opt.timestep * 1e9)
         self.time_ns = 0
         self._synced = True
-        self._lidar_dirs: dict[int, np.ndarray] = {}  # lidar -> (2, n) cos, sin of its beams
+        # per lidar: (2, n) cos, sin of its beam angles in its frame
+        self._lidar_dirs = [beam_dirs(cfg) for cfg in robot.lidars] if robot is not None else []
         self._no_noise = np.zeros(0)
         self._normals: dict[int, NormalDraws] = {}  # lidar -> its noise draws (see scan)
         self._vel6 = np.zeros(6)  # mj_objectVelocity's output, reused
@@ -387,7 +388,7 @@ class Simulation:
         self._sync()
         args = self._scan_args.get(index)
         if args is None:
-            site, dirs = self._lidar_site[index], self._beam_dirs(index, cfg)
+            site, dirs = self._lidar_site[index], self._lidar_dirs[index]
             args = self._scan_args[index] = scan_args(self.model, self.data, site, dirs, cfg, self._ray_fast)
         normals = self._draw_normals(index, cfg, args[2].shape[0], rng)  # the cast draws nothing: the same draws
         return scan_with(args, cfg, normals)
@@ -403,13 +404,6 @@ class Simulation:
             kept = self._normals[index] = NormalDraws(gen, n)
         return kept.draw()
 
-    def _beam_dirs(self, index: int, cfg: LidarConfig) -> np.ndarray:
-        """(2, n) cos, sin of lidar ``index``'s beam angles in its frame, worked out once."""
-        angles = self._lidar_dirs.get(index)
-        if angles is None:
-            angles = self._lidar_dirs[index] = beam_dirs(cfg)
-        return angles
-
     def true_ranges(self, index: int = 0, *, backend: str | None = None) -> np.ndarray:
         """Noise-free ranges (m, float64) of lidar ``index``; ``backend`` "numba" (primitives by
         :mod:`navlab.sim.raycast`, meshes by ``mj_multiRay``) or "mujoco" (all by ``mj_multiRay``)."""
@@ -418,7 +412,7 @@ class Simulation:
         self._sync()
         m, d = self.model, self.data
         site = self._lidar_site[index]
-        angles = self._beam_dirs(index, cfg)
+        angles = self._lidar_dirs[index]
         rot = d.site_xmat[site].reshape(3, 3)
         pnt = d.site_xpos[site].copy()
         if (backend or self.lidar_backend) == "mujoco":
