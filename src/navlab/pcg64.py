@@ -238,7 +238,7 @@ class NormalDraws:
 
     @staticmethod
     def _checked_words(gen: np.random.Generator) -> np.ndarray | None:
-        """:func:`_pcg64_words` of ``gen`` if the compiled loop gives NumPy's draws on a copy of it, else None."""
+        """:func:`pcg64_words` of ``gen`` if the compiled loop gives NumPy's draws on a copy of it, else None."""
         if _TABLES is None or pcg64_words(gen) is None:
             return None
         a, b = copy.deepcopy(gen), copy.deepcopy(gen)
