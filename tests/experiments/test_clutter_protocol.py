@@ -31,6 +31,8 @@ def test_clutter_settings_per_robot() -> None:
     with its own files."""
     assert clutter_params("jackal")["local_costmap.width"] == clutter_params("jackal")["local_costmap.height"] == 8.0
     assert clutter_params("mybot")["local_costmap.width"] == 6.0
+    key = "global_costmap.obstacle_layer.occluded_unknown_cost"  # shadows priced for the Jackal only (session 9)
+    assert clutter_params("jackal")[key] == 20 and key not in clutter_params("mybot")
     assert clutter_params("jackal")["recovery_behaviors"] == clutter_params("mybot")["recovery_behaviors"]
     assert clutter_params("jackal_skid") == OWN_FILES_PARAMS
 

@@ -11,6 +11,7 @@ import numpy as np
 from navlab.core import read_params
 from navlab.grid import COST_FREE, COST_LETHAL, COST_UNKNOWN, Grid
 from navlab.navigation.costmap.footprint import Footprint, make_footprint
+from navlab.navigation.costmap.hidden_cells import hidden_costs, mark_shadows, write_hidden
 from navlab.navigation.costmap.kernels import combine, mark_returns
 from navlab.navigation.costmap.layer import Layer, costmap_of, origin_shift, same_geometry, shifted
 from navlab.navigation.costmap.params import ObservationSource, ObstacleLayerParams, layer_params
@@ -168,9 +169,66 @@ class ObstacleLayer(ObservationLayer):
     footprint (``footprint_clearing_enabled``); combines into the master by maximum (``combination_method``
     1, unknown cells of the layer skipped) or overwrite (0). Call :meth:`match_size` (the layered costmap
     does) before :meth:`add_scan`.
+
+    navlab's opt-in prices for never-observed cells likely to be closed (``occluded_unknown_cost``,
+    ``unknown_near_obstacle_cost``: ``hidden_cells``): the layer then keeps never-observed cells unknown (whatever
+    ``track_unknown_space`` says; the master's own default is unchanged, unknown layer cells are not combined), keeps
+    where returns cast shadows (:attr:`shadow`) and writes those prices into the master after its own cells.
     """
 
     writes_master_only = True
+    shadow: np.ndarray | None = None  # (H, W) uint8: 1 where a return's shadow fell (occluded_unknown_cost only)
+
+    @property
+    def prices_hidden(self) -> bool:
+        """Whether the layer prices never-observed cells (``occluded_unknown_cost`` or
+        ``unknown_near_obstacle_cost`` set)."""
+        return self.params.occluded_unknown_cost > 0 or self.params.unknown_near_obstacle_cost > 0
+
+    @property
+    def default_value(self) -> int:
+        """What a never-observed cell holds: unknown with ``track_unknown_space`` or hidden-cell prices, else free."""
+        return COST_UNKNOWN if self.prices_hidden else super().default_value
+
+    def _new_cells(self, shape: tuple[int, ...]) -> None:
+        self.shadow = np.zeros(shape, np.uint8) if self.params.occluded_unknown_cost > 0 else None
+
+    def _shift(self, di: int, dj: int) -> None:
+        if self.shadow is not None:
+            self.shadow = shifted(self.shadow, di, dj, 0)
+
+    def _reset_cells(self, where: Any) -> None:
+        if self.shadow is not None:
+            self.shadow[where] = 0
+
+    def update_costs(self, master: Grid) -> None:
+        super().update_costs(master)
+        if self.grid is None or not self.prices_hidden:
+            return
+        p = self.params
+        costs = hidden_costs(
+            self.grid.data,
+            self.shadow,
+            occluded_cost=p.occluded_unknown_cost,
+            near_cost=p.unknown_near_obstacle_cost,
+            near_cells=p.unknown_near_obstacle_distance / self.grid.resolution,
+        )
+        write_hidden(master.data, costs)
+
+    def _mark_shadows(
+        self, origin: tuple[float, float], pts: np.ndarray, ok: np.ndarray, src: ObservationSource
+    ) -> None:
+        """Where the real returns ``pts`` (N, 2, m; ``ok`` (N,)) seen from ``origin`` (m) cast shadows, out to
+        ``occluded_unknown_range`` (0: the source's ``raytrace_range``) from the sensor and at most
+        ``occluded_unknown_depth`` (0: no limit) past the return."""
+        if self.shadow is None or self.grid is None:
+            return
+        g = self.grid
+        reach = self.params.occluded_unknown_range or src.raytrace_range
+        ox, oy, res = g.origin[0], g.origin[1], g.resolution
+        cells = np.ascontiguousarray((pts - (ox, oy)) / res)
+        depth = self.params.occluded_unknown_depth / res
+        mark_shadows(self.shadow, (origin[0] - ox) / res, (origin[1] - oy) / res, cells, ok, reach / res, depth)
 
     def add_scan(
         self,
@@ -222,6 +280,8 @@ class ObstacleLayer(ObservationLayer):
                 src.obstacle_range,
                 np.uint8(COST_LETHAL),
             )
+        if self.shadow is not None:
+            self._mark_shadows((float(o[0]), float(o[1])), pts, ok & finite, src)
 
     def add_ranges(
         self,
@@ -253,3 +313,10 @@ class ObstacleLayer(ObservationLayer):
             (bool(src.clearing), float(src.raytrace_range), float(src.raytrace_min_range), np.uint8(COST_FREE)),
             (bool(src.marking), float(src.obstacle_min_range), float(src.obstacle_range), np.uint8(COST_LETHAL)),
         )
+        if self.shadow is not None:
+            r = np.asarray(ranges, dtype=np.float64)
+            ok = np.isfinite(r) & (r >= limits[0]) & (r < limits[1])
+            c, s = math.cos(yaw), math.sin(yaw)
+            lx, ly = r[ok] * beams[0][ok], r[ok] * beams[1][ok]
+            pts = np.stack([x + c * lx - s * ly, y + s * lx + c * ly], axis=1)
+            self._mark_shadows((x, y), pts, np.ones(len(pts), bool), src)

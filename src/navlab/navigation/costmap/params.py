@@ -113,6 +113,15 @@ class ObstacleLayerParams:
     footprint_clearing_enabled: bool = True
     combination_method: int = 1
     observation_sources: str = ""
+    # navlab (costmap.hidden_cells; the obstacle layer only, 0 = off: costmap_2d's behaviour): costs (0..252) for
+    # never-observed cells likely to be closed: those in a return's laser shadow within occluded_unknown_range m of
+    # the sensor (0: the source's raytrace_range) and occluded_unknown_depth m of the return (0: no limit), those
+    # within unknown_near_obstacle_distance m of a marked cell
+    occluded_unknown_cost: int = 0
+    occluded_unknown_range: float = 0.0
+    occluded_unknown_depth: float = 0.0
+    unknown_near_obstacle_cost: int = 0
+    unknown_near_obstacle_distance: float = 0.5
     PARAMS: ClassVar[ParamSpec]
 
 
@@ -342,9 +351,20 @@ LAYER_SPEC = ParamSpec("layer", NavigationError, aliases=ALIASES, ignored=IGNORE
 StaticLayerParams.PARAMS = replace(
     LAYER_SPEC, what="static_layer", at_least={"lethal_cost_threshold": 1}, at_most={"lethal_cost_threshold": 100}
 )
+_HIDDEN_COSTS = dict.fromkeys(("occluded_unknown_cost", "unknown_near_obstacle_cost"), 0)
 ObstacleLayerParams.PARAMS = replace(
-    LAYER_SPEC, what="obstacle_layer", at_least=_RANGES, choices={"combination_method": (0, 1)}
-)  # overwrite, maximum
+    LAYER_SPEC,
+    what="obstacle_layer",
+    at_least={
+        **_RANGES,
+        **_HIDDEN_COSTS,
+        "occluded_unknown_range": 0.0,
+        "occluded_unknown_depth": 0.0,
+        "unknown_near_obstacle_distance": 0.0,
+    },
+    at_most=dict.fromkeys(_HIDDEN_COSTS, 252),
+    choices={"combination_method": (0, 1)},  # overwrite, maximum
+)
 InflationLayerParams.PARAMS = replace(
     LAYER_SPEC, what="inflation_layer", at_least={"inflation_radius": 0.0, "cost_scaling_factor": 0.0}
 )
