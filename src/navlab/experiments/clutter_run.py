@@ -59,8 +59,20 @@ CLUTTER_ROBOTS = ("mybot", "jackal")
 # Per robot, on top of CLUTTER_PARAMS. The Jackal's MPPI looks 2 s ahead: at 2 m/s that is 4 m, and rollout points
 # off a 6 m window (3 m each way) count as collisions, which held its cruise to ~1.5 m/s; an 8 m window lets it
 # reach ~1.9 m/s on open ground (Nav2's MPPI guide: a local costmap larger than the horizon).
+# Both of the Jackal's costmaps at 0.025 m (session 9): on 0.05 m cells a 0.6 m gap between posts, which the 0.43 m
+# box passes with 8 cm a side, and a 0.45 m one it cannot pass both read ~0.25 m to the nearest LETHAL cell, so no
+# global padding closed the second (tuning world 36: plans flip back into a pocket through it) and kept the first
+# open (worlds 43, 21); at 0.025 m the padding 0.035 m parts them. The local side then has to pass 0.6 m gaps: on
+# 0.05 m cells the marked posts reach up to a cell into the gap, the footprint "collides" in the gap (every MPPI
+# sample does; the robot stands, recovers, comes back: 10-20 s), on 0.025 m cells it passes.
 CLUTTER_ROBOT_PARAMS: dict[str, dict[str, Any]] = {
-    "jackal": {"local_costmap.width": 8.0, "local_costmap.height": 8.0},
+    "jackal": {
+        "local_costmap.width": 8.0,
+        "local_costmap.height": 8.0,
+        "local_costmap.resolution": 0.025,
+        "global_costmap.resolution": 0.025,
+        "global_costmap.footprint_padding": 0.035,
+    },
 }
 # Any other robot drives with its files as ROS 1's move_base reads them: that move_base has no progress checker (a
 # robot that stops making progress goes on until its oscillation timeout, recoveries or the 100 s limit), so
