@@ -63,11 +63,20 @@ CLUTTER_ROBOTS = ("mybot", "jackal")
 # occluded_unknown_cost; a free cell 0): first plans keep off ways that run into a cluster's shadow, where BARN's
 # clusters hide the cylinders that close them. Tuning set, seeds 0-4: 0.49402 -> 0.49478; world 34 6.4-6.5 s at every
 # seed (10-11.6 s before), world 43 seed 4 at the cap; 10 does not fix 34, 30 and more lose world 36 (session 9).
+# Both of the Jackal's costmaps at 0.025 m (session 9): on 0.05 m cells a 0.6 m gap between posts, which the 0.43 m
+# box passes with 8 cm a side, and a 0.45 m one it cannot pass both read ~0.25 m to the nearest LETHAL cell, so no
+# global padding closed the second (tuning world 36: plans flip back into a pocket through it) and kept the first
+# open (worlds 43, 21); at 0.025 m the padding 0.035 m parts them. The local side then has to pass 0.6 m gaps: on
+# 0.05 m cells the marked posts reach up to a cell into the gap, the footprint "collides" in the gap (every MPPI
+# sample does; the robot stands, recovers, comes back: 10-20 s), on 0.025 m cells it passes.
 CLUTTER_ROBOT_PARAMS: dict[str, dict[str, Any]] = {
     "jackal": {
         "local_costmap.width": 8.0,
         "local_costmap.height": 8.0,
         "global_costmap.obstacle_layer.occluded_unknown_cost": 20,
+        "local_costmap.resolution": 0.025,
+        "global_costmap.resolution": 0.025,
+        "global_costmap.footprint_padding": 0.035,
     },
 }
 # Any other robot drives with its files as ROS 1's move_base reads them: that move_base has no progress checker (a
