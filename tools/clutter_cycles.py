@@ -22,19 +22,17 @@ import math
 from typing import Any
 
 import numpy as np
+from clutter_plans import clutter_world, drive, parse_params  # tools/, beside this script
 
 FOOTPRINT = np.array([[-0.254, -0.215], [-0.254, 0.215], [0.254, 0.215], [0.254, -0.215]])  # m, the Jackal's
 
 
 def record(which: str, index: int, seed: int, params: dict[str, Any]) -> tuple[Any, dict[str, Any], dict[str, list]]:
     """Run the world; (world, trial figures, {"cycles": [...], "plans": [(t, grid, plan)], "recoveries": [...]})."""
-    from navlab.experiments.clutter_protocol import SETS, speed_overrides
-    from navlab.experiments.clutter_run import run_clutter_world
     from navlab.navigation.controllers import mppi, mppi_critics, mppi_rotation
     from navlab.navigation.move_base import MoveBase
-    from navlab.world import clutter_suite
 
-    world = clutter_suite(50, seed=SETS[which])[index]
+    world = clutter_world(which, index)
     log: dict[str, list] = {"cycles": [], "plans": [], "recoveries": []}
     cycle: dict[str, Any] = {}
     clock: list[Any] = []
@@ -89,13 +87,7 @@ def record(which: str, index: int, seed: int, params: dict[str, Any]) -> tuple[A
     for cls, name, new, _ in patches:
         setattr(cls, name, new)
     try:
-        trial = run_clutter_world(
-            world,
-            controller="mppi",
-            move_base_params={**speed_overrides("mppi", 2.0), **params},
-            seed=seed,
-            robot="jackal",
-        )
+        trial = drive(world, seed, params)
     finally:
         mppi_critics.SCORERS["CostCritic"] = cost_critic
         for cls, name, _, old in patches:
@@ -184,10 +176,7 @@ def main() -> None:
     ap.add_argument("--out", default="", help="the picture (PNG), with --at")
     ap.add_argument("--param", action="append", default=[], metavar="KEY=JSON", help="a move_base override")
     a = ap.parse_args()
-    params = {}
-    for kv in a.param:
-        key, _, value = kv.partition("=")
-        params[key] = json.loads(value)
+    params = parse_params(a.param)
     world, trial, log = record(a.set, a.world, a.seed, params)
     for c in log["cycles"][:: max(1, a.every)]:
         print(describe(c))

@@ -21,15 +21,39 @@ from typing import Any
 import numpy as np
 
 
-def record(which: str, index: int, seed: int, params: dict[str, Any]) -> tuple[Any, dict[str, Any], list[Any]]:
-    """Run the world; (world, trial figures, [(t s, costmap Grid copy, start (x, y, yaw), plan (N, 2+) or None)])."""
-    from navlab.experiments.clutter_protocol import SETS, speed_overrides
-    from navlab.experiments.clutter_run import run_clutter_world
-    from navlab.grid import Grid
-    from navlab.navigation.move_base import MoveBase
+def clutter_world(which: str, index: int) -> Any:
+    """World ``index`` (0-49) of ``bench clutter``'s set ``which`` (test or tuning)."""
+    from navlab.experiments.clutter_protocol import SETS
     from navlab.world import clutter_suite
 
-    world = clutter_suite(50, seed=SETS[which])[index]
+    return clutter_suite(50, seed=SETS[which])[index]
+
+
+def drive(world: Any, seed: int, params: dict[str, Any]) -> dict[str, Any]:
+    """One trial of the Jackal with MPPI at 2 m/s through ``world``, as ``bench clutter`` runs it, plus ``params``."""
+    from navlab.experiments.clutter_protocol import speed_overrides
+    from navlab.experiments.clutter_run import run_clutter_world
+
+    return run_clutter_world(
+        world, controller="mppi", move_base_params={**speed_overrides("mppi", 2.0), **params}, seed=seed, robot="jackal"
+    )
+
+
+def parse_params(pairs: list[str]) -> dict[str, Any]:
+    """``KEY=JSON`` strings as move_base overrides."""
+    params = {}
+    for kv in pairs:
+        key, _, value = kv.partition("=")
+        params[key] = json.loads(value)
+    return params
+
+
+def record(which: str, index: int, seed: int, params: dict[str, Any]) -> tuple[Any, dict[str, Any], list[Any]]:
+    """Run the world; (world, trial figures, [(t s, costmap Grid copy, start (x, y, yaw), plan (N, 2+) or None)])."""
+    from navlab.grid import Grid
+    from navlab.navigation.move_base import MoveBase
+
+    world = clutter_world(which, index)
     plans: list[Any] = []
     make_plan = MoveBase.make_plan
 
@@ -42,13 +66,7 @@ def record(which: str, index: int, seed: int, params: dict[str, Any]) -> tuple[A
 
     MoveBase.make_plan = on_make_plan  # type: ignore[method-assign]
     try:
-        trial = run_clutter_world(
-            world,
-            controller="mppi",
-            move_base_params={**speed_overrides("mppi", 2.0), **params},
-            seed=seed,
-            robot="jackal",
-        )
+        trial = drive(world, seed, params)
     finally:
         MoveBase.make_plan = make_plan  # type: ignore[method-assign]
     return world, trial, plans
@@ -127,10 +145,7 @@ def main() -> None:
     ap.add_argument("--every", type=int, default=2, help="draw every N-th plan")
     ap.add_argument("--param", action="append", default=[], metavar="KEY=JSON", help="a move_base override")
     a = ap.parse_args()
-    params = {}
-    for kv in a.param:
-        key, _, value = kv.partition("=")
-        params[key] = json.loads(value)
+    params = parse_params(a.param)
     world, trial, plans = record(a.set, a.world, a.seed, params)
     figures = {k: trial[k] for k in ("world", "success", "failure", "barn_time_s", "score")}
     figures["cap_time_s"] = round(2 * trial["t_opt_s"], 2)
