@@ -175,3 +175,12 @@ def test_near_obstacle_price_in_the_layer() -> None:
 def test_prices_above_252_are_refused(key: str) -> None:
     with pytest.raises(NavigationError, match=key):
         ObstacleLayer({key: 253})
+
+
+@pytest.mark.parametrize("key", ["occluded_unknown_cost", "unknown_near_obstacle_cost"])
+def test_the_voxel_layer_refuses_hidden_cell_prices_by_name(key: str) -> None:
+    from navlab.navigation.costmap.voxel_layer import VoxelLayer
+
+    with pytest.raises(NavigationError, match=f"voxel_layer: {key} is an obstacle_layer parameter"):
+        VoxelLayer({key: 20})
+    VoxelLayer({key: 0})  # off: accepted as before

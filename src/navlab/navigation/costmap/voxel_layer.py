@@ -25,6 +25,7 @@ from navlab.navigation.costmap.layer import shifted
 from navlab.navigation.costmap.obstacle_layer import ObservationLayer
 from navlab.navigation.costmap.params import IGNORED, ObstacleLayerParams
 from navlab.navigation.costmap.voxel_kernels import observe
+from navlab.navigation.errors import NavigationError
 
 UNKNOWN_COLUMN = np.uint32(0xFFFF)  # every voxel unknown (voxel_grid's reset)
 
@@ -41,7 +42,14 @@ class VoxelLayerParams(ObstacleLayerParams):
     publish_voxel_map: bool = False
 
     def validate(self) -> None:
-        """The obstacle layer's checks (ranges, combination_method) come from the spec; nothing spans fields."""
+        """The obstacle layer's checks (ranges, combination_method) come from the spec; the obstacle layer's prices
+        for hidden cells (``costmap.hidden_cells``) are not the voxel layer's: refused by name."""
+        for key in ("occluded_unknown_cost", "unknown_near_obstacle_cost"):
+            if getattr(self, key):
+                raise NavigationError(
+                    f"voxel_layer: {key} is an obstacle_layer parameter (costmap_2d::ObstacleLayer); the voxel layer "
+                    "does not price hidden cells: set it on an obstacle_layer or remove it"
+                )
 
 
 VOXEL_KEYS = frozenset(
