@@ -167,7 +167,7 @@ def draw(world: Any, log: dict[str, list], times: list[float], box: list[float],
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--set", default="tuning", choices=("test", "tuning"))
+    ap.add_argument("--set", default="tuning", help="test, tuning or a suite seed >= 2")
     ap.add_argument("--world", type=int, default=43, help="index in the set, 0-49")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--every", type=int, default=5, help="print every N-th cycle")

@@ -22,11 +22,12 @@ import numpy as np
 
 
 def clutter_world(which: str, index: int) -> Any:
-    """World ``index`` (0-49) of ``bench clutter``'s set ``which`` (test or tuning)."""
+    """World ``index`` (0-49) of ``bench clutter``'s set ``which`` (test or tuning), or of the suite whose seed
+    ``which`` is (a number >= 2: more worlds to look at, neither tuning nor test)."""
     from navlab.experiments.clutter_protocol import SETS
     from navlab.world import clutter_suite
 
-    return clutter_suite(50, seed=SETS[which])[index]
+    return clutter_suite(50, seed=SETS[which] if which in SETS else int(which))[index]
 
 
 def drive(world: Any, seed: int, params: dict[str, Any]) -> dict[str, Any]:
@@ -139,7 +140,7 @@ def draw(world: Any, trial: dict[str, Any], plans: list[Any], every: int, out: s
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("out", help="the picture (PNG)")
-    ap.add_argument("--set", default="tuning", choices=("test", "tuning"))
+    ap.add_argument("--set", default="tuning", help="test, tuning or a suite seed >= 2")
     ap.add_argument("--world", type=int, default=36, help="index in the set, 0-49")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--every", type=int, default=2, help="draw every N-th plan")
