@@ -3,11 +3,17 @@
 from __future__ import annotations
 
 import json
+import math
+import os
+import signal
 import socket
+import tempfile
+import time
 from pathlib import Path
 
 import pytest
 
+from navlab.experiments import backends
 from navlab.experiments.backends import init_ray, run_tasks, wait_for_shutdown
 from navlab.experiments.errors import ExperimentError
 from navlab.experiments.scenario import scenario_from_dict
@@ -79,3 +85,36 @@ def test_a_refused_connection_names_the_cluster_and_token_authentication(monkeyp
 
 def test_local_workers_return_every_item_once() -> None:
     assert sorted(run_tasks(abs, [-3, 1, -2], workers=1)) == [(0, 3), (1, 1), (2, 2)]
+
+
+def test_local_worker_processes_return_every_item_once_and_raise_a_trial_s_error() -> None:
+    assert sorted(run_tasks(abs, [-3, 1, -2, 5, -4], workers=2)) == [(0, 3), (1, 1), (2, 2), (3, 5), (4, 4)]
+    with pytest.raises(ValueError, match="math domain error") as err:
+        list(run_tasks(math.sqrt, [4.0, -1.0, 9.0], workers=2))
+    assert "in worker process" in "\n".join(err.value.__notes__)  # with the worker's traceback
+
+
+def _stubborn(seconds: float) -> str:
+    """A trial that swallows SIGTERM (as native code calling back into Python can) and writes a temporary file."""
+    signal.signal(signal.SIGTERM, signal.SIG_IGN)
+    with open(os.path.join(tempfile.mkdtemp(prefix="navlab-trial-"), "x"), "w") as f:
+        f.write("x")
+    time.sleep(seconds)
+    status = dict(line.split(":", 1) for line in Path("/proc/self/status").read_text().splitlines())
+    return status["SigIgn"].strip()
+
+
+def test_closing_local_workers_ends_even_one_that_ignores_sigterm_and_removes_its_files(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Ctrl-C in the driver closes the generator: the workers are signalled, then killed after the grace time,
+    and their temporary folders go with them (they write under a folder of the driver's)."""
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
+    monkeypatch.setattr(backends, "STOP_GRACE_S", 2.0)
+    tasks = run_tasks(_stubborn, [0.0, 120.0, 120.0], workers=2)
+    i, ignored = next(tasks)
+    assert i == 0 and int(ignored, 16) & (1 << (signal.SIGINT - 1))  # a worker ignores Ctrl-C (the driver's)
+    t0 = time.monotonic()
+    tasks.close()
+    assert time.monotonic() - t0 < 6.0
+    assert list(tmp_path.iterdir()) == []

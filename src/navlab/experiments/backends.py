@@ -5,7 +5,17 @@
 results file looks the same whichever backend ran the trials. ``fn`` must be a module-level function
 (workers import it by name).
 
-- ``local``: ``workers`` = 1 runs in this process; more start that many ``spawn`` processes.
+- ``local``: ``workers`` = 1 runs in this process; more start that many ``spawn`` processes, each fed one item at
+  a time over its own pipe (no lock shared with the workers, so nothing the driver can block on). A worker starts
+  with Ctrl-C held back and then ignores it (a terminal signals the whole job: the driver decides). Closing the
+  generator (Ctrl-C in the driver) ends them in bounded time: SIGTERM, which a worker turns into SystemExit (its
+  ``finally`` blocks and exit handlers run: no leaked semaphore), sent again every ``RESEND_S``, then SIGKILL for
+  any left after ``STOP_GRACE_S``. The exception can land where it cannot propagate: native code calling back
+  into Python (a Numba function turns it into ``SystemError(... returned a result with an exception set)``, an
+  extension module's import into ``ImportError``) or a finalizer (``__del__``: "Exception ignored"). A worker
+  whose item ends after SIGTERM therefore exits whatever the item's outcome, a finalizer's "Exception ignored" is
+  not printed, and the driver repeats the signal. Whatever is left, the worker's temporary files go to a folder
+  of the driver's, removed once the workers are gone.
 - ``ray``: ``ray.init(address=$RAY_ADDRESS)`` when the variable is set (a cluster whose nodes have navlab
   installed), else a local instance with ``workers`` CPUs (default: every core); each item is one Ray task
   of one CPU. Ray is imported only here, only for this backend. An instance started here is shut down at
@@ -17,23 +27,29 @@ results file looks the same whichever backend ran the trials. ``fn`` must be a m
 
 from __future__ import annotations
 
-import functools
+import contextlib
 import logging
 import os
+import shutil
+import signal
+import tempfile
 import threading
+import time
+import traceback
 from collections.abc import Callable, Generator, Iterator, Sequence
-from typing import Any, TypeVar
+from multiprocessing.connection import Connection, wait
+from multiprocessing.process import BaseProcess
+from typing import Any, TypeVar, cast
 
 from navlab.experiments.errors import ExperimentError
 
 BACKENDS = ("local", "ray")
 SHUTDOWN_THREAD = "ray-shutdown"  # the name of the thread stopping a local Ray instance started here
+STOP_GRACE_S = 10.0  # local workers still running this long after the first SIGTERM are killed (SIGKILL)
+RESEND_S = 1.0  # SIGTERM again to a local worker still running after this long
+_terminated = False  # in a local worker: the driver's SIGTERM has come
 T = TypeVar("T")
 R = TypeVar("R")
-
-
-def _indexed(fn: Callable[[T], R], job: tuple[int, T]) -> tuple[int, R]:
-    return job[0], fn(job[1])
 
 
 def run_tasks(
@@ -55,22 +71,147 @@ def run_tasks(
         for i, item in enumerate(items):
             yield i, fn(item)
         return
-    import multiprocessing
+    yield from _run_local(fn, items, n)
 
-    with multiprocessing.get_context("spawn").Pool(n, initializer=_worker_signals) as pool:
-        yield from pool.imap_unordered(functools.partial(_indexed, fn), list(enumerate(items)))
+
+def _run_local(fn: Callable[[T], R], items: Sequence[T], n: int) -> Iterator[tuple[int, R]]:
+    """``fn`` over ``items`` in ``n`` spawned worker processes; every way out (the end, an error, Ctrl-C, the
+    generator closed) stops the workers within ``STOP_GRACE_S`` and removes their temporary files."""
+    import multiprocessing
+    from multiprocessing import resource_tracker
+
+    ctx = multiprocessing.get_context("spawn")
+    resource_tracker.ensure_running()  # every spawn needs it; started inside _sigint_held, it would unblock SIGINT
+    todo = list(enumerate(items))[::-1]  # popped from the end: in order
+    procs: list[BaseProcess] = []
+    pipes: list[Connection] = []  # the driver's end of each worker's pipe
+    running: dict[Connection, tuple[BaseProcess, int]] = {}  # a busy worker's pipe: the worker, its item
+    scratch = tempfile.mkdtemp(prefix="navlab-workers-")
+    try:
+        for _ in range(n):
+            here, there = ctx.Pipe()
+            pipes.append(here)
+            proc: BaseProcess = ctx.Process(target=_worker, args=(there, fn, scratch), daemon=True)
+            procs.append(proc)
+            with _sigint_held():  # inherited across exec: the worker ignores Ctrl-C before one can reach it
+                proc.start()
+            there.close()  # the worker's end is the worker's alone: its death is an EOF here
+            _hand_out(here, proc, todo, running)
+        while running:
+            for conn in cast(list[Connection], wait(list(running))):
+                proc, i = running.pop(conn)
+                try:
+                    ok, value = conn.recv()
+                except (EOFError, OSError):
+                    proc.join(1.0)
+                    raise ExperimentError(
+                        f"worker process {proc.pid} ended (exit code {proc.exitcode}) while running item {i}"
+                    ) from None
+                if not ok:
+                    raise value  # the worker's exception, its traceback in a note
+                _hand_out(conn, proc, todo, running)
+                yield i, value
+    finally:
+        for conn in pipes:
+            conn.close()  # an idle worker reads EOF and ends
+        try:
+            _stop(procs)
+        finally:  # also after a second Ctrl-C
+            shutil.rmtree(scratch, ignore_errors=True)
+
+
+def _hand_out(
+    conn: Connection, proc: BaseProcess, todo: list[tuple[int, Any]], running: dict[Connection, tuple[BaseProcess, int]]
+) -> None:
+    """Send the next item to the worker at ``conn`` (none left: close its pipe, it ends)."""
+    if not todo:
+        conn.close()
+        return
+    i, item = todo.pop()
+    try:
+        conn.send((i, item))
+    except OSError:  # BrokenPipeError: the worker died
+        proc.join(1.0)
+        raise ExperimentError(f"worker process {proc.pid} ended (exit code {proc.exitcode}) before item {i}") from None
+    running[conn] = (proc, i)
+
+
+def _stop(procs: list[BaseProcess]) -> None:
+    """End the workers: SIGTERM every ``RESEND_S`` while they run, SIGKILL after ``STOP_GRACE_S``."""
+    end = time.monotonic() + STOP_GRACE_S
+    try:
+        while (alive := [p for p in procs if p.is_alive()]) and time.monotonic() < end:
+            for p in alive:
+                p.terminate()
+            resend = min(time.monotonic() + RESEND_S, end)
+            while (alive := [p for p in alive if p.is_alive()]) and (left := resend - time.monotonic()) > 0:
+                wait([p.sentinel for p in alive], timeout=left)
+    finally:  # also on a second Ctrl-C while waiting
+        for p in procs:
+            if p.is_alive():
+                p.kill()
+            p.join(5.0)
+
+
+@contextlib.contextmanager
+def _sigint_held() -> Iterator[None]:
+    """SIGINT blocked in this thread meanwhile: a child started here inherits the mask (``exec`` keeps it); a
+    Ctrl-C that comes meanwhile reaches this process when the mask is restored."""
+    before = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, before)
+
+
+def _worker(conn: Connection, fn: Callable[[Any], Any], scratch: str) -> None:
+    """A worker process: ``fn`` on each ``(i, item)`` it reads, ``(True, result)`` or ``(False, exception)`` sent
+    back; it ends when the driver closes the pipe, or on SIGTERM."""
+    _worker_signals()
+    tempfile.tempdir = os.environ["TMPDIR"] = scratch  # the driver removes it, however the worker ends
+    try:
+        while True:
+            try:
+                i, item = conn.recv()
+            except (EOFError, OSError):  # the driver closed its end (a reset if a reply was left unread)
+                return
+            try:
+                reply = (True, fn(item))
+            except Exception as exc:  # SystemExit (SIGTERM) ends the worker
+                exc.add_note(f"in worker process {os.getpid()} (item {i}):\n{traceback.format_exc().rstrip()}")
+                reply = (False, exc)
+            if _terminated:  # SIGTERM came, but native code swallowed its exception or turned it into another
+                raise SystemExit(143)
+            try:
+                conn.send(reply)  # pickled whole before any byte is written
+            except OSError:  # the driver has gone
+                return
+            except Exception as exc:  # an unpicklable result or exception
+                conn.send((False, ExperimentError(f"item {i}: its result could not be sent back: {exc!r}")))
+    finally:  # on its way out: the interpreter's exit runs undisturbed (the driver kills it past the grace time)
+        signal.signal(signal.SIGTERM, signal.SIG_IGN)
 
 
 def _worker_signals() -> None:
     """A worker leaves Ctrl-C to the driver (a terminal sends it to every process of the job) and ends on the
-    pool's SIGTERM as on an exception, so its ``finally`` blocks (a trial's temporary folder) still run."""
-    import signal
+    driver's SIGTERM as on an exception, so its ``finally`` blocks and exit handlers still run."""
+    import sys
 
     def end(_signum: int, _frame: Any) -> None:
+        global _terminated
+        _terminated = True
         raise SystemExit(143)
 
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    default_hook = sys.unraisablehook
+
+    def unraisable(info: Any) -> None:
+        if not (_terminated and info.exc_type is SystemExit):  # raised in a finalizer: the driver signals again
+            default_hook(info)
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # discards a Ctrl-C held back since the worker started
     signal.signal(signal.SIGTERM, end)
+    sys.unraisablehook = unraisable
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
 
 
 def _run_ray(fn: Callable[[T], R], items: Sequence[T], workers: int | None) -> Iterator[tuple[int, R]]:
