@@ -47,7 +47,6 @@ BACKENDS = ("local", "ray")
 SHUTDOWN_THREAD = "ray-shutdown"  # the name of the thread stopping a local Ray instance started here
 STOP_GRACE_S = 10.0  # local workers still running this long after the first SIGTERM are killed (SIGKILL)
 RESEND_S = 1.0  # SIGTERM again to a local worker still running after this long
-_terminated = False  # in a local worker: the driver's SIGTERM has come
 T = TypeVar("T")
 R = TypeVar("R")
 
@@ -167,7 +166,7 @@ def _sigint_held() -> Iterator[None]:
 def _worker(conn: Connection, fn: Callable[[Any], Any], scratch: str) -> None:
     """A worker process: ``fn`` on each ``(i, item)`` it reads, ``(True, result)`` or ``(False, exception)`` sent
     back; it ends when the driver closes the pipe, or on SIGTERM."""
-    _worker_signals()
+    terminated = _worker_signals()
     tempfile.tempdir = os.environ["TMPDIR"] = scratch  # the driver removes it, however the worker ends
     try:
         while True:
@@ -180,7 +179,7 @@ def _worker(conn: Connection, fn: Callable[[Any], Any], scratch: str) -> None:
             except Exception as exc:  # SystemExit (SIGTERM) ends the worker
                 exc.add_note(f"in worker process {os.getpid()} (item {i}):\n{traceback.format_exc().rstrip()}")
                 reply = (False, exc)
-            if _terminated:  # SIGTERM came, but native code swallowed its exception or turned it into another
+            if terminated.is_set():  # SIGTERM came, but native code swallowed its exception or turned it into another
                 raise SystemExit(143)
             try:
                 conn.send(reply)  # pickled whole before any byte is written
@@ -192,26 +191,28 @@ def _worker(conn: Connection, fn: Callable[[Any], Any], scratch: str) -> None:
         signal.signal(signal.SIGTERM, signal.SIG_IGN)
 
 
-def _worker_signals() -> None:
+def _worker_signals() -> threading.Event:
     """A worker leaves Ctrl-C to the driver (a terminal sends it to every process of the job) and ends on the
-    driver's SIGTERM as on an exception, so its ``finally`` blocks and exit handlers still run."""
+    driver's SIGTERM as on an exception, so its ``finally`` blocks and exit handlers still run; the event returned
+    is set once that SIGTERM has come."""
     import sys
 
     def end(_signum: int, _frame: Any) -> None:
-        global _terminated
-        _terminated = True
+        terminated.set()
         raise SystemExit(143)
 
+    terminated = threading.Event()
     default_hook = sys.unraisablehook
 
     def unraisable(info: Any) -> None:
-        if not (_terminated and info.exc_type is SystemExit):  # raised in a finalizer: the driver signals again
+        if not (terminated.is_set() and info.exc_type is SystemExit):  # raised in a finalizer: the driver signals again
             default_hook(info)
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # discards a Ctrl-C held back since the worker started
     signal.signal(signal.SIGTERM, end)
     sys.unraisablehook = unraisable
     signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+    return terminated
 
 
 def _run_ray(fn: Callable[[T], R], items: Sequence[T], workers: int | None) -> Iterator[tuple[int, R]]:
